@@ -1,0 +1,18 @@
+//! lut-gen: everything slotforge knows about a channel mix before any HDL.
+//!
+//! - [`mix`]: the TOML format and its validation (errors name file, line, field);
+//! - [`parts`]: ADC and mux models as data, and the SPI timing they imply;
+//! - [`synth`]: slot-grid choice and jitter-free placement, or a diagnosis;
+//! - [`validate`]: an independent proof of a schedule's promises;
+//! - [`lut`]: the slot LUT as a full frame table and in compact form;
+//! - [`audit`]: rates, intervals, headroom, settling and Nyquist, as text or JSON.
+
+pub mod mix;
+pub mod parts;
+pub mod schedule;
+pub mod synth;
+pub mod validate;
+
+pub use mix::{load, parse, Mix, MixError};
+pub use schedule::{FrameGrid, SamplingInstant, Schedule};
+pub use synth::{synthesize, Infeasible};

@@ -1,0 +1,777 @@
+//! The channel-mix file: TOML in, a validated [`Mix`] out.
+//!
+//! Parsing goes through `toml::Spanned` so that every semantic error (a
+//! duplicate name, a rate that gives a fractional number of samples per frame)
+//! can still name the line it came from, exactly like a syntax error does.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use toml::Spanned;
+
+use crate::parts::{AdcPart, MuxPart};
+
+/// A bad mix file: where, which field, and why.  Always exit code 2.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MixError {
+    pub file: PathBuf,
+    pub line: usize,
+    pub column: usize,
+    /// Dotted path of the offending field, e.g. `channel[3].rate_hz`.
+    pub field: String,
+    pub message: String,
+}
+
+impl fmt::Display for MixError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}:{}:{}: {}: {}",
+            self.file.display(),
+            self.line,
+            self.column,
+            self.field,
+            self.message
+        )
+    }
+}
+
+impl std::error::Error for MixError {}
+
+/// A validated channel mix.  Every invariant the scheduler relies on
+/// (whole cycles per slice and frame, whole samples per frame, unique names,
+/// unique mux inputs) holds once a `Mix` exists.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Mix {
+    pub name: String,
+    pub description: String,
+    pub clock_hz: u64,
+    pub frame_us: u64,
+    pub slice_us: u64,
+    /// Set by the mix to force the slot grid; `None` lets the synthesizer pick.
+    pub slots_per_slice: Option<u64>,
+    pub branches: Vec<Branch>,
+    pub channels: Vec<Channel>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Branch {
+    pub name: String,
+    pub adc: AdcPart,
+    /// Requested SCLK; the gateware uses the fastest legal SCLK at or below it.
+    pub sclk_hz: u64,
+    pub mux: MuxPart,
+    pub mux_devices: u32,
+    pub settle_ns: u64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Channel {
+    pub name: String,
+    /// Index into [`Mix::branches`].
+    pub branch: usize,
+    pub rate_hz: u64,
+    /// Mux input on its branch: device = input / 8, select = input % 8.
+    pub input: u32,
+    pub kind: Option<String>,
+    pub bandwidth_hz: Option<f64>,
+    pub sync: Option<String>,
+}
+
+impl Mix {
+    pub fn frame_cycles(&self) -> u64 {
+        self.clock_hz * self.frame_us / 1_000_000
+    }
+    pub fn slice_cycles(&self) -> u64 {
+        self.clock_hz * self.slice_us / 1_000_000
+    }
+    pub fn slices_per_frame(&self) -> u64 {
+        self.frame_us / self.slice_us
+    }
+    /// Samples of `rate_hz` in one frame (whole by validation).
+    pub fn samples_per_frame(&self, rate_hz: u64) -> u64 {
+        rate_hz * self.frame_us / 1_000_000
+    }
+    pub fn branch_index(&self, name: &str) -> Option<usize> {
+        self.branches.iter().position(|b| b.name == name)
+    }
+    pub fn channel_index(&self, name: &str) -> Option<usize> {
+        self.channels.iter().position(|c| c.name == name)
+    }
+}
+
+// ---------------------------------------------------------------- raw form
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMix {
+    name: Option<Spanned<String>>,
+    description: Option<String>,
+    clock: Option<Spanned<RawClock>>,
+    frame: Option<Spanned<RawFrame>>,
+    #[serde(default)]
+    branch: Vec<Spanned<RawBranch>>,
+    #[serde(default)]
+    channel: Vec<Spanned<RawChannel>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawClock {
+    hz: Spanned<i64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFrame {
+    period_us: Spanned<i64>,
+    slice_us: Spanned<i64>,
+    slots_per_slice: Option<Spanned<i64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBranch {
+    name: Spanned<String>,
+    adc: Spanned<String>,
+    sclk_hz: Option<Spanned<i64>>,
+    mux: Spanned<String>,
+    mux_devices: Option<Spanned<i64>>,
+    settle_ns: Option<Spanned<i64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawChannel {
+    name: Spanned<String>,
+    branch: Spanned<String>,
+    rate_hz: Spanned<i64>,
+    input: Option<Spanned<i64>>,
+    kind: Option<String>,
+    /// Integer or float: TOML keeps the two apart.
+    bandwidth_hz: Option<Spanned<toml::Value>>,
+    sync: Option<Spanned<String>>,
+}
+
+// ---------------------------------------------------------------- loading
+
+/// Reads and validates a mix file.
+pub fn load(path: &Path) -> Result<Mix, MixError> {
+    let text = std::fs::read_to_string(path).map_err(|e| MixError {
+        file: path.to_path_buf(),
+        line: 0,
+        column: 0,
+        field: "(file)".into(),
+        message: format!("cannot read: {e}"),
+    })?;
+    parse(path, &text)
+}
+
+/// Parses and validates mix text; `file` is only used in messages.
+pub fn parse(file: &Path, text: &str) -> Result<Mix, MixError> {
+    let cx = Cx { file, text };
+    let raw: RawMix = toml::from_str(text).map_err(|e| cx.toml_error(&e))?;
+    cx.validate(raw)
+}
+
+struct Cx<'a> {
+    file: &'a Path,
+    text: &'a str,
+}
+
+impl Cx<'_> {
+    fn at(
+        &self,
+        span: Range<usize>,
+        field: impl Into<String>,
+        message: impl Into<String>,
+    ) -> MixError {
+        let (line, column) = line_col(self.text, span.start);
+        MixError {
+            file: self.file.to_path_buf(),
+            line,
+            column,
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    fn toml_error(&self, e: &toml::de::Error) -> MixError {
+        let (line, column) = e
+            .span()
+            .map(|s| line_col(self.text, s.start))
+            .unwrap_or((0, 0));
+        let message = e.message().to_string();
+        let field = field_from_toml_message(&message, self.text, e.span());
+        MixError {
+            file: self.file.to_path_buf(),
+            line,
+            column,
+            field,
+            message,
+        }
+    }
+
+    fn positive(&self, v: &Spanned<i64>, field: &str) -> Result<u64, MixError> {
+        if *v.get_ref() <= 0 {
+            return Err(self.at(
+                v.span(),
+                field,
+                format!("must be positive, got {}", v.get_ref()),
+            ));
+        }
+        Ok(*v.get_ref() as u64)
+    }
+
+    fn validate(&self, raw: RawMix) -> Result<Mix, MixError> {
+        let whole = 0..0;
+        let name = match &raw.name {
+            Some(n) if !n.get_ref().trim().is_empty() => n.get_ref().clone(),
+            Some(n) => return Err(self.at(n.span(), "name", "must not be empty")),
+            None => return Err(self.at(whole, "name", "missing: every mix has a name")),
+        };
+        let clock = raw
+            .clock
+            .as_ref()
+            .ok_or_else(|| self.at(0..0, "clock", "missing table [clock] with `hz`"))?;
+        let clock_hz = self.positive(&clock.get_ref().hz, "clock.hz")?;
+        let frame = raw.frame.as_ref().ok_or_else(|| {
+            self.at(
+                0..0,
+                "frame",
+                "missing table [frame] with `period_us` and `slice_us`",
+            )
+        })?;
+        let fr = frame.get_ref();
+        let frame_us = self.positive(&fr.period_us, "frame.period_us")?;
+        let slice_us = self.positive(&fr.slice_us, "frame.slice_us")?;
+        if frame_us % slice_us != 0 {
+            return Err(self.at(
+                fr.slice_us.span(),
+                "frame.slice_us",
+                format!("a {frame_us} us frame is not a whole number of {slice_us} us slices"),
+            ));
+        }
+        if (clock_hz as u128 * frame_us as u128) % 1_000_000 != 0 {
+            return Err(self.at(
+                clock.get_ref().hz.span(),
+                "clock.hz",
+                format!(
+                    "{clock_hz} Hz gives {:.3} cycles per {frame_us} us frame, not a whole number",
+                    clock_hz as f64 * frame_us as f64 / 1e6
+                ),
+            ));
+        }
+        if (clock_hz as u128 * slice_us as u128) % 1_000_000 != 0 {
+            return Err(self.at(
+                clock.get_ref().hz.span(),
+                "clock.hz",
+                format!(
+                    "{clock_hz} Hz gives {:.3} cycles per {slice_us} us slice, not a whole number",
+                    clock_hz as f64 * slice_us as f64 / 1e6
+                ),
+            ));
+        }
+        let slice_cycles = clock_hz * slice_us / 1_000_000;
+        let slots_per_slice = match &fr.slots_per_slice {
+            None => None,
+            Some(s) => {
+                let v = self.positive(s, "frame.slots_per_slice")?;
+                if slice_cycles % v != 0 {
+                    return Err(self.at(
+                        s.span(),
+                        "frame.slots_per_slice",
+                        format!("{v} slots do not divide a {slice_cycles}-cycle slice into whole cycles"),
+                    ));
+                }
+                Some(v)
+            }
+        };
+
+        if raw.branch.is_empty() {
+            return Err(self.at(0..0, "branch", "the mix declares no [[branch]]"));
+        }
+        if raw.channel.is_empty() {
+            return Err(self.at(
+                0..0,
+                "channel",
+                "the mix declares no [[channel]]: nothing to sample",
+            ));
+        }
+
+        let mut branches = Vec::new();
+        let mut branch_names: BTreeMap<String, usize> = BTreeMap::new();
+        for (i, b) in raw.branch.iter().enumerate() {
+            let span = b.span();
+            let b = b.get_ref();
+            let f = |k: &str| format!("branch[{i}].{k}");
+            let bname = b.name.get_ref().clone();
+            if bname.trim().is_empty() {
+                return Err(self.at(b.name.span(), f("name"), "must not be empty"));
+            }
+            if branch_names.insert(bname.clone(), i).is_some() {
+                return Err(self.at(
+                    b.name.span(),
+                    f("name"),
+                    format!("duplicate branch name `{bname}`"),
+                ));
+            }
+            let adc = AdcPart::by_name(b.adc.get_ref()).ok_or_else(|| {
+                self.at(
+                    b.adc.span(),
+                    f("adc"),
+                    format!(
+                        "unknown ADC `{}` (known: {})",
+                        b.adc.get_ref(),
+                        AdcPart::known().join(", ")
+                    ),
+                )
+            })?;
+            let mux = MuxPart::by_name(b.mux.get_ref()).ok_or_else(|| {
+                self.at(
+                    b.mux.span(),
+                    f("mux"),
+                    format!(
+                        "unknown mux `{}` (known: {})",
+                        b.mux.get_ref(),
+                        MuxPart::known().join(", ")
+                    ),
+                )
+            })?;
+            let sclk_hz = match &b.sclk_hz {
+                None => adc.sclk_max_hz,
+                Some(s) => {
+                    let v = self.positive(s, &f("sclk_hz"))?;
+                    if v > adc.sclk_max_hz || v < adc.sclk_min_hz {
+                        return Err(self.at(
+                            s.span(),
+                            f("sclk_hz"),
+                            format!(
+                                "{v} Hz is outside the {} SCLK range {}..={} Hz",
+                                adc.name, adc.sclk_min_hz, adc.sclk_max_hz
+                            ),
+                        ));
+                    }
+                    v
+                }
+            };
+            if clock_hz < 2 * adc.sclk_min_hz {
+                return Err(self.at(
+                    clock.get_ref().hz.span(),
+                    "clock.hz",
+                    format!(
+                        "{clock_hz} Hz is too slow to generate the {} minimum SCLK",
+                        adc.name
+                    ),
+                ));
+            }
+            let mux_devices = match &b.mux_devices {
+                None => 1,
+                Some(m) => {
+                    let v = self.positive(m, &f("mux_devices"))?;
+                    if v > 32 {
+                        return Err(self.at(
+                            m.span(),
+                            f("mux_devices"),
+                            "at most 32 mux devices per branch",
+                        ));
+                    }
+                    v as u32
+                }
+            };
+            let settle_ns = match &b.settle_ns {
+                None => 0,
+                Some(s) if *s.get_ref() < 0 => {
+                    return Err(self.at(s.span(), f("settle_ns"), "must not be negative"));
+                }
+                Some(s) => *s.get_ref() as u64,
+            };
+            let _ = span;
+            branches.push(Branch {
+                name: bname,
+                adc,
+                sclk_hz,
+                mux,
+                mux_devices,
+                settle_ns,
+            });
+        }
+
+        let mut channels = Vec::new();
+        let mut channel_names = BTreeSet::new();
+        let mut used_inputs: Vec<BTreeSet<u32>> = vec![BTreeSet::new(); branches.len()];
+        // Explicit inputs first, so that automatic ones fill the gaps deterministically.
+        let mut pending_auto = Vec::new();
+        let mut sync_groups: BTreeMap<String, Vec<(usize, Range<usize>)>> = BTreeMap::new();
+        for (i, c) in raw.channel.iter().enumerate() {
+            let c = c.get_ref();
+            let f = |k: &str| format!("channel[{i}].{k}");
+            let cname = c.name.get_ref().clone();
+            if cname.trim().is_empty() {
+                return Err(self.at(c.name.span(), f("name"), "must not be empty"));
+            }
+            if !channel_names.insert(cname.clone()) {
+                return Err(self.at(
+                    c.name.span(),
+                    f("name"),
+                    format!("duplicate channel name `{cname}`"),
+                ));
+            }
+            let branch = *branch_names.get(c.branch.get_ref()).ok_or_else(|| {
+                self.at(
+                    c.branch.span(),
+                    f("branch"),
+                    format!(
+                        "unknown branch `{}` (declared: {})",
+                        c.branch.get_ref(),
+                        branches
+                            .iter()
+                            .map(|b| b.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                )
+            })?;
+            let rate_hz = self.positive(&c.rate_hz, &f("rate_hz"))?;
+            if (rate_hz as u128 * frame_us as u128) % 1_000_000 != 0 {
+                return Err(self.at(
+                    c.rate_hz.span(),
+                    f("rate_hz"),
+                    format!(
+                        "{rate_hz} Hz gives {:.3} samples per {frame_us} us frame, not a whole number \
+                         (rates must be multiples of {:.3} Hz)",
+                        rate_hz as f64 * frame_us as f64 / 1e6,
+                        1e6 / frame_us as f64
+                    ),
+                ));
+            }
+            let capacity = 8 * branches[branch].mux_devices;
+            let input = match &c.input {
+                None => {
+                    pending_auto.push(i);
+                    u32::MAX
+                }
+                Some(v) => {
+                    if *v.get_ref() < 0 || *v.get_ref() >= capacity as i64 {
+                        return Err(self.at(
+                            v.span(),
+                            f("input"),
+                            format!(
+                                "input {} is beyond branch `{}`: {} mux device(s) give inputs 0..={}",
+                                v.get_ref(),
+                                branches[branch].name,
+                                branches[branch].mux_devices,
+                                capacity - 1
+                            ),
+                        ));
+                    }
+                    let inp = *v.get_ref() as u32;
+                    if !used_inputs[branch].insert(inp) {
+                        return Err(self.at(
+                            v.span(),
+                            f("input"),
+                            format!(
+                                "input {inp} of branch `{}` is already used by another channel",
+                                branches[branch].name
+                            ),
+                        ));
+                    }
+                    inp
+                }
+            };
+            let bandwidth_hz = match &c.bandwidth_hz {
+                None => None,
+                Some(b) => {
+                    let v = match b.get_ref() {
+                        toml::Value::Integer(i) => *i as f64,
+                        toml::Value::Float(x) => *x,
+                        other => {
+                            return Err(self.at(
+                                b.span(),
+                                f("bandwidth_hz"),
+                                format!("must be a number, got {}", other.type_str()),
+                            ))
+                        }
+                    };
+                    if !(v > 0.0 && v.is_finite()) {
+                        return Err(self.at(
+                            b.span(),
+                            f("bandwidth_hz"),
+                            format!("must be positive, got {v}"),
+                        ));
+                    }
+                    Some(v)
+                }
+            };
+            let sync = match &c.sync {
+                None => None,
+                Some(s) => {
+                    if s.get_ref().trim().is_empty() {
+                        return Err(self.at(s.span(), f("sync"), "must not be empty"));
+                    }
+                    sync_groups
+                        .entry(s.get_ref().clone())
+                        .or_default()
+                        .push((i, s.span()));
+                    Some(s.get_ref().clone())
+                }
+            };
+            channels.push(Channel {
+                name: cname,
+                branch,
+                rate_hz,
+                input,
+                kind: c.kind.clone(),
+                bandwidth_hz,
+                sync,
+            });
+        }
+        for i in pending_auto {
+            let b = channels[i].branch;
+            let capacity = 8 * branches[b].mux_devices;
+            let free = (0..capacity).find(|k| !used_inputs[b].contains(k)).ok_or_else(|| {
+                self.at(
+                    raw.channel[i].get_ref().name.span(),
+                    format!("channel[{i}].input"),
+                    format!(
+                        "branch `{}` has no free mux input left ({} device(s), {} inputs); add mux_devices",
+                        branches[b].name, branches[b].mux_devices, capacity
+                    ),
+                )
+            })?;
+            used_inputs[b].insert(free);
+            channels[i].input = free;
+        }
+        for (tag, members) in &sync_groups {
+            let mut seen = BTreeMap::new();
+            let rate = channels[members[0].0].rate_hz;
+            for (i, span) in members {
+                let c = &channels[*i];
+                if c.rate_hz != rate {
+                    return Err(self.at(
+                        span.clone(),
+                        format!("channel[{i}].sync"),
+                        format!(
+                            "sync group `{tag}` mixes rates ({} Hz and {} Hz): synchronized channels share every sampling instant, so they need one rate",
+                            rate, c.rate_hz
+                        ),
+                    ));
+                }
+                if let Some(other) = seen.insert(c.branch, *i) {
+                    return Err(self.at(
+                        span.clone(),
+                        format!("channel[{i}].sync"),
+                        format!(
+                            "sync group `{tag}` has `{}` and `{}` on the same branch `{}`: one ADC cannot sample both at one instant",
+                            channels[other].name, c.name, branches[c.branch].name
+                        ),
+                    ));
+                }
+            }
+        }
+        for (bi, b) in branches.iter().enumerate() {
+            if !channels.iter().any(|c| c.branch == bi) {
+                let span = raw.branch[bi].get_ref().name.span();
+                return Err(self.at(
+                    span,
+                    format!("branch[{bi}].name"),
+                    format!("branch `{}` has no channels", b.name),
+                ));
+            }
+        }
+        if channels.len() > u16::MAX as usize {
+            return Err(self.at(0..0, "channel", "more than 65535 channels"));
+        }
+
+        Ok(Mix {
+            name,
+            description: raw.description.unwrap_or_default(),
+            clock_hz,
+            frame_us,
+            slice_us,
+            slots_per_slice,
+            branches,
+            channels,
+        })
+    }
+}
+
+/// 1-based line and column of a byte offset.
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rfind('\n').map(|p| offset - p).unwrap_or(offset + 1);
+    (line, column)
+}
+
+/// toml's messages name the offending key for unknown fields; lift it out so
+/// the field is reported the same way semantic errors report theirs.
+fn field_from_toml_message(message: &str, text: &str, span: Option<Range<usize>>) -> String {
+    if let Some(rest) = message.strip_prefix("unknown field `") {
+        if let Some(end) = rest.find('`') {
+            let key = &rest[..end];
+            return format!("{}{key}", table_prefix(text, span));
+        }
+    }
+    if let Some(rest) = message.strip_prefix("missing field `") {
+        if let Some(end) = rest.find('`') {
+            return format!("{}{}", table_prefix(text, span), &rest[..end]);
+        }
+    }
+    if let Some(s) = span {
+        // The key on the offending line, if the span points into a `key = value` line.
+        let start = text[..s.start.min(text.len())]
+            .rfind('\n')
+            .map(|p| p + 1)
+            .unwrap_or(0);
+        let line = text[start..].lines().next().unwrap_or("");
+        if let Some((k, _)) = line.split_once('=') {
+            return format!("{}{}", table_prefix(text, Some(s)), k.trim());
+        }
+    }
+    "(syntax)".into()
+}
+
+/// `channel[3].` for a position inside the fourth `[[channel]]` table.
+fn table_prefix(text: &str, span: Option<Range<usize>>) -> String {
+    let Some(span) = span else {
+        return String::new();
+    };
+    let upto = &text[..span.start.min(text.len())];
+    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+    let mut current = String::new();
+    for line in upto.lines() {
+        let t = line.trim();
+        if let Some(name) = t.strip_prefix("[[").and_then(|r| r.split("]]").next()) {
+            let name = name.trim().to_string();
+            let n = counts.entry(name.clone()).or_insert(0);
+            current = format!("{name}[{n}].");
+            *n += 1;
+        } else if let Some(name) = t.strip_prefix('[').and_then(|r| r.split(']').next()) {
+            current = format!("{}.", name.trim());
+        }
+    }
+    current
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+name = "t"
+[clock]
+hz = 48_000_000
+[frame]
+period_us = 10_000
+slice_us = 1_000
+[[branch]]
+name = "a"
+adc = "ad7940"
+mux = "tmux1108"
+[[channel]]
+name = "c0"
+branch = "a"
+rate_hz = 1_000
+bandwidth_hz = 400
+"#;
+
+    fn err(text: &str) -> MixError {
+        parse(Path::new("m.toml"), text).unwrap_err()
+    }
+
+    #[test]
+    fn good_mix_parses() {
+        let m = parse(Path::new("m.toml"), GOOD).unwrap();
+        assert_eq!(m.clock_hz, 48_000_000);
+        assert_eq!(m.frame_cycles(), 480_000);
+        assert_eq!(m.slice_cycles(), 48_000);
+        assert_eq!(m.channels[0].input, 0);
+        assert_eq!(m.channels[0].bandwidth_hz, Some(400.0));
+        assert_eq!(m.branches[0].sclk_hz, 2_500_000);
+    }
+
+    #[test]
+    fn unknown_key_names_line_and_field() {
+        let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 1_000\nrat_hz = 3"));
+        assert_eq!(e.line, 16, "{e}");
+        assert_eq!(e.field, "channel[0].rat_hz", "{e}");
+        assert!(e.message.contains("unknown field"), "{e}");
+    }
+
+    #[test]
+    fn fractional_samples_per_frame() {
+        let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 1_050"));
+        assert_eq!(e.field, "channel[0].rate_hz");
+        assert_eq!(e.line, 15);
+        assert!(e.message.contains("10.500 samples"), "{e}");
+    }
+
+    #[test]
+    fn fractional_cycles_per_slice() {
+        let e = err(&GOOD.replace("48_000_000", "48_000_500"));
+        assert_eq!(e.field, "clock.hz");
+        assert_eq!(e.line, 4);
+    }
+
+    #[test]
+    fn zero_and_negative_values() {
+        assert_eq!(
+            err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 0")).field,
+            "channel[0].rate_hz"
+        );
+        assert_eq!(
+            err(&GOOD.replace("slice_us = 1_000", "slice_us = -1")).field,
+            "frame.slice_us"
+        );
+    }
+
+    #[test]
+    fn unknown_branch_adc_mux() {
+        assert_eq!(
+            err(&GOOD.replace("branch = \"a\"", "branch = \"b\"")).field,
+            "channel[0].branch"
+        );
+        assert_eq!(
+            err(&GOOD.replace("ad7940", "ad9999")).field,
+            "branch[0].adc"
+        );
+        assert_eq!(
+            err(&GOOD.replace("tmux1108", "cd4051")).field,
+            "branch[0].mux"
+        );
+    }
+
+    #[test]
+    fn duplicate_names_and_inputs() {
+        let dup = format!("{GOOD}\n[[channel]]\nname = \"c0\"\nbranch = \"a\"\nrate_hz = 100\n");
+        let e = err(&dup);
+        assert_eq!(e.field, "channel[1].name");
+        assert_eq!(e.line, 19);
+        let twice = format!(
+            "{}\n[[channel]]\nname = \"c1\"\nbranch = \"a\"\nrate_hz = 100\ninput = 0\n",
+            GOOD.replace("bandwidth_hz = 400", "input = 0")
+        );
+        assert_eq!(err(&twice).field, "channel[1].input");
+        let beyond = GOOD.replace("bandwidth_hz = 400", "input = 8");
+        assert!(err(&beyond).message.contains("beyond"));
+    }
+
+    #[test]
+    fn empty_mix() {
+        let e = err(
+            "name = \"x\"\n[clock]\nhz = 1000000\n[frame]\nperiod_us = 1000\nslice_us = 1000\n",
+        );
+        assert_eq!(e.field, "branch");
+    }
+
+    #[test]
+    fn syntax_error_has_line() {
+        let e = err("name = \"x\"\n[clock\n");
+        assert_eq!(e.line, 2);
+    }
+}

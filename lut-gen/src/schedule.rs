@@ -1,0 +1,169 @@
+//! The synthesized schedule: the data model every other crate builds on.
+//!
+//! Time is counted in clock cycles from the first rising edge after reset.
+//! The frame is `frame_slots` slots; a channel occupies the slots
+//! `offset_slot + k * period_slots` of every frame, so its sampling instants
+//! (the first cycle of each of those slots, where CS falls) are exactly
+//! `interval_cycles = clock / rate` apart, across frame boundaries too.
+
+use serde::Serialize;
+
+use crate::mix::Mix;
+use crate::parts::SpiTiming;
+
+/// The frame / slice / slot grid shared by all branches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct FrameGrid {
+    pub clock_hz: u64,
+    pub frame_cycles: u64,
+    pub slice_cycles: u64,
+    pub slices_per_frame: u64,
+    pub slots_per_slice: u64,
+    pub slot_cycles: u64,
+    pub frame_slots: u64,
+}
+
+impl FrameGrid {
+    pub fn new(mix: &Mix, slots_per_slice: u64) -> FrameGrid {
+        let slice_cycles = mix.slice_cycles();
+        FrameGrid {
+            clock_hz: mix.clock_hz,
+            frame_cycles: mix.frame_cycles(),
+            slice_cycles,
+            slices_per_frame: mix.slices_per_frame(),
+            slots_per_slice,
+            slot_cycles: slice_cycles / slots_per_slice,
+            frame_slots: mix.slices_per_frame() * slots_per_slice,
+        }
+    }
+
+    /// Where an absolute cycle falls: (frame, slot in frame, cycle in slot).
+    pub fn locate(&self, cycle: u64) -> (u64, u64, u64) {
+        let frame = cycle / self.frame_cycles;
+        let in_frame = cycle % self.frame_cycles;
+        (
+            frame,
+            in_frame / self.slot_cycles,
+            in_frame % self.slot_cycles,
+        )
+    }
+}
+
+/// Per-branch timing derived from its parts and the clock.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BranchPlan {
+    pub name: String,
+    pub spi: SpiTiming,
+    /// Cycles the mux must be steady before a sampling instant.
+    pub settle_cycles: u64,
+    /// Shortest legal slot: a whole conversion, quiet time, throughput limit,
+    /// and the mux settling (it switches one cycle after the previous CS fall).
+    pub min_slot_cycles: u64,
+    pub mux_devices: u32,
+}
+
+/// Where one channel sits in the frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct ChannelSlots {
+    pub samples_per_frame: u64,
+    pub period_slots: u64,
+    pub offset_slot: u64,
+    pub interval_cycles: u64,
+    /// Mux device and address: device = input / 8, select = input % 8.
+    pub device: u32,
+    pub select: u32,
+}
+
+/// How the placement was found (for reports and benchmarks).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Placement {
+    /// Greedy first-fit in period order; exact for harmonic rates.
+    Constructive,
+    /// Bounded backtracking search.
+    Search { nodes: u64 },
+}
+
+/// A sampling instant: the cycle where a branch's CS falls for a channel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+pub struct SamplingInstant {
+    pub cycle: u64,
+    pub branch: usize,
+    pub channel: usize,
+}
+
+/// A complete, validated, jitter-free schedule.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Schedule {
+    pub mix: Mix,
+    pub grid: FrameGrid,
+    pub branches: Vec<BranchPlan>,
+    pub channels: Vec<ChannelSlots>,
+    /// `frame_slots x branches`, row-major: the channel each branch converts in each slot.
+    pub frame_table: Vec<Option<u16>>,
+    pub placement: Placement,
+}
+
+impl Schedule {
+    pub fn branch_count(&self) -> usize {
+        self.branches.len()
+    }
+
+    /// The channel branch `branch` converts in frame slot `slot`.
+    pub fn at(&self, slot: u64, branch: usize) -> Option<usize> {
+        self.frame_table[slot as usize * self.branches.len() + branch].map(usize::from)
+    }
+
+    /// Sampling instants of one branch within one frame, in time order.
+    pub fn branch_instants_in_frame(&self, branch: usize) -> Vec<SamplingInstant> {
+        (0..self.grid.frame_slots)
+            .filter_map(|s| {
+                self.at(s, branch).map(|c| SamplingInstant {
+                    cycle: s * self.grid.slot_cycles,
+                    branch,
+                    channel: c,
+                })
+            })
+            .collect()
+    }
+
+    /// Every sampling instant of every branch in frames `0..frames`, in
+    /// (cycle, branch) order.
+    pub fn instants(&self, frames: u64) -> impl Iterator<Item = SamplingInstant> + '_ {
+        let b = self.branches.len();
+        (0..frames).flat_map(move |f| {
+            (0..self.grid.frame_slots).flat_map(move |s| {
+                (0..b).filter_map(move |br| {
+                    self.at(s, br).map(|c| SamplingInstant {
+                        cycle: f * self.grid.frame_cycles + s * self.grid.slot_cycles,
+                        branch: br,
+                        channel: c,
+                    })
+                })
+            })
+        })
+    }
+
+    /// First sampling instant of a channel after reset.
+    pub fn first_sample_cycle(&self, channel: usize) -> u64 {
+        self.channels[channel].offset_slot * self.grid.slot_cycles
+    }
+
+    /// Samples converted per frame by all branches.
+    pub fn samples_per_frame(&self) -> u64 {
+        self.channels.iter().map(|c| c.samples_per_frame).sum()
+    }
+
+    /// Bits needed for a channel index (at least 1).
+    pub fn channel_bits(&self) -> u32 {
+        bits_for(self.channels.len() as u64)
+    }
+}
+
+/// Bits to hold values `0..n` (at least 1).
+pub fn bits_for(n: u64) -> u32 {
+    if n <= 2 {
+        1
+    } else {
+        64 - (n - 1).leading_zeros()
+    }
+}

@@ -1,0 +1,699 @@
+//! Schedule synthesis: choose the slot grid, then give every channel an
+//! offset so that no two conversions of a branch share a slot.
+//!
+//! A channel of period `p` slots occupies the residue class `offset mod p` of
+//! the frame's `N` slots.  When a branch's periods form a divisibility chain
+//! (harmonic rates) first-fit in increasing period order never fails while
+//! the branch's density is at most 1, so it is used first; otherwise (and for
+//! sync groups, which couple branches) a bounded backtracking search decides.
+//! Every result is re-checked by [`crate::validate`], which shares no code
+//! with this module.
+
+use std::fmt;
+
+use serde::Serialize;
+
+use crate::mix::Mix;
+use crate::parts::{ns_to_cycles, SpiTiming};
+use crate::schedule::{BranchPlan, ChannelSlots, FrameGrid, Placement, Schedule};
+
+/// Backtracking nodes allowed per slot-grid candidate.
+pub const SEARCH_BUDGET: u64 = 400_000;
+
+/// A mix that admits no jitter-free schedule, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Infeasible {
+    pub mix: String,
+    /// The slot grid the diagnosis refers to (the roomiest legal one), if any.
+    pub slots_per_slice: Option<u64>,
+    pub reasons: Vec<String>,
+    pub branches: Vec<BranchDiagnosis>,
+    pub suggestions: Vec<String>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BranchDiagnosis {
+    pub name: String,
+    pub demand_hz: u64,
+    pub capacity_hz: f64,
+    pub demand_slots_per_frame: u64,
+    pub capacity_slots_per_frame: u64,
+    pub unplaced: Vec<String>,
+}
+
+impl fmt::Display for Infeasible {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "mix `{}` has no jitter-free schedule", self.mix)?;
+        if let Some(s) = self.slots_per_slice {
+            writeln!(
+                f,
+                "  (diagnosed at {s} slots per slice, the roomiest legal grid)"
+            )?;
+        }
+        for r in &self.reasons {
+            writeln!(f, "  - {r}")?;
+        }
+        for b in &self.branches {
+            if b.unplaced.is_empty() && b.demand_slots_per_frame <= b.capacity_slots_per_frame {
+                continue;
+            }
+            writeln!(
+                f,
+                "  branch `{}`: demand {} samples/s ({} slots/frame) vs capacity {:.0} samples/s ({} slots/frame)",
+                b.name, b.demand_hz, b.demand_slots_per_frame, b.capacity_hz, b.capacity_slots_per_frame
+            )?;
+            if !b.unplaced.is_empty() {
+                writeln!(f, "    could not place: {}", b.unplaced.join(", "))?;
+            }
+        }
+        if !self.suggestions.is_empty() {
+            writeln!(f, "  what would make it fit:")?;
+            for s in &self.suggestions {
+                writeln!(f, "  * {s}")?;
+            }
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Infeasible {}
+
+/// Channels that must sample together: a sync group, or one channel alone.
+#[derive(Debug, Clone)]
+struct Unit {
+    channels: Vec<usize>,
+    branches: Vec<usize>,
+    period: u64,
+}
+
+/// Per-branch slot occupancy of one frame.
+struct Occupancy {
+    words: Vec<Vec<u64>>,
+    free: Vec<u64>,
+}
+
+impl Occupancy {
+    fn new(branches: usize, slots: u64) -> Self {
+        Occupancy {
+            words: vec![vec![0; slots.div_ceil(64) as usize]; branches],
+            free: vec![slots; branches],
+        }
+    }
+    fn taken(&self, b: usize, s: u64) -> bool {
+        self.words[b][(s / 64) as usize] >> (s % 64) & 1 == 1
+    }
+    fn fits(&self, u: &Unit, offset: u64, slots: u64) -> bool {
+        u.branches.iter().all(|&b| {
+            (offset..slots)
+                .step_by(u.period as usize)
+                .all(|s| !self.taken(b, s))
+        })
+    }
+    fn set(&mut self, u: &Unit, offset: u64, slots: u64, on: bool) {
+        let n = slots / u.period;
+        for &b in &u.branches {
+            for s in (offset..slots).step_by(u.period as usize) {
+                self.words[b][(s / 64) as usize] ^= 1 << (s % 64);
+            }
+            if on {
+                self.free[b] -= n;
+            } else {
+                self.free[b] += n;
+            }
+        }
+    }
+}
+
+/// Offsets in the order that keeps slow channels on one slice slot rotated
+/// by the slice counter (as the reference design does): by slot-in-slice first.
+fn candidate_offsets(period: u64, slots_per_slice: u64) -> impl Iterator<Item = u64> {
+    (0..slots_per_slice.min(period))
+        .flat_map(move |s| (s..period).step_by(slots_per_slice as usize))
+}
+
+fn branch_plans(mix: &Mix) -> Result<Vec<BranchPlan>, String> {
+    mix.branches
+        .iter()
+        .map(|b| {
+            let spi = SpiTiming::derive(&b.adc, mix.clock_hz, b.sclk_hz)
+                .map_err(|e| format!("branch `{}`: {}", b.name, e.0))?;
+            let settle_cycles = ns_to_cycles(b.settle_ns, mix.clock_hz);
+            Ok(BranchPlan {
+                name: b.name.clone(),
+                spi,
+                settle_cycles,
+                // The mux switches in the cycle after a CS fall: it has slot-1 cycles to settle.
+                min_slot_cycles: spi.min_period_cycles.max(settle_cycles + 1),
+                mux_devices: b.mux_devices,
+            })
+        })
+        .collect()
+}
+
+fn units_of(mix: &Mix, frame_slots: u64) -> Vec<Unit> {
+    let mut units: Vec<Unit> = Vec::new();
+    let mut by_tag: std::collections::BTreeMap<&str, usize> = Default::default();
+    for (i, c) in mix.channels.iter().enumerate() {
+        let period = frame_slots / mix.samples_per_frame(c.rate_hz);
+        if let Some(tag) = &c.sync {
+            if let Some(&u) = by_tag.get(tag.as_str()) {
+                units[u].channels.push(i);
+                units[u].branches.push(c.branch);
+                continue;
+            }
+            by_tag.insert(tag, units.len());
+        }
+        units.push(Unit {
+            channels: vec![i],
+            branches: vec![c.branch],
+            period,
+        });
+    }
+    // Fast channels first; among equals, units spanning more branches first.
+    units.sort_by_key(|u| (u.period, std::cmp::Reverse(u.branches.len()), u.channels[0]));
+    units
+}
+
+/// Result of trying one slot grid.
+enum Attempt {
+    Placed(Vec<u64>, Placement),
+    /// Whether the exact search hit its budget rather than proving failure.
+    Failed {
+        bounded: bool,
+    },
+}
+
+fn greedy(units: &[Unit], branches: usize, slots: u64, sps: u64) -> (Vec<Option<u64>>, Occupancy) {
+    let mut occ = Occupancy::new(branches, slots);
+    let mut offsets = Vec::with_capacity(units.len());
+    for u in units {
+        let found = candidate_offsets(u.period, sps).find(|&o| occ.fits(u, o, slots));
+        if let Some(o) = found {
+            occ.set(u, o, slots, true);
+        }
+        offsets.push(found);
+    }
+    (offsets, occ)
+}
+
+struct Search<'a> {
+    units: &'a [Unit],
+    slots: u64,
+    sps: u64,
+    occ: Occupancy,
+    /// Demand (slots per frame) not yet placed, per branch.
+    remaining: Vec<u64>,
+    offsets: Vec<u64>,
+    /// Rank of each placed unit's offset in its candidate order (for symmetry breaking).
+    ranks: Vec<usize>,
+    nodes: u64,
+    budget: u64,
+}
+
+impl Search<'_> {
+    fn interchangeable(&self, i: usize) -> bool {
+        i > 0 && {
+            let (a, b) = (&self.units[i - 1], &self.units[i]);
+            a.period == b.period && a.branches == b.branches
+        }
+    }
+
+    fn run(&mut self, i: usize) -> bool {
+        if i == self.units.len() {
+            return true;
+        }
+        self.nodes += 1;
+        if self.nodes > self.budget {
+            return false;
+        }
+        if (0..self.remaining.len()).any(|b| self.remaining[b] > self.occ.free[b]) {
+            return false;
+        }
+        let u = &self.units[i];
+        let n = self.slots / u.period;
+        let min_rank = if self.interchangeable(i) {
+            self.ranks[i - 1] + 1
+        } else {
+            0
+        };
+        // Translation symmetry: the very first unit may sit at offset 0.
+        let limit = if i == 0 { 1 } else { usize::MAX };
+        let candidates: Vec<u64> = candidate_offsets(u.period, self.sps).collect();
+        for (rank, &o) in candidates.iter().enumerate().skip(min_rank).take(limit) {
+            if !self.occ.fits(u, o, self.slots) {
+                continue;
+            }
+            self.occ.set(u, o, self.slots, true);
+            for &b in &u.branches {
+                self.remaining[b] -= n;
+            }
+            self.offsets.push(o);
+            self.ranks.push(rank);
+            if self.run(i + 1) {
+                return true;
+            }
+            self.offsets.pop();
+            self.ranks.pop();
+            for &b in &u.branches {
+                self.remaining[b] += n;
+            }
+            self.occ.set(u, o, self.slots, false);
+            if self.nodes > self.budget {
+                return false;
+            }
+        }
+        false
+    }
+}
+
+fn attempt(units: &[Unit], branches: usize, slots: u64, sps: u64, budget: u64) -> Attempt {
+    let (offsets, _) = greedy(units, branches, slots, sps);
+    if offsets.iter().all(Option::is_some) {
+        return Attempt::Placed(
+            offsets.into_iter().map(Option::unwrap).collect(),
+            Placement::Constructive,
+        );
+    }
+    let mut remaining = vec![0; branches];
+    for u in units {
+        for &b in &u.branches {
+            remaining[b] += slots / u.period;
+        }
+    }
+    let mut s = Search {
+        units,
+        slots,
+        sps,
+        occ: Occupancy::new(branches, slots),
+        remaining,
+        offsets: Vec::new(),
+        ranks: Vec::new(),
+        nodes: 0,
+        budget,
+    };
+    if s.run(0) {
+        return Attempt::Placed(s.offsets, Placement::Search { nodes: s.nodes });
+    }
+    Attempt::Failed {
+        bounded: s.nodes > s.budget,
+    }
+}
+
+/// Slot grids to try, fewest slots first: divisors of the slice that keep
+/// every branch's slot at or above its shortest legal length.
+pub fn candidate_slots_per_slice(mix: &Mix, min_slot_cycles: u64) -> Vec<u64> {
+    let slice = mix.slice_cycles();
+    if let Some(s) = mix.slots_per_slice {
+        return vec![s];
+    }
+    let mut small = Vec::new();
+    let mut large = Vec::new();
+    let mut d = 1;
+    while d * d <= slice {
+        if slice % d == 0 {
+            small.push(d);
+            if d * d != slice {
+                large.push(slice / d);
+            }
+        }
+        d += 1;
+    }
+    large.reverse();
+    small
+        .into_iter()
+        .chain(large)
+        .filter(|&s| slice / s >= min_slot_cycles)
+        .collect()
+}
+
+/// Synthesizes a jitter-free schedule, or explains why none exists.
+pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
+    let fail = |reasons: Vec<String>, suggestions: Vec<String>| Infeasible {
+        mix: mix.name.clone(),
+        slots_per_slice: None,
+        reasons,
+        branches: Vec::new(),
+        suggestions,
+    };
+    let plans = branch_plans(mix).map_err(|e| fail(vec![e], vec![]))?;
+    let min_slot = plans.iter().map(|p| p.min_slot_cycles).max().unwrap_or(1);
+
+    // Exact intervals need clock / rate to be whole cycles.
+    let inexact: Vec<String> = mix
+        .channels
+        .iter()
+        .filter(|c| mix.clock_hz % c.rate_hz != 0)
+        .map(|c| {
+            format!(
+                "channel `{}`: {} Hz gives {:.3} clock cycles between samples at {} Hz; no grid makes that exact (nearest exact rates: {})",
+                c.name,
+                c.rate_hz,
+                mix.clock_hz as f64 / c.rate_hz as f64,
+                mix.clock_hz,
+                nearest_exact_rates(mix, c.rate_hz)
+            )
+        })
+        .collect();
+    if !inexact.is_empty() {
+        return Err(fail(inexact, vec![]));
+    }
+
+    let candidates = candidate_slots_per_slice(mix, min_slot);
+    if candidates.is_empty() || mix.slice_cycles() / candidates[0] < min_slot {
+        let slowest = plans.iter().max_by_key(|p| p.min_slot_cycles).unwrap();
+        let most = mix.slice_cycles() / min_slot;
+        let reason = match mix.slots_per_slice {
+            Some(s) => format!(
+                "slots_per_slice = {s} gives {}-cycle slots, shorter than the {} cycles branch `{}` needs (conversion, quiet time, throughput and mux settling)",
+                mix.slice_cycles() / s,
+                min_slot,
+                slowest.name
+            ),
+            None => format!(
+                "a {}-cycle slice cannot hold even one {}-cycle slot of branch `{}`",
+                mix.slice_cycles(),
+                min_slot,
+                slowest.name
+            ),
+        };
+        let suggestion = if most > 0 {
+            format!(
+                "use at most {most} slots per slice (a divisor of {} cycles)",
+                mix.slice_cycles()
+            )
+        } else {
+            "lengthen the slice or raise the clock".to_string()
+        };
+        return Err(fail(vec![reason], vec![suggestion]));
+    }
+
+    let k = mix.slices_per_frame();
+    let mut bounded = false;
+    for &sps in &candidates {
+        let slots = k * sps;
+        if mix
+            .channels
+            .iter()
+            .any(|c| slots % mix.samples_per_frame(c.rate_hz) != 0)
+        {
+            continue;
+        }
+        let mut demand = vec![0u64; mix.branches.len()];
+        for c in &mix.channels {
+            demand[c.branch] += mix.samples_per_frame(c.rate_hz);
+        }
+        if demand.iter().any(|&d| d > slots) {
+            continue;
+        }
+        let units = units_of(mix, slots);
+        match attempt(&units, mix.branches.len(), slots, sps, SEARCH_BUDGET) {
+            Attempt::Placed(offsets, placement) => {
+                let schedule = build(mix, plans, sps, &units, &offsets, placement);
+                if let Err(problems) = crate::validate::validate(&schedule) {
+                    return Err(fail(
+                        problems
+                            .into_iter()
+                            .map(|p| {
+                                format!("internal error, validator rejected the schedule: {p}")
+                            })
+                            .collect(),
+                        vec!["please report this mix as a bug".into()],
+                    ));
+                }
+                return Ok(schedule);
+            }
+            Attempt::Failed { bounded: b, .. } => bounded |= b,
+        }
+    }
+    Err(diagnose(mix, &plans, &candidates, bounded))
+}
+
+fn build(
+    mix: &Mix,
+    plans: Vec<BranchPlan>,
+    sps: u64,
+    units: &[Unit],
+    offsets: &[u64],
+    placement: Placement,
+) -> Schedule {
+    let grid = FrameGrid::new(mix, sps);
+    let nb = mix.branches.len();
+    let mut channels = vec![None; mix.channels.len()];
+    let mut table = vec![None; grid.frame_slots as usize * nb];
+    for (u, &o) in units.iter().zip(offsets) {
+        for &c in &u.channels {
+            let ch = &mix.channels[c];
+            channels[c] = Some(ChannelSlots {
+                samples_per_frame: mix.samples_per_frame(ch.rate_hz),
+                period_slots: u.period,
+                offset_slot: o,
+                interval_cycles: mix.clock_hz / ch.rate_hz,
+                device: ch.input / 8,
+                select: ch.input % 8,
+            });
+            for s in (o..grid.frame_slots).step_by(u.period as usize) {
+                table[s as usize * nb + ch.branch] = Some(c as u16);
+            }
+        }
+    }
+    Schedule {
+        mix: mix.clone(),
+        grid,
+        branches: plans,
+        channels: channels.into_iter().map(Option::unwrap).collect(),
+        frame_table: table,
+        placement,
+    }
+}
+
+/// Rates near `rate` that give whole samples per frame and whole cycles per sample.
+fn nearest_exact_rates(mix: &Mix, rate: u64) -> String {
+    let ok = |r: u64| {
+        r > 0 && mix.clock_hz % r == 0 && (r as u128 * mix.frame_us as u128) % 1_000_000 == 0
+    };
+    let below = (1..rate).rev().find(|&r| ok(r));
+    let above = (rate + 1..=rate.saturating_mul(2).max(rate + 1)).find(|&r| ok(r));
+    [below, above]
+        .iter()
+        .flatten()
+        .map(|r| format!("{r} Hz"))
+        .collect::<Vec<_>>()
+        .join(" or ")
+}
+
+fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) -> Infeasible {
+    let k = mix.slices_per_frame();
+    // The roomiest grid whose periods are all whole; else simply the roomiest.
+    let whole = |sps: u64| {
+        mix.channels
+            .iter()
+            .all(|c| (k * sps) % mix.samples_per_frame(c.rate_hz) == 0)
+    };
+    let sps = candidates
+        .iter()
+        .rev()
+        .copied()
+        .find(|&s| whole(s))
+        .unwrap_or(*candidates.last().unwrap());
+    let slots = k * sps;
+    let grid = FrameGrid::new(mix, sps);
+    let frames_per_s = 1e6 / mix.frame_us as f64;
+    let mut reasons = Vec::new();
+    let mut suggestions = Vec::new();
+
+    let nb = mix.branches.len();
+    let mut demand = vec![0u64; nb];
+    for c in &mix.channels {
+        demand[c.branch] += mix.samples_per_frame(c.rate_hz);
+    }
+    let mut unplaced: Vec<Vec<String>> = vec![Vec::new(); nb];
+
+    let not_whole: Vec<&str> = mix
+        .channels
+        .iter()
+        .filter(|c| slots % mix.samples_per_frame(c.rate_hz) != 0)
+        .map(|c| c.name.as_str())
+        .collect();
+    if !not_whole.is_empty() {
+        reasons.push(format!(
+            "no legal slot grid (at most {} slots per slice) spaces {} evenly: their samples per frame do not divide the frame's slots",
+            candidates.last().unwrap(),
+            not_whole.join(", ")
+        ));
+        for c in mix
+            .channels
+            .iter()
+            .filter(|c| slots % mix.samples_per_frame(c.rate_hz) != 0)
+        {
+            unplaced[c.branch].push(c.name.clone());
+            suggestions.push(format!(
+                "`{}`: rates that fit {} slots per slice exactly: {}",
+                c.name,
+                sps,
+                fitting_rates(mix, slots, c.rate_hz)
+            ));
+        }
+    } else {
+        for (b, &d) in demand.iter().enumerate() {
+            if d > slots {
+                reasons.push(format!(
+                    "branch `{}` needs {d} conversions per frame but has only {slots} slots ({:.1} % over)",
+                    mix.branches[b].name,
+                    (d as f64 / slots as f64 - 1.0) * 100.0
+                ));
+            }
+        }
+        let units = units_of(mix, slots);
+        let (offsets, occ) = greedy(&units, nb, slots, sps);
+        let overfull = demand.iter().any(|&d| d > slots);
+        for (u, o) in units.iter().zip(&offsets) {
+            if o.is_none() {
+                for &c in &u.channels {
+                    unplaced[mix.channels[c].branch].push(mix.channels[c].name.clone());
+                }
+                if !overfull {
+                    let c = &mix.channels[u.channels[0]];
+                    let fits: Vec<u64> = (1..=slots)
+                        .filter(|n| slots % n == 0)
+                        .filter(|&n| {
+                            let r = n as f64 * frames_per_s;
+                            r.fract() == 0.0 && mix.clock_hz % (r as u64) == 0
+                        })
+                        .filter(|&n| {
+                            let p = slots / n;
+                            let probe = Unit {
+                                period: p,
+                                ..u.clone()
+                            };
+                            candidate_offsets(p, sps).any(|o| occ.fits(&probe, o, slots))
+                        })
+                        .map(|n| (n as f64 * frames_per_s) as u64)
+                        .collect();
+                    let below = fits.iter().rev().find(|&&r| r < c.rate_hz);
+                    let above = fits.iter().find(|&&r| r > c.rate_hz);
+                    let near: Vec<String> = [below, above]
+                        .iter()
+                        .flatten()
+                        .map(|r| format!("{r} Hz"))
+                        .collect();
+                    if !near.is_empty() {
+                        suggestions.push(format!(
+                            "`{}` ({} Hz) collides with the other channels' progressions; nearest rates that fit beside them: {}",
+                            c.name,
+                            c.rate_hz,
+                            near.join(" or ")
+                        ));
+                    }
+                }
+            }
+        }
+        if !overfull && unplaced.iter().all(Vec::is_empty) {
+            reasons.push("first-fit placed every channel at this grid, but no grid admitted all of them with one rate each".into());
+        }
+        if !overfull && unplaced.iter().any(|u| !u.is_empty()) {
+            reasons.push(if bounded {
+                format!("rates that are not harmonic collide; the exact search stopped after its bound of {SEARCH_BUDGET} nodes per grid without a schedule")
+            } else {
+                "rates that are not harmonic collide: two progressions of periods p and q meet unless their offsets differ modulo gcd(p, q), and no choice of offsets separates them all".into()
+            });
+        }
+        // Move channels from over-full branches to branches with room.
+        for b in 0..nb {
+            if demand[b] <= slots {
+                continue;
+            }
+            let excess = demand[b] - slots;
+            let mut rates: Vec<u64> = mix
+                .channels
+                .iter()
+                .filter(|c| c.branch == b)
+                .map(|c| c.rate_hz)
+                .collect();
+            rates.sort_unstable();
+            rates.dedup();
+            let mut moved = false;
+            for &r in rates.iter().rev() {
+                let n = mix.samples_per_frame(r);
+                let count = excess.div_ceil(n);
+                let have = mix
+                    .channels
+                    .iter()
+                    .filter(|c| c.branch == b && c.rate_hz == r)
+                    .count() as u64;
+                if count > have {
+                    continue;
+                }
+                if let Some(t) = (0..nb)
+                    .filter(|&t| t != b)
+                    .max_by_key(|&t| slots.saturating_sub(demand[t]))
+                {
+                    let room = slots.saturating_sub(demand[t]) / n;
+                    if room >= count {
+                        suggestions.push(format!(
+                            "move {count} of the {r} Hz channels from `{}` to `{}` (room there for {room} more at {r} Hz)",
+                            mix.branches[b].name, mix.branches[t].name
+                        ));
+                        moved = true;
+                        break;
+                    }
+                }
+            }
+            if !moved {
+                suggestions.push(format!(
+                    "add a branch: the other branches cannot absorb {excess} more conversions per frame"
+                ));
+            }
+            if let Some(&fast) = rates.last() {
+                let n = mix.samples_per_frame(fast);
+                let reduce = excess.div_ceil(n);
+                suggestions.push(format!(
+                    "or lower the rate of {reduce} of the {fast} Hz channels on `{}`",
+                    mix.branches[b].name
+                ));
+            }
+        }
+    }
+
+    let branches = (0..nb)
+        .map(|b| BranchDiagnosis {
+            name: mix.branches[b].name.clone(),
+            demand_hz: mix
+                .channels
+                .iter()
+                .filter(|c| c.branch == b)
+                .map(|c| c.rate_hz)
+                .sum(),
+            capacity_hz: mix.clock_hz as f64 / grid.slot_cycles as f64,
+            demand_slots_per_frame: demand[b],
+            capacity_slots_per_frame: slots,
+            unplaced: std::mem::take(&mut unplaced[b]),
+        })
+        .collect();
+    let _ = plans;
+    Infeasible {
+        mix: mix.name.clone(),
+        slots_per_slice: Some(sps),
+        reasons,
+        branches,
+        suggestions,
+    }
+}
+
+/// Rates near `rate` whose period is a whole number of `slots`-slot frames.
+fn fitting_rates(mix: &Mix, slots: u64, rate: u64) -> String {
+    let frames_per_s = 1e6 / mix.frame_us as f64;
+    let rates: Vec<u64> = (1..=slots)
+        .filter(|n| slots % n == 0)
+        .map(|n| n as f64 * frames_per_s)
+        .filter(|r| r.fract() == 0.0 && mix.clock_hz % (*r as u64) == 0)
+        .map(|r| r as u64)
+        .collect();
+    let below = rates.iter().rev().find(|&&r| r < rate);
+    let above = rates.iter().find(|&&r| r > rate);
+    [below, above]
+        .iter()
+        .flatten()
+        .map(|r| format!("{r} Hz"))
+        .collect::<Vec<_>>()
+        .join(" or ")
+}

@@ -1,0 +1,219 @@
+//! An independent proof that a schedule keeps the mix's promises.
+//!
+//! This module deliberately shares no code with `synth`: it reads only the
+//! mix, the grid numbers and the frame table, and checks every promise from
+//! first principles (whole cycles, exact counts, equal cyclic intervals,
+//! datasheet limits, sync groups).  A bug in the synthesizer therefore cannot
+//! hide behind the same bug here.
+
+use std::collections::BTreeMap;
+
+use crate::schedule::Schedule;
+
+/// Returns every broken promise, or `Ok(())`.
+pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
+    let mut bad = Vec::new();
+    let mix = &s.mix;
+    let g = &s.grid;
+    let nb = mix.branches.len();
+
+    if g.clock_hz != mix.clock_hz {
+        bad.push(format!(
+            "grid clock {} != mix clock {}",
+            g.clock_hz, mix.clock_hz
+        ));
+    }
+    if g.frame_cycles as u128 * 1_000_000 != mix.clock_hz as u128 * mix.frame_us as u128 {
+        bad.push(format!(
+            "frame of {} cycles is not {} us",
+            g.frame_cycles, mix.frame_us
+        ));
+    }
+    if g.slot_cycles * g.slots_per_slice != g.slice_cycles {
+        bad.push(format!(
+            "{} slots of {} cycles do not make a {}-cycle slice",
+            g.slots_per_slice, g.slot_cycles, g.slice_cycles
+        ));
+    }
+    if g.slice_cycles * g.slices_per_frame != g.frame_cycles {
+        bad.push("slices do not tile the frame".into());
+    }
+    if g.slots_per_slice * g.slices_per_frame != g.frame_slots {
+        bad.push("frame_slots != slots_per_slice x slices_per_frame".into());
+    }
+    if let Some(forced) = mix.slots_per_slice {
+        if forced != g.slots_per_slice {
+            bad.push(format!(
+                "mix forces {forced} slots per slice, schedule uses {}",
+                g.slots_per_slice
+            ));
+        }
+    }
+    if s.frame_table.len() as u64 != g.frame_slots * nb as u64 {
+        bad.push("frame table has the wrong size".into());
+        return Err(bad);
+    }
+
+    // Datasheet limits, checked against the numbers the gateware will use.
+    for (b, plan) in s.branches.iter().enumerate() {
+        let adc = &mix.branches[b].adc;
+        let ns = |cycles: u64| cycles as f64 * 1e9 / mix.clock_hz as f64;
+        let spi = &plan.spi;
+        let sclk = mix.clock_hz as f64 / spi.sclk_div as f64;
+        if sclk > adc.sclk_max_hz as f64 || sclk < adc.sclk_min_hz as f64 {
+            bad.push(format!(
+                "branch `{}`: SCLK {sclk:.0} Hz outside the {} limits",
+                plan.name, adc.name
+            ));
+        }
+        let (hi, lo) = (spi.sclk_half, spi.sclk_div - spi.sclk_half);
+        if hi * 100 < spi.sclk_div * adc.duty_min_pct as u64
+            || lo * 100 < spi.sclk_div * adc.duty_min_pct as u64
+        {
+            bad.push(format!(
+                "branch `{}`: SCLK duty {hi}/{lo} outside {}..{} %",
+                plan.name,
+                adc.duty_min_pct,
+                100 - adc.duty_min_pct
+            ));
+        }
+        if ns(lo) < adc.data_access_ns as f64 {
+            bad.push(format!(
+                "branch `{}`: SCLK low phase shorter than data access time",
+                plan.name
+            ));
+        }
+        if ns(spi.setup_cycles) < adc.cs_setup_ns as f64 {
+            bad.push(format!(
+                "branch `{}`: CS-to-SCLK setup {} ns < {} ns",
+                plan.name,
+                ns(spi.setup_cycles),
+                adc.cs_setup_ns
+            ));
+        }
+        if spi.read_cycles != spi.setup_cycles + adc.sclk_per_conversion as u64 * spi.sclk_div {
+            bad.push(format!(
+                "branch `{}`: CS-low window is not setup + {} SCLK periods",
+                plan.name, adc.sclk_per_conversion
+            ));
+        }
+        if g.slot_cycles < spi.read_cycles
+            || ns(g.slot_cycles - spi.read_cycles) < adc.quiet_ns as f64
+        {
+            bad.push(format!(
+                "branch `{}`: slot leaves less than t_quiet = {} ns between conversions",
+                plan.name, adc.quiet_ns
+            ));
+        }
+        if (g.slot_cycles as f64) < mix.clock_hz as f64 / adc.max_sps as f64 {
+            bad.push(format!(
+                "branch `{}`: slots faster than {} samples/s",
+                plan.name, adc.max_sps
+            ));
+        }
+        if ns(g.slot_cycles - 1) < mix.branches[b].settle_ns as f64 {
+            bad.push(format!(
+                "branch `{}`: {} ns of settling needed, {} ns available",
+                plan.name,
+                mix.branches[b].settle_ns,
+                ns(g.slot_cycles - 1)
+            ));
+        }
+    }
+
+    // Per-channel slot lists straight from the table.
+    let mut slots_of: Vec<Vec<u64>> = vec![Vec::new(); mix.channels.len()];
+    for slot in 0..g.frame_slots {
+        for b in 0..nb {
+            if let Some(c) = s.frame_table[(slot * nb as u64 + b as u64) as usize] {
+                let c = c as usize;
+                if c >= mix.channels.len() {
+                    bad.push(format!("slot {slot}: unknown channel index {c}"));
+                    continue;
+                }
+                if mix.channels[c].branch != b {
+                    bad.push(format!(
+                        "slot {slot}: channel `{}` converted on the wrong branch",
+                        mix.channels[c].name
+                    ));
+                }
+                slots_of[c].push(slot);
+            }
+        }
+    }
+    for (c, ch) in mix.channels.iter().enumerate() {
+        let want = (ch.rate_hz as u128 * mix.frame_us as u128 / 1_000_000) as usize;
+        let got = &slots_of[c];
+        if got.len() != want {
+            bad.push(format!(
+                "`{}`: {} samples per frame, {} expected",
+                ch.name,
+                got.len(),
+                want
+            ));
+            continue;
+        }
+        if mix.clock_hz % ch.rate_hz != 0 {
+            bad.push(format!("`{}`: clock/rate is not whole", ch.name));
+            continue;
+        }
+        let interval = mix.clock_hz / ch.rate_hz;
+        for i in 0..got.len() {
+            let next = if i + 1 < got.len() {
+                got[i + 1]
+            } else {
+                got[0] + g.frame_slots
+            };
+            let cycles = (next - got[i]) * g.slot_cycles;
+            if cycles != interval {
+                bad.push(format!(
+                    "`{}`: interval from slot {} is {cycles} cycles, {interval} expected",
+                    ch.name, got[i]
+                ));
+                break;
+            }
+        }
+        if let Some(cs) = s.channels.get(c) {
+            if Some(&cs.offset_slot) != got.first()
+                || cs.interval_cycles != interval
+                || cs.samples_per_frame != want as u64
+            {
+                bad.push(format!(
+                    "`{}`: channel summary disagrees with the table",
+                    ch.name
+                ));
+            }
+            if cs.device * 8 + cs.select != ch.input {
+                bad.push(format!(
+                    "`{}`: mux address disagrees with input {}",
+                    ch.name, ch.input
+                ));
+            }
+        } else {
+            bad.push(format!("`{}`: missing from the channel summary", ch.name));
+        }
+    }
+
+    let mut groups: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
+    for (c, ch) in mix.channels.iter().enumerate() {
+        if let Some(t) = &ch.sync {
+            groups.entry(t).or_default().push(c);
+        }
+    }
+    for (tag, members) in groups {
+        for w in members.windows(2) {
+            if slots_of[w[0]] != slots_of[w[1]] {
+                bad.push(format!(
+                    "sync `{tag}`: `{}` and `{}` do not share sampling instants",
+                    mix.channels[w[0]].name, mix.channels[w[1]].name
+                ));
+            }
+        }
+    }
+
+    if bad.is_empty() {
+        Ok(())
+    } else {
+        Err(bad)
+    }
+}
