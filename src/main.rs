@@ -1,3 +1,47 @@
-fn main() {
-    println!("todo");
+//! `slotforge`: a thin CLI over the lut-gen, hdl and cosim crates.
+//!
+//! Exit codes follow SPEC: 0 success, 1 infeasible / divergence / difference,
+//! 2 bad input (always with file, line and field where there is one).
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+mod cmd;
+
+#[derive(Parser)]
+#[command(
+    name = "slotforge",
+    version,
+    about = "Jitter-free slot schedules, gateware and cycle-exact checks for multi-rate SPI ADC front ends"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Synthesize the schedule and audit it (rates, intervals, headroom, settling, Nyquist).
+    Audit(cmd::audit::Args),
+    /// Write the slot LUT: slots.hex ($readmemh), slots.csv, slots.md (Table 1 form).
+    Lut(cmd::lut::Args),
+    /// Emit slotforge_top.v, ports.json, slots.hex and constraints.
+    Verilog(cmd::verilog::Args),
+    /// Simulate the design with an ADC model and check it against the reference model.
+    Sim(cmd::sim::Args),
+    /// Check a VCD from any simulator against the mix.
+    Check(cmd::check::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let code = match cli.command {
+        Command::Audit(a) => cmd::audit::run(a),
+        Command::Lut(a) => cmd::lut::run(a),
+        Command::Verilog(a) => cmd::verilog::run(a),
+        Command::Sim(a) => cmd::sim::run(a),
+        Command::Check(a) => cmd::check::run(a),
+    };
+    ExitCode::from(code)
 }
