@@ -16,3 +16,7 @@ pub mod validate;
 pub use mix::{load, parse, Mix, MixError};
 pub use schedule::{FrameGrid, SamplingInstant, Schedule};
 pub use synth::{synthesize, Infeasible};
+pub mod audit;
+pub mod lut;
+
+pub use audit::AuditReport;

@@ -255,7 +255,7 @@ impl Cx<'_> {
                 format!("a {frame_us} us frame is not a whole number of {slice_us} us slices"),
             ));
         }
-        if (clock_hz as u128 * frame_us as u128) % 1_000_000 != 0 {
+        if !(clock_hz as u128 * frame_us as u128).is_multiple_of(1_000_000) {
             return Err(self.at(
                 clock.get_ref().hz.span(),
                 "clock.hz",
@@ -265,7 +265,7 @@ impl Cx<'_> {
                 ),
             ));
         }
-        if (clock_hz as u128 * slice_us as u128) % 1_000_000 != 0 {
+        if !(clock_hz as u128 * slice_us as u128).is_multiple_of(1_000_000) {
             return Err(self.at(
                 clock.get_ref().hz.span(),
                 "clock.hz",
@@ -436,7 +436,7 @@ impl Cx<'_> {
                 )
             })?;
             let rate_hz = self.positive(&c.rate_hz, &f("rate_hz"))?;
-            if (rate_hz as u128 * frame_us as u128) % 1_000_000 != 0 {
+            if !(rate_hz as u128 * frame_us as u128).is_multiple_of(1_000_000) {
                 return Err(self.at(
                     c.rate_hz.span(),
                     f("rate_hz"),

@@ -310,7 +310,7 @@ pub fn candidate_slots_per_slice(mix: &Mix, min_slot_cycles: u64) -> Vec<u64> {
     let mut large = Vec::new();
     let mut d = 1;
     while d * d <= slice {
-        if slice % d == 0 {
+        if slice.is_multiple_of(d) {
             small.push(d);
             if d * d != slice {
                 large.push(slice / d);
@@ -342,7 +342,7 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
     let inexact: Vec<String> = mix
         .channels
         .iter()
-        .filter(|c| mix.clock_hz % c.rate_hz != 0)
+        .filter(|c| !mix.clock_hz.is_multiple_of(c.rate_hz))
         .map(|c| {
             format!(
                 "channel `{}`: {} Hz gives {:.3} clock cycles between samples at {} Hz; no grid makes that exact (nearest exact rates: {})",
@@ -394,7 +394,7 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
         if mix
             .channels
             .iter()
-            .any(|c| slots % mix.samples_per_frame(c.rate_hz) != 0)
+            .any(|c| !slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
         {
             continue;
         }
@@ -469,7 +469,9 @@ fn build(
 /// Rates near `rate` that give whole samples per frame and whole cycles per sample.
 fn nearest_exact_rates(mix: &Mix, rate: u64) -> String {
     let ok = |r: u64| {
-        r > 0 && mix.clock_hz % r == 0 && (r as u128 * mix.frame_us as u128) % 1_000_000 == 0
+        r > 0
+            && mix.clock_hz.is_multiple_of(r)
+            && (r as u128 * mix.frame_us as u128).is_multiple_of(1_000_000)
     };
     let below = (1..rate).rev().find(|&r| ok(r));
     let above = (rate + 1..=rate.saturating_mul(2).max(rate + 1)).find(|&r| ok(r));
@@ -487,7 +489,7 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
     let whole = |sps: u64| {
         mix.channels
             .iter()
-            .all(|c| (k * sps) % mix.samples_per_frame(c.rate_hz) == 0)
+            .all(|c| (k * sps).is_multiple_of(mix.samples_per_frame(c.rate_hz)))
     };
     let sps = candidates
         .iter()
@@ -511,7 +513,7 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
     let not_whole: Vec<&str> = mix
         .channels
         .iter()
-        .filter(|c| slots % mix.samples_per_frame(c.rate_hz) != 0)
+        .filter(|c| !slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
         .map(|c| c.name.as_str())
         .collect();
     if !not_whole.is_empty() {
@@ -523,7 +525,7 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
         for c in mix
             .channels
             .iter()
-            .filter(|c| slots % mix.samples_per_frame(c.rate_hz) != 0)
+            .filter(|c| !slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
         {
             unplaced[c.branch].push(c.name.clone());
             suggestions.push(format!(
@@ -554,10 +556,10 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
                 if !overfull {
                     let c = &mix.channels[u.channels[0]];
                     let fits: Vec<u64> = (1..=slots)
-                        .filter(|n| slots % n == 0)
+                        .filter(|n| slots.is_multiple_of(*n))
                         .filter(|&n| {
                             let r = n as f64 * frames_per_s;
-                            r.fract() == 0.0 && mix.clock_hz % (r as u64) == 0
+                            r.fract() == 0.0 && mix.clock_hz.is_multiple_of(r as u64)
                         })
                         .filter(|&n| {
                             let p = slots / n;
@@ -683,9 +685,9 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
 fn fitting_rates(mix: &Mix, slots: u64, rate: u64) -> String {
     let frames_per_s = 1e6 / mix.frame_us as f64;
     let rates: Vec<u64> = (1..=slots)
-        .filter(|n| slots % n == 0)
+        .filter(|n| slots.is_multiple_of(*n))
         .map(|n| n as f64 * frames_per_s)
-        .filter(|r| r.fract() == 0.0 && mix.clock_hz % (*r as u64) == 0)
+        .filter(|r| r.fract() == 0.0 && mix.clock_hz.is_multiple_of(*r as u64))
         .map(|r| r as u64)
         .collect();
     let below = rates.iter().rev().find(|&&r| r < rate);

@@ -153,7 +153,7 @@ pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
             ));
             continue;
         }
-        if mix.clock_hz % ch.rate_hz != 0 {
+        if !mix.clock_hz.is_multiple_of(ch.rate_hz) {
             bad.push(format!("`{}`: clock/rate is not whole", ch.name));
             continue;
         }

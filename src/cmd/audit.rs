@@ -1,16 +1,40 @@
-//! `slotforge audit`.
+//! `slotforge audit MIX [--json]`: does the mix fit, and how well?
 
 use std::path::PathBuf;
+
+use lut_gen::AuditReport;
 
 #[derive(clap::Args)]
 pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
+    /// Print the SPEC's JSON report instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 pub fn run(args: Args) -> u8 {
-    match super::schedule(&args.mix) {
-        Ok(_) => 0,
-        Err(c) => c,
+    let mix = match lut_gen::load(&args.mix) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let (report, diagnosis) = match lut_gen::synthesize(&mix) {
+        Ok(s) => (AuditReport::of_schedule(&s), None),
+        Err(why) => (AuditReport::of_infeasible(&mix, &why), Some(why)),
+    };
+    if args.json {
+        print!("{}", report.to_json());
+    } else if let Some(why) = &diagnosis {
+        print!("{why}");
+    } else {
+        print!("{}", report.to_text());
+    }
+    if report.feasible {
+        0
+    } else {
+        1
     }
 }

@@ -1,16 +1,30 @@
-//! `slotforge lut`.
+//! `slotforge lut MIX -o DIR`: the slot LUT as `$readmemh` hex, CSV and Table 1 markdown.
 
 use std::path::PathBuf;
+
+use lut_gen::lut;
 
 #[derive(clap::Args)]
 pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
+    /// Output directory (created if missing; only slots.* files are written).
+    #[arg(short = 'o', long = "out")]
+    pub out: PathBuf,
 }
 
 pub fn run(args: Args) -> u8 {
-    match super::schedule(&args.mix) {
-        Ok(_) => 0,
-        Err(c) => c,
+    let s = match super::schedule(&args.mix) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let files = [
+        ("slots.hex", lut::to_hex(&s)),
+        ("slots.csv", lut::to_csv(&s)),
+        ("slots.md", lut::to_markdown(&s)),
+    ];
+    match super::write_files(&args.out, &files) {
+        Ok(()) => 0,
+        Err(code) => code,
     }
 }

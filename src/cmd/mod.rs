@@ -19,3 +19,29 @@ pub fn schedule(path: &Path) -> Result<lut_gen::Schedule, u8> {
         1u8
     })
 }
+
+/// Writes generated files into `dir` (created if missing).  Each file is
+/// written to a temporary name and renamed, so an interrupted run never
+/// leaves a half-written file, and nothing else in `dir` is touched.
+pub fn write_files(dir: &Path, files: &[(&str, String)]) -> Result<(), u8> {
+    if dir.exists() && !dir.is_dir() {
+        eprintln!("error: {}: exists and is not a directory", dir.display());
+        return Err(2);
+    }
+    std::fs::create_dir_all(dir).map_err(|e| {
+        eprintln!("error: {}: cannot create directory: {e}", dir.display());
+        2u8
+    })?;
+    for (name, text) in files {
+        let path = dir.join(name);
+        let tmp = dir.join(format!(".{name}.tmp"));
+        std::fs::write(&tmp, text)
+            .and_then(|()| std::fs::rename(&tmp, &path))
+            .map_err(|e| {
+                let _ = std::fs::remove_file(&tmp);
+                eprintln!("error: {}: cannot write: {e}", path.display());
+                2u8
+            })?;
+    }
+    Ok(())
+}
