@@ -37,3 +37,30 @@ fn eskin34_reproduces_table_1() {
     assert_eq!(s.at(9 * 30, stat), None);
     lut_gen::validate::validate(&s).unwrap();
 }
+
+/// Snapshots of the reference outputs: a change here is reviewed like code
+/// (`make update-snapshots`, then read the diff).
+#[test]
+fn eskin34_audit_and_lut_snapshots() {
+    let s = eskin();
+    insta::assert_snapshot!(
+        "eskin34_audit_json",
+        lut_gen::AuditReport::of_schedule(&s).to_json()
+    );
+    insta::assert_snapshot!(
+        "eskin34_audit_text",
+        lut_gen::AuditReport::of_schedule(&s).to_text()
+    );
+    insta::assert_snapshot!("eskin34_slots_md", lut_gen::lut::to_markdown(&s));
+    insta::assert_snapshot!("eskin34_slots_csv", lut_gen::lut::to_csv(&s));
+    insta::assert_snapshot!("eskin34_slots_hex", lut_gen::lut::to_hex(&s));
+}
+
+#[test]
+fn compact_lut_expands_to_the_frame_table() {
+    let s = eskin();
+    let c = lut_gen::lut::CompactLut::from_schedule(&s);
+    assert_eq!(c.expand(), s.frame_table);
+    assert_eq!(c.rotations.len(), 1);
+    assert_eq!(c.entries(), 30 * 3 + 10);
+}

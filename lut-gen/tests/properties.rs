@@ -1,0 +1,213 @@
+//! Properties of synthesis over random mixes.
+//!
+//! Feasible mixes are generated *with a witness*: channels are dropped onto a
+//! random slot grid only where their progression is free, so a jitter-free
+//! schedule is known to exist (the synthesizer may find another, possibly on
+//! a smaller grid).  Over-full mixes exceed an ADC's throughput, so no
+//! schedule can exist.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use lut_gen::lut::CompactLut;
+use proptest::prelude::*;
+
+const CLOCK: u64 = 48_000_000;
+/// Slots per 1 ms slice whose slots (>= 480 cycles: 100 kSPS) divide 48 000 cycles.
+const GRIDS: [u64; 12] = [10, 12, 16, 20, 24, 30, 40, 48, 50, 60, 80, 96];
+
+#[derive(Debug, Clone)]
+struct Spec {
+    branches: usize,
+    /// (branch, rate_hz, sync tag)
+    channels: Vec<(usize, u64, Option<String>)>,
+}
+
+fn to_toml(spec: &Spec) -> String {
+    let mut t = String::from("name = \"prop\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n");
+    for b in 0..spec.branches {
+        let _ = write!(
+            t,
+            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 4\n"
+        );
+    }
+    for (i, (b, r, sync)) in spec.channels.iter().enumerate() {
+        let _ = write!(
+            t,
+            "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {r}\n"
+        );
+        if let Some(s) = sync {
+            let _ = writeln!(t, "sync = \"{s}\"");
+        }
+    }
+    t
+}
+
+/// Builds a feasible mix from random draws: (grid index, branches, draws of (branch, period choice, offset seed, sync?)).
+fn feasible_spec(grid: usize, branches: usize, draws: Vec<(usize, usize, u64, bool)>) -> Spec {
+    let sps = GRIDS[grid % GRIDS.len()];
+    let slots = 10 * sps;
+    // Periods (in slots) whose rate is a whole number of Hz dividing the clock.
+    let periods: Vec<u64> = (1..=slots)
+        .filter(|p| slots % p == 0)
+        .filter(|p| {
+            let rate = (slots / p) * 100;
+            CLOCK % rate == 0
+        })
+        .collect();
+    let mut occ = vec![vec![false; slots as usize]; branches];
+    let mut channels = Vec::new();
+    let mut per_branch = vec![0usize; branches];
+    let mut tags = 0;
+    for (b, pi, seed, sync) in draws {
+        let b = b % branches;
+        let p = periods[pi % periods.len()];
+        let o = seed % p;
+        let partner = if sync && branches > 1 {
+            Some((b + 1) % branches)
+        } else {
+            None
+        };
+        let targets: Vec<usize> = std::iter::once(b).chain(partner).collect();
+        if targets.iter().any(|&t| per_branch[t] >= 32) {
+            continue;
+        }
+        let free = targets
+            .iter()
+            .all(|&t| (o..slots).step_by(p as usize).all(|s| !occ[t][s as usize]));
+        if !free {
+            continue;
+        }
+        let rate = (slots / p) * 100;
+        let tag = partner.map(|_| {
+            tags += 1;
+            format!("g{tags}")
+        });
+        for &t in &targets {
+            for s in (o..slots).step_by(p as usize) {
+                occ[t][s as usize] = true;
+            }
+            per_branch[t] += 1;
+            channels.push((t, rate, tag.clone()));
+        }
+    }
+    // Every branch needs a channel: give empty ones a slow one where it fits.
+    for b in 0..branches {
+        if per_branch[b] == 0 {
+            let p = slots;
+            if let Some(o) = (0..p).find(|&o| !occ[b][o as usize]) {
+                occ[b][o as usize] = true;
+                channels.push((b, 100, None));
+                per_branch[b] += 1;
+            }
+        }
+    }
+    Spec { branches, channels }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, .. ProptestConfig::default() })]
+
+    #[test]
+    fn feasible_mixes_get_validated_schedules(
+        grid in 0usize..12,
+        branches in 1usize..6,
+        draws in prop::collection::vec((0usize..8, 0usize..64, 0u64..10_000, prop::bool::weighted(0.2)), 1..24),
+    ) {
+        let spec = feasible_spec(grid, branches, draws);
+        prop_assume!(spec.channels.iter().filter(|c| c.0 == 0).count() > 0);
+        let text = to_toml(&spec);
+        let mix = lut_gen::parse(Path::new("prop.toml"), &text).expect("generated mix parses");
+        let s = lut_gen::synthesize(&mix).map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
+        prop_assert!(lut_gen::validate::validate(&s).is_ok());
+        prop_assert_eq!(CompactLut::from_schedule(&s).expand(), s.frame_table.clone());
+        let audit = lut_gen::AuditReport::of_schedule(&s);
+        prop_assert!(audit.feasible, "{:?}", audit.errors);
+        for c in &audit.channels {
+            prop_assert_eq!(c.jitter_cycles, 0);
+            prop_assert_eq!(c.achieved_hz, c.requested_hz as f64);
+        }
+    }
+
+    #[test]
+    fn over_full_mixes_are_reported_infeasible(
+        branches in 1usize..4,
+        full in 0usize..4,
+        rates in prop::collection::vec(prop::sample::select(vec![1_000u64, 2_000, 4_000, 5_000, 8_000, 10_000]), 1..40),
+    ) {
+        let full = full % branches;
+        // Pile channels onto one branch until it asks for more than 100 kSPS.
+        let mut channels = Vec::new();
+        let mut sum = 0;
+        for r in rates.iter().cycle() {
+            if sum > 100_000 {
+                break;
+            }
+            sum += r;
+            channels.push((full, *r, None));
+        }
+        prop_assume!(channels.len() <= 32);
+        for b in 0..branches {
+            if b != full {
+                channels.push((b, 1_000, None));
+            }
+        }
+        let text = to_toml(&Spec { branches, channels });
+        let mix = lut_gen::parse(Path::new("prop.toml"), &text).expect("generated mix parses");
+        let why = lut_gen::synthesize(&mix).expect_err("an over-full branch cannot be scheduled");
+        prop_assert!(why.branches.iter().any(|b| b.name == format!("b{full}") && b.demand_slots_per_frame > b.capacity_slots_per_frame), "{why}");
+    }
+}
+
+/// The issue's example: 3 kHz and 2 kHz on one ADC need 12 slots per slice, not 6.
+#[test]
+fn fewest_slots_that_hold_the_demand_are_not_always_enough() {
+    let text =
+        "name = \"x\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n\
+                [[branch]]\nname = \"a\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n\
+                [[channel]]\nname = \"f3\"\nbranch = \"a\"\nrate_hz = 3_000\n\
+                [[channel]]\nname = \"f2\"\nbranch = \"a\"\nrate_hz = 2_000\n";
+    let mix = lut_gen::parse(Path::new("x.toml"), text).unwrap();
+    let s = lut_gen::synthesize(&mix).unwrap();
+    assert_eq!(s.grid.slots_per_slice, 12);
+}
+
+/// Forcing 6 slots for the same mix is diagnosed, naming the colliding channel.
+#[test]
+fn colliding_rates_on_a_forced_grid_are_diagnosed() {
+    let text = "name = \"x\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\nslots_per_slice = 6\n\
+                [[branch]]\nname = \"a\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n\
+                [[channel]]\nname = \"f3\"\nbranch = \"a\"\nrate_hz = 3_000\n\
+                [[channel]]\nname = \"f2\"\nbranch = \"a\"\nrate_hz = 2_000\n";
+    let mix = lut_gen::parse(Path::new("x.toml"), text).unwrap();
+    let why = lut_gen::synthesize(&mix).unwrap_err();
+    assert_eq!(why.slots_per_slice, Some(6));
+    assert_eq!(why.branches[0].unplaced, vec!["f2".to_string()]);
+    let text = why.to_string();
+    assert!(text.contains("gcd"), "{text}");
+    assert!(text.contains("nearest rates that fit"), "{text}");
+}
+
+/// The validator is not a rubber stamp: it catches a moved sample.
+#[test]
+fn validator_rejects_a_jittered_table() {
+    let mix = lut_gen::load(Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../mixes/eskin34.toml"
+    )))
+    .unwrap();
+    let mut s = lut_gen::synthesize(&mix).unwrap();
+    let nb = s.branches.len();
+    let acoustic = mix.branch_index("acoustic").unwrap();
+    // Move CH36's slot-16 sample to slot 17: one interval shrinks, one grows.
+    let a = 16 * nb + acoustic;
+    let b = 17 * nb + acoustic;
+    s.frame_table.swap(a, b);
+    let problems = lut_gen::validate::validate(&s).unwrap_err();
+    assert!(
+        problems
+            .iter()
+            .any(|p| p.contains("CH36") && p.contains("interval")),
+        "{problems:?}"
+    );
+}
