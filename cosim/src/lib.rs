@@ -1,1 +1,18 @@
-//! cosim (under construction)
+//! cosim: the reference model of slotforge's gateware, an AD7940 model,
+//! simulation back ends and the cycle-exact waveform checker.
+//!
+//! The model is built from lut-gen's [`lut_gen::Schedule`] alone, following
+//! `docs/timing.md`; it never reads the `hdl` crate.
+
+pub mod adc;
+pub mod checker;
+pub mod model;
+pub mod pins;
+pub mod report;
+pub mod run;
+
+pub use adc::{Adc, Stimulus};
+pub use checker::{CheckOptions, Checker, Invariants};
+pub use model::{CycleModel, SlotModel};
+pub use pins::{Layout, Pins, Signal};
+pub use report::Report;

@@ -1,0 +1,247 @@
+//! AD7940 model: samples the analog input its branch's mux selects at the CS
+//! falling edge and shifts the 16-bit word out on MISO (two leading zeros,
+//! then the 14-bit code MSB first).
+//!
+//! Datasheet edges (shared/notes/datasheets.md): bit 0 is driven after CS
+//! falls, bit `i` after SCLK falling edge `i`, the line is invalid from 10 ns
+//! (t7, hold) to 80..120 ns (t4, access) after each falling edge and high-Z
+//! from 45 ns (t8) after falling edge 16.  [`Adc::drive`] works at cycle level
+//! (a bit is valid for the whole cycle after the edge; high-Z reads as 1, a
+//! weak pull-up); [`miso_events`] gives the same waveform at event level with
+//! the invalid windows, for waveform output.
+
+use std::f64::consts::PI;
+
+use lut_gen::Schedule;
+
+use crate::pins::{Layout, Pins};
+
+/// What each analog input carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Stimulus {
+    /// A code unique per (channel, slot) over any window of 16384 / channels slots.
+    #[default]
+    Pattern,
+    /// A sine per channel at a channel-specific frequency below its Nyquist limit.
+    Sine,
+    /// A square wave per channel (steps between two channel-specific levels).
+    Step,
+    /// A linear chirp per channel from 0 to its Nyquist frequency over each frame.
+    Chirp,
+}
+
+impl std::str::FromStr for Stimulus {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Stimulus, String> {
+        match s {
+            "pattern" => Ok(Stimulus::Pattern),
+            "sine" => Ok(Stimulus::Sine),
+            "step" => Ok(Stimulus::Step),
+            "chirp" => Ok(Stimulus::Chirp),
+            _ => Err(format!(
+                "unknown stimulus `{s}` (pattern, sine, step, chirp)"
+            )),
+        }
+    }
+}
+
+/// The analog world: the code each channel's input converts to at any instant.
+#[derive(Debug, Clone)]
+pub struct Analog {
+    pub kind: Stimulus,
+    channels: u64,
+    slot_cycles: u64,
+    frame_cycles: u64,
+    clock_hz: f64,
+    /// Per channel: signal frequency for sine/step, Nyquist frequency for chirp.
+    freq: Vec<f64>,
+}
+
+impl Analog {
+    pub fn new(s: &Schedule, kind: Stimulus) -> Analog {
+        let freq = s
+            .mix
+            .channels
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let nyq = c.rate_hz as f64 / 2.0;
+                match kind {
+                    Stimulus::Chirp => nyq,
+                    _ => {
+                        c.bandwidth_hz.unwrap_or(nyq / 4.0).min(nyq * 0.9)
+                            * (0.5 + 0.5 * ((i % 7) as f64 / 7.0))
+                    }
+                }
+            })
+            .collect();
+        Analog {
+            kind,
+            channels: s.channels.len() as u64,
+            slot_cycles: s.grid.slot_cycles,
+            frame_cycles: s.grid.frame_cycles,
+            clock_hz: s.grid.clock_hz as f64,
+            freq,
+        }
+    }
+
+    /// The 14-bit code input `id` converts to when sampled in cycle `cycle`.
+    /// `id < channels` is a channel; larger ids are unconnected inputs.
+    #[inline]
+    pub fn code(&self, id: u64, cycle: u64) -> u16 {
+        if self.kind == Stimulus::Pattern || id >= self.channels {
+            let n = (cycle / self.slot_cycles) * (self.channels + 64) + id;
+            return ((n.wrapping_mul(0x2F5B) + 0x1A5) & 0x3fff) as u16;
+        }
+        let i = id as usize;
+        let t = cycle as f64 / self.clock_hz;
+        let x = match self.kind {
+            Stimulus::Sine => (2.0 * PI * self.freq[i] * t + i as f64).sin(),
+            Stimulus::Step => {
+                if (self.freq[i] * t).fract() < 0.5 {
+                    -0.8 + 0.02 * (i % 10) as f64
+                } else {
+                    0.8 - 0.02 * (i % 10) as f64
+                }
+            }
+            Stimulus::Chirp => {
+                let tf = (cycle % self.frame_cycles) as f64 / self.clock_hz;
+                let span = self.frame_cycles as f64 / self.clock_hz;
+                (PI * self.freq[i] / span * tf * tf).sin()
+            }
+            Stimulus::Pattern => unreachable!(),
+        };
+        (8192.0 + 8000.0 * x).round().clamp(0.0, 16383.0) as u16
+    }
+
+    /// The id of the input a branch's mux pins select (unconnected inputs and
+    /// an invalid enable get ids beyond the channels).
+    pub fn input_id(&self, layout: &Layout, p: &Pins, b: usize) -> u64 {
+        match layout.selected(p, b) {
+            Ok(ch) => ch as u64,
+            Err(_) => {
+                let en = layout.en(p, b);
+                self.channels
+                    + 1
+                    + ((b as u64 * 64 + en.trailing_zeros() as u64 * 8 + layout.sel(p, b) as u64)
+                        % 63)
+            }
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct AdcState {
+    word: u16,
+    falls: u8,
+}
+
+/// The AD7940s of all branches, at cycle level.
+#[derive(Debug, Clone)]
+pub struct Adc {
+    pub analog: Analog,
+    layout: Layout,
+    st: Vec<AdcState>,
+    prev_cs: u8,
+    prev_sclk: u8,
+    miso: u64,
+}
+
+impl Adc {
+    pub fn new(s: &Schedule, kind: Stimulus) -> Adc {
+        let nb = s.branches.len();
+        let all = ((1u16 << nb) - 1) as u8;
+        Adc {
+            analog: Analog::new(s, kind),
+            layout: Layout::new(s),
+            st: vec![AdcState::default(); nb],
+            prev_cs: all,
+            prev_sclk: all,
+            miso: (1u64 << nb) - 1,
+        }
+    }
+
+    /// MISO of every branch during cycle `cycle`, given the outputs in it.
+    #[inline]
+    pub fn drive(&mut self, cycle: u64, p: &Pins) -> u64 {
+        if p.cs_n == self.prev_cs && p.sclk == self.prev_sclk {
+            return self.miso;
+        }
+        let fell_cs = self.prev_cs & !p.cs_n;
+        let fell_sclk = self.prev_sclk & !p.sclk & !p.cs_n;
+        let mut miso = 0u64;
+        for b in 0..self.st.len() {
+            let bit = 1u8 << b;
+            let st = &mut self.st[b];
+            if fell_cs & bit != 0 {
+                let id = self.analog.input_id(&self.layout, p, b);
+                st.word = self.analog.code(id, cycle) & 0x3fff;
+                st.falls = 0;
+            }
+            if fell_sclk & bit != 0 {
+                st.falls = st.falls.saturating_add(1);
+            }
+            let v = if p.cs_n & bit != 0 || st.falls >= 16 {
+                1 // high-Z, weak pull-up
+            } else {
+                (st.word >> (15 - st.falls)) & 1
+            };
+            miso |= (v as u64) << b;
+        }
+        self.prev_cs = p.cs_n;
+        self.prev_sclk = p.sclk;
+        self.miso = miso;
+        miso
+    }
+}
+
+/// One MISO level change at event level, in nanoseconds from the CS falling edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MisoEvent {
+    pub ns: f64,
+    /// `Some(bit)` driven, `None` invalid (x) or high-Z after the last bit.
+    pub level: Option<u8>,
+    pub high_z: bool,
+}
+
+/// The MISO waveform of one conversion of `word` with SCLK falling edges at
+/// `falls_ns` (relative to the CS fall): bit 0 from t3 after CS falls, then
+/// for each falling edge an invalid window from t7 (10 ns) to t4 (80 ns at 5 V)
+/// and the next bit, high-Z t8 (45 ns) after edge 16.
+pub fn miso_events(word: u16, falls_ns: &[f64]) -> Vec<MisoEvent> {
+    let bit = |i: usize| Some(((word >> (15 - i)) & 1) as u8);
+    let mut v = vec![
+        MisoEvent {
+            ns: 0.0,
+            level: None,
+            high_z: false,
+        },
+        MisoEvent {
+            ns: 35.0,
+            level: bit(0),
+            high_z: false,
+        },
+    ];
+    for (k, &f) in falls_ns.iter().enumerate() {
+        let i = k + 1;
+        if i >= 16 {
+            v.push(MisoEvent {
+                ns: f + 45.0,
+                level: None,
+                high_z: true,
+            });
+            break;
+        }
+        v.push(MisoEvent {
+            ns: f + 10.0,
+            level: None,
+            high_z: false,
+        });
+        v.push(MisoEvent {
+            ns: f + 80.0,
+            level: bit(i),
+            high_z: false,
+        });
+    }
+    v
+}

@@ -1,0 +1,1079 @@
+//! The streaming checker: feed it one cycle of pins at a time (in-process
+//! back ends, or cycles recovered from a VCD), then [`Checker::finish`].
+//!
+//! Two independent layers:
+//! - invariants from the mix alone ([`Invariants`] for counts, intervals and
+//!   the sample stream; edge tracking per branch for SPI timing, mux settling
+//!   and exclusivity, and MISO decoding);
+//! - cycle-exact equality with the [`CycleModel`] built from the schedule.
+
+use std::collections::VecDeque;
+
+use lut_gen::parts::ns_to_cycles;
+use lut_gen::{FrameGrid, Schedule};
+use serde_json::{json, Value};
+
+use crate::model::CycleModel;
+use crate::pins::{Layout, Pins, Signal};
+use crate::report::{ChannelStats, Divergence, Report, Violation};
+
+/// How much the checker records (it always counts everything).
+#[derive(Debug, Clone, Copy)]
+pub struct CheckOptions {
+    /// Compare every pin against the cycle-level model.
+    pub model: bool,
+    /// Divergences and violations listed in the report (each).
+    pub max_records: usize,
+}
+
+impl Default for CheckOptions {
+    fn default() -> Self {
+        CheckOptions {
+            model: true,
+            max_records: 50,
+        }
+    }
+}
+
+/// Datasheet and mix limits of one branch, in cycles (from the mix, not the schedule's SPI plan).
+#[derive(Debug, Clone)]
+struct Limits {
+    sclk_max_hz: u64,
+    sclk_min_hz: u64,
+    duty_min_pct: u64,
+    setup_min: u64,
+    quiet_min: u64,
+    settle_min: u64,
+}
+
+/// Collects violations; shared by both layers.
+#[derive(Debug, Clone)]
+struct Recorder {
+    grid: FrameGrid,
+    max: usize,
+    violations: Vec<Violation>,
+    violation_count: u64,
+}
+
+impl Recorder {
+    #[allow(clippy::too_many_arguments)]
+    fn violation(
+        &mut self,
+        cycle: u64,
+        rule: &str,
+        signal: Option<String>,
+        expected: Option<Value>,
+        actual: Option<Value>,
+        channel: Option<String>,
+        detail: String,
+    ) {
+        self.violation_count += 1;
+        if self.violations.len() < self.max {
+            let (frame, slot, _) = self.grid.locate(cycle);
+            self.violations.push(Violation {
+                cycle,
+                frame,
+                slot,
+                rule: rule.into(),
+                signal,
+                expected,
+                actual,
+                channel,
+                detail,
+            });
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Pending {
+    complete: u64,
+    instant: u64,
+    branch: usize,
+    channel: Option<u16>,
+    code: Option<u16>,
+}
+
+/// Model-independent checks at conversion level: per-channel counts per
+/// frame and exact intervals, and the merged sample stream (every completed
+/// conversion emitted once, in order, with its channel and MISO word).
+#[derive(Debug, Clone)]
+pub struct Invariants {
+    rec: Recorder,
+    names: Vec<String>,
+    branch_names: Vec<String>,
+    ch_branch: Vec<usize>,
+    interval: Vec<u64>,
+    spf: Vec<u64>,
+    last: Vec<u64>,
+    has_last: Vec<bool>,
+    in_frame: Vec<u64>,
+    samples: Vec<u64>,
+    imin: Vec<u64>,
+    imax: Vec<u64>,
+    /// Frame whose counts are being accumulated.
+    frame: u64,
+    frame_cycles: u64,
+    queue: VecDeque<Pending>,
+    /// Emission lateness allowed after completion (cycles).
+    slack: u64,
+    emitted: u64,
+    conversions: u64,
+}
+
+impl Invariants {
+    pub fn new(s: &Schedule, max_records: usize) -> Invariants {
+        let mix = &s.mix;
+        let n = mix.channels.len();
+        Invariants {
+            rec: Recorder {
+                grid: s.grid,
+                max: max_records,
+                violations: Vec::new(),
+                violation_count: 0,
+            },
+            names: mix.channels.iter().map(|c| c.name.clone()).collect(),
+            branch_names: mix.branches.iter().map(|b| b.name.clone()).collect(),
+            ch_branch: mix.channels.iter().map(|c| c.branch).collect(),
+            interval: mix
+                .channels
+                .iter()
+                .map(|c| mix.clock_hz / c.rate_hz)
+                .collect(),
+            spf: mix
+                .channels
+                .iter()
+                .map(|c| mix.samples_per_frame(c.rate_hz))
+                .collect(),
+            last: vec![0; n],
+            has_last: vec![false; n],
+            in_frame: vec![0; n],
+            samples: vec![0; n],
+            imin: vec![u64::MAX; n],
+            imax: vec![0; n],
+            frame: 0,
+            frame_cycles: mix.frame_cycles(),
+            queue: VecDeque::new(),
+            slack: mix.branches.len() as u64 + 1,
+            emitted: 0,
+            conversions: 0,
+        }
+    }
+
+    fn name(&self, ch: Option<u16>) -> Option<String> {
+        ch.and_then(|c| self.names.get(c as usize).cloned())
+    }
+
+    /// Closes every frame that ends at or before cycle `c`.
+    pub fn close_frames(&mut self, c: u64) {
+        while (self.frame + 1) * self.frame_cycles <= c {
+            let end = (self.frame + 1) * self.frame_cycles - 1;
+            for ch in 0..self.names.len() {
+                if self.in_frame[ch] != self.spf[ch] {
+                    let name = self.names[ch].clone();
+                    self.rec.violation(
+                        end,
+                        "samples-per-frame",
+                        None,
+                        Some(json!(self.spf[ch])),
+                        Some(json!(self.in_frame[ch])),
+                        Some(name.clone()),
+                        format!(
+                            "{name} sampled {} times in frame {}, expected {}",
+                            self.in_frame[ch], self.frame, self.spf[ch]
+                        ),
+                    );
+                }
+                self.in_frame[ch] = 0;
+            }
+            self.frame += 1;
+        }
+    }
+
+    /// A sampling instant of `channel` on `branch` at cycle `t`.
+    #[inline]
+    pub fn instant(&mut self, t: u64, branch: usize, channel: u16) {
+        let ch = channel as usize;
+        if t >= (self.frame + 1) * self.frame_cycles {
+            self.close_frames(t);
+        }
+        if ch >= self.names.len() {
+            self.rec.violation(
+                t,
+                "channel",
+                None,
+                None,
+                Some(json!(ch)),
+                None,
+                format!("channel index {ch} is not in the mix"),
+            );
+            return;
+        }
+        if self.ch_branch[ch] != branch {
+            let name = self.names[ch].clone();
+            self.rec.violation(
+                t,
+                "branch",
+                None,
+                Some(json!(self.branch_names[self.ch_branch[ch]])),
+                Some(json!(self.branch_names[branch])),
+                Some(name.clone()),
+                format!("{name} sampled on the wrong branch"),
+            );
+        }
+        self.in_frame[ch] += 1;
+        self.samples[ch] += 1;
+        if self.has_last[ch] {
+            let d = t - self.last[ch];
+            self.imin[ch] = self.imin[ch].min(d);
+            self.imax[ch] = self.imax[ch].max(d);
+            if d != self.interval[ch] {
+                let name = self.names[ch].clone();
+                self.rec.violation(
+                    t,
+                    "interval",
+                    None,
+                    Some(json!(self.interval[ch])),
+                    Some(json!(d)),
+                    Some(name.clone()),
+                    format!("{name} sampled {d} cycles after its previous instant (cycle {}), expected {}", self.last[ch], self.interval[ch]),
+                );
+            }
+        }
+        self.has_last[ch] = true;
+        self.last[ch] = t;
+    }
+
+    fn expire(&mut self, c: u64) {
+        while let Some(p) = self.queue.front() {
+            if p.complete + self.slack >= c {
+                break;
+            }
+            let p = *p;
+            self.queue.pop_front();
+            self.rec.violation(
+                p.complete,
+                "sample-missing",
+                Some("sample_valid".into()),
+                Some(json!(1)),
+                Some(json!(0)),
+                self.name(p.channel),
+                format!(
+                    "conversion of branch {} sampled at cycle {} completed at cycle {} but was never emitted",
+                    self.branch_names[p.branch], p.instant, p.complete
+                ),
+            );
+        }
+    }
+
+    /// A conversion completed (CS rose) at cycle `c`; `code` is the 14-bit word
+    /// read from MISO (`None` if x/z was captured), `channel` the one selected
+    /// at the sampling instant `instant`.
+    #[inline]
+    pub fn completion(
+        &mut self,
+        c: u64,
+        branch: usize,
+        channel: Option<u16>,
+        code: Option<u16>,
+        instant: u64,
+    ) {
+        self.conversions += 1;
+        self.expire(c);
+        self.queue.push_back(Pending {
+            complete: c,
+            instant,
+            branch,
+            channel,
+            code,
+        });
+    }
+
+    /// `sample_valid` was high in cycle `c` with this channel and value.
+    #[inline]
+    pub fn emitted(&mut self, c: u64, channel: u16, value: u16) {
+        self.emitted += 1;
+        self.expire(c);
+        let Some(p) = self.queue.pop_front() else {
+            self.rec.violation(
+                c,
+                "sample-unexpected",
+                Some("sample_valid".into()),
+                Some(json!(0)),
+                Some(json!(1)),
+                self.name(Some(channel)),
+                format!("sample_valid with channel {channel} value {value} but no conversion is waiting"),
+            );
+            return;
+        };
+        if p.complete >= c {
+            self.rec.violation(
+                c,
+                "sample-early",
+                Some("sample_valid".into()),
+                None,
+                None,
+                self.name(p.channel),
+                format!(
+                    "sample emitted in cycle {c}, before its conversion completed (cycle {})",
+                    p.complete
+                ),
+            );
+        }
+        if let Some(ch) = p.channel {
+            if ch != channel {
+                self.rec.violation(
+                    c,
+                    "sample-channel",
+                    Some("sample_channel".into()),
+                    Some(json!(ch)),
+                    Some(json!(channel)),
+                    self.name(Some(ch)),
+                    format!(
+                        "sample_channel {channel} but the mux selected {} ({}) at the sampling instant (cycle {})",
+                        ch,
+                        self.names.get(ch as usize).map(String::as_str).unwrap_or("?"),
+                        p.instant
+                    ),
+                );
+            }
+        }
+        if let Some(code) = p.code {
+            if code != value {
+                self.rec.violation(
+                    c,
+                    "sample-value",
+                    Some("sample_value".into()),
+                    Some(json!(code)),
+                    Some(json!(value)),
+                    self.name(p.channel),
+                    format!("sample_value {value:#06x} but MISO carried {code:#06x} (conversion sampled at cycle {})", p.instant),
+                );
+            }
+        }
+    }
+
+    /// Ends the check after `cycles` cycles: closes complete frames and flags
+    /// conversions still waiting.
+    pub fn finish(&mut self, cycles: u64) -> (u64, Vec<ChannelStats>) {
+        let frames = cycles / self.frame_cycles;
+        self.close_frames(frames * self.frame_cycles);
+        self.expire(cycles);
+        let channels = (0..self.names.len())
+            .map(|c| ChannelStats {
+                name: self.names[c].clone(),
+                branch: self.branch_names[self.ch_branch[c]].clone(),
+                samples: self.samples[c],
+                interval_cycles: self.interval[c],
+                interval_cycles_min: (self.imin[c] != u64::MAX).then_some(self.imin[c]),
+                interval_cycles_max: (self.imin[c] != u64::MAX).then_some(self.imax[c]),
+            })
+            .collect();
+        (frames, channels)
+    }
+
+    /// Records a violation found outside the conversion-level checks.
+    #[allow(clippy::too_many_arguments)]
+    pub fn violation(
+        &mut self,
+        cycle: u64,
+        rule: &str,
+        signal: Option<String>,
+        expected: Option<Value>,
+        actual: Option<Value>,
+        channel: Option<String>,
+        detail: String,
+    ) {
+        self.rec
+            .violation(cycle, rule, signal, expected, actual, channel, detail)
+    }
+
+    pub fn violation_count(&self) -> u64 {
+        self.rec.violation_count
+    }
+
+    /// Builds the report (call [`Invariants::finish`] first).
+    pub fn report(
+        self,
+        source: &str,
+        mix: &str,
+        cycles: u64,
+        frames: u64,
+        channels: Vec<ChannelStats>,
+        samples: u64,
+    ) -> Report {
+        Report {
+            ok: self.rec.violation_count == 0 && cycles > 0,
+            mix: mix.into(),
+            source: source.into(),
+            cycles,
+            frames,
+            samples,
+            channels,
+            divergence_count: 0,
+            divergences: Vec::new(),
+            violation_count: self.rec.violation_count,
+            violations: self.rec.violations,
+            model_compared: false,
+        }
+    }
+
+    pub fn emitted_count(&self) -> u64 {
+        self.emitted
+    }
+}
+
+#[derive(Debug, Clone, Default)]
+struct BranchState {
+    low: bool,
+    t: u64,
+    ch: Option<u16>,
+    falls: u32,
+    rises: u32,
+    last_fall: u64,
+    last_rise: u64,
+    word: u16,
+    word_bad: bool,
+    cs_rise: Option<u64>,
+    mux_since: u64,
+    mux_from_reset: bool,
+    en_multi: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Phase {
+    PreReset,
+    Reset,
+    Run,
+    Stopped,
+}
+
+const CONTEXT_BEFORE: usize = 3;
+const CONTEXT_AFTER: u8 = 2;
+
+/// The cycle-level streaming checker.
+#[derive(Debug, Clone)]
+pub struct Checker {
+    opts: CheckOptions,
+    mix_name: String,
+    layout: Layout,
+    signals: Vec<Signal>,
+    names: Vec<String>,
+    branch_names: Vec<String>,
+    limits: Vec<Limits>,
+    clock_hz: u64,
+    grid: FrameGrid,
+    model: Option<CycleModel>,
+    inv: Invariants,
+    phase: Phase,
+    c: u64,
+    prev: Pins,
+    prev_xz: Pins,
+    prev_miso: u64,
+    prev_miso_xz: u64,
+    reset_pins: (Pins, Pins),
+    br: Vec<BranchState>,
+    next_frame_at: u64,
+    /// Last cycles (cycle, actual, expected) for divergence context.
+    hist: VecDeque<(u64, Pins, Option<Pins>)>,
+    ctx_open: Vec<(usize, u8)>,
+    diverging: Vec<bool>,
+    divergence_count: u64,
+    divergences: Vec<Divergence>,
+    div_active: bool,
+    xz_seen: bool,
+    rst_x_seen: bool,
+}
+
+const NO_XZ: Pins = Pins {
+    cs_n: 0,
+    sclk: 0,
+    mux_sel: 0,
+    mux_en: 0,
+    sample_valid: false,
+    sample_channel: 0,
+    sample_value: 0,
+};
+
+impl Checker {
+    pub fn new(s: &Schedule, opts: CheckOptions) -> Checker {
+        let layout = Layout::new(s);
+        let mix = &s.mix;
+        let limits = mix
+            .branches
+            .iter()
+            .map(|b| Limits {
+                sclk_max_hz: b.adc.sclk_max_hz,
+                sclk_min_hz: b.adc.sclk_min_hz,
+                duty_min_pct: b.adc.duty_min_pct as u64,
+                setup_min: ns_to_cycles(b.adc.cs_setup_ns, mix.clock_hz).max(1),
+                quiet_min: ns_to_cycles(b.adc.quiet_ns, mix.clock_hz).max(1),
+                settle_min: ns_to_cycles(b.settle_ns, mix.clock_hz),
+            })
+            .collect();
+        let signals = layout.signals();
+        let nsig = signals.len();
+        Checker {
+            opts,
+            mix_name: mix.name.clone(),
+            signals,
+            names: mix.channels.iter().map(|c| c.name.clone()).collect(),
+            branch_names: mix.branches.iter().map(|b| b.name.clone()).collect(),
+            limits,
+            clock_hz: mix.clock_hz,
+            grid: s.grid,
+            model: opts.model.then(|| CycleModel::new(s)),
+            inv: Invariants::new(s, opts.max_records),
+            phase: Phase::PreReset,
+            c: 0,
+            prev: Pins::default(),
+            prev_xz: NO_XZ,
+            prev_miso: 0,
+            prev_miso_xz: 0,
+            reset_pins: (Pins::default(), NO_XZ),
+            br: vec![BranchState::default(); layout.branches],
+            layout,
+            next_frame_at: s.grid.frame_cycles,
+            hist: VecDeque::with_capacity(CONTEXT_BEFORE + 1),
+            ctx_open: Vec::new(),
+            diverging: vec![false; nsig],
+            divergence_count: 0,
+            divergences: Vec::new(),
+            div_active: false,
+            xz_seen: false,
+            rst_x_seen: false,
+        }
+    }
+
+    /// Cycles checked after reset so far.
+    pub fn cycles(&self) -> u64 {
+        self.c
+    }
+
+    /// Whether anything failed so far.
+    pub fn failed(&self) -> bool {
+        self.divergence_count > 0 || self.inv.violation_count() > 0
+    }
+
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// One clock cycle: `rst` as sampled at the edge that began it, the
+    /// outputs in it, and `adc_miso` during it.
+    #[inline]
+    pub fn cycle(&mut self, rst: bool, p: &Pins, miso: u64) {
+        if self.phase == Phase::Run && !rst && !self.xz_seen {
+            self.run_cycle(p, &NO_XZ, miso, 0);
+        } else {
+            self.cycle_xz(Some(rst), p, &NO_XZ, miso, 0);
+        }
+    }
+
+    /// Like [`Checker::cycle`] with 4-state values: bits set in `xz` /
+    /// `miso_xz` are x or z; `rst = None` is an x/z reset.
+    pub fn cycle_xz(&mut self, rst: Option<bool>, p: &Pins, xz: &Pins, miso: u64, miso_xz: u64) {
+        match (rst, self.phase) {
+            (_, Phase::Stopped) => return,
+            (None, Phase::PreReset | Phase::Reset) => return,
+            (None, Phase::Run) => {
+                if !self.rst_x_seen {
+                    self.rst_x_seen = true;
+                    self.inv.violation(
+                        self.c,
+                        "x-or-z",
+                        Some("rst".into()),
+                        None,
+                        Some(json!("x")),
+                        None,
+                        "rst is x/z after reset was released".into(),
+                    );
+                }
+            }
+            (Some(true), Phase::Run) => {
+                self.inv.violation(
+                    self.c,
+                    "reset",
+                    Some("rst".into()),
+                    None,
+                    None,
+                    None,
+                    "reset asserted again: checking stops here".into(),
+                );
+                self.phase = Phase::Stopped;
+                return;
+            }
+            (Some(true), _) => {
+                self.phase = Phase::Reset;
+                self.reset_pins = (*p, *xz);
+                self.prev = *p;
+                self.prev_xz = *xz;
+                return;
+            }
+            (Some(false), Phase::PreReset) => return,
+            (Some(false), Phase::Reset) => self.start(),
+            (Some(false), Phase::Run) => {}
+        }
+        self.xz_seen |= *xz != NO_XZ || miso_xz != 0;
+        self.run_cycle(p, xz, miso, miso_xz);
+    }
+
+    fn start(&mut self) {
+        self.phase = Phase::Run;
+        let (rp, rxz) = self.reset_pins;
+        if let Some(m) = &self.model {
+            let e = m.reset_pins();
+            for i in 0..self.signals.len() {
+                let s = self.signals[i];
+                let (ev, av, ax) = (
+                    s.get(&self.layout, &e),
+                    s.get(&self.layout, &rp),
+                    s.get(&self.layout, &rxz),
+                );
+                if ev != av || ax != 0 {
+                    self.divergence_count += 1;
+                    if self.divergences.len() < self.opts.max_records {
+                        self.divergences.push(Divergence {
+                            cycle: 0,
+                            frame: 0,
+                            slot: 0,
+                            signal: format!("{} (in reset)", s.name(&self.layout)),
+                            expected: json!(ev),
+                            actual: if ax != 0 { json!("x") } else { json!(av) },
+                            branch: s.branch().map(|b| self.branch_names[b].clone()),
+                            channel: None,
+                            context: vec![format!(
+                                "reset: {} | expected {}",
+                                fmt_pins(&rp),
+                                fmt_pins(&e)
+                            )],
+                        });
+                    }
+                }
+            }
+        }
+        for b in 0..self.layout.branches {
+            let st = &mut self.br[b];
+            st.mux_from_reset = true;
+            st.low = rp.cs_n >> b & 1 == 0;
+        }
+    }
+
+    #[inline]
+    fn run_cycle(&mut self, p: &Pins, xz: &Pins, miso: u64, miso_xz: u64) {
+        let c = self.c;
+        let mut expected = None;
+        if let Some(m) = &mut self.model {
+            let e = *m.pins();
+            if e != *p || *xz != NO_XZ || self.div_active {
+                self.compare(c, &e, p, xz);
+            }
+            expected = Some(e);
+            self.model.as_mut().unwrap().step(miso);
+        }
+        if !self.ctx_open.is_empty() {
+            self.add_context(c, p, expected);
+        }
+        if self.hist.len() > CONTEXT_BEFORE {
+            self.hist.pop_front();
+        }
+        self.hist.push_back((c, *p, expected));
+
+        if *xz != self.prev_xz {
+            self.xz_changes(c, p, xz);
+        }
+        if *p != self.prev || p.sample_valid || *xz != NO_XZ {
+            self.edges(c, p, xz);
+        }
+        if c + 1 == self.next_frame_at {
+            self.inv.close_frames(c + 1);
+            self.next_frame_at += self.grid.frame_cycles;
+        }
+        self.prev = *p;
+        self.prev_xz = *xz;
+        self.prev_miso = miso;
+        self.prev_miso_xz = miso_xz;
+        self.c = c + 1;
+    }
+
+    fn compare(&mut self, c: u64, e: &Pins, p: &Pins, xz: &Pins) {
+        let mut any = false;
+        for i in 0..self.signals.len() {
+            let s = self.signals[i];
+            let (ev, av, ax) = (
+                s.get(&self.layout, e),
+                s.get(&self.layout, p),
+                s.get(&self.layout, xz),
+            );
+            let bad = ev != av || ax != 0;
+            if bad {
+                any = true;
+                if !self.diverging[i] && self.divergences.len() < self.opts.max_records {
+                    let (frame, slot, _) = self.grid.locate(c);
+                    let m = self.model.as_ref().unwrap();
+                    let ch = match s.branch() {
+                        Some(b) => Some(m.branch_channel(b)),
+                        None if e.sample_valid => Some(e.sample_channel),
+                        None => Some(p.sample_channel),
+                    };
+                    let mut context: Vec<String> = self
+                        .hist
+                        .iter()
+                        .map(|(hc, hp, he)| ctx_line(*hc, hp, he.as_ref()))
+                        .collect();
+                    context.push(format!("{} <- diverges", ctx_line(c, p, Some(e))));
+                    self.divergences.push(Divergence {
+                        cycle: c,
+                        frame,
+                        slot,
+                        signal: s.name(&self.layout),
+                        expected: json!(ev),
+                        actual: if ax != 0 {
+                            json!(format!("{av:#b} with x/z mask {ax:#b}"))
+                        } else {
+                            json!(av)
+                        },
+                        branch: s.branch().map(|b| self.branch_names[b].clone()),
+                        channel: ch.and_then(|c| self.names.get(c as usize).cloned()),
+                        context,
+                    });
+                    self.ctx_open
+                        .push((self.divergences.len() - 1, CONTEXT_AFTER));
+                }
+            }
+            self.diverging[i] = bad;
+        }
+        if any {
+            self.divergence_count += 1;
+        }
+        self.div_active = any;
+    }
+
+    fn add_context(&mut self, c: u64, p: &Pins, e: Option<Pins>) {
+        // The cycle that opened the context is already in it.
+        let line = ctx_line(c, p, e.as_ref());
+        let divs = &mut self.divergences;
+        self.ctx_open.retain_mut(|(i, left)| {
+            if divs[*i].cycle == c {
+                return true;
+            }
+            divs[*i].context.push(line.clone());
+            *left -= 1;
+            *left > 0
+        });
+    }
+
+    fn xz_changes(&mut self, c: u64, p: &Pins, xz: &Pins) {
+        for i in 0..self.signals.len() {
+            let s = self.signals[i];
+            let now = s.get(&self.layout, xz);
+            let was = s.get(&self.layout, &self.prev_xz);
+            let matters =
+                !matches!(s, Signal::SampleChannel | Signal::SampleValue) || p.sample_valid;
+            if now != 0 && was == 0 && matters {
+                self.inv.violation(
+                    c,
+                    "x-or-z",
+                    Some(s.name(&self.layout)),
+                    None,
+                    Some(json!("x")),
+                    None,
+                    format!("{} is x/z (mask {now:#b})", s.name(&self.layout)),
+                );
+            }
+        }
+    }
+
+    fn edges(&mut self, c: u64, p: &Pins, xz: &Pins) {
+        let prev = self.prev;
+        let dcs = prev.cs_n ^ p.cs_n;
+        let dsclk = prev.sclk ^ p.sclk;
+        for b in 0..self.layout.branches {
+            let bit = 1u8 << b;
+            let (sel, en) = (self.layout.sel(p, b), self.layout.en(p, b));
+            if sel != self.layout.sel(&prev, b) || en != self.layout.en(&prev, b) {
+                let st = &mut self.br[b];
+                st.mux_since = c;
+                st.mux_from_reset = false;
+                let multi = en.count_ones() > 1;
+                if multi && !st.en_multi {
+                    self.inv.violation(
+                        c,
+                        "mux-exclusive",
+                        Some(Signal::MuxEn(b).name(&self.layout)),
+                        Some(json!("at most one bit set")),
+                        Some(json!(en)),
+                        None,
+                        format!(
+                            "branch {}: {} mux devices enabled at once",
+                            self.branch_names[b],
+                            en.count_ones()
+                        ),
+                    );
+                }
+                self.br[b].en_multi = multi;
+            }
+            let low_now = p.cs_n & bit == 0;
+            if dcs & bit != 0 && low_now {
+                self.cs_fall(b, c, p, xz);
+            }
+            if dsclk & bit != 0 {
+                if self.br[b].low {
+                    if p.sclk & bit == 0 {
+                        self.sclk_fall(b, c);
+                    } else {
+                        self.sclk_rise(b, c);
+                    }
+                } else {
+                    self.inv.violation(
+                        c,
+                        "sclk-idle",
+                        Some(Signal::Sclk(b).name(&self.layout)),
+                        None,
+                        Some(json!(p.sclk >> b & 1)),
+                        None,
+                        "SCLK toggles while CS is high".into(),
+                    );
+                }
+            }
+            if dcs & bit != 0 && !low_now {
+                self.cs_rise(b, c, p);
+            }
+        }
+        if p.sample_valid {
+            if xz.sample_channel != 0 || xz.sample_value != 0 || xz.sample_valid {
+                // already flagged as x/z; the value cannot be compared
+                self.inv.emitted(c, p.sample_channel, p.sample_value);
+            } else {
+                self.inv.emitted(c, p.sample_channel, p.sample_value);
+            }
+        }
+    }
+
+    fn cs_fall(&mut self, b: usize, c: u64, p: &Pins, xz: &Pins) {
+        let lim = self.limits[b].clone();
+        let name = |s: Signal, l: &Layout| Some(s.name(l));
+        if let Some(r) = self.br[b].cs_rise {
+            if c - r < lim.quiet_min {
+                self.inv.violation(
+                    c,
+                    "cs-quiet",
+                    name(Signal::CsN(b), &self.layout),
+                    Some(json!(lim.quiet_min)),
+                    Some(json!(c - r)),
+                    None,
+                    format!(
+                        "CS high for {} cycles between conversions, the ADC needs {} (t_quiet)",
+                        c - r,
+                        lim.quiet_min
+                    ),
+                );
+            }
+        }
+        if p.sclk >> b & 1 == 0 {
+            self.inv.violation(
+                c,
+                "sclk-idle",
+                name(Signal::Sclk(b), &self.layout),
+                Some(json!(1)),
+                Some(json!(0)),
+                None,
+                "SCLK is low when CS falls (CPOL=1 idles high)".into(),
+            );
+        }
+        let sel_x = self.layout.sel(xz, b) != 0 || self.layout.en(xz, b) != 0;
+        let ch = match self.layout.selected(p, b) {
+            Ok(ch) if !sel_x => Some(ch),
+            Ok(_) => None,
+            Err(e) => {
+                self.inv.violation(
+                    c,
+                    "mux-select",
+                    name(Signal::MuxEn(b), &self.layout),
+                    None,
+                    Some(json!(self.layout.en(p, b))),
+                    None,
+                    format!("at the sampling instant: {e}"),
+                );
+                None
+            }
+        };
+        let st = &self.br[b];
+        if !st.mux_from_reset && c - st.mux_since < lim.settle_min {
+            let since = st.mux_since;
+            self.inv.violation(
+                c,
+                "mux-settle",
+                name(Signal::MuxSel(b), &self.layout),
+                Some(json!(lim.settle_min)),
+                Some(json!(c - since)),
+                ch.and_then(|ch| self.names.get(ch as usize).cloned()),
+                format!("mux switched in cycle {since}, {} cycles before the sampling instant; settling needs {}", c - since, lim.settle_min),
+            );
+        }
+        let st = &mut self.br[b];
+        st.low = true;
+        st.t = c;
+        st.ch = ch;
+        st.falls = 0;
+        st.rises = 0;
+        st.word = 0;
+        st.word_bad = false;
+        if let Some(ch) = ch {
+            self.inv.instant(c, b, ch);
+        }
+    }
+
+    fn sclk_fall(&mut self, b: usize, c: u64) {
+        let lim = &self.limits[b];
+        let st = &mut self.br[b];
+        st.falls += 1;
+        let mut v: Vec<(&str, Option<Value>, Option<Value>, String)> = Vec::new();
+        if st.falls == 1 {
+            if c - st.t < lim.setup_min {
+                v.push((
+                    "cs-setup",
+                    Some(json!(lim.setup_min)),
+                    Some(json!(c - st.t)),
+                    format!(
+                        "first SCLK falling edge {} cycles after CS fell, needs {} (t2)",
+                        c - st.t,
+                        lim.setup_min
+                    ),
+                ));
+            }
+        } else {
+            let period = c - st.last_fall;
+            let low = st.last_rise.saturating_sub(st.last_fall);
+            let high = c - st.last_rise;
+            if period * lim.sclk_max_hz < self.clock_hz {
+                v.push((
+                    "sclk-frequency",
+                    Some(json!(lim.sclk_max_hz)),
+                    Some(json!(self.clock_hz / period.max(1))),
+                    format!(
+                        "SCLK period of {period} cycles is faster than {} Hz",
+                        lim.sclk_max_hz
+                    ),
+                ));
+            }
+            if period * lim.sclk_min_hz > self.clock_hz {
+                v.push((
+                    "sclk-frequency",
+                    Some(json!(lim.sclk_min_hz)),
+                    Some(json!(self.clock_hz / period.max(1))),
+                    format!(
+                        "SCLK period of {period} cycles is slower than {} Hz",
+                        lim.sclk_min_hz
+                    ),
+                ));
+            }
+            if st.last_rise < st.last_fall
+                || low * 100 < period * lim.duty_min_pct
+                || high * 100 < period * lim.duty_min_pct
+            {
+                v.push((
+                    "sclk-duty",
+                    Some(json!(format!(">= {} %", lim.duty_min_pct))),
+                    Some(json!(format!("low {low} / high {high} cycles"))),
+                    format!("SCLK period {period}: low {low}, high {high} cycles"),
+                ));
+            }
+        }
+        st.last_fall = c;
+        let signal = Signal::Sclk(b).name(&self.layout);
+        for (rule, e, a, d) in v {
+            self.inv
+                .violation(c, rule, Some(signal.clone()), e, a, None, d);
+        }
+    }
+
+    fn sclk_rise(&mut self, b: usize, c: u64) {
+        let st = &mut self.br[b];
+        st.rises += 1;
+        st.last_rise = c;
+        if st.rises <= 15 {
+            if self.prev_miso_xz >> b & 1 != 0 {
+                st.word_bad = true;
+                self.inv.violation(
+                    c,
+                    "x-or-z",
+                    Some(Signal::Miso(b).name(&self.layout)),
+                    None,
+                    Some(json!("x")),
+                    None,
+                    format!("MISO is x/z when SCLK rises ({}, bit {})", c, st.rises),
+                );
+            }
+            let st = &mut self.br[b];
+            st.word = (st.word << 1) | (self.prev_miso >> b & 1) as u16;
+        }
+    }
+
+    fn cs_rise(&mut self, b: usize, c: u64, p: &Pins) {
+        let st = self.br[b].clone();
+        self.br[b].low = false;
+        self.br[b].cs_rise = Some(c);
+        if c == 0 && st.falls == 0 {
+            return; // CS low through reset: no conversion to account for
+        }
+        let chname = st.ch.and_then(|ch| self.names.get(ch as usize).cloned());
+        if st.falls != 16 || st.rises != 16 {
+            self.inv.violation(
+                c,
+                "sclk-count",
+                Some(Signal::Sclk(b).name(&self.layout)),
+                Some(json!(16)),
+                Some(json!(st.falls)),
+                chname.clone(),
+                format!("{} SCLK falling and {} rising edges in the CS-low window from cycle {}, expected 16", st.falls, st.rises, st.t),
+            );
+        }
+        if p.sclk >> b & 1 == 0 {
+            self.inv.violation(
+                c,
+                "sclk-idle",
+                Some(Signal::Sclk(b).name(&self.layout)),
+                Some(json!(1)),
+                Some(json!(0)),
+                chname,
+                "SCLK is low when CS rises".into(),
+            );
+        }
+        let code = (!st.word_bad).then_some(st.word & 0x3fff);
+        self.inv.completion(c, b, st.ch, code, st.t);
+    }
+
+    /// Ends the check and builds the report.
+    pub fn finish(mut self, source: &str) -> Report {
+        let cycles = self.c;
+        if self.phase == Phase::PreReset || (self.phase == Phase::Reset && cycles == 0) {
+            self.inv.violation(0, "no-cycles", Some("rst".into()), None, None, None, "no cycle after a released reset was seen (rst must be high, then low, at rising clock edges)".into());
+        }
+        let (frames, channels) = self.inv.finish(cycles);
+        let samples = self.inv.emitted_count();
+        let model = self.model.is_some();
+        let mut r = self
+            .inv
+            .report(source, &self.mix_name, cycles, frames, channels, samples);
+        r.divergence_count = self.divergence_count;
+        r.divergences = self.divergences;
+        r.model_compared = model;
+        r.ok = r.ok && r.divergence_count == 0;
+        r
+    }
+}
+
+fn fmt_pins(p: &Pins) -> String {
+    format!(
+        "cs_n={:b} sclk={:b} mux_sel={:#x} mux_en={:#x} valid={} ch={} value={:#06x}",
+        p.cs_n, p.sclk, p.mux_sel, p.mux_en, p.sample_valid as u8, p.sample_channel, p.sample_value
+    )
+}
+
+fn ctx_line(c: u64, p: &Pins, e: Option<&Pins>) -> String {
+    match e {
+        Some(e) if e != p => format!("cycle {c}: {} | expected {}", fmt_pins(p), fmt_pins(e)),
+        _ => format!("cycle {c}: {}", fmt_pins(p)),
+    }
+}

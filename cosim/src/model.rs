@@ -1,0 +1,350 @@
+//! The reference model, built from lut-gen's [`Schedule`] only (never from `hdl`).
+//!
+//! - [`SlotModel`]: every conversion of a frame (instant, branch, channel,
+//!   completion and emission cycles) as a periodic template, so hours of
+//!   acquisition cost a few nanoseconds per sample;
+//! - [`CycleModel`]: the value of every output pin in every cycle, as
+//!   `docs/timing.md` specifies, driven by the MISO bits it captures (so the
+//!   predicted `sample_value` is the word shifted in on MISO, whatever the
+//!   stimulus).  It only does work at the cycles where something happens.
+
+use lut_gen::Schedule;
+
+use crate::pins::{Layout, Pins};
+
+/// One conversion in the periodic frame template.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Conversion {
+    /// Sampling instant (CS falling), cycles from the start of the frame.
+    pub instant: u64,
+    pub branch: usize,
+    pub channel: u16,
+    /// Cycle in which CS rises again (`instant + read_cycles`).
+    pub complete: u64,
+    /// Cycle in which `sample_valid` carries it (may lie in the next frame).
+    pub emit: u64,
+}
+
+/// Slot-level model: the periodic frame template of conversions.
+#[derive(Debug, Clone)]
+pub struct SlotModel {
+    pub frame_cycles: u64,
+    /// Conversions of one frame in (instant, branch) order.
+    pub conversions: Vec<Conversion>,
+    /// The same conversions in emission order.
+    pub emissions: Vec<Conversion>,
+}
+
+impl SlotModel {
+    pub fn new(s: &Schedule) -> SlotModel {
+        let g = &s.grid;
+        let nb = s.branches.len();
+        let mut conversions = Vec::new();
+        for slot in 0..g.frame_slots {
+            for b in 0..nb {
+                if let Some(ch) = s.at(slot, b) {
+                    let instant = slot * g.slot_cycles;
+                    conversions.push(Conversion {
+                        instant,
+                        branch: b,
+                        channel: ch as u16,
+                        complete: instant + s.branches[b].spi.read_cycles,
+                        emit: 0,
+                    });
+                }
+            }
+        }
+        // Merge: completions leave one per cycle, in (completion, branch) order.
+        let mut order: Vec<usize> = (0..conversions.len()).collect();
+        order.sort_by_key(|&i| (conversions[i].complete, conversions[i].branch));
+        let mut last_emit = 0u64;
+        let mut first = true;
+        for &i in &order {
+            let e = conversions[i].complete + 1;
+            let e = if first { e } else { e.max(last_emit + 1) };
+            first = false;
+            conversions[i].emit = e;
+            last_emit = e;
+        }
+        let mut emissions = conversions.clone();
+        emissions.sort_by_key(|c| c.emit);
+        SlotModel {
+            frame_cycles: g.frame_cycles,
+            conversions,
+            emissions,
+        }
+    }
+
+    /// Every conversion of frames `0..frames`, with absolute cycles.
+    pub fn iter(&self, frames: u64) -> impl Iterator<Item = Conversion> + '_ {
+        (0..frames).flat_map(move |f| {
+            let base = f * self.frame_cycles;
+            self.conversions.iter().map(move |c| Conversion {
+                instant: c.instant + base,
+                complete: c.complete + base,
+                emit: c.emit + base,
+                ..*c
+            })
+        })
+    }
+}
+
+#[derive(Debug, Clone)]
+struct BranchModel {
+    /// (cycle in frame, channel) of this branch's instants.
+    inst: Vec<(u64, u16)>,
+    /// Current instant (the last one at or before the model's cycle).
+    t: Option<u64>,
+    tch: u16,
+    /// Next instant: index in `inst` and frame.
+    ni: usize,
+    nf: u64,
+    tn: u64,
+    tnch: u16,
+    /// Cycle offsets after an instant where this branch's pins change or MISO is captured.
+    offs: Vec<u64>,
+    oi: usize,
+    /// Next cycle at which this branch needs attention.
+    next: u64,
+    word: u16,
+    su: u64,
+    d: u64,
+    h: u64,
+    r: u64,
+    /// (device, select) of each channel (indexed by channel).
+    addr: Vec<(u32, u32)>,
+}
+
+impl BranchModel {
+    fn advance_next_instant(&mut self, frame_cycles: u64) {
+        if self.inst.is_empty() {
+            self.tn = u64::MAX;
+            return;
+        }
+        let (off, ch) = self.inst[self.ni];
+        self.tn = self.nf * frame_cycles + off;
+        self.tnch = ch;
+        self.ni += 1;
+        if self.ni == self.inst.len() {
+            self.ni = 0;
+            self.nf += 1;
+        }
+    }
+}
+
+/// Cycle-level model of `slotforge_top`'s outputs.
+#[derive(Debug, Clone)]
+pub struct CycleModel {
+    layout: Layout,
+    br: Vec<BranchModel>,
+    frame_cycles: u64,
+    c: u64,
+    pins: Pins,
+    reset: Pins,
+    next_event: u64,
+    pending: u8,
+    pend: [(u16, u16); 8],
+    capture: u8,
+}
+
+impl CycleModel {
+    /// The model at cycle 0 (the first cycle after reset).
+    pub fn new(s: &Schedule) -> CycleModel {
+        let layout = Layout::new(s);
+        let g = &s.grid;
+        let addr: Vec<(u32, u32)> = s.channels.iter().map(|c| (c.device, c.select)).collect();
+        let mut br = Vec::new();
+        for (b, plan) in s.branches.iter().enumerate() {
+            let spi = &plan.spi;
+            let (su, d, h, r) = (
+                spi.setup_cycles,
+                spi.sclk_div,
+                spi.sclk_half,
+                spi.read_cycles,
+            );
+            let mut offs = vec![1, r];
+            for i in 0..16 {
+                let fall = su + i * d;
+                offs.push(fall);
+                offs.push(fall + h);
+                if i < 15 {
+                    offs.push(fall + h - 1);
+                }
+            }
+            offs.retain(|&o| o > 0);
+            offs.sort_unstable();
+            offs.dedup();
+            let inst: Vec<(u64, u16)> = (0..g.frame_slots)
+                .filter_map(|slot| s.at(slot, b).map(|ch| (slot * g.slot_cycles, ch as u16)))
+                .collect();
+            let mut m = BranchModel {
+                inst,
+                t: None,
+                tch: 0,
+                ni: 0,
+                nf: 0,
+                tn: u64::MAX,
+                tnch: 0,
+                offs,
+                oi: 0,
+                next: 0,
+                word: 0,
+                su,
+                d,
+                h,
+                r,
+                addr: addr.clone(),
+            };
+            m.advance_next_instant(g.frame_cycles);
+            br.push(m);
+        }
+        let mut reset = Pins {
+            cs_n: ((1u16 << s.branches.len()) - 1) as u8,
+            sclk: ((1u16 << s.branches.len()) - 1) as u8,
+            ..Pins::default()
+        };
+        for (b, m) in br.iter().enumerate() {
+            if m.tn != u64::MAX {
+                let (dev, sel) = m.addr[m.tnch as usize];
+                layout.set_mux(&mut reset, b, dev, sel);
+            }
+        }
+        let mut model = CycleModel {
+            layout,
+            br,
+            frame_cycles: g.frame_cycles,
+            c: 0,
+            pins: reset,
+            reset,
+            next_event: 0,
+            pending: 0,
+            pend: [(0, 0); 8],
+            capture: 0,
+        };
+        model.process();
+        model
+    }
+
+    /// Output values in every cycle in which `rst` was sampled high.
+    pub fn reset_pins(&self) -> Pins {
+        self.reset
+    }
+
+    /// The cycle the model is in.
+    pub fn cycle(&self) -> u64 {
+        self.c
+    }
+
+    /// Predicted outputs in the current cycle.
+    #[inline]
+    pub fn pins(&self) -> &Pins {
+        &self.pins
+    }
+
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// The channel branch `b` is busy with or heading for in the current cycle.
+    pub fn branch_channel(&self, b: usize) -> u16 {
+        let m = &self.br[b];
+        match m.t {
+            Some(t) if self.c < t + m.r => m.tch,
+            _ => m.tnch,
+        }
+    }
+
+    /// Ends the current cycle, in which `adc_miso` carried `miso` (bit b =
+    /// branch b), and moves to the next one.
+    #[inline]
+    pub fn step(&mut self, miso: u64) {
+        if self.capture == 0
+            && self.pending == 0
+            && !self.pins.sample_valid
+            && self.c + 1 < self.next_event
+        {
+            self.c += 1;
+            return;
+        }
+        self.step_slow(miso);
+    }
+
+    fn step_slow(&mut self, miso: u64) {
+        let mut cap = self.capture;
+        while cap != 0 {
+            let b = cap.trailing_zeros() as usize;
+            cap &= cap - 1;
+            let m = &mut self.br[b];
+            m.word = (m.word << 1) | ((miso >> b) & 1) as u16;
+        }
+        self.capture = 0;
+        if self.pending != 0 {
+            let b = self.pending.trailing_zeros() as usize;
+            self.pending &= self.pending - 1;
+            self.pins.sample_valid = true;
+            self.pins.sample_channel = self.pend[b].0;
+            self.pins.sample_value = self.pend[b].1;
+        } else {
+            self.pins.sample_valid = false;
+        }
+        self.c += 1;
+        if self.c >= self.next_event {
+            self.process();
+        }
+    }
+
+    /// Handles the events of cycle `self.c`.
+    fn process(&mut self) {
+        let c = self.c;
+        let mut next = u64::MAX;
+        for b in 0..self.br.len() {
+            let m = &mut self.br[b];
+            if m.next <= c {
+                if c == m.tn {
+                    m.t = Some(m.tn);
+                    m.tch = m.tnch;
+                    m.advance_next_instant(self.frame_cycles);
+                    m.oi = 0;
+                    m.word = 0;
+                }
+                let bit = 1u8 << b;
+                let (mut cs, mut sclk) = (true, true);
+                let ch = if m.t == Some(c) { m.tch } else { m.tnch };
+                if let Some(t) = m.t {
+                    let k = c - t;
+                    while m.oi < m.offs.len() && m.offs[m.oi] <= k {
+                        m.oi += 1;
+                    }
+                    m.next = if m.oi < m.offs.len() {
+                        (t + m.offs[m.oi]).min(m.tn)
+                    } else {
+                        m.tn
+                    };
+                    if k < m.r {
+                        cs = false;
+                        if k >= m.su && (k - m.su) % m.d < m.h {
+                            sclk = false;
+                        }
+                        if k >= m.su && k < m.su + 15 * m.d && (k - m.su) % m.d == m.h - 1 {
+                            self.capture |= bit;
+                        }
+                    }
+                    if k == m.r {
+                        self.pending |= bit;
+                        self.pend[b] = (m.tch, m.word & 0x3fff);
+                    }
+                } else {
+                    m.next = m.tn;
+                }
+                self.pins.cs_n = (self.pins.cs_n & !bit) | if cs { bit } else { 0 };
+                self.pins.sclk = (self.pins.sclk & !bit) | if sclk { bit } else { 0 };
+                if m.tn != u64::MAX || m.t.is_some() {
+                    let (dev, sel) = m.addr[ch as usize];
+                    self.layout.set_mux(&mut self.pins, b, dev, sel);
+                }
+            }
+            next = next.min(self.br[b].next);
+        }
+        self.next_event = next;
+    }
+}

@@ -1,0 +1,128 @@
+//! The check report, serializable to SPEC's `sim --json` / `check --json`.
+
+use serde::Serialize;
+use serde_json::Value;
+
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ChannelStats {
+    pub name: String,
+    pub branch: String,
+    pub samples: u64,
+    /// Nominal interval (clock / rate).
+    pub interval_cycles: u64,
+    pub interval_cycles_min: Option<u64>,
+    pub interval_cycles_max: Option<u64>,
+}
+
+/// A difference between the design's pins and the reference model.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Divergence {
+    pub cycle: u64,
+    pub frame: u64,
+    pub slot: u64,
+    pub signal: String,
+    pub expected: Value,
+    pub actual: Value,
+    pub branch: Option<String>,
+    pub channel: Option<String>,
+    /// A few cycles around the divergence: `cycle: actual | expected`.
+    pub context: Vec<String>,
+}
+
+/// A broken invariant (independent of the model).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Violation {
+    pub cycle: u64,
+    pub frame: u64,
+    pub slot: u64,
+    pub rule: String,
+    pub signal: Option<String>,
+    pub expected: Option<Value>,
+    pub actual: Option<Value>,
+    pub channel: Option<String>,
+    pub detail: String,
+}
+
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Report {
+    pub ok: bool,
+    pub mix: String,
+    /// `model`, `rusthdl`, `verilator` or `vcd`.
+    pub source: String,
+    /// Cycles checked after reset.
+    pub cycles: u64,
+    /// Complete frames checked.
+    pub frames: u64,
+    /// Samples emitted on `sample_valid` (model backend: conversions).
+    pub samples: u64,
+    pub channels: Vec<ChannelStats>,
+    /// Cycles in which some pin differed from the model (all of them, not only those listed).
+    pub divergence_count: u64,
+    pub divergences: Vec<Divergence>,
+    pub violation_count: u64,
+    pub violations: Vec<Violation>,
+    /// Whether the pins were compared against the cycle-level model.
+    pub model_compared: bool,
+}
+
+impl Report {
+    /// A short human summary, with the first divergence and violations.
+    pub fn summary(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "{} [{}]: {} cycles, {} frames, {} samples, {} divergent cycles, {} violations: {}",
+            self.mix,
+            self.source,
+            self.cycles,
+            self.frames,
+            self.samples,
+            self.divergence_count,
+            self.violation_count,
+            if self.ok { "PASS" } else { "FAIL" }
+        );
+        if let Some(d) = self.divergences.first() {
+            let _ = writeln!(
+                s,
+                "first divergence: cycle {} (frame {}, slot {}): {} expected {} actual {}{}{}",
+                d.cycle,
+                d.frame,
+                d.slot,
+                d.signal,
+                d.expected,
+                d.actual,
+                d.branch
+                    .as_ref()
+                    .map(|b| format!(", branch {b}"))
+                    .unwrap_or_default(),
+                d.channel
+                    .as_ref()
+                    .map(|c| format!(", channel {c}"))
+                    .unwrap_or_default()
+            );
+            for l in &d.context {
+                let _ = writeln!(s, "    {l}");
+            }
+        }
+        for v in self.violations.iter().take(10) {
+            let _ = writeln!(
+                s,
+                "violation: cycle {} (frame {}, slot {}): {}{}: {}",
+                v.cycle,
+                v.frame,
+                v.slot,
+                v.rule,
+                v.signal
+                    .as_ref()
+                    .map(|x| format!(" on {x}"))
+                    .unwrap_or_default(),
+                v.detail
+            );
+        }
+        if self.violations.len() > 10 {
+            let _ = writeln!(s, "... {} more violations", self.violation_count - 10);
+        }
+        s
+    }
+}

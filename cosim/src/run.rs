@@ -1,0 +1,277 @@
+//! Driving a design cycle by cycle with the ADC model, fully checked, and
+//! the slot-level model back end.
+
+use lut_gen::Schedule;
+
+use crate::adc::{Adc, Analog, Stimulus};
+use crate::checker::{CheckOptions, Checker, Invariants};
+use crate::model::{CycleModel, SlotModel};
+use crate::pins::Pins;
+use crate::report::Report;
+
+/// Anything that behaves like `slotforge_top`: one call per rising clock
+/// edge, with `rst` and `adc_miso` as sampled at that edge; returns the
+/// outputs after the edge.
+pub trait Dut {
+    fn step(&mut self, rst: bool, miso: u64) -> Pins;
+}
+
+impl<D: Dut + ?Sized> Dut for Box<D> {
+    fn step(&mut self, rst: bool, miso: u64) -> Pins {
+        (**self).step(rst, miso)
+    }
+}
+
+/// The cycle-level model used as a design (for testing the checker, and as
+/// a golden pin source).
+pub struct ModelDut {
+    schedule: Schedule,
+    reset: Pins,
+    m: Option<CycleModel>,
+}
+
+impl ModelDut {
+    pub fn new(s: &Schedule) -> ModelDut {
+        ModelDut {
+            reset: CycleModel::new(s).reset_pins(),
+            schedule: s.clone(),
+            m: None,
+        }
+    }
+}
+
+impl Dut for ModelDut {
+    fn step(&mut self, rst: bool, miso: u64) -> Pins {
+        if rst {
+            self.m = None;
+            return self.reset;
+        }
+        match &mut self.m {
+            None => {
+                let m = CycleModel::new(&self.schedule);
+                let p = *m.pins();
+                self.m = Some(m);
+                p
+            }
+            Some(m) => {
+                m.step(miso);
+                *m.pins()
+            }
+        }
+    }
+}
+
+/// Something that watches every cycle of a run (waveform writers).
+pub trait Observer {
+    /// `cycle` counts from 0 at the first reset cycle of the run.
+    fn cycle(&mut self, cycle: u64, rst: bool, pins: &Pins, miso: u64);
+}
+
+/// Options of an in-process run.
+#[derive(Debug, Clone, Copy)]
+pub struct RunOptions {
+    pub stimulus: Stimulus,
+    pub check: CheckOptions,
+    /// Cycles with `rst` high before cycle 0.
+    pub reset_cycles: u64,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            stimulus: Stimulus::Pattern,
+            check: CheckOptions::default(),
+            reset_cycles: 4,
+        }
+    }
+}
+
+/// Runs `frames` frames of `dut` with the ADC model, feeding every cycle to
+/// the checker (and to `obs`).
+pub fn run_dut<D: Dut + ?Sized>(
+    s: &Schedule,
+    dut: &mut D,
+    frames: u64,
+    opts: &RunOptions,
+    source: &str,
+    mut obs: Option<&mut dyn Observer>,
+) -> Report {
+    let mut adc = Adc::new(s, opts.stimulus);
+    let mut chk = Checker::new(s, opts.check);
+    let ones = (1u64 << s.branches.len()) - 1;
+    let mut miso = ones;
+    let mut k = 0u64;
+    for _ in 0..opts.reset_cycles {
+        let p = dut.step(true, miso);
+        miso = adc.drive(0, &p);
+        chk.cycle(true, &p, miso);
+        if let Some(o) = obs.as_deref_mut() {
+            o.cycle(k, true, &p, miso);
+        }
+        k += 1;
+    }
+    let total = frames * s.grid.frame_cycles;
+    match obs {
+        None => {
+            for c in 0..total {
+                let p = dut.step(false, miso);
+                miso = adc.drive(c, &p);
+                chk.cycle(false, &p, miso);
+            }
+        }
+        Some(o) => {
+            for c in 0..total {
+                let p = dut.step(false, miso);
+                miso = adc.drive(c, &p);
+                chk.cycle(false, &p, miso);
+                o.cycle(k + c, false, &p, miso);
+            }
+        }
+    }
+    chk.finish(source)
+}
+
+/// Runs `dut` for `frames` frames with no checking at all (the baseline for benchmarks).
+pub fn run_unchecked<D: Dut + ?Sized>(
+    s: &Schedule,
+    dut: &mut D,
+    frames: u64,
+    stimulus: Stimulus,
+) -> u64 {
+    let mut adc = Adc::new(s, stimulus);
+    let mut miso = (1u64 << s.branches.len()) - 1;
+    let mut acc = 0u64;
+    for _ in 0..4 {
+        let p = dut.step(true, miso);
+        miso = adc.drive(0, &p);
+    }
+    for c in 0..frames * s.grid.frame_cycles {
+        let p = dut.step(false, miso);
+        miso = adc.drive(c, &p);
+        acc = acc.wrapping_add(p.sample_value as u64);
+    }
+    acc
+}
+
+/// The slot-level back end: every conversion of `frames` frames from the
+/// periodic frame template, with the stimulus' codes, through the
+/// conversion-level invariants (counts, intervals, sample stream), plus the
+/// per-branch timing checks that do not need cycles (SPI numbers against
+/// the ADC's limits, CS spacing against the quiet time, mux settling).
+pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usize) -> Report {
+    let sm = SlotModel::new(s);
+    let analog = Analog::new(s, stimulus);
+    let mut inv = Invariants::new(s, max_records);
+    static_checks(s, &sm, &mut inv);
+    let f = s.grid.frame_cycles;
+    let mut samples = 0u64;
+    for frame in 0..frames {
+        let base = frame * f;
+        for cv in &sm.conversions {
+            inv.instant(base + cv.instant, cv.branch, cv.channel);
+        }
+        for cv in &sm.emissions {
+            let t = base + cv.instant;
+            let code = analog.code(cv.channel as u64, t);
+            inv.completion(
+                base + cv.complete,
+                cv.branch,
+                Some(cv.channel),
+                Some(code),
+                t,
+            );
+            inv.emitted(base + cv.emit, cv.channel, code);
+            samples += 1;
+        }
+    }
+    let cycles = frames * f;
+    let (fr, channels) = inv.finish(cycles);
+    let _ = samples;
+    let samples = inv.emitted_count();
+    inv.report("model", &s.mix.name, cycles, fr, channels, samples)
+}
+
+fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
+    use lut_gen::parts::ns_to_cycles;
+    use serde_json::json;
+    let mix = &s.mix;
+    let clock = mix.clock_hz;
+    for (b, plan) in s.branches.iter().enumerate() {
+        let adc = &mix.branches[b].adc;
+        let spi = &plan.spi;
+        let d = spi.sclk_div;
+        let sig = Some(format!("adc_sclk[{b}]"));
+        if d * adc.sclk_max_hz < clock || d * adc.sclk_min_hz > clock {
+            inv.violation(
+                0,
+                "sclk-frequency",
+                sig.clone(),
+                Some(json!(adc.sclk_max_hz)),
+                Some(json!(clock / d)),
+                None,
+                format!("branch {}: SCLK divider {d}", plan.name),
+            );
+        }
+        let (lo, hi) = (spi.sclk_half, d - spi.sclk_half);
+        if lo * 100 < d * adc.duty_min_pct as u64 || hi * 100 < d * adc.duty_min_pct as u64 {
+            inv.violation(
+                0,
+                "sclk-duty",
+                sig.clone(),
+                None,
+                None,
+                None,
+                format!("branch {}: SCLK low {lo} / high {hi} cycles", plan.name),
+            );
+        }
+        if spi.setup_cycles < ns_to_cycles(adc.cs_setup_ns, clock).max(1) {
+            inv.violation(
+                0,
+                "cs-setup",
+                Some(format!("adc_cs_n[{b}]")),
+                None,
+                None,
+                None,
+                format!("branch {}: setup {} cycles", plan.name, spi.setup_cycles),
+            );
+        }
+        let quiet = ns_to_cycles(adc.quiet_ns, clock).max(1);
+        let settle = ns_to_cycles(mix.branches[b].settle_ns, clock);
+        let inst: Vec<u64> = sm
+            .conversions
+            .iter()
+            .filter(|c| c.branch == b)
+            .map(|c| c.instant)
+            .collect();
+        for (i, &t) in inst.iter().enumerate() {
+            let next = if i + 1 < inst.len() {
+                inst[i + 1]
+            } else {
+                inst[0] + s.grid.frame_cycles
+            };
+            let gap = next - t;
+            if gap < spi.read_cycles + quiet {
+                inv.violation(
+                    next % s.grid.frame_cycles,
+                    "cs-quiet",
+                    Some(format!("adc_cs_n[{b}]")),
+                    Some(json!(spi.read_cycles + quiet)),
+                    Some(json!(gap)),
+                    None,
+                    format!("branch {}: conversions {gap} cycles apart", plan.name),
+                );
+            }
+            if gap.saturating_sub(1) < settle {
+                inv.violation(
+                    next % s.grid.frame_cycles,
+                    "mux-settle",
+                    Some(format!("mux_sel[{}:{}]", 3 * b + 2, 3 * b)),
+                    Some(json!(settle)),
+                    Some(json!(gap - 1)),
+                    None,
+                    format!("branch {}: mux has {} cycles to settle", plan.name, gap - 1),
+                );
+            }
+        }
+    }
+}
