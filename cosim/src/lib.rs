@@ -6,6 +6,7 @@
 
 pub mod adc;
 pub mod checker;
+pub mod faults;
 pub mod model;
 pub mod pins;
 pub mod report;

@@ -24,3 +24,39 @@ fn slot_model_passes() {
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.samples, 100 * 349);
 }
+
+#[test]
+fn every_fault_is_caught() {
+    use cosim::faults::{Fault, FaultyDut};
+    let s = eskin();
+    let at = s.grid.frame_cycles / 2 + 7;
+    for f in Fault::all(&s) {
+        let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
+        let r = run_dut(&s, &mut dut, 2, &RunOptions::default(), "faulty", None);
+        assert!(!r.ok, "fault {} not caught", f.name());
+        assert!(r.divergence_count > 0, "fault {}: no divergence", f.name());
+        assert!(
+            r.violation_count > 0,
+            "fault {}: no invariant violation\n{}",
+            f.name(),
+            r.summary()
+        );
+        let d = &r.divergences[0];
+        assert!(
+            d.cycle + 2 * s.grid.slot_cycles >= at,
+            "fault {} first divergence at {}",
+            f.name(),
+            d.cycle
+        );
+        eprintln!(
+            "{}: {} divergent cycles, {} violations; first: {} at {} ({:?}), rule {}",
+            f.name(),
+            r.divergence_count,
+            r.violation_count,
+            d.signal,
+            d.cycle,
+            d.channel,
+            r.violations[0].rule
+        );
+    }
+}
