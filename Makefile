@@ -1,0 +1,62 @@
+# slotforge flows.  `make run` = the main job on the reference mix; `make test` = everything CI checks.
+MIX ?= mixes/eskin34.toml
+OUT ?= out/$(basename $(notdir $(MIX)))
+CARGO ?= cargo
+SLOTFORGE = $(CARGO) run --quiet --release --bin slotforge --
+
+# System tools the flows need; installed with apt-get only when missing.
+TOOLS = verilator g++ iverilog yosys nextpnr-ice40
+APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm
+
+.PHONY: run test tools lut audit verilog cosim synth bench update-snapshots lint clean
+
+run: tools
+	$(SLOTFORGE) audit $(MIX)
+	$(SLOTFORGE) lut $(MIX) -o $(OUT)
+	$(SLOTFORGE) verilog $(MIX) -o $(OUT)
+	$(SLOTFORGE) sim $(MIX) --backend model --frames 100
+	$(SLOTFORGE) sim $(MIX) --backend verilator --frames 2
+	@echo "outputs in $(OUT)"
+
+test: tools
+	$(CARGO) fmt --all -- --check
+	$(CARGO) test --workspace --locked
+
+tools:
+	@missing=""; for t in $(TOOLS); do command -v $$t >/dev/null 2>&1 || missing="$$missing $$t"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing missing tools:$$missing"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y $(APT_PACKAGES); \
+	fi
+
+audit:
+	$(SLOTFORGE) audit $(MIX)
+
+lut:
+	$(SLOTFORGE) lut $(MIX) -o $(OUT)
+
+verilog: tools
+	$(SLOTFORGE) verilog $(MIX) -o $(OUT)
+
+cosim: tools
+	$(SLOTFORGE) sim $(MIX) --backend model --frames 100
+	$(SLOTFORGE) sim $(MIX) --backend rusthdl --frames 2
+	$(SLOTFORGE) sim $(MIX) --backend verilator --frames 2
+
+synth: tools verilog
+	bash hdl/synth.sh $(OUT)/slotforge_top.v
+
+bench:
+	$(CARGO) bench -p lut-gen --bench synthesis
+
+lint:
+	$(CARGO) clippy --workspace --all-targets -- -D warnings
+
+# Golden snapshots change only through this command; review the diff like code.
+update-snapshots:
+	INSTA_UPDATE=always $(CARGO) test --workspace
+	git status --short -- '*.snap'
+
+clean:
+	rm -rf out
