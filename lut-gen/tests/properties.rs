@@ -211,3 +211,28 @@ fn validator_rejects_a_jittered_table() {
         "{problems:?}"
     );
 }
+
+proptest! {
+    /// Garbage and near-miss mixes are rejected with a located error, never a panic.
+    #[test]
+    fn parser_never_panics(text in "[a-z_\\[\\]=\"0-9 \\n.-]{0,300}") {
+        let _ = lut_gen::parse(Path::new("fuzz.toml"), &text);
+    }
+
+    #[test]
+    fn mutated_reference_mix_never_panics(cut in 0usize..4000, insert in "[a-z_=\"0-9\\n-]{0,12}") {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../mixes/eskin34.toml")).unwrap();
+        let cut = cut.min(text.len());
+        let cut = (0..=cut).rev().find(|&i| text.is_char_boundary(i)).unwrap();
+        let mutated = format!("{}{}{}", &text[..cut], insert, &text[cut..]);
+        match lut_gen::parse(Path::new("m.toml"), &mutated) {
+            Err(e) => {
+                prop_assert!(e.line >= 1, "{e}");
+                prop_assert!(!e.field.is_empty(), "{e}");
+            }
+            Ok(mix) => {
+                let _ = lut_gen::synthesize(&mix);
+            }
+        }
+    }
+}
