@@ -8,9 +8,14 @@ use std::path::Path;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 
 fn big_mix(branches: usize) -> lut_gen::Mix {
-    let mut t = String::from("name = \"big\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n");
+    let mut t = String::from(
+        "name = \"big\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n",
+    );
     for b in 0..branches {
-        let _ = write!(t, "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 13\n");
+        let _ = write!(
+            t,
+            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 13\n"
+        );
     }
     for b in 0..branches {
         for i in 0..100 {
@@ -19,7 +24,10 @@ fn big_mix(branches: usize) -> lut_gen::Mix {
                 40..=79 => 500,
                 _ => 1_000,
             };
-            let _ = write!(t, "[[channel]]\nname = \"b{b}c{i}\"\nbranch = \"b{b}\"\nrate_hz = {rate}\n");
+            let _ = write!(
+                t,
+                "[[channel]]\nname = \"b{b}c{i}\"\nbranch = \"b{b}\"\nrate_hz = {rate}\n"
+            );
         }
     }
     lut_gen::parse(Path::new("big.toml"), &t).expect("bench mix parses")
@@ -31,12 +39,16 @@ fn synthesis_and_audit(c: &mut Criterion) {
     for branches in [10usize, 30, 100] {
         let mix = big_mix(branches);
         g.throughput(Throughput::Elements(mix.channels.len() as u64));
-        g.bench_with_input(BenchmarkId::from_parameter(mix.channels.len()), &mix, |b, mix| {
-            b.iter(|| {
-                let s = lut_gen::synthesize(mix).expect("feasible");
-                lut_gen::AuditReport::of_schedule(&s)
-            })
-        });
+        g.bench_with_input(
+            BenchmarkId::from_parameter(mix.channels.len()),
+            &mix,
+            |b, mix| {
+                b.iter(|| {
+                    let s = lut_gen::synthesize(mix).expect("feasible");
+                    lut_gen::AuditReport::of_schedule(&s)
+                })
+            },
+        );
     }
     g.finish();
 }
