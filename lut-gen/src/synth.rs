@@ -548,6 +548,8 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
         let units = units_of(mix, slots);
         let (offsets, occ) = greedy(&units, nb, slots, sps);
         let overfull = demand.iter().any(|&d| d > slots);
+        // (rate, nearest fitting rates) -> channels, so identical advice is given once.
+        let mut collisions: Vec<((u64, String), Vec<String>)> = Vec::new();
         for (u, o) in units.iter().zip(&offsets) {
             if o.is_none() {
                 for &c in &u.channels {
@@ -579,15 +581,20 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
                         .map(|r| format!("{r} Hz"))
                         .collect();
                     if !near.is_empty() {
-                        suggestions.push(format!(
-                            "`{}` ({} Hz) collides with the other channels' progressions; nearest rates that fit beside them: {}",
-                            c.name,
-                            c.rate_hz,
-                            near.join(" or ")
-                        ));
+                        let key = (c.rate_hz, near.join(" or "));
+                        match collisions.iter_mut().find(|(k, _)| *k == key) {
+                            Some((_, names)) => names.push(c.name.clone()),
+                            None => collisions.push((key, vec![c.name.clone()])),
+                        }
                     }
                 }
             }
+        }
+        for ((rate, near), names) in collisions {
+            suggestions.push(format!(
+                "{} ({rate} Hz) collide with the other channels' progressions; nearest rates that fit beside them, one channel at a time: {near}",
+                names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+            ));
         }
         if !overfull && unplaced.iter().all(Vec::is_empty) {
             reasons.push("first-fit placed every channel at this grid, but no grid admitted all of them with one rate each".into());
