@@ -11,9 +11,12 @@ pub mod model;
 pub mod pins;
 pub mod report;
 pub mod run;
+pub mod vcd;
+pub mod vcdout;
 
 pub use adc::{Adc, Stimulus};
 pub use checker::{CheckOptions, Checker, Invariants};
 pub use model::{CycleModel, SlotModel};
 pub use pins::{Layout, Pins, Signal};
 pub use report::Report;
+pub use vcd::{check_vcd, VcdError};

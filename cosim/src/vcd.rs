@@ -1,0 +1,970 @@
+//! Checking VCD files from any simulator.
+//!
+//! A hand-written streaming reader (one line buffer, so memory stays flat in
+//! the file size) rather than the `vcd` or `wellen` crates: `vcd` 0.7 rejects
+//! legal forms (`$var logic`, other scope types, long identifier codes) and
+//! `wellen` panics on some malformed values and silently drops steps where
+//! time goes backwards (shared/notes/waveforms.md); every malformed input here
+//! must be a clear error instead.
+//!
+//! Rules:
+//! - ports are found by the names of `docs/timing.md` in one scope (given, or
+//!   the only scope that has them all; scopes whose ports share identifier
+//!   codes, like an Icarus testbench and its DUT, are the same);
+//! - vectors are left-extended (0 for a leading 0/1, x/z for a leading x/z),
+//!   bit-blasted vectors (`name [3]`) are accepted;
+//! - a rising `clk` edge is a 0 -> 1 change over a timestep (x -> 1 is not an
+//!   edge); at an edge at time T the outputs are the values once timestep T
+//!   has closed, `rst` and `adc_miso` the values before T;
+//! - without a dumped `clk`, edges are inferred: the clock period is the gcd of
+//!   the intervals between timesteps that change an output, its phase the first
+//!   such timestep (a first pass over the file finds both);
+//! - x/z is a violation on any output after reset, on `sample_channel` /
+//!   `sample_value` only while `sample_valid`, on `adc_miso` when it is captured.
+
+use std::collections::HashMap;
+use std::fmt;
+use std::fs::File;
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+
+use lut_gen::Schedule;
+
+use crate::checker::{CheckOptions, Checker};
+use crate::pins::{Layout, Pins};
+use crate::report::Report;
+
+/// Why a VCD could not be checked (exit 2).
+#[derive(Debug)]
+pub enum VcdError {
+    Io(PathBuf, std::io::Error),
+    /// Bad syntax at a line.
+    Malformed {
+        file: PathBuf,
+        line: u64,
+        message: String,
+    },
+    /// The file ends in the middle of something.
+    Truncated {
+        file: PathBuf,
+        line: u64,
+        message: String,
+    },
+    /// The ports of `docs/timing.md` are not (all) there, or do not fit the mix.
+    Ports {
+        file: PathBuf,
+        message: String,
+    },
+}
+
+impl fmt::Display for VcdError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            VcdError::Io(p, e) => write!(f, "{}: {e}", p.display()),
+            VcdError::Malformed {
+                file,
+                line,
+                message,
+            } => write!(f, "{}:{line}: malformed VCD: {message}", file.display()),
+            VcdError::Truncated {
+                file,
+                line,
+                message,
+            } => write!(f, "{}:{line}: truncated VCD: {message}", file.display()),
+            VcdError::Ports { file, message } => write!(f, "{}: {message}", file.display()),
+        }
+    }
+}
+
+impl std::error::Error for VcdError {}
+
+// ------------------------------------------------------------------ lexer
+
+struct Lexer<R> {
+    rd: R,
+    line: Vec<u8>,
+    pos: usize,
+    lineno: u64,
+    eof: bool,
+    ends_with_newline: bool,
+    file: PathBuf,
+}
+
+impl<R: BufRead> Lexer<R> {
+    fn new(rd: R, file: &Path) -> Self {
+        Lexer {
+            rd,
+            line: Vec::with_capacity(256),
+            pos: 0,
+            lineno: 0,
+            eof: false,
+            ends_with_newline: true,
+            file: file.to_path_buf(),
+        }
+    }
+
+    /// The next whitespace-separated token as a range of `self.line`.
+    #[inline]
+    fn next(&mut self) -> Result<Option<(usize, usize)>, VcdError> {
+        loop {
+            let l = &self.line;
+            let mut i = self.pos;
+            while i < l.len() && l[i].is_ascii_whitespace() {
+                i += 1;
+            }
+            if i < l.len() {
+                let s = i;
+                while i < l.len() && !l[i].is_ascii_whitespace() {
+                    i += 1;
+                }
+                self.pos = i;
+                return Ok(Some((s, i)));
+            }
+            if self.eof {
+                return Ok(None);
+            }
+            self.line.clear();
+            self.pos = 0;
+            let n = self
+                .rd
+                .read_until(b'\n', &mut self.line)
+                .map_err(|e| VcdError::Io(self.file.clone(), e))?;
+            if n == 0 {
+                self.eof = true;
+                return Ok(None);
+            }
+            self.lineno += 1;
+            self.ends_with_newline = self.line.last() == Some(&b'\n');
+        }
+    }
+
+    fn tok(&self, r: (usize, usize)) -> &[u8] {
+        &self.line[r.0..r.1]
+    }
+
+    fn malformed(&self, m: impl Into<String>) -> VcdError {
+        VcdError::Malformed {
+            file: self.file.clone(),
+            line: self.lineno,
+            message: m.into(),
+        }
+    }
+
+    fn truncated(&self, m: impl Into<String>) -> VcdError {
+        VcdError::Truncated {
+            file: self.file.clone(),
+            line: self.lineno,
+            message: m.into(),
+        }
+    }
+
+    /// Tokens up to `$end` (exclusive).
+    fn until_end(&mut self, what: &str) -> Result<Vec<String>, VcdError> {
+        let mut v = Vec::new();
+        loop {
+            match self.next()? {
+                None => return Err(self.truncated(format!("end of file inside {what}"))),
+                Some(r) => {
+                    let t = self.tok(r);
+                    if t == b"$end" {
+                        return Ok(v);
+                    }
+                    v.push(String::from_utf8_lossy(t).into_owned());
+                }
+            }
+        }
+    }
+}
+
+// ------------------------------------------------------------------ header
+
+#[derive(Debug, Clone)]
+struct Var {
+    scope: String,
+    name: String,
+    width: u32,
+    /// (msb, lsb) of the declared range, if any.
+    range: Option<(i64, i64)>,
+    id: Vec<u8>,
+}
+
+struct Header {
+    vars: Vec<Var>,
+    timescale: String,
+}
+
+fn parse_header<R: BufRead>(lx: &mut Lexer<R>) -> Result<Header, VcdError> {
+    let mut scopes: Vec<String> = Vec::new();
+    let mut vars = Vec::new();
+    let mut timescale = String::from("1s");
+    loop {
+        let Some(r) = lx.next()? else {
+            return Err(lx.truncated("end of file before $enddefinitions"));
+        };
+        let t = lx.tok(r).to_vec();
+        match t.as_slice() {
+            b"$enddefinitions" => {
+                lx.until_end("$enddefinitions")?;
+                return Ok(Header { vars, timescale });
+            }
+            b"$scope" => {
+                let v = lx.until_end("$scope")?;
+                let name = v
+                    .get(1)
+                    .or(v.first())
+                    .cloned()
+                    .ok_or_else(|| lx.malformed("$scope without a name"))?;
+                scopes.push(name);
+            }
+            b"$upscope" => {
+                lx.until_end("$upscope")?;
+                if scopes.pop().is_none() {
+                    return Err(lx.malformed("$upscope without $scope"));
+                }
+            }
+            b"$timescale" => timescale = lx.until_end("$timescale")?.join(""),
+            b"$var" => {
+                let v = lx.until_end("$var")?;
+                if v.len() < 4 {
+                    return Err(
+                        lx.malformed("$var needs a type, a width, an identifier code and a name")
+                    );
+                }
+                let width: u32 = v[1]
+                    .parse()
+                    .map_err(|_| lx.malformed(format!("$var width `{}` is not a number", v[1])))?;
+                if width == 0 {
+                    return Err(lx.malformed("$var width 0"));
+                }
+                let reference = v[3..].join("");
+                let (name, range) = match reference.find('[') {
+                    Some(i) => {
+                        let rng = reference[i..].trim_start_matches('[').trim_end_matches(']');
+                        let parsed = match rng.split_once(':') {
+                            Some((a, b)) => a.trim().parse().ok().zip(b.trim().parse().ok()),
+                            None => rng.trim().parse().ok().map(|x: i64| (x, x)),
+                        };
+                        (reference[..i].to_string(), parsed)
+                    }
+                    None => (reference, None),
+                };
+                vars.push(Var {
+                    scope: scopes.join("."),
+                    name,
+                    width,
+                    range,
+                    id: v[2].as_bytes().to_vec(),
+                });
+            }
+            t if t.starts_with(b"$") => {
+                let what = String::from_utf8_lossy(t).into_owned();
+                lx.until_end(&what)?;
+            }
+            other => {
+                return Err(lx.malformed(format!(
+                    "unexpected `{}` in the header",
+                    String::from_utf8_lossy(other)
+                )))
+            }
+        }
+    }
+}
+
+// ------------------------------------------------------------------ ports
+
+const CLK: usize = 0;
+const RST: usize = 1;
+const MISO: usize = 2;
+const CS: usize = 3;
+const SCLK: usize = 4;
+const SEL: usize = 5;
+const EN: usize = 6;
+const VALID: usize = 7;
+const CHAN: usize = 8;
+const VALUE: usize = 9;
+const PORTS: [&str; 10] = [
+    "clk",
+    "rst",
+    "adc_miso",
+    "adc_cs_n",
+    "adc_sclk",
+    "mux_sel",
+    "mux_en",
+    "sample_valid",
+    "sample_channel",
+    "sample_value",
+];
+
+/// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
+/// (or `lsb - j` when the range is ascending).
+#[derive(Debug, Clone, Copy)]
+struct Sink {
+    port: u8,
+    width: u32,
+    lsb: i64,
+    down: bool,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Val {
+    v: u64,
+    x: u64,
+}
+
+struct Resolved {
+    /// id code -> sinks (empty for signals we do not need).
+    ids: HashMap<Vec<u8>, Vec<Sink>>,
+    has_clk: bool,
+    scope: String,
+    widths: [u32; 10],
+}
+
+fn resolve(
+    h: &Header,
+    layout: &Layout,
+    want: Option<&str>,
+    file: &Path,
+) -> Result<Resolved, VcdError> {
+    let perr = |m: String| VcdError::Ports {
+        file: file.to_path_buf(),
+        message: m,
+    };
+    let mut scopes: Vec<&str> = h.vars.iter().map(|v| v.scope.as_str()).collect();
+    scopes.sort_unstable();
+    scopes.dedup();
+    let has = |sc: &str, name: &str| h.vars.iter().any(|v| v.scope == sc && v.name == name);
+    let required = &PORTS[1..];
+    let candidates: Vec<&str> = match want {
+        Some(w) => {
+            let m: Vec<&str> = scopes
+                .iter()
+                .copied()
+                .filter(|s| *s == w || s.ends_with(&format!(".{w}")))
+                .collect();
+            if m.is_empty() {
+                return Err(perr(format!(
+                    "no scope `{w}` in the VCD (scopes: {})",
+                    scopes.join(", ")
+                )));
+            }
+            if m.len() > 1 {
+                return Err(perr(format!("scope `{w}` is ambiguous: {}", m.join(", "))));
+            }
+            m
+        }
+        None => scopes
+            .iter()
+            .copied()
+            .filter(|s| required.iter().all(|p| has(s, p)))
+            .collect(),
+    };
+    let Some(&scope) = candidates.last() else {
+        let best = scopes
+            .iter()
+            .map(|s| (required.iter().filter(|p| has(s, p)).count(), *s))
+            .max();
+        let hint = match best {
+            Some((n, s)) if n > 0 => {
+                let missing: Vec<&str> = required.iter().copied().filter(|p| !has(s, p)).collect();
+                format!("; scope `{s}` lacks {}", missing.join(", "))
+            }
+            _ => String::new(),
+        };
+        return Err(perr(format!(
+            "no scope has all the ports of slotforge_top ({}){hint}",
+            required.join(", ")
+        )));
+    };
+    let ids_of = |sc: &str| -> Vec<Vec<Vec<u8>>> {
+        PORTS
+            .iter()
+            .map(|p| {
+                h.vars
+                    .iter()
+                    .filter(|v| v.scope == sc && v.name == *p)
+                    .map(|v| v.id.clone())
+                    .collect()
+            })
+            .collect()
+    };
+    if candidates.len() > 1 {
+        let first = ids_of(candidates[0]);
+        if candidates.iter().any(|c| ids_of(c)[1..] != first[1..]) {
+            return Err(perr(format!(
+                "several scopes have the ports of slotforge_top: {}; choose one with --scope",
+                candidates.join(", ")
+            )));
+        }
+    }
+    // clk may sit in an enclosing scope (a testbench) if the DUT's is not dumped.
+    let widths = [
+        1,
+        1,
+        layout.branches as u32,
+        layout.branches as u32,
+        layout.branches as u32,
+        3 * layout.branches as u32,
+        layout.mux_devices,
+        1,
+        layout.channel_bits,
+        14,
+    ];
+    let mut ids: HashMap<Vec<u8>, Vec<Sink>> = HashMap::new();
+    for v in &h.vars {
+        ids.entry(v.id.clone()).or_default();
+    }
+    let mut has_clk = false;
+    for (p, name) in PORTS.iter().enumerate() {
+        let vs: Vec<&Var> = h
+            .vars
+            .iter()
+            .filter(|v| v.scope == scope && v.name == *name)
+            .collect();
+        if vs.is_empty() {
+            if p == CLK {
+                continue;
+            }
+            return Err(perr(format!("port `{name}` not found in scope `{scope}`")));
+        }
+        let mut covered = 0u32;
+        for v in vs {
+            let (msb, lsb) = v.range.unwrap_or((v.width as i64 - 1, 0));
+            let down = msb >= lsb;
+            let low = msb.min(lsb);
+            if low < 0
+                || msb.max(lsb) >= widths[p] as i64
+                || (msb - lsb).unsigned_abs() + 1 != v.width as u64
+            {
+                return Err(perr(format!(
+                    "port `{name}` in `{scope}` is declared {}{} but the mix needs {} bit(s) [{}:0]",
+                    v.width,
+                    v.range.map(|(a, b)| format!(" [{a}:{b}]")).unwrap_or_default(),
+                    widths[p],
+                    widths[p] - 1
+                )));
+            }
+            covered += v.width;
+            ids.get_mut(&v.id).unwrap().push(Sink {
+                port: p as u8,
+                width: v.width,
+                lsb,
+                down,
+            });
+        }
+        if covered != widths[p] {
+            return Err(perr(format!(
+                "port `{name}` in `{scope}` has {covered} bit(s), the mix needs {}",
+                widths[p]
+            )));
+        }
+        if p == CLK {
+            has_clk = true;
+        }
+    }
+    Ok(Resolved {
+        ids,
+        has_clk,
+        scope: scope.to_string(),
+        widths,
+    })
+}
+
+// ------------------------------------------------------------------ body
+
+/// Parses a vector/scalar value into (value, x/z mask), left-extended to `width`.
+#[inline]
+fn parse_value(s: &[u8], width: u32) -> Option<Val> {
+    let mut v = 0u64;
+    let mut x = 0u64;
+    let n = s.len();
+    if n == 0 {
+        return None;
+    }
+    let take = n.min(64);
+    for &ch in &s[n - take..] {
+        v <<= 1;
+        x <<= 1;
+        match ch {
+            b'0' | b'l' | b'L' => {}
+            b'1' | b'h' | b'H' => v |= 1,
+            b'x' | b'X' | b'z' | b'Z' | b'u' | b'U' | b'w' | b'W' | b'-' => x |= 1,
+            _ => return None,
+        }
+    }
+    for &ch in &s[..n - take] {
+        if !matches!(
+            ch,
+            b'0' | b'1'
+                | b'x'
+                | b'X'
+                | b'z'
+                | b'Z'
+                | b'l'
+                | b'L'
+                | b'h'
+                | b'H'
+                | b'u'
+                | b'U'
+                | b'w'
+                | b'W'
+                | b'-'
+        ) {
+            return None;
+        }
+    }
+    if (n as u32) < width && n < 64 && matches!(s[0], b'x' | b'X' | b'z' | b'Z') {
+        let w = width.min(64);
+        let ext = (if w == 64 { u64::MAX } else { (1u64 << w) - 1 }) & !((1u64 << n) - 1);
+        x |= ext;
+    }
+    Some(Val { v, x })
+}
+
+struct State {
+    port: [Val; 10],
+}
+
+impl State {
+    #[inline]
+    fn apply(&mut self, sink: &Sink, val: Val) -> bool {
+        let p = &mut self.port[sink.port as usize];
+        let (old_v, old_x) = (p.v, p.x);
+        let wmask = if sink.width >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << sink.width) - 1
+        };
+        let (vv, vx) = (val.v & wmask, val.x & wmask);
+        if sink.down {
+            let m = wmask << sink.lsb;
+            p.v = (p.v & !m) | (vv << sink.lsb);
+            p.x = (p.x & !m) | (vx << sink.lsb);
+        } else {
+            // ascending range [lsb:msb]: var bit j (from the right) is port bit lsb + width-1-j
+            for j in 0..sink.width {
+                let pb = sink.lsb as u32 + sink.width - 1 - j;
+                p.v = (p.v & !(1 << pb)) | (((vv >> j) & 1) << pb);
+                p.x = (p.x & !(1 << pb)) | (((vx >> j) & 1) << pb);
+            }
+        }
+        p.v != old_v || p.x != old_x
+    }
+
+    fn pins(&self) -> (Pins, Pins) {
+        let g = |i: usize| self.port[i];
+        (
+            Pins {
+                cs_n: g(CS).v as u8,
+                sclk: g(SCLK).v as u8,
+                mux_sel: g(SEL).v as u32,
+                mux_en: g(EN).v,
+                sample_valid: g(VALID).v & 1 == 1,
+                sample_channel: g(CHAN).v as u16,
+                sample_value: g(VALUE).v as u16,
+            },
+            Pins {
+                cs_n: g(CS).x as u8,
+                sclk: g(SCLK).x as u8,
+                mux_sel: g(SEL).x as u32,
+                mux_en: g(EN).x,
+                sample_valid: g(VALID).x & 1 == 1,
+                sample_channel: g(CHAN).x as u16,
+                sample_value: g(VALUE).x as u16,
+            },
+        )
+    }
+}
+
+/// Where cycles come from: the dumped clock, or an inferred period.
+#[derive(Clone, Copy)]
+enum Clocking {
+    Clk,
+    Inferred { period: u64, phase: u64 },
+}
+
+/// A sink for recovered cycles: `(rst, pins, xz, miso, miso_xz)`.
+pub trait CycleSink {
+    fn cycle(&mut self, rst: Option<bool>, pins: &Pins, xz: &Pins, miso: u64, miso_xz: u64);
+}
+
+impl CycleSink for Checker {
+    fn cycle(&mut self, rst: Option<bool>, pins: &Pins, xz: &Pins, miso: u64, miso_xz: u64) {
+        self.cycle_xz(rst, pins, xz, miso, miso_xz)
+    }
+}
+
+/// Counts cycles only (the bare-parse baseline for benchmarks).
+#[derive(Default)]
+pub struct CountCycles(pub u64);
+
+impl CycleSink for CountCycles {
+    fn cycle(&mut self, _: Option<bool>, _: &Pins, _: &Pins, _: u64, _: u64) {
+        self.0 += 1;
+    }
+}
+
+/// What the body pass learnt.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct BodyInfo {
+    pub cycles: u64,
+    pub last_time: u64,
+    /// gcd of intervals between output-changing timesteps, and the first of them.
+    pub period: u64,
+    pub phase: Option<u64>,
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+fn body<R: BufRead>(
+    lx: &mut Lexer<R>,
+    res: &Resolved,
+    clocking: Option<Clocking>,
+    sink: &mut dyn CycleSink,
+) -> Result<BodyInfo, VcdError> {
+    let mut st = State {
+        port: [Val { v: 0, x: 0 }; 10],
+    };
+    for (i, w) in res.widths.iter().enumerate() {
+        st.port[i].x = if *w >= 64 { u64::MAX } else { (1u64 << w) - 1 };
+    }
+    let mut before = st.port;
+    let mut time = 0u64;
+    let mut seen_time = false;
+    let mut out_changed = false;
+    let mut first_step = true;
+    let mut info = BodyInfo::default();
+    // A cycle is handed on at the next edge, when the MISO it carried (the
+    // value just before that edge) is known.
+    let mut pending: Option<(Option<bool>, Pins, Pins)> = None;
+    fn edge(
+        pending: &mut Option<(Option<bool>, Pins, Pins)>,
+        sink: &mut dyn CycleSink,
+        info: &mut BodyInfo,
+        rst: Option<bool>,
+        pins: Pins,
+        xz: Pins,
+        miso: Val,
+    ) {
+        if let Some((r, p, x)) = pending.take() {
+            sink.cycle(r, &p, &x, miso.v, miso.x);
+        }
+        info.cycles += 1;
+        *pending = Some((rst, pins, xz));
+    }
+    let mut close = |st: &State,
+                     before: &[Val; 10],
+                     t: u64,
+                     next: Option<u64>,
+                     out_changed: bool,
+                     first: bool,
+                     info: &mut BodyInfo| {
+        if out_changed && !first {
+            match info.phase {
+                None => info.phase = Some(t),
+                Some(p0) => info.period = gcd(info.period, t - p0),
+            }
+        }
+        let (pins, xz) = st.pins();
+        let rst_of = |v: &Val| {
+            if v.x & 1 != 0 {
+                None
+            } else {
+                Some(v.v & 1 == 1)
+            }
+        };
+        match clocking {
+            None => {}
+            Some(Clocking::Clk) => {
+                let (b, a) = (before[CLK], st.port[CLK]);
+                if b.x & 1 == 0 && a.x & 1 == 0 && b.v & 1 == 0 && a.v & 1 == 1 {
+                    edge(
+                        &mut pending,
+                        sink,
+                        info,
+                        rst_of(&before[RST]),
+                        pins,
+                        xz,
+                        before[MISO],
+                    );
+                }
+            }
+            Some(Clocking::Inferred { period, phase }) => {
+                if t >= phase && (t - phase) % period == 0 {
+                    edge(
+                        &mut pending,
+                        sink,
+                        info,
+                        rst_of(&before[RST]),
+                        pins,
+                        xz,
+                        before[MISO],
+                    );
+                }
+                if let Some(n) = next {
+                    let mut e = if t < phase {
+                        phase
+                    } else {
+                        t - (t - phase) % period + period
+                    };
+                    while e < n {
+                        edge(
+                            &mut pending,
+                            sink,
+                            info,
+                            rst_of(&st.port[RST]),
+                            pins,
+                            xz,
+                            st.port[MISO],
+                        );
+                        e += period;
+                    }
+                }
+            }
+        }
+    };
+    while let Some(r) = lx.next()? {
+        let t = lx.tok(r);
+        match t[0] {
+            b'#' => {
+                let nt: u64 = std::str::from_utf8(&t[1..])
+                    .ok()
+                    .and_then(|s| s.parse().ok())
+                    .ok_or_else(|| {
+                        lx.malformed(format!("bad timestamp `{}`", String::from_utf8_lossy(t)))
+                    })?;
+                if seen_time && nt < time {
+                    return Err(lx.malformed(format!("time goes backwards from {time} to {nt}")));
+                }
+                if !seen_time || nt > time {
+                    if seen_time || out_changed {
+                        close(
+                            &st,
+                            &before,
+                            time,
+                            Some(nt),
+                            out_changed,
+                            first_step,
+                            &mut info,
+                        );
+                        first_step = false;
+                    }
+                    before = st.port;
+                    out_changed = false;
+                    time = nt;
+                    seen_time = true;
+                }
+            }
+            b'$' => {
+                // $dumpvars / $dumpall / $dumpon / $dumpoff / $end: values follow as usual.
+                if t == b"$comment" {
+                    lx.until_end("$comment")?;
+                }
+            }
+            b'b' | b'B' | b'r' | b'R' | b's' | b'S' => {
+                let kind = t[0].to_ascii_lowercase();
+                let val_range = (r.0 + 1, r.1);
+                let Some(idr) = lx.next_same_line_or_any()? else {
+                    return Err(lx.truncated(
+                        "value change without an identifier code at the end of the file",
+                    ));
+                };
+                let val = lx.line[val_range.0..val_range.1].to_vec();
+                let id = lx.tok(idr);
+                let Some(sinks) = res.ids.get(id) else {
+                    return Err(lx.malformed(format!(
+                        "value change for undeclared identifier code `{}`",
+                        String::from_utf8_lossy(id)
+                    )));
+                };
+                if kind == b'b' && !sinks.is_empty() {
+                    for s in sinks {
+                        let v = parse_value(&val, s.width).ok_or_else(|| {
+                            lx.malformed(format!(
+                                "bad vector value `b{}`",
+                                String::from_utf8_lossy(&val)
+                            ))
+                        })?;
+                        out_changed |= st.apply(s, v) && s.port as usize >= CS;
+                    }
+                } else if kind == b'b' && parse_value(&val, 1).is_none() && val.len() <= 64 {
+                    return Err(lx.malformed(format!(
+                        "bad vector value `b{}`",
+                        String::from_utf8_lossy(&val)
+                    )));
+                }
+            }
+            c => {
+                if !matches!(
+                    c,
+                    b'0' | b'1'
+                        | b'x'
+                        | b'X'
+                        | b'z'
+                        | b'Z'
+                        | b'u'
+                        | b'U'
+                        | b'w'
+                        | b'W'
+                        | b'l'
+                        | b'L'
+                        | b'h'
+                        | b'H'
+                        | b'-'
+                ) {
+                    return Err(
+                        lx.malformed(format!("unexpected `{}`", String::from_utf8_lossy(t)))
+                    );
+                }
+                if t.len() < 2 {
+                    return Err(lx.malformed("scalar value change without an identifier code"));
+                }
+                let Some(sinks) = res.ids.get(&t[1..]) else {
+                    return Err(lx.malformed(format!(
+                        "value change for undeclared identifier code `{}`",
+                        String::from_utf8_lossy(&t[1..])
+                    )));
+                };
+                if !sinks.is_empty() {
+                    let v = parse_value(&t[..1], 1).unwrap();
+                    for s in sinks {
+                        let v = Val {
+                            v: v.v,
+                            x: if v.x != 0 { u64::MAX } else { 0 },
+                        };
+                        out_changed |= st.apply(s, v) && s.port as usize >= CS;
+                    }
+                }
+            }
+        }
+    }
+    if !lx.ends_with_newline {
+        return Err(lx.truncated("the last line is incomplete"));
+    }
+    close(&st, &before, time, None, out_changed, first_step, &mut info);
+    if let Some((r, p, x)) = pending.take() {
+        sink.cycle(r, &p, &x, st.port[MISO].v, st.port[MISO].x);
+    }
+    info.last_time = time;
+    Ok(info)
+}
+
+impl<R: BufRead> Lexer<R> {
+    /// A syntax error on an incomplete last line is a truncation.
+    fn truncation(&mut self, e: VcdError) -> VcdError {
+        match e {
+            VcdError::Malformed {
+                file,
+                line,
+                message,
+            } if !self.line.ends_with(b"\n")
+                && self.rd.fill_buf().map(|b| b.is_empty()).unwrap_or(false) =>
+            {
+                VcdError::Truncated {
+                    file,
+                    line,
+                    message: format!("{message} (the last line is incomplete)"),
+                }
+            }
+            e => e,
+        }
+    }
+
+    fn next_same_line_or_any(&mut self) -> Result<Option<(usize, usize)>, VcdError> {
+        self.next()
+    }
+}
+
+/// Header facts of a VCD.
+#[derive(Debug, Clone)]
+pub struct VcdInfo {
+    pub scope: String,
+    pub timescale: String,
+    pub clock_dumped: bool,
+    /// Inferred clock period in timescale units (only without a dumped clock).
+    pub inferred_period: Option<u64>,
+    pub clock_cycles: u64,
+}
+
+fn open(path: &Path) -> Result<Lexer<BufReader<File>>, VcdError> {
+    let f = File::open(path).map_err(|e| VcdError::Io(path.to_path_buf(), e))?;
+    Ok(Lexer::new(BufReader::with_capacity(1 << 20, f), path))
+}
+
+/// Streams the cycles of a VCD into `sink`.
+pub fn read_cycles(
+    s: &Schedule,
+    path: &Path,
+    scope: Option<&str>,
+    sink: &mut dyn CycleSink,
+) -> Result<VcdInfo, VcdError> {
+    let layout = Layout::new(s);
+    let mut lx = open(path)?;
+    let h = parse_header(&mut lx)?;
+    let res = resolve(&h, &layout, scope, path)?;
+    let clocking = if res.has_clk {
+        Clocking::Clk
+    } else {
+        let mut pre = open(path)?;
+        parse_header(&mut pre)?;
+        let info =
+            body(&mut pre, &res, None, &mut CountCycles(0)).map_err(|e| pre.truncation(e))?;
+        match info.phase {
+            Some(phase) if info.period > 0 => Clocking::Inferred { period: info.period, phase: phase % info.period },
+            _ => {
+                return Err(VcdError::Ports {
+                    file: path.to_path_buf(),
+                    message: format!("`clk` is not dumped in `{}` and too few output changes to infer the clock period", res.scope),
+                })
+            }
+        }
+    };
+    let info = body(&mut lx, &res, Some(clocking), sink).map_err(|e| lx.truncation(e))?;
+    Ok(VcdInfo {
+        scope: res.scope,
+        timescale: h.timescale,
+        clock_dumped: res.has_clk,
+        inferred_period: match clocking {
+            Clocking::Inferred { period, .. } => Some(period),
+            Clocking::Clk => None,
+        },
+        clock_cycles: info.cycles,
+    })
+}
+
+/// Checks a VCD against the schedule: every invariant and, unless
+/// `opts.model` is false, cycle-exact equality with the reference model.
+pub fn check_vcd_with(
+    s: &Schedule,
+    path: &Path,
+    scope: Option<&str>,
+    opts: CheckOptions,
+) -> Result<(Report, VcdInfo), VcdError> {
+    let mut chk = Checker::new(s, opts);
+    let info = read_cycles(s, path, scope, &mut chk)?;
+    Ok((chk.finish("vcd"), info))
+}
+
+/// Checks a VCD with the default options.
+pub fn check_vcd(
+    s: &Schedule,
+    path: impl AsRef<Path>,
+    scope: Option<&str>,
+) -> Result<Report, VcdError> {
+    check_vcd_with(s, path.as_ref(), scope, CheckOptions::default()).map(|r| r.0)
+}
+
+/// Reads a whole file through the same reader without checking (benchmark baseline).
+pub fn parse_only(s: &Schedule, path: &Path, scope: Option<&str>) -> Result<u64, VcdError> {
+    let mut c = CountCycles(0);
+    read_cycles(s, path, scope, &mut c)?;
+    Ok(c.0)
+}
+
+#[allow(dead_code)]
+fn _assert_read<R: Read>(_: R) {}
