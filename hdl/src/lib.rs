@@ -1,1 +1,41 @@
-//! hdl (under construction)
+//! slotforge's acquisition gateware, described with rust-hdl and generated
+//! from a `lut_gen::Schedule`, plus its Verilog/constraint emission and a
+//! fast in-process simulator.
+//!
+//! rust-hdl stays behind this API: nothing public here names a rust-hdl type.
+//!
+//! - [`emit`] / [`Emitted`]: `slotforge_top.v`, `ports.json`, `slots.hex`,
+//!   `slotforge.pcf`, `slotforge.sdc`, `slotforge.xdc`;
+//! - [`RtlSim`] / [`Pins`]: cycle-accurate simulation of the same blocks.
+//!
+//! The cycle-level behaviour is `docs/timing.md`; the design choices are in
+//! `hdl/DESIGN.md`.
+
+mod core;
+mod emit;
+mod plan;
+mod sim;
+
+pub use emit::{emit, Board, Emitted};
+pub use plan::{
+    MAX_BRANCHES, MAX_CHANNELS, MAX_DEVICES, MAX_DEVICES_PER_BRANCH, MAX_FRAME_SLOTS, MAX_SCLK_DIV,
+    MAX_SLOT_CYCLES,
+};
+pub use sim::{Pins, RtlSim};
+
+/// Why gateware could not be produced.
+#[derive(Debug, thiserror::Error)]
+pub enum HdlError {
+    /// The schedule is valid but outside what this gateware implements.
+    #[error("unsupported by the gateware: {0}")]
+    Unsupported(String),
+    /// The board file is unreadable, malformed or lacks pins.
+    #[error("board file {path}: {message}")]
+    Board { path: String, message: String },
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+}

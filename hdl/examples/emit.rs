@@ -1,0 +1,27 @@
+//! `cargo run -p hdl --example emit -- MIX.toml OUTDIR [BOARD.toml]`
+use std::path::Path;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() < 3 {
+        eprintln!("usage: emit MIX.toml OUTDIR [BOARD.toml]");
+        std::process::exit(2);
+    }
+    let mix = lut_gen::load(Path::new(&args[1])).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2)
+    });
+    let s = lut_gen::synthesize(&mix).unwrap_or_else(|e| {
+        eprintln!("{e:?}");
+        std::process::exit(1)
+    });
+    let board = args.get(3).map(Path::new);
+    let out = hdl::emit(&s, board).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(1)
+    });
+    out.write_to(Path::new(&args[2])).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(1)
+    });
+}

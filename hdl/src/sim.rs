@@ -1,0 +1,90 @@
+//! A fast in-process simulator of the gateware: rust-hdl's own model of the
+//! very blocks that are emitted as Verilog, driven by a direct clock loop.
+
+use rust_hdl::prelude::*;
+
+use crate::core::Core;
+use crate::{plan, HdlError};
+
+/// Output pins of `slotforge_top` in one clock cycle.
+///
+/// Bit `b` of `cs_n`/`sclk` is branch `b`; `mux_sel` bits `[3b+2:3b]` are
+/// branch `b`'s select; `mux_en` is ordered as the `mux_en` port (branch 0's
+/// devices first, then branch 1's, ...).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Pins {
+    pub cs_n: u8,
+    pub sclk: u8,
+    pub mux_sel: u32,
+    pub mux_en: u64,
+    pub sample_valid: bool,
+    pub sample_channel: u16,
+    pub sample_value: u16,
+}
+
+/// Cycle-accurate simulator of the emitted gateware.
+///
+/// Each [`RtlSim::step`] applies exactly one rising clock edge.  The two
+/// arguments are the input levels that this edge samples, i.e. the levels
+/// present during the cycle *before* the returned one:
+///
+/// - `rst`: a step with `rst = true` returns the reset values of
+///   `docs/timing.md`; the first step with `rst = false` after reset returns
+///   the outputs **in cycle 0**, the next one cycle 1, and so on;
+/// - `miso` (bit `b` = `adc_miso[b]`): the value of `adc_miso` **during the
+///   cycle returned by the previous call** (during cycle `c - 1` when this
+///   call returns cycle `c`).  A caller therefore computes MISO for cycle `c`
+///   from the pins of cycle `c` and passes it with the next call, exactly
+///   like a testbench that sets inputs and then raises the clock.
+///
+/// The simulator starts before any edge (register contents undefined), so
+/// begin with at least one `rst = true` step.
+pub struct RtlSim {
+    core: Box<Core>,
+    nb: usize,
+    ch_mask: u16,
+}
+
+impl RtlSim {
+    pub fn new(schedule: &lut_gen::Schedule) -> Result<RtlSim, HdlError> {
+        let p = plan::plan(schedule)?;
+        let mut core = Box::new(Core::new(&p));
+        core.connect_all();
+        core.clock.next = Clock::from(false);
+        simulate(&mut *core, 1000);
+        let nb = p.branches.len();
+        Ok(RtlSim {
+            core,
+            nb,
+            ch_mask: ((1u32 << p.channel_bits) - 1) as u16,
+        })
+    }
+
+    /// Number of branches (valid bits of `cs_n`, `sclk`, `miso`).
+    pub fn branches(&self) -> usize {
+        self.nb
+    }
+
+    /// Apply one rising clock edge; see the type's documentation.
+    pub fn step(&mut self, rst: bool, miso: u8) -> Pins {
+        let c = &mut *self.core;
+        c.rst.next = rst;
+        c.adc_miso.next = (miso as u64).into();
+        c.clock.next = Clock::from(false);
+        let ok = simulate(c, 1000);
+        debug_assert!(ok, "combinational logic did not settle");
+        c.clock.next = Clock::from(true);
+        let ok = simulate(c, 1000);
+        debug_assert!(ok, "combinational logic did not settle");
+        let lanes = ((1u32 << self.nb) - 1) as u8;
+        Pins {
+            cs_n: c.adc_cs_n.val().to_u64() as u8 & lanes,
+            sclk: c.adc_sclk.val().to_u64() as u8 & lanes,
+            mux_sel: c.mux_sel.val().to_u64() as u32,
+            mux_en: c.mux_en.val().to_u64(),
+            sample_valid: c.sample_valid.val(),
+            sample_channel: c.sample_channel.val().to_u64() as u16 & self.ch_mask,
+            sample_value: c.sample_value.val().to_u64() as u16,
+        }
+    }
+}
