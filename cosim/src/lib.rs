@@ -13,6 +13,7 @@ pub mod report;
 pub mod run;
 pub mod vcd;
 pub mod vcdout;
+pub mod verilator;
 
 pub use adc::{Adc, Stimulus};
 pub use checker::{CheckOptions, Checker, Invariants};

@@ -1,4 +1,5 @@
 //! Checking VCD files from any simulator.
+#![allow(clippy::manual_is_multiple_of)]
 //!
 //! A hand-written streaming reader (one line buffer, so memory stays flat in
 //! the file size) rather than the `vcd` or `wellen` crates: `vcd` 0.7 rejects

@@ -1,0 +1,379 @@
+//! The Verilator back end: the emitted `slotforge_top.v` verilated and
+//! compiled at run time into a shared library with a small `extern "C"`
+//! shim, loaded with `libloading`, stepped one FFI call per clock cycle.
+//!
+//! Built models are cached under `$SLOTFORGE_CACHE`, else
+//! `$XDG_CACHE_HOME/slotforge`, else `~/.cache/slotforge`, keyed on a hash of
+//! the Verilog, the shim and the `verilator --version` / `g++ --version`
+//! banners, so a second run does not rebuild.
+
+use std::fmt;
+use std::marker::PhantomData;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::pins::Pins;
+use crate::run::Dut;
+
+/// Why the Verilator back end could not run (a bad environment: exit 2).
+#[derive(Debug)]
+pub enum BackendError {
+    /// A tool is not installed.
+    MissingTool {
+        tool: String,
+        hint: String,
+    },
+    /// A build step failed; `log` has its output.
+    Build {
+        step: String,
+        log: String,
+    },
+    Io(String),
+    Other(String),
+}
+
+impl fmt::Display for BackendError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BackendError::MissingTool { tool, hint } => {
+                write!(f, "`{tool}` is not installed or not on PATH ({hint})")
+            }
+            BackendError::Build { step, log } => write!(f, "{step} failed:\n{log}"),
+            BackendError::Io(m) | BackendError::Other(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for BackendError {}
+
+const TOP: &str = "slotforge_top";
+
+const SHIM: &str = r#"
+#include "Vslotforge_top.h"
+#include "verilated.h"
+#include <cstdint>
+
+struct SfPins {
+    uint64_t mux_en;
+    uint32_t mux_sel;
+    uint16_t sample_channel;
+    uint16_t sample_value;
+    uint8_t cs_n;
+    uint8_t sclk;
+    uint8_t sample_valid;
+    uint8_t pad;
+};
+
+struct SfModel {
+    VerilatedContext* ctx;
+    Vslotforge_top* top;
+};
+
+extern "C" void* sf_new() {
+    SfModel* m = new SfModel;
+    m->ctx = new VerilatedContext;
+    m->top = new Vslotforge_top(m->ctx);
+    m->top->clk = 0;
+    m->top->rst = 1;
+    m->top->adc_miso = 0;
+    m->top->eval();
+    return m;
+}
+
+extern "C" void sf_step(void* p, uint8_t rst, uint64_t miso, SfPins* o) {
+    SfModel* m = (SfModel*)p;
+    Vslotforge_top* t = m->top;
+    t->rst = rst;
+    t->adc_miso = miso;
+    t->clk = 1;
+    t->eval();
+    o->cs_n = t->adc_cs_n;
+    o->sclk = t->adc_sclk;
+    o->mux_sel = t->mux_sel;
+    o->mux_en = t->mux_en;
+    o->sample_valid = t->sample_valid;
+    o->sample_channel = t->sample_channel;
+    o->sample_value = t->sample_value;
+    t->clk = 0;
+    t->eval();
+}
+
+extern "C" void sf_free(void* p) {
+    SfModel* m = (SfModel*)p;
+    m->top->final();
+    delete m->top;
+    delete m->ctx;
+    delete m;
+}
+"#;
+
+#[repr(C)]
+#[derive(Default)]
+struct SfPins {
+    mux_en: u64,
+    mux_sel: u32,
+    sample_channel: u16,
+    sample_value: u16,
+    cs_n: u8,
+    sclk: u8,
+    sample_valid: u8,
+    pad: u8,
+}
+
+/// FNV-1a, 64 bit: a stable cache key across Rust versions.
+pub fn fnv64(parts: &[&[u8]]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for p in parts {
+        for &b in *p {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x100_0000_01b3);
+        }
+        h ^= 0xff;
+        h = h.wrapping_mul(0x100_0000_01b3);
+    }
+    h
+}
+
+fn tool_version(tool: &str, hint: &str) -> Result<String, BackendError> {
+    match Command::new(tool).arg("--version").output() {
+        Ok(o) if o.status.success() => Ok(String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .next()
+            .unwrap_or("")
+            .to_string()),
+        Ok(o) => Err(BackendError::Build {
+            step: format!("{tool} --version"),
+            log: String::from_utf8_lossy(&o.stderr).into(),
+        }),
+        Err(_) => Err(BackendError::MissingTool {
+            tool: tool.into(),
+            hint: hint.into(),
+        }),
+    }
+}
+
+/// The cache directory for built models.
+pub fn cache_root() -> PathBuf {
+    if let Some(d) = std::env::var_os("SLOTFORGE_CACHE") {
+        return PathBuf::from(d);
+    }
+    if let Some(d) = std::env::var_os("XDG_CACHE_HOME") {
+        return PathBuf::from(d).join("slotforge");
+    }
+    if let Some(h) = std::env::var_os("HOME") {
+        return PathBuf::from(h).join(".cache").join("slotforge");
+    }
+    std::env::temp_dir().join("slotforge-cache")
+}
+
+fn run(cmd: &mut Command, step: &str) -> Result<(), BackendError> {
+    let o = cmd
+        .output()
+        .map_err(|e| BackendError::Io(format!("{step}: {e}")))?;
+    if !o.status.success() {
+        let mut log = String::from_utf8_lossy(&o.stdout).into_owned();
+        log.push_str(&String::from_utf8_lossy(&o.stderr));
+        return Err(BackendError::Build {
+            step: step.into(),
+            log,
+        });
+    }
+    Ok(())
+}
+
+/// A built model: where its library is and whether this call built it.
+#[derive(Debug, Clone)]
+pub struct Built {
+    pub library: PathBuf,
+    pub cached: bool,
+    pub key: String,
+}
+
+/// Verilates and compiles `verilog` (top `slotforge_top`), or finds it in the cache.
+pub fn build(verilog: &str) -> Result<Built, BackendError> {
+    let vv = tool_version("verilator", "apt-get install -y verilator")?;
+    let gv = tool_version("g++", "apt-get install -y g++")?;
+    let key = format!(
+        "{:016x}",
+        fnv64(&[
+            verilog.as_bytes(),
+            SHIM.as_bytes(),
+            vv.as_bytes(),
+            gv.as_bytes()
+        ])
+    );
+    let dir = cache_root().join("verilator").join(&key);
+    let lib = dir.join("libslotforge_top.so");
+    if lib.exists() {
+        return Ok(Built {
+            library: lib,
+            cached: true,
+            key,
+        });
+    }
+    let io = |e: std::io::Error| BackendError::Io(format!("{}: {e}", dir.display()));
+    let tmp = cache_root()
+        .join("verilator")
+        .join(format!("{key}.tmp{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).map_err(io)?;
+    std::fs::write(tmp.join("slotforge_top.v"), verilog).map_err(io)?;
+    std::fs::write(tmp.join("shim.cpp"), SHIM).map_err(io)?;
+    let obj = tmp.join("obj");
+    run(
+        Command::new("verilator")
+            .args([
+                "--cc",
+                "-O3",
+                "--x-assign",
+                "fast",
+                "--x-initial",
+                "fast",
+                "-Wno-fatal",
+                "-Wno-lint",
+                "-Wno-style",
+                "--top-module",
+                TOP,
+                "-Mdir",
+            ])
+            .arg(&obj)
+            .arg(tmp.join("slotforge_top.v")),
+        "verilator",
+    )?;
+    let root = Command::new("verilator")
+        .args(["--getenv", "VERILATOR_ROOT"])
+        .output()
+        .map_err(|e| BackendError::Io(e.to_string()))?;
+    let root = PathBuf::from(String::from_utf8_lossy(&root.stdout).trim());
+    let inc = root.join("include");
+    let mut sources: Vec<PathBuf> = std::fs::read_dir(&obj)
+        .map_err(io)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "cpp"))
+        .collect();
+    sources.sort();
+    sources.push(inc.join("verilated.cpp"));
+    if inc.join("verilated_threads.cpp").exists() {
+        sources.push(inc.join("verilated_threads.cpp"));
+    }
+    sources.push(tmp.join("shim.cpp"));
+    // Two compilers at a time (the machine has two cores).
+    let objects: Vec<PathBuf> = sources
+        .iter()
+        .enumerate()
+        .map(|(i, _)| tmp.join(format!("o{i}.o")))
+        .collect();
+    let compile = |src: &Path, out: &Path| {
+        run(
+            Command::new("g++")
+                .args(["-c", "-fPIC", "-O2", "-std=gnu++17", "-w"])
+                .arg("-I")
+                .arg(&obj)
+                .arg("-I")
+                .arg(&inc)
+                .arg("-I")
+                .arg(inc.join("vltstd"))
+                .arg(src)
+                .arg("-o")
+                .arg(out),
+            &format!("g++ {}", src.display()),
+        )
+    };
+    let pairs: Vec<(&PathBuf, &PathBuf)> = sources.iter().zip(objects.iter()).collect();
+    let (a, b): (Vec<_>, Vec<_>) = pairs.iter().enumerate().partition(|(i, _)| i % 2 == 0);
+    std::thread::scope(|sc| {
+        let h = sc.spawn(|| b.iter().try_for_each(|(_, (s, o))| compile(s, o)));
+        let r1 = a.iter().try_for_each(|(_, (s, o))| compile(s, o));
+        let r2 = h
+            .join()
+            .unwrap_or_else(|_| Err(BackendError::Other("compiler thread panicked".into())));
+        r1.and(r2)
+    })?;
+    run(
+        Command::new("g++")
+            .args(["-shared", "-o"])
+            .arg(tmp.join("libslotforge_top.so"))
+            .args(&objects)
+            .arg("-pthread"),
+        "g++ -shared",
+    )?;
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::rename(&tmp, &dir).map_err(io)?;
+    Ok(Built {
+        library: lib,
+        cached: false,
+        key,
+    })
+}
+
+type NewFn = unsafe extern "C" fn() -> *mut std::ffi::c_void;
+type StepFn = unsafe extern "C" fn(*mut std::ffi::c_void, u8, u64, *mut SfPins);
+type FreeFn = unsafe extern "C" fn(*mut std::ffi::c_void);
+
+/// A verilated `slotforge_top`, loaded in process.  Not `Send`: a Verilator
+/// model must be evaluated on the thread that created it.
+pub struct VerilatedDut {
+    _lib: libloading::Library,
+    step: StepFn,
+    free: FreeFn,
+    model: *mut std::ffi::c_void,
+    out: SfPins,
+    _not_send: PhantomData<*const ()>,
+}
+
+impl VerilatedDut {
+    /// Builds (or finds in the cache) and loads the model of `verilog`.
+    pub fn new(verilog: &str) -> Result<(VerilatedDut, Built), BackendError> {
+        let built = build(verilog)?;
+        let dut = VerilatedDut::load(&built.library)?;
+        Ok((dut, built))
+    }
+
+    /// Loads an already-built model library.
+    pub fn load(library: &Path) -> Result<VerilatedDut, BackendError> {
+        let err = |e: libloading::Error| {
+            BackendError::Other(format!("loading {}: {e}", library.display()))
+        };
+        // SAFETY: the library is one this module built from SHIM; the symbol
+        // types match the shim's extern "C" declarations.
+        unsafe {
+            let lib = libloading::Library::new(library).map_err(err)?;
+            let new: NewFn = *lib.get::<NewFn>(b"sf_new\0").map_err(err)?;
+            let step: StepFn = *lib.get::<StepFn>(b"sf_step\0").map_err(err)?;
+            let free: FreeFn = *lib.get::<FreeFn>(b"sf_free\0").map_err(err)?;
+            let model = new();
+            Ok(VerilatedDut {
+                _lib: lib,
+                step,
+                free,
+                model,
+                out: SfPins::default(),
+                _not_send: PhantomData,
+            })
+        }
+    }
+}
+
+impl Dut for VerilatedDut {
+    #[inline]
+    fn step(&mut self, rst: bool, miso: u64) -> Pins {
+        // SAFETY: `model` came from sf_new of the same library and is freed only in Drop.
+        unsafe { (self.step)(self.model, rst as u8, miso, &mut self.out) };
+        Pins {
+            cs_n: self.out.cs_n,
+            sclk: self.out.sclk,
+            mux_sel: self.out.mux_sel,
+            mux_en: self.out.mux_en,
+            sample_valid: self.out.sample_valid != 0,
+            sample_channel: self.out.sample_channel,
+            sample_value: self.out.sample_value,
+        }
+    }
+}
+
+impl Drop for VerilatedDut {
+    fn drop(&mut self) {
+        // SAFETY: created by sf_new, freed once.
+        unsafe { (self.free)(self.model) }
+    }
+}
