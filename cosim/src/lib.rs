@@ -5,6 +5,7 @@
 //! `docs/timing.md`; it never reads the `hdl` crate.
 
 pub mod adc;
+pub mod backend;
 pub mod checker;
 pub mod faults;
 pub mod model;
@@ -16,6 +17,7 @@ pub mod vcdout;
 pub mod verilator;
 
 pub use adc::{Adc, Stimulus};
+pub use backend::{run, Backend, SimError, SimOptions, VcdOut};
 pub use checker::{CheckOptions, Checker, Invariants};
 pub use model::{CycleModel, SlotModel};
 pub use pins::{Layout, Pins, Signal};

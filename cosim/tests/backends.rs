@@ -1,0 +1,62 @@
+//! Every preset mix on every back end: rusthdl and verilator for 2 frames, model for 100.
+
+use std::path::{Path, PathBuf};
+
+use cosim::{run, Backend, SimOptions};
+
+fn mixes() -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    v
+}
+
+fn schedule(p: &Path) -> lut_gen::Schedule {
+    lut_gen::synthesize(&lut_gen::load(p).unwrap()).unwrap()
+}
+
+fn have(tool: &str) -> bool {
+    std::process::Command::new(tool)
+        .arg("--version")
+        .output()
+        .is_ok()
+}
+
+#[test]
+fn model_backend_100_frames() {
+    for p in mixes() {
+        let s = schedule(&p);
+        let r = run(&s, Backend::Model, 100, &SimOptions::default()).unwrap();
+        assert!(r.ok, "{}: {}", p.display(), r.summary());
+        assert_eq!(r.samples, 100 * s.samples_per_frame());
+    }
+}
+
+#[test]
+fn rusthdl_backend_2_frames() {
+    for p in mixes() {
+        let s = schedule(&p);
+        let r = run(&s, Backend::RustHdl, 2, &SimOptions::default()).unwrap();
+        assert!(r.ok, "{}: {}", p.display(), r.summary());
+        assert_eq!(r.samples, 2 * s.samples_per_frame());
+        assert!(r.model_compared);
+    }
+}
+
+#[test]
+fn verilator_backend_2_frames() {
+    if !have("verilator") || !have("g++") {
+        eprintln!("verilator or g++ missing: skipped");
+        return;
+    }
+    for p in mixes() {
+        let s = schedule(&p);
+        let r = run(&s, Backend::Verilator, 2, &SimOptions::default()).unwrap();
+        assert!(r.ok, "{}: {}", p.display(), r.summary());
+        assert_eq!(r.samples, 2 * s.samples_per_frame());
+    }
+}
