@@ -1,14 +1,91 @@
-//! `slotforge sim` (being built: see the issue tracker).
+//! `slotforge sim MIX --backend B --frames N [--vcd F --from A --to B] [--json] [--stimulus S]`
+//!
+//! Exit 0: every cycle passed; 1: a divergence or violation; 2: bad input or
+//! a missing tool.
 
 use std::path::PathBuf;
+
+use cosim::{Backend, SimOptions, Stimulus, VcdOut};
 
 #[derive(clap::Args)]
 pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
+    /// model (slot-level), rusthdl (in process) or verilator (the emitted Verilog).
+    #[arg(long, default_value = "model")]
+    pub backend: String,
+    /// Frames to simulate.
+    #[arg(long, default_value_t = 2)]
+    pub frames: u64,
+    /// Write a VCD of frames --from..--to (plus a GTKWave .gtkw beside it).
+    #[arg(long)]
+    pub vcd: Option<PathBuf>,
+    /// First frame of the VCD window.
+    #[arg(long, default_value_t = 0)]
+    pub from: u64,
+    /// End (exclusive) of the VCD window; default: one frame after --from.
+    #[arg(long)]
+    pub to: Option<u64>,
+    /// ADC input: pattern (unique code per channel and slot), sine, step or chirp.
+    #[arg(long, default_value = "pattern")]
+    pub stimulus: String,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
-pub fn run(_args: Args) -> u8 {
-    eprintln!("error: `slotforge sim` is not available in this build yet");
-    2
+pub fn run(a: Args) -> u8 {
+    let backend: Backend = match a.backend.parse() {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let stimulus: Stimulus = match a.stimulus.parse() {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let to = a.to.unwrap_or(a.from + 1);
+    if a.vcd.is_some() && to <= a.from {
+        eprintln!("error: --to ({to}) must be after --from ({})", a.from);
+        return 2;
+    }
+    let s = match super::schedule(&a.mix) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let opts = SimOptions {
+        stimulus,
+        vcd: a.vcd.map(|path| VcdOut {
+            path,
+            from_frame: a.from,
+            to_frame: to,
+            gtkw: true,
+        }),
+        ..SimOptions::default()
+    };
+    let report = match cosim::run(&s, backend, a.frames, &opts) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).expect("report serializes")
+        );
+    } else {
+        print!("{}", report.summary());
+    }
+    if report.ok {
+        0
+    } else {
+        1
+    }
 }
