@@ -130,19 +130,20 @@ impl Logic for SlotRom {
 // Timing generator
 // ---------------------------------------------------------------------------
 
-/// Runs one cycle ahead of the outputs: `start1` is high in cycle `c` iff
-/// cycle `c + 1` is the first cycle of a slot; `addr` is the (combinational)
+/// Runs ahead of the outputs: `st` (`start2`) is high in cycle `c` iff
+/// cycle `c + 1` (`c + 2`) is the first cycle of a slot; `addr` is the (combinational)
 /// next value of the slot pointer, so the ROMs' registered data always
 /// describe the next slot to start.
 #[derive(LogicBlock)]
 pub struct TimingGen {
     pub clock: Signal<In, Clock>,
     pub rst: Signal<In, Bit>,
-    pub start1: Signal<Out, Bit>,
+    pub start2: Signal<Out, Bit>,
     pub addr: Signal<Out, Bits<SLOT_BITS>>,
     /// (c + 2) mod slot_cycles during cycle c.
     cnt: DFF<Bits<CNT_BITS>>,
     st: DFF<Bit>,
+    st2: DFF<Bit>,
     /// Frame slot index of the next slot start (> c).
     slot: DFF<Bits<SLOT_BITS>>,
     nxt: Signal<Local, Bits<SLOT_BITS>>,
@@ -160,10 +161,11 @@ impl TimingGen {
         TimingGen {
             clock: Default::default(),
             rst: Default::default(),
-            start1: Default::default(),
+            start2: Default::default(),
             addr: Default::default(),
             cnt: Default::default(),
             st: Default::default(),
+            st2: Default::default(),
             slot: Default::default(),
             nxt: Default::default(),
             k_cnt_last: c(plan.slot_cycles - 1),
@@ -180,13 +182,14 @@ impl TimingGen {
 impl Logic for TimingGen {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, cnt, st, slot);
+        dff_setup!(self, clock, cnt, st, st2, slot);
         if self.cnt.q.val() == self.k_cnt_last.val() {
             self.cnt.d.next = self.k_cnt_zero.val();
         } else {
             self.cnt.d.next = self.cnt.q.val() + self.k_cnt_one.val();
         }
-        self.st.d.next = self.cnt.q.val() == self.k_cnt_zero.val();
+        self.st2.d.next = self.cnt.q.val() == self.k_cnt_last.val();
+        self.st.d.next = self.st2.q.val();
         self.nxt.next = self.slot.q.val();
         if self.st.q.val() {
             if self.slot.q.val() == self.k_slot_last.val() {
@@ -198,11 +201,12 @@ impl Logic for TimingGen {
         if self.rst.val() {
             self.cnt.d.next = self.k_cnt_rst.val();
             self.st.d.next = true;
+            self.st2.d.next = false;
             self.nxt.next = self.k_slot_zero.val();
         }
         self.slot.d.next = self.nxt.val();
         self.addr.next = self.nxt.val();
-        self.start1.next = self.st.q.val();
+        self.start2.next = self.st2.q.val();
     }
 }
 
@@ -214,7 +218,7 @@ impl Logic for TimingGen {
 pub struct BranchUnit {
     pub clock: Signal<In, Clock>,
     pub rst: Signal<In, Bit>,
-    pub start: Signal<In, Bit>,
+    pub start2: Signal<In, Bit>,
     pub addr: Signal<In, Bits<SLOT_BITS>>,
     pub miso: Signal<In, Bit>,
     pub cs_n: Signal<Out, Bit>,
@@ -225,6 +229,8 @@ pub struct BranchUnit {
     pub res_ch: Signal<Out, Bits<CH_BITS>>,
     pub res_val: Signal<Out, Bits<14>>,
     rom: SlotRom,
+    /// High in cycle t - 1 for every sampling instant t.
+    go: DFF<Bit>,
     r_cs_n: DFF<Bit>,
     r_sclk: DFF<Bit>,
     ph: DFF<Bits<PH_BITS>>,
@@ -256,6 +262,7 @@ pub struct BranchUnit {
     k_sel_rst: Constant<Bits<3>>,
     k_en_rst: Constant<Bits<EN_BITS>>,
     k_en_one: Constant<Bits<EN_BITS>>,
+    k_conv0: Constant<Bit>,
 }
 
 impl BranchUnit {
@@ -263,7 +270,7 @@ impl BranchUnit {
         BranchUnit {
             clock: Default::default(),
             rst: Default::default(),
-            start: Default::default(),
+            start2: Default::default(),
             addr: Default::default(),
             miso: Default::default(),
             cs_n: Signal::new_with_default(true),
@@ -274,6 +281,7 @@ impl BranchUnit {
             res_ch: Default::default(),
             res_val: Default::default(),
             rom: SlotRom::new(rom),
+            go: Default::default(),
             r_cs_n: Default::default(),
             r_sclk: Default::default(),
             ph: Default::default(),
@@ -305,6 +313,7 @@ impl BranchUnit {
             k_sel_rst: c(rom.reset_sel as u64),
             k_en_rst: c(rom.reset_en),
             k_en_one: c(1),
+            k_conv0: Constant::new(rom.words[0] >> 16 & 1 == 1),
         }
     }
 }
@@ -313,7 +322,7 @@ impl Logic for BranchUnit {
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, r_cs_n, r_sclk, ph, nfall, shift, cur_ch, first, p_sel, p_dev, r_sel,
+            self, clock, go, r_cs_n, r_sclk, ph, nfall, shift, cur_ch, first, p_sel, p_dev, r_sel,
             r_en, r_done, r_rch, r_rval
         );
         self.rom.clock.next = self.clock.val();
@@ -322,7 +331,9 @@ impl Logic for BranchUnit {
         self.half.next = self.ph.q.val() == self.k_ph_half.val();
         self.r_done.d.next = false;
         self.first.d.next = false;
-        if self.start.val() & self.rom.conv.val() {
+        // Registered one cycle early so the ROM's output is off the critical path.
+        self.go.d.next = self.start2.val() & self.rom.conv.val();
+        if self.go.q.val() {
             // The edge that begins sampling instant t: CS falls.
             self.r_cs_n.d.next = false;
             self.r_sclk.d.next = true;
@@ -371,6 +382,7 @@ impl Logic for BranchUnit {
             }
         }
         if self.rst.val() {
+            self.go.d.next = self.k_conv0.val();
             self.r_cs_n.d.next = true;
             self.r_sclk.d.next = true;
             self.r_done.d.next = false;
@@ -588,7 +600,7 @@ impl Logic for Core {
         self.timing.rst.next = rst;
         self.merge.clock.next = clk;
         self.merge.rst.next = rst;
-        let start = self.timing.start1.val();
+        let start = self.timing.start2.val();
         let addr = self.timing.addr.val();
         let miso = self.adc_miso.val().to_u64();
         let (mut cs, mut sclk, mut sel, mut en, mut done) = (0u64, 0u64, 0u64, 0u128, 0u64);
@@ -598,7 +610,7 @@ impl Logic for Core {
         for (b, u) in self.branches.iter_mut().enumerate() {
             u.clock.next = clk;
             u.rst.next = rst;
-            u.start.next = start;
+            u.start2.next = start;
             u.addr.next = addr;
             u.miso.next = (miso >> b) & 1 == 1;
             cs |= (u.cs_n.val() as u64) << b;
@@ -654,7 +666,7 @@ impl Logic for Core {
         for u in self.branches.iter_mut() {
             u.clock.connect();
             u.rst.connect();
-            u.start.connect();
+            u.start2.connect();
             u.addr.connect();
             u.miso.connect();
         }
@@ -713,7 +725,7 @@ fn core_glue(nb: usize, devices: &[usize]) -> String {
     for b in 0..nb {
         let u = format!("branches${b}");
         s.push_str(&format!(
-            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start = timing$start1;\n  {u}$addr = timing$addr;\n  {u}$miso = adc_miso[{b}];\n"
+            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$addr = timing$addr;\n  {u}$miso = adc_miso[{b}];\n"
         ));
     }
     s.push_str(&format!(
@@ -783,4 +795,253 @@ fn core_glue(nb: usize, devices: &[usize]) -> String {
         ));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    //! The SPI master and mux control in rust-hdl's simulator (direct clock
+    //! loop with `simulate()`), against a behavioural AD7940 with the
+    //! datasheet's delays expressed in nanoseconds.
+    use super::*;
+    use crate::plan::BranchRom;
+
+    #[derive(LogicBlock)]
+    struct Harness {
+        clock: Signal<In, Clock>,
+        rst: Signal<In, Bit>,
+        miso: Signal<In, Bit>,
+        timing: TimingGen,
+        unit: BranchUnit,
+    }
+
+    impl Logic for Harness {
+        #[hdl_gen]
+        fn update(&mut self) {
+            self.timing.clock.next = self.clock.val();
+            self.timing.rst.next = self.rst.val();
+            self.unit.clock.next = self.clock.val();
+            self.unit.rst.next = self.rst.val();
+            self.unit.start2.next = self.timing.start2.val();
+            self.unit.addr.next = self.timing.addr.val();
+            self.unit.miso.next = self.miso.val();
+        }
+    }
+
+    const CLOCK_HZ: u64 = 50_000_000; // 20 ns per cycle
+    const NS: u64 = 20;
+    const SLOT: u64 = 500;
+
+    /// 4 slots: converts channel 0 (dev 1, sel 3) in slot 0, channel 7
+    /// (dev 0, sel 5) in slot 2; slots 1 and 3 idle.
+    fn rom(div: u64, setup: u64) -> BranchRom {
+        let w =
+            |conv: u32, ch: u32, sel: u32, dev: u32| (conv << 16) | (ch << 8) | (sel << 5) | dev;
+        BranchRom {
+            words: vec![w(1, 0, 5, 0), 0, w(1, 7, 3, 1), 0],
+            addr_bits: 2,
+            sclk_div: div,
+            sclk_half: div / 2,
+            setup_cycles: setup,
+            read_cycles: setup + 16 * div,
+            reset_sel: 3,
+            reset_en: 0b10,
+            devices: 2,
+            en_offset: 0,
+        }
+    }
+
+    fn harness(div: u64, setup: u64) -> Harness {
+        let plan = Plan {
+            slot_cycles: SLOT,
+            frame_slots: 4,
+            channel_bits: 3,
+            branches: vec![rom(div, setup)],
+        };
+        let mut h = Harness {
+            clock: Default::default(),
+            rst: Default::default(),
+            miso: Default::default(),
+            timing: TimingGen::new(&plan),
+            unit: BranchUnit::new(&plan.branches[0]),
+        };
+        h.connect_all();
+        h
+    }
+
+    /// AD7940 serial output with datasheet timing: t3 (CS to first bit)
+    /// <= 48 ns, t4 (SCLK fall to data) <= 120 ns, t7 (hold) >= 10 ns,
+    /// t8 (16th fall to high-Z) <= 45 ns.  Outside valid windows it drives
+    /// alternating garbage.
+    struct Ad7940 {
+        word: u16,
+        cs_fall_ns: Option<u64>,
+        falls: Vec<u64>,
+        garbage: bool,
+    }
+
+    impl Ad7940 {
+        fn miso(&mut self, now_ns: u64) -> bool {
+            self.garbage = !self.garbage;
+            let Some(cs) = self.cs_fall_ns else {
+                return self.garbage;
+            };
+            let bit = |i: usize| (self.word >> (15 - i)) & 1 == 1;
+            // most recent fall whose data is valid, and whether an older bit is held
+            let n = self.falls.len();
+            if n >= 16 && now_ns >= self.falls[15] + 45 {
+                return self.garbage;
+            }
+            if n == 0 {
+                return if now_ns >= cs + 48 {
+                    bit(0)
+                } else {
+                    self.garbage
+                };
+            }
+            let last = self.falls[n - 1];
+            if now_ns >= last + 120 {
+                if n < 16 {
+                    bit(n)
+                } else {
+                    self.garbage
+                }
+            } else if now_ns < last + 10 {
+                bit(n - 1)
+            } else {
+                self.garbage
+            }
+        }
+    }
+
+    struct Trace {
+        cs_n: Vec<bool>,
+        sclk: Vec<bool>,
+        sel: Vec<u64>,
+        en: Vec<u64>,
+        done: Vec<(u64, u64, u64)>,
+    }
+
+    fn run(div: u64, setup: u64, cycles: u64, word: u16) -> Trace {
+        let mut h = harness(div, setup);
+        let mut adc = Ad7940 {
+            word,
+            cs_fall_ns: None,
+            falls: vec![],
+            garbage: false,
+        };
+        let mut t = Trace {
+            cs_n: vec![],
+            sclk: vec![],
+            sel: vec![],
+            en: vec![],
+            done: vec![],
+        };
+        let mut miso = false;
+        let mut prev = (true, true);
+        for c in 0..cycles + 2 {
+            let reset = c < 2;
+            h.rst.next = reset;
+            h.miso.next = miso;
+            h.clock.next = Clock::from(false);
+            assert!(simulate(&mut h, 100));
+            h.clock.next = Clock::from(true);
+            assert!(simulate(&mut h, 100));
+            let (cs_n, sclk) = (h.unit.cs_n.val(), h.unit.sclk.val());
+            if reset {
+                assert!(cs_n && sclk);
+                assert_eq!(h.unit.mux_en.val().to_u64(), 0b10);
+                continue;
+            }
+            let cyc = c - 2;
+            let now = cyc * NS;
+            if prev.0 && !cs_n {
+                adc.cs_fall_ns = Some(now);
+                adc.falls.clear();
+            }
+            if cs_n {
+                adc.cs_fall_ns = None;
+            }
+            if !cs_n && prev.1 && !sclk {
+                adc.falls.push(now);
+            }
+            // MISO is sampled at the end of this cycle: the worst case is
+            // its value just before the next edge.
+            miso = adc.miso(now + NS - 1);
+            prev = (cs_n, sclk);
+            t.cs_n.push(cs_n);
+            t.sclk.push(sclk);
+            t.sel.push(h.unit.mux_sel.val().to_u64());
+            t.en.push(h.unit.mux_en.val().to_u64());
+            if h.unit.done.val() {
+                t.done.push((
+                    cyc,
+                    h.unit.res_ch.val().to_u64(),
+                    h.unit.res_val.val().to_u64(),
+                ));
+            }
+        }
+        t
+    }
+
+    fn check_spi(div: u64, setup: u64) {
+        let r = setup + 16 * div;
+        let word = 0x2d5b & 0x3fff;
+        let t = run(div, setup, 4 * SLOT, word);
+        for (k, &inst) in [0u64, 2 * SLOT].iter().enumerate() {
+            // CS low exactly for R cycles from the instant
+            assert!(inst == 0 || t.cs_n[inst as usize - 1]);
+            for c in inst..inst + r {
+                assert!(!t.cs_n[c as usize], "cs_n low in cycle {c}");
+            }
+            assert!(t.cs_n[(inst + r) as usize]);
+            // SCLK: idle high, 16 falling edges, exact phase, CS-to-SCLK setup
+            let falls: Vec<u64> = (inst + 1..inst + r + 1)
+                .filter(|&c| t.sclk[c as usize - 1] && !t.sclk[c as usize])
+                .collect();
+            assert_eq!(falls.len(), 16);
+            assert!(falls[0] - inst >= 1 && (falls[0] - inst) * NS >= 10, "t2");
+            for (i, &f) in falls.iter().enumerate() {
+                assert_eq!(f, inst + setup + i as u64 * div);
+                for c in f..f + div / 2 {
+                    assert!(!t.sclk[c as usize]);
+                }
+                for c in f + div / 2..f + div {
+                    assert!(t.sclk[c as usize]);
+                }
+            }
+            // the 14-bit code was captured despite worst-case delays
+            let (done_at, ch, val) = t.done[k];
+            assert_eq!(done_at, inst + r);
+            assert_eq!(ch, [0, 7][k]);
+            assert_eq!(val, word as u64);
+        }
+        // mux: reset value until instant 0, next channel from t+1, stable
+        // through the next instant; one device at a time
+        assert_eq!((t.sel[0], t.en[0]), (3, 0b10));
+        for c in 1..2 * SLOT + 1 {
+            assert_eq!(
+                (t.sel[c as usize], t.en[c as usize]),
+                (5, 0b01),
+                "cycle {c}"
+            );
+        }
+        for c in 2 * SLOT + 1..4 * SLOT {
+            assert_eq!(
+                (t.sel[c as usize], t.en[c as usize]),
+                (3, 0b10),
+                "cycle {c}"
+            );
+        }
+        assert!(t.en.iter().all(|e| e.count_ones() == 1));
+    }
+
+    #[test]
+    fn spi_master_reads_ad7940_at_2_5_mhz() {
+        check_spi(20, 1); // 50 MHz / 20 = 2.5 MHz, 200 ns low phase > t4
+    }
+
+    #[test]
+    fn spi_master_with_long_setup_and_slow_sclk() {
+        check_spi(40, 25); // setup longer than half a period
+    }
 }

@@ -103,6 +103,18 @@ impl Board {
     }
 }
 
+/// The name place-and-route tools give a port bit: yosys and nextpnr call
+/// the only bit of a 1-bit vector port by the port's name.
+fn pnr_name(bits: &[(String, &'static str)], bit: &str) -> String {
+    if let Some(base) = bit.strip_suffix("[0]") {
+        let wider = format!("{base}[1]");
+        if !bits.iter().any(|(n, _)| *n == wider) {
+            return base.to_string();
+        }
+    }
+    bit.to_string()
+}
+
 /// Port bit names in port-table order (the order of docs/timing.md).
 fn port_bits(s: &Schedule, p: &Plan) -> Vec<(String, &'static str)> {
     let nb = p.branches.len();
@@ -493,8 +505,13 @@ fn xdc(s: &Schedule, p: &Plan) -> String {
         "set_property IOSTANDARD LVCMOS33 [get_ports {{clk rst adc_miso[*] adc_cs_n[*] adc_sclk[*] mux_sel[*] mux_en[*] sample_valid sample_channel[*] sample_value[*]}}]"
     );
     let _ = writeln!(t, "# Pin locations: uncomment and fill in for your board.");
-    for (bit, _) in port_bits(s, p) {
-        let _ = writeln!(t, "# set_property PACKAGE_PIN <pin> [get_ports {{{bit}}}]");
+    let bits = port_bits(s, p);
+    for (bit, _) in &bits {
+        let _ = writeln!(
+            t,
+            "# set_property PACKAGE_PIN <pin> [get_ports {{{}}}]",
+            pnr_name(&bits, bit)
+        );
     }
     t
 }
@@ -510,8 +527,9 @@ fn pcf_template(s: &Schedule, p: &Plan) -> String {
         t,
         "# No board file was given: replace every <pin> and uncomment, or emit with a board file."
     );
-    for (bit, dir) in port_bits(s, p) {
-        let _ = writeln!(t, "# set_io {bit} <pin>    # {dir}");
+    let bits = port_bits(s, p);
+    for (bit, dir) in &bits {
+        let _ = writeln!(t, "# set_io {} <pin>    # {dir}", pnr_name(&bits, bit));
     }
     t
 }
@@ -573,7 +591,7 @@ fn pcf_board(s: &Schedule, p: &Plan, path: &Path, b: &Board) -> Result<String, H
             return Err(err(format!("pin {pin} is assigned twice")));
         }
         used.push(pin);
-        let _ = writeln!(t, "set_io {bit} {pin}    # {dir}");
+        let _ = writeln!(t, "set_io {} {pin}    # {dir}", pnr_name(&bits, bit));
     }
     Ok(t)
 }
