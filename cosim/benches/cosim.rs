@@ -1,0 +1,95 @@
+//! Side-by-side throughput ratios (not a timed test):
+//!   cargo bench -p cosim --bench cosim [-- FRAMES]
+//!
+//! 1. verilator back end with full checking vs the same verilated model stepped unchecked;
+//! 2. rusthdl back end with full checking vs hdl::RtlSim stepped unchecked;
+//! 3. model back end vs real time;
+//! 4. `check` of a VCD vs a bare streaming parse with the same reader.
+
+use std::path::Path;
+use std::time::Instant;
+
+use cosim::backend::{verilog, RustHdlDut};
+use cosim::run::{run_dut, run_model, run_unchecked, ModelDut, RunOptions};
+use cosim::verilator::VerilatedDut;
+use cosim::vcdout::VcdWriter;
+use cosim::Stimulus;
+
+fn secs<T>(f: impl FnOnce() -> T) -> (f64, T) {
+    let t = Instant::now();
+    let r = f();
+    (t.elapsed().as_secs_f64(), r)
+}
+
+fn main() {
+    let frames: u64 = std::env::args().skip(1).find_map(|a| a.parse().ok()).unwrap_or(10);
+    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml");
+    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    let cycles = frames * s.grid.frame_cycles;
+    let real = frames as f64 * s.mix.frame_us as f64 * 1e-6;
+    let opts = RunOptions::default();
+    println!("mix eskin34, {frames} frames = {cycles} cycles = {real} s of acquisition");
+
+    // 1. verilator
+    let v = verilog(&s).unwrap();
+    let (mut dut, built) = VerilatedDut::new(&v).unwrap();
+    println!("verilator model {} ({})", built.key, if built.cached { "cached" } else { "built" });
+    let (tu, _) = secs(|| run_unchecked(&s, &mut dut, frames, Stimulus::Pattern));
+    drop(dut);
+    let (mut dut, _) = VerilatedDut::new(&v).unwrap();
+    let (tc, r) = secs(|| run_dut(&s, &mut dut, frames, &opts, "verilator", None));
+    assert!(r.ok);
+    println!(
+        "verilator: checked {:.2} Mcycles/s, unchecked {:.2} Mcycles/s, ratio {:.2} (goal >= 0.5)",
+        cycles as f64 / tc / 1e6,
+        cycles as f64 / tu / 1e6,
+        tu / tc
+    );
+
+    // 2. rusthdl (fewer frames: it is much slower)
+    let hf = (frames / 5).max(1);
+    let hc = hf * s.grid.frame_cycles;
+    let mut dut = RustHdlDut::new(&s).unwrap();
+    let (tu, _) = secs(|| run_unchecked(&s, &mut dut, hf, Stimulus::Pattern));
+    let mut dut = RustHdlDut::new(&s).unwrap();
+    let (tc, r) = secs(|| run_dut(&s, &mut dut, hf, &opts, "rusthdl", None));
+    assert!(r.ok);
+    println!(
+        "rusthdl: checked {:.3} Mcycles/s, RtlSim unchecked {:.3} Mcycles/s, ratio {:.2} ({hf} frames)",
+        hc as f64 / tc / 1e6,
+        hc as f64 / tu / 1e6,
+        tu / tc
+    );
+
+    // 3. model back end vs real time
+    let mf = 10_000u64;
+    let (tm, r) = secs(|| run_model(&s, mf, Stimulus::Pattern, 20));
+    assert!(r.ok);
+    let mreal = mf as f64 * s.mix.frame_us as f64 * 1e-6;
+    println!(
+        "model: {mf} frames ({mreal} s of acquisition, {} samples) in {tm:.3} s: {:.0}x real time (goal >= 1000)",
+        r.samples,
+        mreal / tm
+    );
+
+    // 4. VCD check vs bare parse
+    let dir = std::env::temp_dir().join(format!("slotforge-bench-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let vcd = dir.join("bench.vcd");
+    let vf = (frames / 2).max(1);
+    let mut w = VcdWriter::create(&vcd, &s, 0, u64::MAX).unwrap();
+    let _ = run_dut(&s, &mut ModelDut::new(&s), vf, &opts, "gen", Some(&mut w));
+    w.finish().unwrap();
+    let size = std::fs::metadata(&vcd).unwrap().len() as f64;
+    let (tp, n) = secs(|| cosim::vcd::parse_only(&s, &vcd, None).unwrap());
+    let (tk, r) = secs(|| cosim::check_vcd(&s, &vcd, None).unwrap());
+    assert!(r.ok, "{}", r.summary());
+    println!(
+        "vcd: {:.1} MB, {n} cycles; parse only {:.0} MB/s, check {:.0} MB/s, ratio {:.2} (goal >= 0.8)",
+        size / 1e6,
+        size / tp / 1e6,
+        size / tk / 1e6,
+        tp / tk
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
