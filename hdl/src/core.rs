@@ -828,7 +828,7 @@ mod tests {
     }
 
     const CLOCK_HZ: u64 = 50_000_000; // 20 ns per cycle
-    const NS: u64 = 20;
+    const NS: u64 = 1_000_000_000 / CLOCK_HZ;
     const SLOT: u64 = 500;
 
     /// 4 slots: converts channel 0 (dev 1, sel 3) in slot 0, channel 7

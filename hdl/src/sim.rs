@@ -41,6 +41,7 @@ pub struct Pins {
 /// begin with at least one `rst = true` step.
 pub struct RtlSim {
     core: Box<Core>,
+    passes: u64,
     nb: usize,
     ch_mask: u16,
 }
@@ -55,6 +56,7 @@ impl RtlSim {
         let nb = p.branches.len();
         Ok(RtlSim {
             core,
+            passes: 0,
             nb,
             ch_mask: ((1u32 << p.channel_bits) - 1) as u16,
         })
@@ -65,16 +67,21 @@ impl RtlSim {
         self.nb
     }
 
+    /// Evaluation passes over the design so far (a cost measure).
+    pub fn passes(&self) -> u64 {
+        self.passes
+    }
+
     /// Apply one rising clock edge; see the type's documentation.
     pub fn step(&mut self, rst: bool, miso: u8) -> Pins {
         let c = &mut *self.core;
         c.rst.next = rst;
         c.adc_miso.next = (miso as u64).into();
         c.clock.next = Clock::from(false);
-        let ok = simulate(c, 1000);
+        let ok = settle(c, &mut self.passes);
         debug_assert!(ok, "combinational logic did not settle");
         c.clock.next = Clock::from(true);
-        let ok = simulate(c, 1000);
+        let ok = settle(c, &mut self.passes);
         debug_assert!(ok, "combinational logic did not settle");
         let lanes = ((1u32 << self.nb) - 1) as u8;
         Pins {
@@ -87,4 +94,16 @@ impl RtlSim {
             sample_value: c.sample_value.val().to_u64() as u16,
         }
     }
+}
+
+/// `rust_hdl::simulate`, counting passes.
+fn settle<B: Block>(uut: &mut B, passes: &mut u64) -> bool {
+    for _ in 0..1000 {
+        uut.update_all();
+        *passes += 1;
+        if !uut.has_changed() {
+            return true;
+        }
+    }
+    false
 }

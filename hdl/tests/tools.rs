@@ -138,3 +138,32 @@ fn ports_json_follows_the_contract() {
     assert_eq!(ch[0]["name"], "CH1");
     assert_eq!(ch[0]["branch"], "standard");
 }
+
+#[test]
+fn board_file_pcf_covers_every_port_bit() {
+    let board = root().join("constraints/ice40-hx8k-breakout.toml");
+    for (tag, s) in [("eskin34", eskin34()), ("tiny", tiny()), ("wide8", wide())] {
+        let e = hdl::emit(&s, Some(&board)).expect("board file maps every bit");
+        let pcf = e.file("slotforge.pcf").unwrap();
+        let template = hdl::emit(&s, None).unwrap();
+        let bits = template
+            .file("slotforge.pcf")
+            .unwrap()
+            .lines()
+            .filter(|l| l.starts_with("# set_io"))
+            .count();
+        assert_eq!(
+            pcf.lines().filter(|l| l.starts_with("set_io")).count(),
+            bits,
+            "{tag}"
+        );
+        assert!(pcf.contains("set_io clk J3"));
+    }
+    // tiny: 1-bit vector ports are named as the tools name them
+    let e = hdl::emit(&tiny(), Some(&board)).unwrap();
+    let pcf = e.file("slotforge.pcf").unwrap();
+    assert!(
+        pcf.contains("set_io adc_cs_n ") && pcf.contains("set_io mux_en "),
+        "{pcf}"
+    );
+}
