@@ -413,11 +413,7 @@ fn ports_json(s: &Schedule, p: &Plan) -> String {
         "clock_hz": s.grid.clock_hz,
         "reset": {"port": "rst", "active_high": true, "synchronous": true},
         "branches": branches,
-        "sample": {
-            "valid": "sample_valid",
-            "channel": if w == 1 { "sample_channel[0]".to_string() } else { format!("sample_channel[{}:0]", w - 1) },
-            "value": "sample_value[13:0]",
-        },
+        "sample": {"valid": "sample_valid", "channel": "sample_channel", "value": "sample_value"},
         "channels": channels,
         "ports": ports,
     });

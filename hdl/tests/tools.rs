@@ -132,6 +132,8 @@ fn ports_json_follows_the_contract() {
     assert_eq!(br[1]["mux_en"][0], "mux_en[4]");
     assert_eq!(br[2]["mux_en"][0], "mux_en[6]");
     assert_eq!(v["sample"]["valid"], "sample_valid");
+    assert_eq!(v["sample"]["channel"], "sample_channel");
+    assert_eq!(v["sample"]["value"], "sample_value");
     let ch = v["channels"].as_array().unwrap();
     assert_eq!(ch.len(), 41);
     assert_eq!(ch[0]["index"], 0);
