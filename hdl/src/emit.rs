@@ -158,7 +158,11 @@ pub fn emit(s: &Schedule, board: Option<&Path>) -> Result<Emitted, HdlError> {
     let mut files = vec![
         ("slotforge_top.v".to_string(), verilog(s, &p)),
         ("ports.json".to_string(), ports_json(s, &p)),
-        ("slots.hex".to_string(), slots_hex(s, &p)),
+        // The schedule's LUT in the one layout `slotforge lut` also writes, so
+        // the two commands can share an output directory; the ROM image the
+        // gateware embeds (per-branch words) is `slot_rom.hex`.
+        ("slots.hex".to_string(), lut_gen::lut::to_hex(s)),
+        ("slot_rom.hex".to_string(), slots_hex(s, &p)),
         ("slotforge.sdc".to_string(), sdc(s)),
         ("slotforge.xdc".to_string(), xdc(s, &p)),
         (

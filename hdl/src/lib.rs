@@ -4,7 +4,7 @@
 //!
 //! rust-hdl stays behind this API: nothing public here names a rust-hdl type.
 //!
-//! - [`emit`] / [`Emitted`]: `slotforge_top.v`, `ports.json`, `slots.hex`,
+//! - [`emit`] / [`Emitted`]: `slotforge_top.v`, `ports.json`, `slots.hex` (the LUT), `slot_rom.hex` (the ROM image),
 //!   `slotforge.pcf`, `slotforge.sdc`, `slotforge.xdc`;
 //! - [`RtlSim`] / [`Pins`]: cycle-accurate simulation of the same blocks.
 //!

@@ -106,6 +106,7 @@ fn emission_is_deterministic() {
         names,
         [
             "ports.json",
+            "slot_rom.hex",
             "slotforge.pcf",
             "slotforge.sdc",
             "slotforge.xdc",

@@ -1,4 +1,4 @@
-//! `slotforge verilog` (being built: see the issue tracker).
+//! `slotforge verilog MIX -o DIR`: the gateware and everything a tool flow needs.
 
 use std::path::PathBuf;
 
@@ -6,9 +6,43 @@ use std::path::PathBuf;
 pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
+    /// Output directory (created if missing; only the generated files are written).
+    #[arg(short = 'o', long = "out")]
+    pub out: PathBuf,
+    /// Board file mapping port bits to pins (see constraints/); without it the
+    /// PCF is a template listing every port bit.
+    #[arg(long)]
+    pub board: Option<PathBuf>,
 }
 
-pub fn run(_args: Args) -> u8 {
-    eprintln!("error: `slotforge verilog` is not available in this build yet");
-    2
+pub fn run(args: Args) -> u8 {
+    let s = match super::schedule(&args.mix) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let emitted = match hdl::emit(&s, args.board.as_deref()) {
+        Ok(e) => e,
+        Err(e @ hdl::HdlError::Unsupported(_)) => {
+            eprintln!("error: {}: {e}", args.mix.display());
+            return 1;
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let files: Vec<(&str, String)> = emitted
+        .files
+        .iter()
+        .map(|(n, t)| (n.as_str(), t.clone()))
+        .collect();
+    match super::write_files(&args.out, &files) {
+        Ok(()) => {
+            for (name, _) in &files {
+                println!("{}", args.out.join(name).display());
+            }
+            0
+        }
+        Err(code) => code,
+    }
 }
