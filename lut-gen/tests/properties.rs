@@ -49,10 +49,10 @@ fn feasible_spec(grid: usize, branches: usize, draws: Vec<(usize, usize, u64, bo
     let slots = 10 * sps;
     // Periods (in slots) whose rate is a whole number of Hz dividing the clock.
     let periods: Vec<u64> = (1..=slots)
-        .filter(|p| slots % p == 0)
+        .filter(|p| slots.is_multiple_of(*p))
         .filter(|p| {
             let rate = (slots / p) * 100;
-            CLOCK % rate == 0
+            CLOCK.is_multiple_of(rate)
         })
         .collect();
     let mut occ = vec![vec![false; slots as usize]; branches];
