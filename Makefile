@@ -44,11 +44,13 @@ cosim: tools
 	$(SLOTFORGE) sim $(MIX) --backend rusthdl --frames 2
 	$(SLOTFORGE) sim $(MIX) --backend verilator --frames 2
 
-synth: tools verilog
-	bash hdl/synth.sh $(OUT)/slotforge_top.v
+# Place and route on an iCE40 HX8K; prints LCs and Fmax (figures: docs/synthesis.md).
+synth: tools
+	bash hdl/synth.sh $(MIX)
 
 bench:
 	$(CARGO) bench -p lut-gen --bench synthesis
+	$(CARGO) bench -p cosim --bench cosim
 
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
