@@ -6,7 +6,11 @@
 //!
 //! - [`emit`] / [`Emitted`]: `slotforge_top.v`, `ports.json`, `slots.hex` (the LUT), `slot_rom.hex` (the ROM image),
 //!   `slotforge.pcf`, `slotforge.sdc`, `slotforge.xdc`;
-//! - [`RtlSim`] / [`Pins`]: cycle-accurate simulation of the same blocks.
+//! - [`RtlSim`] / [`Pins`]: cycle-accurate simulation of the same blocks;
+//! - [`stock_simulation_cycles`] / [`StockRun`]: the same blocks under
+//!   rust-hdl's stock threaded `Simulation` engine (the reference that
+//!   `RtlSim`'s speed is measured against), and [`rtlsim_cycles`], the
+//!   identical run with `RtlSim`.
 //!
 //! The cycle-level behaviour is `docs/timing.md`; the design choices are in
 //! `hdl/DESIGN.md`.
@@ -15,6 +19,7 @@ mod core;
 mod emit;
 mod plan;
 mod sim;
+mod stock;
 
 pub use emit::{emit, Board, Emitted};
 pub use plan::{
@@ -22,6 +27,7 @@ pub use plan::{
     MAX_SLOT_CYCLES,
 };
 pub use sim::{Pins, RtlSim};
+pub use stock::{pattern_miso, rtlsim_cycles, stock_simulation_cycles, StockRun};
 
 /// Why gateware could not be produced.
 #[derive(Debug, thiserror::Error)]
@@ -32,6 +38,10 @@ pub enum HdlError {
     /// The board file is unreadable, malformed or lacks pins.
     #[error("board file {path}: {message}")]
     Board { path: String, message: String },
+    /// rust-hdl's stock `Simulation` engine failed (design check, no
+    /// convergence, testbench panic).
+    #[error("rust-hdl simulation: {0}")]
+    Simulation(String),
     #[error("{path}: {source}")]
     Io {
         path: String,

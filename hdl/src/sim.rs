@@ -42,8 +42,40 @@ pub struct Pins {
 pub struct RtlSim {
     core: Box<Core>,
     passes: u64,
+    reader: PinReader,
+}
+
+/// What is needed to turn the core's fixed-maximum ports into [`Pins`].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PinReader {
     nb: usize,
+    lanes: u8,
     ch_mask: u16,
+}
+
+impl PinReader {
+    pub(crate) fn new(p: &plan::Plan) -> PinReader {
+        let nb = p.branches.len();
+        PinReader {
+            nb,
+            lanes: ((1u32 << nb) - 1) as u8,
+            ch_mask: ((1u32 << p.channel_bits) - 1) as u16,
+        }
+    }
+}
+
+/// The `slotforge_top` outputs of the core as they are now.
+#[inline]
+pub(crate) fn read_pins(c: &Core, r: &PinReader) -> Pins {
+    Pins {
+        cs_n: c.adc_cs_n.val().to_u64() as u8 & r.lanes,
+        sclk: c.adc_sclk.val().to_u64() as u8 & r.lanes,
+        mux_sel: c.mux_sel.val().to_u64() as u32,
+        mux_en: c.mux_en.val().to_u64(),
+        sample_valid: c.sample_valid.val(),
+        sample_channel: c.sample_channel.val().to_u64() as u16 & r.ch_mask,
+        sample_value: c.sample_value.val().to_u64() as u16,
+    }
 }
 
 impl RtlSim {
@@ -53,18 +85,16 @@ impl RtlSim {
         core.connect_all();
         core.clock.next = Clock::from(false);
         simulate(&mut *core, 1000);
-        let nb = p.branches.len();
         Ok(RtlSim {
             core,
             passes: 0,
-            nb,
-            ch_mask: ((1u32 << p.channel_bits) - 1) as u16,
+            reader: PinReader::new(&p),
         })
     }
 
     /// Number of branches (valid bits of `cs_n`, `sclk`, `miso`).
     pub fn branches(&self) -> usize {
-        self.nb
+        self.reader.nb
     }
 
     /// Evaluation passes over the design so far (a cost measure).
@@ -83,16 +113,7 @@ impl RtlSim {
         c.clock.next = Clock::from(true);
         let ok = settle(c, &mut self.passes);
         debug_assert!(ok, "combinational logic did not settle");
-        let lanes = ((1u32 << self.nb) - 1) as u8;
-        Pins {
-            cs_n: c.adc_cs_n.val().to_u64() as u8 & lanes,
-            sclk: c.adc_sclk.val().to_u64() as u8 & lanes,
-            mux_sel: c.mux_sel.val().to_u64() as u32,
-            mux_en: c.mux_en.val().to_u64(),
-            sample_valid: c.sample_valid.val(),
-            sample_channel: c.sample_channel.val().to_u64() as u16 & self.ch_mask,
-            sample_value: c.sample_value.val().to_u64() as u16,
-        }
+        read_pins(c, &self.reader)
     }
 }
 
