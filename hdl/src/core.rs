@@ -569,6 +569,8 @@ pub struct Core {
     pub merge: Merger,
     /// Devices per branch (the glue's only per-mix parameter besides the count).
     _devices: Vec<usize>,
+    /// The value last written to `mux_en.next` (simulation only).
+    _mux_en: u64,
 }
 
 impl Core {
@@ -588,7 +590,68 @@ impl Core {
             branches: plan.branches.iter().map(BranchUnit::new).collect(),
             merge: Merger::default(),
             _devices: plan.branches.iter().map(|b| b.devices).collect(),
+            _mux_en: 0,
         }
+    }
+}
+
+/// Drive one clock signal to `level` now (as its own `update_all` would).
+#[inline(always)]
+fn drive(sig: &mut Signal<In, Clock>, level: Clock) {
+    sig.next = level;
+    sig.update_all();
+}
+
+impl Core {
+    /// `mux_en` as a number (the value of the `mux_en` signal).
+    pub fn mux_en_u64(&self) -> u64 {
+        self._mux_en
+    }
+
+    /// Put `level` on every clock signal of the hierarchy at once: the
+    /// zero-skew clock net of the emitted Verilog.
+    ///
+    /// rust-hdl's own propagation moves the clock one hierarchy level per
+    /// evaluation pass (`Core.clock` -> `timing.clock` -> `timing.cnt.clock`),
+    /// which costs three passes per clock level before any flip-flop can
+    /// react. After this call the next pass sees the edge at every flip-flop
+    /// and ROM together, and the per-pass copies that the blocks' own
+    /// `update` (`clock!`/`dff_setup!` wiring) make are no-ops.  Only the
+    /// clock moves here; data still propagates through rust-hdl's passes.
+    pub fn drive_clock(&mut self, level: bool) {
+        let k = Clock::from(level);
+        drive(&mut self.clock, k);
+        let t = &mut self.timing;
+        drive(&mut t.clock, k);
+        drive(&mut t.cnt.clock, k);
+        drive(&mut t.st.clock, k);
+        drive(&mut t.st2.clock, k);
+        drive(&mut t.slot.clock, k);
+        for u in self.branches.iter_mut() {
+            drive(&mut u.clock, k);
+            drive(&mut u.rom.clock, k);
+            drive(&mut u.go.clock, k);
+            drive(&mut u.r_cs_n.clock, k);
+            drive(&mut u.r_sclk.clock, k);
+            drive(&mut u.ph.clock, k);
+            drive(&mut u.nfall.clock, k);
+            drive(&mut u.shift.clock, k);
+            drive(&mut u.cur_ch.clock, k);
+            drive(&mut u.first.clock, k);
+            drive(&mut u.p_sel.clock, k);
+            drive(&mut u.p_dev.clock, k);
+            drive(&mut u.r_sel.clock, k);
+            drive(&mut u.r_en.clock, k);
+            drive(&mut u.r_done.clock, k);
+            drive(&mut u.r_rch.clock, k);
+            drive(&mut u.r_rval.clock, k);
+        }
+        let m = &mut self.merge;
+        drive(&mut m.clock, k);
+        drive(&mut m.r_valid.clock, k);
+        drive(&mut m.r_ch.clock, k);
+        drive(&mut m.r_val.clock, k);
+        drive(&mut m.pend.clock, k);
     }
 }
 
@@ -635,24 +698,31 @@ impl Logic for Core {
         self.adc_cs_n.next = (cs | idle).into();
         self.adc_sclk.next = (sclk | idle).into();
         self.mux_sel.next = sel.into();
-        self.mux_en.next = (en as u64).into();
+        // `mux_en` is 64 bits wide, which rust-hdl stores as `[bool; 64]`:
+        // converting it on every evaluation pass dominated the simulation,
+        // so it is written only when its value changes (same signal value).
+        let en = en as u64;
+        if en != self._mux_en {
+            self._mux_en = en;
+            self.mux_en.next = en.into();
+        }
         self.merge.done.next = done.into();
-        self.merge.ch0.next = chs[0].into();
-        self.merge.ch1.next = chs[1].into();
-        self.merge.ch2.next = chs[2].into();
-        self.merge.ch3.next = chs[3].into();
-        self.merge.ch4.next = chs[4].into();
-        self.merge.ch5.next = chs[5].into();
-        self.merge.ch6.next = chs[6].into();
-        self.merge.ch7.next = chs[7].into();
-        self.merge.v0.next = vals[0].into();
-        self.merge.v1.next = vals[1].into();
-        self.merge.v2.next = vals[2].into();
-        self.merge.v3.next = vals[3].into();
-        self.merge.v4.next = vals[4].into();
-        self.merge.v5.next = vals[5].into();
-        self.merge.v6.next = vals[6].into();
-        self.merge.v7.next = vals[7].into();
+        // Lanes >= nb keep their default 0 (the glue ties them to zero).
+        let m = &mut self.merge;
+        let lanes = [
+            (&mut m.ch0, &mut m.v0),
+            (&mut m.ch1, &mut m.v1),
+            (&mut m.ch2, &mut m.v2),
+            (&mut m.ch3, &mut m.v3),
+            (&mut m.ch4, &mut m.v4),
+            (&mut m.ch5, &mut m.v5),
+            (&mut m.ch6, &mut m.v6),
+            (&mut m.ch7, &mut m.v7),
+        ];
+        for (b, (ch, v)) in lanes.into_iter().enumerate().take(nb) {
+            ch.next = chs[b].into();
+            v.next = vals[b].into();
+        }
         self.sample_valid.next = self.merge.valid.val();
         self.sample_channel.next = self.merge.channel.val();
         self.sample_value.next = self.merge.value.val();
