@@ -9,6 +9,7 @@ pub mod backend;
 pub mod checker;
 pub mod faults;
 pub mod model;
+pub mod mutate;
 pub mod pins;
 pub mod report;
 pub mod run;

@@ -1,0 +1,389 @@
+//! Mutation test of the checker: mutants of the emitted Verilog that the
+//! independent Icarus testbench (`tests/tb/adc_tb.v`, judged as
+//! `tests/icarus.rs` judges it) rejects must all be rejected by
+//! `cosim::check_vcd` on the VCD of the same Icarus run.
+//!
+//! One Icarus run per mutant gives both verdicts: the testbench is compiled
+//! unchanged next to a two-line module that dumps the ports of `adc_tb.dut`.
+//! Mutants come from `cosim::mutate` (deterministic sites, fixed counts per
+//! operator) on `tests/data/mutants.toml`, a two-branch mix with harmonic
+//! and non-harmonic rates and two mux devices on one branch; 2.5 frames of
+//! 4000 cycles each.  Run with `--nocapture` for the per-mutant table.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use cosim::mutate::{self, Operator};
+
+/// Sites per operator: 36 mutants on the test mix.
+const PER_OP: [(Operator, usize); 8] = [
+    (Operator::RelOp, 5),
+    (Operator::Const, 8),
+    (Operator::Reset, 5),
+    (Operator::AndOr, 3),
+    (Operator::Arith, 3),
+    (Operator::DropNot, 2),
+    (Operator::Concat, 4),
+    (Operator::Stuck, 6),
+];
+
+/// A normal run takes about half a second.
+const VVP_TIMEOUT: Duration = Duration::from_secs(20);
+
+fn have(tool: &str) -> bool {
+    Command::new(tool).arg("-V").output().is_ok()
+}
+
+fn manifest() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+struct Bench {
+    mix: lut_gen::Mix,
+    s: lut_gen::Schedule,
+    cycles: u64,
+    tb: PathBuf,
+}
+
+#[derive(Debug)]
+struct Verdicts {
+    /// iverilog's complaint, if it did not compile.
+    compile: Option<String>,
+    /// The independent testbench's verdict.
+    independent: Result<(), String>,
+    /// `check_vcd`'s verdict.
+    check: Result<(), String>,
+}
+
+impl Bench {
+    fn run(&self, verilog: &str, dir: &Path) -> Verdicts {
+        std::fs::write(dir.join("slotforge_top.v"), verilog).unwrap();
+        std::fs::write(
+            dir.join("dump.v"),
+            "module dump;\n  initial begin\n    $dumpfile(\"wave.vcd\");\n    $dumpvars(1, adc_tb.dut);\n  end\nendmodule\n",
+        )
+        .unwrap();
+        let s = &self.s;
+        let nb = s.branches.len();
+        let nm: u32 = s.branches.iter().map(|b| b.mux_devices).sum();
+        let half_ns = 1e9 / s.grid.clock_hz as f64 / 2.0;
+        let o = Command::new("iverilog")
+            .args(["-g2005", "-o", "sim"])
+            .arg(format!("-DNB={nb}"))
+            .arg(format!("-DNM={nm}"))
+            .arg(format!("-DWC={}", s.channel_bits()))
+            .arg(format!("-DCLK_HALF={half_ns:.4}"))
+            .arg(format!("-DCYCLES={}", self.cycles))
+            .arg("-DLOG=\"tb.log\"")
+            .arg(&self.tb)
+            .args(["dump.v", "slotforge_top.v"])
+            .current_dir(dir)
+            .output()
+            .unwrap();
+        if !o.status.success() {
+            let e = String::from_utf8_lossy(&o.stderr).to_string();
+            return Verdicts {
+                compile: Some(e.clone()),
+                independent: Err(format!("does not compile: {e}")),
+                check: Err("no VCD: does not compile".into()),
+            };
+        }
+        let mut child = Command::new("vvp")
+            .args(["-n", "sim"])
+            .current_dir(dir)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let t0 = Instant::now();
+        let ran = loop {
+            if let Some(st) = child.try_wait().unwrap() {
+                break if st.success() {
+                    Ok(())
+                } else {
+                    Err(format!("vvp: {st}"))
+                };
+            }
+            if t0.elapsed() > VVP_TIMEOUT {
+                let _ = child.kill();
+                let _ = child.wait();
+                break Err(format!("vvp: no finish within {VVP_TIMEOUT:?}"));
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        };
+        let independent = ran.clone().and_then(|()| {
+            let log = std::fs::read_to_string(dir.join("tb.log")).map_err(|e| e.to_string())?;
+            judge(&self.mix, s, &log, self.cycles)
+        });
+        let check = match cosim::check_vcd(s, dir.join("wave.vcd"), None) {
+            Ok(r) if r.ok => Ok(()),
+            Ok(r) => Err(r.summary().lines().next().unwrap_or("").to_string()),
+            Err(e) => Err(format!("error: {e}")),
+        };
+        Verdicts {
+            compile: None,
+            independent,
+            check,
+        }
+    }
+}
+
+/// The verdict of `tests/icarus.rs` on a testbench log, as a `Result`.
+fn judge(mix: &lut_gen::Mix, s: &lut_gen::Schedule, text: &str, cycles: u64) -> Result<(), String> {
+    struct Conversion {
+        cycle: u64,
+        channel: usize,
+        code: u16,
+    }
+    let nb = s.branches.len();
+    let mut first_device = vec![0u32; nb];
+    for b in 1..nb {
+        first_device[b] = first_device[b - 1] + s.branches[b - 1].mux_devices;
+    }
+    let address: BTreeMap<(usize, u32, u32), usize> = s
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(c, cs)| ((mix.channels[c].branch, cs.select, cs.device), c))
+        .collect();
+    let mut conversions: Vec<Vec<Conversion>> = (0..nb).map(|_| Vec::new()).collect();
+    let mut samples: Vec<(u64, usize, u16)> = Vec::new();
+    for line in text.lines() {
+        let f: Vec<u64> = line
+            .split_whitespace()
+            .skip(1)
+            .map(|x| x.parse())
+            .collect::<Result<_, _>>()
+            .map_err(|_| format!("log line with unknowns: {line:?}"))?;
+        match line.split_whitespace().next() {
+            Some("CS") if f.len() == 5 => {
+                let (b, cycle, sel, en, code) =
+                    (f[0] as usize, f[1], f[2] as u32, f[3], f[4] as u16);
+                let mine = (en >> first_device[b]) & ((1 << s.branches[b].mux_devices) - 1);
+                if mine.count_ones() != 1 {
+                    return Err(format!(
+                        "cycle {cycle}: branch {b} enables {mine:b}: not exactly one device"
+                    ));
+                }
+                let device = mine.trailing_zeros();
+                let channel = *address.get(&(b, sel, device)).ok_or_else(|| {
+                    format!("cycle {cycle}: branch {b} samples unused input {device}.{sel}")
+                })?;
+                conversions[b].push(Conversion {
+                    cycle,
+                    channel,
+                    code,
+                });
+            }
+            Some("SAMPLE") if f.len() == 3 => samples.push((f[0], f[1] as usize, f[2] as u16)),
+            _ => return Err(format!("bad log line {line:?}")),
+        }
+    }
+    // 1. conversions exactly at the schedule's instants, on the right channel
+    let frames = cycles.div_ceil(s.grid.frame_cycles);
+    for (b, convs) in conversions.iter().enumerate() {
+        let expected: Vec<(u64, usize)> = s
+            .instants(frames)
+            .filter(|i| i.branch == b && i.cycle < cycles - 2)
+            .map(|i| (i.cycle, i.channel))
+            .collect();
+        let got: Vec<(u64, usize)> = convs.iter().map(|c| (c.cycle, c.channel)).collect();
+        if got != expected {
+            let k = got
+                .iter()
+                .zip(&expected)
+                .take_while(|(a, b)| a == b)
+                .count();
+            return Err(format!(
+                "branch {b}: conversions differ from the schedule at #{k}: got {:?}, expected {:?} ({} vs {})",
+                got.get(k),
+                expected.get(k),
+                got.len(),
+                expected.len()
+            ));
+        }
+    }
+    // 2. every interval is exactly clock/rate
+    for (c, ch) in mix.channels.iter().enumerate() {
+        let times: Vec<u64> = conversions[ch.branch]
+            .iter()
+            .filter(|x| x.channel == c)
+            .map(|x| x.cycle)
+            .collect();
+        if times.is_empty() {
+            return Err(format!("{} never sampled", ch.name));
+        }
+        for w in times.windows(2) {
+            if w[1] - w[0] != mix.clock_hz / ch.rate_hz {
+                return Err(format!("{}: interval at cycle {}", ch.name, w[0]));
+            }
+        }
+    }
+    // 3. every sample leaves with the channel and the code the ADC shifted out, in order
+    let mut per_channel: BTreeMap<usize, Vec<u16>> = BTreeMap::new();
+    for (_, ch, v) in &samples {
+        per_channel.entry(*ch).or_default().push(*v);
+    }
+    let read = s.branches.iter().map(|b| b.spi.read_cycles).max().unwrap();
+    for (c, ch) in mix.channels.iter().enumerate() {
+        let shifted: Vec<u16> = conversions[ch.branch]
+            .iter()
+            .filter(|x| x.channel == c && x.cycle + read + 1 + nb as u64 <= cycles - 2)
+            .map(|x| x.code)
+            .collect();
+        let got = per_channel.get(&c).cloned().unwrap_or_default();
+        if got.len() < shifted.len() {
+            return Err(format!(
+                "{}: {} samples out, {} conversions done",
+                ch.name,
+                got.len(),
+                shifted.len()
+            ));
+        }
+        if got[..shifted.len()] != shifted[..] {
+            return Err(format!(
+                "{}: sample values differ from the ADC's words",
+                ch.name
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn short(r: &Result<(), String>) -> String {
+    match r {
+        Ok(()) => "accept".into(),
+        Err(e) => {
+            let e = e.replace('\n', " ");
+            format!("REJECT ({})", e.chars().take(90).collect::<String>())
+        }
+    }
+}
+
+#[test]
+fn every_mutant_the_independent_testbench_rejects_is_rejected_by_check() {
+    if !have("iverilog") {
+        eprintln!("iverilog missing: skipped");
+        return;
+    }
+    let t0 = Instant::now();
+    let mix = lut_gen::load(&manifest().join("tests/data/mutants.toml")).unwrap();
+    let s = lut_gen::synthesize(&mix).unwrap();
+    let bench = Bench {
+        cycles: s.grid.frame_cycles * 5 / 2 + 50,
+        tb: manifest().join("../tests/tb/adc_tb.v"),
+        mix,
+        s,
+    };
+    let original = hdl::emit(&bench.s, None)
+        .unwrap()
+        .file("slotforge_top.v")
+        .unwrap()
+        .to_string();
+
+    // the unmutated design passes both, so the test can fail
+    let d = tempfile::tempdir().unwrap();
+    let v = bench.run(&original, d.path());
+    assert!(v.compile.is_none(), "original: {v:?}");
+    assert_eq!(v.independent, Ok(()), "original, independent testbench");
+    assert_eq!(v.check, Ok(()), "original, check_vcd");
+
+    // COSIM_MUTANTS=N: up to N sites per operator instead of PER_OP (a longer hunt)
+    let per_op: Vec<(Operator, usize)> = match std::env::var("COSIM_MUTANTS") {
+        Ok(n) => {
+            let n = n
+                .parse()
+                .expect("COSIM_MUTANTS: a number of sites per operator");
+            Operator::ALL.iter().map(|&o| (o, n)).collect()
+        }
+        Err(_) => PER_OP.to_vec(),
+    };
+    let mutants = mutate::mutants(&original, &per_op);
+    assert!(mutants.len() >= 30, "only {} mutants", mutants.len());
+    let results: Mutex<Vec<Option<Verdicts>>> =
+        Mutex::new((0..mutants.len()).map(|_| None).collect());
+    let next = AtomicUsize::new(0);
+    std::thread::scope(|sc| {
+        let workers = std::env::var("COSIM_MUTANT_JOBS")
+            .ok()
+            .and_then(|j| j.parse().ok())
+            .unwrap_or(2);
+        for _ in 0..workers {
+            sc.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(m) = mutants.get(i) else { break };
+                let d = tempfile::tempdir().unwrap();
+                let v = bench.run(&m.text, d.path());
+                results.lock().unwrap()[i] = Some(v);
+            });
+        }
+    });
+    let results: Vec<Verdicts> = results
+        .into_inner()
+        .unwrap()
+        .into_iter()
+        .map(Option::unwrap)
+        .collect();
+
+    let mut per_op: BTreeMap<Operator, [usize; 4]> = BTreeMap::new();
+    let (mut compiled, mut by_tb, mut by_check, mut both_accept) = (0, 0, 0, 0);
+    let mut slipped = Vec::new();
+    for (m, v) in mutants.iter().zip(&results) {
+        eprintln!(
+            "{:<60} tb: {:<40} check: {}",
+            m.describe(),
+            if v.compile.is_some() {
+                "does not compile".into()
+            } else {
+                short(&v.independent)
+            },
+            if v.compile.is_some() {
+                String::new()
+            } else {
+                short(&v.check)
+            }
+        );
+        let e = per_op.entry(m.site.op).or_default();
+        e[0] += 1;
+        if v.compile.is_some() {
+            continue;
+        }
+        compiled += 1;
+        let (tb_rej, chk_rej) = (v.independent.is_err(), v.check.is_err());
+        by_tb += tb_rej as usize;
+        by_check += chk_rej as usize;
+        e[1] += tb_rej as usize;
+        e[2] += chk_rej as usize;
+        if !tb_rej && !chk_rej {
+            both_accept += 1;
+            e[3] += 1;
+        }
+        if tb_rej && !chk_rej {
+            slipped.push(format!("{}: {}", m.describe(), short(&v.independent)));
+        }
+    }
+    eprintln!("operator  mutants  killed-by-tb  killed-by-check  both-accept");
+    for (op, [n, t, c, a]) in &per_op {
+        eprintln!("{:<9} {n:>7} {t:>13} {c:>16} {a:>12}", op.name());
+    }
+    eprintln!(
+        "{} mutants, {compiled} compile; independent testbench kills {by_tb}, check kills {by_check}; \
+         {both_accept} accepted by both (equivalent on this stimulus); {:.1} s",
+        mutants.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    assert!(
+        slipped.is_empty(),
+        "mutants the independent testbench rejects but check accepts:\n{}",
+        slipped.join("\n")
+    );
+    assert!(compiled >= 20, "only {compiled} mutants compile");
+    assert!(
+        by_tb >= compiled / 2,
+        "the testbench kills only {by_tb} of {compiled}"
+    );
+}
