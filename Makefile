@@ -15,8 +15,10 @@ run: tools
 	$(SLOTFORGE) lut $(MIX) -o $(OUT)
 	$(SLOTFORGE) verilog $(MIX) -o $(OUT)
 	$(SLOTFORGE) sim $(MIX) --backend model --frames 100
-	$(SLOTFORGE) sim $(MIX) --backend verilator --frames 2
-	@echo "outputs in $(OUT)"
+	$(SLOTFORGE) sim $(MIX) --backend rusthdl --frames 2
+	$(SLOTFORGE) sim $(MIX) --backend verilator --frames 2 --vcd $(OUT)/frame0.vcd --from 0 --to 1
+	$(SLOTFORGE) check $(MIX) $(OUT)/frame0.vcd
+	@echo "outputs in $(OUT) (open $(OUT)/frame0.gtkw in GTKWave)"
 
 test: tools
 	$(CARGO) fmt --all -- --check
