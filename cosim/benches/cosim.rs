@@ -1,20 +1,20 @@
 //! Side-by-side throughput ratios (not a timed test):
 //!   cargo bench -p cosim --bench cosim [-- FRAMES]
 //!
-//! 1. verilator back end with full checking vs the same verilated model stepped unchecked;
-//! 2. rusthdl back end with full checking vs hdl::RtlSim stepped unchecked;
-//! 2b. rusthdl back end with full checking vs the same core under rust-hdl's
-//!     stock threaded `Simulation` (goal >= 20x);
-//! 3. model back end vs real time;
-//! 4. `check` of a VCD vs a bare streaming parse with the same reader.
+//! - 1: verilator back end with full checking vs the same verilated model stepped unchecked;
+//! - 2: rusthdl back end with full checking vs hdl::RtlSim stepped unchecked;
+//! - 2b: rusthdl back end with full checking vs the same core under rust-hdl's
+//!   stock threaded `Simulation` (goal >= 20x);
+//! - 3: model back end vs real time;
+//! - 4: `check` of a VCD vs a bare streaming parse with the same reader.
 
 use std::path::Path;
 use std::time::Instant;
 
 use cosim::backend::{verilog, RustHdlDut};
 use cosim::run::{run_dut, run_model, run_unchecked, ModelDut, RunOptions};
-use cosim::verilator::VerilatedDut;
 use cosim::vcdout::VcdWriter;
+use cosim::verilator::VerilatedDut;
 use cosim::Stimulus;
 
 fn secs<T>(f: impl FnOnce() -> T) -> (f64, T) {
@@ -24,7 +24,10 @@ fn secs<T>(f: impl FnOnce() -> T) -> (f64, T) {
 }
 
 fn main() {
-    let frames: u64 = std::env::args().skip(1).find_map(|a| a.parse().ok()).unwrap_or(10);
+    let frames: u64 = std::env::args()
+        .skip(1)
+        .find_map(|a| a.parse().ok())
+        .unwrap_or(10);
     let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml");
     let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
     let cycles = frames * s.grid.frame_cycles;
@@ -35,7 +38,11 @@ fn main() {
     // 1. verilator
     let v = verilog(&s).unwrap();
     let (mut dut, built) = VerilatedDut::new(&v).unwrap();
-    println!("verilator model {} ({})", built.key, if built.cached { "cached" } else { "built" });
+    println!(
+        "verilator model {} ({})",
+        built.key,
+        if built.cached { "cached" } else { "built" }
+    );
     let (tu, _) = secs(|| run_unchecked(&s, &mut dut, frames, Stimulus::Pattern));
     drop(dut);
     let (mut dut, _) = VerilatedDut::new(&v).unwrap();

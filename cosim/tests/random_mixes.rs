@@ -24,7 +24,9 @@ impl Rng {
 fn random_mix(seed: u64) -> String {
     let mut r = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
     let nb = 1 + r.next() % 3;
-    let mut t = String::from("name = \"rand\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 2_000\nslice_us = 1_000\n");
+    let mut t = String::from(
+        "name = \"rand\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 2_000\nslice_us = 1_000\n",
+    );
     let mut devs = Vec::new();
     for b in 0..nb {
         let d = 1 + r.next() % 3;
@@ -42,7 +44,10 @@ fn random_mix(seed: u64) -> String {
             continue;
         }
         let rate = r.pick(&[500u64, 1_000, 2_000, 4_000, 8_000]);
-        let _ = write!(t, "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {rate}\ninput = {input}\n");
+        let _ = write!(
+            t,
+            "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {rate}\ninput = {input}\n"
+        );
     }
     t
 }
@@ -52,8 +57,12 @@ fn random_feasible_mixes() {
     let mut tested = 0;
     for seed in 0..40u64 {
         let text = random_mix(seed);
-        let Ok(mix) = lut_gen::parse(Path::new("rand.toml"), &text) else { continue };
-        let Ok(s) = lut_gen::synthesize(&mix) else { continue };
+        let Ok(mix) = lut_gen::parse(Path::new("rand.toml"), &text) else {
+            continue;
+        };
+        let Ok(s) = lut_gen::synthesize(&mix) else {
+            continue;
+        };
         // branches without channels are not interesting here
         if (0..s.branches.len()).any(|b| s.branch_instants_in_frame(b).is_empty()) {
             continue;
@@ -78,8 +87,18 @@ fn random_feasible_mixes() {
                 Fault::MuxLate { branch } => s.branches[branch].settle_cycles > 2,
                 _ => true,
             };
-            assert!(r.divergence_count > 0, "seed {seed}: fault {} missed by the model\n{text}\n{}", f.name(), r.summary());
-            assert!(!invariant_visible || r.violation_count > 0, "seed {seed}: fault {} missed by the invariants\n{text}\n{}", f.name(), r.summary());
+            assert!(
+                r.divergence_count > 0,
+                "seed {seed}: fault {} missed by the model\n{text}\n{}",
+                f.name(),
+                r.summary()
+            );
+            assert!(
+                !invariant_visible || r.violation_count > 0,
+                "seed {seed}: fault {} missed by the invariants\n{text}\n{}",
+                f.name(),
+                r.summary()
+            );
         }
     }
     assert!(tested >= 10, "only {tested} random mixes were feasible");
