@@ -46,7 +46,7 @@ cosim: tools
 	$(SLOTFORGE) sim $(MIX) --backend rusthdl --frames 2
 	$(SLOTFORGE) sim $(MIX) --backend verilator --frames 2
 
-# Place and route on an iCE40 HX8K; prints LCs and Fmax (figures: docs/synthesis.md).
+# Place and route on an iCE40 HX8K; prints LCs and Fmax (figures: docs/performance.md).
 synth: tools
 	bash hdl/synth.sh $(MIX)
 
