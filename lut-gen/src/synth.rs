@@ -425,7 +425,7 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
             Attempt::Failed { bounded: b, .. } => bounded |= b,
         }
     }
-    Err(diagnose(mix, &plans, &candidates, bounded))
+    Err(diagnose(mix, &candidates, bounded))
 }
 
 fn build(
@@ -468,13 +468,18 @@ fn build(
 
 /// Rates near `rate` that give whole samples per frame and whole cycles per sample.
 fn nearest_exact_rates(mix: &Mix, rate: u64) -> String {
-    let ok = |r: u64| {
-        r > 0
-            && mix.clock_hz.is_multiple_of(r)
+    let exact = (1..=rate.saturating_mul(2).max(2)).filter(|&r| {
+        mix.clock_hz.is_multiple_of(r)
             && (r as u128 * mix.frame_us as u128).is_multiple_of(1_000_000)
-    };
-    let below = (1..rate).rev().find(|&r| ok(r));
-    let above = (rate + 1..=rate.saturating_mul(2).max(rate + 1)).find(|&r| ok(r));
+    });
+    nearest(exact, rate)
+}
+
+/// The closest candidates below and above `rate` ("a Hz or b Hz"); `rates` ascending.
+fn nearest(rates: impl IntoIterator<Item = u64>, rate: u64) -> String {
+    let rates: Vec<u64> = rates.into_iter().collect();
+    let below = rates.iter().rev().find(|&&r| r < rate);
+    let above = rates.iter().find(|&&r| r > rate);
     [below, above]
         .iter()
         .flatten()
@@ -483,7 +488,18 @@ fn nearest_exact_rates(mix: &Mix, rate: u64) -> String {
         .join(" or ")
 }
 
-fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) -> Infeasible {
+/// Exact rates on a grid of `slots` slots per frame, ascending, with their
+/// samples per frame: the period is whole slots and the interval whole cycles.
+fn grid_rates(mix: &Mix, slots: u64) -> impl Iterator<Item = (u64, u64)> + '_ {
+    let frames_per_s = 1e6 / mix.frame_us as f64;
+    (1..=slots)
+        .filter(move |n| slots.is_multiple_of(*n))
+        .map(move |n| (n, n as f64 * frames_per_s))
+        .filter(|(_, r)| r.fract() == 0.0 && mix.clock_hz.is_multiple_of(*r as u64))
+        .map(|(n, r)| (n, r as u64))
+}
+
+fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
     let k = mix.slices_per_frame();
     // The roomiest grid whose periods are all whole; else simply the roomiest.
     let whole = |sps: u64| {
@@ -499,7 +515,6 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
         .unwrap_or(*candidates.last().unwrap());
     let slots = k * sps;
     let grid = FrameGrid::new(mix, sps);
-    let frames_per_s = 1e6 / mix.frame_us as f64;
     let mut reasons = Vec::new();
     let mut suggestions = Vec::new();
 
@@ -532,7 +547,7 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
                 "`{}`: rates that fit {} slots per slice exactly: {}",
                 c.name,
                 sps,
-                fitting_rates(mix, slots, c.rate_hz)
+                nearest(grid_rates(mix, slots).map(|(_, r)| r), c.rate_hz)
             ));
         }
     } else {
@@ -557,13 +572,8 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
                 }
                 if !overfull {
                     let c = &mix.channels[u.channels[0]];
-                    let fits: Vec<u64> = (1..=slots)
-                        .filter(|n| slots.is_multiple_of(*n))
-                        .filter(|&n| {
-                            let r = n as f64 * frames_per_s;
-                            r.fract() == 0.0 && mix.clock_hz.is_multiple_of(r as u64)
-                        })
-                        .filter(|&n| {
+                    let fits = grid_rates(mix, slots)
+                        .filter(|&(n, _)| {
                             let p = slots / n;
                             let probe = Unit {
                                 period: p,
@@ -571,17 +581,10 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
                             };
                             candidate_offsets(p, sps).any(|o| occ.fits(&probe, o, slots))
                         })
-                        .map(|n| (n as f64 * frames_per_s) as u64)
-                        .collect();
-                    let below = fits.iter().rev().find(|&&r| r < c.rate_hz);
-                    let above = fits.iter().find(|&&r| r > c.rate_hz);
-                    let near: Vec<String> = [below, above]
-                        .iter()
-                        .flatten()
-                        .map(|r| format!("{r} Hz"))
-                        .collect();
+                        .map(|(_, r)| r);
+                    let near = nearest(fits, c.rate_hz);
                     if !near.is_empty() {
-                        let key = (c.rate_hz, near.join(" or "));
+                        let key = (c.rate_hz, near);
                         match collisions.iter_mut().find(|(k, _)| *k == key) {
                             Some((_, names)) => names.push(c.name.clone()),
                             None => collisions.push((key, vec![c.name.clone()])),
@@ -678,7 +681,6 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
             unplaced: std::mem::take(&mut unplaced[b]),
         })
         .collect();
-    let _ = plans;
     Infeasible {
         mix: mix.name.clone(),
         slots_per_slice: Some(sps),
@@ -686,23 +688,4 @@ fn diagnose(mix: &Mix, plans: &[BranchPlan], candidates: &[u64], bounded: bool) 
         branches,
         suggestions,
     }
-}
-
-/// Rates near `rate` whose period is a whole number of `slots`-slot frames.
-fn fitting_rates(mix: &Mix, slots: u64, rate: u64) -> String {
-    let frames_per_s = 1e6 / mix.frame_us as f64;
-    let rates: Vec<u64> = (1..=slots)
-        .filter(|n| slots.is_multiple_of(*n))
-        .map(|n| n as f64 * frames_per_s)
-        .filter(|r| r.fract() == 0.0 && mix.clock_hz.is_multiple_of(*r as u64))
-        .map(|r| r as u64)
-        .collect();
-    let below = rates.iter().rev().find(|&&r| r < rate);
-    let above = rates.iter().find(|&&r| r > rate);
-    [below, above]
-        .iter()
-        .flatten()
-        .map(|r| format!("{r} Hz"))
-        .collect::<Vec<_>>()
-        .join(" or ")
 }
