@@ -2,7 +2,7 @@
 # Synthesize and place-and-route the gateware of a mix for an iCE40-HX8K
 # (ct256) and print logic cells and Fmax.
 #
-#   hdl/synth.sh [MIX.toml ...]      (default: mixes/*.toml)
+#   hdl/synth.sh [MIX.toml ...]      (default: mixes/*.toml hdl/tests/data/*.toml)
 #
 # Uses: cargo (emits the Verilog through hdl::emit), yosys, nextpnr-ice40.
 # Work files go to target/synth/<mix>/.
@@ -12,7 +12,7 @@ for t in yosys nextpnr-ice40; do
   command -v "$t" >/dev/null || { echo "synth.sh: $t is not installed (make installs it)" >&2; exit 2; }
 done
 mixes=("$@")
-[ ${#mixes[@]} -gt 0 ] || mixes=(mixes/*.toml)
+[ ${#mixes[@]} -gt 0 ] || mixes=(mixes/*.toml hdl/tests/data/*.toml)
 board=constraints/ice40-hx8k-breakout.toml
 cargo build -q -p hdl --example emit
 printf '%-12s %10s %6s %6s %6s %10s %10s %s\n' mix clock_MHz LCs LUT4 DFF BRAM Fmax_MHz "Fmax/clock"

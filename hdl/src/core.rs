@@ -5,10 +5,13 @@
 //!
 //! ```text
 //! Core                    fixed-maximum ports (8 branches, 64 mux enables, 8-bit channel)
-//!  |- timing: TimingGen   cycle-in-slot counter, slot-in-frame counter, slot-start strobe
+//!  |- timing: TimingGen   cycle-in-slot counter, slot-in-frame counter, slot-start strobes
+//!  |- seqs: Vec<SpiSeq>   one SPI sequencer per distinct SPI timing (usually one):
+//!  |                      CS/SCLK levels, capture and completion strobes for every slot
 //!  |- branches: Vec<BranchUnit>, one per branch of the mix
 //!  |    |- rom: SlotRom   that branch's column of the frame table (BRAM-friendly)
-//!  |    `- DFFs           CS/SCLK/MISO SPI master and mux control
+//!  |    `- DFFs           "converts this slot" flag, CS/SCLK outputs gated by it,
+//!  |                      MISO shift register, channel, mux control
 //!  `- merge: Merger       8-lane pending set + lowest-branch-first sample stream
 //! ```
 //!
@@ -17,7 +20,7 @@
 
 use rust_hdl::prelude::*;
 
-use crate::plan::{BranchRom, Plan, MAX_BRANCHES};
+use crate::plan::{BranchRom, Plan, SeqTiming, MAX_BRANCHES};
 
 /// Width of the cycle-in-slot counter.
 pub const CNT_BITS: usize = 16;
@@ -33,8 +36,6 @@ pub const DEV_BITS: usize = 5;
 pub const EN_BITS: usize = 32;
 /// Total mux enables on the core.
 pub const EN_TOTAL: usize = 64;
-/// Width of a ROM word: conv(1) ch(8) next_sel(3) next_dev(5).
-pub const WORD_BITS: usize = 17;
 
 fn c<const N: usize>(v: u64) -> Constant<Bits<N>> {
     Constant::new(Bits::<N>::from(v))
@@ -46,17 +47,19 @@ fn c<const N: usize>(v: u64) -> Constant<Bits<N>> {
 
 /// One branch's column of the frame table, read synchronously (one cycle of
 /// latency) so that synthesis maps it to block RAM.  Custom Verilog so the
-/// memory is declared with the exact depth of the frame.
+/// memory is declared with the exact depth and word width of the mix.
 #[derive(LogicBlock)]
 pub struct SlotRom {
     pub clock: Signal<In, Clock>,
     pub address: Signal<In, Bits<SLOT_BITS>>,
     pub conv: Signal<Out, Bit>,
     pub ch: Signal<Out, Bits<CH_BITS>>,
-    pub nsel: Signal<Out, Bits<3>>,
-    pub ndev: Signal<Out, Bits<DEV_BITS>>,
+    pub msel: Signal<Out, Bits<3>>,
+    pub mdev: Signal<Out, Bits<DEV_BITS>>,
     _words: Vec<u32>,
     _addr_bits: usize,
+    _ch_bits: usize,
+    _dev_bits: usize,
 }
 
 impl SlotRom {
@@ -66,10 +69,12 @@ impl SlotRom {
             address: Default::default(),
             conv: Default::default(),
             ch: Default::default(),
-            nsel: Default::default(),
-            ndev: Default::default(),
+            msel: Default::default(),
+            mdev: Default::default(),
             _words: rom.words.clone(),
             _addr_bits: rom.addr_bits,
+            _ch_bits: rom.ch_bits,
+            _dev_bits: rom.dev_bits,
         }
     }
 }
@@ -79,42 +84,58 @@ impl Logic for SlotRom {
         if self.clock.pos_edge() {
             let a = self.address.val().to_u64() as usize;
             let w = self._words.get(a).copied().unwrap_or(0) as u64;
-            self.conv.next = (w >> 16) & 1 == 1;
-            self.ch.next = ((w >> 8) & 0xff).into();
-            self.nsel.next = ((w >> 5) & 0x7).into();
-            self.ndev.next = (w & 0x1f).into();
+            let (cw, dw) = (self._ch_bits, self._dev_bits);
+            self.conv.next = (w >> (cw + 3 + dw)) & 1 == 1;
+            self.ch.next = ((w >> (3 + dw)) & ((1 << cw) - 1)).into();
+            self.msel.next = ((w >> dw) & 0x7).into();
+            self.mdev.next = (w & ((1 << dw) - 1)).into();
         }
     }
 
     fn connect(&mut self) {
         self.conv.connect();
         self.ch.connect();
-        self.nsel.connect();
-        self.ndev.connect();
+        self.msel.connect();
+        self.mdev.connect();
     }
 
     fn hdl(&self) -> Verilog {
         let aw = self._addr_bits;
+        let (cw, dw) = (self._ch_bits, self._dev_bits);
+        let wb = 1 + cw + 3 + dw; // BranchRom::word_bits
+        let digits = wb.div_ceil(4);
         let depth = 1usize << aw;
         let mut s = String::new();
         s.push_str(&format!(
             "reg [{}:0] mem [0:{}];\nreg [{}:0] q;\n\ninitial begin\n",
-            WORD_BITS - 1,
+            wb - 1,
             depth - 1,
-            WORD_BITS - 1
+            wb - 1
         ));
         for a in 0..depth {
             let w = self._words.get(a).copied().unwrap_or(0);
-            s.push_str(&format!("  mem[{a}] = {WORD_BITS}'h{w:05x};\n"));
+            s.push_str(&format!("  mem[{a}] = {wb}'h{w:0digits$x};\n"));
         }
         s.push_str("end\n\n");
         s.push_str(&format!(
             "always @(posedge clock) begin\n  q <= mem[address[{}:0]];\nend\n\n",
             aw - 1
         ));
-        s.push_str(
-            "always @(*) begin\n  conv = q[16];\n  ch = q[15:8];\n  nsel = q[7:5];\n  ndev = q[4:0];\nend\n",
-        );
+        let pad = |field: String, bits: usize, full: usize| {
+            if bits < full {
+                format!("{{{}'h0, {field}}}", full - bits)
+            } else {
+                field
+            }
+        };
+        s.push_str(&format!(
+            "always @(*) begin\n  conv = q[{}];\n  ch = {};\n  msel = q[{}:{}];\n  mdev = {};\nend\n",
+            wb - 1,
+            pad(format!("q[{}:{}]", wb - 2, 3 + dw), cw, CH_BITS),
+            dw + 2,
+            dw,
+            pad(format!("q[{}:0]", dw - 1), dw, DEV_BITS),
+        ));
         if aw < SLOT_BITS {
             s.push_str(&format!(
                 "\n// address bits above the frame depth are always zero\nwire unused_address_hi = |address[{}:{}];\n",
@@ -130,20 +151,24 @@ impl Logic for SlotRom {
 // Timing generator
 // ---------------------------------------------------------------------------
 
-/// Runs ahead of the outputs: `st` (`start2`) is high in cycle `c` iff
-/// cycle `c + 1` (`c + 2`) is the first cycle of a slot; `addr` is the (combinational)
-/// next value of the slot pointer, so the ROMs' registered data always
-/// describe the next slot to start.
+/// Runs ahead of the outputs: `start2` (`start1`, `start0`) is high in cycle
+/// `c` iff cycle `c + 2` (`c + 1`, `c`) is the first cycle of a slot; `addr`
+/// is the (combinational) next value of the slot pointer, so the ROMs'
+/// registered data describe slot `u` from the second cycle of slot `u - 1`
+/// through its last, and slot `u + 1` in the first cycle of slot `u`.
 #[derive(LogicBlock)]
 pub struct TimingGen {
     pub clock: Signal<In, Clock>,
     pub rst: Signal<In, Bit>,
     pub start2: Signal<Out, Bit>,
+    pub start1: Signal<Out, Bit>,
+    pub start0: Signal<Out, Bit>,
     pub addr: Signal<Out, Bits<SLOT_BITS>>,
     /// (c + 2) mod slot_cycles during cycle c.
     cnt: DFF<Bits<CNT_BITS>>,
     st: DFF<Bit>,
     st2: DFF<Bit>,
+    st0: DFF<Bit>,
     /// Frame slot index of the next slot start (> c).
     slot: DFF<Bits<SLOT_BITS>>,
     nxt: Signal<Local, Bits<SLOT_BITS>>,
@@ -162,10 +187,13 @@ impl TimingGen {
             clock: Default::default(),
             rst: Default::default(),
             start2: Default::default(),
+            start1: Default::default(),
+            start0: Default::default(),
             addr: Default::default(),
             cnt: Default::default(),
             st: Default::default(),
             st2: Default::default(),
+            st0: Default::default(),
             slot: Default::default(),
             nxt: Default::default(),
             k_cnt_last: c(plan.slot_cycles - 1),
@@ -182,7 +210,7 @@ impl TimingGen {
 impl Logic for TimingGen {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, cnt, st, st2, slot);
+        dff_setup!(self, clock, cnt, st, st2, st0, slot);
         if self.cnt.q.val() == self.k_cnt_last.val() {
             self.cnt.d.next = self.k_cnt_zero.val();
         } else {
@@ -190,6 +218,7 @@ impl Logic for TimingGen {
         }
         self.st2.d.next = self.cnt.q.val() == self.k_cnt_last.val();
         self.st.d.next = self.st2.q.val();
+        self.st0.d.next = self.st.q.val();
         self.nxt.next = self.slot.q.val();
         if self.st.q.val() {
             if self.slot.q.val() == self.k_slot_last.val() {
@@ -202,49 +231,43 @@ impl Logic for TimingGen {
             self.cnt.d.next = self.k_cnt_rst.val();
             self.st.d.next = true;
             self.st2.d.next = false;
+            self.st0.d.next = false;
             self.nxt.next = self.k_slot_zero.val();
         }
         self.slot.d.next = self.nxt.val();
         self.addr.next = self.nxt.val();
         self.start2.next = self.st2.q.val();
+        self.start1.next = self.st.q.val();
+        self.start0.next = self.st0.q.val();
     }
 }
 
 // ---------------------------------------------------------------------------
-// Branch: SPI master + mux control
+// SPI sequencer: one per distinct SPI timing, shared by its branches
 // ---------------------------------------------------------------------------
 
+/// Every conversion starts at a slot start, so CS/SCLK/capture timing
+/// inside a slot is the same for every branch with the same SPI timing.
+/// The sequencer runs one cycle ahead of the branches' output registers and
+/// starts a (virtual) conversion in every slot: in cycle `c`, `cs_n` and
+/// `sclk` are the levels a converting branch has in cycle `c + 1`, `cap` is
+/// high iff a converting branch captures MISO at the edge that ends cycle
+/// `c`, and `done` is high in cycle `t + R - 1`.
 #[derive(LogicBlock)]
-pub struct BranchUnit {
+pub struct SpiSeq {
     pub clock: Signal<In, Clock>,
     pub rst: Signal<In, Bit>,
     pub start2: Signal<In, Bit>,
-    pub addr: Signal<In, Bits<SLOT_BITS>>,
-    pub miso: Signal<In, Bit>,
     pub cs_n: Signal<Out, Bit>,
     pub sclk: Signal<Out, Bit>,
-    pub mux_sel: Signal<Out, Bits<3>>,
-    pub mux_en: Signal<Out, Bits<EN_BITS>>,
+    pub cap: Signal<Out, Bit>,
     pub done: Signal<Out, Bit>,
-    pub res_ch: Signal<Out, Bits<CH_BITS>>,
-    pub res_val: Signal<Out, Bits<14>>,
-    rom: SlotRom,
-    /// High in cycle t - 1 for every sampling instant t.
-    go: DFF<Bit>,
     r_cs_n: DFF<Bit>,
     r_sclk: DFF<Bit>,
     ph: DFF<Bits<PH_BITS>>,
     nfall: DFF<Bits<5>>,
-    shift: DFF<Bits<14>>,
-    cur_ch: DFF<Bits<CH_BITS>>,
-    first: DFF<Bit>,
-    p_sel: DFF<Bits<3>>,
-    p_dev: DFF<Bits<DEV_BITS>>,
-    r_sel: DFF<Bits<3>>,
-    r_en: DFF<Bits<EN_BITS>>,
+    r_cap: DFF<Bit>,
     r_done: DFF<Bit>,
-    r_rch: DFF<Bits<CH_BITS>>,
-    r_rval: DFF<Bits<14>>,
     wrap: Signal<Local, Bit>,
     half: Signal<Local, Bit>,
     k_ph_last: Constant<Bits<PH_BITS>>,
@@ -255,10 +278,133 @@ pub struct BranchUnit {
     k_nf_zero: Constant<Bits<5>>,
     k_nf_one: Constant<Bits<5>>,
     k_nf_end: Constant<Bits<5>>,
+}
+
+impl SpiSeq {
+    fn new(t: &SeqTiming) -> SpiSeq {
+        SpiSeq {
+            clock: Default::default(),
+            rst: Default::default(),
+            start2: Default::default(),
+            cs_n: Default::default(),
+            sclk: Default::default(),
+            cap: Default::default(),
+            done: Default::default(),
+            r_cs_n: Default::default(),
+            r_sclk: Default::default(),
+            ph: Default::default(),
+            nfall: Default::default(),
+            r_cap: Default::default(),
+            r_done: Default::default(),
+            wrap: Default::default(),
+            half: Default::default(),
+            k_ph_last: c(t.sclk_div - 1),
+            k_ph_half: c(t.sclk_half - 1),
+            k_ph_start: c(t.sclk_div - t.setup_cycles),
+            k_ph_zero: c(0),
+            k_ph_one: c(1),
+            k_nf_zero: c(0),
+            k_nf_one: c(1),
+            k_nf_end: c(16),
+        }
+    }
+}
+
+impl Logic for SpiSeq {
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(self, clock, r_cs_n, r_sclk, ph, nfall, r_cap, r_done);
+        self.wrap.next = self.ph.q.val() == self.k_ph_last.val();
+        self.half.next = self.ph.q.val() == self.k_ph_half.val();
+        self.r_cap.d.next = false;
+        self.r_done.d.next = false;
+        if self.start2.val() {
+            // Cycle t - 2: a converting branch's CS falls at the edge that begins t.
+            self.r_cs_n.d.next = false;
+            self.r_sclk.d.next = true;
+            self.ph.d.next = self.k_ph_start.val();
+            self.nfall.d.next = self.k_nf_zero.val();
+        } else if !self.r_cs_n.q.val() {
+            if self.wrap.val() {
+                self.ph.d.next = self.k_ph_zero.val();
+            } else {
+                self.ph.d.next = self.ph.q.val() + self.k_ph_one.val();
+            }
+            if self.wrap.val() {
+                if self.nfall.q.val() == self.k_nf_end.val() {
+                    // Cycle t + R - 2: CS rises at the edge that begins t + R.
+                    self.r_cs_n.d.next = true;
+                    self.r_done.d.next = true;
+                } else {
+                    self.nfall.d.next = self.nfall.q.val() + self.k_nf_one.val();
+                    self.r_sclk.d.next = false;
+                }
+            }
+            if self.half.val() {
+                self.r_sclk.d.next = true;
+                if (self.nfall.q.val() != self.k_nf_zero.val())
+                    & (self.nfall.q.val() != self.k_nf_end.val())
+                {
+                    // SCLK rising edge i (1..=15) begins the next cycle + 1:
+                    // capture serial bit i at the end of the next cycle.
+                    self.r_cap.d.next = true;
+                }
+            }
+        }
+        if self.rst.val() {
+            // The state of cycle t - 1 for an instant t at cycle 0.
+            self.r_cs_n.d.next = false;
+            self.r_sclk.d.next = true;
+            self.ph.d.next = self.k_ph_start.val();
+            self.nfall.d.next = self.k_nf_zero.val();
+            self.r_cap.d.next = false;
+            self.r_done.d.next = false;
+        }
+        self.cs_n.next = self.r_cs_n.q.val();
+        self.sclk.next = self.r_sclk.q.val();
+        self.cap.next = self.r_cap.q.val();
+        self.done.next = self.r_done.q.val();
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Branch: per-branch SPI outputs, shift register, mux control
+// ---------------------------------------------------------------------------
+
+#[derive(LogicBlock)]
+pub struct BranchUnit {
+    pub clock: Signal<In, Clock>,
+    pub rst: Signal<In, Bit>,
+    pub start2: Signal<In, Bit>,
+    pub start1: Signal<In, Bit>,
+    pub start0: Signal<In, Bit>,
+    pub addr: Signal<In, Bits<SLOT_BITS>>,
+    pub seq_cs_n: Signal<In, Bit>,
+    pub seq_sclk: Signal<In, Bit>,
+    pub seq_cap: Signal<In, Bit>,
+    pub seq_done: Signal<In, Bit>,
+    pub miso: Signal<In, Bit>,
+    pub cs_n: Signal<Out, Bit>,
+    pub sclk: Signal<Out, Bit>,
+    pub mux_sel: Signal<Out, Bits<3>>,
+    pub mux_en: Signal<Out, Bits<EN_BITS>>,
+    pub done: Signal<Out, Bit>,
+    pub res_ch: Signal<Out, Bits<CH_BITS>>,
+    pub res_val: Signal<Out, Bits<14>>,
+    rom: SlotRom,
+    /// The branch converts in the slot of cycle c + 1 (cycles t - 1 ..= t + S - 2).
+    act: DFF<Bit>,
+    r_cs_n: DFF<Bit>,
+    r_sclk: DFF<Bit>,
+    /// MISO bits; after a completion it holds the code until the next slot.
+    shift: DFF<Bits<14>>,
+    /// Channel of the current slot's conversion (loaded in cycle t - 1).
+    cur_ch: DFF<Bits<CH_BITS>>,
+    r_sel: DFF<Bits<3>>,
+    r_en: DFF<Bits<EN_BITS>>,
+    r_done: DFF<Bit>,
     k_sh_one: Constant<Bits<4>>,
     k_sh_lsb: Constant<Bits<14>>,
-    k_val_zero: Constant<Bits<14>>,
-    k_ch_zero: Constant<Bits<CH_BITS>>,
     k_sel_rst: Constant<Bits<3>>,
     k_en_rst: Constant<Bits<EN_BITS>>,
     k_en_one: Constant<Bits<EN_BITS>>,
@@ -271,7 +417,13 @@ impl BranchUnit {
             clock: Default::default(),
             rst: Default::default(),
             start2: Default::default(),
+            start1: Default::default(),
+            start0: Default::default(),
             addr: Default::default(),
+            seq_cs_n: Default::default(),
+            seq_sclk: Default::default(),
+            seq_cap: Default::default(),
+            seq_done: Default::default(),
             miso: Default::default(),
             cs_n: Signal::new_with_default(true),
             sclk: Signal::new_with_default(true),
@@ -281,39 +433,20 @@ impl BranchUnit {
             res_ch: Default::default(),
             res_val: Default::default(),
             rom: SlotRom::new(rom),
-            go: Default::default(),
+            act: Default::default(),
             r_cs_n: Default::default(),
             r_sclk: Default::default(),
-            ph: Default::default(),
-            nfall: Default::default(),
             shift: Default::default(),
             cur_ch: Default::default(),
-            first: Default::default(),
-            p_sel: Default::default(),
-            p_dev: Default::default(),
             r_sel: Default::default(),
             r_en: Default::default(),
             r_done: Default::default(),
-            r_rch: Default::default(),
-            r_rval: Default::default(),
-            wrap: Default::default(),
-            half: Default::default(),
-            k_ph_last: c(rom.sclk_div - 1),
-            k_ph_half: c(rom.sclk_half - 1),
-            k_ph_start: c(rom.sclk_div - rom.setup_cycles),
-            k_ph_zero: c(0),
-            k_ph_one: c(1),
-            k_nf_zero: c(0),
-            k_nf_one: c(1),
-            k_nf_end: c(16),
             k_sh_one: c(1),
             k_sh_lsb: c(1),
-            k_val_zero: c(0),
-            k_ch_zero: c(0),
             k_sel_rst: c(rom.reset_sel as u64),
             k_en_rst: c(rom.reset_en),
             k_en_one: c(1),
-            k_conv0: Constant::new(rom.words[0] >> 16 & 1 == 1),
+            k_conv0: Constant::new(rom.conv0),
         }
     }
 }
@@ -321,75 +454,41 @@ impl BranchUnit {
 impl Logic for BranchUnit {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(
-            self, clock, go, r_cs_n, r_sclk, ph, nfall, shift, cur_ch, first, p_sel, p_dev, r_sel,
-            r_en, r_done, r_rch, r_rval
-        );
+        dff_setup!(self, clock, act, r_cs_n, r_sclk, shift, cur_ch, r_sel, r_en, r_done);
         self.rom.clock.next = self.clock.val();
         self.rom.address.next = self.addr.val();
-        self.wrap.next = self.ph.q.val() == self.k_ph_last.val();
-        self.half.next = self.ph.q.val() == self.k_ph_half.val();
-        self.r_done.d.next = false;
-        self.first.d.next = false;
-        // Registered one cycle early so the ROM's output is off the critical path.
-        self.go.d.next = self.start2.val() & self.rom.conv.val();
-        if self.go.q.val() {
-            // The edge that begins sampling instant t: CS falls.
-            self.r_cs_n.d.next = false;
-            self.r_sclk.d.next = true;
-            self.ph.d.next = self.k_ph_start.val();
-            self.nfall.d.next = self.k_nf_zero.val();
+        if self.start2.val() {
+            // Cycle t - 2: the ROM describes the slot starting at t.
+            self.act.d.next = self.rom.conv.val();
+        }
+        if self.start1.val() {
             self.cur_ch.d.next = self.rom.ch.val();
-            self.p_sel.d.next = self.rom.nsel.val();
-            self.p_dev.d.next = self.rom.ndev.val();
-            self.first.d.next = true;
-        } else if !self.r_cs_n.q.val() {
-            if self.wrap.val() {
-                self.ph.d.next = self.k_ph_zero.val();
+        }
+        if self.start0.val() {
+            // First cycle of a slot: the ROM already describes the next slot,
+            // whose mux field is the channel of the branch's next instant.
+            self.r_sel.d.next = self.rom.msel.val();
+            self.r_en.d.next = self.k_en_one.val() << self.rom.mdev.val();
+        }
+        self.r_cs_n.d.next = self.seq_cs_n.val() | !self.act.q.val();
+        self.r_sclk.d.next = self.seq_sclk.val() | !self.act.q.val();
+        // Cycle t + R - 1: the conversion completes in the next cycle.
+        self.r_done.d.next = self.seq_done.val() & self.act.q.val();
+        if self.seq_cap.val() {
+            // Every slot's capture strobes shift, converting or not: the
+            // code is read by the merger before the next slot starts.
+            if self.miso.val() {
+                self.shift.d.next =
+                    (self.shift.q.val() << self.k_sh_one.val()) | self.k_sh_lsb.val();
             } else {
-                self.ph.d.next = self.ph.q.val() + self.k_ph_one.val();
-            }
-            if self.first.q.val() {
-                // Cycle t + 1: switch the mux to the branch's next channel.
-                self.r_sel.d.next = self.p_sel.q.val();
-                self.r_en.d.next = self.k_en_one.val() << self.p_dev.q.val();
-            }
-            if self.wrap.val() {
-                if self.nfall.q.val() == self.k_nf_end.val() {
-                    // Cycle t + R: CS rises, the conversion is complete.
-                    self.r_cs_n.d.next = true;
-                    self.r_done.d.next = true;
-                    self.r_rch.d.next = self.cur_ch.q.val();
-                    self.r_rval.d.next = self.shift.q.val();
-                } else {
-                    self.nfall.d.next = self.nfall.q.val() + self.k_nf_one.val();
-                    self.r_sclk.d.next = false;
-                }
-            }
-            if self.half.val() {
-                self.r_sclk.d.next = true;
-                if (self.nfall.q.val() != self.k_nf_zero.val())
-                    & (self.nfall.q.val() != self.k_nf_end.val())
-                {
-                    // SCLK rising edge i (1..=15): capture serial bit i.
-                    if self.miso.val() {
-                        self.shift.d.next =
-                            (self.shift.q.val() << self.k_sh_one.val()) | self.k_sh_lsb.val();
-                    } else {
-                        self.shift.d.next = self.shift.q.val() << self.k_sh_one.val();
-                    }
-                }
+                self.shift.d.next = self.shift.q.val() << self.k_sh_one.val();
             }
         }
         if self.rst.val() {
-            self.go.d.next = self.k_conv0.val();
+            self.act.d.next = self.k_conv0.val();
             self.r_cs_n.d.next = true;
             self.r_sclk.d.next = true;
             self.r_done.d.next = false;
-            self.first.d.next = false;
-            self.nfall.d.next = self.k_nf_zero.val();
-            self.r_rch.d.next = self.k_ch_zero.val();
-            self.r_rval.d.next = self.k_val_zero.val();
             self.r_sel.d.next = self.k_sel_rst.val();
             self.r_en.d.next = self.k_en_rst.val();
         }
@@ -398,8 +497,8 @@ impl Logic for BranchUnit {
         self.mux_sel.next = self.r_sel.q.val();
         self.mux_en.next = self.r_en.q.val();
         self.done.next = self.r_done.q.val();
-        self.res_ch.next = self.r_rch.q.val();
-        self.res_val.next = self.r_rval.q.val();
+        self.res_ch.next = self.cur_ch.q.val();
+        self.res_val.next = self.shift.q.val();
     }
 }
 
@@ -565,10 +664,13 @@ pub struct Core {
     pub sample_channel: Signal<Out, Bits<CH_BITS>>,
     pub sample_value: Signal<Out, Bits<14>>,
     pub timing: TimingGen,
+    pub seqs: Vec<SpiSeq>,
     pub branches: Vec<BranchUnit>,
     pub merge: Merger,
-    /// Devices per branch (the glue's only per-mix parameter besides the count).
+    /// Devices per branch (the glue's per-mix parameters besides the count).
     _devices: Vec<usize>,
+    /// Sequencer of each branch.
+    _seq_of: Vec<usize>,
     /// The value last written to `mux_en.next` (simulation only).
     _mux_en: u64,
 }
@@ -587,9 +689,11 @@ impl Core {
             sample_channel: Default::default(),
             sample_value: Default::default(),
             timing: TimingGen::new(plan),
+            seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
             branches: plan.branches.iter().map(BranchUnit::new).collect(),
             merge: Merger::default(),
             _devices: plan.branches.iter().map(|b| b.devices).collect(),
+            _seq_of: plan.branches.iter().map(|b| b.seq).collect(),
             _mux_en: 0,
         }
     }
@@ -626,25 +730,28 @@ impl Core {
         drive(&mut t.cnt.clock, k);
         drive(&mut t.st.clock, k);
         drive(&mut t.st2.clock, k);
+        drive(&mut t.st0.clock, k);
         drive(&mut t.slot.clock, k);
+        for q in self.seqs.iter_mut() {
+            drive(&mut q.clock, k);
+            drive(&mut q.r_cs_n.clock, k);
+            drive(&mut q.r_sclk.clock, k);
+            drive(&mut q.ph.clock, k);
+            drive(&mut q.nfall.clock, k);
+            drive(&mut q.r_cap.clock, k);
+            drive(&mut q.r_done.clock, k);
+        }
         for u in self.branches.iter_mut() {
             drive(&mut u.clock, k);
             drive(&mut u.rom.clock, k);
-            drive(&mut u.go.clock, k);
+            drive(&mut u.act.clock, k);
             drive(&mut u.r_cs_n.clock, k);
             drive(&mut u.r_sclk.clock, k);
-            drive(&mut u.ph.clock, k);
-            drive(&mut u.nfall.clock, k);
             drive(&mut u.shift.clock, k);
             drive(&mut u.cur_ch.clock, k);
-            drive(&mut u.first.clock, k);
-            drive(&mut u.p_sel.clock, k);
-            drive(&mut u.p_dev.clock, k);
             drive(&mut u.r_sel.clock, k);
             drive(&mut u.r_en.clock, k);
             drive(&mut u.r_done.clock, k);
-            drive(&mut u.r_rch.clock, k);
-            drive(&mut u.r_rval.clock, k);
         }
         let m = &mut self.merge;
         drive(&mut m.clock, k);
@@ -664,7 +771,16 @@ impl Logic for Core {
         self.merge.clock.next = clk;
         self.merge.rst.next = rst;
         let start = self.timing.start2.val();
+        let start1 = self.timing.start1.val();
+        let start0 = self.timing.start0.val();
         let addr = self.timing.addr.val();
+        let mut seq = [(false, false, false, false); MAX_BRANCHES];
+        for (i, q) in self.seqs.iter_mut().enumerate() {
+            q.clock.next = clk;
+            q.rst.next = rst;
+            q.start2.next = start;
+            seq[i] = (q.cs_n.val(), q.sclk.val(), q.cap.val(), q.done.val());
+        }
         let miso = self.adc_miso.val().to_u64();
         let (mut cs, mut sclk, mut sel, mut en, mut done) = (0u64, 0u64, 0u64, 0u128, 0u64);
         let mut en_off = 0usize;
@@ -674,7 +790,14 @@ impl Logic for Core {
             u.clock.next = clk;
             u.rst.next = rst;
             u.start2.next = start;
+            u.start1.next = start1;
+            u.start0.next = start0;
             u.addr.next = addr;
+            let (q_cs, q_sclk, q_cap, q_done) = seq[self._seq_of[b]];
+            u.seq_cs_n.next = q_cs;
+            u.seq_sclk.next = q_sclk;
+            u.seq_cap.next = q_cap;
+            u.seq_done.next = q_done;
             u.miso.next = (miso >> b) & 1 == 1;
             cs |= (u.cs_n.val() as u64) << b;
             sclk |= (u.sclk.val() as u64) << b;
@@ -733,11 +856,22 @@ impl Logic for Core {
         self.timing.rst.connect();
         self.merge.clock.connect();
         self.merge.rst.connect();
+        for q in self.seqs.iter_mut() {
+            q.clock.connect();
+            q.rst.connect();
+            q.start2.connect();
+        }
         for u in self.branches.iter_mut() {
             u.clock.connect();
             u.rst.connect();
             u.start2.connect();
+            u.start1.connect();
+            u.start0.connect();
             u.addr.connect();
+            u.seq_cs_n.connect();
+            u.seq_sclk.connect();
+            u.seq_cap.connect();
+            u.seq_done.connect();
             u.miso.connect();
         }
         self.merge.done.connect();
@@ -767,12 +901,17 @@ impl Logic for Core {
     }
 
     fn hdl(&self) -> Verilog {
-        Verilog::Custom(core_glue(self.branches.len(), &self._devices))
+        Verilog::Custom(core_glue(
+            self.branches.len(),
+            &self._devices,
+            &self._seq_of,
+            self.seqs.len(),
+        ))
     }
 }
 
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
-fn core_glue(nb: usize, devices: &[usize]) -> String {
+fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> String {
     let mut s = String::new();
     let cat = |f: &dyn Fn(usize) -> String, pad: Option<String>| -> String {
         let mut parts: Vec<String> = (0..nb).rev().map(f).collect();
@@ -792,10 +931,20 @@ fn core_glue(nb: usize, devices: &[usize]) -> String {
     for (who, _) in [("timing", 0), ("merge", 0)] {
         s.push_str(&format!("  {who}$clock = clock;\n  {who}$rst = rst;\n"));
     }
-    for b in 0..nb {
-        let u = format!("branches${b}");
+    for i in 0..nseq {
+        let q = format!("seqs${i}");
         s.push_str(&format!(
-            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$addr = timing$addr;\n  {u}$miso = adc_miso[{b}];\n"
+            "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = timing$start2;\n"
+        ));
+    }
+    for (b, seq) in seq_of.iter().enumerate().take(nb) {
+        let u = format!("branches${b}");
+        let q = format!("seqs${seq}");
+        s.push_str(&format!(
+            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = timing$start0;\n  {u}$addr = timing$addr;\n"
+        ));
+        s.push_str(&format!(
+            "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$miso = adc_miso[{b}];\n"
         ));
     }
     s.push_str(&format!(
@@ -881,6 +1030,7 @@ mod tests {
         rst: Signal<In, Bit>,
         miso: Signal<In, Bit>,
         timing: TimingGen,
+        seq: SpiSeq,
         unit: BranchUnit,
     }
 
@@ -891,8 +1041,17 @@ mod tests {
             self.timing.rst.next = self.rst.val();
             self.unit.clock.next = self.clock.val();
             self.unit.rst.next = self.rst.val();
+            self.seq.clock.next = self.clock.val();
+            self.seq.rst.next = self.rst.val();
+            self.seq.start2.next = self.timing.start2.val();
             self.unit.start2.next = self.timing.start2.val();
+            self.unit.start1.next = self.timing.start1.val();
+            self.unit.start0.next = self.timing.start0.val();
             self.unit.addr.next = self.timing.addr.val();
+            self.unit.seq_cs_n.next = self.seq.cs_n.val();
+            self.unit.seq_sclk.next = self.seq.sclk.val();
+            self.unit.seq_cap.next = self.seq.cap.val();
+            self.unit.seq_done.next = self.seq.done.val();
             self.unit.miso.next = self.miso.val();
         }
     }
@@ -903,21 +1062,27 @@ mod tests {
 
     /// 4 slots: converts channel 0 (dev 1, sel 3) in slot 0, channel 7
     /// (dev 0, sel 5) in slot 2; slots 1 and 3 idle.
-    fn rom(div: u64, setup: u64) -> BranchRom {
-        let w =
-            |conv: u32, ch: u32, sel: u32, dev: u32| (conv << 16) | (ch << 8) | (sel << 5) | dev;
-        BranchRom {
-            words: vec![w(1, 0, 5, 0), 0, w(1, 7, 3, 1), 0],
+    fn rom() -> BranchRom {
+        let mut r = BranchRom {
+            words: vec![],
             addr_bits: 2,
-            sclk_div: div,
-            sclk_half: div / 2,
-            setup_cycles: setup,
-            read_cycles: setup + 16 * div,
+            ch_bits: 3,
+            dev_bits: 1,
+            seq: 0,
             reset_sel: 3,
             reset_en: 0b10,
+            conv0: true,
             devices: 2,
             en_offset: 0,
-        }
+        };
+        // mux fields: the first instant at this slot or later
+        r.words = vec![
+            r.word(true, 0, 3, 1),
+            r.word(false, 0, 5, 0),
+            r.word(true, 7, 5, 0),
+            r.word(false, 0, 3, 1),
+        ];
+        r
     }
 
     fn harness(div: u64, setup: u64) -> Harness {
@@ -925,13 +1090,20 @@ mod tests {
             slot_cycles: SLOT,
             frame_slots: 4,
             channel_bits: 3,
-            branches: vec![rom(div, setup)],
+            seqs: vec![SeqTiming {
+                sclk_div: div,
+                sclk_half: div / 2,
+                setup_cycles: setup,
+                read_cycles: setup + 16 * div,
+            }],
+            branches: vec![rom()],
         };
         let mut h = Harness {
             clock: Default::default(),
             rst: Default::default(),
             miso: Default::default(),
             timing: TimingGen::new(&plan),
+            seq: SpiSeq::new(&plan.seqs[0]),
             unit: BranchUnit::new(&plan.branches[0]),
         };
         h.connect_all();
@@ -1112,6 +1284,7 @@ mod tests {
 
     #[test]
     fn spi_master_with_long_setup_and_slow_sclk() {
-        check_spi(40, 25); // setup longer than half a period
+        // setup longer than half a period; R = 404 of the 500-cycle slot
+        check_spi(24, 20);
     }
 }

@@ -432,7 +432,11 @@ fn ports_json(s: &Schedule, p: &Plan) -> String {
 
 fn slots_hex(s: &Schedule, p: &Plan) -> String {
     let mut t = String::new();
-    let aw = p.branches[0].addr_bits;
+    let r0 = &p.branches[0];
+    let aw = r0.addr_bits;
+    let (cw, dw) = (r0.ch_bits, r0.dev_bits);
+    let wb = r0.word_bits();
+    let digits = wb.div_ceil(4);
     let _ = writeln!(
         t,
         "// slotforge slot ROM image for mix \"{}\" ($readmemh)",
@@ -440,7 +444,7 @@ fn slots_hex(s: &Schedule, p: &Plan) -> String {
     );
     let _ = writeln!(
         t,
-        "// {} branches x {} words (frame of {} slots padded to 2^{aw}); address = branch * {} + slot",
+        "// {} branches x {} words of {wb} bits (frame of {} slots padded to 2^{aw}); address = branch * {} + slot",
         p.branches.len(),
         1u64 << aw,
         p.frame_slots,
@@ -448,16 +452,22 @@ fn slots_hex(s: &Schedule, p: &Plan) -> String {
     );
     let _ = writeln!(
         t,
-        "// word[16] = branch converts in this slot, [15:8] channel index converted,"
+        "// word[{}] = branch converts in this slot, [{}:{}] channel index converted,",
+        wb - 1,
+        wb - 2,
+        3 + dw
     );
     let _ = writeln!(
         t,
-        "// [7:5] mux select and [4:0] mux device of the branch's next instant (cyclic)"
+        "// [{}:{dw}] mux select and [{}:0] mux device of the branch's first instant at this slot or later (cyclic)",
+        dw + 2,
+        dw - 1
     );
+    let _ = cw;
     for (b, r) in p.branches.iter().enumerate() {
         let _ = writeln!(t, "// branch {b}: {}", s.branches[b].name);
         for w in &r.words {
-            let _ = writeln!(t, "{w:05x}");
+            let _ = writeln!(t, "{w:0digits$x}");
         }
     }
     t

@@ -14,25 +14,49 @@ pub const MAX_FRAME_SLOTS: u64 = 1 << crate::core::SLOT_BITS;
 pub const MAX_SLOT_CYCLES: u64 = 1 << crate::core::CNT_BITS;
 pub const MAX_SCLK_DIV: u64 = (1 << crate::core::PH_BITS) - 1;
 
-/// One branch's slot ROM and SPI numbers.
-#[derive(Debug, Clone)]
-pub struct BranchRom {
-    /// `2^addr_bits` words: bit 16 = converts in this slot, [15:8] channel
-    /// converted, [7:5] mux select and [4:0] mux device of the branch's next
-    /// instant after this slot (cyclic).  Zero where the branch is idle.
-    pub words: Vec<u32>,
-    pub addr_bits: usize,
+/// The SPI timing of one or more branches: one shared sequencer each.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SeqTiming {
     pub sclk_div: u64,
     pub sclk_half: u64,
     pub setup_cycles: u64,
-    #[allow(dead_code)] // kept for reports and tests
     pub read_cycles: u64,
+}
+
+/// One branch's slot ROM and numbers.
+#[derive(Debug, Clone)]
+pub struct BranchRom {
+    /// `2^addr_bits` words of [`BranchRom::word_bits`] bits, for frame slot
+    /// `u`: `{conv, ch[ch_bits], msel[3], mdev[dev_bits]}`: whether the branch
+    /// converts in slot `u` and which channel, and the mux select/device of
+    /// the branch's first instant at slot `u` or later (cyclic), i.e. what
+    /// the mux addresses after the first cycle of slot `u - 1`.
+    pub words: Vec<u32>,
+    pub addr_bits: usize,
+    pub ch_bits: usize,
+    pub dev_bits: usize,
+    /// Index of the branch's SPI sequencer in [`Plan::seqs`].
+    pub seq: usize,
     pub reset_sel: u32,
     /// One-hot mux enable of the first instant of frame 0 (0 if the branch never converts).
     pub reset_en: u64,
+    /// Whether the branch converts in slot 0.
+    pub conv0: bool,
     pub devices: usize,
     /// First device bit of this branch in the `mux_en` port.
     pub en_offset: usize,
+}
+
+impl BranchRom {
+    pub fn word_bits(&self) -> usize {
+        1 + self.ch_bits + 3 + self.dev_bits
+    }
+
+    /// Pack one ROM word.
+    pub fn word(&self, conv: bool, ch: u32, sel: u32, dev: u32) -> u32 {
+        let (cw, dw) = (self.ch_bits, self.dev_bits);
+        ((conv as u32) << (cw + 3 + dw)) | (ch << (3 + dw)) | (sel << dw) | dev
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -40,6 +64,7 @@ pub struct Plan {
     pub slot_cycles: u64,
     pub frame_slots: u64,
     pub channel_bits: u32,
+    pub seqs: Vec<SeqTiming>,
     pub branches: Vec<BranchRom>,
 }
 
@@ -93,6 +118,8 @@ pub fn plan(s: &Schedule) -> Result<Plan, HdlError> {
         )));
     }
     let aw = addr_bits(g.frame_slots);
+    let cw = s.channel_bits().max(1) as usize;
+    let mut seqs: Vec<SeqTiming> = Vec::new();
     let mut branches = Vec::with_capacity(nb);
     let mut en_offset = 0usize;
     for (b, bp) in s.branches.iter().enumerate() {
@@ -128,9 +155,12 @@ pub fn plan(s: &Schedule) -> Result<Plan, HdlError> {
                 bp.name, spi.read_cycles
             )));
         }
-        if spi.read_cycles >= g.slot_cycles {
+        // The branch's shift register and channel register hold a result
+        // until the merger takes it (at most nb - 1 cycles after the
+        // completion at t + R); the next slot must not start before.
+        if spi.read_cycles + nb as u64 > g.slot_cycles {
             return Err(unsupported(format!(
-                "branch {}: a conversion ({} cycles) does not end inside a slot ({} cycles)",
+                "branch {}: a conversion ({} cycles) plus the merger's {nb} cycles does not fit in a slot ({} cycles)",
                 bp.name, spi.read_cycles, g.slot_cycles
             )));
         }
@@ -141,46 +171,75 @@ pub fn plan(s: &Schedule) -> Result<Plan, HdlError> {
                 bp.name
             )));
         }
-        let slots: Vec<Option<usize>> = (0..g.frame_slots).map(|t| s.at(t, b)).collect();
-        let instants: Vec<usize> = (0..slots.len()).filter(|&t| slots[t].is_some()).collect();
-        let mut words = vec![0u32; 1 << aw];
-        for (k, &t) in instants.iter().enumerate() {
-            let ch = slots[t].unwrap();
-            let next_t = instants[(k + 1) % instants.len()];
-            let nx = &s.channels[slots[next_t].unwrap()];
-            if nx.select > 7 || nx.device as usize >= devices {
-                return Err(unsupported(format!(
-                    "branch {}: channel device {} select {} outside the branch's muxes",
-                    bp.name, nx.device, nx.select
-                )));
-            }
-            words[t] = (1 << 16) | ((ch as u32) << 8) | (nx.select << 5) | nx.device;
-        }
-        let (reset_sel, reset_en) = match instants.first() {
-            Some(&t) => {
-                let c0 = &s.channels[slots[t].unwrap()];
-                (c0.select, 1u64 << c0.device)
-            }
-            None => (0, 0),
-        };
-        branches.push(BranchRom {
-            words,
-            addr_bits: aw,
+        let timing = SeqTiming {
             sclk_div: spi.sclk_div,
             sclk_half: spi.sclk_half,
             setup_cycles: spi.setup_cycles,
             read_cycles: spi.read_cycles,
-            reset_sel,
-            reset_en,
+        };
+        let seq = match seqs.iter().position(|t| *t == timing) {
+            Some(i) => i,
+            None => {
+                seqs.push(timing);
+                seqs.len() - 1
+            }
+        };
+        let slots: Vec<Option<usize>> = (0..g.frame_slots).map(|t| s.at(t, b)).collect();
+        for c in slots.iter().flatten() {
+            let ch = &s.channels[*c];
+            if ch.select > 7 || ch.device as usize >= devices {
+                return Err(unsupported(format!(
+                    "branch {}: channel device {} select {} outside the branch's muxes",
+                    bp.name, ch.device, ch.select
+                )));
+            }
+        }
+        // next[u]: the channel of the first instant at slot u or later (cyclic).
+        let n = slots.len();
+        let mut next: Vec<Option<usize>> = vec![None; n];
+        let mut cur: Option<usize> = None;
+        for u in (0..2 * n).rev() {
+            if let Some(c) = slots[u % n] {
+                cur = Some(c);
+            }
+            if u < n {
+                next[u] = cur;
+            }
+        }
+        let mut rom = BranchRom {
+            words: vec![],
+            addr_bits: aw,
+            ch_bits: cw,
+            dev_bits: addr_bits(devices as u64),
+            seq,
+            reset_sel: 0,
+            reset_en: 0,
+            conv0: slots[0].is_some(),
             devices,
             en_offset,
-        });
+        };
+        let mut words = vec![0u32; 1 << aw];
+        for u in 0..n {
+            let (sel, dev) = match next[u] {
+                Some(c) => (s.channels[c].select, s.channels[c].device),
+                None => (0, 0),
+            };
+            let ch = slots[u].unwrap_or(0) as u32;
+            words[u] = rom.word(slots[u].is_some(), ch, sel, dev);
+        }
+        rom.words = words;
+        if let Some(c) = next[0] {
+            rom.reset_sel = s.channels[c].select;
+            rom.reset_en = 1u64 << s.channels[c].device;
+        }
+        branches.push(rom);
         en_offset += devices;
     }
     Ok(Plan {
         slot_cycles: g.slot_cycles,
         frame_slots: g.frame_slots,
         channel_bits: s.channel_bits(),
+        seqs,
         branches,
     })
 }

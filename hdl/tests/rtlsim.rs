@@ -73,3 +73,17 @@ fn wide_mix_matches_timing_contract() {
     let s = wide();
     run_and_compare(&s, 2 * s.grid.frame_cycles);
 }
+
+/// Three SPI timings: one shared sequencer each.
+#[test]
+fn three_speed_mix_matches_timing_contract() {
+    let s = two_speed();
+    run_and_compare(&s, 2 * s.grid.frame_cycles);
+}
+
+/// Eight branches of 32 channels (256 channels, 4 mux devices each).
+#[test]
+fn u2_256_channels_match_timing_contract() {
+    let s = data_mix("u2");
+    run_and_compare(&s, s.grid.frame_cycles + s.grid.slice_cycles);
+}

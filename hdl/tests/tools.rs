@@ -96,6 +96,18 @@ fn gates_wide8() {
 }
 
 #[test]
+fn gates_three_speed() {
+    gates(&two_speed(), "threespeed");
+}
+
+#[test]
+fn gates_branch_count_mixes() {
+    for name in ["b4", "b5", "b6", "u2"] {
+        gates(&data_mix(name), name);
+    }
+}
+
+#[test]
 fn emission_is_deterministic() {
     let s = eskin34();
     let a = hdl::emit(&s, None).unwrap();

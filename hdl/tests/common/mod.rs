@@ -83,6 +83,53 @@ slice_us = 1_000
     from_toml("wide8.toml", &t)
 }
 
+/// Three branches with three SPI timings (three sequencers) and settling
+/// times: 2.5 MHz, 1 MHz and 2 MHz SCLK.
+pub fn two_speed() -> Schedule {
+    let mut t = String::from(
+        r#"
+name = "threespeed"
+[clock]
+hz = 48_000_000
+[frame]
+period_us = 10_000
+slice_us = 1_000
+"#,
+    );
+    for (b, (sclk, settle, d)) in [
+        (2_500_000u64, 0u64, 2u32),
+        (1_000_000, 5_000, 1),
+        (2_000_000, 1_000, 3),
+    ]
+    .iter()
+    .enumerate()
+    {
+        t.push_str(&format!(
+            "[[branch]]\nname = \"s{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = {d}\nsclk_hz = {sclk}\nsettle_ns = {settle}\n"
+        ));
+    }
+    let rates = [2_000u64, 1_000, 100, 1_000, 500];
+    let mut n = 0;
+    for (b, d) in [2usize, 1, 3].iter().enumerate() {
+        for k in 0..(3 + b) {
+            t.push_str(&format!(
+                "[[channel]]\nname = \"T{n}\"\nbranch = \"s{b}\"\nrate_hz = {}\ninput = {}\n",
+                rates[(n) % rates.len()],
+                (k * 5) % (d * 8)
+            ));
+            n += 1;
+        }
+    }
+    from_toml("threespeed.toml", &t)
+}
+
+/// A mix file of `hdl/tests/data/`.
+pub fn data_mix(name: &str) -> Schedule {
+    let path = root().join(format!("hdl/tests/data/{name}.toml"));
+    let mix = lut_gen::load(&path).expect("mix loads");
+    lut_gen::synthesize(&mix).expect("mix is feasible")
+}
+
 /// Behavioural AD7940 (datasheet timing in cycles): the input is sampled at
 /// the CS falling edge; bit 0 (a leading zero) appears t3 after CS falls,
 /// bit i t4 after SCLK falling edge i; old data is held for t7; after falling
