@@ -22,6 +22,9 @@ pub enum Backend {
     RustHdl,
     /// The emitted `slotforge_top.v` compiled by Verilator, cycle by cycle, fully checked.
     Verilator,
+    /// The emitted `slotforge_top.v` in Icarus Verilog with a Verilog ADC model;
+    /// its VCD goes through the VCD checker (a cross-check of the other back ends).
+    Icarus,
 }
 
 impl std::str::FromStr for Backend {
@@ -31,8 +34,9 @@ impl std::str::FromStr for Backend {
             "model" => Ok(Backend::Model),
             "rusthdl" | "rust-hdl" => Ok(Backend::RustHdl),
             "verilator" => Ok(Backend::Verilator),
+            "icarus" | "iverilog" => Ok(Backend::Icarus),
             _ => Err(format!(
-                "unknown back end `{s}` (model, rusthdl, verilator)"
+                "unknown back end `{s}` (model, rusthdl, verilator, icarus)"
             )),
         }
     }
@@ -44,6 +48,7 @@ impl Backend {
             Backend::Model => "model",
             Backend::RustHdl => "rusthdl",
             Backend::Verilator => "verilator",
+            Backend::Icarus => "icarus",
         }
     }
 }
@@ -63,6 +68,7 @@ pub struct SimOptions {
     pub stimulus: Stimulus,
     pub check: CheckOptions,
     pub vcd: Option<VcdOut>,
+    /// Reset cycles before cycle 0 (raised to [`crate::run::reset_cycles`]).
     pub reset_cycles: u64,
 }
 
@@ -90,7 +96,7 @@ impl fmt::Display for SimError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             SimError::Hdl(m) => write!(f, "gateware: {m}"),
-            SimError::Backend(e) => write!(f, "verilator back end: {e}"),
+            SimError::Backend(e) => write!(f, "simulation back end: {e}"),
             SimError::Io(m) => f.write_str(m),
         }
     }
@@ -145,10 +151,14 @@ pub fn run(
     frames: u64,
     opts: &SimOptions,
 ) -> Result<Report, SimError> {
+    if backend == Backend::Icarus {
+        return crate::icarus::run(s, frames, opts);
+    }
+    let reset = crate::run::reset_cycles(s, opts.reset_cycles);
     let ro = RunOptions {
         stimulus: opts.stimulus,
         check: opts.check,
-        reset_cycles: opts.reset_cycles,
+        reset_cycles: reset,
     };
     let mut writer = match &opts.vcd {
         None => None,
@@ -157,9 +167,9 @@ pub fn run(
             let from = if v.from_frame == 0 {
                 0
             } else {
-                opts.reset_cycles + v.from_frame * f
+                reset + v.from_frame * f
             };
-            let to = opts.reset_cycles + v.to_frame.max(v.from_frame + 1) * f;
+            let to = reset + v.to_frame.max(v.from_frame + 1) * f;
             if v.gtkw {
                 write_gtkw(&v.path.with_extension("gtkw"), &v.path, s)
                     .map_err(|e| SimError::Io(format!("{}: {e}", v.path.display())))?;
@@ -196,6 +206,7 @@ pub fn run(
             let (mut dut, _) = VerilatedDut::new(&v)?;
             run_dut(s, &mut dut, frames, &ro, "verilator", obs)
         }
+        Backend::Icarus => unreachable!("handled above"),
     };
     if let Some(w) = writer {
         w.finish().map_err(|e| SimError::Io(e.to_string()))?;

@@ -355,9 +355,35 @@ impl Invariants {
 
     /// Ends the check after `cycles` cycles: closes complete frames and flags
     /// conversions still waiting.
+    ///
+    /// Per-frame counts are checked on complete frames only; in a trailing
+    /// partial frame a channel may not exceed its samples per frame (its
+    /// samples still count in the channel statistics).
     pub fn finish(&mut self, cycles: u64) -> (u64, Vec<ChannelStats>) {
         let frames = cycles / self.frame_cycles;
         self.close_frames(frames * self.frame_cycles);
+        if cycles > frames * self.frame_cycles {
+            for ch in 0..self.names.len() {
+                if self.in_frame[ch] > self.spf[ch] {
+                    let name = self.names[ch].clone();
+                    self.rec.violation(
+                        cycles - 1,
+                        "samples-per-frame",
+                        None,
+                        Some(json!(self.spf[ch])),
+                        Some(json!(self.in_frame[ch])),
+                        Some(name.clone()),
+                        format!(
+                            "{name} sampled {} times in the first {} cycles of frame {}, expected {} in the whole frame",
+                            self.in_frame[ch],
+                            cycles % self.frame_cycles,
+                            frames,
+                            self.spf[ch]
+                        ),
+                    );
+                }
+            }
+        }
         self.expire(cycles);
         let channels = (0..self.names.len())
             .map(|c| ChannelStats {
@@ -408,6 +434,7 @@ impl Invariants {
             source: source.into(),
             cycles,
             frames,
+            partial_frame_cycles: cycles - frames * self.frame_cycles,
             samples,
             channels,
             divergence_count: 0,
@@ -436,7 +463,11 @@ struct BranchState {
     word_bad: bool,
     cs_rise: Option<u64>,
     mux_since: u64,
+    /// The mux pins have not changed since reset was released.
     mux_from_reset: bool,
+    /// Consecutive reset cycles, up to release, in which the mux pins held
+    /// their final reset value (they count towards the first settling).
+    reset_held: u64,
     en_multi: bool,
 }
 
@@ -604,6 +635,23 @@ impl Checker {
                 return;
             }
             (Some(true), _) => {
+                let (was, was_xz) = self.reset_pins;
+                let first = self.phase != Phase::Reset;
+                for b in 0..self.layout.branches {
+                    let l = &self.layout;
+                    let known = l.sel(xz, b) == 0 && l.en(xz, b) == 0;
+                    let same = !first
+                        && l.sel(&was_xz, b) == 0
+                        && l.en(&was_xz, b) == 0
+                        && l.sel(p, b) == l.sel(&was, b)
+                        && l.en(p, b) == l.en(&was, b);
+                    let st = &mut self.br[b];
+                    st.reset_held = match (known, same) {
+                        (false, _) => 0,
+                        (true, false) => 1,
+                        (true, true) => st.reset_held + 1,
+                    };
+                }
                 self.phase = Phase::Reset;
                 self.reset_pins = (*p, *xz);
                 self.prev = *p;
@@ -899,7 +947,20 @@ impl Checker {
             }
         };
         let st = &self.br[b];
-        if !st.mux_from_reset && c - st.mux_since < lim.settle_min {
+        if st.mux_from_reset && c + st.reset_held < lim.settle_min {
+            // The first conversion after reset: the mux value was set in
+            // reset and held through `reset_held` reset cycles and cycles 0..c.
+            let held = st.reset_held;
+            self.inv.violation(
+                c,
+                "mux-settle",
+                name(Signal::MuxSel(b), &self.layout),
+                Some(json!(lim.settle_min)),
+                Some(json!(c + held)),
+                ch.and_then(|ch| self.names.get(ch as usize).cloned()),
+                format!("first conversion after reset: the mux value was held through {held} reset cycles and {c} cycles after reset, settling needs {} (hold rst for at least {} cycles)", lim.settle_min, lim.settle_min.saturating_sub(c)),
+            );
+        } else if !st.mux_from_reset && c - st.mux_since < lim.settle_min {
             let since = st.mux_since;
             self.inv.violation(
                 c,

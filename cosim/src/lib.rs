@@ -8,6 +8,7 @@ pub mod adc;
 pub mod backend;
 pub mod checker;
 pub mod faults;
+pub mod icarus;
 pub mod model;
 pub mod mutate;
 pub mod pins;

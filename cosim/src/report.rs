@@ -53,6 +53,10 @@ pub struct Report {
     pub cycles: u64,
     /// Complete frames checked.
     pub frames: u64,
+    /// Cycles checked after the last complete frame (a partial frame: its
+    /// samples are counted and checked, its per-frame counts only against
+    /// the maximum).
+    pub partial_frame_cycles: u64,
     /// Samples emitted on `sample_valid` (model backend: conversions).
     pub samples: u64,
     pub channels: Vec<ChannelStats>,
@@ -72,11 +76,16 @@ impl Report {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "{} [{}]: {} cycles, {} frames, {} samples, {} divergent cycles, {} violations: {}",
+            "{} [{}]: {} cycles, {} frames{}, {} samples, {} divergent cycles, {} violations: {}",
             self.mix,
             self.source,
             self.cycles,
             self.frames,
+            if self.partial_frame_cycles > 0 {
+                format!(" + {} cycles of a partial frame", self.partial_frame_cycles)
+            } else {
+                String::new()
+            },
             self.samples,
             self.divergence_count,
             self.violation_count,

@@ -72,7 +72,7 @@ pub trait Observer {
 pub struct RunOptions {
     pub stimulus: Stimulus,
     pub check: CheckOptions,
-    /// Cycles with `rst` high before cycle 0.
+    /// Cycles with `rst` high before cycle 0 (raised to [`reset_cycles`]).
     pub reset_cycles: u64,
 }
 
@@ -84,6 +84,20 @@ impl Default for RunOptions {
             reset_cycles: 4,
         }
     }
+}
+
+/// The reset cycles of a run asked for `requested`: at least the longest
+/// mux settling time of any branch, so that the mux value held through
+/// reset settles the first conversion (docs/timing.md, "Reset values").
+pub fn reset_cycles(s: &Schedule, requested: u64) -> u64 {
+    let settle = s
+        .mix
+        .branches
+        .iter()
+        .map(|b| lut_gen::parts::ns_to_cycles(b.settle_ns, s.mix.clock_hz))
+        .max()
+        .unwrap_or(0);
+    requested.max(settle).max(1)
 }
 
 /// Runs `frames` frames of `dut` with the ADC model, feeding every cycle to
@@ -101,7 +115,7 @@ pub fn run_dut<D: Dut + ?Sized>(
     let ones = (1u64 << s.branches.len()) - 1;
     let mut miso = ones;
     let mut k = 0u64;
-    for _ in 0..opts.reset_cycles {
+    for _ in 0..reset_cycles(s, opts.reset_cycles) {
         let p = dut.step(true, miso);
         miso = adc.drive(0, &p);
         chk.cycle(true, &p, miso);

@@ -1,75 +1,142 @@
-//! A second simulator: the emitted Verilog in Icarus with a Verilog AD7940
-//! model (cosim/tb/adc_tb.v.in); its VCD must pass `check`.
+//! The `icarus` back end: the emitted Verilog in Icarus with a Verilog
+//! AD7940 model (cosim/tb/adc_tb.v.in); its VCD must pass the checker, and
+//! its ADCs must give the codes of cosim's own ADC model.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use cosim::Layout;
+use cosim::run::{run_dut, Observer, RunOptions};
+use cosim::vcd::{read_cycles, CycleSink};
+use cosim::{Backend, Pins, SimOptions, Stimulus, VcdOut};
 
 fn have(tool: &str) -> bool {
     Command::new(tool).arg("-V").output().is_ok()
 }
 
-fn icarus_run(mix: &Path, frames: u64) -> (lut_gen::Schedule, tempfile::TempDir) {
-    let s = lut_gen::synthesize(&lut_gen::load(mix).unwrap()).unwrap();
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn schedule(p: &Path) -> lut_gen::Schedule {
+    lut_gen::synthesize(&lut_gen::load(p).unwrap()).unwrap()
+}
+
+/// `(cycle after reset, channel, value)` of every sample.
+#[derive(Default)]
+struct Samples {
+    c: u64,
+    v: Vec<(u64, u16, u16)>,
+}
+
+impl CycleSink for Samples {
+    fn cycle(&mut self, rst: Option<bool>, p: &Pins, _: &Pins, _: u64, _: u64) {
+        if rst == Some(false) {
+            if p.sample_valid {
+                self.v.push((self.c, p.sample_channel, p.sample_value));
+            }
+            self.c += 1;
+        }
+    }
+}
+
+impl Observer for Samples {
+    fn cycle(&mut self, _: u64, rst: bool, p: &Pins, _: u64) {
+        CycleSink::cycle(self, Some(rst), p, p, 0, 0);
+    }
+}
+
+#[test]
+fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
+    if !have("iverilog") {
+        eprintln!("iverilog missing: skipped");
+        return;
+    }
+    let s = schedule(&data("tiny.toml"));
     let d = tempfile::tempdir().unwrap();
-    hdl::emit(&s, None).unwrap().write_to(d.path()).unwrap();
-    let l = Layout::new(&s);
-    let tb = include_str!("../tb/adc_tb.v.in")
-        .replace("@NB@", &l.branches.to_string())
-        .replace("@M@", &l.mux_devices.to_string())
-        .replace("@W@", &l.channel_bits.to_string())
-        .replace("@CYCLES@", &(frames * s.grid.frame_cycles).to_string());
-    std::fs::write(d.path().join("tb.v"), tb).unwrap();
-    let o = Command::new("iverilog")
-        .args(["-g2005", "-o", "sim", "tb.v", "slotforge_top.v"])
-        .current_dir(d.path())
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "iverilog: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let o = Command::new("vvp")
-        .args(["-n", "sim"])
-        .current_dir(d.path())
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "vvp: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    (s, d)
+    for stimulus in [Stimulus::Pattern, Stimulus::Sine] {
+        let wave = d.path().join("wave.vcd");
+        let opts = SimOptions {
+            stimulus,
+            vcd: Some(VcdOut {
+                path: wave.clone(),
+                from_frame: 0,
+                to_frame: 3,
+                gtkw: false,
+            }),
+            ..SimOptions::default()
+        };
+        let r = cosim::run(&s, Backend::Icarus, 3, &opts).unwrap();
+        assert!(r.ok, "{stimulus:?}: {}", r.summary());
+        assert_eq!(r.source, "icarus");
+        assert!(r.model_compared);
+        assert_eq!(r.frames, 3);
+        assert_eq!(r.samples, 3 * s.samples_per_frame());
+        // the same sample stream (cycles, channels, codes) as the in-process ADC model
+        let mut ic = Samples::default();
+        read_cycles(&s, &wave, None, &mut ic).unwrap();
+        let mut rh = Samples::default();
+        let mut dut = cosim::backend::RustHdlDut::new(&s).unwrap();
+        let ro = RunOptions {
+            stimulus,
+            ..RunOptions::default()
+        };
+        let rr = run_dut(&s, &mut dut, 3, &ro, "rusthdl", Some(&mut rh));
+        assert!(rr.ok);
+        assert_eq!(ic.v.len() as u64, 3 * s.samples_per_frame());
+        assert_eq!(
+            ic.v, rh.v,
+            "{stimulus:?}: Icarus's ADC codes differ from cosim's"
+        );
+    }
 }
 
 #[test]
-fn icarus_vcd_of_the_emitted_verilog_passes_check() {
+fn icarus_backend_vcd_windows() {
     if !have("iverilog") {
         eprintln!("iverilog missing: skipped");
         return;
     }
-    let tiny = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/tiny.toml");
-    let (s, d) = icarus_run(&tiny, 3);
-    let r = cosim::check_vcd(&s, d.path().join("wave.vcd"), None).unwrap();
-    assert!(r.ok, "{}", r.summary());
-    assert_eq!(r.frames, 3);
-    assert_eq!(r.samples, 3 * s.samples_per_frame());
-    // the DUT scope works too, and the same VCD fails for a corrupted value
-    let r = cosim::check_vcd(&s, d.path().join("wave.vcd"), Some("tb")).unwrap();
-    assert!(r.ok, "{}", r.summary());
+    let s = schedule(&data("tiny.toml"));
+    let d = tempfile::tempdir().unwrap();
+    let f = s.grid.frame_cycles;
+    for (from, to, checks) in [(0, 2, true), (1, 2, false)] {
+        let wave = d.path().join(format!("w{from}{to}.vcd"));
+        let opts = SimOptions {
+            vcd: Some(VcdOut {
+                path: wave.clone(),
+                from_frame: from,
+                to_frame: to,
+                gtkw: false,
+            }),
+            ..SimOptions::default()
+        };
+        let r = cosim::run(&s, Backend::Icarus, 3, &opts).unwrap();
+        assert!(r.ok, "{}", r.summary());
+        let cycles = cosim::vcd::parse_only(&s, &wave, None).unwrap();
+        let reset = cosim::run::reset_cycles(&s, opts.reset_cycles);
+        if checks {
+            // a window from frame 0 has the reset and checks on its own
+            assert_eq!(cycles, reset + (to - from) * f);
+            let r = cosim::check_vcd(&s, &wave, None).unwrap();
+            assert!(r.ok, "{}", r.summary());
+            assert_eq!(r.frames, to - from);
+        } else {
+            assert_eq!(cycles, (to - from) * f);
+        }
+    }
 }
 
 #[test]
-fn icarus_eskin34_one_frame() {
+fn icarus_backend_eskin34_one_frame() {
     if !have("iverilog") {
         eprintln!("iverilog missing: skipped");
         return;
     }
-    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml");
-    let (s, d) = icarus_run(&mix, 1);
-    let r = cosim::check_vcd(&s, d.path().join("wave.vcd"), None).unwrap();
+    let s = schedule(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml"));
+    let r = cosim::run(&s, Backend::Icarus, 1, &SimOptions::default()).unwrap();
     assert!(r.ok, "{}", r.summary());
+    assert_eq!(r.frames, 1);
     assert_eq!(r.samples, s.samples_per_frame());
 }

@@ -1,5 +1,7 @@
 //! `slotforge sim MIX --backend B --frames N [--vcd F --from A --to B] [--json] [--stimulus S]`
 //!
+//! Back ends: model, rusthdl, verilator, icarus (see `cosim::Backend`).
+//!
 //! Exit 0: every cycle passed; 1: a divergence or violation; 2: bad input or
 //! a missing tool.
 
@@ -11,7 +13,7 @@ use cosim::{Backend, SimOptions, Stimulus, VcdOut};
 pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
-    /// model (slot-level), rusthdl (in process) or verilator (the emitted Verilog).
+    /// model (slot-level), rusthdl (in process), verilator or icarus (the emitted Verilog).
     #[arg(long, default_value = "model")]
     pub backend: String,
     /// Frames to simulate.
@@ -49,6 +51,10 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
+    if a.frames == 0 {
+        eprintln!("error: --frames must be at least 1");
+        return 2;
+    }
     let to = a.to.unwrap_or(a.from + 1);
     if a.vcd.is_some() && to <= a.from {
         eprintln!("error: --to ({to}) must be after --from ({})", a.from);

@@ -1,0 +1,315 @@
+//! The Icarus back end: the emitted `slotforge_top.v` in Icarus Verilog with
+//! a Verilog AD7940 per branch (`cosim/tb/adc_tb.v.in`), run by `vvp` into a
+//! temporary VCD that the streaming VCD checker then reads (every invariant
+//! and cycle-exact equality with the reference model), like any waveform
+//! handed to `slotforge check`.
+//!
+//! The testbench's ADCs give the same codes as cosim's cycle-level ADC model
+//! ([`crate::adc::Adc`]) for the chosen stimulus: `pattern` by the same
+//! formula, the others from a table of the schedule's conversions (a
+//! conversion the schedule does not expect falls back to the pattern
+//! formula; the checker decodes every value from MISO in any case).  Reset
+//! lasts [`crate::run::reset_cycles`] cycles, as in the in-process back ends.
+
+use std::fmt::Write as _;
+use std::fs::File;
+use std::io::{BufRead, BufReader, BufWriter, Write};
+use std::path::Path;
+use std::process::Command;
+
+use lut_gen::Schedule;
+
+use crate::adc::{Analog, Stimulus};
+use crate::backend::{SimError, SimOptions, VcdOut};
+use crate::pins::{Layout, Pins};
+use crate::report::Report;
+use crate::verilator::BackendError;
+
+const TEMPLATE: &str = include_str!("../tb/adc_tb.v.in");
+
+/// Half a clock period in picoseconds (the same as cosim's own VCDs).
+pub fn half_period_ps(s: &Schedule) -> u64 {
+    (500_000_000_000u64 / s.grid.clock_hz).max(1)
+}
+
+/// A generated testbench: `tb.v` and the code tables it reads (`codes<b>.hex`).
+#[derive(Debug, Clone)]
+pub struct Testbench {
+    pub tb: String,
+    pub tables: Vec<(String, String)>,
+    /// Reset cycles before cycle 0.
+    pub reset_cycles: u64,
+}
+
+/// The testbench for `cycles` cycles after reset with `stimulus`.
+pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u64) -> Testbench {
+    let l = Layout::new(s);
+    let analog = Analog::new(s, stimulus);
+    let nch = s.channels.len() as u64;
+    let frames = cycles.div_ceil(s.grid.frame_cycles);
+    let mut adcs = String::new();
+    let mut tables = Vec::new();
+    for b in 0..l.branches {
+        let (lo, n) = (l.en_lo[b], l.en_n[b]);
+        let kbits = n + 3;
+        let _ = writeln!(adcs, "  // branch {b} ({})", s.branches[b].name);
+        let _ = writeln!(
+            adcs,
+            "  reg [15:0] word{b};\n  reg [4:0] falls{b};\n  reg out{b};\n  reg drive{b} = 0;\n  \
+             reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [13:0] code{b};\n  \
+             assign adc_miso[{b}] = drive{b} ? out{b} : 1'bz;"
+        );
+        // the input id cosim's ADC model gives each (enable, select) of this branch
+        let id_of = |en: u64, sel: u32| {
+            let p = Pins {
+                mux_sel: sel << (3 * b),
+                mux_en: en << lo,
+                ..Pins::default()
+            };
+            analog.input_id(&l, &p, b)
+        };
+        let ens: Vec<u64> = if n <= 6 {
+            (0..1u64 << n).collect()
+        } else {
+            (0..n).map(|d| 1u64 << d).collect()
+        };
+        let mut cases = String::new();
+        for &en in &ens {
+            for sel in 0..8u32 {
+                let key = (en << 3) | sel as u64;
+                let _ = writeln!(
+                    cases,
+                    "      {kbits}'d{key}: id{b} = 64'd{};",
+                    id_of(en, sel)
+                );
+            }
+        }
+        let _ = writeln!(cases, "      default: id{b} = 64'd{};", id_of(0, 0));
+        let table = if stimulus == Stimulus::Pattern {
+            String::new()
+        } else {
+            let mut hex = String::new();
+            let mut len = 0u64;
+            for i in s.instants(frames).filter(|i| i.branch == b) {
+                let code = analog.code(i.channel as u64, i.cycle) & 0x3fff;
+                let _ = writeln!(
+                    hex,
+                    "{:04x}{:08x}{:04x}",
+                    i.channel as u16, i.cycle as u32, code
+                );
+                len += 1;
+            }
+            if len == 0 {
+                String::new()
+            } else {
+                let name = format!("codes{b}.hex");
+                tables.push((name.clone(), hex));
+                let _ = writeln!(
+                    adcs,
+                    "  reg [63:0] tab{b} [0:{}];\n  initial $readmemh(\"{name}\", tab{b});",
+                    len - 1
+                );
+                format!(
+                    "    if (n{b} < {len} && tab{b}[n{b}][63:48] == id{b}[15:0] && tab{b}[n{b}][47:16] == cyc[31:0])\n      \
+                     code{b} = tab{b}[n{b}][13:0];\n"
+                )
+            }
+        };
+        let _ = write!(
+            adcs,
+            "  always @(negedge adc_cs_n[{b}]) if (!rst) begin\n    \
+             case ({{mux_en[{hi}:{lo}], mux_sel[{sh}:{sl}]}})\n{cases}    endcase\n    \
+             code{b} = pattern(cyc, id{b});\n{table}    n{b} = n{b} + 1;\n    \
+             word{b} = {{2'b00, code{b}}};\n    falls{b} = 0;\n    out{b} = word{b}[15];\n    drive{b} = 1;\n  end\n  \
+             always @(posedge adc_cs_n[{b}]) drive{b} = 0;\n  \
+             always @(negedge adc_sclk[{b}]) if (!adc_cs_n[{b}]) begin\n    \
+             falls{b} = falls{b} + 1;\n    if (falls{b} >= 16) drive{b} = 0; else out{b} = word{b}[15 - falls{b}];\n  end\n\n",
+            hi = lo + n - 1,
+            sh = 3 * b + 2,
+            sl = 3 * b,
+        );
+    }
+    let tb = TEMPLATE
+        .replace("@NB@", &l.branches.to_string())
+        .replace("@M@", &l.mux_devices.to_string())
+        .replace("@W@", &l.channel_bits.to_string())
+        .replace("@RESET@", &reset_cycles.to_string())
+        .replace("@CYCLES@", &cycles.to_string())
+        .replace("@HALF@", &half_period_ps(s).to_string())
+        .replace("@SLOT@", &s.grid.slot_cycles.to_string())
+        .replace("@NCH_PLUS_64@", &(nch + 64).to_string())
+        .replace("@ADCS@", &adcs);
+    Testbench {
+        tb,
+        tables,
+        reset_cycles,
+    }
+}
+
+fn tool_missing(tool: &str) -> BackendError {
+    BackendError::MissingTool {
+        tool: tool.into(),
+        hint:
+            "the icarus back end needs Icarus Verilog: `apt-get install iverilog`, or `make tools`"
+                .into(),
+    }
+}
+
+fn spawn(cmd: &mut Command, tool: &str, step: &str) -> Result<(), BackendError> {
+    let out = cmd.output().map_err(|e| {
+        if e.kind() == std::io::ErrorKind::NotFound {
+            tool_missing(tool)
+        } else {
+            BackendError::Io(format!("{tool}: {e}"))
+        }
+    })?;
+    if out.status.success() {
+        Ok(())
+    } else {
+        Err(BackendError::Build {
+            step: step.into(),
+            log: format!(
+                "{}{}",
+                String::from_utf8_lossy(&out.stdout),
+                String::from_utf8_lossy(&out.stderr)
+            ),
+        })
+    }
+}
+
+/// Simulates `frames` frames of the emitted gateware (`hdl::emit`, every
+/// file it writes) in Icarus and checks the VCD.  `opts.vcd` gets the
+/// requested window of Icarus's own VCD (scope `tb`; no `.gtkw`).
+pub fn run(s: &Schedule, frames: u64, opts: &SimOptions) -> Result<Report, SimError> {
+    let io = |e: std::io::Error| SimError::Io(format!("icarus back end: {e}"));
+    // Name the missing tool before doing any work.
+    for tool in ["iverilog", "vvp"] {
+        if let Err(e) = Command::new(tool).arg("-V").output() {
+            return Err(if e.kind() == std::io::ErrorKind::NotFound {
+                tool_missing(tool).into()
+            } else {
+                BackendError::Io(format!("{tool}: {e}")).into()
+            });
+        }
+    }
+    let dir = tempfile::Builder::new()
+        .prefix("slotforge-icarus-")
+        .tempdir()
+        .map_err(io)?;
+    let d = dir.path();
+    let reset = crate::run::reset_cycles(s, opts.reset_cycles);
+    let cycles = frames * s.grid.frame_cycles;
+    let tb = testbench(s, opts.stimulus, reset, cycles);
+    hdl::emit(s, None)
+        .and_then(|e| e.write_to(d))
+        .map_err(|e| SimError::Hdl(e.to_string()))?;
+    std::fs::write(d.join("tb.v"), &tb.tb).map_err(io)?;
+    for (name, text) in &tb.tables {
+        std::fs::write(d.join(name), text).map_err(io)?;
+    }
+    spawn(
+        Command::new("iverilog")
+            .args(["-g2005", "-o", "sim.vvp", "tb.v", "slotforge_top.v"])
+            .current_dir(d),
+        "iverilog",
+        "iverilog (compiling the emitted Verilog and the testbench)",
+    )?;
+    spawn(
+        Command::new("vvp").args(["-n", "sim.vvp"]).current_dir(d),
+        "vvp",
+        "vvp (running the simulation)",
+    )?;
+    let wave = d.join("wave.vcd");
+    let (mut report, _) = crate::vcd::check_vcd_with(s, &wave, Some("tb"), opts.check)
+        .map_err(|e| SimError::Io(format!("icarus back end: reading its VCD: {e}")))?;
+    report.source = "icarus".into();
+    if let Some(v) = &opts.vcd {
+        write_window(s, &wave, v, reset, frames)
+            .map_err(|e| SimError::Io(format!("{}: {e}", v.path.display())))?;
+    }
+    Ok(report)
+}
+
+/// Copies frames `[v.from_frame, v.to_frame)` of Icarus's VCD to `v.path`
+/// (frame 0 includes the reset cycles; a later window starts with the
+/// values at its first cycle, times shifted to start near 0).
+fn write_window(
+    s: &Schedule,
+    wave: &Path,
+    v: &VcdOut,
+    reset: u64,
+    frames: u64,
+) -> std::io::Result<()> {
+    let f = s.grid.frame_cycles;
+    let h = half_period_ps(s);
+    let to_frame = v.to_frame.max(v.from_frame + 1);
+    if v.from_frame == 0 && to_frame >= frames {
+        std::fs::copy(wave, &v.path)?;
+        return Ok(());
+    }
+    // Edge k (from the first reset edge) is at (2k + 1) h; a window of edges
+    // [k0, k1) spans times [2 k0 h, 2 k1 h).
+    let k0 = if v.from_frame == 0 {
+        0
+    } else {
+        reset + v.from_frame * f
+    };
+    let k1 = reset + to_frame * f;
+    let (t0, t1) = (2 * k0 * h, 2 * k1 * h);
+    let mut rd = BufReader::new(File::open(wave)?);
+    let mut w = BufWriter::new(File::create(&v.path)?);
+    let mut line = String::new();
+    // header
+    loop {
+        line.clear();
+        if rd.read_line(&mut line)? == 0 {
+            return Err(std::io::Error::other("VCD ends in its header"));
+        }
+        w.write_all(line.as_bytes())?;
+        if line.contains("$enddefinitions") {
+            break;
+        }
+    }
+    let mut last: std::collections::BTreeMap<String, String> = Default::default();
+    let mut inside = t0 == 0;
+    loop {
+        line.clear();
+        if rd.read_line(&mut line)? == 0 {
+            break;
+        }
+        let l = line.trim_end();
+        if let Some(t) = l.strip_prefix('#') {
+            let t: u64 = t
+                .parse()
+                .map_err(|_| std::io::Error::other(format!("bad time `{l}`")))?;
+            if t >= t1 {
+                writeln!(w, "#{}", t1 - t0)?;
+                break;
+            }
+            if !inside && t >= t0 {
+                inside = true;
+                writeln!(w, "#0\n$dumpvars")?;
+                for v in last.values() {
+                    writeln!(w, "{v}")?;
+                }
+                writeln!(w, "$end")?;
+            }
+            if inside {
+                writeln!(w, "#{}", t - t0)?;
+            }
+        } else if l.starts_with('$') || l.is_empty() {
+            if inside && t0 == 0 {
+                writeln!(w, "{l}")?;
+            }
+        } else if inside {
+            writeln!(w, "{l}")?;
+        } else {
+            let id = match l.split_once(' ') {
+                Some((_, id)) => id,
+                None => &l[1..],
+            };
+            last.insert(id.to_string(), l.to_string());
+        }
+    }
+    w.flush()
+}

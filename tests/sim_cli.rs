@@ -1,0 +1,380 @@
+//! End-to-end tests of `slotforge sim` and `slotforge check`: every back end
+//! passes with SPEC's JSON, a VCD written by `sim --vcd` passes `check` and
+//! its corrupted copies fail with the divergence named, and bad input of any
+//! kind exits 2 with a message and no panic.
+
+use std::path::{Path, PathBuf};
+use std::process::Command as Std;
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+
+fn slotforge() -> Command {
+    Command::cargo_bin("slotforge").unwrap()
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn eskin34() -> PathBuf {
+    root().join("mixes/eskin34.toml")
+}
+
+/// A two-branch mix with a 4000-cycle frame (fast in every simulator).
+fn tiny() -> PathBuf {
+    root().join("cosim/tests/data/tiny.toml")
+}
+
+fn have(tool: &str) -> bool {
+    let ok = Std::new(tool).arg("--version").output().is_ok()
+        || Std::new(tool).arg("-V").output().is_ok();
+    if !ok {
+        eprintln!("`{tool}` is not installed: skipped (make tools installs it)");
+    }
+    ok
+}
+
+/// Runs `sim --json` and checks SPEC's fields; returns the report.
+fn sim_json(mix: &Path, backend: &str, frames: u64) -> serde_json::Value {
+    let out = slotforge()
+        .arg("sim")
+        .arg(mix)
+        .args([
+            "--backend",
+            backend,
+            "--frames",
+            &frames.to_string(),
+            "--json",
+        ])
+        .assert()
+        .code(0);
+    let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    for key in [
+        "ok",
+        "cycles",
+        "frames",
+        "samples",
+        "channels",
+        "divergences",
+        "violations",
+    ] {
+        assert!(v.get(key).is_some(), "{backend}: missing {key}");
+    }
+    assert_eq!(v["ok"], true, "{backend}");
+    assert_eq!(v["frames"], frames, "{backend}");
+    assert!(v["divergences"].as_array().unwrap().is_empty());
+    assert!(v["violations"].as_array().unwrap().is_empty());
+    let chans = v["channels"].as_array().unwrap();
+    assert!(!chans.is_empty());
+    let mut total = 0;
+    for c in chans {
+        for key in [
+            "name",
+            "samples",
+            "interval_cycles_min",
+            "interval_cycles_max",
+        ] {
+            assert!(c.get(key).is_some(), "{backend}: channel missing {key}");
+        }
+        assert!(c["samples"].as_u64().unwrap() >= frames);
+        // zero jitter: every interval is the nominal one
+        assert_eq!(c["interval_cycles_min"], c["interval_cycles_max"], "{c}");
+        total += c["samples"].as_u64().unwrap();
+    }
+    assert_eq!(v["samples"].as_u64().unwrap(), total, "{backend}");
+    v
+}
+
+#[test]
+fn sim_model_100_frames() {
+    let v = sim_json(&eskin34(), "model", 100);
+    assert_eq!(v["samples"], 34_900);
+    assert_eq!(v["cycles"], 100 * 480_000);
+}
+
+#[test]
+fn sim_rusthdl_2_frames() {
+    let v = sim_json(&eskin34(), "rusthdl", 2);
+    assert_eq!(v["samples"], 698);
+    assert_eq!(v["cycles"], 960_000);
+}
+
+#[test]
+fn sim_verilator_2_frames() {
+    if !have("verilator") || !have("g++") {
+        return;
+    }
+    let v = sim_json(&eskin34(), "verilator", 2);
+    assert_eq!(v["samples"], 698);
+    assert_eq!(v["source"], "verilator");
+}
+
+#[test]
+fn sim_icarus_small_mix() {
+    if !have("iverilog") {
+        return;
+    }
+    let v = sim_json(&tiny(), "icarus", 3);
+    assert_eq!(v["source"], "icarus");
+    assert_eq!(v["samples"], 30);
+    assert_eq!(v["cycles"], 12_000);
+}
+
+#[test]
+fn sim_icarus_names_the_missing_tool() {
+    let empty = tempfile::tempdir().unwrap();
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--backend", "icarus", "--frames", "1"])
+        .env("PATH", empty.path())
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("`iverilog` is not installed"))
+        .stderr(predicate::str::contains("panicked").not());
+}
+
+/// A VCD of 3 frames of the tiny mix (with reset), written by `sim --vcd`.
+fn sim_vcd(dir: &Path) -> PathBuf {
+    let wave = dir.join("wave.vcd");
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args([
+            "--backend",
+            "rusthdl",
+            "--frames",
+            "3",
+            "--from",
+            "0",
+            "--to",
+            "3",
+        ])
+        .arg("--vcd")
+        .arg(&wave)
+        .assert()
+        .code(0);
+    assert!(dir.join("wave.gtkw").exists());
+    wave
+}
+
+/// The identifier code of `name` in a VCD header.
+fn id_of(text: &str, name: &str) -> String {
+    text.lines()
+        .find_map(|l| {
+            let t: Vec<&str> = l.split_whitespace().collect();
+            (t.len() >= 5 && t[0] == "$var" && t[4] == name).then(|| t[3].to_string())
+        })
+        .unwrap_or_else(|| panic!("no $var {name}"))
+}
+
+/// Indices of the vector value changes of `id` in the body.
+fn changes(lines: &[String], id: &str) -> Vec<usize> {
+    lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.starts_with('b') && l.split_whitespace().nth(1) == Some(id))
+        .map(|(i, _)| i)
+        .collect()
+}
+
+fn check_json(wave: &Path, code: i32) -> serde_json::Value {
+    let out = slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(wave)
+        .arg("--json")
+        .assert()
+        .code(code);
+    serde_json::from_slice(&out.get_output().stdout).unwrap()
+}
+
+#[test]
+fn check_passes_a_sim_vcd_and_fails_corrupted_copies() {
+    let d = tempfile::tempdir().unwrap();
+    let wave = sim_vcd(d.path());
+    let v = check_json(&wave, 0);
+    assert_eq!(v["ok"], true);
+    assert_eq!(v["frames"], 3);
+    assert_eq!(v["samples"], 30);
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&wave)
+        .assert()
+        .code(0)
+        .stdout(predicate::str::contains("PASS"));
+
+    let text = std::fs::read_to_string(&wave).unwrap();
+    let lines: Vec<String> = text.lines().map(String::from).collect();
+
+    // 1. one sample_value bit flipped in the middle of the file
+    let id = id_of(&text, "sample_value");
+    let ch = changes(&lines, &id);
+    let i = ch[ch.len() / 2];
+    let mut bad = lines.clone();
+    let (val, rest) = bad[i].split_once(' ').unwrap();
+    let mut bits: Vec<u8> = val[1..].bytes().collect();
+    let last = bits.len() - 1;
+    bits[last] = if bits[last] == b'0' { b'1' } else { b'0' };
+    bad[i] = format!("b{} {rest}", String::from_utf8(bits).unwrap());
+    let p = d.path().join("flipped.vcd");
+    std::fs::write(&p, bad.join("\n") + "\n").unwrap();
+    let v = check_json(&p, 1);
+    assert_eq!(v["ok"], false);
+    let div = &v["divergences"][0];
+    assert_eq!(div["signal"], "sample_value");
+    assert!(div["cycle"].as_u64().unwrap() > 4000, "{div}");
+    assert!(div["expected"].is_number() && div["actual"].is_number());
+    assert_ne!(div["expected"], div["actual"]);
+    // the invariant layer sees it too: the value is not the word on MISO
+    assert!(v["violations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|x| x["rule"] == "sample-value"));
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&p)
+        .assert()
+        .code(1)
+        .stdout(predicate::str::contains("first divergence: cycle"))
+        .stdout(predicate::str::contains("sample_value"));
+
+    // 2. a CS edge moved one clock later
+    let id = id_of(&text, "adc_cs_n");
+    let ch = changes(&lines, &id);
+    let i = ch[ch.len() / 2];
+    let mut bad = lines.clone();
+    let moved = bad.remove(i);
+    // two timesteps later (falling then rising clock edge) is the next cycle's edge
+    let mut seen = 0;
+    let mut j = i;
+    while seen < 2 {
+        if bad[j].starts_with('#') {
+            seen += 1;
+        }
+        j += 1;
+    }
+    bad.insert(j, moved);
+    let p = d.path().join("moved.vcd");
+    std::fs::write(&p, bad.join("\n") + "\n").unwrap();
+    let v = check_json(&p, 1);
+    assert_eq!(v["ok"], false);
+    let div = &v["divergences"][0];
+    assert!(
+        div["signal"].as_str().unwrap().starts_with("adc_cs_n"),
+        "{div}"
+    );
+    assert!(div["cycle"].as_u64().unwrap() > 4000, "{div}");
+}
+
+#[test]
+fn check_truncated_and_missing_files_exit_2() {
+    let d = tempfile::tempdir().unwrap();
+    let wave = sim_vcd(d.path());
+    let text = std::fs::read(&wave).unwrap();
+    // cut in the middle of a line, past the header
+    let mut cut = text.len() / 2;
+    while text[cut] == b'\n' || text[cut - 1] == b'\n' {
+        cut += 1;
+    }
+    let p = d.path().join("truncated.vcd");
+    std::fs::write(&p, &text[..cut]).unwrap();
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&p)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("truncated VCD"))
+        .stderr(predicate::str::contains("truncated.vcd"))
+        .stderr(predicate::str::contains("panicked").not());
+    // cut inside the header
+    std::fs::write(&p, &text[..200]).unwrap();
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&p)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("truncated VCD"))
+        .stderr(predicate::str::contains("panicked").not());
+    let missing = d.path().join("missing.vcd");
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&missing)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("missing.vcd"))
+        .stderr(predicate::str::contains("panicked").not());
+    // a VCD of another mix: ports that do not fit
+    slotforge()
+        .arg("check")
+        .arg(eskin34())
+        .arg(&wave)
+        .assert()
+        .code(predicate::in_iter([1, 2]))
+        .stderr(predicate::str::contains("panicked").not());
+}
+
+#[test]
+fn bad_input_exits_2() {
+    let d = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(tiny()).unwrap();
+    let bad = d.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        text.replace("rate_hz = 4_000", "rate_hz = 4_000\nrat = 1"),
+    )
+    .unwrap();
+    for cmd in [&["sim"][..], &["check"][..]] {
+        let mut c = slotforge();
+        c.args(cmd).arg(&bad);
+        if cmd[0] == "check" {
+            c.arg(d.path().join("whatever.vcd"));
+        }
+        c.assert()
+            .code(2)
+            .stderr(predicate::str::contains("bad.toml:"))
+            .stderr(predicate::str::contains("rat"))
+            .stderr(predicate::str::contains("panicked").not());
+    }
+    slotforge()
+        .arg("sim")
+        .arg(d.path().join("nope.toml"))
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("nope.toml"));
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--backend", "ghdl"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("unknown back end `ghdl`"))
+        .stderr(predicate::str::contains("icarus"));
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--stimulus", "noise"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("unknown stimulus"));
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--frames", "0"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--frames"));
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--vcd", "x.vcd", "--from", "2", "--to", "1"])
+        .assert()
+        .code(2);
+}
