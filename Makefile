@@ -45,6 +45,7 @@ cosim: tools
 	$(SLOTFORGE) sim $(MIX) --backend model --frames 100
 	$(SLOTFORGE) sim $(MIX) --backend rusthdl --frames 2
 	$(SLOTFORGE) sim $(MIX) --backend verilator --frames 2
+	$(SLOTFORGE) sim $(MIX) --backend icarus --frames 1
 
 # Place and route on an iCE40 HX8K; prints LCs and Fmax (figures: docs/performance.md).
 synth: tools
