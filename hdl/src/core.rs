@@ -20,12 +20,15 @@
 
 use rust_hdl::prelude::*;
 
-use crate::plan::{BranchRom, Plan, SeqTiming, MAX_BRANCHES};
+use crate::plan::{BranchRom, CompactRom, Plan, SeqTiming, MAX_BRANCHES};
 
 /// Width of the cycle-in-slot counter.
-pub const CNT_BITS: usize = 16;
-/// Width of the slot-in-frame counter (ROM address).
+pub const CNT_BITS: usize = 20;
+/// Width of the slot counter (ROM address): slot in frame (full LUT) or
+/// slot in slice (compact LUT).
 pub const SLOT_BITS: usize = 12;
+/// Width of the slice counter (compact LUT only).
+pub const SLICE_BITS: usize = 10;
 /// Width of the SCLK phase counter.
 pub const PH_BITS: usize = 10;
 /// Width of a channel index.
@@ -51,7 +54,9 @@ fn c<const N: usize>(v: u64) -> Constant<Bits<N>> {
 #[derive(LogicBlock)]
 pub struct SlotRom {
     pub clock: Signal<In, Clock>,
+    pub rst: Signal<In, Bit>,
     pub address: Signal<In, Bits<SLOT_BITS>>,
+    pub slice: Signal<In, Bits<SLICE_BITS>>,
     pub conv: Signal<Out, Bit>,
     pub ch: Signal<Out, Bits<CH_BITS>>,
     pub msel: Signal<Out, Bits<3>>,
@@ -60,13 +65,20 @@ pub struct SlotRom {
     _addr_bits: usize,
     _ch_bits: usize,
     _dev_bits: usize,
+    _compact: Option<CompactRom>,
+    /// Compact form: slice-table word, its slice, rotation word.
+    _q1: u32,
+    _jq: usize,
+    _q2: u32,
 }
 
 impl SlotRom {
     fn new(rom: &BranchRom) -> SlotRom {
         SlotRom {
             clock: Default::default(),
+            rst: Default::default(),
             address: Default::default(),
+            slice: Default::default(),
             conv: Default::default(),
             ch: Default::default(),
             msel: Default::default(),
@@ -75,20 +87,65 @@ impl SlotRom {
             _addr_bits: rom.addr_bits,
             _ch_bits: rom.ch_bits,
             _dev_bits: rom.dev_bits,
+            _compact: rom.compact.clone(),
+            _q1: 0,
+            _jq: 0,
+            _q2: 0,
         }
+    }
+
+    fn word_bits(&self) -> usize {
+        1 + self._ch_bits + 3 + self._dev_bits
+    }
+
+    /// Compact form: the payload width of a slice-table word and the
+    /// rotation-table address read in reset (slot 0's).
+    fn compact_numbers(c: &CompactRom, wb: usize) -> (usize, usize) {
+        let payload = wb.max(c.group_bits);
+        let w0 = c.slice_words[0];
+        let a0 = if w0 >> payload & 1 == 1 {
+            ((w0 & ((1 << payload) - 1)) as usize) << c.slice_bits
+        } else {
+            0
+        };
+        (payload, a0)
+    }
+
+    fn set_outputs(&mut self, w: u64) {
+        let (cw, dw) = (self._ch_bits, self._dev_bits);
+        self.conv.next = (w >> (cw + 3 + dw)) & 1 == 1;
+        self.ch.next = ((w >> (3 + dw)) & ((1 << cw) - 1)).into();
+        self.msel.next = ((w >> dw) & 0x7).into();
+        self.mdev.next = (w & ((1 << dw) - 1)).into();
     }
 }
 
 impl Logic for SlotRom {
     fn update(&mut self) {
-        if self.clock.pos_edge() {
+        let wb = self.word_bits();
+        if let Some(c) = &self._compact {
+            let (payload, a0) = Self::compact_numbers(c, wb);
+            if self.clock.pos_edge() {
+                let ra = if self.rst.val() {
+                    a0
+                } else {
+                    (((self._q1 as usize) & ((1 << c.group_bits) - 1)) << c.slice_bits) | self._jq
+                };
+                self._q2 = c.rot_words.get(ra).copied().unwrap_or(0);
+                let a = self.address.val().to_u64() as usize & ((1 << c.slice_addr_bits) - 1);
+                self._q1 = c.slice_words.get(a).copied().unwrap_or(0);
+                self._jq = self.slice.val().to_u64() as usize & ((1 << c.slice_bits) - 1);
+            }
+            let w = if self._q1 >> payload & 1 == 1 {
+                self._q2
+            } else {
+                self._q1 & ((1 << payload) - 1)
+            };
+            self.set_outputs(w as u64);
+        } else if self.clock.pos_edge() {
             let a = self.address.val().to_u64() as usize;
             let w = self._words.get(a).copied().unwrap_or(0) as u64;
-            let (cw, dw) = (self._ch_bits, self._dev_bits);
-            self.conv.next = (w >> (cw + 3 + dw)) & 1 == 1;
-            self.ch.next = ((w >> (3 + dw)) & ((1 << cw) - 1)).into();
-            self.msel.next = ((w >> dw) & 0x7).into();
-            self.mdev.next = (w & ((1 << dw) - 1)).into();
+            self.set_outputs(w);
         }
     }
 
@@ -100,27 +157,66 @@ impl Logic for SlotRom {
     }
 
     fn hdl(&self) -> Verilog {
-        let aw = self._addr_bits;
         let (cw, dw) = (self._ch_bits, self._dev_bits);
-        let wb = 1 + cw + 3 + dw; // BranchRom::word_bits
-        let digits = wb.div_ceil(4);
-        let depth = 1usize << aw;
+        let wb = self.word_bits();
         let mut s = String::new();
-        s.push_str(&format!(
-            "reg [{}:0] mem [0:{}];\nreg [{}:0] q;\n\ninitial begin\n",
-            wb - 1,
-            depth - 1,
-            wb - 1
-        ));
-        for a in 0..depth {
-            let w = self._words.get(a).copied().unwrap_or(0);
-            s.push_str(&format!("  mem[{a}] = {wb}'h{w:0digits$x};\n"));
+        let table = |s: &mut String, name: &str, bits: usize, words: &[u32]| {
+            let digits = bits.div_ceil(4);
+            s.push_str(&format!(
+                "reg [{}:0] {name} [0:{}];\n",
+                bits - 1,
+                words.len() - 1
+            ));
+            s.push_str("initial begin\n");
+            for (a, w) in words.iter().enumerate() {
+                s.push_str(&format!("  {name}[{a}] = {bits}'h{w:0digits$x};\n"));
+            }
+            s.push_str("end\n\n");
+        };
+        let mut unused = vec![];
+        let used_addr;
+        if let Some(c) = &self._compact {
+            let (payload, a0) = Self::compact_numbers(c, wb);
+            let sw = 1 + payload;
+            let (gb, sb) = (c.group_bits, c.slice_bits);
+            table(&mut s, "smem", sw, &c.slice_words);
+            table(&mut s, "rmem", wb, &c.rot_words);
+            s.push_str(&format!(
+                "// slice table word (rotation flag + word or group), its slice, rotation word\nreg [{}:0] q1;\nreg [{}:0] jq;\nreg [{}:0] q2;\nwire [{}:0] ra = rst ? {}'h{a0:x} : {{q1[{}:0], jq}};\nwire [{}:0] q = q1[{}] ? q2 : q1[{}:0];\n\n",
+                sw - 1,
+                sb - 1,
+                wb - 1,
+                gb + sb - 1,
+                gb + sb,
+                gb - 1,
+                wb - 1,
+                sw - 1,
+                wb - 1
+            ));
+            s.push_str(&format!(
+                "always @(posedge clock) begin\n  q1 <= smem[address[{}:0]];\n  jq <= slice[{}:0];\n  q2 <= rmem[ra];\nend\n\n",
+                c.slice_addr_bits - 1,
+                sb - 1
+            ));
+            if payload > wb && gb < payload {
+                unused.push(format!("q1[{}:{}]", payload - 1, gb.max(wb)));
+            }
+            used_addr = c.slice_addr_bits;
+            if sb < SLICE_BITS {
+                unused.push(format!("slice[{}:{}]", SLICE_BITS - 1, sb));
+            }
+        } else {
+            let aw = self._addr_bits;
+            table(&mut s, "mem", wb, &self._words);
+            s.push_str(&format!("reg [{}:0] q;\n\n", wb - 1));
+            s.push_str(&format!(
+                "always @(posedge clock) begin\n  q <= mem[address[{}:0]];\nend\n\n",
+                aw - 1
+            ));
+            used_addr = aw;
+            unused.push("slice".to_string());
+            unused.push("rst".to_string());
         }
-        s.push_str("end\n\n");
-        s.push_str(&format!(
-            "always @(posedge clock) begin\n  q <= mem[address[{}:0]];\nend\n\n",
-            aw - 1
-        ));
         let pad = |field: String, bits: usize, full: usize| {
             if bits < full {
                 format!("{{{}'h0, {field}}}", full - bits)
@@ -136,11 +232,13 @@ impl Logic for SlotRom {
             dw,
             pad(format!("q[{}:0]", dw - 1), dw, DEV_BITS),
         ));
-        if aw < SLOT_BITS {
+        if used_addr < SLOT_BITS {
+            unused.push(format!("address[{}:{}]", SLOT_BITS - 1, used_addr));
+        }
+        if !unused.is_empty() {
             s.push_str(&format!(
-                "\n// address bits above the frame depth are always zero\nwire unused_address_hi = |address[{}:{}];\n",
-                SLOT_BITS - 1,
-                aw
+                "\n// inputs and bits this LUT form and size do not use\nwire unused_rom = |{{{}}};\n",
+                unused.join(", ")
             ));
         }
         Verilog::Custom(s)
@@ -164,14 +262,22 @@ pub struct TimingGen {
     pub start1: Signal<Out, Bit>,
     pub start0: Signal<Out, Bit>,
     pub addr: Signal<Out, Bits<SLOT_BITS>>,
+    pub slice: Signal<Out, Bits<SLICE_BITS>>,
     /// (c + 2) mod slot_cycles during cycle c.
     cnt: DFF<Bits<CNT_BITS>>,
     st: DFF<Bit>,
     st2: DFF<Bit>,
     st0: DFF<Bit>,
-    /// Frame slot index of the next slot start (> c).
+    /// Index of the next slot start (> c): in the frame (full LUT) or in the
+    /// slice (compact LUT), with its slice in `sl`.
     slot: DFF<Bits<SLOT_BITS>>,
+    sl: DFF<Bits<SLICE_BITS>>,
     nxt: Signal<Local, Bits<SLOT_BITS>>,
+    nxt_sl: Signal<Local, Bits<SLICE_BITS>>,
+    k_compact: Constant<Bit>,
+    k_sl_last: Constant<Bits<SLICE_BITS>>,
+    k_sl_zero: Constant<Bits<SLICE_BITS>>,
+    k_sl_one: Constant<Bits<SLICE_BITS>>,
     k_cnt_last: Constant<Bits<CNT_BITS>>,
     k_cnt_rst: Constant<Bits<CNT_BITS>>,
     k_cnt_zero: Constant<Bits<CNT_BITS>>,
@@ -190,17 +296,32 @@ impl TimingGen {
             start1: Default::default(),
             start0: Default::default(),
             addr: Default::default(),
+            slice: Default::default(),
             cnt: Default::default(),
             st: Default::default(),
             st2: Default::default(),
             st0: Default::default(),
             slot: Default::default(),
+            sl: Default::default(),
             nxt: Default::default(),
+            nxt_sl: Default::default(),
+            k_compact: Constant::new(plan.compact),
+            k_sl_last: c(if plan.compact {
+                plan.slices_per_frame - 1
+            } else {
+                0
+            }),
+            k_sl_zero: c(0),
+            k_sl_one: c(1),
             k_cnt_last: c(plan.slot_cycles - 1),
             k_cnt_rst: c(1 % plan.slot_cycles),
             k_cnt_zero: c(0),
             k_cnt_one: c(1),
-            k_slot_last: c(plan.frame_slots - 1),
+            k_slot_last: c(if plan.compact {
+                plan.slots_per_slice - 1
+            } else {
+                plan.frame_slots - 1
+            }),
             k_slot_zero: c(0),
             k_slot_one: c(1),
         }
@@ -210,7 +331,7 @@ impl TimingGen {
 impl Logic for TimingGen {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, cnt, st, st2, st0, slot);
+        dff_setup!(self, clock, cnt, st, st2, st0, slot, sl);
         if self.cnt.q.val() == self.k_cnt_last.val() {
             self.cnt.d.next = self.k_cnt_zero.val();
         } else {
@@ -220,9 +341,17 @@ impl Logic for TimingGen {
         self.st.d.next = self.st2.q.val();
         self.st0.d.next = self.st.q.val();
         self.nxt.next = self.slot.q.val();
+        self.nxt_sl.next = self.sl.q.val();
         if self.st.q.val() {
             if self.slot.q.val() == self.k_slot_last.val() {
                 self.nxt.next = self.k_slot_zero.val();
+                if self.k_compact.val() {
+                    if self.sl.q.val() == self.k_sl_last.val() {
+                        self.nxt_sl.next = self.k_sl_zero.val();
+                    } else {
+                        self.nxt_sl.next = self.sl.q.val() + self.k_sl_one.val();
+                    }
+                }
             } else {
                 self.nxt.next = self.slot.q.val() + self.k_slot_one.val();
             }
@@ -233,9 +362,12 @@ impl Logic for TimingGen {
             self.st2.d.next = false;
             self.st0.d.next = false;
             self.nxt.next = self.k_slot_zero.val();
+            self.nxt_sl.next = self.k_sl_zero.val();
         }
         self.slot.d.next = self.nxt.val();
+        self.sl.d.next = self.nxt_sl.val();
         self.addr.next = self.nxt.val();
+        self.slice.next = self.nxt_sl.val();
         self.start2.next = self.st2.q.val();
         self.start1.next = self.st.q.val();
         self.start0.next = self.st0.q.val();
@@ -379,6 +511,7 @@ pub struct BranchUnit {
     pub start1: Signal<In, Bit>,
     pub start0: Signal<In, Bit>,
     pub addr: Signal<In, Bits<SLOT_BITS>>,
+    pub slice: Signal<In, Bits<SLICE_BITS>>,
     pub seq_cs_n: Signal<In, Bit>,
     pub seq_sclk: Signal<In, Bit>,
     pub seq_cap: Signal<In, Bit>,
@@ -403,6 +536,11 @@ pub struct BranchUnit {
     r_sel: DFF<Bits<3>>,
     r_en: DFF<Bits<EN_BITS>>,
     r_done: DFF<Bit>,
+    /// Compact LUT only: the mux field of the current slot's word (the
+    /// branch's next instant after it), moved to the mux at the slot start.
+    p_sel: DFF<Bits<3>>,
+    p_dev: DFF<Bits<DEV_BITS>>,
+    k_compact: Constant<Bit>,
     k_sh_one: Constant<Bits<4>>,
     k_sh_lsb: Constant<Bits<14>>,
     k_sel_rst: Constant<Bits<3>>,
@@ -420,6 +558,7 @@ impl BranchUnit {
             start1: Default::default(),
             start0: Default::default(),
             addr: Default::default(),
+            slice: Default::default(),
             seq_cs_n: Default::default(),
             seq_sclk: Default::default(),
             seq_cap: Default::default(),
@@ -441,6 +580,9 @@ impl BranchUnit {
             r_sel: Default::default(),
             r_en: Default::default(),
             r_done: Default::default(),
+            p_sel: Default::default(),
+            p_dev: Default::default(),
+            k_compact: Constant::new(rom.compact.is_some()),
             k_sh_one: c(1),
             k_sh_lsb: c(1),
             k_sel_rst: c(rom.reset_sel as u64),
@@ -454,21 +596,35 @@ impl BranchUnit {
 impl Logic for BranchUnit {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, act, r_cs_n, r_sclk, shift, cur_ch, r_sel, r_en, r_done);
+        dff_setup!(
+            self, clock, act, r_cs_n, r_sclk, shift, cur_ch, r_sel, r_en, r_done, p_sel, p_dev
+        );
         self.rom.clock.next = self.clock.val();
+        self.rom.rst.next = self.rst.val();
         self.rom.address.next = self.addr.val();
+        self.rom.slice.next = self.slice.val();
         if self.start2.val() {
             // Cycle t - 2: the ROM describes the slot starting at t.
             self.act.d.next = self.rom.conv.val();
         }
         if self.start1.val() {
             self.cur_ch.d.next = self.rom.ch.val();
+            if self.k_compact.val() {
+                self.p_sel.d.next = self.rom.msel.val();
+                self.p_dev.d.next = self.rom.mdev.val();
+            }
         }
         if self.start0.val() {
-            // First cycle of a slot: the ROM already describes the next slot,
-            // whose mux field is the channel of the branch's next instant.
-            self.r_sel.d.next = self.rom.msel.val();
-            self.r_en.d.next = self.k_en_one.val() << self.rom.mdev.val();
+            if self.k_compact.val() {
+                self.r_sel.d.next = self.p_sel.q.val();
+                self.r_en.d.next = self.k_en_one.val() << self.p_dev.q.val();
+            } else {
+                // First cycle of a slot: the ROM already describes the next
+                // slot, whose mux field is the channel of the branch's next
+                // instant.
+                self.r_sel.d.next = self.rom.msel.val();
+                self.r_en.d.next = self.k_en_one.val() << self.rom.mdev.val();
+            }
         }
         self.r_cs_n.d.next = self.seq_cs_n.val() | !self.act.q.val();
         self.r_sclk.d.next = self.seq_sclk.val() | !self.act.q.val();
@@ -732,6 +888,7 @@ impl Core {
         drive(&mut t.st2.clock, k);
         drive(&mut t.st0.clock, k);
         drive(&mut t.slot.clock, k);
+        drive(&mut t.sl.clock, k);
         for q in self.seqs.iter_mut() {
             drive(&mut q.clock, k);
             drive(&mut q.r_cs_n.clock, k);
@@ -752,6 +909,8 @@ impl Core {
             drive(&mut u.r_sel.clock, k);
             drive(&mut u.r_en.clock, k);
             drive(&mut u.r_done.clock, k);
+            drive(&mut u.p_sel.clock, k);
+            drive(&mut u.p_dev.clock, k);
         }
         let m = &mut self.merge;
         drive(&mut m.clock, k);
@@ -774,6 +933,7 @@ impl Logic for Core {
         let start1 = self.timing.start1.val();
         let start0 = self.timing.start0.val();
         let addr = self.timing.addr.val();
+        let slice = self.timing.slice.val();
         let mut seq = [(false, false, false, false); MAX_BRANCHES];
         for (i, q) in self.seqs.iter_mut().enumerate() {
             q.clock.next = clk;
@@ -793,6 +953,7 @@ impl Logic for Core {
             u.start1.next = start1;
             u.start0.next = start0;
             u.addr.next = addr;
+            u.slice.next = slice;
             let (q_cs, q_sclk, q_cap, q_done) = seq[self._seq_of[b]];
             u.seq_cs_n.next = q_cs;
             u.seq_sclk.next = q_sclk;
@@ -868,6 +1029,7 @@ impl Logic for Core {
             u.start1.connect();
             u.start0.connect();
             u.addr.connect();
+            u.slice.connect();
             u.seq_cs_n.connect();
             u.seq_sclk.connect();
             u.seq_cap.connect();
@@ -941,7 +1103,7 @@ fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> Str
         let u = format!("branches${b}");
         let q = format!("seqs${seq}");
         s.push_str(&format!(
-            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = timing$start0;\n  {u}$addr = timing$addr;\n"
+            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = timing$start0;\n  {u}$addr = timing$addr;\n  {u}$slice = timing$slice;\n"
         ));
         s.push_str(&format!(
             "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$miso = adc_miso[{b}];\n"
@@ -1048,6 +1210,7 @@ mod tests {
             self.unit.start1.next = self.timing.start1.val();
             self.unit.start0.next = self.timing.start0.val();
             self.unit.addr.next = self.timing.addr.val();
+            self.unit.slice.next = self.timing.slice.val();
             self.unit.seq_cs_n.next = self.seq.cs_n.val();
             self.unit.seq_sclk.next = self.seq.sclk.val();
             self.unit.seq_cap.next = self.seq.cap.val();
@@ -1074,6 +1237,7 @@ mod tests {
             conv0: true,
             devices: 2,
             en_offset: 0,
+            compact: None,
         };
         // mux fields: the first instant at this slot or later
         r.words = vec![
@@ -1087,6 +1251,9 @@ mod tests {
 
     fn harness(div: u64, setup: u64) -> Harness {
         let plan = Plan {
+            compact: false,
+            slots_per_slice: 4,
+            slices_per_frame: 1,
             slot_cycles: SLOT,
             frame_slots: 4,
             channel_bits: 3,

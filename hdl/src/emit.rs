@@ -12,7 +12,7 @@ use rust_hdl::prelude::*;
 use serde::Deserialize;
 
 use crate::core::{Core, CH_BITS, EN_TOTAL};
-use crate::plan::{plan, Plan, MAX_BRANCHES};
+use crate::plan::{plan_with, LutForm, Plan, MAX_BRANCHES};
 use crate::HdlError;
 
 /// Name the rust-hdl `top` module gets in the emitted file.
@@ -150,7 +150,13 @@ fn port_bits(s: &Schedule, p: &Plan) -> Vec<(String, &'static str)> {
 /// Generate every file for a schedule.  With `board`, the PCF maps port bits
 /// to that board's pins; without, a template PCF lists every port bit.
 pub fn emit(s: &Schedule, board: Option<&Path>) -> Result<Emitted, HdlError> {
-    let p = plan(s)?;
+    emit_with(s, board, LutForm::Auto)
+}
+
+/// [`emit`] with the slot LUT form chosen by the caller (`Auto` is [`emit`]'s
+/// rule, see hdl/DESIGN.md).
+pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Emitted, HdlError> {
+    let p = plan_with(s, form)?;
     let board = match board {
         Some(path) => Some((path, Board::load(path)?)),
         None => None,
@@ -464,6 +470,39 @@ fn slots_hex(s: &Schedule, p: &Plan) -> String {
         dw - 1
     );
     let _ = cw;
+    if p.compact {
+        let _ = writeln!(
+            t,
+            "// COMPACT form ({} slots per slice x {} slices): per branch a slice table (address = slot in slice;",
+            p.slots_per_slice, p.slices_per_frame
+        );
+        let _ = writeln!(
+            t,
+            "// top bit set: the rest is a rotation group g, else the word itself) and a rotation table (address = g << slice_bits | slice)"
+        );
+        let _ = writeln!(
+            t,
+            "// whose words are as above except that the mux field is the branch's first instant after the slot"
+        );
+        for (b, r) in p.branches.iter().enumerate() {
+            let c = r.compact.as_ref().expect("compact plan");
+            let sw = 1 + wb.max(c.group_bits);
+            let _ = writeln!(t, "// branch {b}: {} slice table", s.branches[b].name);
+            let sd = sw.div_ceil(4);
+            for w in &c.slice_words {
+                let _ = writeln!(t, "{w:0sd$x}");
+            }
+            let _ = writeln!(
+                t,
+                "// branch {b}: {} rotation table (slice_bits {})",
+                s.branches[b].name, c.slice_bits
+            );
+            for w in &c.rot_words {
+                let _ = writeln!(t, "{w:0digits$x}");
+            }
+        }
+        return t;
+    }
     for (b, r) in p.branches.iter().enumerate() {
         let _ = writeln!(t, "// branch {b}: {}", s.branches[b].name);
         for w in &r.words {

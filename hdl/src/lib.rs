@@ -21,10 +21,10 @@ mod plan;
 mod sim;
 mod stock;
 
-pub use emit::{emit, Board, Emitted};
+pub use emit::{emit, emit_with, Board, Emitted};
 pub use plan::{
-    MAX_BRANCHES, MAX_CHANNELS, MAX_DEVICES, MAX_DEVICES_PER_BRANCH, MAX_FRAME_SLOTS, MAX_SCLK_DIV,
-    MAX_SLOT_CYCLES,
+    LutForm, FULL_LUT_MAX_BITS, MAX_BRANCHES, MAX_CHANNELS, MAX_DEVICES, MAX_DEVICES_PER_BRANCH,
+    MAX_FRAME_SLOTS, MAX_SCLK_DIV, MAX_SLICES_PER_FRAME, MAX_SLOTS_PER_SLICE, MAX_SLOT_CYCLES,
 };
 pub use sim::{Pins, RtlSim};
 pub use stock::{pattern_miso, rtlsim_cycles, stock_simulation_cycles, StockRun};

@@ -10,7 +10,14 @@ pub const MAX_BRANCHES: usize = 8;
 pub const MAX_CHANNELS: usize = 256;
 pub const MAX_DEVICES_PER_BRANCH: usize = 32;
 pub const MAX_DEVICES: usize = 64;
+/// Largest frame the full-frame slot ROM takes.
 pub const MAX_FRAME_SLOTS: u64 = 1 << crate::core::SLOT_BITS;
+/// Limits of the compact slot LUT (slice table + rotation groups).
+pub const MAX_SLOTS_PER_SLICE: u64 = 1 << crate::core::SLOT_BITS;
+pub const MAX_SLICES_PER_FRAME: u64 = 1 << crate::core::SLICE_BITS;
+/// The full-frame ROMs are used while they fit in this many bits (16 of the
+/// HX8K's 32 block RAMs): they cost no logic cells.
+pub const FULL_LUT_MAX_BITS: u64 = 16 * 4096;
 pub const MAX_SLOT_CYCLES: u64 = 1 << crate::core::CNT_BITS;
 pub const MAX_SCLK_DIV: u64 = (1 << crate::core::PH_BITS) - 1;
 
@@ -45,6 +52,9 @@ pub struct BranchRom {
     pub devices: usize,
     /// First device bit of this branch in the `mux_en` port.
     pub en_offset: usize,
+    /// The compact form (only in a compact plan; `words` is then empty and
+    /// the mux field of slot `u`'s word is the next instant after slot `u`).
+    pub compact: Option<CompactRom>,
 }
 
 impl BranchRom {
@@ -59,8 +69,38 @@ impl BranchRom {
     }
 }
 
+/// Which form of the slot LUT the gateware embeds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LutForm {
+    /// Full frame table while it fits (`MAX_FRAME_SLOTS` slots,
+    /// `FULL_LUT_MAX_BITS` bits over all branches), else compact.
+    #[default]
+    Auto,
+    /// One ROM word per frame slot and branch.
+    Full,
+    /// A slice table plus rotation groups indexed by a slice counter.
+    Compact,
+}
+
+/// A branch's compact LUT: `slice_words[p]` for slot-in-slice `p` is
+/// `{rot, payload}`: a ROM word (as in [`BranchRom::words`]) when that slot's
+/// word is the same in every slice, else (`rot` = 1) a rotation group `g`
+/// whose word for slice `j` is `rot_words[g << slice_bits | j]`.
+#[derive(Debug, Clone)]
+pub struct CompactRom {
+    pub slice_words: Vec<u32>,
+    pub slice_addr_bits: usize,
+    pub rot_words: Vec<u32>,
+    pub group_bits: usize,
+    pub slice_bits: usize,
+}
+
 #[derive(Debug, Clone)]
 pub struct Plan {
+    /// Compact LUT (then every branch has `compact`), else full frame table.
+    pub compact: bool,
+    pub slots_per_slice: u64,
+    pub slices_per_frame: u64,
     pub slot_cycles: u64,
     pub frame_slots: u64,
     pub channel_bits: u32,
@@ -81,6 +121,65 @@ fn unsupported(msg: String) -> HdlError {
 }
 
 pub fn plan(s: &Schedule) -> Result<Plan, HdlError> {
+    plan_with(s, LutForm::Auto)
+}
+
+/// Compact a per-slot word table (`[slice][slot in slice]` order) into a
+/// slice table and rotation groups.
+fn compact_words(table: &[u32], sps: usize, k: usize, word_bits: usize) -> CompactRom {
+    let mut groups: Vec<Vec<u32>> = vec![];
+    let mut cells: Vec<(bool, u32)> = vec![];
+    for p in 0..sps {
+        let col: Vec<u32> = (0..k).map(|j| table[j * sps + p]).collect();
+        if col.iter().all(|w| *w == col[0]) {
+            cells.push((false, col[0]));
+        } else {
+            let g = groups.iter().position(|x| *x == col).unwrap_or_else(|| {
+                groups.push(col.clone());
+                groups.len() - 1
+            });
+            cells.push((true, g as u32));
+        }
+    }
+    let group_bits = addr_bits(groups.len().max(1) as u64);
+    let slice_bits = addr_bits(k as u64);
+    let payload = word_bits.max(group_bits);
+    let slice_addr_bits = addr_bits(sps as u64);
+    let mut slice_words = vec![0u32; 1 << slice_addr_bits];
+    for (p, &(rot, v)) in cells.iter().enumerate() {
+        slice_words[p] = ((rot as u32) << payload) | v;
+    }
+    let mut rot_words = vec![0u32; 1 << (group_bits + slice_bits)];
+    for (g, col) in groups.iter().enumerate() {
+        for (j, w) in col.iter().enumerate() {
+            rot_words[(g << slice_bits) | j] = *w;
+        }
+    }
+    CompactRom {
+        slice_words,
+        slice_addr_bits,
+        rot_words,
+        group_bits,
+        slice_bits,
+    }
+}
+
+impl CompactRom {
+    /// The word of frame slot `j * sps + p` (what the hardware looks up).
+    pub fn word(&self, p: usize, j: usize, word_bits: usize) -> u32 {
+        let payload = word_bits.max(self.group_bits);
+        let w = self.slice_words[p];
+        if w >> payload & 1 == 1 {
+            let g = (w & ((1 << payload) - 1)) as usize;
+            self.rot_words[(g << self.slice_bits) | j]
+        } else {
+            w & ((1 << payload) - 1)
+        }
+    }
+}
+
+/// Like [`plan`], with the slot LUT form chosen by the caller.
+pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
     let g = &s.grid;
     let nb = s.branches.len();
     if nb == 0 || nb > MAX_BRANCHES {
@@ -94,10 +193,36 @@ pub fn plan(s: &Schedule) -> Result<Plan, HdlError> {
             s.channels.len()
         )));
     }
-    if g.frame_slots == 0 || g.frame_slots > MAX_FRAME_SLOTS {
+    let sps = g.slots_per_slice;
+    let k = g.slices_per_frame;
+    if g.frame_slots == 0 || sps * k != g.frame_slots {
+        return Err(unsupported(format!(
+            "{} slots per frame is not {sps} slots x {k} slices",
+            g.frame_slots
+        )));
+    }
+    let cw = s.channel_bits().max(1) as usize;
+    let max_dev_bits = s
+        .branches
+        .iter()
+        .map(|b| addr_bits(b.mux_devices.max(1) as u64))
+        .max()
+        .unwrap_or(1);
+    let full_bits = (1u64 << addr_bits(g.frame_slots)) * (4 + cw + max_dev_bits) as u64 * nb as u64;
+    let compact = match form {
+        LutForm::Full => false,
+        LutForm::Compact => true,
+        LutForm::Auto => g.frame_slots > MAX_FRAME_SLOTS || full_bits > FULL_LUT_MAX_BITS,
+    };
+    if !compact && g.frame_slots > MAX_FRAME_SLOTS {
         return Err(unsupported(format!(
             "{} slots per frame: the full-frame slot ROM holds at most {MAX_FRAME_SLOTS}",
             g.frame_slots
+        )));
+    }
+    if compact && (sps > MAX_SLOTS_PER_SLICE || k > MAX_SLICES_PER_FRAME) {
+        return Err(unsupported(format!(
+            "{sps} slots per slice x {k} slices: the compact slot LUT supports at most {MAX_SLOTS_PER_SLICE} slots per slice and at most {MAX_SLICES_PER_FRAME} slices"
         )));
     }
     if g.slot_cycles < 2 || g.slot_cycles > MAX_SLOT_CYCLES {
@@ -118,7 +243,6 @@ pub fn plan(s: &Schedule) -> Result<Plan, HdlError> {
         )));
     }
     let aw = addr_bits(g.frame_slots);
-    let cw = s.channel_bits().max(1) as usize;
     let mut seqs: Vec<SeqTiming> = Vec::new();
     let mut branches = Vec::with_capacity(nb);
     let mut en_offset = 0usize;
@@ -217,17 +341,37 @@ pub fn plan(s: &Schedule) -> Result<Plan, HdlError> {
             conv0: slots[0].is_some(),
             devices,
             en_offset,
+            compact: None,
         };
-        let mut words = vec![0u32; 1 << aw];
-        for u in 0..n {
-            let (sel, dev) = match next[u] {
-                Some(c) => (s.channels[c].select, s.channels[c].device),
-                None => (0, 0),
-            };
-            let ch = slots[u].unwrap_or(0) as u32;
-            words[u] = rom.word(slots[u].is_some(), ch, sel, dev);
+        let mux = |c: Option<usize>| match c {
+            Some(c) => (s.channels[c].select, s.channels[c].device),
+            None => (0, 0),
+        };
+        if compact {
+            // The word of slot u carries the mux field of the next instant
+            // *after* slot u: the branch moves it to the mux one slot later.
+            let table: Vec<u32> = (0..n)
+                .map(|u| {
+                    let (sel, dev) = mux(next[(u + 1) % n]);
+                    rom.word(slots[u].is_some(), slots[u].unwrap_or(0) as u32, sel, dev)
+                })
+                .collect();
+            let c = compact_words(&table, sps as usize, k as usize, rom.word_bits());
+            debug_assert!((0..n).all(|u| c.word(
+                u % sps as usize,
+                u / sps as usize,
+                rom.word_bits()
+            ) == table[u]));
+            rom.compact = Some(c);
+        } else {
+            let mut words = vec![0u32; 1 << aw];
+            for u in 0..n {
+                let (sel, dev) = mux(next[u]);
+                let ch = slots[u].unwrap_or(0) as u32;
+                words[u] = rom.word(slots[u].is_some(), ch, sel, dev);
+            }
+            rom.words = words;
         }
-        rom.words = words;
         if let Some(c) = next[0] {
             rom.reset_sel = s.channels[c].select;
             rom.reset_en = 1u64 << s.channels[c].device;
@@ -236,6 +380,9 @@ pub fn plan(s: &Schedule) -> Result<Plan, HdlError> {
         en_offset += devices;
     }
     Ok(Plan {
+        compact,
+        slots_per_slice: sps,
+        slices_per_frame: k,
         slot_cycles: g.slot_cycles,
         frame_slots: g.frame_slots,
         channel_bits: s.channel_bits(),

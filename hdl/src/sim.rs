@@ -80,7 +80,15 @@ pub(crate) fn read_pins(c: &Core, r: &PinReader) -> Pins {
 
 impl RtlSim {
     pub fn new(schedule: &lut_gen::Schedule) -> Result<RtlSim, HdlError> {
-        let p = plan::plan(schedule)?;
+        Self::with_form(schedule, plan::LutForm::Auto)
+    }
+
+    /// [`RtlSim::new`] with the slot LUT form chosen by the caller.
+    pub fn with_form(
+        schedule: &lut_gen::Schedule,
+        form: plan::LutForm,
+    ) -> Result<RtlSim, HdlError> {
+        let p = plan::plan_with(schedule, form)?;
         let mut core = Box::new(Core::new(&p));
         core.connect_all();
         core.clock.next = Clock::from(false);

@@ -87,3 +87,28 @@ fn u2_256_channels_match_timing_contract() {
     let s = data_mix("u2");
     run_and_compare(&s, s.grid.frame_cycles + s.grid.slice_cycles);
 }
+
+/// The reference mix with the compact slot LUT (slice table + rotation
+/// groups + slice counter) instead of the full frame table: same pins.
+#[test]
+fn eskin34_compact_lut_matches_timing_contract() {
+    let s = eskin34();
+    run_and_compare_with(&s, 2 * s.grid.frame_cycles, hdl::LutForm::Compact);
+}
+
+/// A frame of more slots than the full-frame ROM takes: compact LUT.
+#[test]
+fn long_frame_needs_and_uses_the_compact_lut() {
+    let s = long_frame();
+    assert!(s.grid.frame_slots > hdl::MAX_FRAME_SLOTS);
+    assert!(hdl::RtlSim::with_form(&s, hdl::LutForm::Full).is_err());
+    run_and_compare(&s, 2 * s.grid.frame_cycles);
+}
+
+/// A slot longer than 65536 cycles (the slot counter is 20 bits).
+#[test]
+fn long_slot_matches_timing_contract() {
+    let s = long_slot();
+    assert!(s.grid.slot_cycles > 1 << 16);
+    run_and_compare(&s, 3 * s.grid.frame_cycles);
+}

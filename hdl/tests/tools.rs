@@ -39,6 +39,11 @@ fn run(dir: &Path, cmd: &mut Command) -> (bool, String) {
 
 fn gates(s: &Schedule, tag: &str) {
     let dir = emit_to(s, tag);
+    gates_in(&dir, tag);
+}
+
+fn gates_in(dir: &Path, tag: &str) {
+    let dir = dir.to_path_buf();
     // Verilator: clean under -Wall (the only waiver is inline: DECLFILENAME).
     let (ok, text) = run(
         &dir,
@@ -105,6 +110,19 @@ fn gates_branch_count_mixes() {
     for name in ["b4", "b5", "b6", "u2"] {
         gates(&data_mix(name), name);
     }
+}
+
+#[test]
+fn gates_compact_lut() {
+    gates(&long_frame(), "longframe");
+    gates(&long_slot(), "longslot");
+    let s = eskin34();
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("hdl-gates-eskin34-compact");
+    let _ = std::fs::remove_dir_all(&dir);
+    let e = hdl::emit_with(&s, None, hdl::LutForm::Compact).expect("emits");
+    assert!(e.file("slot_rom.hex").unwrap().contains("COMPACT"));
+    e.write_to(&dir).expect("writes");
+    gates_in(&dir, "eskin34-compact");
 }
 
 #[test]

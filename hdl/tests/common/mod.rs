@@ -123,6 +123,20 @@ slice_us = 1_000
     from_toml("threespeed.toml", &t)
 }
 
+/// `hdl/tests/data/longframe.toml`: a frame of 200 ms with 5 Hz channels
+/// and 40 slots per slice: 8000 slots, more than the full-frame ROM takes,
+/// so the compact LUT is chosen.  A slow clock (8 MHz) keeps simulating
+/// whole frames cheap.
+pub fn long_frame() -> Schedule {
+    data_mix("longframe")
+}
+
+/// `hdl/tests/data/longslot.toml`: one 1 kHz channel alone at 100 MHz, one
+/// slot of 100 000 cycles per slice, beyond a 16-bit slot counter.
+pub fn long_slot() -> Schedule {
+    data_mix("longslot")
+}
+
 /// A mix file of `hdl/tests/data/`.
 pub fn data_mix(name: &str) -> Schedule {
     let path = root().join(format!("hdl/tests/data/{name}.toml"));
@@ -339,8 +353,12 @@ pub struct Run {
 }
 
 pub fn run_and_compare(s: &Schedule, cycles: u64) -> Run {
+    run_and_compare_with(s, cycles, hdl::LutForm::Auto)
+}
+
+pub fn run_and_compare_with(s: &Schedule, cycles: u64, form: hdl::LutForm) -> Run {
     let reference = Reference::new(s);
-    let mut sim = hdl::RtlSim::new(s).expect("gateware for the mix");
+    let mut sim = hdl::RtlSim::with_form(s, form).expect("gateware for the mix");
     let nb = s.branches.len();
     let mut adcs: Vec<Adc> = (0..nb)
         .map(|b| Adc::new(s.grid.clock_hz, 0x1234 + b as u64))
