@@ -19,6 +19,11 @@ use std::time::{Duration, Instant};
 
 use cosim::mutate::{self, Operator};
 
+// The independent testbench's verdict, shared with the root tests/icarus.rs.
+#[path = "../../tests/tb/judge.rs"]
+mod judge;
+use judge::judge;
+
 /// Sites per operator: 36 mutants on the test mix.
 const PER_OP: [(Operator, usize); 8] = [
     (Operator::RelOp, 5),
@@ -130,128 +135,6 @@ impl Bench {
             check,
         }
     }
-}
-
-/// The verdict of `tests/icarus.rs` on a testbench log, as a `Result`.
-fn judge(mix: &lut_gen::Mix, s: &lut_gen::Schedule, text: &str, cycles: u64) -> Result<(), String> {
-    struct Conversion {
-        cycle: u64,
-        channel: usize,
-        code: u16,
-    }
-    let nb = s.branches.len();
-    let mut first_device = vec![0u32; nb];
-    for b in 1..nb {
-        first_device[b] = first_device[b - 1] + s.branches[b - 1].mux_devices;
-    }
-    let address: BTreeMap<(usize, u32, u32), usize> = s
-        .channels
-        .iter()
-        .enumerate()
-        .map(|(c, cs)| ((mix.channels[c].branch, cs.select, cs.device), c))
-        .collect();
-    let mut conversions: Vec<Vec<Conversion>> = (0..nb).map(|_| Vec::new()).collect();
-    let mut samples: Vec<(u64, usize, u16)> = Vec::new();
-    for line in text.lines() {
-        let f: Vec<u64> = line
-            .split_whitespace()
-            .skip(1)
-            .map(|x| x.parse())
-            .collect::<Result<_, _>>()
-            .map_err(|_| format!("log line with unknowns: {line:?}"))?;
-        match line.split_whitespace().next() {
-            Some("CS") if f.len() == 5 => {
-                let (b, cycle, sel, en, code) =
-                    (f[0] as usize, f[1], f[2] as u32, f[3], f[4] as u16);
-                let mine = (en >> first_device[b]) & ((1 << s.branches[b].mux_devices) - 1);
-                if mine.count_ones() != 1 {
-                    return Err(format!(
-                        "cycle {cycle}: branch {b} enables {mine:b}: not exactly one device"
-                    ));
-                }
-                let device = mine.trailing_zeros();
-                let channel = *address.get(&(b, sel, device)).ok_or_else(|| {
-                    format!("cycle {cycle}: branch {b} samples unused input {device}.{sel}")
-                })?;
-                conversions[b].push(Conversion {
-                    cycle,
-                    channel,
-                    code,
-                });
-            }
-            Some("SAMPLE") if f.len() == 3 => samples.push((f[0], f[1] as usize, f[2] as u16)),
-            _ => return Err(format!("bad log line {line:?}")),
-        }
-    }
-    // 1. conversions exactly at the schedule's instants, on the right channel
-    let frames = cycles.div_ceil(s.grid.frame_cycles);
-    for (b, convs) in conversions.iter().enumerate() {
-        let expected: Vec<(u64, usize)> = s
-            .instants(frames)
-            .filter(|i| i.branch == b && i.cycle < cycles - 2)
-            .map(|i| (i.cycle, i.channel))
-            .collect();
-        let got: Vec<(u64, usize)> = convs.iter().map(|c| (c.cycle, c.channel)).collect();
-        if got != expected {
-            let k = got
-                .iter()
-                .zip(&expected)
-                .take_while(|(a, b)| a == b)
-                .count();
-            return Err(format!(
-                "branch {b}: conversions differ from the schedule at #{k}: got {:?}, expected {:?} ({} vs {})",
-                got.get(k),
-                expected.get(k),
-                got.len(),
-                expected.len()
-            ));
-        }
-    }
-    // 2. every interval is exactly clock/rate
-    for (c, ch) in mix.channels.iter().enumerate() {
-        let times: Vec<u64> = conversions[ch.branch]
-            .iter()
-            .filter(|x| x.channel == c)
-            .map(|x| x.cycle)
-            .collect();
-        if times.is_empty() {
-            return Err(format!("{} never sampled", ch.name));
-        }
-        for w in times.windows(2) {
-            if w[1] - w[0] != mix.clock_hz / ch.rate_hz {
-                return Err(format!("{}: interval at cycle {}", ch.name, w[0]));
-            }
-        }
-    }
-    // 3. every sample leaves with the channel and the code the ADC shifted out, in order
-    let mut per_channel: BTreeMap<usize, Vec<u16>> = BTreeMap::new();
-    for (_, ch, v) in &samples {
-        per_channel.entry(*ch).or_default().push(*v);
-    }
-    let read = s.branches.iter().map(|b| b.spi.read_cycles).max().unwrap();
-    for (c, ch) in mix.channels.iter().enumerate() {
-        let shifted: Vec<u16> = conversions[ch.branch]
-            .iter()
-            .filter(|x| x.channel == c && x.cycle + read + 1 + nb as u64 <= cycles - 2)
-            .map(|x| x.code)
-            .collect();
-        let got = per_channel.get(&c).cloned().unwrap_or_default();
-        if got.len() < shifted.len() {
-            return Err(format!(
-                "{}: {} samples out, {} conversions done",
-                ch.name,
-                got.len(),
-                shifted.len()
-            ));
-        }
-        if got[..shifted.len()] != shifted[..] {
-            return Err(format!(
-                "{}: sample values differ from the ADC's words",
-                ch.name
-            ));
-        }
-    }
-    Ok(())
 }
 
 fn short(r: &Result<(), String>) -> String {
