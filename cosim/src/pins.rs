@@ -81,6 +81,20 @@ impl Signal {
     }
 }
 
+/// The top module's ports in the order of docs/timing.md's port table.
+pub const PORT_NAMES: [&str; 10] = [
+    "clk",
+    "rst",
+    "adc_miso",
+    "adc_cs_n",
+    "adc_sclk",
+    "mux_sel",
+    "mux_en",
+    "sample_valid",
+    "sample_channel",
+    "sample_value",
+];
+
 /// Port bit layout of a schedule's top module.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Layout {
@@ -98,6 +112,23 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// Width of each port of [`PORT_NAMES`], in the same order.
+    pub fn port_widths(&self) -> [u32; 10] {
+        let nb = self.branches as u32;
+        [
+            1,
+            1,
+            nb,
+            nb,
+            nb,
+            3 * nb,
+            self.mux_devices,
+            1,
+            self.channel_bits,
+            14,
+        ]
+    }
+
     pub fn new(s: &Schedule) -> Layout {
         let nb = s.branches.len();
         assert!(nb <= 8, "at most 8 branches are supported by the checker");

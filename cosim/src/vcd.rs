@@ -283,18 +283,7 @@ const EN: usize = 6;
 const VALID: usize = 7;
 const CHAN: usize = 8;
 const VALUE: usize = 9;
-const PORTS: [&str; 10] = [
-    "clk",
-    "rst",
-    "adc_miso",
-    "adc_cs_n",
-    "adc_sclk",
-    "mux_sel",
-    "mux_en",
-    "sample_valid",
-    "sample_channel",
-    "sample_value",
-];
+use crate::pins::PORT_NAMES as PORTS;
 
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
 /// (or `lsb - j` when the range is ascending).
@@ -398,18 +387,7 @@ fn resolve(
         }
     }
     // clk may sit in an enclosing scope (a testbench) if the DUT's is not dumped.
-    let widths = [
-        1,
-        1,
-        layout.branches as u32,
-        layout.branches as u32,
-        layout.branches as u32,
-        3 * layout.branches as u32,
-        layout.mux_devices,
-        1,
-        layout.channel_bits,
-        14,
-    ];
+    let widths = layout.port_widths();
     let mut ids: HashMap<Vec<u8>, Vec<Sink>> = HashMap::new();
     for v in &h.vars {
         ids.entry(v.id.clone()).or_default();

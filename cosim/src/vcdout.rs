@@ -7,7 +7,7 @@ use std::path::Path;
 
 use lut_gen::Schedule;
 
-use crate::pins::{Layout, Pins};
+use crate::pins::{Layout, Pins, PORT_NAMES};
 use crate::run::Observer;
 
 /// Writes the ports of every cycle in `[from, to)` (cycles counted from the
@@ -41,37 +41,13 @@ fn id_code(mut n: usize) -> String {
 impl VcdWriter {
     pub fn create(path: &Path, s: &Schedule, from: u64, to: u64) -> std::io::Result<VcdWriter> {
         let l = Layout::new(s);
-        let nb = l.branches as u32;
-        let mut widths = vec![
-            1,
-            1,
-            nb,
-            nb,
-            nb,
-            3 * nb,
-            l.mux_devices,
-            1,
-            l.channel_bits,
-            14,
-        ];
-        let names = [
-            "clk",
-            "rst",
-            "adc_miso",
-            "adc_cs_n",
-            "adc_sclk",
-            "mux_sel",
-            "mux_en",
-            "sample_valid",
-            "sample_channel",
-            "sample_value",
-        ];
+        let mut widths = l.port_widths().to_vec();
         let mut w = BufWriter::new(File::create(path)?);
         writeln!(w, "$date slotforge sim $end")?;
         writeln!(w, "$version slotforge cosim (mix {}) $end", s.mix.name)?;
         writeln!(w, "$timescale 1ps $end")?;
         writeln!(w, "$scope module slotforge_top $end")?;
-        for (i, n) in names.iter().enumerate() {
+        for (i, n) in PORT_NAMES.iter().enumerate() {
             if matches!(i, 0 | 1 | 7) {
                 writeln!(w, "$var wire 1 {} {n} $end", id_code(i))?;
             } else {
