@@ -324,7 +324,7 @@ fn resolve(
     scopes.dedup();
     let has = |sc: &str, name: &str| h.vars.iter().any(|v| v.scope == sc && v.name == name);
     let required = &PORTS[1..];
-    let candidates: Vec<&str> = match want {
+    let mut candidates: Vec<&str> = match want {
         Some(w) => {
             let m: Vec<&str> = scopes
                 .iter()
@@ -348,6 +348,30 @@ fn resolve(
             .filter(|s| required.iter().all(|p| has(s, p)))
             .collect(),
     };
+    // A design's inner modules may carry ports of the same names (the gateware's
+    // fixed-width core does): keep the scopes whose widths are the mix's.
+    let widths = layout.port_widths();
+    let width_of = |sc: &str, p: &str| -> u32 {
+        h.vars
+            .iter()
+            .filter(|v| v.scope == sc && v.name == p)
+            .map(|v| v.width)
+            .sum()
+    };
+    let exact: Vec<&str> = candidates
+        .iter()
+        .copied()
+        .filter(|c| {
+            PORTS
+                .iter()
+                .zip(widths)
+                .skip(1)
+                .all(|(p, w)| width_of(c, p) == w)
+        })
+        .collect();
+    if !exact.is_empty() {
+        candidates = exact;
+    }
     let Some(&scope) = candidates.last() else {
         let best = scopes
             .iter()
@@ -387,7 +411,6 @@ fn resolve(
         }
     }
     // clk may sit in an enclosing scope (a testbench) if the DUT's is not dumped.
-    let widths = layout.port_widths();
     let mut ids: HashMap<Vec<u8>, Vec<Sink>> = HashMap::new();
     for v in &h.vars {
         ids.entry(v.id.clone()).or_default();

@@ -225,3 +225,48 @@ fn wrong_mix_is_a_port_error() {
     let e = cosim::check_vcd(&eskin, &p, None).unwrap_err();
     assert!(matches!(e, VcdError::Ports { .. }), "{e}");
 }
+
+/// A full dump also holds the gateware's inner core, whose ports have the same
+/// names at their fixed maximum widths: the scope whose widths are the mix's wins.
+#[test]
+fn inner_module_with_same_port_names_does_not_confuse_scope_detection() {
+    let d = tempfile::tempdir().unwrap();
+    let (s, p) = good_vcd(d.path());
+    let q = d.path().join("nested.vcd");
+    rewrite(&p, &q, |t| {
+        let core: String = [
+            ("rst", 1),
+            ("adc_miso", 8),
+            ("adc_cs_n", 8),
+            ("adc_sclk", 8),
+            ("mux_sel", 24),
+            ("mux_en", 64),
+            ("sample_valid", 1),
+            ("sample_channel", 8),
+            ("sample_value", 14),
+        ]
+        .iter()
+        .enumerate()
+        .map(|(i, (n, w))| {
+            format!(
+                "$var wire {w} ~{} {n} [{}:0] $end\n",
+                (b'A' + i as u8) as char,
+                w - 1
+            )
+        })
+        .collect();
+        t.replacen(
+            "$scope module slotforge_top $end\n",
+            &format!(
+                "$scope module slotforge_top $end\n$scope module core $end\n{core}$upscope $end\n"
+            ),
+            1,
+        )
+    });
+    assert!(std::fs::read_to_string(&q)
+        .unwrap()
+        .contains("$scope module core"));
+    let r = cosim::check_vcd(&s, &q, None).unwrap();
+    assert!(r.ok, "{}", r.summary());
+    assert_eq!(r.samples, 30);
+}
