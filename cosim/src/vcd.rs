@@ -371,6 +371,19 @@ fn resolve(
         .collect();
     if !exact.is_empty() {
         candidates = exact;
+    } else if candidates.len() > 1 {
+        let c = candidates[0];
+        let (p, w) = PORTS
+            .iter()
+            .zip(widths)
+            .skip(1)
+            .find(|(p, w)| width_of(c, p) != *w)
+            .expect("a candidate whose widths differ");
+        return Err(perr(format!(
+            "the scopes with slotforge_top's ports ({}) do not have this mix's widths (`{p}`: {w} bit(s) expected, {} in `{c}`): is the VCD from another mix?",
+            candidates.join(", "),
+            width_of(c, p)
+        )));
     }
     let Some(&scope) = candidates.last() else {
         let best = scopes

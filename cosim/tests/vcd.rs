@@ -269,4 +269,11 @@ fn inner_module_with_same_port_names_does_not_confuse_scope_detection() {
     let r = cosim::check_vcd(&s, &q, None).unwrap();
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.samples, 30);
+    // Against another mix neither scope fits: say so rather than "ambiguous".
+    let eskin = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml");
+    let other = lut_gen::synthesize(&lut_gen::load(&eskin).unwrap()).unwrap();
+    match cosim::check_vcd(&other, &q, None) {
+        Err(e) => assert!(e.to_string().contains("another mix"), "{e}"),
+        Ok(r) => panic!("accepted: {}", r.summary()),
+    }
 }
