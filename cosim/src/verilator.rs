@@ -212,9 +212,14 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
         });
     }
     let io = |e: std::io::Error| BackendError::Io(format!("{}: {e}", dir.display()));
-    let tmp = cache_root()
-        .join("verilator")
-        .join(format!("{key}.tmp{}", std::process::id()));
+    // Unique per build, so that concurrent builds of one key (parallel tests,
+    // two processes) never share a work directory; the first to finish wins.
+    static BUILDS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let tmp = cache_root().join("verilator").join(format!(
+        "{key}.tmp{}-{}",
+        std::process::id(),
+        BUILDS.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+    ));
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).map_err(io)?;
     std::fs::write(tmp.join("slotforge_top.v"), verilog).map_err(io)?;
@@ -297,8 +302,28 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
             .arg("-pthread"),
         "g++ -shared",
     )?;
+    if lib.exists() {
+        // Another build of the same key finished first: use it.
+        let _ = std::fs::remove_dir_all(&tmp);
+        return Ok(Built {
+            library: lib,
+            cached: true,
+            key,
+        });
+    }
+    // A directory without the library is the remains of an interrupted build.
     let _ = std::fs::remove_dir_all(&dir);
-    std::fs::rename(&tmp, &dir).map_err(io)?;
+    if let Err(e) = std::fs::rename(&tmp, &dir) {
+        let _ = std::fs::remove_dir_all(&tmp);
+        if !lib.exists() {
+            return Err(io(e));
+        }
+        return Ok(Built {
+            library: lib,
+            cached: true,
+            key,
+        });
+    }
     Ok(Built {
         library: lib,
         cached: false,
