@@ -32,6 +32,8 @@ enum Command {
     Sim(cmd::sim::Args),
     /// Check a VCD from any simulator against the mix.
     Check(cmd::check::Args),
+    /// Inject each kind of fault into a design's pins; report what the checker caught.
+    Faults(cmd::faults::Args),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
         Command::Verilog(a) => cmd::verilog::run(a),
         Command::Sim(a) => cmd::sim::run(a),
         Command::Check(a) => cmd::check::run(a),
+        Command::Faults(a) => cmd::faults::run(a),
     };
     ExitCode::from(code)
 }

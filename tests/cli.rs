@@ -182,3 +182,31 @@ fn lut_refuses_to_replace_a_file_with_a_directory() {
         .code(2);
     assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep me");
 }
+
+#[test]
+fn faults_are_all_caught_on_the_reference_mix() {
+    let out = slotforge()
+        .args(["faults", "--json"])
+        .arg(preset("eskin34.toml"))
+        .assert()
+        .success();
+    let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    assert_eq!(v["ok"], true);
+    let faults = v["faults"].as_array().unwrap();
+    // 3 stream faults + 4 per branch + two-mux-en on the two multi-device branches.
+    assert_eq!(faults.len(), 3 + 3 * 4 + 2);
+    for f in faults {
+        assert_eq!(f["caught"], true, "{f}");
+        assert!(f["violation_count"].as_u64().unwrap() > 0, "{f}");
+        assert!(
+            f["first_divergence"]["cycle"].as_u64().unwrap() + 2 * 1600
+                >= f["injected_at"].as_u64().unwrap(),
+            "{f}"
+        );
+    }
+    slotforge()
+        .args(["faults", "--backend", "nope"])
+        .arg(preset("eskin34.toml"))
+        .assert()
+        .code(2);
+}

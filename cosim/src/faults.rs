@@ -198,3 +198,60 @@ fn copy_mux(layout: &Layout, p: &mut Pins, from: &Pins, b: usize) {
     let enm = ((1u64 << layout.en_n[b]) - 1) << layout.en_lo[b];
     p.mux_en = (p.mux_en & !enm) | (from.mux_en & enm);
 }
+
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct FirstDivergence {
+    pub signal: String,
+    pub cycle: u64,
+}
+
+/// What the checker made of one injected fault.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct FaultOutcome {
+    pub fault: String,
+    /// The cycle around which the fault was injected.
+    pub injected_at: u64,
+    pub caught: bool,
+    pub divergence_count: u64,
+    pub violation_count: u64,
+    /// First divergent signal and its cycle, if any.
+    pub first_divergence: Option<FirstDivergence>,
+    /// Invariant rules the fault broke (first few, deduplicated).
+    pub rules: Vec<String>,
+}
+
+/// Every fault of [`Fault::all`], injected one at a time into the design that
+/// `make_dut` builds, mid-way through the second frame, each run checked in full.
+pub fn campaign<D: Dut>(
+    s: &Schedule,
+    frames: u64,
+    mut make_dut: impl FnMut() -> D,
+) -> Vec<FaultOutcome> {
+    let frames = frames.max(2);
+    let at = s.grid.frame_cycles + s.grid.frame_cycles / 2 + 7;
+    Fault::all(s)
+        .into_iter()
+        .map(|f| {
+            let mut dut = FaultyDut::new(s, make_dut(), f, at);
+            let r = crate::run::run_dut(s, &mut dut, frames, &Default::default(), "faults", None);
+            let mut rules: Vec<String> = Vec::new();
+            for v in &r.violations {
+                if rules.len() < 4 && !rules.contains(&v.rule) {
+                    rules.push(v.rule.clone());
+                }
+            }
+            FaultOutcome {
+                fault: f.name(),
+                injected_at: at,
+                caught: !r.ok,
+                divergence_count: r.divergence_count,
+                violation_count: r.violation_count,
+                first_divergence: r.divergences.first().map(|d| FirstDivergence {
+                    signal: d.signal.clone(),
+                    cycle: d.cycle,
+                }),
+                rules,
+            }
+        })
+        .collect()
+}

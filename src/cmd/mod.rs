@@ -2,6 +2,7 @@
 
 pub mod audit;
 pub mod check;
+pub mod faults;
 pub mod lut;
 pub mod sim;
 pub mod verilog;
