@@ -227,11 +227,10 @@ impl Cx<'_> {
     }
 
     fn validate(&self, raw: RawMix) -> Result<Mix, MixError> {
-        let whole = 0..0;
         let name = match &raw.name {
             Some(n) if !n.get_ref().trim().is_empty() => n.get_ref().clone(),
             Some(n) => return Err(self.at(n.span(), "name", "must not be empty")),
-            None => return Err(self.at(whole, "name", "missing: every mix has a name")),
+            None => return Err(self.at(0..0, "name", "missing: every mix has a name")),
         };
         let clock = raw
             .clock
@@ -305,7 +304,6 @@ impl Cx<'_> {
         let mut branches = Vec::new();
         let mut branch_names: BTreeMap<String, usize> = BTreeMap::new();
         for (i, b) in raw.branch.iter().enumerate() {
-            let span = b.span();
             let b = b.get_ref();
             let f = |k: &str| format!("branch[{i}].{k}");
             let bname = b.name.get_ref().clone();
@@ -389,7 +387,6 @@ impl Cx<'_> {
                 }
                 Some(s) => *s.get_ref() as u64,
             };
-            let _ = span;
             branches.push(Branch {
                 name: bname,
                 adc,
