@@ -627,7 +627,9 @@ fn field_from_toml_message(message: &str, text: &str, span: Option<Range<usize>>
             .unwrap_or(0);
         let line = text[start..].lines().next().unwrap_or("");
         if let Some((k, _)) = line.split_once('=') {
-            return format!("{}{}", table_prefix(text, Some(s)), k.trim());
+            if !k.trim().is_empty() {
+                return format!("{}{}", table_prefix(text, Some(s)), k.trim());
+            }
         }
     }
     "(syntax)".into()
@@ -770,5 +772,8 @@ bandwidth_hz = 400
     fn syntax_error_has_line() {
         let e = err("name = \"x\"\n[clock\n");
         assert_eq!(e.line, 2);
+        // A line with no key still names something (found by proptest).
+        let e = err("name = \"x\"\n=description = \"y\"\n");
+        assert_eq!((e.line, e.field.as_str()), (2, "(syntax)"), "{e}");
     }
 }
