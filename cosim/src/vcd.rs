@@ -565,28 +565,21 @@ impl State {
         p.v != old_v || p.x != old_x
     }
 
+    /// The pins' values and their x/z masks.
     fn pins(&self) -> (Pins, Pins) {
-        let g = |i: usize| self.port[i];
-        (
+        let pick = |f: fn(&Val) -> u64| {
+            let g = |i: usize| f(&self.port[i]);
             Pins {
-                cs_n: g(CS).v as u8,
-                sclk: g(SCLK).v as u8,
-                mux_sel: g(SEL).v as u32,
-                mux_en: g(EN).v,
-                sample_valid: g(VALID).v & 1 == 1,
-                sample_channel: g(CHAN).v as u16,
-                sample_value: g(VALUE).v as u16,
-            },
-            Pins {
-                cs_n: g(CS).x as u8,
-                sclk: g(SCLK).x as u8,
-                mux_sel: g(SEL).x as u32,
-                mux_en: g(EN).x,
-                sample_valid: g(VALID).x & 1 == 1,
-                sample_channel: g(CHAN).x as u16,
-                sample_value: g(VALUE).x as u16,
-            },
-        )
+                cs_n: g(CS) as u8,
+                sclk: g(SCLK) as u8,
+                mux_sel: g(SEL) as u32,
+                mux_en: g(EN),
+                sample_valid: g(VALID) & 1 == 1,
+                sample_channel: g(CHAN) as u16,
+                sample_value: g(VALUE) as u16,
+            }
+        };
+        (pick(|p| p.v), pick(|p| p.x))
     }
 }
 

@@ -299,6 +299,15 @@ fn attempt(units: &[Unit], branches: usize, slots: u64, sps: u64, budget: u64) -
     }
 }
 
+/// Conversions each branch needs per frame (independent of the slot grid).
+fn demand_per_frame(mix: &Mix) -> Vec<u64> {
+    let mut demand = vec![0u64; mix.branches.len()];
+    for c in &mix.channels {
+        demand[c.branch] += mix.samples_per_frame(c.rate_hz);
+    }
+    demand
+}
+
 /// Slot grids to try, fewest slots first: divisors of the slice that keep
 /// every branch's slot at or above its shortest legal length.
 pub fn candidate_slots_per_slice(mix: &Mix, min_slot_cycles: u64) -> Vec<u64> {
@@ -388,6 +397,7 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
     }
 
     let k = mix.slices_per_frame();
+    let demand = demand_per_frame(mix);
     let mut bounded = false;
     for &sps in &candidates {
         let slots = k * sps;
@@ -397,10 +407,6 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
             .any(|c| !slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
         {
             continue;
-        }
-        let mut demand = vec![0u64; mix.branches.len()];
-        for c in &mix.channels {
-            demand[c.branch] += mix.samples_per_frame(c.rate_hz);
         }
         if demand.iter().any(|&d| d > slots) {
             continue;
@@ -519,10 +525,7 @@ fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
     let mut suggestions = Vec::new();
 
     let nb = mix.branches.len();
-    let mut demand = vec![0u64; nb];
-    for c in &mix.channels {
-        demand[c.branch] += mix.samples_per_frame(c.rate_hz);
-    }
+    let demand = demand_per_frame(mix);
     let mut unplaced: Vec<Vec<String>> = vec![Vec::new(); nb];
 
     let not_whole: Vec<&str> = mix
