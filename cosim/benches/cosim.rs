@@ -11,11 +11,11 @@
 use std::path::Path;
 use std::time::Instant;
 
-use cosim::backend::{verilog, RustHdlDut};
-use cosim::run::{run_dut, run_model, run_unchecked, ModelDut, RunOptions};
-use cosim::vcdout::VcdWriter;
+use cosim::rusthdl::{verilog, RustHdlDut};
 use cosim::verilator::VerilatedDut;
 use cosim::Stimulus;
+use judge::run::{run_dut, run_model, run_unchecked, ModelDut, RunOptions};
+use judge::vcdout::VcdWriter;
 
 fn secs<T>(f: impl FnOnce() -> T) -> (f64, T) {
     let t = Instant::now();
@@ -111,8 +111,8 @@ fn main() {
     let _ = run_dut(&s, &mut ModelDut::new(&s), vf, &opts, "gen", Some(&mut w));
     w.finish().unwrap();
     let size = std::fs::metadata(&vcd).unwrap().len() as f64;
-    let (tp, n) = secs(|| cosim::vcd::parse_only(&s, &vcd, None).unwrap());
-    let (tk, r) = secs(|| cosim::check_vcd(&s, &vcd, None).unwrap());
+    let (tp, n) = secs(|| judge::vcd::parse_only(&s, &vcd, None).unwrap());
+    let (tk, r) = secs(|| judge::check_vcd(&s, &vcd, None).unwrap());
     assert!(r.ok, "{}", r.summary());
     println!(
         "vcd: {:.1} MB, {n} cycles; parse only {:.0} MB/s, check {:.0} MB/s, ratio {:.2} (goal >= 0.8)",

@@ -5,11 +5,11 @@
 //! handed to `slotforge check`.
 //!
 //! The testbench's ADCs give the same codes as cosim's cycle-level ADC model
-//! ([`crate::adc::Adc`]) for the chosen stimulus: `pattern` by the same
+//! ([`judge::adc::Adc`]) for the chosen stimulus: `pattern` by the same
 //! formula, the others from a table of the schedule's conversions (a
 //! conversion the schedule does not expect falls back to the pattern
 //! formula; the checker decodes every value from MISO in any case).  Reset
-//! lasts [`crate::run::reset_cycles`] cycles, as in the in-process back ends.
+//! lasts [`judge::run::reset_cycles`] cycles, as in the in-process back ends.
 
 use std::fmt::Write as _;
 use std::fs::File;
@@ -19,11 +19,12 @@ use std::process::Command;
 
 use lut_gen::Schedule;
 
-use crate::adc::{Analog, Stimulus};
-use crate::backend::{SimError, SimOptions, VcdOut};
-use crate::pins::{Layout, Pins};
-use crate::report::Report;
-use crate::verilator::BackendError;
+use judge::adc::{Analog, Stimulus};
+use judge::Report;
+use lut_gen::ports::{Layout, Pins, Role, PORTS, TOP_MODULE};
+
+use crate::error::{BackendError, SimError};
+use crate::options::{SimOptions, VcdOut};
 
 const TEMPLATE: &str = include_str!("../tb/adc_tb.v.in");
 
@@ -57,7 +58,8 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
             adcs,
             "  reg [15:0] word{b};\n  reg [4:0] falls{b};\n  reg out{b};\n  reg drive{b} = 0;\n  \
              reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [13:0] code{b};\n  \
-             assign adc_miso[{b}] = drive{b} ? out{b} : 1'bz;"
+             assign {miso}[{b}] = drive{b} ? out{b} : 1'bz;",
+            miso = Role::Miso.name()
         );
         // the input id cosim's ADC model gives each (enable, select) of this branch
         let id_of = |en: u64, sel: u32| {
@@ -117,28 +119,59 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         };
         let _ = write!(
             adcs,
-            "  always @(negedge adc_cs_n[{b}]) if (!rst) begin\n    \
-             case ({{mux_en[{hi}:{lo}], mux_sel[{sh}:{sl}]}})\n{cases}    endcase\n    \
+            "  always @(negedge {cs}[{b}]) if (!{rst}) begin\n    \
+             case ({{{en}[{hi}:{lo}], {sel}[{sh}:{sl}]}})\n{cases}    endcase\n    \
              code{b} = pattern(cyc, id{b});\n{table}    n{b} = n{b} + 1;\n    \
              word{b} = {{2'b00, code{b}}};\n    falls{b} = 0;\n    out{b} = word{b}[15];\n    drive{b} = 1;\n  end\n  \
-             always @(posedge adc_cs_n[{b}]) drive{b} = 0;\n  \
-             always @(negedge adc_sclk[{b}]) if (!adc_cs_n[{b}]) begin\n    \
+             always @(posedge {cs}[{b}]) drive{b} = 0;\n  \
+             always @(negedge {sclk}[{b}]) if (!{cs}[{b}]) begin\n    \
              falls{b} = falls{b} + 1;\n    if (falls{b} >= 16) drive{b} = 0; else out{b} = word{b}[15 - falls{b}];\n  end\n\n",
+            cs = Role::CsN.name(),
+            sclk = Role::Sclk.name(),
+            rst = Role::Reset.name(),
+            en = Role::MuxEn.name(),
+            sel = Role::MuxSel.name(),
             hi = lo + n - 1,
             sh = 3 * b + 2,
             sl = 3 * b,
         );
     }
-    let tb = TEMPLATE
+    // The DUT's ports as testbench signals: inputs driven (MISO pulled up,
+    // as the ADC model's idle line), outputs as wires.
+    let mut decls = String::new();
+    for p in &PORTS {
+        let w = l.width(p.role);
+        let range = if p.vector {
+            format!("[{}:0] ", w - 1)
+        } else {
+            String::new()
+        };
+        let _ = match p.role {
+            Role::Clock => writeln!(decls, "  reg {} = 0;", p.name),
+            Role::Reset => writeln!(decls, "  reg {} = 1;", p.name),
+            Role::Miso => writeln!(decls, "  tri1 {range}{};", p.name),
+            _ => writeln!(decls, "  wire {range}{};", p.name),
+        };
+    }
+    let connect = PORTS
+        .iter()
+        .map(|p| format!(".{0}({0})", p.name))
+        .collect::<Vec<_>>()
+        .join(",\n    ");
+    let mut tb = TEMPLATE
+        .replace("@DECLS@", decls.trim_end_matches('\n'))
+        .replace("@CONNECT@", &connect)
+        .replace("@TOP@", TOP_MODULE)
         .replace("@NB@", &l.branches.to_string())
-        .replace("@M@", &l.mux_devices.to_string())
-        .replace("@W@", &l.channel_bits.to_string())
         .replace("@RESET@", &reset_cycles.to_string())
         .replace("@CYCLES@", &cycles.to_string())
         .replace("@HALF@", &half_period_ps(s).to_string())
         .replace("@SLOT@", &s.grid.slot_cycles.to_string())
         .replace("@NCH_PLUS_64@", &(nch + 64).to_string())
         .replace("@ADCS@", &adcs);
+    for r in Role::ALL {
+        tb = tb.replace(&format!("@{}@", r.key()), r.name());
+    }
     Testbench {
         tb,
         tables,
@@ -197,7 +230,7 @@ pub fn run(s: &Schedule, frames: u64, opts: &SimOptions) -> Result<Report, SimEr
         .tempdir()
         .map_err(io)?;
     let d = dir.path();
-    let reset = crate::run::reset_cycles(s, opts.reset_cycles);
+    let reset = judge::run::reset_cycles(s, opts.reset_cycles);
     let cycles = frames * s.grid.frame_cycles;
     let tb = testbench(s, opts.stimulus, reset, cycles);
     hdl::emit(s, None)
@@ -209,7 +242,7 @@ pub fn run(s: &Schedule, frames: u64, opts: &SimOptions) -> Result<Report, SimEr
     }
     spawn(
         Command::new("iverilog")
-            .args(["-g2005", "-o", "sim.vvp", "tb.v", "slotforge_top.v"])
+            .args(["-g2005", "-o", "sim.vvp", "tb.v", hdl::VERILOG_FILE])
             .current_dir(d),
         "iverilog",
         "iverilog (compiling the emitted Verilog and the testbench)",
@@ -220,7 +253,7 @@ pub fn run(s: &Schedule, frames: u64, opts: &SimOptions) -> Result<Report, SimEr
         "vvp (running the simulation)",
     )?;
     let wave = d.join("wave.vcd");
-    let (mut report, _) = crate::vcd::check_vcd_with(s, &wave, Some("tb"), opts.check)
+    let (mut report, _) = judge::vcd::check_vcd_with(s, &wave, Some("tb"), opts.check)
         .map_err(|e| SimError::Io(format!("icarus back end: reading its VCD: {e}")))?;
     report.source = "icarus".into();
     if let Some(v) = &opts.vcd {

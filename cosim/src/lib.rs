@@ -1,27 +1,27 @@
-//! cosim: the reference model of slotforge's gateware, an AD7940 model,
-//! simulation back ends and the cycle-exact waveform checker.
+//! cosim: the simulation engines that run slotforge's gateware and hand
+//! its pins to the judge.
 //!
-//! The model is built from lut-gen's [`lut_gen::Schedule`] alone, following
-//! `docs/timing.md`; it never reads the `hdl` crate.
+//! The judge (reference model, ADC model, checker, VCD I/O) is the `judge`
+//! crate beside this one, which never sees `hdl`; this crate depends on both
+//! and holds the back ends:
+//!
+//! - [`run`] ([`backend`]): one dispatch over [`Backend`]: `model` (the
+//!   judge's slot-level model), `rusthdl` ([`rusthdl`]: `hdl::RtlSim` in
+//!   process), `verilator` ([`verilator`]: the emitted Verilog verilated at
+//!   run time), `icarus` ([`icarus`]: the emitted Verilog in Icarus with a
+//!   Verilog ADC, its VCD read by the judge);
+//! - [`SimOptions`] / [`SimError`]: what a run is asked to do and why it
+//!   could not run.
 
-pub mod adc;
 pub mod backend;
-pub mod checker;
-pub mod faults;
+pub mod error;
 pub mod icarus;
-pub mod model;
-pub mod mutate;
-pub mod pins;
-pub mod report;
-pub mod run;
-pub mod vcd;
-pub mod vcdout;
+pub mod options;
+pub mod rusthdl;
 pub mod verilator;
 
-pub use adc::{Adc, Stimulus};
-pub use backend::{run, Backend, SimError, SimOptions, VcdOut};
-pub use checker::{CheckOptions, Checker, Invariants};
-pub use model::{CycleModel, SlotModel};
-pub use pins::{Layout, Pins, Signal};
-pub use report::Report;
-pub use vcd::{check_vcd, VcdError};
+pub use backend::run;
+pub use error::{BackendError, SimError};
+pub use judge::{CheckOptions, Report, Stimulus};
+pub use options::{Backend, SimOptions, VcdOut};
+pub use rusthdl::RustHdlDut;

@@ -7,49 +7,19 @@
 //! the Verilog, the shim and the `verilator --version` / `g++ --version`
 //! banners, so a second run does not rebuild.
 
-use std::fmt;
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use crate::pins::Pins;
-use crate::run::Dut;
+use judge::run::Dut;
+use lut_gen::ports::{Pins, Role, TOP_MODULE};
 
-/// Why the Verilator back end could not run (a bad environment: exit 2).
-#[derive(Debug)]
-pub enum BackendError {
-    /// A tool is not installed.
-    MissingTool {
-        tool: String,
-        hint: String,
-    },
-    /// A build step failed; `log` has its output.
-    Build {
-        step: String,
-        log: String,
-    },
-    Io(String),
-    Other(String),
-}
+use crate::error::BackendError;
 
-impl fmt::Display for BackendError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            BackendError::MissingTool { tool, hint } => {
-                write!(f, "`{tool}` is not installed or not on PATH ({hint})")
-            }
-            BackendError::Build { step, log } => write!(f, "{step} failed:\n{log}"),
-            BackendError::Io(m) | BackendError::Other(m) => f.write_str(m),
-        }
-    }
-}
-
-impl std::error::Error for BackendError {}
-
-const TOP: &str = "slotforge_top";
-
-const SHIM: &str = r#"
-#include "Vslotforge_top.h"
+/// The C++ shim around the verilated top; `@TOP@` and `@<role key>@` are
+/// replaced by the pin contract's names ([`shim`]).
+const SHIM_TEMPLATE: &str = r#"
+#include "V@TOP@.h"
 #include "verilated.h"
 #include <cstdint>
 
@@ -66,35 +36,35 @@ struct SfPins {
 
 struct SfModel {
     VerilatedContext* ctx;
-    Vslotforge_top* top;
+    V@TOP@* top;
 };
 
 extern "C" void* sf_new() {
     SfModel* m = new SfModel;
     m->ctx = new VerilatedContext;
-    m->top = new Vslotforge_top(m->ctx);
-    m->top->clk = 0;
-    m->top->rst = 1;
-    m->top->adc_miso = 0;
+    m->top = new V@TOP@(m->ctx);
+    m->top->@clock@ = 0;
+    m->top->@reset@ = 1;
+    m->top->@miso@ = 0;
     m->top->eval();
     return m;
 }
 
 extern "C" void sf_step(void* p, uint8_t rst, uint64_t miso, SfPins* o) {
     SfModel* m = (SfModel*)p;
-    Vslotforge_top* t = m->top;
-    t->rst = rst;
-    t->adc_miso = miso;
-    t->clk = 1;
+    V@TOP@* t = m->top;
+    t->@reset@ = rst;
+    t->@miso@ = miso;
+    t->@clock@ = 1;
     t->eval();
-    o->cs_n = t->adc_cs_n;
-    o->sclk = t->adc_sclk;
-    o->mux_sel = t->mux_sel;
-    o->mux_en = t->mux_en;
-    o->sample_valid = t->sample_valid;
-    o->sample_channel = t->sample_channel;
-    o->sample_value = t->sample_value;
-    t->clk = 0;
+    o->cs_n = t->@cs_n@;
+    o->sclk = t->@sclk@;
+    o->mux_sel = t->@mux_sel@;
+    o->mux_en = t->@mux_en@;
+    o->sample_valid = t->@valid@;
+    o->sample_channel = t->@channel@;
+    o->sample_value = t->@value@;
+    t->@clock@ = 0;
     t->eval();
 }
 
@@ -106,6 +76,15 @@ extern "C" void sf_free(void* p) {
     delete m;
 }
 "#;
+
+/// The shim's C++ text with the contract's module and port names.
+fn shim() -> String {
+    let mut t = SHIM_TEMPLATE.replace("@TOP@", TOP_MODULE);
+    for r in Role::ALL {
+        t = t.replace(&format!("@{}@", r.key()), r.name());
+    }
+    t
+}
 
 #[repr(C)]
 #[derive(Default)]
@@ -191,19 +170,20 @@ pub struct Built {
 
 /// Verilates and compiles `verilog` (top `slotforge_top`), or finds it in the cache.
 pub fn build(verilog: &str) -> Result<Built, BackendError> {
+    let shim = shim();
     let vv = tool_version("verilator", "apt-get install -y verilator")?;
     let gv = tool_version("g++", "apt-get install -y g++")?;
     let key = format!(
         "{:016x}",
         fnv64(&[
             verilog.as_bytes(),
-            SHIM.as_bytes(),
+            shim.as_bytes(),
             vv.as_bytes(),
             gv.as_bytes()
         ])
     );
     let dir = cache_root().join("verilator").join(&key);
-    let lib = dir.join("libslotforge_top.so");
+    let lib = dir.join(format!("lib{TOP_MODULE}.so"));
     if lib.exists() {
         return Ok(Built {
             library: lib,
@@ -222,8 +202,8 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
     ));
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).map_err(io)?;
-    std::fs::write(tmp.join("slotforge_top.v"), verilog).map_err(io)?;
-    std::fs::write(tmp.join("shim.cpp"), SHIM).map_err(io)?;
+    std::fs::write(tmp.join(format!("{TOP_MODULE}.v")), verilog).map_err(io)?;
+    std::fs::write(tmp.join("shim.cpp"), &shim).map_err(io)?;
     let obj = tmp.join("obj");
     run(
         Command::new("verilator")
@@ -238,11 +218,11 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
                 "-Wno-lint",
                 "-Wno-style",
                 "--top-module",
-                TOP,
+                TOP_MODULE,
                 "-Mdir",
             ])
             .arg(&obj)
-            .arg(tmp.join("slotforge_top.v")),
+            .arg(tmp.join(format!("{TOP_MODULE}.v"))),
         "verilator",
     )?;
     let root = Command::new("verilator")
@@ -297,7 +277,7 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
     run(
         Command::new("g++")
             .args(["-shared", "-o"])
-            .arg(tmp.join("libslotforge_top.so"))
+            .arg(tmp.join(format!("lib{TOP_MODULE}.so")))
             .args(&objects)
             .arg("-pthread"),
         "g++ -shared",

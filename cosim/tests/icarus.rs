@@ -5,9 +5,10 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use cosim::run::{run_dut, Observer, RunOptions};
-use cosim::vcd::{read_cycles, CycleSink};
-use cosim::{Backend, Pins, SimOptions, Stimulus, VcdOut};
+use cosim::{Backend, SimOptions, Stimulus, VcdOut};
+use judge::run::{run_dut, Observer, RunOptions};
+use judge::vcd::{read_cycles, CycleSink};
+use judge::Pins;
 
 fn have(tool: &str) -> bool {
     Command::new(tool).arg("-V").output().is_ok()
@@ -77,7 +78,7 @@ fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
         let mut ic = Samples::default();
         read_cycles(&s, &wave, None, &mut ic).unwrap();
         let mut rh = Samples::default();
-        let mut dut = cosim::backend::RustHdlDut::new(&s).unwrap();
+        let mut dut = cosim::RustHdlDut::new(&s).unwrap();
         let ro = RunOptions {
             stimulus,
             ..RunOptions::default()
@@ -114,12 +115,12 @@ fn icarus_backend_vcd_windows() {
         };
         let r = cosim::run(&s, Backend::Icarus, 3, &opts).unwrap();
         assert!(r.ok, "{}", r.summary());
-        let cycles = cosim::vcd::parse_only(&s, &wave, None).unwrap();
-        let reset = cosim::run::reset_cycles(&s, opts.reset_cycles);
+        let cycles = judge::vcd::parse_only(&s, &wave, None).unwrap();
+        let reset = judge::run::reset_cycles(&s, opts.reset_cycles);
         if checks {
             // a window from frame 0 has the reset and checks on its own
             assert_eq!(cycles, reset + (to - from) * f);
-            let r = cosim::check_vcd(&s, &wave, None).unwrap();
+            let r = judge::check_vcd(&s, &wave, None).unwrap();
             assert!(r.ok, "{}", r.summary());
             assert_eq!(r.frames, to - from);
         } else {

@@ -1,11 +1,11 @@
 //! Mutation test of the checker: mutants of the emitted Verilog that the
 //! independent Icarus testbench (`tests/tb/adc_tb.v`, judged as
 //! `tests/icarus.rs` judges it) rejects must all be rejected by
-//! `cosim::check_vcd` on the VCD of the same Icarus run.
+//! `judge::check_vcd` on the VCD of the same Icarus run.
 //!
 //! One Icarus run per mutant gives both verdicts: the testbench is compiled
 //! unchanged next to a two-line module that dumps the ports of `adc_tb.dut`.
-//! Mutants come from `cosim::mutate` (deterministic sites, fixed counts per
+//! Mutants come from the test-only `mutate` module (deterministic sites, fixed counts per
 //! operator) on `tests/data/mutants.toml`, a two-branch mix with harmonic
 //! and non-harmonic rates and two mux devices on one branch; 2.5 frames of
 //! 4000 cycles each.  Run with `--nocapture` for the per-mutant table.
@@ -17,7 +17,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use cosim::mutate::{self, Operator};
+mod mutate;
+use mutate::Operator;
 
 // The independent testbench's verdict, shared with the root tests/icarus.rs.
 #[path = "../../tests/tb/judge.rs"]
@@ -124,7 +125,7 @@ impl Bench {
             let log = std::fs::read_to_string(dir.join("tb.log")).map_err(|e| e.to_string())?;
             judge(&self.mix, s, &log, self.cycles)
         });
-        let check = match cosim::check_vcd(s, dir.join("wave.vcd"), None) {
+        let check = match ::judge::check_vcd(s, dir.join("wave.vcd"), None) {
             Ok(r) if r.ok => Ok(()),
             Ok(r) => Err(r.summary().lines().next().unwrap_or("").to_string()),
             Err(e) => Err(format!("error: {e}")),

@@ -4,8 +4,8 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use cosim::faults::{Fault, FaultyDut};
-use cosim::run::{run_dut, ModelDut, RunOptions};
+use judge::faults::{Fault, FaultyDut};
+use judge::run::{run_dut, ModelDut, RunOptions};
 
 struct Rng(u64);
 impl Rng {
@@ -74,7 +74,7 @@ fn random_feasible_mixes() {
         assert_eq!(r.samples, 2 * s.samples_per_frame());
         let m = cosim::run(&s, cosim::Backend::Model, 10, &cosim::SimOptions::default()).unwrap();
         assert!(m.ok, "seed {seed}: {}", m.summary());
-        if let Ok(mut dut) = cosim::backend::RustHdlDut::new(&s) {
+        if let Ok(mut dut) = cosim::RustHdlDut::new(&s) {
             let r = run_dut(&s, &mut dut, 2, &opts, "rusthdl", None);
             assert!(r.ok, "seed {seed} rusthdl:\n{text}\n{}", r.summary());
         }

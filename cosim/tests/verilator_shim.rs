@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use cosim::run::{run_dut, RunOptions};
 use cosim::verilator::VerilatedDut;
+use judge::run::{run_dut, RunOptions};
 
 const STANDIN: &str = r#"
 module slotforge_top(input clk, input rst, input [1:0] adc_miso,

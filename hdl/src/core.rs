@@ -20,25 +20,8 @@
 
 use rust_hdl::prelude::*;
 
-use crate::plan::{BranchRom, CompactRom, Plan, SeqTiming, MAX_BRANCHES};
-
-/// Width of the cycle-in-slot counter.
-pub const CNT_BITS: usize = 20;
-/// Width of the slot counter (ROM address): slot in frame (full LUT) or
-/// slot in slice (compact LUT).
-pub const SLOT_BITS: usize = 12;
-/// Width of the slice counter (compact LUT only).
-pub const SLICE_BITS: usize = 10;
-/// Width of the SCLK phase counter.
-pub const PH_BITS: usize = 10;
-/// Width of a channel index.
-pub const CH_BITS: usize = 8;
-/// Width of a device index inside a branch.
-pub const DEV_BITS: usize = 5;
-/// Per-branch mux enables (one-hot over at most 32 devices).
-pub const EN_BITS: usize = 32;
-/// Total mux enables on the core.
-pub const EN_TOTAL: usize = 64;
+use crate::plan::{BranchRom, CompactRom, Plan, SeqTiming};
+use crate::widths::*;
 
 fn c<const N: usize>(v: u64) -> Constant<Bits<N>> {
     Constant::new(Bits::<N>::from(v))

@@ -7,21 +7,29 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use lut_gen::ports::{self, Dir, Layout, Role, PORTS, TOP_MODULE};
 use lut_gen::Schedule;
 use rust_hdl::prelude::*;
 use serde::Deserialize;
 
-use crate::core::{Core, CH_BITS, EN_TOTAL};
-use crate::plan::{plan_with, LutForm, Plan, MAX_BRANCHES};
+use crate::core::Core;
+use crate::plan::{plan_with, LutForm, Plan};
+use crate::widths::{CH_BITS, EN_TOTAL, MAX_BRANCHES};
 use crate::HdlError;
 
 /// Name the rust-hdl `top` module gets in the emitted file.
 const CORE: &str = "slotforge_core";
 
-/// The emitted files, in memory.  `files` is ordered by name.
+/// The emitted Verilog file.
+pub const VERILOG_FILE: &str = "slotforge_top.v";
+/// The emitted port manifest.
+pub const MANIFEST_FILE: &str = "ports.json";
+
+/// The emitted files, in memory, ordered by name.  Only [`emit`] makes
+/// one, and it always holds [`VERILOG_FILE`] and [`MANIFEST_FILE`].
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Emitted {
-    pub files: Vec<(String, String)>,
+    files: Vec<(String, String)>,
 }
 
 impl Emitted {
@@ -33,14 +41,21 @@ impl Emitted {
             .map(|(_, t)| t.as_str())
     }
 
+    /// Every file as `(name, content)`, ordered by name.
+    pub fn files(&self) -> &[(String, String)] {
+        &self.files
+    }
+
     /// `slotforge_top.v`.
     pub fn verilog(&self) -> &str {
-        self.file("slotforge_top.v").unwrap_or_default()
+        self.file(VERILOG_FILE)
+            .expect("emit always writes the Verilog")
     }
 
     /// `ports.json`.
     pub fn ports_json(&self) -> &str {
-        self.file("ports.json").unwrap_or_default()
+        self.file(MANIFEST_FILE)
+            .expect("emit always writes ports.json")
     }
 
     /// Write every file into `dir` (created if missing).
@@ -105,7 +120,7 @@ impl Board {
 
 /// The name place-and-route tools give a port bit: yosys and nextpnr call
 /// the only bit of a 1-bit vector port by the port's name.
-fn pnr_name(bits: &[(String, &'static str)], bit: &str) -> String {
+fn pnr_name(bits: &[(String, Dir)], bit: &str) -> String {
     if let Some(base) = bit.strip_suffix("[0]") {
         let wider = format!("{base}[1]");
         if !bits.iter().any(|(n, _)| *n == wider) {
@@ -113,38 +128,6 @@ fn pnr_name(bits: &[(String, &'static str)], bit: &str) -> String {
         }
     }
     bit.to_string()
-}
-
-/// Port bit names in port-table order (the order of docs/timing.md).
-fn port_bits(s: &Schedule, p: &Plan) -> Vec<(String, &'static str)> {
-    let nb = p.branches.len();
-    let m: usize = p.branches.iter().map(|b| b.devices).sum();
-    let w = p.channel_bits as usize;
-    let mut v = vec![("clk".to_string(), "input"), ("rst".to_string(), "input")];
-    let _ = s;
-    for b in 0..nb {
-        v.push((format!("adc_miso[{b}]"), "input"));
-    }
-    for b in 0..nb {
-        v.push((format!("adc_cs_n[{b}]"), "output"));
-    }
-    for b in 0..nb {
-        v.push((format!("adc_sclk[{b}]"), "output"));
-    }
-    for i in 0..3 * nb {
-        v.push((format!("mux_sel[{i}]"), "output"));
-    }
-    for i in 0..m {
-        v.push((format!("mux_en[{i}]"), "output"));
-    }
-    v.push(("sample_valid".to_string(), "output"));
-    for i in 0..w {
-        v.push((format!("sample_channel[{i}]"), "output"));
-    }
-    for i in 0..14 {
-        v.push((format!("sample_value[{i}]"), "output"));
-    }
-    v
 }
 
 /// Generate every file for a schedule.  With `board`, the PCF maps port bits
@@ -162,20 +145,20 @@ pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Em
         None => None,
     };
     let mut files = vec![
-        ("slotforge_top.v".to_string(), verilog(s, &p)),
-        ("ports.json".to_string(), ports_json(s, &p)),
+        (VERILOG_FILE.to_string(), verilog(s, &p)),
+        (MANIFEST_FILE.to_string(), ports::manifest(s)),
         // The schedule's LUT in the one layout `slotforge lut` also writes, so
         // the two commands can share an output directory; the ROM image the
         // gateware embeds (per-branch words) is `slot_rom.hex`.
         ("slots.hex".to_string(), lut_gen::lut::to_hex(s)),
         ("slot_rom.hex".to_string(), slots_hex(s, &p)),
         ("slotforge.sdc".to_string(), sdc(s)),
-        ("slotforge.xdc".to_string(), xdc(s, &p)),
+        ("slotforge.xdc".to_string(), xdc(s)),
         (
             "slotforge.pcf".to_string(),
             match &board {
-                Some((path, b)) => pcf_board(s, &p, path, b)?,
-                None => pcf_template(s, &p),
+                Some((path, b)) => pcf_board(s, path, b)?,
+                None => pcf_template(s),
             },
         ),
     ];
@@ -233,19 +216,44 @@ fn tidy(text: &str) -> String {
     out
 }
 
+/// The wire that carries a port's lanes between the wrapper and the core,
+/// and the core's width of it, for the ports the core has at its fixed
+/// maximum width (the wrapper exposes exactly the mix's bits).
+fn core_lanes(r: Role) -> Option<(&'static str, usize)> {
+    match r {
+        Role::Miso => Some(("core_miso", MAX_BRANCHES)),
+        Role::CsN => Some(("core_cs_n", MAX_BRANCHES)),
+        Role::Sclk => Some(("core_sclk", MAX_BRANCHES)),
+        Role::MuxSel => Some((
+            "core_mux_sel",
+            ports::MUX_SELECT_BITS as usize * MAX_BRANCHES,
+        )),
+        Role::MuxEn => Some(("core_mux_en", EN_TOTAL)),
+        Role::SampleChannel => Some(("core_channel", CH_BITS)),
+        Role::Clock | Role::Reset | Role::SampleValid | Role::SampleValue => None,
+    }
+}
+
+/// The core's name for a port: the core (`core.rs`) names its ports as the
+/// contract does (a test compares them), except rust-hdl's own `clock`.
+fn core_port_name(r: Role) -> &'static str {
+    match r {
+        Role::Clock => "clock",
+        r => r.name(),
+    }
+}
+
 fn verilog(s: &Schedule, p: &Plan) -> String {
     let mut core = Core::new(p);
     core.connect_all();
     let body = tidy(&rename_top(&generate_verilog(&core)))
         .replace("endmodule // top\n", &format!("endmodule // {CORE}\n"));
-    let nb = p.branches.len();
-    let m: usize = p.branches.iter().map(|b| b.devices).sum();
-    let w = p.channel_bits as usize;
+    let l = Layout::new(s);
     let g = &s.grid;
     let mut v = String::new();
     let _ = writeln!(
         v,
-        "// slotforge_top: acquisition gateware for mix \"{}\"",
+        "// {TOP_MODULE}: acquisition gateware for mix \"{}\"",
         s.mix.name
     );
     let _ = writeln!(
@@ -260,12 +268,13 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     for (b, bp) in s.branches.iter().enumerate() {
         let _ = writeln!(
             v,
-            "// branch {b} \"{}\": sclk_div {} setup {} read {} cycles, {} mux device(s) at mux_en[{}:{}]",
+            "// branch {b} \"{}\": sclk_div {} setup {} read {} cycles, {} mux device(s) at {}[{}:{}]",
             bp.name,
             bp.spi.sclk_div,
             bp.spi.setup_cycles,
             bp.spi.read_cycles,
             p.branches[b].devices,
+            Role::MuxEn.name(),
             p.branches[b].en_offset + p.branches[b].devices - 1,
             p.branches[b].en_offset
         );
@@ -276,17 +285,20 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     );
     let _ = writeln!(v, "`default_nettype none");
     let _ = writeln!(v);
-    let _ = writeln!(v, "module slotforge_top (");
-    let _ = writeln!(v, "    input  wire clk,");
-    let _ = writeln!(v, "    input  wire rst,");
-    let _ = writeln!(v, "    input  wire [{}:0] adc_miso,", nb - 1);
-    let _ = writeln!(v, "    output wire [{}:0] adc_cs_n,", nb - 1);
-    let _ = writeln!(v, "    output wire [{}:0] adc_sclk,", nb - 1);
-    let _ = writeln!(v, "    output wire [{}:0] mux_sel,", 3 * nb - 1);
-    let _ = writeln!(v, "    output wire [{}:0] mux_en,", m - 1);
-    let _ = writeln!(v, "    output wire sample_valid,");
-    let _ = writeln!(v, "    output wire [{}:0] sample_channel,", w - 1);
-    let _ = writeln!(v, "    output wire [13:0] sample_value");
+    let _ = writeln!(v, "module {TOP_MODULE} (");
+    for (i, port) in PORTS.iter().enumerate() {
+        let dir = match port.dir {
+            Dir::In => "input ",
+            Dir::Out => "output",
+        };
+        let range = if port.vector {
+            format!("[{}:0] ", l.width(port.role) - 1)
+        } else {
+            String::new()
+        };
+        let sep = if i + 1 < PORTS.len() { "," } else { "" };
+        let _ = writeln!(v, "    {dir} wire {range}{}{sep}", port.name);
+    }
     let _ = writeln!(v, ");");
     let _ = writeln!(v);
     let _ = writeln!(
@@ -294,37 +306,30 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
         "    // The core has fixed maximum widths ({MAX_BRANCHES} branches, {EN_TOTAL} mux enables, {CH_BITS}-bit channel);"
     );
     let _ = writeln!(v, "    // this wrapper exposes exactly the mix's bits.");
-    let _ = writeln!(v, "    wire [{}:0] core_miso;", MAX_BRANCHES - 1);
-    let _ = writeln!(v, "    wire [{}:0] core_cs_n;", MAX_BRANCHES - 1);
-    let _ = writeln!(v, "    wire [{}:0] core_sclk;", MAX_BRANCHES - 1);
-    let _ = writeln!(v, "    wire [{}:0] core_mux_sel;", 3 * MAX_BRANCHES - 1);
-    let _ = writeln!(v, "    wire [{}:0] core_mux_en;", EN_TOTAL - 1);
-    let _ = writeln!(v, "    wire [{}:0] core_channel;", CH_BITS - 1);
-    if nb < MAX_BRANCHES {
-        let _ = writeln!(
-            v,
-            "    assign core_miso = {{{}'h0, adc_miso}};",
-            MAX_BRANCHES - nb
-        );
-    } else {
-        let _ = writeln!(v, "    assign core_miso = adc_miso;");
+    let wired: Vec<(Role, &str, usize)> = PORTS
+        .iter()
+        .filter_map(|port| core_lanes(port.role).map(|(wire, cw)| (port.role, wire, cw)))
+        .collect();
+    for &(_, wire, cw) in &wired {
+        let _ = writeln!(v, "    wire [{}:0] {wire};", cw - 1);
     }
-    let _ = writeln!(v, "    assign adc_cs_n = core_cs_n[{}:0];", nb - 1);
-    let _ = writeln!(v, "    assign adc_sclk = core_sclk[{}:0];", nb - 1);
-    let _ = writeln!(v, "    assign mux_sel = core_mux_sel[{}:0];", 3 * nb - 1);
-    let _ = writeln!(v, "    assign mux_en = core_mux_en[{}:0];", m - 1);
-    let _ = writeln!(v, "    assign sample_channel = core_channel[{}:0];", w - 1);
     let mut unused = vec![];
-    if nb < MAX_BRANCHES {
-        unused.push(format!("core_cs_n[{}:{nb}]", MAX_BRANCHES - 1));
-        unused.push(format!("core_sclk[{}:{nb}]", MAX_BRANCHES - 1));
-        unused.push(format!("core_mux_sel[{}:{}]", 3 * MAX_BRANCHES - 1, 3 * nb));
-    }
-    if m < EN_TOTAL {
-        unused.push(format!("core_mux_en[{}:{m}]", EN_TOTAL - 1));
-    }
-    if w < CH_BITS {
-        unused.push(format!("core_channel[{}:{w}]", CH_BITS - 1));
+    for &(r, wire, cw) in &wired {
+        let (name, w) = (r.name(), l.width(r) as usize);
+        match r.port().dir {
+            Dir::In if w < cw => {
+                let _ = writeln!(v, "    assign {wire} = {{{}'h0, {name}}};", cw - w);
+            }
+            Dir::In => {
+                let _ = writeln!(v, "    assign {wire} = {name};");
+            }
+            Dir::Out => {
+                let _ = writeln!(v, "    assign {name} = {wire}[{}:0];", w - 1);
+                if w < cw {
+                    unused.push(format!("{wire}[{}:{w}]", cw - 1));
+                }
+            }
+        }
     }
     if !unused.is_empty() {
         let _ = writeln!(
@@ -335,16 +340,14 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     }
     let _ = writeln!(v);
     let _ = writeln!(v, "    {CORE} core (");
-    let _ = writeln!(v, "        .clock(clk),");
-    let _ = writeln!(v, "        .rst(rst),");
-    let _ = writeln!(v, "        .adc_miso(core_miso),");
-    let _ = writeln!(v, "        .adc_cs_n(core_cs_n),");
-    let _ = writeln!(v, "        .adc_sclk(core_sclk),");
-    let _ = writeln!(v, "        .mux_sel(core_mux_sel),");
-    let _ = writeln!(v, "        .mux_en(core_mux_en),");
-    let _ = writeln!(v, "        .sample_valid(sample_valid),");
-    let _ = writeln!(v, "        .sample_channel(core_channel),");
-    let _ = writeln!(v, "        .sample_value(sample_value)");
+    for (i, port) in PORTS.iter().enumerate() {
+        let to = wired
+            .iter()
+            .find(|(r, ..)| *r == port.role)
+            .map_or(port.name, |(_, wire, _)| *wire);
+        let sep = if i + 1 < PORTS.len() { "," } else { "" };
+        let _ = writeln!(v, "        .{}({to}){sep}", core_port_name(port.role));
+    }
     let _ = writeln!(v, "    );");
     let _ = writeln!(v, "endmodule");
     let _ = writeln!(v);
@@ -359,77 +362,6 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     v.push_str(&body);
     let _ = writeln!(v, "`default_nettype wire");
     v
-}
-
-// ---------------------------------------------------------------------------
-// ports.json
-// ---------------------------------------------------------------------------
-
-fn ports_json(s: &Schedule, p: &Plan) -> String {
-    use serde_json::json;
-    let w = p.channel_bits as usize;
-    let nb = p.branches.len();
-    let m: usize = p.branches.iter().map(|b| b.devices).sum();
-    let branches: Vec<_> = s
-        .branches
-        .iter()
-        .enumerate()
-        .map(|(b, bp)| {
-            let r = &p.branches[b];
-            json!({
-                "name": bp.name,
-                "cs_n": format!("adc_cs_n[{b}]"),
-                "sclk": format!("adc_sclk[{b}]"),
-                "miso": format!("adc_miso[{b}]"),
-                "mux_sel": format!("mux_sel[{}:{}]", 3 * b + 2, 3 * b),
-                "mux_en": (0..r.devices).map(|d| format!("mux_en[{}]", r.en_offset + d)).collect::<Vec<_>>(),
-                "sclk_div": bp.spi.sclk_div,
-                "setup_cycles": bp.spi.setup_cycles,
-                "read_cycles": bp.spi.read_cycles,
-            })
-        })
-        .collect();
-    let channels: Vec<_> = s
-        .channels
-        .iter()
-        .enumerate()
-        .map(|(i, c)| {
-            let mc = &s.mix.channels[i];
-            json!({
-                "index": i,
-                "name": mc.name,
-                "branch": s.branches[mc.branch].name,
-                "device": c.device,
-                "select": c.select,
-            })
-        })
-        .collect();
-    let ports = json!([
-        {"name": "clk", "dir": "in", "width": 1},
-        {"name": "rst", "dir": "in", "width": 1},
-        {"name": "adc_miso", "dir": "in", "width": nb},
-        {"name": "adc_cs_n", "dir": "out", "width": nb},
-        {"name": "adc_sclk", "dir": "out", "width": nb},
-        {"name": "mux_sel", "dir": "out", "width": 3 * nb},
-        {"name": "mux_en", "dir": "out", "width": m},
-        {"name": "sample_valid", "dir": "out", "width": 1},
-        {"name": "sample_channel", "dir": "out", "width": w},
-        {"name": "sample_value", "dir": "out", "width": 14},
-    ]);
-    let doc = json!({
-        "top": "slotforge_top",
-        "mix": s.mix.name,
-        "clock": "clk",
-        "clock_hz": s.grid.clock_hz,
-        "reset": {"port": "rst", "active_high": true, "synchronous": true},
-        "branches": branches,
-        "sample": {"valid": "sample_valid", "channel": "sample_channel", "value": "sample_value"},
-        "channels": channels,
-        "ports": ports,
-    });
-    let mut t = serde_json::to_string_pretty(&doc).expect("json");
-    t.push('\n');
-    t
 }
 
 // ---------------------------------------------------------------------------
@@ -537,7 +469,7 @@ fn sdc(s: &Schedule) -> String {
     )
 }
 
-fn xdc(s: &Schedule, p: &Plan) -> String {
+fn xdc(s: &Schedule) -> String {
     let mut t = String::new();
     let _ = writeln!(
         t,
@@ -551,10 +483,19 @@ fn xdc(s: &Schedule, p: &Plan) -> String {
     );
     let _ = writeln!(
         t,
-        "set_property IOSTANDARD LVCMOS33 [get_ports {{clk rst adc_miso[*] adc_cs_n[*] adc_sclk[*] mux_sel[*] mux_en[*] sample_valid sample_channel[*] sample_value[*]}}]"
+        "set_property IOSTANDARD LVCMOS33 [get_ports {{{}}}]",
+        PORTS
+            .iter()
+            .map(|p| if p.vector {
+                format!("{}[*]", p.name)
+            } else {
+                p.name.to_string()
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
     );
     let _ = writeln!(t, "# Pin locations: uncomment and fill in for your board.");
-    let bits = port_bits(s, p);
+    let bits = Layout::new(s).bits();
     for (bit, _) in &bits {
         let _ = writeln!(
             t,
@@ -565,7 +506,7 @@ fn xdc(s: &Schedule, p: &Plan) -> String {
     t
 }
 
-fn pcf_template(s: &Schedule, p: &Plan) -> String {
+fn pcf_template(s: &Schedule) -> String {
     let mut t = String::new();
     let _ = writeln!(
         t,
@@ -576,15 +517,20 @@ fn pcf_template(s: &Schedule, p: &Plan) -> String {
         t,
         "# No board file was given: replace every <pin> and uncomment, or emit with a board file."
     );
-    let bits = port_bits(s, p);
+    let bits = Layout::new(s).bits();
     for (bit, dir) in &bits {
-        let _ = writeln!(t, "# set_io {} <pin>    # {dir}", pnr_name(&bits, bit));
+        let _ = writeln!(
+            t,
+            "# set_io {} <pin>    # {}",
+            pnr_name(&bits, bit),
+            dir.verilog()
+        );
     }
     t
 }
 
-fn pcf_board(s: &Schedule, p: &Plan, path: &Path, b: &Board) -> Result<String, HdlError> {
-    let bits = port_bits(s, p);
+fn pcf_board(s: &Schedule, path: &Path, b: &Board) -> Result<String, HdlError> {
+    let bits = Layout::new(s).bits();
     let err = |m: String| HdlError::Board {
         path: path.display().to_string(),
         message: m,
@@ -594,19 +540,7 @@ fn pcf_board(s: &Schedule, p: &Plan, path: &Path, b: &Board) -> Result<String, H
             // Pins for bits another mix has (e.g. adc_cs_n[7]) are fine; only
             // names that can never be a port bit are errors.
             let base = k.split('[').next().unwrap_or("");
-            let known = [
-                "clk",
-                "rst",
-                "adc_miso",
-                "adc_cs_n",
-                "adc_sclk",
-                "mux_sel",
-                "mux_en",
-                "sample_valid",
-                "sample_channel",
-                "sample_value",
-            ];
-            if !known.contains(&base) {
+            if !PORTS.iter().any(|p| p.name == base) {
                 return Err(err(format!("[pins] names `{k}`, which is not a port bit")));
             }
         }
@@ -640,7 +574,61 @@ fn pcf_board(s: &Schedule, p: &Plan, path: &Path, b: &Board) -> Result<String, H
             return Err(err(format!("pin {pin} is assigned twice")));
         }
         used.push(pin);
-        let _ = writeln!(t, "set_io {} {pin}    # {dir}", pnr_name(&bits, bit));
+        let _ = writeln!(
+            t,
+            "set_io {} {pin}    # {}",
+            pnr_name(&bits, bit),
+            dir.verilog()
+        );
     }
     Ok(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The core's ports are rust-hdl field names (`core.rs`), which cannot
+    /// be generated from the contract's table: this is where a port renamed
+    /// in `lut_gen::ports::PORTS` without renaming the core's field fails.
+    #[test]
+    fn core_ports_are_the_contracts() {
+        let m = lut_gen::mix::parse(
+            Path::new("eskin34.toml"),
+            include_str!("../../mixes/eskin34.toml"),
+        )
+        .unwrap();
+        let s = lut_gen::synthesize(&m).unwrap();
+        let v = emit(&s, None).unwrap();
+        let head = format!("module {CORE}(");
+        let line = v
+            .verilog()
+            .lines()
+            .find(|l| l.starts_with(&head))
+            .expect("the core module");
+        let ports: Vec<&str> = line[head.len()..]
+            .trim_end_matches(");")
+            .split(',')
+            .collect();
+        let want: Vec<&str> = PORTS.iter().map(|p| core_port_name(p.role)).collect();
+        assert_eq!(ports, want);
+        // and the wrapper exposes exactly the contract's ports, in order
+        let top = format!("module {TOP_MODULE} (");
+        let decl: Vec<String> = v
+            .verilog()
+            .lines()
+            .skip_while(|l| *l != top)
+            .skip(1)
+            .take_while(|l| *l != ");")
+            .map(|l| {
+                l.trim_end_matches(',')
+                    .rsplit(' ')
+                    .next()
+                    .unwrap()
+                    .to_string()
+            })
+            .collect();
+        let names: Vec<String> = PORTS.iter().map(|p| p.name.to_string()).collect();
+        assert_eq!(decl, names);
+    }
 }

@@ -19,14 +19,17 @@ mod core;
 mod emit;
 mod plan;
 mod sim;
+#[cfg(feature = "stock")]
 mod stock;
+mod widths;
 
-pub use emit::{emit, emit_with, Board, Emitted};
+pub use emit::{emit, emit_with, Board, Emitted, MANIFEST_FILE, VERILOG_FILE};
 pub use plan::{
-    LutForm, FULL_LUT_MAX_BITS, MAX_BRANCHES, MAX_CHANNELS, MAX_DEVICES, MAX_DEVICES_PER_BRANCH,
-    MAX_FRAME_SLOTS, MAX_SCLK_DIV, MAX_SLICES_PER_FRAME, MAX_SLOTS_PER_SLICE, MAX_SLOT_CYCLES,
+    LutForm, FULL_LUT_MAX_BITS, MAX_FRAME_SLOTS, MAX_SCLK_DIV, MAX_SLICES_PER_FRAME,
+    MAX_SLOTS_PER_SLICE, MAX_SLOT_CYCLES,
 };
-pub use sim::{Pins, RtlSim};
+pub use sim::RtlSim;
+#[cfg(feature = "stock")]
 pub use stock::{pattern_miso, rtlsim_cycles, stock_simulation_cycles, StockRun};
 
 /// Why gateware could not be produced.

@@ -5,21 +5,17 @@ use lut_gen::Schedule;
 
 use crate::HdlError;
 
-/// Branch lanes of the fixed-maximum core.
-pub const MAX_BRANCHES: usize = 8;
-pub const MAX_CHANNELS: usize = 256;
-pub const MAX_DEVICES_PER_BRANCH: usize = 32;
-pub const MAX_DEVICES: usize = 64;
+use crate::widths::{CNT_BITS, PH_BITS, SLICE_BITS, SLOT_BITS};
 /// Largest frame the full-frame slot ROM takes.
-pub const MAX_FRAME_SLOTS: u64 = 1 << crate::core::SLOT_BITS;
+pub const MAX_FRAME_SLOTS: u64 = 1 << SLOT_BITS;
 /// Limits of the compact slot LUT (slice table + rotation groups).
-pub const MAX_SLOTS_PER_SLICE: u64 = 1 << crate::core::SLOT_BITS;
-pub const MAX_SLICES_PER_FRAME: u64 = 1 << crate::core::SLICE_BITS;
+pub const MAX_SLOTS_PER_SLICE: u64 = 1 << SLOT_BITS;
+pub const MAX_SLICES_PER_FRAME: u64 = 1 << SLICE_BITS;
 /// The full-frame ROMs are used while they fit in this many bits (16 of the
 /// HX8K's 32 block RAMs): they cost no logic cells.
 pub const FULL_LUT_MAX_BITS: u64 = 16 * 4096;
-pub const MAX_SLOT_CYCLES: u64 = 1 << crate::core::CNT_BITS;
-pub const MAX_SCLK_DIV: u64 = (1 << crate::core::PH_BITS) - 1;
+pub const MAX_SLOT_CYCLES: u64 = 1 << CNT_BITS;
+pub const MAX_SCLK_DIV: u64 = (1 << PH_BITS) - 1;
 
 /// The SPI timing of one or more branches: one shared sequencer each.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -182,17 +178,8 @@ impl CompactRom {
 pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
     let g = &s.grid;
     let nb = s.branches.len();
-    if nb == 0 || nb > MAX_BRANCHES {
-        return Err(unsupported(format!(
-            "{nb} branches: the gateware supports 1 to {MAX_BRANCHES}"
-        )));
-    }
-    if s.channels.is_empty() || s.channels.len() > MAX_CHANNELS {
-        return Err(unsupported(format!(
-            "{} channels: the gateware supports 1 to {MAX_CHANNELS}",
-            s.channels.len()
-        )));
-    }
+    // branch, channel and device counts: the pin contract's limits
+    lut_gen::ports::Layout::fits(s).map_err(unsupported)?;
     let sps = g.slots_per_slice;
     let k = g.slices_per_frame;
     if g.frame_slots == 0 || sps * k != g.frame_slots {
@@ -235,12 +222,6 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         return Err(unsupported(
             "frame table size does not match the grid".into(),
         ));
-    }
-    let total_devices: usize = s.branches.iter().map(|b| b.mux_devices as usize).sum();
-    if total_devices > MAX_DEVICES {
-        return Err(unsupported(format!(
-            "{total_devices} mux devices in total: the gateware supports at most {MAX_DEVICES}"
-        )));
     }
     let aw = addr_bits(g.frame_slots);
     let mut seqs: Vec<SeqTiming> = Vec::new();
@@ -288,13 +269,7 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
                 bp.name, spi.read_cycles, g.slot_cycles
             )));
         }
-        let devices = bp.mux_devices as usize;
-        if devices == 0 || devices > MAX_DEVICES_PER_BRANCH {
-            return Err(unsupported(format!(
-                "branch {}: {devices} mux devices; the gateware supports 1 to {MAX_DEVICES_PER_BRANCH}",
-                bp.name
-            )));
-        }
+        let devices = bp.mux_devices.max(1) as usize;
         let timing = SeqTiming {
             sclk_div: spi.sclk_div,
             sclk_half: spi.sclk_half,

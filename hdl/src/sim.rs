@@ -3,24 +3,10 @@
 
 use rust_hdl::prelude::*;
 
+use lut_gen::ports::Pins;
+
 use crate::core::Core;
 use crate::{plan, HdlError};
-
-/// Output pins of `slotforge_top` in one clock cycle.
-///
-/// Bit `b` of `cs_n`/`sclk` is branch `b`; `mux_sel` bits `[3b+2:3b]` are
-/// branch `b`'s select; `mux_en` is ordered as the `mux_en` port (branch 0's
-/// devices first, then branch 1's, ...).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Pins {
-    pub cs_n: u8,
-    pub sclk: u8,
-    pub mux_sel: u32,
-    pub mux_en: u64,
-    pub sample_valid: bool,
-    pub sample_channel: u16,
-    pub sample_value: u16,
-}
 
 /// Cycle-accurate simulator of the emitted gateware.
 ///

@@ -16,7 +16,9 @@ use rust_hdl::prelude::*;
 
 use crate::core::Core;
 use crate::sim::{read_pins, PinReader};
-use crate::{plan, HdlError, Pins};
+use lut_gen::ports::Pins;
+
+use crate::{plan, HdlError};
 
 /// Result of one run of the gateware for a number of cycles (after one reset
 /// cycle) with the [`pattern_miso`] stimulus.

@@ -131,7 +131,7 @@ fn emission_is_deterministic() {
     let a = hdl::emit(&s, None).unwrap();
     let b = hdl::emit(&s, None).unwrap();
     assert_eq!(a, b);
-    let names: Vec<&str> = a.files.iter().map(|(n, _)| n.as_str()).collect();
+    let names: Vec<&str> = a.files().iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(
         names,
         [

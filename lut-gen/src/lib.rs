@@ -5,10 +5,12 @@
 //! - [`synth`]: slot-grid choice and jitter-free placement, or a diagnosis;
 //! - [`validate`]: an independent proof of a schedule's promises;
 //! - [`lut`]: the slot LUT as a full frame table and in compact form;
+//! - [`ports`]: the pin contract of `slotforge_top` (names, roles, widths, lanes, limits, `ports.json`);
 //! - [`audit`]: rates, intervals, headroom, settling and Nyquist, as text or JSON.
 
 pub mod mix;
 pub mod parts;
+pub mod ports;
 pub mod schedule;
 pub mod synth;
 pub mod validate;

@@ -6,7 +6,7 @@
 
 use std::path::PathBuf;
 
-use cosim::checker::CheckOptions;
+use judge::CheckOptions;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -30,11 +30,14 @@ pub fn run(a: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
+    if let Err(code) = super::fits_pins(&s) {
+        return code;
+    }
     let opts = CheckOptions {
         model: !a.no_model,
         ..CheckOptions::default()
     };
-    let (report, info) = match cosim::vcd::check_vcd_with(&s, &a.wave, a.scope.as_deref(), opts) {
+    let (report, info) = match judge::vcd::check_vcd_with(&s, &a.wave, a.scope.as_deref(), opts) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");

@@ -5,9 +5,19 @@
 
 use std::path::PathBuf;
 
-use cosim::backend::RustHdlDut;
-use cosim::faults::{campaign, FaultOutcome};
-use cosim::run::ModelDut;
+use cosim::RustHdlDut;
+use judge::faults::{campaign, FaultOutcome};
+use judge::ModelDut;
+
+/// The designs faults are injected into (in process: the injector sits
+/// between the design's pins and the checker).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Target {
+    /// The cycle-level reference model's pins.
+    Model,
+    /// The gateware in rust-hdl's simulator.
+    Rusthdl,
+}
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -15,8 +25,8 @@ pub struct Args {
     pub mix: PathBuf,
     /// The design the faults are injected into: model (the cycle-level
     /// reference model's pins) or rusthdl (the gateware, in process).
-    #[arg(long, default_value = "model")]
-    pub backend: String,
+    #[arg(long, value_enum, default_value_t = Target::Model)]
+    pub backend: Target,
     /// Frames per faulty run (at least 2; the fault lands in the second).
     #[arg(long, default_value_t = 2)]
     pub frames: u64,
@@ -30,9 +40,12 @@ pub fn run(a: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let outcomes: Vec<FaultOutcome> = match a.backend.as_str() {
-        "model" => campaign(&s, a.frames, || ModelDut::new(&s)),
-        "rusthdl" => {
+    if let Err(code) = super::fits_pins(&s) {
+        return code;
+    }
+    let outcomes: Vec<FaultOutcome> = match a.backend {
+        Target::Model => campaign(&s, a.frames, || ModelDut::new(&s)),
+        Target::Rusthdl => {
             if let Err(e) = RustHdlDut::new(&s) {
                 eprintln!("error: {e}");
                 return 2;
@@ -41,16 +54,15 @@ pub fn run(a: Args) -> u8 {
                 RustHdlDut::new(&s).expect("built once already")
             })
         }
-        other => {
-            eprintln!("error: unknown back end `{other}` for faults (model, rusthdl)");
-            return 2;
-        }
     };
     let missed = outcomes.iter().filter(|o| !o.caught).count();
     if a.json {
         let v = serde_json::json!({
             "mix": s.mix.name,
-            "backend": a.backend,
+            "backend": match a.backend {
+                Target::Model => "model",
+                Target::Rusthdl => "rusthdl",
+            },
             "ok": missed == 0,
             "faults": outcomes,
         });

@@ -21,6 +21,20 @@ pub fn schedule(path: &Path) -> Result<lut_gen::Schedule, u8> {
     })
 }
 
+/// The `--backend` value parser: the names `cosim::Backend` knows.
+pub fn backend(s: &str) -> Result<cosim::Backend, String> {
+    s.parse()
+}
+
+/// Checks that a schedule fits the pin contract's limits (the checker and
+/// the engines size their pins from them), else prints why: exit 2.
+pub fn fits_pins(s: &lut_gen::Schedule) -> Result<(), u8> {
+    lut_gen::ports::Layout::fits(s).map_err(|m| {
+        eprintln!("error: mix `{}`: {m}", s.mix.name);
+        2u8
+    })
+}
+
 /// Writes generated files into `dir` (created if missing).  Each file is
 /// written to a temporary name and renamed, so an interrupted run never
 /// leaves a half-written file, and nothing else in `dir` is touched.

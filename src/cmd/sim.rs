@@ -14,8 +14,8 @@ pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
     /// model (slot-level), rusthdl (in process), verilator or icarus (the emitted Verilog).
-    #[arg(long, default_value = "model")]
-    pub backend: String,
+    #[arg(long, default_value = "model", value_parser = super::backend)]
+    pub backend: Backend,
     /// Frames to simulate.
     #[arg(long, default_value_t = 2)]
     pub frames: u64,
@@ -37,13 +37,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> u8 {
-    let backend: Backend = match a.backend.parse() {
-        Ok(b) => b,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
-    };
+    let backend = a.backend;
     let stimulus: Stimulus = match a.stimulus.parse() {
         Ok(s) => s,
         Err(e) => {
@@ -64,6 +58,9 @@ pub fn run(a: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
+    if let Err(code) = super::fits_pins(&s) {
+        return code;
+    }
     let opts = SimOptions {
         stimulus,
         vcd: a.vcd.map(|path| VcdOut {

@@ -32,7 +32,7 @@ pub fn run(args: Args) -> u8 {
         }
     };
     let files: Vec<(&str, String)> = emitted
-        .files
+        .files()
         .iter()
         .map(|(n, t)| (n.as_str(), t.clone()))
         .collect();

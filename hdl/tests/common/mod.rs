@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use hdl::Pins;
+use lut_gen::ports::Pins;
 use lut_gen::Schedule;
 
 pub fn root() -> PathBuf {

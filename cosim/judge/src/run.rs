@@ -1,13 +1,15 @@
 //! Driving a design cycle by cycle with the ADC model, fully checked, and
 //! the slot-level model back end.
 
+use lut_gen::ports::{Layout, Signal};
 use lut_gen::Schedule;
 
 use crate::adc::{Adc, Analog, Stimulus};
-use crate::checker::{CheckOptions, Checker, Invariants};
+use crate::checker::{CheckOptions, Checker};
+use crate::invariants::Invariants;
 use crate::model::{CycleModel, SlotModel};
-use crate::pins::Pins;
 use crate::report::Report;
+use lut_gen::ports::Pins;
 
 /// Anything that behaves like `slotforge_top`: one call per rising clock
 /// edge, with `rst` and `adc_miso` as sampled at that edge; returns the
@@ -178,7 +180,6 @@ pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usi
     let mut inv = Invariants::new(s, max_records);
     static_checks(s, &sm, &mut inv);
     let f = s.grid.frame_cycles;
-    let mut samples = 0u64;
     for frame in 0..frames {
         let base = frame * f;
         for cv in &sm.conversions {
@@ -195,12 +196,10 @@ pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usi
                 t,
             );
             inv.emitted(base + cv.emit, cv.channel, code);
-            samples += 1;
         }
     }
     let cycles = frames * f;
     let (fr, channels) = inv.finish(cycles);
-    let _ = samples;
     let samples = inv.emitted_count();
     inv.report("model", &s.mix.name, cycles, fr, channels, samples)
 }
@@ -210,11 +209,12 @@ fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
     use serde_json::json;
     let mix = &s.mix;
     let clock = mix.clock_hz;
+    let layout = Layout::new(s);
     for (b, plan) in s.branches.iter().enumerate() {
         let adc = &mix.branches[b].adc;
         let spi = &plan.spi;
         let d = spi.sclk_div;
-        let sig = Some(format!("adc_sclk[{b}]"));
+        let sig = Some(Signal::Sclk(b).name(&layout));
         if d * adc.sclk_max_hz < clock || d * adc.sclk_min_hz > clock {
             inv.violation(
                 0,
@@ -242,7 +242,7 @@ fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
             inv.violation(
                 0,
                 "cs-setup",
-                Some(format!("adc_cs_n[{b}]")),
+                Some(Signal::CsN(b).name(&layout)),
                 None,
                 None,
                 None,
@@ -268,7 +268,7 @@ fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
                 inv.violation(
                     next % s.grid.frame_cycles,
                     "cs-quiet",
-                    Some(format!("adc_cs_n[{b}]")),
+                    Some(Signal::CsN(b).name(&layout)),
                     Some(json!(spi.read_cycles + quiet)),
                     Some(json!(gap)),
                     None,
@@ -279,7 +279,7 @@ fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
                 inv.violation(
                     next % s.grid.frame_cycles,
                     "mux-settle",
-                    Some(format!("mux_sel[{}:{}]", 3 * b + 2, 3 * b)),
+                    Some(Signal::MuxSel(b).name(&layout)),
                     Some(json!(settle)),
                     Some(json!(gap - 1)),
                     None,

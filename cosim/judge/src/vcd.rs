@@ -26,14 +26,15 @@
 use std::collections::HashMap;
 use std::fmt;
 use std::fs::File;
-use std::io::{BufRead, BufReader, Read};
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
+use lut_gen::ports::{Role, PORT_NAMES as PORTS, TOP_MODULE};
 use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker};
-use crate::pins::{Layout, Pins};
 use crate::report::Report;
+use lut_gen::ports::{Layout, Pins};
 
 /// Why a VCD could not be checked (exit 2).
 #[derive(Debug)]
@@ -159,6 +160,26 @@ impl<R: BufRead> Lexer<R> {
         }
     }
 
+    /// A syntax error on an incomplete last line is a truncation.
+    fn truncation(&mut self, e: VcdError) -> VcdError {
+        match e {
+            VcdError::Malformed {
+                file,
+                line,
+                message,
+            } if !self.line.ends_with(b"\n")
+                && self.rd.fill_buf().map(|b| b.is_empty()).unwrap_or(false) =>
+            {
+                VcdError::Truncated {
+                    file,
+                    line,
+                    message: format!("{message} (the last line is incomplete)"),
+                }
+            }
+            e => e,
+        }
+    }
+
     /// Tokens up to `$end` (exclusive).
     fn until_end(&mut self, what: &str) -> Result<Vec<String>, VcdError> {
         let mut v = Vec::new();
@@ -273,17 +294,17 @@ fn parse_header<R: BufRead>(lx: &mut Lexer<R>) -> Result<Header, VcdError> {
 
 // ------------------------------------------------------------------ ports
 
-const CLK: usize = 0;
-const RST: usize = 1;
-const MISO: usize = 2;
-const CS: usize = 3;
-const SCLK: usize = 4;
-const SEL: usize = 5;
-const EN: usize = 6;
-const VALID: usize = 7;
-const CHAN: usize = 8;
-const VALUE: usize = 9;
-use crate::pins::PORT_NAMES as PORTS;
+// Indices into the port table.
+const CLK: usize = Role::Clock as usize;
+const RST: usize = Role::Reset as usize;
+const MISO: usize = Role::Miso as usize;
+const CS: usize = Role::CsN as usize;
+const SCLK: usize = Role::Sclk as usize;
+const SEL: usize = Role::MuxSel as usize;
+const EN: usize = Role::MuxEn as usize;
+const VALID: usize = Role::SampleValid as usize;
+const CHAN: usize = Role::SampleChannel as usize;
+const VALUE: usize = Role::SampleValue as usize;
 
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
 /// (or `lsb - j` when the range is ascending).
@@ -380,7 +401,7 @@ fn resolve(
             .find(|(p, w)| width_of(c, p) != *w)
             .expect("a candidate whose widths differ");
         return Err(perr(format!(
-            "the scopes with slotforge_top's ports ({}) do not have this mix's widths (`{p}`: {w} bit(s) expected, {} in `{c}`): is the VCD from another mix?",
+            "the scopes with {TOP_MODULE}'s ports ({}) do not have this mix's widths (`{p}`: {w} bit(s) expected, {} in `{c}`): is the VCD from another mix?",
             candidates.join(", "),
             width_of(c, p)
         )));
@@ -398,7 +419,7 @@ fn resolve(
             _ => String::new(),
         };
         return Err(perr(format!(
-            "no scope has all the ports of slotforge_top ({}){hint}",
+            "no scope has all the ports of {TOP_MODULE} ({}){hint}",
             required.join(", ")
         )));
     };
@@ -418,7 +439,7 @@ fn resolve(
         let first = ids_of(candidates[0]);
         if candidates.iter().any(|c| ids_of(c)[1..] != first[1..]) {
             return Err(perr(format!(
-                "several scopes have the ports of slotforge_top: {}; choose one with --scope",
+                "several scopes have the ports of {TOP_MODULE}: {}; choose one with --scope",
                 candidates.join(", ")
             )));
         }
@@ -777,7 +798,7 @@ fn body<R: BufRead>(
             b'b' | b'B' | b'r' | b'R' | b's' | b'S' => {
                 let kind = t[0].to_ascii_lowercase();
                 let val_range = (r.0 + 1, r.1);
-                let Some(idr) = lx.next_same_line_or_any()? else {
+                let Some(idr) = lx.next()? else {
                     return Err(lx.truncated(
                         "value change without an identifier code at the end of the file",
                     ));
@@ -860,32 +881,6 @@ fn body<R: BufRead>(
     }
     info.last_time = time;
     Ok(info)
-}
-
-impl<R: BufRead> Lexer<R> {
-    /// A syntax error on an incomplete last line is a truncation.
-    fn truncation(&mut self, e: VcdError) -> VcdError {
-        match e {
-            VcdError::Malformed {
-                file,
-                line,
-                message,
-            } if !self.line.ends_with(b"\n")
-                && self.rd.fill_buf().map(|b| b.is_empty()).unwrap_or(false) =>
-            {
-                VcdError::Truncated {
-                    file,
-                    line,
-                    message: format!("{message} (the last line is incomplete)"),
-                }
-            }
-            e => e,
-        }
-    }
-
-    fn next_same_line_or_any(&mut self) -> Result<Option<(usize, usize)>, VcdError> {
-        self.next()
-    }
 }
 
 /// Header facts of a VCD.
@@ -973,6 +968,3 @@ pub fn parse_only(s: &Schedule, path: &Path, scope: Option<&str>) -> Result<u64,
     read_cycles(s, path, scope, &mut c)?;
     Ok(c.0)
 }
-
-#[allow(dead_code)]
-fn _assert_read<R: Read>(_: R) {}

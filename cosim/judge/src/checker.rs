@@ -2,7 +2,7 @@
 //! back ends, or cycles recovered from a VCD), then [`Checker::finish`].
 //!
 //! Two independent layers:
-//! - invariants from the mix alone ([`Invariants`] for counts, intervals and
+//! - invariants from the mix alone ([`Invariants`], `invariants.rs`, for counts, intervals and
 //!   the sample stream; edge tracking per branch for SPI timing, mux settling
 //!   and exclusivity, and MISO decoding);
 //! - cycle-exact equality with the [`CycleModel`] built from the schedule.
@@ -13,9 +13,11 @@ use lut_gen::parts::ns_to_cycles;
 use lut_gen::{FrameGrid, Schedule};
 use serde_json::{json, Value};
 
+use lut_gen::ports::{Layout, Pins, Role, Signal};
+
+use crate::invariants::Invariants;
 use crate::model::CycleModel;
-use crate::pins::{Layout, Pins, Signal};
-use crate::report::{ChannelStats, Divergence, Report, Violation};
+use crate::report::{Divergence, Report};
 
 /// How much the checker records (it always counts everything).
 #[derive(Debug, Clone, Copy)]
@@ -44,410 +46,6 @@ struct Limits {
     setup_min: u64,
     quiet_min: u64,
     settle_min: u64,
-}
-
-/// Collects violations; shared by both layers.
-#[derive(Debug, Clone)]
-struct Recorder {
-    grid: FrameGrid,
-    max: usize,
-    violations: Vec<Violation>,
-    violation_count: u64,
-}
-
-impl Recorder {
-    #[allow(clippy::too_many_arguments)]
-    fn violation(
-        &mut self,
-        cycle: u64,
-        rule: &str,
-        signal: Option<String>,
-        expected: Option<Value>,
-        actual: Option<Value>,
-        channel: Option<String>,
-        detail: String,
-    ) {
-        self.violation_count += 1;
-        if self.violations.len() < self.max {
-            let (frame, slot, _) = self.grid.locate(cycle);
-            self.violations.push(Violation {
-                cycle,
-                frame,
-                slot,
-                rule: rule.into(),
-                signal,
-                expected,
-                actual,
-                channel,
-                detail,
-            });
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Pending {
-    complete: u64,
-    instant: u64,
-    branch: usize,
-    channel: Option<u16>,
-    code: Option<u16>,
-}
-
-/// Model-independent checks at conversion level: per-channel counts per
-/// frame and exact intervals, and the merged sample stream (every completed
-/// conversion emitted once, in order, with its channel and MISO word).
-#[derive(Debug, Clone)]
-pub struct Invariants {
-    rec: Recorder,
-    names: Vec<String>,
-    branch_names: Vec<String>,
-    ch_branch: Vec<usize>,
-    interval: Vec<u64>,
-    spf: Vec<u64>,
-    last: Vec<u64>,
-    has_last: Vec<bool>,
-    in_frame: Vec<u64>,
-    samples: Vec<u64>,
-    imin: Vec<u64>,
-    imax: Vec<u64>,
-    /// Frame whose counts are being accumulated.
-    frame: u64,
-    frame_cycles: u64,
-    queue: VecDeque<Pending>,
-    /// Emission lateness allowed after completion (cycles).
-    slack: u64,
-    emitted: u64,
-    conversions: u64,
-}
-
-impl Invariants {
-    pub fn new(s: &Schedule, max_records: usize) -> Invariants {
-        let mix = &s.mix;
-        let n = mix.channels.len();
-        Invariants {
-            rec: Recorder {
-                grid: s.grid,
-                max: max_records,
-                violations: Vec::new(),
-                violation_count: 0,
-            },
-            names: mix.channels.iter().map(|c| c.name.clone()).collect(),
-            branch_names: mix.branches.iter().map(|b| b.name.clone()).collect(),
-            ch_branch: mix.channels.iter().map(|c| c.branch).collect(),
-            interval: mix
-                .channels
-                .iter()
-                .map(|c| mix.clock_hz / c.rate_hz)
-                .collect(),
-            spf: mix
-                .channels
-                .iter()
-                .map(|c| mix.samples_per_frame(c.rate_hz))
-                .collect(),
-            last: vec![0; n],
-            has_last: vec![false; n],
-            in_frame: vec![0; n],
-            samples: vec![0; n],
-            imin: vec![u64::MAX; n],
-            imax: vec![0; n],
-            frame: 0,
-            frame_cycles: mix.frame_cycles(),
-            queue: VecDeque::new(),
-            slack: mix.branches.len() as u64 + 1,
-            emitted: 0,
-            conversions: 0,
-        }
-    }
-
-    fn name(&self, ch: Option<u16>) -> Option<String> {
-        ch.and_then(|c| self.names.get(c as usize).cloned())
-    }
-
-    /// Closes every frame that ends at or before cycle `c`.
-    pub fn close_frames(&mut self, c: u64) {
-        while (self.frame + 1) * self.frame_cycles <= c {
-            let end = (self.frame + 1) * self.frame_cycles - 1;
-            for ch in 0..self.names.len() {
-                if self.in_frame[ch] != self.spf[ch] {
-                    let name = self.names[ch].clone();
-                    self.rec.violation(
-                        end,
-                        "samples-per-frame",
-                        None,
-                        Some(json!(self.spf[ch])),
-                        Some(json!(self.in_frame[ch])),
-                        Some(name.clone()),
-                        format!(
-                            "{name} sampled {} times in frame {}, expected {}",
-                            self.in_frame[ch], self.frame, self.spf[ch]
-                        ),
-                    );
-                }
-                self.in_frame[ch] = 0;
-            }
-            self.frame += 1;
-        }
-    }
-
-    /// A sampling instant of `channel` on `branch` at cycle `t`.
-    #[inline]
-    pub fn instant(&mut self, t: u64, branch: usize, channel: u16) {
-        let ch = channel as usize;
-        if t >= (self.frame + 1) * self.frame_cycles {
-            self.close_frames(t);
-        }
-        if ch >= self.names.len() {
-            self.rec.violation(
-                t,
-                "channel",
-                None,
-                None,
-                Some(json!(ch)),
-                None,
-                format!("channel index {ch} is not in the mix"),
-            );
-            return;
-        }
-        if self.ch_branch[ch] != branch {
-            let name = self.names[ch].clone();
-            self.rec.violation(
-                t,
-                "branch",
-                None,
-                Some(json!(self.branch_names[self.ch_branch[ch]])),
-                Some(json!(self.branch_names[branch])),
-                Some(name.clone()),
-                format!("{name} sampled on the wrong branch"),
-            );
-        }
-        self.in_frame[ch] += 1;
-        self.samples[ch] += 1;
-        if self.has_last[ch] {
-            let d = t - self.last[ch];
-            self.imin[ch] = self.imin[ch].min(d);
-            self.imax[ch] = self.imax[ch].max(d);
-            if d != self.interval[ch] {
-                let name = self.names[ch].clone();
-                self.rec.violation(
-                    t,
-                    "interval",
-                    None,
-                    Some(json!(self.interval[ch])),
-                    Some(json!(d)),
-                    Some(name.clone()),
-                    format!("{name} sampled {d} cycles after its previous instant (cycle {}), expected {}", self.last[ch], self.interval[ch]),
-                );
-            }
-        }
-        self.has_last[ch] = true;
-        self.last[ch] = t;
-    }
-
-    fn expire(&mut self, c: u64) {
-        while let Some(p) = self.queue.front() {
-            if p.complete + self.slack >= c {
-                break;
-            }
-            let p = *p;
-            self.queue.pop_front();
-            self.rec.violation(
-                p.complete,
-                "sample-missing",
-                Some("sample_valid".into()),
-                Some(json!(1)),
-                Some(json!(0)),
-                self.name(p.channel),
-                format!(
-                    "conversion of branch {} sampled at cycle {} completed at cycle {} but was never emitted",
-                    self.branch_names[p.branch], p.instant, p.complete
-                ),
-            );
-        }
-    }
-
-    /// A conversion completed (CS rose) at cycle `c`; `code` is the 14-bit word
-    /// read from MISO (`None` if x/z was captured), `channel` the one selected
-    /// at the sampling instant `instant`.
-    #[inline]
-    pub fn completion(
-        &mut self,
-        c: u64,
-        branch: usize,
-        channel: Option<u16>,
-        code: Option<u16>,
-        instant: u64,
-    ) {
-        self.conversions += 1;
-        self.expire(c);
-        self.queue.push_back(Pending {
-            complete: c,
-            instant,
-            branch,
-            channel,
-            code,
-        });
-    }
-
-    /// `sample_valid` was high in cycle `c` with this channel and value.
-    #[inline]
-    pub fn emitted(&mut self, c: u64, channel: u16, value: u16) {
-        self.emitted += 1;
-        self.expire(c);
-        let Some(p) = self.queue.pop_front() else {
-            self.rec.violation(
-                c,
-                "sample-unexpected",
-                Some("sample_valid".into()),
-                Some(json!(0)),
-                Some(json!(1)),
-                self.name(Some(channel)),
-                format!("sample_valid with channel {channel} value {value} but no conversion is waiting"),
-            );
-            return;
-        };
-        if p.complete >= c {
-            self.rec.violation(
-                c,
-                "sample-early",
-                Some("sample_valid".into()),
-                None,
-                None,
-                self.name(p.channel),
-                format!(
-                    "sample emitted in cycle {c}, before its conversion completed (cycle {})",
-                    p.complete
-                ),
-            );
-        }
-        if let Some(ch) = p.channel {
-            if ch != channel {
-                self.rec.violation(
-                    c,
-                    "sample-channel",
-                    Some("sample_channel".into()),
-                    Some(json!(ch)),
-                    Some(json!(channel)),
-                    self.name(Some(ch)),
-                    format!(
-                        "sample_channel {channel} but the mux selected {} ({}) at the sampling instant (cycle {})",
-                        ch,
-                        self.names.get(ch as usize).map(String::as_str).unwrap_or("?"),
-                        p.instant
-                    ),
-                );
-            }
-        }
-        if let Some(code) = p.code {
-            if code != value {
-                self.rec.violation(
-                    c,
-                    "sample-value",
-                    Some("sample_value".into()),
-                    Some(json!(code)),
-                    Some(json!(value)),
-                    self.name(p.channel),
-                    format!("sample_value {value:#06x} but MISO carried {code:#06x} (conversion sampled at cycle {})", p.instant),
-                );
-            }
-        }
-    }
-
-    /// Ends the check after `cycles` cycles: closes complete frames and flags
-    /// conversions still waiting.
-    ///
-    /// Per-frame counts are checked on complete frames only; in a trailing
-    /// partial frame a channel may not exceed its samples per frame (its
-    /// samples still count in the channel statistics).
-    pub fn finish(&mut self, cycles: u64) -> (u64, Vec<ChannelStats>) {
-        let frames = cycles / self.frame_cycles;
-        self.close_frames(frames * self.frame_cycles);
-        if cycles > frames * self.frame_cycles {
-            for ch in 0..self.names.len() {
-                if self.in_frame[ch] > self.spf[ch] {
-                    let name = self.names[ch].clone();
-                    self.rec.violation(
-                        cycles - 1,
-                        "samples-per-frame",
-                        None,
-                        Some(json!(self.spf[ch])),
-                        Some(json!(self.in_frame[ch])),
-                        Some(name.clone()),
-                        format!(
-                            "{name} sampled {} times in the first {} cycles of frame {}, expected {} in the whole frame",
-                            self.in_frame[ch],
-                            cycles % self.frame_cycles,
-                            frames,
-                            self.spf[ch]
-                        ),
-                    );
-                }
-            }
-        }
-        self.expire(cycles);
-        let channels = (0..self.names.len())
-            .map(|c| ChannelStats {
-                name: self.names[c].clone(),
-                branch: self.branch_names[self.ch_branch[c]].clone(),
-                samples: self.samples[c],
-                interval_cycles: self.interval[c],
-                interval_cycles_min: (self.imin[c] != u64::MAX).then_some(self.imin[c]),
-                interval_cycles_max: (self.imin[c] != u64::MAX).then_some(self.imax[c]),
-            })
-            .collect();
-        (frames, channels)
-    }
-
-    /// Records a violation found outside the conversion-level checks.
-    #[allow(clippy::too_many_arguments)]
-    pub fn violation(
-        &mut self,
-        cycle: u64,
-        rule: &str,
-        signal: Option<String>,
-        expected: Option<Value>,
-        actual: Option<Value>,
-        channel: Option<String>,
-        detail: String,
-    ) {
-        self.rec
-            .violation(cycle, rule, signal, expected, actual, channel, detail)
-    }
-
-    pub fn violation_count(&self) -> u64 {
-        self.rec.violation_count
-    }
-
-    /// Builds the report (call [`Invariants::finish`] first).
-    pub fn report(
-        self,
-        source: &str,
-        mix: &str,
-        cycles: u64,
-        frames: u64,
-        channels: Vec<ChannelStats>,
-        samples: u64,
-    ) -> Report {
-        Report {
-            ok: self.rec.violation_count == 0 && cycles > 0,
-            mix: mix.into(),
-            source: source.into(),
-            cycles,
-            frames,
-            partial_frame_cycles: cycles - frames * self.frame_cycles,
-            samples,
-            channels,
-            divergence_count: 0,
-            divergences: Vec::new(),
-            violation_count: self.rec.violation_count,
-            violations: self.rec.violations,
-            model_compared: false,
-        }
-    }
-
-    pub fn emitted_count(&self) -> u64 {
-        self.emitted
-    }
 }
 
 #[derive(Debug, Clone, Default)]
@@ -616,7 +214,7 @@ impl Checker {
                     self.inv.violation(
                         self.c,
                         "x-or-z",
-                        Some("rst".into()),
+                        Some(Role::Reset.name().into()),
                         None,
                         Some(json!("x")),
                         None,
@@ -628,7 +226,7 @@ impl Checker {
                 self.inv.violation(
                     self.c,
                     "reset",
-                    Some("rst".into()),
+                    Some(Role::Reset.name().into()),
                     None,
                     None,
                     None,
@@ -1117,7 +715,7 @@ impl Checker {
     pub fn finish(mut self, source: &str) -> Report {
         let cycles = self.c;
         if self.phase == Phase::PreReset || (self.phase == Phase::Reset && cycles == 0) {
-            self.inv.violation(0, "no-cycles", Some("rst".into()), None, None, None, "no cycle after a released reset was seen (rst must be high, then low, at rising clock edges)".into());
+            self.inv.violation(0, "no-cycles", Some(Role::Reset.name().into()), None, None, None, "no cycle after a released reset was seen (rst must be high, then low, at rising clock edges)".into());
         }
         let (frames, channels) = self.inv.finish(cycles);
         let samples = self.inv.emitted_count();

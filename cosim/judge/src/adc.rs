@@ -14,7 +14,7 @@ use std::f64::consts::PI;
 
 use lut_gen::Schedule;
 
-use crate::pins::{Layout, Pins};
+use lut_gen::ports::{Layout, Pins};
 
 /// What each analog input carries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

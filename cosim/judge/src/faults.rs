@@ -3,8 +3,8 @@
 
 use lut_gen::Schedule;
 
-use crate::pins::{Layout, Pins};
 use crate::run::Dut;
+use lut_gen::ports::{Layout, Pins};
 
 /// A kind of fault, injected around the first conversion of `branch` at or after a cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -2,13 +2,13 @@
 
 use std::path::{Path, PathBuf};
 
-use cosim::faults::{Fault, FaultyDut};
-use cosim::run::{run_dut, Dut, ModelDut, RunOptions};
-use cosim::vcdout::VcdWriter;
-use cosim::VcdError;
+use judge::faults::{Fault, FaultyDut};
+use judge::run::{run_dut, Dut, ModelDut, RunOptions};
+use judge::vcdout::VcdWriter;
+use judge::VcdError;
 
 fn tiny() -> lut_gen::Schedule {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/tiny.toml");
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml");
     lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap()
 }
 
@@ -36,7 +36,7 @@ fn rewrite(src: &Path, dst: &Path, f: impl Fn(&str) -> String) {
 fn generated_vcd_passes() {
     let d = tempfile::tempdir().unwrap();
     let (s, p) = good_vcd(d.path());
-    let r = cosim::check_vcd(&s, &p, None).unwrap();
+    let r = judge::check_vcd(&s, &p, None).unwrap();
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.frames, 3);
     assert_eq!(r.samples, 30);
@@ -50,7 +50,7 @@ fn faulty_vcd_fails_with_first_divergence() {
     let p = d.path().join("bad.vcd");
     let mut dut = FaultyDut::new(&s, ModelDut::new(&s), Fault::WrongSampleBit, 4100);
     write_vcd(&s, &mut dut, 3, &p);
-    let r = cosim::check_vcd(&s, &p, None).unwrap();
+    let r = judge::check_vcd(&s, &p, None).unwrap();
     assert!(!r.ok);
     let dv = &r.divergences[0];
     assert_eq!(dv.signal, "sample_value");
@@ -68,7 +68,7 @@ fn timescale_does_not_matter() {
     rewrite(&p, &q, |t| {
         t.replace("$timescale 1ps $end", "$timescale\n  1 ns\n$end")
     });
-    let r = cosim::check_vcd(&s, &q, None).unwrap();
+    let r = judge::check_vcd(&s, &q, None).unwrap();
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.cycles, 12000);
 }
@@ -84,7 +84,7 @@ fn missing_clock_is_inferred() {
             .map(|l| format!("{l}\n"))
             .collect()
     });
-    let r = cosim::check_vcd(&s, &q, None).unwrap();
+    let r = judge::check_vcd(&s, &q, None).unwrap();
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.frames, 3);
 }
@@ -114,12 +114,12 @@ fn icarus_style_shared_codes_and_short_vectors() {
         )
     });
     assert!(std::fs::read_to_string(&q).unwrap().contains("\nb0 "));
-    let r = cosim::check_vcd(&s, &q, None).unwrap();
+    let r = judge::check_vcd(&s, &q, None).unwrap();
     assert!(r.ok, "{}", r.summary());
-    let r = cosim::check_vcd(&s, &q, Some("tb.dut")).unwrap();
+    let r = judge::check_vcd(&s, &q, Some("tb.dut")).unwrap();
     assert!(r.ok, "{}", r.summary());
     assert!(matches!(
-        cosim::check_vcd(&s, &q, Some("nowhere")),
+        judge::check_vcd(&s, &q, Some("nowhere")),
         Err(VcdError::Ports { .. })
     ));
 }
@@ -144,7 +144,7 @@ fn x_on_miso_at_capture_is_a_violation() {
             })
             .collect()
     });
-    let r = cosim::check_vcd(&s, &q, None).unwrap();
+    let r = judge::check_vcd(&s, &q, None).unwrap();
     assert!(!r.ok);
     assert!(
         r.violations.iter().any(|v| v.rule == "x-or-z"),
@@ -166,13 +166,13 @@ fn broken_files_are_errors() {
     }
     std::fs::write(&q, &cut).unwrap();
     assert!(matches!(
-        cosim::check_vcd(&s, &q, None),
+        judge::check_vcd(&s, &q, None),
         Err(VcdError::Truncated { .. })
     ));
     // cut in the header
     std::fs::write(&q, &full[..200]).unwrap();
     assert!(matches!(
-        cosim::check_vcd(&s, &q, None),
+        judge::check_vcd(&s, &q, None),
         Err(VcdError::Truncated { .. })
     ));
     // garbage values, backwards time, undeclared ids
@@ -186,7 +186,7 @@ fn broken_files_are_errors() {
             .unwrap()
             .replacen(from, to, 1);
         std::fs::write(&q, t).unwrap();
-        let e = cosim::check_vcd(&s, &q, None);
+        let e = judge::check_vcd(&s, &q, None);
         assert!(
             matches!(e, Err(VcdError::Malformed { .. })),
             "{from:?}: {e:?}"
@@ -205,10 +205,10 @@ fn broken_files_are_errors() {
             b[i] = (seed >> 32) as u8;
         }
         std::fs::write(&q, &b).unwrap();
-        let _ = cosim::check_vcd(&s, &q, None);
+        let _ = judge::check_vcd(&s, &q, None);
     }
     assert!(matches!(
-        cosim::check_vcd(&s, d.path().join("none.vcd"), None),
+        judge::check_vcd(&s, d.path().join("none.vcd"), None),
         Err(VcdError::Io(..))
     ));
 }
@@ -218,11 +218,11 @@ fn wrong_mix_is_a_port_error() {
     let d = tempfile::tempdir().unwrap();
     let (_, p) = good_vcd(d.path());
     let eskin = lut_gen::synthesize(
-        &lut_gen::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml"))
+        &lut_gen::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../mixes/eskin34.toml"))
             .unwrap(),
     )
     .unwrap();
-    let e = cosim::check_vcd(&eskin, &p, None).unwrap_err();
+    let e = judge::check_vcd(&eskin, &p, None).unwrap_err();
     assert!(matches!(e, VcdError::Ports { .. }), "{e}");
 }
 
@@ -266,13 +266,13 @@ fn inner_module_with_same_port_names_does_not_confuse_scope_detection() {
     assert!(std::fs::read_to_string(&q)
         .unwrap()
         .contains("$scope module core"));
-    let r = cosim::check_vcd(&s, &q, None).unwrap();
+    let r = judge::check_vcd(&s, &q, None).unwrap();
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.samples, 30);
     // Against another mix neither scope fits: say so rather than "ambiguous".
-    let eskin = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml");
+    let eskin = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../mixes/eskin34.toml");
     let other = lut_gen::synthesize(&lut_gen::load(&eskin).unwrap()).unwrap();
-    match cosim::check_vcd(&other, &q, None) {
+    match judge::check_vcd(&other, &q, None) {
         Err(e) => assert!(e.to_string().contains("another mix"), "{e}"),
         Ok(r) => panic!("accepted: {}", r.summary()),
     }

@@ -1,8 +1,8 @@
-use cosim::run::{run_dut, run_model, ModelDut, RunOptions};
+use judge::run::{run_dut, run_model, ModelDut, RunOptions};
 use std::path::Path;
 
 fn eskin() -> lut_gen::Schedule {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml");
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../mixes/eskin34.toml");
     lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap()
 }
 
@@ -20,14 +20,14 @@ fn model_pins_pass_the_checker() {
 #[test]
 fn slot_model_passes() {
     let s = eskin();
-    let r = run_model(&s, 100, cosim::Stimulus::Pattern, 20);
+    let r = run_model(&s, 100, judge::Stimulus::Pattern, 20);
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.samples, 100 * 349);
 }
 
 #[test]
 fn every_fault_is_caught() {
-    use cosim::faults::{Fault, FaultyDut};
+    use judge::faults::{Fault, FaultyDut};
     let s = eskin();
     let at = s.grid.frame_cycles / 2 + 7;
     for f in Fault::all(&s) {
@@ -62,7 +62,7 @@ fn every_fault_is_caught() {
 }
 
 /// Drives the checker by hand: `reset` reset cycles, then `cycles` cycles of the model's pins.
-fn check_by_hand(s: &lut_gen::Schedule, reset: u64, cycles: u64) -> cosim::Report {
+fn check_by_hand(s: &lut_gen::Schedule, reset: u64, cycles: u64) -> judge::Report {
     check_by_hand_with(s, reset, cycles, 0)
 }
 
@@ -73,11 +73,11 @@ fn check_by_hand_with(
     reset: u64,
     cycles: u64,
     wrong_mux: u64,
-) -> cosim::Report {
-    use cosim::run::Dut;
+) -> judge::Report {
+    use judge::run::Dut;
     let mut dut = ModelDut::new(s);
-    let mut adc = cosim::Adc::new(s, cosim::Stimulus::Pattern);
-    let mut chk = cosim::Checker::new(s, cosim::CheckOptions::default());
+    let mut adc = judge::Adc::new(s, judge::Stimulus::Pattern);
+    let mut chk = judge::Checker::new(s, judge::CheckOptions::default());
     let mut miso = (1u64 << s.branches.len()) - 1;
     for i in 0..reset {
         let mut p = dut.step(true, miso);
@@ -98,7 +98,7 @@ fn check_by_hand_with(
 #[test]
 fn first_conversion_settles_on_the_reset_cycles_that_held_the_mux() {
     let s = eskin();
-    let settle = cosim::run::reset_cycles(&s, 0);
+    let settle = judge::run::reset_cycles(&s, 0);
     assert_eq!(settle, 96, "2 us at 48 MHz");
     // A mux steady through the whole reset counts as settled, however short the reset.
     let r = check_by_hand(&s, 4, 2000);

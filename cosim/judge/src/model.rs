@@ -10,7 +10,7 @@
 
 use lut_gen::Schedule;
 
-use crate::pins::{Layout, Pins};
+use lut_gen::ports::{Layout, Pins};
 
 /// One conversion in the periodic frame template.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

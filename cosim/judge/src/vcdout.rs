@@ -7,8 +7,11 @@ use std::path::Path;
 
 use lut_gen::Schedule;
 
-use crate::pins::{Layout, Pins, PORT_NAMES};
 use crate::run::Observer;
+use lut_gen::ports::{Layout, Pins, Role, PORTS, TOP_MODULE};
+
+/// The lanes of a branch that its view in the waveform shows, in order.
+const BRANCH_VIEW: [Role; 5] = [Role::CsN, Role::Sclk, Role::Miso, Role::MuxSel, Role::MuxEn];
 
 /// Writes the ports of every cycle in `[from, to)` (cycles counted from the
 /// first reset cycle of the run) to a VCD with a 1 ps timescale.  Besides the
@@ -46,9 +49,10 @@ impl VcdWriter {
         writeln!(w, "$date slotforge sim $end")?;
         writeln!(w, "$version slotforge cosim (mix {}) $end", s.mix.name)?;
         writeln!(w, "$timescale 1ps $end")?;
-        writeln!(w, "$scope module slotforge_top $end")?;
-        for (i, n) in PORT_NAMES.iter().enumerate() {
-            if matches!(i, 0 | 1 | 7) {
+        writeln!(w, "$scope module {TOP_MODULE} $end")?;
+        for (i, port) in PORTS.iter().enumerate() {
+            let n = port.name;
+            if !port.vector {
                 writeln!(w, "$var wire 1 {} {n} $end", id_code(i))?;
             } else {
                 writeln!(
@@ -62,19 +66,23 @@ impl VcdWriter {
         }
         for (b, br) in s.branches.iter().enumerate() {
             writeln!(w, "$scope module branch_{} $end", br.name)?;
-            let base = widths.len();
-            widths.extend([1, 1, 1, 3, l.en_n[b]]);
-            writeln!(w, "$var wire 1 {} cs_n $end", id_code(base))?;
-            writeln!(w, "$var wire 1 {} sclk $end", id_code(base + 1))?;
-            writeln!(w, "$var wire 1 {} miso $end", id_code(base + 2))?;
-            writeln!(w, "$var wire 3 {} mux_sel [2:0] $end", id_code(base + 3))?;
-            writeln!(
-                w,
-                "$var wire {} {} mux_en [{}:0] $end",
-                l.en_n[b],
-                id_code(base + 4),
-                l.en_n[b] - 1
-            )?;
+            for r in BRANCH_VIEW {
+                let (hi, lo) = l.lane_bits(r, b);
+                let n = hi - lo + 1;
+                let i = widths.len();
+                widths.push(n);
+                if matches!(r, Role::MuxSel | Role::MuxEn) {
+                    writeln!(
+                        w,
+                        "$var wire {n} {} {} [{}:0] $end",
+                        id_code(i),
+                        r.key(),
+                        n - 1
+                    )?;
+                } else {
+                    writeln!(w, "$var wire 1 {} {} $end", id_code(i), r.key())?;
+                }
+            }
             writeln!(w, "$upscope $end")?;
         }
         writeln!(w, "$upscope $end")?;
@@ -98,26 +106,18 @@ impl VcdWriter {
     fn write_cycle(&mut self, k: u64, rst: bool, p: &Pins, miso: u64) -> std::io::Result<()> {
         let t = (k - self.from + 1) * 2 * self.half_ps;
         self.cur.clear();
-        self.cur.extend([
-            1,
-            rst as u64,
-            miso,
-            p.cs_n as u64,
-            p.sclk as u64,
-            p.mux_sel as u64,
-            p.mux_en,
-            p.sample_valid as u64,
-            p.sample_channel as u64,
-            p.sample_value as u64,
-        ]);
+        self.cur.extend(Role::ALL.map(|r| match r {
+            Role::Clock => 1,
+            Role::Reset => rst as u64,
+            Role::Miso => miso,
+            r => p.value(r),
+        }));
         for b in 0..self.layout.branches {
-            self.cur.extend([
-                (p.cs_n >> b & 1) as u64,
-                (p.sclk >> b & 1) as u64,
-                miso >> b & 1,
-                self.layout.sel(p, b) as u64,
-                self.layout.en(p, b),
-            ]);
+            for r in BRANCH_VIEW {
+                let (hi, lo) = self.layout.lane_bits(r, b);
+                let v = if r == Role::Miso { miso } else { p.value(r) };
+                self.cur.push((v >> lo) & ((1u64 << (hi - lo + 1)) - 1));
+            }
         }
         // rst is sampled at the edge that begins cycle k: it changes half a
         // period before it; the outputs and MISO of cycle k change at the edge.
@@ -149,7 +149,10 @@ impl VcdWriter {
     }
 
     fn put(&mut self, i: usize) -> std::io::Result<()> {
-        if self.widths[i] == 1 && !matches!(i, 2..=4) {
+        // a 1-bit value as a scalar change, except the branch-lane ports
+        // (`adc_cs_n` of a one-branch mix is still a vector)
+        let lanes = i < PORTS.len() && matches!(Role::ALL[i], Role::Miso | Role::CsN | Role::Sclk);
+        if self.widths[i] == 1 && !lanes {
             writeln!(self.w, "{}{}", self.cur[i], self.ids[i])
         } else {
             writeln!(self.w, "b{:b} {}", self.cur[i], self.ids[i])
@@ -183,29 +186,33 @@ pub fn write_gtkw(path: &Path, vcd: &Path, s: &Schedule) -> std::io::Result<()> 
     writeln!(w, "[dumpfile] \"{}\"", vcd.display())?;
     writeln!(w, "[timestart] 0")?;
     writeln!(w, "@28")?;
-    writeln!(w, "slotforge_top.clk")?;
-    writeln!(w, "slotforge_top.rst")?;
+    let top = TOP_MODULE;
+    writeln!(w, "{top}.{}", Role::Clock.name())?;
+    writeln!(w, "{top}.{}", Role::Reset.name())?;
     for (b, br) in s.branches.iter().enumerate() {
-        let sc = format!("slotforge_top.branch_{}", br.name);
+        let sc = format!("{top}.branch_{}", br.name);
         writeln!(w, "@800200")?;
         writeln!(w, "-branch {b} {}", br.name)?;
         writeln!(w, "@28")?;
-        writeln!(w, "{sc}.cs_n")?;
-        writeln!(w, "{sc}.sclk")?;
-        writeln!(w, "{sc}.miso")?;
+        for r in [Role::CsN, Role::Sclk, Role::Miso] {
+            writeln!(w, "{sc}.{}", r.key())?;
+        }
         writeln!(w, "@22")?;
-        writeln!(w, "{sc}.mux_sel[2:0]")?;
-        writeln!(w, "{sc}.mux_en[{}:0]", l.en_n[b] - 1)?;
+        for r in [Role::MuxSel, Role::MuxEn] {
+            let (hi, lo) = l.lane_bits(r, b);
+            writeln!(w, "{sc}.{}[{}:0]", r.key(), hi - lo)?;
+        }
         writeln!(w, "@1000200")?;
         writeln!(w, "-branch {b} {}", br.name)?;
     }
     writeln!(w, "@800200")?;
     writeln!(w, "-samples")?;
     writeln!(w, "@28")?;
-    writeln!(w, "slotforge_top.sample_valid")?;
+    writeln!(w, "{top}.{}", Role::SampleValid.name())?;
     writeln!(w, "@24")?;
-    writeln!(w, "slotforge_top.sample_channel[{}:0]", l.channel_bits - 1)?;
-    writeln!(w, "slotforge_top.sample_value[13:0]")?;
+    for r in [Role::SampleChannel, Role::SampleValue] {
+        writeln!(w, "{top}.{}[{}:0]", r.name(), l.width(r) - 1)?;
+    }
     writeln!(w, "@1000200")?;
     writeln!(w, "-samples")?;
     w.flush()

@@ -1,0 +1,39 @@
+//! judge: what slotforge holds a design's waveform against, built from
+//! lut-gen's [`lut_gen::Schedule`] alone (`docs/timing.md`).
+//!
+//! This crate depends on neither `hdl` nor rust-hdl, so the independence of
+//! the reference model from the gateware is enforced by the crate graph: a
+//! gateware bug cannot hide behind the same bug in the model.  The
+//! simulation engines that produce waveforms live beside it, in `cosim`.
+//!
+//! - [`model`]: the reference model ([`SlotModel`] for conversions over
+//!   hours, [`CycleModel`] for every pin at every cycle);
+//! - [`adc`]: the AD7940 model and stimuli;
+//! - [`checker`] / [`invariants`]: the streaming cycle-exact comparison and
+//!   the mix's invariants;
+//! - [`run`]: a [`Dut`] driven with the ADC model into the checker, and the
+//!   slot-level model run;
+//! - [`faults`]: faults injected into any [`Dut`]'s pins;
+//! - [`vcd`] / [`vcdout`]: reading a VCD from any simulator, writing one.
+//!
+//! The pins themselves ([`Pins`], [`Layout`], [`Signal`]) are the pin
+//! contract's, `lut_gen::ports`.
+
+pub mod adc;
+pub mod checker;
+pub mod faults;
+pub mod invariants;
+pub mod model;
+pub mod report;
+pub mod run;
+pub mod vcd;
+pub mod vcdout;
+
+pub use adc::{Adc, Stimulus};
+pub use checker::{CheckOptions, Checker};
+pub use invariants::Invariants;
+pub use lut_gen::ports::{Layout, Pins, Signal};
+pub use model::{CycleModel, SlotModel};
+pub use report::Report;
+pub use run::{Dut, ModelDut, Observer};
+pub use vcd::{check_vcd, VcdError};

@@ -1,0 +1,76 @@
+//! What a simulation run is asked to do: the back end, the stimulus, the
+//! checking and the waveform window.
+
+use std::path::PathBuf;
+
+use judge::{CheckOptions, Stimulus};
+
+/// Where the design's pins come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Backend {
+    /// Slot-level reference model with the conversion-level invariants.
+    Model,
+    /// `hdl::RtlSim` (rust-hdl's model of the emitted blocks), cycle by cycle, fully checked.
+    RustHdl,
+    /// The emitted `slotforge_top.v` compiled by Verilator, cycle by cycle, fully checked.
+    Verilator,
+    /// The emitted `slotforge_top.v` in Icarus Verilog with a Verilog ADC model;
+    /// its VCD goes through the VCD checker (a cross-check of the other back ends).
+    Icarus,
+}
+
+impl std::str::FromStr for Backend {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Backend, String> {
+        match s {
+            "model" => Ok(Backend::Model),
+            "rusthdl" | "rust-hdl" => Ok(Backend::RustHdl),
+            "verilator" => Ok(Backend::Verilator),
+            "icarus" | "iverilog" => Ok(Backend::Icarus),
+            _ => Err(format!(
+                "unknown back end `{s}` (model, rusthdl, verilator, icarus)"
+            )),
+        }
+    }
+}
+
+impl Backend {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Backend::Model => "model",
+            Backend::RustHdl => "rusthdl",
+            Backend::Verilator => "verilator",
+            Backend::Icarus => "icarus",
+        }
+    }
+}
+
+/// A waveform window to write: frames `[from, to)` (frame 0 includes the reset cycles).
+#[derive(Debug, Clone)]
+pub struct VcdOut {
+    pub path: PathBuf,
+    pub from_frame: u64,
+    pub to_frame: u64,
+    /// Also write a GTKWave save file beside it (`.gtkw`).
+    pub gtkw: bool,
+}
+
+#[derive(Debug, Clone)]
+pub struct SimOptions {
+    pub stimulus: Stimulus,
+    pub check: CheckOptions,
+    pub vcd: Option<VcdOut>,
+    /// Reset cycles before cycle 0 (raised to [`judge::run::reset_cycles`]).
+    pub reset_cycles: u64,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        SimOptions {
+            stimulus: Stimulus::Pattern,
+            check: CheckOptions::default(),
+            vcd: None,
+            reset_cycles: 4,
+        }
+    }
+}

@@ -1,0 +1,33 @@
+//! The rust-hdl back end: `hdl::RtlSim` (rust-hdl's own model of the
+//! emitted blocks) as a [`Dut`], in process.
+
+use judge::Dut;
+use lut_gen::ports::Pins;
+use lut_gen::Schedule;
+
+use crate::error::SimError;
+
+/// `hdl::RtlSim` as a [`Dut`].
+pub struct RustHdlDut(hdl::RtlSim);
+
+impl RustHdlDut {
+    pub fn new(s: &Schedule) -> Result<RustHdlDut, SimError> {
+        hdl::RtlSim::new(s)
+            .map(RustHdlDut)
+            .map_err(|e| SimError::Hdl(e.to_string()))
+    }
+}
+
+impl Dut for RustHdlDut {
+    #[inline]
+    fn step(&mut self, rst: bool, miso: u64) -> Pins {
+        self.0.step(rst, miso as u8)
+    }
+}
+
+/// The emitted Verilog of a schedule.
+pub fn verilog(s: &Schedule) -> Result<String, SimError> {
+    hdl::emit(s, None)
+        .map(|e| e.verilog().to_string())
+        .map_err(|e| SimError::Hdl(e.to_string()))
+}

@@ -1,0 +1,33 @@
+//! Register widths of the fixed-maximum core, in one place that both the
+//! planner (`plan.rs`, which checks a schedule against them) and the
+//! rust-hdl blocks (`core.rs`, which are built at them) read.  The lane
+//! counts come from the pin contract's limits (`lut_gen::ports::limits`).
+
+pub use lut_gen::ports::limits::{MAX_BRANCHES, MAX_CHANNELS, MAX_DEVICES, MAX_DEVICES_PER_BRANCH};
+
+/// Bits to count `0..n` (`n` a power of two).
+const fn log2(n: usize) -> usize {
+    n.trailing_zeros() as usize
+}
+
+/// Width of the cycle-in-slot counter.
+pub const CNT_BITS: usize = 20;
+/// Width of the slot counter (ROM address): slot in frame (full LUT) or
+/// slot in slice (compact LUT).
+pub const SLOT_BITS: usize = 12;
+/// Width of the slice counter (compact LUT only).
+pub const SLICE_BITS: usize = 10;
+/// Width of the SCLK phase counter.
+pub const PH_BITS: usize = 10;
+/// Width of a channel index.
+pub const CH_BITS: usize = log2(MAX_CHANNELS);
+/// Width of a device index inside a branch.
+pub const DEV_BITS: usize = log2(MAX_DEVICES_PER_BRANCH);
+/// Per-branch mux enables (one-hot over the branch's devices).
+pub const EN_BITS: usize = MAX_DEVICES_PER_BRANCH;
+/// Total mux enables on the core.
+pub const EN_TOTAL: usize = MAX_DEVICES;
+
+const _: () = {
+    assert!(MAX_CHANNELS.is_power_of_two() && MAX_DEVICES_PER_BRANCH.is_power_of_two());
+};

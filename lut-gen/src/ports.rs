@@ -1,0 +1,581 @@
+//! The pin contract of `slotforge_top`: the one home of every port name,
+//! direction, role and width, of where each branch's lanes sit in the
+//! ports, of the gateware's size limits, and of `ports.json`.
+//!
+//! The gateware generator, the Verilog wrapper and constraints, the
+//! simulation engines, the VCD reader and writer, the Icarus testbench and
+//! the fault injector all read names and widths from here, so a port renamed
+//! in [`PORTS`] is renamed everywhere.  It sits in lut-gen (the bottom of the
+//! crate graph) because the widths are a function of the schedule alone, and
+//! both sides of the contract (the gateware in `hdl`, the judge in
+//! `cosim/judge`) must see it without seeing each other.
+//!
+//! Cycle-level behaviour of these ports: `docs/timing.md`.
+
+use serde::Serialize;
+
+use crate::schedule::Schedule;
+
+/// Name of the top module.
+pub const TOP_MODULE: &str = "slotforge_top";
+
+/// Bits of a mux select (8:1 multiplexers).
+pub const MUX_SELECT_BITS: u32 = 3;
+/// Mux inputs one select addresses per device.
+pub const INPUTS_PER_DEVICE: u32 = 1 << MUX_SELECT_BITS;
+/// Bits of `sample_value` (the widest converter word the gateware carries).
+pub const SAMPLE_VALUE_BITS: u32 = 14;
+
+/// What the gateware can carry: its fixed-maximum core has this many lanes.
+/// `hdl` builds its core at these sizes and refuses larger mixes; the judge
+/// sizes [`Pins`] from them.
+pub mod limits {
+    /// Branch lanes (one SPI port and one mux select each).
+    pub const MAX_BRANCHES: usize = 8;
+    /// Channels (`sample_channel` is `log2(MAX_CHANNELS)` bits wide in the core).
+    pub const MAX_CHANNELS: usize = 256;
+    /// Mux devices of one branch.
+    pub const MAX_DEVICES_PER_BRANCH: usize = 32;
+    /// Mux devices over all branches (`mux_en` bits in the core).
+    pub const MAX_DEVICES: usize = 64;
+}
+
+/// What a port is for; the index into [`PORTS`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum Role {
+    Clock,
+    Reset,
+    Miso,
+    CsN,
+    Sclk,
+    MuxSel,
+    MuxEn,
+    SampleValid,
+    SampleChannel,
+    SampleValue,
+}
+
+/// Direction seen from the gateware.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum Dir {
+    In,
+    Out,
+}
+
+impl Dir {
+    /// `ports.json`'s spelling.
+    pub fn short(self) -> &'static str {
+        match self {
+            Dir::In => "in",
+            Dir::Out => "out",
+        }
+    }
+
+    /// Verilog's spelling.
+    pub fn verilog(self) -> &'static str {
+        match self {
+            Dir::In => "input",
+            Dir::Out => "output",
+        }
+    }
+}
+
+/// One port of `slotforge_top`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Port {
+    pub role: Role,
+    pub name: &'static str,
+    pub dir: Dir,
+    /// Declared as a vector (`[w-1:0]`) even when one bit wide.
+    pub vector: bool,
+    /// The role's key in `ports.json` (`"cs_n"` in a branch, `"valid"` in
+    /// `"sample"`), also the name of a branch's lane in a waveform's
+    /// per-branch view.
+    pub key: &'static str,
+}
+
+/// The ports of `slotforge_top`, in the order of docs/timing.md's port
+/// table (and of the Verilog port list, `ports.json` and the PCF).
+pub const PORTS: [Port; 10] = [
+    port(Role::Clock, "clk", Dir::In, false, "clock"),
+    port(Role::Reset, "rst", Dir::In, false, "reset"),
+    port(Role::Miso, "adc_miso", Dir::In, true, "miso"),
+    port(Role::CsN, "adc_cs_n", Dir::Out, true, "cs_n"),
+    port(Role::Sclk, "adc_sclk", Dir::Out, true, "sclk"),
+    port(Role::MuxSel, "mux_sel", Dir::Out, true, "mux_sel"),
+    port(Role::MuxEn, "mux_en", Dir::Out, true, "mux_en"),
+    port(Role::SampleValid, "sample_valid", Dir::Out, false, "valid"),
+    port(
+        Role::SampleChannel,
+        "sample_channel",
+        Dir::Out,
+        true,
+        "channel",
+    ),
+    port(Role::SampleValue, "sample_value", Dir::Out, true, "value"),
+];
+
+/// The names of [`PORTS`], in the same order.
+pub const PORT_NAMES: [&str; 10] = {
+    let mut n = [""; 10];
+    let mut i = 0;
+    while i < PORTS.len() {
+        n[i] = PORTS[i].name;
+        i += 1;
+    }
+    n
+};
+
+const fn port(role: Role, name: &'static str, dir: Dir, vector: bool, key: &'static str) -> Port {
+    Port {
+        role,
+        name,
+        dir,
+        vector,
+        key,
+    }
+}
+
+impl Role {
+    /// Every role, in port order.
+    pub const ALL: [Role; 10] = [
+        Role::Clock,
+        Role::Reset,
+        Role::Miso,
+        Role::CsN,
+        Role::Sclk,
+        Role::MuxSel,
+        Role::MuxEn,
+        Role::SampleValid,
+        Role::SampleChannel,
+        Role::SampleValue,
+    ];
+
+    pub const fn port(self) -> &'static Port {
+        &PORTS[self as usize]
+    }
+
+    /// The port's name, e.g. `adc_cs_n`.
+    pub const fn name(self) -> &'static str {
+        self.port().name
+    }
+
+    /// The role's key in `ports.json`, e.g. `cs_n`.
+    pub const fn key(self) -> &'static str {
+        self.port().key
+    }
+
+    /// The roles with one lane per branch, in port order.
+    pub const LANES: [Role; 5] = [Role::Miso, Role::CsN, Role::Sclk, Role::MuxSel, Role::MuxEn];
+}
+
+impl Pins {
+    /// The value of output port `r` (inputs read as 0).
+    pub fn value(&self, r: Role) -> u64 {
+        match r {
+            Role::Clock | Role::Reset | Role::Miso => 0,
+            Role::CsN => self.cs_n as u64,
+            Role::Sclk => self.sclk as u64,
+            Role::MuxSel => self.mux_sel as u64,
+            Role::MuxEn => self.mux_en,
+            Role::SampleValid => self.sample_valid as u64,
+            Role::SampleChannel => self.sample_channel as u64,
+            Role::SampleValue => self.sample_value as u64,
+        }
+    }
+}
+
+/// The value of every output port of `slotforge_top` in one cycle.
+///
+/// Bit `b` of `cs_n`/`sclk` is branch `b`, `mux_sel[3b+2:3b]` is branch
+/// `b`'s select, `mux_en` holds the branches' devices in branch order (see
+/// [`Layout`]).  Sized for [`limits`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize)]
+pub struct Pins {
+    pub cs_n: u8,
+    pub sclk: u8,
+    pub mux_sel: u32,
+    pub mux_en: u64,
+    pub sample_valid: bool,
+    pub sample_channel: u16,
+    pub sample_value: u16,
+}
+
+const _: () = {
+    assert!(
+        limits::MAX_BRANCHES <= 8,
+        "Pins::cs_n / sclk hold one bit per branch"
+    );
+    assert!(limits::MAX_BRANCHES * MUX_SELECT_BITS as usize <= 32);
+    assert!(limits::MAX_DEVICES <= 64);
+    assert!(limits::MAX_CHANNELS <= 1 << 16);
+    assert!(SAMPLE_VALUE_BITS <= 16);
+};
+
+/// A signal of one branch or of the sample stream, as the checker and the
+/// fault injector name it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Signal {
+    CsN(usize),
+    Sclk(usize),
+    MuxSel(usize),
+    MuxEn(usize),
+    Miso(usize),
+    SampleValid,
+    SampleChannel,
+    SampleValue,
+}
+
+impl Signal {
+    pub fn role(&self) -> Role {
+        match *self {
+            Signal::CsN(_) => Role::CsN,
+            Signal::Sclk(_) => Role::Sclk,
+            Signal::MuxSel(_) => Role::MuxSel,
+            Signal::MuxEn(_) => Role::MuxEn,
+            Signal::Miso(_) => Role::Miso,
+            Signal::SampleValid => Role::SampleValid,
+            Signal::SampleChannel => Role::SampleChannel,
+            Signal::SampleValue => Role::SampleValue,
+        }
+    }
+
+    /// The port-level name, e.g. `adc_cs_n[1]`, `mux_sel[5:3]`.
+    pub fn name(&self, layout: &Layout) -> String {
+        match self.branch() {
+            Some(b) => layout.lane(self.role(), b),
+            None => self.role().name().to_string(),
+        }
+    }
+
+    /// This signal's value in `p`.
+    pub fn get(&self, layout: &Layout, p: &Pins) -> u64 {
+        match *self {
+            Signal::CsN(b) => (p.cs_n >> b) as u64 & 1,
+            Signal::Sclk(b) => (p.sclk >> b) as u64 & 1,
+            Signal::Miso(_) => 0,
+            Signal::MuxSel(b) => layout.sel(p, b) as u64,
+            Signal::MuxEn(b) => layout.en(p, b),
+            Signal::SampleValid => p.sample_valid as u64,
+            Signal::SampleChannel => p.sample_channel as u64,
+            Signal::SampleValue => p.sample_value as u64,
+        }
+    }
+
+    /// The branch this signal belongs to, if any.
+    pub fn branch(&self) -> Option<usize> {
+        match *self {
+            Signal::CsN(b)
+            | Signal::Sclk(b)
+            | Signal::MuxSel(b)
+            | Signal::MuxEn(b)
+            | Signal::Miso(b) => Some(b),
+            _ => None,
+        }
+    }
+}
+
+/// The port bit layout of a schedule's top module: widths, and where each
+/// branch's lanes sit.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Layout {
+    pub branches: usize,
+    /// First `mux_en` bit of each branch.
+    pub en_lo: Vec<u32>,
+    /// `mux_en` bits of each branch (at least one).
+    pub en_n: Vec<u32>,
+    /// Total mux devices (width of `mux_en`).
+    pub mux_devices: u32,
+    /// Width of `sample_channel`.
+    pub channel_bits: u32,
+    /// `(branch, device, select)` -> channel, as `lookup[branch][device * 8 + select]`.
+    pub lookup: Vec<Vec<Option<u16>>>,
+}
+
+impl Layout {
+    /// The layout of `s`'s top module.
+    ///
+    /// # Panics
+    /// When `s` exceeds [`limits`]; callers that take user mixes check
+    /// [`Layout::fits`] first.
+    pub fn new(s: &Schedule) -> Layout {
+        if let Err(m) = Layout::fits(s) {
+            panic!("{m}");
+        }
+        let nb = s.branches.len();
+        let mut en_lo = Vec::with_capacity(nb);
+        let mut en_n = Vec::with_capacity(nb);
+        let mut acc = 0;
+        for b in &s.branches {
+            en_lo.push(acc);
+            en_n.push(b.mux_devices.max(1));
+            acc += b.mux_devices.max(1);
+        }
+        let mut lookup: Vec<Vec<Option<u16>>> = (0..nb)
+            .map(|b| vec![None; (en_n[b] * INPUTS_PER_DEVICE) as usize])
+            .collect();
+        for (c, ch) in s.channels.iter().enumerate() {
+            let b = s.mix.channels[c].branch;
+            let i = (ch.device * INPUTS_PER_DEVICE + ch.select) as usize;
+            if i < lookup[b].len() {
+                lookup[b][i] = Some(c as u16);
+            }
+        }
+        Layout {
+            branches: nb,
+            en_lo,
+            en_n,
+            mux_devices: acc,
+            channel_bits: s.channel_bits(),
+            lookup,
+        }
+    }
+
+    /// Whether `s` fits the gateware's [`limits`], or which limit it exceeds.
+    pub fn fits(s: &Schedule) -> Result<(), String> {
+        use limits::*;
+        let nb = s.branches.len();
+        if nb == 0 || nb > MAX_BRANCHES {
+            return Err(format!(
+                "{nb} branches: the gateware supports 1 to {MAX_BRANCHES}"
+            ));
+        }
+        if s.channels.is_empty() || s.channels.len() > MAX_CHANNELS {
+            return Err(format!(
+                "{} channels: the gateware supports 1 to {MAX_CHANNELS}",
+                s.channels.len()
+            ));
+        }
+        if let Some(b) = s
+            .branches
+            .iter()
+            .find(|b| b.mux_devices as usize > MAX_DEVICES_PER_BRANCH)
+        {
+            return Err(format!(
+                "branch {}: {} mux devices: the gateware supports at most {MAX_DEVICES_PER_BRANCH} per branch",
+                b.name, b.mux_devices
+            ));
+        }
+        let total: usize = s.branches.iter().map(|b| b.mux_devices as usize).sum();
+        if total > MAX_DEVICES {
+            return Err(format!(
+                "{total} mux devices in total: the gateware supports at most {MAX_DEVICES}"
+            ));
+        }
+        Ok(())
+    }
+
+    /// Width in bits of the port with role `r`.
+    pub fn width(&self, r: Role) -> u32 {
+        let nb = self.branches as u32;
+        match r {
+            Role::Clock | Role::Reset | Role::SampleValid => 1,
+            Role::Miso | Role::CsN | Role::Sclk => nb,
+            Role::MuxSel => MUX_SELECT_BITS * nb,
+            Role::MuxEn => self.mux_devices,
+            Role::SampleChannel => self.channel_bits,
+            Role::SampleValue => SAMPLE_VALUE_BITS,
+        }
+    }
+
+    /// Width of each port of [`PORTS`], in the same order.
+    pub fn port_widths(&self) -> [u32; 10] {
+        Role::ALL.map(|r| self.width(r))
+    }
+
+    /// The bits of port `r` that belong to branch `b`, as `(msb, lsb)`.
+    pub fn lane_bits(&self, r: Role, b: usize) -> (u32, u32) {
+        let b32 = b as u32;
+        match r {
+            Role::Miso | Role::CsN | Role::Sclk => (b32, b32),
+            Role::MuxSel => (
+                MUX_SELECT_BITS * b32 + MUX_SELECT_BITS - 1,
+                MUX_SELECT_BITS * b32,
+            ),
+            Role::MuxEn => (self.en_lo[b] + self.en_n[b] - 1, self.en_lo[b]),
+            _ => panic!("{} has no branch lanes", r.name()),
+        }
+    }
+
+    /// Branch `b`'s lane of port `r` as Verilog names it: `adc_cs_n[1]`,
+    /// `mux_sel[5:3]`, `mux_en[2]`.
+    pub fn lane(&self, r: Role, b: usize) -> String {
+        let (hi, lo) = self.lane_bits(r, b);
+        if hi == lo {
+            format!("{}[{lo}]", r.name())
+        } else {
+            format!("{}[{hi}:{lo}]", r.name())
+        }
+    }
+
+    /// Every port bit with its direction, in port order (`clk`, `rst`,
+    /// `adc_miso[0]`, ...): the rows of a PCF or XDC.
+    pub fn bits(&self) -> Vec<(String, Dir)> {
+        let mut v = Vec::new();
+        for p in &PORTS {
+            if p.vector {
+                for i in 0..self.width(p.role) {
+                    v.push((format!("{}[{i}]", p.name), p.dir));
+                }
+            } else {
+                v.push((p.name.to_string(), p.dir));
+            }
+        }
+        v
+    }
+
+    #[inline]
+    pub fn sel(&self, p: &Pins, b: usize) -> u32 {
+        (p.mux_sel >> (MUX_SELECT_BITS as usize * b)) & (INPUTS_PER_DEVICE - 1)
+    }
+
+    #[inline]
+    pub fn en(&self, p: &Pins, b: usize) -> u64 {
+        (p.mux_en >> self.en_lo[b]) & ((1u64 << self.en_n[b]) - 1)
+    }
+
+    /// Branch `b`'s mux pins addressing `(device, select)`.
+    pub fn set_mux(&self, p: &mut Pins, b: usize, device: u32, select: u32) {
+        let sh = MUX_SELECT_BITS as usize * b;
+        let m = INPUTS_PER_DEVICE - 1;
+        p.mux_sel = (p.mux_sel & !(m << sh)) | ((select & m) << sh);
+        let mask = ((1u64 << self.en_n[b]) - 1) << self.en_lo[b];
+        p.mux_en = (p.mux_en & !mask) | ((1u64 << device) << self.en_lo[b]);
+    }
+
+    /// The channel branch `b`'s mux pins select, or why none is.
+    pub fn selected(&self, p: &Pins, b: usize) -> Result<u16, String> {
+        let en = self.en(p, b);
+        if en.count_ones() != 1 {
+            return Err(format!(
+                "{} of branch {b} is {en:#b}: not one device enabled",
+                Role::MuxEn.name()
+            ));
+        }
+        let dev = en.trailing_zeros();
+        let sel = self.sel(p, b);
+        self.lookup[b][(dev * INPUTS_PER_DEVICE + sel) as usize]
+            .ok_or_else(|| format!("no channel on branch {b} device {dev} select {sel}"))
+    }
+
+    /// Every signal, in report order.
+    pub fn signals(&self) -> Vec<Signal> {
+        let mut v = Vec::new();
+        for b in 0..self.branches {
+            v.push(Signal::CsN(b));
+            v.push(Signal::Sclk(b));
+            v.push(Signal::MuxSel(b));
+            v.push(Signal::MuxEn(b));
+        }
+        v.extend([
+            Signal::SampleValid,
+            Signal::SampleChannel,
+            Signal::SampleValue,
+        ]);
+        v
+    }
+}
+
+/// `ports.json`: every port bit's role, so that any tool finds a branch's
+/// signals without guessing names (SPEC's shape plus `mix`, `clock_hz`, the
+/// port list and each branch's SPI numbers).
+pub fn manifest(s: &Schedule) -> String {
+    use serde_json::json;
+    let l = Layout::new(s);
+    let bit = |r: Role, i: u32| format!("{}[{i}]", r.name());
+    let branches: Vec<_> = s
+        .branches
+        .iter()
+        .enumerate()
+        .map(|(b, bp)| {
+            let (_, en_lo) = l.lane_bits(Role::MuxEn, b);
+            let mut o = serde_json::Map::new();
+            o.insert("name".into(), json!(bp.name));
+            for r in Role::LANES {
+                let v = match r {
+                    Role::MuxEn => json!((0..s.branches[b].mux_devices.max(1))
+                        .map(|d| bit(Role::MuxEn, en_lo + d))
+                        .collect::<Vec<_>>()),
+                    r => json!(l.lane(r, b)),
+                };
+                o.insert(r.key().into(), v);
+            }
+            o.insert("sclk_div".into(), json!(bp.spi.sclk_div));
+            o.insert("setup_cycles".into(), json!(bp.spi.setup_cycles));
+            o.insert("read_cycles".into(), json!(bp.spi.read_cycles));
+            serde_json::Value::Object(o)
+        })
+        .collect();
+    let channels: Vec<_> = s
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let mc = &s.mix.channels[i];
+            json!({
+                "index": i,
+                "name": mc.name,
+                "branch": s.branches[mc.branch].name,
+                "device": c.device,
+                "select": c.select,
+            })
+        })
+        .collect();
+    let ports: Vec<_> = PORTS
+        .iter()
+        .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": l.width(p.role)}))
+        .collect();
+    let doc = json!({
+        "top": TOP_MODULE,
+        "mix": s.mix.name,
+        "clock": Role::Clock.name(),
+        "clock_hz": s.grid.clock_hz,
+        "reset": {"port": Role::Reset.name(), "active_high": true, "synchronous": true},
+        "branches": branches,
+        "sample": {
+            Role::SampleValid.key(): Role::SampleValid.name(),
+            Role::SampleChannel.key(): Role::SampleChannel.name(),
+            Role::SampleValue.key(): Role::SampleValue.name(),
+        },
+        "channels": channels,
+        "ports": ports,
+    });
+    let mut t = serde_json::to_string_pretty(&doc).expect("json");
+    t.push('\n');
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn roles_index_the_table() {
+        for (i, r) in Role::ALL.iter().enumerate() {
+            assert_eq!(PORTS[i].role, *r);
+            assert_eq!(*r as usize, i);
+        }
+        let mut names: Vec<&str> = PORTS.iter().map(|p| p.name).collect();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), PORTS.len(), "port names are unique");
+    }
+
+    #[test]
+    fn lanes_and_bits_follow_the_widths() {
+        let m = crate::mix::parse(
+            std::path::Path::new("t.toml"),
+            include_str!("../../mixes/eskin34.toml"),
+        )
+        .unwrap();
+        let s = crate::synthesize(&m).unwrap();
+        let l = Layout::new(&s);
+        let total: u32 = l.port_widths().iter().sum();
+        assert_eq!(l.bits().len() as u32, total);
+        assert_eq!(l.lane(Role::MuxSel, 1), "mux_sel[5:3]");
+        assert_eq!(l.lane(Role::CsN, 2), "adc_cs_n[2]");
+        let (hi, lo) = l.lane_bits(Role::MuxEn, l.branches - 1);
+        assert_eq!(hi + 1, l.mux_devices);
+        assert!(lo <= hi);
+    }
+}
