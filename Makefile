@@ -8,7 +8,7 @@ SLOTFORGE = $(CARGO) run --quiet --release --bin slotforge --
 TOOLS = verilator g++ iverilog yosys nextpnr-ice40
 APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm
 
-.PHONY: run test tools lut audit verilog cosim synth bench update-snapshots lint clean
+.PHONY: run test tools lut audit verilog cosim synth bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 run: tools
 	$(SLOTFORGE) audit $(MIX)
@@ -54,6 +54,25 @@ synth: tools
 bench:
 	$(CARGO) bench -p lut-gen --bench synthesis
 	$(CARGO) bench -p cosim --bench cosim
+
+# Long-running fuzzing of the mix parser and the VCD reader (not part of `make test`;
+# docs/fuzzing.md).  Crashes and hangs land in fuzz/crashes/; exit 1 if any.
+FUZZ = $(CARGO) run --quiet --release -p slotforge-fuzz --
+FUZZ_COUNT ?= 100000
+FUZZ_SEED ?= 1
+
+fuzz: fuzz-mix fuzz-vcd
+
+fuzz-mix:
+	$(FUZZ) mix --count $(FUZZ_COUNT) --seed $(FUZZ_SEED)
+
+fuzz-vcd:
+	$(FUZZ) vcd --count $(FUZZ_COUNT) --seed $(FUZZ_SEED)
+
+# Rewrites fuzz/seeds/vcd/ from real `slotforge sim` waveforms.
+fuzz-seeds:
+	$(CARGO) build --quiet --release --bin slotforge
+	fuzz/seeds/make-vcd-seeds.sh $${CARGO_TARGET_DIR:-target}/release/slotforge
 
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings

@@ -4,7 +4,6 @@
 //! kind exits 2 with a message and no panic.
 
 use std::path::{Path, PathBuf};
-use std::process::Command as Std;
 
 use assert_cmd::Command;
 use predicates::prelude::*;
@@ -26,14 +25,9 @@ fn tiny() -> PathBuf {
     root().join("cosim/tests/data/tiny.toml")
 }
 
-fn have(tool: &str) -> bool {
-    let ok = Std::new(tool).arg("--version").output().is_ok()
-        || Std::new(tool).arg("-V").output().is_ok();
-    if !ok {
-        eprintln!("`{tool}` is not installed: skipped (make tools installs it)");
-    }
-    ok
-}
+// Missing tools fail under CI=true, skip loudly elsewhere.
+#[path = "common/tools.rs"]
+mod tools;
 
 /// Runs `sim --json` and checks SPEC's fields; returns the report.
 fn sim_json(mix: &Path, backend: &str, frames: u64) -> serde_json::Value {
@@ -102,7 +96,7 @@ fn sim_rusthdl_2_frames() {
 
 #[test]
 fn sim_verilator_2_frames() {
-    if !have("verilator") || !have("g++") {
+    if !tools::require_tools(&["verilator", "g++"]) {
         return;
     }
     let v = sim_json(&eskin34(), "verilator", 2);
@@ -112,7 +106,7 @@ fn sim_verilator_2_frames() {
 
 #[test]
 fn sim_icarus_small_mix() {
-    if !have("iverilog") {
+    if !tools::require_tool("iverilog") {
         return;
     }
     let v = sim_json(&tiny(), "icarus", 3);

@@ -19,12 +19,9 @@ fn schedule(p: &Path) -> lut_gen::Schedule {
     lut_gen::synthesize(&lut_gen::load(p).unwrap()).unwrap()
 }
 
-fn have(tool: &str) -> bool {
-    std::process::Command::new(tool)
-        .arg("--version")
-        .output()
-        .is_ok()
-}
+// Missing tools fail under CI=true, skip loudly elsewhere.
+#[path = "../../tests/common/tools.rs"]
+mod tools;
 
 #[test]
 fn model_backend_100_frames() {
@@ -49,8 +46,7 @@ fn rusthdl_backend_2_frames() {
 
 #[test]
 fn verilator_backend_2_frames() {
-    if !have("verilator") || !have("g++") {
-        eprintln!("verilator or g++ missing: skipped");
+    if !tools::require_tools(&["verilator", "g++"]) {
         return;
     }
     for p in mixes() {

@@ -3,16 +3,15 @@
 //! its ADCs must give the codes of cosim's own ADC model.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use cosim::{Backend, SimOptions, Stimulus, VcdOut};
 use judge::run::{run_dut, Observer, RunOptions};
 use judge::vcd::{read_cycles, CycleSink};
 use judge::Pins;
 
-fn have(tool: &str) -> bool {
-    Command::new(tool).arg("-V").output().is_ok()
-}
+// Missing tools fail under CI=true, skip loudly elsewhere.
+#[path = "../../tests/common/tools.rs"]
+mod tools;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -50,8 +49,7 @@ impl Observer for Samples {
 
 #[test]
 fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
-    if !have("iverilog") {
-        eprintln!("iverilog missing: skipped");
+    if !tools::require_tool("iverilog") {
         return;
     }
     let s = schedule(&data("tiny.toml"));
@@ -95,8 +93,7 @@ fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
 
 #[test]
 fn icarus_backend_vcd_windows() {
-    if !have("iverilog") {
-        eprintln!("iverilog missing: skipped");
+    if !tools::require_tool("iverilog") {
         return;
     }
     let s = schedule(&data("tiny.toml"));
@@ -131,8 +128,7 @@ fn icarus_backend_vcd_windows() {
 
 #[test]
 fn icarus_backend_eskin34_one_frame() {
-    if !have("iverilog") {
-        eprintln!("iverilog missing: skipped");
+    if !tools::require_tool("iverilog") {
         return;
     }
     let s = schedule(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml"));

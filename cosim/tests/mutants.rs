@@ -25,6 +25,10 @@ use mutate::Operator;
 mod judge;
 use judge::judge;
 
+// Missing tools fail under CI=true, skip loudly elsewhere.
+#[path = "../../tests/common/tools.rs"]
+mod tools;
+
 /// Sites per operator: 36 mutants on the test mix.
 const PER_OP: [(Operator, usize); 8] = [
     (Operator::RelOp, 5),
@@ -39,10 +43,6 @@ const PER_OP: [(Operator, usize); 8] = [
 
 /// A normal run takes about half a second.
 const VVP_TIMEOUT: Duration = Duration::from_secs(20);
-
-fn have(tool: &str) -> bool {
-    Command::new(tool).arg("-V").output().is_ok()
-}
 
 fn manifest() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -150,8 +150,7 @@ fn short(r: &Result<(), String>) -> String {
 
 #[test]
 fn every_mutant_the_independent_testbench_rejects_is_rejected_by_check() {
-    if !have("iverilog") {
-        eprintln!("iverilog missing: skipped");
+    if !tools::require_tool("iverilog") {
         return;
     }
     let t0 = Instant::now();

@@ -640,6 +640,11 @@ pub struct BodyInfo {
     /// gcd of intervals between output-changing timesteps, and the first of them.
     pub period: u64,
     pub phase: Option<u64>,
+    /// The longest stretch between two consecutive timesteps, in time units.
+    pub max_gap: u64,
+    /// The shortest interval between two output-changing timesteps (0: fewer than two).
+    pub min_out_gap: u64,
+    last_out: Option<u64>,
 }
 
 fn gcd(a: u64, b: u64) -> u64 {
@@ -698,6 +703,15 @@ fn body<R: BufRead>(
                 None => info.phase = Some(t),
                 Some(p0) => info.period = gcd(info.period, t - p0),
             }
+            if let Some(prev) = info.last_out {
+                let g = t - prev;
+                info.min_out_gap = if info.min_out_gap == 0 {
+                    g
+                } else {
+                    info.min_out_gap.min(g)
+                };
+            }
+            info.last_out = Some(t);
         }
         let (pins, xz) = st.pins();
         let rst_of = |v: &Val| {
@@ -751,7 +765,7 @@ fn body<R: BufRead>(
                             xz,
                             st.port[MISO],
                         );
-                        e += period;
+                        e = e.saturating_add(period);
                     }
                 }
             }
@@ -771,6 +785,9 @@ fn body<R: BufRead>(
                     return Err(lx.malformed(format!("time goes backwards from {time} to {nt}")));
                 }
                 if !seen_time || nt > time {
+                    if seen_time {
+                        info.max_gap = info.max_gap.max(nt - time);
+                    }
                     if seen_time || out_changed {
                         close(
                             &st,
@@ -797,13 +814,14 @@ fn body<R: BufRead>(
             }
             b'b' | b'B' | b'r' | b'R' | b's' | b'S' => {
                 let kind = t[0].to_ascii_lowercase();
-                let val_range = (r.0 + 1, r.1);
+                // Copied before the next token: the identifier code may sit on
+                // the next line, which replaces the line buffer.
+                let val = t[1..].to_vec();
                 let Some(idr) = lx.next()? else {
                     return Err(lx.truncated(
                         "value change without an identifier code at the end of the file",
                     ));
                 };
-                let val = lx.line[val_range.0..val_range.1].to_vec();
                 let id = lx.tok(idr);
                 let Some(sinks) = res.ids.get(id) else {
                     return Err(lx.malformed(format!(
@@ -883,6 +901,15 @@ fn body<R: BufRead>(
     Ok(info)
 }
 
+/// Without a dumped `clk`, at most this many frames (of at least 2^16
+/// cycles) may pass between two timesteps: outputs change every frame, and
+/// a long reset fits.
+const INFERRED_GAP_FRAMES: u64 = 16;
+
+/// Without a dumped `clk`, the closest two output changes must be at most
+/// this many inferred cycles apart.
+const INFERRED_MIN_GAP: u64 = 64;
+
 /// Header facts of a VCD.
 #[derive(Debug, Clone)]
 pub struct VcdInfo {
@@ -917,7 +944,35 @@ pub fn read_cycles(
         parse_header(&mut pre)?;
         let info =
             body(&mut pre, &res, None, &mut CountCycles(0)).map_err(|e| pre.truncation(e))?;
+        // One timestamp off the clock grid makes the gcd (the period) tiny
+        // and the cycle count enormous: refuse a period that no two output
+        // changes are close to (a sample gives two one cycle apart; SCLK
+        // toggles every few cycles), or that puts more than a bounded number
+        // of cycles between two timesteps, instead of reading for hours.
+        let gap_limit = INFERRED_GAP_FRAMES * s.grid.frame_cycles.max(1 << 16);
+        let off_grid = |why: String| {
+            VcdError::Ports {
+            file: path.to_path_buf(),
+            message: format!(
+                "`clk` is not dumped in `{}` and the inferred clock period ({} time units, the gcd of the intervals between output changes) {why}: a timestamp is off the clock grid? dump `clk`",
+                res.scope, info.period
+            ),
+        }
+        };
         match info.phase {
+            Some(_) if info.period > 0 && info.min_out_gap / info.period > INFERRED_MIN_GAP => {
+                return Err(off_grid(format!(
+                    "leaves the closest two output changes {} cycles apart (more than {INFERRED_MIN_GAP})",
+                    info.min_out_gap / info.period
+                )))
+            }
+            Some(_) if info.period > 0 && info.max_gap / info.period > gap_limit => {
+                return Err(off_grid(format!(
+                    "puts {} cycles between two timesteps (more than {INFERRED_GAP_FRAMES} frames of {} cycles)",
+                    info.max_gap / info.period,
+                    s.grid.frame_cycles
+                )))
+            }
             Some(phase) if info.period > 0 => Clocking::Inferred { period: info.period, phase: phase % info.period },
             _ => {
                 return Err(VcdError::Ports {

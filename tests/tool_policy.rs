@@ -1,0 +1,47 @@
+//! The tool-test policy of `tests/common/tools.rs` (shared with cosim's
+//! tests): a missing tool fails under CI and skips loudly elsewhere; it can
+//! never pass silently.
+
+#[path = "common/tools.rs"]
+mod tools;
+
+use tools::{ci_is_set, decide, gate, tool_present, Decision};
+
+#[test]
+fn decision_table() {
+    for ci in [None, Some(""), Some("0"), Some("false"), Some("FALSE")] {
+        assert_eq!(decide(true, ci), Decision::Run, "CI={ci:?}");
+        assert_eq!(decide(false, ci), Decision::Skip, "CI={ci:?}");
+    }
+    for ci in [
+        Some("true"),
+        Some("TRUE"),
+        Some("1"),
+        Some("yes"),
+        Some(" true "),
+    ] {
+        assert_eq!(decide(true, ci), Decision::Run, "CI={ci:?}");
+        assert_eq!(decide(false, ci), Decision::Fail, "CI={ci:?}");
+    }
+    assert!(ci_is_set(Some("true")));
+    assert!(!ci_is_set(None));
+}
+
+#[test]
+#[should_panic(expected = "`no-such-tool` is not installed, and CI is set")]
+fn missing_tool_under_ci_panics_naming_the_tool() {
+    gate("no-such-tool", false, Some("true"), "some_test");
+}
+
+#[test]
+fn missing_tool_outside_ci_skips_and_present_tool_runs() {
+    assert!(!gate("no-such-tool", false, None, "some_test"));
+    assert!(gate("no-such-tool", true, Some("true"), "some_test"));
+}
+
+#[test]
+fn presence_probe() {
+    assert!(!tool_present("slotforge-no-such-tool-7f3a"));
+    // cargo runs this test, so cargo itself is on hand.
+    assert!(tool_present(env!("CARGO")));
+}
