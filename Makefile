@@ -8,7 +8,7 @@ SLOTFORGE = $(CARGO) run --quiet --release --bin slotforge --
 TOOLS = verilator g++ iverilog yosys nextpnr-ice40
 APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm
 
-.PHONY: run test tools lut audit verilog cosim synth bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
+.PHONY: run test tools lut audit verilog cosim golden golden-update synth bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 run: tools
 	$(SLOTFORGE) audit $(MIX)
@@ -23,6 +23,23 @@ run: tools
 test: tools
 	$(CARGO) fmt --all -- --check
 	$(CARGO) test --workspace --locked
+	$(MAKE) golden
+
+# Every preset against its golden (golden/<mix>/: event log, Figure 6 windows),
+# on the emitted Verilog in Verilator.  The debug build `cargo test` made.
+PRESETS = $(wildcard mixes/*.toml)
+GOLDEN_BACKEND ?= verilator
+golden: tools
+	@for m in $(PRESETS); do \
+	  $(CARGO) run --quiet --locked --bin slotforge -- golden $$m --backend $(GOLDEN_BACKEND) || exit 1; \
+	done
+
+# Goldens change only through this command; review the diff like code.
+golden-update: tools
+	@for m in $(PRESETS); do \
+	  $(CARGO) run --quiet --locked --bin slotforge -- golden $$m --backend $(GOLDEN_BACKEND) --update || exit 1; \
+	done
+	git status --short -- golden
 
 tools:
 	@missing=""; for t in $(TOOLS); do command -v $$t >/dev/null 2>&1 || missing="$$missing $$t"; done; \

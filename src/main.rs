@@ -34,6 +34,8 @@ enum Command {
     Check(cmd::check::Args),
     /// Inject each kind of fault into a design's pins; report what the checker caught.
     Faults(cmd::faults::Args),
+    /// Simulate and compare with the mix's golden event log and waveforms (golden/<mix>/).
+    Golden(cmd::golden::Args),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +47,7 @@ fn main() -> ExitCode {
         Command::Sim(a) => cmd::sim::run(a),
         Command::Check(a) => cmd::check::run(a),
         Command::Faults(a) => cmd::faults::run(a),
+        Command::Golden(a) => cmd::golden::run(a),
     };
     ExitCode::from(code)
 }

@@ -1,8 +1,11 @@
 //! The back ends behind one call: [`run`] dispatches to each engine.
 
+use judge::events::Trace;
 use judge::run::{reset_cycles, run_dut, run_model, Dut, ModelDut, Observer, RunOptions};
+use judge::vcd::CycleSink;
 use judge::vcdout::{write_gtkw, VcdWriter};
 use judge::Report;
+use lut_gen::ports::Pins;
 use lut_gen::Schedule;
 
 use crate::error::SimError;
@@ -21,17 +24,49 @@ pub fn run(
         Backend::Model => {
             if let Some(v) = &opts.vcd {
                 // The slot-level model has no pins: the cycle model draws the window.
-                let window = v.to_frame.max(v.from_frame + 1).min(frames.max(1));
-                in_process(s, &mut ModelDut::new(s), window, opts, "model")?;
+                let f = s.grid.frame_cycles;
+                let window = v.to.max(v.from + 1).div_ceil(f).min(frames.max(1));
+                in_process(s, &mut ModelDut::new(s), window, opts, "model", None)?;
             }
             Ok(run_model(s, frames, opts.stimulus, opts.check.max_records))
         }
-        Backend::RustHdl => in_process(s, &mut RustHdlDut::new(s)?, frames, opts, "rusthdl"),
+        _ => run_traced(s, backend, frames, opts, None),
+    }
+}
+
+/// Like [`run`], and every cycle's pins go to `trace` too (the `model` back
+/// end then runs the cycle-level model, which has pins).
+pub fn run_traced(
+    s: &Schedule,
+    backend: Backend,
+    frames: u64,
+    opts: &SimOptions,
+    trace: Option<&mut Trace>,
+) -> Result<Report, SimError> {
+    match backend {
+        Backend::Model => in_process(s, &mut ModelDut::new(s), frames, opts, "model", trace),
+        Backend::RustHdl => in_process(s, &mut RustHdlDut::new(s)?, frames, opts, "rusthdl", trace),
         Backend::Verilator => {
             let (mut dut, _) = VerilatedDut::new(&verilog(s)?)?;
-            in_process(s, &mut dut, frames, opts, "verilator")
+            in_process(s, &mut dut, frames, opts, "verilator", trace)
         }
-        Backend::Icarus => crate::icarus::run(s, frames, opts),
+        Backend::Icarus => {
+            crate::icarus::run(s, frames, opts, trace.map(|t| t as &mut dyn CycleSink))
+        }
+    }
+}
+
+/// Two observers of one run.
+struct Tee<'a>(Option<&'a mut dyn Observer>, Option<&'a mut dyn Observer>);
+
+impl Observer for Tee<'_> {
+    fn cycle(&mut self, cycle: u64, rst: bool, pins: &Pins, miso: u64) {
+        if let Some(o) = self.0.as_deref_mut() {
+            o.cycle(cycle, rst, pins, miso);
+        }
+        if let Some(o) = self.1.as_deref_mut() {
+            o.cycle(cycle, rst, pins, miso);
+        }
     }
 }
 
@@ -42,6 +77,7 @@ fn in_process(
     frames: u64,
     opts: &SimOptions,
     source: &str,
+    trace: Option<&mut Trace>,
 ) -> Result<Report, SimError> {
     let reset = reset_cycles(s, opts.reset_cycles);
     let ro = RunOptions {
@@ -52,13 +88,7 @@ fn in_process(
     let mut writer = match &opts.vcd {
         None => None,
         Some(v) => {
-            let f = s.grid.frame_cycles;
-            let from = if v.from_frame == 0 {
-                0
-            } else {
-                reset + v.from_frame * f
-            };
-            let to = reset + v.to_frame.max(v.from_frame + 1) * f;
+            let (from, to) = v.run_cycles(reset);
             if v.gtkw {
                 write_gtkw(&v.path.with_extension("gtkw"), &v.path, s)
                     .map_err(|e| SimError::Io(format!("{}: {e}", v.path.display())))?;
@@ -69,7 +99,11 @@ fn in_process(
             )
         }
     };
-    let obs = writer.as_mut().map(|w| w as &mut dyn Observer);
+    let mut tee = Tee(
+        writer.as_mut().map(|w| w as &mut dyn Observer),
+        trace.map(|t| t as &mut dyn Observer),
+    );
+    let obs = (tee.0.is_some() || tee.1.is_some()).then_some(&mut tee as &mut dyn Observer);
     let report = run_dut(s, dut, frames, &ro, source, obs);
     if let Some(w) = writer {
         w.finish().map_err(|e| SimError::Io(e.to_string()))?;

@@ -20,6 +20,8 @@ use std::process::Command;
 use lut_gen::Schedule;
 
 use judge::adc::{Analog, Stimulus};
+use judge::vcd::CycleSink;
+use judge::vcdout::edge_ps;
 use judge::Report;
 use lut_gen::ports::{Layout, Pins, Role, PORTS, TOP_MODULE};
 
@@ -27,11 +29,6 @@ use crate::error::{BackendError, SimError};
 use crate::options::{SimOptions, VcdOut};
 
 const TEMPLATE: &str = include_str!("../tb/adc_tb.v.in");
-
-/// Half a clock period in picoseconds (the same as cosim's own VCDs).
-pub fn half_period_ps(s: &Schedule) -> u64 {
-    (500_000_000_000u64 / s.grid.clock_hz).max(1)
-}
 
 /// A generated testbench: `tb.v` and the code tables it reads (`codes<b>.hex`).
 #[derive(Debug, Clone)]
@@ -165,7 +162,7 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         .replace("@NB@", &l.branches.to_string())
         .replace("@RESET@", &reset_cycles.to_string())
         .replace("@CYCLES@", &cycles.to_string())
-        .replace("@HALF@", &half_period_ps(s).to_string())
+        .replace("@HZ@", &s.grid.clock_hz.to_string())
         .replace("@SLOT@", &s.grid.slot_cycles.to_string())
         .replace("@NCH_PLUS_64@", &(nch + 64).to_string())
         .replace("@ADCS@", &adcs);
@@ -213,7 +210,14 @@ fn spawn(cmd: &mut Command, tool: &str, step: &str) -> Result<(), BackendError> 
 /// Simulates `frames` frames of the emitted gateware (`hdl::emit`, every
 /// file it writes) in Icarus and checks the VCD.  `opts.vcd` gets the
 /// requested window of Icarus's own VCD (scope `tb`; no `.gtkw`).
-pub fn run(s: &Schedule, frames: u64, opts: &SimOptions) -> Result<Report, SimError> {
+///
+/// With `trace`, every cycle of Icarus's VCD also goes there.
+pub fn run(
+    s: &Schedule,
+    frames: u64,
+    opts: &SimOptions,
+    trace: Option<&mut dyn CycleSink>,
+) -> Result<Report, SimError> {
     let io = |e: std::io::Error| SimError::Io(format!("icarus back end: {e}"));
     // Name the missing tool before doing any work.
     for tool in ["iverilog", "vvp"] {
@@ -256,6 +260,10 @@ pub fn run(s: &Schedule, frames: u64, opts: &SimOptions) -> Result<Report, SimEr
     let (mut report, _) = judge::vcd::check_vcd_with(s, &wave, Some("tb"), opts.check)
         .map_err(|e| SimError::Io(format!("icarus back end: reading its VCD: {e}")))?;
     report.source = "icarus".into();
+    if let Some(sink) = trace {
+        judge::vcd::read_cycles(s, &wave, Some("tb"), sink)
+            .map_err(|e| SimError::Io(format!("icarus back end: reading its VCD: {e}")))?;
+    }
     if let Some(v) = &opts.vcd {
         write_window(s, &wave, v, reset, frames)
             .map_err(|e| SimError::Io(format!("{}: {e}", v.path.display())))?;
@@ -263,9 +271,9 @@ pub fn run(s: &Schedule, frames: u64, opts: &SimOptions) -> Result<Report, SimEr
     Ok(report)
 }
 
-/// Copies frames `[v.from_frame, v.to_frame)` of Icarus's VCD to `v.path`
-/// (frame 0 includes the reset cycles; a later window starts with the
-/// values at its first cycle, times shifted to start near 0).
+/// Copies the window `v` of Icarus's VCD to `v.path` (a window from cycle 0
+/// includes the reset cycles; a later one starts with the values at its
+/// first cycle).  Times stay the run's own, exact ([`edge_ps`]).
 fn write_window(
     s: &Schedule,
     wave: &Path,
@@ -273,22 +281,16 @@ fn write_window(
     reset: u64,
     frames: u64,
 ) -> std::io::Result<()> {
-    let f = s.grid.frame_cycles;
-    let h = half_period_ps(s);
-    let to_frame = v.to_frame.max(v.from_frame + 1);
-    if v.from_frame == 0 && to_frame >= frames {
+    let hz = s.grid.clock_hz;
+    let (k0, k1) = v.run_cycles(reset);
+    if k0 == 0 && k1 >= reset + frames * s.grid.frame_cycles {
         std::fs::copy(wave, &v.path)?;
         return Ok(());
     }
-    // Edge k (from the first reset edge) is at (2k + 1) h; a window of edges
-    // [k0, k1) spans times [2 k0 h, 2 k1 h).
-    let k0 = if v.from_frame == 0 {
-        0
-    } else {
-        reset + v.from_frame * f
-    };
-    let k1 = reset + to_frame * f;
-    let (t0, t1) = (2 * k0 * h, 2 * k1 * h);
+    // The testbench's clock toggles at edge n = 1, 2, ...: rising edge k
+    // (from the first reset edge) is edge 2k + 1, so a window of cycles
+    // [k0, k1) spans times [edge 2 k0, edge 2 k1).
+    let (t0, t1) = (edge_ps(hz, 2 * k0), edge_ps(hz, 2 * k1));
     let mut rd = BufReader::new(File::open(wave)?);
     let mut w = BufWriter::new(File::create(&v.path)?);
     let mut line = String::new();
@@ -316,19 +318,19 @@ fn write_window(
                 .parse()
                 .map_err(|_| std::io::Error::other(format!("bad time `{l}`")))?;
             if t >= t1 {
-                writeln!(w, "#{}", t1 - t0)?;
+                writeln!(w, "#{t1}")?;
                 break;
             }
             if !inside && t >= t0 {
                 inside = true;
-                writeln!(w, "#0\n$dumpvars")?;
+                writeln!(w, "#{t0}\n$dumpvars")?;
                 for v in last.values() {
                     writeln!(w, "{v}")?;
                 }
                 writeln!(w, "$end")?;
             }
-            if inside {
-                writeln!(w, "#{}", t - t0)?;
+            if inside && (t0 == 0 || t > t0) {
+                writeln!(w, "#{t}")?;
             }
         } else if l.starts_with('$') || l.is_empty() {
             if inside && t0 == 0 {

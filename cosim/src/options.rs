@@ -45,14 +45,35 @@ impl Backend {
     }
 }
 
-/// A waveform window to write: frames `[from, to)` (frame 0 includes the reset cycles).
+/// A waveform window to write: cycles `[from, to)` counted from cycle 0
+/// (the first cycle after reset); a window from 0 also holds the reset
+/// cycles.
 #[derive(Debug, Clone)]
 pub struct VcdOut {
     pub path: PathBuf,
-    pub from_frame: u64,
-    pub to_frame: u64,
+    pub from: u64,
+    pub to: u64,
     /// Also write a GTKWave save file beside it (`.gtkw`).
     pub gtkw: bool,
+}
+
+impl VcdOut {
+    /// A window of whole frames `[from, to)` of `frame_cycles` cycles.
+    pub fn frames(path: PathBuf, from: u64, to: u64, frame_cycles: u64) -> VcdOut {
+        VcdOut {
+            path,
+            from: from * frame_cycles,
+            to: to.max(from + 1) * frame_cycles,
+            gtkw: false,
+        }
+    }
+
+    /// The window as run cycles `[k0, k1)` counted from the first of
+    /// `reset` reset cycles.
+    pub fn run_cycles(&self, reset: u64) -> (u64, u64) {
+        let k0 = if self.from == 0 { 0 } else { reset + self.from };
+        (k0, reset + self.to.max(self.from + 1))
+    }
 }
 
 #[derive(Debug, Clone)]

@@ -60,8 +60,8 @@ fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
             stimulus,
             vcd: Some(VcdOut {
                 path: wave.clone(),
-                from_frame: 0,
-                to_frame: 3,
+                from: 0,
+                to: 3 * s.grid.frame_cycles,
                 gtkw: false,
             }),
             ..SimOptions::default()
@@ -104,8 +104,8 @@ fn icarus_backend_vcd_windows() {
         let opts = SimOptions {
             vcd: Some(VcdOut {
                 path: wave.clone(),
-                from_frame: from,
-                to_frame: to,
+                from: from * f,
+                to: to * f,
                 gtkw: false,
             }),
             ..SimOptions::default()

@@ -116,6 +116,7 @@ fn unsupported(msg: String) -> HdlError {
     HdlError::Unsupported(msg)
 }
 
+#[cfg(feature = "stock")]
 pub fn plan(s: &Schedule) -> Result<Plan, HdlError> {
     plan_with(s, LutForm::Auto)
 }

@@ -3,6 +3,7 @@
 pub mod audit;
 pub mod check;
 pub mod faults;
+pub mod golden;
 pub mod lut;
 pub mod sim;
 pub mod verilog;
@@ -24,6 +25,77 @@ pub fn schedule(path: &Path) -> Result<lut_gen::Schedule, u8> {
 /// The `--backend` value parser: the names `cosim::Backend` knows.
 pub fn backend(s: &str) -> Result<cosim::Backend, String> {
     s.parse()
+}
+
+/// A waveform window bound: a frame number, or a time after cycle 0 (the
+/// first cycle after reset) such as `3ms`, `250us`, `1.5ms`, `800ns`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bound {
+    Frame(u64),
+    /// Picoseconds.
+    Time(u128),
+}
+
+/// Parses a `--from`/`--to` value.
+pub fn bound(s: &str) -> Result<Bound, String> {
+    let s = s.trim();
+    if let Ok(n) = s.parse::<u64>() {
+        return Ok(Bound::Frame(n));
+    }
+    let split = s.find(|c: char| c.is_ascii_alphabetic()).ok_or_else(|| {
+        format!("`{s}` is neither a frame number nor a time with a unit (3ms, 250us)")
+    })?;
+    let (num, unit) = s.split_at(split);
+    let scale: u128 = match unit {
+        "s" => 1_000_000_000_000,
+        "ms" => 1_000_000_000,
+        "us" => 1_000_000,
+        "ns" => 1_000,
+        "ps" => 1,
+        _ => {
+            return Err(format!(
+                "`{s}`: unknown time unit `{unit}` (s, ms, us, ns, ps)"
+            ))
+        }
+    };
+    let (int, frac) = num.split_once('.').unwrap_or((num, ""));
+    let bad = || format!("`{s}` is not a time such as 3ms or 1.5ms");
+    if int.is_empty() && frac.is_empty() {
+        return Err(bad());
+    }
+    let int: u128 = if int.is_empty() {
+        0
+    } else {
+        int.parse().map_err(|_| bad())?
+    };
+    let mut ps = int.checked_mul(scale).ok_or_else(bad)?;
+    let mut place = scale;
+    for c in frac.chars() {
+        let d = c.to_digit(10).ok_or_else(bad)? as u128;
+        place /= 10;
+        if place == 0 {
+            return Err(format!("`{s}` is finer than 1 ps"));
+        }
+        ps += d * place;
+    }
+    if ps > 1_000_000_000_000 * 1_000_000 {
+        return Err(format!("`{s}` is too long"));
+    }
+    Ok(Bound::Time(ps))
+}
+
+impl Bound {
+    /// Cycles after cycle 0: whole frames, or the time rounded to the
+    /// nearest cycle.
+    pub fn cycles(self, s: &lut_gen::Schedule) -> u64 {
+        match self {
+            Bound::Frame(n) => n.saturating_mul(s.grid.frame_cycles),
+            Bound::Time(ps) => {
+                let f = s.grid.clock_hz as u128;
+                ((ps * f + 500_000_000_000) / 1_000_000_000_000) as u64
+            }
+        }
+    }
 }
 
 /// Checks that a schedule fits the pin contract's limits (the checker and

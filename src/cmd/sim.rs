@@ -19,15 +19,18 @@ pub struct Args {
     /// Frames to simulate.
     #[arg(long, default_value_t = 2)]
     pub frames: u64,
-    /// Write a VCD of frames --from..--to (plus a GTKWave .gtkw beside it).
+    /// Write a VCD of the window --from..--to (plus a GTKWave .gtkw beside
+    /// it); times in it are exact (each edge rounded once to 1 ps).
     #[arg(long)]
     pub vcd: Option<PathBuf>,
-    /// First frame of the VCD window.
-    #[arg(long, default_value_t = 0)]
-    pub from: u64,
-    /// End (exclusive) of the VCD window; default: one frame after --from.
-    #[arg(long)]
-    pub to: Option<u64>,
+    /// Start of the VCD window: a frame number, or a time after cycle 0 (the
+    /// first cycle after reset) with a unit: 3ms, 250us, 1.5ms.  A window
+    /// from 0 also shows the reset.
+    #[arg(long, default_value = "0", value_parser = super::bound)]
+    pub from: super::Bound,
+    /// End (exclusive) of the VCD window, as --from; default: one frame after --from.
+    #[arg(long, value_parser = super::bound)]
+    pub to: Option<super::Bound>,
     /// ADC input: pattern (unique code per channel and slot), sine, step or chirp.
     #[arg(long, default_value = "pattern")]
     pub stimulus: String,
@@ -49,11 +52,6 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: --frames must be at least 1");
         return 2;
     }
-    let to = a.to.unwrap_or(a.from + 1);
-    if a.vcd.is_some() && to <= a.from {
-        eprintln!("error: --to ({to}) must be after --from ({})", a.from);
-        return 2;
-    }
     let s = match super::schedule(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
@@ -61,12 +59,21 @@ pub fn run(a: Args) -> u8 {
     if let Err(code) = super::fits_pins(&s) {
         return code;
     }
+    let from = a.from.cycles(&s);
+    let to = match a.to {
+        Some(b) => b.cycles(&s),
+        None => from + s.grid.frame_cycles,
+    };
+    if a.vcd.is_some() && to <= from {
+        eprintln!("error: --to ({to} cycles) must be after --from ({from} cycles)");
+        return 2;
+    }
     let opts = SimOptions {
         stimulus,
         vcd: a.vcd.map(|path| VcdOut {
             path,
-            from_frame: a.from,
-            to_frame: to,
+            from,
+            to,
             gtkw: true,
         }),
         ..SimOptions::default()

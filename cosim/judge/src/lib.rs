@@ -14,13 +14,16 @@
 //! - [`run`]: a [`Dut`] driven with the ADC model into the checker, and the
 //!   slot-level model run;
 //! - [`faults`]: faults injected into any [`Dut`]'s pins;
-//! - [`vcd`] / [`vcdout`]: reading a VCD from any simulator, writing one.
+//! - [`vcd`] / [`vcdout`]: reading a VCD from any simulator, writing one;
+//! - [`events`]: a run's pins as a reviewable event log, and the
+//!   comparison of two logs by signal role (golden tests).
 //!
 //! The pins themselves ([`Pins`], [`Layout`], [`Signal`]) are the pin
 //! contract's, `lut_gen::ports`.
 
 pub mod adc;
 pub mod checker;
+pub mod events;
 pub mod faults;
 pub mod invariants;
 pub mod model;

@@ -10,11 +10,23 @@ use lut_gen::Schedule;
 use crate::run::Observer;
 use lut_gen::ports::{Layout, Pins, Role, PORTS, TOP_MODULE};
 
+/// The time in picoseconds of clock edge `n` of a run (edge `2k + 1` falls
+/// before cycle `k` (counted from the first reset cycle), edge `2k + 2`
+/// rises to begin it): the exact time `n / (2 clock)` rounded once, so
+/// intervals read off a waveform carry no accumulated drift.  Every VCD
+/// slotforge writes (here and the Icarus testbench's clock) uses it.
+pub fn edge_ps(clock_hz: u64, n: u64) -> u64 {
+    let f = clock_hz as u128;
+    ((n as u128 * 1_000_000_000_000 + f) / (2 * f)) as u64
+}
+
 /// The lanes of a branch that its view in the waveform shows, in order.
 const BRANCH_VIEW: [Role; 5] = [Role::CsN, Role::Sclk, Role::Miso, Role::MuxSel, Role::MuxEn];
 
 /// Writes the ports of every cycle in `[from, to)` (cycles counted from the
-/// first reset cycle of the run) to a VCD with a 1 ps timescale.  Besides the
+/// first reset cycle of the run) to a VCD with a 1 ps timescale, at the
+/// run's own times ([`edge_ps`]: time 0 is the start of the run, cycle `k`
+/// begins at the rising edge `(k + 1)` clock periods later).  Besides the
 /// ports of `slotforge_top`, a sub-scope per branch (`branch_<name>`) repeats
 /// that branch's bits for viewing; checkers ignore it.
 pub struct VcdWriter {
@@ -22,7 +34,7 @@ pub struct VcdWriter {
     layout: Layout,
     from: u64,
     to: u64,
-    half_ps: u64,
+    clock_hz: u64,
     prev: Vec<u64>,
     cur: Vec<u64>,
     widths: Vec<u32>,
@@ -87,14 +99,13 @@ impl VcdWriter {
         }
         writeln!(w, "$upscope $end")?;
         writeln!(w, "$enddefinitions $end")?;
-        let half_ps = (500_000_000_000u64 / s.grid.clock_hz).max(1);
         let ids = (0..widths.len()).map(id_code).collect();
         Ok(VcdWriter {
             w,
             layout: l,
             from,
             to,
-            half_ps,
+            clock_hz: s.grid.clock_hz,
             prev: Vec::new(),
             cur: Vec::new(),
             widths,
@@ -104,7 +115,10 @@ impl VcdWriter {
     }
 
     fn write_cycle(&mut self, k: u64, rst: bool, p: &Pins, miso: u64) -> std::io::Result<()> {
-        let t = (k - self.from + 1) * 2 * self.half_ps;
+        let (fall, rise) = (
+            edge_ps(self.clock_hz, 2 * k + 1),
+            edge_ps(self.clock_hz, 2 * k + 2),
+        );
         self.cur.clear();
         self.cur.extend(Role::ALL.map(|r| match r {
             Role::Clock => 1,
@@ -122,7 +136,7 @@ impl VcdWriter {
         // rst is sampled at the edge that begins cycle k: it changes half a
         // period before it; the outputs and MISO of cycle k change at the edge.
         let first = self.prev.is_empty();
-        writeln!(self.w, "#{}", t - self.half_ps)?;
+        writeln!(self.w, "#{fall}")?;
         if first {
             writeln!(self.w, "$dumpvars")?;
         }
@@ -135,7 +149,7 @@ impl VcdWriter {
         if first {
             writeln!(self.w, "$end")?;
         }
-        writeln!(self.w, "#{t}")?;
+        writeln!(self.w, "#{rise}")?;
         writeln!(self.w, "1{}", self.ids[0])?;
         if !first {
             for i in 2..self.cur.len() {

@@ -1,0 +1,377 @@
+//! `slotforge golden MIX [--backend B] [--update]`: simulate the mix and
+//! compare the run with its golden in `golden/<mix>/`, by signal role.
+//!
+//! A golden folder holds `events.log` (the decoded event log of the first
+//! frames after reset, `judge::events`) and, if `golden.toml` asks for them,
+//! waveform windows as VCD with a GTKWave save file each (the reference
+//! mix keeps the four windows of the paper's Figure 6).  Windows are
+//! compared cycle by cycle on every port, not byte by byte.
+//!
+//! Exit 0: identical; 1: a difference (first one shown, with a count), or
+//! the run itself fails the checker; 2: bad input, a missing golden, a
+//! missing tool.
+
+use std::path::{Path, PathBuf};
+
+use cosim::{Backend, SimOptions};
+use judge::events::{compare, EventLog, Trace};
+use judge::vcdout::{write_gtkw, VcdWriter};
+use lut_gen::Schedule;
+use serde::Deserialize;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The channel-mix file (TOML).
+    pub mix: PathBuf,
+    /// Which simulator runs the design: verilator or icarus (the emitted
+    /// Verilog), rusthdl (in process), or model (the cycle-level reference
+    /// model's own pins).
+    #[arg(long, default_value = "verilator", value_parser = super::backend)]
+    pub backend: Backend,
+    /// Rewrite the golden from this run and say what changed.
+    #[arg(long)]
+    pub update: bool,
+    /// Where the golden folders are (one per mix, named by the mix's `name`).
+    #[arg(long, default_value = "golden")]
+    pub dir: PathBuf,
+}
+
+/// `golden/<mix>/golden.toml`: what the golden holds.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Manifest {
+    /// Frames the event log covers (default 1).
+    #[serde(default = "one")]
+    frames: u64,
+    #[serde(default)]
+    window: Vec<Window>,
+}
+
+fn one() -> u64 {
+    1
+}
+
+/// A waveform window kept as a golden VCD.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Window {
+    /// File name in the golden folder (`.vcd`; the `.gtkw` goes beside it).
+    file: String,
+    /// Bounds as for `sim --from/--to`: a frame number or a time (`3ms`).
+    from: String,
+    to: String,
+}
+
+const EVENTS: &str = "events.log";
+const MANIFEST: &str = "golden.toml";
+/// Differences listed after the first one.
+const SHOWN: usize = 5;
+
+fn load_manifest(path: &Path) -> Result<Manifest, String> {
+    if !path.exists() {
+        return Ok(Manifest {
+            frames: 1,
+            window: Vec::new(),
+        });
+    }
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let m: Manifest = toml::from_str(&text).map_err(|e| {
+        let line = e
+            .span()
+            .map(|sp| text[..sp.start].matches('\n').count() + 1)
+            .unwrap_or(0);
+        format!("{}:{line}: {}", path.display(), e.message())
+    })?;
+    if m.frames == 0 {
+        return Err(format!("{}: `frames` must be at least 1", path.display()));
+    }
+    for w in &m.window {
+        if w.file.contains('/') || !w.file.ends_with(".vcd") {
+            return Err(format!(
+                "{}: window file `{}` must be a plain `.vcd` file name",
+                path.display(),
+                w.file
+            ));
+        }
+    }
+    Ok(m)
+}
+
+/// A window's run cycles `[k0, k1)` (from the first reset cycle).
+fn window_cycles(s: &Schedule, w: &Window, reset: u64, file: &Path) -> Result<(u64, u64), String> {
+    let b = |v: &str, field: &str| {
+        super::bound(v).map_err(|e| format!("{}: window `{}` {field}: {e}", file.display(), w.file))
+    };
+    let (from, to) = (b(&w.from, "from")?.cycles(s), b(&w.to, "to")?.cycles(s));
+    if to <= from {
+        return Err(format!(
+            "{}: window `{}` ends ({to} cycles) before it starts ({from})",
+            file.display(),
+            w.file
+        ));
+    }
+    let k0 = if from == 0 { 0 } else { reset + from };
+    Ok((k0, reset + to))
+}
+
+/// Writes the window `[k0, k1)` of `trace` as a VCD plus its `.gtkw`.
+fn write_window(s: &Schedule, trace: &Trace, k0: u64, k1: u64, path: &Path) -> std::io::Result<()> {
+    use judge::run::Observer;
+    let mut w = VcdWriter::create(path, s, k0, k1)?;
+    for (k, (rst, p, miso)) in trace.cycles.iter().enumerate().take(k1 as usize) {
+        w.cycle(k as u64, *rst, p, *miso);
+    }
+    w.finish()?;
+    let name = Path::new(path.file_name().expect("a file name"));
+    write_gtkw(&path.with_extension("gtkw"), name, s)
+}
+
+/// The cycles of a VCD window as read back by the judge's reader.
+fn read_window(s: &Schedule, path: &Path) -> Result<Trace, String> {
+    let mut t = Trace::default();
+    judge::vcd::read_cycles(s, path, None, &mut t).map_err(|e| e.to_string())?;
+    Ok(t)
+}
+
+/// The first cycle where two windows differ, or `None`.
+fn first_window_difference(a: &Trace, b: &Trace) -> Option<String> {
+    for (i, (x, y)) in a.cycles.iter().zip(&b.cycles).enumerate() {
+        if x != y {
+            return Some(format!(
+                "window cycle {i}: expected rst={} {:?} miso={:#b}, actual rst={} {:?} miso={:#b}",
+                x.0, x.1, x.2, y.0, y.1, y.2
+            ));
+        }
+    }
+    (a.len() != b.len()).then(|| format!("{} cycles expected, {} found", a.len(), b.len()))
+}
+
+pub fn run(a: Args) -> u8 {
+    let s = match super::schedule(&a.mix) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    if let Err(code) = super::fits_pins(&s) {
+        return code;
+    }
+    let dir = a.dir.join(&s.mix.name);
+    let manifest_path = dir.join(MANIFEST);
+    let manifest = match load_manifest(&manifest_path) {
+        Ok(m) => m,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let events_path = dir.join(EVENTS);
+    let golden = if events_path.exists() {
+        let text = match std::fs::read_to_string(&events_path) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("error: {}: cannot read: {e}", events_path.display());
+                return 2;
+            }
+        };
+        match EventLog::parse(&text) {
+            Ok(l) => Some(l),
+            Err(e) if a.update => {
+                eprintln!("note: {}: {e}; replacing it", events_path.display());
+                None
+            }
+            Err(e) => {
+                eprintln!("error: {}: {e}", events_path.display());
+                return 2;
+            }
+        }
+    } else if a.update {
+        None
+    } else {
+        eprintln!(
+            "error: no golden for mix `{}`: {} does not exist (record one with `slotforge golden {} --update`)",
+            s.mix.name,
+            events_path.display(),
+            a.mix.display()
+        );
+        return 2;
+    };
+
+    // One run covers the event log and every window.
+    let f = s.grid.frame_cycles;
+    let opts = SimOptions::default();
+    let reset = judge::run::reset_cycles(&s, opts.reset_cycles);
+    let mut windows = Vec::new();
+    for w in &manifest.window {
+        match window_cycles(&s, w, reset, &manifest_path) {
+            Ok(k) => windows.push((w, k)),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return 2;
+            }
+        }
+    }
+    let frames = windows
+        .iter()
+        .map(|(_, (_, k1))| (k1 - reset).div_ceil(f))
+        .max()
+        .unwrap_or(0)
+        .max(manifest.frames);
+    let mut trace = Trace::default();
+    let report = match cosim::run_traced(&s, a.backend, frames, &opts, Some(&mut trace)) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let log = EventLog::from_trace(&s, &trace, manifest.frames * f);
+    let who = format!("golden {} ({})", s.mix.name, a.backend.name());
+    if !report.ok {
+        eprint!("{who}: the run fails the checker:\n{}", report.summary());
+    }
+
+    if a.update {
+        return update(
+            &s,
+            &dir,
+            golden.as_ref(),
+            &log,
+            &trace,
+            &windows,
+            &who,
+            report.ok,
+        );
+    }
+    let golden = golden.expect("loaded above");
+    let cmp = compare(&golden, &log, SHOWN + 1);
+    let mut differ = false;
+    if cmp.same() {
+        println!(
+            "{who}: same as {}: {} events over {} cycles",
+            events_path.display(),
+            log.events.len(),
+            log.cycles
+        );
+    } else {
+        differ = true;
+        println!(
+            "{who}: DIFFERS from {}: {} event(s) differ",
+            events_path.display(),
+            cmp.count
+        );
+        if cmp.expected_cycles != cmp.actual_cycles {
+            println!(
+                "  the golden covers {} cycles, this run {}",
+                cmp.expected_cycles, cmp.actual_cycles
+            );
+        }
+        for (i, d) in cmp.first.iter().enumerate().take(SHOWN) {
+            let what = if i == 0 { "first" } else { "then " };
+            println!("  {what}: {}", d.describe(&s));
+        }
+    }
+    let tmp = match tempfile::tempdir() {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("error: temporary directory: {e}");
+            return 2;
+        }
+    };
+    for (w, (k0, k1)) in &windows {
+        let gold = dir.join(&w.file);
+        let new = tmp.path().join(&w.file);
+        if let Err(e) = write_window(&s, &trace, *k0, *k1, &new) {
+            eprintln!("error: {}: {e}", new.display());
+            return 2;
+        }
+        let expected = match read_window(&s, &gold) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("error: golden window {e} (re-record with --update)");
+                return 2;
+            }
+        };
+        let actual = match read_window(&s, &new) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("error: this run's window {}: {e}", w.file);
+                return 2;
+            }
+        };
+        match first_window_difference(&expected, &actual) {
+            None => println!("{who}: window {} same ({} cycles)", w.file, actual.len()),
+            Some(d) => {
+                differ = true;
+                println!("{who}: window {} DIFFERS: {d}", w.file);
+            }
+        }
+    }
+    if differ || !report.ok {
+        1
+    } else {
+        0
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn update(
+    s: &Schedule,
+    dir: &Path,
+    old: Option<&EventLog>,
+    log: &EventLog,
+    trace: &Trace,
+    windows: &[(&Window, (u64, u64))],
+    who: &str,
+    ok: bool,
+) -> u8 {
+    if !ok {
+        eprintln!("{who}: not recording a golden from a run that fails the checker");
+        return 1;
+    }
+    match old {
+        None => println!(
+            "{who}: new golden: {} events over {} cycles",
+            log.events.len(),
+            log.cycles
+        ),
+        Some(old) => {
+            let cmp = compare(old, log, SHOWN);
+            if cmp.same() {
+                println!("{who}: unchanged ({} events)", log.events.len());
+            } else {
+                println!("{who}: {} event(s) changed", cmp.count);
+                for d in &cmp.first {
+                    println!("  {}", d.describe(s));
+                }
+            }
+        }
+    }
+    // nothing run-specific (path, back end): every simulator must give this file
+    let header = [format!(
+        "recorded by `slotforge golden --update` (pattern stimulus, {} reset cycles); change it only that way",
+        trace.cycle_zero().unwrap_or(0)
+    )];
+    let text = log.render(s, &header);
+    if let Err(code) = super::write_files(dir, &[(EVENTS, text)]) {
+        return code;
+    }
+    for (w, (k0, k1)) in windows {
+        let path = dir.join(&w.file);
+        let tmp = dir.join(format!(".{}.tmp", w.file));
+        if let Err(e) =
+            write_window(s, trace, *k0, *k1, &tmp).and_then(|()| std::fs::rename(&tmp, &path))
+        {
+            eprintln!("error: {}: {e}", path.display());
+            return 2;
+        }
+        // the .gtkw names the final file
+        let name = Path::new(path.file_name().expect("a file name"));
+        if let Err(e) = write_gtkw(&path.with_extension("gtkw"), name, s) {
+            eprintln!("error: {}: {e}", path.display());
+            return 2;
+        }
+        let _ = std::fs::remove_file(tmp.with_extension("gtkw"));
+        println!("{who}: window {} written ({} cycles)", w.file, k1 - k0);
+    }
+    0
+}
