@@ -186,27 +186,86 @@ fn lut_refuses_to_replace_a_file_with_a_directory() {
 #[test]
 fn faults_are_all_caught_on_the_reference_mix() {
     let out = slotforge()
-        .args(["faults", "--json"])
+        .args(["faults", "--json", "--false-alarm-mixes", "4"])
         .arg(preset("eskin34.toml"))
         .assert()
         .success();
     let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
     assert_eq!(v["ok"], true);
-    let faults = v["faults"].as_array().unwrap();
-    // 3 stream faults + 4 per branch + two-mux-en on the two multi-device branches.
-    assert_eq!(faults.len(), 3 + 3 * 4 + 2);
-    for f in faults {
-        assert_eq!(f["caught"], true, "{f}");
-        assert!(f["violation_count"].as_u64().unwrap() > 0, "{f}");
-        assert!(
-            f["first_divergence"]["cycle"].as_u64().unwrap() + 2 * 1600
-                >= f["injected_at"].as_u64().unwrap(),
-            "{f}"
-        );
+    let sites = v["sites"].as_array().unwrap();
+    let names: Vec<&str> = sites.iter().map(|s| s["name"].as_str().unwrap()).collect();
+    assert_eq!(
+        names,
+        ["frame-start", "slice-boundary", "mid-frame", "last-slot"]
+    );
+    let classes = v["classes"].as_array().unwrap();
+    let class = |n: &str| {
+        classes
+            .iter()
+            .find(|c| c["name"] == n)
+            .unwrap_or_else(|| panic!("{n}"))
+    };
+    // stream faults and reset glitches at every site; branch faults at
+    // every site of each of the 3 branches; two-mux-en on the two
+    // multi-device branches
+    for n in [
+        "wrong-channel",
+        "wrong-sample-bit",
+        "drop-sample",
+        "reset-glitch",
+    ] {
+        assert_eq!(class(n)["injected"], 4, "{n}");
     }
+    for n in ["cs-late", "sclk-extra-edge", "mux-late", "wrong-mux"] {
+        assert_eq!(class(n)["injected"], 12, "{n}");
+    }
+    assert_eq!(class("two-mux-en")["injected"], 8);
+    for c in classes {
+        assert_eq!(c["injected"], c["detected"], "{c}");
+        assert!(c["missed"].as_array().unwrap().is_empty());
+    }
+    assert_eq!(v["false_alarms"]["rejected"], 0);
+    assert_eq!(v["false_alarms"]["mixes"], 4);
     slotforge()
         .args(["faults", "--backend", "nope"])
         .arg(preset("eskin34.toml"))
         .assert()
         .code(2);
+}
+
+#[test]
+fn gateware_faults_are_caught_at_every_site() {
+    let tiny = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml");
+    let out = slotforge()
+        .args([
+            "faults",
+            "--backend",
+            "rusthdl",
+            "--json",
+            "--false-alarm-mixes",
+            "3",
+        ])
+        .arg(&tiny)
+        .assert()
+        .success();
+    let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    let classes = v["classes"].as_array().unwrap();
+    for n in [
+        "rom-word",
+        "rom-swap",
+        "slot-wrap-early",
+        "slot-wrap-late",
+        "reset-glitch",
+    ] {
+        let c = classes
+            .iter()
+            .find(|c| c["name"] == n)
+            .unwrap_or_else(|| panic!("{n} missing: {v}"));
+        assert!(c["injected"].as_u64().unwrap() >= 1, "{c}");
+        assert_eq!(c["injected"], c["detected"], "{c}");
+    }
+    let rom = classes.iter().find(|c| c["name"] == "rom-word").unwrap();
+    // every branch at every site
+    assert!(rom["injected"].as_u64().unwrap() >= 2 * 3, "{rom}");
+    assert_eq!(v["ok"], true);
 }

@@ -10,11 +10,14 @@
 //!   process), `verilator` ([`verilator`]: the emitted Verilog verilated at
 //!   run time), `icarus` ([`icarus`]: the emitted Verilog in Icarus with a
 //!   Verilog ADC, its VCD read by the judge);
+//! - [`faults`]: the fault campaign (pin faults, reset glitches and faults
+//!   built into the gateware, at many sites; false alarms over random mixes);
 //! - [`SimOptions`] / [`SimError`]: what a run is asked to do and why it
 //!   could not run.
 
 pub mod backend;
 pub mod error;
+pub mod faults;
 pub mod icarus;
 pub mod options;
 pub mod rusthdl;

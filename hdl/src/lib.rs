@@ -17,6 +17,7 @@
 
 mod core;
 mod emit;
+mod fault;
 mod plan;
 mod sim;
 #[cfg(feature = "stock")]
@@ -24,6 +25,7 @@ mod stock;
 mod widths;
 
 pub use emit::{emit, emit_with, Board, Emitted, MANIFEST_FILE, VERILOG_FILE};
+pub use fault::GatewareFault;
 pub use plan::{
     LutForm, FULL_LUT_MAX_BITS, MAX_FRAME_SLOTS, MAX_SCLK_DIV, MAX_SLICES_PER_FRAME,
     MAX_SLOTS_PER_SLICE, MAX_SLOT_CYCLES,

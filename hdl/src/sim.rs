@@ -75,15 +75,30 @@ impl RtlSim {
         form: plan::LutForm,
     ) -> Result<RtlSim, HdlError> {
         let p = plan::plan_with(schedule, form)?;
-        let mut core = Box::new(Core::new(&p));
+        Ok(Self::from_plan(&p))
+    }
+
+    /// The gateware with a design-level fault built in (see
+    /// [`crate::GatewareFault`]); the LUT form is the one the fault lives in.
+    pub fn with_fault(
+        schedule: &lut_gen::Schedule,
+        fault: crate::GatewareFault,
+    ) -> Result<RtlSim, HdlError> {
+        let mut p = plan::plan_with(schedule, fault.lut_form())?;
+        fault.apply(&mut p)?;
+        Ok(Self::from_plan(&p))
+    }
+
+    fn from_plan(p: &plan::Plan) -> RtlSim {
+        let mut core = Box::new(Core::new(p));
         core.connect_all();
         core.clock.next = Clock::from(false);
         simulate(&mut *core, 1000);
-        Ok(RtlSim {
+        RtlSim {
             core,
             passes: 0,
-            reader: PinReader::new(&p),
-        })
+            reader: PinReader::new(p),
+        }
     }
 
     /// Number of branches (valid bits of `cs_n`, `sclk`, `miso`).

@@ -1,38 +1,40 @@
-//! `slotforge faults MIX [--backend B] [--json]`: inject each kind of fault
-//! into a design's pins and report whether the checker caught it.
+//! `slotforge faults MIX [--backend B] [--json]`: inject every class of
+//! fault at many sites across the frame (`cosim::faults`) and report what the
+//! checker caught, plus clean runs over random feasible mixes that it must
+//! not reject.
 //!
-//! Exit 0: every fault caught; 1: a fault slipped through; 2: bad input.
+//! Exit 0: every injection caught and no false alarm; 1: a miss or a false
+//! alarm; 2: bad input.
 
 use std::path::PathBuf;
 
-use cosim::RustHdlDut;
-use judge::faults::{campaign, FaultOutcome};
-use judge::ModelDut;
-
-/// The designs faults are injected into (in process: the injector sits
-/// between the design's pins and the checker).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Target {
-    /// The cycle-level reference model's pins.
-    Model,
-    /// The gateware in rust-hdl's simulator.
-    Rusthdl,
-}
+use cosim::faults::{campaign, Target};
 
 #[derive(clap::Args)]
 pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
-    /// The design the faults are injected into: model (the cycle-level
-    /// reference model's pins) or rusthdl (the gateware, in process).
-    #[arg(long, value_enum, default_value_t = Target::Model)]
-    pub backend: Target,
-    /// Frames per faulty run (at least 2; the fault lands in the second).
-    #[arg(long, default_value_t = 2)]
+    /// The design the faults go into: model (the cycle-level reference
+    /// model's pins: pin faults and reset glitches) or rusthdl (the
+    /// gateware: also faults built into its slot ROM and counters).
+    #[arg(long, value_enum, default_value_t = Backend::Model)]
+    pub backend: Backend,
+    /// Frames per run (at least 3; faults land in frame 1).
+    #[arg(long, default_value_t = 3)]
     pub frames: u64,
-    /// Print the outcomes as JSON.
+    /// Random feasible mixes run clean to count false alarms.
+    #[arg(long, default_value_t = 10)]
+    pub false_alarm_mixes: u64,
+    /// Print the campaign as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--backend` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Backend {
+    Model,
+    Rusthdl,
 }
 
 pub fn run(a: Args) -> u8 {
@@ -43,58 +45,58 @@ pub fn run(a: Args) -> u8 {
     if let Err(code) = super::fits_pins(&s) {
         return code;
     }
-    let outcomes: Vec<FaultOutcome> = match a.backend {
-        Target::Model => campaign(&s, a.frames, || ModelDut::new(&s)),
-        Target::Rusthdl => {
-            if let Err(e) = RustHdlDut::new(&s) {
-                eprintln!("error: {e}");
-                return 2;
-            }
-            campaign(&s, a.frames, || {
-                RustHdlDut::new(&s).expect("built once already")
-            })
+    let target = match a.backend {
+        Backend::Model => Target::Model,
+        Backend::Rusthdl => Target::Rusthdl,
+    };
+    let c = match campaign(&s, target, a.frames, a.false_alarm_mixes) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
         }
     };
-    let missed = outcomes.iter().filter(|o| !o.caught).count();
     if a.json {
-        let v = serde_json::json!({
-            "mix": s.mix.name,
-            "backend": match a.backend {
-                Target::Model => "model",
-                Target::Rusthdl => "rusthdl",
-            },
-            "ok": missed == 0,
-            "faults": outcomes,
-        });
-        println!("{}", serde_json::to_string_pretty(&v).expect("serializes"));
+        let mut v = serde_json::to_value(&c).expect("serializes");
+        v["ok"] = serde_json::json!(c.ok());
+        println!("{}", serde_json::to_string_pretty(&v).expect("json"));
     } else {
-        for o in &outcomes {
-            let first = o
-                .first_divergence
-                .as_ref()
-                .map(|d| format!("first divergence {} at cycle {}", d.signal, d.cycle))
-                .unwrap_or_else(|| "no divergence".into());
+        println!(
+            "faults on {} ({:?}), sites: {}",
+            c.mix,
+            c.target,
+            c.sites
+                .iter()
+                .map(|s| format!("{} (cycle {}, slot {})", s.name, s.cycle, s.slot))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        for k in &c.classes {
             println!(
-                "{:<22} {}  {} divergent cycles, {} violations ({}); {}",
-                o.fault,
-                if o.caught { "CAUGHT" } else { "MISSED" },
-                o.divergence_count,
-                o.violation_count,
-                if o.rules.is_empty() {
-                    "-".to_string()
-                } else {
-                    o.rules.join(", ")
-                },
-                first
+                "  {:<20} {:<8} {:>3} of {:>3} caught{}",
+                k.name,
+                k.level,
+                k.detected,
+                k.injected,
+                if k.missed.is_empty() { "" } else { "  MISSED" }
             );
+            for m in &k.missed {
+                println!("      missed {} at {} (cycle {})", m.fault, m.site, m.cycle);
+            }
         }
         println!(
-            "{} of {} faults caught",
-            outcomes.len() - missed,
-            outcomes.len()
+            "{} of {} injections caught; false alarms: {} of {} clean runs over {} random mixes",
+            c.detected,
+            c.injected,
+            c.false_alarms.rejected,
+            c.false_alarms.runs,
+            c.false_alarms.mixes
         );
+        for e in &c.false_alarms.examples {
+            println!("  false alarm: {e}");
+        }
     }
-    if missed == 0 {
+    if c.ok() {
         0
     } else {
         1

@@ -25,9 +25,30 @@ pub enum Fault {
     TwoMuxEn { branch: usize },
     /// The wrong mux input (select bit 0 flipped) held through one instant of `branch`.
     WrongMux { branch: usize },
+    /// The design is reset for a few cycles in mid-run while its `rst` port
+    /// stays low (a glitch, a brown-out): it restarts its frame.
+    ResetGlitch,
 }
 
+/// Cycles a [`Fault::ResetGlitch`] holds the design in reset.
+pub const GLITCH_CYCLES: u64 = 3;
+
 impl Fault {
+    /// The fault's class: its name without the branch.
+    pub fn class(&self) -> &'static str {
+        match self {
+            Fault::WrongChannel => "wrong-channel",
+            Fault::WrongSampleBit => "wrong-sample-bit",
+            Fault::DropSample => "drop-sample",
+            Fault::CsLate { .. } => "cs-late",
+            Fault::SclkExtraEdge { .. } => "sclk-extra-edge",
+            Fault::MuxLate { .. } => "mux-late",
+            Fault::TwoMuxEn { .. } => "two-mux-en",
+            Fault::WrongMux { .. } => "wrong-mux",
+            Fault::ResetGlitch => "reset-glitch",
+        }
+    }
+
     pub fn name(&self) -> String {
         match self {
             Fault::WrongChannel => "wrong-channel".into(),
@@ -38,6 +59,7 @@ impl Fault {
             Fault::MuxLate { branch } => format!("mux-late-b{branch}"),
             Fault::TwoMuxEn { branch } => format!("two-mux-en-b{branch}"),
             Fault::WrongMux { branch } => format!("wrong-mux-b{branch}"),
+            Fault::ResetGlitch => "reset-glitch".into(),
         }
     }
 
@@ -47,6 +69,7 @@ impl Fault {
             Fault::WrongChannel,
             Fault::WrongSampleBit,
             Fault::DropSample,
+            Fault::ResetGlitch,
         ];
         for b in 0..s.branches.len() {
             if s.branch_instants_in_frame(b).is_empty() {
@@ -75,12 +98,15 @@ pub struct FaultyDut<D> {
     t: u64,
     su: u64,
     d: u64,
-    h: u64,
     r: u64,
     cycle: Option<u64>,
     done: bool,
     prev_cs: u8,
+    prev_sclk: u8,
+    /// Cycles SCLK is high in one period.
+    high: u64,
     held: Option<Pins>,
+    changed: bool,
 }
 
 impl<D: Dut> FaultyDut<D> {
@@ -112,28 +138,38 @@ impl<D: Dut> FaultyDut<D> {
             t,
             su: spi.setup_cycles,
             d: spi.sclk_div,
-            h: spi.sclk_half,
             r: spi.read_cycles,
             cycle: None,
             done: false,
             prev_cs: 0xff,
+            prev_sclk: 0xff,
+            high: spi.sclk_div - spi.sclk_half,
             held: None,
+            changed: false,
         }
     }
 }
 
 impl<D: Dut> Dut for FaultyDut<D> {
     fn step(&mut self, rst: bool, miso: u64) -> Pins {
-        let mut p = self.inner.step(rst, miso);
+        let next = self.cycle.map_or(0, |c| c + 1);
+        let glitch = !rst
+            && self.fault == Fault::ResetGlitch
+            && next >= self.at
+            && next < self.at + GLITCH_CYCLES;
+        let mut p = self.inner.step(rst || glitch, miso);
         if rst {
             self.cycle = None;
             self.prev_cs = p.cs_n;
             return p;
         }
-        let c = self.cycle.map_or(0, |c| c + 1);
+        let c = next;
         self.cycle = Some(c);
+        let orig = p;
         let orig_cs = p.cs_n;
+        let orig_sclk = p.sclk;
         match self.fault {
+            Fault::ResetGlitch => {}
             Fault::WrongChannel | Fault::WrongSampleBit | Fault::DropSample => {
                 if !self.done && c >= self.at && p.sample_valid {
                     self.done = true;
@@ -151,8 +187,16 @@ impl<D: Dut> Dut for FaultyDut<D> {
                 }
             }
             Fault::SclkExtraEdge { branch } => {
-                if c == self.t + self.su + 3 * self.d + self.h + 1 {
-                    p.sclk &= !(1u8 << branch);
+                // a one-cycle low pulse in a high phase of SCLK, two periods
+                // into the read (one more falling edge than the part expects)
+                // (in the middle of the high phase when it is 3 cycles or
+                // more; else the high phase vanishes: one falling edge fewer)
+                let bit = 1u8 << branch;
+                let mid_high = self.prev_sclk & bit != 0 || self.high < 3;
+                if !self.done && c >= self.t + self.su + 2 * self.d && p.sclk & bit != 0 && mid_high
+                {
+                    p.sclk &= !bit;
+                    self.done = true;
                 }
             }
             Fault::MuxLate { branch } => {
@@ -178,7 +222,17 @@ impl<D: Dut> Dut for FaultyDut<D> {
             }
         }
         self.prev_cs = orig_cs;
+        self.prev_sclk = orig_sclk;
+        self.changed |= glitch || p != orig;
         p
+    }
+}
+
+impl<D> FaultyDut<D> {
+    /// Whether the fault has changed anything yet (a fault that found
+    /// nothing to change was not injected).
+    pub fn injected(&self) -> bool {
+        self.changed
     }
 }
 
@@ -197,61 +251,4 @@ fn copy_mux(layout: &Layout, p: &mut Pins, from: &Pins, b: usize) {
     p.mux_sel = (p.mux_sel & !selm) | (from.mux_sel & selm);
     let enm = ((1u64 << layout.en_n[b]) - 1) << layout.en_lo[b];
     p.mux_en = (p.mux_en & !enm) | (from.mux_en & enm);
-}
-
-#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
-pub struct FirstDivergence {
-    pub signal: String,
-    pub cycle: u64,
-}
-
-/// What the checker made of one injected fault.
-#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
-pub struct FaultOutcome {
-    pub fault: String,
-    /// The cycle around which the fault was injected.
-    pub injected_at: u64,
-    pub caught: bool,
-    pub divergence_count: u64,
-    pub violation_count: u64,
-    /// First divergent signal and its cycle, if any.
-    pub first_divergence: Option<FirstDivergence>,
-    /// Invariant rules the fault broke (first few, deduplicated).
-    pub rules: Vec<String>,
-}
-
-/// Every fault of [`Fault::all`], injected one at a time into the design that
-/// `make_dut` builds, mid-way through the second frame, each run checked in full.
-pub fn campaign<D: Dut>(
-    s: &Schedule,
-    frames: u64,
-    mut make_dut: impl FnMut() -> D,
-) -> Vec<FaultOutcome> {
-    let frames = frames.max(2);
-    let at = s.grid.frame_cycles + s.grid.frame_cycles / 2 + 7;
-    Fault::all(s)
-        .into_iter()
-        .map(|f| {
-            let mut dut = FaultyDut::new(s, make_dut(), f, at);
-            let r = crate::run::run_dut(s, &mut dut, frames, &Default::default(), "faults", None);
-            let mut rules: Vec<String> = Vec::new();
-            for v in &r.violations {
-                if rules.len() < 4 && !rules.contains(&v.rule) {
-                    rules.push(v.rule.clone());
-                }
-            }
-            FaultOutcome {
-                fault: f.name(),
-                injected_at: at,
-                caught: !r.ok,
-                divergence_count: r.divergence_count,
-                violation_count: r.violation_count,
-                first_divergence: r.divergences.first().map(|d| FirstDivergence {
-                    signal: d.signal.clone(),
-                    cycle: d.cycle,
-                }),
-                rules,
-            }
-        })
-        .collect()
 }

@@ -1,0 +1,86 @@
+//! Faults the gateware itself can suffer: a corrupted slot-ROM word, two
+//! words swapped, a counter that wraps one slot or slice early or late.
+//! They are built into the real blocks (the plan the core is generated
+//! from), so the checker is tested against what the gateware would do, not
+//! against a pin-level imitation of it.
+
+use crate::plan::{LutForm, Plan};
+use crate::HdlError;
+
+/// A design-level fault of the gateware.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GatewareFault {
+    /// Branch `branch`'s slot-ROM word for frame slot `slot` holds the word
+    /// of frame slot `from` instead (another channel's entry).
+    RomWord { branch: usize, slot: u64, from: u64 },
+    /// Branch `branch`'s slot-ROM words of frame slots `a` and `b` swapped.
+    RomSwap { branch: usize, a: u64, b: u64 },
+    /// The slot counter wraps after `frame_slots + delta` slots (full LUT).
+    SlotWrap { delta: i64 },
+    /// The slice counter wraps after `slices_per_frame + delta` slices
+    /// (compact LUT, whose slot counter counts slots in the slice).
+    SliceWrap { delta: i64 },
+}
+
+impl GatewareFault {
+    /// The LUT form the fault lives in.
+    pub fn lut_form(&self) -> LutForm {
+        match self {
+            GatewareFault::SliceWrap { .. } => LutForm::Compact,
+            _ => LutForm::Full,
+        }
+    }
+
+    pub(crate) fn apply(&self, p: &mut Plan) -> Result<(), HdlError> {
+        let bad = |m: String| HdlError::Unsupported(format!("fault {self:?}: {m}"));
+        let wrap = |n: u64, delta: i64| -> Result<u64, HdlError> {
+            let v = n as i64 + delta;
+            if v < 1 {
+                return Err(bad(format!("a counter of {n} cannot wrap {delta} early")));
+            }
+            Ok(v as u64)
+        };
+        match *self {
+            GatewareFault::RomWord { branch, slot, from } => {
+                let w = rom(p, branch).map_err(bad)?;
+                let (s, f) = (slot as usize, from as usize);
+                if s >= w.len() || f >= w.len() {
+                    return Err(bad("slot outside the frame".into()));
+                }
+                w[s] = w[f];
+            }
+            GatewareFault::RomSwap { branch, a, b } => {
+                let w = rom(p, branch).map_err(bad)?;
+                let (a, b) = (a as usize, b as usize);
+                if a >= w.len() || b >= w.len() {
+                    return Err(bad("slot outside the frame".into()));
+                }
+                w.swap(a, b);
+            }
+            GatewareFault::SlotWrap { delta } => {
+                if p.compact {
+                    return Err(bad("the plan has a compact LUT".into()));
+                }
+                p.frame_slots = wrap(p.frame_slots, delta)?;
+            }
+            GatewareFault::SliceWrap { delta } => {
+                if !p.compact {
+                    return Err(bad("the plan has a full LUT".into()));
+                }
+                p.slices_per_frame = wrap(p.slices_per_frame, delta)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Branch `b`'s full-frame ROM words.
+fn rom(p: &mut Plan, b: usize) -> Result<&mut Vec<u32>, String> {
+    if p.compact {
+        return Err("the plan has a compact LUT".into());
+    }
+    p.branches
+        .get_mut(b)
+        .map(|r| &mut r.words)
+        .ok_or_else(|| format!("no branch {b}"))
+}
