@@ -17,6 +17,16 @@ pub fn run(
     frames: u64,
     opts: &SimOptions,
 ) -> Result<Report, SimError> {
+    if let (Some(path), Backend::Model | Backend::RustHdl) = (&opts.rtl, backend) {
+        return Err(SimError::Rtl(crate::rtl::RtlError {
+            file: path.clone(),
+            port: None,
+            message: format!(
+                "the {} back end simulates no Verilog; outside Verilog runs on verilator or icarus",
+                backend.name()
+            ),
+        }));
+    }
     match backend {
         Backend::Model => {
             if let Some(v) = &opts.vcd {
@@ -28,7 +38,11 @@ pub fn run(
         }
         Backend::RustHdl => in_process(s, &mut RustHdlDut::new(s)?, frames, opts, "rusthdl"),
         Backend::Verilator => {
-            let (mut dut, _) = VerilatedDut::new(&verilog(s)?)?;
+            let text = match &opts.rtl {
+                Some(path) => crate::rtl::load_rtl(s, path)?,
+                None => verilog(s)?,
+            };
+            let (mut dut, _) = VerilatedDut::new(&text)?;
             in_process(s, &mut dut, frames, opts, "verilator")
         }
         Backend::Icarus => crate::icarus::run(s, frames, opts),

@@ -10,6 +10,8 @@
 //!   process), `verilator` ([`verilator`]: the emitted Verilog verilated at
 //!   run time), `icarus` ([`icarus`]: the emitted Verilog in Icarus with a
 //!   Verilog ADC, its VCD read by the judge);
+//! - [`rtl`]: outside Verilog for the verilator and icarus back ends
+//!   (`SimOptions::rtl`), its top's ports checked against the pin contract;
 //! - [`SimOptions`] / [`SimError`]: what a run is asked to do and why it
 //!   could not run.
 
@@ -17,6 +19,7 @@ pub mod backend;
 pub mod error;
 pub mod icarus;
 pub mod options;
+pub mod rtl;
 pub mod rusthdl;
 pub mod verilator;
 
