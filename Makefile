@@ -5,8 +5,8 @@ CARGO ?= cargo
 SLOTFORGE = $(CARGO) run --quiet --release --bin slotforge --
 
 # System tools the flows need; installed with apt-get only when missing.
-TOOLS = verilator g++ iverilog yosys nextpnr-ice40
-APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm
+TOOLS = verilator g++ iverilog yosys nextpnr-ice40 sigrok-cli
+APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm sigrok-cli
 
 .PHONY: run test tools lut audit verilog cosim golden golden-update synth bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 

@@ -20,6 +20,7 @@ pub fn run(
     frames: u64,
     opts: &SimOptions,
 ) -> Result<Report, SimError> {
+    no_rtl_in_process(backend, opts)?;
     match backend {
         Backend::Model => {
             if let Some(v) = &opts.vcd {
@@ -34,6 +35,23 @@ pub fn run(
     }
 }
 
+/// `--rtl` needs a Verilog simulator.
+fn no_rtl_in_process(backend: Backend, opts: &SimOptions) -> Result<(), SimError> {
+    match (&opts.rtl, backend) {
+        (Some(path), Backend::Model | Backend::RustHdl) => {
+            Err(SimError::Rtl(crate::rtl::RtlError {
+                file: path.clone(),
+                port: None,
+                message: format!(
+                "the {} back end simulates no Verilog; outside Verilog runs on verilator or icarus",
+                backend.name()
+            ),
+            }))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Like [`run`], and every cycle's pins go to `trace` too (the `model` back
 /// end then runs the cycle-level model, which has pins).
 pub fn run_traced(
@@ -43,11 +61,16 @@ pub fn run_traced(
     opts: &SimOptions,
     trace: Option<&mut Trace>,
 ) -> Result<Report, SimError> {
+    no_rtl_in_process(backend, opts)?;
     match backend {
         Backend::Model => in_process(s, &mut ModelDut::new(s), frames, opts, "model", trace),
         Backend::RustHdl => in_process(s, &mut RustHdlDut::new(s)?, frames, opts, "rusthdl", trace),
         Backend::Verilator => {
-            let (mut dut, _) = VerilatedDut::new(&verilog(s)?)?;
+            let text = match &opts.rtl {
+                Some(path) => crate::rtl::load_rtl(s, path)?,
+                None => verilog(s)?,
+            };
+            let (mut dut, _) = VerilatedDut::new(&text)?;
             in_process(s, &mut dut, frames, opts, "verilator", trace)
         }
         Backend::Icarus => {

@@ -40,6 +40,9 @@ pub enum SimError {
     Hdl(String),
     Backend(BackendError),
     Io(String),
+    /// Outside Verilog (`--rtl`) that cannot be simulated: unreadable, no
+    /// `slotforge_top`, a port off the contract, or a back end that runs no Verilog.
+    Rtl(crate::rtl::RtlError),
 }
 
 impl fmt::Display for SimError {
@@ -48,6 +51,7 @@ impl fmt::Display for SimError {
             SimError::Hdl(m) => write!(f, "gateware: {m}"),
             SimError::Backend(e) => write!(f, "simulation back end: {e}"),
             SimError::Io(m) => f.write_str(m),
+            SimError::Rtl(e) => write!(f, "--rtl: {e}"),
         }
     }
 }

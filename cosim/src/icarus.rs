@@ -237,16 +237,30 @@ pub fn run(
     let reset = judge::run::reset_cycles(s, opts.reset_cycles);
     let cycles = frames * s.grid.frame_cycles;
     let tb = testbench(s, opts.stimulus, reset, cycles);
-    hdl::emit(s, None)
-        .and_then(|e| e.write_to(d))
-        .map_err(|e| SimError::Hdl(e.to_string()))?;
+    match &opts.rtl {
+        // outside Verilog (checked against the contract) in the emitted file's place
+        Some(path) => {
+            std::fs::write(d.join(hdl::VERILOG_FILE), crate::rtl::load_rtl(s, path)?).map_err(io)?
+        }
+        None => hdl::emit(s, None)
+            .and_then(|e| e.write_to(d))
+            .map_err(|e| SimError::Hdl(e.to_string()))?,
+    }
     std::fs::write(d.join("tb.v"), &tb.tb).map_err(io)?;
     for (name, text) in &tb.tables {
         std::fs::write(d.join(name), text).map_err(io)?;
     }
     spawn(
         Command::new("iverilog")
-            .args(["-g2005", "-o", "sim.vvp", "tb.v", hdl::VERILOG_FILE])
+            .args([
+                "-g2005",
+                "-s",
+                "tb",
+                "-o",
+                "sim.vvp",
+                "tb.v",
+                hdl::VERILOG_FILE,
+            ])
             .current_dir(d),
         "iverilog",
         "iverilog (compiling the emitted Verilog and the testbench)",

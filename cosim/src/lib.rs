@@ -12,6 +12,8 @@
 //!   Verilog ADC, its VCD read by the judge);
 //! - [`faults`]: the fault campaign (pin faults, reset glitches and faults
 //!   built into the gateware, at many sites; false alarms over random mixes);
+//! - [`rtl`]: outside Verilog for the verilator and icarus back ends
+//!   (`SimOptions::rtl`), its top's ports checked against the pin contract;
 //! - [`SimOptions`] / [`SimError`]: what a run is asked to do and why it
 //!   could not run.
 
@@ -20,6 +22,7 @@ pub mod error;
 pub mod faults;
 pub mod icarus;
 pub mod options;
+pub mod rtl;
 pub mod rusthdl;
 pub mod verilator;
 

@@ -83,6 +83,10 @@ pub struct SimOptions {
     pub vcd: Option<VcdOut>,
     /// Reset cycles before cycle 0 (raised to [`judge::run::reset_cycles`]).
     pub reset_cycles: u64,
+    /// Simulate this Verilog file instead of the emitted one (verilator and
+    /// icarus only); its `slotforge_top` must honour the pin contract
+    /// ([`crate::rtl::load_rtl`]).
+    pub rtl: Option<PathBuf>,
 }
 
 impl Default for SimOptions {
@@ -92,6 +96,7 @@ impl Default for SimOptions {
             check: CheckOptions::default(),
             vcd: None,
             reset_cycles: 4,
+            rtl: None,
         }
     }
 }

@@ -1,4 +1,5 @@
-//! `slotforge golden MIX [--backend B] [--update]`: simulate the mix and
+//! `slotforge golden MIX [--backend B] [--rtl FILE.v] [--update]`: simulate the mix (or
+//! outside Verilog) and
 //! compare the run with its golden in `golden/<mix>/`, by signal role.
 //!
 //! A golden folder holds `events.log` (the decoded event log of the first
@@ -28,6 +29,10 @@ pub struct Args {
     /// model's own pins).
     #[arg(long, default_value = "verilator", value_parser = super::backend)]
     pub backend: Backend,
+    /// Simulate this Verilog instead of the emitted design (verilator and
+    /// icarus): any top `slotforge_top` that honours the mix's port contract.
+    #[arg(long)]
+    pub rtl: Option<PathBuf>,
     /// Rewrite the golden from this run and say what changed.
     #[arg(long)]
     pub update: bool,
@@ -198,7 +203,10 @@ pub fn run(a: Args) -> u8 {
 
     // One run covers the event log and every window.
     let f = s.grid.frame_cycles;
-    let opts = SimOptions::default();
+    let opts = SimOptions {
+        rtl: a.rtl.clone(),
+        ..SimOptions::default()
+    };
     let reset = judge::run::reset_cycles(&s, opts.reset_cycles);
     let mut windows = Vec::new();
     for w in &manifest.window {
@@ -225,7 +233,15 @@ pub fn run(a: Args) -> u8 {
         }
     };
     let log = EventLog::from_trace(&s, &trace, manifest.frames * f);
-    let who = format!("golden {} ({})", s.mix.name, a.backend.name());
+    let who = match &a.rtl {
+        Some(r) => format!(
+            "golden {} ({}, {})",
+            s.mix.name,
+            a.backend.name(),
+            r.display()
+        ),
+        None => format!("golden {} ({})", s.mix.name, a.backend.name()),
+    };
     if !report.ok {
         eprint!("{who}: the run fails the checker:\n{}", report.summary());
     }

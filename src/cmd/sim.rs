@@ -1,6 +1,8 @@
-//! `slotforge sim MIX --backend B --frames N [--vcd F --from A --to B] [--json] [--stimulus S]`
+//! `slotforge sim MIX --backend B --frames N [--vcd F --from A --to B] [--json] [--stimulus S] [--rtl FILE.v]`
 //!
-//! Back ends: model, rusthdl, verilator, icarus (see `cosim::Backend`).
+//! Back ends: model, rusthdl, verilator, icarus (see `cosim::Backend`);
+//! `--rtl` (verilator, icarus) simulates outside Verilog whose top honours
+//! the pin contract (`cosim::rtl`).
 //!
 //! Exit 0: every cycle passed; 1: a divergence or violation; 2: bad input or
 //! a missing tool.
@@ -37,6 +39,10 @@ pub struct Args {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Simulate this Verilog (verilator, icarus) instead of the emitted one;
+    /// its top module must honour the pin contract for the mix.
+    #[arg(long, value_name = "FILE.v")]
+    pub rtl: Option<PathBuf>,
 }
 
 pub fn run(a: Args) -> u8 {
@@ -76,6 +82,7 @@ pub fn run(a: Args) -> u8 {
             to,
             gtkw: true,
         }),
+        rtl: a.rtl,
         ..SimOptions::default()
     };
     let report = match cosim::run(&s, backend, a.frames, &opts) {
