@@ -90,7 +90,8 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
             let mut hex = String::new();
             let mut len = 0u64;
             for i in s.instants(frames).filter(|i| i.branch == b) {
-                let code = analog.code(i.channel as u64, i.cycle) & 0x3fff;
+                let bits = s.mix.branches[b].adc.bits;
+                let code = analog.code_bits(i.channel as u64, i.cycle, bits) & 0x3fff;
                 let _ = writeln!(
                     hex,
                     "{:04x}{:08x}{:04x}",
@@ -119,10 +120,15 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
             "  always @(negedge {cs}[{b}]) if (!{rst}) begin\n    \
              case ({{{en}[{hi}:{lo}], {sel}[{sh}:{sl}]}})\n{cases}    endcase\n    \
              code{b} = pattern(cyc, id{b});\n{table}    n{b} = n{b} + 1;\n    \
-             word{b} = {{2'b00, code{b}}};\n    falls{b} = 0;\n    out{b} = word{b}[15];\n    drive{b} = 1;\n  end\n  \
+             word{b} = {{2'b00, code{b}{mask}}};\n    falls{b} = 0;\n    out{b} = word{b}[15];\n    drive{b} = 1;\n  end\n  \
              always @(posedge {cs}[{b}]) drive{b} = 0;\n  \
              always @(negedge {sclk}[{b}]) if (!{cs}[{b}]) begin\n    \
              falls{b} = falls{b} + 1;\n    if (falls{b} >= 16) drive{b} = 0; else out{b} = word{b}[15 - falls{b}];\n  end\n\n",
+            // A CS part narrower than 14 bits: its extra leading bits are zeros.
+            mask = match s.mix.branches[b].adc.bits {
+                w if w < 14 => format!(" & 14'h{:x}", (1u32 << w) - 1),
+                _ => String::new(),
+            },
             cs = Role::CsN.name(),
             sclk = Role::Sclk.name(),
             rst = Role::Reset.name(),

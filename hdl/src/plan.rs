@@ -230,9 +230,17 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
     let mut en_offset = 0usize;
     for (b, bp) in s.branches.iter().enumerate() {
         let adc = &s.mix.branches[b].adc;
-        if adc.sclk_per_conversion != 16 || adc.bits != 14 || adc.leading_zeros != 2 {
+        // CS-style parts: the 14-bit shift register holds serial bits
+        // 2..=15, so any 16-clock word whose data bits end at the 16th clock
+        // after at least two leading zeros is read as its code.
+        let cs_ok = adc.start == lut_gen::parts::Start::Cs
+            && adc.word_sclks() == 16
+            && adc.trailing_bits == 0
+            && adc.leading_bits >= 2
+            && s.mix.branches[b].chain == 1;
+        if !cs_ok {
             return Err(unsupported(format!(
-                "branch {}: ADC {} is not a 16-clock, 2-leading-zero, 14-bit SPI ADC",
+                "branch {}: ADC {} is not a 16-clock CS-style SPI ADC with at least 2 leading zeros and no chain",
                 bp.name, adc.name
             )));
         }

@@ -35,7 +35,68 @@ pub struct AuditReport {
     pub errors: Vec<String>,
     pub warnings: Vec<String>,
     pub branches: Vec<BranchAudit>,
+    /// What each branch's converter allows (throughput, bits, chain).
+    pub parts: Vec<PartAudit>,
     pub channels: Vec<ChannelAudit>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PartAudit {
+    pub branch: String,
+    pub adc: String,
+    /// `cs` (CS falling samples) or `cnv` (CNV rising samples).
+    pub start: crate::parts::Start,
+    pub bits: u32,
+    /// Parts daisy-chained on the branch, and how many the part allows.
+    pub chain: u32,
+    pub chain_max: u32,
+    /// The part's throughput limit, per part.
+    pub max_sps: u64,
+    pub sclk_max_hz: u64,
+    pub conversion_ns: u64,
+    /// Cycles one conversion holds the port (conversion + every word read).
+    pub read_cycles: u64,
+    /// Conversions per second the branch allows (the shortest legal slot),
+    /// and samples per second (times the chain).
+    pub max_conversions_hz: f64,
+    pub max_samples_hz: f64,
+}
+
+impl PartAudit {
+    fn of(
+        mix: &crate::mix::Mix,
+        b: usize,
+        plan: Option<&crate::schedule::BranchPlan>,
+    ) -> PartAudit {
+        let br = &mix.branches[b];
+        let a = &br.adc;
+        let spi = plan.map(|p| p.spi).or_else(|| {
+            crate::parts::SpiTiming::derive(a, mix.clock_hz, br.sclk_hz, br.chain).ok()
+        });
+        let min_slot = plan
+            .map(|p| p.min_slot_cycles)
+            .or(spi.map(|t| t.min_period_cycles))
+            .unwrap_or(0);
+        let conv_hz = if min_slot > 0 {
+            mix.clock_hz as f64 / min_slot as f64
+        } else {
+            0.0
+        };
+        PartAudit {
+            branch: br.name.clone(),
+            adc: a.name.clone(),
+            start: a.start,
+            bits: a.bits,
+            chain: br.chain,
+            chain_max: a.chain_max,
+            max_sps: a.max_sps,
+            sclk_max_hz: a.sclk_max_hz,
+            conversion_ns: a.conversion_ns,
+            read_cycles: spi.map(|t| t.read_cycles).unwrap_or(0),
+            max_conversions_hz: conv_hz,
+            max_samples_hz: conv_hz * br.chain as f64,
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -101,7 +162,8 @@ impl AuditReport {
             let slots: Vec<u64> = branch_slots[ch.branch]
                 .iter()
                 .copied()
-                .filter(|&t| s.at(t, ch.branch) == Some(c))
+                // A chain member is read in its lead's conversions.
+                .filter(|&t| s.at(t, ch.branch) == Some(mix.lead_of(c)))
                 .collect();
             let n = slots.len();
             let intervals: Vec<u64> = (0..n)
@@ -203,7 +265,13 @@ impl AuditReport {
                 free.clear();
                 let br = &mix.branches[b];
                 let inputs = br.mux_devices * br.mux.inputs;
-                let taken = mix.channels.iter().filter(|c| c.branch == b).count() as u32;
+                let taken = mix
+                    .channels
+                    .iter()
+                    .filter(|c| c.branch == b)
+                    .map(|c| c.input)
+                    .collect::<std::collections::BTreeSet<_>>()
+                    .len() as u32;
                 BranchAudit {
                     name: br.name.clone(),
                     utilization: used as f64 / g.frame_slots as f64,
@@ -218,7 +286,11 @@ impl AuditReport {
             .collect();
 
         let aggregate_hz: u64 = mix.channels.iter().map(|c| c.rate_hz).sum();
-        let adc_limit_hz: u64 = mix.branches.iter().map(|b| b.adc.max_sps).sum();
+        let adc_limit_hz: u64 = mix
+            .branches
+            .iter()
+            .map(|b| b.adc.max_sps * b.chain as u64)
+            .sum();
         let lut = CompactLut::from_schedule(s);
         AuditReport {
             mix: mix.name.clone(),
@@ -236,6 +308,9 @@ impl AuditReport {
                 Placement::Constructive => "constructive (first-fit)".into(),
                 Placement::Search { nodes } => format!("exact search ({nodes} nodes)"),
             },
+            parts: (0..nb)
+                .map(|b| PartAudit::of(mix, b, Some(&s.branches[b])))
+                .collect(),
             lut_entries_compact: lut.entries(),
             lut_entries_full: g.frame_slots as usize * nb,
             errors,
@@ -263,7 +338,11 @@ impl AuditReport {
         }
         errors.extend(why.suggestions.iter().map(|s| format!("suggestion: {s}")));
         let aggregate_hz: u64 = mix.channels.iter().map(|c| c.rate_hz).sum();
-        let adc_limit_hz: u64 = mix.branches.iter().map(|b| b.adc.max_sps).sum();
+        let adc_limit_hz: u64 = mix
+            .branches
+            .iter()
+            .map(|b| b.adc.max_sps * b.chain as u64)
+            .sum();
         let sps = why.slots_per_slice.unwrap_or(0);
         let slice_cycles = mix.slice_cycles();
         AuditReport {
@@ -283,6 +362,9 @@ impl AuditReport {
             adc_limit_hz,
             adc_utilization: aggregate_hz as f64 / adc_limit_hz as f64,
             placement: "none".into(),
+            parts: (0..mix.branches.len())
+                .map(|b| PartAudit::of(mix, b, None))
+                .collect(),
             lut_entries_compact: 0,
             lut_entries_full: 0,
             errors,
@@ -372,6 +454,41 @@ impl AuditReport {
                     b.sclk_hz,
                     b.free_mux_inputs,
                     head.join(" ")
+                );
+            }
+        }
+        if !self.parts.is_empty() {
+            let _ = writeln!(
+                o,
+                "\n{:<16} {:<10} {:>5} {:>5} {:>6} {:>9} {:>10} {:>9} {:>13} {:>13}",
+                "branch",
+                "adc",
+                "start",
+                "bits",
+                "chain",
+                "max SPS",
+                "SCLK max",
+                "t_conv",
+                "conv/s max",
+                "samples/s max"
+            );
+            for p in &self.parts {
+                let _ = writeln!(
+                    o,
+                    "{:<16} {:<10} {:>5} {:>5} {:>6} {:>9} {:>10} {:>9} {:>13.0} {:>13.0}",
+                    p.branch,
+                    p.adc,
+                    match p.start {
+                        crate::parts::Start::Cs => "cs",
+                        crate::parts::Start::Cnv => "cnv",
+                    },
+                    p.bits,
+                    format!("{}/{}", p.chain, p.chain_max),
+                    p.max_sps,
+                    p.sclk_max_hz,
+                    format!("{}ns", p.conversion_ns),
+                    p.max_conversions_hz,
+                    p.max_samples_hz
                 );
             }
         }

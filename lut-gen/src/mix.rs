@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 use toml::Spanned;
 
-use crate::parts::{AdcPart, MuxPart};
+use crate::parts::{AdcPart, MuxPart, Start};
 
 /// A bad mix file: where, which field, and why.  Always exit code 2.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -53,6 +53,8 @@ pub struct Mix {
     pub slice_us: u64,
     /// Set by the mix to force the slot grid; `None` lets the synthesizer pick.
     pub slots_per_slice: Option<u64>,
+    /// Parts the mix declares itself (`[[adc_part]]`), in file order.
+    pub parts: Vec<AdcPart>,
     pub branches: Vec<Branch>,
     pub channels: Vec<Channel>,
 }
@@ -66,6 +68,8 @@ pub struct Branch {
     pub mux: MuxPart,
     pub mux_devices: u32,
     pub settle_ns: u64,
+    /// Parts of `adc` daisy-chained on this branch's port (1: no chain).
+    pub chain: u32,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -79,6 +83,9 @@ pub struct Channel {
     pub kind: Option<String>,
     pub bandwidth_hz: Option<f64>,
     pub sync: Option<String>,
+    /// Position of its part in the branch's chain: 0 is the part whose
+    /// output drives the FPGA's MISO, whose word comes out first.
+    pub member: u32,
 }
 
 impl Mix {
@@ -101,6 +108,30 @@ impl Mix {
     pub fn channel_index(&self, name: &str) -> Option<usize> {
         self.channels.iter().position(|c| c.name == name)
     }
+
+    /// The channels converted together with `c` (same branch, same mux
+    /// input), by chain member: `chain` entries, `None` for a member no
+    /// channel reads.
+    pub fn conversion_group(&self, c: usize) -> Vec<Option<usize>> {
+        let ch = &self.channels[c];
+        let mut g = vec![None; self.branches[ch.branch].chain as usize];
+        for (i, o) in self.channels.iter().enumerate() {
+            if o.branch == ch.branch && o.input == ch.input {
+                g[o.member as usize] = Some(i);
+            }
+        }
+        g
+    }
+
+    /// The channel that stands for `c`'s conversion group in the frame
+    /// table: the group's first channel in file order.
+    pub fn lead_of(&self, c: usize) -> usize {
+        let ch = &self.channels[c];
+        self.channels
+            .iter()
+            .position(|o| o.branch == ch.branch && o.input == ch.input)
+            .unwrap_or(c)
+    }
 }
 
 // ---------------------------------------------------------------- raw form
@@ -112,6 +143,8 @@ struct RawMix {
     description: Option<String>,
     clock: Option<Spanned<RawClock>>,
     frame: Option<Spanned<RawFrame>>,
+    #[serde(default)]
+    adc_part: Vec<Spanned<RawAdcPart>>,
     #[serde(default)]
     branch: Vec<Spanned<RawBranch>>,
     #[serde(default)]
@@ -141,6 +174,26 @@ struct RawBranch {
     mux: Spanned<String>,
     mux_devices: Option<Spanned<i64>>,
     settle_ns: Option<Spanned<i64>>,
+    chain: Option<Spanned<i64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawAdcPart {
+    name: Spanned<String>,
+    bits: Spanned<i64>,
+    start: Spanned<String>,
+    leading_bits: Option<Spanned<i64>>,
+    trailing_bits: Option<Spanned<i64>>,
+    sclk_min_hz: Option<Spanned<i64>>,
+    sclk_max_hz: Spanned<i64>,
+    duty_min_pct: Option<Spanned<i64>>,
+    setup_ns: Option<Spanned<i64>>,
+    quiet_ns: Option<Spanned<i64>>,
+    conversion_ns: Option<Spanned<i64>>,
+    data_access_ns: Option<Spanned<i64>>,
+    max_sps: Spanned<i64>,
+    chain_max: Option<Spanned<i64>>,
 }
 
 #[derive(Deserialize)]
@@ -154,6 +207,7 @@ struct RawChannel {
     /// Integer or float: TOML keeps the two apart.
     bandwidth_hz: Option<Spanned<toml::Value>>,
     sync: Option<Spanned<String>>,
+    member: Option<Spanned<i64>>,
 }
 
 // ---------------------------------------------------------------- loading
@@ -224,6 +278,129 @@ impl Cx<'_> {
             ));
         }
         Ok(*v.get_ref() as u64)
+    }
+
+    fn nonneg(&self, v: &Option<Spanned<i64>>, field: &str, default: u64) -> Result<u64, MixError> {
+        match v {
+            None => Ok(default),
+            Some(x) if *x.get_ref() < 0 => Err(self.at(
+                x.span(),
+                field,
+                format!("must not be negative, got {}", x.get_ref()),
+            )),
+            Some(x) => Ok(*x.get_ref() as u64),
+        }
+    }
+
+    /// A `[[adc_part]]` table, checked like every other field.
+    fn adc_part(&self, i: usize, p: &RawAdcPart) -> Result<AdcPart, MixError> {
+        let f = |k: &str| format!("adc_part[{i}].{k}");
+        let name = p.name.get_ref().trim().to_ascii_lowercase();
+        if name.is_empty() {
+            return Err(self.at(p.name.span(), f("name"), "must not be empty"));
+        }
+        if AdcPart::by_name(&name).is_some() {
+            return Err(self.at(
+                p.name.span(),
+                f("name"),
+                format!("`{name}` is a built-in part; give the declared part its own name"),
+            ));
+        }
+        let bits = self.positive(&p.bits, &f("bits"))?;
+        if bits > 16 {
+            return Err(self.at(
+                p.bits.span(),
+                f("bits"),
+                format!("{bits} data bits: the sample stream carries at most 16"),
+            ));
+        }
+        let start = match p.start.get_ref().as_str() {
+            "cs" => Start::Cs,
+            "cnv" => Start::Cnv,
+            other => {
+                return Err(self.at(
+                    p.start.span(),
+                    f("start"),
+                    format!("unknown start `{other}` (\"cs\": CS falling starts the conversion, \"cnv\": CNV rising)"),
+                ))
+            }
+        };
+        let leading_bits = self.nonneg(&p.leading_bits, &f("leading_bits"), 0)?;
+        let trailing_bits = self.nonneg(&p.trailing_bits, &f("trailing_bits"), 0)?;
+        if leading_bits + bits + trailing_bits > 32 {
+            return Err(self.at(
+                p.bits.span(),
+                f("bits"),
+                "leading + data + trailing bits exceed 32 serial clocks per word",
+            ));
+        }
+        if start == Start::Cs && leading_bits == 0 {
+            return Err(self.at(
+                p.start.span(),
+                f("leading_bits"),
+                "a \"cs\" part drives its first bit at CS falling, before any clock: it needs at least one leading bit (the MSB cannot be the first bit)",
+            ));
+        }
+        let sclk_max_hz = self.positive(&p.sclk_max_hz, &f("sclk_max_hz"))?;
+        let sclk_min_hz = self.nonneg(&p.sclk_min_hz, &f("sclk_min_hz"), 1)?.max(1);
+        if sclk_min_hz > sclk_max_hz {
+            return Err(self.at(
+                p.sclk_min_hz
+                    .as_ref()
+                    .map(|s| s.span())
+                    .unwrap_or(p.sclk_max_hz.span()),
+                f("sclk_min_hz"),
+                format!("{sclk_min_hz} Hz is above sclk_max_hz {sclk_max_hz} Hz"),
+            ));
+        }
+        let duty_min_pct = self.nonneg(&p.duty_min_pct, &f("duty_min_pct"), 40)?;
+        if duty_min_pct > 50 {
+            return Err(self.at(
+                p.duty_min_pct.as_ref().unwrap().span(),
+                f("duty_min_pct"),
+                format!("{duty_min_pct} %: no clock has both phases above half the period"),
+            ));
+        }
+        let conversion_ns = self.nonneg(&p.conversion_ns, &f("conversion_ns"), 0)?;
+        if start == Start::Cs && conversion_ns != 0 {
+            return Err(self.at(
+                p.conversion_ns.as_ref().unwrap().span(),
+                f("conversion_ns"),
+                "a \"cs\" part converts while it is read: conversion_ns applies to \"cnv\" parts only",
+            ));
+        }
+        let max_sps = self.positive(&p.max_sps, &f("max_sps"))?;
+        let chain_max = match &p.chain_max {
+            None => 1,
+            Some(c) => {
+                let v = self.positive(c, &f("chain_max"))?;
+                if v > 1 && start == Start::Cs {
+                    return Err(self.at(
+                        c.span(),
+                        f("chain_max"),
+                        "chains are read in one CNV-high window: only \"cnv\" parts chain here",
+                    ));
+                }
+                v
+            }
+        };
+        Ok(AdcPart {
+            name,
+            bits: bits as u32,
+            start,
+            leading_bits: leading_bits as u32,
+            trailing_bits: trailing_bits as u32,
+            sclk_min_hz,
+            sclk_max_hz,
+            duty_min_pct: duty_min_pct as u32,
+            max_sps,
+            setup_ns: self.nonneg(&p.setup_ns, &f("setup_ns"), 10)?,
+            quiet_ns: self.nonneg(&p.quiet_ns, &f("quiet_ns"), 0)?,
+            conversion_ns,
+            data_access_ns: self.nonneg(&p.data_access_ns, &f("data_access_ns"), 0)?,
+            data_hold_ns: 0,
+            chain_max: chain_max as u32,
+        })
     }
 
     fn validate(&self, raw: RawMix) -> Result<Mix, MixError> {
@@ -301,6 +478,21 @@ impl Cx<'_> {
             ));
         }
 
+        let mut parts: Vec<AdcPart> = Vec::new();
+        for (i, p) in raw.adc_part.iter().enumerate() {
+            let part = self.adc_part(i, p.get_ref())?;
+            if parts.iter().any(|q| q.name == part.name) {
+                return Err(self.at(
+                    p.get_ref().name.span(),
+                    format!("adc_part[{i}].name"),
+                    format!("duplicate part name `{}`", part.name),
+                ));
+            }
+            parts.push(part);
+        }
+        let mut known_parts: Vec<String> = AdcPart::known().iter().map(|s| s.to_string()).collect();
+        known_parts.extend(parts.iter().map(|p| p.name.clone()));
+
         let mut branches = Vec::new();
         let mut branch_names: BTreeMap<String, usize> = BTreeMap::new();
         for (i, b) in raw.branch.iter().enumerate() {
@@ -317,17 +509,37 @@ impl Cx<'_> {
                     format!("duplicate branch name `{bname}`"),
                 ));
             }
-            let adc = AdcPart::by_name(b.adc.get_ref()).ok_or_else(|| {
-                self.at(
-                    b.adc.span(),
-                    f("adc"),
-                    format!(
-                        "unknown ADC `{}` (known: {})",
-                        b.adc.get_ref(),
-                        AdcPart::known().join(", ")
-                    ),
-                )
-            })?;
+            let wanted = b.adc.get_ref().to_ascii_lowercase();
+            let adc = AdcPart::by_name(&wanted)
+                .or_else(|| parts.iter().find(|p| p.name == wanted).cloned())
+                .ok_or_else(|| {
+                    self.at(
+                        b.adc.span(),
+                        f("adc"),
+                        format!(
+                            "unknown ADC `{}` (known: {})",
+                            b.adc.get_ref(),
+                            known_parts.join(", ")
+                        ),
+                    )
+                })?;
+            let chain = match &b.chain {
+                None => 1,
+                Some(c) => {
+                    let v = self.positive(c, &f("chain"))?;
+                    if v > adc.chain_max as u64 {
+                        return Err(self.at(
+                            c.span(),
+                            f("chain"),
+                            format!(
+                                "{v} parts in a chain: `{}` allows at most {}",
+                                adc.name, adc.chain_max
+                            ),
+                        ));
+                    }
+                    v as u32
+                }
+            };
             let mux = MuxPart::by_name(b.mux.get_ref()).ok_or_else(|| {
                 self.at(
                     b.mux.span(),
@@ -368,6 +580,13 @@ impl Cx<'_> {
             }
             let mux_devices = match &b.mux_devices {
                 None => 1,
+                Some(m) if mux == MuxPart::NONE => {
+                    return Err(self.at(
+                        m.span(),
+                        f("mux_devices"),
+                        "a branch with mux = \"none\" has no mux devices",
+                    ));
+                }
                 Some(m) => {
                     let v = self.positive(m, &f("mux_devices"))?;
                     if v > 32 {
@@ -394,12 +613,14 @@ impl Cx<'_> {
                 mux,
                 mux_devices,
                 settle_ns,
+                chain,
             });
         }
 
         let mut channels = Vec::new();
         let mut channel_names = BTreeSet::new();
-        let mut used_inputs: Vec<BTreeSet<u32>> = vec![BTreeSet::new(); branches.len()];
+        // (input, member) pairs in use per branch.
+        let mut used_inputs: Vec<BTreeSet<(u32, u32)>> = vec![BTreeSet::new(); branches.len()];
         // Explicit inputs first, so that automatic ones fill the gaps deterministically.
         let mut pending_auto = Vec::new();
         let mut sync_groups: BTreeMap<String, Vec<(usize, Range<usize>)>> = BTreeMap::new();
@@ -445,7 +666,26 @@ impl Cx<'_> {
                     ),
                 ));
             }
-            let capacity = 8 * branches[branch].mux_devices;
+            let capacity = branches[branch].mux.inputs * branches[branch].mux_devices;
+            let chain = branches[branch].chain;
+            let member = match &c.member {
+                None => 0,
+                Some(m) => {
+                    if *m.get_ref() < 0 || *m.get_ref() >= chain as i64 {
+                        return Err(self.at(
+                            m.span(),
+                            f("member"),
+                            format!(
+                                "member {} is beyond branch `{}`: its chain of {chain} part(s) has members 0..={}",
+                                m.get_ref(),
+                                branches[branch].name,
+                                chain - 1
+                            ),
+                        ));
+                    }
+                    *m.get_ref() as u32
+                }
+            };
             let input = match &c.input {
                 None => {
                     pending_auto.push(i);
@@ -466,12 +706,17 @@ impl Cx<'_> {
                         ));
                     }
                     let inp = *v.get_ref() as u32;
-                    if !used_inputs[branch].insert(inp) {
+                    if !used_inputs[branch].insert((inp, member)) {
+                        let which = if chain > 1 {
+                            format!(" (chain member {member})")
+                        } else {
+                            String::new()
+                        };
                         return Err(self.at(
                             v.span(),
                             f("input"),
                             format!(
-                                "input {inp} of branch `{}` is already used by another channel",
+                                "input {inp}{which} of branch `{}` is already used by another channel",
                                 branches[branch].name
                             ),
                         ));
@@ -524,12 +769,14 @@ impl Cx<'_> {
                 kind: c.kind.clone(),
                 bandwidth_hz,
                 sync,
+                member,
             });
         }
         for i in pending_auto {
             let b = channels[i].branch;
-            let capacity = 8 * branches[b].mux_devices;
-            let free = (0..capacity).find(|k| !used_inputs[b].contains(k)).ok_or_else(|| {
+            let capacity = branches[b].mux.inputs * branches[b].mux_devices;
+            let m = channels[i].member;
+            let free = (0..capacity).find(|k| !used_inputs[b].contains(&(*k, m))).ok_or_else(|| {
                 self.at(
                     raw.channel[i].get_ref().name.span(),
                     format!("channel[{i}].input"),
@@ -539,8 +786,26 @@ impl Cx<'_> {
                     ),
                 )
             })?;
-            used_inputs[b].insert(free);
+            used_inputs[b].insert((free, m));
             channels[i].input = free;
+        }
+        // Channels of one branch on one mux input are read in one conversion
+        // (one per chain member): they share every sampling instant.
+        for i in 0..channels.len() {
+            for j in 0..i {
+                let (a, c) = (&channels[j], &channels[i]);
+                if a.branch == c.branch && a.input == c.input && a.rate_hz != c.rate_hz {
+                    return Err(self.at(
+                        raw.channel[i].get_ref().rate_hz.span(),
+                        format!("channel[{i}].rate_hz"),
+                        format!(
+                            "`{}` ({} Hz) and `{}` ({} Hz) are chain members {} and {} of one conversion on branch `{}` (mux input {}): chained parts are sampled together, so they need one rate",
+                            c.name, c.rate_hz, a.name, a.rate_hz, c.member, a.member,
+                            branches[c.branch].name, c.input
+                        ),
+                    ));
+                }
+            }
         }
         for (tag, members) in &sync_groups {
             let mut seen = BTreeMap::new();
@@ -558,12 +823,37 @@ impl Cx<'_> {
                     ));
                 }
                 if let Some(other) = seen.insert(c.branch, *i) {
+                    if channels[other].input == c.input {
+                        // Members of one chained conversion: one instant anyway.
+                        continue;
+                    }
                     return Err(self.at(
                         span.clone(),
                         format!("channel[{i}].sync"),
                         format!(
                             "sync group `{tag}` has `{}` and `{}` on the same branch `{}`: one ADC cannot sample both at one instant",
                             channels[other].name, c.name, branches[c.branch].name
+                        ),
+                    ));
+                }
+            }
+        }
+        for i in 0..channels.len() {
+            for j in 0..i {
+                let (a, c) = (&channels[j], &channels[i]);
+                if a.branch == c.branch && a.input == c.input && a.sync != c.sync {
+                    let span = raw.channel[i]
+                        .get_ref()
+                        .sync
+                        .as_ref()
+                        .map(|s| s.span())
+                        .unwrap_or(raw.channel[i].get_ref().name.span());
+                    return Err(self.at(
+                        span,
+                        format!("channel[{i}].sync"),
+                        format!(
+                            "`{}` and `{}` are read in one chained conversion, so they are in the same sync group or none: give them the same `sync`",
+                            c.name, a.name
                         ),
                     ));
                 }
@@ -590,6 +880,7 @@ impl Cx<'_> {
             frame_us,
             slice_us,
             slots_per_slice,
+            parts,
             branches,
             channels,
         })
@@ -616,7 +907,15 @@ fn field_from_toml_message(message: &str, text: &str, span: Option<Range<usize>>
     }
     if let Some(rest) = message.strip_prefix("missing field `") {
         if let Some(end) = rest.find('`') {
-            return format!("{}{}", table_prefix(text, span), &rest[..end]);
+            // The span starts at the table's header: count that header too.
+            let past_header = span.map(|s| {
+                let eol = text[s.start.min(text.len())..]
+                    .find('\n')
+                    .map(|p| s.start + p)
+                    .unwrap_or(text.len());
+                eol..eol
+            });
+            return format!("{}{}", table_prefix(text, past_header), &rest[..end]);
         }
     }
     if let Some(s) = span {
@@ -775,5 +1074,76 @@ bandwidth_hz = 400
         // A line with no key still names something (found by proptest).
         let e = err("name = \"x\"\n=description = \"y\"\n");
         assert_eq!((e.line, e.field.as_str()), (2, "(syntax)"), "{e}");
+    }
+
+    const CHAIN: &str = r#"
+name = "t"
+[clock]
+hz = 48_000_000
+[frame]
+period_us = 10_000
+slice_us = 1_000
+[[branch]]
+name = "a"
+adc = "ad7685"
+chain = 2
+mux = "none"
+[[channel]]
+name = "x"
+branch = "a"
+member = 0
+rate_hz = 8_000
+[[channel]]
+name = "y"
+branch = "a"
+member = 1
+rate_hz = 8_000
+"#;
+
+    #[test]
+    fn chain_members_share_one_conversion() {
+        let m = parse(Path::new("m.toml"), CHAIN).unwrap();
+        assert_eq!(m.branches[0].chain, 2);
+        assert_eq!(m.conversion_group(1), vec![Some(0), Some(1)]);
+        assert_eq!(m.lead_of(1), 0);
+    }
+
+    #[test]
+    fn chain_members_with_different_rates_are_rejected() {
+        let e = err(&CHAIN.replacen("rate_hz = 8_000", "rate_hz = 4_000", 1));
+        assert_eq!(e.field, "channel[1].rate_hz", "{e}");
+        assert_eq!(e.line, 22, "{e}");
+        assert!(
+            e.message.contains("chained parts are sampled together"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn chain_limits_and_members() {
+        let e = err(&CHAIN.replace("chain = 2", "chain = 9"));
+        assert_eq!(e.field, "branch[0].chain", "{e}");
+        assert!(e.message.contains("at most 8"), "{e}");
+        let e = err(&CHAIN.replace("member = 1", "member = 2"));
+        assert_eq!(e.field, "channel[1].member", "{e}");
+        let e = err(&CHAIN.replace("member = 1", "member = 0"));
+        assert_eq!(e.field, "channel[1].input", "{e}");
+    }
+
+    #[test]
+    fn declared_parts_are_validated() {
+        let part = "[[adc_part]]\nname = \"p\"\nbits = 12\nstart = \"cs\"\nleading_bits = 4\nsclk_max_hz = 20_000_000\nmax_sps = 1_000_000\n";
+        let good = format!("{}{part}", GOOD.replace("ad7940", "p"));
+        let m = parse(Path::new("m.toml"), &good).unwrap();
+        assert_eq!(m.branches[0].adc.bits, 12);
+        assert_eq!(m.parts.len(), 1);
+        let e = err(&good.replace("start = \"cs\"", "start = \"cnvst\""));
+        assert_eq!((e.field.as_str(), e.line), ("adc_part[0].start", 20), "{e}");
+        let e = err(&good.replace("bits = 12", "bits = 20"));
+        assert_eq!(e.field, "adc_part[0].bits", "{e}");
+        let e = err(&good.replace("max_sps = 1_000_000", "max_sps = 1_000_000\nchain_max = 2"));
+        assert_eq!(e.field, "adc_part[0].chain_max", "{e}");
+        let e = err(&good.replace("sclk_max_hz = 20_000_000\n", ""));
+        assert_eq!(e.field, "adc_part[0].sclk_max_hz", "{e}");
     }
 }

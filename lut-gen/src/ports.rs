@@ -14,6 +14,7 @@
 
 use serde::Serialize;
 
+use crate::parts::Start;
 use crate::schedule::Schedule;
 
 /// Name of the top module.
@@ -23,8 +24,10 @@ pub const TOP_MODULE: &str = "slotforge_top";
 pub const MUX_SELECT_BITS: u32 = 3;
 /// Mux inputs one select addresses per device.
 pub const INPUTS_PER_DEVICE: u32 = 1 << MUX_SELECT_BITS;
-/// Bits of `sample_value` (the widest converter word the gateware carries).
-pub const SAMPLE_VALUE_BITS: u32 = 14;
+/// The most bits `sample_value` can have (the widest converter word the
+/// gateware carries); a mix's width is [`Layout::width`]`(Role::SampleValue)`:
+/// the widest part of the mix (14 for AD7940s, 16 with an AD7685).
+pub const SAMPLE_VALUE_BITS: u32 = 16;
 
 /// What the gateware can carry: its fixed-maximum core has this many lanes.
 /// `hdl` builds its core at these sizes and refuses larger mixes; the judge
@@ -288,6 +291,11 @@ pub struct Layout {
     pub mux_devices: u32,
     /// Width of `sample_channel`.
     pub channel_bits: u32,
+    /// Width of `sample_value`: the widest part's data bits.
+    pub value_bits: u32,
+    /// How each branch's conversion pin (the `adc_cs_n` lane) works: CS
+    /// (active low) or CNV (active high).
+    pub starts: Vec<Start>,
     /// `(branch, device, select)` -> channel, as `lookup[branch][device * 8 + select]`.
     pub lookup: Vec<Vec<Option<u16>>>,
 }
@@ -317,7 +325,8 @@ impl Layout {
         for (c, ch) in s.channels.iter().enumerate() {
             let b = s.mix.channels[c].branch;
             let i = (ch.device * INPUTS_PER_DEVICE + ch.select) as usize;
-            if i < lookup[b].len() {
+            // Chain members share an address: it names the conversion's lead.
+            if i < lookup[b].len() && lookup[b][i].is_none() {
                 lookup[b][i] = Some(c as u16);
             }
         }
@@ -327,6 +336,8 @@ impl Layout {
             en_n,
             mux_devices: acc,
             channel_bits: s.channel_bits(),
+            value_bits: s.mix.branches.iter().map(|b| b.adc.bits).max().unwrap_or(1),
+            starts: s.mix.branches.iter().map(|b| b.adc.start).collect(),
             lookup,
         }
     }
@@ -374,7 +385,7 @@ impl Layout {
             Role::MuxSel => MUX_SELECT_BITS * nb,
             Role::MuxEn => self.mux_devices,
             Role::SampleChannel => self.channel_bits,
-            Role::SampleValue => SAMPLE_VALUE_BITS,
+            Role::SampleValue => self.value_bits,
         }
     }
 
@@ -498,7 +509,18 @@ pub fn manifest(s: &Schedule) -> String {
                         .collect::<Vec<_>>()),
                     r => json!(l.lane(r, b)),
                 };
+                if r == Role::CsN && l.starts[b] == Start::Cnv {
+                    // The same lane, driven as the AD7685's CNV (active high).
+                    o.insert("cnv".into(), v);
+                    o.insert("active_high".into(), json!(true));
+                    continue;
+                }
                 o.insert(r.key().into(), v);
+            }
+            if s.mix.branches[b].adc.start == Start::Cnv || s.mix.branches[b].chain > 1 {
+                o.insert("adc".into(), json!(s.mix.branches[b].adc.name));
+                o.insert("chain".into(), json!(s.mix.branches[b].chain));
+                o.insert("conversion_cycles".into(), json!(bp.spi.conv_cycles));
             }
             o.insert("sclk_div".into(), json!(bp.spi.sclk_div));
             o.insert("setup_cycles".into(), json!(bp.spi.setup_cycles));

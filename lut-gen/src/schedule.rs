@@ -101,9 +101,30 @@ pub struct Schedule {
     /// `frame_slots x branches`, row-major: the channel each branch converts in each slot.
     pub frame_table: Vec<Option<u16>>,
     pub placement: Placement,
+    /// Per channel: the channels read in its conversion, by chain member
+    /// (`Mix::conversion_group`); `[Some(c)]` for an unchained channel.
+    #[serde(skip)]
+    pub groups: Vec<Vec<Option<usize>>>,
 }
 
 impl Schedule {
+    /// `groups` of a mix.
+    pub fn groups_of(mix: &Mix) -> Vec<Vec<Option<usize>>> {
+        (0..mix.channels.len())
+            .map(|c| mix.conversion_group(c))
+            .collect()
+    }
+
+    /// The words one conversion of `lead` (a frame-table entry) delivers, in
+    /// the order they leave the chain: (member, channel) for every member a
+    /// channel reads.
+    pub fn words_of(&self, lead: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.groups[lead]
+            .iter()
+            .enumerate()
+            .filter_map(|(m, c)| c.map(|c| (m, c)))
+    }
+
     pub fn branch_count(&self) -> usize {
         self.branches.len()
     }

@@ -135,7 +135,7 @@ fn branch_plans(mix: &Mix) -> Result<Vec<BranchPlan>, String> {
     mix.branches
         .iter()
         .map(|b| {
-            let spi = SpiTiming::derive(&b.adc, mix.clock_hz, b.sclk_hz)
+            let spi = SpiTiming::derive(&b.adc, mix.clock_hz, b.sclk_hz, b.chain)
                 .map_err(|e| format!("branch `{}`: {}", b.name, e.0))?;
             let settle_cycles = ns_to_cycles(b.settle_ns, mix.clock_hz);
             Ok(BranchPlan {
@@ -154,6 +154,10 @@ fn units_of(mix: &Mix, frame_slots: u64) -> Vec<Unit> {
     let mut units: Vec<Unit> = Vec::new();
     let mut by_tag: std::collections::BTreeMap<&str, usize> = Default::default();
     for (i, c) in mix.channels.iter().enumerate() {
+        if mix.lead_of(i) != i {
+            // Read in its lead's conversion (a chain member): placed with it.
+            continue;
+        }
         let period = frame_slots / mix.samples_per_frame(c.rate_hz);
         if let Some(tag) = &c.sync {
             if let Some(&u) = by_tag.get(tag.as_str()) {
@@ -302,7 +306,10 @@ fn attempt(units: &[Unit], branches: usize, slots: u64, sps: u64, budget: u64) -
 /// Conversions each branch needs per frame (independent of the slot grid).
 fn demand_per_frame(mix: &Mix) -> Vec<u64> {
     let mut demand = vec![0u64; mix.branches.len()];
-    for c in &mix.channels {
+    for (i, c) in mix.channels.iter().enumerate() {
+        if mix.lead_of(i) != i {
+            continue;
+        }
         demand[c.branch] += mix.samples_per_frame(c.rate_hz);
     }
     demand
@@ -449,14 +456,16 @@ fn build(
     for (u, &o) in units.iter().zip(offsets) {
         for &c in &u.channels {
             let ch = &mix.channels[c];
-            channels[c] = Some(ChannelSlots {
-                samples_per_frame: mix.samples_per_frame(ch.rate_hz),
-                period_slots: u.period,
-                offset_slot: o,
-                interval_cycles: mix.clock_hz / ch.rate_hz,
-                device: ch.input / 8,
-                select: ch.input % 8,
-            });
+            for m in mix.conversion_group(c).into_iter().flatten() {
+                channels[m] = Some(ChannelSlots {
+                    samples_per_frame: mix.samples_per_frame(ch.rate_hz),
+                    period_slots: u.period,
+                    offset_slot: o,
+                    interval_cycles: mix.clock_hz / ch.rate_hz,
+                    device: ch.input / 8,
+                    select: ch.input % 8,
+                });
+            }
             for s in (o..grid.frame_slots).step_by(u.period as usize) {
                 table[s as usize * nb + ch.branch] = Some(c as u16);
             }
@@ -469,6 +478,7 @@ fn build(
         channels: channels.into_iter().map(Option::unwrap).collect(),
         frame_table: table,
         placement,
+        groups: Schedule::groups_of(mix),
     }
 }
 

@@ -83,18 +83,26 @@ pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
                 plan.name
             ));
         }
-        if ns(spi.setup_cycles) < adc.cs_setup_ns as f64 {
+        if ns(spi.setup_cycles) < (adc.setup_ns + adc.conversion_ns) as f64 {
             bad.push(format!(
-                "branch `{}`: CS-to-SCLK setup {} ns < {} ns",
+                "branch `{}`: conversion start to first SCLK {} ns < {} ns",
                 plan.name,
                 ns(spi.setup_cycles),
-                adc.cs_setup_ns
+                adc.setup_ns + adc.conversion_ns
             ));
         }
-        if spi.read_cycles != spi.setup_cycles + adc.sclk_per_conversion as u64 * spi.sclk_div {
+        let chain = mix.branches[b].chain as u64;
+        let sclks = (adc.leading_bits + adc.bits + adc.trailing_bits) as u64 * chain;
+        if spi.read_cycles != spi.setup_cycles + sclks * spi.sclk_div {
             bad.push(format!(
-                "branch `{}`: CS-low window is not setup + {} SCLK periods",
-                plan.name, adc.sclk_per_conversion
+                "branch `{}`: conversion window is not setup + {sclks} SCLK periods",
+                plan.name
+            ));
+        }
+        if chain > adc.chain_max as u64 {
+            bad.push(format!(
+                "branch `{}`: {chain} parts chained, `{}` allows {}",
+                plan.name, adc.name, adc.chain_max
             ));
         }
         if g.slot_cycles < spi.read_cycles
@@ -137,7 +145,15 @@ pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
                         mix.channels[c].name
                     ));
                 }
-                slots_of[c].push(slot);
+                // Every channel read in this conversion (chain members).
+                for (m, g) in mix.conversion_group(c).into_iter().enumerate() {
+                    if let Some(g) = g {
+                        if mix.channels[g].member as usize != m {
+                            bad.push(format!("`{}`: wrong chain member", mix.channels[g].name));
+                        }
+                        slots_of[g].push(slot);
+                    }
+                }
             }
         }
     }

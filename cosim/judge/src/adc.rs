@@ -1,6 +1,13 @@
-//! AD7940 model: samples the analog input its branch's mux selects at the CS
-//! falling edge and shifts the 16-bit word out on MISO (two leading zeros,
-//! then the 14-bit code MSB first).
+//! ADC models from the part data (`lut_gen::parts`):
+//!
+//! - CS parts (AD7940): sample the analog input the branch's mux selects at
+//!   the CS falling edge and shift the word out on MISO (the leading bits as
+//!   zeros, then the code MSB first), one bit per SCLK falling edge;
+//! - CNV parts (AD7685, chain mode): every part of the chain samples its own
+//!   input at the CNV rising edge; the chain then shifts all words out of the
+//!   part nearest the host (member 0 first), MSB first, one bit per SCK
+//!   falling edge; after the last word the first part's SDI (tied low)
+//!   follows, so the line reads 0.
 //!
 //! Datasheet edges (shared/notes/datasheets.md): bit 0 is driven after CS
 //! falls, bit `i` after SCLK falling edge `i`, the line is invalid from 10 ns
@@ -85,6 +92,27 @@ impl Analog {
         }
     }
 
+    /// The `bits`-bit code input `id` converts to when sampled in cycle
+    /// `cycle` (the 14-bit [`Analog::code`] for 14 bits).
+    #[inline]
+    pub fn code_bits(&self, id: u64, cycle: u64, bits: u32) -> u16 {
+        if bits == 14 {
+            return self.code(id, cycle);
+        }
+        let mask = ((1u32 << bits) - 1) as u16;
+        if self.kind == Stimulus::Pattern || id >= self.channels {
+            let n = (cycle / self.slot_cycles) * (self.channels + 64) + id;
+            return (n.wrapping_mul(0x2F5B).wrapping_add(0x1A5) as u16) & mask;
+        }
+        let c = self.code(id, cycle) as u32;
+        (if bits > 14 {
+            c << (bits - 14)
+        } else {
+            c >> (14 - bits)
+        }) as u16
+            & mask
+    }
+
     /// The 14-bit code input `id` converts to when sampled in cycle `cycle`.
     /// `id < channels` is a channel; larger ids are unconnected inputs.
     #[inline]
@@ -132,16 +160,33 @@ impl Analog {
 
 #[derive(Debug, Clone, Copy, Default)]
 struct AdcState {
-    word: u16,
-    falls: u8,
+    /// The serial stream of the conversion, first bit in the top of `len` bits.
+    stream: u128,
+    len: u32,
+    falls: u32,
 }
 
-/// The AD7940s of all branches, at cycle level.
+/// One branch's part(s), as the model needs them.
+#[derive(Debug, Clone)]
+struct PartModel {
+    cnv: bool,
+    bits: u32,
+    leading: u32,
+    word_sclks: u32,
+    /// Per lead channel: the channel of each chain member.
+    groups: Vec<Vec<Option<usize>>>,
+    chain: u32,
+}
+
+/// The ADCs of all branches, at cycle level.
 #[derive(Debug, Clone)]
 pub struct Adc {
     pub analog: Analog,
     layout: Layout,
     st: Vec<AdcState>,
+    parts: Vec<PartModel>,
+    /// Conversion-pin levels in the CS-active-low view (CNV lanes inverted).
+    flip: u8,
     prev_cs: u8,
     prev_sclk: u8,
     miso: u64,
@@ -151,10 +196,30 @@ impl Adc {
     pub fn new(s: &Schedule, kind: Stimulus) -> Adc {
         let nb = s.branches.len();
         let all = ((1u16 << nb) - 1) as u8;
+        let parts: Vec<PartModel> = s
+            .mix
+            .branches
+            .iter()
+            .map(|b| PartModel {
+                cnv: b.adc.start == lut_gen::parts::Start::Cnv,
+                bits: b.adc.bits,
+                leading: b.adc.leading_bits,
+                word_sclks: b.adc.word_sclks(),
+                groups: s.groups.clone(),
+                chain: b.chain,
+            })
+            .collect();
+        let flip = parts
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.cnv)
+            .fold(0u8, |a, (b, _)| a | 1 << b);
         Adc {
             analog: Analog::new(s, kind),
             layout: Layout::new(s),
             st: vec![AdcState::default(); nb],
+            parts,
+            flip,
             prev_cs: all,
             prev_sclk: all,
             miso: (1u64 << nb) - 1,
@@ -164,32 +229,62 @@ impl Adc {
     /// MISO of every branch during cycle `cycle`, given the outputs in it.
     #[inline]
     pub fn drive(&mut self, cycle: u64, p: &Pins) -> u64 {
-        if p.cs_n == self.prev_cs && p.sclk == self.prev_sclk {
+        // CS view: conversion active low, shifting clock edge = a fall.
+        let (cs_n, sclk) = (p.cs_n ^ self.flip, p.sclk ^ self.flip);
+        if cs_n == self.prev_cs && sclk == self.prev_sclk {
             return self.miso;
         }
-        let fell_cs = self.prev_cs & !p.cs_n;
-        let fell_sclk = self.prev_sclk & !p.sclk & !p.cs_n;
+        let fell_cs = self.prev_cs & !cs_n;
+        // CS parts shift on SCLK falling edges; CNV parts on SCK falling
+        // edges, which are rises in the inverted view.
+        let fell_sclk =
+            (self.prev_sclk & !sclk & !self.flip) | (!self.prev_sclk & sclk & self.flip);
+        let fell_sclk = fell_sclk & !cs_n;
         let mut miso = 0u64;
         for b in 0..self.st.len() {
             let bit = 1u8 << b;
+            let pm = &self.parts[b];
             let st = &mut self.st[b];
             if fell_cs & bit != 0 {
                 let id = self.analog.input_id(&self.layout, p, b);
-                st.word = self.analog.code(id, cycle) & 0x3fff;
+                st.stream = 0;
+                st.len = 0;
                 st.falls = 0;
+                for m in 0..pm.chain as usize {
+                    // Each chained part converts its own input: the member's
+                    // channel, or an unconnected input.
+                    let mid = match pm.groups.get(id as usize).and_then(|g| g.get(m)) {
+                        Some(Some(c)) => *c as u64,
+                        Some(None) => id + 100 + m as u64,
+                        None if m == 0 => id,
+                        None => id + 100 + m as u64,
+                    };
+                    let code = self.analog.code_bits(mid, cycle, pm.bits) as u128;
+                    let trailing = pm.word_sclks - pm.leading - pm.bits;
+                    st.stream = (st.stream << pm.word_sclks) | (code << trailing);
+                    st.len += pm.word_sclks;
+                }
             }
             if fell_sclk & bit != 0 {
                 st.falls = st.falls.saturating_add(1);
             }
-            let v = if p.cs_n & bit != 0 || st.falls >= 16 {
+            let v = if cs_n & bit != 0 {
                 1 // high-Z, weak pull-up
+            } else if st.falls >= st.len {
+                // CS parts: high-Z after the last bit; a chain: the first
+                // part's SDI (tied low) comes through.
+                if pm.cnv {
+                    0
+                } else {
+                    1
+                }
             } else {
-                (st.word >> (15 - st.falls)) & 1
+                ((st.stream >> (st.len - 1 - st.falls)) & 1) as u8
             };
             miso |= (v as u64) << b;
         }
-        self.prev_cs = p.cs_n;
-        self.prev_sclk = p.sclk;
+        self.prev_cs = cs_n;
+        self.prev_sclk = sclk;
         self.miso = miso;
         miso
     }

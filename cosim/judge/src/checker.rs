@@ -43,9 +43,20 @@ struct Limits {
     sclk_max_hz: u64,
     sclk_min_hz: u64,
     duty_min_pct: u64,
+    /// Cycles from the conversion start to the first data clock (CNV
+    /// parts: the conversion time plus the setup).
     setup_min: u64,
     quiet_min: u64,
     settle_min: u64,
+    /// CNV part: conversion pin active high, SCK idles low, bits read at
+    /// SCK rising edges (all of them); CS part: bits 1.. read at SCLK rising
+    /// edges.  The checker works in the CS view (CNV lanes inverted).
+    cnv: bool,
+    /// Serial clocks per conversion, per word; data and leading bits.
+    sclks: u32,
+    word_sclks: u32,
+    bits: u32,
+    leading: u32,
 }
 
 #[derive(Debug, Clone, Default)]
@@ -57,7 +68,8 @@ struct BranchState {
     rises: u32,
     last_fall: u64,
     last_rise: u64,
-    word: u16,
+    /// Bits read from MISO in this conversion (the last in bit 0).
+    word: u128,
     word_bad: bool,
     cs_rise: Option<u64>,
     mux_since: u64,
@@ -104,6 +116,10 @@ pub struct Checker {
     /// Reset cycles seen in the current reset, up to release.
     reset_len: u64,
     br: Vec<BranchState>,
+    /// CNV lanes of `adc_cs_n`/`adc_sclk` (inverted into the CS view).
+    flip: u8,
+    /// Per channel: the channels read in its conversion, by chain member.
+    groups: Vec<Vec<Option<usize>>>,
     next_frame_at: u64,
     /// Last cycles (cycle, actual, expected) for divergence context.
     hist: VecDeque<(u64, Pins, Option<Pins>)>,
@@ -137,14 +153,28 @@ impl Checker {
                 sclk_max_hz: b.adc.sclk_max_hz,
                 sclk_min_hz: b.adc.sclk_min_hz,
                 duty_min_pct: b.adc.duty_min_pct as u64,
-                setup_min: ns_to_cycles(b.adc.cs_setup_ns, mix.clock_hz).max(1),
+                setup_min: ns_to_cycles(b.adc.conversion_ns, mix.clock_hz)
+                    + ns_to_cycles(b.adc.setup_ns, mix.clock_hz).max(1),
                 quiet_min: ns_to_cycles(b.adc.quiet_ns, mix.clock_hz).max(1),
                 settle_min: ns_to_cycles(b.settle_ns, mix.clock_hz),
+                cnv: b.adc.start == lut_gen::parts::Start::Cnv,
+                sclks: b.adc.word_sclks() * b.chain,
+                word_sclks: b.adc.word_sclks(),
+                bits: b.adc.bits,
+                leading: b.adc.leading_bits,
             })
             .collect();
         let signals = layout.signals();
         let nsig = signals.len();
+        let flip = mix
+            .branches
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.adc.start == lut_gen::parts::Start::Cnv)
+            .fold(0u8, |a, (b, _)| a | 1 << b);
         Checker {
+            flip,
+            groups: s.groups.clone(),
             opts,
             mix_name: mix.name.clone(),
             signals,
@@ -302,6 +332,7 @@ impl Checker {
                 }
             }
         }
+        let rp = self.view(&rp);
         for b in 0..self.layout.branches {
             let st = &mut self.br[b];
             st.mux_from_reset = true;
@@ -434,8 +465,39 @@ impl Checker {
         }
     }
 
+    /// The CS view of the pins: CNV lanes inverted, so that "low" is
+    /// "converting" and a fall of the serial clock is a SCK rising edge.
+    #[inline]
+    fn view(&self, p: &Pins) -> Pins {
+        Pins {
+            cs_n: p.cs_n ^ self.flip,
+            sclk: p.sclk ^ self.flip,
+            ..*p
+        }
+    }
+
+    /// Reads serial bit `idx` of branch `b`'s conversion from MISO as it was
+    /// in the cycle before the edge at `c`.
+    fn capture(&mut self, b: usize, c: u64, idx: u32) {
+        if self.prev_miso_xz >> b & 1 != 0 {
+            self.br[b].word_bad = true;
+            self.inv.violation(
+                c,
+                "x-or-z",
+                Some(Signal::Miso(b).name(&self.layout)),
+                None,
+                Some(json!("x")),
+                None,
+                format!("MISO is x/z when the serial clock reads it ({c}, bit {idx})"),
+            );
+        }
+        let st = &mut self.br[b];
+        st.word = (st.word << 1) | (self.prev_miso >> b & 1) as u128;
+    }
+
     fn edges(&mut self, c: u64, p: &Pins, xz: &Pins) {
-        let prev = self.prev;
+        let p = &self.view(p);
+        let prev = self.view(&self.prev);
         let dcs = prev.cs_n ^ p.cs_n;
         let dsclk = prev.sclk ^ p.sclk;
         for b in 0..self.layout.branches {
@@ -528,7 +590,12 @@ impl Checker {
                 Some(json!(1)),
                 Some(json!(0)),
                 None,
-                "SCLK is low when CS falls (CPOL=1 idles high)".into(),
+                if self.limits[b].cnv {
+                    "SCK is high when CNV rises (chain mode needs SCK low)"
+                } else {
+                    "SCLK is low when CS falls (CPOL=1 idles high)"
+                }
+                .into(),
             );
         }
         let sel_x = self.layout.sel(xz, b) != 0 || self.layout.en(xz, b) != 0;
@@ -587,14 +654,27 @@ impl Checker {
         st.word = 0;
         st.word_bad = false;
         if let Some(ch) = ch {
-            self.inv.instant(c, b, ch);
+            match self.groups.get(ch as usize) {
+                // Every chained part samples at this instant.
+                Some(g) => {
+                    for m in g.clone().into_iter().flatten() {
+                        self.inv.instant(c, b, m as u16);
+                    }
+                }
+                None => self.inv.instant(c, b, ch),
+            }
         }
     }
 
     fn sclk_fall(&mut self, b: usize, c: u64) {
-        let lim = &self.limits[b];
+        let lim = self.limits[b].clone();
+        self.br[b].falls += 1;
+        let falls = self.br[b].falls;
+        if lim.cnv && falls <= lim.sclks {
+            // SCK rising edge `falls`: serial bit falls - 1.
+            self.capture(b, c, falls - 1);
+        }
         let st = &mut self.br[b];
-        st.falls += 1;
         let mut v: Vec<(&str, Option<Value>, Option<Value>, String)> = Vec::new();
         if st.falls == 1 {
             if c - st.t < lim.setup_min {
@@ -659,21 +739,9 @@ impl Checker {
         let st = &mut self.br[b];
         st.rises += 1;
         st.last_rise = c;
-        if st.rises <= 15 {
-            if self.prev_miso_xz >> b & 1 != 0 {
-                st.word_bad = true;
-                self.inv.violation(
-                    c,
-                    "x-or-z",
-                    Some(Signal::Miso(b).name(&self.layout)),
-                    None,
-                    Some(json!("x")),
-                    None,
-                    format!("MISO is x/z when SCLK rises ({}, bit {})", c, st.rises),
-                );
-            }
-            let st = &mut self.br[b];
-            st.word = (st.word << 1) | (self.prev_miso >> b & 1) as u16;
+        let idx = st.rises;
+        if !self.limits[b].cnv && idx < self.limits[b].sclks {
+            self.capture(b, c, idx);
         }
     }
 
@@ -685,15 +753,17 @@ impl Checker {
             return; // CS low through reset: no conversion to account for
         }
         let chname = st.ch.and_then(|ch| self.names.get(ch as usize).cloned());
-        if st.falls != 16 || st.rises != 16 {
+        let lim = self.limits[b].clone();
+        let n = lim.sclks;
+        if st.falls != n || st.rises != n {
             self.inv.violation(
                 c,
                 "sclk-count",
                 Some(Signal::Sclk(b).name(&self.layout)),
-                Some(json!(16)),
+                Some(json!(n)),
                 Some(json!(st.falls)),
                 chname.clone(),
-                format!("{} SCLK falling and {} rising edges in the CS-low window from cycle {}, expected 16", st.falls, st.rises, st.t),
+                format!("{} SCLK falling and {} rising edges in the conversion window from cycle {}, expected {n}", st.falls, st.rises, st.t),
             );
         }
         if p.sclk >> b & 1 == 0 {
@@ -704,11 +774,35 @@ impl Checker {
                 Some(json!(1)),
                 Some(json!(0)),
                 chname,
-                "SCLK is low when CS rises".into(),
+                if lim.cnv {
+                    "SCK is high when CNV falls"
+                } else {
+                    "SCLK is low when CS rises"
+                }
+                .into(),
             );
         }
-        let code = (!st.word_bad).then_some(st.word & 0x3fff);
-        self.inv.completion(c, b, st.ch, code, st.t);
+        // Bit j of the serial stream sits at sclks-1-j of `word` (CS parts
+        // never read bit 0, a leading zero).
+        let mask = (1u128 << lim.bits) - 1;
+        let word = |w: u32| {
+            let end = w * lim.word_sclks + lim.leading + lim.bits;
+            ((st.word >> (n - end)) & mask) as u16
+        };
+        match st.ch {
+            Some(ch) if (ch as usize) < self.groups.len() => {
+                for (m, g) in self.groups[ch as usize].clone().into_iter().enumerate() {
+                    if let Some(g) = g {
+                        let code = (!st.word_bad).then_some(word(m as u32));
+                        self.inv.completion(c, b, Some(g as u16), code, st.t);
+                    }
+                }
+            }
+            _ => {
+                let code = (!st.word_bad).then_some(word(0));
+                self.inv.completion(c, b, st.ch, code, st.t);
+            }
+        }
     }
 
     /// Ends the check and builds the report.

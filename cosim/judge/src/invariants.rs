@@ -119,7 +119,7 @@ impl Invariants {
             frame: 0,
             frame_cycles: mix.frame_cycles(),
             queue: VecDeque::new(),
-            slack: mix.branches.len() as u64 + 1,
+            slack: mix.branches.iter().map(|b| b.chain as u64).sum::<u64>() + 1,
             emitted: 0,
             conversions: 0,
         }
@@ -259,7 +259,17 @@ impl Invariants {
     pub fn emitted(&mut self, c: u64, channel: u16, value: u16) {
         self.emitted += 1;
         self.expire(c);
-        let Some(p) = self.queue.pop_front() else {
+        // The merged stream sends the lowest branch's waiting word first
+        // (a chain's words in member order); within a branch, in order.
+        let pick = self
+            .queue
+            .iter()
+            .enumerate()
+            .filter(|(_, q)| q.complete < c)
+            .min_by_key(|(i, q)| (q.branch, *i))
+            .map(|(i, _)| i)
+            .unwrap_or(0);
+        let Some(p) = self.queue.remove(pick) else {
             self.rec.violation(
                 c,
                 "sample-unexpected",

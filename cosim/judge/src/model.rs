@@ -12,13 +12,16 @@ use lut_gen::Schedule;
 
 use lut_gen::ports::{Layout, Pins};
 
-/// One conversion in the periodic frame template.
+/// One conversion's word in the periodic frame template (a chained
+/// conversion gives one per chain member read).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Conversion {
-    /// Sampling instant (CS falling), cycles from the start of the frame.
+    /// Sampling instant (CS falling or CNV rising), cycles from the start of the frame.
     pub instant: u64,
     pub branch: usize,
     pub channel: u16,
+    /// Chain member (0 for unchained parts).
+    pub member: u16,
     /// Cycle in which CS rises again (`instant + read_cycles`).
     pub complete: u64,
     /// Cycle in which `sample_valid` carries it (may lie in the next frame).
@@ -44,27 +47,45 @@ impl SlotModel {
             for b in 0..nb {
                 if let Some(ch) = s.at(slot, b) {
                     let instant = slot * g.slot_cycles;
-                    conversions.push(Conversion {
-                        instant,
-                        branch: b,
-                        channel: ch as u16,
-                        complete: instant + s.branches[b].spi.read_cycles,
-                        emit: 0,
-                    });
+                    for (m, c) in s.words_of(ch) {
+                        conversions.push(Conversion {
+                            instant,
+                            branch: b,
+                            channel: c as u16,
+                            member: m as u16,
+                            complete: instant + s.branches[b].spi.read_cycles,
+                            emit: 0,
+                        });
+                    }
                 }
             }
         }
-        // Merge: completions leave one per cycle, in (completion, branch) order.
+        // Merge: one word leaves per cycle; in cycle c + 1 the lowest
+        // (branch, member) of those completed by cycle c.
         let mut order: Vec<usize> = (0..conversions.len()).collect();
-        order.sort_by_key(|&i| (conversions[i].complete, conversions[i].branch));
-        let mut last_emit = 0u64;
-        let mut first = true;
-        for &i in &order {
-            let e = conversions[i].complete + 1;
-            let e = if first { e } else { e.max(last_emit + 1) };
-            first = false;
-            conversions[i].emit = e;
-            last_emit = e;
+        order.sort_by_key(|&i| {
+            (
+                conversions[i].complete,
+                conversions[i].branch,
+                conversions[i].member,
+            )
+        });
+        let mut pending = std::collections::BTreeSet::new();
+        let mut k = 0;
+        let mut c = 0u64;
+        while k < order.len() || !pending.is_empty() {
+            if pending.is_empty() {
+                c = c.max(conversions[order[k]].complete);
+            }
+            while k < order.len() && conversions[order[k]].complete <= c {
+                let i = order[k];
+                pending.insert((conversions[i].branch, conversions[i].member, i));
+                k += 1;
+            }
+            let first = *pending.iter().next().unwrap();
+            pending.remove(&first);
+            conversions[first.2].emit = c + 1;
+            c += 1;
         }
         let mut emissions = conversions.clone();
         emissions.sort_by_key(|c| c.emit);
@@ -106,11 +127,21 @@ struct BranchModel {
     oi: usize,
     /// Next cycle at which this branch needs attention.
     next: u64,
-    word: u16,
+    /// Bits captured from MISO in this conversion (the last in bit 0).
+    word: u128,
     su: u64,
     d: u64,
     h: u64,
     r: u64,
+    /// CNV style: the pin is active high and SCK idles low.
+    cnv: bool,
+    /// Captures per conversion (rising edges that read a bit).
+    caps: u64,
+    /// Serial bits per conversion, per word, data bits and leading bits.
+    sclks: u64,
+    word_sclks: u64,
+    bits: u32,
+    leading: u64,
     /// (device, select) of each channel (indexed by channel).
     addr: Vec<(u32, u32)>,
 }
@@ -143,8 +174,10 @@ pub struct CycleModel {
     reset: Pins,
     next_event: u64,
     pending: u8,
-    pend: [(u16, u16); 8],
+    /// Per branch: (channel, value) of the words waiting, first to leave first.
+    pend: Vec<std::collections::VecDeque<(u16, u16)>>,
     capture: u8,
+    groups: Vec<Vec<Option<usize>>>,
 }
 
 impl CycleModel {
@@ -162,12 +195,15 @@ impl CycleModel {
                 spi.sclk_half,
                 spi.read_cycles,
             );
+            let cnv = spi.style == lut_gen::parts::Start::Cnv;
+            let sclks = spi.sclks();
+            let caps = if cnv { sclks } else { sclks - 1 };
             let mut offs = vec![1, r];
-            for i in 0..16 {
+            for i in 0..sclks {
                 let fall = su + i * d;
                 offs.push(fall);
                 offs.push(fall + h);
-                if i < 15 {
+                if i < caps {
                     offs.push(fall + h - 1);
                 }
             }
@@ -193,14 +229,26 @@ impl CycleModel {
                 d,
                 h,
                 r,
+                cnv,
+                caps,
+                sclks,
+                word_sclks: spi.word_sclks as u64,
+                bits: spi.bits,
+                leading: spi.leading_bits as u64,
                 addr: addr.clone(),
             };
             m.advance_next_instant(g.frame_cycles);
             br.push(m);
         }
+        // Idle levels: CS high / SCLK high, CNV low / SCK low.
+        let cs_idle = br
+            .iter()
+            .enumerate()
+            .filter(|(_, m)| !m.cnv)
+            .fold(0u8, |a, (b, _)| a | 1 << b);
         let mut reset = Pins {
-            cs_n: ((1u16 << s.branches.len()) - 1) as u8,
-            sclk: ((1u16 << s.branches.len()) - 1) as u8,
+            cs_n: cs_idle,
+            sclk: cs_idle,
             ..Pins::default()
         };
         for (b, m) in br.iter().enumerate() {
@@ -218,8 +266,9 @@ impl CycleModel {
             reset,
             next_event: 0,
             pending: 0,
-            pend: [(0, 0); 8],
+            pend: vec![Default::default(); s.branches.len()],
             capture: 0,
+            groups: s.groups.clone(),
         };
         model.process();
         model
@@ -275,15 +324,18 @@ impl CycleModel {
             let b = cap.trailing_zeros() as usize;
             cap &= cap - 1;
             let m = &mut self.br[b];
-            m.word = (m.word << 1) | ((miso >> b) & 1) as u16;
+            m.word = (m.word << 1) | ((miso >> b) & 1) as u128;
         }
         self.capture = 0;
         if self.pending != 0 {
             let b = self.pending.trailing_zeros() as usize;
-            self.pending &= self.pending - 1;
+            let (ch, v) = self.pend[b].pop_front().unwrap_or_default();
+            if self.pend[b].is_empty() {
+                self.pending &= self.pending - 1;
+            }
             self.pins.sample_valid = true;
-            self.pins.sample_channel = self.pend[b].0;
-            self.pins.sample_value = self.pend[b].1;
+            self.pins.sample_channel = ch;
+            self.pins.sample_value = v;
         } else {
             self.pins.sample_valid = false;
         }
@@ -325,16 +377,36 @@ impl CycleModel {
                         if k >= m.su && (k - m.su) % m.d < m.h {
                             sclk = false;
                         }
-                        if k >= m.su && k < m.su + 15 * m.d && (k - m.su) % m.d == m.h - 1 {
+                        if k >= m.su && k < m.su + m.caps * m.d && (k - m.su) % m.d == m.h - 1 {
                             self.capture |= bit;
                         }
                     }
                     if k == m.r {
+                        // Bit j of the serial stream sits at sclks-1-j of `word`.
                         self.pending |= bit;
-                        self.pend[b] = (m.tch, m.word & 0x3fff);
+                        let mask = (1u128 << m.bits) - 1;
+                        for (w, c) in self.groups[m.tch as usize].iter().enumerate() {
+                            if let Some(c) = c {
+                                let end = w as u64 * m.word_sclks + m.leading + m.bits as u64;
+                                let v = (m.word >> (m.sclks - end)) & mask;
+                                self.pend[b].push_back((*c as u16, v as u16));
+                            }
+                        }
                     }
                 } else {
                     m.next = m.tn;
+                }
+                if m.cnv {
+                    // CNV is active high; SCK idles low and is high in the
+                    // second half of each period (rising edge i in its middle).
+                    cs = !cs;
+                    sclk = match m.t {
+                        Some(t) => {
+                            let k = c - t;
+                            k >= m.su && k < m.r && (k - m.su) % m.d >= m.h
+                        }
+                        None => false,
+                    };
                 }
                 self.pins.cs_n = (self.pins.cs_n & !bit) | if cs { bit } else { 0 };
                 self.pins.sclk = (self.pins.sclk & !bit) | if sclk { bit } else { 0 };

@@ -187,7 +187,7 @@ pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usi
         }
         for cv in &sm.emissions {
             let t = base + cv.instant;
-            let code = analog.code(cv.channel as u64, t);
+            let code = analog.code_bits(cv.channel as u64, t, s.mix.branches[cv.branch].adc.bits);
             inv.completion(
                 base + cv.complete,
                 cv.branch,
@@ -202,6 +202,16 @@ pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usi
     let (fr, channels) = inv.finish(cycles);
     let samples = inv.emitted_count();
     inv.report("model", &s.mix.name, cycles, fr, channels, samples)
+}
+
+/// The first word of a conversion stands for it (chains give several).
+fn sm_first_member(sm: &SlotModel, c: &crate::model::Conversion) -> u16 {
+    sm.conversions
+        .iter()
+        .filter(|o| o.branch == c.branch && o.instant == c.instant)
+        .map(|o| o.member)
+        .min()
+        .unwrap_or(0)
 }
 
 fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
@@ -238,7 +248,9 @@ fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
                 format!("branch {}: SCLK low {lo} / high {hi} cycles", plan.name),
             );
         }
-        if spi.setup_cycles < ns_to_cycles(adc.cs_setup_ns, clock).max(1) {
+        if spi.setup_cycles
+            < ns_to_cycles(adc.conversion_ns, clock) + ns_to_cycles(adc.setup_ns, clock).max(1)
+        {
             inv.violation(
                 0,
                 "cs-setup",
@@ -254,7 +266,7 @@ fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
         let inst: Vec<u64> = sm
             .conversions
             .iter()
-            .filter(|c| c.branch == b)
+            .filter(|c| c.branch == b && c.member == sm_first_member(sm, c))
             .map(|c| c.instant)
             .collect();
         for (i, &t) in inst.iter().enumerate() {

@@ -172,7 +172,7 @@ struct Lane {
 
 impl Adc {
     pub fn new(clock_hz: u64, seed: u64) -> Adc {
-        let part = lut_gen::parts::AdcPart::AD7940;
+        let part = lut_gen::parts::AdcPart::ad7940();
         Adc {
             access: lut_gen::parts::ns_to_cycles(part.data_access_ns, clock_hz),
             hold: part.data_hold_ns * clock_hz / 1_000_000_000,
