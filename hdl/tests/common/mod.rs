@@ -289,7 +289,14 @@ impl<'a> Reference<'a> {
             }
             let sa = slot_abs - back;
             let t = sa * g.slot_cycles;
-            if self.s.at(sa % g.frame_slots, b).is_some() && t <= c && c < t + spi.read_cycles {
+            // "Start-up": an instant the mux cannot have settled for since
+            // the first reset edge (one cycle before cycle 0) is skipped
+            let settled = t + 1 >= self.s.branches[b].settle_cycles;
+            if self.s.at(sa % g.frame_slots, b).is_some()
+                && settled
+                && t <= c
+                && c < t + spi.read_cycles
+            {
                 return Some(t);
             }
         }
