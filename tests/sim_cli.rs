@@ -83,7 +83,11 @@ fn sim_json(mix: &Path, backend: &str, frames: u64) -> serde_json::Value {
 #[test]
 fn sim_model_100_frames() {
     let v = sim_json(&eskin34(), "model", 100);
-    assert_eq!(v["samples"], 34_900 - 3, "less the 3 instants skipped at start-up");
+    assert_eq!(
+        v["samples"],
+        34_900 - 3,
+        "less the 3 instants skipped at start-up"
+    );
     assert_eq!(v["cycles"], 100 * 480_000);
 }
 
@@ -111,7 +115,11 @@ fn sim_icarus_small_mix() {
     }
     let v = sim_json(&tiny(), "icarus", 3);
     assert_eq!(v["source"], "icarus");
-    assert_eq!(v["samples"], 30 - 2, "less the 2 instants skipped at start-up");
+    assert_eq!(
+        v["samples"],
+        30 - 2,
+        "less the 2 instants skipped at start-up"
+    );
     assert_eq!(v["cycles"], 12_000);
 }
 
@@ -191,7 +199,11 @@ fn check_passes_a_sim_vcd_and_fails_corrupted_copies() {
     let v = check_json(&wave, 0);
     assert_eq!(v["ok"], true);
     assert_eq!(v["frames"], 3);
-    assert_eq!(v["samples"], 30 - 2, "less the 2 instants skipped at start-up");
+    assert_eq!(
+        v["samples"],
+        30 - 2,
+        "less the 2 instants skipped at start-up"
+    );
     slotforge()
         .arg("check")
         .arg(tiny())

@@ -65,7 +65,7 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         // the input id cosim's ADC model gives each (enable, select) of this branch
         let id_of = |en: u64, sel: u32| {
             let p = Pins {
-                mux_sel: sel << (3 * b),
+                mux_sel: (sel as u64) << (3 * b),
                 mux_en: en << lo,
                 ..Pins::default()
             };

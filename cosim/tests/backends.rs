@@ -64,3 +64,25 @@ fn verilator_backend_2_frames() {
         assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
     }
 }
+
+/// The largest mixes (issue 9): three AD7940s at 100 % (300 channels) and
+/// the gateware's 16 branches, one frame each on rusthdl and verilator with
+/// a one-cycle reset.
+#[test]
+fn largest_mixes_one_frame() {
+    let verilator = tools::require_tools(&["verilator", "g++"]);
+    for name in ["full300", "b16"] {
+        let p =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../hdl/tests/data/{name}.toml"));
+        let s = schedule(&p);
+        let mut backends = vec![Backend::RustHdl];
+        if verilator {
+            backends.push(Backend::Verilator);
+        }
+        for b in backends {
+            let r = run(&s, b, 1, &one_cycle_reset()).unwrap();
+            assert!(r.ok, "{name} {b:?}: {}", r.summary());
+            assert_eq!(r.samples, s.samples_per_frame() - s.startup_skips());
+        }
+    }
+}

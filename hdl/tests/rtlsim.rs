@@ -97,6 +97,23 @@ fn u2_256_channels_match_timing_contract() {
     run_and_compare(&s, s.grid.frame_cycles + s.grid.slice_cycles);
 }
 
+/// Three AD7940s at 100 %: 300 channels at 1 kHz (issue 9), two frames.
+#[test]
+fn full300_matches_timing_contract() {
+    let s = data_mix("full300");
+    assert_eq!(s.channels.len(), 300);
+    run_and_compare(&s, 2 * s.grid.frame_cycles);
+}
+
+/// The gateware's 16 branches (32 channels each, 4 mux devices each: all
+/// 64 enables), two frames.
+#[test]
+fn b16_matches_timing_contract() {
+    let s = data_mix("b16");
+    assert_eq!(s.branches.len(), lut_gen::ports::limits::MAX_BRANCHES);
+    run_and_compare(&s, 2 * s.grid.frame_cycles);
+}
+
 /// The reference mix with the compact slot LUT (slice table + rotation
 /// groups + slice counter) instead of the full frame table: same pins.
 #[test]

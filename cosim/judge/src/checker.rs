@@ -437,7 +437,7 @@ impl Checker {
         let dcs = prev.cs_n ^ p.cs_n;
         let dsclk = prev.sclk ^ p.sclk;
         for b in 0..self.layout.branches {
-            let bit = 1u8 << b;
+            let bit = 1u16 << b;
             let (sel, en) = (self.layout.sel(p, b), self.layout.en(p, b));
             if sel != self.layout.sel(&prev, b) || en != self.layout.en(&prev, b) {
                 let st = &mut self.br[b];

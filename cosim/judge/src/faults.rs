@@ -79,7 +79,7 @@ pub struct FaultyDut<D> {
     r: u64,
     cycle: Option<u64>,
     done: bool,
-    prev_cs: u8,
+    prev_cs: u16,
     held: Option<Pins>,
 }
 
@@ -146,13 +146,13 @@ impl<D: Dut> Dut for FaultyDut<D> {
             }
             Fault::CsLate { branch } => {
                 if c >= self.t && c <= self.t + self.r {
-                    let bit = 1u8 << branch;
+                    let bit = 1u16 << branch;
                     p.cs_n = (p.cs_n & !bit) | (self.prev_cs & bit);
                 }
             }
             Fault::SclkExtraEdge { branch } => {
                 if c == self.t + self.su + 3 * self.d + self.h + 1 {
-                    p.sclk &= !(1u8 << branch);
+                    p.sclk &= !(1u16 << branch);
                 }
             }
             Fault::MuxLate { branch } => {
@@ -193,7 +193,7 @@ fn pins_before(layout: &Layout, p: &Pins, branch: usize, _t_prev: u64) -> Pins {
 }
 
 fn copy_mux(layout: &Layout, p: &mut Pins, from: &Pins, b: usize) {
-    let selm = 7u32 << (3 * b);
+    let selm = 7u64 << (3 * b);
     p.mux_sel = (p.mux_sel & !selm) | (from.mux_sel & selm);
     let enm = ((1u64 << layout.en_n[b]) - 1) << layout.en_lo[b];
     p.mux_en = (p.mux_en & !enm) | (from.mux_en & enm);

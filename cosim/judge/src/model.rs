@@ -180,9 +180,9 @@ pub struct CycleModel {
     pins: Pins,
     reset: Pins,
     next_event: u64,
-    pending: u8,
-    pend: [(u16, u16); 8],
-    capture: u8,
+    pending: u16,
+    pend: [(u16, u16); lut_gen::ports::limits::MAX_BRANCHES],
+    capture: u16,
 }
 
 impl CycleModel {
@@ -239,8 +239,8 @@ impl CycleModel {
             br.push(m);
         }
         let mut reset = Pins {
-            cs_n: ((1u16 << s.branches.len()) - 1) as u8,
-            sclk: ((1u16 << s.branches.len()) - 1) as u8,
+            cs_n: ((1u32 << s.branches.len()) - 1) as u16,
+            sclk: ((1u32 << s.branches.len()) - 1) as u16,
             ..Pins::default()
         };
         for (b, m) in br.iter().enumerate() {
@@ -258,7 +258,7 @@ impl CycleModel {
             reset,
             next_event: 0,
             pending: 0,
-            pend: [(0, 0); 8],
+            pend: [(0, 0); lut_gen::ports::limits::MAX_BRANCHES],
             capture: 0,
         };
         model.process();
@@ -348,7 +348,7 @@ impl CycleModel {
                     m.oi = 0;
                     m.word = 0;
                 }
-                let bit = 1u8 << b;
+                let bit = 1u16 << b;
                 let (mut cs, mut sclk) = (true, true);
                 let ch = if m.t == Some(c) { m.tch } else { m.tnch };
                 if let Some(t) = m.t {
