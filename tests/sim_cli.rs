@@ -71,7 +71,8 @@ fn sim_json(mix: &Path, backend: &str, frames: u64) -> serde_json::Value {
         ] {
             assert!(c.get(key).is_some(), "{backend}: channel missing {key}");
         }
-        assert!(c["samples"].as_u64().unwrap() >= frames);
+        // (a channel whose instant at cycle 0 is skipped at start-up has one less)
+        assert!(c["samples"].as_u64().unwrap() + 1 >= frames);
         // zero jitter: every interval is the nominal one
         assert_eq!(c["interval_cycles_min"], c["interval_cycles_max"], "{c}");
         total += c["samples"].as_u64().unwrap();
