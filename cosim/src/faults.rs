@@ -386,7 +386,7 @@ struct GatewareDut(hdl::RtlSim);
 
 impl Dut for GatewareDut {
     fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
-        self.0.step(rst, miso as u8)
+        self.0.step(rst, miso)
     }
 }
 

@@ -113,6 +113,25 @@ impl Schedule {
         self.frame_table[slot as usize * self.branches.len() + branch].map(usize::from)
     }
 
+    /// docs/timing.md, "Start-up": whether the gateware skips branch `b`'s
+    /// instant at cycle `t` of the first frame after reset.  The mux pins take
+    /// their reset value at the first reset edge, so at instant `t` they have
+    /// held it for `t + 1` cycles at the least (a one-cycle reset); an
+    /// instant with `t + 1 < settle_cycles` would sample an unsettled mux.
+    /// Slots are longer than the settling time, so only an instant at cycle 0
+    /// can be skipped.
+    pub fn skipped_at_startup(&self, b: usize, t: u64) -> bool {
+        t + 1 < self.branches[b].settle_cycles
+    }
+
+    /// How many instants of the first frame after reset the gateware skips
+    /// (see [`Schedule::skipped_at_startup`]).
+    pub fn startup_skips(&self) -> u64 {
+        (0..self.branches.len())
+            .filter(|&b| self.at(0, b).is_some() && self.skipped_at_startup(b, 0))
+            .count() as u64
+    }
+
     /// Sampling instants of one branch within one frame, in time order.
     pub fn branch_instants_in_frame(&self, branch: usize) -> Vec<SamplingInstant> {
         (0..self.grid.frame_slots)

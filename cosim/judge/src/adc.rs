@@ -142,15 +142,15 @@ pub struct Adc {
     pub analog: Analog,
     layout: Layout,
     st: Vec<AdcState>,
-    prev_cs: u8,
-    prev_sclk: u8,
+    prev_cs: u16,
+    prev_sclk: u16,
     miso: u64,
 }
 
 impl Adc {
     pub fn new(s: &Schedule, kind: Stimulus) -> Adc {
         let nb = s.branches.len();
-        let all = ((1u16 << nb) - 1) as u8;
+        let all = ((1u32 << nb) - 1) as u16;
         Adc {
             analog: Analog::new(s, kind),
             layout: Layout::new(s),
@@ -171,7 +171,7 @@ impl Adc {
         let fell_sclk = self.prev_sclk & !p.sclk & !p.cs_n;
         let mut miso = 0u64;
         for b in 0..self.st.len() {
-            let bit = 1u8 << b;
+            let bit = 1u16 << b;
             let st = &mut self.st[b];
             if fell_cs & bit != 0 {
                 let id = self.analog.input_id(&self.layout, p, b);

@@ -25,7 +25,9 @@ pub struct Conversion {
     pub emit: u64,
 }
 
-/// Slot-level model: the periodic frame template of conversions.
+/// Slot-level model: the periodic frame template of conversions, and the
+/// first frame after reset, which lacks the instants skipped at start-up
+/// (docs/timing.md, "Start-up").
 #[derive(Debug, Clone)]
 pub struct SlotModel {
     pub frame_cycles: u64,
@@ -33,6 +35,33 @@ pub struct SlotModel {
     pub conversions: Vec<Conversion>,
     /// The same conversions in emission order.
     pub emissions: Vec<Conversion>,
+    /// Frame 0: conversions in (instant, branch) order ...
+    pub first: Vec<Conversion>,
+    /// ... and in emission order.
+    pub first_emissions: Vec<Conversion>,
+}
+
+/// Whether branch `b`'s instant `t` (cycles from reset release) samples a
+/// mux that has had at least `settle` cycles: the mux took its value at the
+/// first reset edge, one cycle before cycle 0 at the least.
+fn settled_at_startup(t: u64, settle: u64) -> bool {
+    t + 1 >= settle
+}
+
+/// Emission cycles: completions leave one per cycle, in (completion, branch) order.
+fn merge(mut conversions: Vec<Conversion>) -> (Vec<Conversion>, Vec<Conversion>) {
+    let mut order: Vec<usize> = (0..conversions.len()).collect();
+    order.sort_by_key(|&i| (conversions[i].complete, conversions[i].branch));
+    let mut last_emit = None;
+    for &i in &order {
+        let e = conversions[i].complete + 1;
+        let e = last_emit.map_or(e, |l: u64| e.max(l + 1));
+        conversions[i].emit = e;
+        last_emit = Some(e);
+    }
+    let mut emissions = conversions.clone();
+    emissions.sort_by_key(|c| c.emit);
+    (conversions, emissions)
 }
 
 impl SlotModel {
@@ -54,24 +83,29 @@ impl SlotModel {
                 }
             }
         }
-        // Merge: completions leave one per cycle, in (completion, branch) order.
-        let mut order: Vec<usize> = (0..conversions.len()).collect();
-        order.sort_by_key(|&i| (conversions[i].complete, conversions[i].branch));
-        let mut last_emit = 0u64;
-        let mut first = true;
-        for &i in &order {
-            let e = conversions[i].complete + 1;
-            let e = if first { e } else { e.max(last_emit + 1) };
-            first = false;
-            conversions[i].emit = e;
-            last_emit = e;
-        }
-        let mut emissions = conversions.clone();
-        emissions.sort_by_key(|c| c.emit);
+        let first: Vec<Conversion> = conversions
+            .iter()
+            .filter(|c| settled_at_startup(c.instant, s.branches[c.branch].settle_cycles))
+            .copied()
+            .collect();
+        let (conversions, emissions) = merge(conversions);
+        let (first, first_emissions) = merge(first);
         SlotModel {
             frame_cycles: g.frame_cycles,
             conversions,
             emissions,
+            first,
+            first_emissions,
+        }
+    }
+
+    /// Frame `f`'s conversions relative to its start, in (instant, branch)
+    /// and in emission order.
+    pub fn frame(&self, f: u64) -> (&[Conversion], &[Conversion]) {
+        if f == 0 {
+            (&self.first, &self.first_emissions)
+        } else {
+            (&self.conversions, &self.emissions)
         }
     }
 
@@ -79,7 +113,7 @@ impl SlotModel {
     pub fn iter(&self, frames: u64) -> impl Iterator<Item = Conversion> + '_ {
         (0..frames).flat_map(move |f| {
             let base = f * self.frame_cycles;
-            self.conversions.iter().map(move |c| Conversion {
+            self.frame(f).0.iter().map(move |c| Conversion {
                 instant: c.instant + base,
                 complete: c.complete + base,
                 emit: c.emit + base,
@@ -106,6 +140,10 @@ struct BranchModel {
     oi: usize,
     /// Next cycle at which this branch needs attention.
     next: u64,
+    /// The current instant converts (false: skipped at start-up).
+    conv: bool,
+    /// Mux settling time in cycles.
+    settle: u64,
     word: u16,
     su: u64,
     d: u64,
@@ -142,9 +180,9 @@ pub struct CycleModel {
     pins: Pins,
     reset: Pins,
     next_event: u64,
-    pending: u8,
-    pend: [(u16, u16); 8],
-    capture: u8,
+    pending: u16,
+    pend: [(u16, u16); lut_gen::ports::limits::MAX_BRANCHES],
+    capture: u16,
 }
 
 impl CycleModel {
@@ -188,6 +226,8 @@ impl CycleModel {
                 offs,
                 oi: 0,
                 next: 0,
+                conv: false,
+                settle: plan.settle_cycles,
                 word: 0,
                 su,
                 d,
@@ -199,8 +239,8 @@ impl CycleModel {
             br.push(m);
         }
         let mut reset = Pins {
-            cs_n: ((1u16 << s.branches.len()) - 1) as u8,
-            sclk: ((1u16 << s.branches.len()) - 1) as u8,
+            cs_n: ((1u32 << s.branches.len()) - 1) as u16,
+            sclk: ((1u32 << s.branches.len()) - 1) as u16,
             ..Pins::default()
         };
         for (b, m) in br.iter().enumerate() {
@@ -218,7 +258,7 @@ impl CycleModel {
             reset,
             next_event: 0,
             pending: 0,
-            pend: [(0, 0); 8],
+            pend: [(0, 0); lut_gen::ports::limits::MAX_BRANCHES],
             capture: 0,
         };
         model.process();
@@ -303,11 +343,12 @@ impl CycleModel {
                 if c == m.tn {
                     m.t = Some(m.tn);
                     m.tch = m.tnch;
+                    m.conv = settled_at_startup(m.tn, m.settle);
                     m.advance_next_instant(self.frame_cycles);
                     m.oi = 0;
                     m.word = 0;
                 }
-                let bit = 1u8 << b;
+                let bit = 1u16 << b;
                 let (mut cs, mut sclk) = (true, true);
                 let ch = if m.t == Some(c) { m.tch } else { m.tnch };
                 if let Some(t) = m.t {
@@ -320,7 +361,7 @@ impl CycleModel {
                     } else {
                         m.tn
                     };
-                    if k < m.r {
+                    if k < m.r && m.conv {
                         cs = false;
                         if k >= m.su && (k - m.su) % m.d < m.h {
                             sclk = false;
@@ -329,7 +370,7 @@ impl CycleModel {
                             self.capture |= bit;
                         }
                     }
-                    if k == m.r {
+                    if k == m.r && m.conv {
                         self.pending |= bit;
                         self.pend[b] = (m.tch, m.word & 0x3fff);
                     }
