@@ -20,7 +20,7 @@ pub mod options;
 pub mod rusthdl;
 pub mod verilator;
 
-pub use backend::{run, run_traced};
+pub use backend::{run, run_observed, run_traced, Tracer};
 pub use error::{BackendError, SimError};
 pub use judge::{CheckOptions, Report, Stimulus};
 pub use options::{Backend, SimOptions, VcdOut};
