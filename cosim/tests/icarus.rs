@@ -54,7 +54,7 @@ fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
     }
     let s = schedule(&data("tiny.toml"));
     let d = tempfile::tempdir().unwrap();
-    for stimulus in [Stimulus::Pattern, Stimulus::Sine] {
+    for stimulus in [Stimulus::Pattern, Stimulus::Sine(None)] {
         let wave = d.path().join("wave.vcd");
         let opts = SimOptions {
             stimulus,
