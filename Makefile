@@ -10,15 +10,12 @@ APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm sigrok-c
 
 .PHONY: run test tools lut audit verilog cosim golden golden-update synth bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
+# The main job on the reference mix: audit, LUT, Verilog, co-simulation, golden,
+# faults, synthesis estimate, and build/eskin34/report.html with its charts.
+BUILD ?= build/$(basename $(notdir $(MIX)))
 run: tools
-	$(SLOTFORGE) audit $(MIX)
-	$(SLOTFORGE) lut $(MIX) -o $(OUT)
-	$(SLOTFORGE) verilog $(MIX) -o $(OUT)
-	$(SLOTFORGE) sim $(MIX) --backend model --frames 100
-	$(SLOTFORGE) sim $(MIX) --backend rusthdl --frames 2
-	$(SLOTFORGE) sim $(MIX) --backend verilator --frames 2 --vcd $(OUT)/frame0.vcd --from 0 --to 1
-	$(SLOTFORGE) check $(MIX) $(OUT)/frame0.vcd
-	@echo "outputs in $(OUT) (open $(OUT)/frame0.gtkw in GTKWave)"
+	$(SLOTFORGE) build $(MIX) -o $(BUILD)
+	@echo "open $(BUILD)/report.html (or report.md); waveforms: $(BUILD)/frame0.vcd + .gtkw"
 
 test: tools
 	$(CARGO) fmt --all -- --check
@@ -100,4 +97,4 @@ update-snapshots:
 	git status --short -- '*.snap'
 
 clean:
-	rm -rf out
+	rm -rf out build

@@ -20,7 +20,7 @@ for mix in "${mixes[@]}"; do
   name=$(basename "$mix" .toml)
   out=target/synth/$name
   rm -rf "$out"; mkdir -p "$out"
-  target/debug/examples/emit "$mix" "$out" "$board"
+  "${CARGO_TARGET_DIR:-target}/debug/examples/emit" "$mix" "$out" "$board"
   clock_hz=$(sed -n 's/.*"clock_hz": \([0-9]*\).*/\1/p' "$out/ports.json")
   clock_mhz=$(awk -v h="$clock_hz" 'BEGIN{printf "%.3f", h/1e6}')
   (cd "$out" && yosys -q -l yosys.log -p "read_verilog slotforge_top.v; synth_ice40 -top slotforge_top -json slotforge.json; check -assert; tee -q -o stat.txt stat" >/dev/null)

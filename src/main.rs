@@ -22,6 +22,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job: audit, LUT, Verilog, co-simulation, golden, faults, synthesis estimate, and a report with charts.
+    Build(cmd::build::Args),
     /// Synthesize the schedule and audit it (rates, intervals, headroom, settling, Nyquist).
     Audit(cmd::audit::Args),
     /// Write the slot LUT: slots.hex ($readmemh), slots.csv, slots.md (Table 1 form).
@@ -41,6 +43,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let code = match cli.command {
+        Command::Build(a) => cmd::build::run(a),
         Command::Audit(a) => cmd::audit::run(a),
         Command::Lut(a) => cmd::lut::run(a),
         Command::Verilog(a) => cmd::verilog::run(a),

@@ -269,3 +269,61 @@ fn gateware_faults_are_caught_at_every_site() {
     assert!(rom["injected"].as_u64().unwrap() >= 2 * 3, "{rom}");
     assert_eq!(v["ok"], true);
 }
+
+/// A mix of `nb` AD7940 branches with `per` channels each at 1 kHz (10 ms frame).
+fn big_mix(nb: usize, per: usize, devices: usize) -> String {
+    let mut t = String::from(
+        "name = \"big\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n",
+    );
+    for b in 0..nb {
+        t += &format!(
+            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = {devices}\n"
+        );
+    }
+    for b in 0..nb {
+        for i in 0..per {
+            t += &format!(
+                "[[channel]]\nname = \"b{b}c{i}\"\nbranch = \"b{b}\"\nrate_hz = 100\ninput = {i}\n"
+            );
+        }
+    }
+    t
+}
+
+#[test]
+fn verilog_refuses_mixes_beyond_the_gateware_limits() {
+    let d = tempfile::tempdir().unwrap();
+    let limits = [
+        (
+            big_mix(17, 1, 1),
+            "17 branches: the gateware supports 1 to 16",
+        ),
+        (
+            big_mix(5, 205, 26),
+            "1025 channels: the gateware supports 1 to 1024",
+        ),
+    ];
+    for (text, msg) in limits {
+        let p = write_mix(d.path(), &text);
+        slotforge().arg("audit").arg(&p).assert().code(0);
+        slotforge()
+            .arg("verilog")
+            .arg(&p)
+            .arg("-o")
+            .arg(d.path().join("out"))
+            .assert()
+            .code(1)
+            .stderr(predicate::str::contains(msg));
+    }
+    // the largest mixes of the test data emit
+    for name in ["full300", "b16"] {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("hdl/tests/data/{name}.toml"));
+        slotforge()
+            .arg("verilog")
+            .arg(&p)
+            .arg("-o")
+            .arg(d.path().join(name))
+            .assert()
+            .code(0);
+    }
+}

@@ -6,7 +6,9 @@
 //! - 2b: rusthdl back end with full checking vs the same core under rust-hdl's
 //!   stock threaded `Simulation` (goal >= 20x);
 //! - 3: model back end vs real time;
-//! - 4: `check` of a VCD vs a bare streaming parse with the same reader.
+//! - 4: `check` of a VCD vs a bare streaming parse with the same reader;
+//! - 5: `check` vs the `wellen` crate's bare load of the same VCD (single-
+//!   and multi-threaded).
 
 use std::path::Path;
 use std::time::Instant;
@@ -120,6 +122,32 @@ fn main() {
         size / tp / 1e6,
         size / tk / 1e6,
         tp / tk
+    );
+
+    // 5. check against the wellen crate's bare load of the same VCD (header
+    // + body + every signal), single- and multi-threaded
+    let wellen_load = |multi_thread: bool| {
+        secs(|| {
+            let opts = wellen::LoadOptions {
+                multi_thread,
+                remove_scopes_with_empty_name: false,
+            };
+            let mut w = wellen::simple::read_with_options(&vcd, &opts).expect("wellen reads it");
+            let h = w.hierarchy();
+            let refs: Vec<wellen::SignalRef> = h.all_vars().map(|v| h[v].signal_ref()).collect();
+            w.load_signals(&refs);
+            refs.len()
+        })
+    };
+    let (tw1, nv) = wellen_load(false);
+    let (twm, _) = wellen_load(true);
+    println!(
+        "vcd vs wellen ({nv} vars): check {:.0} MB/s, wellen single-threaded {:.0} MB/s, multi-threaded {:.0} MB/s; check / wellen-1 = {:.2}, check / wellen-mt = {:.2}",
+        size / tk / 1e6,
+        size / tw1 / 1e6,
+        size / twm / 1e6,
+        tw1 / tk,
+        twm / tk
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

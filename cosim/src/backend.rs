@@ -61,22 +61,63 @@ pub fn run_traced(
     opts: &SimOptions,
     trace: Option<&mut Trace>,
 ) -> Result<Report, SimError> {
+    run_observed(
+        s,
+        backend,
+        frames,
+        opts,
+        trace.map(|t| t as &mut dyn Tracer),
+    )
+}
+
+/// What can watch every cycle of any back end: the in-process ones call it
+/// as an [`Observer`], Icarus (through its VCD) as a [`CycleSink`].  Every
+/// type that is both is one ([`Trace`], [`judge::samples::SampleLog`]).
+pub trait Tracer: Observer + CycleSink {
+    fn as_observer(&mut self) -> &mut dyn Observer;
+    fn as_sink(&mut self) -> &mut dyn CycleSink;
+}
+
+impl<T: Observer + CycleSink> Tracer for T {
+    fn as_observer(&mut self) -> &mut dyn Observer {
+        self
+    }
+    fn as_sink(&mut self) -> &mut dyn CycleSink {
+        self
+    }
+}
+
+/// Like [`run_traced`] with any [`Tracer`] (e.g. one that keeps only the
+/// samples, not every cycle).
+pub fn run_observed(
+    s: &Schedule,
+    backend: Backend,
+    frames: u64,
+    opts: &SimOptions,
+    trace: Option<&mut dyn Tracer>,
+) -> Result<Report, SimError> {
     no_rtl_in_process(backend, opts)?;
     match backend {
-        Backend::Model => in_process(s, &mut ModelDut::new(s), frames, opts, "model", trace),
-        Backend::RustHdl => in_process(s, &mut RustHdlDut::new(s)?, frames, opts, "rusthdl", trace),
+        Backend::Model => in_process(s, &mut ModelDut::new(s), frames, opts, "model", obs(trace)),
+        Backend::RustHdl => {
+            let mut dut = RustHdlDut::new(s)?;
+            in_process(s, &mut dut, frames, opts, "rusthdl", obs(trace))
+        }
         Backend::Verilator => {
             let text = match &opts.rtl {
                 Some(path) => crate::rtl::load_rtl(s, path)?,
                 None => verilog(s)?,
             };
             let (mut dut, _) = VerilatedDut::new(&text)?;
-            in_process(s, &mut dut, frames, opts, "verilator", trace)
+            in_process(s, &mut dut, frames, opts, "verilator", obs(trace))
         }
-        Backend::Icarus => {
-            crate::icarus::run(s, frames, opts, trace.map(|t| t as &mut dyn CycleSink))
-        }
+        Backend::Icarus => crate::icarus::run(s, frames, opts, trace.map(|t| t.as_sink())),
     }
+}
+
+/// A tracer as the observer of an in-process run.
+fn obs(t: Option<&mut dyn Tracer>) -> Option<&mut dyn Observer> {
+    t.map(|t| t.as_observer())
 }
 
 /// Two observers of one run.
@@ -100,7 +141,7 @@ fn in_process(
     frames: u64,
     opts: &SimOptions,
     source: &str,
-    trace: Option<&mut Trace>,
+    trace: Option<&mut dyn Observer>,
 ) -> Result<Report, SimError> {
     let reset = reset_cycles(s, opts.reset_cycles);
     let ro = RunOptions {
@@ -124,7 +165,7 @@ fn in_process(
     };
     let mut tee = Tee(
         writer.as_mut().map(|w| w as &mut dyn Observer),
-        trace.map(|t| t as &mut dyn Observer),
+        trace.map(|t| &mut *t as &mut dyn Observer),
     );
     let obs = (tee.0.is_some() || tee.1.is_some()).then_some(&mut tee as &mut dyn Observer);
     let report = run_dut(s, dut, frames, &ro, source, obs);

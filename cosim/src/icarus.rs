@@ -9,7 +9,8 @@
 //! formula, the others from a table of the schedule's conversions (a
 //! conversion the schedule does not expect falls back to the pattern
 //! formula; the checker decodes every value from MISO in any case).  Reset
-//! lasts [`judge::run::reset_cycles`] cycles, as in the in-process back ends.
+//! lasts [`judge::run::reset_cycles`] cycles (the run's `reset_cycles`, one
+//! at the least), as in the in-process back ends.
 
 use std::fmt::Write as _;
 use std::fs::File;
@@ -61,7 +62,7 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         // the input id cosim's ADC model gives each (enable, select) of this branch
         let id_of = |en: u64, sel: u32| {
             let p = Pins {
-                mux_sel: sel << (3 * b),
+                mux_sel: (sel as u64) << (3 * b),
                 mux_en: en << lo,
                 ..Pins::default()
             };
@@ -89,8 +90,14 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         } else {
             let mut hex = String::new();
             let mut len = 0u64;
-            for i in s.instants(frames).filter(|i| i.branch == b) {
-                let bits = s.mix.branches[b].adc.bits;
+            // the conversions the gateware makes: less those skipped at
+            // start-up (docs/timing.md, "Start-up")
+            let f = s.grid.frame_cycles;
+            let bits = s.mix.branches[b].adc.bits;
+            for i in s
+                .instants(frames)
+                .filter(|i| i.branch == b && !(i.cycle < f && s.skipped_at_startup(b, i.cycle)))
+            {
                 let code = analog.code_bits(i.channel as u64, i.cycle, bits) & 0x3fff;
                 let _ = writeln!(
                     hex,

@@ -26,7 +26,7 @@ pub mod rtl;
 pub mod rusthdl;
 pub mod verilator;
 
-pub use backend::{run, run_traced};
+pub use backend::{run, run_observed, run_traced, Tracer};
 pub use error::{BackendError, SimError};
 pub use judge::{CheckOptions, Report, Stimulus};
 pub use options::{Backend, SimOptions, VcdOut};

@@ -21,7 +21,7 @@ impl RustHdlDut {
 impl Dut for RustHdlDut {
     #[inline]
     fn step(&mut self, rst: bool, miso: u64) -> Pins {
-        self.0.step(rst, miso as u8)
+        self.0.step(rst, miso)
     }
 }
 

@@ -23,16 +23,19 @@ const SHIM_TEMPLATE: &str = r#"
 #include "verilated.h"
 #include <cstdint>
 
+// The Rust `SfPins` (repr(C)); Verilator's port types (CData/SData/IData/
+// QData for up to 8/16/32/64 bits) convert to these widths by assignment.
 struct SfPins {
     uint64_t mux_en;
-    uint32_t mux_sel;
+    uint64_t mux_sel;
     uint16_t sample_channel;
     uint16_t sample_value;
-    uint8_t cs_n;
-    uint8_t sclk;
+    uint16_t cs_n;
+    uint16_t sclk;
     uint8_t sample_valid;
-    uint8_t pad;
+    uint8_t pad[7];
 };
+static_assert(sizeof(SfPins) == 32, "SfPins must match the Rust layout");
 
 struct SfModel {
     VerilatedContext* ctx;
@@ -86,18 +89,22 @@ fn shim() -> String {
     t
 }
 
+/// The outputs as the shim writes them: the C++ `SfPins` above, field for
+/// field, wide enough for the contract's limits (`Pins`).
 #[repr(C)]
 #[derive(Default)]
 struct SfPins {
     mux_en: u64,
-    mux_sel: u32,
+    mux_sel: u64,
     sample_channel: u16,
     sample_value: u16,
-    cs_n: u8,
-    sclk: u8,
+    cs_n: u16,
+    sclk: u16,
     sample_valid: u8,
-    pad: u8,
+    pad: [u8; 7],
 }
+
+const _: () = assert!(std::mem::size_of::<SfPins>() == 32);
 
 /// FNV-1a, 64 bit: a stable cache key across Rust versions.
 pub fn fnv64(parts: &[&[u8]]) -> u64 {

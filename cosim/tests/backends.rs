@@ -23,13 +23,21 @@ fn schedule(p: &Path) -> lut_gen::Schedule {
 #[path = "../../tests/common/tools.rs"]
 mod tools;
 
+/// The gateware is correct for any reset of one cycle or more (docs/timing.md, "Start-up").
+fn one_cycle_reset() -> SimOptions {
+    SimOptions {
+        reset_cycles: 1,
+        ..SimOptions::default()
+    }
+}
+
 #[test]
 fn model_backend_100_frames() {
     for p in mixes() {
         let s = schedule(&p);
         let r = run(&s, Backend::Model, 100, &SimOptions::default()).unwrap();
         assert!(r.ok, "{}: {}", p.display(), r.summary());
-        assert_eq!(r.samples, 100 * s.samples_per_frame());
+        assert_eq!(r.samples, 100 * s.samples_per_frame() - s.startup_skips());
     }
 }
 
@@ -37,9 +45,9 @@ fn model_backend_100_frames() {
 fn rusthdl_backend_2_frames() {
     for p in mixes() {
         let s = schedule(&p);
-        let r = run(&s, Backend::RustHdl, 2, &SimOptions::default()).unwrap();
+        let r = run(&s, Backend::RustHdl, 2, &one_cycle_reset()).unwrap();
         assert!(r.ok, "{}: {}", p.display(), r.summary());
-        assert_eq!(r.samples, 2 * s.samples_per_frame());
+        assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
         assert!(r.model_compared);
     }
 }
@@ -51,8 +59,30 @@ fn verilator_backend_2_frames() {
     }
     for p in mixes() {
         let s = schedule(&p);
-        let r = run(&s, Backend::Verilator, 2, &SimOptions::default()).unwrap();
+        let r = run(&s, Backend::Verilator, 2, &one_cycle_reset()).unwrap();
         assert!(r.ok, "{}: {}", p.display(), r.summary());
-        assert_eq!(r.samples, 2 * s.samples_per_frame());
+        assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
+    }
+}
+
+/// The largest mixes (issue 9): three AD7940s at 100 % (300 channels) and
+/// the gateware's 16 branches, one frame each on rusthdl and verilator with
+/// a one-cycle reset.
+#[test]
+fn largest_mixes_one_frame() {
+    let verilator = tools::require_tools(&["verilator", "g++"]);
+    for name in ["full300", "b16"] {
+        let p =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../hdl/tests/data/{name}.toml"));
+        let s = schedule(&p);
+        let mut backends = vec![Backend::RustHdl];
+        if verilator {
+            backends.push(Backend::Verilator);
+        }
+        for b in backends {
+            let r = run(&s, b, 1, &one_cycle_reset()).unwrap();
+            assert!(r.ok, "{name} {b:?}: {}", r.summary());
+            assert_eq!(r.samples, s.samples_per_frame() - s.startup_skips());
+        }
     }
 }

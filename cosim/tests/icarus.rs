@@ -54,7 +54,7 @@ fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
     }
     let s = schedule(&data("tiny.toml"));
     let d = tempfile::tempdir().unwrap();
-    for stimulus in [Stimulus::Pattern, Stimulus::Sine] {
+    for stimulus in [Stimulus::Pattern, Stimulus::Sine(None)] {
         let wave = d.path().join("wave.vcd");
         let opts = SimOptions {
             stimulus,
@@ -71,7 +71,7 @@ fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
         assert_eq!(r.source, "icarus");
         assert!(r.model_compared);
         assert_eq!(r.frames, 3);
-        assert_eq!(r.samples, 3 * s.samples_per_frame());
+        assert_eq!(r.samples, 3 * s.samples_per_frame() - s.startup_skips());
         // the same sample stream (cycles, channels, codes) as the in-process ADC model
         let mut ic = Samples::default();
         read_cycles(&s, &wave, None, &mut ic).unwrap();
@@ -83,7 +83,10 @@ fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
         };
         let rr = run_dut(&s, &mut dut, 3, &ro, "rusthdl", Some(&mut rh));
         assert!(rr.ok);
-        assert_eq!(ic.v.len() as u64, 3 * s.samples_per_frame());
+        assert_eq!(
+            ic.v.len() as u64,
+            3 * s.samples_per_frame() - s.startup_skips()
+        );
         assert_eq!(
             ic.v, rh.v,
             "{stimulus:?}: Icarus's ADC codes differ from cosim's"
@@ -132,8 +135,13 @@ fn icarus_backend_eskin34_one_frame() {
         return;
     }
     let s = schedule(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml"));
-    let r = cosim::run(&s, Backend::Icarus, 1, &SimOptions::default()).unwrap();
+    // a one-cycle reset (docs/timing.md, "Start-up")
+    let opts = SimOptions {
+        reset_cycles: 1,
+        ..SimOptions::default()
+    };
+    let r = cosim::run(&s, Backend::Icarus, 1, &opts).unwrap();
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.frames, 1);
-    assert_eq!(r.samples, s.samples_per_frame());
+    assert_eq!(r.samples, s.samples_per_frame() - s.startup_skips());
 }

@@ -71,7 +71,7 @@ fn random_feasible_mixes() {
         let opts = RunOptions::default();
         let r = run_dut(&s, &mut ModelDut::new(&s), 2, &opts, "model", None);
         assert!(r.ok, "seed {seed}:\n{text}\n{}", r.summary());
-        assert_eq!(r.samples, 2 * s.samples_per_frame());
+        assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
         let m = cosim::run(&s, cosim::Backend::Model, 10, &cosim::SimOptions::default()).unwrap();
         assert!(m.ok, "seed {seed}: {}", m.summary());
         if let Ok(mut dut) = cosim::RustHdlDut::new(&s) {

@@ -18,11 +18,11 @@ fn main() {
     sim.step(true, 0);
     let t0 = Instant::now();
     let mut samples = 0u64;
-    let mut miso = 0u8;
+    let mut miso = 0u64;
     for c in 0..cycles {
         let p = sim.step(false, miso);
         samples += p.sample_valid as u64;
-        miso = (c as u8).wrapping_mul(37) ^ p.sclk;
+        miso = (c as u8).wrapping_mul(37) as u64 ^ p.sclk as u64;
     }
     let dt = t0.elapsed().as_secs_f64();
     println!(

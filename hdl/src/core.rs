@@ -4,7 +4,7 @@
 //! simulator every flip-flop sees the clock edge in the same pass):
 //!
 //! ```text
-//! Core                    fixed-maximum ports (8 branches, 64 mux enables, 8-bit channel)
+//! Core                    fixed-maximum ports (16 branches, 64 mux enables, 10-bit channel)
 //!  |- timing: TimingGen   cycle-in-slot counter, slot-in-frame counter, slot-start strobes
 //!  |- seqs: Vec<SpiSeq>   one SPI sequencer per distinct SPI timing (usually one):
 //!  |                      CS/SCLK levels, capture and completion strobes for every slot
@@ -12,7 +12,7 @@
 //!  |    |- rom: SlotRom   that branch's column of the frame table (BRAM-friendly)
 //!  |    `- DFFs           "converts this slot" flag, CS/SCLK outputs gated by it,
 //!  |                      MISO shift register, channel, mux control
-//!  `- merge: Merger       8-lane pending set + lowest-branch-first sample stream
+//!  `- merge: Merger       pending set + lowest-branch-first sample stream (Verilog over the mix's lanes)
 //! ```
 //!
 //! No literal appears in a kernel: every number is a sized `Constant`, so the
@@ -645,27 +645,18 @@ impl Logic for BranchUnit {
 // Merged sample stream
 // ---------------------------------------------------------------------------
 
+/// P(c) = pending completions plus this cycle's; the lowest branch in it
+/// leaves in the next cycle (docs/timing.md, "Merged sample stream").
+/// Fixed-maximum lanes (`MAX_BRANCHES`); the update is a loop and the
+/// Verilog a priority chain over the mix's branches only, generated per mix,
+/// so the lanes a mix does not have cost nothing.
 #[derive(LogicBlock)]
 pub struct Merger {
     pub clock: Signal<In, Clock>,
     pub rst: Signal<In, Bit>,
     pub done: Signal<In, Bits<MAX_BRANCHES>>,
-    pub ch0: Signal<In, Bits<CH_BITS>>,
-    pub ch1: Signal<In, Bits<CH_BITS>>,
-    pub ch2: Signal<In, Bits<CH_BITS>>,
-    pub ch3: Signal<In, Bits<CH_BITS>>,
-    pub ch4: Signal<In, Bits<CH_BITS>>,
-    pub ch5: Signal<In, Bits<CH_BITS>>,
-    pub ch6: Signal<In, Bits<CH_BITS>>,
-    pub ch7: Signal<In, Bits<CH_BITS>>,
-    pub v0: Signal<In, Bits<14>>,
-    pub v1: Signal<In, Bits<14>>,
-    pub v2: Signal<In, Bits<14>>,
-    pub v3: Signal<In, Bits<14>>,
-    pub v4: Signal<In, Bits<14>>,
-    pub v5: Signal<In, Bits<14>>,
-    pub v6: Signal<In, Bits<14>>,
-    pub v7: Signal<In, Bits<14>>,
+    pub ch: [Signal<In, Bits<CH_BITS>>; MAX_BRANCHES],
+    pub v: [Signal<In, Bits<14>>; MAX_BRANCHES],
     pub valid: Signal<Out, Bit>,
     pub channel: Signal<Out, Bits<CH_BITS>>,
     pub value: Signal<Out, Bits<14>>,
@@ -673,43 +664,18 @@ pub struct Merger {
     r_ch: DFF<Bits<CH_BITS>>,
     r_val: DFF<Bits<14>>,
     pend: DFF<Bits<MAX_BRANCHES>>,
-    p: Signal<Local, Bits<MAX_BRANCHES>>,
-    k_m0: Constant<Bits<MAX_BRANCHES>>,
-    k_m1: Constant<Bits<MAX_BRANCHES>>,
-    k_m2: Constant<Bits<MAX_BRANCHES>>,
-    k_m3: Constant<Bits<MAX_BRANCHES>>,
-    k_m4: Constant<Bits<MAX_BRANCHES>>,
-    k_m5: Constant<Bits<MAX_BRANCHES>>,
-    k_m6: Constant<Bits<MAX_BRANCHES>>,
-    k_m7: Constant<Bits<MAX_BRANCHES>>,
-    k_zero: Constant<Bits<MAX_BRANCHES>>,
-    k_ch_zero: Constant<Bits<CH_BITS>>,
-    k_val_zero: Constant<Bits<14>>,
+    /// Branches of the mix (lanes `0..nb` are used).
+    _nb: usize,
 }
 
-impl Default for Merger {
-    fn default() -> Merger {
-        let m = |b: u64| c::<MAX_BRANCHES>(0xff & !(1u64 << b));
+impl Merger {
+    fn new(nb: usize) -> Merger {
         Merger {
             clock: Default::default(),
             rst: Default::default(),
             done: Default::default(),
-            ch0: Default::default(),
-            ch1: Default::default(),
-            ch2: Default::default(),
-            ch3: Default::default(),
-            ch4: Default::default(),
-            ch5: Default::default(),
-            ch6: Default::default(),
-            ch7: Default::default(),
-            v0: Default::default(),
-            v1: Default::default(),
-            v2: Default::default(),
-            v3: Default::default(),
-            v4: Default::default(),
-            v5: Default::default(),
-            v6: Default::default(),
-            v7: Default::default(),
+            ch: std::array::from_fn(|_| Default::default()),
+            v: std::array::from_fn(|_| Default::default()),
             valid: Default::default(),
             channel: Default::default(),
             value: Default::default(),
@@ -717,72 +683,99 @@ impl Default for Merger {
             r_ch: Default::default(),
             r_val: Default::default(),
             pend: Default::default(),
-            p: Default::default(),
-            k_m0: m(0),
-            k_m1: m(1),
-            k_m2: m(2),
-            k_m3: m(3),
-            k_m4: m(4),
-            k_m5: m(5),
-            k_m6: m(6),
-            k_m7: m(7),
-            k_zero: c(0),
-            k_ch_zero: c(0),
-            k_val_zero: c(0),
+            _nb: nb,
         }
     }
 }
 
 impl Logic for Merger {
-    #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(self, clock, r_valid, r_ch, r_val, pend);
-        // P(c): pending completions plus those of this cycle.
-        self.p.next = self.pend.q.val() | self.done.val();
-        self.r_valid.d.next = self.p.val().any();
-        self.pend.d.next = self.k_zero.val();
-        if self.p.val().get_bit(0) {
-            self.r_ch.d.next = self.ch0.val();
-            self.r_val.d.next = self.v0.val();
-            self.pend.d.next = self.p.val() & self.k_m0.val();
-        } else if self.p.val().get_bit(1) {
-            self.r_ch.d.next = self.ch1.val();
-            self.r_val.d.next = self.v1.val();
-            self.pend.d.next = self.p.val() & self.k_m1.val();
-        } else if self.p.val().get_bit(2) {
-            self.r_ch.d.next = self.ch2.val();
-            self.r_val.d.next = self.v2.val();
-            self.pend.d.next = self.p.val() & self.k_m2.val();
-        } else if self.p.val().get_bit(3) {
-            self.r_ch.d.next = self.ch3.val();
-            self.r_val.d.next = self.v3.val();
-            self.pend.d.next = self.p.val() & self.k_m3.val();
-        } else if self.p.val().get_bit(4) {
-            self.r_ch.d.next = self.ch4.val();
-            self.r_val.d.next = self.v4.val();
-            self.pend.d.next = self.p.val() & self.k_m4.val();
-        } else if self.p.val().get_bit(5) {
-            self.r_ch.d.next = self.ch5.val();
-            self.r_val.d.next = self.v5.val();
-            self.pend.d.next = self.p.val() & self.k_m5.val();
-        } else if self.p.val().get_bit(6) {
-            self.r_ch.d.next = self.ch6.val();
-            self.r_val.d.next = self.v6.val();
-            self.pend.d.next = self.p.val() & self.k_m6.val();
-        } else if self.p.val().get_bit(7) {
-            self.r_ch.d.next = self.ch7.val();
-            self.r_val.d.next = self.v7.val();
-            self.pend.d.next = self.p.val() & self.k_m7.val();
+        let p = self.pend.q.val().to_u64() | self.done.val().to_u64();
+        self.r_valid.d.next = p != 0;
+        self.pend.d.next = 0u64.into();
+        if p != 0 {
+            let b = p.trailing_zeros() as usize;
+            self.r_ch.d.next = self.ch[b].val();
+            self.r_val.d.next = self.v[b].val();
+            self.pend.d.next = (p & (p - 1)).into();
         }
         if self.rst.val() {
             self.r_valid.d.next = false;
-            self.r_ch.d.next = self.k_ch_zero.val();
-            self.r_val.d.next = self.k_val_zero.val();
-            self.pend.d.next = self.k_zero.val();
+            self.r_ch.d.next = 0u64.into();
+            self.r_val.d.next = 0u64.into();
+            self.pend.d.next = 0u64.into();
         }
         self.valid.next = self.r_valid.q.val();
         self.channel.next = self.r_ch.q.val();
         self.value.next = self.r_val.q.val();
+    }
+
+    fn connect(&mut self) {
+        self.r_valid.clock.connect();
+        self.r_valid.d.connect();
+        self.r_ch.clock.connect();
+        self.r_ch.d.connect();
+        self.r_val.clock.connect();
+        self.r_val.d.connect();
+        self.pend.clock.connect();
+        self.pend.d.connect();
+        self.valid.connect();
+        self.channel.connect();
+        self.value.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        let nb = self._nb;
+        let w = MAX_BRANCHES;
+        let mut s = format!(
+            "// P(c) of the mix's {nb} lanes: pending plus this cycle's completions\nwire [{}:0] p = pend$q[{0}:0] | done[{0}:0];\n\n",
+            nb - 1
+        );
+        s.push_str("always @(*) begin\n");
+        for f in ["r_valid", "r_ch", "r_val", "pend"] {
+            s.push_str(&format!("  {f}$clock = clock;\n"));
+        }
+        s.push_str(&format!(
+            "  r_valid$d = |p;\n  r_ch$d = r_ch$q;\n  r_val$d = r_val$q;\n  pend$d = {w}'h0;\n"
+        ));
+        for b in 0..nb {
+            let kw = if b == 0 { "if" } else { "else if" };
+            let mut rest = String::new();
+            if nb > 1 {
+                rest = format!("p & {nb}'h{:x}", ((1u64 << nb) - 1) & !(1u64 << b));
+            }
+            let pend = if nb == 1 {
+                format!("{w}'h0")
+            } else if nb < w {
+                format!("{{{}'h0, {rest}}}", w - nb)
+            } else {
+                rest
+            };
+            s.push_str(&format!(
+                "  {kw} (p[{b}]) begin\n    r_ch$d = ch${b};\n    r_val$d = v${b};\n    pend$d = {pend};\n  end\n"
+            ));
+        }
+        s.push_str(&format!(
+            "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = 14'h0;\n    pend$d = {w}'h0;\n  end\n"
+        ));
+        s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
+        let mut unused: Vec<String> = Vec::new();
+        if nb < w {
+            unused.push(format!("done[{}:{nb}]", w - 1));
+            unused.push(format!("pend$q[{}:{nb}]", w - 1));
+            for b in nb..w {
+                unused.push(format!("ch${b}"));
+                unused.push(format!("v${b}"));
+            }
+        }
+        if !unused.is_empty() {
+            s.push_str(&format!(
+                "\n// lanes of branches the mix does not have (tied to zero by the core)\nwire unused_lanes = |{{{}}};\n",
+                unused.join(", ")
+            ));
+        }
+        Verilog::Custom(s)
     }
 }
 
@@ -812,6 +805,8 @@ pub struct Core {
     _seq_of: Vec<usize>,
     /// The value last written to `mux_en.next` (simulation only).
     _mux_en: u64,
+    /// The value last written to `mux_sel.next` (simulation only).
+    _mux_sel: u64,
 }
 
 impl Core {
@@ -830,10 +825,11 @@ impl Core {
             timing: TimingGen::new(plan),
             seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
             branches: plan.branches.iter().map(BranchUnit::new).collect(),
-            merge: Merger::default(),
+            merge: Merger::new(plan.branches.len()),
             _devices: plan.branches.iter().map(|b| b.devices).collect(),
             _seq_of: plan.branches.iter().map(|b| b.seq).collect(),
             _mux_en: 0,
+            _mux_sel: 0,
         }
     }
 }
@@ -849,6 +845,11 @@ impl Core {
     /// `mux_en` as a number (the value of the `mux_en` signal).
     pub fn mux_en_u64(&self) -> u64 {
         self._mux_en
+    }
+
+    /// `mux_sel` as a number (the value of the `mux_sel` signal).
+    pub fn mux_sel_u64(&self) -> u64 {
+        self._mux_sel
     }
 
     /// Put `level` on every clock signal of the hierarchy at once: the
@@ -957,17 +958,17 @@ impl Logic for Core {
         // Unused lanes read as all ones on CS/SCLK (idle level) in the core;
         // the wrapper only exposes the mix's branches.
         let nb = self.branches.len();
-        let idle: u64 = if nb >= MAX_BRANCHES {
-            0
-        } else {
-            (0xffu64 >> nb) << nb
-        };
+        let idle: u64 = ((1u64 << MAX_BRANCHES) - 1) & !((1u64 << nb) - 1);
         self.adc_cs_n.next = (cs | idle).into();
         self.adc_sclk.next = (sclk | idle).into();
-        self.mux_sel.next = sel.into();
-        // `mux_en` is 64 bits wide, which rust-hdl stores as `[bool; 64]`:
-        // converting it on every evaluation pass dominated the simulation,
-        // so it is written only when its value changes (same signal value).
+        // `mux_sel` (48 bits) and `mux_en` (64 bits) are wider than rust-hdl's
+        // short bit vectors (32 bits), so it stores them as `[bool; N]`:
+        // converting them on every evaluation pass dominated the simulation,
+        // so they are written only when their value changes (same signal value).
+        if sel != self._mux_sel {
+            self._mux_sel = sel;
+            self.mux_sel.next = sel.into();
+        }
         let en = en as u64;
         if en != self._mux_en {
             self._mux_en = en;
@@ -976,19 +977,9 @@ impl Logic for Core {
         self.merge.done.next = done.into();
         // Lanes >= nb keep their default 0 (the glue ties them to zero).
         let m = &mut self.merge;
-        let lanes = [
-            (&mut m.ch0, &mut m.v0),
-            (&mut m.ch1, &mut m.v1),
-            (&mut m.ch2, &mut m.v2),
-            (&mut m.ch3, &mut m.v3),
-            (&mut m.ch4, &mut m.v4),
-            (&mut m.ch5, &mut m.v5),
-            (&mut m.ch6, &mut m.v6),
-            (&mut m.ch7, &mut m.v7),
-        ];
-        for (b, (ch, v)) in lanes.into_iter().enumerate().take(nb) {
-            ch.next = chs[b].into();
-            v.next = vals[b].into();
+        for b in 0..nb {
+            m.ch[b].next = chs[b].into();
+            m.v[b].next = vals[b].into();
         }
         self.sample_valid.next = self.merge.valid.val();
         self.sample_channel.next = self.merge.channel.val();
@@ -1020,22 +1011,10 @@ impl Logic for Core {
             u.miso.connect();
         }
         self.merge.done.connect();
-        self.merge.ch0.connect();
-        self.merge.ch1.connect();
-        self.merge.ch2.connect();
-        self.merge.ch3.connect();
-        self.merge.ch4.connect();
-        self.merge.ch5.connect();
-        self.merge.ch6.connect();
-        self.merge.ch7.connect();
-        self.merge.v0.connect();
-        self.merge.v1.connect();
-        self.merge.v2.connect();
-        self.merge.v3.connect();
-        self.merge.v4.connect();
-        self.merge.v5.connect();
-        self.merge.v6.connect();
-        self.merge.v7.connect();
+        for b in 0..MAX_BRANCHES {
+            self.merge.ch[b].connect();
+            self.merge.v[b].connect();
+        }
         self.adc_cs_n.connect();
         self.adc_sclk.connect();
         self.mux_sel.connect();
@@ -1130,11 +1109,11 @@ fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> Str
     for b in 0..MAX_BRANCHES {
         if b < nb {
             s.push_str(&format!(
-                "  merge$ch{b} = branches${b}$res_ch;\n  merge$v{b} = branches${b}$res_val;\n"
+                "  merge$ch${b} = branches${b}$res_ch;\n  merge$v${b} = branches${b}$res_val;\n"
             ));
         } else {
             s.push_str(&format!(
-                "  merge$ch{b} = {CH_BITS}'h0;\n  merge$v{b} = 14'h0;\n"
+                "  merge$ch${b} = {CH_BITS}'h0;\n  merge$v${b} = 14'h0;\n"
             ));
         }
     }

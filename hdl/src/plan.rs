@@ -43,7 +43,8 @@ pub struct BranchRom {
     pub reset_sel: u32,
     /// One-hot mux enable of the first instant of frame 0 (0 if the branch never converts).
     pub reset_en: u64,
-    /// Whether the branch converts in slot 0.
+    /// Whether the branch converts in slot 0 of frame 0, right after reset
+    /// (docs/timing.md, "Start-up").
     pub conv0: bool,
     pub devices: usize,
     /// First device bit of this branch in the `mux_en` port.
@@ -322,7 +323,10 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
             seq,
             reset_sel: 0,
             reset_en: 0,
-            conv0: slots[0].is_some(),
+            // docs/timing.md, "Start-up": the mux takes its reset value at
+            // the first reset edge, one cycle before cycle 0 at the least;
+            // an instant at cycle 0 it cannot have settled for is skipped.
+            conv0: slots[0].is_some() && bp.settle_cycles <= 1,
             devices,
             en_offset,
             compact: None,

@@ -35,7 +35,7 @@ pub struct RtlSim {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct PinReader {
     nb: usize,
-    lanes: u8,
+    lanes: u16,
     ch_mask: u16,
 }
 
@@ -44,7 +44,7 @@ impl PinReader {
         let nb = p.branches.len();
         PinReader {
             nb,
-            lanes: ((1u32 << nb) - 1) as u8,
+            lanes: ((1u32 << nb) - 1) as u16,
             ch_mask: ((1u32 << p.channel_bits) - 1) as u16,
         }
     }
@@ -54,9 +54,9 @@ impl PinReader {
 #[inline]
 pub(crate) fn read_pins(c: &Core, r: &PinReader) -> Pins {
     Pins {
-        cs_n: c.adc_cs_n.val().to_u64() as u8 & r.lanes,
-        sclk: c.adc_sclk.val().to_u64() as u8 & r.lanes,
-        mux_sel: c.mux_sel.val().to_u64() as u32,
+        cs_n: c.adc_cs_n.val().to_u64() as u16 & r.lanes,
+        sclk: c.adc_sclk.val().to_u64() as u16 & r.lanes,
+        mux_sel: c.mux_sel_u64(),
         mux_en: c.mux_en_u64(),
         sample_valid: c.sample_valid.val(),
         sample_channel: c.sample_channel.val().to_u64() as u16 & r.ch_mask,
@@ -112,16 +112,17 @@ impl RtlSim {
     }
 
     /// Apply one rising clock edge; see the type's documentation.
-    pub fn step(&mut self, rst: bool, miso: u8) -> Pins {
+    pub fn step(&mut self, rst: bool, miso: u64) -> Pins {
+        let miso = miso & self.reader.lanes as u64;
         let c = &mut *self.core;
         // Falling edge: no logic reacts to it, so it only has to reach every
         // flip-flop's clock (done directly by `drive_clock`); evaluation
         // passes are needed only when an input changes and its new value
         // has to propagate to the flip-flops' D inputs.
         c.drive_clock(false);
-        if c.rst.val() != rst || c.adc_miso.val().to_u64() != miso as u64 {
+        if c.rst.val() != rst || c.adc_miso.val().to_u64() != miso {
             c.rst.next = rst;
-            c.adc_miso.next = (miso as u64).into();
+            c.adc_miso.next = miso.into();
             let ok = settle(c, &mut self.passes);
             debug_assert!(ok, "combinational logic did not settle");
         }

@@ -57,8 +57,8 @@ impl StockRun {
 /// The MISO stimulus of [`stock_simulation_cycles`] and [`rtlsim_cycles`]:
 /// the value of `adc_miso` during cycle `cycle`, given that cycle's pins
 /// (an arbitrary deterministic pattern that also follows SCLK).
-pub fn pattern_miso(cycle: u64, pins: &Pins) -> u8 {
-    (cycle as u8).wrapping_mul(37) ^ pins.sclk
+pub fn pattern_miso(cycle: u64, pins: &Pins) -> u64 {
+    (cycle as u8).wrapping_mul(37) as u64 ^ pins.sclk as u64
 }
 
 /// Run the gateware of `s` for one reset cycle and then `cycles` cycles
@@ -94,7 +94,7 @@ pub fn stock_simulation_cycles(s: &lut_gen::Schedule, cycles: u64) -> Result<Sto
             let pins = read_pins(&x, &reader);
             run.record(c, pins);
             // MISO during cycle c, sampled by the edge that begins c + 1.
-            x.adc_miso.next = (pattern_miso(c, &pins) as u64).into();
+            x.adc_miso.next = pattern_miso(c, &pins).into();
         }
         *tb_out.lock().unwrap() = run;
         sim.done(x)
@@ -121,7 +121,7 @@ pub fn rtlsim_cycles(s: &lut_gen::Schedule, cycles: u64) -> Result<StockRun, Hdl
         reset_pins: sim.step(true, 0),
         ..Default::default()
     };
-    let mut miso = 0u8;
+    let mut miso = 0u64;
     for c in 0..cycles {
         let pins = sim.step(false, miso);
         run.record(c, pins);

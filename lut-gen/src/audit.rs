@@ -34,6 +34,9 @@ pub struct AuditReport {
     pub lut_entries_full: usize,
     pub errors: Vec<String>,
     pub warnings: Vec<String>,
+    /// Facts worth knowing that are neither errors nor warnings (e.g. an
+    /// SCLK the clock cannot give exactly).
+    pub notes: Vec<String>,
     pub branches: Vec<BranchAudit>,
     /// What each branch's converter allows (throughput, bits, chain).
     pub parts: Vec<PartAudit>,
@@ -102,27 +105,88 @@ impl PartAudit {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BranchAudit {
     pub name: String,
-    /// Conversions per frame over slots per frame.
+    /// Of the slot grid: conversions per frame over slots per frame.
     pub utilization: f64,
     pub conversions_per_frame: u64,
     pub slots_per_frame: u64,
+    /// Samples per second the branch's channels demand (sum of their rates).
+    pub demand_sps: u64,
+    /// The ADC's maximum throughput (datasheet).
+    pub adc_max_sps: u64,
+    /// Of the ADC: `demand_sps / adc_max_sps`.
+    pub adc_utilization: f64,
+    /// SCLK asked for (`sclk_hz` in the mix, or the ADC's maximum by default).
+    pub sclk_requested_hz: u64,
+    /// Whether the mix sets `sclk_hz` (else the ADC's maximum is asked for).
+    pub sclk_explicit: bool,
+    /// SCLK used: `clock_hz / sclk_div`.
     pub sclk_hz: f64,
+    /// System clocks per SCLK period (even, so the duty is exactly 50 %).
+    pub sclk_div: u64,
     pub min_slot_cycles: u64,
     pub free_mux_inputs: u32,
     /// How many more channels of each rate present in the mix would still fit.
     pub headroom: Vec<Headroom>,
 }
 
+/// Which limit ends a branch's headroom at one rate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Limit {
+    /// No free mux input left for another channel.
+    MuxInputs,
+    /// The ADC's maximum samples per second.
+    AdcThroughput,
+    /// The free slots of the slot grid.
+    SlotGrid,
+}
+
+impl Limit {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Limit::MuxInputs => "free mux inputs",
+            Limit::AdcThroughput => "ADC throughput",
+            Limit::SlotGrid => "slot grid",
+        }
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Headroom {
     pub rate_hz: u64,
-    /// Further channels at this rate that the branch's free slots hold.
+    /// Further channels at this rate on this branch: the least of the three
+    /// limits below.
     pub more_channels: u64,
+    /// The limit that binds (the first of inputs, ADC, grid at the minimum).
+    pub binding: Limit,
+    /// Channels the free mux inputs allow.
+    pub by_mux_inputs: u64,
+    /// Channels the ADC's remaining throughput allows: `(max_sps - demand) / rate`.
+    pub by_adc_throughput: u64,
+    /// Channels the free slots of the current slot grid hold.
+    pub by_slot_grid: u64,
+    /// A finer slot grid (more slots per slice, still legal for every
+    /// branch) on which more would fit; `None` when none would.
+    pub finer_grid: Option<FinerGrid>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FinerGrid {
+    pub slots_per_slice: u64,
+    pub slot_cycles: u64,
+    /// Further channels at this rate with that grid (least of the limits).
+    pub more_channels: u64,
+    pub binding: Limit,
+    /// Channels that grid's free slots hold after re-placing the branch's channels.
+    pub by_slot_grid: u64,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ChannelAudit {
     pub name: String,
+    /// The value `sample_channel` carries for this channel: its index in the
+    /// mix file, 0-based, in file order of the `[[channel]]` tables.
+    pub sample_channel: usize,
     pub branch: String,
     pub requested_hz: u64,
     pub achieved_hz: f64,
@@ -138,6 +202,9 @@ pub struct ChannelAudit {
     pub bandwidth_hz: Option<f64>,
     /// `rate / 2`, against which `bandwidth_hz` is checked.
     pub nyquist_hz: f64,
+    /// Where a tone at `bandwidth_hz` shows up when that is above Nyquist:
+    /// the folded frequency `|f - k rate|` nearest 0 ([`alias_hz`]).
+    pub alias_hz: Option<f64>,
 }
 
 impl AuditReport {
@@ -147,6 +214,7 @@ impl AuditReport {
         let mix = &s.mix;
         let mut warnings = Vec::new();
         let mut errors = Vec::new();
+        let mut notes = Vec::new();
 
         // Instants per branch over one frame, straight from the table.
         let branch_slots: Vec<Vec<u64>> = (0..nb)
@@ -205,12 +273,20 @@ impl AuditReport {
                 ));
             }
             let nyquist = ch.rate_hz as f64 / 2.0;
+            let mut alias = None;
             if let Some(bw) = ch.bandwidth_hz {
+                if bw > nyquist {
+                    alias = Some(alias_hz(bw, ch.rate_hz as f64));
+                }
                 if bw >= nyquist {
                     warnings.push(format!(
-                        "`{}`: bandwidth {bw} Hz is not below Nyquist ({nyquist} Hz at {} Hz): it will alias; sample at more than {} Hz",
+                        "`{}`: bandwidth {bw} Hz is not below Nyquist ({nyquist} Hz at {} Hz): it will alias{}; sample at more than {} Hz",
                         ch.name,
                         ch.rate_hz,
+                        match alias {
+                            Some(a) => format!(" (a {bw} Hz tone shows as {} Hz)", fmt_hz(a)),
+                            None => String::new(),
+                        },
                         2.0 * bw
                     ));
                 }
@@ -223,6 +299,7 @@ impl AuditReport {
             }
             channels.push(ChannelAudit {
                 name: ch.name.clone(),
+                sample_channel: c,
                 branch: mix.branches[ch.branch].name.clone(),
                 requested_hz: ch.rate_hz,
                 achieved_hz: if lo > 0 {
@@ -240,29 +317,18 @@ impl AuditReport {
                 settle_required_ns: required,
                 bandwidth_hz: ch.bandwidth_hz,
                 nyquist_hz: nyquist,
+                alias_hz: alias,
             });
         }
 
         let mut rates: Vec<u64> = mix.channels.iter().map(|c| c.rate_hz).collect();
         rates.sort_unstable();
         rates.dedup();
-        let branches = (0..nb)
+        let finer = FinerGrids::of(s);
+        let branches: Vec<BranchAudit> = (0..nb)
             .map(|b| {
                 let used = branch_slots[b].len() as u64;
-                let mut free: Vec<bool> =
-                    (0..g.frame_slots).map(|t| s.at(t, b).is_none()).collect();
-                let headroom = rates
-                    .iter()
-                    .map(|&r| Headroom {
-                        rate_hz: r,
-                        more_channels: more_that_fit(
-                            &mut free.clone(),
-                            g.frame_slots,
-                            mix.samples_per_frame(r),
-                        ),
-                    })
-                    .collect();
-                free.clear();
+                let free: Vec<bool> = (0..g.frame_slots).map(|t| s.at(t, b).is_none()).collect();
                 let br = &mix.branches[b];
                 let inputs = br.mux_devices * br.mux.inputs;
                 let taken = mix
@@ -272,18 +338,82 @@ impl AuditReport {
                     .map(|c| c.input)
                     .collect::<std::collections::BTreeSet<_>>()
                     .len() as u32;
+                // A chain of N parts gives N samples per conversion.
+                let adc_max_sps = br.adc.max_sps * br.chain as u64;
+                let free_inputs = inputs.saturating_sub(taken);
+                let demand_sps: u64 = mix
+                    .channels
+                    .iter()
+                    .filter(|c| c.branch == b)
+                    .map(|c| c.rate_hz)
+                    .sum();
+                let headroom = rates
+                    .iter()
+                    .map(|&r| {
+                        let by_grid = more_that_fit(
+                            &mut free.clone(),
+                            g.frame_slots,
+                            mix.samples_per_frame(r),
+                        );
+                        let by_adc = adc_max_sps.saturating_sub(demand_sps) / r;
+                        let (more, binding) = least(free_inputs as u64, by_adc, by_grid);
+                        let finer_grid = finer
+                            .best(
+                                b,
+                                mix.samples_per_frame(r),
+                                more,
+                                free_inputs as u64,
+                                by_adc,
+                            )
+                            .filter(|f| f.more_channels > more);
+                        Headroom {
+                            rate_hz: r,
+                            more_channels: more,
+                            binding,
+                            by_mux_inputs: free_inputs as u64,
+                            by_adc_throughput: by_adc,
+                            by_slot_grid: by_grid,
+                            finer_grid,
+                        }
+                    })
+                    .collect();
+                let spi = &s.branches[b].spi;
                 BranchAudit {
                     name: br.name.clone(),
                     utilization: used as f64 / g.frame_slots as f64,
                     conversions_per_frame: used,
                     slots_per_frame: g.frame_slots,
-                    sclk_hz: s.branches[b].spi.sclk_hz,
+                    demand_sps,
+                    adc_max_sps,
+                    adc_utilization: demand_sps as f64 / adc_max_sps as f64,
+                    sclk_requested_hz: br.sclk_hz,
+                    sclk_explicit: br.sclk_explicit,
+                    sclk_hz: spi.sclk_hz,
+                    sclk_div: spi.sclk_div,
                     min_slot_cycles: s.branches[b].min_slot_cycles,
-                    free_mux_inputs: inputs - taken,
+                    free_mux_inputs: free_inputs,
                     headroom,
                 }
             })
             .collect();
+
+        for b in &branches {
+            if b.sclk_hz != b.sclk_requested_hz as f64 {
+                notes.push(format!(
+                    "branch `{}`: SCLK {} Hz {}, {} Hz used = {} Hz / {} (SCLK comes from even dividers of the clock only)",
+                    b.name,
+                    b.sclk_requested_hz,
+                    if b.sclk_explicit {
+                        "requested"
+                    } else {
+                        "asked by default (the ADC's maximum; no sclk_hz in the mix)"
+                    },
+                    fmt_hz(b.sclk_hz),
+                    g.clock_hz,
+                    b.sclk_div
+                ));
+            }
+        }
 
         let aggregate_hz: u64 = mix.channels.iter().map(|c| c.rate_hz).sum();
         let adc_limit_hz: u64 = mix
@@ -315,6 +445,7 @@ impl AuditReport {
             lut_entries_full: g.frame_slots as usize * nb,
             errors,
             warnings,
+            notes,
             branches,
             channels,
         }
@@ -369,6 +500,7 @@ impl AuditReport {
             lut_entries_full: 0,
             errors,
             warnings: Vec::new(),
+            notes: Vec::new(),
             branches: why
                 .branches
                 .iter()
@@ -378,7 +510,22 @@ impl AuditReport {
                         / b.capacity_slots_per_frame.max(1) as f64,
                     conversions_per_frame: b.demand_slots_per_frame,
                     slots_per_frame: b.capacity_slots_per_frame,
+                    demand_sps: b.demand_hz,
+                    adc_max_sps: mix.branch_index(&b.name).map_or(0, |i| {
+                        mix.branches[i].adc.max_sps * mix.branches[i].chain as u64
+                    }),
+                    adc_utilization: mix.branch_index(&b.name).map_or(0.0, |i| {
+                        b.demand_hz as f64
+                            / (mix.branches[i].adc.max_sps * mix.branches[i].chain as u64) as f64
+                    }),
+                    sclk_requested_hz: mix
+                        .branch_index(&b.name)
+                        .map_or(0, |i| mix.branches[i].sclk_hz),
+                    sclk_explicit: mix
+                        .branch_index(&b.name)
+                        .is_some_and(|i| mix.branches[i].sclk_explicit),
                     sclk_hz: 0.0,
+                    sclk_div: 0,
                     min_slot_cycles: 0,
                     free_mux_inputs: 0,
                     headroom: Vec::new(),
@@ -436,25 +583,62 @@ impl AuditReport {
         if !self.branches.is_empty() {
             let _ = writeln!(
                 o,
-                "\n{:<16} {:>8} {:>11} {:>10} {:>11}  headroom (more channels at rate)",
-                "branch", "util %", "conv/frame", "SCLK Hz", "free inputs"
+                "\n{:<16} {:>11} {:>11} {:>8} {:>11} {:>8} {:>10} {:>11}",
+                "branch",
+                "demand S/s",
+                "ADC max S/s",
+                "of ADC %",
+                "conv/frame",
+                "of grid %",
+                "SCLK Hz",
+                "free inputs"
             );
             for b in &self.branches {
-                let head: Vec<String> = b
-                    .headroom
-                    .iter()
-                    .map(|h| format!("{}@{}Hz", h.more_channels, h.rate_hz))
-                    .collect();
                 let _ = writeln!(
                     o,
-                    "{:<16} {:>8.1} {:>11} {:>10.0} {:>11}  {}",
+                    "{:<16} {:>11} {:>11} {:>8.1} {:>11} {:>8.1} {:>10} {:>11}",
                     b.name,
-                    b.utilization * 100.0,
+                    b.demand_sps,
+                    b.adc_max_sps,
+                    b.adc_utilization * 100.0,
                     format!("{}/{}", b.conversions_per_frame, b.slots_per_frame),
-                    b.sclk_hz,
-                    b.free_mux_inputs,
-                    head.join(" ")
+                    b.utilization * 100.0,
+                    fmt_hz(b.sclk_hz),
+                    b.free_mux_inputs
                 );
+            }
+            let _ = writeln!(
+                o,
+                "of ADC = demanded samples/s over the ADC's maximum; of grid = conversions over the slots of the slot grid"
+            );
+            let _ = writeln!(
+                o,
+                "\nheadroom: more channels per rate = the least of what the free mux inputs, the ADC throughput and the slot grid allow"
+            );
+            for b in &self.branches {
+                for h in &b.headroom {
+                    let mut line = format!(
+                        "  {:<16} {:>7} Hz: {:>4} more (limit: {}; inputs {}, ADC {}, grid {})",
+                        b.name,
+                        h.rate_hz,
+                        h.more_channels,
+                        h.binding.describe(),
+                        h.by_mux_inputs,
+                        h.by_adc_throughput,
+                        h.by_slot_grid
+                    );
+                    if let Some(f) = &h.finer_grid {
+                        let _ = write!(
+                            line,
+                            "; up to {} more with a {}-slot slice (limit: {}; that grid: {})",
+                            f.more_channels,
+                            f.slots_per_slice,
+                            f.binding.describe(),
+                            f.by_slot_grid
+                        );
+                    }
+                    let _ = writeln!(o, "{line}");
+                }
             }
         }
         if !self.parts.is_empty() {
@@ -495,8 +679,9 @@ impl AuditReport {
         if !self.channels.is_empty() {
             let _ = writeln!(
                 o,
-                "\n{:<12} {:<12} {:>8} {:>11} {:>6} {:>10} {:>6} {:>9} {:>8} {:>12} {:>9}",
+                "\n{:<12} {:>3} {:<12} {:>8} {:>11} {:>6} {:>10} {:>6} {:>9} {:>8} {:>12} {:>9} {:>6}",
                 "channel",
+                "#",
                 "branch",
                 "rate Hz",
                 "achieved",
@@ -506,13 +691,15 @@ impl AuditReport {
                 "first",
                 "dev.sel",
                 "settle ns",
-                "bw/nyq"
+                "bw/nyq",
+                "alias"
             );
             for c in &self.channels {
                 let _ = writeln!(
                     o,
-                    "{:<12} {:<12} {:>8} {:>11.3} {:>6} {:>10} {:>6} {:>9} {:>8} {:>12} {:>9}",
+                    "{:<12} {:>3} {:<12} {:>8} {:>11.3} {:>6} {:>10} {:>6} {:>9} {:>8} {:>12} {:>9} {:>6}",
                     c.name,
+                    c.sample_channel,
                     c.branch,
                     c.requested_hz,
                     c.achieved_hz,
@@ -525,9 +712,21 @@ impl AuditReport {
                     match c.bandwidth_hz {
                         Some(bw) => format!("{bw}/{}", c.nyquist_hz),
                         None => "-".into(),
-                    }
+                    },
+                    c.alias_hz.map_or("-".into(), fmt_hz)
                 );
             }
+            let _ = writeln!(
+                o,
+                "# = the value `sample_channel` carries for the channel: its index in the mix file, 0-based, in [[channel]] order"
+            );
+            let _ = writeln!(
+                o,
+                "interval, first: cycles (first = first sampling instant after cycle 0); dev.sel = mux device.select; alias = where a tone at bw shows when bw is above Nyquist"
+            );
+        }
+        for n in &self.notes {
+            let _ = writeln!(o, "note: {n}");
         }
         for w in &self.warnings {
             let _ = writeln!(o, "warning: {w}");
@@ -556,4 +755,335 @@ fn more_that_fit(free: &mut [bool], slots: u64, n: u64) -> u64 {
         }
     }
     count
+}
+
+/// The least of the three headroom limits and which one binds (ties go to
+/// the first of inputs, ADC, grid: the hardest to change).
+fn least(inputs: u64, adc: u64, grid: u64) -> (u64, Limit) {
+    let mut best = (inputs, Limit::MuxInputs);
+    if adc < best.0 {
+        best = (adc, Limit::AdcThroughput);
+    }
+    if grid < best.0 {
+        best = (grid, Limit::SlotGrid);
+    }
+    best
+}
+
+/// Where a tone of `f` Hz sampled at `fs` Hz shows up: the folded frequency
+/// `|f - k fs|` nearest 0, in `0..=fs/2`.
+pub fn alias_hz(f: f64, fs: f64) -> f64 {
+    let r = f.abs().rem_euclid(fs);
+    r.min(fs - r)
+}
+
+/// A frequency as an integer when it is one, else with up to 3 decimals.
+fn fmt_hz(f: f64) -> String {
+    if f.fract() == 0.0 {
+        format!("{f:.0}")
+    } else {
+        let t = format!("{f:.3}");
+        t.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+/// The finer slot grids (more slots per slice than the schedule's, every
+/// slot still at least the longest shortest-legal-slot of all branches,
+/// since the grid is shared) on which every branch's channels place.  On
+/// such a grid a branch's headroom at a rate is found by placing its
+/// channels together with the extra ones, first-fit in period order as the
+/// synthesizer does: exact when the periods are harmonic, a lower bound
+/// otherwise.  Sync groups are not re-checked: synthesizing with
+/// `slots_per_slice` set is the proof.
+struct FinerGrids {
+    /// Per branch, the periods (in frame slots of each grid) are derived
+    /// from these samples-per-frame counts.
+    demand: Vec<Vec<u64>>,
+    /// (slots per slice, slot cycles, frame slots).
+    grids: Vec<(u64, u64, u64)>,
+}
+
+/// Finer grids with more frame slots than this are not examined (the audit
+/// stays quick for one-second frames).
+const FINER_GRID_MAX_FRAME_SLOTS: u64 = 1 << 20;
+
+impl FinerGrids {
+    fn of(s: &Schedule) -> FinerGrids {
+        let g = &s.grid;
+        let mix = &s.mix;
+        let min_slot = s
+            .branches
+            .iter()
+            .map(|b| b.min_slot_cycles)
+            .max()
+            .unwrap_or(1);
+        let demand: Vec<Vec<u64>> = (0..s.branches.len())
+            .map(|b| {
+                mix.channels
+                    .iter()
+                    .filter(|c| c.branch == b)
+                    .map(|c| mix.samples_per_frame(c.rate_hz))
+                    .collect()
+            })
+            .collect();
+        let mut any = mix.clone();
+        any.slots_per_slice = None;
+        let grids = crate::synth::candidate_slots_per_slice(&any, min_slot)
+            .into_iter()
+            .filter(|&sps| sps > g.slots_per_slice)
+            .filter(|&sps| sps * g.slices_per_frame <= FINER_GRID_MAX_FRAME_SLOTS)
+            .map(|sps| (sps, g.slice_cycles / sps, sps * g.slices_per_frame))
+            .filter(|&(sps, _, frame_slots)| {
+                demand.iter().all(|d| place(d, 0, 0, sps, frame_slots))
+            })
+            .collect();
+        FinerGrids { demand, grids }
+    }
+
+    /// The coarsest finer grid that allows the most further channels of `n`
+    /// samples per frame on `branch`, given the limits no grid changes.
+    fn best(&self, branch: usize, n: u64, now: u64, inputs: u64, adc: u64) -> Option<FinerGrid> {
+        let cap = inputs.min(adc);
+        if now >= cap {
+            return None;
+        }
+        let mut best: Option<FinerGrid> = None;
+        for &(sps, slot_cycles, frame_slots) in &self.grids {
+            let d = &self.demand[branch];
+            // Largest k in 0..=cap that places (placement is monotone in k).
+            let (mut lo, mut hi) = (0, cap);
+            while lo < hi {
+                let mid = (lo + hi).div_ceil(2);
+                if place(d, n, mid, sps, frame_slots) {
+                    lo = mid;
+                } else {
+                    hi = mid - 1;
+                }
+            }
+            let (more, binding) = least(inputs, adc, lo);
+            if best.as_ref().is_none_or(|b| more > b.more_channels) {
+                best = Some(FinerGrid {
+                    slots_per_slice: sps,
+                    slot_cycles,
+                    more_channels: more,
+                    binding,
+                    by_slot_grid: lo,
+                });
+            }
+            if more >= cap {
+                break;
+            }
+        }
+        best
+    }
+}
+
+/// Whether progressions of the given samples-per-frame counts, plus `k`
+/// more of `n` each, place first-fit (shortest period first, offsets by slot
+/// in slice first, as the synthesizer orders them) on one branch of a grid
+/// of `sps` slots per slice and `frame_slots` slots per frame.
+fn place(demand: &[u64], n: u64, k: u64, sps: u64, frame_slots: u64) -> bool {
+    let mut periods = Vec::with_capacity(demand.len() + k as usize);
+    for &m in demand.iter().chain(std::iter::repeat_n(&n, k as usize)) {
+        if m == 0 || !frame_slots.is_multiple_of(m) {
+            return false;
+        }
+        periods.push(frame_slots / m);
+    }
+    periods.sort_unstable();
+    let mut free = vec![true; frame_slots as usize];
+    for p in periods {
+        let Some(o) = crate::synth::candidate_offsets(p, sps).find(|&o| {
+            (o..frame_slots)
+                .step_by(p as usize)
+                .all(|t| free[t as usize])
+        }) else {
+            return false;
+        };
+        for t in (o..frame_slots).step_by(p as usize) {
+            free[t as usize] = false;
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// A mix in the reference design's shape, written out here so the
+    /// expected figures can be counted by hand: branch `fast` with `n_fast`
+    /// channels at 1 kHz on 4 mux devices (32 inputs), branch `slow` with 3
+    /// channels at 100 Hz on one device, one 2 kHz channel on `slow`.
+    fn mix(n_fast: usize, clock: u64, sclk: Option<u64>, bw_2k: f64) -> crate::Mix {
+        let mut t = format!(
+            "name = \"t\"\n[clock]\nhz = {clock}\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n\
+             [[branch]]\nname = \"fast\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 4\nsettle_ns = 2_000\n{}\
+             [[branch]]\nname = \"slow\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n",
+            sclk.map_or(String::new(), |s| format!("sclk_hz = {s}\n"))
+        );
+        for i in 0..n_fast {
+            t += &format!("[[channel]]\nname = \"F{i}\"\nbranch = \"fast\"\nrate_hz = 1_000\n");
+        }
+        for i in 0..3 {
+            t += &format!("[[channel]]\nname = \"S{i}\"\nbranch = \"slow\"\nrate_hz = 100\n");
+        }
+        t += &format!(
+            "[[channel]]\nname = \"A\"\nbranch = \"slow\"\nrate_hz = 2_000\nbandwidth_hz = {bw_2k}\n"
+        );
+        crate::parse(Path::new("t.toml"), &t).unwrap()
+    }
+
+    fn audit(m: &crate::Mix) -> AuditReport {
+        AuditReport::of_schedule(&crate::synthesize(m).unwrap())
+    }
+
+    #[test]
+    fn utilization_against_the_adc_and_the_grid() {
+        let m = mix(30, 48_000_000, Some(2_500_000), 900.0);
+        let a = audit(&m);
+        // Recount from the rates: 30 x 1000 S/s on an ADC of 100 kSPS.
+        let fast = &a.branches[0];
+        assert_eq!(fast.demand_sps, 30 * 1000);
+        assert_eq!(fast.adc_max_sps, 100_000);
+        assert!((fast.adc_utilization - 0.30).abs() < 1e-12);
+        // 30 conversions per 1 ms slice fill a 30-slot grid.
+        assert_eq!(a.slots_per_slice, 30);
+        assert_eq!(fast.conversions_per_frame, 30 * 10);
+        assert!((fast.utilization - 1.0).abs() < 1e-12);
+        // slow: 3 x 100 + 2000 = 2300 S/s; per 10 ms frame 3 x 1 + 20 = 23 of 300 slots.
+        let slow = &a.branches[1];
+        assert_eq!(slow.demand_sps, 3 * 100 + 2000);
+        assert!((slow.adc_utilization - 0.023).abs() < 1e-12);
+        assert_eq!(slow.conversions_per_frame, 23);
+        assert!((slow.utilization - 23.0 / 300.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn headroom_names_the_binding_limit() {
+        let m = mix(30, 48_000_000, None, 900.0);
+        let a = audit(&m);
+        let at = |b: usize, r: u64| {
+            a.branches[b]
+                .headroom
+                .iter()
+                .find(|h| h.rate_hz == r)
+                .unwrap()
+                .clone()
+        };
+        // fast: 32 inputs - 30 = 2 free; ADC (100000 - 30000) / 1000 = 70;
+        // the 30-slot grid is full, so the grid binds at 0.
+        let h = at(0, 1000);
+        assert_eq!(
+            (h.by_mux_inputs, h.by_adc_throughput, h.by_slot_grid),
+            (2, 70, 0)
+        );
+        assert_eq!((h.more_channels, h.binding), (0, Limit::SlotGrid));
+        // A finer grid: 32 slots of 1500 cycles (>= the 480-cycle shortest
+        // slot) leave 2 per slice, i.e. 2 more 1 kHz channels; then the
+        // inputs bind.
+        let f = h.finer_grid.expect("a finer grid helps");
+        assert_eq!(f.slots_per_slice, 32);
+        assert_eq!(48_000 % f.slots_per_slice, 0);
+        assert!(f.slot_cycles >= a.branches[0].min_slot_cycles);
+        assert_eq!((f.more_channels, f.binding), (2, Limit::MuxInputs));
+        // ADC: 100 Hz: (100000 - 30000) / 100 = 700.
+        assert_eq!(at(0, 100).by_adc_throughput, 700);
+        // slow: 8 inputs - 4 = 4 free bind; its grid has 300 - 23 slots free.
+        let h = at(1, 100);
+        assert_eq!((h.more_channels, h.binding), (4, Limit::MuxInputs));
+        assert_eq!(h.by_adc_throughput, (100_000 - 2300) / 100);
+        assert!(h.by_slot_grid >= 4 && h.finer_grid.is_none());
+        // With 10 fewer fast channels the synthesizer picks the fewest
+        // slots, 20 per slice, which they fill: 12 free inputs, but the grid
+        // binds; 32 slots per slice (24 leaves 4, 25 cannot hold 2 kHz, 30
+        // leaves 10) make room for all 12.
+        let a = audit(&mix(20, 48_000_000, None, 900.0));
+        assert_eq!(a.slots_per_slice, 20);
+        let h = &a.branches[0].headroom[1];
+        assert_eq!(h.rate_hz, 1000);
+        assert_eq!(
+            (h.by_mux_inputs, h.more_channels, h.binding),
+            (12, 0, Limit::SlotGrid)
+        );
+        let f = h.finer_grid.as_ref().unwrap();
+        assert_eq!(
+            (f.slots_per_slice, f.more_channels, f.binding),
+            (32, 12, Limit::MuxInputs)
+        );
+    }
+
+    #[test]
+    fn adc_throughput_can_bind() {
+        // 30 fast channels at 1 kHz; a 2 kHz headroom counts (100000 - 30000) / 2000 = 35.
+        let a = audit(&mix(30, 48_000_000, None, 900.0));
+        let h = a.branches[0]
+            .headroom
+            .iter()
+            .find(|h| h.rate_hz == 2000)
+            .unwrap();
+        assert_eq!(h.by_adc_throughput, 35);
+        assert_eq!(least(40, 35, 50), (35, Limit::AdcThroughput));
+        assert_eq!(least(2, 2, 2), (2, Limit::MuxInputs));
+        assert_eq!(least(9, 9, 3), (3, Limit::SlotGrid));
+    }
+
+    #[test]
+    fn aliasing_folds_to_the_nearest_multiple() {
+        let cases = [
+            (600.0, 1000.0, 400.0),
+            (1400.0, 1000.0, 400.0),
+            (2600.0, 1000.0, 400.0),
+            (500.0, 1000.0, 500.0),
+            (1000.0, 1000.0, 0.0),
+            (6000.0, 5000.0, 1000.0),
+            (250.5, 100.0, 49.5),
+            (900.0, 2000.0, 900.0),
+            (1100.0, 2000.0, 900.0),
+        ];
+        for (f, fs, want) in cases {
+            assert!((alias_hz(f, fs) - want).abs() < 1e-9, "{f} at {fs}");
+        }
+        // In the report: 1100 Hz on the 2 kHz channel shows at 900 Hz.
+        let a = audit(&mix(30, 48_000_000, None, 1100.0));
+        let c = a.channels.iter().find(|c| c.name == "A").unwrap();
+        assert_eq!(c.alias_hz, Some(900.0));
+        assert!(a.warnings.iter().any(|w| w.contains("shows as 900 Hz")));
+        // At or below Nyquist: no alias figure.
+        let a = audit(&mix(30, 48_000_000, None, 1000.0));
+        let c = a.channels.iter().find(|c| c.name == "A").unwrap();
+        assert_eq!(c.alias_hz, None);
+        assert!(a.to_text().contains("alias"));
+    }
+
+    #[test]
+    fn inexact_sclk_is_reported_with_the_value_used() {
+        // 48 MHz / 2.5 MHz = 19.2: the even divider 20 gives 2.4 MHz.
+        let a = audit(&mix(30, 48_000_000, Some(2_500_000), 900.0));
+        let b = &a.branches[0];
+        assert_eq!((b.sclk_requested_hz, b.sclk_div), (2_500_000, 20));
+        assert_eq!(b.sclk_hz, 2_400_000.0);
+        assert!(b.sclk_explicit && !a.branches[1].sclk_explicit);
+        assert!(a.notes.iter().any(|n| n.contains("`fast`")
+            && n.contains("2500000 Hz requested")
+            && n.contains("2400000 Hz used")));
+        assert!(a.to_text().contains("note: branch `fast`"));
+        // 50 MHz / 20 = 2.5 MHz exactly: nothing to say.
+        let a = audit(&mix(30, 50_000_000, Some(2_500_000), 900.0));
+        assert_eq!(a.branches[0].sclk_hz, 2_500_000.0);
+        assert!(a.notes.is_empty(), "{:?}", a.notes);
+    }
+
+    #[test]
+    fn sample_channel_is_the_file_index() {
+        let m = mix(5, 48_000_000, None, 900.0);
+        let a = audit(&m);
+        let names: Vec<&str> = a.channels.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["F0", "F1", "F2", "F3", "F4", "S0", "S1", "S2", "A"]);
+        for (i, c) in a.channels.iter().enumerate() {
+            assert_eq!(c.sample_channel, i);
+        }
+        assert!(a.to_text().contains("its index in the mix file, 0-based"));
+    }
 }

@@ -63,8 +63,12 @@ pub struct Mix {
 pub struct Branch {
     pub name: String,
     pub adc: AdcPart,
-    /// Requested SCLK; the gateware uses the fastest legal SCLK at or below it.
+    /// Requested SCLK (the ADC's maximum when the mix leaves it out); the
+    /// gateware uses the fastest SCLK at or below it that an even divider
+    /// of the clock gives.
     pub sclk_hz: u64,
+    /// Whether `sclk_hz` was written in the mix (else it is the default).
+    pub sclk_explicit: bool,
     pub mux: MuxPart,
     pub mux_devices: u32,
     pub settle_ns: u64,
@@ -610,6 +614,7 @@ impl Cx<'_> {
                 name: bname,
                 adc,
                 sclk_hz,
+                sclk_explicit: b.sclk_hz.is_some(),
                 mux,
                 mux_devices,
                 settle_ns,

@@ -34,9 +34,9 @@ pub const SAMPLE_VALUE_BITS: u32 = 16;
 /// sizes [`Pins`] from them.
 pub mod limits {
     /// Branch lanes (one SPI port and one mux select each).
-    pub const MAX_BRANCHES: usize = 8;
+    pub const MAX_BRANCHES: usize = 16;
     /// Channels (`sample_channel` is `log2(MAX_CHANNELS)` bits wide in the core).
-    pub const MAX_CHANNELS: usize = 256;
+    pub const MAX_CHANNELS: usize = 1024;
     /// Mux devices of one branch.
     pub const MAX_DEVICES_PER_BRANCH: usize = 32;
     /// Mux devices over all branches (`mux_en` bits in the core).
@@ -179,7 +179,7 @@ impl Pins {
             Role::Clock | Role::Reset | Role::Miso => 0,
             Role::CsN => self.cs_n as u64,
             Role::Sclk => self.sclk as u64,
-            Role::MuxSel => self.mux_sel as u64,
+            Role::MuxSel => self.mux_sel,
             Role::MuxEn => self.mux_en,
             Role::SampleValid => self.sample_valid as u64,
             Role::SampleChannel => self.sample_channel as u64,
@@ -195,9 +195,9 @@ impl Pins {
 /// [`Layout`]).  Sized for [`limits`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize)]
 pub struct Pins {
-    pub cs_n: u8,
-    pub sclk: u8,
-    pub mux_sel: u32,
+    pub cs_n: u16,
+    pub sclk: u16,
+    pub mux_sel: u64,
     pub mux_en: u64,
     pub sample_valid: bool,
     pub sample_channel: u16,
@@ -206,10 +206,10 @@ pub struct Pins {
 
 const _: () = {
     assert!(
-        limits::MAX_BRANCHES <= 8,
+        limits::MAX_BRANCHES <= 16,
         "Pins::cs_n / sclk hold one bit per branch"
     );
-    assert!(limits::MAX_BRANCHES * MUX_SELECT_BITS as usize <= 32);
+    assert!(limits::MAX_BRANCHES * MUX_SELECT_BITS as usize <= 64);
     assert!(limits::MAX_DEVICES <= 64);
     assert!(limits::MAX_CHANNELS <= 1 << 16);
     assert!(SAMPLE_VALUE_BITS <= 16);
@@ -437,7 +437,7 @@ impl Layout {
 
     #[inline]
     pub fn sel(&self, p: &Pins, b: usize) -> u32 {
-        (p.mux_sel >> (MUX_SELECT_BITS as usize * b)) & (INPUTS_PER_DEVICE - 1)
+        ((p.mux_sel >> (MUX_SELECT_BITS as usize * b)) & (INPUTS_PER_DEVICE as u64 - 1)) as u32
     }
 
     #[inline]
@@ -448,8 +448,8 @@ impl Layout {
     /// Branch `b`'s mux pins addressing `(device, select)`.
     pub fn set_mux(&self, p: &mut Pins, b: usize, device: u32, select: u32) {
         let sh = MUX_SELECT_BITS as usize * b;
-        let m = INPUTS_PER_DEVICE - 1;
-        p.mux_sel = (p.mux_sel & !(m << sh)) | ((select & m) << sh);
+        let m = INPUTS_PER_DEVICE as u64 - 1;
+        p.mux_sel = (p.mux_sel & !(m << sh)) | ((select as u64 & m) << sh);
         let mask = ((1u64 << self.en_n[b]) - 1) << self.en_lo[b];
         p.mux_en = (p.mux_en & !mask) | ((1u64 << device) << self.en_lo[b]);
     }

@@ -134,6 +134,29 @@ impl Schedule {
         self.frame_table[slot as usize * self.branches.len() + branch].map(usize::from)
     }
 
+    /// docs/timing.md, "Start-up": whether the gateware skips branch `b`'s
+    /// instant at cycle `t` of the first frame after reset.  The mux pins take
+    /// their reset value at the first reset edge, so at instant `t` they have
+    /// held it for `t + 1` cycles at the least (a one-cycle reset); an
+    /// instant with `t + 1 < settle_cycles` would sample an unsettled mux.
+    /// Slots are longer than the settling time, so only an instant at cycle 0
+    /// can be skipped.
+    pub fn skipped_at_startup(&self, b: usize, t: u64) -> bool {
+        t + 1 < self.branches[b].settle_cycles
+    }
+
+    /// How many samples the instants of the first frame after reset that the
+    /// gateware skips would have given (see [`Schedule::skipped_at_startup`];
+    /// a chained conversion gives one sample per chain member).
+    pub fn startup_skips(&self) -> u64 {
+        (0..self.branches.len())
+            .filter(|&b| self.skipped_at_startup(b, 0))
+            .filter_map(|b| self.at(0, b))
+            // a chained conversion gives one sample per chain member
+            .map(|lead| self.words_of(lead).count() as u64)
+            .sum()
+    }
+
     /// Sampling instants of one branch within one frame, in time order.
     pub fn branch_instants_in_frame(&self, branch: usize) -> Vec<SamplingInstant> {
         (0..self.grid.frame_slots)

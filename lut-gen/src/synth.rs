@@ -126,7 +126,7 @@ impl Occupancy {
 
 /// Offsets in the order that keeps slow channels on one slice slot rotated
 /// by the slice counter (as the reference design does): by slot-in-slice first.
-fn candidate_offsets(period: u64, slots_per_slice: u64) -> impl Iterator<Item = u64> {
+pub(crate) fn candidate_offsets(period: u64, slots_per_slice: u64) -> impl Iterator<Item = u64> {
     (0..slots_per_slice.min(period))
         .flat_map(move |s| (s..period).step_by(slots_per_slice as usize))
 }

@@ -12,6 +12,7 @@
 //! the run itself fails the checker; 2: bad input, a missing golden, a
 //! missing tool.
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use cosim::{Backend, SimOptions};
@@ -65,6 +66,16 @@ struct Window {
     /// Bounds as for `sim --from/--to`: a frame number or a time (`3ms`).
     from: String,
     to: String,
+}
+
+macro_rules! outln {
+    ($o:expr, $($a:tt)*) => {{ let _ = writeln!($o.out, $($a)*); }};
+}
+macro_rules! errln {
+    ($o:expr, $($a:tt)*) => {{ let _ = writeln!($o.err, $($a)*); }};
+}
+macro_rules! errp {
+    ($o:expr, $($a:tt)*) => {{ let _ = write!($o.err, $($a)*); }};
 }
 
 const EVENTS: &str = "events.log";
@@ -153,6 +164,23 @@ fn first_window_difference(a: &Trace, b: &Trace) -> Option<String> {
 }
 
 pub fn run(a: Args) -> u8 {
+    let mut out = Output::default();
+    let code = execute(&a, &mut out);
+    print!("{}", out.out);
+    eprint!("{}", out.err);
+    code
+}
+
+/// What a golden run printed: `out` for stdout, `err` for stderr.
+#[derive(Debug, Default)]
+pub struct Output {
+    pub out: String,
+    pub err: String,
+}
+
+/// The golden command, its messages collected in `o` (the `build` job
+/// puts them in its report).
+pub fn execute(a: &Args, o: &mut Output) -> u8 {
     let s = match super::schedule(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
@@ -165,7 +193,7 @@ pub fn run(a: Args) -> u8 {
     let manifest = match load_manifest(&manifest_path) {
         Ok(m) => m,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!(o, "error: {e}");
             return 2;
         }
     };
@@ -174,25 +202,25 @@ pub fn run(a: Args) -> u8 {
         let text = match std::fs::read_to_string(&events_path) {
             Ok(t) => t,
             Err(e) => {
-                eprintln!("error: {}: cannot read: {e}", events_path.display());
+                errln!(o, "error: {}: cannot read: {e}", events_path.display());
                 return 2;
             }
         };
         match EventLog::parse(&text) {
             Ok(l) => Some(l),
             Err(e) if a.update => {
-                eprintln!("note: {}: {e}; replacing it", events_path.display());
+                errln!(o, "note: {}: {e}; replacing it", events_path.display());
                 None
             }
             Err(e) => {
-                eprintln!("error: {}: {e}", events_path.display());
+                errln!(o, "error: {}: {e}", events_path.display());
                 return 2;
             }
         }
     } else if a.update {
         None
     } else {
-        eprintln!(
+        errln!(o,
             "error: no golden for mix `{}`: {} does not exist (record one with `slotforge golden {} --update`)",
             s.mix.name,
             events_path.display(),
@@ -213,7 +241,7 @@ pub fn run(a: Args) -> u8 {
         match window_cycles(&s, w, reset, &manifest_path) {
             Ok(k) => windows.push((w, k)),
             Err(e) => {
-                eprintln!("error: {e}");
+                errln!(o, "error: {e}");
                 return 2;
             }
         }
@@ -228,7 +256,7 @@ pub fn run(a: Args) -> u8 {
     let report = match cosim::run_traced(&s, a.backend, frames, &opts, Some(&mut trace)) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!(o, "error: {e}");
             return 2;
         }
     };
@@ -243,11 +271,12 @@ pub fn run(a: Args) -> u8 {
         None => format!("golden {} ({})", s.mix.name, a.backend.name()),
     };
     if !report.ok {
-        eprint!("{who}: the run fails the checker:\n{}", report.summary());
+        errp!(o, "{who}: the run fails the checker:\n{}", report.summary());
     }
 
     if a.update {
         return update(
+            o,
             &s,
             &dir,
             golden.as_ref(),
@@ -262,7 +291,8 @@ pub fn run(a: Args) -> u8 {
     let cmp = compare(&golden, &log, SHOWN + 1);
     let mut differ = false;
     if cmp.same() {
-        println!(
+        outln!(
+            o,
             "{who}: same as {}: {} events over {} cycles",
             events_path.display(),
             log.events.len(),
@@ -270,26 +300,29 @@ pub fn run(a: Args) -> u8 {
         );
     } else {
         differ = true;
-        println!(
+        outln!(
+            o,
             "{who}: DIFFERS from {}: {} event(s) differ",
             events_path.display(),
             cmp.count
         );
         if cmp.expected_cycles != cmp.actual_cycles {
-            println!(
+            outln!(
+                o,
                 "  the golden covers {} cycles, this run {}",
-                cmp.expected_cycles, cmp.actual_cycles
+                cmp.expected_cycles,
+                cmp.actual_cycles
             );
         }
         for (i, d) in cmp.first.iter().enumerate().take(SHOWN) {
             let what = if i == 0 { "first" } else { "then " };
-            println!("  {what}: {}", d.describe(&s));
+            outln!(o, "  {what}: {}", d.describe(&s));
         }
     }
     let tmp = match tempfile::tempdir() {
         Ok(t) => t,
         Err(e) => {
-            eprintln!("error: temporary directory: {e}");
+            errln!(o, "error: temporary directory: {e}");
             return 2;
         }
     };
@@ -297,28 +330,28 @@ pub fn run(a: Args) -> u8 {
         let gold = dir.join(&w.file);
         let new = tmp.path().join(&w.file);
         if let Err(e) = write_window(&s, &trace, *k0, *k1, &new) {
-            eprintln!("error: {}: {e}", new.display());
+            errln!(o, "error: {}: {e}", new.display());
             return 2;
         }
         let expected = match read_window(&s, &gold) {
             Ok(t) => t,
             Err(e) => {
-                eprintln!("error: golden window {e} (re-record with --update)");
+                errln!(o, "error: golden window {e} (re-record with --update)");
                 return 2;
             }
         };
         let actual = match read_window(&s, &new) {
             Ok(t) => t,
             Err(e) => {
-                eprintln!("error: this run's window {}: {e}", w.file);
+                errln!(o, "error: this run's window {}: {e}", w.file);
                 return 2;
             }
         };
         match first_window_difference(&expected, &actual) {
-            None => println!("{who}: window {} same ({} cycles)", w.file, actual.len()),
+            None => outln!(o, "{who}: window {} same ({} cycles)", w.file, actual.len()),
             Some(d) => {
                 differ = true;
-                println!("{who}: window {} DIFFERS: {d}", w.file);
+                outln!(o, "{who}: window {} DIFFERS: {d}", w.file);
             }
         }
     }
@@ -331,6 +364,7 @@ pub fn run(a: Args) -> u8 {
 
 #[allow(clippy::too_many_arguments)]
 fn update(
+    o: &mut Output,
     s: &Schedule,
     dir: &Path,
     old: Option<&EventLog>,
@@ -341,11 +375,15 @@ fn update(
     ok: bool,
 ) -> u8 {
     if !ok {
-        eprintln!("{who}: not recording a golden from a run that fails the checker");
+        errln!(
+            o,
+            "{who}: not recording a golden from a run that fails the checker"
+        );
         return 1;
     }
     match old {
-        None => println!(
+        None => outln!(
+            o,
             "{who}: new golden: {} events over {} cycles",
             log.events.len(),
             log.cycles
@@ -353,11 +391,11 @@ fn update(
         Some(old) => {
             let cmp = compare(old, log, SHOWN);
             if cmp.same() {
-                println!("{who}: unchanged ({} events)", log.events.len());
+                outln!(o, "{who}: unchanged ({} events)", log.events.len());
             } else {
-                println!("{who}: {} event(s) changed", cmp.count);
+                outln!(o, "{who}: {} event(s) changed", cmp.count);
                 for d in &cmp.first {
-                    println!("  {}", d.describe(s));
+                    outln!(o, "  {}", d.describe(s));
                 }
             }
         }
@@ -377,17 +415,17 @@ fn update(
         if let Err(e) =
             write_window(s, trace, *k0, *k1, &tmp).and_then(|()| std::fs::rename(&tmp, &path))
         {
-            eprintln!("error: {}: {e}", path.display());
+            errln!(o, "error: {}: {e}", path.display());
             return 2;
         }
         // the .gtkw names the final file
         let name = Path::new(path.file_name().expect("a file name"));
         if let Err(e) = write_gtkw(&path.with_extension("gtkw"), name, s) {
-            eprintln!("error: {}: {e}", path.display());
+            errln!(o, "error: {}: {e}", path.display());
             return 2;
         }
         let _ = std::fs::remove_file(tmp.with_extension("gtkw"));
-        println!("{who}: window {} written ({} cycles)", w.file, k1 - k0);
+        outln!(o, "{who}: window {} written ({} cycles)", w.file, k1 - k0);
     }
     0
 }

@@ -1,6 +1,7 @@
 //! One module per subcommand; each exposes `Args` (clap) and `run(Args) -> u8`.
 
 pub mod audit;
+pub mod build;
 pub mod check;
 pub mod faults;
 pub mod golden;

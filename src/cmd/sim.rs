@@ -1,4 +1,4 @@
-//! `slotforge sim MIX --backend B --frames N [--vcd F --from A --to B] [--json] [--stimulus S] [--rtl FILE.v]`
+//! `slotforge sim MIX --backend B --frames N [--vcd F --from A --to B] [--json] [--stimulus S] [--samples F.csv] [--rtl FILE.v]`
 //!
 //! Back ends: model, rusthdl, verilator, icarus (see `cosim::Backend`);
 //! `--rtl` (verilator, icarus) simulates outside Verilog whose top honours
@@ -33,9 +33,18 @@ pub struct Args {
     /// End (exclusive) of the VCD window, as --from; default: one frame after --from.
     #[arg(long, value_parser = super::bound)]
     pub to: Option<super::Bound>,
-    /// ADC input: pattern (unique code per channel and slot), sine, step or chirp.
+    /// ADC input: pattern (unique code per channel and slot), sine (a
+    /// channel-specific frequency below its Nyquist limit), sine:HZ (every
+    /// channel at HZ, e.g. sine:600 or sine:1.5e3; above Nyquist it aliases),
+    /// step or chirp.
     #[arg(long, default_value = "pattern")]
     pub stimulus: String,
+    /// Write every sample as CSV: `cycle,time_s,channel,value` (cycle from
+    /// cycle 0, the first after reset; time_s = cycle / clock, rounded once
+    /// to 1 ps; channel = its name; value = the ADC code), one row per
+    /// sample_valid strobe.  With --backend model the cycle-level model runs.
+    #[arg(long)]
+    pub samples: Option<PathBuf>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -74,6 +83,24 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: --to ({to} cycles) must be after --from ({from} cycles)");
         return 2;
     }
+    if let Some(p) = &a.samples {
+        let same = |q: &std::path::Path| {
+            p == q || matches!((p.canonicalize(), q.canonicalize()), (Ok(x), Ok(y)) if x == y)
+        };
+        let vcd = a.vcd.as_deref();
+        let gtkw = vcd.map(|v| v.with_extension("gtkw"));
+        if same(&a.mix) || vcd.is_some_and(same) || gtkw.as_deref().is_some_and(same) {
+            eprintln!(
+                "error: --samples {}: is the mix or the waveform of this run; name another file",
+                p.display()
+            );
+            return 2;
+        }
+        if p.is_dir() {
+            eprintln!("error: --samples {}: is a directory", p.display());
+            return 2;
+        }
+    }
     let opts = SimOptions {
         stimulus,
         vcd: a.vcd.map(|path| VcdOut {
@@ -85,13 +112,25 @@ pub fn run(a: Args) -> u8 {
         rtl: a.rtl,
         ..SimOptions::default()
     };
-    let report = match cosim::run(&s, backend, a.frames, &opts) {
+    let mut log = judge::samples::SampleLog::new();
+    let result = if a.samples.is_some() {
+        cosim::run_observed(&s, backend, a.frames, &opts, Some(&mut log))
+    } else {
+        cosim::run(&s, backend, a.frames, &opts)
+    };
+    let report = match result {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");
             return 2;
         }
     };
+    if let Some(p) = &a.samples {
+        if let Err(e) = log.write_csv(&s, p) {
+            eprintln!("error: --samples {}: {e}", p.display());
+            return 2;
+        }
+    }
     if a.json {
         println!(
             "{}",

@@ -3,8 +3,12 @@
 // Rust test (tests/icarus.rs) compares the log with lut-gen's schedule.
 //
 // Defines (from the test): NB branches, NM mux devices, WC channel bits,
-// CLK_HALF clock half period in ns, CYCLES cycles to run, LOG log file name.
+// CLK_HALF clock half period in ns, CYCLES cycles to run, LOG log file name,
+// RESET rising edges with rst high (default 6).
 `timescale 1ns/1ps
+`ifndef RESET
+`define RESET 6
+`endif
 module adc_tb;
   reg clk = 1'b0;
   reg rst = 1'b1;
@@ -18,6 +22,9 @@ module adc_tb;
   wire [13:0] sample_value;
   integer log;
   integer cycle = -1;
+  integer edges = 0;
+  reg [3*`NB-1:0] last_sel;
+  reg [`NM-1:0] last_en;
 
   slotforge_top dut (
     .clk(clk), .rst(rst), .adc_miso(miso), .adc_cs_n(cs_n), .adc_sclk(sclk),
@@ -31,6 +38,21 @@ module adc_tb;
   // with rst sampled low.  Outputs are read 1 ns after each edge.
   always @(posedge clk) begin
     if (!rst || cycle >= 0) cycle <= cycle + 1;
+  end
+
+  // Rising edges from the first one (a reset edge): the mux pins are logged
+  // at the first edge and whenever they change, reset or not, with the edge
+  // that began cycle 0, so the log tells how long a value had been on the
+  // pins at each conversion.
+  always @(posedge clk) begin
+    edges = edges + 1;
+    #1;
+    if (cycle == 0)
+      $fdisplay(log, "CYCLE0 %0d", edges);
+    if (edges == 1 || mux_sel !== last_sel || mux_en !== last_en)
+      $fdisplay(log, "MUX %0d %0d %0d", edges, mux_sel, mux_en);
+    last_sel = mux_sel;
+    last_en = mux_en;
   end
 
   always @(posedge clk) begin
@@ -84,7 +106,7 @@ module adc_tb;
 
   initial begin
     log = $fopen(`LOG, "w");
-    repeat (5) @(posedge clk);
+    repeat (`RESET) @(posedge clk);
     @(negedge clk) rst = 1'b0;
     wait (cycle == `CYCLES);
     $fclose(log);

@@ -9,6 +9,16 @@ use std::collections::BTreeMap;
 /// address at the instant), every interval exactly clock/rate, and every
 /// sample leaving with the channel and the code the ADC shifted out, in order.
 /// `cycles` is how long the testbench ran.
+///
+/// Mux settling, physically: a conversion's mux select and enables must have
+/// been on the pins for at least the branch's `settle_ns` (in whole cycles,
+/// rounded up) at its CS fall, counted from the edge at which they last
+/// changed.  Reset cycles count when the pins held their value through them;
+/// the first rising edge (a reset edge) counts as a change, since what the
+/// pins showed before it (power-up values) is not the design's.  So an
+/// instant in the first cycles after a short reset may be missing from the
+/// conversions (the design waits for its mux, docs/timing.md "Start-up"),
+/// but one that is there must have settled.
 pub fn judge(
     mix: &lut_gen::Mix,
     s: &lut_gen::Schedule,
@@ -33,6 +43,10 @@ pub fn judge(
         .collect();
     let mut conversions: Vec<Vec<Conversion>> = (0..nb).map(|_| Vec::new()).collect();
     let mut samples: Vec<(u64, usize, u16)> = Vec::new();
+    // (edge, mux_sel, mux_en) at the first edge and at every change, and
+    // the edge that began cycle 0
+    let mut mux: Vec<(u64, u64, u64)> = Vec::new();
+    let mut edge0: Option<u64> = None;
     for line in text.lines() {
         let f: Vec<u64> = line
             .split_whitespace()
@@ -61,18 +75,56 @@ pub fn judge(
                 });
             }
             Some("SAMPLE") if f.len() == 3 => samples.push((f[0], f[1] as usize, f[2] as u16)),
+            Some("MUX") if f.len() == 3 => mux.push((f[0], f[1], f[2])),
+            Some("CYCLE0") if f.len() == 1 => edge0 = Some(f[0]),
             _ => return Err(format!("bad log line {line:?}")),
         }
     }
+    let edge0 = edge0.ok_or("the log has no CYCLE0 line")?;
+    let settle: Vec<u64> = mix
+        .branches
+        .iter()
+        .map(|b| (b.settle_ns as u128 * mix.clock_hz as u128).div_ceil(1_000_000_000) as u64)
+        .collect();
+    // 0. every conversion's mux had settled (see above)
+    for (b, convs) in conversions.iter().enumerate() {
+        let lanes = |sel: u64, en: u64| {
+            let m = (1u64 << s.branches[b].mux_devices) - 1;
+            ((sel >> (3 * b)) & 7, (en >> first_device[b]) & m)
+        };
+        for c in convs {
+            let at = edge0 + c.cycle;
+            let mut since = None;
+            let mut value = None;
+            for &(e, sel, en) in mux.iter().take_while(|m| m.0 <= at) {
+                let v = lanes(sel, en);
+                if value != Some(v) {
+                    since = Some(e);
+                    value = Some(v);
+                }
+            }
+            let since = since.ok_or_else(|| format!("cycle {}: no mux value logged", c.cycle))?;
+            if at - since < settle[b] {
+                return Err(format!(
+                    "cycle {}: branch {b} converts on a mux that changed {} cycles before (edge {since}, cycle 0 at edge {edge0}); settling needs {}",
+                    c.cycle,
+                    at - since,
+                    settle[b]
+                ));
+            }
+        }
+    }
     // 1. conversions exactly at the schedule's instants, on the right channel
+    // (an instant within the settling time of cycle 0 may be skipped)
     let frames = cycles.div_ceil(s.grid.frame_cycles);
     for (b, convs) in conversions.iter().enumerate() {
+        let got: Vec<(u64, usize)> = convs.iter().map(|c| (c.cycle, c.channel)).collect();
         let expected: Vec<(u64, usize)> = s
             .instants(frames)
             .filter(|i| i.branch == b && i.cycle < cycles - 2)
             .map(|i| (i.cycle, i.channel))
+            .filter(|i| i.0 >= settle[b] || got.contains(i))
             .collect();
-        let got: Vec<(u64, usize)> = convs.iter().map(|c| (c.cycle, c.channel)).collect();
         if got != expected {
             let k = got
                 .iter()

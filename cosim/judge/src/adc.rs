@@ -24,13 +24,16 @@ use lut_gen::Schedule;
 use lut_gen::ports::{Layout, Pins};
 
 /// What each analog input carries.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Stimulus {
     /// A code unique per (channel, slot) over any window of 16384 / channels slots.
     #[default]
     Pattern,
-    /// A sine per channel at a channel-specific frequency below its Nyquist limit.
-    Sine,
+    /// A sine per channel: at the given frequency in Hz on every channel
+    /// (`sine:600`; any frequency, also above a channel's Nyquist limit, so
+    /// that aliasing can be seen), or with `None` (`sine`) at a
+    /// channel-specific frequency below its Nyquist limit.
+    Sine(Option<f64>),
     /// A square wave per channel (steps between two channel-specific levels).
     Step,
     /// A linear chirp per channel from 0 to its Nyquist frequency over each frame.
@@ -40,13 +43,26 @@ pub enum Stimulus {
 impl std::str::FromStr for Stimulus {
     type Err = String;
     fn from_str(s: &str) -> Result<Stimulus, String> {
+        if let Some(hz) = s.strip_prefix("sine:") {
+            let f: f64 = hz.trim().parse().map_err(|_| {
+                format!(
+                    "stimulus `{s}`: `{hz}` is not a frequency in Hz (e.g. sine:600, sine:1.5e3)"
+                )
+            })?;
+            if !f.is_finite() || f <= 0.0 {
+                return Err(format!(
+                    "stimulus `{s}`: the frequency must be a positive number of Hz"
+                ));
+            }
+            return Ok(Stimulus::Sine(Some(f)));
+        }
         match s {
             "pattern" => Ok(Stimulus::Pattern),
-            "sine" => Ok(Stimulus::Sine),
+            "sine" => Ok(Stimulus::Sine(None)),
             "step" => Ok(Stimulus::Step),
             "chirp" => Ok(Stimulus::Chirp),
             _ => Err(format!(
-                "unknown stimulus `{s}` (pattern, sine, step, chirp)"
+                "unknown stimulus `{s}` (pattern, sine, sine:HZ, step, chirp)"
             )),
         }
     }
@@ -75,6 +91,7 @@ impl Analog {
                 let nyq = c.rate_hz as f64 / 2.0;
                 match kind {
                     Stimulus::Chirp => nyq,
+                    Stimulus::Sine(Some(f)) => f,
                     _ => {
                         c.bandwidth_hz.unwrap_or(nyq / 4.0).min(nyq * 0.9)
                             * (0.5 + 0.5 * ((i % 7) as f64 / 7.0))
@@ -124,7 +141,7 @@ impl Analog {
         let i = id as usize;
         let t = cycle as f64 / self.clock_hz;
         let x = match self.kind {
-            Stimulus::Sine => (2.0 * PI * self.freq[i] * t + i as f64).sin(),
+            Stimulus::Sine(_) => (2.0 * PI * self.freq[i] * t + i as f64).sin(),
             Stimulus::Step => {
                 if (self.freq[i] * t).fract() < 0.5 {
                     -0.8 + 0.02 * (i % 10) as f64
@@ -186,16 +203,16 @@ pub struct Adc {
     st: Vec<AdcState>,
     parts: Vec<PartModel>,
     /// Conversion-pin levels in the CS-active-low view (CNV lanes inverted).
-    flip: u8,
-    prev_cs: u8,
-    prev_sclk: u8,
+    flip: u16,
+    prev_cs: u16,
+    prev_sclk: u16,
     miso: u64,
 }
 
 impl Adc {
     pub fn new(s: &Schedule, kind: Stimulus) -> Adc {
         let nb = s.branches.len();
-        let all = ((1u16 << nb) - 1) as u8;
+        let all = ((1u32 << nb) - 1) as u16;
         let parts: Vec<PartModel> = s
             .mix
             .branches
@@ -213,7 +230,7 @@ impl Adc {
             .iter()
             .enumerate()
             .filter(|(_, p)| p.cnv)
-            .fold(0u8, |a, (b, _)| a | 1 << b);
+            .fold(0u16, |a, (b, _)| a | 1 << b);
         Adc {
             analog: Analog::new(s, kind),
             layout: Layout::new(s),
@@ -242,7 +259,7 @@ impl Adc {
         let fell_sclk = fell_sclk & !cs_n;
         let mut miso = 0u64;
         for b in 0..self.st.len() {
-            let bit = 1u8 << b;
+            let bit = 1u16 << b;
             let pm = &self.parts[b];
             let st = &mut self.st[b];
             if fell_cs & bit != 0 {

@@ -76,7 +76,9 @@ struct BranchState {
     /// The mux pins have not changed since reset was released.
     mux_from_reset: bool,
     /// Consecutive reset cycles, up to release, in which the mux pins held
-    /// their final reset value (they count towards the first settling).
+    /// their final reset value, counting the one in which they took it (the
+    /// first reset cycle seen at the latest): they count towards the first
+    /// settling.
     reset_held: u64,
     en_multi: bool,
 }
@@ -113,11 +115,9 @@ pub struct Checker {
     prev_miso: u64,
     prev_miso_xz: u64,
     reset_pins: (Pins, Pins),
-    /// Reset cycles seen in the current reset, up to release.
-    reset_len: u64,
     br: Vec<BranchState>,
     /// CNV lanes of `adc_cs_n`/`adc_sclk` (inverted into the CS view).
-    flip: u8,
+    flip: u16,
     /// Per channel: the channels read in its conversion, by chain member.
     groups: Vec<Vec<Option<usize>>>,
     next_frame_at: u64,
@@ -171,7 +171,7 @@ impl Checker {
             .iter()
             .enumerate()
             .filter(|(_, b)| b.adc.start == lut_gen::parts::Start::Cnv)
-            .fold(0u8, |a, (b, _)| a | 1 << b);
+            .fold(0u16, |a, (b, _)| a | 1 << b);
         Checker {
             flip,
             groups: s.groups.clone(),
@@ -192,7 +192,6 @@ impl Checker {
             prev_miso: 0,
             prev_miso_xz: 0,
             reset_pins: (Pins::default(), NO_XZ),
-            reset_len: 0,
             br: vec![BranchState::default(); layout.branches],
             layout,
             next_frame_at: s.grid.frame_cycles,
@@ -283,7 +282,6 @@ impl Checker {
                         (true, true) => st.reset_held + 1,
                     };
                 }
-                self.reset_len = if first { 1 } else { self.reset_len + 1 };
                 self.phase = Phase::Reset;
                 self.reset_pins = (*p, *xz);
                 self.prev = *p;
@@ -501,7 +499,7 @@ impl Checker {
         let dcs = prev.cs_n ^ p.cs_n;
         let dsclk = prev.sclk ^ p.sclk;
         for b in 0..self.layout.branches {
-            let bit = 1u8 << b;
+            let bit = 1u16 << b;
             let (sel, en) = (self.layout.sel(p, b), self.layout.en(p, b));
             if sel != self.layout.sel(&prev, b) || en != self.layout.en(&prev, b) {
                 let st = &mut self.br[b];
@@ -616,13 +614,13 @@ impl Checker {
             }
         };
         let st = &self.br[b];
-        if st.mux_from_reset && st.reset_held < self.reset_len && c + st.reset_held < lim.settle_min
-        {
-            // The first conversion after reset, with a mux value that was
-            // not steady through the whole reset: it has settled only through
-            // the last `reset_held` reset cycles and cycles 0..c.  (A value
-            // steady through the whole reset is taken as settled: how long a
-            // board holds reset is its own business, not the gateware's.)
+        if st.mux_from_reset && c + st.reset_held < lim.settle_min {
+            // The first conversion after reset: the mux value has settled
+            // through the last `reset_held` reset cycles (those since it
+            // last moved; the first reset cycle seen counts as a move, as
+            // the pins' values before the first reset edge are not the
+            // gateware's) and cycles 0..c.  A short reset is no excuse: the
+            // gateware must be correct for any reset of one cycle or more.
             let held = st.reset_held;
             self.inv.violation(
                 c,
@@ -631,7 +629,7 @@ impl Checker {
                 Some(json!(lim.settle_min)),
                 Some(json!(c + held)),
                 ch.and_then(|ch| self.names.get(ch as usize).cloned()),
-                format!("first conversion after reset: the mux value changed or was unknown during reset, then held through {held} reset cycles and {c} cycles after reset; settling needs {}", lim.settle_min),
+                format!("first conversion after reset: the mux value held through {held} reset cycles and {c} cycles after reset; settling needs {}", lim.settle_min),
             );
         } else if !st.mux_from_reset && c - st.mux_since < lim.settle_min {
             let since = st.mux_since;

@@ -101,8 +101,8 @@ pub struct FaultyDut<D> {
     r: u64,
     cycle: Option<u64>,
     done: bool,
-    prev_cs: u8,
-    prev_sclk: u8,
+    prev_cs: u16,
+    prev_sclk: u16,
     /// Cycles SCLK is high in one period.
     high: u64,
     held: Option<Pins>,
@@ -182,7 +182,7 @@ impl<D: Dut> Dut for FaultyDut<D> {
             }
             Fault::CsLate { branch } => {
                 if c >= self.t && c <= self.t + self.r {
-                    let bit = 1u8 << branch;
+                    let bit = 1u16 << branch;
                     p.cs_n = (p.cs_n & !bit) | (self.prev_cs & bit);
                 }
             }
@@ -191,7 +191,7 @@ impl<D: Dut> Dut for FaultyDut<D> {
                 // into the read (one more falling edge than the part expects)
                 // (in the middle of the high phase when it is 3 cycles or
                 // more; else the high phase vanishes: one falling edge fewer)
-                let bit = 1u8 << branch;
+                let bit = 1u16 << branch;
                 let mid_high = self.prev_sclk & bit != 0 || self.high < 3;
                 if !self.done && c >= self.t + self.su + 2 * self.d && p.sclk & bit != 0 && mid_high
                 {
@@ -247,7 +247,7 @@ fn pins_before(layout: &Layout, p: &Pins, branch: usize, _t_prev: u64) -> Pins {
 }
 
 fn copy_mux(layout: &Layout, p: &mut Pins, from: &Pins, b: usize) {
-    let selm = 7u32 << (3 * b);
+    let selm = 7u64 << (3 * b);
     p.mux_sel = (p.mux_sel & !selm) | (from.mux_sel & selm);
     let enm = ((1u64 << layout.en_n[b]) - 1) << layout.en_lo[b];
     p.mux_en = (p.mux_en & !enm) | (from.mux_en & enm);

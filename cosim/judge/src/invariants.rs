@@ -70,6 +70,9 @@ pub struct Invariants {
     ch_branch: Vec<usize>,
     interval: Vec<u64>,
     spf: Vec<u64>,
+    /// Samples per channel in frame 0: `spf` less the instants skipped at
+    /// start-up (docs/timing.md, "Start-up").
+    spf0: Vec<u64>,
     last: Vec<u64>,
     has_last: Vec<bool>,
     in_frame: Vec<u64>,
@@ -90,6 +93,22 @@ impl Invariants {
     pub fn new(s: &Schedule, max_records: usize) -> Invariants {
         let mix = &s.mix;
         let n = mix.channels.len();
+        let spf: Vec<u64> = mix
+            .channels
+            .iter()
+            .map(|c| mix.samples_per_frame(c.rate_hz))
+            .collect();
+        let mut spf0 = spf.clone();
+        for b in 0..s.branches.len() {
+            if let Some(lead) = s.at(0, b) {
+                if s.skipped_at_startup(b, 0) {
+                    // every chain member read in that conversion
+                    for (_, ch) in s.words_of(lead) {
+                        spf0[ch] -= 1;
+                    }
+                }
+            }
+        }
         Invariants {
             rec: Recorder {
                 grid: s.grid,
@@ -105,11 +124,8 @@ impl Invariants {
                 .iter()
                 .map(|c| mix.clock_hz / c.rate_hz)
                 .collect(),
-            spf: mix
-                .channels
-                .iter()
-                .map(|c| mix.samples_per_frame(c.rate_hz))
-                .collect(),
+            spf,
+            spf0,
             last: vec![0; n],
             has_last: vec![false; n],
             in_frame: vec![0; n],
@@ -133,19 +149,24 @@ impl Invariants {
     pub fn close_frames(&mut self, c: u64) {
         while (self.frame + 1) * self.frame_cycles <= c {
             let end = (self.frame + 1) * self.frame_cycles - 1;
-            for ch in 0..self.names.len() {
-                if self.in_frame[ch] != self.spf[ch] {
+            let spf = if self.frame == 0 {
+                &self.spf0
+            } else {
+                &self.spf
+            };
+            for (ch, &want) in spf.iter().enumerate() {
+                if self.in_frame[ch] != want {
                     let name = self.names[ch].clone();
                     self.rec.violation(
                         end,
                         "samples-per-frame",
                         None,
-                        Some(json!(self.spf[ch])),
+                        Some(json!(want)),
                         Some(json!(self.in_frame[ch])),
                         Some(name.clone()),
                         format!(
-                            "{name} sampled {} times in frame {}, expected {}",
-                            self.in_frame[ch], self.frame, self.spf[ch]
+                            "{name} sampled {} times in frame {}, expected {want}",
+                            self.in_frame[ch], self.frame
                         ),
                     );
                 }
@@ -342,22 +363,22 @@ impl Invariants {
         let frames = cycles / self.frame_cycles;
         self.close_frames(frames * self.frame_cycles);
         if cycles > frames * self.frame_cycles {
-            for ch in 0..self.names.len() {
-                if self.in_frame[ch] > self.spf[ch] {
+            let spf = if frames == 0 { &self.spf0 } else { &self.spf };
+            for (ch, &most) in spf.iter().enumerate() {
+                if self.in_frame[ch] > most {
                     let name = self.names[ch].clone();
                     self.rec.violation(
                         cycles - 1,
                         "samples-per-frame",
                         None,
-                        Some(json!(self.spf[ch])),
+                        Some(json!(most)),
                         Some(json!(self.in_frame[ch])),
                         Some(name.clone()),
                         format!(
-                            "{name} sampled {} times in the first {} cycles of frame {}, expected {} in the whole frame",
+                            "{name} sampled {} times in the first {} cycles of frame {}, expected {most} in the whole frame",
                             self.in_frame[ch],
                             cycles % self.frame_cycles,
                             frames,
-                            self.spf[ch]
                         ),
                     );
                 }

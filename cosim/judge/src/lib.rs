@@ -16,7 +16,8 @@
 //! - [`faults`]: faults injected into any [`Dut`]'s pins;
 //! - [`vcd`] / [`vcdout`]: reading a VCD from any simulator, writing one;
 //! - [`events`]: a run's pins as a reviewable event log, and the
-//!   comparison of two logs by signal role (golden tests).
+//!   comparison of two logs by signal role (golden tests);
+//! - [`samples`]: a run's samples as CSV (`cycle,time_s,channel,value`).
 //!
 //! The pins themselves ([`Pins`], [`Layout`], [`Signal`]) are the pin
 //! contract's, `lut_gen::ports`.
@@ -29,6 +30,7 @@ pub mod invariants;
 pub mod model;
 pub mod report;
 pub mod run;
+pub mod samples;
 pub mod vcd;
 pub mod vcdout;
 

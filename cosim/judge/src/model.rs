@@ -28,7 +28,9 @@ pub struct Conversion {
     pub emit: u64,
 }
 
-/// Slot-level model: the periodic frame template of conversions.
+/// Slot-level model: the periodic frame template of conversions, and the
+/// first frame after reset, which lacks the instants skipped at start-up
+/// (docs/timing.md, "Start-up").
 #[derive(Debug, Clone)]
 pub struct SlotModel {
     pub frame_cycles: u64,
@@ -36,6 +38,50 @@ pub struct SlotModel {
     pub conversions: Vec<Conversion>,
     /// The same conversions in emission order.
     pub emissions: Vec<Conversion>,
+    /// Frame 0: conversions in (instant, branch) order ...
+    pub first: Vec<Conversion>,
+    /// ... and in emission order.
+    pub first_emissions: Vec<Conversion>,
+}
+
+/// Whether branch `b`'s instant `t` (cycles from reset release) samples a
+/// mux that has had at least `settle` cycles: the mux took its value at the
+/// first reset edge, one cycle before cycle 0 at the least.
+fn settled_at_startup(t: u64, settle: u64) -> bool {
+    t + 1 >= settle
+}
+
+/// Emission cycles: one word leaves per cycle; in cycle c + 1 the lowest
+/// (branch, member) of those completed by cycle c.
+fn merge(mut conversions: Vec<Conversion>) -> (Vec<Conversion>, Vec<Conversion>) {
+    let mut order: Vec<usize> = (0..conversions.len()).collect();
+    order.sort_by_key(|&i| {
+        (
+            conversions[i].complete,
+            conversions[i].branch,
+            conversions[i].member,
+        )
+    });
+    let mut pending = std::collections::BTreeSet::new();
+    let mut k = 0;
+    let mut c = 0u64;
+    while k < order.len() || !pending.is_empty() {
+        if pending.is_empty() {
+            c = c.max(conversions[order[k]].complete);
+        }
+        while k < order.len() && conversions[order[k]].complete <= c {
+            let i = order[k];
+            pending.insert((conversions[i].branch, conversions[i].member, i));
+            k += 1;
+        }
+        let first = *pending.iter().next().unwrap();
+        pending.remove(&first);
+        conversions[first.2].emit = c + 1;
+        c += 1;
+    }
+    let mut emissions = conversions.clone();
+    emissions.sort_by_key(|c| c.emit);
+    (conversions, emissions)
 }
 
 impl SlotModel {
@@ -60,39 +106,29 @@ impl SlotModel {
                 }
             }
         }
-        // Merge: one word leaves per cycle; in cycle c + 1 the lowest
-        // (branch, member) of those completed by cycle c.
-        let mut order: Vec<usize> = (0..conversions.len()).collect();
-        order.sort_by_key(|&i| {
-            (
-                conversions[i].complete,
-                conversions[i].branch,
-                conversions[i].member,
-            )
-        });
-        let mut pending = std::collections::BTreeSet::new();
-        let mut k = 0;
-        let mut c = 0u64;
-        while k < order.len() || !pending.is_empty() {
-            if pending.is_empty() {
-                c = c.max(conversions[order[k]].complete);
-            }
-            while k < order.len() && conversions[order[k]].complete <= c {
-                let i = order[k];
-                pending.insert((conversions[i].branch, conversions[i].member, i));
-                k += 1;
-            }
-            let first = *pending.iter().next().unwrap();
-            pending.remove(&first);
-            conversions[first.2].emit = c + 1;
-            c += 1;
-        }
-        let mut emissions = conversions.clone();
-        emissions.sort_by_key(|c| c.emit);
+        let first: Vec<Conversion> = conversions
+            .iter()
+            .filter(|c| settled_at_startup(c.instant, s.branches[c.branch].settle_cycles))
+            .copied()
+            .collect();
+        let (conversions, emissions) = merge(conversions);
+        let (first, first_emissions) = merge(first);
         SlotModel {
             frame_cycles: g.frame_cycles,
             conversions,
             emissions,
+            first,
+            first_emissions,
+        }
+    }
+
+    /// Frame `f`'s conversions relative to its start, in (instant, branch)
+    /// and in emission order.
+    pub fn frame(&self, f: u64) -> (&[Conversion], &[Conversion]) {
+        if f == 0 {
+            (&self.first, &self.first_emissions)
+        } else {
+            (&self.conversions, &self.emissions)
         }
     }
 
@@ -100,7 +136,7 @@ impl SlotModel {
     pub fn iter(&self, frames: u64) -> impl Iterator<Item = Conversion> + '_ {
         (0..frames).flat_map(move |f| {
             let base = f * self.frame_cycles;
-            self.conversions.iter().map(move |c| Conversion {
+            self.frame(f).0.iter().map(move |c| Conversion {
                 instant: c.instant + base,
                 complete: c.complete + base,
                 emit: c.emit + base,
@@ -127,6 +163,10 @@ struct BranchModel {
     oi: usize,
     /// Next cycle at which this branch needs attention.
     next: u64,
+    /// The current instant converts (false: skipped at start-up).
+    conv: bool,
+    /// Mux settling time in cycles.
+    settle: u64,
     /// Bits captured from MISO in this conversion (the last in bit 0).
     word: u128,
     su: u64,
@@ -173,10 +213,10 @@ pub struct CycleModel {
     pins: Pins,
     reset: Pins,
     next_event: u64,
-    pending: u8,
+    pending: u16,
     /// Per branch: (channel, value) of the words waiting, first to leave first.
     pend: Vec<std::collections::VecDeque<(u16, u16)>>,
-    capture: u8,
+    capture: u16,
     groups: Vec<Vec<Option<usize>>>,
 }
 
@@ -224,6 +264,8 @@ impl CycleModel {
                 offs,
                 oi: 0,
                 next: 0,
+                conv: false,
+                settle: plan.settle_cycles,
                 word: 0,
                 su,
                 d,
@@ -245,7 +287,7 @@ impl CycleModel {
             .iter()
             .enumerate()
             .filter(|(_, m)| !m.cnv)
-            .fold(0u8, |a, (b, _)| a | 1 << b);
+            .fold(0u16, |a, (b, _)| a | 1 << b);
         let mut reset = Pins {
             cs_n: cs_idle,
             sclk: cs_idle,
@@ -355,11 +397,12 @@ impl CycleModel {
                 if c == m.tn {
                     m.t = Some(m.tn);
                     m.tch = m.tnch;
+                    m.conv = settled_at_startup(m.tn, m.settle);
                     m.advance_next_instant(self.frame_cycles);
                     m.oi = 0;
                     m.word = 0;
                 }
-                let bit = 1u8 << b;
+                let bit = 1u16 << b;
                 let (mut cs, mut sclk) = (true, true);
                 let ch = if m.t == Some(c) { m.tch } else { m.tnch };
                 if let Some(t) = m.t {
@@ -372,7 +415,7 @@ impl CycleModel {
                     } else {
                         m.tn
                     };
-                    if k < m.r {
+                    if k < m.r && m.conv {
                         cs = false;
                         if k >= m.su && (k - m.su) % m.d < m.h {
                             sclk = false;
@@ -381,7 +424,7 @@ impl CycleModel {
                             self.capture |= bit;
                         }
                     }
-                    if k == m.r {
+                    if k == m.r && m.conv {
                         // Bit j of the serial stream sits at sclks-1-j of `word`.
                         self.pending |= bit;
                         let mask = (1u128 << m.bits) - 1;
@@ -403,7 +446,7 @@ impl CycleModel {
                     sclk = match m.t {
                         Some(t) => {
                             let k = c - t;
-                            k >= m.su && k < m.r && (k - m.su) % m.d >= m.h
+                            m.conv && k >= m.su && k < m.r && (k - m.su) % m.d >= m.h
                         }
                         None => false,
                     };

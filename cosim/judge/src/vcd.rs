@@ -591,9 +591,9 @@ impl State {
         let pick = |f: fn(&Val) -> u64| {
             let g = |i: usize| f(&self.port[i]);
             Pins {
-                cs_n: g(CS) as u8,
-                sclk: g(SCLK) as u8,
-                mux_sel: g(SEL) as u32,
+                cs_n: g(CS) as u16,
+                sclk: g(SCLK) as u16,
+                mux_sel: g(SEL),
                 mux_en: g(EN),
                 sample_valid: g(VALID) & 1 == 1,
                 sample_channel: g(CHAN) as u16,

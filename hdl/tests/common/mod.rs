@@ -250,7 +250,7 @@ pub fn selected(s: &Schedule, b: usize, pins: &Pins) -> Option<usize> {
         return None;
     }
     let dev = en.trailing_zeros();
-    let sel = (pins.mux_sel >> (3 * b)) & 7;
+    let sel = ((pins.mux_sel >> (3 * b)) & 7) as u32;
     s.channels
         .iter()
         .enumerate()
@@ -289,7 +289,14 @@ impl<'a> Reference<'a> {
             }
             let sa = slot_abs - back;
             let t = sa * g.slot_cycles;
-            if self.s.at(sa % g.frame_slots, b).is_some() && t <= c && c < t + spi.read_cycles {
+            // "Start-up": an instant the mux cannot have settled for since
+            // the first reset edge (one cycle before cycle 0) is skipped
+            let settled = t + 1 >= self.s.branches[b].settle_cycles;
+            if self.s.at(sa % g.frame_slots, b).is_some()
+                && settled
+                && t <= c
+                && c < t + spi.read_cycles
+            {
                 return Some(t);
             }
         }
@@ -315,8 +322,8 @@ impl<'a> Reference<'a> {
     }
 
     /// (cs_n, sclk, mux_sel, mux_en) in cycle c.
-    pub fn pins(&self, c: u64) -> (u8, u8, u32, u64) {
-        let (mut cs, mut sclk, mut sel, mut en) = (0u8, 0u8, 0u32, 0u64);
+    pub fn pins(&self, c: u64) -> (u16, u16, u64, u64) {
+        let (mut cs, mut sclk, mut sel, mut en) = (0u16, 0u16, 0u64, 0u64);
         let mut off = 0;
         for (b, bp) in self.s.branches.iter().enumerate() {
             let spi = &bp.spi;
@@ -333,7 +340,7 @@ impl<'a> Reference<'a> {
             sclk |= sclk_b << b;
             if let Some((_, ch)) = self.next_instant(b, c) {
                 let cc = &self.s.channels[ch];
-                sel |= cc.select << (3 * b);
+                sel |= (cc.select as u64) << (3 * b);
                 en |= 1u64 << (off + cc.device as usize);
             }
             off += bp.mux_devices as usize;
@@ -364,10 +371,10 @@ pub fn run_and_compare_with(s: &Schedule, cycles: u64, form: hdl::LutForm) -> Ru
         .map(|b| Adc::new(s.grid.clock_hz, 0x1234 + b as u64))
         .collect();
     // reset: several cycles, outputs must be the reset values
-    let mut miso = 0u8;
+    let mut miso = 0u64;
     for _ in 0..3 {
         let p = sim.step(true, miso);
-        let all = ((1u32 << nb) - 1) as u8;
+        let all = ((1u32 << nb) - 1) as u16;
         assert_eq!(p.cs_n, all, "cs_n during reset");
         assert_eq!(p.sclk, all, "sclk during reset");
         assert!(!p.sample_valid && p.sample_channel == 0 && p.sample_value == 0);
@@ -381,7 +388,7 @@ pub fn run_and_compare_with(s: &Schedule, cycles: u64, form: hdl::LutForm) -> Ru
     }
     let mut samples = vec![];
     let mut instants = vec![];
-    let mut prev_cs = ((1u32 << nb) - 1) as u8;
+    let mut prev_cs = ((1u32 << nb) - 1) as u16;
     // sample stream reference: per branch completion queue
     let mut pending: Vec<Option<(usize, u16)>> = vec![None; nb];
     let mut expect_next: Option<(usize, u16)> = None;
@@ -426,7 +433,7 @@ pub fn run_and_compare_with(s: &Schedule, cycles: u64, form: hdl::LutForm) -> Ru
             }
         }
         // ADCs see this cycle's pins and drive MISO during it
-        let mut m = 0u8;
+        let mut m = 0u64;
         for b in 0..nb {
             let cs_b = (p.cs_n >> b) & 1 == 1;
             let sclk_b = (p.sclk >> b) & 1 == 1;

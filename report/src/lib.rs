@@ -1,0 +1,346 @@
+//! report: the main job's report, `report.html` (self-contained: SVG
+//! inline, no scripts, no external files) and `report.md` (figures as files
+//! beside it), and the charts in it ([`chart`]).
+//!
+//! It knows nothing of simulation: the `build` command measures, and hands
+//! this crate steps, sections, tables and charts to lay out.
+
+pub mod chart;
+
+use std::fmt::Write as _;
+
+pub use chart::{draw, Axes, Series, Table};
+
+/// How a step of the job ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    Ok,
+    Failed,
+    /// Not run (a tool is missing, or nothing to do); says why in `summary`.
+    Skipped,
+}
+
+impl Status {
+    pub fn word(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Failed => "FAILED",
+            Status::Skipped => "skipped",
+        }
+    }
+}
+
+/// One step of the job.
+#[derive(Debug, Clone)]
+pub struct Step {
+    pub name: String,
+    pub status: Status,
+    pub seconds: f64,
+    /// One line.
+    pub summary: String,
+    /// Preformatted detail (a command's output), may be empty.
+    pub detail: String,
+}
+
+/// A chart with the table it was drawn from.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    /// File stem: `<stem>.svg` and `<stem>.csv`.
+    pub stem: String,
+    pub title: String,
+    pub caption: String,
+    pub svg: String,
+    pub table: Table,
+}
+
+/// A section of the report: paragraphs, tables and figures.
+#[derive(Debug, Clone, Default)]
+pub struct Section {
+    pub title: String,
+    pub paragraphs: Vec<String>,
+    pub tables: Vec<(String, Table)>,
+    pub figures: Vec<Figure>,
+    /// Preformatted text blocks.
+    pub pre: Vec<String>,
+}
+
+/// The whole report.
+#[derive(Debug, Clone, Default)]
+pub struct Document {
+    pub title: String,
+    pub subtitle: String,
+    pub steps: Vec<Step>,
+    pub sections: Vec<Section>,
+}
+
+impl Document {
+    pub fn ok(&self) -> bool {
+        self.steps.iter().all(|s| s.status != Status::Failed)
+    }
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The SVG made embeddable: no XML prolog, a title for screen readers.
+fn inline_svg(svg: &str, title: &str) -> String {
+    let body = match svg.find("<svg") {
+        Some(i) => &svg[i..],
+        None => svg,
+    };
+    body.replacen(
+        '>',
+        &format!(" role=\"img\" aria-label=\"{}\">", esc(title)),
+        1,
+    )
+}
+
+fn html_table(t: &Table) -> String {
+    let mut h = String::from("<table>\n<tr>");
+    for c in &t.columns {
+        let _ = write!(h, "<th>{}</th>", esc(c));
+    }
+    h.push_str("</tr>\n");
+    for r in &t.rows {
+        h.push_str("<tr>");
+        for c in r {
+            let _ = write!(h, "<td>{}</td>", esc(c));
+        }
+        h.push_str("</tr>\n");
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+fn md_table(t: &Table) -> String {
+    let cell = |s: &str| s.replace('|', "\\|");
+    let mut m = format!(
+        "| {} |\n|{}|\n",
+        t.columns
+            .iter()
+            .map(|c| cell(c))
+            .collect::<Vec<_>>()
+            .join(" | "),
+        t.columns
+            .iter()
+            .map(|_| "---")
+            .collect::<Vec<_>>()
+            .join("|")
+    );
+    for r in &t.rows {
+        let _ = writeln!(
+            m,
+            "| {} |",
+            r.iter().map(|c| cell(c)).collect::<Vec<_>>().join(" | ")
+        );
+    }
+    m
+}
+
+fn steps_table(d: &Document) -> Table {
+    let mut t = Table::new(&["step", "status", "seconds", "result"]);
+    for s in &d.steps {
+        t.push(vec![
+            s.name.clone(),
+            s.status.word().into(),
+            format!("{:.2}", s.seconds),
+            s.summary.clone(),
+        ]);
+    }
+    t
+}
+
+/// `report.html`: one self-contained file.
+pub fn html(d: &Document) -> String {
+    let mut h = String::new();
+    let _ = write!(
+        h,
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n<style>\n\
+         body{{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}}\n\
+         table{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top}}\n\
+         th{{background:#eee}}pre{{background:#f6f6f6;padding:.6em;overflow-x:auto;font-size:85%}}\n\
+         .ok{{color:#176917}}.FAILED{{color:#b00;font-weight:bold}}.skipped{{color:#777}}figure{{margin:1.5em 0}}\n\
+         figcaption{{font-size:90%;color:#444;max-width:900px}}svg{{max-width:100%;height:auto}}\n\
+         </style>\n</head>\n<body>\n<h1>{}</h1>\n<p>{}</p>\n",
+        esc(&d.title),
+        esc(&d.title),
+        esc(&d.subtitle)
+    );
+    let verdict = if d.ok() { "ok" } else { "FAILED" };
+    let _ = writeln!(
+        h,
+        "<h2>Steps: <span class=\"{verdict}\">{verdict}</span></h2>\n<table>\n<tr><th>step</th><th>status</th><th>seconds</th><th>result</th></tr>"
+    );
+    for s in &d.steps {
+        let w = s.status.word();
+        let _ = writeln!(
+            h,
+            "<tr><td>{}</td><td class=\"{w}\">{w}</td><td>{:.2}</td><td>{}</td></tr>",
+            esc(&s.name),
+            s.seconds,
+            esc(&s.summary)
+        );
+    }
+    h.push_str("</table>\n");
+    for s in d
+        .steps
+        .iter()
+        .filter(|s| s.status == Status::Failed && !s.detail.is_empty())
+    {
+        let _ = writeln!(
+            h,
+            "<h3>{} failed</h3>\n<pre>{}</pre>",
+            esc(&s.name),
+            esc(&s.detail)
+        );
+    }
+    for sec in &d.sections {
+        let _ = writeln!(h, "<h2>{}</h2>", esc(&sec.title));
+        for p in &sec.paragraphs {
+            let _ = writeln!(h, "<p>{}</p>", esc(p));
+        }
+        for (cap, t) in &sec.tables {
+            if !cap.is_empty() {
+                let _ = writeln!(h, "<p><b>{}</b></p>", esc(cap));
+            }
+            h.push_str(&html_table(t));
+        }
+        for p in &sec.pre {
+            let _ = writeln!(h, "<pre>{}</pre>", esc(p));
+        }
+        for f in &sec.figures {
+            let _ = writeln!(
+                h,
+                "<figure>\n{}\n<figcaption><b>{}</b>. {} (data: <code>{}.csv</code>)</figcaption>\n</figure>",
+                inline_svg(&f.svg, &f.title),
+                esc(&f.title),
+                esc(&f.caption),
+                esc(&f.stem)
+            );
+        }
+    }
+    h.push_str("</body>\n</html>\n");
+    h
+}
+
+/// `report.md`: the same, figures as `<stem>.svg` files beside it.
+pub fn markdown(d: &Document) -> String {
+    let mut m = format!("# {}\n\n{}\n\n", d.title, d.subtitle);
+    let _ = writeln!(
+        m,
+        "## Steps: {}\n\n{}",
+        if d.ok() { "ok" } else { "FAILED" },
+        md_table(&steps_table(d))
+    );
+    for s in d
+        .steps
+        .iter()
+        .filter(|s| s.status == Status::Failed && !s.detail.is_empty())
+    {
+        let _ = writeln!(
+            m,
+            "### {} failed\n\n```text\n{}\n```\n",
+            s.name,
+            s.detail.trim_end()
+        );
+    }
+    for sec in &d.sections {
+        let _ = writeln!(m, "## {}\n", sec.title);
+        for p in &sec.paragraphs {
+            let _ = writeln!(m, "{p}\n");
+        }
+        for (cap, t) in &sec.tables {
+            if !cap.is_empty() {
+                let _ = writeln!(m, "**{cap}**\n");
+            }
+            let _ = writeln!(m, "{}", md_table(t));
+        }
+        for p in &sec.pre {
+            let _ = writeln!(m, "```text\n{}\n```\n", p.trim_end());
+        }
+        for f in &sec.figures {
+            let _ = writeln!(
+                m,
+                "![{}]({}.svg)\n\n*{}.* {} (data: [{}.csv]({}.csv))\n",
+                f.title, f.stem, f.title, f.caption, f.stem, f.stem
+            );
+        }
+    }
+    m
+}
+
+/// Every file of the report: `report.html`, `report.md`, and each figure's
+/// `.svg` and `.csv`.
+pub fn files(d: &Document) -> Vec<(String, String)> {
+    let mut v = vec![
+        ("report.html".to_string(), html(d)),
+        ("report.md".to_string(), markdown(d)),
+    ];
+    for f in d.sections.iter().flat_map(|s| &s.figures) {
+        v.push((format!("{}.svg", f.stem), f.svg.clone()));
+        v.push((format!("{}.csv", f.stem), f.table.csv()));
+    }
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn html_is_self_contained_and_shows_failures() {
+        let svg = draw(
+            &Axes::new("c", "x", "y"),
+            &[Series::line("s", vec![(0.0, 0.0), (1.0, 1.0)])],
+            300,
+            200,
+        );
+        let mut t = Table::new(&["x", "y"]);
+        t.push(vec!["0".into(), "0".into()]);
+        let d = Document {
+            title: "r <1>".into(),
+            subtitle: "s".into(),
+            steps: vec![
+                Step {
+                    name: "a".into(),
+                    status: Status::Ok,
+                    seconds: 1.0,
+                    summary: "fine".into(),
+                    detail: String::new(),
+                },
+                Step {
+                    name: "b".into(),
+                    status: Status::Failed,
+                    seconds: 0.5,
+                    summary: "bad".into(),
+                    detail: "why".into(),
+                },
+            ],
+            sections: vec![Section {
+                title: "charts".into(),
+                figures: vec![Figure {
+                    stem: "c".into(),
+                    title: "C".into(),
+                    caption: "cap".into(),
+                    svg,
+                    table: t,
+                }],
+                ..Section::default()
+            }],
+        };
+        assert!(!d.ok());
+        let h = html(&d);
+        assert!(h.contains("r &lt;1&gt;"));
+        assert!(h.contains("<svg") && !h.contains("<?xml"));
+        assert!(!h.contains("<script") && !h.contains("src=\"http"));
+        assert!(h.contains("class=\"FAILED\""));
+        let m = markdown(&d);
+        assert!(m.contains("![C](c.svg)") && m.contains("| b | FAILED |"));
+        let names: Vec<String> = files(&d).into_iter().map(|f| f.0).collect();
+        assert_eq!(names, ["report.html", "report.md", "c.svg", "c.csv"]);
+    }
+}

@@ -1,0 +1,620 @@
+//! The measurements behind the report's charts, all taken in the build's
+//! own run: speed against accuracy of each verification method, a timing
+//! diagram of one slice, where scheduling breaks over random mixes, the
+//! fault campaign, and the place-and-route estimate.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use cosim::{Backend, SimOptions};
+use judge::events::Trace;
+use judge::faults::{Fault, FaultyDut};
+use judge::run::{run_dut, Dut, ModelDut, RunOptions};
+use judge::vcdout::VcdWriter;
+use lut_gen::ports::{Layout, Role};
+use lut_gen::Schedule;
+use report::{draw, Axes, Figure, Section, Series, Table};
+
+use super::frame_seconds;
+
+/// Simulated cycles and wall seconds per method.
+#[derive(Debug, Default)]
+pub struct Speeds {
+    pub runs: Vec<(String, u64, f64)>,
+}
+
+impl Speeds {
+    pub fn add(&mut self, method: &str, cycles: u64, seconds: f64) {
+        self.runs.push((method.into(), cycles, seconds.max(1e-9)));
+    }
+
+    fn of(&self, method: &str) -> Option<(u64, f64)> {
+        self.runs.iter().find(|r| r.0 == method).map(|r| (r.1, r.2))
+    }
+}
+
+/// A place-and-route estimate.
+pub struct Synth {
+    pub lcs: u64,
+    pub brams: u64,
+    pub fmax_mhz: f64,
+}
+
+/// yosys `synth_ice40` and nextpnr-ice40 on the emitted Verilog (IO left
+/// unconstrained: the estimate does not depend on a board).
+pub fn synthesize(s: &Schedule, verilog: &Path, work: &Path) -> Result<Synth, String> {
+    use std::process::Command;
+    std::fs::create_dir_all(work).map_err(|e| e.to_string())?;
+    let top = verilog.join(hdl::VERILOG_FILE);
+    let json = work.join("slotforge.json");
+    let y = Command::new("yosys")
+        .arg("-q")
+        .arg("-l")
+        .arg(work.join("yosys.log"))
+        .arg("-p")
+        .arg(format!(
+            "read_verilog {}; synth_ice40 -top {} -json {}",
+            top.display(),
+            lut_gen::ports::TOP_MODULE,
+            json.display()
+        ))
+        .output()
+        .map_err(|e| format!("yosys: {e}"))?;
+    if !y.status.success() {
+        return Err(String::from_utf8_lossy(&y.stderr).into_owned());
+    }
+    let n = Command::new("nextpnr-ice40")
+        .args([
+            "--hx8k",
+            "--package",
+            "ct256",
+            "--pcf-allow-unconstrained",
+            "--seed",
+            "1",
+        ])
+        .arg("--freq")
+        .arg(format!("{}", s.grid.clock_hz as f64 / 1e6))
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .map_err(|e| format!("nextpnr-ice40: {e}"))?;
+    let log = format!(
+        "{}{}",
+        String::from_utf8_lossy(&n.stdout),
+        String::from_utf8_lossy(&n.stderr)
+    );
+    let _ = std::fs::write(work.join("nextpnr.log"), &log);
+    if !n.status.success() {
+        return Err(log.lines().rev().take(20).collect::<Vec<_>>().join("\n"));
+    }
+    let used = |cell: &str| -> u64 {
+        let key = format!("{cell}:");
+        log.lines()
+            .filter_map(|l| Some(&l[l.find(&key)? + key.len()..]))
+            .filter_map(|r| r.trim().split('/').next()?.trim().parse().ok())
+            .next_back()
+            .unwrap_or(0)
+    };
+    let fmax = log
+        .lines()
+        .filter(|l| l.contains("Max frequency for clock"))
+        .filter_map(|l| {
+            l.rsplit("': ")
+                .next()?
+                .split(' ')
+                .next()?
+                .parse::<f64>()
+                .ok()
+        })
+        .next_back()
+        .ok_or("nextpnr reported no Fmax")?;
+    Ok(Synth {
+        lcs: used("ICESTORM_LC"),
+        brams: used("ICESTORM_RAM"),
+        fmax_mhz: fmax,
+    })
+}
+
+/// The pin faults of the quick measure: each class once, mid-frame 0.
+fn pin_faults(s: &Schedule) -> Vec<Fault> {
+    let mut seen: Vec<&str> = Vec::new();
+    Fault::all(s)
+        .into_iter()
+        .filter(|f| {
+            let new = !seen.contains(&f.class());
+            seen.push(f.class());
+            new
+        })
+        .collect()
+}
+
+/// Whether the checker rejects `dut` with `f` injected mid-frame 0.
+fn caught(s: &Schedule, dut: Box<dyn Dut>, f: Fault) -> bool {
+    let at = s.grid.frame_cycles / 2 + 7;
+    let mut d = FaultyDut::new(s, dut, f, at);
+    !run_dut(s, &mut d, 2, &RunOptions::default(), "faults", None).ok
+}
+
+/// Speed (simulated seconds per wall second) against accuracy (share of the
+/// fault classes each method detects), both measured now.
+pub fn speed_accuracy(
+    s: &Schedule,
+    vcd: &Path,
+    speeds: &mut Speeds,
+    campaign: Option<&cosim::faults::Campaign>,
+) -> Result<(Section, String), String> {
+    let g = &s.grid;
+    let f = g.frame_cycles;
+    // speed
+    let n = (1.0 / frame_seconds(s)).ceil().max(10.0) as u64; // >= 1 s of acquisition
+    let t = Instant::now();
+    let _ = judge::run::run_model(s, n, judge::Stimulus::Pattern, 10);
+    speeds.add("model", n * f, t.elapsed().as_secs_f64());
+    let t = Instant::now();
+    cosim::run(s, Backend::RustHdl, 1, &SimOptions::default()).map_err(|e| e.to_string())?;
+    speeds.add("rusthdl", f, t.elapsed().as_secs_f64());
+    let icarus = super::tool_present("iverilog");
+    if icarus {
+        let t = Instant::now();
+        cosim::run(s, Backend::Icarus, 1, &SimOptions::default()).map_err(|e| e.to_string())?;
+        speeds.add("icarus", f, t.elapsed().as_secs_f64());
+    }
+    if vcd.exists() {
+        let t = Instant::now();
+        let r = judge::check_vcd(s, vcd, None).map_err(|e| e.to_string())?;
+        speeds.add("check", r.cycles, t.elapsed().as_secs_f64());
+    }
+    // accuracy: every class once, through each method's own path
+    let pins = pin_faults(s);
+    let gw = cosim::faults::one_gateware_fault_per_class(s);
+    let classes = (pins.len() + gw.len()) as f64;
+    let mut acc: Vec<(String, usize, String)> = Vec::new();
+    // rusthdl: pin faults on its pins, design faults built into it
+    let mut k = 0;
+    for &p in &pins {
+        let dut = Box::new(cosim::RustHdlDut::new(s).map_err(|e| e.to_string())?);
+        k += caught(s, dut, p) as usize;
+    }
+    for &(_, gf) in &gw {
+        if let Ok(dut) = cosim::faults::gateware_dut(s, gf) {
+            let mut d = dut;
+            k += !run_dut(s, &mut d, 2, &RunOptions::default(), "faults", None).ok as usize;
+        }
+    }
+    acc.push((
+        "rusthdl".into(),
+        k,
+        "pin and reset faults on its pins; ROM and counter faults built into it".into(),
+    ));
+    // verilator: pin faults on its pins (its Verilog holds no injected design fault)
+    if speeds.of("verilator").is_some() {
+        let v = cosim::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+        let mut k = 0;
+        for &p in &pins {
+            let (dut, _) = cosim::verilator::VerilatedDut::new(&v).map_err(|e| e.to_string())?;
+            k += caught(s, Box::new(dut), p) as usize;
+        }
+        acc.push(("verilator".into(), k, "pin and reset faults on its pins; design faults not injectable into its compiled Verilog here".into()));
+    }
+    // check: a VCD of faulty pins, read back
+    let tmp = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let mut k = 0;
+    for &p in &pins {
+        let path = tmp.path().join("f.vcd");
+        let reset = judge::run::reset_cycles(s, 4);
+        let mut w = VcdWriter::create(&path, s, 0, reset + 2 * f).map_err(|e| e.to_string())?;
+        let at = f / 2 + 7;
+        let mut d = FaultyDut::new(s, Box::new(ModelDut::new(s)) as Box<dyn Dut>, p, at);
+        let _ = run_dut(s, &mut d, 2, &RunOptions::default(), "faults", Some(&mut w));
+        w.finish().map_err(|e| e.to_string())?;
+        let r = judge::check_vcd(s, &path, None).map_err(|e| e.to_string())?;
+        k += !r.ok as usize;
+    }
+    acc.push((
+        "check".into(),
+        k,
+        "a VCD of faulty pins (any simulator's)".into(),
+    ));
+    if icarus {
+        acc.push((
+            "icarus".into(),
+            k,
+            "its VCD goes through check: as check".into(),
+        ));
+    }
+    acc.push(("model".into(), 0, "the slot-level model has no pins: it answers rate questions (hours per second), sees no design fault".into()));
+
+    let mut table = Table::new(&[
+        "method",
+        "simulated_cycles",
+        "wall_seconds",
+        "simulated_seconds_per_wall_second",
+        "fault_classes_detected",
+        "fault_classes",
+        "share_detected",
+        "how faults reach it",
+    ]);
+    let mut series = Vec::new();
+    for (m, k, how) in &acc {
+        let Some((cycles, secs)) = speeds.of(m) else {
+            continue;
+        };
+        let sim_s = cycles as f64 / g.clock_hz as f64;
+        let speed = sim_s / secs;
+        let share = *k as f64 / classes;
+        table.push(vec![
+            m.clone(),
+            cycles.to_string(),
+            format!("{secs:.4}"),
+            format!("{speed:.6}"),
+            k.to_string(),
+            (classes as usize).to_string(),
+            format!("{share:.3}"),
+            how.clone(),
+        ]);
+        series.push(Series::scatter(m, vec![(speed, share)]));
+    }
+    let mut axes = Axes::new(
+        "Speed against accuracy of the verification methods",
+        "simulated seconds per wall second (log)",
+        "share of fault classes detected",
+    );
+    axes.log_x = true;
+    let svg = draw(&axes, &series, 820, 460);
+    let mut para = vec![format!(
+        "Each method simulated this mix in this run; its speed is simulated acquisition time per wall second. Accuracy is the share of {} fault classes ({} on the pins or the reset, {} built into the gateware) that the method rejects when each is injected once in the middle of frame 0.",
+        classes, pins.len(), gw.len()
+    )];
+    if let Some(c) = campaign {
+        para.push(format!(
+            "The full campaign ({:?} target) injected {} faults at {} sites and caught {}.",
+            c.target,
+            c.injected,
+            c.sites.len(),
+            c.detected
+        ));
+    }
+    para.push("Use the slot-level model for rates, intervals and headroom over hours; rusthdl for fast cycle-exact checks of the gateware, including its ROM and counters; verilator for long runs of the emitted Verilog; check (and icarus through it) for waveforms from any simulator.".into());
+    let line = table
+        .rows
+        .iter()
+        .map(|r| {
+            format!(
+                "{} {}x",
+                r[0],
+                &r[3][..r[3].find('.').unwrap_or(r[3].len())]
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    Ok((
+        Section {
+            title: "Speed against accuracy".into(),
+            paragraphs: para,
+            figures: vec![Figure {
+                stem: "speed-accuracy".into(),
+                title: "Speed against accuracy".into(),
+                caption: "x: simulated seconds per wall second, measured in this run; y: share of fault classes detected".into(),
+                svg,
+                table,
+            }],
+            ..Section::default()
+        },
+        line,
+    ))
+}
+
+/// A timing diagram of the first slice after reset, per branch (mux select,
+/// CS, SCLK) and the sample strobes, from the rust-hdl simulation; and
+/// WaveDrom JSON of the first conversion of branch 0.
+pub fn timing(s: &Schedule) -> Result<(Section, String), String> {
+    let g = &s.grid;
+    let slice = g.slots_per_slice * g.slot_cycles;
+    let mut trace = Trace::default();
+    cosim::run_traced(
+        s,
+        Backend::RustHdl,
+        1,
+        &SimOptions::default(),
+        Some(&mut trace),
+    )
+    .map_err(|e| e.to_string())?;
+    let z = trace.cycle_zero().ok_or("no cycle after reset")?;
+    let cycles = &trace.cycles[z..(z + slice as usize).min(trace.len())];
+    let l = Layout::new(s);
+    let us = |c: usize| c as f64 * 1e6 / g.clock_hz as f64;
+    let mut names = Vec::new();
+    let mut series = Vec::new();
+    let mut table = Table::new(&["cycle", "time_us", "signal", "value"]);
+    let mut row = 0.0;
+    let lane = |p: &lut_gen::ports::Pins, r: Role, b: usize| {
+        let (hi, lo) = l.lane_bits(r, b);
+        (p.value(r) >> lo) & ((1u64 << (hi - lo + 1)) - 1)
+    };
+    let mut add = |name: String, val: &dyn Fn(&lut_gen::ports::Pins) -> u64, scale: f64| {
+        let mut pts = Vec::new();
+        let mut prev = None;
+        for (c, (_, p, _)) in cycles.iter().enumerate() {
+            let v = val(p);
+            if prev != Some(v) {
+                pts.push((us(c), row + 0.8 * (v as f64 / scale)));
+                table.push(vec![
+                    c.to_string(),
+                    format!("{:.6}", us(c)),
+                    name.clone(),
+                    v.to_string(),
+                ]);
+                prev = Some(v);
+            }
+        }
+        pts.push((us(cycles.len()), pts.last().map_or(row, |p| p.1)));
+        let mut sr = Series::line(&name, pts);
+        sr.steps = true;
+        series.push(sr);
+        names.push(name);
+        row += 1.0;
+    };
+    add("sample_valid".into(), &|p| p.sample_valid as u64, 1.0);
+    for (b, br) in s.branches.iter().enumerate().rev() {
+        add(
+            format!("{} sclk", br.name),
+            &|p| lane(p, Role::Sclk, b),
+            1.0,
+        );
+        add(format!("{} cs_n", br.name), &|p| lane(p, Role::CsN, b), 1.0);
+        add(
+            format!("{} mux_sel", br.name),
+            &|p| lane(p, Role::MuxSel, b),
+            7.0,
+        );
+    }
+    let mut axes = Axes::new(
+        "One slice after reset, per branch (rust-hdl simulation)",
+        "time after reset (us)",
+        "",
+    );
+    axes.y_names = names;
+    let svg = draw(&axes, &series, 1000, 120 + 36 * series.len() as u32);
+    // WaveDrom: the first conversion of branch 0, one character per SCLK half period
+    let spi = s.branches[0].spi;
+    let t0 = cycles
+        .iter()
+        .position(|(_, p, _)| p.cs_n & 1 == 0)
+        .ok_or("branch 0 does not convert in the first slice")?;
+    let step = spi.sclk_half.max(1) as usize;
+    let from = t0.saturating_sub(2 * step);
+    let to = (t0 + spi.read_cycles as usize + 4 * step).min(cycles.len());
+    let wave = |f: &dyn Fn(&lut_gen::ports::Pins, u64) -> u64| {
+        let mut w = String::new();
+        let mut prev = None;
+        for (_, p, miso) in cycles[from..to].iter().step_by(step) {
+            let v = f(p, *miso);
+            w.push(if prev == Some(v) {
+                '.'
+            } else if v == 0 {
+                '0'
+            } else {
+                '1'
+            });
+            prev = Some(v);
+        }
+        w
+    };
+    let mut sel = String::new();
+    let mut data = Vec::new();
+    let mut prev = None;
+    for (_, p, _) in cycles[from..to].iter().step_by(step) {
+        let v = lane(p, Role::MuxSel, 0);
+        if prev == Some(v) {
+            sel.push('.');
+        } else {
+            sel.push('=');
+            data.push(v.to_string());
+        }
+        prev = Some(v);
+    }
+    let wd = serde_json::json!({
+        "signal": [
+            {"name": "cs_n", "wave": wave(&|p, _| (p.cs_n & 1) as u64)},
+            {"name": "sclk", "wave": wave(&|p, _| (p.sclk & 1) as u64)},
+            {"name": "miso", "wave": wave(&|_, m| m & 1)},
+            {"name": "mux_sel", "wave": sel, "data": data},
+            {"name": "sample_valid", "wave": wave(&|p, _| p.sample_valid as u64)},
+        ],
+        "head": {"text": format!("{}: first conversion of branch {} (one step = {} clock cycles)", s.mix.name, s.branches[0].name, step)},
+        "config": {"hscale": 1},
+    });
+    let mut text = serde_json::to_string_pretty(&wd).expect("json");
+    text.push('\n');
+    Ok((
+        Section {
+            title: "Timing of one slice".into(),
+            paragraphs: vec![format!(
+                "What the paper's Figure 4 shows, drawn from simulation: for each branch the mux select, CS and SCLK over the first slice ({} slots of {} cycles) after reset, and the merged sample strobes. conversion.wavedrom.json has the first conversion of branch {} for WaveDrom.",
+                g.slots_per_slice, g.slot_cycles, s.branches[0].name
+            )],
+            figures: vec![Figure {
+                stem: "timing-slice".into(),
+                title: "One slice per branch".into(),
+                caption: "steps are the pins' levels; mux_sel is scaled from 0..7".into(),
+                svg,
+                table,
+            }],
+            ..Section::default()
+        },
+        text,
+    ))
+}
+
+/// A random mix of a family, as TOML text, and its ADC utilization.
+fn family_mix(family: &str, seed: u64) -> (String, f64) {
+    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let nb = 1 + next() % 3;
+    let mut t = String::from(
+        "name = \"r\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n",
+    );
+    for b in 0..nb {
+        let _ = write!(
+            t,
+            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 8\n"
+        );
+    }
+    let rates: &[u64] = match family {
+        // harmonic (and the sync pairs): periods divide one another
+        "harmonic" | "sync" => &[100, 500, 1_000, 2_000, 5_000, 10_000],
+        // periods that do not: the slot grid must hold several at once
+        _ => &[200, 300, 400, 500, 600, 800, 1_200],
+    };
+    let target = 0.05 + (next() % 1000) as f64 / 1000.0 * 1.1; // utilization aimed at
+    let mut demand = 0.0;
+    let mut i = 0;
+    let cap = nb as f64 * 100_000.0;
+    let mut per_branch = vec![0u64; nb as usize];
+    while demand / cap < target && i < 64 * nb {
+        let b = (next() % nb) as usize;
+        if per_branch[b] >= 64 {
+            i += 1;
+            continue;
+        }
+        let r = rates[(next() % rates.len() as u64) as usize];
+        if family == "sync" && nb >= 2 && next() % 2 == 0 {
+            // a pair on two branches, one instant
+            let b2 = (b + 1) % nb as usize;
+            if per_branch[b2] < 64 {
+                let _ = write!(
+                    t,
+                    "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {r}\nsync = \"g{i}\"\n[[channel]]\nname = \"d{i}\"\nbranch = \"b{b2}\"\nrate_hz = {r}\nsync = \"g{i}\"\n"
+                );
+                per_branch[b] += 1;
+                per_branch[b2] += 1;
+                demand += 2.0 * r as f64;
+                i += 1;
+                continue;
+            }
+        }
+        let _ = write!(
+            t,
+            "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {r}\n"
+        );
+        per_branch[b] += 1;
+        demand += r as f64;
+        i += 1;
+    }
+    (t, demand / cap)
+}
+
+/// Over random mixes of three families: ADC utilization against whether an
+/// exact schedule exists, and how long synthesis took.
+pub fn schedulability() -> (Section, String) {
+    let mut table = Table::new(&["family", "seed", "utilization", "feasible", "synthesis_ms"]);
+    let mut series: Vec<Series> = Vec::new();
+    let mut counts = Vec::new();
+    for family in ["harmonic", "non-harmonic", "sync"] {
+        let (mut ok_pts, mut no_pts) = (Vec::new(), Vec::new());
+        for seed in 1..=40u64 {
+            let (text, util) = family_mix(family, seed);
+            let Ok(mix) = lut_gen::parse(Path::new("random.toml"), &text) else {
+                continue;
+            };
+            let t = Instant::now();
+            let feasible = lut_gen::synthesize(&mix).is_ok();
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            table.push(vec![
+                family.into(),
+                seed.to_string(),
+                format!("{util:.4}"),
+                feasible.to_string(),
+                format!("{ms:.4}"),
+            ]);
+            if feasible {
+                ok_pts.push((util * 100.0, ms.max(1e-4)));
+            } else {
+                no_pts.push((util * 100.0, ms.max(1e-4)));
+            }
+        }
+        let best = ok_pts.iter().map(|p| p.0).fold(0.0f64, f64::max);
+        let worst = no_pts.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+        counts.push(format!(
+            "{family}: {} of {} feasible, exact schedules up to {best:.0} % utilization{}",
+            ok_pts.len(),
+            ok_pts.len() + no_pts.len(),
+            if worst.is_finite() {
+                format!(", the first without one at {worst:.0} %")
+            } else {
+                String::new()
+            }
+        ));
+        series.push(Series::scatter(
+            &format!("{family}, exact schedule"),
+            ok_pts,
+        ));
+        series.push(Series::scatter(&format!("{family}, none"), no_pts));
+    }
+    let mut axes = Axes::new(
+        "Where scheduling breaks: utilization against feasibility and synthesis time",
+        "ADC utilization (% of the AD7940s' 100 kSPS)",
+        "synthesis time (ms, log)",
+    );
+    axes.log_y = true;
+    let svg = draw(&axes, &series, 900, 480);
+    let line = counts.join("; ");
+    (
+        Section {
+            title: "Where scheduling breaks".into(),
+            paragraphs: vec![
+                format!("Random mixes on 1-3 AD7940 branches (10 ms frame, 1 ms slice) of three families: harmonic rates (100 Hz to 10 kHz, whole samples per 1 ms slice or per 10 ms frame), non-harmonic rates (200, 300, 400, 500, 600, 800 Hz, 1.2 kHz), and sync groups (pairs sampled at one instant on two branches). {line}."),
+                "A mix fails when its demand exceeds a branch's ADC, or earlier when no slot grid holds every rate's period exactly (non-harmonic rates) or sync partners cannot share a free slot; the time to decide is the y axis.".into(),
+            ],
+            figures: vec![Figure {
+                stem: "schedulability".into(),
+                title: "Where scheduling breaks".into(),
+                caption: "each point a random mix; x: demand over the ADCs' throughput; y: time to synthesize (or to prove there is no exact schedule)".into(),
+                svg,
+                table,
+            }],
+            ..Section::default()
+        },
+        line,
+    )
+}
+
+/// The fault campaign as a table.
+pub fn faults_section(c: &cosim::faults::Campaign) -> Section {
+    let mut t = Table::new(&["class", "level", "injected", "detected"]);
+    for k in &c.classes {
+        t.push(vec![
+            k.name.clone(),
+            k.level.into(),
+            k.injected.to_string(),
+            k.detected.to_string(),
+        ]);
+    }
+    Section {
+        title: "Fault campaign".into(),
+        paragraphs: vec![
+            format!(
+                "Target {:?}; sites: {}. {} of {} injections caught. False alarms: {} of {} clean runs over {} random feasible mixes.",
+                c.target,
+                c.sites
+                    .iter()
+                    .map(|s| format!("{} (slot {})", s.name, s.slot))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                c.detected,
+                c.injected,
+                c.false_alarms.rejected,
+                c.false_alarms.runs,
+                c.false_alarms.mixes
+            ),
+        ],
+        tables: vec![(String::new(), t)],
+        ..Section::default()
+    }
+}
