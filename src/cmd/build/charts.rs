@@ -280,11 +280,8 @@ pub fn speed_accuracy(
         .rows
         .iter()
         .map(|r| {
-            format!(
-                "{} {}x",
-                r[0],
-                &r[3][..r[3].find('.').unwrap_or(r[3].len())]
-            )
+            let v: f64 = r[3].parse().unwrap_or(0.0);
+            format!("{} {v:.3}x real time, {} of {} classes", r[0], r[4], r[5])
         })
         .collect::<Vec<_>>()
         .join(", ");
