@@ -352,7 +352,11 @@ pub fn timing(s: &Schedule) -> Result<(Section, String), String> {
         names.push(name);
         row += 1.0;
     };
-    add("sample_valid".into(), &|p| p.sample_valid as u64, 1.0);
+    add(
+        Role::SampleValid.name().into(),
+        &|p| p.sample_valid as u64,
+        1.0,
+    );
     for (b, br) in s.branches.iter().enumerate().rev() {
         add(
             format!("{} sclk", br.name),
@@ -413,11 +417,11 @@ pub fn timing(s: &Schedule) -> Result<(Section, String), String> {
     }
     let wd = serde_json::json!({
         "signal": [
-            {"name": "cs_n", "wave": wave(&|p, _| (p.cs_n & 1) as u64)},
-            {"name": "sclk", "wave": wave(&|p, _| (p.sclk & 1) as u64)},
-            {"name": "miso", "wave": wave(&|_, m| m & 1)},
-            {"name": "mux_sel", "wave": sel, "data": data},
-            {"name": "sample_valid", "wave": wave(&|p, _| p.sample_valid as u64)},
+            {"name": Role::CsN.key(), "wave": wave(&|p, _| (p.cs_n & 1) as u64)},
+            {"name": Role::Sclk.key(), "wave": wave(&|p, _| (p.sclk & 1) as u64)},
+            {"name": Role::Miso.key(), "wave": wave(&|_, m| m & 1)},
+            {"name": Role::MuxSel.key(), "wave": sel, "data": data},
+            {"name": Role::SampleValid.name(), "wave": wave(&|p, _| p.sample_valid as u64)},
         ],
         "head": {"text": format!("{}: first conversion of branch {} (one step = {} clock cycles)", s.mix.name, s.branches[0].name, step)},
         "config": {"hscale": 1},
