@@ -41,6 +41,14 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // A closed pipe (`slotforge audit mix.toml | head`) ends the process
+    // quietly, as for any Unix tool, instead of a panic in println!.
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread
+    // exists touches no Rust state.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let code = match cli.command {
         Command::Build(a) => cmd::build::run(a),

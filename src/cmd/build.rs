@@ -347,6 +347,19 @@ pub fn run(a: Args) -> u8 {
             Err(e) => Outcome::Failed(e, String::new()),
         },
     );
+    job.step(
+        "chart: Figure 7 (sampling rate)",
+        |_| match charts::figure7(&s) {
+            Ok(Some((sec, line))) => {
+                sections.push(sec);
+                Outcome::Ok(line)
+            }
+            Ok(None) => {
+                Outcome::Skipped("the mix has no channels at 100 Hz, 1 kHz and 2 kHz".into())
+            }
+            Err(e) => Outcome::Failed(e, String::new()),
+        },
+    );
     job.step("chart: where scheduling breaks", |_| {
         let (sec, line) = charts::schedulability();
         sections.push(sec);
