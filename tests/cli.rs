@@ -302,6 +302,10 @@ fn verilog_refuses_mixes_beyond_the_gateware_limits() {
             big_mix(5, 205, 26),
             "1025 channels: the gateware supports 1 to 1024",
         ),
+        (
+            big_mix(5, 1, 26),
+            "130 mux devices in total: the gateware supports at most 128",
+        ),
     ];
     for (text, msg) in limits {
         let p = write_mix(d.path(), &text);
@@ -316,7 +320,7 @@ fn verilog_refuses_mixes_beyond_the_gateware_limits() {
             .stderr(predicate::str::contains(msg));
     }
     // the largest mixes of the test data emit
-    for name in ["full300", "b16"] {
+    for name in ["full300", "b16", "ch1024"] {
         let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("hdl/tests/data/{name}.toml"));
         slotforge()
             .arg("verilog")

@@ -63,7 +63,7 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         let id_of = |en: u64, sel: u32| {
             let p = Pins {
                 mux_sel: (sel as u64) << (3 * b),
-                mux_en: en << lo,
+                mux_en: (en as u128) << lo,
                 ..Pins::default()
             };
             analog.input_id(&l, &p, b)

@@ -24,9 +24,11 @@ const SHIM_TEMPLATE: &str = r#"
 #include <cstdint>
 
 // The Rust `SfPins` (repr(C)); Verilator's port types (CData/SData/IData/
-// QData for up to 8/16/32/64 bits) convert to these widths by assignment.
+// QData for up to 8/16/32/64 bits) convert to these widths by assignment;
+// `mux_en` may be wider than 64 bits (a `VlWide` of 32-bit words), so it
+// travels as two 64-bit words, low first (`sf_wide`).
 struct SfPins {
-    uint64_t mux_en;
+    uint64_t mux_en[2];
     uint64_t mux_sel;
     uint16_t sample_channel;
     uint16_t sample_value;
@@ -35,7 +37,21 @@ struct SfPins {
     uint8_t sample_valid;
     uint8_t pad[7];
 };
-static_assert(sizeof(SfPins) == 32, "SfPins must match the Rust layout");
+static_assert(sizeof(SfPins) == 40, "SfPins must match the Rust layout");
+
+// A port of up to 64 bits.
+template <typename T> static inline void sf_wide(uint64_t* o, const T& v) {
+    o[0] = v;
+    o[1] = 0;
+}
+
+// A port of more than 64 bits (at most 128 are carried).
+template <std::size_t N> static inline void sf_wide(uint64_t* o, const VlWide<N>& v) {
+    static_assert(N <= 4, "mux_en is at most 128 bits");
+    o[0] = 0;
+    o[1] = 0;
+    for (std::size_t i = 0; i < N; ++i) o[i / 2] |= (uint64_t)v[i] << (32 * (i % 2));
+}
 
 struct SfModel {
     VerilatedContext* ctx;
@@ -63,7 +79,7 @@ extern "C" void sf_step(void* p, uint8_t rst, uint64_t miso, SfPins* o) {
     o->cs_n = t->@cs_n@;
     o->sclk = t->@sclk@;
     o->mux_sel = t->@mux_sel@;
-    o->mux_en = t->@mux_en@;
+    sf_wide(o->mux_en, t->@mux_en@);
     o->sample_valid = t->@valid@;
     o->sample_channel = t->@channel@;
     o->sample_value = t->@value@;
@@ -94,7 +110,8 @@ fn shim() -> String {
 #[repr(C)]
 #[derive(Default)]
 struct SfPins {
-    mux_en: u64,
+    /// Low word first.
+    mux_en: [u64; 2],
     mux_sel: u64,
     sample_channel: u16,
     sample_value: u16,
@@ -104,7 +121,8 @@ struct SfPins {
     pad: [u8; 7],
 }
 
-const _: () = assert!(std::mem::size_of::<SfPins>() == 32);
+const _: () = assert!(std::mem::size_of::<SfPins>() == 40);
+const _: () = assert!(lut_gen::ports::limits::MAX_DEVICES <= 128);
 
 /// FNV-1a, 64 bit: a stable cache key across Rust versions.
 pub fn fnv64(parts: &[&[u8]]) -> u64 {
@@ -375,7 +393,7 @@ impl Dut for VerilatedDut {
             cs_n: self.out.cs_n,
             sclk: self.out.sclk,
             mux_sel: self.out.mux_sel,
-            mux_en: self.out.mux_en,
+            mux_en: self.out.mux_en[0] as u128 | (self.out.mux_en[1] as u128) << 64,
             sample_valid: self.out.sample_valid != 0,
             sample_channel: self.out.sample_channel,
             sample_value: self.out.sample_value,

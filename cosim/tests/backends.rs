@@ -65,13 +65,14 @@ fn verilator_backend_2_frames() {
     }
 }
 
-/// The largest mixes (issue 9): three AD7940s at 100 % (300 channels) and
-/// the gateware's 16 branches, one frame each on rusthdl and verilator with
-/// a one-cycle reset.
+/// The largest mixes (issue 9): three AD7940s at 100 % (300 channels), the
+/// gateware's 16 branches, and its 1,024 channels on 128 mux devices (a
+/// 128-bit `mux_en`), one frame each on rusthdl and verilator with a
+/// one-cycle reset.
 #[test]
 fn largest_mixes_one_frame() {
     let verilator = tools::require_tools(&["verilator", "g++"]);
-    for name in ["full300", "b16"] {
+    for name in ["full300", "b16", "ch1024"] {
         let p =
             Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../hdl/tests/data/{name}.toml"));
         let s = schedule(&p);

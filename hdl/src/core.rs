@@ -804,7 +804,7 @@ pub struct Core {
     /// Sequencer of each branch.
     _seq_of: Vec<usize>,
     /// The value last written to `mux_en.next` (simulation only).
-    _mux_en: u64,
+    _mux_en: u128,
     /// The value last written to `mux_sel.next` (simulation only).
     _mux_sel: u64,
 }
@@ -843,7 +843,7 @@ fn drive(sig: &mut Signal<In, Clock>, level: Clock) {
 
 impl Core {
     /// `mux_en` as a number (the value of the `mux_en` signal).
-    pub fn mux_en_u64(&self) -> u64 {
+    pub fn mux_en_u128(&self) -> u128 {
         self._mux_en
     }
 
@@ -961,7 +961,7 @@ impl Logic for Core {
         let idle: u64 = ((1u64 << MAX_BRANCHES) - 1) & !((1u64 << nb) - 1);
         self.adc_cs_n.next = (cs | idle).into();
         self.adc_sclk.next = (sclk | idle).into();
-        // `mux_sel` (48 bits) and `mux_en` (64 bits) are wider than rust-hdl's
+        // `mux_sel` (48 bits) and `mux_en` (128 bits) are wider than rust-hdl's
         // short bit vectors (32 bits), so it stores them as `[bool; N]`:
         // converting them on every evaluation pass dominated the simulation,
         // so they are written only when their value changes (same signal value).
@@ -969,10 +969,9 @@ impl Logic for Core {
             self._mux_sel = sel;
             self.mux_sel.next = sel.into();
         }
-        let en = en as u64;
         if en != self._mux_en {
             self._mux_en = en;
-            self.mux_en.next = en.into();
+            self.mux_en.next = en.to_bits();
         }
         self.merge.done.next = done.into();
         // Lanes >= nb keep their default 0 (the glue ties them to zero).

@@ -57,7 +57,7 @@ pub(crate) fn read_pins(c: &Core, r: &PinReader) -> Pins {
         cs_n: c.adc_cs_n.val().to_u64() as u16 & r.lanes,
         sclk: c.adc_sclk.val().to_u64() as u16 & r.lanes,
         mux_sel: c.mux_sel_u64(),
-        mux_en: c.mux_en_u64(),
+        mux_en: c.mux_en_u128(),
         sample_valid: c.sample_valid.val(),
         sample_channel: c.sample_channel.val().to_u64() as u16 & r.ch_mask,
         sample_value: c.sample_value.val().to_u64() as u16,

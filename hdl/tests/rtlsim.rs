@@ -114,6 +114,17 @@ fn b16_matches_timing_contract() {
     run_and_compare(&s, 2 * s.grid.frame_cycles);
 }
 
+/// The gateware's 1,024 channels: 16 branches x 64 channels on 8 mux
+/// devices each, all 128 enables (`mux_en` wider than 64 bits), one frame.
+#[test]
+fn ch1024_matches_timing_contract() {
+    let s = data_mix("ch1024");
+    assert_eq!(s.channels.len(), lut_gen::ports::limits::MAX_CHANNELS);
+    let devices: u32 = s.branches.iter().map(|b| b.mux_devices).sum();
+    assert_eq!(devices as usize, lut_gen::ports::limits::MAX_DEVICES);
+    run_and_compare(&s, s.grid.frame_cycles + s.grid.slice_cycles);
+}
+
 /// The reference mix with the compact slot LUT (slice table + rotation
 /// groups + slice counter) instead of the full frame table: same pins.
 #[test]

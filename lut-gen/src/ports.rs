@@ -39,8 +39,9 @@ pub mod limits {
     pub const MAX_CHANNELS: usize = 1024;
     /// Mux devices of one branch.
     pub const MAX_DEVICES_PER_BRANCH: usize = 32;
-    /// Mux devices over all branches (`mux_en` bits in the core).
-    pub const MAX_DEVICES: usize = 64;
+    /// Mux devices over all branches (`mux_en` bits in the core): 1,024
+    /// channels of 8:1 muxes.
+    pub const MAX_DEVICES: usize = 128;
 }
 
 /// What a port is for; the index into [`PORTS`].
@@ -173,17 +174,19 @@ impl Role {
 }
 
 impl Pins {
-    /// The value of output port `r` (inputs read as 0).
-    pub fn value(&self, r: Role) -> u64 {
+    /// The value of output port `r` (inputs read as 0); `u128` because
+    /// `mux_en` has up to [`limits::MAX_DEVICES`] bits.
+    #[inline]
+    pub fn value(&self, r: Role) -> u128 {
         match r {
             Role::Clock | Role::Reset | Role::Miso => 0,
-            Role::CsN => self.cs_n as u64,
-            Role::Sclk => self.sclk as u64,
-            Role::MuxSel => self.mux_sel,
+            Role::CsN => self.cs_n as u128,
+            Role::Sclk => self.sclk as u128,
+            Role::MuxSel => self.mux_sel as u128,
             Role::MuxEn => self.mux_en,
-            Role::SampleValid => self.sample_valid as u64,
-            Role::SampleChannel => self.sample_channel as u64,
-            Role::SampleValue => self.sample_value as u64,
+            Role::SampleValid => self.sample_valid as u128,
+            Role::SampleChannel => self.sample_channel as u128,
+            Role::SampleValue => self.sample_value as u128,
         }
     }
 }
@@ -198,7 +201,7 @@ pub struct Pins {
     pub cs_n: u16,
     pub sclk: u16,
     pub mux_sel: u64,
-    pub mux_en: u64,
+    pub mux_en: u128,
     pub sample_valid: bool,
     pub sample_channel: u16,
     pub sample_value: u16,
@@ -210,7 +213,11 @@ const _: () = {
         "Pins::cs_n / sclk hold one bit per branch"
     );
     assert!(limits::MAX_BRANCHES * MUX_SELECT_BITS as usize <= 64);
-    assert!(limits::MAX_DEVICES <= 64);
+    assert!(limits::MAX_DEVICES <= 128);
+    assert!(
+        limits::MAX_DEVICES_PER_BRANCH < 64,
+        "Layout::en returns u64"
+    );
     assert!(limits::MAX_CHANNELS <= 1 << 16);
     assert!(SAMPLE_VALUE_BITS <= 16);
 };
@@ -442,7 +449,7 @@ impl Layout {
 
     #[inline]
     pub fn en(&self, p: &Pins, b: usize) -> u64 {
-        (p.mux_en >> self.en_lo[b]) & ((1u64 << self.en_n[b]) - 1)
+        ((p.mux_en >> self.en_lo[b]) as u64) & ((1u64 << self.en_n[b]) - 1)
     }
 
     /// Branch `b`'s mux pins addressing `(device, select)`.
@@ -450,8 +457,8 @@ impl Layout {
         let sh = MUX_SELECT_BITS as usize * b;
         let m = INPUTS_PER_DEVICE as u64 - 1;
         p.mux_sel = (p.mux_sel & !(m << sh)) | ((select as u64 & m) << sh);
-        let mask = ((1u64 << self.en_n[b]) - 1) << self.en_lo[b];
-        p.mux_en = (p.mux_en & !mask) | ((1u64 << device) << self.en_lo[b]);
+        let mask = ((1u128 << self.en_n[b]) - 1) << self.en_lo[b];
+        p.mux_en = (p.mux_en & !mask) | ((1u128 << device) << self.en_lo[b]);
     }
 
     /// The channel branch `b`'s mux pins select, or why none is.

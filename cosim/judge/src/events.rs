@@ -274,7 +274,7 @@ impl EventLog {
 fn lane_value(l: &Layout, p: &Pins, r: Role, b: usize) -> u64 {
     let (hi, lo) = l.lane_bits(r, b);
     let w = hi - lo + 1;
-    (p.value(r) >> lo) & if w >= 64 { u64::MAX } else { (1 << w) - 1 }
+    ((p.value(r) >> lo) as u64) & if w >= 64 { u64::MAX } else { (1 << w) - 1 }
 }
 
 /// One difference between two logs.

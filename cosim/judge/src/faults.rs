@@ -212,7 +212,7 @@ impl<D: Dut> Dut for FaultyDut<D> {
             Fault::TwoMuxEn { branch } => {
                 if c >= self.t && c < self.t + 5 {
                     let n = self.layout.en_n[branch];
-                    p.mux_en |= ((1u64 << n) - 1) << self.layout.en_lo[branch];
+                    p.mux_en |= ((1u128 << n) - 1) << self.layout.en_lo[branch];
                 }
             }
             Fault::WrongMux { branch } => {
@@ -249,6 +249,6 @@ fn pins_before(layout: &Layout, p: &Pins, branch: usize, _t_prev: u64) -> Pins {
 fn copy_mux(layout: &Layout, p: &mut Pins, from: &Pins, b: usize) {
     let selm = 7u64 << (3 * b);
     p.mux_sel = (p.mux_sel & !selm) | (from.mux_sel & selm);
-    let enm = ((1u64 << layout.en_n[b]) - 1) << layout.en_lo[b];
+    let enm = ((1u128 << layout.en_n[b]) - 1) << layout.en_lo[b];
     p.mux_en = (p.mux_en & !enm) | (from.mux_en & enm);
 }

@@ -318,8 +318,8 @@ struct Sink {
 
 #[derive(Debug, Clone, Copy, Default)]
 struct Val {
-    v: u64,
-    x: u64,
+    v: u128,
+    x: u128,
 }
 
 struct Resolved {
@@ -510,13 +510,13 @@ fn resolve(
 /// Parses a vector/scalar value into (value, x/z mask), left-extended to `width`.
 #[inline]
 fn parse_value(s: &[u8], width: u32) -> Option<Val> {
-    let mut v = 0u64;
-    let mut x = 0u64;
+    let mut v = 0u128;
+    let mut x = 0u128;
     let n = s.len();
     if n == 0 {
         return None;
     }
-    let take = n.min(64);
+    let take = n.min(128);
     for &ch in &s[n - take..] {
         v <<= 1;
         x <<= 1;
@@ -548,9 +548,13 @@ fn parse_value(s: &[u8], width: u32) -> Option<Val> {
             return None;
         }
     }
-    if (n as u32) < width && n < 64 && matches!(s[0], b'x' | b'X' | b'z' | b'Z') {
-        let w = width.min(64);
-        let ext = (if w == 64 { u64::MAX } else { (1u64 << w) - 1 }) & !((1u64 << n) - 1);
+    if (n as u32) < width && n < 128 && matches!(s[0], b'x' | b'X' | b'z' | b'Z') {
+        let w = width.min(128);
+        let ext = (if w == 128 {
+            u128::MAX
+        } else {
+            (1u128 << w) - 1
+        }) & !((1u128 << n) - 1);
         x |= ext;
     }
     Some(Val { v, x })
@@ -565,10 +569,10 @@ impl State {
     fn apply(&mut self, sink: &Sink, val: Val) -> bool {
         let p = &mut self.port[sink.port as usize];
         let (old_v, old_x) = (p.v, p.x);
-        let wmask = if sink.width >= 64 {
-            u64::MAX
+        let wmask = if sink.width >= 128 {
+            u128::MAX
         } else {
-            (1u64 << sink.width) - 1
+            (1u128 << sink.width) - 1
         };
         let (vv, vx) = (val.v & wmask, val.x & wmask);
         if sink.down {
@@ -588,12 +592,12 @@ impl State {
 
     /// The pins' values and their x/z masks.
     fn pins(&self) -> (Pins, Pins) {
-        let pick = |f: fn(&Val) -> u64| {
+        let pick = |f: fn(&Val) -> u128| {
             let g = |i: usize| f(&self.port[i]);
             Pins {
                 cs_n: g(CS) as u16,
                 sclk: g(SCLK) as u16,
-                mux_sel: g(SEL),
+                mux_sel: g(SEL) as u64,
                 mux_en: g(EN),
                 sample_valid: g(VALID) & 1 == 1,
                 sample_channel: g(CHAN) as u16,
@@ -665,7 +669,11 @@ fn body<R: BufRead>(
         port: [Val { v: 0, x: 0 }; 10],
     };
     for (i, w) in res.widths.iter().enumerate() {
-        st.port[i].x = if *w >= 64 { u64::MAX } else { (1u64 << w) - 1 };
+        st.port[i].x = if *w >= 128 {
+            u128::MAX
+        } else {
+            (1u128 << w) - 1
+        };
     }
     let mut before = st.port;
     let mut time = 0u64;
@@ -686,7 +694,7 @@ fn body<R: BufRead>(
         miso: Val,
     ) {
         if let Some((r, p, x)) = pending.take() {
-            sink.cycle(r, &p, &x, miso.v, miso.x);
+            sink.cycle(r, &p, &x, miso.v as u64, miso.x as u64);
         }
         info.cycles += 1;
         *pending = Some((rst, pins, xz));
@@ -882,7 +890,7 @@ fn body<R: BufRead>(
                     for s in sinks {
                         let v = Val {
                             v: v.v,
-                            x: if v.x != 0 { u64::MAX } else { 0 },
+                            x: if v.x != 0 { u128::MAX } else { 0 },
                         };
                         out_changed |= st.apply(s, v) && s.port as usize >= CS;
                     }
@@ -895,7 +903,7 @@ fn body<R: BufRead>(
     }
     close(&st, &before, time, None, out_changed, first_step, &mut info);
     if let Some((r, p, x)) = pending.take() {
-        sink.cycle(r, &p, &x, st.port[MISO].v, st.port[MISO].x);
+        sink.cycle(r, &p, &x, st.port[MISO].v as u64, st.port[MISO].x as u64);
     }
     info.last_time = time;
     Ok(info)

@@ -35,8 +35,8 @@ pub struct VcdWriter {
     from: u64,
     to: u64,
     clock_hz: u64,
-    prev: Vec<u64>,
-    cur: Vec<u64>,
+    prev: Vec<u128>,
+    cur: Vec<u128>,
     widths: Vec<u32>,
     ids: Vec<String>,
     err: Option<std::io::Error>,
@@ -122,15 +122,19 @@ impl VcdWriter {
         self.cur.clear();
         self.cur.extend(Role::ALL.map(|r| match r {
             Role::Clock => 1,
-            Role::Reset => rst as u64,
-            Role::Miso => miso,
+            Role::Reset => rst as u128,
+            Role::Miso => miso as u128,
             r => p.value(r),
         }));
         for b in 0..self.layout.branches {
             for r in BRANCH_VIEW {
                 let (hi, lo) = self.layout.lane_bits(r, b);
-                let v = if r == Role::Miso { miso } else { p.value(r) };
-                self.cur.push((v >> lo) & ((1u64 << (hi - lo + 1)) - 1));
+                let v = if r == Role::Miso {
+                    miso as u128
+                } else {
+                    p.value(r)
+                };
+                self.cur.push((v >> lo) & ((1u128 << (hi - lo + 1)) - 1));
             }
         }
         // rst is sampled at the edge that begins cycle k: it changes half a

@@ -245,7 +245,7 @@ impl Adc {
 pub fn selected(s: &Schedule, b: usize, pins: &Pins) -> Option<usize> {
     let off: usize = s.branches[..b].iter().map(|x| x.mux_devices as usize).sum();
     let n = s.branches[b].mux_devices as usize;
-    let en = (pins.mux_en >> off) & ((1u64 << n) - 1);
+    let en = (pins.mux_en >> off) & ((1u128 << n) - 1);
     if en.count_ones() != 1 {
         return None;
     }
@@ -322,8 +322,8 @@ impl<'a> Reference<'a> {
     }
 
     /// (cs_n, sclk, mux_sel, mux_en) in cycle c.
-    pub fn pins(&self, c: u64) -> (u16, u16, u64, u64) {
-        let (mut cs, mut sclk, mut sel, mut en) = (0u16, 0u16, 0u64, 0u64);
+    pub fn pins(&self, c: u64) -> (u16, u16, u64, u128) {
+        let (mut cs, mut sclk, mut sel, mut en) = (0u16, 0u16, 0u64, 0u128);
         let mut off = 0;
         for (b, bp) in self.s.branches.iter().enumerate() {
             let spi = &bp.spi;
@@ -341,7 +341,7 @@ impl<'a> Reference<'a> {
             if let Some((_, ch)) = self.next_instant(b, c) {
                 let cc = &self.s.channels[ch];
                 sel |= (cc.select as u64) << (3 * b);
-                en |= 1u64 << (off + cc.device as usize);
+                en |= 1u128 << (off + cc.device as usize);
             }
             off += bp.mux_devices as usize;
         }
@@ -404,7 +404,7 @@ pub fn run_and_compare_with(s: &Schedule, cycles: u64, form: hdl::LutForm) -> Ru
         for b in 0..nb {
             let en_b = {
                 let off: usize = s.branches[..b].iter().map(|x| x.mux_devices as usize).sum();
-                (p.mux_en >> off) & ((1u64 << s.branches[b].mux_devices) - 1)
+                (p.mux_en >> off) & ((1u128 << s.branches[b].mux_devices) - 1)
             };
             assert!(
                 en_b.count_ones() <= 1,

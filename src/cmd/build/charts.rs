@@ -327,7 +327,7 @@ pub fn timing(s: &Schedule) -> Result<(Section, String), String> {
     let mut row = 0.0;
     let lane = |p: &lut_gen::ports::Pins, r: Role, b: usize| {
         let (hi, lo) = l.lane_bits(r, b);
-        (p.value(r) >> lo) & ((1u64 << (hi - lo + 1)) - 1)
+        ((p.value(r) >> lo) as u64) & ((1u64 << (hi - lo + 1)) - 1)
     };
     let mut add = |name: String, val: &dyn Fn(&lut_gen::ports::Pins) -> u64, scale: f64| {
         let mut pts = Vec::new();
