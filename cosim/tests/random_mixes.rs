@@ -1,62 +1,16 @@
 //! Random feasible mixes: the checker passes the model's pins and hdl's
 //! RtlSim, and catches every injected fault.
 
-use std::fmt::Write;
 use std::path::Path;
 
 use judge::faults::{Fault, FaultyDut};
 use judge::run::{run_dut, ModelDut, RunOptions};
 
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn pick<T: Copy>(&mut self, v: &[T]) -> T {
-        v[(self.next() % v.len() as u64) as usize]
-    }
-}
-
-/// A mix of 1-3 branches with 2 ms frames and a few channels per branch.
-fn random_mix(seed: u64) -> String {
-    let mut r = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
-    let nb = 1 + r.next() % 3;
-    let mut t = String::from(
-        "name = \"rand\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 2_000\nslice_us = 1_000\n",
-    );
-    let mut devs = Vec::new();
-    for b in 0..nb {
-        let d = 1 + r.next() % 3;
-        devs.push(d);
-        let sclk = r.pick(&[2_500_000u64, 1_000_000, 2_000_000]);
-        let settle = r.pick(&[0u64, 1_000, 2_000, 5_000]);
-        let _ = write!(t, "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nsclk_hz = {sclk}\nmux = \"tmux1108\"\nmux_devices = {d}\nsettle_ns = {settle}\n");
-    }
-    let n = 2 + r.next() % 8;
-    let mut used = std::collections::HashSet::new();
-    for i in 0..n {
-        let b = r.next() % nb;
-        let input = r.next() % (devs[b as usize] * 8);
-        if !used.insert((b, input)) {
-            continue;
-        }
-        let rate = r.pick(&[500u64, 1_000, 2_000, 4_000, 8_000]);
-        let _ = write!(
-            t,
-            "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {rate}\ninput = {input}\n"
-        );
-    }
-    t
-}
-
 #[test]
 fn random_feasible_mixes() {
     let mut tested = 0;
     for seed in 0..40u64 {
-        let text = random_mix(seed);
+        let text = cosim::faults::random_mix(seed);
         let Ok(mix) = lut_gen::parse(Path::new("rand.toml"), &text) else {
             continue;
         };

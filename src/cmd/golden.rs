@@ -127,20 +127,23 @@ fn window_cycles(s: &Schedule, w: &Window, reset: u64, file: &Path) -> Result<(u
             w.file
         ));
     }
-    let k0 = if from == 0 { 0 } else { reset + from };
-    Ok((k0, reset + to))
+    let v = cosim::VcdOut {
+        path: file.to_path_buf(),
+        from,
+        to,
+        gtkw: false,
+    };
+    Ok(v.run_cycles(reset))
 }
 
-/// Writes the window `[k0, k1)` of `trace` as a VCD plus its `.gtkw`.
+/// Writes the window `[k0, k1)` of `trace` as a VCD.
 fn write_window(s: &Schedule, trace: &Trace, k0: u64, k1: u64, path: &Path) -> std::io::Result<()> {
     use judge::run::Observer;
     let mut w = VcdWriter::create(path, s, k0, k1)?;
     for (k, (rst, p, miso)) in trace.cycles.iter().enumerate().take(k1 as usize) {
         w.cycle(k as u64, *rst, p, *miso);
     }
-    w.finish()?;
-    let name = Path::new(path.file_name().expect("a file name"));
-    write_gtkw(&path.with_extension("gtkw"), name, s)
+    w.finish()
 }
 
 /// The cycles of a VCD window as read back by the judge's reader.
@@ -418,13 +421,12 @@ fn update(
             errln!(o, "error: {}: {e}", path.display());
             return 2;
         }
-        // the .gtkw names the final file
+        // the .gtkw names the VCD beside it, so the folder can move
         let name = Path::new(path.file_name().expect("a file name"));
         if let Err(e) = write_gtkw(&path.with_extension("gtkw"), name, s) {
             errln!(o, "error: {}: {e}", path.display());
             return 2;
         }
-        let _ = std::fs::remove_file(tmp.with_extension("gtkw"));
         outln!(o, "{who}: window {} written ({} cycles)", w.file, k1 - k0);
     }
     0

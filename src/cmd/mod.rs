@@ -108,6 +108,19 @@ pub fn fits_pins(s: &lut_gen::Schedule) -> Result<(), u8> {
     })
 }
 
+/// Writes `text` to `dir/name` through a temporary file and a rename, so an
+/// interrupted run never leaves a half-written file.
+pub fn write_atomic(dir: &Path, name: &str, text: &str) -> Result<(), String> {
+    let path = dir.join(name);
+    let tmp = dir.join(format!(".{name}.tmp"));
+    std::fs::write(&tmp, text)
+        .and_then(|()| std::fs::rename(&tmp, &path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            format!("{}: cannot write: {e}", path.display())
+        })
+}
+
 /// Writes generated files into `dir` (created if missing).  Each file is
 /// written to a temporary name and renamed, so an interrupted run never
 /// leaves a half-written file, and nothing else in `dir` is touched.
@@ -121,15 +134,10 @@ pub fn write_files(dir: &Path, files: &[(&str, String)]) -> Result<(), u8> {
         2u8
     })?;
     for (name, text) in files {
-        let path = dir.join(name);
-        let tmp = dir.join(format!(".{name}.tmp"));
-        std::fs::write(&tmp, text)
-            .and_then(|()| std::fs::rename(&tmp, &path))
-            .map_err(|e| {
-                let _ = std::fs::remove_file(&tmp);
-                eprintln!("error: {}: cannot write: {e}", path.display());
-                2u8
-            })?;
+        write_atomic(dir, name, text).map_err(|e| {
+            eprintln!("error: {e}");
+            2u8
+        })?;
     }
     Ok(())
 }

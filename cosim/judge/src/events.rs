@@ -307,6 +307,23 @@ impl Comparison {
     }
 }
 
+/// A difference at `at`'s (cycle, where, signal).
+fn differ(
+    at: &Event,
+    expected: Option<&String>,
+    actual: Option<&String>,
+    note: &str,
+) -> Difference {
+    Difference {
+        cycle: at.cycle,
+        scope: at.scope.clone(),
+        signal: at.signal.clone(),
+        expected: expected.cloned(),
+        actual: actual.cloned(),
+        note: note.to_string(),
+    }
+}
+
 /// Compares `actual` with `expected` by (cycle, where, signal) and value.
 pub fn compare(expected: &EventLog, actual: &EventLog, keep: usize) -> Comparison {
     // Only the cycles both cover are compared event by event; a different
@@ -341,53 +358,20 @@ pub fn compare(expected: &EventLog, actual: &EventLog, keep: usize) -> Compariso
             std::cmp::Ordering::Equal => {
                 let (x, y) = (a[i], b[j]);
                 if x.value != y.value {
-                    push(
-                        &mut cmp,
-                        Difference {
-                            cycle: x.cycle,
-                            scope: x.scope.clone(),
-                            signal: x.signal.clone(),
-                            expected: Some(x.value.clone()),
-                            actual: Some(y.value.clone()),
-                            note: if x.note.is_empty() {
-                                y.note.clone()
-                            } else {
-                                x.note.clone()
-                            },
-                        },
-                    );
+                    let note = if x.note.is_empty() { &y.note } else { &x.note };
+                    push(&mut cmp, differ(x, Some(&x.value), Some(&y.value), note));
                 }
                 i += 1;
                 j += 1;
             }
             std::cmp::Ordering::Less => {
                 let x = a[i];
-                push(
-                    &mut cmp,
-                    Difference {
-                        cycle: x.cycle,
-                        scope: x.scope.clone(),
-                        signal: x.signal.clone(),
-                        expected: Some(x.value.clone()),
-                        actual: None,
-                        note: x.note.clone(),
-                    },
-                );
+                push(&mut cmp, differ(x, Some(&x.value), None, &x.note));
                 i += 1;
             }
             std::cmp::Ordering::Greater => {
                 let y = b[j];
-                push(
-                    &mut cmp,
-                    Difference {
-                        cycle: y.cycle,
-                        scope: y.scope.clone(),
-                        signal: y.signal.clone(),
-                        expected: None,
-                        actual: Some(y.value.clone()),
-                        note: y.note.clone(),
-                    },
-                );
+                push(&mut cmp, differ(y, None, Some(&y.value), &y.note));
                 j += 1;
             }
         }
