@@ -8,6 +8,11 @@ SLOTFORGE = $(CARGO) run --quiet --release --bin slotforge --
 TOOLS = verilator g++ iverilog yosys nextpnr-ice40 sigrok-cli
 APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm sigrok-cli
 
+# CI builds once from a fresh clone: incremental artefacts would only take disk.
+ifdef CI
+export CARGO_INCREMENTAL = 0
+endif
+
 .PHONY: run test tools lut audit verilog cosim golden golden-update synth bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 # The main job on the reference mix: audit, LUT, Verilog, co-simulation, golden,
