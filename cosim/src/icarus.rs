@@ -24,6 +24,7 @@ use judge::adc::{Analog, Stimulus};
 use judge::vcd::CycleSink;
 use judge::vcdout::edge_ps;
 use judge::Report;
+use lut_gen::parts::Start;
 use lut_gen::ports::{Layout, Pins, Role, PORTS, TOP_MODULE};
 
 use crate::error::{BackendError, SimError};
@@ -52,6 +53,10 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         let (lo, n) = (l.en_lo[b], l.en_n[b]);
         let kbits = n + 3;
         let _ = writeln!(adcs, "  // branch {b} ({})", s.branches[b].name);
+        if s.mix.branches[b].adc.start == Start::Cnv {
+            cnv_chain(s, &l, &analog, stimulus, b, frames, &mut adcs, &mut tables);
+            continue;
+        }
         let _ = writeln!(
             adcs,
             "  reg [15:0] word{b};\n  reg [4:0] falls{b};\n  reg out{b};\n  reg drive{b} = 0;\n  \
@@ -187,6 +192,151 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         tables,
         reset_cycles,
     }
+}
+
+/// The input id cosim's ADC model gives branch `b`'s mux address `(en, sel)`.
+fn input_id(l: &Layout, analog: &Analog, b: usize, en: u64, sel: u32) -> u64 {
+    let p = Pins {
+        mux_sel: (sel as u64) << (3 * b),
+        mux_en: (en as u128) << l.en_lo[b],
+        ..Pins::default()
+    };
+    analog.input_id(l, &p, b)
+}
+
+/// Branch `b`'s parts in CNV chain mode (AD7685 style, no busy indicator),
+/// as `judge::adc::Adc` models them: at the CNV rising edge every part of
+/// the chain samples its own input (the chain member's channel); while CNV
+/// is high the stream of all words leaves MSB first, member 0's first, one
+/// bit per SCK falling edge, zeros after the last (the first part's SDI is
+/// tied low); CNV low releases the line (pulled up).
+#[allow(clippy::too_many_arguments)]
+fn cnv_chain(
+    s: &Schedule,
+    l: &Layout,
+    analog: &Analog,
+    stimulus: Stimulus,
+    b: usize,
+    frames: u64,
+    adcs: &mut String,
+    tables: &mut Vec<(String, String)>,
+) {
+    let part = &s.mix.branches[b].adc;
+    let chain = s.mix.branches[b].chain as usize;
+    let ws = part.word_sclks() as usize;
+    let len = ws * chain;
+    let trailing = ws - part.leading_bits as usize - part.bits as usize;
+    let mask = (1u32 << part.bits) - 1;
+    let (lo, n) = (l.en_lo[b], l.en_n[b]);
+    let _ = writeln!(
+        adcs,
+        "  // {chain} x {} in CNV chain mode: {len} serial bits per conversion\n  reg [{}:0] stream{b};\n  reg [15:0] falls{b};\n  reg drive{b} = 0;\n  reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [63:0] mid{b};\n  reg [15:0] code{b};\n  assign {miso}[{b}] = drive{b} ? (falls{b} >= 16'd{len} ? 1'b0 : stream{b}[{}-falls{b}]) : 1'bz;",
+        part.name,
+        len - 1,
+        len - 1,
+        miso = Role::Miso.name()
+    );
+    let mut cases = String::new();
+    let ens: Vec<u64> = if n <= 6 {
+        (0..1u64 << n).collect()
+    } else {
+        (0..n).map(|d| 1u64 << d).collect()
+    };
+    for &en in &ens {
+        for sel in 0..8u32 {
+            let _ = writeln!(
+                cases,
+                "      {}'d{}: id{b} = 64'd{};",
+                n + 3,
+                (en << 3) | sel as u64,
+                input_id(l, analog, b, en, sel)
+            );
+        }
+    }
+    let _ = writeln!(
+        cases,
+        "      default: id{b} = 64'd{};",
+        input_id(l, analog, b, 0, 0)
+    );
+    // the table of codes the model's stimulus gives, one line per word
+    let table = if stimulus == Stimulus::Pattern {
+        None
+    } else {
+        let mut hex = String::new();
+        let mut words = 0u64;
+        let f = s.grid.frame_cycles;
+        for i in s
+            .instants(frames)
+            .filter(|i| i.branch == b && !(i.cycle < f && s.skipped_at_startup(b, i.cycle)))
+        {
+            for (_, c) in s.words_of(i.channel) {
+                let code = analog.code_bits(c as u64, i.cycle, part.bits) as u32 & mask;
+                let _ = writeln!(hex, "{:04x}{:08x}{:04x}", c as u16, i.cycle as u32, code);
+                words += 1;
+            }
+        }
+        (words > 0).then(|| {
+            let name = format!("codes{b}.hex");
+            tables.push((name.clone(), hex));
+            let _ = writeln!(
+                adcs,
+                "  reg [63:0] tab{b} [0:{}];\n  initial $readmemh(\"{name}\", tab{b});",
+                words - 1
+            );
+            words
+        })
+    };
+    let mut members = String::new();
+    for m in 0..chain {
+        // judge::adc::Adc: the member's channel, or an unconnected input
+        let _ = writeln!(members, "    case (id{b})");
+        let mut leads: Vec<usize> = (0..s.groups.len()).collect();
+        leads.retain(|&c| s.mix.channels[c].branch == b);
+        for lead in leads {
+            let mid = match s.groups[lead].get(m) {
+                Some(Some(c)) => *c as u64,
+                _ => lead as u64 + 100 + m as u64,
+            };
+            let _ = writeln!(members, "      64'd{lead}: mid{b} = 64'd{mid};");
+        }
+        let fallback = if m == 0 {
+            format!("id{b}")
+        } else {
+            format!("id{b} + 64'd{}", 100 + m)
+        };
+        let _ = writeln!(
+            members,
+            "      default: mid{b} = {fallback};\n    endcase\n    code{b} = pattern16(cyc, mid{b}) & 16'h{mask:x};"
+        );
+        if let Some(words) = table {
+            let _ = writeln!(
+                members,
+                "    if (n{b} < {words} && tab{b}[n{b}][63:48] == mid{b}[15:0] && tab{b}[n{b}][47:16] == cyc[31:0])\n      code{b} = tab{b}[n{b}][15:0];\n    n{b} = n{b} + 1;"
+            );
+        }
+        let pad = len - part.bits as usize;
+        let code = if pad > 0 {
+            format!("{{{pad}'h0, code{b}[{}:0]}}", part.bits - 1)
+        } else {
+            format!("code{b}[{}:0]", part.bits - 1)
+        };
+        let _ = writeln!(
+            members,
+            "    stream{b} = (stream{b} << {ws}) | ({code} << {trailing});"
+        );
+    }
+    let _ = write!(
+        adcs,
+        "  always @(posedge {cs}[{b}]) if (!{rst}) begin\n    case ({{{en}[{hi}:{lo}], {sel}[{sh}:{sl}]}})\n{cases}    endcase\n    stream{b} = {len}'h0;\n{members}    falls{b} = 0;\n    drive{b} = 1;\n  end\n  always @(negedge {cs}[{b}]) drive{b} = 0;\n  always @(negedge {sclk}[{b}]) if ({cs}[{b}]) falls{b} = falls{b} + 1;\n\n",
+        cs = Role::CsN.name(),
+        sclk = Role::Sclk.name(),
+        rst = Role::Reset.name(),
+        en = Role::MuxEn.name(),
+        sel = Role::MuxSel.name(),
+        hi = lo + n - 1,
+        sh = 3 * b + 2,
+        sl = 3 * b,
+    );
 }
 
 fn tool_missing(tool: &str) -> BackendError {

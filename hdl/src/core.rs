@@ -18,6 +18,8 @@
 //! No literal appears in a kernel: every number is a sized `Constant`, so the
 //! emitted Verilog has no 32-bit literals and lints clean.
 
+use std::fmt::Write as _;
+
 use rust_hdl::prelude::*;
 
 use crate::plan::{BranchRom, CompactRom, Plan, SeqTiming};
@@ -364,10 +366,16 @@ impl Logic for TimingGen {
 /// Every conversion starts at a slot start, so CS/SCLK/capture timing
 /// inside a slot is the same for every branch with the same SPI timing.
 /// The sequencer runs one cycle ahead of the branches' output registers and
-/// starts a (virtual) conversion in every slot: in cycle `c`, `cs_n` and
+/// starts a (virtual) conversion in every slot: in cycle `c`, `cs_n` (the
+/// conversion pin, active low whatever its polarity on the board) and
 /// `sclk` are the levels a converting branch has in cycle `c + 1`, `cap` is
-/// high iff a converting branch captures MISO at the edge that ends cycle
-/// `c`, and `done` is high in cycle `t + R - 1`.
+/// high iff a converting branch captures a data bit from MISO at the edge
+/// that ends cycle `c`, and `done` is high in cycle `t + R - 1`.
+///
+/// One phase counter times both the setup (for CNV parts the conversion
+/// time too) and the SCLK periods: it starts at `sclk_div - setup` modulo
+/// `2^PH_BITS`, so it reaches the end of a period exactly `setup` cycles
+/// after the start, however long the setup.
 #[derive(LogicBlock)]
 pub struct SpiSeq {
     pub clock: Signal<In, Clock>,
@@ -380,7 +388,9 @@ pub struct SpiSeq {
     r_cs_n: DFF<Bit>,
     r_sclk: DFF<Bit>,
     ph: DFF<Bits<PH_BITS>>,
-    nfall: DFF<Bits<5>>,
+    nfall: DFF<Bits<NFALL_BITS>>,
+    /// Index within its word of the serial bit the next rising edge reads.
+    wbit: DFF<Bits<WORD_BIT_BITS>>,
     r_cap: DFF<Bit>,
     r_done: DFF<Bit>,
     wrap: Signal<Local, Bit>,
@@ -390,13 +400,25 @@ pub struct SpiSeq {
     k_ph_start: Constant<Bits<PH_BITS>>,
     k_ph_zero: Constant<Bits<PH_BITS>>,
     k_ph_one: Constant<Bits<PH_BITS>>,
-    k_nf_zero: Constant<Bits<5>>,
-    k_nf_one: Constant<Bits<5>>,
-    k_nf_end: Constant<Bits<5>>,
+    k_nf_zero: Constant<Bits<NFALL_BITS>>,
+    k_nf_one: Constant<Bits<NFALL_BITS>>,
+    k_nf_end: Constant<Bits<NFALL_BITS>>,
+    k_wb_first: Constant<Bits<WORD_BIT_BITS>>,
+    k_wb_last: Constant<Bits<WORD_BIT_BITS>>,
+    k_wb_zero: Constant<Bits<WORD_BIT_BITS>>,
+    k_wb_one: Constant<Bits<WORD_BIT_BITS>>,
+    k_data_lo: Constant<Bits<WORD_BIT_BITS>>,
+    k_data_n: Constant<Bits<WORD_BIT_BITS>>,
+    /// SCLK level between conversions (CS parts high, CNV parts low).
+    k_sclk_idle: Constant<Bit>,
+    /// The last rising edge reads a bit (CNV parts; a CS part's last edge
+    /// comes after its last bit).
+    k_cap_last: Constant<Bit>,
 }
 
 impl SpiSeq {
     fn new(t: &SeqTiming) -> SpiSeq {
+        let ph_mod = 1u64 << PH_BITS;
         SpiSeq {
             clock: Default::default(),
             rst: Default::default(),
@@ -409,18 +431,27 @@ impl SpiSeq {
             r_sclk: Default::default(),
             ph: Default::default(),
             nfall: Default::default(),
+            wbit: Default::default(),
             r_cap: Default::default(),
             r_done: Default::default(),
             wrap: Default::default(),
             half: Default::default(),
             k_ph_last: c(t.sclk_div - 1),
             k_ph_half: c(t.sclk_half - 1),
-            k_ph_start: c(t.sclk_div - t.setup_cycles),
+            k_ph_start: c((t.sclk_div + ph_mod - t.setup_cycles) % ph_mod),
             k_ph_zero: c(0),
             k_ph_one: c(1),
             k_nf_zero: c(0),
             k_nf_one: c(1),
-            k_nf_end: c(16),
+            k_nf_end: c(t.sclks),
+            k_wb_first: c(t.first_bit()),
+            k_wb_last: c(t.word_sclks - 1),
+            k_wb_zero: c(0),
+            k_wb_one: c(1),
+            k_data_lo: c(t.leading_bits),
+            k_data_n: c(t.bits),
+            k_sclk_idle: Constant::new(!t.cnv),
+            k_cap_last: Constant::new(t.cnv),
         }
     }
 }
@@ -428,17 +459,19 @@ impl SpiSeq {
 impl Logic for SpiSeq {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, r_cs_n, r_sclk, ph, nfall, r_cap, r_done);
+        dff_setup!(self, clock, r_cs_n, r_sclk, ph, nfall, wbit, r_cap, r_done);
         self.wrap.next = self.ph.q.val() == self.k_ph_last.val();
         self.half.next = self.ph.q.val() == self.k_ph_half.val();
         self.r_cap.d.next = false;
         self.r_done.d.next = false;
         if self.start2.val() {
-            // Cycle t - 2: a converting branch's CS falls at the edge that begins t.
+            // Cycle t - 2: a converting branch's conversion pin becomes
+            // active at the edge that begins t.
             self.r_cs_n.d.next = false;
-            self.r_sclk.d.next = true;
+            self.r_sclk.d.next = self.k_sclk_idle.val();
             self.ph.d.next = self.k_ph_start.val();
             self.nfall.d.next = self.k_nf_zero.val();
+            self.wbit.d.next = self.k_wb_first.val();
         } else if !self.r_cs_n.q.val() {
             if self.wrap.val() {
                 self.ph.d.next = self.k_ph_zero.val();
@@ -447,21 +480,30 @@ impl Logic for SpiSeq {
             }
             if self.wrap.val() {
                 if self.nfall.q.val() == self.k_nf_end.val() {
-                    // Cycle t + R - 2: CS rises at the edge that begins t + R.
+                    // Cycle t + R - 2: the pin is released (and SCLK back at
+                    // idle) at the edge that begins t + R.
                     self.r_cs_n.d.next = true;
+                    self.r_sclk.d.next = self.k_sclk_idle.val();
                     self.r_done.d.next = true;
                 } else {
                     self.nfall.d.next = self.nfall.q.val() + self.k_nf_one.val();
                     self.r_sclk.d.next = false;
                 }
             }
-            if self.half.val() {
+            if self.half.val() & (self.nfall.q.val() != self.k_nf_zero.val()) {
+                // SCLK rising edge `nfall` begins the next cycle + 1: capture
+                // the serial bit it reads at the end of the next cycle, if
+                // that bit is a data bit.
                 self.r_sclk.d.next = true;
-                if (self.nfall.q.val() != self.k_nf_zero.val())
-                    & (self.nfall.q.val() != self.k_nf_end.val())
+                if self.wbit.q.val() == self.k_wb_last.val() {
+                    self.wbit.d.next = self.k_wb_zero.val();
+                } else {
+                    self.wbit.d.next = self.wbit.q.val() + self.k_wb_one.val();
+                }
+                // (wbit - leading) wraps to >= 32 below the window.
+                if ((self.wbit.q.val() - self.k_data_lo.val()) < self.k_data_n.val())
+                    & ((self.nfall.q.val() != self.k_nf_end.val()) | self.k_cap_last.val())
                 {
-                    // SCLK rising edge i (1..=15) begins the next cycle + 1:
-                    // capture serial bit i at the end of the next cycle.
                     self.r_cap.d.next = true;
                 }
             }
@@ -469,9 +511,10 @@ impl Logic for SpiSeq {
         if self.rst.val() {
             // The state of cycle t - 1 for an instant t at cycle 0.
             self.r_cs_n.d.next = false;
-            self.r_sclk.d.next = true;
+            self.r_sclk.d.next = self.k_sclk_idle.val();
             self.ph.d.next = self.k_ph_start.val();
             self.nfall.d.next = self.k_nf_zero.val();
+            self.wbit.d.next = self.k_wb_first.val();
             self.r_cap.d.next = false;
             self.r_done.d.next = false;
         }
@@ -500,20 +543,24 @@ pub struct BranchUnit {
     pub seq_cap: Signal<In, Bit>,
     pub seq_done: Signal<In, Bit>,
     pub miso: Signal<In, Bit>,
+    /// The merger takes this branch's word at the end of this cycle.
+    pub grant: Signal<In, Bit>,
+    /// The conversion pin at its board polarity (CS low or CNV high while active).
     pub cs_n: Signal<Out, Bit>,
     pub sclk: Signal<Out, Bit>,
     pub mux_sel: Signal<Out, Bits<3>>,
     pub mux_en: Signal<Out, Bits<EN_BITS>>,
     pub done: Signal<Out, Bit>,
     pub res_ch: Signal<Out, Bits<CH_BITS>>,
-    pub res_val: Signal<Out, Bits<14>>,
+    pub res_val: Signal<Out, Bits<VALUE_BITS>>,
+    /// More words of this conversion follow the one on `res_*`.
+    pub more: Signal<Out, Bit>,
     rom: SlotRom,
+    reader: WordReader,
     /// The branch converts in the slot of cycle c + 1 (cycles t - 1 ..= t + S - 2).
     act: DFF<Bit>,
     r_cs_n: DFF<Bit>,
     r_sclk: DFF<Bit>,
-    /// MISO bits; after a completion it holds the code until the next slot.
-    shift: DFF<Bits<14>>,
     /// Channel of the current slot's conversion (loaded in cycle t - 1).
     cur_ch: DFF<Bits<CH_BITS>>,
     r_sel: DFF<Bits<3>>,
@@ -524,8 +571,9 @@ pub struct BranchUnit {
     p_sel: DFF<Bits<3>>,
     p_dev: DFF<Bits<DEV_BITS>>,
     k_compact: Constant<Bit>,
-    k_sh_one: Constant<Bits<4>>,
-    k_sh_lsb: Constant<Bits<14>>,
+    /// The conversion pin is a CNV (active high); SCLK's idle level.
+    k_cnv: Constant<Bit>,
+    k_sclk_idle: Constant<Bit>,
     k_sel_rst: Constant<Bits<3>>,
     k_en_rst: Constant<Bits<EN_BITS>>,
     k_en_one: Constant<Bits<EN_BITS>>,
@@ -547,18 +595,20 @@ impl BranchUnit {
             seq_cap: Default::default(),
             seq_done: Default::default(),
             miso: Default::default(),
-            cs_n: Signal::new_with_default(true),
-            sclk: Signal::new_with_default(true),
+            grant: Default::default(),
+            cs_n: Signal::new_with_default(!rom.cnv),
+            sclk: Signal::new_with_default(!rom.cnv),
             mux_sel: Default::default(),
             mux_en: Default::default(),
             done: Default::default(),
             res_ch: Default::default(),
             res_val: Default::default(),
+            more: Default::default(),
             rom: SlotRom::new(rom),
+            reader: WordReader::new(rom),
             act: Default::default(),
             r_cs_n: Default::default(),
             r_sclk: Default::default(),
-            shift: Default::default(),
             cur_ch: Default::default(),
             r_sel: Default::default(),
             r_en: Default::default(),
@@ -566,8 +616,8 @@ impl BranchUnit {
             p_sel: Default::default(),
             p_dev: Default::default(),
             k_compact: Constant::new(rom.compact.is_some()),
-            k_sh_one: c(1),
-            k_sh_lsb: c(1),
+            k_cnv: Constant::new(rom.cnv),
+            k_sclk_idle: Constant::new(!rom.cnv),
             k_sel_rst: c(rom.reset_sel as u64),
             k_en_rst: c(rom.reset_en),
             k_en_one: c(1),
@@ -579,9 +629,7 @@ impl BranchUnit {
 impl Logic for BranchUnit {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(
-            self, clock, act, r_cs_n, r_sclk, shift, cur_ch, r_sel, r_en, r_done, p_sel, p_dev
-        );
+        dff_setup!(self, clock, act, r_cs_n, r_sclk, cur_ch, r_sel, r_en, r_done, p_sel, p_dev);
         self.rom.clock.next = self.clock.val();
         self.rom.rst.next = self.rst.val();
         self.rom.address.next = self.addr.val();
@@ -610,34 +658,199 @@ impl Logic for BranchUnit {
             }
         }
         self.r_cs_n.d.next = self.seq_cs_n.val() | !self.act.q.val();
-        self.r_sclk.d.next = self.seq_sclk.val() | !self.act.q.val();
+        if self.act.q.val() {
+            self.r_sclk.d.next = self.seq_sclk.val();
+        } else {
+            self.r_sclk.d.next = self.k_sclk_idle.val();
+        }
         // Cycle t + R - 1: the conversion completes in the next cycle.
         self.r_done.d.next = self.seq_done.val() & self.act.q.val();
-        if self.seq_cap.val() {
-            // Every slot's capture strobes shift, converting or not: the
-            // code is read by the merger before the next slot starts.
-            if self.miso.val() {
-                self.shift.d.next =
-                    (self.shift.q.val() << self.k_sh_one.val()) | self.k_sh_lsb.val();
-            } else {
-                self.shift.d.next = self.shift.q.val() << self.k_sh_one.val();
-            }
-        }
+        // Every slot's capture strobes shift, converting or not: the words
+        // are taken by the merger before the next slot starts.
+        self.reader.clock.next = self.clock.val();
+        self.reader.rst.next = self.rst.val();
+        self.reader.cap.next = self.seq_cap.val();
+        self.reader.miso.next = self.miso.val();
+        self.reader.grant.next = self.grant.val();
+        self.reader.lead.next = self.cur_ch.q.val();
         if self.rst.val() {
             self.act.d.next = self.k_conv0.val();
             self.r_cs_n.d.next = true;
-            self.r_sclk.d.next = true;
+            self.r_sclk.d.next = self.k_sclk_idle.val();
             self.r_done.d.next = false;
             self.r_sel.d.next = self.k_sel_rst.val();
             self.r_en.d.next = self.k_en_rst.val();
         }
-        self.cs_n.next = self.r_cs_n.q.val();
+        self.cs_n.next = self.r_cs_n.q.val() ^ self.k_cnv.val();
         self.sclk.next = self.r_sclk.q.val();
         self.mux_sel.next = self.r_sel.q.val();
         self.mux_en.next = self.r_en.q.val();
         self.done.next = self.r_done.q.val();
-        self.res_ch.next = self.cur_ch.q.val();
-        self.res_val.next = self.shift.q.val();
+        self.res_ch.next = self.reader.ch.val();
+        self.res_val.next = self.reader.val.val();
+        self.more.next = self.reader.more.val();
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Word reader: the data bits of one conversion, word by word to the merger
+// ---------------------------------------------------------------------------
+
+/// The data bits a branch shifts in from MISO (every word of a chain, MSB
+/// first), and which word the merger takes next.  After a completion the
+/// first word out sits in the top `bits` of the register; each word the
+/// merger takes shifts the next one up, and names it by its chain member.
+/// Custom Verilog so the register has exactly the mix's width (`chain *
+/// bits`) and the member table only the branch's own conversions.
+#[derive(LogicBlock)]
+pub struct WordReader {
+    pub clock: Signal<In, Clock>,
+    pub rst: Signal<In, Bit>,
+    pub cap: Signal<In, Bit>,
+    pub miso: Signal<In, Bit>,
+    pub grant: Signal<In, Bit>,
+    /// The conversion's lead channel (its frame-table entry).
+    pub lead: Signal<In, Bits<CH_BITS>>,
+    pub val: Signal<Out, Bits<VALUE_BITS>>,
+    pub ch: Signal<Out, Bits<CH_BITS>>,
+    pub more: Signal<Out, Bit>,
+    _bits: usize,
+    _chain: usize,
+    _members: Vec<(u32, Vec<u32>)>,
+    /// The shift register and the member of the word on `val`.
+    _sh: u128,
+    _om: usize,
+}
+
+impl WordReader {
+    fn new(rom: &BranchRom) -> WordReader {
+        WordReader {
+            clock: Default::default(),
+            rst: Default::default(),
+            cap: Default::default(),
+            miso: Default::default(),
+            grant: Default::default(),
+            lead: Default::default(),
+            val: Default::default(),
+            ch: Default::default(),
+            more: Default::default(),
+            _bits: rom.bits as usize,
+            _chain: rom.chain as usize,
+            _members: rom.members.clone(),
+            _sh: 0,
+            _om: 0,
+        }
+    }
+
+    fn width(&self) -> usize {
+        self._bits * self._chain
+    }
+
+    fn member_channel(&self, lead: u32, m: usize) -> u32 {
+        match self._members.iter().find(|(l, _)| *l == lead) {
+            Some((_, chans)) => chans[m],
+            None => lead,
+        }
+    }
+}
+
+impl Logic for WordReader {
+    fn update(&mut self) {
+        let w = self.width();
+        let mask = if w >= 128 {
+            u128::MAX
+        } else {
+            (1u128 << w) - 1
+        };
+        if self.clock.pos_edge() {
+            if self.rst.val() {
+                self._om = 0;
+            }
+            if self.cap.val() {
+                self._sh = ((self._sh << 1) | self.miso.val() as u128) & mask;
+            } else if self.grant.val() && self._chain > 1 && !self.rst.val() {
+                if self._om + 1 < self._chain {
+                    self._sh = (self._sh << self._bits) & mask;
+                    self._om += 1;
+                } else {
+                    self._om = 0;
+                }
+            }
+        }
+        let top = (self._sh >> (w - self._bits)) as u64 & ((1u64 << self._bits) - 1);
+        self.val.next = top.into();
+        let lead = self.lead.val().to_u64() as u32;
+        self.ch.next = (self.member_channel(lead, self._om) as u64).into();
+        self.more.next = self._om + 1 < self._chain;
+    }
+
+    fn connect(&mut self) {
+        self.val.connect();
+        self.ch.connect();
+        self.more.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        let (bits, n) = (self._bits, self._chain);
+        let w = self.width();
+        let mb = MEMBER_BITS;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "// {n} word(s) of {bits} data bits, the first out in the top bits"
+        );
+        let _ = writeln!(s, "reg [{}:0] sh;\ninitial sh = {w}'h0;", w - 1);
+        let shifted_in = if w == 1 {
+            "miso".to_string()
+        } else {
+            format!("{{sh[{}:0], miso}}", w - 2)
+        };
+        let top = if bits == w {
+            "sh".to_string()
+        } else {
+            format!("sh[{}:{}]", w - 1, w - bits)
+        };
+        let val = if bits < VALUE_BITS {
+            format!("{{{}'h0, {top}}}", VALUE_BITS - bits)
+        } else {
+            top
+        };
+        if n == 1 {
+            let _ = writeln!(s, "\nalways @(posedge clock) begin");
+            let _ = writeln!(s, "  if (cap) sh <= {shifted_in};");
+            let _ = writeln!(s, "end\n");
+            let _ = writeln!(s, "always @(*) begin");
+            let _ = writeln!(s, "  val = {val};\n  ch = lead;\n  more = 1'b0;");
+            let _ = writeln!(s, "end\n");
+            let _ = writeln!(s, "// a single word: nothing to step through");
+            let _ = writeln!(s, "wire unused_reader = |{{grant, rst}};");
+            return Verilog::Custom(s);
+        }
+        let last = n - 1;
+        let _ = writeln!(s, "// chain member of the word on val");
+        let _ = writeln!(s, "reg [{}:0] om;\ninitial om = {mb}'h0;\n", mb - 1);
+        let _ = writeln!(s, "always @(posedge clock) begin");
+        let _ = writeln!(s, "  if (rst) om <= {mb}'h0;");
+        let _ = writeln!(s, "  if (cap) sh <= {shifted_in};");
+        let _ = writeln!(s, "  else if (grant && !rst) begin");
+        let _ = writeln!(s, "    if (om != {mb}'h{last:x}) begin");
+        let _ = writeln!(s, "      sh <= {{sh[{}:0], {bits}'h0}};", w - bits - 1);
+        let _ = writeln!(s, "      om <= om + {mb}'h1;");
+        let _ = writeln!(s, "    end else om <= {mb}'h0;");
+        let _ = writeln!(s, "  end\nend\n");
+        let _ = writeln!(s, "always @(*) begin");
+        let _ = writeln!(s, "  val = {val};");
+        let _ = writeln!(s, "  more = om != {mb}'h{last:x};");
+        let _ = writeln!(s, "  case ({{lead, om}})");
+        let kb = CH_BITS + mb;
+        for (lead, chans) in &self._members {
+            for (m, c) in chans.iter().enumerate() {
+                let key = ((*lead as usize) << mb) | m;
+                let _ = writeln!(s, "    {kb}'h{key:x}: ch = {CH_BITS}'d{c};");
+            }
+        }
+        let _ = writeln!(s, "    default: ch = lead;\n  endcase\nend");
+        Verilog::Custom(s)
     }
 }
 
@@ -655,14 +868,18 @@ pub struct Merger {
     pub clock: Signal<In, Clock>,
     pub rst: Signal<In, Bit>,
     pub done: Signal<In, Bits<MAX_BRANCHES>>,
+    /// Lane `b` has more words of the same conversion after the one offered.
+    pub more: Signal<In, Bits<MAX_BRANCHES>>,
     pub ch: [Signal<In, Bits<CH_BITS>>; MAX_BRANCHES],
-    pub v: [Signal<In, Bits<14>>; MAX_BRANCHES],
+    pub v: [Signal<In, Bits<VALUE_BITS>>; MAX_BRANCHES],
+    /// The lane whose word is taken at the end of this cycle (one-hot).
+    pub grant: Signal<Out, Bits<MAX_BRANCHES>>,
     pub valid: Signal<Out, Bit>,
     pub channel: Signal<Out, Bits<CH_BITS>>,
-    pub value: Signal<Out, Bits<14>>,
+    pub value: Signal<Out, Bits<VALUE_BITS>>,
     r_valid: DFF<Bit>,
     r_ch: DFF<Bits<CH_BITS>>,
-    r_val: DFF<Bits<14>>,
+    r_val: DFF<Bits<VALUE_BITS>>,
     pend: DFF<Bits<MAX_BRANCHES>>,
     /// Branches of the mix (lanes `0..nb` are used).
     _nb: usize,
@@ -674,8 +891,10 @@ impl Merger {
             clock: Default::default(),
             rst: Default::default(),
             done: Default::default(),
+            more: Default::default(),
             ch: std::array::from_fn(|_| Default::default()),
             v: std::array::from_fn(|_| Default::default()),
+            grant: Default::default(),
             valid: Default::default(),
             channel: Default::default(),
             value: Default::default(),
@@ -694,11 +913,15 @@ impl Logic for Merger {
         let p = self.pend.q.val().to_u64() | self.done.val().to_u64();
         self.r_valid.d.next = p != 0;
         self.pend.d.next = 0u64.into();
+        self.grant.next = 0u64.into();
         if p != 0 {
             let b = p.trailing_zeros() as usize;
+            let more = self.more.val().to_u64() & (1 << b);
             self.r_ch.d.next = self.ch[b].val();
             self.r_val.d.next = self.v[b].val();
-            self.pend.d.next = (p & (p - 1)).into();
+            // A chained conversion stays pending until its last word leaves.
+            self.pend.d.next = ((p & (p - 1)) | more).into();
+            self.grant.next = (1u64 << b).into();
         }
         if self.rst.val() {
             self.r_valid.d.next = false;
@@ -720,6 +943,7 @@ impl Logic for Merger {
         self.r_val.d.connect();
         self.pend.clock.connect();
         self.pend.d.connect();
+        self.grant.connect();
         self.valid.connect();
         self.channel.connect();
         self.value.connect();
@@ -737,7 +961,7 @@ impl Logic for Merger {
             s.push_str(&format!("  {f}$clock = clock;\n"));
         }
         s.push_str(&format!(
-            "  r_valid$d = |p;\n  r_ch$d = r_ch$q;\n  r_val$d = r_val$q;\n  pend$d = {w}'h0;\n"
+            "  r_valid$d = |p;\n  r_ch$d = r_ch$q;\n  r_val$d = r_val$q;\n  pend$d = {w}'h0;\n  grant = {w}'h0;\n"
         ));
         for b in 0..nb {
             let kw = if b == 0 { "if" } else { "else if" };
@@ -753,16 +977,18 @@ impl Logic for Merger {
                 rest
             };
             s.push_str(&format!(
-                "  {kw} (p[{b}]) begin\n    r_ch$d = ch${b};\n    r_val$d = v${b};\n    pend$d = {pend};\n  end\n"
+                "  {kw} (p[{b}]) begin\n    r_ch$d = ch${b};\n    r_val$d = v${b};\n    pend$d = {pend};\n    pend$d[{b}] = more[{b}];\n    grant = {w}'h{:x};\n  end\n",
+                1u64 << b
             ));
         }
         s.push_str(&format!(
-            "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = 14'h0;\n    pend$d = {w}'h0;\n  end\n"
+            "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = {VALUE_BITS}'h0;\n    pend$d = {w}'h0;\n  end\n"
         ));
         s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
         let mut unused: Vec<String> = Vec::new();
         if nb < w {
             unused.push(format!("done[{}:{nb}]", w - 1));
+            unused.push(format!("more[{}:{nb}]", w - 1));
             unused.push(format!("pend$q[{}:{nb}]", w - 1));
             for b in nb..w {
                 unused.push(format!("ch${b}"));
@@ -794,7 +1020,7 @@ pub struct Core {
     pub mux_en: Signal<Out, Bits<EN_TOTAL>>,
     pub sample_valid: Signal<Out, Bit>,
     pub sample_channel: Signal<Out, Bits<CH_BITS>>,
-    pub sample_value: Signal<Out, Bits<14>>,
+    pub sample_value: Signal<Out, Bits<VALUE_BITS>>,
     pub timing: TimingGen,
     pub seqs: Vec<SpiSeq>,
     pub branches: Vec<BranchUnit>,
@@ -879,6 +1105,7 @@ impl Core {
             drive(&mut q.r_sclk.clock, k);
             drive(&mut q.ph.clock, k);
             drive(&mut q.nfall.clock, k);
+            drive(&mut q.wbit.clock, k);
             drive(&mut q.r_cap.clock, k);
             drive(&mut q.r_done.clock, k);
         }
@@ -888,7 +1115,7 @@ impl Core {
             drive(&mut u.act.clock, k);
             drive(&mut u.r_cs_n.clock, k);
             drive(&mut u.r_sclk.clock, k);
-            drive(&mut u.shift.clock, k);
+            drive(&mut u.reader.clock, k);
             drive(&mut u.cur_ch.clock, k);
             drive(&mut u.r_sel.clock, k);
             drive(&mut u.r_en.clock, k);
@@ -926,7 +1153,9 @@ impl Logic for Core {
             seq[i] = (q.cs_n.val(), q.sclk.val(), q.cap.val(), q.done.val());
         }
         let miso = self.adc_miso.val().to_u64();
+        let grant = self.merge.grant.val().to_u64();
         let (mut cs, mut sclk, mut sel, mut en, mut done) = (0u64, 0u64, 0u64, 0u128, 0u64);
+        let mut more = 0u64;
         let mut en_off = 0usize;
         let mut chs = [0u64; MAX_BRANCHES];
         let mut vals = [0u64; MAX_BRANCHES];
@@ -944,6 +1173,8 @@ impl Logic for Core {
             u.seq_cap.next = q_cap;
             u.seq_done.next = q_done;
             u.miso.next = (miso >> b) & 1 == 1;
+            u.grant.next = (grant >> b) & 1 == 1;
+            more |= (u.more.val() as u64) << b;
             cs |= (u.cs_n.val() as u64) << b;
             sclk |= (u.sclk.val() as u64) << b;
             sel |= u.mux_sel.val().to_u64() << (3 * b);
@@ -974,6 +1205,7 @@ impl Logic for Core {
             self.mux_en.next = en.to_bits();
         }
         self.merge.done.next = done.into();
+        self.merge.more.next = more.into();
         // Lanes >= nb keep their default 0 (the glue ties them to zero).
         let m = &mut self.merge;
         for b in 0..nb {
@@ -1008,8 +1240,10 @@ impl Logic for Core {
             u.seq_cap.connect();
             u.seq_done.connect();
             u.miso.connect();
+            u.grant.connect();
         }
         self.merge.done.connect();
+        self.merge.more.connect();
         for b in 0..MAX_BRANCHES {
             self.merge.ch[b].connect();
             self.merge.v[b].connect();
@@ -1067,7 +1301,7 @@ fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> Str
             "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = timing$start0;\n  {u}$addr = timing$addr;\n  {u}$slice = timing$slice;\n"
         ));
         s.push_str(&format!(
-            "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$miso = adc_miso[{b}];\n"
+            "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$miso = adc_miso[{b}];\n  {u}$grant = merge$grant[{b}];\n"
         ));
     }
     s.push_str(&format!(
@@ -1105,6 +1339,10 @@ fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> Str
         "  merge$done = {};\n",
         cat(&|b| format!("branches${b}$done"), pad_lanes("1'b0"))
     ));
+    s.push_str(&format!(
+        "  merge$more = {};\n",
+        cat(&|b| format!("branches${b}$more"), pad_lanes("1'b0"))
+    ));
     for b in 0..MAX_BRANCHES {
         if b < nb {
             s.push_str(&format!(
@@ -1112,7 +1350,7 @@ fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> Str
             ));
         } else {
             s.push_str(&format!(
-                "  merge$ch${b} = {CH_BITS}'h0;\n  merge$v${b} = 14'h0;\n"
+                "  merge$ch${b} = {CH_BITS}'h0;\n  merge$v${b} = {VALUE_BITS}'h0;\n"
             ));
         }
     }
@@ -1131,7 +1369,7 @@ fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> Str
     }
     if nb < MAX_BRANCHES {
         s.push_str(&format!(
-            "// lanes of branches the mix does not have\nwire unused_miso = |adc_miso[{}:{}];\n",
+            "// lanes of branches the mix does not have\nwire unused_miso = |adc_miso[{}:{}];\nwire unused_grant = |merge$grant[{0}:{1}];\n",
             MAX_BRANCHES - 1,
             nb
         ));
@@ -1177,6 +1415,7 @@ mod tests {
             self.unit.seq_cap.next = self.seq.cap.val();
             self.unit.seq_done.next = self.seq.done.val();
             self.unit.miso.next = self.miso.val();
+            self.unit.grant.next = self.unit.done.val();
         }
     }
 
@@ -1198,6 +1437,10 @@ mod tests {
             conv0: true,
             devices: 2,
             en_offset: 0,
+            cnv: false,
+            bits: 14,
+            chain: 1,
+            members: vec![],
             compact: None,
         };
         // mux fields: the first instant at this slot or later
@@ -1223,6 +1466,11 @@ mod tests {
                 sclk_half: div / 2,
                 setup_cycles: setup,
                 read_cycles: setup + 16 * div,
+                cnv: false,
+                sclks: 16,
+                word_sclks: 16,
+                leading_bits: 2,
+                bits: 14,
             }],
             branches: vec![rom()],
         };

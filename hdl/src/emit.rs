@@ -14,7 +14,7 @@ use serde::Deserialize;
 
 use crate::core::Core;
 use crate::plan::{plan_with, LutForm, Plan};
-use crate::widths::{CH_BITS, EN_TOTAL, MAX_BRANCHES};
+use crate::widths::{CH_BITS, EN_TOTAL, MAX_BRANCHES, VALUE_BITS};
 use crate::HdlError;
 
 /// Name the rust-hdl `top` module gets in the emitted file.
@@ -230,7 +230,8 @@ fn core_lanes(r: Role) -> Option<(&'static str, usize)> {
         )),
         Role::MuxEn => Some(("core_mux_en", EN_TOTAL)),
         Role::SampleChannel => Some(("core_channel", CH_BITS)),
-        Role::Clock | Role::Reset | Role::SampleValid | Role::SampleValue => None,
+        Role::SampleValue => Some(("core_value", VALUE_BITS)),
+        Role::Clock | Role::Reset | Role::SampleValid => None,
     }
 }
 

@@ -5,7 +5,9 @@ use lut_gen::Schedule;
 
 use crate::HdlError;
 
-use crate::widths::{CNT_BITS, PH_BITS, SLICE_BITS, SLOT_BITS};
+use crate::widths::{
+    CNT_BITS, MEMBER_BITS, NFALL_BITS, PH_BITS, SLICE_BITS, SLOT_BITS, WORD_BIT_BITS,
+};
 /// Largest frame the full-frame slot ROM takes.
 pub const MAX_FRAME_SLOTS: u64 = 1 << SLOT_BITS;
 /// Limits of the compact slot LUT (slice table + rotation groups).
@@ -16,14 +18,44 @@ pub const MAX_SLICES_PER_FRAME: u64 = 1 << SLICE_BITS;
 pub const FULL_LUT_MAX_BITS: u64 = 16 * 4096;
 pub const MAX_SLOT_CYCLES: u64 = 1 << CNT_BITS;
 pub const MAX_SCLK_DIV: u64 = (1 << PH_BITS) - 1;
+/// The phase counter also times the setup (and a CNV part's conversion):
+/// it starts at `sclk_div - setup` modulo `2^PH_BITS`.
+pub const MAX_SETUP_CYCLES: u64 = (1 << PH_BITS) - 1;
+/// SCLK periods per conversion (`nfall`), serial clocks per word (the
+/// in-word bit counter) and chained words (the word reader's member count).
+pub const MAX_SCLKS: u64 = (1 << NFALL_BITS) - 1;
+pub const MAX_WORD_SCLKS: u64 = 1 << (WORD_BIT_BITS - 1);
+pub const MAX_CHAIN: u64 = 1 << MEMBER_BITS;
 
 /// The SPI timing of one or more branches: one shared sequencer each.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SeqTiming {
     pub sclk_div: u64,
     pub sclk_half: u64,
+    /// Conversion start to the first SCLK period (CNV parts: t_CONV too).
     pub setup_cycles: u64,
     pub read_cycles: u64,
+    /// CNV style: SCK idles low, and the last rising edge captures too.
+    pub cnv: bool,
+    /// SCLK periods per conversion (every word of the chain).
+    pub sclks: u64,
+    /// Serial clocks per word, and which of them carry data bits.
+    pub word_sclks: u64,
+    pub leading_bits: u64,
+    pub bits: u64,
+}
+
+impl SeqTiming {
+    /// The serial bit index (within its word) that rising edge 1 captures:
+    /// a CS part drives bit 0 before any clock and edge `i` captures bit
+    /// `i`; a CNV part's edge `i` captures bit `i - 1`.
+    pub fn first_bit(&self) -> u64 {
+        if self.cnv {
+            0
+        } else {
+            1 % self.word_sclks
+        }
+    }
 }
 
 /// One branch's slot ROM and numbers.
@@ -49,6 +81,14 @@ pub struct BranchRom {
     pub devices: usize,
     /// First device bit of this branch in the `mux_en` port.
     pub en_offset: usize,
+    /// The conversion pin is a CNV (active high, SCK idles low), not a CS.
+    pub cnv: bool,
+    /// Data bits per word, and words per conversion (parts in the chain).
+    pub bits: u32,
+    pub chain: u32,
+    /// Chained branches: for each lead channel (the frame table's entry),
+    /// the channel of every chain member in the order the words leave.
+    pub members: Vec<(u32, Vec<u32>)>,
     /// The compact form (only in a compact plan; `words` is then empty and
     /// the mux field of slot `u`'s word is the next instant after slot `u`).
     pub compact: Option<CompactRom>,
@@ -231,21 +271,43 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
     let mut en_offset = 0usize;
     for (b, bp) in s.branches.iter().enumerate() {
         let adc = &s.mix.branches[b].adc;
-        // CS-style parts: the 14-bit shift register holds serial bits
-        // 2..=15, so any 16-clock word whose data bits end at the 16th clock
-        // after at least two leading zeros is read as its code.
-        let cs_ok = adc.start == lut_gen::parts::Start::Cs
-            && adc.word_sclks() == 16
-            && adc.trailing_bits == 0
-            && adc.leading_bits >= 2
-            && s.mix.branches[b].chain == 1;
-        if !cs_ok {
+        let chain = s.mix.branches[b].chain;
+        let cnv = adc.start == lut_gen::parts::Start::Cnv;
+        let spi = &bp.spi;
+        let sclks = adc.word_sclks() as u64 * chain as u64;
+        // What the sequencer's counters and the word reader can hold.
+        if adc.bits < 1 || adc.bits > lut_gen::ports::SAMPLE_VALUE_BITS {
             return Err(unsupported(format!(
-                "branch {}: ADC {} is not a 16-clock CS-style SPI ADC with at least 2 leading zeros and no chain",
+                "branch {}: ADC {} has {} data bits: the gateware carries 1 to {}",
+                bp.name,
+                adc.name,
+                adc.bits,
+                lut_gen::ports::SAMPLE_VALUE_BITS
+            )));
+        }
+        if adc.word_sclks() > MAX_WORD_SCLKS as u32 {
+            return Err(unsupported(format!(
+                "branch {}: ADC {} takes {} serial clocks per word: the gateware counts at most {MAX_WORD_SCLKS}",
+                bp.name,
+                adc.name,
+                adc.word_sclks()
+            )));
+        }
+        if chain < 1 || chain as u64 > MAX_CHAIN || sclks > MAX_SCLKS {
+            return Err(unsupported(format!(
+                "branch {}: a chain of {chain} x {} serial clocks: the gateware reads at most {MAX_CHAIN} words and {MAX_SCLKS} clocks per conversion",
+                bp.name,
+                adc.word_sclks()
+            )));
+        }
+        if !cnv && adc.leading_bits < 1 {
+            // A CS part drives its first bit before any SCLK edge: the
+            // master has no edge to capture it at (docs/timing.md).
+            return Err(unsupported(format!(
+                "branch {}: CS-style ADC {} needs at least one leading bit before its MSB",
                 bp.name, adc.name
             )));
         }
-        let spi = &bp.spi;
         if spi.sclk_div < 2 || spi.sclk_div > MAX_SCLK_DIV || spi.sclk_div % 2 != 0 {
             return Err(unsupported(format!(
                 "branch {}: SCLK divider {} must be even and in 2..={MAX_SCLK_DIV}",
@@ -258,24 +320,26 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
                 bp.name, spi.sclk_half
             )));
         }
-        if spi.setup_cycles < 1 || spi.setup_cycles > spi.sclk_div {
+        if spi.setup_cycles < 1 || spi.setup_cycles > MAX_SETUP_CYCLES {
             return Err(unsupported(format!(
-                "branch {}: CS setup of {} cycles must be within 1..=sclk_div ({})",
-                bp.name, spi.setup_cycles, spi.sclk_div
+                "branch {}: conversion start to first SCLK of {} cycles must be within 1..={MAX_SETUP_CYCLES}",
+                bp.name, spi.setup_cycles
             )));
         }
-        if spi.read_cycles != spi.setup_cycles + 16 * spi.sclk_div {
+        if spi.read_cycles != spi.setup_cycles + sclks * spi.sclk_div {
             return Err(unsupported(format!(
-                "branch {}: read_cycles {} != setup + 16 * sclk_div",
+                "branch {}: read_cycles {} != setup + {sclks} * sclk_div",
                 bp.name, spi.read_cycles
             )));
         }
         // The branch's shift register and channel register hold a result
-        // until the merger takes it (at most nb - 1 cycles after the
+        // until the merger has taken every word (at most one word of every
+        // branch's chain before each of this branch's words, after the
         // completion at t + R); the next slot must not start before.
-        if spi.read_cycles + nb as u64 > g.slot_cycles {
+        let words: u64 = s.mix.branches.iter().map(|b| b.chain as u64).sum();
+        if spi.read_cycles + words > g.slot_cycles {
             return Err(unsupported(format!(
-                "branch {}: a conversion ({} cycles) plus the merger's {nb} cycles does not fit in a slot ({} cycles)",
+                "branch {}: a conversion ({} cycles) plus the merger's {words} cycles does not fit in a slot ({} cycles)",
                 bp.name, spi.read_cycles, g.slot_cycles
             )));
         }
@@ -285,6 +349,11 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
             sclk_half: spi.sclk_half,
             setup_cycles: spi.setup_cycles,
             read_cycles: spi.read_cycles,
+            cnv,
+            sclks,
+            word_sclks: adc.word_sclks() as u64,
+            leading_bits: adc.leading_bits as u64,
+            bits: adc.bits as u64,
         };
         let seq = match seqs.iter().position(|t| *t == timing) {
             Some(i) => i,
@@ -302,6 +371,30 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
                     bp.name, ch.device, ch.select
                 )));
             }
+        }
+        // A chained conversion delivers one word per member, every one
+        // named by a channel (the word reader has no way to skip a word).
+        let mut members: Vec<(u32, Vec<u32>)> = Vec::new();
+        if chain > 1 {
+            for &lead in slots.iter().flatten() {
+                if members.iter().any(|(l, _)| *l as usize == lead) {
+                    continue;
+                }
+                let group = &s.groups[lead];
+                let chans: Vec<u32> = (0..chain as usize)
+                    .filter_map(|m| group.get(m).copied().flatten().map(|c| c as u32))
+                    .collect();
+                if chans.len() != chain as usize {
+                    return Err(unsupported(format!(
+                        "branch {}: the conversion of channel {} reads {chain} chained words but only {} of them are declared channels: the gateware needs a channel for every member",
+                        bp.name,
+                        s.mix.channels[lead].name,
+                        chans.len()
+                    )));
+                }
+                members.push((lead as u32, chans));
+            }
+            members.sort();
         }
         // next[u]: the channel of the first instant at slot u or later (cyclic).
         let n = slots.len();
@@ -329,6 +422,10 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
             conv0: slots[0].is_some() && bp.settle_cycles <= 1,
             devices,
             en_offset,
+            cnv,
+            bits: adc.bits,
+            chain,
+            members,
             compact: None,
         };
         let mux = |c: Option<usize>| match c {

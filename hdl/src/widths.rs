@@ -19,6 +19,14 @@ pub const SLOT_BITS: usize = 12;
 pub const SLICE_BITS: usize = 10;
 /// Width of the SCLK phase counter.
 pub const PH_BITS: usize = 10;
+/// Width of the SCLK period counter (periods per conversion, all words).
+pub const NFALL_BITS: usize = 8;
+/// Width of the in-word serial bit counter (up to 32 clocks per word).
+pub const WORD_BIT_BITS: usize = 6;
+/// Width of the chain member counter (up to 8 chained parts).
+pub const MEMBER_BITS: usize = 3;
+/// Width of `sample_value` in the core: the widest word the pin contract carries.
+pub const VALUE_BITS: usize = lut_gen::ports::SAMPLE_VALUE_BITS as usize;
 /// Width of a channel index.
 pub const CH_BITS: usize = log2(MAX_CHANNELS);
 /// Width of a device index inside a branch.
