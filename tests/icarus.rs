@@ -91,9 +91,12 @@ fn icarus_one_cycle_reset_samples_no_unsettled_mux() {
     run_testbench(&root().join("mixes/eskin34.toml"), 11, 1);
 }
 
+/// The presets read by AD7940s (this testbench's part); the AD7685 chain of
+/// `vibrotactile8k` is checked independently by sigrok (tests/sigrok.rs) and
+/// simulated by cosim's icarus back end with its chain model.
 #[test]
 fn icarus_other_presets_match_the_schedule() {
-    for p in ["vibrotactile8k.toml", "induction5k.toml", "softslip1k.toml"] {
+    for p in ["induction5k.toml", "softslip1k.toml"] {
         run_testbench(&root().join("mixes").join(p), 12, 6);
     }
 }

@@ -4,10 +4,13 @@
 //! design emitted for that branch's conversions (`sample_valid` strobes with
 //! `sample_channel`/`sample_value`, the channel's branch from the mix).
 //!
-//! Nothing of slotforge's own SPI decoding is used: the AD7940 read is
-//! decoded by sigrok in mode 3 (cpol=1, cpha=1), 16-bit words, and the code is
-//! `(word >> 1) & 0x3fff` (the part shifts out two leading zeros, the first
-//! after CS falls, before the first rising SCLK edge).  sigrok's VCD input
+//! Nothing of slotforge's own SPI decoding is used: a CS-style read (the
+//! AD7940) is decoded by sigrok in mode 3 (cpol=1, cpha=1), CS active low,
+//! one word per CS, and the code is `(word >> 1) & 0x3fff` for the AD7940 (the
+//! part shifts out two leading zeros, the first after CS falls, before the
+//! first rising SCLK edge); a CNV-style chain (four AD7685s) in mode 0 (cpol=0,
+//! cpha=0) with CNV as an active-high select, one 16-bit word per chained
+//! part, member 0's first, each word the code.  sigrok's VCD input
 //! takes only 1-bit signals, so the test hands it a VCD of the branches'
 //! scalar lanes, times converted to nanoseconds.
 
@@ -141,10 +144,48 @@ fn scalar_vcd(src: &str) -> (String, Vec<String>) {
     (out, branches)
 }
 
-/// The 16-bit words sigrok's SPI decoder reads on MISO of branch `b`.
-fn sigrok_words(vcd: &Path, b: usize) -> Vec<u16> {
+/// How sigrok reads a branch's part: its SPI decoder options and the code
+/// in each decoded word.
+struct PartDecoder {
+    options: String,
+    wordsize: u32,
+    /// Right shift and mask from a decoded word to the code.
+    shift: u32,
+    mask: u16,
+}
+
+impl PartDecoder {
+    fn of(part: &lut_gen::parts::AdcPart) -> PartDecoder {
+        let w = part.word_sclks();
+        let cnv = part.start == lut_gen::parts::Start::Cnv;
+        // Mode 3 reads stream bits 1..=w at the w rising edges (bit 0 comes
+        // before the first); mode 0 reads bits 0..w.
+        let (options, shift) = if cnv {
+            ("cs_polarity=active-high:cpol=0:cpha=0", part.trailing_bits)
+        } else {
+            (
+                "cs_polarity=active-low:cpol=1:cpha=1",
+                part.trailing_bits + 1,
+            )
+        };
+        PartDecoder {
+            options: options.to_string(),
+            wordsize: w,
+            shift,
+            mask: ((1u32 << part.bits) - 1) as u16,
+        }
+    }
+
+    fn code(&self, word: u32) -> u16 {
+        (word >> self.shift) as u16 & self.mask
+    }
+}
+
+/// The words sigrok's SPI decoder reads on MISO of branch `b`.
+fn sigrok_words(vcd: &Path, b: usize, d: &PartDecoder) -> Vec<u32> {
     let dec = format!(
-        "spi:clk=b{b}_sclk:miso=b{b}_miso:cs=b{b}_cs_n:cs_polarity=active-low:cpol=1:cpha=1:wordsize=16"
+        "spi:clk=b{b}_sclk:miso=b{b}_miso:cs=b{b}_cs_n:{}:wordsize={}",
+        d.options, d.wordsize
     );
     let out = Process::new("sigrok-cli")
         .args(["-I", "vcd", "-i"])
@@ -158,20 +199,14 @@ fn sigrok_words(vcd: &Path, b: usize) -> Vec<u16> {
         .lines()
         .map(|l| {
             let w = l.rsplit(':').next().unwrap().trim();
-            u16::from_str_radix(w, 16).unwrap_or_else(|_| panic!("sigrok line `{l}`"))
+            u32::from_str_radix(w, 16).unwrap_or_else(|_| panic!("sigrok line `{l}`"))
         })
         .collect()
 }
 
-/// The AD7940 code in a mode-3 16-bit word.
-fn code(word: u16) -> u16 {
-    (word >> 1) & 0x3fff
-}
-
 /// The comparison: the decoded words of a branch against the sample values
 /// emitted for its channels, in order.
-fn compare(branch: &str, words: &[u16], samples: &[u16]) -> Result<(), String> {
-    let decoded: Vec<u16> = words.iter().map(|&w| code(w)).collect();
+fn compare(branch: &str, decoded: &[u16], samples: &[u16]) -> Result<(), String> {
     if let Some(k) = (0..decoded.len().min(samples.len())).find(|&k| decoded[k] != samples[k]) {
         return Err(format!(
             "branch {branch}: conversion {k}: SPI (sigrok) read {:#06x}, the design emitted sample_value {:#06x}",
@@ -218,7 +253,11 @@ fn decode_preset(mix: &Path, dir: &Path) -> (Schedule, Vec<Decoded>) {
             .iter()
             .position(|x| &x.name == name)
             .unwrap_or_else(|| panic!("{stem}: scope branch_{name} is no branch of the mix"));
-        let words = sigrok_words(&scalar, k);
+        let d = PartDecoder::of(&s.mix.branches[b].adc);
+        let words: Vec<u16> = sigrok_words(&scalar, k, &d)
+            .into_iter()
+            .map(|w| d.code(w))
+            .collect();
         let values: Vec<u16> = samples
             .0
             .iter()
@@ -226,11 +265,13 @@ fn decode_preset(mix: &Path, dir: &Path) -> (Schedule, Vec<Decoded>) {
             .map(|&(_, v)| v)
             .collect();
         // every conversion of the frame was emitted and decoded (but those
-        // the gateware skips at start-up: their mux has not settled)
-        let expect = s
+        // the gateware skips at start-up: their mux has not settled), one
+        // sample per chained word
+        let expect: usize = s
             .instants(1)
             .filter(|i| i.branch == b && !s.skipped_at_startup(b, i.cycle))
-            .count();
+            .map(|i| s.words_of(i.channel).count())
+            .sum();
         assert_eq!(values.len(), expect, "{stem}: samples of branch {name}");
         out.push((name.clone(), words, values));
     }
@@ -244,11 +285,15 @@ fn sigrok_decodes_every_branch_as_the_sample_stream() {
     }
     let dir = tempfile::tempdir().unwrap();
     let mut multi = 0;
+    let mut chained = 0;
     let mut seen = Vec::new();
     for mix in presets() {
         let (s, branches) = decode_preset(&mix, dir.path());
         if s.branches.len() > 1 {
             multi += 1;
+        }
+        if s.mix.branches.iter().any(|b| b.chain > 1) {
+            chained += 1;
         }
         let mut total = 0;
         for (name, words, values) in &branches {
@@ -274,6 +319,7 @@ fn sigrok_decodes_every_branch_as_the_sample_stream() {
         multi >= 2,
         "eskin34 and another multi-branch preset: {seen:?}"
     );
+    assert!(chained >= 1, "a preset with a daisy chain: {seen:?}");
 }
 
 /// The comparison fails on a wrong value, a missing or an extra word, and

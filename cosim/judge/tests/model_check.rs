@@ -234,7 +234,7 @@ fn preset(name: &str) -> lut_gen::Schedule {
 /// instants, and every chained word reaches the sample stream.
 #[test]
 fn ad7685_chain_model_passes_the_checker() {
-    let s = preset("cosim/tests/data/vibrotactile8k-ad7685");
+    let s = preset("mixes/vibrotactile8k");
     let mut dut = ModelDut::new(&s);
     let r = run_dut(&s, &mut dut, 2, &RunOptions::default(), "model-dut", None);
     assert!(r.ok, "{}", r.summary());
@@ -256,7 +256,7 @@ fn ad7685_chain_model_passes_the_checker() {
 #[test]
 fn ad7685_chain_faults_are_caught() {
     use judge::faults::{Fault, FaultyDut};
-    let s = preset("cosim/tests/data/vibrotactile8k-ad7685");
+    let s = preset("mixes/vibrotactile8k");
     let at = s.grid.frame_cycles / 2 + 7;
     for f in Fault::all(&s) {
         let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
