@@ -87,3 +87,30 @@ fn largest_mixes_one_frame() {
         }
     }
 }
+
+/// Converter parts (issue 10): a chain of two AD7685s behind a mux (two
+/// conversion groups, members declared out of order), a lone AD7685 and an
+/// AD7940 on one clock, with a sine stimulus and a one-cycle reset, on the
+/// three engines that run the gateware.
+#[test]
+fn cnv_chain_and_cs_parts_on_every_engine() {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../hdl/tests/data/cnvmix.toml");
+    let s = schedule(&p);
+    assert_eq!(s.mix.branches[0].chain, 2);
+    let mut backends = vec![Backend::RustHdl];
+    if tools::require_tools(&["verilator", "g++"]) {
+        backends.push(Backend::Verilator);
+    }
+    if tools::require_tool("iverilog") {
+        backends.push(Backend::Icarus);
+    }
+    let opts = SimOptions {
+        stimulus: judge::Stimulus::Sine(None),
+        ..one_cycle_reset()
+    };
+    for b in backends {
+        let r = run(&s, b, 2, &opts).unwrap();
+        assert!(r.ok, "cnvmix on {}: {}", b.name(), r.summary());
+        assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
+    }
+}

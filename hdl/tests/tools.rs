@@ -112,6 +112,19 @@ fn gates_branch_count_mixes() {
     }
 }
 
+/// Converter parts (issue 10): the seed-000 AD7685 chain, a user-declared
+/// 12-bit CS part, and a mix of a chain behind a mux, a lone AD7685 and an
+/// AD7940 on one clock.
+#[test]
+fn gates_converter_parts() {
+    gates(&data_mix("cnvmix"), "cnvmix");
+    for preset in ["vibrotactile8k", "induction5k-adc12"] {
+        let path = common::root().join(format!("mixes/{preset}.toml"));
+        let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
+        gates(&s, preset);
+    }
+}
+
 #[test]
 fn gates_compact_lut() {
     gates(&long_frame(), "longframe");
