@@ -63,6 +63,11 @@ pub struct ClassOutcome {
     pub detected: u64,
     /// Injections the checker did not catch.
     pub missed: Vec<Injection>,
+    /// Gateware faults whose outputs equalled the reference model's in every
+    /// cycle of the run: equivalent on this mix (no output checker can see
+    /// them; e.g. a frame one slot short when every slot converts the same
+    /// channels), so not counted as injected.
+    pub equivalent: Vec<Injection>,
 }
 
 /// Clean runs over random feasible mixes.
@@ -336,16 +341,18 @@ pub fn campaign(
             Ok(sim) => {
                 let mut dut = GatewareDut(sim);
                 let r = run_dut(s, &mut dut, frames, &opts, "faults", None);
-                Some((c.class, "gateware", outcome(name, &c.site, &r)))
+                let equivalent = r.ok && r.model_compared && r.divergence_count == 0;
+                Some((c.class, "gateware", outcome(name, &c.site, &r), equivalent))
             }
             // a fault the mix's gateware cannot hold (e.g. a frame too long for the full LUT)
             Err(_) => None,
         }
     });
     let mut classes: Vec<ClassOutcome> = Vec::new();
-    for (class, level, inj) in pin
+    for (class, level, inj, equivalent) in pin
         .into_iter()
         .flatten()
+        .map(|(c, l, i)| (c, l, i, false))
         .chain(design.into_iter().flatten())
     {
         let c = match classes.iter_mut().find(|c| c.name == class) {
@@ -357,10 +364,15 @@ pub fn campaign(
                     injected: 0,
                     detected: 0,
                     missed: vec![],
+                    equivalent: vec![],
                 });
                 classes.last_mut().expect("just pushed")
             }
         };
+        if equivalent {
+            c.equivalent.push(inj);
+            continue;
+        }
         c.injected += 1;
         if inj.detected {
             c.detected += 1;

@@ -83,6 +83,12 @@ pub fn run(a: Args) -> u8 {
             for m in &k.missed {
                 println!("      missed {} at {} (cycle {})", m.fault, m.site, m.cycle);
             }
+            for m in &k.equivalent {
+                println!(
+                    "      no effect: {} at {} (cycle {}): every output equals the model's in every cycle (an equivalent fault on this mix; not counted)",
+                    m.fault, m.site, m.cycle
+                );
+            }
         }
         println!(
             "{} of {} injections caught; false alarms: {} of {} clean runs over {} random mixes",
