@@ -16,18 +16,15 @@ fn slotforge() -> Command {
     Command::cargo_bin("slotforge").unwrap()
 }
 
+#[path = "common/presets.rs"]
+mod common_presets;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 fn presets() -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("mixes"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    v.sort();
-    v
+    common_presets::presets(&root())
 }
 
 /// Copies `golden/<name>` into a temporary golden root.

@@ -28,19 +28,15 @@ use lut_gen::Schedule;
 #[path = "common/tools.rs"]
 mod tools;
 
+#[path = "common/presets.rs"]
+mod common_presets;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Every preset in `mixes/`.
 fn presets() -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("mixes"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    v.sort();
-    v
+    common_presets::presets(&root())
 }
 
 /// The sample stream of a VCD: `(channel, value)` at each `sample_valid`.

@@ -50,8 +50,6 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
     let mut adcs = String::new();
     let mut tables = Vec::new();
     for b in 0..l.branches {
-        let (lo, n) = (l.en_lo[b], l.en_n[b]);
-        let kbits = n + 3;
         let _ = writeln!(adcs, "  // branch {b} ({})", s.branches[b].name);
         if s.mix.branches[b].adc.start == Start::Cnv {
             cnv_chain(s, &l, &analog, stimulus, b, frames, &mut adcs, &mut tables);
@@ -64,32 +62,7 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
              assign {miso}[{b}] = drive{b} ? out{b} : 1'bz;",
             miso = Role::Miso.name()
         );
-        // the input id cosim's ADC model gives each (enable, select) of this branch
-        let id_of = |en: u64, sel: u32| {
-            let p = Pins {
-                mux_sel: (sel as u64) << (3 * b),
-                mux_en: (en as u128) << lo,
-                ..Pins::default()
-            };
-            analog.input_id(&l, &p, b)
-        };
-        let ens: Vec<u64> = if n <= 6 {
-            (0..1u64 << n).collect()
-        } else {
-            (0..n).map(|d| 1u64 << d).collect()
-        };
-        let mut cases = String::new();
-        for &en in &ens {
-            for sel in 0..8u32 {
-                let key = (en << 3) | sel as u64;
-                let _ = writeln!(
-                    cases,
-                    "      {kbits}'d{key}: id{b} = 64'd{};",
-                    id_of(en, sel)
-                );
-            }
-        }
-        let _ = writeln!(cases, "      default: id{b} = 64'd{};", id_of(0, 0));
+        let id_case = id_case(&l, &analog, b);
         let table = if stimulus == Stimulus::Pattern {
             String::new()
         } else {
@@ -129,8 +102,7 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         };
         let _ = write!(
             adcs,
-            "  always @(negedge {cs}[{b}]) if (!{rst}) begin\n    \
-             case ({{{en}[{hi}:{lo}], {sel}[{sh}:{sl}]}})\n{cases}    endcase\n    \
+            "  always @(negedge {cs}[{b}]) if (!{rst}) begin\n{id_case}    \
              code{b} = pattern(cyc, id{b});\n{table}    n{b} = n{b} + 1;\n    \
              word{b} = {{2'b00, code{b}{mask}}};\n    falls{b} = 0;\n    out{b} = word{b}[15];\n    drive{b} = 1;\n  end\n  \
              always @(posedge {cs}[{b}]) drive{b} = 0;\n  \
@@ -144,11 +116,6 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
             cs = Role::CsN.name(),
             sclk = Role::Sclk.name(),
             rst = Role::Reset.name(),
-            en = Role::MuxEn.name(),
-            sel = Role::MuxSel.name(),
-            hi = lo + n - 1,
-            sh = 3 * b + 2,
-            sl = 3 * b,
         );
     }
     // The DUT's ports as testbench signals: inputs driven (MISO pulled up,
@@ -194,14 +161,44 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
     }
 }
 
-/// The input id cosim's ADC model gives branch `b`'s mux address `(en, sel)`.
-fn input_id(l: &Layout, analog: &Analog, b: usize, en: u64, sel: u32) -> u64 {
-    let p = Pins {
-        mux_sel: (sel as u64) << (3 * b),
-        mux_en: (en as u128) << l.en_lo[b],
-        ..Pins::default()
+/// A `case` setting `id<b>` to the input id cosim's ADC model gives each
+/// (enable, select) of branch `b`'s mux pins (every enable pattern for up to
+/// six devices, else the one-hot ones; others as `(0, 0)`).
+fn id_case(l: &Layout, analog: &Analog, b: usize) -> String {
+    let (lo, n) = (l.en_lo[b], l.en_n[b]);
+    let id_of = |en: u64, sel: u32| {
+        let p = Pins {
+            mux_sel: (sel as u64) << (3 * b),
+            mux_en: (en as u128) << lo,
+            ..Pins::default()
+        };
+        analog.input_id(l, &p, b)
     };
-    analog.input_id(l, &p, b)
+    let ens: Vec<u64> = if n <= 6 {
+        (0..1u64 << n).collect()
+    } else {
+        (0..n).map(|d| 1u64 << d).collect()
+    };
+    let mut s = format!(
+        "    case ({{{en}[{}:{lo}], {sel}[{}:{}]}})\n",
+        lo + n - 1,
+        3 * b + 2,
+        3 * b,
+        en = Role::MuxEn.name(),
+        sel = Role::MuxSel.name(),
+    );
+    for &en in &ens {
+        for sel in 0..8u32 {
+            let key = (en << 3) | sel as u64;
+            let _ = writeln!(s, "      {}'d{key}: id{b} = 64'd{};", n + 3, id_of(en, sel));
+        }
+    }
+    let _ = writeln!(
+        s,
+        "      default: id{b} = 64'd{};\n    endcase",
+        id_of(0, 0)
+    );
+    s
 }
 
 /// Branch `b`'s parts in CNV chain mode (AD7685 style, no busy indicator),
@@ -227,7 +224,6 @@ fn cnv_chain(
     let len = ws * chain;
     let trailing = ws - part.leading_bits as usize - part.bits as usize;
     let mask = (1u32 << part.bits) - 1;
-    let (lo, n) = (l.en_lo[b], l.en_n[b]);
     let _ = writeln!(
         adcs,
         "  // {chain} x {} in CNV chain mode: {len} serial bits per conversion\n  reg [{}:0] stream{b};\n  reg [15:0] falls{b};\n  reg drive{b} = 0;\n  reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [63:0] mid{b};\n  reg [15:0] code{b};\n  assign {miso}[{b}] = drive{b} ? (falls{b} >= 16'd{len} ? 1'b0 : stream{b}[{}-falls{b}]) : 1'bz;",
@@ -236,28 +232,7 @@ fn cnv_chain(
         len - 1,
         miso = Role::Miso.name()
     );
-    let mut cases = String::new();
-    let ens: Vec<u64> = if n <= 6 {
-        (0..1u64 << n).collect()
-    } else {
-        (0..n).map(|d| 1u64 << d).collect()
-    };
-    for &en in &ens {
-        for sel in 0..8u32 {
-            let _ = writeln!(
-                cases,
-                "      {}'d{}: id{b} = 64'd{};",
-                n + 3,
-                (en << 3) | sel as u64,
-                input_id(l, analog, b, en, sel)
-            );
-        }
-    }
-    let _ = writeln!(
-        cases,
-        "      default: id{b} = 64'd{};",
-        input_id(l, analog, b, 0, 0)
-    );
+    let id_case = id_case(l, analog, b);
     // the table of codes the model's stimulus gives, one line per word
     let table = if stimulus == Stimulus::Pattern {
         None
@@ -286,13 +261,14 @@ fn cnv_chain(
             words
         })
     };
+    let leads: Vec<usize> = (0..s.groups.len())
+        .filter(|&c| s.mix.channels[c].branch == b)
+        .collect();
     let mut members = String::new();
     for m in 0..chain {
         // judge::adc::Adc: the member's channel, or an unconnected input
         let _ = writeln!(members, "    case (id{b})");
-        let mut leads: Vec<usize> = (0..s.groups.len()).collect();
-        leads.retain(|&c| s.mix.channels[c].branch == b);
-        for lead in leads {
+        for &lead in &leads {
             let mid = match s.groups[lead].get(m) {
                 Some(Some(c)) => *c as u64,
                 _ => lead as u64 + 100 + m as u64,
@@ -327,15 +303,10 @@ fn cnv_chain(
     }
     let _ = write!(
         adcs,
-        "  always @(posedge {cs}[{b}]) if (!{rst}) begin\n    case ({{{en}[{hi}:{lo}], {sel}[{sh}:{sl}]}})\n{cases}    endcase\n    stream{b} = {len}'h0;\n{members}    falls{b} = 0;\n    drive{b} = 1;\n  end\n  always @(negedge {cs}[{b}]) drive{b} = 0;\n  always @(negedge {sclk}[{b}]) if ({cs}[{b}]) falls{b} = falls{b} + 1;\n\n",
+        "  always @(posedge {cs}[{b}]) if (!{rst}) begin\n{id_case}    stream{b} = {len}'h0;\n{members}    falls{b} = 0;\n    drive{b} = 1;\n  end\n  always @(negedge {cs}[{b}]) drive{b} = 0;\n  always @(negedge {sclk}[{b}]) if ({cs}[{b}]) falls{b} = falls{b} + 1;\n\n",
         cs = Role::CsN.name(),
         sclk = Role::Sclk.name(),
         rst = Role::Reset.name(),
-        en = Role::MuxEn.name(),
-        sel = Role::MuxSel.name(),
-        hi = lo + n - 1,
-        sh = 3 * b + 2,
-        sl = 3 * b,
     );
 }
 

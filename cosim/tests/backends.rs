@@ -4,15 +4,11 @@ use std::path::{Path, PathBuf};
 
 use cosim::{run, Backend, SimOptions};
 
+#[path = "../../tests/common/presets.rs"]
+mod common_presets;
+
 fn mixes() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    v.sort();
-    v
+    common_presets::presets(&Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
 }
 
 fn schedule(p: &Path) -> lut_gen::Schedule {

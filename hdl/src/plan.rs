@@ -266,6 +266,8 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         ));
     }
     let aw = addr_bits(g.frame_slots);
+    // words per round of the merger: one per chained part of every branch
+    let words: u64 = s.mix.branches.iter().map(|b| b.chain as u64).sum();
     let mut seqs: Vec<SeqTiming> = Vec::new();
     let mut branches = Vec::with_capacity(nb);
     let mut en_offset = 0usize;
@@ -336,7 +338,6 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         // until the merger has taken every word (at most one word of every
         // branch's chain before each of this branch's words, after the
         // completion at t + R); the next slot must not start before.
-        let words: u64 = s.mix.branches.iter().map(|b| b.chain as u64).sum();
         if spi.read_cycles + words > g.slot_cycles {
             return Err(unsupported(format!(
                 "branch {}: a conversion ({} cycles) plus the merger's {words} cycles does not fit in a slot ({} cycles)",
