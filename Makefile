@@ -24,15 +24,27 @@ run: tools
 	$(SLOTFORGE) build $(MIX) -o $(BUILD)
 	@echo "open $(BUILD)/report.html (or report.md); waveforms: $(BUILD)/frame0.vcd + .gtkw"
 
+# cargo-nextest (when installed) runs every test in its own process across all
+# test binaries, so a long test of one binary no longer leaves a core idle.
+NEXTEST := $(shell $(CARGO) nextest --version >/dev/null 2>&1 && echo yes)
+
 test: tools
 	$(CARGO) fmt --all -- --check
+ifeq ($(NEXTEST),yes)
+	$(CARGO) nextest run --workspace --locked --no-fail-fast
+else
 	$(CARGO) test --workspace --locked
+endif
 	$(MAKE) golden
 
 # Campaigns, all-preset proofs and long runs: not in `make test` (which must stay
 # under 15 minutes on 2 cores); run before an issue is resolved.
 test-long: tools
+ifeq ($(NEXTEST),yes)
+	$(CARGO) nextest run --workspace --locked --no-fail-fast --run-ignored only
+else
 	$(CARGO) test --workspace --locked -- --ignored
+endif
 
 # Every preset against its golden (golden/<mix>/: event log, Figure 6 windows),
 # on the emitted Verilog in Verilator.  The debug build `cargo test` made.

@@ -39,9 +39,22 @@ fn golden_copy(name: &str) -> tempfile::TempDir {
     d
 }
 
+/// Every preset against its golden on rusthdl (`make golden` runs them all on
+/// Verilator in `make test`; `backends.rs` runs rusthdl against the model).
 #[test]
+#[ignore = "long: make test-long"]
 fn every_preset_has_a_golden_and_matches_it_in_process() {
-    for mix in presets() {
+    goldens_match_in_process(&presets());
+}
+
+/// The reference mix (event log and Figure 6 windows) on rusthdl.
+#[test]
+fn reference_golden_matches_in_process() {
+    goldens_match_in_process(&[root().join("mixes/eskin34.toml")]);
+}
+
+fn goldens_match_in_process(mixes: &[PathBuf]) {
+    for mix in mixes {
         let name = mix.file_stem().unwrap().to_str().unwrap().to_string();
         assert!(
             root()
@@ -54,7 +67,7 @@ fn every_preset_has_a_golden_and_matches_it_in_process() {
         slotforge()
             .current_dir(root())
             .args(["golden", "--backend", "rusthdl"])
-            .arg(&mix)
+            .arg(mix)
             .assert()
             .success()
             .stdout(predicate::str::contains("same as"));
@@ -213,18 +226,29 @@ fn change_times(vcd: &Path, scope: &str, var: &str, value: char) -> Vec<u64> {
     out
 }
 
+/// slotforge's own VCD writer (any back end but icarus).
 #[test]
-fn vcd_times_are_exact_in_every_writer() {
+fn vcd_times_are_exact_in_slotforges_writer() {
+    vcd_times_are_exact(&["rusthdl"]);
+}
+
+/// Icarus writes its own VCD from the testbench's clock (a whole frame of
+/// eskin34 in Icarus: `make test-long`).
+#[test]
+#[ignore = "long: make test-long"]
+fn vcd_times_are_exact_in_icarus() {
+    if tools::require_tool("iverilog") {
+        vcd_times_are_exact(&["icarus"]);
+    }
+}
+
+fn vcd_times_are_exact(backends: &[&str]) {
     // eskin34's `standard` branch converts its 30 channels at 1 kHz, one per
     // 1600-cycle slot: the same channel's CS falls are 48 000 cycles = 1 ms
     // apart, exactly 10^9 ps, although one slot (33 333.33 ns) is not a
     // whole number of picoseconds.
     let d = tempfile::tempdir().unwrap();
-    let mut backends = vec!["rusthdl"];
-    if tools::require_tool("iverilog") {
-        backends.push("icarus");
-    }
-    for backend in backends {
+    for &backend in backends {
         let vcd = d.path().join(format!("{backend}.vcd"));
         slotforge()
             .arg("sim")
@@ -299,8 +323,20 @@ fn vcd_times_are_exact_in_every_writer() {
     }
 }
 
+/// One preset on the three engines (every preset: `make test-long`); the
+/// goldens tie rusthdl and Verilator to one log for every preset already.
 #[test]
 fn rusthdl_verilator_and_icarus_give_identical_event_logs() {
+    identical_event_logs(&[root().join("mixes/softslip1k.toml")]);
+}
+
+#[test]
+#[ignore = "long: make test-long"]
+fn rusthdl_verilator_and_icarus_give_identical_event_logs_on_every_preset() {
+    identical_event_logs(&presets());
+}
+
+fn identical_event_logs(mixes: &[PathBuf]) {
     use judge::events::{compare, EventLog, Trace};
     let mut backends = vec![cosim::Backend::RustHdl];
     if tools::require_tool("verilator") && tools::require_tool("g++") {
@@ -309,8 +345,8 @@ fn rusthdl_verilator_and_icarus_give_identical_event_logs() {
     if tools::require_tool("iverilog") {
         backends.push(cosim::Backend::Icarus);
     }
-    for mix in presets() {
-        let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    for mix in mixes {
+        let s = lut_gen::synthesize(&lut_gen::load(mix).unwrap()).unwrap();
         let f = s.grid.frame_cycles;
         let logs: Vec<(cosim::Backend, EventLog)> = backends
             .iter()

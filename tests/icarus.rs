@@ -79,6 +79,7 @@ fn run_testbench(mix_path: &Path, frames_tenths: u64, reset: u64) {
 }
 
 #[test]
+#[ignore = "long: make test-long"]
 fn icarus_reference_mix_matches_the_schedule() {
     run_testbench(&root().join("mixes/eskin34.toml"), 11, 6);
 }
@@ -95,6 +96,7 @@ fn icarus_one_cycle_reset_samples_no_unsettled_mux() {
 /// `vibrotactile8k` is checked independently by sigrok (tests/sigrok.rs) and
 /// simulated by cosim's icarus back end with its chain model.
 #[test]
+#[ignore = "long: make test-long"]
 fn icarus_other_presets_match_the_schedule() {
     for p in ["induction5k.toml", "softslip1k.toml"] {
         run_testbench(&root().join("mixes").join(p), 12, 6);

@@ -66,6 +66,7 @@ fn verilator_backend_2_frames() {
 /// 128-bit `mux_en`), one frame each on rusthdl and verilator with a
 /// one-cycle reset.
 #[test]
+#[ignore = "long: make test-long"]
 fn largest_mixes_one_frame() {
     let verilator = tools::require_tools(&["verilator", "g++"]);
     for name in ["full300", "b16", "ch1024"] {
@@ -88,10 +89,27 @@ fn largest_mixes_one_frame() {
 /// conversion groups, members declared out of order), a lone AD7685 and an
 /// AD7940 on one clock, with a sine stimulus and a one-cycle reset, on the
 /// three engines that run the gateware.
+///
+/// The default suite runs `cnvmix2ms` (the same branches and channels in a
+/// 2 ms frame: Icarus takes seconds, not minutes); `make test-long` runs
+/// cnvmix's 10 ms frame too.
 #[test]
 fn cnv_chain_and_cs_parts_on_every_engine() {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../hdl/tests/data/cnvmix.toml");
-    let s = schedule(&p);
+    cnv_chain_and_cs_parts(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cnvmix2ms.toml"),
+    );
+}
+
+#[test]
+#[ignore = "long: make test-long"]
+fn cnv_chain_and_cs_parts_on_every_engine_10ms_frame() {
+    cnv_chain_and_cs_parts(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../hdl/tests/data/cnvmix.toml"),
+    );
+}
+
+fn cnv_chain_and_cs_parts(p: &Path) {
+    let s = schedule(p);
     assert_eq!(s.mix.branches[0].chain, 2);
     let mut backends = vec![Backend::RustHdl];
     if tools::require_tools(&["verilator", "g++"]) {
@@ -106,7 +124,7 @@ fn cnv_chain_and_cs_parts_on_every_engine() {
     };
     for b in backends {
         let r = run(&s, b, 2, &opts).unwrap();
-        assert!(r.ok, "cnvmix on {}: {}", b.name(), r.summary());
+        assert!(r.ok, "{} on {}: {}", s.mix.name, b.name(), r.summary());
         assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
     }
 }

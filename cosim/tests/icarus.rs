@@ -130,6 +130,7 @@ fn icarus_backend_vcd_windows() {
 }
 
 #[test]
+#[ignore = "long: make test-long"]
 fn icarus_backend_eskin34_one_frame() {
     if !tools::require_tool("iverilog") {
         return;

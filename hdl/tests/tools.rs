@@ -106,6 +106,7 @@ fn gates_three_speed() {
 }
 
 #[test]
+#[ignore = "long: make test-long"]
 fn gates_branch_count_mixes() {
     for name in ["b4", "b5", "b6", "u2", "full300", "b16", "ch1024"] {
         gates(&data_mix(name), name);
