@@ -282,9 +282,11 @@ pub fn run(a: Args) -> u8 {
                 let json = serde_json::to_string_pretty(&c).expect("campaign");
                 let _ = j.write("", &[("faults.json", json)]);
                 let line = format!(
-                    "{} of {} injections caught over {} classes and {} sites; {} false alarms in {} clean runs",
+                    "{} of {} injections detected ({} undetected, {} proved equivalent) over {} classes and {} sites; {} false alarms in {} clean runs",
                     c.detected,
                     c.injected,
+                    c.undetected,
+                    c.proved_equivalent,
                     c.classes.len(),
                     c.sites.len(),
                     c.false_alarms.rejected,
