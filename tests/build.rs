@@ -31,13 +31,24 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         return;
     }
     let d = tempfile::tempdir().unwrap();
-    let out = d.path().join("b");
+    // a golden for the mix, so that no step is skipped (--strict)
+    let gold = d.path().join("golden");
     slotforge()
-        .args(["build", "--quiet", "-o"])
-        .arg(&out)
+        .args(["golden", "--backend", "rusthdl", "--update", "--dir"])
+        .arg(&gold)
         .arg(tiny())
         .assert()
         .success();
+    let out = d.path().join("b");
+    slotforge()
+        .args(["build", "--quiet", "--strict", "--golden"])
+        .arg(&gold)
+        .arg("-o")
+        .arg(&out)
+        .arg(tiny())
+        .assert()
+        .success()
+        .stdout(predicates::str::contains("0 failed, 0 skipped"));
     for f in [
         "audit.txt",
         "audit.json",

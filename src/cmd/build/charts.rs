@@ -81,13 +81,16 @@ pub fn synthesize(s: &Schedule, verilog: &Path, work: &Path) -> Result<Synth, St
     if !n.status.success() {
         return Err(log.lines().rev().take(20).collect::<Vec<_>>().join("\n"));
     }
-    let used = |cell: &str| -> u64 {
+    // a log without the utilisation lines is an error, never "0 cells"
+    let used = |cell: &str| -> Result<u64, String> {
         let key = format!("{cell}:");
         log.lines()
             .filter_map(|l| Some(&l[l.find(&key)? + key.len()..]))
             .filter_map(|r| r.trim().split('/').next()?.trim().parse().ok())
             .next_back()
-            .unwrap_or(0)
+            .ok_or_else(|| {
+                format!("nextpnr's log (synth/nextpnr.log) has no `{cell}` utilisation line")
+            })
     };
     let fmax = log
         .lines()
@@ -103,8 +106,8 @@ pub fn synthesize(s: &Schedule, verilog: &Path, work: &Path) -> Result<Synth, St
         .next_back()
         .ok_or("nextpnr reported no Fmax")?;
     Ok(Synth {
-        lcs: used("ICESTORM_LC"),
-        brams: used("ICESTORM_RAM"),
+        lcs: used("ICESTORM_LC")?,
+        brams: used("ICESTORM_RAM")?,
         fmax_mhz: fmax,
     })
 }
@@ -554,6 +557,11 @@ pub fn faults_section(c: &cosim::faults::Campaign) -> Section {
     }
 }
 
+/// Where sampling at `fs` puts a sine of `f` Hz: |f - fs * round(f / fs)|.
+fn alias_hz(f: f64, fs: f64) -> f64 {
+    (f - fs * (f / fs).round()).abs()
+}
+
 /// The strongest frequency (1 Hz steps up to half the sample rate) in a
 /// channel's samples: a direct DFT of the mean-free codes.
 fn peak_hz(samples: &[(f64, f64)], fs: f64) -> f64 {
@@ -662,6 +670,20 @@ pub fn figure7(s: &Schedule) -> Result<Option<(Section, String)>, String> {
     let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len().max(1) as f64).sqrt();
     let saved = 1.0 - y100.len() as f64 / y1k.len().max(1) as f64;
     let fb = peak_hz(&y100, 100.0);
+    // the step fails unless each peak is where aliasing puts it (the DFT
+    // steps by 1 Hz)
+    for (what, got, f, fs) in [
+        ("600 Hz at 1 kHz", f1, 600.0, 1_000.0),
+        ("600 Hz at 2 kHz", f2, 600.0, 2_000.0),
+        ("2 Hz at 100 Hz", fb, 2.0, 100.0),
+    ] {
+        let want = alias_hz(f, fs);
+        if (got - want).abs() > 1.0 {
+            return Err(format!(
+                "Figure 7: {what} shows as {got:.0} Hz; aliasing puts it at {want:.0} Hz"
+            ));
+        }
+    }
 
     let ms = |v: &[(f64, f64)], upto: f64| -> Vec<(f64, f64)> {
         v.iter()
@@ -734,7 +756,7 @@ pub fn figure7(s: &Schedule) -> Result<Option<(Section, String)>, String> {
             title: "Figure 7: sampling rate against reconstruction".into(),
             paragraphs: vec![
                 format!("The paper's Figure 7, from simulation ({} back end, the emitted design, codes from the ADC model's quantization of a sine on every channel). {line}.", backend.name()),
-                "A channel sampled below twice its signal's frequency folds it: 600 Hz sampled at 1 kHz is indistinguishable from 400 Hz. The same channel at 2 kHz keeps it. A slow signal needs no fast rate: at 100 Hz a 2 Hz signal keeps its shape with a tenth of the data.".into(),
+                format!("A channel sampled below twice its signal's frequency folds it to |f - fs * round(f / fs)|: measured here, 600 Hz at 1 kHz shows as {f1:.0} Hz (aliasing puts it at {:.0} Hz), at 2 kHz as {f2:.0} Hz ({:.0} Hz), and 2 Hz at 100 Hz as {fb:.0} Hz ({:.0} Hz); this step fails when a peak is more than 1 Hz from there. A slow signal needs no fast rate: at 100 Hz a 2 Hz signal keeps its shape with {:.0} % less data than at 1 kHz.", alias_hz(600.0, 1_000.0), alias_hz(600.0, 2_000.0), alias_hz(2.0, 100.0), saved * 100.0),
             ],
             figures: vec![
                 Figure {
