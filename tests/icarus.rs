@@ -98,8 +98,7 @@ fn the_testbench_judge_rejects_unknown_and_extra_samples() {
     judge::judge(&mix, &s, &text, cycles).unwrap();
     let last = text
         .lines()
-        .filter(|l| l.starts_with("SAMPLE"))
-        .last()
+        .rfind(|l| l.starts_with("SAMPLE"))
         .unwrap()
         .to_string();
     let f: Vec<&str> = last.split_whitespace().collect();

@@ -107,7 +107,7 @@ fn vcd(changes: &[(u64, u8)], end: u64) -> String {
         let _ = writeln!(out, "#{t}");
         for (k, id) in ['!', '"', '#'].iter().enumerate() {
             let bit = v >> k & 1;
-            if prev.map_or(true, |p| p >> k & 1 != bit) {
+            if prev.map(|p| p >> k & 1) != Some(bit) {
                 let _ = writeln!(out, "{bit}{id}");
             }
         }
