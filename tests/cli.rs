@@ -410,8 +410,10 @@ fn gateware_faults_are_undetected_not_dropped_without_detectors() {
                 .unwrap()["injected"]
         );
         if c["level"] == "gateware" {
+            // refuted, or undecided within the time limit: never proved
             for i in c["undetected"].as_array().unwrap() {
-                assert_eq!(i["equivalence"]["verdict"], "differs", "{i}");
+                let v = i["equivalence"]["verdict"].as_str().unwrap();
+                assert!(v == "differs" || v == "undecided", "{i}");
             }
         }
     }
