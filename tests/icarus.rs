@@ -23,6 +23,18 @@ fn require(tool: &str) {
 }
 
 fn run_testbench(mix_path: &Path, frames_tenths: u64, reset: u64) {
+    let (mix, s, text, cycles) = testbench_log(mix_path, frames_tenths, reset);
+    if let Err(e) = judge::judge(&mix, &s, &text, cycles) {
+        panic!("{} with a {reset}-cycle reset: {e}", mix_path.display());
+    }
+}
+
+/// Runs the testbench; returns the mix, schedule, log and cycles run.
+fn testbench_log(
+    mix_path: &Path,
+    frames_tenths: u64,
+    reset: u64,
+) -> (lut_gen::Mix, lut_gen::Schedule, String, u64) {
     require("iverilog");
     let mix = lut_gen::load(mix_path).unwrap();
     let s = lut_gen::synthesize(&mix).unwrap();
@@ -73,9 +85,29 @@ fn run_testbench(mix_path: &Path, frames_tenths: u64, reset: u64) {
     );
 
     let text = std::fs::read_to_string(&log).unwrap();
-    if let Err(e) = judge::judge(&mix, &s, &text, cycles) {
-        panic!("{} with a {reset}-cycle reset: {e}", mix_path.display());
-    }
+    (mix, s, text, cycles)
+}
+
+/// The judge checks every sample: one of a channel id the mix does not
+/// have, or one more than a channel's conversions, fails (on a real log of
+/// the small two-branch mix).
+#[test]
+fn the_testbench_judge_rejects_unknown_and_extra_samples() {
+    let tiny = root().join("cosim/tests/data/tiny.toml");
+    let (mix, s, text, cycles) = testbench_log(&tiny, 25, 4);
+    judge::judge(&mix, &s, &text, cycles).unwrap();
+    let last = text
+        .lines()
+        .rfind(|l| l.starts_with("SAMPLE"))
+        .unwrap()
+        .to_string();
+    let f: Vec<&str> = last.split_whitespace().collect();
+    let unknown = format!("{text}SAMPLE {} {} 5\n", f[1], mix.channels.len());
+    let e = judge::judge(&mix, &s, &unknown, cycles).unwrap_err();
+    assert!(e.contains("channel id"), "{e}");
+    let extra = format!("{text}{last}\n");
+    let e = judge::judge(&mix, &s, &extra, cycles).unwrap_err();
+    assert!(e.contains("more than its") || e.contains("differs"), "{e}");
 }
 
 #[test]

@@ -10,6 +10,17 @@
 //! (`hdl::GatewareFault`: a slot-ROM word changed to another channel's, two
 //! words swapped, the slot counter wrapping one early or late, the slice
 //! counter off by one), which only the `rusthdl` target can carry.
+//!
+//! Every run is judged by each detector on its own ([`Detector`]: the
+//! cycle-by-cycle comparison with the model, the model-free invariants,
+//! sigrok's SPI decode of the pins, `prove`), so the campaign is a matrix of
+//! fault class x detector that can show what each one misses.  An injection
+//! no detector catches is undetected; a gateware fault is let off only when
+//! it is proved equivalent to the clean gateware at the ports for all time
+//! ([`crate::equiv`]).
+
+use std::collections::BTreeMap;
+use std::time::Instant;
 
 use judge::faults::{Fault, FaultyDut};
 use judge::run::{run_dut, Dut, ModelDut, RunOptions};
@@ -17,8 +28,81 @@ use judge::Report;
 use lut_gen::Schedule;
 use serde::Serialize;
 
+use crate::equiv::Equivalence;
 use crate::error::SimError;
 use crate::rusthdl::RustHdlDut;
+use crate::sigrok::SpiCapture;
+
+/// A detector of the judge, measured apart from the others.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Detector {
+    /// Every pin in every cycle against the cycle-level reference model.
+    Model,
+    /// The mix's invariants, without the model: counts, intervals,
+    /// settling, SCLK count and period, stream order and content.
+    Invariants,
+    /// sigrok-cli's SPI decoder on CS, SCLK and MISO against the emitted
+    /// samples and the schedule's conversion count.
+    Sigrok,
+    /// The faulty design proving the full contract (`prove`).
+    Prove,
+}
+
+impl Detector {
+    pub const ALL: [Detector; 4] = [
+        Detector::Model,
+        Detector::Invariants,
+        Detector::Sigrok,
+        Detector::Prove,
+    ];
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            Detector::Model => "model",
+            Detector::Invariants => "invariants",
+            Detector::Sigrok => "sigrok",
+            Detector::Prove => "prove",
+        }
+    }
+
+    /// Why this detector has no view of a fault class, by design.
+    pub fn blind_to(&self, class: &str) -> Option<&'static str> {
+        match (self, class) {
+            (
+                Detector::Sigrok,
+                "mux-late" | "two-mux-en" | "wrong-mux" | "select-swap",
+            ) => Some("the SPI decode reads CS, SCLK and MISO only: mux pins are outside its view, and the design emits whatever code MISO carried"),
+            _ => None,
+        }
+    }
+}
+
+/// One detector's column of the matrix, with what it cost in this run.
+#[derive(Debug, Clone, Serialize)]
+pub struct Column {
+    pub detector: Detector,
+    /// Why it did not run (a tool missing, a crate not built in).
+    pub not_run: Option<String>,
+    pub detected: u64,
+    pub injected: u64,
+    /// Simulated cycles it judged and the wall seconds it took (the model
+    /// and the invariants: a clean run of the target checked with and
+    /// without the model; sigrok: every decode of the campaign).
+    pub cycles: u64,
+    pub seconds: f64,
+}
+
+impl Column {
+    /// Share of injections it caught (0 when it did not run).
+    pub fn share(&self) -> f64 {
+        if self.injected == 0 {
+            0.0
+        } else {
+            self.detected as f64 / self.injected as f64
+        }
+    }
+}
 
 /// The design the faults go into.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -46,11 +130,16 @@ pub struct Injection {
     pub fault: String,
     pub site: &'static str,
     pub cycle: u64,
-    pub detected: bool,
+    /// Detectors (that ran) which rejected the run.
+    pub detected_by: Vec<Detector>,
     pub divergences: u64,
     pub violations: u64,
     /// Invariant rules broken (first few).
     pub rules: Vec<String>,
+    /// sigrok's first complaint.
+    pub sigrok: Option<String>,
+    /// Gateware faults no detector caught: the equivalence check's answer.
+    pub equivalence: Option<Equivalence>,
 }
 
 /// A class of fault over all its sites.
@@ -59,15 +148,19 @@ pub struct ClassOutcome {
     pub name: String,
     /// `pins`, `reset` or `gateware`.
     pub level: &'static str,
+    /// Injections (proved-equivalent ones included).
     pub injected: u64,
+    /// Injections some detector caught.
     pub detected: u64,
-    /// Injections the checker did not catch.
-    pub missed: Vec<Injection>,
-    /// Gateware faults whose outputs equalled the reference model's in every
-    /// cycle of the run: equivalent on this mix (no output checker can see
-    /// them; e.g. a frame one slot short when every slot converts the same
-    /// channels), so not counted as injected.
-    pub equivalent: Vec<Injection>,
+    /// Per detector that ran: injections it caught.
+    pub detected_by: BTreeMap<Detector, u64>,
+    /// Per detector with no view of this class: why.
+    pub cannot_see: BTreeMap<Detector, String>,
+    /// Injections no detector caught and no proof excuses.
+    pub undetected: Vec<Injection>,
+    /// Gateware faults no detector caught, proved equivalent to the clean
+    /// gateware at the ports for all time.
+    pub proved_equivalent: Vec<Injection>,
 }
 
 /// Clean runs over random feasible mixes.
@@ -86,16 +179,26 @@ pub struct Campaign {
     pub mix: String,
     pub target: Target,
     pub sites: Vec<Site>,
+    /// The detectors' names, in column order.
+    pub detectors: Vec<Detector>,
+    /// The matrix's columns: per detector, its total and its cost.
+    pub columns: Vec<Column>,
     pub classes: Vec<ClassOutcome>,
     pub injected: u64,
     pub detected: u64,
+    pub undetected: u64,
+    pub proved_equivalent: u64,
     pub false_alarms: FalseAlarms,
 }
 
 impl Campaign {
-    /// Every injection caught and no clean run rejected.
+    /// Nothing undetected and no clean run rejected.
     pub fn ok(&self) -> bool {
-        self.detected == self.injected && self.false_alarms.rejected == 0
+        self.undetected == 0 && self.false_alarms.rejected == 0
+    }
+
+    pub fn column(&self, d: Detector) -> Option<&Column> {
+        self.columns.iter().find(|c| c.detector == d)
     }
 }
 
@@ -134,7 +237,68 @@ pub fn sites(s: &Schedule) -> Vec<Site> {
     v
 }
 
-fn outcome(fault: String, site: &Site, r: &Report) -> Injection {
+/// A run judged by every detector that runs.
+struct Judged {
+    report: Report,
+    /// sigrok's verdict (`None`: not run).
+    sigrok: Option<Result<(), String>>,
+    sigrok_cycles: u64,
+    sigrok_seconds: f64,
+}
+
+impl Judged {
+    fn cost(&self) -> (u64, f64) {
+        (self.sigrok_cycles, self.sigrok_seconds)
+    }
+
+    fn detected_by(&self) -> Vec<Detector> {
+        let r = &self.report;
+        let mut v = Vec::new();
+        if r.model_compared && r.divergence_count > 0 {
+            v.push(Detector::Model);
+        }
+        if r.violation_count > 0 {
+            v.push(Detector::Invariants);
+        }
+        if matches!(self.sigrok, Some(Err(_))) {
+            v.push(Detector::Sigrok);
+        }
+        v
+    }
+}
+
+/// Runs `dut` for `frames` frames under the checker (model comparison and
+/// invariants, counted apart) and, with `sigrok`, decodes its SPI pins.
+fn judge_run(s: &Schedule, dut: &mut dyn Dut, frames: u64, sigrok: bool) -> Result<Judged, String> {
+    let opts = RunOptions::default();
+    if !sigrok {
+        let report = run_dut(s, dut, frames, &opts, "faults", None);
+        return Ok(Judged {
+            report,
+            sigrok: None,
+            sigrok_cycles: 0,
+            sigrok_seconds: 0.0,
+        });
+    }
+    let mut cap = SpiCapture::new(s, judge::run::reset_cycles(s, opts.reset_cycles));
+    let report = run_dut(s, dut, frames, &opts, "faults", Some(&mut cap));
+    let t = Instant::now();
+    let verdict = if judge::switch::disabled("sigrok") {
+        Ok(())
+    } else {
+        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+        crate::sigrok::check(s, &cap, frames, dir.path())?
+    };
+    Ok(Judged {
+        report,
+        sigrok: Some(verdict),
+        sigrok_cycles: (frames - 1) * s.grid.frame_cycles,
+        sigrok_seconds: t.elapsed().as_secs_f64(),
+    })
+}
+
+fn outcome(fault: String, site: &Site, j: &Judged) -> Injection {
+    let r = &j.report;
     let mut rules: Vec<String> = Vec::new();
     for v in &r.violations {
         if rules.len() < 4 && !rules.contains(&v.rule) {
@@ -145,10 +309,12 @@ fn outcome(fault: String, site: &Site, r: &Report) -> Injection {
         fault,
         site: site.name,
         cycle: site.cycle,
-        detected: !r.ok,
+        detected_by: j.detected_by(),
         divergences: r.divergence_count,
         violations: r.violation_count,
         rules,
+        sigrok: j.sigrok.clone().and_then(|v| v.err()),
+        equivalence: None,
     }
 }
 
@@ -270,6 +436,226 @@ fn parallel<T: Send, R: Send>(jobs: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R>
         .collect()
 }
 
+/// Why a detector does not run here (`None`: it runs).
+fn not_run(d: Detector) -> Option<String> {
+    match d {
+        Detector::Model | Detector::Invariants => None,
+        Detector::Sigrok => crate::sigrok::available().err().map(|e| e.to_string()),
+        Detector::Prove => {
+            Some("not run: `prove` (the formal crate) is not built into this slotforge yet".into())
+        }
+    }
+}
+
+/// One judged injection: its class, level and outcome, and sigrok's share
+/// of the work (cycles decoded, seconds).
+type Judgement = (&'static str, &'static str, Injection, (u64, f64));
+
+/// The pin faults and reset glitches at every site.
+fn pin_injections(
+    s: &Schedule,
+    target: Target,
+    sites: &[Site],
+    frames: u64,
+    sigrok: bool,
+) -> Result<Vec<Judgement>, String> {
+    let mut jobs = Vec::new();
+    for site in sites {
+        for f in Fault::all(s) {
+            jobs.push((f, *site));
+        }
+    }
+    let runs = parallel(jobs, |(f, site)| -> Result<Option<Judgement>, String> {
+        let inner: Box<dyn Dut> = match target {
+            Target::Model => Box::new(ModelDut::new(s)),
+            Target::Rusthdl => Box::new(RustHdlDut::new(s).map_err(|e| e.to_string())?),
+        };
+        let mut dut = FaultyDut::new(s, inner, f, site.cycle);
+        let j = judge_run(s, &mut dut, frames, sigrok)?;
+        let level = if f == Fault::ResetGlitch {
+            "reset"
+        } else {
+            "pins"
+        };
+        // a fault that found nothing to change was not injected
+        Ok(dut
+            .injected()
+            .then(|| (f.class(), level, outcome(f.name(), &site, &j), j.cost())))
+    });
+    Ok(runs
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
+/// The design-level faults of the gateware at every site.
+fn design_cases(s: &Schedule, sites: &[Site]) -> Vec<DesignCase> {
+    let mut design = Vec::new();
+    for site in sites {
+        for b in 0..s.branches.len() {
+            design.extend(rom_cases(s, b, *site));
+        }
+    }
+    for (delta, class) in [(-1, "slot-wrap-early"), (1, "slot-wrap-late")] {
+        design.push(DesignCase {
+            fault: hdl::GatewareFault::SlotWrap { delta },
+            site: sites[0],
+            class,
+        });
+    }
+    if s.grid.slices_per_frame > 1 {
+        for (delta, class) in [(-1, "slice-count-short"), (1, "slice-count-long")] {
+            design.push(DesignCase {
+                fault: hdl::GatewareFault::SliceWrap { delta },
+                site: sites[0],
+                class,
+            });
+        }
+    }
+    design
+}
+
+/// A gateware fault no detector caught: proved equivalent, or why not.
+fn equivalence(s: &Schedule, f: hdl::GatewareFault) -> Equivalence {
+    let undecided = |why: String| Equivalence::Undecided { why };
+    let (gold, gate) = match hdl::verilog_pair(s, f) {
+        Ok(p) => p,
+        Err(e) => return undecided(format!("no Verilog for the fault: {e}")),
+    };
+    match tempfile::tempdir() {
+        Ok(dir) => crate::equiv::check(&gold, &gate, dir.path())
+            .unwrap_or_else(|e| undecided(e.to_string())),
+        Err(e) => undecided(e.to_string()),
+    }
+}
+
+/// The design-level faults, each judged; an uncaught one goes to the
+/// equivalence check.
+fn gateware_injections(
+    s: &Schedule,
+    sites: &[Site],
+    frames: u64,
+    sigrok: bool,
+) -> Result<Vec<Judgement>, String> {
+    let runs = parallel(
+        design_cases(s, sites),
+        |c| -> Result<Option<Judgement>, String> {
+            let name = format!("{}: {:?}", c.class, c.fault);
+            // a fault the mix's gateware cannot hold (e.g. a frame too long for the full LUT)
+            let Ok(sim) = hdl::RtlSim::with_fault(s, c.fault) else {
+                return Ok(None);
+            };
+            let mut dut = GatewareDut(sim);
+            let j = judge_run(s, &mut dut, frames, sigrok)?;
+            let mut inj = outcome(name, &c.site, &j);
+            if inj.detected_by.is_empty() {
+                inj.equivalence = Some(equivalence(s, c.fault));
+            }
+            Ok(Some((c.class, "gateware", inj, j.cost())))
+        },
+    );
+    Ok(runs
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .flatten()
+        .collect())
+}
+
+/// The matrix: injections grouped by class, counted per detector.
+fn classes(judged: Vec<Judgement>, ran: &[Detector]) -> Vec<ClassOutcome> {
+    let mut classes: Vec<ClassOutcome> = Vec::new();
+    for (class, level, inj, _) in judged {
+        let c = match classes.iter().position(|c| c.name == class) {
+            Some(i) => &mut classes[i],
+            None => {
+                classes.push(ClassOutcome {
+                    name: class.to_string(),
+                    level,
+                    injected: 0,
+                    detected: 0,
+                    detected_by: ran.iter().map(|&d| (d, 0)).collect(),
+                    cannot_see: Detector::ALL
+                        .iter()
+                        .filter_map(|d| Some((*d, d.blind_to(class)?.to_string())))
+                        .collect(),
+                    undetected: vec![],
+                    proved_equivalent: vec![],
+                });
+                classes.last_mut().expect("just pushed")
+            }
+        };
+        c.injected += 1;
+        for d in &inj.detected_by {
+            *c.detected_by.entry(*d).or_default() += 1;
+        }
+        if !inj.detected_by.is_empty() {
+            c.detected += 1;
+        } else if matches!(inj.equivalence, Some(Equivalence::Proved { .. })) {
+            c.proved_equivalent.push(inj);
+        } else {
+            c.undetected.push(inj);
+        }
+    }
+    classes
+}
+
+/// The columns: per detector its totals, and its cost measured now (the
+/// checker on a clean run of the target with and without the model;
+/// sigrok's decodes summed over the campaign).
+fn columns(
+    s: &Schedule,
+    target: Target,
+    frames: u64,
+    classes: &[ClassOutcome],
+    sigrok_cost: (u64, f64),
+) -> Vec<Column> {
+    let timed = |model: bool| -> (u64, f64) {
+        let mut dut: Box<dyn Dut> = match target {
+            Target::Model => Box::new(ModelDut::new(s)),
+            Target::Rusthdl => match RustHdlDut::new(s) {
+                Ok(d) => Box::new(d),
+                Err(_) => return (0, 0.0),
+            },
+        };
+        let mut opts = RunOptions::default();
+        opts.check.model = model;
+        let t = Instant::now();
+        let r = run_dut(s, &mut dut, frames, &opts, "timing", None);
+        (r.cycles, t.elapsed().as_secs_f64())
+    };
+    Detector::ALL
+        .iter()
+        .map(|&d| {
+            let why = not_run(d);
+            let (cycles, seconds) = match d {
+                _ if why.is_some() => (0, 0.0),
+                Detector::Model => timed(true),
+                Detector::Invariants => timed(false),
+                Detector::Sigrok => sigrok_cost,
+                Detector::Prove => (0, 0.0),
+            };
+            Column {
+                detector: d,
+                detected: classes
+                    .iter()
+                    .map(|c| c.detected_by.get(&d).copied().unwrap_or(0))
+                    .sum(),
+                injected: if why.is_some() {
+                    0
+                } else {
+                    classes.iter().map(|c| c.injected).sum()
+                },
+                not_run: why,
+                cycles,
+                seconds,
+            }
+        })
+        .collect()
+}
+
 /// The campaign on `s` with `frames` frames per run (at least 3: faults land
 /// in frame 1, and the next frame shows what a fault left behind), and
 /// `false_alarm_mixes` random feasible mixes run clean.
@@ -284,112 +670,33 @@ pub fn campaign(
         RustHdlDut::new(s)?;
     }
     let sites = sites(s);
-    let opts = RunOptions::default();
-    let make = || -> Box<dyn Dut> {
-        match target {
-            Target::Model => Box::new(ModelDut::new(s)),
-            Target::Rusthdl => Box::new(RustHdlDut::new(s).expect("built once already")),
-        }
-    };
-    // pin faults and reset glitches at every site
-    let mut pin_jobs = Vec::new();
-    for site in &sites {
-        for f in Fault::all(s) {
-            pin_jobs.push((f, *site));
-        }
-    }
-    let pin = parallel(pin_jobs, |(f, site)| {
-        let mut dut = FaultyDut::new(s, make(), f, site.cycle);
-        let r = run_dut(s, &mut dut, frames, &opts, "faults", None);
-        let level = if f == Fault::ResetGlitch {
-            "reset"
-        } else {
-            "pins"
-        };
-        // a fault that found nothing to change is not counted as injected
-        dut.injected()
-            .then(|| (f.class(), level, outcome(f.name(), &site, &r)))
-    });
-    // design-level faults in the gateware
-    let mut design = Vec::new();
-    if target == Target::Rusthdl {
-        for site in &sites {
-            for b in 0..s.branches.len() {
-                design.extend(rom_cases(s, b, *site));
-            }
-        }
-        for (delta, class) in [(-1, "slot-wrap-early"), (1, "slot-wrap-late")] {
-            design.push(DesignCase {
-                fault: hdl::GatewareFault::SlotWrap { delta },
-                site: sites[0],
-                class,
-            });
-        }
-        if s.grid.slices_per_frame > 1 {
-            for (delta, class) in [(-1, "slice-count-short"), (1, "slice-count-long")] {
-                design.push(DesignCase {
-                    fault: hdl::GatewareFault::SliceWrap { delta },
-                    site: sites[0],
-                    class,
-                });
-            }
-        }
-    }
-    let design = parallel(design, |c| {
-        let name = format!("{}: {:?}", c.class, c.fault);
-        match hdl::RtlSim::with_fault(s, c.fault) {
-            Ok(sim) => {
-                let mut dut = GatewareDut(sim);
-                let r = run_dut(s, &mut dut, frames, &opts, "faults", None);
-                let equivalent = r.ok && r.model_compared && r.divergence_count == 0;
-                Some((c.class, "gateware", outcome(name, &c.site, &r), equivalent))
-            }
-            // a fault the mix's gateware cannot hold (e.g. a frame too long for the full LUT)
-            Err(_) => None,
-        }
-    });
-    let mut classes: Vec<ClassOutcome> = Vec::new();
-    for (class, level, inj, equivalent) in pin
+    let ran: Vec<Detector> = Detector::ALL
         .into_iter()
-        .flatten()
-        .map(|(c, l, i)| (c, l, i, false))
-        .chain(design.into_iter().flatten())
-    {
-        let c = match classes.iter_mut().find(|c| c.name == class) {
-            Some(c) => c,
-            None => {
-                classes.push(ClassOutcome {
-                    name: class.to_string(),
-                    level,
-                    injected: 0,
-                    detected: 0,
-                    missed: vec![],
-                    equivalent: vec![],
-                });
-                classes.last_mut().expect("just pushed")
-            }
-        };
-        if equivalent {
-            c.equivalent.push(inj);
-            continue;
-        }
-        c.injected += 1;
-        if inj.detected {
-            c.detected += 1;
-        } else {
-            c.missed.push(inj);
-        }
+        .filter(|d| not_run(*d).is_none())
+        .collect();
+    let sigrok = ran.contains(&Detector::Sigrok);
+    let mut judged = pin_injections(s, target, &sites, frames, sigrok).map_err(SimError::Io)?;
+    if target == Target::Rusthdl {
+        judged.extend(gateware_injections(s, &sites, frames, sigrok).map_err(SimError::Io)?);
     }
-    let injected = classes.iter().map(|c| c.injected).sum();
-    let detected = classes.iter().map(|c| c.detected).sum();
+    let cost = judged
+        .iter()
+        .fold((0u64, 0.0f64), |a, j| (a.0 + j.3 .0, a.1 + j.3 .1));
+    let classes = classes(judged, &ran);
+    let columns = columns(s, target, frames, &classes, cost);
+    let sum = |f: fn(&ClassOutcome) -> u64| classes.iter().map(f).sum();
     Ok(Campaign {
         mix: s.mix.name.clone(),
         target,
         sites,
+        detectors: Detector::ALL.to_vec(),
+        columns,
+        injected: sum(|c| c.injected),
+        detected: sum(|c| c.detected),
+        undetected: sum(|c| c.undetected.len() as u64),
+        proved_equivalent: sum(|c| c.proved_equivalent.len() as u64),
         classes,
-        injected,
-        detected,
-        false_alarms: false_alarms(target, false_alarm_mixes),
+        false_alarms: false_alarms(target, false_alarm_mixes, sigrok),
     })
 }
 
@@ -403,8 +710,9 @@ impl Dut for GatewareDut {
 }
 
 /// Clean runs of `target` over the first `n` feasible mixes of
-/// [`random_mix`]; every rejection is a false alarm.
-pub fn false_alarms(target: Target, n: u64) -> FalseAlarms {
+/// [`random_mix`], judged by every detector (sigrok with `sigrok`); every
+/// rejection is a false alarm.
+pub fn false_alarms(target: Target, n: u64, sigrok: bool) -> FalseAlarms {
     let mut fa = FalseAlarms {
         mixes: 0,
         runs: 0,
@@ -433,12 +741,21 @@ pub fn false_alarms(target: Target, n: u64) -> FalseAlarms {
         };
         fa.mixes += 1;
         let mut dut = dut;
-        let r = run_dut(&s, &mut dut, 2, &RunOptions::default(), "clean", None);
+        let j = judge_run(&s, &mut dut, 2, sigrok);
         fa.runs += 1;
-        if !r.ok {
+        let why = match &j {
+            Err(e) => Some(format!("sigrok-cli failed: {e}")),
+            Ok(j) if !j.report.ok => Some(j.report.summary()),
+            Ok(Judged {
+                sigrok: Some(Err(e)),
+                ..
+            }) => Some(format!("sigrok: {e}")),
+            Ok(_) => None,
+        };
+        if let Some(why) = why {
             fa.rejected += 1;
             if fa.examples.len() < 3 {
-                fa.examples.push(format!("seed {seed}: {}", r.summary()));
+                fa.examples.push(format!("seed {seed}: {why}"));
             }
         }
     }

@@ -11,19 +11,26 @@
 //!   run time), `icarus` ([`icarus`]: the emitted Verilog in Icarus with a
 //!   Verilog ADC, its VCD read by the judge);
 //! - [`faults`]: the fault campaign (pin faults, reset glitches and faults
-//!   built into the gateware, at many sites; false alarms over random mixes);
+//!   built into the gateware, at many sites; false alarms over random mixes),
+//!   judged by each detector apart: a matrix of fault class x detector;
+//! - [`sigrok`]: sigrok-cli's SPI decode of the pins as a detector;
+//! - [`equiv`]: a faulty gateware proved equivalent to the clean one at the
+//!   ports (yosys miter, ABC), or not; [`tools`]: the one runner of those tools;
 //! - [`rtl`]: outside Verilog for the verilator and icarus back ends
 //!   (`SimOptions::rtl`), its top's ports checked against the pin contract;
 //! - [`SimOptions`] / [`SimError`]: what a run is asked to do and why it
 //!   could not run.
 
 pub mod backend;
+pub mod equiv;
 pub mod error;
 pub mod faults;
 pub mod icarus;
 pub mod options;
 pub mod rtl;
 pub mod rusthdl;
+pub mod sigrok;
+pub mod tools;
 pub mod verilator;
 
 pub use backend::{run, run_observed, run_traced, Tracer};

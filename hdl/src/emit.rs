@@ -166,6 +166,19 @@ pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Em
     Ok(Emitted { files })
 }
 
+/// The Verilog of the gateware with a design-level fault built in, and of
+/// the clean gateware in the same LUT form, for an equivalence check of the
+/// two at the ports.
+pub fn verilog_pair(
+    s: &Schedule,
+    fault: crate::GatewareFault,
+) -> Result<(String, String), HdlError> {
+    let clean = plan_with(s, fault.lut_form())?;
+    let mut faulty = clean.clone();
+    fault.apply(&mut faulty)?;
+    Ok((verilog(s, &clean), verilog(s, &faulty)))
+}
+
 // ---------------------------------------------------------------------------
 // Verilog
 // ---------------------------------------------------------------------------

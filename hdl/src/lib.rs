@@ -24,7 +24,7 @@ mod sim;
 mod stock;
 mod widths;
 
-pub use emit::{emit, emit_with, Board, Emitted, MANIFEST_FILE, VERILOG_FILE};
+pub use emit::{emit, emit_with, verilog_pair, Board, Emitted, MANIFEST_FILE, VERILOG_FILE};
 pub use fault::GatewareFault;
 pub use plan::{
     LutForm, FULL_LUT_MAX_BITS, MAX_FRAME_SLOTS, MAX_SCLK_DIV, MAX_SLICES_PER_FRAME,

@@ -38,6 +38,17 @@ pub struct Args {
     /// No progress display (for CI logs).
     #[arg(long)]
     pub quiet: bool,
+    /// A skipped step (a tool missing, a measurement not possible) fails the
+    /// build, as it always does when the CI environment variable is set.
+    #[arg(long)]
+    pub strict: bool,
+}
+
+/// Whether skipped steps fail: `--strict`, or `CI` set (not empty, `0` or `false`).
+fn strict(flag: bool) -> bool {
+    let ci = std::env::var("CI").unwrap_or_default();
+    let ci = ci.trim();
+    flag || !(ci.is_empty() || ci == "0" || ci.eq_ignore_ascii_case("false"))
 }
 
 /// How one step ended, with a one-line summary and optional detail.
@@ -282,9 +293,11 @@ pub fn run(a: Args) -> u8 {
                 let json = serde_json::to_string_pretty(&c).expect("campaign");
                 let _ = j.write("", &[("faults.json", json)]);
                 let line = format!(
-                    "{} of {} injections caught over {} classes and {} sites; {} false alarms in {} clean runs",
+                    "{} of {} injections detected ({} undetected, {} proved equivalent) over {} classes and {} sites; {} false alarms in {} clean runs",
                     c.detected,
                     c.injected,
+                    c.undetected,
+                    c.proved_equivalent,
                     c.classes.len(),
                     c.sites.len(),
                     c.false_alarms.rejected,
@@ -350,9 +363,10 @@ pub fn run(a: Args) -> u8 {
                 sections.push(sec);
                 Outcome::Ok(line)
             }
-            Ok(None) => {
-                Outcome::Skipped("the mix has no channels at 100 Hz, 1 kHz and 2 kHz".into())
-            }
+            // not a degraded step: the figure needs those rates
+            Ok(None) => Outcome::Ok(
+                "not applicable: the mix has no channels at 100 Hz, 1 kHz and 2 kHz".into(),
+            ),
             Err(e) => Outcome::Failed(e, String::new()),
         },
     );
@@ -390,13 +404,34 @@ pub fn run(a: Args) -> u8 {
         .iter()
         .filter(|s| s.status == Status::Failed)
         .count();
+    let skipped: Vec<&str> = job
+        .doc
+        .steps
+        .iter()
+        .filter(|s| s.status == Status::Skipped)
+        .map(|s| s.name.as_str())
+        .collect();
     println!(
-        "{}: {} steps, {} failed; report in {}",
+        "{}: {} steps, {} failed, {} skipped{}; report in {}",
         s.mix.name,
         job.doc.steps.len(),
         failed,
+        skipped.len(),
+        if skipped.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", skipped.join(", "))
+        },
         Path::new(&a.out).join("report.html").display()
     );
+    if !skipped.is_empty() && strict(a.strict) {
+        eprintln!(
+            "error: {} step(s) skipped under --strict or CI: {}",
+            skipped.len(),
+            skipped.join(", ")
+        );
+        return 1;
+    }
     if failed == 0 {
         0
     } else {

@@ -3,12 +3,15 @@
 //! checker caught, plus clean runs over random feasible mixes that it must
 //! not reject.
 //!
-//! Exit 0: every injection caught and no false alarm; 1: a miss or a false
+//! Every run is judged by each detector apart (model comparison, invariants,
+//! sigrok's SPI decode, `prove`): the output is a matrix of fault class x
+//! detector.  Exit 0: every injection detected (or, for a gateware fault,
+//! proved equivalent) and no false alarm; 1: anything undetected or a false
 //! alarm; 2: bad input.
 
 use std::path::PathBuf;
 
-use cosim::faults::{campaign, Target};
+use cosim::faults::{campaign, Campaign, Target};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -61,50 +64,115 @@ pub fn run(a: Args) -> u8 {
         v["ok"] = serde_json::json!(c.ok());
         println!("{}", serde_json::to_string_pretty(&v).expect("json"));
     } else {
-        println!(
-            "faults on {} ({:?}), sites: {}",
-            c.mix,
-            c.target,
-            c.sites
-                .iter()
-                .map(|s| format!("{} (cycle {}, slot {})", s.name, s.cycle, s.slot))
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-        for k in &c.classes {
-            println!(
-                "  {:<20} {:<8} {:>3} of {:>3} caught{}",
-                k.name,
-                k.level,
-                k.detected,
-                k.injected,
-                if k.missed.is_empty() { "" } else { "  MISSED" }
-            );
-            for m in &k.missed {
-                println!("      missed {} at {} (cycle {})", m.fault, m.site, m.cycle);
-            }
-            for m in &k.equivalent {
-                println!(
-                    "      no effect: {} at {} (cycle {}): every output equals the model's in every cycle (an equivalent fault on this mix; not counted)",
-                    m.fault, m.site, m.cycle
-                );
-            }
-        }
-        println!(
-            "{} of {} injections caught; false alarms: {} of {} clean runs over {} random mixes",
-            c.detected,
-            c.injected,
-            c.false_alarms.rejected,
-            c.false_alarms.runs,
-            c.false_alarms.mixes
-        );
-        for e in &c.false_alarms.examples {
-            println!("  false alarm: {e}");
-        }
+        print!("{}", text(&c));
     }
     if c.ok() {
         0
     } else {
         1
     }
+}
+
+/// The campaign as text: the matrix, then what was missed and why.
+fn text(c: &Campaign) -> String {
+    use std::fmt::Write as _;
+    let mut o = String::new();
+    let sites: Vec<String> = c
+        .sites
+        .iter()
+        .map(|s| format!("{} (cycle {}, slot {})", s.name, s.cycle, s.slot))
+        .collect();
+    let _ = writeln!(
+        o,
+        "faults on {} ({:?}), sites: {}",
+        c.mix,
+        c.target,
+        sites.join(", ")
+    );
+    let _ = write!(o, "  {:<18} {:<8}", "class", "level");
+    for d in &c.detectors {
+        let _ = write!(o, " {:>12}", d.name());
+    }
+    let _ = writeln!(o, " {:>10} {:>10}", "undetected", "proved-eq");
+    for k in &c.classes {
+        let _ = write!(o, "  {:<18} {:<8}", k.name, k.level);
+        for d in &c.detectors {
+            let cell = match (k.detected_by.get(d), k.cannot_see.get(d)) {
+                (_, Some(_)) => "cannot see".to_string(),
+                (Some(n), None) => format!("{n} of {}", k.injected),
+                (None, None) => "not run".to_string(),
+            };
+            let _ = write!(o, " {cell:>12}");
+        }
+        let _ = writeln!(
+            o,
+            " {:>10} {:>10}",
+            k.undetected.len(),
+            k.proved_equivalent.len()
+        );
+    }
+    let mut blind: Vec<(&str, &str)> = Vec::new();
+    for k in &c.classes {
+        for (d, why) in &k.cannot_see {
+            if !blind.contains(&(d.name(), why.as_str())) {
+                blind.push((d.name(), why));
+            }
+        }
+    }
+    for (d, why) in blind {
+        let _ = writeln!(o, "  cannot see: {d}: {why}");
+    }
+    for col in &c.columns {
+        match &col.not_run {
+            Some(why) => {
+                let _ = writeln!(o, "  {}: {why}", col.detector.name());
+            }
+            None => {
+                let _ = writeln!(
+                    o,
+                    "  {}: {} of {} injections",
+                    col.detector.name(),
+                    col.detected,
+                    col.injected
+                );
+            }
+        }
+    }
+    for k in &c.classes {
+        for m in &k.undetected {
+            let _ = writeln!(
+                o,
+                "      UNDETECTED {} at {} (cycle {}){}",
+                m.fault,
+                m.site,
+                m.cycle,
+                m.equivalence
+                    .as_ref()
+                    .map(|e| format!(": equivalence {e:?}"))
+                    .unwrap_or_default()
+            );
+        }
+        for m in &k.proved_equivalent {
+            let _ = writeln!(
+                o,
+                "      proved equivalent: {} at {} (cycle {}): every output equals the clean gateware's for every input, for all time",
+                m.fault, m.site, m.cycle
+            );
+        }
+    }
+    let _ = writeln!(
+        o,
+        "{} injections: {} detected, {} undetected, {} proved equivalent; false alarms: {} of {} clean runs over {} random mixes",
+        c.injected,
+        c.detected,
+        c.undetected,
+        c.proved_equivalent,
+        c.false_alarms.rejected,
+        c.false_alarms.runs,
+        c.false_alarms.mixes
+    );
+    for e in &c.false_alarms.examples {
+        let _ = writeln!(o, "  false alarm: {e}");
+    }
+    o
 }

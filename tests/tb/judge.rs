@@ -7,8 +7,9 @@ use std::collections::BTreeMap;
 /// Compares a log of `tests/tb/adc_tb.v` with the schedule: conversions at
 /// exactly the schedule's instants on the right channel (decoded from the mux
 /// address at the instant), every interval exactly clock/rate, and every
-/// sample leaving with the channel and the code the ADC shifted out, in order.
-/// `cycles` is how long the testbench ran.
+/// sample leaving with the channel and the code the ADC shifted out, in order;
+/// a sample of a channel id the mix does not have, or beyond the channel's
+/// conversions, fails.  `cycles` is how long the testbench ran.
 ///
 /// Mux settling, physically: a conversion's mux select and enables must have
 /// been on the pins for at least the branch's `settle_ns` (in whole cycles,
@@ -157,8 +158,16 @@ pub fn judge(
         }
     }
     // 3. every sample leaves with the channel and the code the ADC shifted out, in order
+    // (and every sample is one: an unknown channel id, or more samples of a
+    // channel than it had conversions, is a failure)
     let mut per_channel: BTreeMap<usize, Vec<u16>> = BTreeMap::new();
-    for (_, ch, v) in &samples {
+    for (cycle, ch, v) in &samples {
+        if *ch >= mix.channels.len() {
+            return Err(format!(
+                "cycle {cycle}: a sample of channel id {ch}, which the mix does not have ({} channels)",
+                mix.channels.len()
+            ));
+        }
         per_channel.entry(*ch).or_default().push(*v);
     }
     let read = s.branches.iter().map(|b| b.spi.read_cycles).max().unwrap();
@@ -180,6 +189,27 @@ pub fn judge(
         if got[..shifted.len()] != shifted[..] {
             return Err(format!(
                 "{}: sample values differ from the ADC's words",
+                ch.name
+            ));
+        }
+        // the samples past those checked above: conversions that ended near
+        // the end of the run; there may be no more of them than conversions
+        let all: Vec<u16> = conversions[ch.branch]
+            .iter()
+            .filter(|x| x.channel == c)
+            .map(|x| x.code)
+            .collect();
+        if got.len() > all.len() {
+            return Err(format!(
+                "{}: {} samples out, more than its {} conversions",
+                ch.name,
+                got.len(),
+                all.len()
+            ));
+        }
+        if got[..] != all[..got.len()] {
+            return Err(format!(
+                "{}: a late sample's value differs from the ADC's word",
                 ch.name
             ));
         }

@@ -1,6 +1,8 @@
 //! Fault injection: a [`Dut`] wrapper that corrupts a design's pins in one
 //! precise way, to prove the checker catches each kind of fault.
 
+use std::collections::VecDeque;
+
 use lut_gen::Schedule;
 
 use crate::run::Dut;
@@ -28,6 +30,24 @@ pub enum Fault {
     /// The design is reset for a few cycles in mid-run while its `rst` port
     /// stays low (a glitch, a brown-out): it restarts its frame.
     ResetGlitch,
+    // Faults that keep a legal-looking timeline: every CS window, SCLK burst
+    // and mux switch is well formed, so only a model-free check of the
+    // mix's invariants (or the model) can tell them from a good design.
+    /// One conversion of `branch` (CS, SCLK and mux lanes) moved one slot
+    /// later, into a slot where the branch is idle.
+    ConversionMoved { branch: usize },
+    /// One channel's instants start one sampling interval later: its
+    /// conversion at the site vanishes (CS and SCLK idle, no sample), the
+    /// following ones fall where they were.
+    PhaseShift { branch: usize },
+    /// The mux addresses of two channels of `branch` with the same rate
+    /// swapped for one frame (each instant converts the other's input).
+    SelectSwap { branch: usize },
+    /// One conversion of `branch` read with SCLK at half its frequency, still
+    /// within the part's limits (the CS window grows to fit the 16 clocks).
+    SclkSlow { branch: usize },
+    /// One sample leaves with the code of the conversion emitted before it.
+    NeighbourCode,
 }
 
 /// Cycles a [`Fault::ResetGlitch`] holds the design in reset.
@@ -46,20 +66,38 @@ impl Fault {
             Fault::TwoMuxEn { .. } => "two-mux-en",
             Fault::WrongMux { .. } => "wrong-mux",
             Fault::ResetGlitch => "reset-glitch",
+            Fault::ConversionMoved { .. } => "conversion-moved",
+            Fault::PhaseShift { .. } => "phase-shift",
+            Fault::SelectSwap { .. } => "select-swap",
+            Fault::SclkSlow { .. } => "sclk-slow",
+            Fault::NeighbourCode => "neighbour-code",
+        }
+    }
+
+    /// The branch a fault is injected on (stream faults: none).
+    pub fn branch(&self) -> Option<usize> {
+        match *self {
+            Fault::CsLate { branch }
+            | Fault::SclkExtraEdge { branch }
+            | Fault::MuxLate { branch }
+            | Fault::TwoMuxEn { branch }
+            | Fault::WrongMux { branch }
+            | Fault::ConversionMoved { branch }
+            | Fault::PhaseShift { branch }
+            | Fault::SelectSwap { branch }
+            | Fault::SclkSlow { branch } => Some(branch),
+            Fault::WrongChannel
+            | Fault::WrongSampleBit
+            | Fault::DropSample
+            | Fault::ResetGlitch
+            | Fault::NeighbourCode => None,
         }
     }
 
     pub fn name(&self) -> String {
-        match self {
-            Fault::WrongChannel => "wrong-channel".into(),
-            Fault::WrongSampleBit => "wrong-sample-bit".into(),
-            Fault::DropSample => "drop-sample".into(),
-            Fault::CsLate { branch } => format!("cs-late-b{branch}"),
-            Fault::SclkExtraEdge { branch } => format!("sclk-extra-edge-b{branch}"),
-            Fault::MuxLate { branch } => format!("mux-late-b{branch}"),
-            Fault::TwoMuxEn { branch } => format!("two-mux-en-b{branch}"),
-            Fault::WrongMux { branch } => format!("wrong-mux-b{branch}"),
-            Fault::ResetGlitch => "reset-glitch".into(),
+        match self.branch() {
+            Some(b) => format!("{}-b{b}", self.class()),
+            None => self.class().into(),
         }
     }
 
@@ -82,9 +120,40 @@ impl Fault {
             if s.branches[b].mux_devices >= 2 {
                 v.push(Fault::TwoMuxEn { branch: b });
             }
+            v.push(Fault::ConversionMoved { branch: b });
+            v.push(Fault::PhaseShift { branch: b });
+            if same_rate_pair(s, b).is_some() {
+                v.push(Fault::SelectSwap { branch: b });
+            }
+            if slow_sclk_div(s, b).is_some() {
+                v.push(Fault::SclkSlow { branch: b });
+            }
         }
+        v.push(Fault::NeighbourCode);
         v
     }
+}
+
+/// Two channels of branch `b` with the same rate (the first such pair).
+pub fn same_rate_pair(s: &Schedule, b: usize) -> Option<(usize, usize)> {
+    let mix = &s.mix;
+    let on: Vec<usize> = (0..mix.channels.len())
+        .filter(|&c| mix.channels[c].branch == b)
+        .collect();
+    on.iter().enumerate().find_map(|(i, &x)| {
+        on[i + 1..]
+            .iter()
+            .find(|&&y| mix.channels[y].rate_hz == mix.channels[x].rate_hz)
+            .map(|&y| (x, y))
+    })
+}
+
+/// The SCLK divider of [`Fault::SclkSlow`] on branch `b`: twice the
+/// branch's, if the part still allows that frequency.
+pub fn slow_sclk_div(s: &Schedule, b: usize) -> Option<u64> {
+    let d = s.branches[b].spi.sclk_div * 2;
+    let part = &s.mix.branches[b].adc;
+    (d * part.sclk_min_hz <= s.mix.clock_hz).then_some(d)
 }
 
 /// Wraps a design and injects one fault at or after cycle `at`.
@@ -107,28 +176,51 @@ pub struct FaultyDut<D> {
     high: u64,
     held: Option<Pins>,
     changed: bool,
+    /// Legal-timeline faults: the original pins of the last `hist_len`
+    /// cycles (the newest last), the cycles a lane is moved or stretched
+    /// by, the channels concerned and the last sample value emitted.
+    hist: VecDeque<Pins>,
+    hist_len: usize,
+    shift: u64,
+    d_slow: u64,
+    words: u64,
+    channels: (u16, u16),
+    last_value: Option<u16>,
+    frame: u64,
+    /// Every channel's mux (device, select).
+    addresses: Vec<(u32, u32)>,
 }
 
 impl<D: Dut> FaultyDut<D> {
     pub fn new(s: &Schedule, inner: D, fault: Fault, at: u64) -> FaultyDut<D> {
-        let b = match fault {
-            Fault::CsLate { branch }
-            | Fault::SclkExtraEdge { branch }
-            | Fault::MuxLate { branch }
-            | Fault::TwoMuxEn { branch }
-            | Fault::WrongMux { branch } => branch,
+        let b = fault.branch().unwrap_or(0);
+        let spi = s.branches[b].spi;
+        let slot = s.grid.slot_cycles;
+        let d_slow = slow_sclk_div(s, b).unwrap_or(spi.sclk_div);
+        let n = (spi.words * spi.word_sclks) as u64;
+        let r_slow = spi.read_cycles + n * (d_slow - spi.sclk_div);
+        // the span a fault's conversion needs before the branch's next one
+        let need = match fault {
+            Fault::ConversionMoved { .. } => slot + spi.read_cycles + spi.quiet_cycles + 1,
+            Fault::SclkSlow { .. } => r_slow + spi.quiet_cycles + 1,
             _ => 0,
         };
-        let mut prev = 0;
-        let mut t = 0;
-        for i in s.instants(u64::MAX).filter(|i| i.branch == b) {
-            if i.cycle >= at && i.cycle > 0 {
-                t = i.cycle;
-                break;
+        let (prev, t) = target_instant(s, b, at, need);
+        let (hist_len, shift) = match fault {
+            Fault::ConversionMoved { .. } => ((slot + spi.read_cycles + 2) as usize, slot),
+            Fault::SclkSlow { .. } => ((r_slow + 2) as usize, r_slow),
+            _ => (0, 0),
+        };
+        let channels = match fault {
+            Fault::SelectSwap { branch } => same_rate_pair(s, branch)
+                .map(|(x, y)| (x as u16, y as u16))
+                .unwrap_or((0, 0)),
+            Fault::PhaseShift { branch } => {
+                let c = s.at((t % s.grid.frame_cycles) / slot, branch).unwrap_or(0) as u16;
+                (c, c)
             }
-            prev = i.cycle;
-        }
-        let spi = s.branches[b].spi;
+            _ => (0, 0),
+        };
         FaultyDut {
             inner,
             fault,
@@ -146,8 +238,42 @@ impl<D: Dut> FaultyDut<D> {
             high: spi.sclk_div - spi.sclk_half,
             held: None,
             changed: false,
+            hist: VecDeque::with_capacity(hist_len + 1),
+            hist_len,
+            shift,
+            d_slow,
+            words: n,
+            channels,
+            last_value: None,
+            frame: s.grid.frame_cycles,
+            addresses: s.channels.iter().map(|c| (c.device, c.select)).collect(),
         }
     }
+}
+
+/// (previous instant, first instant at or after `at`, not at cycle 0) of
+/// branch `b` whose next instant is at least `need` cycles later; a fault
+/// that finds none within two frames lands nowhere (it is not injected).
+fn target_instant(s: &Schedule, b: usize, at: u64, need: u64) -> (u64, u64) {
+    let limit = at + 2 * s.grid.frame_cycles;
+    let mut it = s
+        .instants(u64::MAX)
+        .filter(|i| i.branch == b)
+        .map(|i| i.cycle)
+        .take_while(|&c| c <= limit + s.grid.frame_cycles)
+        .peekable();
+    let mut prev = 0;
+    while let Some(c) = it.next() {
+        if c > limit {
+            break;
+        }
+        let next = it.peek().copied().unwrap_or(u64::MAX);
+        if c >= at && c > 0 && next - c >= need {
+            return (prev, c);
+        }
+        prev = c;
+    }
+    (u64::MAX, u64::MAX)
 }
 
 impl<D: Dut> Dut for FaultyDut<D> {
@@ -168,6 +294,12 @@ impl<D: Dut> Dut for FaultyDut<D> {
         let orig = p;
         let orig_cs = p.cs_n;
         let orig_sclk = p.sclk;
+        if self.hist_len > 0 {
+            if self.hist.len() == self.hist_len {
+                self.hist.pop_front();
+            }
+            self.hist.push_back(orig);
+        }
         match self.fault {
             Fault::ResetGlitch => {}
             Fault::WrongChannel | Fault::WrongSampleBit | Fault::DropSample => {
@@ -181,7 +313,7 @@ impl<D: Dut> Dut for FaultyDut<D> {
                 }
             }
             Fault::CsLate { branch } => {
-                if c >= self.t && c <= self.t + self.r {
+                if c >= self.t && c <= self.t.saturating_add(self.r) {
                     let bit = 1u16 << branch;
                     p.cs_n = (p.cs_n & !bit) | (self.prev_cs & bit);
                 }
@@ -193,14 +325,17 @@ impl<D: Dut> Dut for FaultyDut<D> {
                 // more; else the high phase vanishes: one falling edge fewer)
                 let bit = 1u16 << branch;
                 let mid_high = self.prev_sclk & bit != 0 || self.high < 3;
-                if !self.done && c >= self.t + self.su + 2 * self.d && p.sclk & bit != 0 && mid_high
+                if !self.done
+                    && c >= self.t.saturating_add(self.su + 2 * self.d)
+                    && p.sclk & bit != 0
+                    && mid_high
                 {
                     p.sclk &= !bit;
                     self.done = true;
                 }
             }
             Fault::MuxLate { branch } => {
-                if c == self.t_prev + 1 {
+                if c == self.t_prev.saturating_add(1) {
                     self.held = Some(pins_before(&self.layout, &p, branch, self.t_prev));
                 }
                 if c > self.t_prev && c + 2 < self.t {
@@ -210,7 +345,7 @@ impl<D: Dut> Dut for FaultyDut<D> {
                 }
             }
             Fault::TwoMuxEn { branch } => {
-                if c >= self.t && c < self.t + 5 {
+                if c >= self.t && c < self.t.saturating_add(5) {
                     let n = self.layout.en_n[branch];
                     p.mux_en |= ((1u128 << n) - 1) << self.layout.en_lo[branch];
                 }
@@ -220,11 +355,105 @@ impl<D: Dut> Dut for FaultyDut<D> {
                     p.mux_sel ^= 1 << (3 * branch);
                 }
             }
+            Fault::ConversionMoved { branch } => self.move_conversion(c, &mut p, branch),
+            Fault::SclkSlow { branch } => self.slow_sclk(c, &mut p, branch),
+            Fault::PhaseShift { branch } => {
+                let bit = 1u16 << branch;
+                if c >= self.t && c <= self.t.saturating_add(self.r) {
+                    // the branch's lanes stay as they were before the instant
+                    p.cs_n = (p.cs_n & !bit) | (self.prev_cs & bit);
+                    p.sclk = (p.sclk & !bit) | (self.prev_sclk & bit);
+                }
+                if !self.done
+                    && c > self.t.saturating_add(self.r)
+                    && p.sample_valid
+                    && p.sample_channel == self.channels.0
+                {
+                    p.sample_valid = false;
+                    self.done = true;
+                }
+            }
+            Fault::SelectSwap { branch } => {
+                if c >= self.at && c < self.at + self.frame {
+                    self.swap_selects(&mut p, branch);
+                }
+            }
+            Fault::NeighbourCode => {
+                if p.sample_valid {
+                    if let (false, true, Some(v)) = (self.done, c >= self.at, self.last_value) {
+                        p.sample_value = v;
+                        self.done = true;
+                    }
+                    self.last_value = Some(orig.sample_value);
+                }
+            }
         }
-        self.prev_cs = orig_cs;
-        self.prev_sclk = orig_sclk;
+        let frozen = matches!(self.fault, Fault::PhaseShift { .. })
+            && c >= self.t
+            && c <= self.t.saturating_add(self.r);
+        if !frozen {
+            self.prev_cs = orig_cs;
+            self.prev_sclk = orig_sclk;
+        }
         self.changed |= glitch || p != orig;
         p
+    }
+}
+
+impl<D> FaultyDut<D> {
+    /// The original pins `k` cycles ago (0: this cycle).
+    fn orig(&self, k: u64) -> Option<&Pins> {
+        let n = self.hist.len() as u64;
+        (k < n).then(|| &self.hist[(n - 1 - k) as usize])
+    }
+
+    /// [`Fault::ConversionMoved`]: the branch's CS, SCLK and mux lanes
+    /// delayed by one slot from the instant until the moved window closes.
+    fn move_conversion(&self, c: u64, p: &mut Pins, b: usize) {
+        let end = self.t.saturating_add(self.shift + self.r + 1);
+        if c < self.t || c >= end {
+            return;
+        }
+        if let Some(o) = self.orig(self.shift).copied() {
+            let bit = 1u16 << b;
+            p.cs_n = (p.cs_n & !bit) | (o.cs_n & bit);
+            p.sclk = (p.sclk & !bit) | (o.sclk & bit);
+            copy_mux(&self.layout, p, &o, b);
+        }
+    }
+
+    /// [`Fault::SclkSlow`]: the conversion's serial clocks stretched to the
+    /// slow period (setup as it was, the tail after the last clock kept).
+    fn slow_sclk(&self, c: u64, p: &mut Pins, b: usize) {
+        let (t, su, d, d2, n) = (self.t, self.su, self.d, self.d_slow, self.words);
+        let end = t.saturating_add(self.shift);
+        if c < t.saturating_add(su) || c >= end {
+            return;
+        }
+        let j = c - t - su;
+        let src = if j < n * d2 {
+            t + su + j * d / d2
+        } else {
+            t + su + n * d + (j - n * d2)
+        };
+        if let Some(o) = self.orig(c - src) {
+            let bit = 1u16 << b;
+            p.cs_n = (p.cs_n & !bit) | (o.cs_n & bit);
+            p.sclk = (p.sclk & !bit) | (o.sclk & bit);
+        }
+    }
+
+    /// [`Fault::SelectSwap`]: branch `b` addressing one of the pair shows
+    /// the other's mux address.
+    fn swap_selects(&self, p: &mut Pins, b: usize) {
+        let (x, y) = self.channels;
+        let other = match self.layout.selected(p, b) {
+            Ok(ch) if ch == x => y,
+            Ok(ch) if ch == y => x,
+            _ => return,
+        };
+        let (dev, sel) = self.addresses[other as usize];
+        self.layout.set_mux(p, b, dev, sel);
     }
 }
 

@@ -32,6 +32,9 @@ impl Recorder {
         channel: Option<String>,
         detail: String,
     ) {
+        if crate::switch::disabled("invariants") {
+            return;
+        }
         self.violation_count += 1;
         if self.violations.len() < self.max {
             let (frame, slot, _) = self.grid.locate(cycle);

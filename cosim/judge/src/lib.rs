@@ -17,7 +17,8 @@
 //! - [`vcd`] / [`vcdout`]: reading a VCD from any simulator, writing one;
 //! - [`events`]: a run's pins as a reviewable event log, and the
 //!   comparison of two logs by signal role (golden tests);
-//! - [`samples`]: a run's samples as CSV (`cycle,time_s,channel,value`).
+//! - [`samples`]: a run's samples as CSV (`cycle,time_s,channel,value`);
+//! - [`switch`]: the test-only switch that turns a detector off.
 //!
 //! The pins themselves ([`Pins`], [`Layout`], [`Signal`]) are the pin
 //! contract's, `lut_gen::ports`.
@@ -31,6 +32,7 @@ pub mod model;
 pub mod report;
 pub mod run;
 pub mod samples;
+pub mod switch;
 pub mod vcd;
 pub mod vcdout;
 

@@ -9,9 +9,6 @@ use std::time::Instant;
 
 use cosim::{Backend, SimOptions};
 use judge::events::Trace;
-use judge::faults::{Fault, FaultyDut};
-use judge::run::{run_dut, Dut, ModelDut, RunOptions};
-use judge::vcdout::VcdWriter;
 use lut_gen::ports::{Layout, Role};
 use lut_gen::Schedule;
 use report::{draw, Axes, Figure, Section, Series, Table};
@@ -27,10 +24,6 @@ pub struct Speeds {
 impl Speeds {
     pub fn add(&mut self, method: &str, cycles: u64, seconds: f64) {
         self.runs.push((method.into(), cycles, seconds.max(1e-9)));
-    }
-
-    fn of(&self, method: &str) -> Option<(u64, f64)> {
-        self.runs.iter().find(|r| r.0 == method).map(|r| (r.1, r.2))
     }
 }
 
@@ -88,13 +81,16 @@ pub fn synthesize(s: &Schedule, verilog: &Path, work: &Path) -> Result<Synth, St
     if !n.status.success() {
         return Err(log.lines().rev().take(20).collect::<Vec<_>>().join("\n"));
     }
-    let used = |cell: &str| -> u64 {
+    // a log without the utilisation lines is an error, never "0 cells"
+    let used = |cell: &str| -> Result<u64, String> {
         let key = format!("{cell}:");
         log.lines()
             .filter_map(|l| Some(&l[l.find(&key)? + key.len()..]))
             .filter_map(|r| r.trim().split('/').next()?.trim().parse().ok())
             .next_back()
-            .unwrap_or(0)
+            .ok_or_else(|| {
+                format!("nextpnr's log (synth/nextpnr.log) has no `{cell}` utilisation line")
+            })
     };
     let fmax = log
         .lines()
@@ -110,34 +106,14 @@ pub fn synthesize(s: &Schedule, verilog: &Path, work: &Path) -> Result<Synth, St
         .next_back()
         .ok_or("nextpnr reported no Fmax")?;
     Ok(Synth {
-        lcs: used("ICESTORM_LC"),
-        brams: used("ICESTORM_RAM"),
+        lcs: used("ICESTORM_LC")?,
+        brams: used("ICESTORM_RAM")?,
         fmax_mhz: fmax,
     })
 }
 
-/// The pin faults of the quick measure: each class once, mid-frame 0.
-fn pin_faults(s: &Schedule) -> Vec<Fault> {
-    let mut seen: Vec<&str> = Vec::new();
-    Fault::all(s)
-        .into_iter()
-        .filter(|f| {
-            let new = !seen.contains(&f.class());
-            seen.push(f.class());
-            new
-        })
-        .collect()
-}
-
-/// Whether the checker rejects `dut` with `f` injected mid-frame 0.
-fn caught(s: &Schedule, dut: Box<dyn Dut>, f: Fault) -> bool {
-    let at = s.grid.frame_cycles / 2 + 7;
-    let mut d = FaultyDut::new(s, dut, f, at);
-    !run_dut(s, &mut d, 2, &RunOptions::default(), "faults", None).ok
-}
-
-/// Speed (simulated seconds per wall second) against accuracy (share of the
-/// fault classes each method detects), both measured now.
+/// Speed against accuracy of the fault campaign's detectors (its matrix and
+/// the timings it measured); the engines' speeds are measured now too.
 pub fn speed_accuracy(
     s: &Schedule,
     vcd: &Path,
@@ -165,123 +141,74 @@ pub fn speed_accuracy(
         let r = judge::check_vcd(s, vcd, None).map_err(|e| e.to_string())?;
         speeds.add("check", r.cycles, t.elapsed().as_secs_f64());
     }
-    // accuracy: every class once, through each method's own path
-    let pins = pin_faults(s);
-    let gw = cosim::faults::one_gateware_fault_per_class(s);
-    let classes = (pins.len() + gw.len()) as f64;
-    let mut acc: Vec<(String, usize, String)> = Vec::new();
-    // rusthdl: pin faults on its pins, design faults built into it
-    let mut k = 0;
-    for &p in &pins {
-        let dut = Box::new(cosim::RustHdlDut::new(s).map_err(|e| e.to_string())?);
-        k += caught(s, dut, p) as usize;
-    }
-    for &(_, gf) in &gw {
-        if let Ok(dut) = cosim::faults::gateware_dut(s, gf) {
-            let mut d = dut;
-            k += !run_dut(s, &mut d, 2, &RunOptions::default(), "faults", None).ok as usize;
-        }
-    }
-    acc.push((
-        "rusthdl".into(),
-        k,
-        "pin and reset faults on its pins; ROM and counter faults built into it".into(),
-    ));
-    // verilator: pin faults on its pins (its Verilog holds no injected design fault)
-    if speeds.of("verilator").is_some() {
-        let v = cosim::rusthdl::verilog(s).map_err(|e| e.to_string())?;
-        let mut k = 0;
-        for &p in &pins {
-            let (dut, _) = cosim::verilator::VerilatedDut::new(&v).map_err(|e| e.to_string())?;
-            k += caught(s, Box::new(dut), p) as usize;
-        }
-        acc.push(("verilator".into(), k, "pin and reset faults on its pins; design faults not injectable into its compiled Verilog here".into()));
-    }
-    // check: a VCD of faulty pins, read back
-    let tmp = tempfile::tempdir().map_err(|e| e.to_string())?;
-    let mut k = 0;
-    for &p in &pins {
-        let path = tmp.path().join("f.vcd");
-        let reset = judge::run::reset_cycles(s, 4);
-        let mut w = VcdWriter::create(&path, s, 0, reset + 2 * f).map_err(|e| e.to_string())?;
-        let at = f / 2 + 7;
-        let mut d = FaultyDut::new(s, Box::new(ModelDut::new(s)) as Box<dyn Dut>, p, at);
-        let _ = run_dut(s, &mut d, 2, &RunOptions::default(), "faults", Some(&mut w));
-        w.finish().map_err(|e| e.to_string())?;
-        let r = judge::check_vcd(s, &path, None).map_err(|e| e.to_string())?;
-        k += !r.ok as usize;
-    }
-    acc.push((
-        "check".into(),
-        k,
-        "a VCD of faulty pins (any simulator's)".into(),
-    ));
-    if icarus {
-        acc.push((
-            "icarus".into(),
-            k,
-            "its VCD goes through check: as check".into(),
-        ));
-    }
-    acc.push(("model".into(), 0, "the slot-level model has no pins: it answers rate questions (hours per second), sees no design fault".into()));
-
+    // accuracy: the fault campaign's matrix, each detector's column with
+    // the cost measured in the same campaign
+    let c = campaign.ok_or("no fault campaign in this run: the chart draws its matrix")?;
     let mut table = Table::new(&[
-        "method",
+        "detector",
         "simulated_cycles",
         "wall_seconds",
         "simulated_seconds_per_wall_second",
-        "fault_classes_detected",
-        "fault_classes",
+        "injections_detected",
+        "injections",
         "share_detected",
-        "how faults reach it",
     ]);
     let mut series = Vec::new();
-    for (m, k, how) in &acc {
-        let Some((cycles, secs)) = speeds.of(m) else {
+    let mut not_run = Vec::new();
+    for col in &c.columns {
+        if let Some(why) = &col.not_run {
+            not_run.push(format!("{}: {why}", col.detector.name()));
             continue;
-        };
-        let sim_s = cycles as f64 / g.clock_hz as f64;
-        let speed = sim_s / secs;
-        let share = *k as f64 / classes;
+        }
+        let speed = col.cycles as f64 / g.clock_hz as f64 / col.seconds.max(1e-9);
         table.push(vec![
-            m.clone(),
-            cycles.to_string(),
-            format!("{secs:.4}"),
+            col.detector.name().into(),
+            col.cycles.to_string(),
+            format!("{:.4}", col.seconds),
             format!("{speed:.6}"),
-            k.to_string(),
-            (classes as usize).to_string(),
-            format!("{share:.3}"),
-            how.clone(),
+            col.detected.to_string(),
+            col.injected.to_string(),
+            format!("{:.3}", col.share()),
         ]);
-        series.push(Series::scatter(m, vec![(speed, share)]));
+        series.push(Series::scatter(
+            col.detector.name(),
+            vec![(speed, col.share())],
+        ));
     }
     let mut axes = Axes::new(
-        "Speed against accuracy of the verification methods",
+        "Speed against accuracy of the detectors",
         "simulated seconds per wall second (log)",
-        "share of fault classes detected",
+        "share of injections detected",
     );
     axes.log_x = true;
     let svg = draw(&axes, &series, 820, 460);
+    let engines = speeds
+        .runs
+        .iter()
+        .map(|(m, cycles, secs)| format!("{m} {:.3}x", *cycles as f64 / g.clock_hz as f64 / secs))
+        .collect::<Vec<_>>()
+        .join(", ");
     let mut para = vec![format!(
-        "Each method simulated this mix in this run; its speed is simulated acquisition time per wall second. Accuracy is the share of {} fault classes ({} on the pins or the reset, {} built into the gateware) that the method rejects when each is injected once in the middle of frame 0.",
-        classes, pins.len(), gw.len()
+        "Each point is one detector of the fault campaign of this run ({:?} target, {} injections at {} sites): its share of injections detected (the matrix's column) against its speed, measured in the same campaign (model and invariants: the checker on a clean run with and without the model; sigrok: its decodes).",
+        c.target,
+        c.injected,
+        c.sites.len()
     )];
-    if let Some(c) = campaign {
-        para.push(format!(
-            "The full campaign ({:?} target) injected {} faults at {} sites and caught {}.",
-            c.target,
-            c.injected,
-            c.sites.len(),
-            c.detected
-        ));
+    if !not_run.is_empty() {
+        para.push(format!("Not drawn: {}.", not_run.join("; ")));
     }
-    para.push("Use the slot-level model for rates, intervals and headroom over hours; rusthdl for fast cycle-exact checks of the gateware, including its ROM and counters; verilator for long runs of the emitted Verilog; check (and icarus through it) for waveforms from any simulator.".into());
+    para.push(format!(
+        "Simulation engines in this run, simulated time per wall second: {engines}."
+    ));
     let line = table
         .rows
         .iter()
         .map(|r| {
             let v: f64 = r[3].parse().unwrap_or(0.0);
-            format!("{} {v:.3}x real time, {} of {} classes", r[0], r[4], r[5])
+            format!(
+                "{} {v:.3}x real time, {} of {} injections",
+                r[0], r[4], r[5]
+            )
         })
         .collect::<Vec<_>>()
         .join(", ");
@@ -292,7 +219,7 @@ pub fn speed_accuracy(
             figures: vec![Figure {
                 stem: "speed-accuracy".into(),
                 title: "Speed against accuracy".into(),
-                caption: "x: simulated seconds per wall second, measured in this run; y: share of fault classes detected".into(),
+                caption: "x: simulated seconds per wall second, measured in this run; y: share of the campaign's injections each detector caught".into(),
                 svg,
                 table,
             }],
@@ -588,28 +515,38 @@ pub fn schedulability() -> (Section, String) {
 
 /// The fault campaign as a table.
 pub fn faults_section(c: &cosim::faults::Campaign) -> Section {
-    let mut t = Table::new(&["class", "level", "injected", "detected"]);
+    let mut head = vec!["class", "level", "injected"];
+    head.extend(c.detectors.iter().map(|d| d.name()));
+    head.extend(["undetected", "proved_equivalent"]);
+    let mut t = Table::new(&head);
     for k in &c.classes {
-        t.push(vec![
-            k.name.clone(),
-            k.level.into(),
-            k.injected.to_string(),
-            k.detected.to_string(),
-        ]);
+        let mut row = vec![k.name.clone(), k.level.into(), k.injected.to_string()];
+        for d in &c.detectors {
+            row.push(match (k.detected_by.get(d), k.cannot_see.get(d)) {
+                (_, Some(why)) => format!("cannot see ({why})"),
+                (Some(n), None) => n.to_string(),
+                (None, None) => "not run".into(),
+            });
+        }
+        row.push(k.undetected.len().to_string());
+        row.push(k.proved_equivalent.len().to_string());
+        t.push(row);
     }
     Section {
         title: "Fault campaign".into(),
         paragraphs: vec![
             format!(
-                "Target {:?}; sites: {}. {} of {} injections caught. False alarms: {} of {} clean runs over {} random feasible mixes.",
+                "Target {:?}; sites: {}. {} injections: {} detected, {} undetected, {} proved equivalent. False alarms: {} of {} clean runs over {} random feasible mixes.",
                 c.target,
                 c.sites
                     .iter()
                     .map(|s| format!("{} (slot {})", s.name, s.slot))
                     .collect::<Vec<_>>()
                     .join(", "),
-                c.detected,
                 c.injected,
+                c.detected,
+                c.undetected,
+                c.proved_equivalent,
                 c.false_alarms.rejected,
                 c.false_alarms.runs,
                 c.false_alarms.mixes
@@ -618,6 +555,11 @@ pub fn faults_section(c: &cosim::faults::Campaign) -> Section {
         tables: vec![(String::new(), t)],
         ..Section::default()
     }
+}
+
+/// Where sampling at `fs` puts a sine of `f` Hz: |f - fs * round(f / fs)|.
+fn alias_hz(f: f64, fs: f64) -> f64 {
+    (f - fs * (f / fs).round()).abs()
 }
 
 /// The strongest frequency (1 Hz steps up to half the sample rate) in a
@@ -728,6 +670,20 @@ pub fn figure7(s: &Schedule) -> Result<Option<(Section, String)>, String> {
     let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len().max(1) as f64).sqrt();
     let saved = 1.0 - y100.len() as f64 / y1k.len().max(1) as f64;
     let fb = peak_hz(&y100, 100.0);
+    // the step fails unless each peak is where aliasing puts it (the DFT
+    // steps by 1 Hz)
+    for (what, got, f, fs) in [
+        ("600 Hz at 1 kHz", f1, 600.0, 1_000.0),
+        ("600 Hz at 2 kHz", f2, 600.0, 2_000.0),
+        ("2 Hz at 100 Hz", fb, 2.0, 100.0),
+    ] {
+        let want = alias_hz(f, fs);
+        if (got - want).abs() > 1.0 {
+            return Err(format!(
+                "Figure 7: {what} shows as {got:.0} Hz; aliasing puts it at {want:.0} Hz"
+            ));
+        }
+    }
 
     let ms = |v: &[(f64, f64)], upto: f64| -> Vec<(f64, f64)> {
         v.iter()
@@ -800,7 +756,7 @@ pub fn figure7(s: &Schedule) -> Result<Option<(Section, String)>, String> {
             title: "Figure 7: sampling rate against reconstruction".into(),
             paragraphs: vec![
                 format!("The paper's Figure 7, from simulation ({} back end, the emitted design, codes from the ADC model's quantization of a sine on every channel). {line}.", backend.name()),
-                "A channel sampled below twice its signal's frequency folds it: 600 Hz sampled at 1 kHz is indistinguishable from 400 Hz. The same channel at 2 kHz keeps it. A slow signal needs no fast rate: at 100 Hz a 2 Hz signal keeps its shape with a tenth of the data.".into(),
+                format!("A channel sampled below twice its signal's frequency folds it to |f - fs * round(f / fs)|: measured here, 600 Hz at 1 kHz shows as {f1:.0} Hz (aliasing puts it at {:.0} Hz), at 2 kHz as {f2:.0} Hz ({:.0} Hz), and 2 Hz at 100 Hz as {fb:.0} Hz ({:.0} Hz); this step fails when a peak is more than 1 Hz from there. A slow signal needs no fast rate: at 100 Hz a 2 Hz signal keeps its shape with {:.0} % less data than at 1 kHz.", alias_hz(600.0, 1_000.0), alias_hz(600.0, 2_000.0), alias_hz(2.0, 100.0), saved * 100.0),
             ],
             figures: vec![
                 Figure {

@@ -1,0 +1,87 @@
+//! The equivalence check behind "proved equivalent" (`cosim::equiv`): it
+//! must prove what is equivalent and refute what is not, or the campaign's
+//! "proved equivalent" column would excuse misses.
+
+use std::path::PathBuf;
+
+use cosim::equiv::{check, Equivalence};
+use hdl::GatewareFault;
+
+// Missing tools fail under CI=true, skip loudly elsewhere.
+#[path = "../../tests/common/tools.rs"]
+mod tools;
+
+fn schedule(name: &str) -> lut_gen::Schedule {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name);
+    lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap()
+}
+
+fn verdict(mix: &str, f: GatewareFault) -> Equivalence {
+    let s = schedule(mix);
+    let (gold, gate) = hdl::verilog_pair(&s, f).unwrap();
+    assert_ne!(gold, gate, "the fault changes the Verilog");
+    let dir = tempfile::tempdir().unwrap();
+    check(&gold, &gate, dir.path()).unwrap()
+}
+
+/// One channel converted in every slot: a frame one slot short changes the
+/// slot counter but no output, for any input, ever: proved.
+#[test]
+fn a_frame_one_slot_short_is_proved_equivalent_when_every_slot_is_alike() {
+    if !tools::require_tools(&["yosys", "yosys-abc"]) {
+        return;
+    }
+    let v = verdict("every_slot.toml", GatewareFault::SlotWrap { delta: -1 });
+    assert!(matches!(v, Equivalence::Proved { .. }), "{v:?}");
+}
+
+/// A slot-ROM word of another channel changes which input is converted:
+/// refuted with a counterexample, never proved.  (With yosys's
+/// `miter -ignore_gold_x` this was "proved": the flow must not use it.)
+#[test]
+fn a_wrong_rom_word_is_not_equivalent() {
+    if !tools::require_tools(&["yosys", "yosys-abc"]) {
+        return;
+    }
+    let s = schedule("tiny.toml");
+    let conv: Vec<(u64, usize)> = (0..s.grid.frame_slots)
+        .filter_map(|u| s.at(u, 0).map(|c| (u, c)))
+        .collect();
+    let (u, ch) = conv[0];
+    let (from, _) = *conv.iter().find(|(_, c)| *c != ch).unwrap();
+    let v = verdict(
+        "tiny.toml",
+        GatewareFault::RomWord {
+            branch: 0,
+            slot: u,
+            from,
+        },
+    );
+    assert!(matches!(v, Equivalence::Differs { .. }), "{v:?}");
+}
+
+/// ABC's answers as the campaign reads them.
+#[test]
+fn abc_output_is_read_as_proved_differs_or_undecided() {
+    use cosim::equiv::verdict;
+    assert!(matches!(
+        verdict("Property proved.  Time = 0.02 sec\n", 0.1),
+        Equivalence::Proved { .. }
+    ));
+    assert_eq!(
+        verdict(
+            "Output 0 of miter \"miter\" was asserted in frame 3.  Time = 0.02 sec\n",
+            0.1
+        ),
+        Equivalence::Differs { frame: Some(3) }
+    );
+    assert!(matches!(
+        verdict(
+            "Reached timeout (60 seconds) in frame 239.\nProperty UNDECIDED.\n",
+            60.0
+        ),
+        Equivalence::Undecided { .. }
+    ));
+}

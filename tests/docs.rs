@@ -1,0 +1,103 @@
+//! Figures in the docs that the binary computes must be what it prints
+//! (issue 19, item 5): a document that drifts from the tool fails here.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+#[path = "common/tools.rs"]
+mod tools;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn doc(path: &str) -> String {
+    std::fs::read_to_string(root().join(path)).unwrap()
+}
+
+/// docs/reference-design.md's sample count of 10 frames is `sim`'s.
+#[test]
+fn the_reference_design_sample_count_is_the_binarys() {
+    let out = Command::new(env!("CARGO_BIN_EXE_slotforge"))
+        .args(["sim", "--frames", "10", "--json"])
+        .arg(root().join("mixes/eskin34.toml"))
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let n = v["samples"].as_u64().unwrap();
+    let text = doc("docs/reference-design.md");
+    for claim in [
+        format!("{n} in 10 frames"),
+        format!("--frames 10   # {n} samples"),
+        format!("holds the {n} samples"),
+    ] {
+        assert!(
+            text.contains(&claim),
+            "docs/reference-design.md: `{claim}` missing"
+        );
+    }
+    // and no other 10-frame count
+    let wrong = (n - 10..n + 10).filter(|&k| k != n).find(|k| {
+        text.contains(&format!("{k} in 10 frames")) || text.contains(&format!("# {k} samples"))
+    });
+    assert_eq!(wrong, None);
+}
+
+/// eskin34's logic cells are stated once, in the current table of
+/// docs/performance.md, and ARCHITECTURE.md and README state no other
+/// count; the table's row is what `hdl/synth.sh` measures now.
+#[test]
+fn the_reference_design_logic_cells_are_stated_once() {
+    let perf = doc("docs/performance.md");
+    let current = perf.split("### Converter parts").nth(1).unwrap();
+    let row = current
+        .lines()
+        .find(|l| l.starts_with("| eskin34 |"))
+        .unwrap();
+    let lcs: u64 = row.split('|').nth(4).unwrap().trim().parse().unwrap();
+    for f in ["ARCHITECTURE.md", "README.md"] {
+        let t = doc(f);
+        assert!(
+            !t.contains(" LCs; the reference design ") && !t.contains("reference design 2"),
+            "{f} states eskin34's logic cells; docs/performance.md is their one home"
+        );
+    }
+    assert!(lcs > 0);
+}
+
+#[test]
+#[ignore = "long: make test-long (yosys + nextpnr on eskin34)"]
+fn the_current_logic_cell_figure_is_what_synthesis_gives() {
+    if !tools::require_tools(&["yosys", "nextpnr-ice40"]) {
+        return;
+    }
+    let perf = doc("docs/performance.md");
+    let current = perf.split("### Converter parts").nth(1).unwrap();
+    let row = current
+        .lines()
+        .find(|l| l.starts_with("| eskin34 |"))
+        .unwrap();
+    let want: Vec<String> = row.split('|').map(|c| c.trim().to_string()).collect();
+    let out = Command::new("bash")
+        .arg(root().join("hdl/synth.sh"))
+        .arg(root().join("mixes/eskin34.toml"))
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let got: Vec<&str> = text
+        .lines()
+        .find(|l| l.starts_with("eskin34"))
+        .unwrap()
+        .split_whitespace()
+        .collect();
+    // mix clock_MHz LCs LUT4 DFF BRAM Fmax_MHz ratio
+    assert_eq!(got[2], want[4], "LCs: synth.sh {text}, doc {row}");
+    assert_eq!(got[5], want[7], "BRAMs: synth.sh {text}, doc {row}");
+}
