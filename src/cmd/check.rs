@@ -2,7 +2,8 @@
 //!
 //! Exit 0: the waveform keeps every invariant and matches the reference
 //! model at every cycle; 1: it does not; 2: bad mix, unreadable or malformed
-//! VCD, or ports not found.
+//! VCD, ports not found, or (a capture that does not start at reset) no
+//! single frame phase fits its pins.
 
 use std::path::PathBuf;
 
@@ -49,6 +50,22 @@ pub fn run(a: Args) -> u8 {
         v["scope"] = serde_json::json!(info.scope);
         v["timescale"] = serde_json::json!(info.timescale);
         v["clock_dumped"] = serde_json::json!(info.clock_dumped);
+        v["lock"] = match &info.lock {
+            Some(l) => serde_json::json!({
+                "locked_at_cycle": l.locked_at,
+                "frame_cycle": l.frame_cycle,
+                "slot": l.slot,
+                "slot_cycle": l.slot_cycle,
+                "changes": l.changes,
+                "first_candidates": l.first_candidates,
+                "repeat_cycles": l.repeat_cycles,
+                "checked_from_cycle": l.checked_from,
+                "settle_unknown": l.settle_unknown,
+                "forgotten_cycles": l.forgotten_cycles,
+                "text": l.to_string(),
+            }),
+            None => serde_json::Value::Null,
+        };
         println!("{}", serde_json::to_string_pretty(&v).expect("json"));
     } else {
         if !info.clock_dumped {
@@ -56,6 +73,9 @@ pub fn run(a: Args) -> u8 {
                 "note: `clk` is not dumped; clock edges inferred every {} time units",
                 info.inferred_period.unwrap_or(0)
             );
+        }
+        if let Some(l) = &info.lock {
+            eprintln!("note: the capture does not start at reset: {l}");
         }
         print!("{}", report.summary());
     }

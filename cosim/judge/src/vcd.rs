@@ -33,6 +33,7 @@ use lut_gen::ports::{Role, PORT_NAMES as PORTS, TOP_MODULE};
 use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker};
+use crate::lock::{Judge, LockError, LockInfo};
 use crate::report::Report;
 use lut_gen::ports::{Layout, Pins};
 
@@ -57,6 +58,11 @@ pub enum VcdError {
         file: PathBuf,
         message: String,
     },
+    /// The capture did not start at reset and its frame phase could not be found.
+    Phase {
+        file: PathBuf,
+        error: LockError,
+    },
 }
 
 impl fmt::Display for VcdError {
@@ -74,6 +80,7 @@ impl fmt::Display for VcdError {
                 message,
             } => write!(f, "{}:{line}: truncated VCD: {message}", file.display()),
             VcdError::Ports { file, message } => write!(f, "{}: {message}", file.display()),
+            VcdError::Phase { file, error } => write!(f, "{}: {error}", file.display()),
         }
     }
 }
@@ -927,6 +934,8 @@ pub struct VcdInfo {
     /// Inferred clock period in timescale units (only without a dumped clock).
     pub inferred_period: Option<u64>,
     pub clock_cycles: u64,
+    /// How the frame phase was found, when the capture did not start at reset.
+    pub lock: Option<LockInfo>,
 }
 
 fn open(path: &Path) -> Result<Lexer<BufReader<File>>, VcdError> {
@@ -1000,20 +1009,28 @@ pub fn read_cycles(
             Clocking::Clk => None,
         },
         clock_cycles: info.cycles,
+        lock: None,
     })
 }
 
 /// Checks a VCD against the schedule: every invariant and, unless
 /// `opts.model` is false, cycle-exact equality with the reference model.
+/// A VCD that does not start at reset is checked from where its frame phase
+/// is found (`lock.rs`).
 pub fn check_vcd_with(
     s: &Schedule,
     path: &Path,
     scope: Option<&str>,
     opts: CheckOptions,
 ) -> Result<(Report, VcdInfo), VcdError> {
-    let mut chk = Checker::new(s, opts);
-    let info = read_cycles(s, path, scope, &mut chk)?;
-    Ok((chk.finish("vcd"), info))
+    let mut judge = Judge::new(s, opts);
+    let mut info = read_cycles(s, path, scope, &mut judge)?;
+    let (report, lock) = judge.finish("vcd").map_err(|error| VcdError::Phase {
+        file: path.to_path_buf(),
+        error,
+    })?;
+    info.lock = lock;
+    Ok((report, info))
 }
 
 /// Checks a VCD with the default options.
