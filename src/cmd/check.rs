@@ -13,7 +13,7 @@ use judge::CheckOptions;
 pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
-    /// The waveform (VCD) from any simulator.
+    /// The waveform (VCD or FST) from any simulator, from reset or from anywhere in a run.
     pub wave: PathBuf,
     /// Scope of slotforge_top's ports (e.g. `tb.dut`); found automatically when unambiguous.
     #[arg(long)]

@@ -15,6 +15,7 @@
 //!   slot-level model run;
 //! - [`faults`]: faults injected into any [`Dut`]'s pins;
 //! - [`vcd`] / [`vcdout`]: reading a VCD from any simulator, writing one;
+//! - [`fst`]: FST input, through the `wellen` crate;
 //! - [`lock`]: finding the frame phase of a capture that did not start at
 //!   reset, and checking it from there;
 //! - [`events`]: a run's pins as a reviewable event log, and the
@@ -28,6 +29,7 @@ pub mod adc;
 pub mod checker;
 pub mod events;
 pub mod faults;
+pub mod fst;
 pub mod invariants;
 pub mod lock;
 pub mod model;

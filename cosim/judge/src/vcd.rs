@@ -943,8 +943,53 @@ fn open(path: &Path) -> Result<Lexer<BufReader<File>>, VcdError> {
     Ok(Lexer::new(BufReader::with_capacity(1 << 20, f), path))
 }
 
-/// Streams the cycles of a VCD into `sink`.
+/// Streams the cycles of a VCD, or of an FST (through its VCD
+/// transcoding, `fst.rs`), into `sink`.
 pub fn read_cycles(
+    s: &Schedule,
+    path: &Path,
+    scope: Option<&str>,
+    sink: &mut dyn CycleSink,
+) -> Result<VcdInfo, VcdError> {
+    if !crate::fst::is_fst(path) {
+        return read_vcd_cycles(s, path, scope, sink);
+    }
+    let fst_err = |message: String| VcdError::Ports {
+        file: path.to_path_buf(),
+        message,
+    };
+    let mut tmp = tempfile::Builder::new()
+        .suffix(".vcd")
+        .tempfile()
+        .map_err(|e| VcdError::Io(path.to_path_buf(), e))?;
+    crate::fst::to_vcd(path, tmp.as_file_mut()).map_err(fst_err)?;
+    // Errors name the FST, not the temporary file.
+    let named = format!("{} (as VCD)", path.display());
+    read_vcd_cycles(s, tmp.path(), scope, sink).map_err(|e| e.with_file(Path::new(&named)))
+}
+
+impl VcdError {
+    fn with_file(self, f: &Path) -> VcdError {
+        let f = f.to_path_buf();
+        match self {
+            VcdError::Io(_, e) => VcdError::Io(f, e),
+            VcdError::Malformed { line, message, .. } => VcdError::Malformed {
+                file: f,
+                line,
+                message,
+            },
+            VcdError::Truncated { line, message, .. } => VcdError::Truncated {
+                file: f,
+                line,
+                message,
+            },
+            VcdError::Ports { message, .. } => VcdError::Ports { file: f, message },
+            VcdError::Phase { error, .. } => VcdError::Phase { file: f, error },
+        }
+    }
+}
+
+fn read_vcd_cycles(
     s: &Schedule,
     path: &Path,
     scope: Option<&str>,
