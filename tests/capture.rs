@@ -115,3 +115,50 @@ fn check_reads_fst_from_reset_and_mid_run() {
         .stderr(predicate::str::contains("junk.fst"))
         .stderr(predicate::str::contains("panicked").not());
 }
+
+#[test]
+fn golden_keeps_and_verifies_fst_windows() {
+    if !tools::require_tool("vcd2fst") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let g = d.path().join("tiny");
+    std::fs::create_dir_all(&g).unwrap();
+    std::fs::write(
+        g.join("golden.toml"),
+        "frames = 1\n\n[[window]]\nfile = \"w.fst\"\nfrom = \"0.3ms\"\nto = \"1.2ms\"\n",
+    )
+    .unwrap();
+    let golden = |update: bool| {
+        let mut c = slotforge();
+        c.arg("golden")
+            .arg(tiny())
+            .args(["--backend", "rusthdl", "--dir"]);
+        c.arg(d.path());
+        if update {
+            c.arg("--update");
+        }
+        c.assert()
+    };
+    golden(true).code(0);
+    let fst = g.join("w.fst");
+    let head = std::fs::read(&fst).unwrap();
+    assert!(!head[0].is_ascii_graphic(), "w.fst is not an FST");
+    golden(false)
+        .code(0)
+        .stdout(predicate::str::contains("window w.fst same"));
+    // The golden FST window is itself a capture `check` passes, mid-run.
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&fst)
+        .assert()
+        .code(0)
+        .stderr(predicate::str::contains("locked on the frame phase"));
+    // Another window in its place differs.
+    let other = vcd2fst(&sim_window(d.path(), "o.vcd", "0.4ms", "1.3ms"));
+    std::fs::copy(other, &fst).unwrap();
+    golden(false)
+        .code(1)
+        .stdout(predicate::str::contains("window w.fst DIFFERS"));
+}

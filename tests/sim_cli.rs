@@ -402,8 +402,14 @@ fn check_locks_on_windows_from_mid_run() {
         .code(0);
     let v = check_json(&wave, 0);
     assert_eq!(v["ok"], true, "{v}");
-    assert!(v["lock"]["checked_from_cycle"].as_u64().unwrap() < 1000, "{v}");
-    assert!(v["lock"]["text"].as_str().unwrap().contains("locked"), "{v}");
+    assert!(
+        v["lock"]["checked_from_cycle"].as_u64().unwrap() < 1000,
+        "{v}"
+    );
+    assert!(
+        v["lock"]["text"].as_str().unwrap().contains("locked"),
+        "{v}"
+    );
     assert!(v["samples"].as_u64().unwrap() > 15, "{v}");
     for w in ["fig6-3-4ms.vcd", "fig6-9-10ms.vcd"] {
         slotforge()
