@@ -15,6 +15,8 @@
 //!   slot-level model run;
 //! - [`faults`]: faults injected into any [`Dut`]'s pins;
 //! - [`vcd`] / [`vcdout`]: reading a VCD from any simulator, writing one;
+//! - [`timed`] / [`capture`]: logic-analyser captures (no clock, any
+//!   sample rate) checked at time level, the channel map, sigrok input;
 //! - [`fst`]: FST input, through the `wellen` crate;
 //! - [`lock`]: finding the frame phase of a capture that did not start at
 //!   reset, and checking it from there;
@@ -26,6 +28,7 @@
 //! contract's, `lut_gen::ports`.
 
 pub mod adc;
+pub mod capture;
 pub mod checker;
 pub mod events;
 pub mod faults;
@@ -36,6 +39,7 @@ pub mod model;
 pub mod report;
 pub mod run;
 pub mod samples;
+pub mod timed;
 pub mod vcd;
 pub mod vcdout;
 
