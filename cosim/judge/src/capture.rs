@@ -69,6 +69,12 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
     if lanes.is_empty() {
         return Err("--map maps no channel".into());
     }
+    if lanes.len() > 64 {
+        return Err(format!(
+            "--map maps {} channels; at most 64 are checked at once",
+            lanes.len()
+        ));
+    }
     Ok(lanes)
 }
 
@@ -220,15 +226,15 @@ fn parse_vcd(text: &str, path: &Path, lanes: Vec<Lane>) -> Result<Capture, Strin
             continue;
         }
         let (val, code) = match w.as_bytes()[0] {
-            b'0' | b'1' | b'x' | b'z' | b'X' | b'Z' => (&w[..1], &w[1..]),
+            b'0' | b'1' | b'x' | b'z' | b'X' | b'Z' => (w.as_bytes()[0], &w[1..]),
             b'b' | b'B' => {
                 let c = toks.next().map(|x| x.1).unwrap_or("");
-                (&w[w.len() - 1..], c)
+                (*w.as_bytes().last().unwrap_or(&b'0'), c)
             }
             _ => return Err(err(n, format!("unexpected `{w}`"))),
         };
         if let Some((_, li)) = ids.iter().find(|(c, _)| c == code) {
-            if val == "1" {
+            if val == b'1' {
                 cur |= 1 << li;
             } else {
                 cur &= !(1 << li);

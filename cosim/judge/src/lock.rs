@@ -510,7 +510,7 @@ impl<'a> Judge<'a> {
             if c >= from {
                 break;
             }
-            let model_cycle = at - (from - c);
+            let model_cycle = at.saturating_sub(from - c);
             for br in 0..nb {
                 let l = &self.layout;
                 if l.sel(&a.pins, br) != l.sel(&b.pins, br)
