@@ -90,6 +90,7 @@ synth: tools
 	bash hdl/synth.sh $(MIX)
 
 bench:
+	$(CARGO) bench -p judge --bench check_vs_wellen
 	$(CARGO) bench -p lut-gen --bench synthesis
 	$(CARGO) bench -p cosim --bench cosim
 

@@ -385,3 +385,40 @@ fn bad_input_exits_2() {
         .assert()
         .code(2);
 }
+
+/// Issue 17: a window from the middle of a run (`sim --from/--to`, the
+/// goldens' Figure 6 windows) is checked from where its frame phase is found.
+#[test]
+fn check_locks_on_windows_from_mid_run() {
+    let d = tempfile::tempdir().unwrap();
+    let wave = d.path().join("mid.vcd");
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--backend", "rusthdl", "--frames", "3"])
+        .args(["--from", "0.37ms", "--to", "2.6ms", "--vcd"])
+        .arg(&wave)
+        .assert()
+        .code(0);
+    let v = check_json(&wave, 0);
+    assert_eq!(v["ok"], true, "{v}");
+    assert!(
+        v["lock"]["checked_from_cycle"].as_u64().unwrap() < 1000,
+        "{v}"
+    );
+    assert!(
+        v["lock"]["text"].as_str().unwrap().contains("locked"),
+        "{v}"
+    );
+    assert!(v["samples"].as_u64().unwrap() > 15, "{v}");
+    for w in ["fig6-3-4ms.vcd", "fig6-9-10ms.vcd"] {
+        slotforge()
+            .arg("check")
+            .arg(eskin34())
+            .arg(root().join("golden/eskin34").join(w))
+            .assert()
+            .code(0)
+            .stdout(predicate::str::contains("PASS"))
+            .stderr(predicate::str::contains("locked on the frame phase"));
+    }
+}

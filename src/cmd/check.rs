@@ -2,7 +2,8 @@
 //!
 //! Exit 0: the waveform keeps every invariant and matches the reference
 //! model at every cycle; 1: it does not; 2: bad mix, unreadable or malformed
-//! VCD, or ports not found.
+//! VCD, ports not found, or (a capture that does not start at reset) no
+//! single frame phase fits its pins.
 
 use std::path::PathBuf;
 
@@ -12,7 +13,7 @@ use judge::CheckOptions;
 pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
-    /// The waveform (VCD) from any simulator.
+    /// The waveform (VCD or FST) from any simulator, from reset or from anywhere in a run.
     pub wave: PathBuf,
     /// Scope of slotforge_top's ports (e.g. `tb.dut`); found automatically when unambiguous.
     #[arg(long)]
@@ -23,6 +24,74 @@ pub struct Args {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// A logic-analyser capture (sigrok-cli's VCD or a `.sr` session): its
+    /// channels mapped to port bits as ports.json names them
+    /// (`D0=adc_cs_n[0],D1=adc_sclk[0]`), or a file of such lines.  The
+    /// capture is checked at time level, at its own sample rate.
+    #[arg(long)]
+    pub map: Option<String>,
+    /// With --map: the analyser's channel-to-channel skew allowed (`5ns`).
+    #[arg(long, default_value = "0ns")]
+    pub skew: String,
+}
+
+/// `5ns`, `0.5us`, `200ps` in picoseconds.
+fn parse_skew(v: &str) -> Result<u64, String> {
+    let i = v.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(v.len());
+    let x: f64 = v[..i]
+        .trim()
+        .parse()
+        .map_err(|_| format!("--skew `{v}`: expected a time such as 5ns"))?;
+    let k = match &v[i..] {
+        "ps" => 1.0,
+        "ns" => 1e3,
+        "us" => 1e6,
+        _ => return Err(format!("--skew `{v}`: the unit must be ps, ns or us")),
+    };
+    if x < 0.0 {
+        return Err(format!("--skew `{v}` is negative"));
+    }
+    Ok((x * k).round() as u64)
+}
+
+/// `check --map`: a logic-analyser capture at time level.
+fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
+    let prepared = parse_skew(&a.skew).and_then(|skew| {
+        let lanes = judge::capture::parse_map(map, s)?;
+        let cap = judge::capture::read(&a.wave, lanes)?;
+        judge::timed::check_capture(s, &cap, skew).map_err(|e| format!("{}: {e}", a.wave.display()))
+    });
+    let r = match prepared {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    if a.json {
+        let v = serde_json::json!({
+            "ok": r.ok,
+            "mode": "time-level capture",
+            "locked_at_ps": r.locked_at_ps,
+            "slot": r.slot,
+            "phases": r.phases,
+            "edges_checked": r.edges_checked,
+            "conversions": r.conversions,
+            "violations": r.violations.iter().map(|v| serde_json::json!({
+                "time_ps": v.time_ps, "channel": v.channel, "signal": v.port_bit,
+                "rule": v.rule, "detail": v.detail})).collect::<Vec<_>>(),
+            "proved": r.proved,
+            "not_proved": r.not_proved,
+        });
+        println!("{}", serde_json::to_string_pretty(&v).expect("json"));
+    } else {
+        print!("{}", r.summary());
+    }
+    if r.ok {
+        0
+    } else {
+        1
+    }
 }
 
 pub fn run(a: Args) -> u8 {
@@ -32,6 +101,9 @@ pub fn run(a: Args) -> u8 {
     };
     if let Err(code) = super::fits_pins(&s) {
         return code;
+    }
+    if let Some(map) = &a.map {
+        return run_capture(&a, &s, map);
     }
     let opts = CheckOptions {
         model: !a.no_model,
@@ -49,6 +121,22 @@ pub fn run(a: Args) -> u8 {
         v["scope"] = serde_json::json!(info.scope);
         v["timescale"] = serde_json::json!(info.timescale);
         v["clock_dumped"] = serde_json::json!(info.clock_dumped);
+        v["lock"] = match &info.lock {
+            Some(l) => serde_json::json!({
+                "locked_at_cycle": l.locked_at,
+                "frame_cycle": l.frame_cycle,
+                "slot": l.slot,
+                "slot_cycle": l.slot_cycle,
+                "changes": l.changes,
+                "first_candidates": l.first_candidates,
+                "repeat_cycles": l.repeat_cycles,
+                "checked_from_cycle": l.checked_from,
+                "settle_unknown": l.settle_unknown,
+                "forgotten_cycles": l.forgotten_cycles,
+                "text": l.to_string(),
+            }),
+            None => serde_json::Value::Null,
+        };
         println!("{}", serde_json::to_string_pretty(&v).expect("json"));
     } else {
         if !info.clock_dumped {
@@ -56,6 +144,9 @@ pub fn run(a: Args) -> u8 {
                 "note: `clk` is not dumped; clock edges inferred every {} time units",
                 info.inferred_period.unwrap_or(0)
             );
+        }
+        if let Some(l) = &info.lock {
+            eprintln!("note: the capture does not start at reset: {l}");
         }
         print!("{}", report.summary());
     }

@@ -61,7 +61,8 @@ fn one() -> u64 {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Window {
-    /// File name in the golden folder (`.vcd`; the `.gtkw` goes beside it).
+    /// File name in the golden folder (`.vcd`, or `.fst` written through
+    /// GTKWave's `vcd2fst`; the `.gtkw` goes beside it).
     file: String,
     /// Bounds as for `sim --from/--to`: a frame number or a time (`3ms`).
     from: String,
@@ -103,9 +104,9 @@ fn load_manifest(path: &Path) -> Result<Manifest, String> {
         return Err(format!("{}: `frames` must be at least 1", path.display()));
     }
     for w in &m.window {
-        if w.file.contains('/') || !w.file.ends_with(".vcd") {
+        if w.file.contains('/') || !(w.file.ends_with(".vcd") || w.file.ends_with(".fst")) {
             return Err(format!(
-                "{}: window file `{}` must be a plain `.vcd` file name",
+                "{}: window file `{}` must be a plain `.vcd` or `.fst` file name",
                 path.display(),
                 w.file
             ));
@@ -136,14 +137,45 @@ fn window_cycles(s: &Schedule, w: &Window, reset: u64, file: &Path) -> Result<(u
     Ok(v.run_cycles(reset))
 }
 
-/// Writes the window `[k0, k1)` of `trace` as a VCD.
-fn write_window(s: &Schedule, trace: &Trace, k0: u64, k1: u64, path: &Path) -> std::io::Result<()> {
+/// Writes the window `[k0, k1)` of `trace` as a VCD, or as an FST when
+/// `fst` (a VCD converted by GTKWave's `vcd2fst`, which `make tools` installs).
+fn write_window(
+    s: &Schedule,
+    trace: &Trace,
+    k0: u64,
+    k1: u64,
+    path: &Path,
+    fst: bool,
+) -> std::io::Result<()> {
     use judge::run::Observer;
-    let mut w = VcdWriter::create(path, s, k0, k1)?;
+    let vcd = if fst {
+        path.with_extension("fst.vcd")
+    } else {
+        path.to_path_buf()
+    };
+    let mut w = VcdWriter::create(&vcd, s, k0, k1)?;
     for (k, (rst, p, miso)) in trace.cycles.iter().enumerate().take(k1 as usize) {
         w.cycle(k as u64, *rst, p, *miso);
     }
-    w.finish()
+    w.finish()?;
+    if !fst {
+        return Ok(());
+    }
+    let out = std::process::Command::new("vcd2fst")
+        .arg(&vcd)
+        .arg(path)
+        .output();
+    let _ = std::fs::remove_file(&vcd);
+    match out {
+        Ok(o) if o.status.success() => Ok(()),
+        Ok(o) => Err(std::io::Error::other(format!(
+            "vcd2fst failed: {}",
+            String::from_utf8_lossy(&o.stderr).trim()
+        ))),
+        Err(e) => Err(std::io::Error::other(format!(
+            "an FST window needs GTKWave's vcd2fst (`make tools` installs it): {e}"
+        ))),
+    }
 }
 
 /// The cycles of a VCD window as read back by the judge's reader.
@@ -331,8 +363,9 @@ pub fn execute(a: &Args, o: &mut Output) -> u8 {
     };
     for (w, (k0, k1)) in &windows {
         let gold = dir.join(&w.file);
-        let new = tmp.path().join(&w.file);
-        if let Err(e) = write_window(&s, &trace, *k0, *k1, &new) {
+        // This run's window as VCD: the reader compares cycles, whatever the golden's format.
+        let new = tmp.path().join(&w.file).with_extension("vcd");
+        if let Err(e) = write_window(&s, &trace, *k0, *k1, &new, false) {
             errln!(o, "error: {}: {e}", new.display());
             return 2;
         }
@@ -415,8 +448,8 @@ fn update(
     for (w, (k0, k1)) in windows {
         let path = dir.join(&w.file);
         let tmp = dir.join(format!(".{}.tmp", w.file));
-        if let Err(e) =
-            write_window(s, trace, *k0, *k1, &tmp).and_then(|()| std::fs::rename(&tmp, &path))
+        if let Err(e) = write_window(s, trace, *k0, *k1, &tmp, w.file.ends_with(".fst"))
+            .and_then(|()| std::fs::rename(&tmp, &path))
         {
             errln!(o, "error: {}: {e}", path.display());
             return 2;

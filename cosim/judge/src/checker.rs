@@ -81,6 +81,9 @@ struct BranchState {
     /// settling.
     reset_held: u64,
     en_multi: bool,
+    /// Joined mid-stream before this branch's mux last moved: the settling of
+    /// its first conversion cannot be known.
+    mux_unknown: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -130,6 +133,24 @@ pub struct Checker {
     div_active: bool,
     xz_seen: bool,
     rst_x_seen: bool,
+    /// The model cycle checking began at (0: at reset; later: joined mid-stream).
+    origin: u64,
+}
+
+/// Where a check joins a run that it did not see start (a capture from the
+/// middle of a run): the capture's pins just before, and what the capture
+/// showed of the branches' recent past.  Cycles are the model's.
+#[derive(Debug, Clone)]
+pub struct Join {
+    /// The capture's cycle at which checking begins (for reports).
+    pub capture_cycle: u64,
+    /// Pins (and x/z) and MISO in the cycle before.
+    pub prev: Pins,
+    pub prev_xz: Pins,
+    /// Per branch: the cycle its mux last changed, if the capture showed it.
+    pub mux_since: Vec<Option<u64>>,
+    /// Per branch: the cycle its CS last rose, if the capture showed it.
+    pub cs_rise: Vec<Option<u64>>,
 }
 
 const NO_XZ: Pins = Pins {
@@ -203,12 +224,42 @@ impl Checker {
             div_active: false,
             xz_seen: false,
             rst_x_seen: false,
+            origin: 0,
         }
     }
 
-    /// Cycles checked after reset so far.
+    /// A checker that joins a run at the model's current cycle (in steady
+    /// state, where [`CycleModel::quiet`] holds), checking every later cycle
+    /// as strictly as one that saw reset.
+    pub fn join(s: &Schedule, opts: CheckOptions, model: CycleModel, j: &Join) -> Checker {
+        let mut chk = Checker::new(s, opts);
+        let mut model = model;
+        // The sample port holds the last word sent (in the cycle before, at
+        // the latest), from a conversion the check did not see: take it as
+        // the model's.
+        model.hold_sample(j.prev.sample_channel, j.prev.sample_value);
+        let c = model.cycle();
+        chk.model = opts.model.then_some(model);
+        chk.phase = Phase::Run;
+        chk.c = c;
+        chk.origin = c;
+        chk.inv.join_at(c, j.capture_cycle);
+        chk.next_frame_at = (c / s.grid.frame_cycles + 1) * s.grid.frame_cycles;
+        chk.prev = j.prev;
+        chk.prev_xz = j.prev_xz;
+        let view = chk.view(&j.prev);
+        for (b, st) in chk.br.iter_mut().enumerate() {
+            st.low = view.cs_n >> b & 1 == 0;
+            st.cs_rise = j.cs_rise[b];
+            st.mux_unknown = j.mux_since[b].is_none();
+            st.mux_since = j.mux_since[b].unwrap_or(0);
+        }
+        chk
+    }
+
+    /// Cycles checked so far (after reset, or since joining).
     pub fn cycles(&self) -> u64 {
-        self.c
+        self.c - self.origin
     }
 
     /// Whether anything failed so far.
@@ -392,21 +443,22 @@ impl Checker {
             if bad {
                 any = true;
                 if !self.diverging[i] && self.divergences.len() < self.opts.max_records {
-                    let (frame, slot, _) = self.grid.locate(c);
+                    let (cycle, frame, slot) = self.inv.place(c);
                     let m = self.model.as_ref().unwrap();
                     let ch = match s.branch() {
                         Some(b) => Some(m.branch_channel(b)),
                         None if e.sample_valid => Some(e.sample_channel),
                         None => Some(p.sample_channel),
                     };
+                    let inv = &self.inv;
                     let mut context: Vec<String> = self
                         .hist
                         .iter()
-                        .map(|(hc, hp, he)| ctx_line(*hc, hp, he.as_ref()))
+                        .map(|(hc, hp, he)| ctx_line(inv.place(*hc).0, hp, he.as_ref()))
                         .collect();
-                    context.push(format!("{} <- diverges", ctx_line(c, p, Some(e))));
+                    context.push(format!("{} <- diverges", ctx_line(cycle, p, Some(e))));
                     self.divergences.push(Divergence {
-                        cycle: c,
+                        cycle,
                         frame,
                         slot,
                         signal: s.name(&self.layout),
@@ -434,6 +486,7 @@ impl Checker {
 
     fn add_context(&mut self, c: u64, p: &Pins, e: Option<Pins>) {
         // The cycle that opened the context is already in it.
+        let c = self.inv.place(c).0;
         let line = ctx_line(c, p, e.as_ref());
         let divs = &mut self.divergences;
         self.ctx_open.retain_mut(|(i, left)| {
@@ -509,6 +562,7 @@ impl Checker {
                 let st = &mut self.br[b];
                 st.mux_since = c;
                 st.mux_from_reset = false;
+                st.mux_unknown = false;
                 let multi = en.count_ones() > 1;
                 if multi && !st.en_multi {
                     self.inv.violation(
@@ -635,7 +689,7 @@ impl Checker {
                 ch.and_then(|ch| self.names.get(ch as usize).cloned()),
                 format!("first conversion after reset: the mux value held through {held} reset cycles and {c} cycles after reset; settling needs {}", lim.settle_min),
             );
-        } else if !st.mux_from_reset && c - st.mux_since < lim.settle_min {
+        } else if !st.mux_from_reset && !st.mux_unknown && c - st.mux_since < lim.settle_min {
             let since = st.mux_since;
             self.inv.violation(
                 c,
@@ -809,11 +863,11 @@ impl Checker {
 
     /// Ends the check and builds the report.
     pub fn finish(mut self, source: &str) -> Report {
-        let cycles = self.c;
+        let cycles = self.c - self.origin;
         if self.phase == Phase::PreReset || (self.phase == Phase::Reset && cycles == 0) {
             self.inv.violation(0, "no-cycles", Some(Role::Reset.name().into()), None, None, None, "no cycle after a released reset was seen (rst must be high, then low, at rising clock edges)".into());
         }
-        let (frames, channels) = self.inv.finish(cycles);
+        let (frames, channels) = self.inv.finish(self.c);
         let samples = self.inv.emitted_count();
         let model = self.model.is_some();
         let mut r = self

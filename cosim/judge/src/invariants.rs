@@ -18,9 +18,19 @@ pub(crate) struct Recorder {
     max: usize,
     violations: Vec<Violation>,
     violation_count: u64,
+    /// A check that joined mid-stream: model cycle minus capture cycle, and
+    /// the model frame in which it joined (reported as frame 0).
+    shift: u64,
+    frame_base: u64,
 }
 
 impl Recorder {
+    /// (cycle, frame, slot) of model cycle `c` as a report gives them.
+    pub(crate) fn place(&self, c: u64) -> (u64, u64, u64) {
+        let (frame, slot, _) = self.grid.locate(c);
+        (c - self.shift, frame - self.frame_base, slot)
+    }
+
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn violation(
         &mut self,
@@ -37,7 +47,7 @@ impl Recorder {
         }
         self.violation_count += 1;
         if self.violations.len() < self.max {
-            let (frame, slot, _) = self.grid.locate(cycle);
+            let (cycle, frame, slot) = self.place(cycle);
             self.violations.push(Violation {
                 cycle,
                 frame,
@@ -90,6 +100,8 @@ pub struct Invariants {
     slack: u64,
     emitted: u64,
     conversions: u64,
+    /// The model cycle the check began at (0: at reset).
+    origin: u64,
 }
 
 impl Invariants {
@@ -118,6 +130,8 @@ impl Invariants {
                 max: max_records,
                 violations: Vec::new(),
                 violation_count: 0,
+                shift: 0,
+                frame_base: 0,
             },
             names: mix.channels.iter().map(|c| c.name.clone()).collect(),
             branch_names: mix.branches.iter().map(|b| b.name.clone()).collect(),
@@ -141,7 +155,24 @@ impl Invariants {
             slack: mix.branches.iter().map(|b| b.chain as u64).sum::<u64>() + 1,
             emitted: 0,
             conversions: 0,
+            origin: 0,
         }
+    }
+
+    /// The check joins a run at model cycle `origin` (in steady state, after
+    /// frame 0), which is cycle `capture_cycle` of the capture: reports
+    /// give capture cycles and count frames from the one joined.  That first
+    /// frame is partial: its counts are checked against the maximum only.
+    pub fn join_at(&mut self, origin: u64, capture_cycle: u64) {
+        self.origin = origin;
+        self.frame = origin / self.frame_cycles;
+        self.rec.shift = origin - capture_cycle;
+        self.rec.frame_base = self.frame;
+    }
+
+    /// (cycle, frame, slot) of model cycle `c` as reports give them.
+    pub(crate) fn place(&self, c: u64) -> (u64, u64, u64) {
+        self.rec.place(c)
     }
 
     fn name(&self, ch: Option<u16>) -> Option<String> {
@@ -157,8 +188,10 @@ impl Invariants {
             } else {
                 &self.spf
             };
+            let partial = self.frame * self.frame_cycles < self.origin;
             for (ch, &want) in spf.iter().enumerate() {
-                if self.in_frame[ch] != want {
+                let n = self.in_frame[ch];
+                if (partial && n > want) || (!partial && n != want) {
                     let name = self.names[ch].clone();
                     self.rec.violation(
                         end,
@@ -168,8 +201,10 @@ impl Invariants {
                         Some(json!(self.in_frame[ch])),
                         Some(name.clone()),
                         format!(
-                            "{name} sampled {} times in frame {}, expected {want}",
-                            self.in_frame[ch], self.frame
+                            "{name} sampled {} times in frame {}, expected {}{want}",
+                            self.in_frame[ch],
+                            self.frame - self.rec.frame_base,
+                            if partial { "at most " } else { "" }
                         ),
                     );
                 }
@@ -362,6 +397,8 @@ impl Invariants {
     /// Per-frame counts are checked on complete frames only; in a trailing
     /// partial frame a channel may not exceed its samples per frame (its
     /// samples still count in the channel statistics).
+    /// `cycles` is the model cycle the check ended at; the frames returned
+    /// are the complete frames checked.
     pub fn finish(&mut self, cycles: u64) -> (u64, Vec<ChannelStats>) {
         let frames = cycles / self.frame_cycles;
         self.close_frames(frames * self.frame_cycles);
@@ -381,7 +418,7 @@ impl Invariants {
                             "{name} sampled {} times in the first {} cycles of frame {}, expected {most} in the whole frame",
                             self.in_frame[ch],
                             cycles % self.frame_cycles,
-                            frames,
+                            frames - self.rec.frame_base,
                         ),
                     );
                 }
@@ -398,7 +435,8 @@ impl Invariants {
                 interval_cycles_max: (self.imin[c] != u64::MAX).then_some(self.imax[c]),
             })
             .collect();
-        (frames, channels)
+        let first_whole = self.origin.div_ceil(self.frame_cycles);
+        (frames.saturating_sub(first_whole), channels)
     }
 
     /// Records a violation found outside the conversion-level checks.

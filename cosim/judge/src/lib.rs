@@ -15,6 +15,11 @@
 //!   slot-level model run;
 //! - [`faults`]: faults injected into any [`Dut`]'s pins;
 //! - [`vcd`] / [`vcdout`]: reading a VCD from any simulator, writing one;
+//! - [`timed`] / [`capture`]: logic-analyser captures (no clock, any
+//!   sample rate) checked at time level, the channel map, sigrok input;
+//! - [`fst`]: FST input, through the `wellen` crate;
+//! - [`lock`]: finding the frame phase of a capture that did not start at
+//!   reset, and checking it from there;
 //! - [`events`]: a run's pins as a reviewable event log, and the
 //!   comparison of two logs by signal role (golden tests);
 //! - [`samples`]: a run's samples as CSV (`cycle,time_s,channel,value`);
@@ -24,21 +29,26 @@
 //! contract's, `lut_gen::ports`.
 
 pub mod adc;
+pub mod capture;
 pub mod checker;
 pub mod events;
 pub mod faults;
+pub mod fst;
 pub mod invariants;
+pub mod lock;
 pub mod model;
 pub mod report;
 pub mod run;
 pub mod samples;
 pub mod switch;
+pub mod timed;
 pub mod vcd;
 pub mod vcdout;
 
 pub use adc::{Adc, Stimulus};
 pub use checker::{CheckOptions, Checker};
 pub use invariants::Invariants;
+pub use lock::{LockError, LockInfo};
 pub use lut_gen::ports::{Layout, Pins, Signal};
 pub use model::{CycleModel, SlotModel};
 pub use report::Report;

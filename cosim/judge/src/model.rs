@@ -345,6 +345,37 @@ impl CycleModel {
         }
     }
 
+    /// No conversion that began before the current cycle is still running or
+    /// waiting to be emitted: a check that joins here (a capture from the
+    /// middle of a run) needs none of the MISO bits it did not see.
+    pub fn quiet(&self) -> bool {
+        self.pending == 0
+            && self.capture == 0
+            && !self.pins.sample_valid
+            && self.br.iter().all(|m| match m.t {
+                Some(t) => t == self.c || self.c > t + m.r,
+                None => true,
+            })
+    }
+
+    /// The channel and value the sample port holds while no sample is sent
+    /// (the last ones sent): for a check that joins a run mid-stream.
+    pub fn hold_sample(&mut self, channel: u16, value: u16) {
+        if !self.pins.sample_valid {
+            self.pins.sample_channel = channel;
+            self.pins.sample_value = value;
+        }
+    }
+
+    /// The model `cycles` cycles after reset, stepped with MISO low.
+    pub fn at(s: &Schedule, cycles: u64) -> CycleModel {
+        let mut m = CycleModel::new(s);
+        while m.c < cycles {
+            m.step(0);
+        }
+        m
+    }
+
     /// Ends the current cycle, in which `adc_miso` carried `miso` (bit b =
     /// branch b), and moves to the next one.
     #[inline]

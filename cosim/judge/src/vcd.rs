@@ -33,6 +33,7 @@ use lut_gen::ports::{Role, PORT_NAMES as PORTS, TOP_MODULE};
 use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker};
+use crate::lock::{Judge, LockError, LockInfo};
 use crate::report::Report;
 use lut_gen::ports::{Layout, Pins};
 
@@ -57,6 +58,11 @@ pub enum VcdError {
         file: PathBuf,
         message: String,
     },
+    /// The capture did not start at reset and its frame phase could not be found.
+    Phase {
+        file: PathBuf,
+        error: LockError,
+    },
 }
 
 impl fmt::Display for VcdError {
@@ -74,6 +80,7 @@ impl fmt::Display for VcdError {
                 message,
             } => write!(f, "{}:{line}: truncated VCD: {message}", file.display()),
             VcdError::Ports { file, message } => write!(f, "{}: {message}", file.display()),
+            VcdError::Phase { file, error } => write!(f, "{}: {error}", file.display()),
         }
     }
 }
@@ -324,7 +331,7 @@ struct Val {
 
 struct Resolved {
     /// id code -> sinks (empty for signals we do not need).
-    ids: HashMap<Vec<u8>, Vec<Sink>>,
+    ids: Ids,
     has_clk: bool,
     scope: String,
     widths: [u32; 10],
@@ -498,11 +505,75 @@ fn resolve(
         }
     }
     Ok(Resolved {
-        ids,
+        ids: Ids::new(ids),
         has_clk,
         scope: scope.to_string(),
         widths,
     })
+}
+
+/// Identifier code -> sinks.  Codes of up to three characters (every
+/// simulator's first 830 000 signals) index a table directly: hashing the
+/// code of every value change was a tenth of `check`'s time.
+struct Ids {
+    short: Vec<u32>,
+    sinks: Vec<Vec<Sink>>,
+    long: HashMap<Vec<u8>, usize>,
+}
+
+const NO_ID: u32 = u32::MAX;
+
+impl Ids {
+    fn new(map: HashMap<Vec<u8>, Vec<Sink>>) -> Ids {
+        let mut ids = Ids {
+            short: Vec::new(),
+            sinks: Vec::new(),
+            long: HashMap::new(),
+        };
+        for (code, sinks) in map {
+            let i = ids.sinks.len();
+            ids.sinks.push(sinks);
+            match Ids::slot(&code) {
+                Some(k) => {
+                    if ids.short.len() <= k {
+                        ids.short.resize(k + 1, NO_ID);
+                    }
+                    ids.short[k] = i as u32;
+                }
+                None => {
+                    ids.long.insert(code, i);
+                }
+            }
+        }
+        ids
+    }
+
+    /// The table index of a code of 1-3 printable characters.
+    #[inline]
+    fn slot(code: &[u8]) -> Option<usize> {
+        if code.is_empty() || code.len() > 3 {
+            return None;
+        }
+        let mut k = 0usize;
+        for &c in code {
+            if !(b'!'..=b'~').contains(&c) {
+                return None;
+            }
+            k = k * 95 + (c - b'!' + 1) as usize;
+        }
+        Some(k)
+    }
+
+    #[inline]
+    fn get(&self, code: &[u8]) -> Option<&Vec<Sink>> {
+        match Ids::slot(code) {
+            Some(k) => match self.short.get(k) {
+                Some(&i) if i != NO_ID => Some(&self.sinks[i as usize]),
+                _ => None,
+            },
+            None => self.long.get(code).map(|&i| &self.sinks[i]),
+        }
+    }
 }
 
 // ------------------------------------------------------------------ body
@@ -927,6 +998,8 @@ pub struct VcdInfo {
     /// Inferred clock period in timescale units (only without a dumped clock).
     pub inferred_period: Option<u64>,
     pub clock_cycles: u64,
+    /// How the frame phase was found, when the capture did not start at reset.
+    pub lock: Option<LockInfo>,
 }
 
 fn open(path: &Path) -> Result<Lexer<BufReader<File>>, VcdError> {
@@ -934,8 +1007,53 @@ fn open(path: &Path) -> Result<Lexer<BufReader<File>>, VcdError> {
     Ok(Lexer::new(BufReader::with_capacity(1 << 20, f), path))
 }
 
-/// Streams the cycles of a VCD into `sink`.
+/// Streams the cycles of a VCD, or of an FST (through its VCD
+/// transcoding, `fst.rs`), into `sink`.
 pub fn read_cycles(
+    s: &Schedule,
+    path: &Path,
+    scope: Option<&str>,
+    sink: &mut dyn CycleSink,
+) -> Result<VcdInfo, VcdError> {
+    if !crate::fst::is_fst(path) {
+        return read_vcd_cycles(s, path, scope, sink);
+    }
+    let fst_err = |message: String| VcdError::Ports {
+        file: path.to_path_buf(),
+        message,
+    };
+    let mut tmp = tempfile::Builder::new()
+        .suffix(".vcd")
+        .tempfile()
+        .map_err(|e| VcdError::Io(path.to_path_buf(), e))?;
+    crate::fst::to_vcd(path, tmp.as_file_mut()).map_err(fst_err)?;
+    // Errors name the FST, not the temporary file.
+    let named = format!("{} (as VCD)", path.display());
+    read_vcd_cycles(s, tmp.path(), scope, sink).map_err(|e| e.with_file(Path::new(&named)))
+}
+
+impl VcdError {
+    fn with_file(self, f: &Path) -> VcdError {
+        let f = f.to_path_buf();
+        match self {
+            VcdError::Io(_, e) => VcdError::Io(f, e),
+            VcdError::Malformed { line, message, .. } => VcdError::Malformed {
+                file: f,
+                line,
+                message,
+            },
+            VcdError::Truncated { line, message, .. } => VcdError::Truncated {
+                file: f,
+                line,
+                message,
+            },
+            VcdError::Ports { message, .. } => VcdError::Ports { file: f, message },
+            VcdError::Phase { error, .. } => VcdError::Phase { file: f, error },
+        }
+    }
+}
+
+fn read_vcd_cycles(
     s: &Schedule,
     path: &Path,
     scope: Option<&str>,
@@ -1000,20 +1118,28 @@ pub fn read_cycles(
             Clocking::Clk => None,
         },
         clock_cycles: info.cycles,
+        lock: None,
     })
 }
 
 /// Checks a VCD against the schedule: every invariant and, unless
 /// `opts.model` is false, cycle-exact equality with the reference model.
+/// A VCD that does not start at reset is checked from where its frame phase
+/// is found (`lock.rs`).
 pub fn check_vcd_with(
     s: &Schedule,
     path: &Path,
     scope: Option<&str>,
     opts: CheckOptions,
 ) -> Result<(Report, VcdInfo), VcdError> {
-    let mut chk = Checker::new(s, opts);
-    let info = read_cycles(s, path, scope, &mut chk)?;
-    Ok((chk.finish("vcd"), info))
+    let mut judge = Judge::new(s, opts);
+    let mut info = read_cycles(s, path, scope, &mut judge)?;
+    let (report, lock) = judge.finish("vcd").map_err(|error| VcdError::Phase {
+        file: path.to_path_buf(),
+        error,
+    })?;
+    info.lock = lock;
+    Ok((report, info))
 }
 
 /// Checks a VCD with the default options.

@@ -1,0 +1,277 @@
+//! Logic-analyser captures for the time-level check (`timed.rs`): the map
+//! from analyser channels to port bits (`--map D0=adc_cs_n[0],...` or a
+//! file of such lines), sigrok-cli's VCD (1-bit channels, its sample rate in
+//! a comment), and sigrok session files (`.sr`), which sigrok-cli itself
+//! turns into that VCD (the format's own reader, rather than a second one).
+
+use std::path::Path;
+
+use lut_gen::ports::{Layout, Role, PORT_NAMES};
+use lut_gen::Schedule;
+
+use crate::timed::{Capture, Lane};
+
+/// Parses `--map`: `CH=PORT[BIT],...` inline, or the path of a file with one
+/// `CH = PORT[BIT]` per line (`#` comments).  Errors name the line and field.
+pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
+    let (text, file) = match std::fs::read_to_string(spec) {
+        Ok(t) if !spec.contains('=') => (t, Some(spec)),
+        _ => (spec.replace(',', "\n"), None),
+    };
+    let layout = Layout::new(s);
+    let widths = layout.port_widths();
+    let mut lanes: Vec<Lane> = Vec::new();
+    for (n, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let at = |m: String| match file {
+            Some(f) => format!("{f}:{}: {m}", n + 1),
+            None => format!("--map `{line}`: {m}"),
+        };
+        let (ch, port) = line
+            .split_once('=')
+            .ok_or_else(|| at("expected CHANNEL=PORT[BIT], e.g. D0=adc_cs_n[0]".into()))?;
+        let (ch, port) = (ch.trim(), port.trim());
+        let (name, bit) = match port.split_once('[') {
+            Some((nm, rest)) => {
+                let b = rest
+                    .strip_suffix(']')
+                    .and_then(|b| b.trim().parse::<u32>().ok())
+                    .ok_or_else(|| at(format!("bit of `{port}` is not a number in [..]")))?;
+                (nm.trim(), b)
+            }
+            None => (port, 0),
+        };
+        let Some(pi) = PORT_NAMES.iter().position(|p| *p == name) else {
+            return Err(at(format!(
+                "`{name}` is not a port of slotforge_top ({})",
+                PORT_NAMES.join(", ")
+            )));
+        };
+        if bit >= widths[pi] {
+            return Err(at(format!(
+                "`{name}` has {} bit(s) in this mix, no bit {bit}",
+                widths[pi]
+            )));
+        }
+        let role = lut_gen::ports::PORTS[pi].role;
+        if lanes.iter().any(|l| l.channel == ch) {
+            return Err(at(format!("channel `{ch}` is mapped twice")));
+        }
+        lanes.push(Lane {
+            channel: ch.to_string(),
+            role,
+            bit,
+        });
+    }
+    if lanes.is_empty() {
+        return Err("--map maps no channel".into());
+    }
+    if lanes.len() > 64 {
+        return Err(format!(
+            "--map maps {} channels; at most 64 are checked at once",
+            lanes.len()
+        ));
+    }
+    Ok(lanes)
+}
+
+/// Reads a capture: sigrok-cli's VCD, or a `.sr` session through sigrok-cli.
+pub fn read(path: &Path, lanes: Vec<Lane>) -> Result<Capture, String> {
+    let mut head = [0u8; 2];
+    let is_zip = std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
+        .map(|_| &head == b"PK")
+        .unwrap_or(false);
+    if !is_zip {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        return parse_vcd(&text, path, lanes);
+    }
+    let tmp = tempfile::Builder::new()
+        .suffix(".vcd")
+        .tempfile()
+        .map_err(|e| format!("temporary file: {e}"))?;
+    let out = std::process::Command::new("sigrok-cli")
+        .arg("-i")
+        .arg(path)
+        .args(["-O", "vcd", "-o"])
+        .arg(tmp.path())
+        .output()
+        .map_err(|e| {
+            format!(
+                "{}: a sigrok session (.sr) is read through sigrok-cli (`make tools` installs it): {e}",
+                path.display()
+            )
+        })?;
+    if !out.status.success() {
+        return Err(format!(
+            "{}: sigrok-cli cannot read it: {}",
+            path.display(),
+            String::from_utf8_lossy(&out.stderr).trim()
+        ));
+    }
+    let text =
+        std::fs::read_to_string(tmp.path()).map_err(|e| format!("{}: {e}", path.display()))?;
+    parse_vcd(&text, path, lanes)
+}
+
+fn unit_ps(u: &str) -> Option<f64> {
+    Some(match u {
+        "s" => 1e12,
+        "ms" => 1e9,
+        "us" => 1e6,
+        "ns" => 1e3,
+        "ps" => 1.0,
+        "fs" => 1e-3,
+        _ => return None,
+    })
+}
+
+/// sigrok-cli's VCD: 1-bit `$var`s named by the analyser's channels, the
+/// sample rate in `$comment ... at 24 MHz $end`.
+fn parse_vcd(text: &str, path: &Path, lanes: Vec<Lane>) -> Result<Capture, String> {
+    let err = |line: usize, m: String| format!("{}:{line}: {m}", path.display());
+    let mut ids: Vec<(String, usize)> = Vec::new();
+    let mut scale_ps = 1.0;
+    let mut rate_hz: Option<f64> = None;
+    let mut names = Vec::new();
+    let mut steps: Vec<(u64, u64)> = Vec::new();
+    let mut cur = 0u64;
+    let mut t = 0u64;
+    let mut in_body = false;
+    let mut toks = text
+        .lines()
+        .enumerate()
+        .flat_map(|(n, l)| l.split_whitespace().map(move |w| (n + 1, w)))
+        .peekable();
+    while let Some((n, w)) = toks.next() {
+        if !in_body {
+            let mut group = vec![];
+            if w.starts_with('$') && w != "$end" {
+                for (_, x) in toks.by_ref() {
+                    if x == "$end" {
+                        break;
+                    }
+                    group.push(x);
+                }
+            }
+            match w {
+                "$timescale" => {
+                    let s: String = group.concat();
+                    let i = s.find(|c: char| !c.is_ascii_digit()).unwrap_or(s.len());
+                    let k: f64 = s[..i].parse().unwrap_or(1.0);
+                    scale_ps =
+                        k * unit_ps(&s[i..]).ok_or_else(|| err(n, format!("timescale `{s}`")))?;
+                }
+                "$comment" => {
+                    if let Some(i) = group.iter().position(|x| *x == "at") {
+                        if let (Some(v), Some(u)) = (group.get(i + 1), group.get(i + 2)) {
+                            let m = match *u {
+                                "Hz" => 1.0,
+                                "kHz" => 1e3,
+                                "MHz" => 1e6,
+                                "GHz" => 1e9,
+                                _ => 0.0,
+                            };
+                            rate_hz = v.parse::<f64>().ok().map(|v| v * m).filter(|r| *r > 0.0);
+                        }
+                    }
+                }
+                "$var" => {
+                    if group.len() < 4 {
+                        return Err(err(n, "$var needs type, width, code and name".into()));
+                    }
+                    let name = group[3].to_string();
+                    names.push(name.clone());
+                    if let Some(li) = lanes.iter().position(|l| l.channel == name) {
+                        ids.push((group[2].to_string(), li));
+                    }
+                }
+                "$enddefinitions" => {
+                    in_body = true;
+                    let missing: Vec<&str> = lanes
+                        .iter()
+                        .filter(|l| !names.contains(&l.channel))
+                        .map(|l| l.channel.as_str())
+                        .collect();
+                    if !missing.is_empty() {
+                        return Err(format!(
+                            "{}: --map names channel(s) {} that the capture does not have (it has {})",
+                            path.display(),
+                            missing.join(", "),
+                            names.join(", ")
+                        ));
+                    }
+                }
+                _ => {}
+            }
+            continue;
+        }
+        if let Some(ts) = w.strip_prefix('#') {
+            let nt: u64 = ts
+                .parse()
+                .map_err(|_| err(n, format!("bad timestamp `{w}`")))?;
+            if nt < t {
+                return Err(err(n, format!("time goes backwards from {t} to {nt}")));
+            }
+            if steps.last().map(|s| s.1) != Some(cur) || steps.is_empty() {
+                steps.push(((t as f64 * scale_ps) as u64, cur));
+            }
+            t = nt;
+            continue;
+        }
+        if w.starts_with('$') {
+            continue;
+        }
+        let (val, code) = match w.as_bytes()[0] {
+            b'0' | b'1' | b'x' | b'z' | b'X' | b'Z' => (w.as_bytes()[0], &w[1..]),
+            b'b' | b'B' => {
+                let c = toks.next().map(|x| x.1).unwrap_or("");
+                (*w.as_bytes().last().unwrap_or(&b'0'), c)
+            }
+            _ => return Err(err(n, format!("unexpected `{w}`"))),
+        };
+        if let Some((_, li)) = ids.iter().find(|(c, _)| c == code) {
+            if val == b'1' {
+                cur |= 1 << li;
+            } else {
+                cur &= !(1 << li);
+            }
+        }
+    }
+    steps.push(((t as f64 * scale_ps) as u64, cur));
+    // Without the rate comment, the smallest step between timestamps.
+    // With the rate known, one timescale unit is added: sigrok rounds each
+    // sample's time to it.
+    let period_ps = match rate_hz {
+        Some(r) => (1e12 / r).round() as u64 + scale_ps.ceil() as u64,
+        None => steps
+            .windows(2)
+            .map(|w| w[1].0 - w[0].0)
+            .filter(|d| *d > 0)
+            .min()
+            .ok_or_else(|| format!("{}: no sample rate and too few samples", path.display()))?,
+    };
+    Ok(Capture {
+        lanes,
+        period_ps,
+        steps,
+    })
+}
+
+/// Roles the lanes do not cover at all (for the report).
+pub fn unmapped(lanes: &[Lane]) -> Vec<&'static str> {
+    [
+        Role::CsN,
+        Role::Sclk,
+        Role::MuxSel,
+        Role::MuxEn,
+        Role::SampleValid,
+    ]
+    .into_iter()
+    .filter(|r| !lanes.iter().any(|l| l.role == *r))
+    .map(|r| r.name())
+    .collect()
+}

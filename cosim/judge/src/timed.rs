@@ -1,0 +1,627 @@
+//! Time-level checking of a logic-analyser capture: lanes sampled at the
+//! analyser's own rate, asynchronous to the design's clock, with no clock
+//! and no reset, starting anywhere in a run.
+//!
+//! The model's edges of every mapped lane over a steady-state frame form a
+//! periodic template (cycles).  A capture edge seen at time `t` happened in
+//! `(t - T, t]` (T: the sample period), give or take the user's skew, so
+//! with `phi` the time of model cycle 0 every edge says
+//! `t - T - skew <= phi + cycle * Tc <= t + skew`.  The first CS edge of the
+//! first mapped CS lane fits some frame positions (candidates); each later
+//! edge of each lane must be that lane's next template edge, with the same
+//! level, and narrows `phi`'s interval; a candidate whose interval empties
+//! is gone.  One candidate left: every later edge that does not fit is a
+//! fault, named by its lane's role.  Times are kept exact as integers in
+//! units of 1 / (clock_hz) picoseconds.
+//!
+//! What this proves depends on the resolution `T + 2 skew`: every checked
+//! edge within it of the model's time (so every rate, interval, slot order
+//! and SCLK count and period to that accuracy); a lane whose edges can come
+//! closer than that is not checked; mux settling is proved only where the
+//! model's margin exceeds it.
+
+use std::fmt::Write as _;
+
+use lut_gen::ports::{Layout, Pins, Role};
+use lut_gen::Schedule;
+
+use crate::model::CycleModel;
+
+/// One analyser channel mapped to one port bit (`adc_cs_n[0]`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Lane {
+    pub channel: String,
+    pub role: Role,
+    pub bit: u32,
+}
+
+impl Lane {
+    pub fn port_bit(&self) -> String {
+        format!("{}[{}]", self.role.name(), self.bit)
+    }
+
+    fn get(&self, l: &Layout, p: &Pins) -> bool {
+        let v = match self.role {
+            Role::CsN => p.cs_n as u128,
+            Role::Sclk => p.sclk as u128,
+            Role::MuxSel => p.mux_sel as u128,
+            Role::MuxEn => p.mux_en,
+            Role::SampleValid => p.sample_valid as u128,
+            _ => 0,
+        };
+        let _ = l;
+        v >> self.bit & 1 == 1
+    }
+
+    /// Lanes the model predicts without MISO: timing and control outputs.
+    fn predictable(&self) -> bool {
+        matches!(
+            self.role,
+            Role::CsN | Role::Sclk | Role::MuxSel | Role::MuxEn | Role::SampleValid
+        )
+    }
+
+    fn what(&self) -> &'static str {
+        match self.role {
+            Role::CsN => "conversion instant (rate, interval, slot order)",
+            Role::Sclk => "serial clock (SCLK count and period per conversion)",
+            Role::MuxSel | Role::MuxEn => "mux switching (slot order, settling before CS)",
+            Role::SampleValid => "sample stream timing",
+            _ => "",
+        }
+    }
+}
+
+/// A capture: lanes, the sample period, and the lanes' levels (bit i = lane
+/// i) from each time on, in time order (the first entry is the start).
+#[derive(Debug, Clone)]
+pub struct Capture {
+    pub lanes: Vec<Lane>,
+    pub period_ps: u64,
+    pub steps: Vec<(u64, u64)>,
+}
+
+/// One broken expectation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimedViolation {
+    pub time_ps: u64,
+    pub channel: String,
+    pub port_bit: String,
+    pub rule: String,
+    pub detail: String,
+}
+
+/// The outcome of a time-level check.
+#[derive(Debug, Clone)]
+pub struct TimedReport {
+    pub ok: bool,
+    pub edges_checked: u64,
+    pub conversions: u64,
+    /// Time the phase was found at and the frame slot there.
+    pub locked_at_ps: u64,
+    pub slot: u64,
+    pub phases: usize,
+    pub violations: Vec<TimedViolation>,
+    /// What the resolution and the mapped pins allowed to be proved, and not.
+    pub proved: Vec<String>,
+    pub not_proved: Vec<String>,
+}
+
+impl TimedReport {
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "capture: locked at {:.3} us (slot {}){}; {} edges and {} conversions checked at time level, {} violation(s): {}",
+            self.locked_at_ps as f64 / 1e6,
+            self.slot,
+            if self.phases > 1 {
+                format!(", {} phases fit it alike", self.phases)
+            } else {
+                String::new()
+            },
+            self.edges_checked,
+            self.conversions,
+            self.violations.len(),
+            if self.ok { "PASS" } else { "FAIL" }
+        );
+        for v in &self.violations {
+            let _ = writeln!(
+                s,
+                "  {} at {:.3} us on {} ({}): {}",
+                v.rule,
+                v.time_ps as f64 / 1e6,
+                v.channel,
+                v.port_bit,
+                v.detail
+            );
+        }
+        // A failed capture proves nothing; it says what it could have.
+        let label = if self.ok { "proved" } else { "would prove" };
+        for p in &self.proved {
+            let _ = writeln!(s, "  {label}: {p}");
+        }
+        for p in &self.not_proved {
+            let _ = writeln!(s, "  not proved: {p}");
+        }
+        s
+    }
+}
+
+/// Why a capture could not be checked (an input problem).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimedError(pub String);
+
+impl std::fmt::Display for TimedError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// Per lane: (cycle in frame, new level) of the model's edges in a steady frame.
+struct Tpl {
+    frame: u64,
+    edges: Vec<Vec<(u64, bool)>>,
+    /// Closest two edges of each lane, in cycles.
+    min_gap: Vec<u64>,
+    /// Per branch: the least cycles from a mux change to the next instant.
+    settle_margin: Vec<Option<u64>>,
+    conversions_per_frame: u64,
+}
+
+fn template(s: &Schedule, lanes: &[Lane]) -> Tpl {
+    let l = Layout::new(s);
+    let f = s.grid.frame_cycles;
+    let mut m = CycleModel::at(s, f - 1);
+    let mut prev: Vec<bool> = lanes.iter().map(|x| x.get(&l, m.pins())).collect();
+    let mut edges = vec![Vec::new(); lanes.len()];
+    let nb = l.branches;
+    let mut last_mux = vec![0u64; nb];
+    let mut prev_pins = *m.pins();
+    let mut margin: Vec<Option<u64>> = vec![None; nb];
+    let mut conversions = 0;
+    m.step(0);
+    while m.cycle() < 2 * f {
+        let p = *m.pins();
+        for (i, lane) in lanes.iter().enumerate() {
+            let v = lane.get(&l, &p);
+            if v != prev[i] {
+                edges[i].push((m.cycle() - f, v));
+                prev[i] = v;
+            }
+        }
+        for b in 0..nb {
+            if l.sel(&p, b) != l.sel(&prev_pins, b) || l.en(&p, b) != l.en(&prev_pins, b) {
+                last_mux[b] = m.cycle();
+            }
+            let cs = |q: &Pins| (q.cs_n ^ cnv_mask(s)) >> b & 1 == 0;
+            if cs(&p) && !cs(&prev_pins) {
+                conversions += 1;
+                let g = m.cycle() - last_mux[b];
+                margin[b] = Some(margin[b].map_or(g, |x: u64| x.min(g)));
+            }
+        }
+        prev_pins = p;
+        m.step(0);
+    }
+    let min_gap = edges
+        .iter()
+        .map(|e| {
+            let n = e.len();
+            (0..n)
+                .map(|i| (e[(i + 1) % n].0 + f - e[i].0 - 1) % f + 1)
+                .min()
+                .unwrap_or(f)
+        })
+        .collect();
+    Tpl {
+        frame: f,
+        edges,
+        min_gap,
+        settle_margin: margin,
+        conversions_per_frame: conversions,
+    }
+}
+
+fn cnv_mask(s: &Schedule) -> u16 {
+    s.mix
+        .branches
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| b.adc.start == lut_gen::parts::Start::Cnv)
+        .fold(0u16, |a, (b, _)| a | 1 << b)
+}
+
+#[derive(Clone)]
+struct Cand {
+    /// phi's interval, in units of 1/clock ps.
+    lo: i128,
+    hi: i128,
+    /// Per lane: the next template edge (frame wrap, index), once started.
+    ptr: Vec<Option<(u64, usize)>>,
+    c0: u64,
+}
+
+struct Ctx<'a> {
+    tpl: &'a Tpl,
+    /// Sample period and skew, in units.
+    t: i128,
+    skew: i128,
+    /// One cycle in units (1e12).
+    tc: i128,
+    clock: i128,
+}
+
+impl Ctx<'_> {
+    fn abs(&self, lane: usize, (w, j): (u64, usize)) -> u64 {
+        w * self.tpl.frame + self.tpl.edges[lane][j].0
+    }
+
+    fn next(&self, lane: usize, (w, j): (u64, usize)) -> (u64, usize) {
+        if j + 1 == self.tpl.edges[lane].len() {
+            (w + 1, 0)
+        } else {
+            (w, j + 1)
+        }
+    }
+
+    /// Narrows `c`'s interval with an edge of `lane` at `t` (units) that is
+    /// model cycle `cycle`; false when it does not fit.
+    fn fit(&self, c: &mut Cand, cycle: u64, t: i128) -> bool {
+        let ct = cycle as i128 * self.tc;
+        let lo = c.lo.max(t - ct - self.t - self.skew);
+        let hi = c.hi.min(t - ct + self.skew);
+        if lo > hi {
+            return false;
+        }
+        c.lo = lo;
+        c.hi = hi;
+        true
+    }
+
+    /// The first observed edge of a lane after the lock: the first template
+    /// edge of its level near enough.
+    fn start(&self, c: &mut Cand, lane: usize, t: i128, v: bool) -> bool {
+        let e = &self.tpl.edges[lane];
+        if e.is_empty() {
+            return false;
+        }
+        let back = ((self.t + 2 * self.skew) / self.tc) as u64 + 2;
+        let from = c.c0.saturating_sub(back);
+        let (mut w, mut j) = (from / self.tpl.frame, 0usize);
+        let in_frame = from % self.tpl.frame;
+        while j < e.len() && e[j].0 < in_frame {
+            j += 1;
+        }
+        if j == e.len() {
+            w += 1;
+            j = 0;
+        }
+        for _ in 0..=e.len() {
+            let cyc = self.abs(lane, (w, j));
+            if e[j].1 == v {
+                let mut d = c.clone();
+                if self.fit(&mut d, cyc, t) {
+                    *c = d;
+                    c.ptr[lane] = Some(self.next(lane, (w, j)));
+                    return true;
+                }
+            }
+            if cyc as i128 * self.tc + c.lo > t + self.skew {
+                return false;
+            }
+            (w, j) = self.next(lane, (w, j));
+        }
+        false
+    }
+
+    fn step(&self, c: &mut Cand, lane: usize, t: i128, v: bool) -> Result<(), String> {
+        let Some(p) = c.ptr[lane] else {
+            return if self.start(c, lane, t, v) {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{} edge at no time the schedule has one",
+                    if v { "rising" } else { "falling" }
+                ))
+            };
+        };
+        let cyc = self.abs(lane, p);
+        let want = self.tpl.edges[lane][p.1].1;
+        let at = |x: i128| x as f64 / self.clock as f64 / 1e3;
+        let (elo, ehi) = (
+            c.lo + cyc as i128 * self.tc - self.skew,
+            c.hi + cyc as i128 * self.tc + self.t + self.skew,
+        );
+        if want != v {
+            return Err(format!(
+                "{} edge at {:.3} us where the schedule's next edge is {} in [{:.3}, {:.3}] us (frame cycle {}): an edge is missing or extra",
+                if v { "rising" } else { "falling" },
+                at(t) / 1e3,
+                if want { "rising" } else { "falling" },
+                at(elo) / 1e3,
+                at(ehi) / 1e3,
+                cyc % self.tpl.frame
+            ));
+        }
+        if !self.fit(c, cyc, t) {
+            let early = t < elo;
+            return Err(format!(
+                "edge at {:.3} us, {} than the schedule's [{:.3}, {:.3}] us (frame cycle {}, slot timing to within the capture's resolution)",
+                at(t) / 1e3,
+                if early { "earlier" } else { "later" },
+                at(elo) / 1e3,
+                at(ehi) / 1e3,
+                cyc % self.tpl.frame
+            ));
+        }
+        c.ptr[lane] = Some(self.next(lane, p));
+        Ok(())
+    }
+}
+
+/// Checks a capture at time level against the schedule.
+pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedReport, TimedError> {
+    let clock = s.mix.clock_hz as i128;
+    let tc_ps = 1e12 / s.mix.clock_hz as f64;
+    let res_ps = cap.period_ps + 2 * skew_ps;
+    let all = &cap.lanes;
+    let tpl_all = template(s, all);
+    // Lanes the resolution lets us check edge by edge.
+    let mut not_proved = Vec::new();
+    let checked: Vec<usize> = (0..all.len())
+        .filter(|&i| {
+            let lane = &all[i];
+            if !lane.predictable() {
+                not_proved.push(format!(
+                    "{} ({}): its values come from the ADC, not the schedule; not checked at time level",
+                    lane.channel,
+                    lane.port_bit()
+                ));
+                return false;
+            }
+            let gap_ps = tpl_all.min_gap[i] as f64 * tc_ps;
+            if gap_ps <= res_ps as f64 {
+                not_proved.push(format!(
+                    "{} ({}): its edges come {:.1} ns apart, not more than the capture's resolution ({:.1} ns: sample period plus twice the skew); a faster analyser proves it",
+                    lane.channel,
+                    lane.port_bit(),
+                    gap_ps / 1e3,
+                    res_ps as f64 / 1e3
+                ));
+                return false;
+            }
+            true
+        })
+        .collect();
+    let lanes: Vec<Lane> = checked.iter().map(|&i| all[i].clone()).collect();
+    let tpl = template(s, &lanes);
+    let Some(cs_lane) = lanes.iter().position(|l| l.role == Role::CsN) else {
+        return Err(TimedError(
+            "no mapped CS (or CNV) lane the capture's resolution can check: the frame phase cannot be found; map adc_cs_n[N] to an analyser channel".into(),
+        ));
+    };
+    let ctx = Ctx {
+        tpl: &tpl,
+        t: cap.period_ps as i128 * clock,
+        skew: skew_ps as i128 * clock,
+        tc: 1_000_000_000_000,
+        clock,
+    };
+    let idx: Vec<usize> = checked.clone();
+    let mut cands: Option<Vec<Cand>> = None;
+    let mut first_cands = 0;
+    let mut locked_at = 0u64;
+    let mut violations = Vec::new();
+    let mut edges_checked = 0u64;
+    let mut conv_start = None;
+    let mut prev = cap.steps.first().map(|s| s.1).unwrap_or(0);
+    let cs_idle = {
+        let b = lanes[cs_lane].bit;
+        cnv_mask(s) >> b & 1 == 0
+    };
+    'outer: for &(t_ps, v) in cap.steps.iter().skip(1) {
+        let changed = v ^ prev;
+        prev = v;
+        if changed == 0 {
+            continue;
+        }
+        let t = t_ps as i128 * clock;
+        for (li, &ai) in idx.iter().enumerate() {
+            if changed >> ai & 1 == 0 {
+                continue;
+            }
+            let level = v >> ai & 1 == 1;
+            match &mut cands {
+                None => {
+                    // Lock on the first conversion start of the CS lane.
+                    if li != cs_lane || level == cs_idle {
+                        continue;
+                    }
+                    let mut c = Vec::new();
+                    for (j, &(cyc, lv)) in tpl.edges[li].iter().enumerate() {
+                        if lv != level {
+                            continue;
+                        }
+                        let abs = tpl.frame + cyc;
+                        let mut cand = Cand {
+                            lo: i128::MIN / 4,
+                            hi: i128::MAX / 4,
+                            ptr: vec![None; lanes.len()],
+                            c0: abs,
+                        };
+                        if ctx.fit(&mut cand, abs, t) {
+                            cand.ptr[li] = Some(ctx.next(li, (1, j)));
+                            c.push(cand);
+                        }
+                    }
+                    first_cands = c.len();
+                    locked_at = t_ps;
+                    conv_start = Some(t_ps);
+                    cands = Some(c);
+                }
+                Some(c) => {
+                    edges_checked += 1;
+                    let single = c.len() == 1;
+                    let mut errs = Vec::new();
+                    c.retain_mut(|cand| match ctx.step(cand, li, t, level) {
+                        Ok(()) => true,
+                        Err(e) => {
+                            errs.push(e);
+                            false
+                        }
+                    });
+                    if c.is_empty() {
+                        if single {
+                            let lane = &lanes[li];
+                            violations.push(TimedViolation {
+                                time_ps: t_ps,
+                                channel: lane.channel.clone(),
+                                port_bit: lane.port_bit(),
+                                rule: lane.what().into(),
+                                detail: errs.pop().unwrap_or_default(),
+                            });
+                            break 'outer;
+                        }
+                        return Err(TimedError(format!(
+                            "no frame phase of this mix's schedule fits the capture's edges at {:.3} us ({} fitted before): is it the right mix and map, or did the design go wrong before its phase could be found?",
+                            t_ps as f64 / 1e6,
+                            first_cands
+                        )));
+                    }
+                }
+            }
+        }
+    }
+    let Some(cands) = cands else {
+        return Err(TimedError(format!(
+            "no conversion start on {} ({}) in the capture: the frame phase cannot be found",
+            lanes[cs_lane].channel,
+            lanes[cs_lane].port_bit()
+        )));
+    };
+    // A lane must not miss an edge the schedule puts inside the capture.
+    let end = cap.steps.last().map(|s| s.0).unwrap_or(0) as i128 * clock;
+    if violations.is_empty() && cands.len() == 1 {
+        let c = &cands[0];
+        for (li, lane) in lanes.iter().enumerate() {
+            if let Some(p) = c.ptr[li] {
+                let latest = c.hi + ctx.abs(li, p) as i128 * ctx.tc + ctx.t + ctx.skew;
+                if latest < end {
+                    violations.push(TimedViolation {
+                        time_ps: (latest / clock) as u64,
+                        channel: lane.channel.clone(),
+                        port_bit: lane.port_bit(),
+                        rule: lane.what().into(),
+                        detail: "the schedule's edge never came: an edge is missing".into(),
+                    });
+                }
+            }
+        }
+    }
+    let span_ps = (end / clock) as u64 - conv_start.unwrap_or(0);
+    let conversions =
+        (span_ps as f64 / (tpl.frame as f64 * tc_ps) * tpl.conversions_per_frame as f64) as u64;
+    let (proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
+    not_proved.extend(np);
+    Ok(TimedReport {
+        ok: violations.is_empty(),
+        edges_checked,
+        conversions,
+        locked_at_ps: locked_at,
+        slot: cands
+            .first()
+            .map(|c| (c.c0 % tpl.frame) / s.grid.slot_cycles)
+            .unwrap_or(0),
+        phases: cands.len(),
+        violations,
+        proved,
+        not_proved,
+    })
+}
+
+/// The claims a capture at this resolution with these lanes supports.
+fn what_was_proved(
+    s: &Schedule,
+    lanes: &[Lane],
+    tpl: &Tpl,
+    period_ps: u64,
+    skew_ps: u64,
+) -> (Vec<String>, Vec<String>) {
+    let tc_ps = 1e12 / s.mix.clock_hz as f64;
+    let res = (period_ps + 2 * skew_ps) as f64;
+    let mut yes = Vec::new();
+    let mut no = Vec::new();
+    yes.push(format!(
+        "every checked edge within {:.1} ns of the schedule's time (sample period {:.1} ns plus twice the skew {:.1} ns): rates, intervals and slot order of the mapped conversion lanes to ±{:.1} ns",
+        res / 1e3,
+        period_ps as f64 / 1e3,
+        skew_ps as f64 / 1e3,
+        res / 1e3
+    ));
+    if res >= tc_ps {
+        no.push(format!(
+            "cycle exactness: the capture cannot resolve one {:.1} ns clock cycle",
+            tc_ps / 1e3
+        ));
+    }
+    let layout = Layout::new(s);
+    // Every bit of branch `b`'s lane of `r` is checked.
+    let has = |r: Role, b: usize| {
+        let (msb, lsb) = layout.lane_bits(r, b);
+        (lsb..=msb).all(|bit| lanes.iter().any(|l| l.role == r && l.bit == bit))
+    };
+    for (b, br) in s.mix.branches.iter().enumerate() {
+        if !has(Role::CsN, b) {
+            no.push(format!(
+                "branch {}: no CS lane checked, nothing of its conversions",
+                br.name
+            ));
+            continue;
+        }
+        if has(Role::Sclk, b) {
+            yes.push(format!(
+                "branch {}: every SCLK edge of every conversion (count and period)",
+                br.name
+            ));
+        } else {
+            no.push(format!(
+                "branch {}: SCLK count and period (no SCLK lane checked)",
+                br.name
+            ));
+        }
+        let settle_ns = br.settle_ns as f64;
+        let mux = has(Role::MuxSel, b) && has(Role::MuxEn, b);
+        match (mux, tpl.settle_margin[b]) {
+            (true, Some(m)) if settle_ns > 0.0 => {
+                let shown = m as f64 * tc_ps - res;
+                if shown / 1e3 >= settle_ns {
+                    yes.push(format!(
+                        "branch {}: mux settled at least {:.0} ns before each instant (needs {settle_ns:.0} ns)",
+                        br.name,
+                        shown / 1e3
+                    ));
+                } else {
+                    no.push(format!(
+                        "branch {}: mux settling ({settle_ns:.0} ns needed; the schedule's margin is {:.0} ns, the capture's resolution {:.1} ns leaves {:.0} ns): an analyser period under {:.1} ns proves it",
+                        br.name,
+                        m as f64 * tc_ps / 1e3,
+                        res / 1e3,
+                        shown / 1e3,
+                        (m as f64 * tc_ps / 1e3 - settle_ns) * 1e3 / 1e3 - 2.0 * skew_ps as f64 / 1e3
+                    ));
+                }
+            }
+            (false, _) => no.push(format!(
+                "branch {}: slot order by channel and mux settling (not every mux_sel/mux_en bit of it is checked)",
+                br.name
+            )),
+            _ => {}
+        }
+    }
+    if !lanes.iter().any(|l| l.role == Role::SampleValid) {
+        no.push("sample stream timing (no sample_valid lane checked)".into());
+    }
+    no.push("sample values and channels (the link's words are not decoded at time level)".into());
+    (yes, no)
+}
