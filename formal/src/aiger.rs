@@ -29,7 +29,10 @@ pub fn parse(text: &str) -> Result<Aig, String> {
         .and_then(|h| h.strip_prefix("aag "))
         .ok_or("not an ASCII AIGER file")?
         .split_whitespace()
-        .map(|x| x.parse::<u32>().map_err(|_| format!("bad header field `{x}`")))
+        .map(|x| {
+            x.parse::<u32>()
+                .map_err(|_| format!("bad header field `{x}`"))
+        })
         .collect::<Result<_, _>>()?;
     if head.len() < 5 {
         return Err("short AIGER header".into());
@@ -45,7 +48,10 @@ pub fn parse(text: &str) -> Result<Aig, String> {
         let line = lines.next().ok_or("truncated AIGER file")?;
         let v: Vec<u32> = line
             .split_whitespace()
-            .map(|x| x.parse::<u32>().map_err(|_| format!("bad AIGER line `{line}`")))
+            .map(|x| {
+                x.parse::<u32>()
+                    .map_err(|_| format!("bad AIGER line `{line}`"))
+            })
             .collect::<Result<_, _>>()?;
         if v.len() < n {
             return Err(format!("bad AIGER line `{line}`"));
@@ -256,7 +262,8 @@ mod tests {
         assert_eq!(g.latches.len(), 2);
         assert_eq!(g.ands.len(), 3);
         let m = recurrence_miter(&g, &[0], 4, 6);
-        let head = String::from_utf8_lossy(&m[..m.iter().position(|&c| c == b'\n').unwrap()]).into_owned();
+        let head =
+            String::from_utf8_lossy(&m[..m.iter().position(|&c| c == b'\n').unwrap()]).into_owned();
         // one input, two copies of each latch plus the 3-bit counter and `go`
         assert!(head.starts_with("aig "), "{head}");
         let f: Vec<u32> = head[4..].split(' ').map(|x| x.parse().unwrap()).collect();

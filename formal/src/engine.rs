@@ -63,14 +63,23 @@ pub enum Verdict {
 
 /// Runs `program args`, in `dir`, returning stdout+stderr; a missing program
 /// is named.
-pub fn run_tool(dir: &Path, program: &str, args: &[&str], timeout: Duration) -> Result<String, ProveError> {
+pub fn run_tool(
+    dir: &Path,
+    program: &str,
+    args: &[&str],
+    timeout: Duration,
+) -> Result<String, ProveError> {
     let mut child = Command::new(program)
         .args(args)
         .current_dir(dir)
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
-        .map_err(|e| ProveError::Tool(format!("cannot run `{program}`: {e} (install it with `make tools`)")))?;
+        .map_err(|e| {
+            ProveError::Tool(format!(
+                "cannot run `{program}`: {e} (install it with `make tools`)"
+            ))
+        })?;
     let start = Instant::now();
     // The engines take their own time limits; this one only guards a hung tool.
     // (generous: a loaded machine stretches wall time well past CPU time)
@@ -125,7 +134,12 @@ pub fn prepare(dir: &Path, solver: Solver) -> Result<Prepared, ProveError> {
         ),
         Solver::Cvc5 => format!("{read} dffunmap; write_smt2 -wires design.smt2"),
     };
-    run_tool(dir, "yosys", &["-q", "-p", &script], Duration::from_secs(600))?;
+    run_tool(
+        dir,
+        "yosys",
+        &["-q", "-p", &script],
+        Duration::from_secs(600),
+    )?;
     Ok(Prepared {
         dir: dir.to_path_buf(),
     })
@@ -136,14 +150,24 @@ pub fn bmc(p: &Prepared, frames: u64, secs: u64) -> Result<Verdict, ProveError> 
     let cmd = format!(
         "read_aiger design.aig; fold; strash; bmc3 -F {frames} -T {secs}; write_cex -a cex.aiw"
     );
-    let out = run_tool(&p.dir, "yosys-abc", &["-c", &cmd], Duration::from_secs(secs))?;
+    let out = run_tool(
+        &p.dir,
+        "yosys-abc",
+        &["-c", &cmd],
+        Duration::from_secs(secs),
+    )?;
     parse_abc(&out, frames)
 }
 
 /// ABC's `pdr` for at most `secs` seconds.
 pub fn pdr(p: &Prepared, secs: u64) -> Result<Option<Verdict>, ProveError> {
     let cmd = format!("read_aiger design.aig; fold; strash; pdr -T {secs}; write_cex -a cex.aiw");
-    let out = run_tool(&p.dir, "yosys-abc", &["-c", &cmd], Duration::from_secs(secs))?;
+    let out = run_tool(
+        &p.dir,
+        "yosys-abc",
+        &["-c", &cmd],
+        Duration::from_secs(secs),
+    )?;
     if out.contains("Property proved") {
         return Ok(Some(Verdict::Proved));
     }
@@ -206,14 +230,22 @@ pub fn recurrence(p: &Prepared, frame_cycles: u64, secs: u64) -> Result<Option<b
     let aag = std::fs::read_to_string(p.dir.join("design.aag"))
         .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
     let g = crate::aiger::parse(&aag).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
-    let shared = miso_inputs(p)?.iter().map(|&(idx, _)| idx).collect::<Vec<_>>();
+    let shared = miso_inputs(p)?
+        .iter()
+        .map(|&(idx, _)| idx)
+        .collect::<Vec<_>>();
     let check = 2 * frame_cycles + 2;
     let miter = crate::aiger::recurrence_miter(&g, &shared, frame_cycles, check);
     std::fs::write(p.dir.join("recur.aig"), miter)
         .map_err(|e| ProveError::Tool(format!("recur.aig: {e}")))?;
     let frames = check + 2;
     let cmd = format!("read_aiger recur.aig; strash; bmc3 -F {frames} -T {secs}");
-    let out = run_tool(&p.dir, "yosys-abc", &["-c", &cmd], Duration::from_secs(secs))?;
+    let out = run_tool(
+        &p.dir,
+        "yosys-abc",
+        &["-c", &cmd],
+        Duration::from_secs(secs),
+    )?;
     Ok(match parse_abc(&out, frames)? {
         Verdict::Violated { .. } => Some(false),
         Verdict::Bounded { steps } if steps > check => Some(true),
@@ -243,7 +275,16 @@ pub fn smt_induction(p: &Prepared, k: u64, secs: u64) -> Result<Option<Verdict>,
     let out = run_tool(
         &p.dir,
         "yosys-smtbmc",
-        &["-s", "cvc5", "-i", "-t", &k, "--dump-vcd", "smt_cex.vcd", "design.smt2"],
+        &[
+            "-s",
+            "cvc5",
+            "-i",
+            "-t",
+            &k,
+            "--dump-vcd",
+            "smt_cex.vcd",
+            "design.smt2",
+        ],
         Duration::from_secs(secs),
     );
     let out = match out {
@@ -296,11 +337,19 @@ mod tests {
     #[test]
     fn abc_verdicts() {
         assert_eq!(
-            parse_abc("Output 0 of miter \"x\" was asserted in frame 57.  Time = 0.1 sec", 100).unwrap(),
+            parse_abc(
+                "Output 0 of miter \"x\" was asserted in frame 57.  Time = 0.1 sec",
+                100
+            )
+            .unwrap(),
             Verdict::Violated { step: 57 }
         );
         assert_eq!(
-            parse_abc("No output asserted in 1000 frames. Resource limit reached", 1000).unwrap(),
+            parse_abc(
+                "No output asserted in 1000 frames. Resource limit reached",
+                1000
+            )
+            .unwrap(),
             Verdict::Bounded { steps: 1000 }
         );
     }
@@ -308,7 +357,10 @@ mod tests {
     #[test]
     fn solvers() {
         assert_eq!("pdr".parse::<Solver>(), Ok(Solver::Pdr));
-        assert!("z3".parse::<Solver>().unwrap_err().contains("not supported"));
+        assert!("z3"
+            .parse::<Solver>()
+            .unwrap_err()
+            .contains("not supported"));
         assert!("yices".parse::<Solver>().unwrap_err().contains("unknown"));
     }
 }

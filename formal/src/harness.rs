@@ -101,9 +101,7 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
     }
     let layout = Layout::new(s);
     let nb = s.branches.len();
-    let total_words: u64 = (0..nb)
-        .map(|b| u64::from(s.branches[b].spi.words))
-        .sum();
+    let total_words: u64 = (0..nb).map(|b| u64::from(s.branches[b].spi.words)).sum();
     for (b, p) in s.branches.iter().enumerate() {
         let spi = &p.spi;
         if spi.read_cycles >= g.slot_cycles {
@@ -130,7 +128,10 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
     }
     merger(&mut v, &mut props, s, &layout);
     let _ = writeln!(v, "  wire ok = {};", {
-        let w: Vec<&str> = props.iter().map(|p: &PropertyDef| p.wire.as_str()).collect();
+        let w: Vec<&str> = props
+            .iter()
+            .map(|p: &PropertyDef| p.wire.as_str())
+            .collect();
         w.join(" & ")
     });
     v.push_str("  // Checked from the reset cycle's outputs on (step 0 is before any edge).\n");
@@ -210,7 +211,12 @@ fn branch(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
     let (cb, sb) = (width(g.slot_cycles), width(g.frame_slots));
     let chb = layout.channel_bits;
     let en_n = layout.en_n[b];
-    let (su, d, h, r) = (spi.setup_cycles, spi.sclk_div, spi.sclk_half, spi.read_cycles);
+    let (su, d, h, r) = (
+        spi.setup_cycles,
+        spi.sclk_div,
+        spi.sclk_half,
+        spi.read_cycles,
+    );
     let n = spi.sclks();
     let cnv = spi.style == Start::Cnv;
     let caps = if cnv { n } else { n - 1 };
@@ -227,9 +233,7 @@ fn branch(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
         let (act, lead) = t.lead[slot].map_or((0, 0), |l| (1u64, l as u64));
         let (e0, s0) = t.mux0[slot];
         let (e1, s1) = t.mux1[slot];
-        format!(
-            "{{1'b{act}, {chb}'d{lead}, {en_n}'d{e0}, 3'd{s0}, {en_n}'d{e1}, 3'd{s1}}}"
-        )
+        format!("{{1'b{act}, {chb}'d{lead}, {en_n}'d{e0}, 3'd{s0}, {en_n}'d{e1}, 3'd{s1}}}")
     };
     // The most common row becomes the default arm.
     let rows: Vec<String> = (0..g.frame_slots as usize).map(word).collect();
@@ -280,9 +284,15 @@ fn branch(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
         }
     }
     let (cs_exp, sclk_exp) = if cnv {
-        (format!("busy{b}"), format!("conv{b} && ({})", ranges(cb, &high)))
+        (
+            format!("busy{b}"),
+            format!("conv{b} && ({})", ranges(cb, &high)),
+        )
     } else {
-        (format!("!busy{b}"), format!("!(conv{b} && ({}))", ranges(cb, &low)))
+        (
+            format!("!busy{b}"),
+            format!("!(conv{b} && ({}))", ranges(cb, &low)),
+        )
     };
     let (sel_hi, sel_lo) = layout.lane_bits(Role::MuxSel, b);
     let (en_hi, en_lo) = layout.lane_bits(Role::MuxEn, b);
@@ -350,11 +360,12 @@ fn merger(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
         // Words per lead, channel and value of each (lead, word index).
         let _ = writeln!(
             v,
-            "  reg [{}:0] nw{b}, wch{b};\n  reg [{}:0] wval{b};\n  reg [{}:0] pw{b} = 0, wi{b} = 0;\n  \
+            "  reg [{}:0] nw{b};\n  reg [{}:0] wch{b};\n  reg [{}:0] wval{b};\n  reg [{}:0] pw{b} = 0, wi{b} = 0;\n  \
              reg [{}:0] pc{b} = 0;\n  wire [{}:0] pw_e{b} = done{b} ? nw{b} : pw{b};\n  \
              wire [{}:0] wi_e{b} = done{b} ? {nwb}'d0 : wi{b};\n  wire [{}:0] pc_e{b} = done{b} ? lead{b} : pc{b};\n  \
              wire av{b} = pw_e{b} != {nwb}'d0;",
             nwb - 1,
+            chb - 1,
             vb - 1,
             nwb - 1,
             chb - 1,
@@ -371,10 +382,14 @@ fn merger(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
             );
         }
         let _ = writeln!(v, "    default: nw{b} = {nwb}'d0;\n  endcase");
-        let _ = writeln!(v, "  always @* begin\n    wch{b} = 0; wval{b} = 0;\n    case ({{pc_e{b}, wi_e{b}}})");
+        let _ = writeln!(
+            v,
+            "  always @* begin\n    wch{b} = 0; wval{b} = 0;\n    case ({{pc_e{b}, wi_e{b}}})"
+        );
         for &l in &leads {
             for (i, (m, c)) in s.words_of(l).enumerate() {
-                let end = m as u64 * spi.word_sclks as u64 + spi.leading_bits as u64 + spi.bits as u64;
+                let end =
+                    m as u64 * spi.word_sclks as u64 + spi.leading_bits as u64 + spi.bits as u64;
                 let lo = n - end;
                 let hi = lo + spi.bits as u64 - 1;
                 let _ = writeln!(
@@ -393,7 +408,10 @@ fn merger(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
         vb - 1
     );
     for b in 0..nb {
-        let _ = writeln!(v, "    pw{b} <= pw_e{b}; wi{b} <= wi_e{b}; pc{b} <= pc_e{b};");
+        let _ = writeln!(
+            v,
+            "    pw{b} <= pw_e{b}; wi{b} <= wi_e{b}; pc{b} <= pc_e{b};"
+        );
     }
     let avs: Vec<String> = (0..nb).map(|b| format!("av{b}")).collect();
     let _ = writeln!(v, "    exp_valid <= {};", avs.join(" || "));

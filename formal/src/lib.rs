@@ -10,6 +10,7 @@
 
 pub mod aiger;
 pub mod engine;
+pub mod faults;
 pub mod harness;
 pub mod replay;
 
@@ -152,7 +153,8 @@ fn write_inputs(dir: &Path, h: &Harness, design: &str) -> Result<(), ProveError>
 pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, ProveError> {
     let t0 = Instant::now();
     let h = harness::generate(s)?;
-    let work = tempfile::tempdir().map_err(|e| ProveError::Tool(format!("temporary directory: {e}")))?;
+    let work =
+        tempfile::tempdir().map_err(|e| ProveError::Tool(format!("temporary directory: {e}")))?;
     write_inputs(work.path(), &h, design)?;
     let prep = engine::prepare(work.path(), opts.solver)?;
     let t1 = Instant::now();
@@ -175,7 +177,10 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         (
             Outcome::Failed,
             step,
-            format!("a trace from reset violates the contract at step {step} (cycle {})", step as i64 - 2),
+            format!(
+                "a trace from reset violates the contract at step {step} (cycle {})",
+                step as i64 - 2
+            ),
         )
     };
     let (result, depth, note) = match opts.solver {

@@ -38,15 +38,17 @@ fn testbench(s: &Schedule, h: &Harness, steps: u64, period_ps: u64) -> String {
     let mut v = String::new();
     let _ = writeln!(
         v,
-        "`timescale 1ps/1ps\nmodule replay_tb;\n  reg clk = 1'b1;\n  reg [{}:0] adc_miso = 0;\n  \
+        "`timescale 1ps/1ps\nmodule replay_tb;\n  reg clk = 1'b0;\n  reg [{}:0] adc_miso = 0;\n  \
          reg [{}:0] miso [0:{}];\n  integer i;\n  slotforge_formal h (.clk(clk), .adc_miso(adc_miso));\n  \
-         always #{} clk = ~clk;\n  initial begin\n    $readmemb(\"miso.mem\", miso);\n    \
+         // Rising edges at k * period (k >= 1) only: an X-to-1 start would be one.\n  \
+         always begin #{} clk = 1'b0; #{} clk = 1'b1; end\n  initial begin\n    $readmemb(\"miso.mem\", miso);\n    \
          $dumpfile(\"trace.vcd\");\n    $dumpvars(1, h.dut);\n    $dumpvars(1, h);\n    \
          for (i = 0; i < {steps}; i = i + 1) begin\n      #{} adc_miso = miso[i];\n      #{};",
         nb - 1,
         nb - 1,
         steps.max(1) - 1,
         period_ps / 2,
+        period_ps - period_ps / 2,
         period_ps / 4,
         period_ps / 2,
     );
@@ -116,11 +118,23 @@ pub fn replay(
     run_tool(
         work,
         "iverilog",
-        &["-g2005", "-o", "replay.vvp", "replay_tb.v", "harness.v", "design.v"],
+        &[
+            "-g2005",
+            "-o",
+            "replay.vvp",
+            "replay_tb.v",
+            "harness.v",
+            "design.v",
+        ],
         Duration::from_secs(300),
     )?;
     let _ = design;
-    let log = run_tool(work, "vvp", &["-n", "replay.vvp"], Duration::from_secs(3600))?;
+    let log = run_tool(
+        work,
+        "vvp",
+        &["-n", "replay.vvp"],
+        Duration::from_secs(3600),
+    )?;
     let mut step = None;
     let mut failed = Vec::new();
     for line in log.lines() {

@@ -68,7 +68,10 @@ pub fn run(a: Args) -> u8 {
             Ok(h) => {
                 let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
                 let dir = dir.unwrap_or(std::path::Path::new("."));
-                let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("harness.v");
+                let name = path
+                    .file_name()
+                    .and_then(|n| n.to_str())
+                    .unwrap_or("harness.v");
                 if let Err(e) = super::write_atomic(dir, name, &h.verilog) {
                     eprintln!("error: {e}");
                     return 2;
@@ -93,7 +96,10 @@ pub fn run(a: Args) -> u8 {
         }
     };
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&proof).expect("proof serializes"));
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&proof).expect("proof serializes")
+        );
     } else {
         print!("{}", proof.summary());
     }
