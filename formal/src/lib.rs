@@ -126,9 +126,9 @@ impl ProveOptions {
     pub fn new(out_dir: impl Into<PathBuf>) -> ProveOptions {
         ProveOptions {
             solver: Solver::Abc,
-            timeout_s: 600,
+            timeout_s: 1800,
             depth: None,
-            bmc_timeout_s: 300,
+            bmc_timeout_s: 1800,
             out_dir: out_dir.into(),
             own_design: true,
         }
@@ -304,14 +304,16 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     })
 }
 
-/// The first cycle the judge rejects: its first divergence or violation.
+/// The cycle at which the judge rejects a trace: its first divergence from
+/// the cycle-exact model, else its first invariant violation (a violation
+/// can be dated before the cycle that revealed it, e.g. a missing sample at
+/// its conversion's completion).
 pub fn first_rejected(r: &judge::Report) -> Option<u64> {
-    let d = r.divergences.iter().map(|d| d.cycle).min();
-    let v = r.violations.iter().map(|v| v.cycle).min();
-    match (d, v) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    }
+    r.divergences
+        .iter()
+        .map(|d| d.cycle)
+        .min()
+        .or_else(|| r.violations.iter().map(|v| v.cycle).min())
 }
 
 impl Proof {

@@ -18,8 +18,8 @@ pub struct Args {
     /// The engine: `abc` (bounded search to the recurrence bound + the recurrence check, default), `pdr` (ABC IC3) or `cvc5` (k-induction through yosys-smtbmc).
     #[arg(long, default_value = "abc", value_parser = solver)]
     pub solver: Solver,
-    /// Seconds the unbounded engine may take.
-    #[arg(long, default_value_t = 600)]
+    /// Seconds each engine run may take (the search from reset, the recurrence check, pdr or cvc5).
+    #[arg(long, default_value_t = 1800)]
     pub timeout: u64,
     /// Steps from reset the bounded search covers when the proof does not close (default: two frames).
     #[arg(long)]
@@ -86,6 +86,7 @@ pub fn run(a: Args) -> u8 {
     let mut opts = ProveOptions::new(&a.out);
     opts.solver = a.solver;
     opts.timeout_s = a.timeout;
+    opts.bmc_timeout_s = a.timeout;
     opts.depth = a.depth;
     opts.own_design = own;
     let proof = match formal::prove(&s, &design, &opts) {
