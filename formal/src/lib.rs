@@ -337,6 +337,15 @@ impl Proof {
             self.solver_seconds
         );
         let _ = writeln!(s, "  {}", self.note);
+        let _ = writeln!(
+            s,
+            "  design: {}; properties at the ports only, no internal names",
+            if self.own_design {
+                "slotforge's emitted Verilog"
+            } else {
+                "outside Verilog (--rtl)"
+            }
+        );
         for p in &self.properties {
             let _ = writeln!(
                 s,
