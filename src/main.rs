@@ -38,6 +38,8 @@ enum Command {
     Faults(cmd::faults::Args),
     /// Simulate and compare with the mix's golden event log and waveforms (golden/<mix>/).
     Golden(cmd::golden::Args),
+    /// Prove the gateware meets the pin contract for all time (formal: yosys + ABC or cvc5).
+    Prove(cmd::prove::Args),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +61,7 @@ fn main() -> ExitCode {
         Command::Check(a) => cmd::check::run(a),
         Command::Faults(a) => cmd::faults::run(a),
         Command::Golden(a) => cmd::golden::run(a),
+        Command::Prove(a) => cmd::prove::run(a),
     };
     ExitCode::from(code)
 }

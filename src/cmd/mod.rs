@@ -6,6 +6,7 @@ pub mod check;
 pub mod faults;
 pub mod golden;
 pub mod lut;
+pub mod prove;
 pub mod sim;
 pub mod verilog;
 

@@ -1,0 +1,366 @@
+//! The formal back ends: yosys turns harness + design into an AIG (or SMT-LIB
+//! for yosys-smtbmc), ABC's `bmc3` searches from reset and `pdr` (IC3)
+//! proves for all time; cvc5 through `yosys-smtbmc -i` is the k-induction
+//! alternative.  `docs/formal.md` (and the team's measurements) say why
+//! these and not z3 or boolector.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use crate::ProveError;
+
+/// The prover behind `--solver`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Solver {
+    /// ABC over AIGER: `bmc3` from reset to the recurrence bound, and the
+    /// recurrence miter (`aiger.rs`) that makes that bound cover all time.
+    Abc,
+    /// ABC's `pdr` (IC3) on the plain harness.
+    Pdr,
+    /// cvc5 through yosys-smtbmc: k-induction (`-i`) with base case from reset.
+    Cvc5,
+}
+
+impl std::str::FromStr for Solver {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Solver, String> {
+        match s {
+            "abc" => Ok(Solver::Abc),
+            "pdr" => Ok(Solver::Pdr),
+            "cvc5" => Ok(Solver::Cvc5),
+            "z3" | "boolector" => Err(format!(
+                "solver `{s}` is not supported: Debian's {s} fails on yosys 0.23's SMT-LIB \
+                 output of this design (z3 never finishes reading it, boolector breaks the \
+                 pipe); use `abc` (the default), `pdr` or `cvc5`"
+            )),
+            _ => Err(format!("unknown solver `{s}` (abc, pdr, cvc5)")),
+        }
+    }
+}
+
+impl Solver {
+    pub fn name(self) -> &'static str {
+        match self {
+            Solver::Abc => "abc",
+            Solver::Pdr => "pdr",
+            Solver::Cvc5 => "cvc5",
+        }
+    }
+}
+
+/// What one engine run found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Verdict {
+    /// Holds in every reachable state.
+    Proved,
+    /// Violated at this step from the first step (0 = the step before reset's edge).
+    Violated { step: u64 },
+    /// No violation within this many steps; nothing said beyond them.
+    Bounded { steps: u64 },
+}
+
+/// Runs `program args`, in `dir`, returning stdout+stderr; a missing program
+/// is named.
+pub fn run_tool(
+    dir: &Path,
+    program: &str,
+    args: &[&str],
+    timeout: Duration,
+) -> Result<String, ProveError> {
+    let mut child = Command::new(program)
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| {
+            ProveError::Tool(format!(
+                "cannot run `{program}`: {e} (install it with `make tools`)"
+            ))
+        })?;
+    let start = Instant::now();
+    // The engines take their own time limits; this one only guards a hung tool.
+    // (generous: a loaded machine stretches wall time well past CPU time)
+    let guard = timeout * 4 + Duration::from_secs(120);
+    loop {
+        match child.try_wait() {
+            Ok(Some(_)) => break,
+            Ok(None) if start.elapsed() > guard => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return Err(ProveError::Tool(format!(
+                    "`{program}` did not finish in {} s",
+                    guard.as_secs()
+                )));
+            }
+            Ok(None) => std::thread::sleep(Duration::from_millis(20)),
+            Err(e) => return Err(ProveError::Tool(format!("`{program}`: {e}"))),
+        }
+    }
+    let out = child
+        .wait_with_output()
+        .map_err(|e| ProveError::Tool(format!("`{program}`: {e}")))?;
+    let mut text = String::from_utf8_lossy(&out.stdout).into_owned();
+    text.push_str(&String::from_utf8_lossy(&out.stderr));
+    if !out.status.success() {
+        let tail: Vec<&str> = text.lines().rev().take(12).collect();
+        let tail: Vec<&str> = tail.into_iter().rev().collect();
+        return Err(ProveError::Tool(format!(
+            "`{program} {}` failed:\n{}",
+            args.join(" "),
+            tail.join("\n")
+        )));
+    }
+    Ok(text)
+}
+
+/// Files of a prepared design in the work directory.
+pub struct Prepared {
+    pub dir: PathBuf,
+}
+
+/// yosys: harness + design to `design.aig` (+ `design.aim`) or `design.smt2`.
+pub fn prepare(dir: &Path, solver: Solver) -> Result<Prepared, ProveError> {
+    let read = "read_verilog -formal harness.v; read_verilog -formal design.v; \
+                prep -flatten -top slotforge_formal; memory_map; opt -full; async2sync;";
+    let script = match solver {
+        // As SymbiYosys's `abc pdr` engine prepares an AIG (docs/formal.md).
+        Solver::Abc | Solver::Pdr => format!(
+            "{read} chformal -assume -early; setundef -anyseq; opt -full; techmap; opt -fast; \
+             dffunmap; abc -g AND -fast; opt_clean; write_aiger -I -B -zinit -map design.aim design.aig; \
+             write_aiger -ascii -I -B -zinit design.aag"
+        ),
+        Solver::Cvc5 => format!("{read} dffunmap; write_smt2 -wires design.smt2"),
+    };
+    run_tool(
+        dir,
+        "yosys",
+        &["-q", "-p", &script],
+        Duration::from_secs(600),
+    )?;
+    Ok(Prepared {
+        dir: dir.to_path_buf(),
+    })
+}
+
+/// ABC's `bmc3` from reset for at most `frames` steps and `secs` seconds.
+pub fn bmc(p: &Prepared, frames: u64, secs: u64) -> Result<Verdict, ProveError> {
+    let cmd = format!(
+        "read_aiger design.aig; fold; strash; bmc3 -F {frames} -T {secs}; write_cex -a cex.aiw"
+    );
+    let out = run_tool(
+        &p.dir,
+        "yosys-abc",
+        &["-c", &cmd],
+        Duration::from_secs(secs),
+    )?;
+    parse_abc(&out, frames)
+}
+
+/// ABC's `pdr` for at most `secs` seconds.
+pub fn pdr(p: &Prepared, secs: u64) -> Result<Option<Verdict>, ProveError> {
+    let cmd = format!("read_aiger design.aig; fold; strash; pdr -T {secs}; write_cex -a cex.aiw");
+    let out = run_tool(
+        &p.dir,
+        "yosys-abc",
+        &["-c", &cmd],
+        Duration::from_secs(secs),
+    )?;
+    if out.contains("Property proved") {
+        return Ok(Some(Verdict::Proved));
+    }
+    match parse_abc(&out, 0)? {
+        v @ Verdict::Violated { .. } => Ok(Some(v)),
+        _ => Ok(None),
+    }
+}
+
+/// Reads ABC's verdict: "Output 0 of miter ... was asserted in frame N." or
+/// "No output asserted in N frames.".
+fn parse_abc(out: &str, frames: u64) -> Result<Verdict, ProveError> {
+    for line in out.lines() {
+        if let Some(i) = line.find("was asserted in frame ") {
+            let n: String = line[i + 22..]
+                .chars()
+                .take_while(|c| c.is_ascii_digit())
+                .collect();
+            let step = n
+                .parse()
+                .map_err(|_| ProveError::Tool(format!("ABC: cannot read `{line}`")))?;
+            return Ok(Verdict::Violated { step });
+        }
+        if let Some(i) = line.find("No output asserted in ") {
+            let n: String = line[i + 22..]
+                .chars()
+                .take_while(|c| c.is_ascii_digit())
+                .collect();
+            if let Ok(steps) = n.parse() {
+                return Ok(Verdict::Bounded { steps });
+            }
+        }
+    }
+    if frames > 0 {
+        // bmc3 stopped at its time limit: the last frame it finished.
+        let mut done = 0;
+        for line in out.lines() {
+            if let Some(rest) = line.trim_start().strip_prefix(|c: char| c.is_ascii_digit()) {
+                let _ = rest;
+            }
+            let t = line.trim_start();
+            let num: String = t.chars().take_while(|c| c.is_ascii_digit()).collect();
+            if !num.is_empty() && t[num.len()..].trim_start().starts_with(':') {
+                if let Ok(n) = num.parse::<u64>() {
+                    done = n;
+                }
+            }
+        }
+        return Ok(Verdict::Bounded { steps: done });
+    }
+    Ok(Verdict::Bounded { steps: 0 })
+}
+
+/// The recurrence check (`aiger.rs`): whether, for every input, the state
+/// at step `2F + 2` equals the state a second copy started `F` steps later
+/// reaches at step `F + 2`.  `Some(true)`: it does; `Some(false)`: some
+/// input breaks it (no design bug: only the argument fails); `None`: ABC
+/// did not finish.
+pub fn recurrence(p: &Prepared, frame_cycles: u64, secs: u64) -> Result<Option<bool>, ProveError> {
+    let aag = std::fs::read_to_string(p.dir.join("design.aag"))
+        .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
+    let g = crate::aiger::parse(&aag).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
+    let shared = miso_inputs(p)?
+        .iter()
+        .map(|&(idx, _)| idx)
+        .collect::<Vec<_>>();
+    let check = 2 * frame_cycles + 2;
+    let miter = crate::aiger::recurrence_miter(&g, &shared, frame_cycles, check);
+    std::fs::write(p.dir.join("recur.aig"), miter)
+        .map_err(|e| ProveError::Tool(format!("recur.aig: {e}")))?;
+    let frames = check + 2;
+    let cmd = format!("read_aiger recur.aig; strash; bmc3 -F {frames} -T {secs}");
+    let out = run_tool(
+        &p.dir,
+        "yosys-abc",
+        &["-c", &cmd],
+        Duration::from_secs(secs),
+    )?;
+    Ok(match parse_abc(&out, frames)? {
+        Verdict::Violated { .. } => Some(false),
+        Verdict::Bounded { steps } if steps > check => Some(true),
+        _ => None,
+    })
+}
+
+/// `(input index, bit)` of every `adc_miso` bit in the AIG (yosys's map).
+fn miso_inputs(p: &Prepared) -> Result<Vec<(usize, usize)>, ProveError> {
+    let aim = std::fs::read_to_string(p.dir.join("design.aim"))
+        .map_err(|e| ProveError::Tool(format!("design.aim: {e}")))?;
+    let mut v = Vec::new();
+    for line in aim.lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        if f.len() == 4 && f[0] == "input" && f[3] == "adc_miso" {
+            if let (Ok(idx), Ok(bit)) = (f[1].parse(), f[2].parse()) {
+                v.push((idx, bit));
+            }
+        }
+    }
+    Ok(v)
+}
+
+/// cvc5 through yosys-smtbmc: k-induction of depth `k` (base case from reset).
+pub fn smt_induction(p: &Prepared, k: u64, secs: u64) -> Result<Option<Verdict>, ProveError> {
+    let k = k.to_string();
+    let out = run_tool(
+        &p.dir,
+        "yosys-smtbmc",
+        &[
+            "-s",
+            "cvc5",
+            "-i",
+            "-t",
+            &k,
+            "--dump-vcd",
+            "smt_cex.vcd",
+            "design.smt2",
+        ],
+        Duration::from_secs(secs),
+    );
+    let out = match out {
+        Ok(o) => o,
+        // yosys-smtbmc exits 1 when induction or the base case fails.
+        Err(ProveError::Tool(t)) if t.contains("FAILED") || t.contains("failed") => t,
+        Err(e) => return Err(e),
+    };
+    if out.contains("PASSED") && !out.contains("FAILED") {
+        return Ok(Some(Verdict::Proved));
+    }
+    Ok(None)
+}
+
+/// The MISO values of a counterexample, per step, from ABC's AIGER witness
+/// and the yosys map (`input <index> <bit> <name>`).
+pub fn witness_miso(p: &Prepared, branches: usize) -> Result<Vec<u64>, ProveError> {
+    let miso_inputs: Vec<(usize, usize)> = miso_inputs(p)?
+        .into_iter()
+        .filter(|&(_, bit)| bit < branches)
+        .collect();
+    let cex = std::fs::read_to_string(p.dir.join("cex.aiw"))
+        .map_err(|e| ProveError::Tool(format!("ABC wrote no witness: {e}")))?;
+    let mut lines = cex.lines().map(str::trim).filter(|l| !l.is_empty());
+    // "1", "b0", the initial latch values, then one input vector per step.
+    let _status = lines.next();
+    let _prop = lines.next();
+    let _init = lines.next();
+    let mut steps = Vec::new();
+    for l in lines {
+        if l == "." {
+            break;
+        }
+        let bytes = l.as_bytes();
+        let mut m = 0u64;
+        for &(idx, bit) in &miso_inputs {
+            if bytes.get(idx) == Some(&b'1') {
+                m |= 1 << bit;
+            }
+        }
+        steps.push(m);
+    }
+    Ok(steps)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn abc_verdicts() {
+        assert_eq!(
+            parse_abc(
+                "Output 0 of miter \"x\" was asserted in frame 57.  Time = 0.1 sec",
+                100
+            )
+            .unwrap(),
+            Verdict::Violated { step: 57 }
+        );
+        assert_eq!(
+            parse_abc(
+                "No output asserted in 1000 frames. Resource limit reached",
+                1000
+            )
+            .unwrap(),
+            Verdict::Bounded { steps: 1000 }
+        );
+    }
+
+    #[test]
+    fn solvers() {
+        assert_eq!("pdr".parse::<Solver>(), Ok(Solver::Pdr));
+        assert!("z3"
+            .parse::<Solver>()
+            .unwrap_err()
+            .contains("not supported"));
+        assert!("yices".parse::<Solver>().unwrap_err().contains("unknown"));
+    }
+}

@@ -1,0 +1,373 @@
+//! slotforge's formal flow (`slotforge prove`): a harness generated from the
+//! schedule ([`harness`]) asserts the pin contract of `docs/timing.md`
+//! around `slotforge_top` (slotforge's own Verilog or any design on the port
+//! contract), with MISO free and reset held in the first cycle only; an
+//! engine ([`engine`]) proves it for all time or searches it from reset to a
+//! bound; a violation is replayed ([`replay`]) into a VCD that the judge
+//! checks like any other waveform.
+//!
+//! A bounded result is reported as `bounded` with its depth, never as a proof.
+
+pub mod aiger;
+pub mod engine;
+pub mod faults;
+pub mod harness;
+pub mod replay;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use lut_gen::Schedule;
+
+pub use engine::Solver;
+pub use harness::{generate, Harness, HarnessError, PropertyDef};
+
+/// Why `prove` could not give a verdict.
+#[derive(Debug, thiserror::Error)]
+pub enum ProveError {
+    /// The schedule has no harness (beyond the harness's limits).
+    #[error("{0}")]
+    Harness(#[from] HarnessError),
+    /// A tool is missing or failed (yosys, yosys-abc, yosys-smtbmc, iverilog).
+    #[error("{0}")]
+    Tool(String),
+    /// The counterexample files could not be written.
+    #[error("{0}")]
+    Output(String),
+}
+
+/// What was established.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Outcome {
+    /// Every property holds in every reachable state, for any MISO input.
+    Proved,
+    /// No violation from reset within `depth` steps; nothing is claimed beyond.
+    Bounded,
+    /// A trace from reset violates a property.
+    Failed,
+}
+
+impl Outcome {
+    /// SPEC's exit code: 0 proved, 1 counterexample, 3 bounded only.
+    pub fn exit_code(self) -> u8 {
+        match self {
+            Outcome::Proved => 0,
+            Outcome::Failed => 1,
+            Outcome::Bounded => 3,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct PropertyResult {
+    pub name: String,
+    pub result: Outcome,
+    pub what: String,
+}
+
+/// A violation from reset, replayed.
+#[derive(Debug, Clone, Serialize)]
+pub struct Counterexample {
+    /// First failing cycle, counted like `check` counts (cycle 0 = the first
+    /// cycle after reset); -1 is the reset cycle.
+    pub cycle: i64,
+    /// The VCD (design pins under [`replay::DUT_SCOPE`]) and its GTKWave save file.
+    pub vcd: PathBuf,
+    pub gtkw: PathBuf,
+    /// The judge on that VCD: its first rejected cycle and its summary (what
+    /// `slotforge check MIX VCD --scope replay_tb.h.dut` prints).
+    pub check_cycle: Option<u64>,
+    pub diagnosis: String,
+}
+
+/// The result of `prove`, for the CLI and the build report.
+#[derive(Debug, Clone, Serialize)]
+pub struct Proof {
+    pub mix: String,
+    pub solver: Solver,
+    pub result: Outcome,
+    /// Proved: the frames of PDR's inductive invariant (or k of k-induction);
+    /// bounded: steps from reset searched; failed: the failing step.
+    pub depth: u64,
+    pub properties: Vec<PropertyResult>,
+    /// Wall time of the whole run (harness, yosys, engine, replay).
+    pub seconds: f64,
+    /// Engine time alone.
+    pub solver_seconds: f64,
+    /// Whether the design is slotforge's own emitted Verilog.
+    pub own_design: bool,
+    /// What the result means, in words.
+    pub note: String,
+    pub counterexample: Option<Counterexample>,
+    /// `counterexample.cycle`, repeated at the top level as SPEC asks.
+    pub cycle: Option<i64>,
+}
+
+#[derive(Debug, Clone)]
+pub struct ProveOptions {
+    pub solver: Solver,
+    /// Time limit of the unbounded engine, seconds.
+    pub timeout_s: u64,
+    /// Steps the bounded search from reset covers when the proof does not
+    /// close (default: start-up plus two whole frames).
+    pub depth: Option<u64>,
+    /// Time limit of the bounded search, seconds.
+    pub bmc_timeout_s: u64,
+    /// Where a counterexample's VCD and `.gtkw` go.
+    pub out_dir: PathBuf,
+    /// The design is slotforge's own Verilog (reported; the harness is the same).
+    pub own_design: bool,
+}
+
+impl ProveOptions {
+    pub fn new(out_dir: impl Into<PathBuf>) -> ProveOptions {
+        ProveOptions {
+            solver: Solver::Abc,
+            timeout_s: 1800,
+            depth: None,
+            bmc_timeout_s: 1800,
+            out_dir: out_dir.into(),
+            own_design: true,
+        }
+    }
+}
+
+/// Frames the bounded search covers when the recurrence argument fails
+/// (a design that keeps state across frames: look for its violation deeper).
+pub const DEEP_FRAMES: u64 = 8;
+
+/// The work directory's files: the harness and the design.
+fn write_inputs(dir: &Path, h: &Harness, design: &str) -> Result<(), ProveError> {
+    for (name, text) in [("harness.v", h.verilog.as_str()), ("design.v", design)] {
+        std::fs::write(dir.join(name), text)
+            .map_err(|e| ProveError::Tool(format!("{}: {e}", dir.join(name).display())))?;
+    }
+    Ok(())
+}
+
+/// Proves `design` (Verilog with a `slotforge_top` on the port contract)
+/// against the schedule `s`.
+pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, ProveError> {
+    let t0 = Instant::now();
+    let h = harness::generate(s)?;
+    let work =
+        tempfile::tempdir().map_err(|e| ProveError::Tool(format!("temporary directory: {e}")))?;
+    write_inputs(work.path(), &h, design)?;
+    let prep = engine::prepare(work.path(), opts.solver)?;
+    let t1 = Instant::now();
+    let f = h.frame_cycles;
+    // Steps 0..=2F+1 from power-on: the recurrence bound (aiger.rs).
+    let base = 2 * f + 2;
+    let depth = opts.depth.unwrap_or(0).max(base + 2);
+    let bmc_only = |why: String, steps: u64| {
+        (
+            Outcome::Bounded,
+            steps,
+            format!(
+                "NOT a proof: {why}; no violation from reset within {steps} steps ({} cycles after reset, {:.2} frames)",
+                steps.saturating_sub(2),
+                steps.saturating_sub(2) as f64 / f as f64
+            ),
+        )
+    };
+    let failed = |step: u64| {
+        (
+            Outcome::Failed,
+            step,
+            format!(
+                "a trace from reset violates the contract at step {step} (cycle {})",
+                step as i64 - 2
+            ),
+        )
+    };
+    let (result, depth, note) = match opts.solver {
+        Solver::Abc => match engine::bmc(&prep, depth, opts.bmc_timeout_s)? {
+            engine::Verdict::Violated { step } => failed(step),
+            engine::Verdict::Bounded { steps } if steps > base => {
+                match engine::recurrence(&prep, f, opts.timeout_s)? {
+                    Some(true) => (
+                        Outcome::Proved,
+                        base,
+                        format!(
+                            "proved for all time: no violation from reset within {base} steps, and for every input the state at step {base} recurs at step {} of a copy started a frame later, so those steps reach every reachable state (state recurrence, ABC bmc3)",
+                            base - f
+                        ),
+                    ),
+                    // No argument for all time: search deeper for a violation.
+                    r => {
+                        let why = if r.is_some() {
+                            "the design's state does not recur a frame later for every input (it keeps state older than a frame), so no bound covers all time".to_string()
+                        } else {
+                            format!("the recurrence check did not finish in {} s", opts.timeout_s)
+                        };
+                        let deeper = opts.depth.unwrap_or(0).max(DEEP_FRAMES * f);
+                        match engine::bmc(&prep, deeper, opts.bmc_timeout_s)? {
+                            engine::Verdict::Violated { step } => failed(step),
+                            engine::Verdict::Bounded { steps: more } => bmc_only(why, more.max(steps)),
+                            engine::Verdict::Proved => unreachable!("bmc3 proves nothing"),
+                        }
+                    }
+                }
+            }
+            engine::Verdict::Bounded { steps } => bmc_only(
+                format!("the search from reset stopped at its time limit ({} s) before the recurrence bound {base}", opts.bmc_timeout_s),
+                steps,
+            ),
+            engine::Verdict::Proved => unreachable!("bmc3 proves nothing"),
+        },
+        Solver::Pdr | Solver::Cvc5 => {
+            let closed = if opts.solver == Solver::Pdr {
+                engine::pdr(&prep, opts.timeout_s)?
+            } else {
+                engine::smt_induction(&prep, 4, opts.timeout_s)?
+            };
+            match closed {
+                Some(engine::Verdict::Proved) => (
+                    Outcome::Proved,
+                    0,
+                    format!("proved for all time by {}", opts.solver.name()),
+                ),
+                Some(engine::Verdict::Violated { step }) => failed(step),
+                _ => {
+                    let aig = engine::prepare(work.path(), Solver::Abc)?;
+                    match engine::bmc(&aig, depth, opts.bmc_timeout_s)? {
+                        engine::Verdict::Violated { step } => failed(step),
+                        engine::Verdict::Bounded { steps } => bmc_only(
+                            format!("{} did not close in {} s", opts.solver.name(), opts.timeout_s),
+                            steps,
+                        ),
+                        engine::Verdict::Proved => unreachable!("bmc3 proves nothing"),
+                    }
+                }
+            }
+        }
+    };
+    let solver_seconds = t1.elapsed().as_secs_f64();
+    let mut properties: Vec<PropertyResult> = h
+        .properties
+        .iter()
+        .map(|p| PropertyResult {
+            name: p.name.clone(),
+            result,
+            what: p.what.clone(),
+        })
+        .collect();
+    let mut counterexample = None;
+    if result == Outcome::Failed {
+        if opts.solver == Solver::Cvc5 {
+            // the witness comes from ABC: search again on the AIG
+            let aig = engine::prepare(work.path(), Solver::Abc)?;
+            engine::bmc(&aig, depth + 1, opts.bmc_timeout_s)?;
+        }
+        let miso = engine::witness_miso(&prep, s.branches.len())?;
+        let r = replay::replay(s, &h, design, &miso, work.path(), &opts.out_dir)?;
+        for p in &mut properties {
+            p.result = if r.failed.contains(&p.name) {
+                Outcome::Failed
+            } else {
+                Outcome::Bounded
+            };
+        }
+        let (report, _) = judge::vcd::check_vcd_with(
+            s,
+            &r.vcd,
+            Some(replay::DUT_SCOPE),
+            judge::CheckOptions::default(),
+        )
+        .map_err(|e| ProveError::Tool(format!("checking the counterexample: {e}")))?;
+        let check_cycle = first_rejected(&report);
+        let step = r.step.unwrap_or(depth);
+        counterexample = Some(Counterexample {
+            cycle: step as i64 - 2,
+            vcd: r.vcd,
+            gtkw: r.gtkw,
+            check_cycle,
+            diagnosis: report.summary(),
+        });
+    }
+    let cycle = counterexample.as_ref().map(|c| c.cycle);
+    Ok(Proof {
+        mix: s.mix.name.clone(),
+        solver: opts.solver,
+        result,
+        depth,
+        properties,
+        seconds: t0.elapsed().as_secs_f64(),
+        solver_seconds,
+        own_design: opts.own_design,
+        note,
+        counterexample,
+        cycle,
+    })
+}
+
+/// The cycle at which the judge rejects a trace: its first divergence from
+/// the cycle-exact model, else its first invariant violation (a violation
+/// can be dated before the cycle that revealed it, e.g. a missing sample at
+/// its conversion's completion).
+pub fn first_rejected(r: &judge::Report) -> Option<u64> {
+    r.divergences
+        .iter()
+        .map(|d| d.cycle)
+        .min()
+        .or_else(|| r.violations.iter().map(|v| v.cycle).min())
+}
+
+impl Proof {
+    /// The text `prove` prints.
+    pub fn summary(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "{} [{}]: {} ({} properties, depth {}, {:.1} s, solver {:.1} s)",
+            self.mix,
+            self.solver.name(),
+            match self.result {
+                Outcome::Proved => "PROVED",
+                Outcome::Bounded => "BOUNDED ONLY",
+                Outcome::Failed => "FAILED",
+            },
+            self.properties.len(),
+            self.depth,
+            self.seconds,
+            self.solver_seconds
+        );
+        let _ = writeln!(s, "  {}", self.note);
+        let _ = writeln!(
+            s,
+            "  design: {}; properties at the ports only, no internal names",
+            if self.own_design {
+                "slotforge's emitted Verilog"
+            } else {
+                "outside Verilog (--rtl)"
+            }
+        );
+        for p in &self.properties {
+            let _ = writeln!(
+                s,
+                "  {:<8} {}",
+                match p.result {
+                    Outcome::Proved => "proved",
+                    Outcome::Bounded => "bounded",
+                    Outcome::Failed => "FAILED",
+                },
+                p.name
+            );
+        }
+        if let Some(c) = &self.counterexample {
+            let _ = writeln!(
+                s,
+                "counterexample: cycle {} ({} + {})\n{}",
+                c.cycle,
+                c.vcd.display(),
+                c.gtkw.display(),
+                c.diagnosis.trim_end()
+            );
+        }
+        s
+    }
+}

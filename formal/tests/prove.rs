@@ -1,0 +1,258 @@
+//! `formal::prove` end to end: yosys, ABC and Icarus on real designs.
+//!
+//! Default suite (quick): the smallest preset proves for all time; a
+//! Verilog mutant that changes an output fails with a counterexample whose
+//! VCD the checker rejects at the same cycle; a fault that shows only after
+//! several frames fails too (the recurrence check sees the design keeps
+//! state across frames and the search goes deeper).
+//! Long (`make test-long`): every preset and the 16-branch / 1,024-channel
+//! test mixes prove; the mutant campaign; the deep fault classes against a
+//! three-frame simulation.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use formal::faults::DeepFault;
+use formal::{Outcome, Proof, ProveOptions};
+
+#[path = "../../cosim/tests/mutate/mod.rs"]
+#[allow(dead_code)]
+mod mutate;
+
+// Missing tools fail under CI=true, skip loudly elsewhere.
+#[path = "../../tests/common/tools.rs"]
+mod tools;
+
+const TOOLS: [&str; 4] = ["yosys", "yosys-abc", "iverilog", "vvp"];
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn schedule(rel: &str) -> lut_gen::Schedule {
+    let mix = lut_gen::load(&root().join(rel)).expect("mix loads");
+    lut_gen::synthesize(&mix).expect("mix is feasible")
+}
+
+fn emitted(s: &lut_gen::Schedule) -> String {
+    hdl::emit(s, None).expect("emits").verilog().to_string()
+}
+
+fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
+    let mut o = ProveOptions::new(out);
+    o.timeout_s = 1200;
+    o.bmc_timeout_s = 1200;
+    formal::prove(s, design, &o).expect("prove runs")
+}
+
+/// The checker must reject the counterexample's VCD, at the cycle prove names.
+fn assert_counterexample(s: &lut_gen::Schedule, p: &Proof) {
+    assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
+    let c = p.counterexample.as_ref().expect("a counterexample");
+    assert!(c.vcd.exists() && c.gtkw.exists(), "{c:?}");
+    assert!(
+        p.properties.iter().any(|q| q.result == Outcome::Failed),
+        "the replay names the failing property: {}",
+        p.summary()
+    );
+    let report =
+        judge::vcd::check_vcd(s, &c.vcd, Some(formal::replay::DUT_SCOPE)).expect("VCD reads");
+    assert!(
+        !report.ok,
+        "check accepts the counterexample:\n{}",
+        report.summary()
+    );
+    if c.cycle >= 0 {
+        assert_eq!(
+            formal::first_rejected(&report),
+            Some(c.cycle as u64),
+            "check fails at another cycle than prove:\n{}",
+            p.summary()
+        );
+    }
+}
+
+#[test]
+fn smallest_preset_proves_for_all_time() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("mixes/softslip1k.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    eprintln!("{}", p.summary());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
+    assert_eq!(p.depth, 2 * s.grid.frame_cycles + 2);
+    assert!(p.counterexample.is_none());
+}
+
+/// Mutants of the emitted Verilog on the small two-branch mutation mix.
+fn mutants(s: &lut_gen::Schedule) -> Vec<mutate::Mutant> {
+    use mutate::Operator::*;
+    let per_op = [
+        (RelOp, 5),
+        (Const, 8),
+        (Reset, 5),
+        (AndOr, 3),
+        (Arith, 3),
+        (DropNot, 2),
+        (Concat, 4),
+        (Stuck, 6),
+    ];
+    mutate::mutants(&emitted(s), &per_op)
+}
+
+#[test]
+fn an_output_mutant_fails_with_a_counterexample_check_rejects() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("cosim/tests/data/mutants.toml");
+    // A stuck output: it changes a pin whatever the schedule.
+    let m = mutants(&s)
+        .into_iter()
+        .find(|m| m.site.op == mutate::Operator::Stuck)
+        .expect("a stuck-output mutant");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &m.text, dir.path());
+    eprintln!("{}\n{}", m.describe(), p.summary());
+    assert_counterexample(&s, &p);
+}
+
+#[test]
+fn a_fault_after_five_frames_fails_and_is_never_called_proved() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("cosim/tests/data/mutants.toml");
+    let f = DeepFault::LateCounter { frames: 5 };
+    let design = f.apply(&s, &emitted(&s)).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &design, dir.path());
+    eprintln!("{}", p.summary());
+    assert_counterexample(&s, &p);
+    let c = p.counterexample.as_ref().unwrap();
+    assert_eq!(
+        c.cycle as u64,
+        5 * s.grid.frame_cycles + 1,
+        "{}",
+        p.summary()
+    );
+}
+
+#[test]
+fn harness_is_deterministic_and_names_every_contract_property() {
+    let s = schedule("mixes/eskin34.toml");
+    let a = formal::generate(&s).unwrap();
+    let b = formal::generate(&s).unwrap();
+    assert_eq!(a.verilog, b.verilog);
+    let names: Vec<&str> = a.properties.iter().map(|p| p.name.as_str()).collect();
+    for want in [
+        "conversion[standard]",
+        "sclk[static]",
+        "mux[acoustic]",
+        "stream.valid",
+        "stream.channel",
+        "stream.value",
+    ] {
+        assert!(names.contains(&want), "{want} missing from {names:?}");
+    }
+    // The harness never names the design's internals: only the port contract.
+    assert!(
+        !a.verilog.contains("dut."),
+        "harness reaches into the design"
+    );
+}
+
+// ---- long: make test-long -------------------------------------------------
+
+#[test]
+#[ignore = "long: make test-long"]
+fn every_preset_and_the_largest_test_mixes_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let mut mixes: Vec<String> = std::fs::read_dir(root().join("mixes"))
+        .unwrap()
+        .map(|e| format!("mixes/{}", e.unwrap().file_name().to_string_lossy()))
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    mixes.sort();
+    mixes.push("hdl/tests/data/b16.toml".into());
+    mixes.push("hdl/tests/data/ch1024.toml".into());
+    for m in mixes {
+        let s = schedule(&m);
+        let dir = tempfile::tempdir().unwrap();
+        let t = Instant::now();
+        let p = prove(&s, &emitted(&s), dir.path());
+        eprintln!(
+            "{m}: {:?} in {:.1} s\n{}",
+            p.result,
+            t.elapsed().as_secs_f64(),
+            p.summary()
+        );
+        assert_eq!(p.result, Outcome::Proved, "{m}: {}", p.summary());
+    }
+}
+
+#[test]
+#[ignore = "long: make test-long"]
+fn mutant_campaign_every_output_changing_mutant_fails() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("cosim/tests/data/mutants.toml");
+    let (mut failed, mut proved, mut bounded) = (0, 0, 0);
+    for m in mutants(&s) {
+        let dir = tempfile::tempdir().unwrap();
+        let p = prove(&s, &m.text, dir.path());
+        eprintln!("{}: {:?} ({:.1} s)", m.describe(), p.result, p.seconds);
+        match p.result {
+            Outcome::Failed => {
+                assert_counterexample(&s, &p);
+                failed += 1;
+            }
+            // Proved: the mutant's outputs equal the contract in every state
+            // (an equivalent mutant); never silently bounded.
+            Outcome::Proved => proved += 1,
+            Outcome::Bounded => bounded += 1,
+        }
+    }
+    eprintln!("mutants: {failed} failed, {proved} proved (equivalent), {bounded} bounded");
+    assert_eq!(bounded, 0, "every mutant gets a verdict");
+    assert!(failed > 0);
+}
+
+/// A three-frame simulation (Verilator, the default stimulus) passes the
+/// deep faults; prove fails them with a counterexample check rejects.
+#[test]
+#[ignore = "long: make test-long"]
+fn deep_faults_escape_three_frames_of_simulation_and_fail_prove() {
+    if !tools::require_tools(&["yosys", "yosys-abc", "iverilog", "vvp", "verilator"]) {
+        return;
+    }
+    let s = schedule("cosim/tests/data/mutants.toml");
+    for f in [
+        DeepFault::LateCounter { frames: 4 },
+        DeepFault::RareCollision,
+    ] {
+        let design = f.apply(&s, &emitted(&s)).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let rtl = dir.path().join("faulty.v");
+        std::fs::write(&rtl, &design).unwrap();
+        let opts = cosim::SimOptions {
+            rtl: Some(rtl),
+            ..Default::default()
+        };
+        let sim = cosim::run(&s, cosim::Backend::Verilator, 3, &opts).expect("simulates");
+        assert!(
+            sim.ok,
+            "{}: three frames of simulation already catch it",
+            f.name()
+        );
+        let p = prove(&s, &design, dir.path());
+        eprintln!("{}: simulation passes; prove:\n{}", f.name(), p.summary());
+        assert_counterexample(&s, &p);
+    }
+}

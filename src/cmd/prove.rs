@@ -1,0 +1,108 @@
+//! `slotforge prove MIX [--rtl FILE.v] [--solver pdr|cvc5] [--json]`
+//!
+//! Exit 0: proved for all time; 1: a counterexample (its VCD, `.gtkw` and
+//! the checker's diagnosis); 2: bad input or a tool that cannot run;
+//! 3: bounded only (no violation within the depth, not a proof).
+
+use std::path::PathBuf;
+
+use formal::{ProveOptions, Solver};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The channel-mix file (TOML).
+    pub mix: PathBuf,
+    /// Prove this Verilog (a `slotforge_top` on the port contract) instead of the emitted gateware.
+    #[arg(long)]
+    pub rtl: Option<PathBuf>,
+    /// The engine: `abc` (bounded search to the recurrence bound + the recurrence check, default), `pdr` (ABC IC3) or `cvc5` (k-induction through yosys-smtbmc).
+    #[arg(long, default_value = "abc", value_parser = solver)]
+    pub solver: Solver,
+    /// Seconds each engine run may take (the search from reset, the recurrence check, pdr or cvc5).
+    #[arg(long, default_value_t = 1800)]
+    pub timeout: u64,
+    /// Steps from reset the bounded search covers when the proof does not close (default: two frames).
+    #[arg(long)]
+    pub depth: Option<u64>,
+    /// Directory for a counterexample's VCD and .gtkw (created if missing).
+    #[arg(short = 'o', long = "out", default_value = "prove-out")]
+    pub out: PathBuf,
+    /// Also write the generated harness here.
+    #[arg(long)]
+    pub harness: Option<PathBuf>,
+    /// Print the result as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn solver(s: &str) -> Result<Solver, String> {
+    s.parse()
+}
+
+pub fn run(a: Args) -> u8 {
+    let s = match super::schedule(&a.mix) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    if let Err(code) = super::fits_pins(&s) {
+        return code;
+    }
+    let (design, own) = match &a.rtl {
+        Some(path) => match cosim::rtl::load_rtl(&s, path) {
+            Ok(text) => (text, false),
+            Err(e) => {
+                eprintln!("error: {e}");
+                return 2;
+            }
+        },
+        None => match hdl::emit(&s, None) {
+            Ok(e) => (e.verilog().to_string(), true),
+            Err(e) => {
+                eprintln!("error: {}: {e}", a.mix.display());
+                return 2;
+            }
+        },
+    };
+    if let Some(path) = &a.harness {
+        match formal::generate(&s) {
+            Ok(h) => {
+                let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
+                let dir = dir.unwrap_or(std::path::Path::new("."));
+                let name = path
+                    .file_name()
+                    .and_then(|n| n.to_str())
+                    .unwrap_or("harness.v");
+                if let Err(e) = super::write_atomic(dir, name, &h.verilog) {
+                    eprintln!("error: {e}");
+                    return 2;
+                }
+            }
+            Err(e) => {
+                eprintln!("error: mix `{}`: {e}", s.mix.name);
+                return 2;
+            }
+        }
+    }
+    let mut opts = ProveOptions::new(&a.out);
+    opts.solver = a.solver;
+    opts.timeout_s = a.timeout;
+    opts.bmc_timeout_s = a.timeout;
+    opts.depth = a.depth;
+    opts.own_design = own;
+    let proof = match formal::prove(&s, &design, &opts) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    if a.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&proof).expect("proof serializes")
+        );
+    } else {
+        print!("{}", proof.summary());
+    }
+    proof.result.exit_code()
+}

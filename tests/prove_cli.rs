@@ -1,0 +1,88 @@
+//! `slotforge prove`: exit codes and JSON (SPEC: 0 proved, 1 counterexample,
+//! 2 bad input, 3 bounded only; `result`, `depth`, `properties`, `seconds`,
+//! `counterexample`, `cycle`).  On the tiny mix (a 4,000-cycle frame).
+
+use std::path::PathBuf;
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+
+// Missing tools fail under CI=true, skip loudly elsewhere.
+#[path = "common/tools.rs"]
+mod tools;
+
+fn slotforge() -> Command {
+    Command::cargo_bin("slotforge").unwrap()
+}
+
+fn tiny() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml")
+}
+
+#[test]
+fn solvers_that_fail_on_our_netlists_are_refused_with_the_reason() {
+    slotforge()
+        .args(["prove", tiny().to_str().unwrap(), "--solver", "z3"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("z3 never finishes reading it"));
+}
+
+#[test]
+fn a_bad_mix_exits_2_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "name = \"x\"\n[clock]\nhz = \"fast\"\n").unwrap();
+    slotforge()
+        .args(["prove", bad.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("bad.toml"));
+}
+
+#[test]
+fn rtl_off_the_port_contract_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let v = dir.path().join("x.v");
+    std::fs::write(&v, "module slotforge_top(input clk); endmodule\n").unwrap();
+    slotforge()
+        .args([
+            "prove",
+            tiny().to_str().unwrap(),
+            "--rtl",
+            v.to_str().unwrap(),
+        ])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("x.v"));
+}
+
+#[test]
+fn proved_json_has_specs_keys_and_exit_0() {
+    if !tools::require_tools(&["yosys", "yosys-abc"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = slotforge()
+        .args(["prove", tiny().to_str().unwrap(), "--json", "-o"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(v["result"], "proved");
+    assert_eq!(v["depth"], 2 * 4000 + 2);
+    assert!(v["seconds"].as_f64().unwrap() > 0.0);
+    assert!(v["counterexample"].is_null() && v["cycle"].is_null());
+    let props = v["properties"].as_array().unwrap();
+    assert_eq!(props.len(), 2 * 3 + 3, "{props:?}");
+    assert!(props
+        .iter()
+        .all(|p| p["result"] == "proved" && p["name"].is_string()));
+}
