@@ -162,3 +162,53 @@ fn golden_keeps_and_verifies_fst_windows() {
         .code(1)
         .stdout(predicate::str::contains("window w.fst DIFFERS"));
 }
+
+#[test]
+fn check_map_errors_name_the_entry_and_exit_2() {
+    let d = tempfile::tempdir().unwrap();
+    let cap = d.path().join("cap.vcd");
+    std::fs::write(
+        &cap,
+        "$timescale 1 ns $end\n$var wire 1 ! D0 $end\n$enddefinitions $end\n#0\n0!\n",
+    )
+    .unwrap();
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&cap)
+        .args(["--map", "D0=adc_cs_n[9]"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("D0=adc_cs_n[9]"))
+        .stderr(predicate::str::contains("no bit 9"));
+    let map = d.path().join("probes.map");
+    std::fs::write(&map, "# probes\nD0 = adc_cs_n[0]\nD1 = spi_clk[0]\n").unwrap();
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&cap)
+        .arg("--map")
+        .arg(&map)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("probes.map:3"))
+        .stderr(predicate::str::contains("spi_clk"));
+    // A channel the capture lacks, and a capture with no conversion start.
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&cap)
+        .args(["--map", "D0=adc_cs_n[0],D5=adc_sclk[0]"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("D5"));
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&cap)
+        .args(["--map", "D0=adc_cs_n[0]", "--skew", "2ns"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("cap.vcd"))
+        .stderr(predicate::str::contains("panicked").not());
+}

@@ -500,6 +500,12 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
             lanes[cs_lane].port_bit()
         )));
     };
+    if edges_checked == 0 && violations.is_empty() {
+        return Err(TimedError(format!(
+            "the capture ends before any edge after its first conversion start (at {:.3} us): nothing to check",
+            locked_at as f64 / 1e6
+        )));
+    }
     // A lane must not miss an edge the schedule puts inside the capture.
     let end = cap.steps.last().map(|s| s.0).unwrap_or(0) as i128 * clock;
     if violations.is_empty() && cands.len() == 1 {

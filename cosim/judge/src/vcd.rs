@@ -333,6 +333,8 @@ struct Resolved {
     /// id code -> sinks (empty for signals we do not need).
     ids: Ids,
     has_clk: bool,
+    /// `rst` is dumped (without it, every cycle counts as out of reset).
+    has_rst: bool,
     scope: String,
     widths: [u32; 10],
 }
@@ -351,7 +353,15 @@ fn resolve(
     scopes.sort_unstable();
     scopes.dedup();
     let has = |sc: &str, name: &str| h.vars.iter().any(|v| v.scope == sc && v.name == name);
-    let required = &PORTS[1..];
+    // `clk` and `rst` may be absent (a capture without them: cycles are then
+    // inferred, and the frame phase found from the pins, `lock.rs`).
+    let required: Vec<&str> = PORTS
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != CLK && *i != RST)
+        .map(|(_, p)| *p)
+        .collect();
+    let required = &required[..];
     let mut candidates: Vec<&str> = match want {
         Some(w) => {
             let m: Vec<&str> = scopes
@@ -386,16 +396,15 @@ fn resolve(
             .map(|v| v.width)
             .sum()
     };
+    // An absent `rst` fits any mix.
+    let fits = |c: &str, p: &str, w: u32| {
+        let got = width_of(c, p);
+        got == w || (p == PORTS[RST] && got == 0)
+    };
     let exact: Vec<&str> = candidates
         .iter()
         .copied()
-        .filter(|c| {
-            PORTS
-                .iter()
-                .zip(widths)
-                .skip(1)
-                .all(|(p, w)| width_of(c, p) == w)
-        })
+        .filter(|c| PORTS.iter().zip(widths).skip(1).all(|(p, w)| fits(c, p, w)))
         .collect();
     if !exact.is_empty() {
         candidates = exact;
@@ -405,7 +414,7 @@ fn resolve(
             .iter()
             .zip(widths)
             .skip(1)
-            .find(|(p, w)| width_of(c, p) != *w)
+            .find(|(p, w)| !fits(c, p, *w))
             .expect("a candidate whose widths differ");
         return Err(perr(format!(
             "the scopes with {TOP_MODULE}'s ports ({}) do not have this mix's widths (`{p}`: {w} bit(s) expected, {} in `{c}`): is the VCD from another mix?",
@@ -457,6 +466,7 @@ fn resolve(
         ids.entry(v.id.clone()).or_default();
     }
     let mut has_clk = false;
+    let mut has_rst = true;
     for (p, name) in PORTS.iter().enumerate() {
         let vs: Vec<&Var> = h
             .vars
@@ -465,6 +475,10 @@ fn resolve(
             .collect();
         if vs.is_empty() {
             if p == CLK {
+                continue;
+            }
+            if p == RST {
+                has_rst = false;
                 continue;
             }
             return Err(perr(format!("port `{name}` not found in scope `{scope}`")));
@@ -507,6 +521,7 @@ fn resolve(
     Ok(Resolved {
         ids: Ids::new(ids),
         has_clk,
+        has_rst,
         scope: scope.to_string(),
         widths,
     })
@@ -794,7 +809,9 @@ fn body<R: BufRead>(
         }
         let (pins, xz) = st.pins();
         let rst_of = |v: &Val| {
-            if v.x & 1 != 0 {
+            if !res.has_rst {
+                Some(false)
+            } else if v.x & 1 != 0 {
                 None
             } else {
                 Some(v.v & 1 == 1)

@@ -151,3 +151,29 @@ fn a_window_from_reset_is_checked_from_reset() {
     assert!(r.ok, "{}", r.summary());
     assert!(info.lock.is_none());
 }
+
+#[test]
+fn a_window_without_clock_or_reset_is_checked() {
+    let s = tiny();
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("w.vcd");
+    window(&s, &mut ModelDut::new(&s), 5_317, 13_000, &p);
+    // Drop `clk` and `rst` (codes `!` and `"` in slotforge's VCDs).
+    let t = std::fs::read_to_string(&p).unwrap();
+    let q = d.path().join("bare.vcd");
+    let kept: String = t
+        .lines()
+        .filter(|l| {
+            !matches!(*l, "0!" | "1!" | "0\"" | "1\"")
+                && !l.contains(" clk ")
+                && !l.contains(" rst ")
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(&q, kept).unwrap();
+    let (r, info) = check(&s, &q).unwrap();
+    assert!(r.ok, "{}", r.summary());
+    assert!(!info.clock_dumped);
+    assert!(info.lock.is_some());
+    assert!(r.cycles > 7_000, "{}", r.summary());
+}
