@@ -38,6 +38,8 @@ enum Command {
     Faults(cmd::faults::Args),
     /// Simulate and compare with the mix's golden event log and waveforms (golden/<mix>/).
     Golden(cmd::golden::Args),
+    /// Host side: the raw bytes received from the link (a serial-port dump, or `-` for stdin), as samples.
+    Decode(cmd::decode::Args),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +61,7 @@ fn main() -> ExitCode {
         Command::Check(a) => cmd::check::run(a),
         Command::Faults(a) => cmd::faults::run(a),
         Command::Golden(a) => cmd::golden::run(a),
+        Command::Decode(a) => cmd::decode::run(a),
     };
     ExitCode::from(code)
 }

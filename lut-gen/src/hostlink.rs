@@ -215,6 +215,61 @@ pub fn merged_frame(s: &Schedule) -> Vec<(u64, u64, u16)> {
     out
 }
 
+/// Where the samples of each packet were taken, for a host that knows the
+/// mix: per slice, `(channel, sampling instant)` of every sample the packet
+/// of that slice carries in steady state, in output order, the instant in
+/// cycles from the start of the packet's frame (negative for a sample of
+/// the previous frame's end that left in this frame's first slice).
+#[derive(Debug, Clone)]
+pub struct PacketInstants {
+    per_slice: Vec<Vec<(u16, i64)>>,
+    frame_cycles: u64,
+    clock_hz: u64,
+}
+
+impl PacketInstants {
+    pub fn new(s: &Schedule) -> PacketInstants {
+        let g = &s.grid;
+        let mut per_slice = vec![Vec::new(); g.slices_per_frame as usize];
+        for (v, i, ch) in merged_frame(s) {
+            let w = v / g.slice_cycles;
+            let k = (w % g.slices_per_frame) as usize;
+            let shift = (w / g.slices_per_frame * g.frame_cycles) as i64;
+            per_slice[k].push((ch, i as i64 - shift));
+        }
+        PacketInstants {
+            per_slice,
+            frame_cycles: g.frame_cycles,
+            clock_hz: g.clock_hz,
+        }
+    }
+
+    /// The sampling time in seconds of each record of the packet of
+    /// `(frame, slice)` carrying `channels` in order.  A channel with `m`
+    /// records in the packet gets the last `m` of its instants in the slice,
+    /// so a sample skipped at start-up (docs/timing.md) shifts none of the
+    /// others; `None` where the schedule has no instant left for a record.
+    pub fn times(&self, frame: u64, slice: u16, channels: &[u16]) -> Vec<Option<f64>> {
+        let Some(list) = self.per_slice.get(slice as usize) else {
+            return vec![None; channels.len()];
+        };
+        let base = (frame * self.frame_cycles) as i64;
+        let mut seen: BTreeMap<u16, usize> = BTreeMap::new();
+        channels
+            .iter()
+            .map(|&c| {
+                let m = channels.iter().filter(|&&x| x == c).count();
+                let have: Vec<i64> = list.iter().filter(|e| e.0 == c).map(|e| e.1).collect();
+                let i = seen.entry(c).or_insert(0);
+                let k = (have.len() + *i).checked_sub(m);
+                *i += 1;
+                k.and_then(|k| have.get(k))
+                    .map(|&t| (base + t) as f64 / self.clock_hz as f64)
+            })
+            .collect()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -247,6 +302,21 @@ mod tests {
         let e = plan(&s).unwrap().unwrap_err();
         assert_eq!(e.min_baud, Some(1_500_000.0));
         assert!(e.message.contains("1500000"), "{}", e.message);
+    }
+
+    #[test]
+    fn packet_times_are_the_sampling_instants() {
+        let s = eskin(3_000_000);
+        let pi = PacketInstants::new(&s);
+        // slice 0 of frame 1 carries CH35 (channel 34) sampled at cycle 0 of the slice
+        let ch35 = s.mix.channel_index("CH35").unwrap() as u16;
+        let t = pi.times(1, 0, &[ch35, ch35]);
+        let first = s.first_sample_cycle(ch35 as usize) + s.grid.frame_cycles;
+        assert_eq!(t[0], Some(first as f64 / 48e6));
+        // one record only (the first skipped at start-up): the later instant
+        let t1 = pi.times(1, 0, &[ch35]);
+        assert_eq!(t1[0], t[1]);
+        assert!(pi.times(1, 0, &[ch35, ch35, ch35])[0].is_none());
     }
 
     #[test]
