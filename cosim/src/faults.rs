@@ -235,6 +235,7 @@ pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(&'static str, hdl::Gat
             hdl::GatewareFault::SliceWrap { delta: 1 },
         ));
     }
+    v.extend(hdl::GatewareFault::link_faults(s));
     v
 }
 
@@ -333,6 +334,14 @@ pub fn campaign(
                     class,
                 });
             }
+        }
+        // the link stage's faults (a mix with a [link])
+        for (class, fault) in hdl::GatewareFault::link_faults(s) {
+            design.push(DesignCase {
+                fault,
+                site: sites[0],
+                class,
+            });
         }
     }
     let design = parallel(design, |c| {

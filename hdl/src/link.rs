@@ -26,6 +26,8 @@ pub struct LinkParams {
     pub stop_bits: u8,
     /// FIFO depth in tokens.
     pub depth: usize,
+    /// CRC-16/MODBUS initial value (0xFFFF; another only as a fault).
+    pub crc_init: u16,
 }
 
 impl LinkParams {
@@ -45,6 +47,7 @@ impl LinkParams {
             },
             stop_bits: p.stop_bits,
             depth: p.fifo_depth,
+            crc_init: link::format::CRC_INIT,
         }))
     }
 
@@ -225,7 +228,7 @@ impl UartLink {
             nx.have = rest != 0;
             match slot {
                 2 | 3 => {}
-                4 => nx.crc = crc8(0xFFFF, byte),
+                4 => nx.crc = crc8(p.crc_init, byte),
                 _ => nx.crc = crc8(r.crc, byte),
             }
             if slot == 7 {
@@ -393,7 +396,8 @@ fn link_verilog(p: &LinkParams) -> String {
     );
     let _ = writeln!(
         s,
-        "wire [15:0] crc_next = crc8((slot == 4'd4) ? 16'hffff : crc, byte_out);"
+        "wire [15:0] crc_next = crc8((slot == 4'd4) ? 16'h{:04x} : crc, byte_out);",
+        p.crc_init
     );
     let stops = "1'b1, ".repeat(p.stop_bits as usize);
     let parity = match p.parity {
