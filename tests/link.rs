@@ -162,19 +162,31 @@ fn sigrok_reads_the_line_and_decode_gives_the_sample_stream() {
     assert_eq!(piped.status.code(), Some(1));
     assert_eq!(piped.stdout, std::fs::read(&out).unwrap());
 
-    // Garbage first, a flipped bit, a dropped byte: counted, never hidden.
+    // Garbage first, a flipped bit in a code (packet 3), a dropped byte
+    // (packet 6): counted, never hidden.
+    let starts: Vec<usize> = (0..bytes.len())
+        .step_by(4)
+        .filter(|&i| bytes[i] == 0xA5)
+        .collect();
+    assert!(starts.len() >= 9, "a header per slice: {starts:?}");
+    let flip = starts[3] + 4 + 3; // the low byte of packet 3's first record
+    let drop = starts[6] + 5;
     let mut bad = vec![0x00, 0xA5, 0x13, 0x5A, 0xFF];
-    bad.extend(&bytes[..100]);
-    bad.push(bytes[100] ^ 0x10);
-    bad.extend(&bytes[101..700]);
-    bad.extend(&bytes[701..]);
+    for (i, &b) in bytes.iter().enumerate() {
+        if i == flip {
+            bad.push(b ^ 0x01);
+        } else if i != drop {
+            bad.push(b);
+        }
+    }
     let cap2 = dir.path().join("bad.bin");
     std::fs::write(&cap2, &bad).unwrap();
     let out2 = dir.path().join("bad.csv");
     let (code, j) = decode_json(&preset(), &cap2, &out2);
     assert_eq!(code, 1);
     assert!(j["crc_errors"].as_u64().unwrap() >= 1, "{j}");
-    assert!(j["lost_packets"].as_u64().unwrap() >= 2, "{j}");
+    assert_eq!(j["lost_packets"], 2, "{j}");
+    assert_eq!(j["packets"], 7, "{j}");
     assert!(j["skipped_bytes"].as_u64().unwrap() >= 5, "{j}");
     let kept = rows(&std::fs::read_to_string(&out2).unwrap());
     assert!(kept.len() < dec.len() && kept.len() > 200, "{}", kept.len());
