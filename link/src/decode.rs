@@ -131,11 +131,7 @@ impl Decoder {
         }
         let word = (n - 1) / WORD_BYTES * WORD_BYTES;
         let first = self.buf[word];
-        let bad = match first {
-            0..=3 => false,
-            END => false,
-            _ => true,
-        };
+        let bad = !matches!(first, 0..=3 | END);
         if bad || n > MAX_PACKET_BYTES {
             self.lose_sync();
             return;

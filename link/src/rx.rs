@@ -55,7 +55,7 @@ impl UartRx {
         };
         let d = self.fmt.div as u64;
         let t = now - start;
-        if t < d / 2 || (t - d / 2) % d != 0 {
+        if t < d / 2 || !(t - d / 2).is_multiple_of(d) {
             return None;
         }
         let i = ((t - d / 2) / d) as u32;
