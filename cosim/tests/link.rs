@@ -57,3 +57,21 @@ fn the_link_runs_clean_and_every_link_fault_is_caught() {
         }
     }
 }
+
+#[path = "../../tests/common/tools.rs"]
+mod tools;
+
+/// The link in Icarus (the emitted Verilog's `slotforge_link`, its line read
+/// back from Icarus's VCD); verilator and rusthdl run every preset in
+/// `backends.rs`.  Icarus takes minutes per frame of this mix.
+#[test]
+#[ignore = "long: make test-long"]
+fn the_link_runs_clean_in_icarus() {
+    if !tools::require_tool("iverilog") {
+        return;
+    }
+    let s = preset();
+    let r = cosim::run(&s, cosim::Backend::Icarus, 1, &cosim::SimOptions::default()).unwrap();
+    assert!(r.ok, "{}", r.summary());
+    assert_eq!(r.samples, s.samples_per_frame() - s.startup_skips());
+}
