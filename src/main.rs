@@ -40,6 +40,8 @@ enum Command {
     Golden(cmd::golden::Args),
     /// Prove the gateware meets the pin contract for all time (formal: yosys + ABC or cvc5).
     Prove(cmd::prove::Args),
+    /// Host side: the raw bytes received from the link (a serial-port dump, or `-` for stdin), as samples.
+    Decode(cmd::decode::Args),
 }
 
 fn main() -> ExitCode {
@@ -62,6 +64,7 @@ fn main() -> ExitCode {
         Command::Faults(a) => cmd::faults::run(a),
         Command::Golden(a) => cmd::golden::run(a),
         Command::Prove(a) => cmd::prove::run(a),
+        Command::Decode(a) => cmd::decode::run(a),
     };
     ExitCode::from(code)
 }

@@ -401,6 +401,7 @@ pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(&'static str, hdl::Gat
             hdl::GatewareFault::SliceWrap { delta: 1 },
         ));
     }
+    v.extend(hdl::GatewareFault::link_faults(s));
     v
 }
 
@@ -513,6 +514,14 @@ fn design_cases(s: &Schedule, sites: &[Site]) -> Vec<DesignCase> {
                 class,
             });
         }
+    }
+    // the link stage's faults (a mix with a [link])
+    for (class, fault) in hdl::GatewareFault::link_faults(s) {
+        design.push(DesignCase {
+            fault,
+            site: sites[0],
+            class,
+        });
     }
     design
 }

@@ -25,7 +25,7 @@ use judge::vcd::CycleSink;
 use judge::vcdout::edge_ps;
 use judge::Report;
 use lut_gen::parts::Start;
-use lut_gen::ports::{Layout, Pins, Role, PORTS, TOP_MODULE};
+use lut_gen::ports::{Layout, Pins, Role, LINK_PORTS, PORTS, TOP_MODULE};
 
 use crate::error::{BackendError, SimError};
 use crate::options::{SimOptions, VcdOut};
@@ -135,9 +135,19 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
             _ => writeln!(decls, "  wire {range}{};", p.name),
         };
     }
+    let link_ports: &[&str] = if l.link {
+        &[LINK_PORTS[0].name, LINK_PORTS[1].name]
+    } else {
+        &[]
+    };
+    for name in link_ports {
+        let _ = writeln!(decls, "  wire {name};");
+    }
     let connect = PORTS
         .iter()
-        .map(|p| format!(".{0}({0})", p.name))
+        .map(|p| p.name)
+        .chain(link_ports.iter().copied())
+        .map(|n| format!(".{n}({n})"))
         .collect::<Vec<_>>()
         .join(",\n    ");
     let mut tb = TEMPLATE

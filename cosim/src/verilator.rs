@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use judge::run::Dut;
-use lut_gen::ports::{Pins, Role, TOP_MODULE};
+use lut_gen::ports::{Pins, Role, LINK_PORTS, TOP_MODULE};
 
 use crate::error::BackendError;
 
@@ -35,7 +35,9 @@ struct SfPins {
     uint16_t cs_n;
     uint16_t sclk;
     uint8_t sample_valid;
-    uint8_t pad[7];
+    uint8_t link_tx;
+    uint8_t link_overflow;
+    uint8_t pad[5];
 };
 static_assert(sizeof(SfPins) == 40, "SfPins must match the Rust layout");
 
@@ -82,7 +84,7 @@ extern "C" void sf_step(void* p, uint8_t rst, uint64_t miso, SfPins* o) {
     sf_wide(o->mux_en, t->@mux_en@);
     o->sample_valid = t->@valid@;
     o->sample_channel = t->@channel@;
-    o->sample_value = t->@value@;
+    o->sample_value = t->@value@;@LINK@
     t->@clock@ = 0;
     t->eval();
 }
@@ -96,9 +98,18 @@ extern "C" void sf_free(void* p) {
 }
 "#;
 
-/// The shim's C++ text with the contract's module and port names.
-fn shim() -> String {
-    let mut t = SHIM_TEMPLATE.replace("@TOP@", TOP_MODULE);
+/// The shim's C++ text with the contract's module and port names; `link`:
+/// the top has the link's ports ([`LINK_PORTS`]).
+fn shim(link: bool) -> String {
+    let link_pins = if link {
+        let [tx, ovf] = LINK_PORTS.map(|p| p.name);
+        format!("\n    o->link_tx = t->{tx};\n    o->link_overflow = t->{ovf};")
+    } else {
+        String::new()
+    };
+    let mut t = SHIM_TEMPLATE
+        .replace("@TOP@", TOP_MODULE)
+        .replace("@LINK@", &link_pins);
     for r in Role::ALL {
         t = t.replace(&format!("@{}@", r.key()), r.name());
     }
@@ -118,7 +129,9 @@ struct SfPins {
     cs_n: u16,
     sclk: u16,
     sample_valid: u8,
-    pad: [u8; 7],
+    link_tx: u8,
+    link_overflow: u8,
+    pad: [u8; 5],
 }
 
 const _: () = assert!(std::mem::size_of::<SfPins>() == 40);
@@ -195,7 +208,9 @@ pub struct Built {
 
 /// Verilates and compiles `verilog` (top `slotforge_top`), or finds it in the cache.
 pub fn build(verilog: &str) -> Result<Built, BackendError> {
-    let shim = shim();
+    // A top with the link declares its line (emitted Verilog without a
+    // link never names it).
+    let shim = shim(verilog.contains(LINK_PORTS[0].name));
     let vv = tool_version("verilator", "apt-get install -y verilator")?;
     let gv = tool_version("g++", "apt-get install -y g++")?;
     let key = format!(
@@ -397,6 +412,8 @@ impl Dut for VerilatedDut {
             sample_valid: self.out.sample_valid != 0,
             sample_channel: self.out.sample_channel,
             sample_value: self.out.sample_value,
+            link_tx: self.out.link_tx != 0,
+            link_overflow: self.out.link_overflow != 0,
         }
     }
 }

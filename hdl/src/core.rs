@@ -1455,6 +1455,7 @@ mod tests {
 
     fn harness(div: u64, setup: u64) -> Harness {
         let plan = Plan {
+            link: None,
             compact: false,
             slots_per_slice: 4,
             slices_per_frame: 1,

@@ -13,12 +13,15 @@ use rust_hdl::prelude::*;
 use serde::Deserialize;
 
 use crate::core::Core;
+use crate::link::UartLink;
 use crate::plan::{plan_with, LutForm, Plan};
 use crate::widths::{CH_BITS, EN_TOTAL, MAX_BRANCHES, VALUE_BITS};
 use crate::HdlError;
 
 /// Name the rust-hdl `top` module gets in the emitted file.
 const CORE: &str = "slotforge_core";
+/// Name of the link stage's module (a mix with a `[link]` only).
+const LINK: &str = "slotforge_link";
 
 /// The emitted Verilog file.
 pub const VERILOG_FILE: &str = "slotforge_top.v";
@@ -300,6 +303,12 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     let _ = writeln!(v, "`default_nettype none");
     let _ = writeln!(v);
     let _ = writeln!(v, "module {TOP_MODULE} (");
+    let link_ports = if p.link.is_some() {
+        &ports::LINK_PORTS[..]
+    } else {
+        &[]
+    };
+    let nports = PORTS.len() + link_ports.len();
     for (i, port) in PORTS.iter().enumerate() {
         let dir = match port.dir {
             Dir::In => "input ",
@@ -310,8 +319,16 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
         } else {
             String::new()
         };
-        let sep = if i + 1 < PORTS.len() { "," } else { "" };
+        let sep = if i + 1 < nports { "," } else { "" };
         let _ = writeln!(v, "    {dir} wire {range}{}{sep}", port.name);
+    }
+    for (i, port) in link_ports.iter().enumerate() {
+        let sep = if PORTS.len() + i + 1 < nports {
+            ","
+        } else {
+            ""
+        };
+        let _ = writeln!(v, "    {} wire {}{sep}", port.dir.verilog(), port.name);
     }
     let _ = writeln!(v, ");");
     let _ = writeln!(v);
@@ -329,6 +346,12 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     }
     let mut unused = vec![];
     for &(r, wire, cw) in &wired {
+        if p.link.is_some() && matches!(r, Role::SampleChannel | Role::SampleValue) {
+            // the link reads the core's full-width channel and code
+            let (name, w) = (r.name(), l.width(r) as usize);
+            let _ = writeln!(v, "    assign {name} = {wire}[{}:0];", w - 1);
+            continue;
+        }
         let (name, w) = (r.name(), l.width(r) as usize);
         match r.port().dir {
             Dir::In if w < cw => {
@@ -363,6 +386,21 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
         let _ = writeln!(v, "        .{}({to}){sep}", core_port_name(port.role));
     }
     let _ = writeln!(v, "    );");
+    if p.link.is_some() {
+        let [tx, ovf] = ports::LINK_PORTS.map(|p| p.name);
+        let _ = writeln!(v);
+        let _ = writeln!(
+            v,
+            "    // the link to the host: packets of the merged sample stream (docs/packet-format.md)"
+        );
+        let _ = writeln!(
+            v,
+            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .tx({tx}),\n        .ovf({ovf})\n    );",
+            Role::Clock.name(),
+            Role::Reset.name(),
+            Role::SampleValid.name()
+        );
+    }
     let _ = writeln!(v, "endmodule");
     let _ = writeln!(v);
     let _ = writeln!(
@@ -374,6 +412,15 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
         "// The contract asks for ONE self-contained file, so the core's modules cannot\n// live in files named after them: waive Verilator's file-name style rule here.\n/* verilator lint_off DECLFILENAME */"
     );
     v.push_str(&body);
+    if let Some(lp) = p.link {
+        let mut link = UartLink::new(lp);
+        link.connect_all();
+        let text = generate_verilog(&link)
+            .replace("module top(", &format!("module {LINK}("))
+            .replace("endmodule // top", &format!("endmodule // {LINK}"));
+        let _ = writeln!(v, "\n// ---- link stage (hdl/src/link.rs) ----");
+        v.push_str(&tidy(&text));
+    }
     let _ = writeln!(v, "`default_nettype wire");
     v
 }

@@ -20,6 +20,13 @@ pub enum GatewareFault {
     /// The slice counter wraps after `slices_per_frame + delta` slices
     /// (compact LUT, whose slot counter counts slots in the slice).
     SliceWrap { delta: i64 },
+    /// The link's FIFO one token shallower than the schedule's worst-case
+    /// backlog: it overflows.
+    LinkFifoShort,
+    /// The link's baud divider off by `delta` cycles per bit.
+    LinkBaud { delta: i32 },
+    /// The link's CRC starts from 0 instead of 0xFFFF.
+    LinkCrcInit,
 }
 
 impl GatewareFault {
@@ -27,8 +34,24 @@ impl GatewareFault {
     pub fn lut_form(&self) -> LutForm {
         match self {
             GatewareFault::SliceWrap { .. } => LutForm::Compact,
+            // the link does not depend on the LUT's form
+            GatewareFault::LinkFifoShort
+            | GatewareFault::LinkBaud { .. }
+            | GatewareFault::LinkCrcInit => LutForm::Auto,
             _ => LutForm::Full,
         }
+    }
+
+    /// One fault of each link class, for a mix with a `[link]` (none without).
+    pub fn link_faults(s: &lut_gen::Schedule) -> Vec<(&'static str, GatewareFault)> {
+        if s.mix.link.is_none() {
+            return Vec::new();
+        }
+        vec![
+            ("link-fifo-short", GatewareFault::LinkFifoShort),
+            ("link-baud-fast", GatewareFault::LinkBaud { delta: -1 }),
+            ("link-crc-init", GatewareFault::LinkCrcInit),
+        ]
     }
 
     pub(crate) fn apply(&self, p: &mut Plan) -> Result<(), HdlError> {
@@ -68,6 +91,30 @@ impl GatewareFault {
                     return Err(bad("the plan has a full LUT".into()));
                 }
                 p.slices_per_frame = wrap(p.slices_per_frame, delta)?;
+            }
+            GatewareFault::LinkFifoShort
+            | GatewareFault::LinkBaud { .. }
+            | GatewareFault::LinkCrcInit => {
+                let l = p
+                    .link
+                    .as_mut()
+                    .ok_or_else(|| bad("the mix has no link".into()))?;
+                match *self {
+                    GatewareFault::LinkFifoShort if l.depth > 1 => l.depth -= 1,
+                    GatewareFault::LinkFifoShort => {
+                        return Err(bad("a FIFO of one token cannot be shorter".into()))
+                    }
+                    GatewareFault::LinkBaud { delta } => {
+                        l.div = l
+                            .div
+                            .checked_add_signed(delta)
+                            .filter(|&d| d >= 2)
+                            .ok_or_else(|| {
+                                bad(format!("a divider of {} cannot change by {delta}", l.div))
+                            })?
+                    }
+                    _ => l.crc_init = 0,
+                }
             }
         }
         Ok(())

@@ -18,6 +18,7 @@
 mod core;
 mod emit;
 mod fault;
+mod link;
 mod plan;
 mod sim;
 #[cfg(feature = "stock")]

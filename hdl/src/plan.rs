@@ -143,6 +143,8 @@ pub struct Plan {
     pub channel_bits: u32,
     pub seqs: Vec<SeqTiming>,
     pub branches: Vec<BranchRom>,
+    /// The link stage, when the mix has a `[link]`.
+    pub link: Option<crate::link::LinkParams>,
 }
 
 pub fn addr_bits(frame_slots: u64) -> usize {
@@ -474,5 +476,6 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         channel_bits: s.channel_bits(),
         seqs,
         branches,
+        link: crate::link::LinkParams::of(s).map_err(unsupported)?,
     })
 }

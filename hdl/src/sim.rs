@@ -6,6 +6,7 @@ use rust_hdl::prelude::*;
 use lut_gen::ports::Pins;
 
 use crate::core::Core;
+use crate::link::UartLink;
 use crate::{plan, HdlError};
 
 /// Cycle-accurate simulator of the emitted gateware.
@@ -27,6 +28,8 @@ use crate::{plan, HdlError};
 /// begin with at least one `rst = true` step.
 pub struct RtlSim {
     core: Box<Core>,
+    /// The link stage (`slotforge_link`), fed the core's sample stream.
+    link: Option<Box<UartLink>>,
     passes: u64,
     reader: PinReader,
 }
@@ -61,6 +64,8 @@ pub(crate) fn read_pins(c: &Core, r: &PinReader) -> Pins {
         sample_valid: c.sample_valid.val(),
         sample_channel: c.sample_channel.val().to_u64() as u16 & r.ch_mask,
         sample_value: c.sample_value.val().to_u64() as u16,
+        link_tx: false,
+        link_overflow: false,
     }
 }
 
@@ -94,8 +99,16 @@ impl RtlSim {
         core.connect_all();
         core.clock.next = Clock::from(false);
         simulate(&mut *core, 1000);
+        let link = p.link.map(|lp| {
+            let mut l = Box::new(UartLink::new(lp));
+            l.connect_all();
+            l.clock.next = Clock::from(false);
+            simulate(&mut *l, 1000);
+            l
+        });
         RtlSim {
             core,
+            link,
             passes: 0,
             reader: PinReader::new(p),
         }
@@ -114,6 +127,18 @@ impl RtlSim {
     /// Apply one rising clock edge; see the type's documentation.
     pub fn step(&mut self, rst: bool, miso: u64) -> Pins {
         let miso = miso & self.reader.lanes as u64;
+        if let Some(l) = self.link.as_deref_mut() {
+            // The link samples the core's outputs of the cycle this edge ends.
+            let c = &*self.core;
+            l.clock.next = Clock::from(false);
+            l.rst.next = rst;
+            l.valid.next = c.sample_valid.val();
+            l.ch.next = c.sample_channel.val();
+            l.val.next = c.sample_value.val();
+            settle(l, &mut self.passes);
+            l.clock.next = Clock::from(true);
+            settle(l, &mut self.passes);
+        }
         let c = &mut *self.core;
         // Falling edge: no logic reacts to it, so it only has to reach every
         // flip-flop's clock (done directly by `drive_clock`); evaluation
@@ -130,7 +155,12 @@ impl RtlSim {
         c.drive_clock(true);
         let ok = settle(c, &mut self.passes);
         debug_assert!(ok, "combinational logic did not settle");
-        read_pins(c, &self.reader)
+        let mut pins = read_pins(c, &self.reader);
+        if let Some(l) = &self.link {
+            pins.link_tx = l.tx.val();
+            pins.link_overflow = l.ovf.val();
+        }
+        pins
     }
 }
 

@@ -126,6 +126,17 @@ fn gates_converter_parts() {
     }
 }
 
+/// The link to the host (issue 14): the reference design with its UART.
+#[test]
+fn gates_uart_link() {
+    let path = common::root().join("mixes/eskin34-uart.toml");
+    let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
+    let v = hdl::emit(&s, None).unwrap();
+    assert!(v.verilog().contains("module slotforge_link("));
+    assert_eq!(v, hdl::emit(&s, None).unwrap(), "deterministic");
+    gates(&s, "eskin34-uart");
+}
+
 #[test]
 fn gates_compact_lut() {
     gates(&long_frame(), "longframe");

@@ -41,6 +41,10 @@ pub struct AuditReport {
     /// What each branch's converter allows (throughput, bits, chain).
     pub parts: Vec<PartAudit>,
     pub channels: Vec<ChannelAudit>,
+    /// The link to the host (`[link]`): divider, bytes per frame, line
+    /// utilisation, FIFO depth, worst latency, minimum baud.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link: Option<crate::hostlink::LinkPlan>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -422,9 +426,18 @@ impl AuditReport {
             .map(|b| b.adc.max_sps * b.chain as u64)
             .sum();
         let lut = CompactLut::from_schedule(s);
+        let link = match crate::hostlink::plan(s) {
+            None => None,
+            Some(Ok(p)) => Some(p),
+            Some(Err(e)) => {
+                errors.push(e.message);
+                None
+            }
+        };
         AuditReport {
             mix: mix.name.clone(),
             feasible: errors.is_empty(),
+            link,
             clock_hz: g.clock_hz,
             frame_cycles: g.frame_cycles,
             slice_cycles: g.slice_cycles,
@@ -532,6 +545,7 @@ impl AuditReport {
                 })
                 .collect(),
             channels: Vec::new(),
+            link: None,
         }
     }
 
@@ -723,6 +737,30 @@ impl AuditReport {
             let _ = writeln!(
                 o,
                 "interval, first: cycles (first = first sampling instant after cycle 0); dev.sel = mux device.select; alias = where a tone at bw shows when bw is above Nyquist"
+            );
+        }
+        if let Some(l) = &self.link {
+            let _ = writeln!(
+                o,
+                "link {}: {:.0} baud (divider {}, {} asked), {} bits per byte ({} parity, {} stop)",
+                l.kind,
+                l.baud,
+                l.baud_divider,
+                l.baud_requested,
+                l.bits_per_byte,
+                l.parity,
+                l.stop_bits
+            );
+            let _ = writeln!(
+                o,
+                "link: {} words ({} bytes) per frame, line {:.1} % used; FIFO depth {} tokens (worst-case backlog); worst latency instant -> last bit of its packet {} cycles ({:.1} us); minimum baud {:.0}",
+                l.words_per_frame,
+                l.bytes_per_frame,
+                l.utilization * 100.0,
+                l.fifo_depth,
+                l.latency_cycles,
+                l.latency_us,
+                l.min_baud
             );
         }
         for n in &self.notes {

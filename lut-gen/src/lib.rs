@@ -6,8 +6,10 @@
 //! - [`validate`]: an independent proof of a schedule's promises;
 //! - [`lut`]: the slot LUT as a full frame table and in compact form;
 //! - [`ports`]: the pin contract of `slotforge_top` (names, roles, widths, lanes, limits, `ports.json`);
+//! - [`hostlink`]: the link to the host planned from the schedule (divider, bytes per frame, FIFO depth, latency, minimum baud);
 //! - [`audit`]: rates, intervals, headroom, settling and Nyquist, as text or JSON.
 
+pub mod hostlink;
 pub mod mix;
 pub mod parts;
 pub mod ports;

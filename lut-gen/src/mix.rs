@@ -57,7 +57,42 @@ pub struct Mix {
     pub parts: Vec<AdcPart>,
     pub branches: Vec<Branch>,
     pub channels: Vec<Channel>,
+    /// The link to the host (`[link]`); `None`: the parallel sample stream
+    /// is the output.  Reported by the audit's own `link` section.
+    #[serde(skip)]
+    pub link: Option<LinkSpec>,
 }
+
+/// `[link]`: how the samples leave the FPGA (SPEC, "The link to the host").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LinkSpec {
+    pub kind: LinkKind,
+    /// Requested baud (`uart`); the divider's real baud is reported.
+    pub baud: u64,
+    pub parity: link::Parity,
+    pub stop_bits: u8,
+}
+
+/// `[link].kind`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinkKind {
+    Uart,
+}
+
+impl LinkKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            LinkKind::Uart => "uart",
+        }
+    }
+}
+
+/// Fewest clock cycles per UART bit: the checker and a host sample each
+/// bit in its middle, which needs a few cycles of margin either side.
+pub const MIN_BAUD_DIVIDER: u32 = 4;
+/// Largest baud error (real against requested) a UART receiver tolerates
+/// with margin, in percent.
+pub const MAX_BAUD_ERROR_PCT: f64 = 2.0;
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Branch {
@@ -153,6 +188,16 @@ struct RawMix {
     branch: Vec<Spanned<RawBranch>>,
     #[serde(default)]
     channel: Vec<Spanned<RawChannel>>,
+    link: Option<Spanned<RawLink>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLink {
+    kind: Spanned<String>,
+    baud: Option<Spanned<i64>>,
+    parity: Option<Spanned<String>>,
+    stop_bits: Option<Spanned<i64>>,
 }
 
 #[derive(Deserialize)]
@@ -878,6 +923,10 @@ impl Cx<'_> {
             return Err(self.at(0..0, "channel", "more than 65535 channels"));
         }
 
+        let link = match &raw.link {
+            None => None,
+            Some(l) => Some(self.link(l, clock_hz)?),
+        };
         Ok(Mix {
             name,
             description: raw.description.unwrap_or_default(),
@@ -888,6 +937,89 @@ impl Cx<'_> {
             parts,
             branches,
             channels,
+            link,
+        })
+    }
+
+    /// `[link]`: the kind, and for a UART a baud the clock can divide to
+    /// within [`MAX_BAUD_ERROR_PCT`].
+    fn link(&self, l: &Spanned<RawLink>, clock_hz: u64) -> Result<LinkSpec, MixError> {
+        let r = l.get_ref();
+        let kind = match r.kind.get_ref().as_str() {
+            "uart" => LinkKind::Uart,
+            "axis" => {
+                return Err(self.at(
+                    r.kind.span(),
+                    "link.kind",
+                    "\"axis\" (AXI4-Stream) is not implemented yet; \"uart\" is",
+                ))
+            }
+            other => {
+                return Err(self.at(
+                    r.kind.span(),
+                    "link.kind",
+                    format!("unknown link kind `{other}` (known: \"uart\")"),
+                ))
+            }
+        };
+        let baud_raw = r
+            .baud
+            .as_ref()
+            .ok_or_else(|| self.at(l.span(), "link.baud", "missing: a UART link needs `baud`"))?;
+        let baud = self.positive(baud_raw, "link.baud")?;
+        let div = link::UartFormat::divider(clock_hz, baud);
+        let real = link::UartFormat::real_baud(clock_hz, div);
+        if div < MIN_BAUD_DIVIDER {
+            return Err(self.at(
+                baud_raw.span(),
+                "link.baud",
+                format!(
+                    "{baud} baud from a {clock_hz} Hz clock is {div} cycle(s) per bit; the link needs at least {MIN_BAUD_DIVIDER} (at most {} baud)",
+                    clock_hz / MIN_BAUD_DIVIDER as u64
+                ),
+            ));
+        }
+        let err = (real - baud as f64).abs() / baud as f64 * 100.0;
+        if err > MAX_BAUD_ERROR_PCT {
+            return Err(self.at(
+                baud_raw.span(),
+                "link.baud",
+                format!(
+                    "the nearest divider of the {clock_hz} Hz clock ({div}) gives {real:.0} baud, {err:.2} % off {baud}; a receiver tolerates about {MAX_BAUD_ERROR_PCT} %"
+                ),
+            ));
+        }
+        let parity = match &r.parity {
+            None => link::Parity::None,
+            Some(p) => link::Parity::parse(p.get_ref()).ok_or_else(|| {
+                self.at(
+                    p.span(),
+                    "link.parity",
+                    format!(
+                        "unknown parity `{}` (\"none\", \"even\" or \"odd\")",
+                        p.get_ref()
+                    ),
+                )
+            })?,
+        };
+        let stop_bits = match &r.stop_bits {
+            None => 1,
+            Some(s) => match *s.get_ref() {
+                1 | 2 => *s.get_ref() as u8,
+                v => {
+                    return Err(self.at(
+                        s.span(),
+                        "link.stop_bits",
+                        format!("{v} stop bits: 1 or 2"),
+                    ))
+                }
+            },
+        };
+        Ok(LinkSpec {
+            kind,
+            baud,
+            parity,
+            stop_bits,
         })
     }
 }

@@ -205,7 +205,36 @@ pub struct Pins {
     pub sample_valid: bool,
     pub sample_channel: u16,
     pub sample_value: u16,
+    /// The link's serial line (`link_tx`; a mix with a `[link]` only).
+    pub link_tx: bool,
+    /// The link FIFO's sticky overflow flag (`link_overflow`).
+    pub link_overflow: bool,
 }
+
+/// A port of the link to the host: present only when the mix has a
+/// `[link]`, after the ports of [`PORTS`], so a mix without one keeps
+/// exactly today's ports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LinkPort {
+    pub name: &'static str,
+    pub dir: Dir,
+    /// The port's key under `"link"` in `ports.json`.
+    pub key: &'static str,
+}
+
+/// The UART link's ports: the serial line and the FIFO's overflow flag.
+pub const LINK_PORTS: [LinkPort; 2] = [
+    LinkPort {
+        name: "link_tx",
+        dir: Dir::Out,
+        key: "tx",
+    },
+    LinkPort {
+        name: "link_overflow",
+        dir: Dir::Out,
+        key: "overflow",
+    },
+];
 
 const _: () = {
     assert!(
@@ -234,11 +263,16 @@ pub enum Signal {
     SampleValid,
     SampleChannel,
     SampleValue,
+    /// `link_tx`.
+    LinkTx,
+    /// `link_overflow`.
+    LinkOverflow,
 }
 
 impl Signal {
-    pub fn role(&self) -> Role {
-        match *self {
+    /// The port role of a signal of [`PORTS`]; `None` for the link's.
+    pub fn role(&self) -> Option<Role> {
+        Some(match *self {
             Signal::CsN(_) => Role::CsN,
             Signal::Sclk(_) => Role::Sclk,
             Signal::MuxSel(_) => Role::MuxSel,
@@ -247,14 +281,17 @@ impl Signal {
             Signal::SampleValid => Role::SampleValid,
             Signal::SampleChannel => Role::SampleChannel,
             Signal::SampleValue => Role::SampleValue,
-        }
+            Signal::LinkTx | Signal::LinkOverflow => return None,
+        })
     }
 
     /// The port-level name, e.g. `adc_cs_n[1]`, `mux_sel[5:3]`.
     pub fn name(&self, layout: &Layout) -> String {
-        match self.branch() {
-            Some(b) => layout.lane(self.role(), b),
-            None => self.role().name().to_string(),
+        match (self.branch(), self.role()) {
+            (Some(b), Some(r)) => layout.lane(r, b),
+            (_, Some(r)) => r.name().to_string(),
+            (_, None) if *self == Signal::LinkTx => LINK_PORTS[0].name.to_string(),
+            (_, None) => LINK_PORTS[1].name.to_string(),
         }
     }
 
@@ -269,6 +306,8 @@ impl Signal {
             Signal::SampleValid => p.sample_valid as u64,
             Signal::SampleChannel => p.sample_channel as u64,
             Signal::SampleValue => p.sample_value as u64,
+            Signal::LinkTx => p.link_tx as u64,
+            Signal::LinkOverflow => p.link_overflow as u64,
         }
     }
 
@@ -305,6 +344,8 @@ pub struct Layout {
     pub starts: Vec<Start>,
     /// `(branch, device, select)` -> channel, as `lookup[branch][device * 8 + select]`.
     pub lookup: Vec<Vec<Option<u16>>>,
+    /// The mix has a link to the host: [`LINK_PORTS`] follow [`PORTS`].
+    pub link: bool,
 }
 
 impl Layout {
@@ -346,6 +387,7 @@ impl Layout {
             value_bits: s.mix.branches.iter().map(|b| b.adc.bits).max().unwrap_or(1),
             starts: s.mix.branches.iter().map(|b| b.adc.start).collect(),
             lookup,
+            link: s.mix.link.is_some(),
         }
     }
 
@@ -439,6 +481,9 @@ impl Layout {
                 v.push((p.name.to_string(), p.dir));
             }
         }
+        if self.link {
+            v.extend(LINK_PORTS.iter().map(|p| (p.name.to_string(), p.dir)));
+        }
         v
     }
 
@@ -490,6 +535,9 @@ impl Layout {
             Signal::SampleChannel,
             Signal::SampleValue,
         ]);
+        if self.link {
+            v.extend([Signal::LinkTx, Signal::LinkOverflow]);
+        }
         v
     }
 }
@@ -550,11 +598,18 @@ pub fn manifest(s: &Schedule) -> String {
             })
         })
         .collect();
-    let ports: Vec<_> = PORTS
+    let mut ports: Vec<_> = PORTS
         .iter()
         .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": l.width(p.role)}))
         .collect();
-    let doc = json!({
+    if l.link {
+        ports.extend(
+            LINK_PORTS
+                .iter()
+                .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": 1})),
+        );
+    }
+    let mut doc = json!({
         "top": TOP_MODULE,
         "mix": s.mix.name,
         "clock": Role::Clock.name(),
@@ -569,6 +624,20 @@ pub fn manifest(s: &Schedule) -> String {
         "channels": channels,
         "ports": ports,
     });
+    if let Some(Ok(p)) = crate::hostlink::plan(s) {
+        let mut o = serde_json::Map::new();
+        o.insert("kind".into(), json!(p.kind));
+        for lp in &LINK_PORTS {
+            o.insert(lp.key.into(), json!(lp.name));
+        }
+        o.insert("baud".into(), json!(p.baud));
+        o.insert("baud_divider".into(), json!(p.baud_divider));
+        o.insert("parity".into(), json!(p.parity));
+        o.insert("stop_bits".into(), json!(p.stop_bits));
+        o.insert("fifo_depth".into(), json!(p.fifo_depth));
+        o.insert("packet_format".into(), json!("docs/packet-format.md"));
+        doc["link"] = serde_json::Value::Object(o);
+    }
     let mut t = serde_json::to_string_pretty(&doc).expect("json");
     t.push('\n');
     t

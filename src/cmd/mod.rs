@@ -3,6 +3,7 @@
 pub mod audit;
 pub mod build;
 pub mod check;
+pub mod decode;
 pub mod faults;
 pub mod golden;
 pub mod lut;

@@ -161,6 +161,8 @@ const NO_XZ: Pins = Pins {
     sample_valid: false,
     sample_channel: 0,
     sample_value: 0,
+    link_tx: false,
+    link_overflow: false,
 };
 
 impl Checker {
@@ -457,6 +459,9 @@ impl Checker {
                         .map(|(hc, hp, he)| ctx_line(inv.place(*hc).0, hp, he.as_ref()))
                         .collect();
                     context.push(format!("{} <- diverges", ctx_line(cycle, p, Some(e))));
+                    if s == Signal::LinkTx {
+                        context.extend(m.link_context());
+                    }
                     self.divergences.push(Divergence {
                         cycle,
                         frame,
@@ -882,10 +887,18 @@ impl Checker {
 }
 
 fn fmt_pins(p: &Pins) -> String {
-    format!(
+    let mut t = format!(
         "cs_n={:b} sclk={:b} mux_sel={:#x} mux_en={:#x} valid={} ch={} value={:#06x}",
         p.cs_n, p.sclk, p.mux_sel, p.mux_en, p.sample_valid as u8, p.sample_channel, p.sample_value
-    )
+    );
+    // the link's pins (all zero without a link: nothing added)
+    if p.link_tx || p.link_overflow {
+        t.push_str(&format!(
+            " tx={} overflow={}",
+            p.link_tx as u8, p.link_overflow as u8
+        ));
+    }
+    t
 }
 
 fn ctx_line(c: u64, p: &Pins, e: Option<&Pins>) -> String {

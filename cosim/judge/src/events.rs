@@ -113,6 +113,42 @@ pub fn time_us(clock_hz: u64, cycle: u64) -> String {
     format!("{}.{:06}us", ps / 1_000_000, ps % 1_000_000)
 }
 
+/// The scope of the link's events in a log.
+pub const LINK_SCOPE: &str = "link";
+
+/// The link's events in cycle `c`: a byte the line completed (at its last
+/// stop bit's middle sample), a change of the overflow flag.
+fn link_events(
+    events: &mut Vec<Event>,
+    rx: &mut link::rx::UartRx,
+    c: u64,
+    p: &Pins,
+    prev: Option<&Pins>,
+) {
+    if let Some(b) = rx.sample(p.link_tx) {
+        events.push(Event {
+            cycle: c,
+            scope: LINK_SCOPE.into(),
+            signal: "byte".into(),
+            value: format!("{:#04x}", b.byte),
+            note: if b.error {
+                "framing or parity error".into()
+            } else {
+                String::new()
+            },
+        });
+    }
+    if prev.map_or(p.link_overflow, |q| q.link_overflow != p.link_overflow) {
+        events.push(Event {
+            cycle: c,
+            scope: LINK_SCOPE.into(),
+            signal: "overflow".into(),
+            value: (p.link_overflow as u8).to_string(),
+            note: String::new(),
+        });
+    }
+}
+
 impl EventLog {
     /// The events of `trace` over `cycles` cycles from cycle 0 (fewer if the
     /// trace is shorter).
@@ -126,8 +162,16 @@ impl EventLog {
             return EventLog { events, cycles: 0 };
         };
         let n = (trace.len() - z).min(cycles as usize);
+        // The link's line read back as a receiver would, one event per byte.
+        let mut rx = match lut_gen::hostlink::plan(s) {
+            Some(Ok(lp)) => Some(link::rx::UartRx::new(lp.uart())),
+            _ => None,
+        };
         for (c, (_, p, _)) in trace.cycles[z..z + n].iter().enumerate() {
             let c = c as u64;
+            if let Some(rx) = rx.as_mut() {
+                link_events(&mut events, rx, c, p, prev.as_ref());
+            }
             for (b, bname) in branches.iter().enumerate() {
                 for r in LANES {
                     let v = lane_value(&l, p, r, b);

@@ -218,6 +218,9 @@ pub struct CycleModel {
     pend: Vec<std::collections::VecDeque<(u16, u16)>>,
     capture: u16,
     groups: Vec<Vec<Option<usize>>>,
+    /// The link's transmitter, fed the predicted sample stream (a mix with
+    /// a `[link]`).
+    tx: Option<link::TxModel>,
 }
 
 impl CycleModel {
@@ -288,9 +291,15 @@ impl CycleModel {
             .enumerate()
             .filter(|(_, m)| !m.cnv)
             .fold(0u16, |a, (b, _)| a | 1 << b);
+        // The transmitter after its reset edge: line idle (high).
+        let tx = match lut_gen::hostlink::plan(s) {
+            Some(Ok(p)) => Some(link::TxModel::new(p.tx_config(s))),
+            _ => None,
+        };
         let mut reset = Pins {
             cs_n: cs_idle,
             sclk: cs_idle,
+            link_tx: tx.is_some(),
             ..Pins::default()
         };
         for (b, m) in br.iter().enumerate() {
@@ -311,9 +320,39 @@ impl CycleModel {
             pend: vec![Default::default(); s.branches.len()],
             capture: 0,
             groups: s.groups.clone(),
+            tx,
         };
         model.process();
+        // The edge into cycle 0 samples the reset cycle's stream: no sample.
+        model.step_link(false, 0, 0);
         model
+    }
+
+    /// The transmitter's edge at the end of the current cycle, fed this
+    /// cycle's sample stream; its line and flag in the next cycle.
+    #[inline]
+    fn step_link(&mut self, valid: bool, ch: u16, v: u16) {
+        if let Some(t) = &mut self.tx {
+            t.clock(false, valid.then_some((ch, v)));
+            self.pins.link_tx = t.line();
+            self.pins.link_overflow = t.overflow();
+        }
+    }
+
+    /// What the link's line carries in the current cycle, for reports:
+    /// the byte, its bit, its word and packet, and the sample of a record.
+    pub fn link_context(&self) -> Option<String> {
+        let (b, bit) = self.tx.as_ref()?.on_line()?;
+        let what = match (b.kind, b.sample) {
+            (link::format::WordKind::Record, Some((ch, v))) => {
+                format!("record of channel {ch} = {v}")
+            }
+            (k, _) => format!("{k:?}").to_lowercase(),
+        };
+        Some(format!(
+            "link: bit {bit} of byte {:#04x} (byte {} of the {what}) of packet frame {} slice {} (mod 256 frames)",
+            b.byte, b.index, b.packet.0, b.packet.1
+        ))
     }
 
     /// Output values in every cycle in which `rst` was sampled high.
@@ -380,6 +419,17 @@ impl CycleModel {
     /// branch b), and moves to the next one.
     #[inline]
     pub fn step(&mut self, miso: u64) {
+        if self.tx.is_some() {
+            let p = self.pins;
+            self.step_pins(miso);
+            self.step_link(p.sample_valid, p.sample_channel, p.sample_value);
+        } else {
+            self.step_pins(miso);
+        }
+    }
+
+    #[inline]
+    fn step_pins(&mut self, miso: u64) {
         if self.capture == 0
             && self.pending == 0
             && !self.pins.sample_valid

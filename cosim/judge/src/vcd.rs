@@ -29,7 +29,7 @@ use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use lut_gen::ports::{Role, PORT_NAMES as PORTS, TOP_MODULE};
+use lut_gen::ports::{Role, LINK_PORTS, PORT_NAMES as PORTS, TOP_MODULE};
 use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker};
@@ -312,6 +312,8 @@ const EN: usize = Role::MuxEn as usize;
 const VALID: usize = Role::SampleValid as usize;
 const CHAN: usize = Role::SampleChannel as usize;
 const VALUE: usize = Role::SampleValue as usize;
+/// The first of the link's ports in [`State`].
+const LINK: usize = PORTS.len();
 
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
 /// (or `lsb - j` when the range is ascending).
@@ -337,6 +339,8 @@ struct Resolved {
     has_rst: bool,
     scope: String,
     widths: [u32; 10],
+    /// The link's ports are read too.
+    link: bool,
 }
 
 fn resolve(
@@ -518,12 +522,33 @@ fn resolve(
             has_clk = true;
         }
     }
+    if layout.link {
+        for (k, lp) in LINK_PORTS.iter().enumerate() {
+            let v = h
+                .vars
+                .iter()
+                .find(|v| v.scope == scope && v.name == lp.name && v.width == 1)
+                .ok_or_else(|| {
+                    perr(format!(
+                        "port `{}` (the mix's link) not found in scope `{scope}`",
+                        lp.name
+                    ))
+                })?;
+            ids.get_mut(&v.id).unwrap().push(Sink {
+                port: (LINK + k) as u8,
+                width: 1,
+                lsb: 0,
+                down: true,
+            });
+        }
+    }
     Ok(Resolved {
         ids: Ids::new(ids),
         has_clk,
         has_rst,
         scope: scope.to_string(),
         widths,
+        link: layout.link,
     })
 }
 
@@ -646,8 +671,9 @@ fn parse_value(s: &[u8], width: u32) -> Option<Val> {
     Some(Val { v, x })
 }
 
+/// The ports of [`PORTS`], then the link's ([`LINK_PORTS`]).
 struct State {
-    port: [Val; 10],
+    port: [Val; 12],
 }
 
 impl State {
@@ -688,6 +714,8 @@ impl State {
                 sample_valid: g(VALID) & 1 == 1,
                 sample_channel: g(CHAN) as u16,
                 sample_value: g(VALUE) as u16,
+                link_tx: g(LINK) & 1 == 1,
+                link_overflow: g(LINK + 1) & 1 == 1,
             }
         };
         (pick(|p| p.v), pick(|p| p.x))
@@ -752,8 +780,12 @@ fn body<R: BufRead>(
     sink: &mut dyn CycleSink,
 ) -> Result<BodyInfo, VcdError> {
     let mut st = State {
-        port: [Val { v: 0, x: 0 }; 10],
+        port: [Val { v: 0, x: 0 }; 12],
     };
+    if res.link {
+        st.port[LINK].x = 1;
+        st.port[LINK + 1].x = 1;
+    }
     for (i, w) in res.widths.iter().enumerate() {
         st.port[i].x = if *w >= 128 {
             u128::MAX
@@ -786,7 +818,7 @@ fn body<R: BufRead>(
         *pending = Some((rst, pins, xz));
     }
     let mut close = |st: &State,
-                     before: &[Val; 10],
+                     before: &[Val; 12],
                      t: u64,
                      next: Option<u64>,
                      out_changed: bool,

@@ -1,0 +1,464 @@
+//! The link stage (`slotforge_link`): packetizer, FIFO, serializer and UART
+//! transmitter after the merged sample stream, as docs/packet-format.md
+//! ("Timing") states it register by register.
+//!
+//! Like the merger and the word reader, the block is custom Verilog
+//! generated per mix (exact counter widths, the FIFO exactly as deep as the
+//! schedule's worst-case backlog) with its Rust twin in `update`, the two
+//! written register for register; the judge predicts the line from its own
+//! model (`link::TxModel`), never from this file.
+
+use std::fmt::Write as _;
+
+use rust_hdl::prelude::*;
+
+use crate::widths::{CH_BITS, VALUE_BITS};
+
+/// What the link is built for (from `lut_gen::hostlink::LinkPlan`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LinkParams {
+    pub slice_cycles: u64,
+    pub slices_per_frame: u64,
+    /// Clock cycles per UART bit.
+    pub div: u32,
+    /// 0 none, 1 even, 2 odd.
+    pub parity: u8,
+    pub stop_bits: u8,
+    /// FIFO depth in tokens.
+    pub depth: usize,
+    /// CRC-16/MODBUS initial value (0xFFFF; another only as a fault).
+    pub crc_init: u16,
+}
+
+impl LinkParams {
+    pub(crate) fn of(s: &lut_gen::Schedule) -> Result<Option<LinkParams>, String> {
+        let Some(r) = lut_gen::hostlink::plan(s) else {
+            return Ok(None);
+        };
+        let p = r.map_err(|e| e.message)?;
+        Ok(Some(LinkParams {
+            slice_cycles: s.grid.slice_cycles,
+            slices_per_frame: s.grid.slices_per_frame,
+            div: p.baud_divider,
+            parity: match p.parity {
+                "even" => 1,
+                "odd" => 2,
+                _ => 0,
+            },
+            stop_bits: p.stop_bits,
+            depth: p.fifo_depth,
+            crc_init: link::format::CRC_INIT,
+        }))
+    }
+
+    /// Bits per character: start, 8 data, parity, stop.
+    fn char_bits(&self) -> u32 {
+        1 + 8 + (self.parity != 0) as u32 + self.stop_bits as u32
+    }
+
+    /// The character of `byte`, bit 0 (the start bit) first.
+    fn frame(&self, byte: u8) -> u16 {
+        let mut f = (byte as u16) << 1;
+        let mut top = 9;
+        if self.parity != 0 {
+            let odd_ones = byte.count_ones() % 2 == 1;
+            let pbit = if self.parity == 1 {
+                odd_ones
+            } else {
+                !odd_ones
+            };
+            f |= (pbit as u16) << 9;
+            top = 10;
+        }
+        for i in 0..self.stop_bits {
+            f |= 1 << (top + i as u16);
+        }
+        f
+    }
+}
+
+/// Token layout in the FIFO: `{boundary, sample, channel[9:0], code[15:0]}`.
+const TOKEN_BITS: usize = 2 + CH_BITS + VALUE_BITS;
+
+/// The registers of the link (the Rust twin's state).
+#[derive(Debug, Clone, Default)]
+struct Regs {
+    pos: u64,
+    mem: Vec<u32>,
+    wr: usize,
+    rd: usize,
+    n: usize,
+    have: bool,
+    tok: u32,
+    mask: u16,
+    started: bool,
+    hframe: u8,
+    hslice: u16,
+    crc: u16,
+    ovfc: u8,
+    ovf: bool,
+    busy: bool,
+    bitn: u32,
+    dv: u32,
+    chr: u16,
+    tx: bool,
+}
+
+#[derive(LogicBlock)]
+pub struct UartLink {
+    pub clock: Signal<In, Clock>,
+    pub rst: Signal<In, Bit>,
+    pub valid: Signal<In, Bit>,
+    pub ch: Signal<In, Bits<CH_BITS>>,
+    pub val: Signal<In, Bits<VALUE_BITS>>,
+    pub tx: Signal<Out, Bit>,
+    pub ovf: Signal<Out, Bit>,
+    _p: LinkParams,
+    _r: Regs,
+}
+
+fn crc8(mut c: u16, d: u8) -> u16 {
+    c ^= d as u16;
+    for _ in 0..8 {
+        c = if c & 1 == 1 {
+            (c >> 1) ^ 0xA001
+        } else {
+            c >> 1
+        };
+    }
+    c
+}
+
+impl UartLink {
+    pub fn new(p: LinkParams) -> UartLink {
+        UartLink {
+            clock: Default::default(),
+            rst: Default::default(),
+            valid: Default::default(),
+            ch: Default::default(),
+            val: Default::default(),
+            tx: Signal::new_with_default(true),
+            ovf: Default::default(),
+            _p: p,
+            _r: Regs {
+                mem: vec![0; p.depth],
+                tx: true,
+                crc: 0xFFFF,
+                ..Default::default()
+            },
+        }
+    }
+
+    fn edge(&mut self, valid: bool, ch: u32, val: u32) {
+        let p = self._p;
+        let r = &mut self._r;
+        let bnd = r.pos == 0;
+        let push = bnd || valid;
+        let last_tick = r.dv + 1 == p.div;
+        let ready = !r.busy || (last_tick && r.bitn + 1 == p.char_bits());
+        let load = ready && r.have;
+        let pop = !r.have && r.n != 0;
+        let room = r.n < p.depth || pop;
+        let slot = r.mask.trailing_zeros();
+        let rest = r.mask & r.mask.wrapping_sub(1);
+        let byte = match slot {
+            0 => 0x5A,
+            1 => r.ovfc,
+            2 => r.crc as u8,
+            3 => (r.crc >> 8) as u8,
+            4 => 0xA5,
+            5 => r.hframe,
+            6 => (r.hslice >> 8) as u8,
+            7 => r.hslice as u8,
+            8 => ((r.tok >> 24) & 3) as u8,
+            9 => (r.tok >> 16) as u8,
+            10 => (r.tok >> 8) as u8,
+            _ => r.tok as u8,
+        };
+        // next state, from the values before the edge
+        let mut nx = r.clone();
+        nx.pos = if r.pos + 1 == p.slice_cycles {
+            0
+        } else {
+            r.pos + 1
+        };
+        if pop {
+            let t = r.mem[r.rd];
+            nx.tok = t;
+            nx.rd = (r.rd + 1) % p.depth;
+            nx.have = true;
+            let b = t >> 27 & 1 == 1;
+            let s = t >> 26 & 1 == 1;
+            nx.mask = (if s { 0xF00 } else { 0 })
+                | (if b { 0x0F0 } else { 0 })
+                | (if b && r.started { 0x00F } else { 0 });
+        }
+        if push {
+            if room {
+                nx.mem[r.wr] = (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
+                nx.wr = (r.wr + 1) % p.depth;
+            } else {
+                nx.ovfc = r.ovfc.saturating_add(1);
+                nx.ovf = true;
+            }
+        }
+        nx.n = r.n + (push && room) as usize - pop as usize;
+        if r.busy {
+            if last_tick {
+                nx.dv = 0;
+                if r.bitn + 1 == p.char_bits() {
+                    nx.busy = false;
+                    nx.tx = true;
+                } else {
+                    nx.bitn = r.bitn + 1;
+                    nx.tx = r.chr >> 1 & 1 == 1;
+                    nx.chr = r.chr >> 1;
+                }
+            } else {
+                nx.dv = r.dv + 1;
+            }
+        }
+        if load {
+            nx.chr = p.frame(byte);
+            nx.busy = true;
+            nx.bitn = 0;
+            nx.dv = 0;
+            nx.tx = false;
+            nx.mask = rest;
+            nx.have = rest != 0;
+            match slot {
+                2 | 3 => {}
+                4 => nx.crc = crc8(p.crc_init, byte),
+                _ => nx.crc = crc8(r.crc, byte),
+            }
+            if slot == 7 {
+                nx.started = true;
+                if r.hslice as u64 + 1 == p.slices_per_frame {
+                    nx.hslice = 0;
+                    nx.hframe = r.hframe.wrapping_add(1);
+                } else {
+                    nx.hslice = r.hslice + 1;
+                }
+            }
+        }
+        *r = nx;
+    }
+
+    fn reset(&mut self) {
+        let p = self._p;
+        let mem = std::mem::take(&mut self._r.mem);
+        self._r = Regs {
+            pos: p.slice_cycles - 1,
+            mem,
+            crc: 0xFFFF,
+            tx: true,
+            ..Default::default()
+        };
+    }
+}
+
+impl Logic for UartLink {
+    fn update(&mut self) {
+        if self.clock.pos_edge() {
+            if self.rst.val() {
+                self.reset();
+            } else {
+                let (v, c, x) = (
+                    self.valid.val(),
+                    self.ch.val().to_u64() as u32,
+                    self.val.val().to_u64() as u32,
+                );
+                self.edge(v, c, x);
+            }
+        }
+        self.tx.next = self._r.tx;
+        self.ovf.next = self._r.ovf;
+    }
+
+    fn connect(&mut self) {
+        self.tx.connect();
+        self.ovf.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        Verilog::Custom(link_verilog(&self._p))
+    }
+}
+
+/// Bits to hold `0..=n`.
+fn width(n: u64) -> usize {
+    (64 - n.leading_zeros() as usize).max(1)
+}
+
+fn link_verilog(p: &LinkParams) -> String {
+    let mut s = String::new();
+    let pw = width(p.slice_cycles - 1);
+    let aw = width(p.depth as u64 - 1);
+    let nw = width(p.depth as u64);
+    let dw = width(p.div as u64 - 1);
+    let cb = p.char_bits() as usize;
+    let bw = width(cb as u64 - 1);
+    let tb = TOKEN_BITS;
+    let last = |w: usize, v: u64| format!("{w}'d{v}");
+    let _ = writeln!(
+        s,
+        "// UART link: {} cycles per bit, {cb} bits per character, FIFO of {} tokens\n// (the schedule's worst-case backlog); packets: docs/packet-format.md",
+        p.div, p.depth
+    );
+    let _ = writeln!(s, "reg [{}:0] pos;\ninitial pos = {};", pw - 1, last(pw, 0));
+    let _ = writeln!(s, "reg [{}:0] mem [0:{}];", tb - 1, p.depth - 1);
+    for (n, w) in [("wr", aw), ("rd", aw), ("n", nw)] {
+        let _ = writeln!(s, "reg [{}:0] {n};\ninitial {n} = {w}'d0;", w - 1);
+    }
+    let _ = writeln!(
+        s,
+        "reg have;\ninitial have = 1'b0;\n// the popped token without its two flags (they become the mask)\nreg [{}:0] tok;\ninitial tok = {}'d0;\nreg [11:0] mask;\ninitial mask = 12'd0;",
+        tb - 3,
+        tb - 2
+    );
+    let _ = writeln!(
+        s,
+        "reg started;\ninitial started = 1'b0;\nreg [7:0] hframe;\ninitial hframe = 8'd0;\nreg [15:0] hslice;\ninitial hslice = 16'd0;"
+    );
+    let _ = writeln!(
+        s,
+        "reg [15:0] crc;\ninitial crc = 16'hffff;\nreg [7:0] ovfc;\ninitial ovfc = 8'd0;\nreg ovf_r;\ninitial ovf_r = 1'b0;"
+    );
+    let _ = writeln!(
+        s,
+        "reg busy;\ninitial busy = 1'b0;\nreg [{}:0] bitn;\ninitial bitn = {bw}'d0;\nreg [{}:0] dv;\ninitial dv = {dw}'d0;",
+        bw - 1,
+        dw - 1
+    );
+    let _ = writeln!(
+        s,
+        "reg [{}:0] chr;\ninitial chr = {cb}'d0;\nreg tx_r;\ninitial tx_r = 1'b1;\n",
+        cb - 1
+    );
+    let _ = writeln!(s, "wire bnd = pos == {};", last(pw, 0));
+    let _ = writeln!(s, "wire push = bnd | valid;");
+    let _ = writeln!(s, "wire last_tick = dv == {};", last(dw, p.div as u64 - 1));
+    let _ = writeln!(
+        s,
+        "wire ready = !busy | (last_tick & (bitn == {}));",
+        last(bw, cb as u64 - 1)
+    );
+    let _ = writeln!(s, "wire load = ready & have;");
+    let _ = writeln!(s, "wire pop = !have & (n != {nw}'d0);");
+    let _ = writeln!(s, "wire room = (n < {}) | pop;", last(nw, p.depth as u64));
+    let _ = writeln!(s, "wire [11:0] rest = mask & (mask - 12'd1);");
+    let _ = writeln!(s, "wire [{}:0] head = mem[rd];", tb - 1);
+    let _ = writeln!(s, "wire [{}:0] token = {{bnd, valid, ch, val}};", tb - 1);
+    // the lowest byte slot still to send
+    let _ = writeln!(s, "reg [3:0] slot;\nalways @(*) begin\n  casez (mask)");
+    for i in 0..12 {
+        let pat: String = (0..12)
+            .rev()
+            .map(|b| match b.cmp(&i) {
+                std::cmp::Ordering::Greater => '?',
+                std::cmp::Ordering::Equal => '1',
+                std::cmp::Ordering::Less => '0',
+            })
+            .collect();
+        let _ = writeln!(s, "    12'b{pat}: slot = 4'd{i};");
+    }
+    let _ = writeln!(s, "    default: slot = 4'd0;\n  endcase\nend\n");
+    let _ = writeln!(s, "reg [7:0] byte_out;\nalways @(*) begin\n  case (slot)");
+    for (i, e) in [
+        "8'h5a",
+        "ovfc",
+        "crc[7:0]",
+        "crc[15:8]",
+        "8'ha5",
+        "hframe",
+        "hslice[15:8]",
+        "hslice[7:0]",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let _ = writeln!(s, "    4'd{i}: byte_out = {e};");
+    }
+    let _ = writeln!(
+        s,
+        "    4'd8: byte_out = {{{}'d0, tok[{}:24]}};",
+        8 - (CH_BITS - 8),
+        CH_BITS + 15
+    );
+    let _ = writeln!(
+        s,
+        "    4'd9: byte_out = tok[23:16];\n    4'd10: byte_out = tok[15:8];\n    default: byte_out = tok[7:0];\n  endcase\nend\n"
+    );
+    // CRC-16/MODBUS of one byte
+    let _ = writeln!(
+        s,
+        "function [15:0] crc8;\n  input [15:0] c;\n  input [7:0] d;\n  integer i;\n  reg [15:0] x;\n  begin\n    x = c ^ {{8'h00, d}};\n    for (i = 0; i < 8; i = i + 1)\n      x = x[0] ? ((x >> 1) ^ 16'ha001) : (x >> 1);\n    crc8 = x;\n  end\nendfunction\n"
+    );
+    let _ = writeln!(
+        s,
+        "wire [15:0] crc_next = crc8((slot == 4'd4) ? 16'h{:04x} : crc, byte_out);",
+        p.crc_init
+    );
+    let stops = "1'b1, ".repeat(p.stop_bits as usize);
+    let parity = match p.parity {
+        1 => "^byte_out, ",
+        2 => "~^byte_out, ",
+        _ => "",
+    };
+    let _ = writeln!(
+        s,
+        "wire [{}:0] chr_load = {{{stops}{parity}byte_out, 1'b0}};\n",
+        cb - 1
+    );
+    let _ = writeln!(s, "always @(posedge clock) begin\n  if (rst) begin");
+    let _ = writeln!(s, "    pos <= {};", last(pw, p.slice_cycles - 1));
+    let _ = writeln!(
+        s,
+        "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    mask <= 12'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= 16'd0;\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n    bitn <= {bw}'d0;\n    dv <= {dw}'d0;\n    tx_r <= 1'b1;\n  end else begin"
+    );
+    let _ = writeln!(
+        s,
+        "    pos <= (pos == {}) ? {} : pos + {};",
+        last(pw, p.slice_cycles - 1),
+        last(pw, 0),
+        last(pw, 1)
+    );
+    let wrap = |r: &str| {
+        format!(
+            "({r} == {}) ? {aw}'d0 : {r} + {aw}'d1",
+            last(aw, p.depth as u64 - 1)
+        )
+    };
+    let _ = writeln!(
+        s,
+        "    if (pop) begin\n      tok <= head[{}:0];\n      rd <= {};\n      have <= 1'b1;\n      mask <= {{{{4{{head[{}]}}}}, {{4{{head[{}]}}}}, {{4{{head[{}] & started}}}}}};\n    end",
+        tb - 3,
+        wrap("rd"),
+        tb - 2,
+        tb - 1,
+        tb - 1
+    );
+    let _ = writeln!(
+        s,
+        "    if (push) begin\n      if (room) begin\n        mem[wr] <= token;\n        wr <= {};\n      end else begin\n        if (ovfc != 8'hff) ovfc <= ovfc + 8'd1;\n        ovf_r <= 1'b1;\n      end\n    end",
+        wrap("wr")
+    );
+    let _ = writeln!(
+        s,
+        "    n <= n + {{{}'d0, push & room}} - {{{0}'d0, pop}};",
+        nw - 1
+    );
+    let _ = writeln!(
+        s,
+        "    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (bitn == {}) begin\n          busy <= 1'b0;\n          tx_r <= 1'b1;\n        end else begin\n          bitn <= bitn + {bw}'d1;\n          tx_r <= chr[1];\n          chr <= chr >> 1;\n        end\n      end else dv <= dv + {dw}'d1;\n    end",
+        last(bw, cb as u64 - 1)
+    );
+    let _ = writeln!(
+        s,
+        "    if (load) begin\n      chr <= chr_load;\n      busy <= 1'b1;\n      bitn <= {bw}'d0;\n      dv <= {dw}'d0;\n      tx_r <= 1'b0;\n      mask <= rest;\n      have <= rest != 12'd0;\n      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == 16'd{}) begin\n          hslice <= 16'd0;\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + 16'd1;\n      end\n    end",
+        p.slices_per_frame - 1
+    );
+    let _ = writeln!(s, "  end\nend\n");
+    let _ = writeln!(s, "always @(*) begin\n  tx = tx_r;\n  ovf = ovf_r;\nend");
+    s
+}

@@ -1,0 +1,275 @@
+//! The host side: a streaming decoder of the bytes a host received.
+//!
+//! Bytes go in as they arrive ([`Decoder::push`]); a packet's samples come
+//! out when its trailer arrives with a good CRC, so a live stream is followed
+//! packet by packet.  Garbage, lost bytes, a cut stream or a capture that
+//! starts in the middle of a packet never stop it: it counts what it had to
+//! drop ([`Stats`]) and resynchronises on the next header that leads to a
+//! good CRC.
+
+use std::collections::VecDeque;
+
+use crate::format::{self, END, SYNC, WORD_BYTES};
+
+/// One sample of a good packet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Decoded {
+    /// Frame number: the header's counter (mod 256) unwrapped from the first
+    /// packet decoded on.
+    pub frame: u64,
+    pub slice: u16,
+    pub channel: u16,
+    pub value: u16,
+}
+
+/// What the decoder saw.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Stats {
+    pub bytes: u64,
+    pub packets: u64,
+    pub samples: u64,
+    /// Packets whose trailer's CRC did not match.
+    pub crc_errors: u64,
+    /// Packets missing between two good ones (from the frame and slice counters).
+    pub lost_packets: u64,
+    /// Times the decoder had to search for a header again after losing sync.
+    pub resyncs: u64,
+    /// Bytes dropped while searching for a header.
+    pub skipped_bytes: u64,
+    /// The largest overflow count a trailer reported (the FIFO dropped
+    /// that many tokens since reset).
+    pub overflows: u8,
+    /// A packet was still open when the stream ended.
+    pub cut: bool,
+}
+
+impl Stats {
+    /// No loss, no error.
+    pub fn clean(&self) -> bool {
+        self.crc_errors == 0
+            && self.lost_packets == 0
+            && self.resyncs == 0
+            && self.skipped_bytes == 0
+            && self.overflows == 0
+            && !self.cut
+    }
+}
+
+/// The streaming decoder.
+#[derive(Debug, Clone)]
+pub struct Decoder {
+    slices: u64,
+    /// Bytes of the packet being read (from its SYNC on).
+    buf: Vec<u8>,
+    /// Bytes to (re)read before new input.
+    pending: VecDeque<u8>,
+    /// Sequence number (frame * slices + slice) of the last good packet, unwrapped.
+    last: Option<u64>,
+    synced_once: bool,
+    searching: bool,
+    stats: Stats,
+}
+
+/// Longest packet accepted: more records than a slice can hold in the
+/// gateware's limits means garbage.
+const MAX_PACKET_BYTES: usize = WORD_BYTES * (2 + 16 * 4096);
+
+impl Decoder {
+    /// A decoder for a mix with `slices_per_frame` slices per frame.
+    pub fn new(slices_per_frame: u64) -> Decoder {
+        Decoder {
+            slices: slices_per_frame.max(1),
+            buf: Vec::new(),
+            pending: VecDeque::new(),
+            last: None,
+            synced_once: false,
+            searching: false,
+            stats: Stats::default(),
+        }
+    }
+
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    /// Feed received bytes; `out` gets the samples of every packet they complete.
+    pub fn push(&mut self, bytes: &[u8], out: &mut Vec<Decoded>) {
+        self.stats.bytes += bytes.len() as u64;
+        self.pending.extend(bytes);
+        while let Some(b) = self.pending.pop_front() {
+            self.byte(b, out);
+        }
+    }
+
+    /// The stream ended: a packet still open is counted as cut.
+    pub fn finish(&mut self) -> Stats {
+        if !self.buf.is_empty() {
+            self.stats.cut = true;
+            self.stats.skipped_bytes += self.buf.len() as u64;
+            self.buf.clear();
+        }
+        self.stats
+    }
+
+    fn byte(&mut self, b: u8, out: &mut Vec<Decoded>) {
+        if self.buf.is_empty() {
+            if b == SYNC {
+                self.buf.push(b);
+                self.searching = false;
+            } else {
+                self.skip(1);
+            }
+            return;
+        }
+        self.buf.push(b);
+        let n = self.buf.len();
+        if n <= WORD_BYTES {
+            if n == WORD_BYTES && self.header_slice() >= self.slices {
+                self.lose_sync();
+            }
+            return;
+        }
+        let word = (n - 1) / WORD_BYTES * WORD_BYTES;
+        let first = self.buf[word];
+        let bad = !matches!(first, 0..=3 | END);
+        if bad || n > MAX_PACKET_BYTES {
+            self.lose_sync();
+            return;
+        }
+        if first == END && n == word + WORD_BYTES {
+            self.trailer(out);
+        }
+    }
+
+    fn header_slice(&self) -> u64 {
+        u16::from_be_bytes([self.buf[2], self.buf[3]]) as u64
+    }
+
+    fn skip(&mut self, n: u64) {
+        self.stats.skipped_bytes += n;
+        if self.synced_once && !self.searching {
+            self.stats.resyncs += 1;
+        }
+        self.searching = true;
+    }
+
+    /// The packet read so far is not one: drop its SYNC and read the rest again.
+    fn lose_sync(&mut self) {
+        let again: Vec<u8> = self.buf.drain(..).skip(1).collect();
+        for b in again.into_iter().rev() {
+            self.pending.push_front(b);
+        }
+        self.skip(1);
+    }
+
+    fn trailer(&mut self, out: &mut Vec<Decoded>) {
+        let n = self.buf.len();
+        let want = format::crc(&self.buf[..n - 2]);
+        let got = u16::from_le_bytes([self.buf[n - 2], self.buf[n - 1]]);
+        if want != got {
+            self.stats.crc_errors += 1;
+            self.lose_sync();
+            return;
+        }
+        let frame8 = self.buf[1] as u64;
+        let slice = self.header_slice();
+        let period = 256 * self.slices;
+        let seq8 = frame8 * self.slices + slice;
+        let seq = match self.last {
+            None => seq8,
+            Some(last) => {
+                let delta = (seq8 + period - last % period) % period;
+                let delta = if delta == 0 { period } else { delta };
+                self.stats.lost_packets += delta - 1;
+                last + delta
+            }
+        };
+        self.last = Some(seq);
+        self.stats.overflows = self.stats.overflows.max(self.buf[n - 3]);
+        self.stats.packets += 1;
+        for r in self.buf[WORD_BYTES..n - WORD_BYTES].chunks(WORD_BYTES) {
+            out.push(Decoded {
+                frame: seq / self.slices,
+                slice: (seq % self.slices) as u16,
+                channel: u16::from_be_bytes([r[0], r[1]]),
+                value: u16::from_be_bytes([r[2], r[3]]),
+            });
+            self.stats.samples += 1;
+        }
+        self.synced_once = true;
+        self.searching = false;
+        self.buf.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::format::{header, record, trailer};
+
+    fn packet(frame: u8, slice: u16, recs: &[(u16, u16)]) -> Vec<u8> {
+        let mut p = header(frame, slice).to_vec();
+        for &(c, v) in recs {
+            p.extend(record(c, v));
+        }
+        p.extend([END, 0]);
+        let c = format::crc(&p);
+        p.extend(&trailer(0, c)[2..]);
+        p
+    }
+
+    fn decode(bytes: &[u8]) -> (Vec<Decoded>, Stats) {
+        let mut d = Decoder::new(10);
+        let mut out = Vec::new();
+        d.push(bytes, &mut out);
+        (out, d.finish())
+    }
+
+    #[test]
+    fn clean_stream() {
+        let mut s = packet(0, 0, &[(1, 0xA5A5), (2, 0x5A5A)]);
+        s.extend(packet(0, 1, &[]));
+        s.extend(packet(0, 2, &[(3, 7)]));
+        let (out, st) = decode(&s);
+        assert_eq!(out.len(), 3);
+        assert_eq!(out[2].slice, 2);
+        assert!(st.clean(), "{st:?}");
+        assert_eq!(st.packets, 3);
+    }
+
+    #[test]
+    fn losses_are_counted_not_hidden() {
+        let mut s = vec![0x13, 0xA5, 0x00, 0x99]; // mid-packet start: garbage
+        s.extend(packet(255, 9, &[(1, 1)]));
+        let mut bad = packet(0, 0, &[(2, 2)]);
+        bad[6] ^= 0x40; // a flipped bit
+        s.extend(bad);
+        s.extend(packet(0, 2, &[(3, 3)])); // slice 1 lost
+        let mut cut = packet(0, 3, &[(4, 4)]);
+        cut.truncate(7);
+        s.extend(cut);
+        let (out, st) = decode(&s);
+        assert_eq!(
+            out.iter().map(|d| d.channel).collect::<Vec<_>>(),
+            [1, 3],
+            "{st:?}"
+        );
+        assert_eq!(out[1].frame, 256, "frame counter unwrapped");
+        assert_eq!(st.crc_errors, 1);
+        assert_eq!(st.lost_packets, 2);
+        assert!(st.cut && st.resyncs >= 1 && st.skipped_bytes >= 4);
+    }
+
+    #[test]
+    fn any_garbage_never_panics() {
+        let mut x: u32 = 12345;
+        let junk: Vec<u8> = (0..20_000)
+            .map(|_| {
+                x = x.wrapping_mul(1_103_515_245).wrapping_add(12345);
+                (x >> 16) as u8
+            })
+            .collect();
+        let (_, st) = decode(&junk);
+        assert_eq!(st.bytes, 20_000);
+    }
+}

@@ -1,0 +1,26 @@
+//! slotforge's link to the host, without any simulator or HDL.
+//!
+//! - [`format`]: the packet format of `docs/packet-format.md` (sync marker,
+//!   frame counter and slice, per-sample records, CRC-16/MODBUS): the one
+//!   home of every byte's meaning;
+//! - [`uart`]: the UART character (start, 8 data bits LSB first, parity,
+//!   stop bits) and its divider from the clock;
+//! - [`tx`]: the transmitter's cycle model (packetizer, FIFO, serializer,
+//!   UART), which the judge uses to predict the line bit by bit and the
+//!   audit to measure the backlog and the latency;
+//! - [`decode`]: a streaming decoder of the bytes a host received, with
+//!   counts of lost packets, CRC errors and resyncs;
+//! - [`rx`]: a UART receiver that turns a sampled line back into bytes.
+//!
+//! No dependencies, so a host application can embed the decoder.
+
+pub mod decode;
+pub mod format;
+pub mod rx;
+pub mod tx;
+pub mod uart;
+
+pub use decode::{Decoded, Decoder, Stats};
+pub use format::Token;
+pub use tx::{TxConfig, TxModel};
+pub use uart::{Parity, UartFormat};

@@ -1,0 +1,333 @@
+//! The link to the host, planned from the schedule: the UART divider, the
+//! bytes a frame puts on the wire, the FIFO's exact worst-case backlog and
+//! the worst latency to the wire, and whether the line can carry the mix
+//! (with the minimum baud that would when it cannot).
+//!
+//! The packet format and the transmitter's cycle model live in the `link`
+//! crate (their one home); this module feeds that model the merged sample
+//! stream the schedule implies (docs/timing.md, "Merged sample stream").
+
+use std::collections::{BTreeMap, VecDeque};
+
+use link::format;
+use link::tx::{self, TxConfig};
+use link::UartFormat;
+use serde::Serialize;
+
+use crate::mix::LinkSpec;
+use crate::schedule::Schedule;
+
+/// The most tokens the gateware's FIFO holds.
+pub const MAX_FIFO_DEPTH: usize = 1024;
+/// Frames the backlog measurement may run before it calls the stream
+/// undrainable.
+const MAX_FRAMES: u64 = 32;
+
+/// What the audit and the gateware know about a mix's link.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LinkPlan {
+    pub kind: &'static str,
+    pub baud_requested: u64,
+    pub baud_divider: u32,
+    pub baud: f64,
+    pub parity: &'static str,
+    pub stop_bits: u8,
+    pub bits_per_byte: u32,
+    /// Header, records and trailer words (the paper's "packets") per frame.
+    pub words_per_frame: u64,
+    pub bytes_per_frame: u64,
+    /// Line bits per frame over the line's bits per frame.
+    pub utilization: f64,
+    /// The FIFO's exact worst-case backlog (tokens), the depth the gateware gets.
+    pub fifo_depth: usize,
+    /// Worst cycles from a sampling instant to the last bit of its packet.
+    pub latency_cycles: u64,
+    pub latency_us: f64,
+    /// The lowest baud (a divider of the clock) that carries the mix.
+    pub min_baud: f64,
+}
+
+/// Why the link cannot carry the mix.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinkInfeasible {
+    pub message: String,
+    pub min_baud: Option<f64>,
+}
+
+impl LinkPlan {
+    pub fn uart(&self) -> UartFormat {
+        UartFormat {
+            div: self.baud_divider,
+            parity: link::Parity::parse(self.parity).expect("parity name"),
+            stop_bits: self.stop_bits,
+        }
+    }
+
+    /// The transmitter the gateware builds (FIFO of [`LinkPlan::fifo_depth`]).
+    pub fn tx_config(&self, s: &Schedule) -> TxConfig {
+        TxConfig {
+            uart: self.uart(),
+            slice_cycles: s.grid.slice_cycles,
+            slices_per_frame: s.grid.slices_per_frame,
+            depth: Some(self.fifo_depth),
+        }
+    }
+}
+
+/// The mix's link plan; `None` without `[link]`.
+pub fn plan(s: &Schedule) -> Option<Result<LinkPlan, LinkInfeasible>> {
+    let spec = s.mix.link?;
+    Some(plan_spec(s, &spec))
+}
+
+fn uart_of(spec: &LinkSpec, div: u32) -> UartFormat {
+    UartFormat {
+        div,
+        parity: spec.parity,
+        stop_bits: spec.stop_bits,
+    }
+}
+
+fn plan_spec(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> {
+    let g = &s.grid;
+    let div = UartFormat::divider(g.clock_hz, spec.baud);
+    let uart = uart_of(spec, div);
+    let words = format::words_per_frame(s.samples_per_frame(), g.slices_per_frame);
+    let bytes = format::bytes_per_frame(s.samples_per_frame(), g.slices_per_frame);
+    let line_cycles = bytes * uart.char_cycles();
+    let stream = merged_frame(s);
+    let min = min_divider(s, spec, &stream, bytes);
+    let min_baud = min.map(|d| UartFormat::real_baud(g.clock_hz, d));
+    let refuse = |why: String| LinkInfeasible {
+        message: match min_baud {
+            Some(b) => format!("{why}; the minimum baud that carries this mix is {b:.0}"),
+            None => format!("{why}; no baud from this clock carries this mix"),
+        },
+        min_baud,
+    };
+    if line_cycles > g.frame_cycles {
+        return Err(refuse(format!(
+            "link: {bytes} bytes per frame need {line_cycles} cycles of a {:.0}-baud line, the frame has {}",
+            UartFormat::real_baud(g.clock_hz, div),
+            g.frame_cycles
+        )));
+    }
+    let m = measure(s, uart, &stream).ok_or_else(|| {
+        refuse(format!(
+            "link: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens at {:.0} baud",
+            UartFormat::real_baud(g.clock_hz, div)
+        ))
+    })?;
+    Ok(LinkPlan {
+        kind: spec.kind.name(),
+        baud_requested: spec.baud,
+        baud_divider: div,
+        baud: UartFormat::real_baud(g.clock_hz, div),
+        parity: spec.parity.name(),
+        stop_bits: spec.stop_bits,
+        bits_per_byte: uart.bits(),
+        words_per_frame: words,
+        bytes_per_frame: bytes,
+        utilization: line_cycles as f64 / g.frame_cycles as f64,
+        fifo_depth: m.backlog.max(1),
+        latency_cycles: m.latency_cycles,
+        latency_us: m.latency_cycles as f64 * 1e6 / g.clock_hz as f64,
+        min_baud: min_baud.unwrap_or(f64::NAN),
+    })
+}
+
+/// The backlog and latency at one divider, if the FIFO stays within its limit.
+fn measure(s: &Schedule, uart: UartFormat, stream: &[(u64, u64, u16)]) -> Option<tx::Measured> {
+    let cfg = TxConfig {
+        uart,
+        slice_cycles: s.grid.slice_cycles,
+        slices_per_frame: s.grid.slices_per_frame,
+        depth: None,
+    };
+    tx::measure(cfg, stream, MAX_FRAMES).filter(|m| m.backlog <= MAX_FIFO_DEPTH)
+}
+
+/// The largest divider (lowest baud) whose line carries the frame's bytes
+/// and whose backlog fits the FIFO.
+fn min_divider(
+    s: &Schedule,
+    spec: &LinkSpec,
+    stream: &[(u64, u64, u16)],
+    bytes: u64,
+) -> Option<u32> {
+    let per_char = uart_of(spec, 1).bits() as u64;
+    let top = (s.grid.frame_cycles / (bytes * per_char)).min(u32::MAX as u64) as u32;
+    let mut d = top;
+    // A line that is just fast enough may still need more FIFO than the
+    // gateware has: step towards faster lines until the backlog fits.
+    for _ in 0..64 {
+        if d < crate::mix::MIN_BAUD_DIVIDER {
+            return None;
+        }
+        if measure(s, uart_of(spec, d), stream).is_some() {
+            return Some(d);
+        }
+        d -= (d / 16).max(1);
+    }
+    None
+}
+
+/// The merged sample stream of one frame in steady state (docs/timing.md):
+/// `(cycle of sample_valid, sampling instant, channel)` for every sample
+/// whose instant is in the frame, in output order.  A sample of the frame's
+/// end may leave after the frame ends.
+pub fn merged_frame(s: &Schedule) -> Vec<(u64, u64, u16)> {
+    let f = s.grid.frame_cycles;
+    // completions of the previous, this and the next frame, by cycle
+    let mut done: BTreeMap<u64, Vec<(usize, u64, Vec<u16>)>> = BTreeMap::new();
+    for i in s.instants(3) {
+        let e = i.cycle + s.branches[i.branch].spi.read_cycles;
+        let words: Vec<u16> = s.words_of(i.channel).map(|(_, c)| c as u16).collect();
+        done.entry(e).or_default().push((i.branch, i.cycle, words));
+    }
+    let mut pending: BTreeMap<usize, VecDeque<(u16, u64)>> = BTreeMap::new();
+    let mut out = Vec::new();
+    let mut c = 0u64;
+    let events: Vec<u64> = done.keys().copied().collect();
+    let mut next_ev = 0;
+    loop {
+        if pending.values().all(|q| q.is_empty()) {
+            match events.get(next_ev) {
+                Some(&e) => c = c.max(e),
+                None => break,
+            }
+        }
+        while next_ev < events.len() && events[next_ev] <= c {
+            for (b, t, words) in &done[&events[next_ev]] {
+                let q = pending.entry(*b).or_default();
+                q.extend(words.iter().map(|&w| (w, *t)));
+            }
+            next_ev += 1;
+        }
+        if let Some((_, q)) = pending.iter_mut().find(|(_, q)| !q.is_empty()) {
+            let (ch, t) = q.pop_front().expect("non-empty");
+            if (f..2 * f).contains(&t) {
+                out.push((c + 1 - f, t - f, ch));
+            }
+        }
+        c += 1;
+    }
+    out
+}
+
+/// Where the samples of each packet were taken, for a host that knows the
+/// mix: per slice, `(channel, sampling instant)` of every sample the packet
+/// of that slice carries in steady state, in output order, the instant in
+/// cycles from the start of the packet's frame (negative for a sample of
+/// the previous frame's end that left in this frame's first slice).
+#[derive(Debug, Clone)]
+pub struct PacketInstants {
+    per_slice: Vec<Vec<(u16, i64)>>,
+    frame_cycles: u64,
+    clock_hz: u64,
+}
+
+impl PacketInstants {
+    pub fn new(s: &Schedule) -> PacketInstants {
+        let g = &s.grid;
+        let mut per_slice = vec![Vec::new(); g.slices_per_frame as usize];
+        for (v, i, ch) in merged_frame(s) {
+            let w = v / g.slice_cycles;
+            let k = (w % g.slices_per_frame) as usize;
+            let shift = (w / g.slices_per_frame * g.frame_cycles) as i64;
+            per_slice[k].push((ch, i as i64 - shift));
+        }
+        PacketInstants {
+            per_slice,
+            frame_cycles: g.frame_cycles,
+            clock_hz: g.clock_hz,
+        }
+    }
+
+    /// The sampling time in seconds of each record of the packet of
+    /// `(frame, slice)` carrying `channels` in order.  A channel with `m`
+    /// records in the packet gets the last `m` of its instants in the slice,
+    /// so a sample skipped at start-up (docs/timing.md) shifts none of the
+    /// others; `None` where the schedule has no instant left for a record.
+    pub fn times(&self, frame: u64, slice: u16, channels: &[u16]) -> Vec<Option<f64>> {
+        let Some(list) = self.per_slice.get(slice as usize) else {
+            return vec![None; channels.len()];
+        };
+        let base = (frame * self.frame_cycles) as i64;
+        let mut seen: BTreeMap<u16, usize> = BTreeMap::new();
+        channels
+            .iter()
+            .map(|&c| {
+                let m = channels.iter().filter(|&&x| x == c).count();
+                let have: Vec<i64> = list.iter().filter(|e| e.0 == c).map(|e| e.1).collect();
+                let i = seen.entry(c).or_insert(0);
+                let k = (have.len() + *i).checked_sub(m);
+                *i += 1;
+                k.and_then(|k| have.get(k))
+                    .map(|&t| (base + t) as f64 / self.clock_hz as f64)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn eskin(baud: u64) -> Schedule {
+        let text = include_str!("../../mixes/eskin34.toml").to_string()
+            + &format!("\n[link]\nkind = \"uart\"\nbaud = {baud}\n");
+        let m = crate::mix::parse(std::path::Path::new("t.toml"), &text).unwrap();
+        crate::synthesize(&m).unwrap()
+    }
+
+    #[test]
+    fn eskin34_words_are_the_papers_369() {
+        let s = eskin(3_000_000);
+        let p = plan(&s).unwrap().unwrap();
+        assert_eq!(p.words_per_frame, 369);
+        assert_eq!(p.bytes_per_frame, 1476);
+        assert_eq!(p.baud_divider, 16);
+        // 1476 bytes x 10 bits x 16 cycles of a 480,000-cycle frame
+        assert!((p.utilization - 0.492).abs() < 1e-9, "{}", p.utilization);
+        assert!(p.fifo_depth >= 1 && p.fifo_depth < 32, "{}", p.fifo_depth);
+        // 1476 x 10 = 14,760 bits in 10 ms: 1,476,000 baud at the least,
+        // and 48 MHz / 32 = 1.5 Mbaud is the slowest divider that carries it.
+        assert_eq!(p.min_baud, 1_500_000.0);
+    }
+
+    #[test]
+    fn a_slow_line_is_refused_with_the_minimum_baud() {
+        let s = eskin(1_000_000);
+        let e = plan(&s).unwrap().unwrap_err();
+        assert_eq!(e.min_baud, Some(1_500_000.0));
+        assert!(e.message.contains("1500000"), "{}", e.message);
+    }
+
+    #[test]
+    fn packet_times_are_the_sampling_instants() {
+        let s = eskin(3_000_000);
+        let pi = PacketInstants::new(&s);
+        // slice 0 of frame 1 carries CH35 (channel 34) sampled at cycle 0 of the slice
+        let ch35 = s.mix.channel_index("CH35").unwrap() as u16;
+        let t = pi.times(1, 0, &[ch35, ch35]);
+        let first = s.first_sample_cycle(ch35 as usize) + s.grid.frame_cycles;
+        assert_eq!(t[0], Some(first as f64 / 48e6));
+        // one record only (the first skipped at start-up): the later instant
+        let t1 = pi.times(1, 0, &[ch35]);
+        assert_eq!(t1[0], t[1]);
+        assert!(pi.times(1, 0, &[ch35, ch35, ch35])[0].is_none());
+    }
+
+    #[test]
+    fn the_merged_stream_has_every_sample_of_a_frame() {
+        let s = eskin(3_000_000);
+        let m = merged_frame(&s);
+        assert_eq!(m.len() as u64, s.samples_per_frame());
+        assert!(
+            m.windows(2).all(|w| w[0].0 < w[1].0),
+            "one sample per cycle"
+        );
+        assert!(m.iter().all(|&(v, i, _)| v > i));
+    }
+}

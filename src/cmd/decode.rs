@@ -1,0 +1,242 @@
+//! `slotforge decode MIX CAPTURE -o OUT.csv [--json]`: the bytes a host
+//! received from the link, as samples (`frame,slice,channel,value,time_s`).
+//!
+//! The decoding is `link::Decoder` (the packet format's one home); the
+//! sampling times come from the schedule (`lut_gen::hostlink::PacketInstants`).
+//! `CAPTURE` may be `-`: stdin is decoded as it arrives and each packet's
+//! rows are written when its trailer arrives (with `-o -`, to stdout at once).
+//!
+//! Exit 0: a clean stream; 1: losses, CRC errors, resyncs, an overflow the
+//! gateware reported or a cut stream (counted, never fatal); 2: bad input.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use link::{Decoded, Decoder, Stats};
+use lut_gen::hostlink::PacketInstants;
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The channel-mix file (TOML) with a `[link]`.
+    pub mix: PathBuf,
+    /// The raw bytes the host received (a serial-port dump), or `-` for stdin.
+    pub capture: PathBuf,
+    /// The CSV to write, or `-` for stdout.
+    #[arg(short, long)]
+    pub out: PathBuf,
+    /// Print the counts as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The CSV's first line.
+pub const HEADER: &str = "frame,slice,channel,value,time_s";
+
+/// Rows of decoded packets, with names and sampling times from the mix.
+struct Rows {
+    names: Vec<String>,
+    times: PacketInstants,
+    rows: u64,
+}
+
+impl Rows {
+    /// The rows of `d` (whole packets, in order), appended to `out`.
+    fn write(&mut self, d: &[Decoded], out: &mut String) {
+        use std::fmt::Write as _;
+        for packet in d.chunk_by(|a, b| (a.frame, a.slice) == (b.frame, b.slice)) {
+            let chans: Vec<u16> = packet.iter().map(|x| x.channel).collect();
+            let times = self.times.times(packet[0].frame, packet[0].slice, &chans);
+            for (x, t) in packet.iter().zip(times) {
+                let name = self
+                    .names
+                    .get(x.channel as usize)
+                    .cloned()
+                    .unwrap_or_else(|| format!("#{}", x.channel));
+                let t = t.map(|t| format!("{t:.12}")).unwrap_or_default();
+                let _ = writeln!(out, "{},{},{name},{},{t}", x.frame, x.slice, x.value);
+                self.rows += 1;
+            }
+        }
+    }
+}
+
+/// Where rows go: stdout at once, or a temporary file renamed at the end
+/// (an interrupted run leaves no half-written CSV under the user's name).
+enum Sink {
+    Stdout,
+    File {
+        tmp: PathBuf,
+        path: PathBuf,
+        f: std::io::BufWriter<std::fs::File>,
+    },
+}
+
+impl Sink {
+    fn open(path: &Path) -> Result<Sink, String> {
+        if path == Path::new("-") {
+            return Ok(Sink::Stdout);
+        }
+        let name = path
+            .file_name()
+            .ok_or_else(|| format!("{}: not a file name", path.display()))?;
+        let tmp = path.with_file_name(format!(".{}.tmp", name.to_string_lossy()));
+        let f = std::fs::File::create(&tmp)
+            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        Ok(Sink::File {
+            tmp,
+            path: path.to_path_buf(),
+            f: std::io::BufWriter::new(f),
+        })
+    }
+
+    fn put(&mut self, text: &str) -> std::io::Result<()> {
+        match self {
+            Sink::Stdout => {
+                let mut o = std::io::stdout().lock();
+                o.write_all(text.as_bytes())?;
+                o.flush()
+            }
+            Sink::File { f, .. } => f.write_all(text.as_bytes()),
+        }
+    }
+
+    fn finish(self) -> Result<(), String> {
+        if let Sink::File { tmp, path, mut f } = self {
+            f.flush()
+                .and_then(|()| std::fs::rename(&tmp, &path))
+                .map_err(|e| {
+                    let _ = std::fs::remove_file(&tmp);
+                    format!("{}: cannot write: {e}", path.display())
+                })?;
+        }
+        Ok(())
+    }
+}
+
+pub fn run(a: Args) -> u8 {
+    let s = match super::schedule(&a.mix) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    if s.mix.link.is_none() {
+        eprintln!(
+            "error: {}: the mix has no [link]: its samples leave on the parallel sample port, there is nothing to decode",
+            a.mix.display()
+        );
+        return 2;
+    }
+    let mut input: Box<dyn Read> = if a.capture == Path::new("-") {
+        Box::new(std::io::stdin().lock())
+    } else {
+        match std::fs::File::open(&a.capture) {
+            Ok(f) => Box::new(f),
+            Err(e) => {
+                eprintln!(
+                    "error: {}: cannot read the capture: {e}",
+                    a.capture.display()
+                );
+                return 2;
+            }
+        }
+    };
+    let mut sink = match Sink::open(&a.out) {
+        Ok(k) => k,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let mut rows = Rows {
+        names: s.mix.channels.iter().map(|c| c.name.clone()).collect(),
+        times: PacketInstants::new(&s),
+        rows: 0,
+    };
+    let mut dec = Decoder::new(s.grid.slices_per_frame);
+    let mut text = format!("{HEADER}\n");
+    let mut buf = vec![0u8; 1 << 16];
+    let mut got = Vec::new();
+    loop {
+        let n = match input.read(&mut buf) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => {
+                eprintln!("error: {}: reading the capture: {e}", a.capture.display());
+                return 2;
+            }
+        };
+        got.clear();
+        dec.push(&buf[..n], &mut got);
+        rows.write(&got, &mut text);
+        if !text.is_empty() {
+            if let Err(e) = sink.put(&text) {
+                eprintln!("error: {}: cannot write: {e}", a.out.display());
+                return 2;
+            }
+            text.clear();
+        }
+    }
+    let st = dec.finish();
+    if let Err(e) = sink.finish() {
+        eprintln!("error: {e}");
+        return 2;
+    }
+    report(&a, &st, rows.rows);
+    if st.clean() {
+        0
+    } else {
+        1
+    }
+}
+
+fn report(a: &Args, st: &Stats, rows: u64) {
+    let json = serde_json::json!({
+        "ok": st.clean(),
+        "bytes": st.bytes,
+        "packets": st.packets,
+        "samples": rows,
+        "crc_errors": st.crc_errors,
+        "lost_packets": st.lost_packets,
+        "resyncs": st.resyncs,
+        "skipped_bytes": st.skipped_bytes,
+        "overflows": st.overflows,
+        "cut": st.cut,
+    });
+    if a.json {
+        let text = serde_json::to_string_pretty(&json).expect("json") + "\n";
+        if a.out == Path::new("-") {
+            eprint!("{text}");
+        } else {
+            print!("{text}");
+        }
+        return;
+    }
+    let mut msg = format!(
+        "{}: {} bytes, {} packets, {rows} samples",
+        a.capture.display(),
+        st.bytes,
+        st.packets
+    );
+    if st.clean() {
+        msg.push_str(": clean");
+    } else {
+        msg.push_str(&format!(
+            "; {} CRC error(s), {} lost packet(s), {} resync(s), {} byte(s) skipped{}{}",
+            st.crc_errors,
+            st.lost_packets,
+            st.resyncs,
+            st.skipped_bytes,
+            if st.overflows > 0 {
+                format!(", the gateware's FIFO overflowed {} time(s)", st.overflows)
+            } else {
+                String::new()
+            },
+            if st.cut {
+                ", the stream ends inside a packet"
+            } else {
+                ""
+            }
+        ));
+    }
+    eprintln!("{msg}");
+}

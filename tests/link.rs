@@ -1,0 +1,236 @@
+//! The link to the host from the command line, with independent evidence:
+//! sigrok-cli's UART decoder reads `link_tx` from a `sim --vcd` of the
+//! eskin34-uart preset; its bytes through `slotforge decode` are the run's
+//! `--samples`, sample for sample, with sampling times from the schedule.
+//! Also: stdin streaming, a corrupted capture (honest counts), a too-slow
+//! baud refused with the minimum, bad `[link]` input.
+
+use std::path::{Path, PathBuf};
+use std::process::Command as Process;
+
+use assert_cmd::Command;
+
+// Missing tools fail under CI=true, skip loudly elsewhere.
+#[path = "common/tools.rs"]
+mod tools;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn preset() -> PathBuf {
+    root().join("mixes/eskin34-uart.toml")
+}
+
+fn slotforge() -> Command {
+    Command::cargo_bin("slotforge").unwrap()
+}
+
+/// `link_tx` of a slotforge VCD (1 ps timescale) as a one-signal VCD in
+/// 10 ns units, which sigrok reads at 100 MHz.
+fn link_vcd(src: &str) -> String {
+    let id = src
+        .lines()
+        .find(|l| l.starts_with("$var") && l.split_whitespace().nth(4) == Some("link_tx"))
+        .and_then(|l| l.split_whitespace().nth(3))
+        .expect("link_tx in the VCD")
+        .to_string();
+    assert!(src.contains("$timescale 1ps $end"));
+    let mut out = String::from(
+        "$timescale 10ns $end\n$scope module top $end\n$var wire 1 ! tx $end\n$upscope $end\n$enddefinitions $end\n",
+    );
+    let mut t = 0u64;
+    let mut last = None;
+    for l in src
+        .lines()
+        .skip_while(|l| !l.starts_with("$enddefinitions"))
+    {
+        if let Some(ps) = l.strip_prefix('#') {
+            t = (ps.parse::<u64>().unwrap() + 5_000) / 10_000;
+        } else if l.len() == 1 + id.len() && l.ends_with(&id) && l.as_bytes()[0] != b'b' {
+            let v = &l[..1];
+            if last != Some(v.to_string()) {
+                out.push_str(&format!("#{t}\n{v}!\n"));
+                last = Some(v.to_string());
+            }
+        }
+    }
+    out.push_str(&format!("#{}\n", t + 1));
+    out
+}
+
+/// The bytes sigrok's UART decoder reads.
+fn sigrok_bytes(vcd: &Path) -> Vec<u8> {
+    let out = Process::new("sigrok-cli")
+        .args(["-I", "vcd", "-i"])
+        .arg(vcd)
+        .args(["-P", "uart:rx=tx:baudrate=3000000", "-A", "uart=rx-data"])
+        .output()
+        .expect("sigrok-cli runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| u8::from_str_radix(l.rsplit(':').next().unwrap().trim(), 16).unwrap())
+        .collect()
+}
+
+/// CSV rows split into fields, header dropped.
+fn rows(text: &str) -> Vec<Vec<String>> {
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect()
+}
+
+fn decode_json(mix: &Path, cap: &Path, out: &Path) -> (i32, serde_json::Value) {
+    let o = slotforge()
+        .arg("decode")
+        .arg(mix)
+        .arg(cap)
+        .arg("-o")
+        .arg(out)
+        .arg("--json")
+        .output()
+        .unwrap();
+    let j = serde_json::from_slice(&o.stdout).expect("decode --json");
+    (o.status.code().unwrap(), j)
+}
+
+#[test]
+fn sigrok_reads_the_line_and_decode_gives_the_sample_stream() {
+    if !tools::require_tool("sigrok-cli") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (wave, samples) = (dir.path().join("w.vcd"), dir.path().join("s.csv"));
+    slotforge()
+        .arg("sim")
+        .arg(preset())
+        .args(["--backend", "rusthdl", "--frames", "1", "--vcd"])
+        .arg(&wave)
+        .arg("--samples")
+        .arg(&samples)
+        .assert()
+        .code(0);
+    let small = dir.path().join("tx.vcd");
+    std::fs::write(&small, link_vcd(&std::fs::read_to_string(&wave).unwrap())).unwrap();
+    let bytes = sigrok_bytes(&small);
+    let cap = dir.path().join("cap.bin");
+    std::fs::write(&cap, &bytes).unwrap();
+
+    // The run ends inside slice 9's packet (its trailer follows at the next
+    // frame's first cycle): every other packet decodes clean.
+    let out = dir.path().join("out.csv");
+    let (code, j) = decode_json(&preset(), &cap, &out);
+    assert_eq!(code, 1, "{j}");
+    assert_eq!(j["cut"], true, "{j}");
+    for k in ["crc_errors", "lost_packets", "resyncs", "overflows"] {
+        assert_eq!(j[k], 0, "{k}: {j}");
+    }
+    assert_eq!(j["packets"], 9, "{j}");
+    let dec = rows(&std::fs::read_to_string(&out).unwrap());
+    let sim = rows(&std::fs::read_to_string(&samples).unwrap());
+    assert!(
+        dec.len() > 300 && dec.len() < sim.len(),
+        "{} of {}",
+        dec.len(),
+        sim.len()
+    );
+    for (k, (d, s)) in dec.iter().zip(&sim).enumerate() {
+        // decode: frame,slice,channel,value,time_s; sim: cycle,time_s,channel,value
+        assert_eq!((&d[2], &d[3]), (&s[2], &s[3]), "sample {k}");
+        let (instant, strobe): (f64, f64) = (d[4].parse().unwrap(), s[1].parse().unwrap());
+        let lag = strobe - instant;
+        assert!(
+            lag > 0.0 && lag < 33.4e-6,
+            "sample {k}: sampled {instant}, out {strobe}"
+        );
+    }
+
+    // The same bytes on stdin, rows to stdout as packets complete.
+    let piped = slotforge()
+        .arg("decode")
+        .arg(preset())
+        .args(["-", "-o", "-"])
+        .write_stdin(bytes.clone())
+        .output()
+        .unwrap();
+    assert_eq!(piped.status.code(), Some(1));
+    assert_eq!(piped.stdout, std::fs::read(&out).unwrap());
+
+    // Garbage first, a flipped bit in a code (packet 3), a dropped byte
+    // (packet 6): counted, never hidden.
+    let starts: Vec<usize> = (0..bytes.len())
+        .step_by(4)
+        .filter(|&i| bytes[i] == 0xA5)
+        .collect();
+    assert!(starts.len() >= 9, "a header per slice: {starts:?}");
+    let flip = starts[3] + 4 + 3; // the low byte of packet 3's first record
+    let drop = starts[6] + 5;
+    let mut bad = vec![0x00, 0xA5, 0x13, 0x5A, 0xFF];
+    for (i, &b) in bytes.iter().enumerate() {
+        if i == flip {
+            bad.push(b ^ 0x01);
+        } else if i != drop {
+            bad.push(b);
+        }
+    }
+    let cap2 = dir.path().join("bad.bin");
+    std::fs::write(&cap2, &bad).unwrap();
+    let out2 = dir.path().join("bad.csv");
+    let (code, j) = decode_json(&preset(), &cap2, &out2);
+    assert_eq!(code, 1);
+    assert!(j["crc_errors"].as_u64().unwrap() >= 1, "{j}");
+    assert_eq!(j["lost_packets"], 2, "{j}");
+    assert_eq!(j["packets"], 7, "{j}");
+    assert!(j["skipped_bytes"].as_u64().unwrap() >= 5, "{j}");
+    let kept = rows(&std::fs::read_to_string(&out2).unwrap());
+    assert!(kept.len() < dec.len() && kept.len() > 200, "{}", kept.len());
+    assert!(
+        kept.iter().all(|r| dec.contains(r)),
+        "only good packets' samples"
+    );
+}
+
+#[test]
+fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(preset()).unwrap();
+    let slow = dir.path().join("slow.toml");
+    std::fs::write(&slow, text.replace("baud = 3_000_000", "baud = 1_000_000")).unwrap();
+    let o = slotforge().arg("audit").arg(&slow).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let t = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        t.contains("the minimum baud that carries this mix is 1500000"),
+        "{t}"
+    );
+    slotforge()
+        .arg("verilog")
+        .arg(&slow)
+        .arg("-o")
+        .arg(dir.path().join("v"))
+        .assert()
+        .code(1);
+
+    let odd = dir.path().join("odd.toml");
+    std::fs::write(&odd, text.replace("baud = 3_000_000", "baud = 2_900_000")).unwrap();
+    let o = slotforge().arg("audit").arg(&odd).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("link.baud") && e.contains(":326:"), "{e}");
+
+    let o = slotforge()
+        .arg("decode")
+        .arg(root().join("mixes/eskin34.toml"))
+        .arg(&odd)
+        .args(["-o", "-"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("has no [link]"));
+}
