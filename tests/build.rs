@@ -60,30 +60,21 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
     assert!(
         !html.contains("<script") && !html.contains("src=\"http") && !html.contains("href=\"http")
     );
-    // the speed/accuracy table is this run's measurements
-    let sa = csv(&out.join("speed-accuracy.csv"));
-    let row = |m: &str| {
-        sa.iter()
-            .find(|r| r[0] == m)
-            .unwrap_or_else(|| panic!("{m}: {sa:?}"))
-            .clone()
-    };
-    for m in ["model", "rusthdl", "verilator", "check"] {
-        let r = row(m);
-        let speed: f64 = r[3].parse().unwrap();
-        assert!(speed > 0.0 && speed.is_finite(), "{r:?}");
-    }
-    // the slot-level model is the fastest; rust-hdl sees every fault class
-    let speed = |m: &str| row(m)[3].parse::<f64>().unwrap();
-    assert!(speed("model") > speed("rusthdl"));
-    assert_eq!(row("rusthdl")[6], "1.000");
-    assert_eq!(row("model")[4], "0");
     // where scheduling breaks: both outcomes occur over the random mixes
     let sched = csv(&out.join("schedulability.csv"));
     assert!(sched.iter().any(|r| r[3] == "true") && sched.iter().any(|r| r[3] == "false"));
+    // comparing the methods is opt-in
+    assert!(!out.join("speed-accuracy.csv").exists());
     // the timing diagram's table has every branch's CS edges
     let timing = std::fs::read_to_string(out.join("timing-slice.csv")).unwrap();
     assert!(timing.contains("fast cs_n") && timing.contains("slow cs_n"));
+    // Figure 7 uses the mix's own rates: tiny has 4, 2 and 1 kHz
+    for r in ["4000", "2000", "1000"] {
+        assert!(
+            out.join(format!("figure7-{r}hz-spectrum.csv")).is_file(),
+            "{r}"
+        );
+    }
     let wd: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(out.join("conversion.wavedrom.json")).unwrap(),
     )
@@ -110,7 +101,7 @@ fn a_failing_step_fails_the_build_and_the_others_still_run() {
     std::fs::write(&log, text.replacen(" sample ", " sample_x ", 1)).unwrap();
     let out = d.path().join("b");
     slotforge()
-        .args(["build", "--quiet", "--golden"])
+        .args(["build", "--quiet", "--only", "golden,faults", "--golden"])
         .arg(&gold)
         .arg("-o")
         .arg(&out)

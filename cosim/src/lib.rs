@@ -21,6 +21,7 @@ pub mod backend;
 pub mod error;
 pub mod faults;
 pub mod icarus;
+pub mod mixgen;
 pub mod options;
 pub mod rtl;
 pub mod rusthdl;

@@ -5,7 +5,9 @@ pub mod build;
 pub mod check;
 pub mod faults;
 pub mod golden;
+pub mod junit;
 pub mod lut;
+pub mod progress;
 pub mod sim;
 pub mod verilog;
 
