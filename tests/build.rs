@@ -9,6 +9,9 @@ use assert_cmd::Command;
 #[path = "common/tools.rs"]
 mod tools;
 
+#[path = "common/browser.rs"]
+mod browser;
+
 fn slotforge() -> Command {
     Command::cargo_bin("slotforge").unwrap()
 }
@@ -32,12 +35,29 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
     }
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("b");
+    let junit = d.path().join("build.xml");
     slotforge()
         .args(["build", "--quiet", "-o"])
         .arg(&out)
+        .arg("--junit")
+        .arg(&junit)
         .arg(tiny())
         .assert()
         .success();
+    // JUnit: one case per step, the opt-in chart skipped with its reason
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let cases: Vec<_> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("testcase"))
+        .collect();
+    assert_eq!(cases.len(), 11, "{xml}");
+    let speed = cases
+        .iter()
+        .find(|c| c.attribute("name") == Some("speed"))
+        .unwrap();
+    assert!(speed.children().any(|n| n.has_tag_name("skipped")), "{xml}");
+    assert!(!xml.contains("<failure"), "{xml}");
     for f in [
         "audit.txt",
         "audit.json",
@@ -80,6 +100,82 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
     )
     .unwrap();
     assert_eq!(wd["signal"][0]["name"], "cs_n");
+    // the one-cycle strobe is visible in WaveDrom's coarser steps
+    let strobe = wd["signal"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == "sample_valid")
+        .unwrap();
+    assert!(strobe["wave"].as_str().unwrap().contains('1'), "{strobe}");
+    // the report in a real browser
+    if tools::require_tool("chromium") {
+        let r = browser::render(&out);
+        assert!(r.images >= 5, "{r:?}");
+        assert!(r.links.len() > 20, "every artefact linked: {r:?}");
+        assert_eq!(browser::problems(&out, &r), Vec::<String>::new());
+    }
+}
+
+#[test]
+fn unknown_steps_are_refused_before_anything_runs() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("b");
+    slotforge()
+        .args(["build", "--only", "audit,prove", "-o"])
+        .arg(&out)
+        .arg(tiny())
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains(
+            "--only: there is no step `prove`; the steps are audit, lut,",
+        ));
+    assert!(!out.exists());
+    slotforge()
+        .args(["build", "--junit", "/nonexistent/dir/x.xml", "-o"])
+        .arg(&out)
+        .arg(tiny())
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains(
+            "the folder /nonexistent/dir does not exist",
+        ));
+}
+
+#[test]
+fn an_interrupted_build_leaves_a_report_of_the_finished_steps() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("b");
+    // the first steps take milliseconds; the fault campaign takes seconds
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_slotforge"))
+        .args(["build", "--quiet", "--only", "audit,lut,faults", "-o"])
+        .arg(&out)
+        .arg(tiny())
+        .spawn()
+        .unwrap();
+    let md = out.join("report.md");
+    let started = std::time::Instant::now();
+    loop {
+        let text = std::fs::read_to_string(&md).unwrap_or_default();
+        if text.contains("fault campaign) was running") {
+            break;
+        }
+        assert!(
+            started.elapsed().as_secs() < 120,
+            "no report while the campaign ran: {text}"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    let _ = child.wait();
+    let text = std::fs::read_to_string(&md).unwrap();
+    assert!(
+        text.contains("| audit | ok |") && text.contains("| slot LUT | ok |"),
+        "{text}"
+    );
+    assert!(!text.contains("| fault campaign |"), "{text}");
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("the build was interrupted or is still running"));
 }
 
 #[test]
@@ -99,6 +195,30 @@ fn a_failing_step_fails_the_build_and_the_others_still_run() {
     let log = gold.join("tiny/events.log");
     let text = std::fs::read_to_string(&log).unwrap();
     std::fs::write(&log, text.replacen(" sample ", " sample_x ", 1)).unwrap();
+    // golden --junit: one case per mix, the failure with its first difference
+    let xml_path = d.path().join("golden.xml");
+    slotforge()
+        .args(["golden", "--quiet", "--backend", "rusthdl", "--junit"])
+        .arg(&xml_path)
+        .arg("--dir")
+        .arg(&gold)
+        .arg(tiny())
+        .assert()
+        .code(1);
+    let xml = std::fs::read_to_string(&xml_path).unwrap();
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let failure = doc
+        .descendants()
+        .find(|n| n.has_tag_name("failure"))
+        .expect(&xml);
+    assert!(
+        failure.attribute("message").is_some_and(|m| !m.is_empty()),
+        "{xml}"
+    );
+    assert!(
+        failure.text().is_some_and(|t| t.contains("sample")),
+        "{xml}"
+    );
     let out = d.path().join("b");
     slotforge()
         .args(["build", "--quiet", "--only", "golden,faults", "--golden"])

@@ -80,7 +80,7 @@ fn rates(s: &Schedule) -> Vec<(u64, usize)> {
             v.push((c.rate_hz, i));
         }
     }
-    v.sort_by(|a, b| b.0.cmp(&a.0));
+    v.sort_by_key(|r| std::cmp::Reverse(r.0));
     v
 }
 
@@ -145,10 +145,14 @@ fn aliasing(s: &Schedule, rate: f64, ch: usize) -> Result<(Figure, Figure, Strin
     let time = Figure {
         stem: format!("{stem}-time"),
         title: format!("A {f} Hz tone sampled at {rate} Hz"),
-        caption: format!("the continuous {f} Hz input of {name} (line) and its samples (dots): they trace a {want} Hz sine"),
+        caption: format!("the continuous {f} Hz input of {name} (blue) and its samples (dots, joined in red): they trace a {want} Hz sine"),
         svg: draw(
             &Axes::new(&format!("{f} Hz on {name}, sampled at {rate} Hz"), "time (ms)", "ADC code"),
-            &[Series::line(&format!("{f} Hz input"), ms(&cont)), samples],
+            &[
+                Series::line(&format!("{f} Hz input"), ms(&cont)),
+                Series::line(&format!("samples joined: {want} Hz"), ms(&shown)),
+                samples,
+            ],
             900,
             340,
         ),

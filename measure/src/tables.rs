@@ -38,8 +38,13 @@ fn compact(v: &Value) -> String {
     }
 }
 
-/// The audit as tables: the mix's figures (key, value), then one table per
-/// list of records (branches, parts, channels), one row each.
+/// Columns per table: wider record lists are split (the first column, the
+/// record's name, repeated), so no table is wider than the page.
+const COLUMNS: usize = 7;
+
+/// The audit as tables: the mix's figures (key, value), then each list of
+/// records (branches, parts, channels) a row per record, and each list
+/// inside a record (a branch's headroom per rate) its own table.
 pub fn audit(r: &AuditReport) -> Vec<(String, Table)> {
     let v = serde_json::to_value(r).expect("the audit serializes");
     let Value::Object(o) = v else {
@@ -50,16 +55,7 @@ pub fn audit(r: &AuditReport) -> Vec<(String, Table)> {
     for (k, x) in &o {
         match x {
             Value::Array(a) if a.first().is_some_and(Value::is_object) => {
-                let cols: Vec<String> = a[0]
-                    .as_object()
-                    .map(|m| m.keys().cloned().collect())
-                    .unwrap_or_default();
-                let refs: Vec<&str> = cols.iter().map(String::as_str).collect();
-                let mut t = Table::new(&refs);
-                for row in a {
-                    t.push(cols.iter().map(|c| cell(&row[c.as_str()])).collect());
-                }
-                lists.push((format!("Audit: {k}"), t));
+                records(&format!("Audit: {k}"), a, &mut lists)
             }
             Value::Array(a) if a.is_empty() => facts.push(vec![k.clone(), "none".into()]),
             _ => facts.push(vec![k.clone(), cell(x)]),
@@ -68,6 +64,72 @@ pub fn audit(r: &AuditReport) -> Vec<(String, Table)> {
     let mut out = vec![("Audit: the mix".to_string(), facts)];
     out.extend(lists);
     out
+}
+
+/// Records as tables of at most [`COLUMNS`] columns, `name` first; nested
+/// record lists become tables of their own, keyed by the parent's name.
+fn records(title: &str, a: &[Value], out: &mut Vec<(String, Table)>) {
+    let keys: Vec<String> = a[0]
+        .as_object()
+        .map(|m| m.keys().cloned().collect())
+        .unwrap_or_default();
+    let key = if keys.iter().any(|k| k == "name") {
+        "name"
+    } else {
+        keys[0].as_str()
+    }
+    .to_string();
+    let nested = |k: &String| {
+        a.iter().any(|r| {
+            r[k.as_str()]
+                .as_array()
+                .is_some_and(|v| v.first().is_some_and(Value::is_object))
+        })
+    };
+    let plain: Vec<&String> = keys.iter().filter(|k| **k != key && !nested(k)).collect();
+    let chunks: Vec<&[&String]> = plain.chunks(COLUMNS - 1).collect();
+    for (n, cols) in chunks.iter().enumerate() {
+        let mut names = vec![key.as_str()];
+        names.extend(cols.iter().map(|c| c.as_str()));
+        let mut t = Table::new(&names);
+        for row in a {
+            let mut r = vec![cell(&row[key.as_str()])];
+            r.extend(cols.iter().map(|c| cell(&row[c.as_str()])));
+            t.push(r);
+        }
+        let part = if chunks.len() > 1 {
+            format!(" ({} of {})", n + 1, chunks.len())
+        } else {
+            String::new()
+        };
+        out.push((format!("{title}{part}"), t));
+    }
+    for k in keys.iter().filter(|k| nested(k)) {
+        let inner: Vec<Value> = a
+            .iter()
+            .flat_map(|row| {
+                let parent = row[key.as_str()].clone();
+                let key = key.clone();
+                row[k.as_str()]
+                    .as_array()
+                    .cloned()
+                    .unwrap_or_default()
+                    .into_iter()
+                    .map(move |mut x| {
+                        if let Value::Object(m) = &mut x {
+                            let mut with = serde_json::Map::new();
+                            with.insert(key.clone(), parent.clone());
+                            with.extend(std::mem::take(m));
+                            *m = with;
+                        }
+                        x
+                    })
+            })
+            .collect();
+        if !inner.is_empty() {
+            records(&format!("{title}: {k}"), &inner, out);
+        }
+    }
 }
 
 /// The slot table in the paper's Table 1 form: a row per slot of the slice,
@@ -178,9 +240,27 @@ mod tests {
         .unwrap();
         let s = lut_gen::synthesize(&mix).unwrap();
         let t = audit(&AuditReport::of_schedule(&s));
-        let ch = &t.iter().find(|x| x.0 == "Audit: channels").unwrap().1;
-        assert_eq!(ch.rows.len(), 2);
-        assert!(ch.columns.contains(&"alias_hz".to_string()));
+        // channels split into tables of at most 7 columns, name first
+        let ch: Vec<&Table> = t
+            .iter()
+            .filter(|x| x.0.starts_with("Audit: channels ("))
+            .map(|x| &x.1)
+            .collect();
+        assert!(ch.len() > 1);
+        assert!(ch
+            .iter()
+            .all(|t| t.columns.len() <= COLUMNS && t.columns[0] == "name" && t.rows.len() == 2));
+        assert!(ch
+            .iter()
+            .any(|t| t.columns.contains(&"alias_hz".to_string())));
+        // a branch's headroom per rate is a table of its own
+        let hr = &t
+            .iter()
+            .find(|x| x.0.starts_with("Audit: branches: headroom"))
+            .unwrap()
+            .1;
+        assert_eq!(hr.columns[0], "name");
+        assert_eq!(hr.rows.len(), 2, "{hr:?}");
         let st = slot_table(&s);
         let cells: Vec<&String> = st[0].1.rows.iter().flat_map(|r| &r[1..]).collect();
         assert!(cells.iter().any(|c| *c == "X"), "{cells:?}");

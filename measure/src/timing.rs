@@ -64,6 +64,9 @@ pub fn busiest_slice(s: &Schedule) -> u64 {
         .map_or(0, |x| x.0)
 }
 
+/// A diagram row: its name, `(cycle, value)` at each change, full scale.
+type Row = (String, Vec<(u64, u64)>, f64);
+
 fn lane(l: &Layout, p: &Pins, r: Role, b: usize) -> u64 {
     let (hi, lo) = l.lane_bits(r, b);
     ((p.value(r) >> lo) as u64) & ((1u64 << (hi - lo + 1)) - 1)
@@ -92,7 +95,8 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
     let l = Layout::new(s);
     let us = |c: u64| c as f64 * 1e6 / g.clock_hz as f64;
     let name = |c: usize| s.mix.channels[c].name.clone();
-    let mut rows: Vec<(String, Vec<(u64, u64)>, f64)> = Vec::new();
+    // (name, (cycle, value) at each change, full-scale value)
+    let mut rows: Vec<Row> = Vec::new();
     let changes = |f: &dyn Fn(&Pins) -> u64| -> Vec<(u64, u64)> {
         let mut v: Vec<(u64, u64)> = Vec::new();
         for (k, (p, _)) in w.cycles.iter().enumerate() {
@@ -109,13 +113,9 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         1.0,
     ));
     for (b, br) in s.branches.iter().enumerate().rev() {
-        let en_max = ((1u64
-            << l.lane_bits(Role::MuxEn, b)
-                .0
-                .saturating_sub(l.lane_bits(Role::MuxEn, b).1) as u64
-                + 1)
-            - 1)
-        .max(1) as f64;
+        // one-hot: the highest device's bit is the tallest step
+        let (hi, lo) = l.lane_bits(Role::MuxEn, b);
+        let en_max = (1u64 << (hi - lo)) as f64;
         rows.push((
             format!("{} sclk", br.name),
             changes(&|p| lane(&l, p, Role::Sclk, b)),

@@ -23,6 +23,10 @@ pub struct Args {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Also write JUnit XML: one test case for the waveform, a failure
+    /// carrying the first divergence or violation.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
 }
 
 pub fn run(a: Args) -> u8 {
@@ -33,6 +37,13 @@ pub fn run(a: Args) -> u8 {
     if let Err(code) = super::fits_pins(&s) {
         return code;
     }
+    if let Some(j) = &a.junit {
+        if let Err(e) = super::junit::check_writable(j) {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    }
+    let started = std::time::Instant::now();
     let opts = CheckOptions {
         model: !a.no_model,
         ..CheckOptions::default()
@@ -58,6 +69,24 @@ pub fn run(a: Args) -> u8 {
             );
         }
         print!("{}", report.summary());
+    }
+    if let Some(j) = &a.junit {
+        let summary = report.summary();
+        let first = summary.lines().next().unwrap_or("").to_string();
+        let case = super::junit::Case {
+            name: a.wave.display().to_string(),
+            seconds: started.elapsed().as_secs_f64(),
+            outcome: if report.ok {
+                super::junit::Outcome::Passed
+            } else {
+                super::junit::Outcome::Failed(first, summary)
+            },
+        };
+        if let Err(e) = super::junit::write(j, &format!("slotforge check {}", s.mix.name), &[case])
+        {
+            eprintln!("error: {e}");
+            return 2;
+        }
     }
     if report.ok {
         0

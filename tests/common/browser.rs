@@ -51,10 +51,16 @@ pub struct Rendered {
 
 fn chromium(profile: &Path) -> Command {
     let mut c = Command::new("chromium");
-    c.args(["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking", "--hide-scrollbars"])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg("--window-size=1280,1600")
-        .arg("--virtual-time-budget=10000");
+    c.args([
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-background-networking",
+        "--hide-scrollbars",
+    ])
+    .arg(format!("--user-data-dir={}", profile.display()))
+    .arg("--window-size=1280,1600")
+    .arg("--virtual-time-budget=10000");
     c
 }
 
@@ -62,19 +68,44 @@ fn chromium(profile: &Path) -> Command {
 pub fn render(dir: &Path) -> Rendered {
     let html = std::fs::read_to_string(dir.join("report.html")).expect("report.html");
     let probe = dir.join(".probe.html");
-    std::fs::write(&probe, html.replace("</body>", &format!("{PROBE}\n</body>"))).unwrap();
+    std::fs::write(
+        &probe,
+        html.replace("</body>", &format!("{PROBE}\n</body>")),
+    )
+    .unwrap();
     let profile = tempfile::tempdir().unwrap();
-    let out = chromium(profile.path()).arg("--dump-dom").arg(format!("file://{}", probe.display())).output().expect("chromium runs");
+    let out = chromium(profile.path())
+        .arg("--dump-dom")
+        .arg(format!("file://{}", probe.display()))
+        .output()
+        .expect("chromium runs");
     let _ = std::fs::remove_file(&probe);
     let dom = String::from_utf8_lossy(&out.stdout);
     let json = dom
         .split("<pre id=\"probe\">")
         .nth(1)
         .and_then(|r| r.split("</pre>").next())
-        .unwrap_or_else(|| panic!("chromium printed no probe result:\n{}\n{}", &dom[..dom.len().min(500)], String::from_utf8_lossy(&out.stderr)));
-    let json = json.replace("&lt;", "<").replace("&gt;", ">").replace("&quot;", "\"").replace("&amp;", "&");
-    let v: serde_json::Value = serde_json::from_str(&json).unwrap_or_else(|e| panic!("{e}: {json}"));
-    let list = |k: &str| -> Vec<String> { v[k].as_array().unwrap().iter().map(|x| x.as_str().unwrap().to_string()).collect() };
+        .unwrap_or_else(|| {
+            panic!(
+                "chromium printed no probe result:\n{}\n{}",
+                &dom[..dom.len().min(500)],
+                String::from_utf8_lossy(&out.stderr)
+            )
+        });
+    let json = json
+        .replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .replace("&quot;", "\"")
+        .replace("&amp;", "&");
+    let v: serde_json::Value =
+        serde_json::from_str(&json).unwrap_or_else(|e| panic!("{e}: {json}"));
+    let list = |k: &str| -> Vec<String> {
+        v[k].as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_str().unwrap().to_string())
+            .collect()
+    };
     let shot = dir.join("report.png");
     let profile = tempfile::tempdir().unwrap();
     let s = chromium(profile.path())
@@ -96,17 +127,32 @@ pub fn render(dir: &Path) -> Rendered {
 /// Every complaint about a rendered report, empty when it is fine.
 pub fn problems(dir: &Path, r: &Rendered) -> Vec<String> {
     let mut p = Vec::new();
-    p.extend(r.empty_images.iter().map(|i| format!("image with no size: {i}")));
-    p.extend(r.bad_anchors.iter().map(|a| format!("anchor to nothing: {a}")));
+    p.extend(
+        r.empty_images
+            .iter()
+            .map(|i| format!("image with no size: {i}")),
+    );
+    p.extend(
+        r.bad_anchors
+            .iter()
+            .map(|a| format!("anchor to nothing: {a}")),
+    );
     p.extend(r.overflow.iter().map(|o| format!("overflow: {o}")));
     for l in &r.links {
         let f = dir.join(l);
-        let inside = f.canonicalize().map(|c| c.starts_with(dir.canonicalize().unwrap())).unwrap_or(false);
+        let inside = f
+            .canonicalize()
+            .map(|c| c.starts_with(dir.canonicalize().unwrap()))
+            .unwrap_or(false);
         if l.contains("://") || !f.is_file() || !inside {
             p.push(format!("link to no file in the build directory: {l}"));
         }
     }
-    if std::fs::metadata(&r.screenshot).map(|m| m.len()).unwrap_or(0) == 0 {
+    if std::fs::metadata(&r.screenshot)
+        .map(|m| m.len())
+        .unwrap_or(0)
+        == 0
+    {
         p.push("no screenshot".into());
     }
     p
