@@ -153,8 +153,8 @@ pub fn measure(s: &Schedule, vcd: &Path) -> Result<Vec<MethodScore>, String> {
         of: 0,
         how: "no pins: answers rate questions over hours; no fault reaches it".into(),
     });
-    // the cycle-level model's pins
-    let (r, w) = timed(|| cosim::run(s, Backend::Model, 2, &SimOptions::default()));
+    // the cycle-level model's pins (run_observed; `run` would take the slot model)
+    let (r, w) = timed(|| cosim::run_observed(s, Backend::Model, 2, &SimOptions::default(), None));
     r.map_err(e)?;
     let k = pins
         .iter()

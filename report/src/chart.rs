@@ -111,6 +111,8 @@ pub struct Axes {
     pub y_names: Vec<String>,
     /// Vertical reference lines, each with a label at its top.
     pub vlines: Vec<(f64, String)>,
+    /// The legend in the upper left corner instead of the upper right.
+    pub legend_left: bool,
     /// Fixed ranges instead of the data's (every point must lie inside).
     pub x_range: Option<(f64, f64)>,
     pub y_range: Option<(f64, f64)>,
@@ -126,6 +128,7 @@ impl Axes {
             log_y: false,
             y_names: vec![],
             vlines: vec![],
+            legend_left: false,
             x_range: None,
             y_range: None,
         }
@@ -266,6 +269,11 @@ pub fn draw(axes: &Axes, series: &[Series], w: u32, h: u32) -> String {
                 if axes.y_names.is_empty() && series.len() > 1 {
                     let _ = chart
                         .configure_series_labels()
+                        .position(if axes.legend_left {
+                            SeriesLabelPosition::UpperLeft
+                        } else {
+                            SeriesLabelPosition::UpperRight
+                        })
                         .background_style(WHITE.mix(0.85))
                         .border_style(BLACK)
                         .draw();
