@@ -233,3 +233,91 @@ fn a_failing_step_fails_the_build_and_the_others_still_run() {
     assert!(md.contains("| fault campaign | ok |"), "{md}");
     assert!(md.contains("## Steps: FAILED"));
 }
+
+fn skin28() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/skin28.toml")
+}
+
+#[test]
+#[ignore = "long: make test-long"]
+fn a_new_users_mix_builds_by_default_and_its_report_renders() {
+    if !tools::require_tool("verilator") || !tools::require_tool("chromium") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("b");
+    slotforge()
+        .args(["build", "--quiet", "-o"])
+        .arg(&out)
+        .arg(skin28())
+        .assert()
+        .success();
+    // Figure 7 for this mix's own rates; each spectrum peaks at the alias
+    for (rate, alias) in [(5000.0, 2000.0), (500.0, 200.0), (50.0, 20.0)] {
+        let spec = csv(&out.join(format!("figure7-{}hz-spectrum.csv", rate as u64)));
+        let peak = spec[1..]
+            .iter()
+            .max_by(|a, b| {
+                a[4].parse::<f64>()
+                    .unwrap()
+                    .total_cmp(&b[4].parse::<f64>().unwrap())
+            })
+            .unwrap();
+        let f: f64 = peak[3].parse().unwrap();
+        assert!(
+            (f - alias).abs() <= rate / 240.0,
+            "{rate} Hz: peak at {f}, want {alias}"
+        );
+    }
+    let r = browser::render(&out);
+    assert_eq!(browser::problems(&out, &r), Vec::<String>::new());
+}
+
+#[test]
+#[ignore = "long: make test-long"]
+fn charts_all_compares_every_method_on_the_same_faults() {
+    if !tools::require_tool("verilator") || !tools::require_tool("iverilog") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("b");
+    slotforge()
+        .args([
+            "build",
+            "--quiet",
+            "--charts",
+            "all",
+            "--only",
+            "sim,speed",
+            "-o",
+        ])
+        .arg(&out)
+        .arg(tiny())
+        .assert()
+        .success();
+    let sa = csv(&out.join("speed-accuracy.csv"));
+    let row = |m: &str| {
+        sa.iter()
+            .find(|r| r[0] == m)
+            .unwrap_or_else(|| panic!("{m}: {sa:?}"))
+            .clone()
+    };
+    for m in [
+        "slot model",
+        "cycle model",
+        "rusthdl",
+        "verilator",
+        "check",
+        "icarus",
+    ] {
+        let speed: f64 = row(m)[3].parse().unwrap();
+        assert!(speed > 0.0 && speed.is_finite(), "{m}");
+    }
+    // counts, not fractions; the gateware sees every fault that reaches it
+    assert_eq!(row("rusthdl")[4], row("rusthdl")[5]);
+    assert_eq!(row("slot model")[5], "0");
+    assert_eq!(row("verilator")[5], row("check")[5]);
+    let slot: f64 = row("slot model")[3].parse().unwrap();
+    let rusthdl: f64 = row("rusthdl")[3].parse().unwrap();
+    assert!(slot > rusthdl);
+}
