@@ -23,6 +23,9 @@ pub struct Args {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
     /// Also write JUnit XML: one test case for the waveform, a failure
     /// carrying the first divergence or violation.
     #[arg(long, value_name = "FILE")]
@@ -48,7 +51,13 @@ pub fn run(a: Args) -> u8 {
         model: !a.no_model,
         ..CheckOptions::default()
     };
-    let (report, info) = match judge::vcd::check_vcd_with(&s, &a.wave, a.scope.as_deref(), opts) {
+    let spin =
+        super::progress::spinner(&format!("checking {}", a.wave.display()), a.quiet || a.json);
+    let checked = judge::vcd::check_vcd_with(&s, &a.wave, a.scope.as_deref(), opts);
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
+    let (report, info) = match checked {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");

@@ -28,6 +28,9 @@ pub struct Args {
     /// Print the campaign as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// `--backend` values.
@@ -49,7 +52,12 @@ pub fn run(a: Args) -> u8 {
         Backend::Model => Target::Model,
         Backend::Rusthdl => Target::Rusthdl,
     };
-    let c = match campaign(&s, target, a.frames, a.false_alarm_mixes) {
+    let spin = super::progress::spinner("fault campaign", a.quiet || a.json);
+    let c = campaign(&s, target, a.frames, a.false_alarm_mixes);
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
+    let c = match c {
         Ok(c) => c,
         Err(e) => {
             eprintln!("error: {e}");

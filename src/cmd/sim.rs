@@ -48,6 +48,9 @@ pub struct Args {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
     /// Simulate this Verilog (verilator, icarus) instead of the emitted one;
     /// its top module must honour the pin contract for the mix.
     #[arg(long, value_name = "FILE.v")]
@@ -158,10 +161,24 @@ pub fn run(a: Args) -> u8 {
         ..SimOptions::default()
     };
     let mut log = judge::samples::SampleLog::new();
-    let result = if a.samples.is_some() {
-        cosim::run_observed(&s, backend, a.frames, &opts, Some(&mut log))
-    } else {
+    // The slot-level model runs hours per second: no progress to show, and
+    // an observer would make it run the cycle model instead.
+    let result = if backend == Backend::Model && a.samples.is_none() {
         cosim::run(&s, backend, a.frames, &opts)
+    } else {
+        let inner = a
+            .samples
+            .is_some()
+            .then_some(&mut log as &mut dyn cosim::Tracer);
+        let mut p = super::progress::CycleProgress::new(
+            a.frames,
+            s.grid.frame_cycles,
+            a.quiet || a.json,
+            inner,
+        );
+        let r = cosim::run_observed(&s, backend, a.frames, &opts, Some(&mut p));
+        p.finish();
+        r
     };
     let report = match result {
         Ok(r) => r,
