@@ -384,6 +384,47 @@ fn bad_input_exits_2() {
         .args(["--vcd", "x.vcd", "--from", "2", "--to", "1"])
         .assert()
         .code(2);
+    // a window beyond the run is refused before it runs
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--frames", "1", "--vcd", "x.vcd", "--to", "3"])
+        .assert()
+        .code(2)
+        .stderr(
+            predicate::str::contains("is beyond the run")
+                .and(predicate::str::contains("--frames 3")),
+        );
+}
+
+#[test]
+fn vcd_into_a_missing_folder_is_created_and_its_gtkw_finds_it_from_anywhere() {
+    let d = tempfile::tempdir().unwrap();
+    slotforge()
+        .current_dir(d.path())
+        .arg("sim")
+        .arg(tiny())
+        .args([
+            "--backend",
+            "rusthdl",
+            "--frames",
+            "1",
+            "--vcd",
+            "new/deeper/w.vcd",
+        ])
+        .assert()
+        .code(0);
+    let wave = d.path().join("new/deeper/w.vcd");
+    assert!(wave.is_file());
+    let gtkw = std::fs::read_to_string(d.path().join("new/deeper/w.gtkw")).unwrap();
+    let dump = gtkw.lines().next().unwrap();
+    let path = dump
+        .trim_start_matches("[dumpfile] \"")
+        .trim_end_matches('"');
+    assert!(
+        Path::new(path).is_absolute() && Path::new(path).is_file(),
+        "{dump}"
+    );
 }
 
 /// Issue 17: a window from the middle of a run (`sim --from/--to`, the

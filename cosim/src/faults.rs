@@ -775,42 +775,5 @@ pub fn false_alarms(target: Target, n: u64, sigrok: bool) -> FalseAlarms {
 /// mux devices each, random SCLK and settling, and 2-9 channels at rates
 /// from 500 Hz to 8 kHz; some are infeasible on purpose.
 pub fn random_mix(seed: u64) -> String {
-    use std::fmt::Write as _;
-    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = move || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
-    let nb = 1 + next() % 3;
-    let mut t = String::from(
-        "name = \"random\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 2_000\nslice_us = 1_000\n",
-    );
-    let mut devs = Vec::new();
-    for b in 0..nb {
-        let d = 1 + next() % 3;
-        devs.push(d);
-        let sclk = [2_500_000u64, 1_000_000, 2_000_000][(next() % 3) as usize];
-        let settle = [0u64, 1_000, 2_000, 5_000][(next() % 4) as usize];
-        let _ = write!(
-            t,
-            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nsclk_hz = {sclk}\nmux = \"tmux1108\"\nmux_devices = {d}\nsettle_ns = {settle}\n"
-        );
-    }
-    let n = 2 + next() % 8;
-    let mut used = std::collections::BTreeSet::new();
-    for i in 0..n {
-        let b = next() % nb;
-        let input = next() % (devs[b as usize] * 8);
-        if !used.insert((b, input)) {
-            continue;
-        }
-        let rate = [500u64, 1_000, 2_000, 4_000, 8_000][(next() % 5) as usize];
-        let _ = write!(
-            t,
-            "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {rate}\ninput = {input}\n"
-        );
-    }
-    t
+    crate::mixgen::random_mix(seed, &crate::mixgen::Shape::default())
 }

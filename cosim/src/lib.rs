@@ -26,6 +26,7 @@ pub mod equiv;
 pub mod error;
 pub mod faults;
 pub mod icarus;
+pub mod mixgen;
 pub mod options;
 pub mod rtl;
 pub mod rusthdl;

@@ -307,8 +307,8 @@ impl Cx<'_> {
             .span()
             .map(|s| line_col(self.text, s.start))
             .unwrap_or((0, 0));
-        let message = e.message().to_string();
-        let field = field_from_toml_message(&message, self.text, e.span());
+        let field = field_from_toml_message(e.message(), self.text, e.span());
+        let message = plain(e.message(), &field);
         MixError {
             file: self.file.to_path_buf(),
             line,
@@ -670,7 +670,9 @@ impl Cx<'_> {
         let mut channels = Vec::new();
         let mut channel_names = BTreeSet::new();
         // (input, member) pairs in use per branch.
-        let mut used_inputs: Vec<BTreeSet<(u32, u32)>> = vec![BTreeSet::new(); branches.len()];
+        // (input, chain member) -> the channel that has it, to name it in a clash
+        let mut used_inputs: Vec<BTreeMap<(u32, u32), String>> =
+            vec![BTreeMap::new(); branches.len()];
         // Explicit inputs first, so that automatic ones fill the gaps deterministically.
         let mut pending_auto = Vec::new();
         let mut sync_groups: BTreeMap<String, Vec<(usize, Range<usize>)>> = BTreeMap::new();
@@ -710,9 +712,10 @@ impl Cx<'_> {
                     f("rate_hz"),
                     format!(
                         "{rate_hz} Hz gives {:.3} samples per {frame_us} us frame, not a whole number \
-                         (rates must be multiples of {:.3} Hz)",
+                         (rates must be multiples of {:.3} Hz){}",
                         rate_hz as f64 * frame_us as f64 / 1e6,
-                        1e6 / frame_us as f64
+                        1e6 / frame_us as f64,
+                        frames_that_fit(rate_hz, slice_us)
                     ),
                 ));
             }
@@ -756,7 +759,7 @@ impl Cx<'_> {
                         ));
                     }
                     let inp = *v.get_ref() as u32;
-                    if !used_inputs[branch].insert((inp, member)) {
+                    if let Some(other) = used_inputs[branch].insert((inp, member), cname.clone()) {
                         let which = if chain > 1 {
                             format!(" (chain member {member})")
                         } else {
@@ -766,7 +769,7 @@ impl Cx<'_> {
                             v.span(),
                             f("input"),
                             format!(
-                                "input {inp}{which} of branch `{}` is already used by another channel",
+                                "input {inp}{which} of branch `{}` is already taken by channel `{other}`",
                                 branches[branch].name
                             ),
                         ));
@@ -826,7 +829,7 @@ impl Cx<'_> {
             let b = channels[i].branch;
             let capacity = branches[b].mux.inputs * branches[b].mux_devices;
             let m = channels[i].member;
-            let free = (0..capacity).find(|k| !used_inputs[b].contains(&(*k, m))).ok_or_else(|| {
+            let free = (0..capacity).find(|k| !used_inputs[b].contains_key(&(*k, m))).ok_or_else(|| {
                 self.at(
                     raw.channel[i].get_ref().name.span(),
                     format!("channel[{i}].input"),
@@ -836,7 +839,7 @@ impl Cx<'_> {
                     ),
                 )
             })?;
-            used_inputs[b].insert((free, m));
+            used_inputs[b].insert((free, m), channels[i].name.clone());
             channels[i].input = free;
         }
         // Channels of one branch on one mux input are read in one conversion
@@ -1093,6 +1096,73 @@ fn table_prefix(text: &str, span: Option<Range<usize>>) -> String {
     current
 }
 
+/// Frame periods (whole slices, at most 10 s) in which `rate_hz` gives a
+/// whole number of samples, as advice after a fractional count.
+fn frames_that_fit(rate_hz: u64, slice_us: u64) -> String {
+    let g = gcd(rate_hz, 1_000_000);
+    let step = slice_us / gcd(slice_us, 1_000_000 / g) * (1_000_000 / g);
+    let fits: Vec<String> = (1..=3)
+        .map(|k| k * step)
+        .filter(|t| *t <= 10_000_000)
+        .map(|t| format!("{t} us"))
+        .collect();
+    if fits.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; frame periods that fit {rate_hz} Hz with {slice_us} us slices: {}",
+            fits.join(", ")
+        )
+    }
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// A TOML error message in the words of the mix format, not of Rust's
+/// types: `expected i64` becomes "expected a whole number", of Hz, us or ns
+/// by the unit of `field`.
+fn plain(m: &str, field: &str) -> String {
+    let key = field.rsplit('.').next().unwrap_or("");
+    let unit = if key.ends_with("_hz") || key == "hz" {
+        " of Hz"
+    } else if key.ends_with("_us") {
+        " of microseconds"
+    } else if key.ends_with("_ns") {
+        " of nanoseconds"
+    } else {
+        ""
+    };
+    let mut out = m.to_string();
+    for t in ["i64", "u64", "u32", "i32", "usize", "u16", "u8"] {
+        out = out.replace(
+            &format!("expected {t}"),
+            &format!("expected a whole number{unit}"),
+        );
+    }
+    for (rust, words) in [
+        ("expected f64", "expected a number"),
+        ("invalid type: floating point", "got the number"),
+        ("invalid type: string", "got the text"),
+        ("invalid type: integer", "got the number"),
+        ("invalid type: boolean", "got"),
+        ("invalid type: sequence", "got a list"),
+        ("invalid type: map", "got a table"),
+        ("expected a boolean", "expected true or false"),
+        ("expected a string", "expected a name in quotes"),
+        ("expected struct ", "expected the table "),
+        ("expected a sequence", "expected a list"),
+    ] {
+        out = out.replace(rust, words);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1117,6 +1187,33 @@ bandwidth_hz = 400
 
     fn err(text: &str) -> MixError {
         parse(Path::new("m.toml"), text).unwrap_err()
+    }
+
+    #[test]
+    fn messages_use_the_mix_format_words_not_rust_types() {
+        let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 1000.5"));
+        assert_eq!(e.field, "channel[0].rate_hz", "{e}");
+        assert!(e.message.contains("expected a whole number of Hz"), "{e}");
+        let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = \"fast\""));
+        assert!(
+            !e.message.contains("i64") && e.message.contains("got the text"),
+            "{e}"
+        );
+        let e = err(&GOOD.replace("slice_us = 1_000", "slice_us = 1.5"));
+        assert!(e.message.contains("whole number of microseconds"), "{e}");
+        // a fractional count per frame: frame periods that fit the rate
+        let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 1_050"));
+        assert!(
+            e.message.contains(
+                "frame periods that fit 1050 Hz with 1000 us slices: 20000 us, 40000 us, 60000 us"
+            ),
+            "{e}"
+        );
+        // a taken mux input names the channel that has it
+        let two = GOOD.replace("bandwidth_hz = 400", "bandwidth_hz = 400\ninput = 2")
+            + "[[channel]]\nname = \"c1\"\nbranch = \"a\"\nrate_hz = 1_000\ninput = 2\n";
+        let e = err(&two);
+        assert!(e.message.contains("already taken by channel `c0`"), "{e}");
     }
 
     #[test]

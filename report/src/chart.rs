@@ -57,6 +57,20 @@ pub struct Series {
     pub points_only: bool,
     /// Draw as a step line (digital waveforms).
     pub steps: bool,
+    /// The marker of a scatter: shape as well as colour tells series apart.
+    pub marker: Marker,
+    /// Text beside points: `(x, y, text)`.
+    pub labels: Vec<(f64, f64, String)>,
+}
+
+/// A scatter marker's shape.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Marker {
+    #[default]
+    Circle,
+    Cross,
+    Triangle,
+    Square,
 }
 
 impl Series {
@@ -66,6 +80,8 @@ impl Series {
             points,
             points_only: false,
             steps: false,
+            marker: Marker::Circle,
+            labels: Vec::new(),
         }
     }
 
@@ -74,6 +90,12 @@ impl Series {
             points_only: true,
             ..Series::line(name, points)
         }
+    }
+
+    /// The same series with scatter marker `m`.
+    pub fn with_marker(mut self, m: Marker) -> Series {
+        self.marker = m;
+        self
     }
 }
 
@@ -87,6 +109,13 @@ pub struct Axes {
     pub log_y: bool,
     /// Labels at integer y positions (a timing diagram's signal names).
     pub y_names: Vec<String>,
+    /// Vertical reference lines, each with a label at its top.
+    pub vlines: Vec<(f64, String)>,
+    /// The legend in the upper left corner instead of the upper right.
+    pub legend_left: bool,
+    /// Fixed ranges instead of the data's (every point must lie inside).
+    pub x_range: Option<(f64, f64)>,
+    pub y_range: Option<(f64, f64)>,
 }
 
 impl Axes {
@@ -98,6 +127,10 @@ impl Axes {
             log_x: false,
             log_y: false,
             y_names: vec![],
+            vlines: vec![],
+            legend_left: false,
+            x_range: None,
+            y_range: None,
         }
     }
 }
@@ -138,14 +171,21 @@ pub fn draw(axes: &Axes, series: &[Series], w: u32, h: u32) -> String {
     {
         let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
         let _ = root.fill(&WHITE);
-        let (x0, x1) = range(
-            series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
-            axes.log_x,
-        );
-        let (y0, y1) = range(
-            series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
-            axes.log_y,
-        );
+        let (x0, x1) = axes.x_range.unwrap_or_else(|| {
+            range(
+                series
+                    .iter()
+                    .flat_map(|s| s.points.iter().map(|p| p.0))
+                    .chain(axes.vlines.iter().map(|v| v.0)),
+                axes.log_x,
+            )
+        });
+        let (y0, y1) = axes.y_range.unwrap_or_else(|| {
+            range(
+                series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+                axes.log_y,
+            )
+        });
         let mut b = ChartBuilder::on(&root);
         b.caption(&axes.title, ("sans-serif", 18))
             .margin(12)
@@ -188,21 +228,52 @@ pub fn draw(axes: &Axes, series: &[Series], w: u32, h: u32) -> String {
                         s.points.clone()
                     };
                     let r = if s.points_only {
-                        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 3, c.filled())))
+                        let m = s.marker;
+                        chart.draw_series(pts.iter().map(move |p| {
+                            EmptyElement::at(*p) + Polygon::new(shape(m), c.filled())
+                        }))
                     } else {
                         chart.draw_series(LineSeries::new(pts, c.stroke_width(2)))
                     };
                     if let Ok(a) = r {
                         if axes.y_names.is_empty() {
+                            let (m, dots) = (s.marker, s.points_only);
                             a.label(s.name.clone()).legend(move |(x, y)| {
-                                PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2))
+                                // one element type for every legend entry:
+                                // the marker's outline, or a line
+                                let pts = if dots {
+                                    legend_path(m)
+                                } else {
+                                    vec![(0, 0), (16, 0)]
+                                };
+                                EmptyElement::at((x, y)) + PathElement::new(pts, c.stroke_width(2))
                             });
                         }
                     }
+                    let _ = chart.draw_series(s.labels.iter().map(|(x, y, t)| {
+                        EmptyElement::at((*x, *y))
+                            + Text::new(t.clone(), (6, -14), ("sans-serif", 12).into_font())
+                    }));
+                }
+                for (x, label) in &axes.vlines {
+                    let grey = RGBColor(90, 90, 90);
+                    let _ = chart.draw_series(std::iter::once(PathElement::new(
+                        vec![(*x, y0), (*x, y1)],
+                        grey.stroke_width(1),
+                    )));
+                    let _ = chart.draw_series(std::iter::once(
+                        EmptyElement::at((*x, y1))
+                            + Text::new(label.clone(), (3, 2), ("sans-serif", 12).into_font()),
+                    ));
                 }
                 if axes.y_names.is_empty() && series.len() > 1 {
                     let _ = chart
                         .configure_series_labels()
+                        .position(if axes.legend_left {
+                            SeriesLabelPosition::UpperLeft
+                        } else {
+                            SeriesLabelPosition::UpperRight
+                        })
                         .background_style(WHITE.mix(0.85))
                         .border_style(BLACK)
                         .draw();
@@ -234,6 +305,44 @@ pub fn draw(axes: &Axes, series: &[Series], w: u32, h: u32) -> String {
         let _ = root.present();
     }
     svg
+}
+
+/// The marker's outline, pixel offsets around its anchor.
+fn shape(m: Marker) -> Vec<(i32, i32)> {
+    match m {
+        Marker::Circle => (0..12)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::PI / 6.0;
+                (
+                    (4.5 * a.cos()).round() as i32,
+                    (4.5 * a.sin()).round() as i32,
+                )
+            })
+            .collect(),
+        Marker::Cross => vec![
+            (0, -2),
+            (4, -6),
+            (6, -4),
+            (2, 0),
+            (6, 4),
+            (4, 6),
+            (0, 2),
+            (-4, 6),
+            (-6, 4),
+            (-2, 0),
+            (-6, -4),
+            (-4, -6),
+        ],
+        Marker::Triangle => vec![(0, -6), (5, 4), (-5, 4)],
+        Marker::Square => vec![(-4, -4), (4, -4), (4, 4), (-4, 4)],
+    }
+}
+
+/// A marker's outline as one closed path, offset to the legend's sample spot.
+fn legend_path(m: Marker) -> Vec<(i32, i32)> {
+    let mut pts = shape(m);
+    pts.push(pts[0]);
+    pts.into_iter().map(|(x, y)| (x + 8, y)).collect()
 }
 
 /// A short number for axis labels.
@@ -285,6 +394,20 @@ mod tests {
             400,
             300,
         );
-        assert!(s.contains("<circle"));
+        // a filled 12-gon per point, not a circle element
+        assert_eq!(s.matches("<polygon").count(), 2, "{s}");
+        let cross = draw(
+            &Axes::new("m", "x", "y"),
+            &[
+                Series::scatter("a", vec![(0.0, 0.0)]).with_marker(Marker::Cross),
+                Series::scatter("b", vec![(1.0, 1.0)]).with_marker(Marker::Square),
+            ],
+            400,
+            300,
+        );
+        // the two shapes differ in the points they are drawn with
+        let polys: Vec<&str> = cross.split("<polygon").skip(1).collect();
+        assert_eq!(polys.len(), 2);
+        assert_ne!(polys[0].matches(',').count(), polys[1].matches(',').count());
     }
 }

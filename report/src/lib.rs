@@ -9,7 +9,7 @@ pub mod chart;
 
 use std::fmt::Write as _;
 
-pub use chart::{draw, Axes, Series, Table};
+pub use chart::{draw, Axes, Marker, Series, Table};
 
 /// How a step of the job ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,6 +33,8 @@ impl Status {
 /// One step of the job.
 #[derive(Debug, Clone)]
 pub struct Step {
+    /// The step's name on the command line (`--only`, `--skip`).
+    pub id: String,
     pub name: String,
     pub status: Status,
     pub seconds: f64,
@@ -40,6 +42,8 @@ pub struct Step {
     pub summary: String,
     /// Preformatted detail (a command's output), may be empty.
     pub detail: String,
+    /// Files the step wrote, relative to the report (linked from it).
+    pub files: Vec<String>,
 }
 
 /// A chart with the table it was drawn from.
@@ -62,6 +66,27 @@ pub struct Section {
     pub figures: Vec<Figure>,
     /// Preformatted text blocks.
     pub pre: Vec<String>,
+    /// Files to link: (path relative to the report, what it is).
+    pub links: Vec<(String, String)>,
+}
+
+impl Section {
+    /// The section's anchor in `report.html`.
+    pub fn anchor(&self) -> String {
+        slug(&self.title)
+    }
+}
+
+fn slug(t: &str) -> String {
+    let mut s = String::new();
+    for c in t.chars() {
+        if c.is_ascii_alphanumeric() {
+            s.push(c.to_ascii_lowercase());
+        } else if !s.ends_with('-') {
+            s.push('-');
+        }
+    }
+    s.trim_matches('-').to_string()
 }
 
 /// The whole report.
@@ -69,6 +94,8 @@ pub struct Section {
 pub struct Document {
     pub title: String,
     pub subtitle: String,
+    /// A warning shown at the top (e.g. the job had not finished), may be empty.
+    pub note: String,
     pub steps: Vec<Step>,
     pub sections: Vec<Section>,
 }
@@ -102,7 +129,8 @@ fn inline_svg(svg: &str, title: &str) -> String {
 fn html_table(t: &Table) -> String {
     let mut h = String::from("<table>\n<tr>");
     for c in &t.columns {
-        let _ = write!(h, "<th>{}</th>", esc(c));
+        // long snake_case headers may break after an underscore
+        let _ = write!(h, "<th>{}</th>", esc(c).replace('_', "_<wbr>"));
     }
     h.push_str("</tr>\n");
     for r in &t.rows {
@@ -142,50 +170,67 @@ fn md_table(t: &Table) -> String {
 }
 
 fn steps_table(d: &Document) -> Table {
-    let mut t = Table::new(&["step", "status", "seconds", "result"]);
+    let mut t = Table::new(&["step", "status", "seconds", "result", "files"]);
     for s in &d.steps {
         t.push(vec![
             s.name.clone(),
             s.status.word().into(),
             format!("{:.2}", s.seconds),
             s.summary.clone(),
+            s.files
+                .iter()
+                .map(|f| format!("[{f}]({f})"))
+                .collect::<Vec<_>>()
+                .join(" "),
         ]);
     }
     t
 }
 
-/// `report.html`: one self-contained file.
+/// `report.html`: one self-contained file (charts inline), with a table
+/// of contents, a line per step and links to every file the job wrote.
 pub fn html(d: &Document) -> String {
     let mut h = String::new();
     let _ = write!(
         h,
-        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n<style>\n\
-         body{{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}}\n\
-         table{{border-collapse:collapse;margin:1em 0}}td,th{{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top}}\n\
-         th{{background:#eee}}pre{{background:#f6f6f6;padding:.6em;overflow-x:auto;font-size:85%}}\n\
-         .ok{{color:#176917}}.FAILED{{color:#b00;font-weight:bold}}.skipped{{color:#777}}figure{{margin:1.5em 0}}\n\
-         figcaption{{font-size:90%;color:#444;max-width:900px}}svg{{max-width:100%;height:auto}}\n\
-         </style>\n</head>\n<body>\n<h1>{}</h1>\n<p>{}</p>\n",
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n<style>\n{}</style>\n</head>\n<body>\n<h1>{}</h1>\n<p>{}</p>\n",
         esc(&d.title),
+        CSS,
         esc(&d.title),
         esc(&d.subtitle)
     );
+    if !d.note.is_empty() {
+        let _ = writeln!(h, "<p class=\"FAILED\">{}</p>", esc(&d.note));
+    }
     let verdict = if d.ok() { "ok" } else { "FAILED" };
+    h.push_str("<nav><h2>Contents</h2>\n<ol>\n<li><a href=\"#steps\">Steps</a></li>\n");
+    for sec in &d.sections {
+        let _ = writeln!(
+            h,
+            "<li><a href=\"#{}\">{}</a></li>",
+            sec.anchor(),
+            esc(&sec.title)
+        );
+    }
+    h.push_str("</ol>\n</nav>\n");
     let _ = writeln!(
         h,
-        "<h2>Steps: <span class=\"{verdict}\">{verdict}</span></h2>\n<table>\n<tr><th>step</th><th>status</th><th>seconds</th><th>result</th></tr>"
+        "<h2 id=\"steps\">Steps: <span class=\"{verdict}\">{verdict}</span></h2>\n<table>\n<tr><th>step</th><th>status</th><th>seconds</th><th>result</th><th>files</th></tr>"
     );
     for s in &d.steps {
         let w = s.status.word();
         let _ = writeln!(
             h,
-            "<tr><td>{}</td><td class=\"{w}\">{w}</td><td>{:.2}</td><td>{}</td></tr>",
+            "<tr><td>{} <code>{}</code></td><td class=\"{w}\">{w}</td><td class=\"num\">{:.2}</td><td>{}</td><td>{}</td></tr>",
             esc(&s.name),
+            esc(&s.id),
             s.seconds,
-            esc(&s.summary)
+            esc(&s.summary),
+            s.files.iter().map(|f| link(f, f)).collect::<Vec<_>>().join(" ")
         );
     }
-    h.push_str("</table>\n");
+    let total: f64 = d.steps.iter().map(|s| s.seconds).sum();
+    let _ = writeln!(h, "<tr><td>total</td><td></td><td class=\"num\">{total:.2}</td><td></td><td></td></tr>\n</table>");
     for s in d
         .steps
         .iter()
@@ -199,9 +244,21 @@ pub fn html(d: &Document) -> String {
         );
     }
     for sec in &d.sections {
-        let _ = writeln!(h, "<h2>{}</h2>", esc(&sec.title));
+        let _ = writeln!(
+            h,
+            "<section>\n<h2 id=\"{}\">{}</h2>",
+            sec.anchor(),
+            esc(&sec.title)
+        );
         for p in &sec.paragraphs {
             let _ = writeln!(h, "<p>{}</p>", esc(p));
+        }
+        if !sec.links.is_empty() {
+            h.push_str("<ul>\n");
+            for (f, what) in &sec.links {
+                let _ = writeln!(h, "<li>{}: {}</li>", link(f, f), esc(what));
+            }
+            h.push_str("</ul>\n");
         }
         for (cap, t) in &sec.tables {
             if !cap.is_empty() {
@@ -215,21 +272,39 @@ pub fn html(d: &Document) -> String {
         for f in &sec.figures {
             let _ = writeln!(
                 h,
-                "<figure>\n{}\n<figcaption><b>{}</b>. {} (data: <code>{}.csv</code>)</figcaption>\n</figure>",
+                "<figure>\n{}\n<figcaption><b>{}</b>. {} (data: {}, picture: {})</figcaption>\n</figure>",
                 inline_svg(&f.svg, &f.title),
                 esc(&f.title),
                 esc(&f.caption),
-                esc(&f.stem)
+                link(&format!("{}.csv", f.stem), &format!("{}.csv", f.stem)),
+                link(&format!("{}.svg", f.stem), &format!("{}.svg", f.stem)),
             );
         }
+        h.push_str("</section>\n");
     }
     h.push_str("</body>\n</html>\n");
     h
 }
 
+/// The page's style: tables and text wrap inside the page's width (long
+/// names break anywhere rather than run out of their cell).
+const CSS: &str = "body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}\n\
+table{border-collapse:collapse;margin:1em 0;max-width:100%}td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top;overflow-wrap:anywhere}\n\
+th{background:#eee}td.num{text-align:right;white-space:nowrap}td.ok,td.FAILED,td.skipped{white-space:nowrap}pre{background:#f6f6f6;padding:.6em;white-space:pre-wrap;overflow-wrap:anywhere;font-size:85%}\n\
+.ok{color:#176917}.FAILED{color:#b00;font-weight:bold}.skipped{color:#777}figure{margin:1.5em 0}\n\
+figcaption{font-size:90%;color:#444;max-width:900px}svg{max-width:100%;height:auto}code{overflow-wrap:anywhere}\n\
+nav ol{columns:2}\n";
+
+fn link(href: &str, text: &str) -> String {
+    format!("<a href=\"{}\"><code>{}</code></a>", esc(href), esc(text))
+}
+
 /// `report.md`: the same, figures as `<stem>.svg` files beside it.
 pub fn markdown(d: &Document) -> String {
     let mut m = format!("# {}\n\n{}\n\n", d.title, d.subtitle);
+    if !d.note.is_empty() {
+        let _ = writeln!(m, "**{}**\n", d.note);
+    }
     let _ = writeln!(
         m,
         "## Steps: {}\n\n{}",
@@ -252,6 +327,12 @@ pub fn markdown(d: &Document) -> String {
         let _ = writeln!(m, "## {}\n", sec.title);
         for p in &sec.paragraphs {
             let _ = writeln!(m, "{p}\n");
+        }
+        for (f, what) in &sec.links {
+            let _ = writeln!(m, "- [{f}]({f}): {what}");
+        }
+        if !sec.links.is_empty() {
+            m.push('\n');
         }
         for (cap, t) in &sec.tables {
             if !cap.is_empty() {
@@ -304,8 +385,11 @@ mod tests {
         let d = Document {
             title: "r <1>".into(),
             subtitle: "s".into(),
+            note: String::new(),
             steps: vec![
                 Step {
+                    id: "a".into(),
+                    files: vec!["a.txt".into()],
                     name: "a".into(),
                     status: Status::Ok,
                     seconds: 1.0,
@@ -313,6 +397,8 @@ mod tests {
                     detail: String::new(),
                 },
                 Step {
+                    id: "b".into(),
+                    files: vec![],
                     name: "b".into(),
                     status: Status::Failed,
                     seconds: 0.5,
@@ -338,8 +424,14 @@ mod tests {
         assert!(h.contains("<svg") && !h.contains("<?xml"));
         assert!(!h.contains("<script") && !h.contains("src=\"http"));
         assert!(h.contains("class=\"FAILED\""));
+        assert!(h.contains("<a href=\"#charts\">charts</a>") && h.contains("<h2 id=\"charts\">"));
+        assert!(h.contains("<a href=\"a.txt\">") && h.contains("<a href=\"c.csv\">"));
         let m = markdown(&d);
-        assert!(m.contains("![C](c.svg)") && m.contains("| b | FAILED |"));
+        assert!(
+            m.contains("![C](c.svg)")
+                && m.contains("| b | FAILED |")
+                && m.contains("[a.txt](a.txt)")
+        );
         let names: Vec<String> = files(&d).into_iter().map(|f| f.0).collect();
         assert_eq!(names, ["report.html", "report.md", "c.svg", "c.csv"]);
     }

@@ -33,6 +33,13 @@ pub struct Args {
     /// With --map: the analyser's channel-to-channel skew allowed (`5ns`).
     #[arg(long, default_value = "0ns")]
     pub skew: String,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Also write JUnit XML: one test case for the waveform, a failure
+    /// carrying the first divergence or violation.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
 }
 
 /// `5ns`, `0.5us`, `200ps` in picoseconds.
@@ -102,6 +109,13 @@ pub fn run(a: Args) -> u8 {
     if let Err(code) = super::fits_pins(&s) {
         return code;
     }
+    if let Some(j) = &a.junit {
+        if let Err(e) = super::junit::check_writable(j) {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    }
+    let started = std::time::Instant::now();
     if let Some(map) = &a.map {
         return run_capture(&a, &s, map);
     }
@@ -109,7 +123,13 @@ pub fn run(a: Args) -> u8 {
         model: !a.no_model,
         ..CheckOptions::default()
     };
-    let (report, info) = match judge::vcd::check_vcd_with(&s, &a.wave, a.scope.as_deref(), opts) {
+    let spin =
+        super::progress::spinner(&format!("checking {}", a.wave.display()), a.quiet || a.json);
+    let checked = judge::vcd::check_vcd_with(&s, &a.wave, a.scope.as_deref(), opts);
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
+    let (report, info) = match checked {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");
@@ -149,6 +169,24 @@ pub fn run(a: Args) -> u8 {
             eprintln!("note: the capture does not start at reset: {l}");
         }
         print!("{}", report.summary());
+    }
+    if let Some(j) = &a.junit {
+        let summary = report.summary();
+        let first = summary.lines().next().unwrap_or("").to_string();
+        let case = super::junit::Case {
+            name: a.wave.display().to_string(),
+            seconds: started.elapsed().as_secs_f64(),
+            outcome: if report.ok {
+                super::junit::Outcome::Passed
+            } else {
+                super::junit::Outcome::Failed(first, summary)
+            },
+        };
+        if let Err(e) = super::junit::write(j, &format!("slotforge check {}", s.mix.name), &[case])
+        {
+            eprintln!("error: {e}");
+            return 2;
+        }
     }
     if report.ok {
         0

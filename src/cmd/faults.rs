@@ -20,8 +20,8 @@ pub struct Args {
     /// The design the faults go into: model (the cycle-level reference
     /// model's pins: pin faults and reset glitches) or rusthdl (the
     /// gateware: also faults built into its slot ROM and counters).
-    #[arg(long, value_enum, default_value_t = Backend::Model)]
-    pub backend: Backend,
+    #[arg(long, default_value = "model", value_parser = super::backend)]
+    pub backend: cosim::Backend,
     /// Frames per run (at least 3; faults land in frame 1).
     #[arg(long, default_value_t = 3)]
     pub frames: u64,
@@ -31,13 +31,9 @@ pub struct Args {
     /// Print the campaign as JSON.
     #[arg(long)]
     pub json: bool,
-}
-
-/// `--backend` values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Backend {
-    Model,
-    Rusthdl,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 pub fn run(a: Args) -> u8 {
@@ -48,11 +44,25 @@ pub fn run(a: Args) -> u8 {
     if let Err(code) = super::fits_pins(&s) {
         return code;
     }
+    // One back-end name everywhere (cosim::Backend); the campaign injects
+    // into the designs it can build in process.
     let target = match a.backend {
-        Backend::Model => Target::Model,
-        Backend::Rusthdl => Target::Rusthdl,
+        cosim::Backend::Model => Target::Model,
+        cosim::Backend::RustHdl => Target::Rusthdl,
+        other => {
+            eprintln!(
+                "error: --backend {}: the fault campaign injects into model or rusthdl (faults built into the gateware need the design in process)",
+                other.name()
+            );
+            return 2;
+        }
     };
-    let c = match campaign(&s, target, a.frames, a.false_alarm_mixes) {
+    let spin = super::progress::spinner("fault campaign", a.quiet || a.json);
+    let c = campaign(&s, target, a.frames, a.false_alarm_mixes);
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
+    let c = match c {
         Ok(c) => c,
         Err(e) => {
             eprintln!("error: {e}");

@@ -23,8 +23,9 @@ use serde::Deserialize;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The channel-mix file (TOML).
-    pub mix: PathBuf,
+    /// The channel-mix files (TOML), each compared with its own golden.
+    #[arg(required = true)]
+    pub mix: Vec<PathBuf>,
     /// Which simulator runs the design: verilator or icarus (the emitted
     /// Verilog), rusthdl (in process), or model (the cycle-level reference
     /// model's own pins).
@@ -40,6 +41,12 @@ pub struct Args {
     /// Where the golden folders are (one per mix, named by the mix's `name`).
     #[arg(long, default_value = "golden")]
     pub dir: PathBuf,
+    /// Also write JUnit XML: one test case per mix.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
 }
 
 /// `golden/<mix>/golden.toml`: what the golden holds.
@@ -199,11 +206,49 @@ fn first_window_difference(a: &Trace, b: &Trace) -> Option<String> {
 }
 
 pub fn run(a: Args) -> u8 {
-    let mut out = Output::default();
-    let code = execute(&a, &mut out);
-    print!("{}", out.out);
-    eprint!("{}", out.err);
-    code
+    if let Some(j) = &a.junit {
+        if let Err(e) = super::junit::check_writable(j) {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    }
+    let bar = super::progress::Progress::new(a.mix.len() as u64, "mixes", a.quiet);
+    let mut worst = 0;
+    let mut cases = Vec::new();
+    for mix in &a.mix {
+        bar.message(&mix.display().to_string());
+        let t = std::time::Instant::now();
+        let mut out = Output::default();
+        let code = execute(&a, mix, &mut out);
+        bar.println_out(&out.out);
+        bar.println_err(&out.err);
+        bar.inc();
+        let first = out
+            .out
+            .lines()
+            .chain(out.err.lines())
+            .next()
+            .unwrap_or("")
+            .to_string();
+        cases.push(super::junit::Case {
+            name: mix.display().to_string(),
+            seconds: t.elapsed().as_secs_f64(),
+            outcome: if code == 0 {
+                super::junit::Outcome::Passed
+            } else {
+                super::junit::Outcome::Failed(first, format!("{}{}", out.out, out.err))
+            },
+        });
+        worst = worst.max(code);
+    }
+    bar.finish();
+    if let Some(j) = &a.junit {
+        if let Err(e) = super::junit::write(j, "slotforge golden", &cases) {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    }
+    worst
 }
 
 /// What a golden run printed: `out` for stdout, `err` for stderr.
@@ -215,8 +260,8 @@ pub struct Output {
 
 /// The golden command, its messages collected in `o` (the `build` job
 /// puts them in its report).
-pub fn execute(a: &Args, o: &mut Output) -> u8 {
-    let s = match super::schedule(&a.mix) {
+pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
+    let s = match super::schedule(mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
@@ -259,7 +304,7 @@ pub fn execute(a: &Args, o: &mut Output) -> u8 {
             "error: no golden for mix `{}`: {} does not exist (record one with `slotforge golden {} --update`)",
             s.mix.name,
             events_path.display(),
-            a.mix.display()
+            mix.display()
         );
         return 2;
     };

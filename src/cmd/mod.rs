@@ -6,8 +6,10 @@ pub mod check;
 pub mod decode;
 pub mod faults;
 pub mod golden;
+pub mod junit;
 pub mod lut;
 pub mod prove;
+pub mod progress;
 pub mod sim;
 pub mod verilog;
 

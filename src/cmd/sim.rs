@@ -48,10 +48,38 @@ pub struct Args {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No progress display.
+    #[arg(long)]
+    pub quiet: bool,
     /// Simulate this Verilog (verilator, icarus) instead of the emitted one;
     /// its top module must honour the pin contract for the mix.
     #[arg(long, value_name = "FILE.v")]
     pub rtl: Option<PathBuf>,
+}
+
+/// `path` made absolute, its folder created.
+fn absolute_in_new_folder(path: &std::path::Path) -> Result<PathBuf, String> {
+    if path.is_dir() {
+        return Err(format!("{}: is a folder, not a file", path.display()));
+    }
+    let name = path
+        .file_name()
+        .ok_or_else(|| format!("{}: not a file name", path.display()))?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| {
+        format!(
+            "{}: cannot create the folder {}: {e}",
+            path.display(),
+            dir.display()
+        )
+    })?;
+    let dir = dir
+        .canonicalize()
+        .map_err(|e| format!("{}: {e}", dir.display()))?;
+    Ok(dir.join(name))
 }
 
 pub fn run(a: Args) -> u8 {
@@ -83,6 +111,26 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: --to ({to} cycles) must be after --from ({from} cycles)");
         return 2;
     }
+    // A window beyond the run would come out short, after the whole run.
+    let run_cycles = a.frames.saturating_mul(s.grid.frame_cycles);
+    if a.vcd.is_some() && to > run_cycles {
+        eprintln!(
+            "error: --to ({to} cycles) is beyond the run: {} frame(s) of {} cycles end at cycle {run_cycles}; use --frames {}",
+            a.frames,
+            s.grid.frame_cycles,
+            to.div_ceil(s.grid.frame_cycles)
+        );
+        return 2;
+    }
+    // The VCD's folder is created now, not found missing after the run; its
+    // path is made absolute so the .gtkw beside it finds it from anywhere.
+    let vcd = match a.vcd.as_deref().map(absolute_in_new_folder).transpose() {
+        Ok(v) => v,
+        Err(e) => {
+            eprintln!("error: --vcd {e}");
+            return 2;
+        }
+    };
     if let Some(p) = &a.samples {
         let same = |q: &std::path::Path| {
             p == q || matches!((p.canonicalize(), q.canonicalize()), (Ok(x), Ok(y)) if x == y)
@@ -103,7 +151,7 @@ pub fn run(a: Args) -> u8 {
     }
     let opts = SimOptions {
         stimulus,
-        vcd: a.vcd.map(|path| VcdOut {
+        vcd: vcd.map(|path| VcdOut {
             path,
             from,
             to,
@@ -113,10 +161,24 @@ pub fn run(a: Args) -> u8 {
         ..SimOptions::default()
     };
     let mut log = judge::samples::SampleLog::new();
-    let result = if a.samples.is_some() {
-        cosim::run_observed(&s, backend, a.frames, &opts, Some(&mut log))
-    } else {
+    // The slot-level model runs hours per second: no progress to show, and
+    // an observer would make it run the cycle model instead.
+    let result = if backend == Backend::Model && a.samples.is_none() {
         cosim::run(&s, backend, a.frames, &opts)
+    } else {
+        let inner = a
+            .samples
+            .is_some()
+            .then_some(&mut log as &mut dyn cosim::Tracer);
+        let mut p = super::progress::CycleProgress::new(
+            a.frames,
+            s.grid.frame_cycles,
+            a.quiet || a.json,
+            inner,
+        );
+        let r = cosim::run_observed(&s, backend, a.frames, &opts, Some(&mut p));
+        p.finish();
+        r
     };
     let report = match result {
         Ok(r) => r,

@@ -553,6 +553,8 @@ const NO_XZ: Pins = Pins {
     sample_valid: false,
     sample_channel: 0,
     sample_value: 0,
+    link_tx: false,
+    link_overflow: false,
 };
 
 fn fmt_ctl(c: &Ctl) -> String {

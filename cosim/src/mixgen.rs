@@ -1,0 +1,110 @@
+//! The one random-mix generator: feasible-looking mixes as TOML text, drawn
+//! from a [`Shape`] with a seeded xorshift, so a seed always gives the same
+//! mix.  The fault campaign's false-alarm runs use the default shape
+//! ([`crate::faults::random_mix`]); `build`'s schedulability chart uses a
+//! shape around the user's own mix ([`Shape::around`]).
+
+use std::fmt::Write as _;
+
+/// What random mixes are drawn from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shape {
+    pub clock_hz: u64,
+    pub frame_us: u64,
+    pub slice_us: u64,
+    /// Branch count, drawn from `lo..=hi`.
+    pub branches: (u64, u64),
+    /// Mux devices (8 inputs each) per branch, drawn from `lo..=hi`.
+    pub mux_devices: (u64, u64),
+    pub sclk_hz: Vec<u64>,
+    pub settle_ns: Vec<u64>,
+    /// Channel count, drawn from `lo..=hi` (a channel whose mux input is
+    /// taken already is left out).
+    pub channels: (u64, u64),
+    pub rates_hz: Vec<u64>,
+}
+
+impl Default for Shape {
+    /// Small mixes of harmonic rates on a 2 ms frame: quick to run, and
+    /// each one feasible unless the draw overloads a branch.
+    fn default() -> Shape {
+        Shape {
+            clock_hz: 48_000_000,
+            frame_us: 2_000,
+            slice_us: 1_000,
+            branches: (1, 3),
+            mux_devices: (1, 3),
+            sclk_hz: vec![2_500_000, 1_000_000, 2_000_000],
+            settle_ns: vec![0, 1_000, 2_000, 5_000],
+            channels: (2, 9),
+            rates_hz: vec![500, 1_000, 2_000, 4_000, 8_000],
+        }
+    }
+}
+
+impl Shape {
+    /// Mixes around `mix`: its clock, frame, slice, branch count and rates,
+    /// with from one channel up to `max_channels` (enough to overload it).
+    pub fn around(mix: &lut_gen::Mix, max_channels: u64) -> Shape {
+        let mut rates: Vec<u64> = mix.channels.iter().map(|c| c.rate_hz).collect();
+        rates.sort_unstable();
+        rates.dedup();
+        let nb = mix.branches.len() as u64;
+        let per_branch = max_channels.div_ceil(nb.max(1));
+        Shape {
+            clock_hz: mix.clock_hz,
+            frame_us: mix.frame_us,
+            slice_us: mix.slice_us,
+            branches: (nb, nb),
+            // room for every channel a branch may get, with few input clashes
+            mux_devices: (per_branch.div_ceil(4).max(1), per_branch.div_ceil(4).max(1)),
+            sclk_hz: vec![2_500_000],
+            settle_ns: vec![1_000],
+            channels: (1, max_channels.max(1)),
+            rates_hz: rates,
+        }
+    }
+}
+
+/// The random mix of `seed` drawn from `shape`, as TOML text.
+pub fn random_mix(seed: u64, shape: &Shape) -> String {
+    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let pick = |v: u64, (lo, hi): (u64, u64)| lo + v % (hi - lo + 1);
+    let nb = pick(next(), shape.branches);
+    let mut t = format!(
+        "name = \"random\"\n[clock]\nhz = {}\n[frame]\nperiod_us = {}\nslice_us = {}\n",
+        shape.clock_hz, shape.frame_us, shape.slice_us
+    );
+    let mut devs = Vec::new();
+    for b in 0..nb {
+        let d = pick(next(), shape.mux_devices);
+        devs.push(d);
+        let sclk = shape.sclk_hz[(next() % shape.sclk_hz.len() as u64) as usize];
+        let settle = shape.settle_ns[(next() % shape.settle_ns.len() as u64) as usize];
+        let _ = write!(
+            t,
+            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nsclk_hz = {sclk}\nmux = \"tmux1108\"\nmux_devices = {d}\nsettle_ns = {settle}\n"
+        );
+    }
+    let n = pick(next(), shape.channels);
+    let mut used = std::collections::BTreeSet::new();
+    for i in 0..n {
+        let b = next() % nb;
+        let input = next() % (devs[b as usize] * 8);
+        if !used.insert((b, input)) {
+            continue;
+        }
+        let rate = shape.rates_hz[(next() % shape.rates_hz.len() as u64) as usize];
+        let _ = write!(
+            t,
+            "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {rate}\ninput = {input}\n"
+        );
+    }
+    t
+}

@@ -1,0 +1,145 @@
+//! The one yosys + nextpnr-ice40 flow (an iCE40-HX8K, ct256): `build`'s
+//! synthesis step and `hdl/synth.sh` (through `examples/synth.rs`) both run
+//! [`place_and_route`], so the figures in the report and in
+//! `docs/performance.md` come from the same commands.
+
+use std::path::Path;
+use std::process::Command;
+
+/// What place and route reported.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Synth {
+    /// Logic cells placed (`ICESTORM_LC`).
+    pub lcs: u64,
+    /// `SB_LUT4` and flip-flops (`SB_DFF*`) from yosys' `stat`.
+    pub lut4: u64,
+    pub dff: u64,
+    /// Block RAMs (`ICESTORM_RAM`).
+    pub brams: u64,
+    pub fmax_mhz: f64,
+}
+
+/// Whether `tool` can be started.
+pub fn tool_present(tool: &str) -> bool {
+    Command::new(tool)
+        .arg("-V")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok()
+}
+
+/// yosys `synth_ice40` then nextpnr-ice40 on `dir/slotforge_top.v`, work
+/// files and logs (`yosys.log`, `stat.txt`, `nextpnr.log`) in `dir`.  With
+/// `pcf` the pins are placed as the board file says; without, IO is left
+/// unconstrained (the estimate does not depend on a board).
+pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<Synth, String> {
+    let y = Command::new("yosys")
+        .current_dir(dir)
+        .args(["-q", "-l", "yosys.log", "-p"])
+        .arg(format!(
+            "read_verilog {}; synth_ice40 -top {} -json slotforge.json; check -assert; tee -q -o stat.txt stat",
+            hdl::VERILOG_FILE,
+            lut_gen::ports::TOP_MODULE,
+        ))
+        .output()
+        .map_err(|e| format!("yosys could not be started: {e}"))?;
+    if !y.status.success() {
+        return Err(format!(
+            "yosys failed (see {}):\n{}",
+            dir.join("yosys.log").display(),
+            String::from_utf8_lossy(&y.stderr)
+        ));
+    }
+    let mut n = Command::new("nextpnr-ice40");
+    n.current_dir(dir)
+        .args(["--hx8k", "--package", "ct256", "--json", "slotforge.json"])
+        .args([
+            "--seed",
+            "1",
+            "--asc",
+            "slotforge.asc",
+            "--report",
+            "report.json",
+        ])
+        .arg("--freq")
+        .arg(format!("{}", clock_hz as f64 / 1e6));
+    match pcf {
+        Some(p) => n.arg("--pcf").arg(p),
+        None => n.arg("--pcf-allow-unconstrained"),
+    };
+    let n = n
+        .output()
+        .map_err(|e| format!("nextpnr-ice40 could not be started: {e}"))?;
+    let log = format!(
+        "{}{}",
+        String::from_utf8_lossy(&n.stdout),
+        String::from_utf8_lossy(&n.stderr)
+    );
+    let _ = std::fs::write(dir.join("nextpnr.log"), &log);
+    if !n.status.success() {
+        let tail: Vec<&str> = log.lines().rev().take(20).collect();
+        return Err(format!(
+            "nextpnr-ice40 failed (see {}):\n{}",
+            dir.join("nextpnr.log").display(),
+            tail.into_iter().rev().collect::<Vec<_>>().join("\n")
+        ));
+    }
+    let stat = std::fs::read_to_string(dir.join("stat.txt")).unwrap_or_default();
+    Ok(Synth {
+        lcs: used(&log, "ICESTORM_LC"),
+        brams: used(&log, "ICESTORM_RAM"),
+        lut4: cells(&stat, |c| c == "SB_LUT4"),
+        dff: cells(&stat, |c| c.starts_with("SB_DFF")),
+        fmax_mhz: fmax(&log).ok_or("nextpnr-ice40 reported no Fmax")?,
+    })
+}
+
+/// `CELL: used/available` from nextpnr's utilisation table (the last one).
+fn used(log: &str, cell: &str) -> u64 {
+    let key = format!("{cell}:");
+    log.lines()
+        .filter_map(|l| Some(&l[l.find(&key)? + key.len()..]))
+        .filter_map(|r| r.trim().split('/').next()?.trim().parse().ok())
+        .next_back()
+        .unwrap_or(0)
+}
+
+/// The sum of yosys `stat` counts of the cells `pick` accepts (the last
+/// `stat` block only: the top module after synthesis).
+fn cells(stat: &str, pick: impl Fn(&str) -> bool) -> u64 {
+    let last = stat.rfind("Number of cells").map_or(stat, |i| &stat[i..]);
+    last.lines()
+        .filter_map(|l| {
+            let mut w = l.split_whitespace();
+            let (c, n) = (w.next()?, w.next()?);
+            pick(c).then(|| n.parse::<u64>().ok()).flatten()
+        })
+        .sum()
+}
+
+/// The last `Max frequency for clock '...': F MHz` of nextpnr's log.
+fn fmax(log: &str) -> Option<f64> {
+    log.lines()
+        .filter(|l| l.contains("Max frequency for clock"))
+        .filter_map(|l| l.rsplit("': ").next()?.split(' ').next()?.parse().ok())
+        .next_back()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_nextpnr_and_yosys_figures() {
+        let log = "Info: Device utilisation:\nInfo:     ICESTORM_LC:   263/ 7680     3%\nInfo:    ICESTORM_RAM:     3/   32     9%\n\
+                   Info: Max frequency for clock 'clk$SB_IO_IN_$glb_clk': 98.50 MHz (PASS at 48.00 MHz)\n\
+                   Info: Max frequency for clock 'clk$SB_IO_IN_$glb_clk': 117.00 MHz (PASS at 48.00 MHz)\n";
+        assert_eq!(used(log, "ICESTORM_LC"), 263);
+        assert_eq!(used(log, "ICESTORM_RAM"), 3);
+        assert_eq!(fmax(log), Some(117.0));
+        let stat = "   Number of cells: 9\n     SB_CARRY  4\n     SB_DFF 10\n     SB_DFFER 7\n     SB_LUT4 120\n";
+        assert_eq!(cells(stat, |c| c == "SB_LUT4"), 120);
+        assert_eq!(cells(stat, |c| c.starts_with("SB_DFF")), 17);
+    }
+}

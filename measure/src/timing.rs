@@ -1,0 +1,325 @@
+//! The timing diagram of a steady-state slice (frame 1, the slice with the
+//! most conversions: not the start-up slice, where a slow branch may be
+//! empty) from simulation, per branch `mux_en`, `mux_sel` named by the
+//! channel it selects, CS and SCLK, the sample strobe named by channel, and
+//! the slot boundaries; and WaveDrom JSON of one conversion with its
+//! `sample_valid` strobe.
+
+use cosim::{Backend, SimOptions};
+use judge::run::Observer;
+use judge::vcd::CycleSink;
+use lut_gen::ports::{Layout, Pins, Role};
+use lut_gen::Schedule;
+use report::{draw, Axes, Figure, Section, Series, Table};
+
+/// Keeps the pins of cycles `[from, to)` after cycle 0 only.
+struct Window {
+    from: u64,
+    to: u64,
+    seen: u64,
+    zero: Option<u64>,
+    cycles: Vec<(Pins, u64)>,
+}
+
+impl Window {
+    fn push(&mut self, rst: bool, pins: &Pins, miso: u64) {
+        if !rst && self.zero.is_none() {
+            self.zero = Some(self.seen);
+        }
+        if let Some(z) = self.zero {
+            let c = self.seen - z;
+            if (self.from..self.to).contains(&c) {
+                self.cycles.push((*pins, miso));
+            }
+        }
+        self.seen += 1;
+    }
+}
+
+impl Observer for Window {
+    fn cycle(&mut self, _cycle: u64, rst: bool, pins: &Pins, miso: u64) {
+        self.push(rst, pins, miso);
+    }
+}
+
+impl CycleSink for Window {
+    fn cycle(&mut self, rst: Option<bool>, pins: &Pins, _xz: &Pins, miso: u64, _miso_xz: u64) {
+        self.push(rst.unwrap_or(true), pins, miso);
+    }
+}
+
+/// The slice of frame 1 (of 0-based slices) with the most conversions.
+pub fn busiest_slice(s: &Schedule) -> u64 {
+    let g = &s.grid;
+    let nb = s.branches.len();
+    (0..g.slices_per_frame)
+        .map(|j| {
+            let n = (0..g.slots_per_slice)
+                .flat_map(|k| (0..nb).map(move |b| (j * g.slots_per_slice + k, b)))
+                .filter(|&(slot, b)| s.at(slot, b).is_some())
+                .count();
+            (j, n)
+        })
+        .max_by(|a, b| a.1.cmp(&b.1).then(b.0.cmp(&a.0)))
+        .map_or(0, |x| x.0)
+}
+
+/// A diagram row: its name, `(cycle, value)` at each change, full scale.
+type Row = (String, Vec<(u64, u64)>, f64);
+
+fn lane(l: &Layout, p: &Pins, r: Role, b: usize) -> u64 {
+    let (hi, lo) = l.lane_bits(r, b);
+    ((p.value(r) >> lo) as u64) & ((1u64 << (hi - lo + 1)) - 1)
+}
+
+/// The section, the WaveDrom JSON, and a one-line summary.
+pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String), String> {
+    let g = &s.grid;
+    let slice_cycles = g.slots_per_slice * g.slot_cycles;
+    let j = busiest_slice(s);
+    let from = g.frame_cycles + j * slice_cycles;
+    // one slot more: the last conversion's word leaves after its slot
+    let to = from + slice_cycles + g.slot_cycles;
+    let mut w = Window {
+        from,
+        to,
+        seen: 0,
+        zero: None,
+        cycles: Vec::new(),
+    };
+    cosim::run_observed(s, backend, 3, &SimOptions::default(), Some(&mut w))
+        .map_err(|e| e.to_string())?;
+    if w.cycles.is_empty() {
+        return Err("the run gave no cycles in the window".into());
+    }
+    let l = Layout::new(s);
+    let us = |c: u64| c as f64 * 1e6 / g.clock_hz as f64;
+    let name = |c: usize| s.mix.channels[c].name.clone();
+    // (name, (cycle, value) at each change, full-scale value)
+    let mut rows: Vec<Row> = Vec::new();
+    let changes = |f: &dyn Fn(&Pins) -> u64| -> Vec<(u64, u64)> {
+        let mut v: Vec<(u64, u64)> = Vec::new();
+        for (k, (p, _)) in w.cycles.iter().enumerate() {
+            let x = f(p);
+            if v.last().map(|e| e.1) != Some(x) {
+                v.push((from + k as u64, x));
+            }
+        }
+        v
+    };
+    rows.push((
+        Role::SampleValid.name().into(),
+        changes(&|p| p.sample_valid as u64),
+        1.0,
+    ));
+    for (b, br) in s.branches.iter().enumerate().rev() {
+        // one-hot: the highest device's bit is the tallest step
+        let (hi, lo) = l.lane_bits(Role::MuxEn, b);
+        let en_max = (1u64 << (hi - lo)) as f64;
+        rows.push((
+            format!("{} sclk", br.name),
+            changes(&|p| lane(&l, p, Role::Sclk, b)),
+            1.0,
+        ));
+        rows.push((
+            format!("{} {}", br.name, Role::CsN.key()),
+            changes(&|p| lane(&l, p, Role::CsN, b)),
+            1.0,
+        ));
+        rows.push((
+            format!("{} mux_sel", br.name),
+            changes(&|p| lane(&l, p, Role::MuxSel, b)),
+            7.0,
+        ));
+        rows.push((
+            format!("{} mux_en", br.name),
+            changes(&|p| lane(&l, p, Role::MuxEn, b)),
+            en_max,
+        ));
+    }
+    let mut table = Table::new(&["cycle", "time_us", "signal", "value"]);
+    let mut series = Vec::new();
+    let mut names = Vec::new();
+    for (i, (n, ch, scale)) in rows.iter().enumerate() {
+        let base = i as f64;
+        let mut pts: Vec<(f64, f64)> = ch
+            .iter()
+            .map(|&(c, v)| (us(c), base + 0.7 * (v as f64 / scale).min(1.0)))
+            .collect();
+        pts.push((us(to), pts.last().map_or(base, |p| p.1)));
+        for &(c, v) in ch {
+            table.push(vec![
+                c.to_string(),
+                format!("{:.6}", us(c)),
+                n.clone(),
+                v.to_string(),
+            ]);
+        }
+        let mut sr = Series::line(n, pts);
+        sr.steps = true;
+        series.push(sr);
+        names.push(n.clone());
+    }
+    // name the select values and the strobes by channel
+    let nb = s.branches.len();
+    let row_of = |label: &str| {
+        names
+            .iter()
+            .position(|n| n == label)
+            .map_or(0.0, |i| i as f64)
+    };
+    let mut labels = Series::line("", vec![]);
+    for i in s.instants(3).filter(|i| (from..to).contains(&i.cycle)) {
+        let r = row_of(&format!("{} mux_sel", s.branches[i.branch].name));
+        labels.labels.push((us(i.cycle), r + 0.75, name(i.channel)));
+    }
+    for (k, (p, _)) in w.cycles.iter().enumerate() {
+        if p.sample_valid {
+            labels
+                .labels
+                .push((us(from + k as u64), 0.75, name(p.sample_channel as usize)));
+        }
+    }
+    series.push(labels);
+    let mut axes = Axes::new(
+        &format!(
+            "Slice {j} of frame 1, per branch ({} back end)",
+            backend.name()
+        ),
+        "time after cycle 0 (us); grey lines: slot boundaries",
+        "",
+    );
+    axes.y_names = names;
+    axes.x_range = Some((us(from), us(to)));
+    axes.y_range = Some((-0.3, rows.len() as f64));
+    for k in 0..=g.slots_per_slice {
+        let c = from + k * g.slot_cycles;
+        let label = if g.slots_per_slice <= 16 || k % 4 == 0 {
+            format!("{}", j * g.slots_per_slice + k)
+        } else {
+            String::new()
+        };
+        axes.vlines.push((us(c), label));
+    }
+    let svg = draw(&axes, &series, 1000, 140 + 34 * rows.len() as u32);
+    let (wavedrom, wd_line) = wavedrom(s, &l, &w, nb)?;
+    let line = format!(
+        "slice {j} of frame 1 ({} slots of {} cycles), {} conversions; {wd_line}",
+        g.slots_per_slice,
+        g.slot_cycles,
+        s.instants(3)
+            .filter(|i| (from..from + slice_cycles).contains(&i.cycle))
+            .count()
+    );
+    Ok((
+        Section {
+            title: "Timing of a slice".into(),
+            paragraphs: vec![
+                format!("What the paper's Figure 4 shows, drawn from simulation in steady state (frame 1, slice {j}: the slice of the frame with the most conversions). Per branch, from the bottom up: mux_en (the one-hot device enable), mux_sel (labelled with the channel it selects at each sampling instant), CS and SCLK; at the bottom the merged sample_valid strobe, labelled with sample_channel. Grey lines are slot boundaries, numbered by frame slot."),
+                "conversion.wavedrom.json holds one conversion of the first branch in WaveDrom form (one step per SCLK half period; a step shows sample_valid high if the one-cycle strobe falls in it).".into(),
+            ],
+            figures: vec![Figure {
+                stem: "timing-slice".into(),
+                title: format!("Slice {j} of frame 1"),
+                caption: "steps are the pins' levels, one row per signal; text gives the channel a select value or a strobe stands for".into(),
+                svg,
+                table,
+            }],
+            links: vec![("conversion.wavedrom.json".into(), "one conversion for WaveDrom".into())],
+            ..Section::default()
+        },
+        wavedrom,
+        line,
+    ))
+}
+
+/// WaveDrom JSON of the first conversion of branch 0 in the window, up to
+/// and including its `sample_valid` strobe.
+fn wavedrom(s: &Schedule, l: &Layout, w: &Window, _nb: usize) -> Result<(String, String), String> {
+    let spi = s.branches[0].spi;
+    let cyc = &w.cycles;
+    let cs = |p: &Pins| lane(l, p, Role::CsN, 0);
+    let idle = cs(&cyc[0].0);
+    let t0 = cyc
+        .iter()
+        .position(|(p, _)| cs(p) != idle)
+        .ok_or("the first branch does not convert in the slice")?;
+    let step = spi.sclk_half.max(1) as usize;
+    let end = t0 + spi.read_cycles as usize;
+    let strobe = cyc[end.min(cyc.len())..]
+        .iter()
+        .position(|(p, _)| p.sample_valid)
+        .map(|k| end + k);
+    let from = t0.saturating_sub(2 * step);
+    let to = (strobe.unwrap_or(end) + 3 * step).min(cyc.len());
+    // a signal's level per step: its value at the step's first cycle, or
+    // for a strobe whether it is high anywhere in the step
+    let wave = |f: &dyn Fn(&Pins, u64) -> u64, any: bool| -> String {
+        let mut out = String::new();
+        let mut prev = None;
+        for k in (from..to).step_by(step) {
+            let span = &cyc[k..(k + step).min(to)];
+            let v = if any {
+                span.iter().any(|(p, m)| f(p, *m) != 0) as u64
+            } else {
+                f(&span[0].0, span[0].1)
+            };
+            out.push(if prev == Some(v) {
+                '.'
+            } else if v == 0 {
+                '0'
+            } else {
+                '1'
+            });
+            prev = Some(v);
+        }
+        out
+    };
+    let named = |f: &dyn Fn(&Pins) -> String| -> (String, Vec<String>) {
+        let (mut wv, mut data, mut prev) = (String::new(), Vec::new(), None);
+        for k in (from..to).step_by(step) {
+            let v = f(&cyc[k].0);
+            if prev.as_ref() == Some(&v) {
+                wv.push('.');
+            } else {
+                wv.push('=');
+                data.push(v.clone());
+            }
+            prev = Some(v);
+        }
+        (wv, data)
+    };
+    let (sel_w, sel_d) = named(&|p| match l.selected(p, 0) {
+        Ok(c) => s.mix.channels[c as usize].name.clone(),
+        Err(_) => format!("sel {}", l.sel(p, 0)),
+    });
+    let (ch_w, ch_d) = named(&|p| {
+        if p.sample_valid {
+            s.mix.channels[p.sample_channel as usize].name.clone()
+        } else {
+            "-".into()
+        }
+    });
+    let wd = serde_json::json!({
+        "signal": [
+            {"name": Role::CsN.key(), "wave": wave(&|p, _| cs(p), false)},
+            {"name": Role::Sclk.key(), "wave": wave(&|p, _| lane(l, p, Role::Sclk, 0), false)},
+            {"name": Role::Miso.key(), "wave": wave(&|_, m| m & 1, false)},
+            {"name": Role::MuxSel.key(), "wave": sel_w, "data": sel_d},
+            {"name": Role::SampleValid.name(), "wave": wave(&|p, _| p.sample_valid as u64, true)},
+            {"name": Role::SampleChannel.name(), "wave": ch_w, "data": ch_d},
+        ],
+        "head": {"text": format!("{}: a conversion of branch {} in steady state (one step = {} clock cycles)", s.mix.name, s.branches[0].name, step)},
+        "config": {"hscale": 1},
+    });
+    let mut text = serde_json::to_string_pretty(&wd).expect("json");
+    text.push('\n');
+    let line = match strobe {
+        Some(k) => format!(
+            "WaveDrom: a conversion and its sample_valid strobe {} cycles after CS",
+            k - t0
+        ),
+        None => "WaveDrom: a conversion (its strobe falls outside the window)".into(),
+    };
+    Ok((text, line))
+}

@@ -1,0 +1,424 @@
+//! The steps of `build`, by the names `--only` and `--skip` take, each a
+//! call into a library (`lut-gen`, `hdl`, `cosim`, `measure`) and the
+//! writing of its files.
+
+use cosim::{Backend, SimOptions, VcdOut};
+use lut_gen::{AuditReport, Schedule};
+use measure::tables;
+use report::Section;
+
+use super::job::{Done, Job};
+use super::{Args, Charts};
+
+/// Every step: its name on the command line and in the report.
+pub const STEPS: [(&str, &str); 11] = [
+    ("audit", "audit"),
+    ("lut", "slot LUT"),
+    ("verilog", "Verilog, ports.json, constraints"),
+    ("sim", "co-simulation"),
+    ("golden", "golden comparison"),
+    ("faults", "fault campaign"),
+    ("synth", "synthesis estimate (iCE40 HX8K)"),
+    ("timing", "chart: timing of a slice"),
+    ("figure7", "chart: Figure 7 for this mix's rates"),
+    ("schedulability", "chart: where scheduling breaks"),
+    ("speed", "chart: speed against accuracy"),
+];
+
+const MIX_CHARTS: [&str; 3] = ["timing", "figure7", "schedulability"];
+
+/// Which steps run: every step with whether it runs, or why a name given
+/// is unknown (checked before anything runs).
+pub fn plan(a: &Args) -> Result<Vec<(&'static str, bool, &'static str)>, String> {
+    let known = |n: &String| STEPS.iter().any(|s| s.0 == n.trim());
+    for (flag, names) in [("--only", &a.only), ("--skip", &a.skip)] {
+        if let Some(bad) = names.iter().find(|n| !known(n)) {
+            return Err(format!(
+                "{flag}: there is no step `{bad}`; the steps are {}",
+                STEPS.iter().map(|s| s.0).collect::<Vec<_>>().join(", ")
+            ));
+        }
+    }
+    let named = |v: &Vec<String>, id: &str| v.iter().any(|n| n.trim() == id);
+    Ok(STEPS
+        .iter()
+        .map(|&(id, _)| {
+            let (run, why) = if !a.only.is_empty() {
+                (named(&a.only, id), "not in --only")
+            } else if named(&a.skip, id) {
+                (false, "--skip")
+            } else if id == "speed" && a.charts != Charts::All {
+                (
+                    false,
+                    "compares every simulator (minutes): --charts all or --only speed",
+                )
+            } else if MIX_CHARTS.contains(&id) && a.charts == Charts::None {
+                (false, "--charts none")
+            } else {
+                (true, "")
+            };
+            (id, run, why)
+        })
+        .collect())
+}
+
+/// The simulator of the co-simulation and the charts: Verilator when it is
+/// installed (the emitted Verilog), else rust-hdl.
+fn sim_backend() -> Backend {
+    if measure::synth::tool_present("verilator") {
+        Backend::Verilator
+    } else {
+        Backend::RustHdl
+    }
+}
+
+/// Place and route started at once in a thread: yosys and nextpnr are
+/// other processes, so on two cores they run beside the simulations.
+type Background = std::thread::JoinHandle<(Result<measure::synth::Synth, String>, f64)>;
+
+fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
+    if !measure::synth::tool_present("yosys") || !measure::synth::tool_present("nextpnr-ice40") {
+        return None;
+    }
+    let dir = out.join("synth");
+    let e = hdl::emit(s, None).ok()?;
+    std::fs::create_dir_all(&dir).ok()?;
+    super::super::write_atomic(&dir, hdl::VERILOG_FILE, e.verilog()).ok()?;
+    let clock = s.grid.clock_hz;
+    Some(std::thread::spawn(move || {
+        let t = std::time::Instant::now();
+        let r = measure::synth::place_and_route(&dir, None, clock);
+        (r, t.elapsed().as_secs_f64())
+    }))
+}
+
+pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(&'static str, bool, &'static str)]) {
+    let mut sim_report = None;
+    let mut background = if plan.iter().any(|p| p.0 == "synth" && p.1) {
+        start_synth(&job.out, s)
+    } else {
+        None
+    };
+    for &(id, run, why) in plan {
+        let name = STEPS.iter().find(|x| x.0 == id).map_or(id, |x| x.1);
+        if !run {
+            job.not_run(id, name, &format!("not run ({why})"));
+            continue;
+        }
+        job.step(id, name, |j| match id {
+            "audit" => audit(j, s),
+            "lut" => lut(j, s),
+            "verilog" => verilog(j, s),
+            "sim" => sim(j, a, s, &mut sim_report),
+            "golden" => golden(j, a, s),
+            "faults" => faults(j, a, s),
+            "synth" => synth(s, background.take()),
+            "timing" => timing(j, s),
+            "figure7" => figure7(s),
+            "schedulability" => {
+                let (sec, line) = measure::schedulability::schedulability(s);
+                Done::ok(line)
+                    .section(sec)
+                    .files(&["schedulability.svg", "schedulability.csv"])
+            }
+            "speed" => speed(a, s),
+            _ => unreachable!("every step has a runner"),
+        });
+    }
+}
+
+fn written(r: Result<(), String>, d: Done) -> Done {
+    match r {
+        Ok(()) => d,
+        Err(e) => Done::failed(e, ""),
+    }
+}
+
+fn audit(j: &mut Job, s: &Schedule) -> Done {
+    let r = AuditReport::of_schedule(s);
+    let w = j.write(
+        "",
+        &[("audit.txt", r.to_text()), ("audit.json", r.to_json())],
+    );
+    let line = format!(
+        "feasible, {} slots per slice, {} samples/s of the converters' {} ({:.1} %); {} warning(s)",
+        s.grid.slots_per_slice,
+        r.aggregate_hz,
+        r.adc_limit_hz,
+        r.adc_utilization * 100.0,
+        r.warnings.len()
+    );
+    let mut sec = Section {
+        title: "Audit".into(),
+        paragraphs: r
+            .warnings
+            .iter()
+            .map(|w| format!("Warning: {w}"))
+            .chain(r.notes.iter().map(|n| format!("Note: {n}")))
+            .collect(),
+        links: vec![
+            ("audit.txt".into(), "the audit as text".into()),
+            ("audit.json".into(), "as JSON".into()),
+        ],
+        ..Section::default()
+    };
+    sec.tables = tables::audit(&r);
+    written(
+        w,
+        Done::ok(line)
+            .files(&["audit.txt", "audit.json"])
+            .section(sec),
+    )
+}
+
+fn lut(j: &mut Job, s: &Schedule) -> Done {
+    let files = [
+        ("slots.hex", lut_gen::lut::to_hex(s)),
+        ("slots.csv", lut_gen::lut::to_csv(s)),
+        ("slots.md", lut_gen::lut::to_markdown(s)),
+    ];
+    let sec = Section {
+        title: "Slot table".into(),
+        paragraphs: vec![format!(
+            "The schedule as the paper's Table 1: {} slots per slice, {} slices per frame; every slice runs the same slots, and a rotation group's channel changes from slice to slice (the slice counter picks it).",
+            s.grid.slots_per_slice, s.grid.slices_per_frame
+        )],
+        tables: tables::slot_table(s),
+        links: vec![
+            ("lut/slots.hex".into(), "one word per frame slot ($readmemh)".into()),
+            ("lut/slots.csv".into(), "the frame table".into()),
+            ("lut/slots.md".into(), "this table as Markdown".into()),
+        ],
+        ..Section::default()
+    };
+    written(
+        j.write("lut", &files),
+        Done::ok(format!("{} frame slots in lut/slots.*", s.grid.frame_slots))
+            .files(&["lut/slots.hex", "lut/slots.csv", "lut/slots.md"])
+            .section(sec),
+    )
+}
+
+fn verilog(j: &mut Job, s: &Schedule) -> Done {
+    let e = match hdl::emit(s, None) {
+        Ok(e) => e,
+        Err(e) => return Done::failed(format!("{e}"), ""),
+    };
+    let files: Vec<(&str, String)> = e
+        .files()
+        .iter()
+        .map(|(n, t)| (n.as_str(), t.clone()))
+        .collect();
+    let names: Vec<String> = e
+        .files()
+        .iter()
+        .map(|(n, _)| format!("verilog/{n}"))
+        .collect();
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    written(
+        j.write("verilog", &files),
+        Done::ok(format!(
+            "{} lines of Verilog in verilog/",
+            e.verilog().lines().count()
+        ))
+        .files(&refs),
+    )
+}
+
+fn sim(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<judge::Report>) -> Done {
+    let g = &s.grid;
+    let backend = sim_backend();
+    let frames = a.frames.max(1);
+    let opts = SimOptions {
+        vcd: Some(VcdOut {
+            path: j.out.join("frame0.vcd"),
+            from: 0,
+            to: g.frame_cycles,
+            gtkw: true,
+        }),
+        ..SimOptions::default()
+    };
+    let r = match cosim::run(s, backend, frames, &opts) {
+        Ok(r) => r,
+        Err(e) => return Done::failed(format!("{e}"), ""),
+    };
+    let json = serde_json::to_string_pretty(&r).expect("report");
+    let w = j.write("", &[("sim.json", json)]);
+    let sec = Section {
+        title: "Co-simulation".into(),
+        paragraphs: vec![format!(
+            "{} frames of the emitted design in {}, every cycle compared with the reference model and every invariant checked: {}. Sample counts and intervals per channel as the run measured them (jitter = largest minus smallest interval).",
+            r.frames,
+            backend.name(),
+            if r.ok { "no divergence, no violation".to_string() } else { format!("{} divergences, {} violations", r.divergence_count, r.violation_count) }
+        )],
+        tables: vec![("Per-channel intervals (cycles)".into(), tables::intervals(s, &r))],
+        links: vec![
+            ("frame0.vcd".into(), "frame 0 with its reset cycles (VCD)".into()),
+            ("frame0.gtkw".into(), "GTKWave save file for it".into()),
+            ("sim.json".into(), "the check report".into()),
+        ],
+        ..Section::default()
+    };
+    let files = ["frame0.vcd", "frame0.gtkw", "sim.json"];
+    let d = if r.ok {
+        Done::ok(format!(
+            "{}: {} frames, {} samples, every cycle equal to the model, no violation",
+            backend.name(),
+            r.frames,
+            r.samples
+        ))
+    } else {
+        Done::failed(
+            format!(
+                "{} divergences, {} violations",
+                r.divergence_count, r.violation_count
+            ),
+            r.summary(),
+        )
+    };
+    *keep = Some(r);
+    written(w, d.files(&files).section(sec))
+}
+
+fn golden(j: &mut Job, a: &Args, s: &Schedule) -> Done {
+    let dir = a.golden.join(&s.mix.name);
+    if !dir.join("events.log").exists() {
+        return Done::skipped(format!("no golden in {}", dir.display()));
+    }
+    let ga = super::super::golden::Args {
+        mix: vec![a.mix.clone()],
+        backend: sim_backend(),
+        rtl: None,
+        update: false,
+        dir: a.golden.clone(),
+        junit: None,
+        quiet: true,
+    };
+    let mut o = super::super::golden::Output::default();
+    let code = super::super::golden::execute(&ga, &a.mix, &mut o);
+    let w = j.write("", &[("golden.txt", format!("{}{}", o.out, o.err))]);
+    let first = o.out.lines().next().unwrap_or("").to_string();
+    let d = if code == 0 {
+        Done::ok(first)
+    } else {
+        Done::failed(first, format!("{}{}", o.out, o.err))
+    };
+    written(w, d.files(&["golden.txt"]))
+}
+
+fn faults(j: &mut Job, a: &Args, s: &Schedule) -> Done {
+    let target = if a.thorough {
+        cosim::faults::Target::Rusthdl
+    } else {
+        cosim::faults::Target::Model
+    };
+    let c = match cosim::faults::campaign(s, target, 3, 5) {
+        Ok(c) => c,
+        Err(e) => return Done::failed(format!("{e}"), ""),
+    };
+    let json = serde_json::to_string_pretty(&c).expect("campaign");
+    let w = j.write("", &[("faults.json", json)]);
+    let target_name = if a.thorough {
+        "rusthdl (the gateware)"
+    } else {
+        "cycle model (the reference model's pins)"
+    };
+    let line = format!(
+        "{} of {} injections caught over {} classes and {} sites ({target_name}); {} false alarms in {} clean runs",
+        c.detected,
+        c.injected,
+        c.classes.len(),
+        c.sites.len(),
+        c.false_alarms.rejected,
+        c.false_alarms.runs
+    );
+    let sec = Section {
+        title: "Fault campaign".into(),
+        paragraphs: vec![format!(
+            "Target: {target_name}; sites: {}. {line}.",
+            c.sites
+                .iter()
+                .map(|x| format!("{} (slot {})", x.name, x.slot))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )],
+        tables: vec![("Faults by class".into(), tables::faults(&c))],
+        links: vec![("faults.json".into(), "every injection".into())],
+        ..Section::default()
+    };
+    let d = if c.ok() {
+        Done::ok(line)
+    } else {
+        Done::failed(line, "see faults.json")
+    };
+    written(w, d.files(&["faults.json"]).section(sec))
+}
+
+fn synth(s: &Schedule, background: Option<Background>) -> Done {
+    let Some(h) = background else {
+        return Done::skipped("yosys or nextpnr-ice40 not installed (make tools)");
+    };
+    let Ok((r, secs)) = h.join() else {
+        return Done::failed("place and route stopped unexpectedly", "");
+    };
+    let g = &s.grid;
+    match r {
+        Ok(r) => {
+            let line = format!(
+                "{} logic cells, {} block RAMs, Fmax {:.1} MHz = {:.2}x the {:.1} MHz clock ({secs:.1} s beside the other steps)",
+                r.lcs,
+                r.brams,
+                r.fmax_mhz,
+                r.fmax_mhz * 1e6 / g.clock_hz as f64,
+                g.clock_hz as f64 / 1e6
+            );
+            let sec = Section {
+                title: "Synthesis estimate".into(),
+                paragraphs: vec![format!("yosys synth_ice40 and nextpnr-ice40 --hx8k (IO left unconstrained, seed 1), the flow of hdl/synth.sh: {line}; {} LUT4s and {} flip-flops.", r.lut4, r.dff)],
+                links: vec![
+                    ("synth/slotforge_top.v".into(), "the Verilog synthesized".into()),
+                    ("synth/yosys.log".into(), "yosys log".into()),
+                    ("synth/stat.txt".into(), "cell counts".into()),
+                    ("synth/nextpnr.log".into(), "place and route log".into()),
+                ],
+                ..Section::default()
+            };
+            Done::ok(line)
+                .files(&["synth/yosys.log", "synth/nextpnr.log"])
+                .section(sec)
+        }
+        Err(e) => Done::failed("place and route failed", e),
+    }
+}
+
+fn timing(j: &mut Job, s: &Schedule) -> Done {
+    match measure::timing::timing(s, sim_backend()) {
+        Ok((sec, wavedrom, line)) => written(
+            j.write("", &[("conversion.wavedrom.json", wavedrom)]),
+            Done::ok(line)
+                .section(sec)
+                .files(&["timing-slice.svg", "conversion.wavedrom.json"]),
+        ),
+        Err(e) => Done::failed(e, ""),
+    }
+}
+
+fn figure7(s: &Schedule) -> Done {
+    match measure::figure7::figure7(s) {
+        Ok((sec, line)) => Done::ok(line).section(sec),
+        Err(e) => Done::failed(e, ""),
+    }
+}
+
+fn speed(a: &Args, s: &Schedule) -> Done {
+    match measure::speed::measure(s, &a.out.join("frame0.vcd")) {
+        Ok(scores) => {
+            let (sec, line) = measure::speed::section(&scores);
+            Done::ok(line)
+                .section(sec)
+                .files(&["speed-accuracy.svg", "speed-accuracy.csv"])
+        }
+        Err(e) => Done::failed(e, ""),
+    }
+}
