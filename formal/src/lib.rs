@@ -81,6 +81,12 @@ pub struct Counterexample {
     /// `slotforge check MIX VCD --scope replay_tb.h.dut` prints).
     pub check_cycle: Option<u64>,
     pub diagnosis: String,
+    /// Whether the Icarus replay (the witness's MISO bits, Icarus's own
+    /// power-on values) fails the harness too.  False when the violation
+    /// needs power-on values of registers the reset does not set, which the
+    /// engine chose freely and the replay cannot set: still a violation of
+    /// "correct after one reset cycle from any power-on state".
+    pub reproduced: bool,
 }
 
 /// The result of `prove`, for the CLI and the build report.
@@ -279,8 +285,15 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         )
         .map_err(|e| ProveError::Tool(format!("checking the counterexample: {e}")))?;
         let check_cycle = first_rejected(&report);
+        let reproduced = r.step.is_some();
         let step = r.step.unwrap_or(depth);
+        if !reproduced {
+            for p in &mut properties {
+                p.result = Outcome::Failed;
+            }
+        }
         counterexample = Some(Counterexample {
+            reproduced,
             cycle: step as i64 - 2,
             vcd: r.vcd,
             gtkw: r.gtkw,
@@ -359,6 +372,12 @@ impl Proof {
             );
         }
         if let Some(c) = &self.counterexample {
+            if !c.reproduced {
+                let _ = writeln!(
+                    s,
+                    "note: the replay in Icarus does not reproduce the violation: it needs power-on values of registers the reset does not set (the engine chose them; Icarus cannot), so the VCD shows the inputs only and the failing property is not named"
+                );
+            }
             let _ = writeln!(
                 s,
                 "counterexample: cycle {} ({} + {})\n{}",

@@ -49,6 +49,7 @@ fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
 fn assert_counterexample(s: &lut_gen::Schedule, p: &Proof) {
     assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
     let c = p.counterexample.as_ref().expect("a counterexample");
+    assert!(c.reproduced, "the replay reproduces it: {}", p.summary());
     assert!(c.vcd.exists() && c.gtkw.exists(), "{c:?}");
     assert!(
         p.properties.iter().any(|q| q.result == Outcome::Failed),
@@ -207,12 +208,15 @@ fn mutant_campaign_every_output_changing_mutant_fails() {
         return;
     }
     let s = schedule("cosim/tests/data/mutants.toml");
-    let (mut failed, mut proved, mut bounded) = (0, 0, 0);
+    let (mut failed, mut proved, mut bounded, mut power_on) = (0, 0, 0, 0);
     for m in mutants(&s) {
         let dir = tempfile::tempdir().unwrap();
         let p = prove(&s, &m.text, dir.path());
         eprintln!("{}: {:?} ({:.1} s)", m.describe(), p.result, p.seconds);
         match p.result {
+            // A violation that needs power-on values the reset does not set
+            // cannot be replayed in Icarus (docs/formal.md); counted apart.
+            Outcome::Failed if !p.counterexample.as_ref().unwrap().reproduced => power_on += 1,
             Outcome::Failed => {
                 assert_counterexample(&s, &p);
                 failed += 1;
@@ -223,7 +227,10 @@ fn mutant_campaign_every_output_changing_mutant_fails() {
             Outcome::Bounded => bounded += 1,
         }
     }
-    eprintln!("mutants: {failed} failed, {proved} proved (equivalent), {bounded} bounded");
+    eprintln!(
+        "mutants: {failed} failed (replayed, check rejects), {power_on} failed from a power-on state only, \
+         {proved} proved (equivalent), {bounded} bounded"
+    );
     assert_eq!(bounded, 0, "every mutant gets a verdict");
     assert!(failed > 0);
 }
