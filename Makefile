@@ -35,7 +35,7 @@ ifeq ($(NEXTEST),yes)
 else
 	$(CARGO) test --workspace --locked
 endif
-	$(MAKE) golden
+	$(MAKE) golden GOLDEN_SLOTFORGE=$${CARGO_TARGET_DIR:-target}/debug/slotforge
 
 # Campaigns, all-preset proofs and long runs: not in `make test` (which must stay
 # under 15 minutes on 2 cores); run before an issue is resolved.
@@ -50,9 +50,13 @@ endif
 # on the emitted Verilog in Verilator.  The debug build `cargo test` made.
 PRESETS = $(wildcard mixes/*.toml)
 GOLDEN_BACKEND ?= verilator
+# `make test` passes the binary its test build made (the same features:
+# `cargo run` would build the binary a second time without the test-only
+# detector switch).
+GOLDEN_SLOTFORGE ?= $(CARGO) run --quiet --locked --bin slotforge --
 golden: tools
 	@for m in $(PRESETS); do \
-	  $(CARGO) run --quiet --locked --bin slotforge -- golden $$m --backend $(GOLDEN_BACKEND) || exit 1; \
+	  $(GOLDEN_SLOTFORGE) golden $$m --backend $(GOLDEN_BACKEND) || exit 1; \
 	done
 
 # Goldens change only through this command; review the diff like code.

@@ -8,8 +8,8 @@ pub mod faults;
 pub mod golden;
 pub mod junit;
 pub mod lut;
-pub mod prove;
 pub mod progress;
+pub mod prove;
 pub mod sim;
 pub mod verilog;
 
