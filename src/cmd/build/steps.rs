@@ -325,9 +325,11 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule) -> Done {
         "cycle model (the reference model's pins)"
     };
     let line = format!(
-        "{} of {} injections caught over {} classes and {} sites ({target_name}); {} false alarms in {} clean runs",
+        "{} of {} injections detected ({} undetected, {} proved equivalent) over {} classes and {} sites ({target_name}); {} false alarms in {} clean runs",
         c.detected,
         c.injected,
+        c.undetected,
+        c.proved_equivalent,
         c.classes.len(),
         c.sites.len(),
         c.false_alarms.rejected,
