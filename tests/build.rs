@@ -34,10 +34,20 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         return;
     }
     let d = tempfile::tempdir().unwrap();
+    // a golden for the mix, so that no step asked for is skipped (--strict)
+    let gold = d.path().join("golden");
+    slotforge()
+        .args(["golden", "--backend", "rusthdl", "--update", "--dir"])
+        .arg(&gold)
+        .arg(tiny())
+        .assert()
+        .success();
     let out = d.path().join("b");
     let junit = d.path().join("build.xml");
     slotforge()
-        .args(["build", "--quiet", "-o"])
+        .args(["build", "--quiet", "--strict", "--golden"])
+        .arg(&gold)
+        .arg("-o")
         .arg(&out)
         .arg("--junit")
         .arg(&junit)
