@@ -93,8 +93,23 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
     // where scheduling breaks: both outcomes occur over the random mixes
     let sched = csv(&out.join("schedulability.csv"));
     assert!(sched.iter().any(|r| r[3] == "true") && sched.iter().any(|r| r[3] == "false"));
-    // comparing the methods is opt-in
+    // comparing the methods is opt-in; the default fault campaign is the
+    // quick one (every class at one site)
     assert!(!out.join("speed-accuracy.csv").exists());
+    let faults = |dir: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("faults.json")).unwrap()).unwrap()
+    };
+    let quick = faults(&out);
+    assert_eq!(
+        quick["sites"].as_array().unwrap().len(),
+        1,
+        "{}",
+        quick["sites"]
+    );
+    assert!(
+        quick["injected"].as_u64().unwrap() >= 14,
+        "every class once"
+    );
     // the timing diagram's table has every branch's CS edges
     let timing = std::fs::read_to_string(out.join("timing-slice.csv")).unwrap();
     assert!(timing.contains("fast cs_n") && timing.contains("slow cs_n"));
@@ -242,6 +257,10 @@ fn a_failing_step_fails_the_build_and_the_others_still_run() {
     assert!(md.contains("| golden comparison | FAILED |"), "{md}");
     assert!(md.contains("| fault campaign | ok |"), "{md}");
     assert!(md.contains("## Steps: FAILED"));
+    // --only faults asks for the full campaign: every site
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("faults.json")).unwrap()).unwrap();
+    assert!(v["sites"].as_array().unwrap().len() > 1, "{}", v["sites"]);
 }
 
 fn skin28() -> PathBuf {

@@ -106,6 +106,15 @@ fn infeasible_mix_exits_1_with_a_diagnosis() {
         .stdout(predicate::str::contains("branch `a`"))
         .stdout(predicate::str::contains("could not place"))
         .stdout(predicate::str::contains("samples/s"));
+    // An over-full branch leads with demand against capacity, per slice.
+    let out = slotforge().arg("audit").arg(&p).output().unwrap();
+    let first = String::from_utf8_lossy(&out.stdout);
+    let first = first.lines().next().unwrap_or("");
+    assert!(
+        first.starts_with("branch `a` needs ")
+            && first.contains(" conversions per slice, its ADC fits "),
+        "{first}"
+    );
     let out = slotforge()
         .args(["audit", "--json"])
         .arg(&p)

@@ -674,11 +674,22 @@ pub fn campaign(
     frames: u64,
     false_alarm_mixes: u64,
 ) -> Result<Campaign, SimError> {
+    campaign_at(s, target, sites(s), frames, false_alarm_mixes)
+}
+
+/// The campaign at the given sites only (`build`'s quick default runs
+/// every class at one site of [`sites`]).
+pub fn campaign_at(
+    s: &Schedule,
+    target: Target,
+    sites: Vec<Site>,
+    frames: u64,
+    false_alarm_mixes: u64,
+) -> Result<Campaign, SimError> {
     let frames = frames.max(3);
     if target == Target::Rusthdl {
         RustHdlDut::new(s)?;
     }
-    let sites = sites(s);
     let ran: Vec<Detector> = Detector::ALL
         .into_iter()
         .filter(|d| not_run(*d).is_none())

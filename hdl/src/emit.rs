@@ -117,7 +117,7 @@ impl Board {
             message: m,
         };
         let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
-        toml::from_str(&text).map_err(|e| err(e.to_string()))
+        toml::from_str(&text).map_err(|e| err(lut_gen::mix::plain(&e.to_string(), "")))
     }
 }
 

@@ -712,9 +712,9 @@ impl Cx<'_> {
                     f("rate_hz"),
                     format!(
                         "{rate_hz} Hz gives {:.3} samples per {frame_us} us frame, not a whole number \
-                         (rates must be multiples of {:.3} Hz){}",
+                         (rates must be multiples of {} Hz){}",
                         rate_hz as f64 * frame_us as f64 / 1e6,
-                        1e6 / frame_us as f64,
+                        hz_text(1e6 / frame_us as f64),
                         frames_that_fit(rate_hz, slice_us)
                     ),
                 ));
@@ -1098,6 +1098,13 @@ fn table_prefix(text: &str, span: Option<Range<usize>>) -> String {
 
 /// Frame periods (whole slices, at most 10 s) in which `rate_hz` gives a
 /// whole number of samples, as advice after a fractional count.
+/// A frequency as people write it: `100` for 100.000, `0.5` for 0.500,
+/// `33.333` where the digits do not end.
+fn hz_text(hz: f64) -> String {
+    let t = format!("{hz:.3}");
+    t.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 fn frames_that_fit(rate_hz: u64, slice_us: u64) -> String {
     let g = gcd(rate_hz, 1_000_000);
     let step = slice_us / gcd(slice_us, 1_000_000 / g) * (1_000_000 / g);
@@ -1127,7 +1134,7 @@ fn gcd(a: u64, b: u64) -> u64 {
 /// A TOML error message in the words of the mix format, not of Rust's
 /// types: `expected i64` becomes "expected a whole number", of Hz, us or ns
 /// by the unit of `field`.
-fn plain(m: &str, field: &str) -> String {
+pub fn plain(m: &str, field: &str) -> String {
     let key = field.rsplit('.').next().unwrap_or("");
     let unit = if key.ends_with("_hz") || key == "hz" {
         " of Hz"
@@ -1209,6 +1216,15 @@ bandwidth_hz = 400
             ),
             "{e}"
         );
+        // the step between rates in the units people write, not 100.000
+        assert!(
+            e.message.contains("(rates must be multiples of 100 Hz)"),
+            "{e}"
+        );
+        let e = err(&GOOD
+            .replace("period_us = 10_000", "period_us = 30_000")
+            .replace("rate_hz = 1_000", "rate_hz = 50"));
+        assert!(e.message.contains("multiples of 33.333 Hz)"), "{e}");
         // a taken mux input names the channel that has it
         let two = GOOD.replace("bandwidth_hz = 400", "bandwidth_hz = 400\ninput = 2")
             + "[[channel]]\nname = \"c1\"\nbranch = \"a\"\nrate_hz = 1_000\ninput = 2\n";

@@ -43,14 +43,22 @@ pub struct BranchDiagnosis {
 
 impl fmt::Display for Infeasible {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "mix `{}` has no jitter-free schedule", self.mix)?;
+        // An over-full branch is the headline: demand against capacity.
+        let lead = self
+            .reasons
+            .iter()
+            .find(|r| r.contains("conversions per slice"));
+        match lead {
+            Some(r) => writeln!(f, "{r}: mix `{}` has no jitter-free schedule", self.mix)?,
+            None => writeln!(f, "mix `{}` has no jitter-free schedule", self.mix)?,
+        }
         if let Some(s) = self.slots_per_slice {
             writeln!(
                 f,
                 "  (diagnosed at {s} slots per slice, the roomiest legal grid)"
             )?;
         }
-        for r in &self.reasons {
+        for r in self.reasons.iter().filter(|r| Some(*r) != lead) {
             writeln!(f, "  - {r}")?;
         }
         for b in &self.branches {
@@ -515,6 +523,23 @@ fn grid_rates(mix: &Mix, slots: u64) -> impl Iterator<Item = (u64, u64)> + '_ {
         .map(|(n, r)| (n, r as u64))
 }
 
+/// Demand against capacity, per slice as an engineer counts it (the ADC
+/// fits `sps` conversions in a slice at the roomiest grid); per frame too
+/// when a slow rate makes the per-slice demand fractional.
+fn over_capacity(branch: &str, per_frame: u64, sps: u64, slices: u64) -> String {
+    let slots = sps * slices;
+    let over = (per_frame as f64 / slots as f64 - 1.0) * 100.0;
+    let per_slice = if per_frame.is_multiple_of(slices) {
+        format!("{}", per_frame / slices)
+    } else {
+        format!("{:.1}", per_frame as f64 / slices as f64)
+    };
+    format!(
+        "branch `{branch}` needs {per_slice} conversions per slice, its ADC fits {sps} \
+         ({per_frame} against {slots} per frame, {over:.1} % over)"
+    )
+}
+
 fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
     let k = mix.slices_per_frame();
     // The roomiest grid whose periods are all whole; else simply the roomiest.
@@ -566,11 +591,7 @@ fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
     } else {
         for (b, &d) in demand.iter().enumerate() {
             if d > slots {
-                reasons.push(format!(
-                    "branch `{}` needs {d} conversions per frame but has only {slots} slots ({:.1} % over)",
-                    mix.branches[b].name,
-                    (d as f64 / slots as f64 - 1.0) * 100.0
-                ));
+                reasons.push(over_capacity(&mix.branches[b].name, d, sps, k));
             }
         }
         let units = units_of(mix, slots);

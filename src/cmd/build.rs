@@ -40,7 +40,8 @@ pub struct Args {
     pub golden: PathBuf,
     /// Which charts: `mix` (the charts about this mix: timing, figure7,
     /// schedulability), `all` (also `speed`, which runs every simulator and
-    /// takes minutes), or `none`.
+    /// takes minutes, and the fault campaign at every site instead of the
+    /// quick one), or `none`.
     #[arg(long, value_enum, default_value_t = Charts::Mix)]
     pub charts: Charts,
     /// Run only these steps (comma-separated; see `--skip`).

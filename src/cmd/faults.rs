@@ -158,7 +158,7 @@ fn text(c: &Campaign) -> String {
                 m.cycle,
                 m.equivalence
                     .as_ref()
-                    .map(|e| format!(": equivalence {e:?}"))
+                    .map(|e| format!(": equivalence {}", equivalence(e)))
                     .unwrap_or_default()
             );
         }
@@ -185,4 +185,15 @@ fn text(c: &Campaign) -> String {
         let _ = writeln!(o, "  false alarm: {e}");
     }
     o
+}
+
+/// The equivalence check's answer in words (not the enum's Debug form).
+fn equivalence(e: &cosim::equiv::Equivalence) -> String {
+    use cosim::equiv::Equivalence as E;
+    match e {
+        E::Proved { seconds } => format!("proved ({seconds:.1} s)"),
+        E::Differs { frame: Some(f) } => format!("differs (counterexample at frame {f})"),
+        E::Differs { frame: None } => "differs".into(),
+        E::Undecided { why } => format!("undecided: {why}"),
+    }
 }

@@ -105,7 +105,11 @@ fn load_manifest(path: &Path) -> Result<Manifest, String> {
             .span()
             .map(|sp| text[..sp.start].matches('\n').count() + 1)
             .unwrap_or(0);
-        format!("{}:{line}: {}", path.display(), e.message())
+        format!(
+            "{}:{line}: {}",
+            path.display(),
+            lut_gen::mix::plain(e.message(), "")
+        )
     })?;
     if m.frames == 0 {
         return Err(format!("{}: `frames` must be at least 1", path.display()));
