@@ -78,6 +78,7 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         "sim.json",
         "frame0.vcd",
         "frame0.gtkw",
+        "frame0.channels.txt",
         "faults.json",
         "conversion.wavedrom.json",
         "report.html",

@@ -425,6 +425,26 @@ fn vcd_into_a_missing_folder_is_created_and_its_gtkw_finds_it_from_anywhere() {
         Path::new(path).is_absolute() && Path::new(path).is_file(),
         "{dump}"
     );
+    // sample_channel is shown by name: the translate file beside the VCD,
+    // named absolutely in the save file, one line per channel of the mix
+    let filter = gtkw
+        .lines()
+        .find_map(|l| l.strip_prefix("^1 "))
+        .unwrap_or_else(|| panic!("{gtkw}"));
+    assert!(Path::new(filter).is_absolute(), "{filter}");
+    let names = std::fs::read_to_string(filter).unwrap();
+    let mix = std::fs::read_to_string(tiny()).unwrap();
+    let channels = mix.matches("[[channel]]").count();
+    let lines: Vec<&str> = names.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(lines.len(), channels, "{names}");
+    assert!(lines[0].starts_with("0 ") && lines[0].len() > 2, "{names}");
+    let after = gtkw.split(&format!("^1 {filter}")).nth(1).unwrap();
+    assert!(
+        after
+            .trim_start()
+            .starts_with("slotforge_top.sample_channel["),
+        "{gtkw}"
+    );
 }
 
 /// Issue 17: a window from the middle of a run (`sim --from/--to`, the

@@ -64,6 +64,14 @@ pub fn busiest_slice(s: &Schedule) -> u64 {
         .map_or(0, |x| x.0)
 }
 
+/// A trace's full-scale height in rows: the rest of the row holds the
+/// channel names, clear of the row above.
+const HIGH: f64 = 0.55;
+
+/// Strobe labels closer than this share of the window are one label, so
+/// that back-to-back strobes of two branches do not print over each other.
+const STROBE_MERGE: f64 = 0.03;
+
 /// A diagram row: its name, `(cycle, value)` at each change, full scale.
 type Row = (String, Vec<(u64, u64)>, f64);
 
@@ -141,10 +149,11 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
     let mut series = Vec::new();
     let mut names = Vec::new();
     for (i, (n, ch, scale)) in rows.iter().enumerate() {
-        let base = i as f64;
+        // centred on the row's name: low half a trace below, high above
+        let base = i as f64 - HIGH / 2.0;
         let mut pts: Vec<(f64, f64)> = ch
             .iter()
-            .map(|&(c, v)| (us(c), base + 0.7 * (v as f64 / scale).min(1.0)))
+            .map(|&(c, v)| (us(c), base + HIGH * (v as f64 / scale).min(1.0)))
             .collect();
         pts.push((us(to), pts.last().map_or(base, |p| p.1)));
         for &(c, v) in ch {
@@ -168,17 +177,30 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
             .position(|n| n == label)
             .map_or(0.0, |i| i as f64)
     };
+    // a select's name sits just above its own trace's high level, the
+    // strobes' names low in their row beside the strobe
     let mut labels = Series::line("", vec![]);
     for i in s.instants(3).filter(|i| (from..to).contains(&i.cycle)) {
         let r = row_of(&format!("{} mux_sel", s.branches[i.branch].name));
-        labels.labels.push((us(i.cycle), r + 0.75, name(i.channel)));
+        labels
+            .labels
+            .push((us(i.cycle), r + HIGH / 2.0 + 0.05, name(i.channel)));
     }
+    let merge = ((to - from) as f64 * STROBE_MERGE) as u64;
+    let mut strobes: Vec<(u64, Vec<String>)> = Vec::new();
     for (k, (p, _)) in w.cycles.iter().enumerate() {
         if p.sample_valid {
-            labels
-                .labels
-                .push((us(from + k as u64), 0.75, name(p.sample_channel as usize)));
+            let (c, n) = (from + k as u64, name(p.sample_channel as usize));
+            match strobes.last_mut() {
+                Some((c0, names)) if c - *c0 <= merge => names.push(n),
+                _ => strobes.push((c, vec![n])),
+            }
         }
+    }
+    for (c, names) in strobes {
+        labels
+            .labels
+            .push((us(c), 0.05 - HIGH / 2.0, names.join(",")));
     }
     series.push(labels);
     let mut axes = Axes::new(
@@ -191,10 +213,14 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
     );
     axes.y_names = names;
     axes.x_range = Some((us(from), us(to)));
-    axes.y_range = Some((-0.3, rows.len() as f64));
-    for k in 0..=g.slots_per_slice {
+    axes.y_range = Some((-0.6, rows.len() as f64 - 0.3));
+    // the window ends one slot into the next slice (the last word leaves
+    // there): that slot is closed by a boundary too, not cut at the edge
+    for k in 0..=g.slots_per_slice + 1 {
         let c = from + k * g.slot_cycles;
-        let label = if g.slots_per_slice <= 16 || k % 4 == 0 {
+        let label = if k > g.slots_per_slice {
+            String::new()
+        } else if g.slots_per_slice <= 16 || k % 4 == 0 {
             format!("{}", j * g.slots_per_slice + k)
         } else {
             String::new()
@@ -215,7 +241,7 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         Section {
             title: "Timing of a slice".into(),
             paragraphs: vec![
-                format!("What the paper's Figure 4 shows, drawn from simulation in steady state (frame 1, slice {j}: the slice of the frame with the most conversions). Per branch, from the bottom up: mux_en (the one-hot device enable), mux_sel (labelled with the channel it selects at each sampling instant), CS and SCLK; at the bottom the merged sample_valid strobe, labelled with sample_channel. Grey lines are slot boundaries, numbered by frame slot."),
+                format!("What the paper's Figure 4 shows, drawn from simulation in steady state (frame 1, slice {j}: the slice of the frame with the most conversions). Per branch, from the bottom up: mux_en (the one-hot device enable), mux_sel (labelled with the channel it selects at each sampling instant), CS and SCLK; at the bottom the merged sample_valid strobe, labelled with sample_channel. Grey lines are slot boundaries, numbered by frame slot; the last slot drawn is the first of the next slice, where the slice's last sample leaves."),
                 "conversion.wavedrom.json holds one conversion of the first branch in WaveDrom form (one step per SCLK half period; a step shows sample_valid high if the one-cycle strobe falls in it).".into(),
             ],
             figures: vec![Figure {

@@ -197,7 +197,11 @@ pub fn draw(axes: &Axes, series: &[Series], w: u32, h: u32) -> String {
                 let mut chart = $chart;
                 let names = axes.y_names.clone();
                 let mut mesh = chart.configure_mesh();
-                mesh.x_desc(axes.x.as_str()).y_desc(axes.y.as_str());
+                // faint minor lines: dense ones (a log decade's nine)
+                // otherwise read as a grey band
+                mesh.x_desc(axes.x.as_str())
+                    .y_desc(axes.y.as_str())
+                    .light_line_style(RGBColor(246, 246, 246));
                 let fmt = move |v: &f64| {
                     let i = v.round();
                     if (v - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
@@ -240,13 +244,14 @@ pub fn draw(axes: &Axes, series: &[Series], w: u32, h: u32) -> String {
                             let (m, dots) = (s.marker, s.points_only);
                             a.label(s.name.clone()).legend(move |(x, y)| {
                                 // one element type for every legend entry:
-                                // the marker's outline, or a line
+                                // the marker filled as on the plot, or a
+                                // line as a 2-pixel bar
                                 let pts = if dots {
                                     legend_path(m)
                                 } else {
-                                    vec![(0, 0), (16, 0)]
+                                    vec![(0, -1), (16, -1), (16, 1), (0, 1)]
                                 };
-                                EmptyElement::at((x, y)) + PathElement::new(pts, c.stroke_width(2))
+                                EmptyElement::at((x, y)) + Polygon::new(pts, c.filled())
                             });
                         }
                     }
@@ -338,11 +343,9 @@ fn shape(m: Marker) -> Vec<(i32, i32)> {
     }
 }
 
-/// A marker's outline as one closed path, offset to the legend's sample spot.
+/// A marker's outline, offset to the legend's sample spot.
 fn legend_path(m: Marker) -> Vec<(i32, i32)> {
-    let mut pts = shape(m);
-    pts.push(pts[0]);
-    pts.into_iter().map(|(x, y)| (x + 8, y)).collect()
+    shape(m).into_iter().map(|(x, y)| (x + 8, y)).collect()
 }
 
 /// A short number for axis labels.

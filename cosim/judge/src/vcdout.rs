@@ -210,10 +210,34 @@ impl Observer for VcdWriter {
     }
 }
 
+/// The GTKWave translate file of a VCD: `<stem>.channels.txt` beside it.
+pub fn channels_path(vcd: &Path) -> std::path::PathBuf {
+    let stem = vcd
+        .file_stem()
+        .map_or("wave".into(), |s| s.to_string_lossy());
+    vcd.with_file_name(format!("{stem}.channels.txt"))
+}
+
+/// A GTKWave translate (filter) file: each `sample_channel` value as the
+/// trace shows it (decimal) and the channel's name.
+pub fn channels_text(s: &Schedule) -> String {
+    let mut t = String::from("# sample_channel value -> channel name (GTKWave translate file)\n");
+    for (i, c) in s.mix.channels.iter().enumerate() {
+        t.push_str(&format!("{i} {}\n", c.name));
+    }
+    t
+}
+
 /// A GTKWave save file for a VCD written by [`VcdWriter`]: clock and reset,
-/// then one group per branch (cs_n, sclk, miso, mux bits), then the sample stream.
+/// then one group per branch (cs_n, sclk, miso, mux bits), then the sample
+/// stream with `sample_channel` shown as channel names through the
+/// translate file written beside the save file ([`channels_path`]; named
+/// in the save file the way `vcd` is, so it is found wherever the VCD is).
 pub fn write_gtkw(path: &Path, vcd: &Path, s: &Schedule) -> std::io::Result<()> {
     let l = Layout::new(s);
+    let names = channels_path(vcd);
+    let beside = path.with_file_name(names.file_name().unwrap_or_default());
+    std::fs::write(&beside, channels_text(s))?;
     let mut w = BufWriter::new(File::create(path)?);
     writeln!(w, "[dumpfile] \"{}\"", vcd.display())?;
     writeln!(w, "[timestart] 0")?;
@@ -241,10 +265,14 @@ pub fn write_gtkw(path: &Path, vcd: &Path, s: &Schedule) -> std::io::Result<()> 
     writeln!(w, "-samples")?;
     writeln!(w, "@28")?;
     writeln!(w, "{top}.{}", Role::SampleValid.name())?;
+    // 0x2000: translated by filter file 1; 0x24: decimal, right-justified
+    writeln!(w, "@2024")?;
+    writeln!(w, "^1 {}", names.display())?;
+    let ch = Role::SampleChannel;
+    writeln!(w, "{top}.{}[{}:0]", ch.name(), l.width(ch) - 1)?;
     writeln!(w, "@24")?;
-    for r in [Role::SampleChannel, Role::SampleValue] {
-        writeln!(w, "{top}.{}[{}:0]", r.name(), l.width(r) - 1)?;
-    }
+    let v = Role::SampleValue;
+    writeln!(w, "{top}.{}[{}:0]", v.name(), l.width(v) - 1)?;
     writeln!(w, "@1000200")?;
     writeln!(w, "-samples")?;
     w.flush()

@@ -256,11 +256,20 @@ fn sim(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<judge::Report>) ->
         links: vec![
             ("frame0.vcd".into(), "frame 0 with its reset cycles (VCD)".into()),
             ("frame0.gtkw".into(), "GTKWave save file for it".into()),
+            (
+                "frame0.channels.txt".into(),
+                "GTKWave translate file: sample_channel as channel names".into(),
+            ),
             ("sim.json".into(), "the check report".into()),
         ],
         ..Section::default()
     };
-    let files = ["frame0.vcd", "frame0.gtkw", "sim.json"];
+    let files = [
+        "frame0.vcd",
+        "frame0.gtkw",
+        "frame0.channels.txt",
+        "sim.json",
+    ];
     let d = if r.ok {
         Done::ok(format!(
             "{}: {} frames, {} samples, every cycle equal to the model, no violation",
