@@ -409,8 +409,15 @@ mod tests {
             300,
         );
         // the two shapes differ in the points they are drawn with
+        // (the points, then the legend's samples: filled like the points)
         let polys: Vec<&str> = cross.split("<polygon").skip(1).collect();
-        assert_eq!(polys.len(), 2);
-        assert_ne!(polys[0].matches(',').count(), polys[1].matches(',').count());
+        assert_eq!(polys.len(), 4, "{cross}");
+        let corners = |p: &str| p.matches(',').count();
+        assert_ne!(corners(polys[0]), corners(polys[1]));
+        assert_eq!(corners(polys[2]), corners(polys[0]));
+        assert_eq!(corners(polys[3]), corners(polys[1]));
+        let fill = |p: &str| p.split("fill=\"").nth(1).map(|f| f[..7].to_string());
+        assert_eq!(fill(polys[2]), fill(polys[0]));
+        assert!(!polys[2].contains("fill=\"none\""), "{cross}");
     }
 }
