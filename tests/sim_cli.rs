@@ -447,6 +447,48 @@ fn vcd_into_a_missing_folder_is_created_and_its_gtkw_finds_it_from_anywhere() {
     );
 }
 
+#[test]
+fn a_fst_name_writes_fst_that_check_reads_back() {
+    if !tools::require_tool("vcd2fst") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let fst = d.path().join("w.fst");
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--backend", "rusthdl", "--frames", "1", "--vcd"])
+        .arg(&fst)
+        .assert()
+        .code(0);
+    // FST, not VCD text, and no VCD left beside it
+    let bytes = std::fs::read(&fst).unwrap();
+    assert!(!bytes.starts_with(b"$"), "an FST is binary");
+    let left: Vec<_> = std::fs::read_dir(d.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(!left.iter().any(|f| f.contains(".vcd")), "{left:?}");
+    let gtkw = std::fs::read_to_string(d.path().join("w.gtkw")).unwrap();
+    assert!(gtkw.lines().next().unwrap().ends_with("w.fst\""), "{gtkw}");
+    assert!(d.path().join("w.channels.txt").is_file(), "{left:?}");
+    slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&fst)
+        .assert()
+        .code(0);
+    // --fst on a .vcd name writes the .fst
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--backend", "rusthdl", "--frames", "1", "--fst", "--vcd"])
+        .arg(d.path().join("x.vcd"))
+        .assert()
+        .code(0);
+    assert!(d.path().join("x.fst").is_file());
+}
+
 /// Issue 17: a window from the middle of a run (`sim --from/--to`, the
 /// goldens' Figure 6 windows) is checked from where its frame phase is found.
 #[test]

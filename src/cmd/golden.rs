@@ -172,21 +172,9 @@ fn write_window(
     if !fst {
         return Ok(());
     }
-    let out = std::process::Command::new("vcd2fst")
-        .arg(&vcd)
-        .arg(path)
-        .output();
+    let r = super::vcd_to_fst(&vcd, path);
     let _ = std::fs::remove_file(&vcd);
-    match out {
-        Ok(o) if o.status.success() => Ok(()),
-        Ok(o) => Err(std::io::Error::other(format!(
-            "vcd2fst failed: {}",
-            String::from_utf8_lossy(&o.stderr).trim()
-        ))),
-        Err(e) => Err(std::io::Error::other(format!(
-            "an FST window needs GTKWave's vcd2fst (`make tools` installs it): {e}"
-        ))),
-    }
+    r
 }
 
 /// The cycles of a VCD window as read back by the judge's reader.

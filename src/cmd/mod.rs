@@ -145,3 +145,23 @@ pub fn write_files(dir: &Path, files: &[(&str, String)]) -> Result<(), u8> {
     }
     Ok(())
 }
+
+/// Converts `vcd` to FST at `fst` with GTKWave's own `vcd2fst` (`make
+/// tools` installs it): the FST GTKWave writes is the one it reads; a Rust
+/// FST writer crate has not been evaluated yet.
+pub fn vcd_to_fst(vcd: &Path, fst: &Path) -> std::io::Result<()> {
+    let out = std::process::Command::new("vcd2fst")
+        .arg(vcd)
+        .arg(fst)
+        .output();
+    match out {
+        Ok(o) if o.status.success() => Ok(()),
+        Ok(o) => Err(std::io::Error::other(format!(
+            "vcd2fst failed: {}",
+            String::from_utf8_lossy(&o.stderr).trim()
+        ))),
+        Err(e) => Err(std::io::Error::other(format!(
+            "FST needs GTKWave's vcd2fst (`make tools` installs it): {e}"
+        ))),
+    }
+}

@@ -25,6 +25,10 @@ pub struct Args {
     /// it); times in it are exact (each edge rounded once to 1 ps).
     #[arg(long)]
     pub vcd: Option<PathBuf>,
+    /// Write the --vcd window as FST instead (as a name ending in `.fst`
+    /// does), through GTKWave's vcd2fst; `check` reads it back.
+    #[arg(long, requires = "vcd")]
+    pub fst: bool,
     /// Start of the VCD window: a frame number, or a time after cycle 0 (the
     /// first cycle after reset) with a unit: 3ms, 250us, 1.5ms.  A window
     /// from 0 also shows the reset.
@@ -82,6 +86,25 @@ fn absolute_in_new_folder(path: &std::path::Path) -> Result<PathBuf, String> {
     Ok(dir.join(name))
 }
 
+/// The run's VCD `vcd` as the FST `fst`, with its own save file and
+/// translate file; the VCD and the files named after it are removed.
+fn to_fst(
+    s: &lut_gen::Schedule,
+    vcd: &std::path::Path,
+    fst: &std::path::Path,
+) -> std::io::Result<()> {
+    let r = super::vcd_to_fst(vcd, fst);
+    for f in [
+        vcd.to_path_buf(),
+        vcd.with_extension("gtkw"),
+        judge::vcdout::channels_path(vcd),
+    ] {
+        let _ = std::fs::remove_file(f);
+    }
+    r?;
+    judge::vcdout::write_gtkw(&fst.with_extension("gtkw"), fst, s)
+}
+
 pub fn run(a: Args) -> u8 {
     let backend = a.backend;
     let stimulus: Stimulus = match a.stimulus.parse() {
@@ -131,6 +154,20 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
+    // FST: the run writes a VCD beside it, converted at the end; the
+    // converter is looked for now, not found missing after the run.
+    let fst = vcd.as_ref().and_then(|v| {
+        let named = v.extension().is_some_and(|x| x == "fst");
+        (a.fst || named).then(|| v.with_extension("fst"))
+    });
+    if fst.is_some() && !measure::synth::tool_present("vcd2fst") {
+        eprintln!("error: --vcd: FST needs GTKWave's vcd2fst, which is not installed (make tools)");
+        return 2;
+    }
+    let vcd = match &fst {
+        Some(f) => Some(f.with_extension("fst.vcd")),
+        None => vcd,
+    };
     if let Some(p) = &a.samples {
         let same = |q: &std::path::Path| {
             p == q || matches!((p.canonicalize(), q.canonicalize()), (Ok(x), Ok(y)) if x == y)
@@ -151,7 +188,7 @@ pub fn run(a: Args) -> u8 {
     }
     let opts = SimOptions {
         stimulus,
-        vcd: vcd.map(|path| VcdOut {
+        vcd: vcd.clone().map(|path| VcdOut {
             path,
             from,
             to,
@@ -187,6 +224,12 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
+    if let (Some(f), Some(v)) = (&fst, &vcd) {
+        if let Err(e) = to_fst(&s, v, f) {
+            eprintln!("error: --vcd {}: {e}", f.display());
+            return 2;
+        }
+    }
     if let Some(p) = &a.samples {
         if let Err(e) = log.write_csv(&s, p) {
             eprintln!("error: --samples {}: {e}", p.display());
