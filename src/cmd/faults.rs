@@ -197,3 +197,25 @@ fn equivalence(e: &cosim::equiv::Equivalence) -> String {
         E::Undecided { why } => format!("undecided: {why}"),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::equivalence;
+    use cosim::equiv::Equivalence;
+
+    #[test]
+    fn the_equivalence_verdict_is_words_not_the_enum() {
+        let e = equivalence(&Equivalence::Differs { frame: Some(3) });
+        assert_eq!(e, "differs (counterexample at frame 3)");
+        for v in [
+            Equivalence::Proved { seconds: 1.25 },
+            Equivalence::Differs { frame: None },
+            Equivalence::Undecided {
+                why: "time limit".into(),
+            },
+        ] {
+            let t = equivalence(&v);
+            assert!(!t.contains('{') && !t.contains("Some"), "{t}");
+        }
+    }
+}
