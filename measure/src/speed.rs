@@ -91,6 +91,7 @@ pub fn chart(c: &Campaign) -> Figure {
         "what was timed",
     ]);
     let mut series = Vec::new();
+    let mut placed: Vec<(f64, f64)> = Vec::new();
     for (i, m) in scores.iter().enumerate() {
         table.push(vec![
             m.method.clone(),
@@ -109,7 +110,13 @@ pub fn chart(c: &Campaign) -> Figure {
         let label = format!("{} ({} of {})", m.method, m.detected, m.of);
         let mut sr =
             Series::scatter(&label, vec![(x, pct)]).with_marker(MARKERS[i % MARKERS.len()]);
-        sr.labels = vec![(x, pct, label.clone())];
+        // labels of points close together step down, so none hides another
+        let near = placed
+            .iter()
+            .filter(|&&(px, py)| (px / x).log10().abs() < 0.6 && (py - pct).abs() < 6.0)
+            .count();
+        placed.push((x, pct));
+        sr.labels = vec![(x, (pct - 7.0 * near as f64).max(-8.0), label.clone())];
         series.push(sr);
     }
     let real = run_seconds(c);
