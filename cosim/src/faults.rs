@@ -511,6 +511,9 @@ pub struct Plan {
     pub frames: u64,
     /// Random feasible mixes run clean.
     pub false_alarm_mixes: u64,
+    /// The target's own classes (pin faults, reset glitches, and on the
+    /// gateware its design-level faults); off, only the Verilog faults run.
+    pub builtin: bool,
     /// Faulty designs as Verilog (mutants, deep faults).
     pub verilog_faults: Vec<VerilogFault>,
     /// The engines the Verilog faults run on (verilator, icarus).
@@ -526,6 +529,7 @@ impl Plan {
             target,
             frames,
             false_alarm_mixes,
+            builtin: true,
             verilog_faults: vec![],
             verilog_engines: vec![],
             prove: false,
@@ -828,12 +832,18 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
         .collect();
     let sigrok = ran.contains(&Detector::Sigrok);
     let prove = ran.contains(&Detector::Prove);
-    let mut judged = pin_injections(s, target, &sites, frames, sigrok).map_err(SimError::Io)?;
-    if target == Target::Rusthdl {
+    let mut judged = Vec::new();
+    if plan.builtin {
+        judged = pin_injections(s, target, &sites, frames, sigrok).map_err(SimError::Io)?;
+    }
+    if plan.builtin && target == Target::Rusthdl {
         judged.extend(gateware_injections(s, &sites, frames, sigrok, prove).map_err(SimError::Io)?);
     }
     let clean = clean_target_runs(s, target, frames);
-    let mut engine_costs = vec![(engine_name(target), clean[0].0, clean[0].1)];
+    let mut engine_costs = Vec::new();
+    if plan.builtin {
+        engine_costs.push((engine_name(target), clean[0].0, clean[0].1));
+    }
     let mut false_alarms = false_alarms(target, plan.false_alarm_mixes, sigrok);
     if !plan.verilog_faults.is_empty() {
         for &e in &plan.verilog_engines {
