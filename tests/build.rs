@@ -385,3 +385,42 @@ fn charts_all_compares_every_method_on_the_same_faults() {
         }
     }
 }
+
+/// A step that cannot measure is shown as skipped, never passed silently,
+/// and fails the build under `--strict` (and under CI): here the speed
+/// chart, which draws the fault campaign of the same build, with the
+/// faults step left out.  No simulation runs: seconds.
+#[test]
+fn a_skipped_step_fails_strict_and_ci() {
+    let d = tempfile::tempdir().unwrap();
+    let build = |dir: &str, strict: bool, ci: &str| {
+        let out = d.path().join(dir);
+        let mut cmd = slotforge();
+        cmd.args(["build", "--quiet", "--only", "speed", "-o"])
+            .arg(&out)
+            .arg("--junit")
+            .arg(out.with_extension("xml"))
+            .arg(tiny())
+            .env("CI", ci);
+        if strict {
+            cmd.arg("--strict");
+        }
+        let o = cmd.output().unwrap();
+        let xml = std::fs::read_to_string(out.with_extension("xml")).unwrap();
+        (o, xml)
+    };
+    let (o, xml) = build("strict", true, "false");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(err.contains("skipped") && err.contains("speed"), "{err}");
+    assert!(xml.contains("<skipped"), "{xml}");
+    let (o, _) = build("ci", false, "true");
+    assert!(!o.status.success(), "CI=true fails a skipped step too");
+    // outside CI and without --strict the skip is reported, not fatal
+    let (o, xml) = build("plain", false, "false");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        xml.contains("<skipped") && xml.contains("faults step did not run"),
+        "{xml}"
+    );
+}
