@@ -133,7 +133,10 @@ pub fn chart(c: &Campaign) -> Figure {
     axes.log_x = true;
     // a decade of room on each side, so markers and labels stay inside
     axes.x_range = Some((lo / 10.0, hi * 10.0));
-    axes.y_range = Some((-10.0, 115.0));
+    // room above 100 % for the legend (upper right, about 17 px a row of
+    // the plot's ~380 px), so it hides no point or label
+    let frac = ((series.len() * 17 + 20) as f64 / 380.0).min(0.6);
+    axes.y_range = Some((-10.0, ((110.0 + 10.0 * frac) / (1.0 - frac)).max(115.0)));
     axes.vlines = vec![(real.max(1e-6), "real time".into())];
     Figure {
         stem: "speed-accuracy".into(),
