@@ -28,6 +28,65 @@ fn csv(path: &Path) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// The rows of `speed-accuracy.csv` are the columns (detectors that ran)
+/// and the engines of `faults.json` of the same build: the same names,
+/// counts and timings, in that order.
+fn assert_chart_is_the_matrix(out: &Path) {
+    let fj: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("faults.json")).unwrap()).unwrap();
+    let mut want: Vec<(String, u64, f64, u64, u64)> = Vec::new();
+    for c in fj["columns"].as_array().unwrap() {
+        if c["not_run"].is_null() {
+            want.push((
+                c["detector"].as_str().unwrap().to_string(),
+                c["runs"].as_u64().unwrap(),
+                c["seconds"].as_f64().unwrap(),
+                c["detected"].as_u64().unwrap(),
+                c["injected"].as_u64().unwrap(),
+            ));
+        }
+    }
+    for e in fj["engines"].as_array().unwrap() {
+        want.push((
+            format!("engine: {}", e["engine"].as_str().unwrap()),
+            1,
+            e["seconds"].as_f64().unwrap(),
+            e["detected"].as_u64().unwrap(),
+            e["injected"].as_u64().unwrap(),
+        ));
+    }
+    let sa = csv(&out.join("speed-accuracy.csv"));
+    assert_eq!(sa[0][0], "method");
+    let got: Vec<(String, u64, f64, u64, u64)> = sa[1..]
+        .iter()
+        .map(|r| {
+            (
+                r[0].clone(),
+                r[1].parse().unwrap(),
+                r[2].parse().unwrap(),
+                r[4].parse().unwrap(),
+                r[5].parse().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(got.len(), want.len(), "{got:?} vs {want:?}");
+    for (g, w) in got.iter().zip(&want) {
+        assert_eq!((&g.0, g.1, g.3, g.4), (&w.0, w.1, w.3, w.4));
+        assert!((g.2 - w.2).abs() < 1e-5, "{g:?} vs {w:?}");
+    }
+    // the model comparison is there, with counts from the matrix
+    assert!(got.iter().any(|g| g.0 == "model" && g.4 > 0), "{got:?}");
+    let svg = std::fs::read_to_string(out.join("speed-accuracy.svg")).unwrap();
+    assert!(svg.contains("real time"), "{svg}");
+    for w in &want {
+        assert!(
+            svg.contains(&format!("{} ({} of {})", w.0, w.3, w.4)),
+            "{}: no label in the chart",
+            w.0
+        );
+    }
+}
+
 #[test]
 fn build_writes_the_artefacts_and_a_self_contained_report() {
     if !tools::require_tool("verilator") || !tools::require_tool("iverilog") {
@@ -54,7 +113,7 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         .arg(tiny())
         .assert()
         .success();
-    // JUnit: one case per step, the opt-in chart skipped with its reason
+    // JUnit: one case per step, none skipped (--strict), none failed
     let xml = std::fs::read_to_string(&junit).unwrap();
     let doc = roxmltree::Document::parse(&xml).unwrap();
     let cases: Vec<_> = doc
@@ -62,12 +121,10 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         .filter(|n| n.has_tag_name("testcase"))
         .collect();
     assert_eq!(cases.len(), 11, "{xml}");
-    let speed = cases
-        .iter()
-        .find(|c| c.attribute("name") == Some("speed"))
-        .unwrap();
-    assert!(speed.children().any(|n| n.has_tag_name("skipped")), "{xml}");
-    assert!(!xml.contains("<failure"), "{xml}");
+    assert!(
+        !xml.contains("<failure") && !xml.contains("<skipped"),
+        "{xml}"
+    );
     for f in [
         "audit.txt",
         "audit.json",
@@ -94,9 +151,7 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
     // where scheduling breaks: both outcomes occur over the random mixes
     let sched = csv(&out.join("schedulability.csv"));
     assert!(sched.iter().any(|r| r[3] == "true") && sched.iter().any(|r| r[3] == "false"));
-    // comparing the methods is opt-in; the default fault campaign is the
-    // quick one (every class at one site)
-    assert!(!out.join("speed-accuracy.csv").exists());
+    // the default fault campaign is the quick one (every class at one site)
     let faults = |dir: &Path| -> serde_json::Value {
         serde_json::from_str(&std::fs::read_to_string(dir.join("faults.json")).unwrap()).unwrap()
     };
@@ -111,6 +166,8 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         quick["injected"].as_u64().unwrap() >= 14,
         "every class once"
     );
+    // the speed-against-accuracy chart is the fault matrix of this run
+    assert_chart_is_the_matrix(&out);
     // the timing diagram's table has every branch's CS edges
     let timing = std::fs::read_to_string(out.join("timing-slice.csv")).unwrap();
     assert!(timing.contains("fast cs_n") && timing.contains("slow cs_n"));
@@ -306,7 +363,7 @@ fn a_new_users_mix_builds_by_default_and_its_report_renders() {
 #[test]
 #[ignore = "long: make test-long"]
 fn charts_all_compares_every_method_on_the_same_faults() {
-    if !tools::require_tool("verilator") || !tools::require_tool("iverilog") {
+    if !tools::require_tools(&["verilator", "iverilog", "yosys", "yosys-abc", "sigrok-cli"]) {
         return;
     }
     let d = tempfile::tempdir().unwrap();
@@ -318,13 +375,14 @@ fn charts_all_compares_every_method_on_the_same_faults() {
             "--charts",
             "all",
             "--only",
-            "sim,speed",
+            "faults,speed",
             "-o",
         ])
         .arg(&out)
-        .arg(tiny())
+        .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/mutants.toml"))
         .assert()
         .success();
+    assert_chart_is_the_matrix(&out);
     let sa = csv(&out.join("speed-accuracy.csv"));
     let row = |m: &str| {
         sa.iter()
@@ -332,22 +390,57 @@ fn charts_all_compares_every_method_on_the_same_faults() {
             .unwrap_or_else(|| panic!("{m}: {sa:?}"))
             .clone()
     };
-    for m in [
-        "slot model",
-        "cycle model",
-        "rusthdl",
-        "verilator",
-        "check",
-        "icarus",
-    ] {
-        let speed: f64 = row(m)[3].parse().unwrap();
-        assert!(speed > 0.0 && speed.is_finite(), "{m}");
+    // the deep faults reach the Verilog engines; prove catches what the
+    // simulations miss
+    for m in ["engine: verilator", "engine: icarus"] {
+        assert_ne!(row(m)[5], "0", "{m}");
     }
-    // counts, not fractions; the gateware sees every fault that reaches it
-    assert_eq!(row("rusthdl")[4], row("rusthdl")[5]);
-    assert_eq!(row("slot model")[5], "0");
-    assert_eq!(row("verilator")[5], row("check")[5]);
-    let slot: f64 = row("slot model")[3].parse().unwrap();
-    let rusthdl: f64 = row("rusthdl")[3].parse().unwrap();
-    assert!(slot > rusthdl);
+    assert_ne!(row("prove")[4], "0");
+    let faults = std::fs::read_to_string(out.join("faults.json")).unwrap();
+    let fj: serde_json::Value = serde_json::from_str(&faults).unwrap();
+    for c in fj["classes"].as_array().unwrap() {
+        if c["level"] == "verilog" {
+            assert_eq!(c["detected_by"]["model"], 0, "{c}");
+            assert_eq!(c["detected_by"]["prove"], c["injected"], "{c}");
+        }
+    }
+}
+
+/// A step that cannot measure is shown as skipped, never passed silently,
+/// and fails the build under `--strict` (and under CI): here the speed
+/// chart, which draws the fault campaign of the same build, with the
+/// faults step left out.  No simulation runs: seconds.
+#[test]
+fn a_skipped_step_fails_strict_and_ci() {
+    let d = tempfile::tempdir().unwrap();
+    let build = |dir: &str, strict: bool, ci: &str| {
+        let out = d.path().join(dir);
+        let mut cmd = slotforge();
+        cmd.args(["build", "--quiet", "--only", "speed", "-o"])
+            .arg(&out)
+            .arg("--junit")
+            .arg(out.with_extension("xml"))
+            .arg(tiny())
+            .env("CI", ci);
+        if strict {
+            cmd.arg("--strict");
+        }
+        let o = cmd.output().unwrap();
+        let xml = std::fs::read_to_string(out.with_extension("xml")).unwrap();
+        (o, xml)
+    };
+    let (o, xml) = build("strict", true, "false");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(err.contains("skipped") && err.contains("speed"), "{err}");
+    assert!(xml.contains("<skipped"), "{xml}");
+    let (o, _) = build("ci", false, "true");
+    assert!(!o.status.success(), "CI=true fails a skipped step too");
+    // outside CI and without --strict the skip is reported, not fatal
+    let (o, xml) = build("plain", false, "false");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        xml.contains("<skipped") && xml.contains("faults step did not run"),
+        "{xml}"
+    );
 }

@@ -532,3 +532,76 @@ fn verilog_refuses_mixes_beyond_the_gateware_limits() {
             .code(0);
     }
 }
+
+/// `formal`'s deep faults (a counter that misbehaves after the run's last
+/// frame, a merger collision no stimulus drives) on both Verilog engines:
+/// every simulation column misses them, so without `prove` they are
+/// undetected and `faults` exits 1; with `--prove` the prove column
+/// catches every one.  (Proofs and Verilator builds: long.)
+#[test]
+#[ignore = "long: make test-long"]
+fn deep_faults_escape_every_simulation_column_and_prove_catches_them() {
+    if !tools::require_tools(&["verilator", "iverilog", "yosys", "yosys-abc", "sigrok-cli"]) {
+        return;
+    }
+    let mix = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/mutants.toml");
+    let run = |prove: bool| {
+        let mut cmd = slotforge();
+        cmd.args([
+            "faults",
+            "--json",
+            "--false-alarm-mixes",
+            "0",
+            "--engines",
+            "verilator,icarus",
+        ]);
+        if prove {
+            cmd.arg("--prove");
+        }
+        let out = cmd.arg(&mix).output().unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
+        (v, out.status.code().unwrap())
+    };
+    let deep = |v: &serde_json::Value| -> Vec<serde_json::Value> {
+        v["classes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|c| c["level"] == "verilog")
+            .cloned()
+            .collect()
+    };
+    let (without, code) = run(false);
+    assert_eq!(code, 1, "{without}");
+    let classes = deep(&without);
+    assert_eq!(classes.len(), 2, "{without}");
+    for c in &classes {
+        for d in ["model", "invariants", "sigrok"] {
+            assert_eq!(c["detected_by"][d], 0, "{d}: {c}");
+        }
+        assert_eq!(
+            c["undetected"].as_array().unwrap().len() as u64,
+            c["injected"].as_u64().unwrap(),
+            "{c}"
+        );
+    }
+    let (with, code) = run(true);
+    assert_eq!(code, 0, "{with}");
+    for c in deep(&with) {
+        assert_eq!(c["detected_by"]["prove"], c["injected"], "{c}");
+        assert_eq!(c["detected_by"]["model"], 0, "{c}");
+    }
+    // pin faults: prove cannot see them, and says why
+    let pins = with["classes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["level"] == "pins")
+        .unwrap()
+        .clone();
+    assert!(pins["cannot_see"]["prove"]
+        .as_str()
+        .unwrap()
+        .contains("simulation"));
+}

@@ -101,3 +101,43 @@ fn the_current_logic_cell_figure_is_what_synthesis_gives() {
     assert_eq!(got[2], want[4], "LCs: synth.sh {text}, doc {row}");
     assert_eq!(got[5], want[7], "BRAMs: synth.sh {text}, doc {row}");
 }
+
+/// docs/reference-design.md's audit figures are `audit`'s output: the
+/// samples per frame and the aggregate rate of eskin34, and the link lines
+/// of eskin34-uart quoted verbatim (words, bytes, line use, FIFO depth,
+/// latency, minimum baud).  No simulation: milliseconds.
+#[test]
+fn the_reference_design_audit_figures_are_the_binarys() {
+    let audit = |mix: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_slotforge"))
+            .arg("audit")
+            .arg(root().join(mix))
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{mix}");
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let text = doc("docs/reference-design.md");
+    let eskin = audit("mixes/eskin34.toml");
+    let per_frame: u64 = eskin
+        .lines()
+        .find_map(|l| l.split_once(" samples/frame")?.0.parse().ok())
+        .expect("audit prints samples/frame");
+    for claim in [
+        format!("{per_frame} samples per 10 ms"),
+        format!("{per_frame} samples / {:.1} kHz", per_frame as f64 / 10.0),
+    ] {
+        assert!(
+            text.contains(&claim),
+            "docs/reference-design.md: `{claim}` missing"
+        );
+    }
+    let uart = audit("mixes/eskin34-uart.toml");
+    for l in uart.lines().filter(|l| l.starts_with("link")) {
+        assert!(
+            text.contains(l),
+            "docs/reference-design.md does not quote audit's line:\n{l}"
+        );
+    }
+    assert!(uart.lines().any(|l| l.starts_with("link: ")), "{uart}");
+}

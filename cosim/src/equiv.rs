@@ -33,6 +33,20 @@ pub enum Equivalence {
     Differs { frame: Option<u64> },
     /// No answer: a time limit, or a tool's failure (the reason).
     Undecided { why: String },
+    /// Not compared with the clean design, but the faulty design proves
+    /// the full pin contract for all time (`prove`): no run can tell it
+    /// from a correct one at the ports.
+    ContractProved,
+}
+
+impl Equivalence {
+    /// An answer that excuses a fault no detector caught.
+    pub fn is_proof(&self) -> bool {
+        matches!(
+            self,
+            Equivalence::Proved { .. } | Equivalence::ContractProved
+        )
+    }
 }
 
 /// Time ABC's pdr gets per fault.

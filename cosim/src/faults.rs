@@ -30,8 +30,12 @@ use serde::Serialize;
 
 use crate::equiv::Equivalence;
 use crate::error::SimError;
+use crate::options::Backend;
 use crate::rusthdl::RustHdlDut;
 use crate::sigrok::SpiCapture;
+
+mod verilog;
+pub use verilog::{deep_faults, prove, prove_unavailable, ProveVerdict, VerilogFault};
 
 /// A detector of the judge, measured apart from the others.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -66,13 +70,14 @@ impl Detector {
         }
     }
 
-    /// Why this detector has no view of a fault class, by design.
-    pub fn blind_to(&self, class: &str) -> Option<&'static str> {
+    /// Why this detector has no view of a fault class (at `level`), by design.
+    pub fn blind_to(&self, class: &str, level: &str) -> Option<&'static str> {
         match (self, class) {
             (
                 Detector::Sigrok,
                 "mux-late" | "two-mux-en" | "wrong-mux" | "select-swap",
             ) => Some("the SPI decode reads CS, SCLK and MISO only: mux pins are outside its view, and the design emits whatever code MISO carried"),
+            (Detector::Prove, _) if level == "pins" || level == "reset" => Some("the fault is injected into a simulation's pins, not built into a design: prove reads a design, so it has nothing to prove it against"),
             _ => None,
         }
     }
@@ -82,13 +87,29 @@ impl Detector {
 #[derive(Debug, Clone, Serialize)]
 pub struct Column {
     pub detector: Detector,
-    /// Why it did not run (a tool missing, a crate not built in).
+    /// Why it did not run (a tool missing, an opt-in not asked for).
     pub not_run: Option<String>,
     pub detected: u64,
+    /// Injections of the classes it can see (0 when it did not run).
     pub injected: u64,
-    /// Simulated cycles it judged and the wall seconds it took (the model
-    /// and the invariants: a clean run of the target checked with and
-    /// without the model; sigrok: every decode of the campaign).
+    /// The runs it was timed on, the simulated cycles they judged and the
+    /// wall seconds they took (the model and the invariants: a clean run
+    /// of the target checked with and without the model; sigrok: every
+    /// decode of the campaign; prove: every proof, no cycles).
+    pub runs: u64,
+    pub cycles: u64,
+    pub seconds: f64,
+}
+
+/// An engine the faults ran through: how many of the injections that went
+/// through it some detector caught, and what a clean run of it cost.
+#[derive(Debug, Clone, Serialize)]
+pub struct EngineColumn {
+    /// `cycle model`, `rusthdl`, `verilator` or `icarus`.
+    pub engine: &'static str,
+    pub detected: u64,
+    pub injected: u64,
+    /// One clean run of the campaign's frames under the checker.
     pub cycles: u64,
     pub seconds: f64,
 }
@@ -128,6 +149,8 @@ pub struct Site {
 #[derive(Debug, Clone, Serialize)]
 pub struct Injection {
     pub fault: String,
+    /// The engine it ran on (`cycle model`, `rusthdl`, `verilator`, `icarus`).
+    pub engine: &'static str,
     pub site: &'static str,
     pub cycle: u64,
     /// Detectors (that ran) which rejected the run.
@@ -140,13 +163,15 @@ pub struct Injection {
     pub sigrok: Option<String>,
     /// Gateware faults no detector caught: the equivalence check's answer.
     pub equivalence: Option<Equivalence>,
+    /// `prove` on the faulty design (when it ran).
+    pub prove: Option<ProveVerdict>,
 }
 
 /// A class of fault over all its sites.
 #[derive(Debug, Clone, Serialize)]
 pub struct ClassOutcome {
     pub name: String,
-    /// `pins`, `reset` or `gateware`.
+    /// `pins`, `reset`, `gateware` or `verilog`.
     pub level: &'static str,
     /// Injections (proved-equivalent ones included).
     pub injected: u64,
@@ -183,6 +208,11 @@ pub struct Campaign {
     pub detectors: Vec<Detector>,
     /// The matrix's columns: per detector, its total and its cost.
     pub columns: Vec<Column>,
+    /// The engines the faults ran through, each with its total and cost.
+    pub engines: Vec<EngineColumn>,
+    /// Frames per run (the simulated time one injection covers).
+    pub frames: u64,
+    pub clock_hz: u64,
     pub classes: Vec<ClassOutcome>,
     pub injected: u64,
     pub detected: u64,
@@ -237,18 +267,56 @@ pub fn sites(s: &Schedule) -> Vec<Site> {
     v
 }
 
+/// The work of the detectors that are not the checker, per injection.
+#[derive(Debug, Clone, Copy, Default)]
+struct Cost {
+    sigrok_runs: u64,
+    sigrok_cycles: u64,
+    sigrok_seconds: f64,
+    prove_runs: u64,
+    prove_seconds: f64,
+}
+
+impl Cost {
+    fn add(self, o: Cost) -> Cost {
+        Cost {
+            sigrok_runs: self.sigrok_runs + o.sigrok_runs,
+            sigrok_cycles: self.sigrok_cycles + o.sigrok_cycles,
+            sigrok_seconds: self.sigrok_seconds + o.sigrok_seconds,
+            prove_runs: self.prove_runs + o.prove_runs,
+            prove_seconds: self.prove_seconds + o.prove_seconds,
+        }
+    }
+}
+
 /// A run judged by every detector that runs.
 struct Judged {
     report: Report,
     /// sigrok's verdict (`None`: not run).
     sigrok: Option<Result<(), String>>,
-    sigrok_cycles: u64,
-    sigrok_seconds: f64,
+    cost: Cost,
 }
 
 impl Judged {
-    fn cost(&self) -> (u64, f64) {
-        (self.sigrok_cycles, self.sigrok_seconds)
+    /// sigrok's decode of `cap` (the pins of this run), timed.
+    fn decode(
+        &mut self,
+        s: &Schedule,
+        cap: &SpiCapture,
+        frames: u64,
+        dir: &std::path::Path,
+    ) -> Result<(), String> {
+        let t = Instant::now();
+        let verdict = if judge::switch::disabled("sigrok") {
+            Ok(())
+        } else {
+            crate::sigrok::check(s, cap, frames, dir)?
+        };
+        self.sigrok = Some(verdict);
+        self.cost.sigrok_runs += 1;
+        self.cost.sigrok_cycles += (frames - 1) * s.grid.frame_cycles;
+        self.cost.sigrok_seconds += t.elapsed().as_secs_f64();
+        Ok(())
     }
 
     fn detected_by(&self) -> Vec<Detector> {
@@ -276,28 +344,22 @@ fn judge_run(s: &Schedule, dut: &mut dyn Dut, frames: u64, sigrok: bool) -> Resu
         return Ok(Judged {
             report,
             sigrok: None,
-            sigrok_cycles: 0,
-            sigrok_seconds: 0.0,
+            cost: Cost::default(),
         });
     }
     let mut cap = SpiCapture::new(s, judge::run::reset_cycles(s, opts.reset_cycles));
     let report = run_dut(s, dut, frames, &opts, "faults", Some(&mut cap));
-    let t = Instant::now();
-    let verdict = if judge::switch::disabled("sigrok") {
-        Ok(())
-    } else {
-        let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
-        crate::sigrok::check(s, &cap, frames, dir.path())?
-    };
-    Ok(Judged {
+    let mut j = Judged {
         report,
-        sigrok: Some(verdict),
-        sigrok_cycles: (frames - 1) * s.grid.frame_cycles,
-        sigrok_seconds: t.elapsed().as_secs_f64(),
-    })
+        sigrok: None,
+        cost: Cost::default(),
+    };
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    j.decode(s, &cap, frames, dir.path())?;
+    Ok(j)
 }
 
-fn outcome(fault: String, site: &Site, j: &Judged) -> Injection {
+fn outcome(fault: String, site: &Site, j: &Judged, engine: &'static str) -> Injection {
     let r = &j.report;
     let mut rules: Vec<String> = Vec::new();
     for v in &r.violations {
@@ -307,6 +369,7 @@ fn outcome(fault: String, site: &Site, j: &Judged) -> Injection {
     }
     Injection {
         fault,
+        engine,
         site: site.name,
         cycle: site.cycle,
         detected_by: j.detected_by(),
@@ -315,6 +378,7 @@ fn outcome(fault: String, site: &Site, j: &Judged) -> Injection {
         rules,
         sigrok: j.sigrok.clone().and_then(|v| v.err()),
         equivalence: None,
+        prove: None,
     }
 }
 
@@ -368,50 +432,6 @@ fn rom_cases(s: &Schedule, b: usize, site: Site) -> Vec<DesignCase> {
     ]
 }
 
-/// One design-level fault of each class, at the middle of frame 0 on the
-/// first branch that has two channels (ROM faults), for a quick measure of
-/// what a method can see.
-pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(&'static str, hdl::GatewareFault)> {
-    let f = s.grid.frame_cycles;
-    let mid = f / 2 + 7;
-    let site = Site {
-        name: "mid-frame",
-        cycle: mid,
-        slot: (mid % f) / s.grid.slot_cycles,
-    };
-    let mut v: Vec<(&'static str, hdl::GatewareFault)> = (0..s.branches.len())
-        .map(|b| rom_cases(s, b, site))
-        .find(|c| !c.is_empty())
-        .unwrap_or_default()
-        .into_iter()
-        .map(|c| (c.class, c.fault))
-        .collect();
-    v.push((
-        "slot-wrap-early",
-        hdl::GatewareFault::SlotWrap { delta: -1 },
-    ));
-    v.push(("slot-wrap-late", hdl::GatewareFault::SlotWrap { delta: 1 }));
-    if s.grid.slices_per_frame > 1 {
-        v.push((
-            "slice-count-short",
-            hdl::GatewareFault::SliceWrap { delta: -1 },
-        ));
-        v.push((
-            "slice-count-long",
-            hdl::GatewareFault::SliceWrap { delta: 1 },
-        ));
-    }
-    v.extend(hdl::GatewareFault::link_faults(s));
-    v
-}
-
-/// `hdl::RtlSim` with a design-level fault built in, as a [`Dut`].
-pub fn gateware_dut(s: &Schedule, f: hdl::GatewareFault) -> Result<Box<dyn Dut>, SimError> {
-    hdl::RtlSim::with_fault(s, f)
-        .map(|sim| Box::new(GatewareDut(sim)) as Box<dyn Dut>)
-        .map_err(|e| SimError::Hdl(e.to_string()))
-}
-
 /// Runs `jobs` on up to two threads (the machine's cores), in order.
 fn parallel<T: Send, R: Send>(jobs: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
     let n = std::thread::available_parallelism()
@@ -437,20 +457,69 @@ fn parallel<T: Send, R: Send>(jobs: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R>
         .collect()
 }
 
-/// Why a detector does not run here (`None`: it runs).
-fn not_run(d: Detector) -> Option<String> {
-    match d {
-        Detector::Model | Detector::Invariants => None,
-        Detector::Sigrok => crate::sigrok::available().err().map(|e| e.to_string()),
-        Detector::Prove => {
-            Some("not run: `prove` (the formal crate) is not built into this slotforge yet".into())
+/// What the campaign runs: the target of the built-in classes, the
+/// Verilog faults and their engines, and whether `prove` runs.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    pub target: Target,
+    /// Frames per run (at least 3: faults land in frame 1, and the next
+    /// frame shows what a fault left behind).
+    pub frames: u64,
+    /// Random feasible mixes run clean.
+    pub false_alarm_mixes: u64,
+    /// The target's own classes (pin faults, reset glitches, and on the
+    /// gateware its design-level faults); off, only the Verilog faults run.
+    pub builtin: bool,
+    /// Faulty designs as Verilog (mutants, deep faults).
+    pub verilog_faults: Vec<VerilogFault>,
+    /// The engines the Verilog faults run on (verilator, icarus).
+    pub verilog_engines: Vec<Backend>,
+    /// `prove` as a detector of every fault that is a design (opt-in:
+    /// proofs take minutes on a 48 MHz mix).
+    pub prove: bool,
+    /// Where faults land (`None`: every site of [`sites`]; `build`'s quick
+    /// default runs every class at the mid-frame site only).
+    pub sites: Option<Vec<Site>>,
+}
+
+impl Plan {
+    pub fn new(target: Target, frames: u64, false_alarm_mixes: u64) -> Plan {
+        Plan {
+            target,
+            frames,
+            false_alarm_mixes,
+            builtin: true,
+            verilog_faults: vec![],
+            verilog_engines: vec![],
+            prove: false,
+            sites: None,
         }
     }
 }
 
-/// One judged injection: its class, level and outcome, and sigrok's share
-/// of the work (cycles decoded, seconds).
-type Judgement = (&'static str, &'static str, Injection, (u64, f64));
+/// Why a detector does not run here (`None`: it runs).
+fn not_run(d: Detector, plan: &Plan) -> Option<String> {
+    match d {
+        Detector::Model | Detector::Invariants => None,
+        Detector::Sigrok => crate::sigrok::available().err().map(|e| e.to_string()),
+        Detector::Prove if !plan.prove => Some(
+            "not run: opt-in (`faults --prove`; a proof takes seconds on a small-frame mix, minutes on a 48 MHz one)".into(),
+        ),
+        Detector::Prove => prove_unavailable().map(|why| format!("not run: {why}")),
+    }
+}
+
+/// One judged injection: its class, level and outcome, and the work of the
+/// detectors besides the checker.
+type Judgement = (String, &'static str, Injection, Cost);
+
+/// The engine name of a target.
+fn engine_name(t: Target) -> &'static str {
+    match t {
+        Target::Model => "cycle model",
+        Target::Rusthdl => "rusthdl",
+    }
+}
 
 /// The pin faults and reset glitches at every site.
 fn pin_injections(
@@ -479,9 +548,14 @@ fn pin_injections(
             "pins"
         };
         // a fault that found nothing to change was not injected
-        Ok(dut
-            .injected()
-            .then(|| (f.class(), level, outcome(f.name(), &site, &j), j.cost())))
+        Ok(dut.injected().then(|| {
+            (
+                f.class().to_string(),
+                level,
+                outcome(f.name(), &site, &j, engine_name(target)),
+                j.cost,
+            )
+        }))
     });
     Ok(runs
         .into_iter()
@@ -526,27 +600,14 @@ fn design_cases(s: &Schedule, sites: &[Site]) -> Vec<DesignCase> {
     design
 }
 
-/// A gateware fault no detector caught: proved equivalent, or why not.
-fn equivalence(s: &Schedule, f: hdl::GatewareFault) -> Equivalence {
-    let undecided = |why: String| Equivalence::Undecided { why };
-    let (gold, gate) = match hdl::verilog_pair(s, f) {
-        Ok(p) => p,
-        Err(e) => return undecided(format!("no Verilog for the fault: {e}")),
-    };
-    match tempfile::tempdir() {
-        Ok(dir) => crate::equiv::check(&gold, &gate, dir.path())
-            .unwrap_or_else(|e| undecided(e.to_string())),
-        Err(e) => undecided(e.to_string()),
-    }
-}
-
-/// The design-level faults, each judged; an uncaught one goes to the
-/// equivalence check.
+/// The design-level faults, each judged (and proved, with `prove`); an
+/// uncaught one goes to the equivalence check.
 fn gateware_injections(
     s: &Schedule,
     sites: &[Site],
     frames: u64,
     sigrok: bool,
+    prove: bool,
 ) -> Result<Vec<Judgement>, String> {
     let runs = parallel(
         design_cases(s, sites),
@@ -557,12 +618,26 @@ fn gateware_injections(
                 return Ok(None);
             };
             let mut dut = GatewareDut(sim);
-            let j = judge_run(s, &mut dut, frames, sigrok)?;
-            let mut inj = outcome(name, &c.site, &j);
-            if inj.detected_by.is_empty() {
-                inj.equivalence = Some(equivalence(s, c.fault));
-            }
-            Ok(Some((c.class, "gateware", inj, j.cost())))
+            let mut j = judge_run(s, &mut dut, frames, sigrok)?;
+            let mut inj = outcome(name, &c.site, &j, "rusthdl");
+            let pair = hdl::verilog_pair(s, c.fault).map_err(|e| e.to_string());
+            let verdict = match (&pair, prove) {
+                (Ok((_, gate)), true) => {
+                    let (v, secs) = verilog::prove(s, gate);
+                    j.cost.prove_runs += 1;
+                    j.cost.prove_seconds += secs;
+                    Some(v)
+                }
+                (Err(e), true) => Some(ProveVerdict::NoVerdict { why: e.clone() }),
+                _ => None,
+            };
+            verilog::settle(&mut inj, verdict.as_ref(), || match &pair {
+                Ok((gold, gate)) => verilog::equivalence(gold, gate),
+                Err(e) => Equivalence::Undecided {
+                    why: format!("no Verilog for the fault: {e}"),
+                },
+            });
+            Ok(Some((c.class.to_string(), "gateware", inj, j.cost)))
         },
     );
     Ok(runs
@@ -580,16 +655,17 @@ fn classes(judged: Vec<Judgement>, ran: &[Detector]) -> Vec<ClassOutcome> {
         let c = match classes.iter().position(|c| c.name == class) {
             Some(i) => &mut classes[i],
             None => {
+                let cannot_see: BTreeMap<Detector, String> = Detector::ALL
+                    .iter()
+                    .filter_map(|d| Some((*d, d.blind_to(&class, level)?.to_string())))
+                    .collect();
                 classes.push(ClassOutcome {
-                    name: class.to_string(),
+                    name: class,
                     level,
                     injected: 0,
                     detected: 0,
                     detected_by: ran.iter().map(|&d| (d, 0)).collect(),
-                    cannot_see: Detector::ALL
-                        .iter()
-                        .filter_map(|d| Some((*d, d.blind_to(class)?.to_string())))
-                        .collect(),
+                    cannot_see,
                     undetected: vec![],
                     proved_equivalent: vec![],
                 });
@@ -602,7 +678,7 @@ fn classes(judged: Vec<Judgement>, ran: &[Detector]) -> Vec<ClassOutcome> {
         }
         if !inj.detected_by.is_empty() {
             c.detected += 1;
-        } else if matches!(inj.equivalence, Some(Equivalence::Proved { .. })) {
+        } else if inj.equivalence.as_ref().is_some_and(Equivalence::is_proof) {
             c.proved_equivalent.push(inj);
         } else {
             c.undetected.push(inj);
@@ -611,16 +687,51 @@ fn classes(judged: Vec<Judgement>, ran: &[Detector]) -> Vec<ClassOutcome> {
     classes
 }
 
-/// The columns: per detector its totals, and its cost measured now (the
-/// checker on a clean run of the target with and without the model;
-/// sigrok's decodes summed over the campaign).
+/// The columns: per detector its totals over the classes it can see, and
+/// its cost measured now (the checker on a clean run of the target with
+/// and without the model; sigrok's decodes and prove's proofs summed over
+/// the campaign).
 fn columns(
-    s: &Schedule,
-    target: Target,
-    frames: u64,
+    plan: &Plan,
     classes: &[ClassOutcome],
-    sigrok_cost: (u64, f64),
+    cost: Cost,
+    clean: &[(u64, f64); 2],
 ) -> Vec<Column> {
+    Detector::ALL
+        .iter()
+        .map(|&d| {
+            let why = not_run(d, plan);
+            let (runs, cycles, seconds) = match d {
+                _ if why.is_some() => (0, 0, 0.0),
+                Detector::Model => (1, clean[0].0, clean[0].1),
+                Detector::Invariants => (1, clean[1].0, clean[1].1),
+                Detector::Sigrok => (cost.sigrok_runs, cost.sigrok_cycles, cost.sigrok_seconds),
+                Detector::Prove => (cost.prove_runs, 0, cost.prove_seconds),
+            };
+            let seen = classes.iter().filter(|c| !c.cannot_see.contains_key(&d));
+            Column {
+                detector: d,
+                detected: classes
+                    .iter()
+                    .map(|c| c.detected_by.get(&d).copied().unwrap_or(0))
+                    .sum(),
+                injected: if why.is_some() {
+                    0
+                } else {
+                    seen.map(|c| c.injected).sum()
+                },
+                not_run: why,
+                runs,
+                cycles,
+                seconds,
+            }
+        })
+        .collect()
+}
+
+/// A clean run of the target under the checker, with and without the
+/// model, timed: [(cycles, seconds) with the model, without].
+fn clean_target_runs(s: &Schedule, target: Target, frames: u64) -> [(u64, f64); 2] {
     let timed = |model: bool| -> (u64, f64) {
         let mut dut: Box<dyn Dut> = match target {
             Target::Model => Box::new(ModelDut::new(s)),
@@ -635,29 +746,20 @@ fn columns(
         let r = run_dut(s, &mut dut, frames, &opts, "timing", None);
         (r.cycles, t.elapsed().as_secs_f64())
     };
-    Detector::ALL
+    [timed(true), timed(false)]
+}
+
+/// Per engine: injections through it, those some detector caught, and a
+/// clean run's cost.
+fn engine_columns(judged: &[Judgement], costs: &[(&'static str, u64, f64)]) -> Vec<EngineColumn> {
+    costs
         .iter()
-        .map(|&d| {
-            let why = not_run(d);
-            let (cycles, seconds) = match d {
-                _ if why.is_some() => (0, 0.0),
-                Detector::Model => timed(true),
-                Detector::Invariants => timed(false),
-                Detector::Sigrok => sigrok_cost,
-                Detector::Prove => (0, 0.0),
-            };
-            Column {
-                detector: d,
-                detected: classes
-                    .iter()
-                    .map(|c| c.detected_by.get(&d).copied().unwrap_or(0))
-                    .sum(),
-                injected: if why.is_some() {
-                    0
-                } else {
-                    classes.iter().map(|c| c.injected).sum()
-                },
-                not_run: why,
+        .map(|&(engine, cycles, seconds)| {
+            let mine = judged.iter().filter(|j| j.2.engine == engine);
+            EngineColumn {
+                engine,
+                injected: mine.clone().count() as u64,
+                detected: mine.filter(|j| !j.2.detected_by.is_empty()).count() as u64,
                 cycles,
                 seconds,
             }
@@ -665,8 +767,7 @@ fn columns(
         .collect()
 }
 
-/// The campaign on `s` with `frames` frames per run (at least 3: faults land
-/// in frame 1, and the next frame shows what a fault left behind), and
+/// The campaign on `s` with `frames` frames per run and
 /// `false_alarm_mixes` random feasible mixes run clean.
 pub fn campaign(
     s: &Schedule,
@@ -674,36 +775,65 @@ pub fn campaign(
     frames: u64,
     false_alarm_mixes: u64,
 ) -> Result<Campaign, SimError> {
-    campaign_at(s, target, sites(s), frames, false_alarm_mixes)
+    campaign_with(s, &Plan::new(target, frames, false_alarm_mixes))
 }
 
-/// The campaign at the given sites only (`build`'s quick default runs
-/// every class at one site of [`sites`]).
-pub fn campaign_at(
-    s: &Schedule,
-    target: Target,
-    sites: Vec<Site>,
-    frames: u64,
-    false_alarm_mixes: u64,
-) -> Result<Campaign, SimError> {
-    let frames = frames.max(3);
+/// The campaign of `plan` on `s`.
+pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
+    let frames = plan.frames.max(3);
+    let target = plan.target;
+    let sites = plan.sites.clone().unwrap_or_else(|| sites(s));
     if target == Target::Rusthdl {
         RustHdlDut::new(s)?;
     }
     let ran: Vec<Detector> = Detector::ALL
         .into_iter()
-        .filter(|d| not_run(*d).is_none())
+        .filter(|d| not_run(*d, plan).is_none())
         .collect();
     let sigrok = ran.contains(&Detector::Sigrok);
-    let mut judged = pin_injections(s, target, &sites, frames, sigrok).map_err(SimError::Io)?;
-    if target == Target::Rusthdl {
-        judged.extend(gateware_injections(s, &sites, frames, sigrok).map_err(SimError::Io)?);
+    let prove = ran.contains(&Detector::Prove);
+    let mut judged = Vec::new();
+    if plan.builtin {
+        judged = pin_injections(s, target, &sites, frames, sigrok).map_err(SimError::Io)?;
     }
-    let cost = judged
-        .iter()
-        .fold((0u64, 0.0f64), |a, j| (a.0 + j.3 .0, a.1 + j.3 .1));
+    if plan.builtin && target == Target::Rusthdl {
+        judged.extend(gateware_injections(s, &sites, frames, sigrok, prove).map_err(SimError::Io)?);
+    }
+    let clean = clean_target_runs(s, target, frames);
+    let mut engine_costs = Vec::new();
+    if plan.builtin {
+        engine_costs.push((engine_name(target), clean[0].0, clean[0].1));
+    }
+    let mut false_alarms = false_alarms(target, plan.false_alarm_mixes, sigrok);
+    if !plan.verilog_faults.is_empty() {
+        for &e in &plan.verilog_engines {
+            let (cycles, secs, why) =
+                verilog::clean_engine_run(s, e, frames, sigrok).map_err(SimError::Io)?;
+            engine_costs.push((e.name(), cycles, secs));
+            false_alarms.runs += 1;
+            if let Some(why) = why {
+                false_alarms.rejected += 1;
+                false_alarms
+                    .examples
+                    .push(format!("{} on the clean Verilog: {why}", e.name()));
+            }
+        }
+        judged.extend(
+            verilog::verilog_injections(
+                s,
+                &plan.verilog_faults,
+                &plan.verilog_engines,
+                frames,
+                sigrok,
+                prove,
+            )
+            .map_err(SimError::Io)?,
+        );
+    }
+    let cost = judged.iter().fold(Cost::default(), |a, j| a.add(j.3));
+    let engines = engine_columns(&judged, &engine_costs);
     let classes = classes(judged, &ran);
-    let columns = columns(s, target, frames, &classes, cost);
+    let columns = columns(plan, &classes, cost, &clean);
     let sum = |f: fn(&ClassOutcome) -> u64| classes.iter().map(f).sum();
     Ok(Campaign {
         mix: s.mix.name.clone(),
@@ -711,12 +841,15 @@ pub fn campaign_at(
         sites,
         detectors: Detector::ALL.to_vec(),
         columns,
+        engines,
+        frames,
+        clock_hz: s.grid.clock_hz,
         injected: sum(|c| c.injected),
         detected: sum(|c| c.detected),
         undetected: sum(|c| c.undetected.len() as u64),
         proved_equivalent: sum(|c| c.proved_equivalent.len() as u64),
         classes,
-        false_alarms: false_alarms(target, false_alarm_mixes, sigrok),
+        false_alarms,
     })
 }
 

@@ -29,6 +29,8 @@ pub struct SpiCapture {
     changes: Vec<Vec<(u64, u8)>>,
     samples: Vec<(u16, u16)>,
     end: u64,
+    /// Cycles seen as a [`CycleSink`] (a VCD's cycles carry no number).
+    seen: u64,
 }
 
 impl SpiCapture {
@@ -42,6 +44,7 @@ impl SpiCapture {
             changes: vec![Vec::new(); nb],
             samples: Vec::new(),
             end: 0,
+            seen: 0,
         }
     }
 }
@@ -65,6 +68,16 @@ impl Observer for SpiCapture {
         if p.sample_valid {
             self.samples.push((p.sample_channel, p.sample_value));
         }
+    }
+}
+
+/// Icarus's VCD, read back cycle by cycle from its first (reset) cycle, as
+/// the in-process engines' observers see it; x/z bits read as 0.
+impl judge::vcd::CycleSink for SpiCapture {
+    fn cycle(&mut self, rst: Option<bool>, pins: &Pins, _: &Pins, miso: u64, _: u64) {
+        let c = self.seen;
+        self.seen += 1;
+        Observer::cycle(self, c, rst.unwrap_or(false), pins, miso);
     }
 }
 

@@ -17,6 +17,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
+use cosim::faults::{campaign_with, Campaign, Detector, Plan, Target, VerilogFault};
+
 mod mutate;
 use mutate::Operator;
 
@@ -271,4 +273,141 @@ fn every_mutant_the_independent_testbench_rejects_is_rejected_by_check() {
         by_tb >= compiled / 2,
         "the testbench kills only {by_tb} of {compiled}"
     );
+}
+
+// ---- Verilog mutants through the fault campaign ----------------------------
+
+/// The campaign's plan for `mutants` of the test mix on `engines`, without
+/// the target's own classes.
+fn mutant_plan(
+    s: &lut_gen::Schedule,
+    per_op: &[(Operator, usize)],
+    engines: &[cosim::Backend],
+    prove: bool,
+) -> Plan {
+    let original = cosim::rusthdl::verilog(s).unwrap();
+    let mut plan = Plan::new(Target::Model, 3, 0);
+    plan.builtin = false;
+    plan.prove = prove;
+    plan.verilog_engines = engines.to_vec();
+    plan.verilog_faults = mutate::mutants(&original, per_op)
+        .into_iter()
+        .map(|m| VerilogFault {
+            class: format!("mutant:{}", m.site.op.name()),
+            name: m.describe(),
+            verilog: m.text,
+        })
+        .collect();
+    plan
+}
+
+/// Every mutant run is in the matrix: detected, undetected or proved
+/// equivalent, never dropped; an undetected one carries the equivalence
+/// check's answer (never a proof).
+fn assert_every_mutant_is_counted(c: &Campaign, plan: &Plan) {
+    let mut runs = 0;
+    for k in c.classes.iter().filter(|k| k.level == "verilog") {
+        assert_eq!(
+            k.detected + k.undetected.len() as u64 + k.proved_equivalent.len() as u64,
+            k.injected,
+            "{k:?}"
+        );
+        for i in &k.undetected {
+            let e = i.equivalence.as_ref().expect("an equivalence verdict");
+            assert!(!e.is_proof(), "{i:?}");
+        }
+        runs += k.injected;
+    }
+    let n = plan.verilog_engines.len() as u64;
+    assert!(runs > 0 && runs <= n * plan.verilog_faults.len() as u64);
+    let engines: Vec<&str> = c.engines.iter().map(|e| e.engine).collect();
+    let want: Vec<&str> = plan.verilog_engines.iter().map(|e| e.name()).collect();
+    assert_eq!(engines, want);
+    assert_eq!(c.engines.iter().map(|e| e.injected).sum::<u64>(), runs);
+    // the clean Verilog on both engines, judged by every detector, passes
+    assert_eq!(c.false_alarms.rejected, 0, "{:?}", c.false_alarms);
+}
+
+/// A few mutants of the emitted Verilog reach a Verilog engine through the
+/// one campaign (Icarus: it builds in a second, where Verilator builds each
+/// mutant for a minute; the long test runs both): each stuck output is
+/// caught by the model comparison or proved equivalent at the ports.
+#[test]
+fn a_few_mutants_run_through_the_campaign_on_icarus() {
+    if !tools::require_tools(&["iverilog", "yosys", "yosys-abc"]) {
+        return;
+    }
+    let s =
+        lut_gen::synthesize(&lut_gen::load(&manifest().join("tests/data/mutants.toml")).unwrap())
+            .unwrap();
+    // stuck outputs: they change a pin whatever the schedule, so no
+    // equivalence check (up to 90 s each) runs in the default suite
+    let plan = mutant_plan(
+        &s,
+        &[(Operator::Stuck, 2)],
+        &[cosim::Backend::Icarus],
+        false,
+    );
+    assert_eq!(plan.verilog_faults.len(), 2);
+    let c = campaign_with(&s, &plan).unwrap();
+    assert_every_mutant_is_counted(&c, &plan);
+    let stuck = c
+        .classes
+        .iter()
+        .find(|k| k.name == "mutant:stuck")
+        .expect("the stuck output's class");
+    // measured: #0 changes a pin, #1 (a constant already all ones) is
+    // proved equivalent by the miter, not dropped
+    assert_eq!(stuck.injected, 2, "{stuck:?}");
+    assert_eq!(stuck.detected_by[&Detector::Model], 1, "{stuck:?}");
+    assert_eq!(stuck.proved_equivalent.len(), 1, "{stuck:?}");
+    assert!(matches!(
+        stuck.proved_equivalent[0].equivalence,
+        Some(cosim::equiv::Equivalence::Proved { .. })
+    ));
+    assert!(c.column(Detector::Prove).unwrap().not_run.is_some());
+}
+
+/// The full mutant campaign (36 mutants, each on Verilator and Icarus, each
+/// proved): `make test-long`.
+#[test]
+#[ignore = "long: make test-long"]
+fn the_mutant_campaign_through_every_detector_and_prove() {
+    if !tools::require_tools(&["verilator", "iverilog", "yosys", "yosys-abc", "sigrok-cli"]) {
+        return;
+    }
+    let s =
+        lut_gen::synthesize(&lut_gen::load(&manifest().join("tests/data/mutants.toml")).unwrap())
+            .unwrap();
+    let plan = mutant_plan(
+        &s,
+        &PER_OP,
+        &[cosim::Backend::Verilator, cosim::Backend::Icarus],
+        true,
+    );
+    let t = Instant::now();
+    let c = campaign_with(&s, &plan).unwrap();
+    for k in &c.classes {
+        eprintln!(
+            "{:<16} {} injected, {} detected {:?}, {} undetected, {} proved equivalent",
+            k.name,
+            k.injected,
+            k.detected,
+            k.detected_by,
+            k.undetected.len(),
+            k.proved_equivalent.len()
+        );
+        for i in &k.undetected {
+            eprintln!(
+                "    UNDETECTED {} on {}: {:?}",
+                i.fault, i.engine, i.equivalence
+            );
+        }
+    }
+    eprintln!("{:.1} s", t.elapsed().as_secs_f64());
+    assert_every_mutant_is_counted(&c, &plan);
+    // prove sees every mutant's design and catches some the runs miss, or
+    // none slips past the runs
+    let prove = c.column(Detector::Prove).unwrap();
+    assert!(prove.not_run.is_none() && prove.detected > 0, "{prove:?}");
 }

@@ -121,6 +121,7 @@ fn aliasing(s: &Schedule, rate: f64, ch: usize) -> Result<(Figure, Figure, Strin
     // the DFT over every sample; the time panel over 12 sample periods
     let spec = dft::spectrum(&tr.points, rate, 241);
     let (seen, _) = dft::peak(&spec).ok_or("too few samples for a spectrum")?;
+    where_aliasing_puts_it(f, rate, seen, want)?;
     let shown: Vec<(f64, f64)> = tr.points.iter().copied().skip(2).take(13).collect();
     let (t0, t1) = (
         shown.first().map_or(0.0, |p| p.0),
@@ -192,6 +193,20 @@ fn aliasing(s: &Schedule, rate: f64, ch: usize) -> Result<(Figure, Figure, Strin
     };
     let line = format!("{f} Hz at {rate} Hz appears at {seen:.0} Hz");
     Ok((time, spectrum, line))
+}
+
+/// The step fails when the measured apparent frequency `seen` of an `f` Hz
+/// tone sampled at `rate` is not where aliasing puts it (`want`), within
+/// two bins of the 241-point spectrum up to the Nyquist frequency.
+fn where_aliasing_puts_it(f: f64, rate: f64, seen: f64, want: f64) -> Result<(), String> {
+    let tol = rate / 240.0;
+    if (seen - want).abs() <= tol {
+        Ok(())
+    } else {
+        Err(format!(
+            "Figure 7: the {f} Hz tone sampled at {rate} Hz appears at {seen:.0} Hz; aliasing puts it at {want:.0} Hz (tolerance {tol:.1} Hz)"
+        ))
+    }
 }
 
 /// A slow tone (a tenth of the slowest rate) on the slowest channel against
@@ -281,4 +296,22 @@ fn slow(s: &Schedule) -> Result<(Figure, String), String> {
         table,
     };
     Ok((fig, line))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_apparent_frequency_off_its_alias_fails_the_step() {
+        // 1.3 x 1 kHz folds to 300 Hz
+        let want = dft::alias(1300.0, 1000.0);
+        assert!((want - 300.0).abs() < 1e-9, "{want}");
+        assert!(where_aliasing_puts_it(1300.0, 1000.0, 302.0, want).is_ok());
+        let e = where_aliasing_puts_it(1300.0, 1000.0, 1300.0 - 1000.0 + 50.0, want).unwrap_err();
+        assert!(
+            e.contains("appears at 350 Hz") && e.contains("300 Hz"),
+            "{e}"
+        );
+    }
 }

@@ -86,23 +86,33 @@ pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<
         ));
     }
     let stat = std::fs::read_to_string(dir.join("stat.txt")).unwrap_or_default();
+    parse(&log, &stat).map_err(|e| format!("{}: {e}", dir.join("nextpnr.log").display()))
+}
+
+/// The figures of nextpnr's log and yosys's `stat`.  A log without the
+/// utilisation table or an Fmax is an error, never "0 logic cells".
+fn parse(log: &str, stat: &str) -> Result<Synth, String> {
+    let need = |cell: &str| {
+        used(log, cell).ok_or(format!(
+            "no `{cell}: used/available` line in nextpnr-ice40's log: it could not be parsed"
+        ))
+    };
     Ok(Synth {
-        lcs: used(&log, "ICESTORM_LC"),
-        brams: used(&log, "ICESTORM_RAM"),
-        lut4: cells(&stat, |c| c == "SB_LUT4"),
-        dff: cells(&stat, |c| c.starts_with("SB_DFF")),
-        fmax_mhz: fmax(&log).ok_or("nextpnr-ice40 reported no Fmax")?,
+        lcs: need("ICESTORM_LC")?,
+        brams: need("ICESTORM_RAM")?,
+        lut4: cells(stat, |c| c == "SB_LUT4"),
+        dff: cells(stat, |c| c.starts_with("SB_DFF")),
+        fmax_mhz: fmax(log).ok_or("nextpnr-ice40 reported no Fmax")?,
     })
 }
 
 /// `CELL: used/available` from nextpnr's utilisation table (the last one).
-fn used(log: &str, cell: &str) -> u64 {
+fn used(log: &str, cell: &str) -> Option<u64> {
     let key = format!("{cell}:");
     log.lines()
         .filter_map(|l| Some(&l[l.find(&key)? + key.len()..]))
         .filter_map(|r| r.trim().split('/').next()?.trim().parse().ok())
         .next_back()
-        .unwrap_or(0)
 }
 
 /// The sum of yosys `stat` counts of the cells `pick` accepts (the last
@@ -135,11 +145,26 @@ mod tests {
         let log = "Info: Device utilisation:\nInfo:     ICESTORM_LC:   263/ 7680     3%\nInfo:    ICESTORM_RAM:     3/   32     9%\n\
                    Info: Max frequency for clock 'clk$SB_IO_IN_$glb_clk': 98.50 MHz (PASS at 48.00 MHz)\n\
                    Info: Max frequency for clock 'clk$SB_IO_IN_$glb_clk': 117.00 MHz (PASS at 48.00 MHz)\n";
-        assert_eq!(used(log, "ICESTORM_LC"), 263);
-        assert_eq!(used(log, "ICESTORM_RAM"), 3);
+        assert_eq!(used(log, "ICESTORM_LC"), Some(263));
+        assert_eq!(used(log, "ICESTORM_RAM"), Some(3));
+        assert_eq!(parse(log, "").unwrap().lcs, 263);
         assert_eq!(fmax(log), Some(117.0));
         let stat = "   Number of cells: 9\n     SB_CARRY  4\n     SB_DFF 10\n     SB_DFFER 7\n     SB_LUT4 120\n";
         assert_eq!(cells(stat, |c| c == "SB_LUT4"), 120);
         assert_eq!(cells(stat, |c| c.starts_with("SB_DFF")), 17);
+    }
+
+    #[test]
+    fn a_log_that_cannot_be_parsed_is_an_error_not_zero_cells() {
+        // a nextpnr whose table changed its words: no utilisation line
+        let log = "Info: Device utilisation:\nInfo:     LOGIC_CELLS:   263/ 7680     3%\n\
+                   Info: Max frequency for clock 'clk': 98.50 MHz (PASS at 48.00 MHz)\n";
+        let e = parse(log, "").unwrap_err();
+        assert!(
+            e.contains("ICESTORM_LC") && e.contains("could not be parsed"),
+            "{e}"
+        );
+        let no_fmax = "Info:     ICESTORM_LC:   263/ 7680     3%\nInfo:    ICESTORM_RAM:     3/   32     9%\n";
+        assert!(parse(no_fmax, "").unwrap_err().contains("Fmax"));
     }
 }

@@ -5,8 +5,9 @@
 //! `report.html` (self-contained) and `report.md`.  The measuring is in the
 //! `measure` crate; this module parses, calls and writes.
 //!
-//! Fast by default: every default step is about the mix itself; what
-//! compares methods (`speed`) runs with `--charts all` or `--only speed`.
+//! Fast by default: every default step is about the mix itself; the speed
+//! chart is drawn from the fault step's campaign, which with `--charts all`
+//! also runs the deep Verilog faults on every Verilog engine and `prove`.
 //! The report is rewritten after every step, so an interrupted build
 //! leaves a report of the steps that finished.
 //!
@@ -38,10 +39,10 @@ pub struct Args {
     /// Where the golden folders are (`<dir>/<mix name>/`).
     #[arg(long, default_value = "golden")]
     pub golden: PathBuf,
-    /// Which charts: `mix` (the charts about this mix: timing, figure7,
-    /// schedulability), `all` (also `speed`, which runs every simulator and
-    /// takes minutes, and the fault campaign at every site instead of the
-    /// quick one), or `none`.
+    /// Which charts: `mix` (timing, figure7, schedulability, and speed
+    /// against accuracy drawn from the fault campaign), `all` (the campaign
+    /// at every site instead of the quick one, also running the deep Verilog
+    /// faults on Verilator and Icarus and `prove`: minutes), or `none`.
     #[arg(long, value_enum, default_value_t = Charts::Mix)]
     pub charts: Charts,
     /// Run only these steps (comma-separated; see `--skip`).

@@ -25,7 +25,7 @@ pub const STEPS: [(&str, &str); 11] = [
     ("speed", "chart: speed against accuracy"),
 ];
 
-const MIX_CHARTS: [&str; 3] = ["timing", "figure7", "schedulability"];
+const MIX_CHARTS: [&str; 4] = ["timing", "figure7", "schedulability", "speed"];
 
 /// Which steps run: every step with whether it runs, or why a name given
 /// is unknown (checked before anything runs).
@@ -47,11 +47,6 @@ pub fn plan(a: &Args) -> Result<Vec<(&'static str, bool, &'static str)>, String>
                 (named(&a.only, id), "not in --only")
             } else if named(&a.skip, id) {
                 (false, "--skip")
-            } else if id == "speed" && a.charts != Charts::All {
-                (
-                    false,
-                    "compares every simulator (minutes): --charts all or --only speed",
-                )
             } else if MIX_CHARTS.contains(&id) && a.charts == Charts::None {
                 (false, "--charts none")
             } else {
@@ -94,6 +89,7 @@ fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
 
 pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(&'static str, bool, &'static str)]) {
     let mut sim_report = None;
+    let mut campaign = None;
     let mut background = if plan.iter().any(|p| p.0 == "synth" && p.1) {
         start_synth(&job.out, s)
     } else {
@@ -111,7 +107,7 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(&'static str, boo
             "verilog" => verilog(j, s),
             "sim" => sim(j, a, s, &mut sim_report),
             "golden" => golden(j, a, s),
-            "faults" => faults(j, a, s),
+            "faults" => faults(j, a, s, &mut campaign),
             "synth" => synth(s, background.take()),
             "timing" => timing(j, s),
             "figure7" => figure7(s),
@@ -121,7 +117,7 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(&'static str, boo
                     .section(sec)
                     .files(&["schedulability.svg", "schedulability.csv"])
             }
-            "speed" => speed(a, s),
+            "speed" => speed(campaign.as_ref()),
             _ => unreachable!("every step has a runner"),
         });
     }
@@ -316,7 +312,10 @@ fn golden(j: &mut Job, a: &Args, s: &Schedule) -> Done {
     written(w, d.files(&["golden.txt"]))
 }
 
-fn faults(j: &mut Job, a: &Args, s: &Schedule) -> Done {
+/// The campaign's plan: the model's pins (the gateware with `--thorough`);
+/// with `--charts all`, also the deep Verilog faults on every installed
+/// Verilog engine and `prove`, so the speed chart compares every method.
+fn fault_plan(a: &Args, s: &Schedule) -> Result<cosim::faults::Plan, String> {
     let target = if a.thorough {
         cosim::faults::Target::Rusthdl
     } else {
@@ -325,19 +324,39 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule) -> Done {
     // A fresh mix gets every class at one site (mid-frame) and one clean
     // random mix, in seconds; the full campaign (every site, five clean
     // mixes) when it is asked for: --only faults, --charts all, --thorough.
-    let full = a.thorough || a.charts == Charts::All || a.only.iter().any(|n| n.trim() == "faults");
-    let all = cosim::faults::sites(s);
-    let (sites, clean) = if full {
-        (all, 5)
-    } else {
-        (
-            all.into_iter().filter(|x| x.name == "mid-frame").collect(),
-            1,
-        )
-    };
-    let c = match cosim::faults::campaign_at(s, target, sites, 3, clean) {
+    let mut plan = cosim::faults::Plan::new(target, 3, 5);
+    if !full_campaign(a) {
+        let mid = cosim::faults::sites(s).into_iter().filter(|x| x.name == "mid-frame");
+        plan.sites = Some(mid.collect());
+        plan.false_alarm_mixes = 1;
+    }
+    if a.charts == Charts::All {
+        plan.verilog_engines = [
+            ("verilator", Backend::Verilator),
+            ("iverilog", Backend::Icarus),
+        ]
+        .into_iter()
+        .filter(|(tool, _)| measure::synth::tool_present(tool))
+        .map(|(_, b)| b)
+        .collect();
+        plan.verilog_faults = cosim::faults::deep_faults(s, plan.frames)?;
+        plan.prove = true;
+    }
+    Ok(plan)
+}
+
+/// Every site and five clean mixes, rather than the quick default.
+fn full_campaign(a: &Args) -> bool {
+    a.thorough || a.charts == Charts::All || a.only.iter().any(|n| n.trim() == "faults")
+}
+
+fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<cosim::faults::Campaign>) -> Done {
+    let full = full_campaign(a);
+    let c = match fault_plan(a, s)
+        .and_then(|p| cosim::faults::campaign_with(s, &p).map_err(|e| e.to_string()))
+    {
         Ok(c) => c,
-        Err(e) => return Done::failed(format!("{e}"), ""),
+        Err(e) => return Done::failed(e, ""),
     };
     let scope = if full {
         "The full campaign"
@@ -382,6 +401,7 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule) -> Done {
     } else {
         Done::failed(line, "see faults.json")
     };
+    *keep = Some(c);
     written(w, d.files(&["faults.json"]).section(sec))
 }
 
@@ -441,14 +461,15 @@ fn figure7(s: &Schedule) -> Done {
     }
 }
 
-fn speed(a: &Args, s: &Schedule) -> Done {
-    match measure::speed::measure(s, &a.out.join("frame0.vcd")) {
-        Ok(scores) => {
-            let (sec, line) = measure::speed::section(&scores);
-            Done::ok(line)
-                .section(sec)
-                .files(&["speed-accuracy.svg", "speed-accuracy.csv"])
-        }
-        Err(e) => Done::failed(e, ""),
-    }
+/// Drawn from the fault step's campaign of this build, nothing else.
+fn speed(c: Option<&cosim::faults::Campaign>) -> Done {
+    let Some(c) = c else {
+        return Done::skipped(
+            "draws the fault campaign of this build, and the faults step did not run",
+        );
+    };
+    let (sec, line) = measure::speed::section(c);
+    Done::ok(line)
+        .section(sec)
+        .files(&["speed-accuracy.svg", "speed-accuracy.csv"])
 }

@@ -1,0 +1,260 @@
+//! Faults given as Verilog (mutants of the emitted Verilog from the
+//! test-only mutator, `formal`'s deep fault classes) run through the
+//! Verilog engines (Verilator, Icarus) like any other fault: every detector
+//! judges each run apart, and a run no detector rejects is undetected unless
+//! the faulty design is proved equivalent at the ports ([`crate::equiv`]) or
+//! proves the full contract (`prove`).
+//!
+//! `prove` is also a detector here and of the gateware faults: it reads a
+//! design, so it sees every fault that is one (and no pin fault, which
+//! exists only inside a simulation).
+
+use std::time::Instant;
+
+use judge::run::reset_cycles;
+use lut_gen::Schedule;
+use serde::Serialize;
+
+use super::{parallel, Cost, Detector, Injection, Judged, Judgement};
+use crate::equiv::Equivalence;
+use crate::options::{Backend, SimOptions};
+use crate::sigrok::SpiCapture;
+
+/// A faulty design as Verilog text (a `slotforge_top` on the pin contract).
+#[derive(Debug, Clone)]
+pub struct VerilogFault {
+    /// The class it is counted in (e.g. `mutant:relop`, `rare-collision`).
+    pub class: String,
+    /// What was changed, for the report.
+    pub name: String,
+    pub verilog: String,
+}
+
+/// `formal`'s deep fault classes on `s`: `late-counter@frameN` lands in
+/// frame `frames` (just past a run of `frames` frames), `rare-collision`
+/// needs two equal codes back to back, which the stimuli never give.
+pub fn deep_faults(s: &Schedule, frames: u64) -> Result<Vec<VerilogFault>, String> {
+    let clean = crate::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+    [
+        formal::faults::DeepFault::LateCounter { frames },
+        formal::faults::DeepFault::RareCollision,
+    ]
+    .into_iter()
+    .map(|f| {
+        let name = f.name();
+        let class = name.split('@').next().unwrap_or(&name).to_string();
+        Ok(VerilogFault {
+            class,
+            name,
+            verilog: f.apply(s, &clean)?,
+        })
+    })
+    .collect()
+}
+
+/// What `prove` said of one design.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "result", rename_all = "kebab-case")]
+pub enum ProveVerdict {
+    /// The design violates the contract: a counterexample from reset.
+    Failed { cycle: Option<i64> },
+    /// The design proves the full contract for all time.
+    Proved,
+    /// Neither within the time limits, or a tool failed: no verdict.
+    NoVerdict { why: String },
+}
+
+/// Time limits of each proof (seconds): the unbounded engine and the
+/// bounded search.  Small-frame mixes take seconds; a 48 MHz preset minutes.
+pub const PROVE_SECONDS: u64 = 300;
+
+/// `prove` on `design` against `s`.
+pub fn prove(s: &Schedule, design: &str) -> (ProveVerdict, f64) {
+    let t = Instant::now();
+    let no = |why: String| ProveVerdict::NoVerdict { why };
+    let v = match tempfile::tempdir() {
+        Err(e) => no(e.to_string()),
+        Ok(dir) => {
+            let mut o = formal::ProveOptions::new(dir.path());
+            o.timeout_s = PROVE_SECONDS;
+            o.bmc_timeout_s = PROVE_SECONDS;
+            match formal::prove(s, design, &o) {
+                Err(e) => no(e.to_string()),
+                Ok(p) => match p.result {
+                    formal::Outcome::Failed => ProveVerdict::Failed { cycle: p.cycle },
+                    formal::Outcome::Proved => ProveVerdict::Proved,
+                    formal::Outcome::Bounded => no(p.note),
+                },
+            }
+        }
+    };
+    (v, t.elapsed().as_secs_f64())
+}
+
+/// Why `prove` cannot run here (`None`: it can).
+pub fn prove_unavailable() -> Option<String> {
+    ["yosys", "yosys-abc", "iverilog", "vvp"]
+        .into_iter()
+        .find(|t| {
+            std::process::Command::new(t)
+                .arg("-V")
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::null())
+                .status()
+                .is_err()
+        })
+        .map(|t| format!("{t} is not installed (make tools)"))
+}
+
+/// Runs `engine` on `verilog` for `frames` frames under the checker and,
+/// with `sigrok`, sigrok's decode of its pins.
+pub(super) fn judge_verilog(
+    s: &Schedule,
+    engine: Backend,
+    verilog: &str,
+    frames: u64,
+    sigrok: bool,
+) -> Result<Judged, String> {
+    let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
+    let rtl = dir.path().join("faulty.v");
+    std::fs::write(&rtl, verilog).map_err(|e| e.to_string())?;
+    let opts = SimOptions {
+        rtl: Some(rtl),
+        ..SimOptions::default()
+    };
+    let mut cap = SpiCapture::new(s, reset_cycles(s, opts.reset_cycles));
+    let report = crate::run_observed(
+        s,
+        engine,
+        frames,
+        &opts,
+        sigrok.then_some(&mut cap as &mut dyn crate::Tracer),
+    )
+    .map_err(|e| e.to_string())?;
+    let mut j = Judged {
+        report,
+        sigrok: None,
+        cost: Cost::default(),
+    };
+    if sigrok {
+        j.decode(s, &cap, frames, dir.path())?;
+    }
+    Ok(j)
+}
+
+/// Each Verilog fault on each engine, judged; `prove` once per fault (its
+/// verdict holds for every engine's run of it).  A fault the engine cannot
+/// build is not injected there.
+pub(super) fn verilog_injections(
+    s: &Schedule,
+    faults: &[VerilogFault],
+    engines: &[Backend],
+    frames: u64,
+    sigrok: bool,
+    prove: bool,
+) -> Result<Vec<Judgement>, String> {
+    let clean = crate::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+    let mut jobs = Vec::new();
+    for f in faults {
+        for &e in engines {
+            jobs.push((f, e));
+        }
+    }
+    let runs = parallel(jobs, |(f, e)| -> Result<Option<Judgement>, String> {
+        let Ok(j) = judge_verilog(s, e, &f.verilog, frames, sigrok) else {
+            return Ok(None);
+        };
+        let site = super::Site {
+            name: e.name(),
+            cycle: 0,
+            slot: 0,
+        };
+        let inj = super::outcome(f.name.clone(), &site, &j, e.name());
+        Ok(Some((f.class.clone(), "verilog", inj, j.cost)))
+    });
+    let mut out: Vec<Judgement> = runs
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()?
+        .into_iter()
+        .flatten()
+        .collect();
+    // prove each fault once, then the undetected ones' equivalence
+    for f in faults {
+        let (verdict, secs) = if prove {
+            let (v, t) = self::prove(s, &f.verilog);
+            (Some(v), t)
+        } else {
+            (None, 0.0)
+        };
+        let mut first = true;
+        // one equivalence check per fault, whichever engines missed it
+        let mut eq: Option<Equivalence> = None;
+        for j in out.iter_mut().filter(|j| j.2.fault == f.name) {
+            settle(&mut j.2, verdict.as_ref(), || {
+                eq.get_or_insert_with(|| equivalence(&clean, &f.verilog))
+                    .clone()
+            });
+            if first && verdict.is_some() {
+                j.3.prove_runs += 1;
+                j.3.prove_seconds += secs;
+                first = false;
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// `prove`'s verdict into the injection; a run nothing caught gets the
+/// equivalence check's answer (or the contract proof as its excuse).
+pub(super) fn settle(
+    inj: &mut Injection,
+    verdict: Option<&ProveVerdict>,
+    equivalence: impl FnOnce() -> Equivalence,
+) {
+    if let Some(v) = verdict {
+        if matches!(v, ProveVerdict::Failed { .. }) {
+            inj.detected_by.push(Detector::Prove);
+        }
+        inj.prove = Some(v.clone());
+    }
+    if inj.detected_by.is_empty() {
+        let e = equivalence();
+        inj.equivalence = Some(match (e, verdict) {
+            (e @ Equivalence::Proved { .. }, _) => e,
+            (_, Some(ProveVerdict::Proved)) => Equivalence::ContractProved,
+            (e, _) => e,
+        });
+    }
+}
+
+/// The equivalence check of `gate` against the clean Verilog `gold`.
+pub(super) fn equivalence(gold: &str, gate: &str) -> Equivalence {
+    let undecided = |why: String| Equivalence::Undecided { why };
+    match tempfile::tempdir() {
+        Ok(dir) => {
+            crate::equiv::check(gold, gate, dir.path()).unwrap_or_else(|e| undecided(e.to_string()))
+        }
+        Err(e) => undecided(e.to_string()),
+    }
+}
+
+/// A clean run of `engine` judged by every detector (a rejection is a
+/// false alarm; it also builds the engine), then one timed under the
+/// checker: (cycles, seconds, the false alarm).
+pub(super) fn clean_engine_run(
+    s: &Schedule,
+    engine: Backend,
+    frames: u64,
+    sigrok: bool,
+) -> Result<(u64, f64, Option<String>), String> {
+    let clean = crate::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+    let j = judge_verilog(s, engine, &clean, frames, sigrok)?;
+    let why = if !j.report.ok {
+        Some(j.report.summary())
+    } else {
+        j.sigrok.clone().and_then(|v| v.err())
+    };
+    let t = Instant::now();
+    let timed = judge_verilog(s, engine, &clean, frames, false)?;
+    Ok((timed.report.cycles, t.elapsed().as_secs_f64(), why))
+}
