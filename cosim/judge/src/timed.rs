@@ -471,6 +471,9 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
     let mut conv_start = None;
     let mut relocked_at = 0u64;
     let mut edges_at_relock = 0u64;
+    // The stretch since the last lock, and the longest that broke.
+    let mut seg = Segment::default();
+    let mut best_seg = Segment::default();
     let mut prev = cap.steps.first().map(|s| s.1).unwrap_or(0);
     let cs_idle = {
         let b = lanes[cs_lane].bit;
@@ -519,6 +522,11 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
                     }
                     relocked_at = t_ps;
                     edges_at_relock = edges_checked;
+                    seg = Segment {
+                        from_ps: t_ps,
+                        to_ps: t_ps,
+                        starts: 0,
+                    };
                     cands = Some(c);
                 }
                 Some(c) => {
@@ -551,7 +559,15 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
                             false
                         }
                     });
+                    let start_edge =
+                        lane.role == Role::CsN && level != (cnv_mask(s) >> lane.bit & 1 == 0);
+                    if !c.is_empty() && start_edge {
+                        seg.starts += 1;
+                    }
                     if c.is_empty() {
+                        if seg.starts > best_seg.starts {
+                            best_seg = Segment { to_ps: t_ps, ..seg };
+                        }
                         // Every phase that fitted so far broke here: find
                         // the phase again from the next conversion start,
                         // and judge at the end whether the pins prove a
@@ -575,21 +591,45 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
         let held = cands.as_ref().is_some_and(|c| !c.is_empty())
             && end - relocked_at as i128 * clock >= tpl.frame as i128 * ctx.tc
             && edges_checked > edges_at_relock;
-        if !held {
+        if !held && best_seg.starts >= SEGMENT_STARTS {
+            // The pins ran this mix's schedule for a while, then left it.
+            let lane = &lanes[l.lane];
+            let mut first = Found::default();
+            first.push(TimedViolation {
+                time_ps: l.time_ps,
+                channel: lane.channel.clone(),
+                port_bit: lane.port_bit(),
+                rule: "frame phase".into(),
+                detail: format!(
+                    "the capture fits this mix's schedule from {:.3} to {:.3} us ({} conversion starts at their times after the first), and no frame phase fits it past there for a frame: the design left the schedule (a frame of the wrong length, a jump of phase)",
+                    best_seg.from_ps as f64 / 1e6,
+                    best_seg.to_ps as f64 / 1e6,
+                    best_seg.starts
+                ),
+            });
+            for v in found.list {
+                first.push(v);
+            }
+            first.total = found.total + 1;
+            found = first;
+            cands = Some(Vec::new());
+        } else if !held {
             return Err(TimedError(format!(
                 "no frame phase of this mix's schedule fits the capture's edges at {:.3} us ({} fitted before), and none found after it holds for a frame: is it the right mix and map?",
                 l.time_ps as f64 / 1e6,
                 l.fitted
             )));
         }
-        let now = &cands.as_ref().expect("held")[0];
-        let mut first = Found::default();
-        first.push(prelock_fault(&ctx, &lanes, &l, now, relocked_at));
-        for v in found.list {
-            first.push(v);
+        if held {
+            let now = &cands.as_ref().expect("held")[0];
+            let mut first = Found::default();
+            first.push(prelock_fault(&ctx, &lanes, &l, now, relocked_at));
+            for v in found.list {
+                first.push(v);
+            }
+            first.total = found.total + 1;
+            found = first;
         }
-        first.total = found.total + 1;
-        found = first;
     }
     let Some(cands) = cands else {
         return Err(TimedError(format!(
@@ -642,6 +682,20 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
         proved,
         not_proved,
     })
+}
+
+/// Conversion starts a stretch of the capture must fit at their times (after
+/// the lock's own) to show the pins ran this mix's schedule: then a break
+/// after it that no phase survives is the design's, not the input's.
+const SEGMENT_STARTS: u64 = 2;
+
+/// A stretch of the capture between a lock and the edge that broke it.
+#[derive(Debug, Clone, Copy, Default)]
+struct Segment {
+    from_ps: u64,
+    to_ps: u64,
+    /// Conversion starts fitted after the lock's.
+    starts: u64,
 }
 
 /// Every frame phase that fitted the capture broke at one edge.
