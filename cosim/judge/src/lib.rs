@@ -42,6 +42,7 @@ pub mod run;
 pub mod samples;
 pub mod switch;
 pub mod timed;
+pub mod timedlink;
 pub mod vcd;
 mod vcdlex;
 pub mod vcdout;

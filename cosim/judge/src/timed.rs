@@ -27,29 +27,37 @@ use lut_gen::Schedule;
 
 use crate::model::CycleModel;
 
-/// One analyser channel mapped to one port bit (`adc_cs_n[0]`).
+/// One analyser channel mapped to one port bit (`adc_cs_n[0]`), or to the
+/// link's line (`link_tx`, `role` None: decoded, not timed edge by edge).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Lane {
     pub channel: String,
-    pub role: Role,
+    pub role: Option<Role>,
     pub bit: u32,
 }
 
 impl Lane {
     pub fn port_bit(&self) -> String {
-        format!("{}[{}]", self.role.name(), self.bit)
+        match self.role {
+            Some(r) => format!("{}[{}]", r.name(), self.bit),
+            None => lut_gen::ports::LINK_PORTS[0].name.to_string(),
+        }
     }
 
-    fn get(&self, l: &Layout, p: &Pins) -> bool {
+    fn is(&self, r: Role) -> bool {
+        self.role == Some(r)
+    }
+
+    fn get(&self, p: &Pins) -> bool {
         let v = match self.role {
-            Role::CsN => p.cs_n as u128,
-            Role::Sclk => p.sclk as u128,
-            Role::MuxSel => p.mux_sel as u128,
-            Role::MuxEn => p.mux_en,
-            Role::SampleValid => p.sample_valid as u128,
+            Some(Role::CsN) => p.cs_n as u128,
+            Some(Role::Sclk) => p.sclk as u128,
+            Some(Role::MuxSel) => p.mux_sel as u128,
+            Some(Role::MuxEn) => p.mux_en,
+            Some(Role::SampleValid) => p.sample_valid as u128,
+            None => p.link_tx as u128,
             _ => 0,
         };
-        let _ = l;
         v >> self.bit & 1 == 1
     }
 
@@ -57,16 +65,17 @@ impl Lane {
     fn predictable(&self) -> bool {
         matches!(
             self.role,
-            Role::CsN | Role::Sclk | Role::MuxSel | Role::MuxEn | Role::SampleValid
+            Some(Role::CsN | Role::Sclk | Role::MuxSel | Role::MuxEn | Role::SampleValid)
         )
     }
 
     fn what(&self) -> &'static str {
         match self.role {
-            Role::CsN => "conversion instant (rate, interval, slot order)",
-            Role::Sclk => "serial clock (SCLK count and period per conversion)",
-            Role::MuxSel | Role::MuxEn => "mux switching (slot order, settling before CS)",
-            Role::SampleValid => "sample stream timing",
+            Some(Role::CsN) => "conversion instant (rate, interval, slot order)",
+            Some(Role::Sclk) => "serial clock (SCLK count and period per conversion)",
+            Some(Role::MuxSel | Role::MuxEn) => "mux switching (slot order, settling before CS)",
+            Some(Role::SampleValid) => "sample stream timing",
+            None => "link samples (order on the line)",
             _ => "",
         }
     }
@@ -209,7 +218,7 @@ fn template(s: &Schedule, lanes: &[Lane]) -> Tpl {
     let l = Layout::new(s);
     let f = s.grid.frame_cycles;
     let mut m = CycleModel::at(s, f - 1);
-    let mut prev: Vec<bool> = lanes.iter().map(|x| x.get(&l, m.pins())).collect();
+    let mut prev: Vec<bool> = lanes.iter().map(|x| x.get(m.pins())).collect();
     let mut edges = vec![Vec::new(); lanes.len()];
     let nb = l.branches;
     let mut last_mux = vec![0u64; nb];
@@ -220,7 +229,7 @@ fn template(s: &Schedule, lanes: &[Lane]) -> Tpl {
     while m.cycle() < 2 * f {
         let p = *m.pins();
         for (i, lane) in lanes.iter().enumerate() {
-            let v = lane.get(&l, &p);
+            let v = lane.get(&p);
             if v != prev[i] {
                 edges[i].push((m.cycle() - f, v));
                 prev[i] = v;
@@ -425,6 +434,10 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
     let checked: Vec<usize> = (0..all.len())
         .filter(|&i| {
             let lane = &all[i];
+            if lane.role.is_none() {
+                // The link's line: decoded below, not timed edge by edge.
+                return false;
+            }
             if !lane.predictable() {
                 not_proved.push(format!(
                     "{} ({}): its values come from the ADC, not the schedule; not checked at time level",
@@ -449,7 +462,7 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
         .collect();
     let lanes: Vec<Lane> = checked.iter().map(|&i| all[i].clone()).collect();
     let tpl = template(s, &lanes);
-    let Some(cs_lane) = lanes.iter().position(|l| l.role == Role::CsN) else {
+    let Some(cs_lane) = lanes.iter().position(|l| l.is(Role::CsN)) else {
         return Err(TimedError(
             "no mapped CS (or CNV) lane the capture's resolution can check: the frame phase cannot be found; map adc_cs_n[N] to an analyser channel".into(),
         ));
@@ -560,7 +573,7 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
                         }
                     });
                     let start_edge =
-                        lane.role == Role::CsN && level != (cnv_mask(s) >> lane.bit & 1 == 0);
+                        lane.is(Role::CsN) && level != (cnv_mask(s) >> lane.bit & 1 == 0);
                     if !c.is_empty() && start_edge {
                         seg.starts += 1;
                     }
@@ -665,8 +678,21 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
     let span_ps = (end / clock) as u64 - conv_start.unwrap_or(0);
     let conversions =
         (span_ps as f64 / (tpl.frame as f64 * tc_ps) * tpl.conversions_per_frame as f64) as u64;
-    let (proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
+    let (mut proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
     not_proved.extend(np);
+    match cap.lanes.iter().position(|l| l.role.is_none()) {
+        Some(li) => {
+            let lk = crate::timedlink::check_link(s, cap, li);
+            for v in lk.violations {
+                found.push(v);
+            }
+            proved.extend(lk.proved);
+            not_proved.extend(lk.not_proved);
+        }
+        None if Layout::new(s).link => not_proved
+            .push("the link's samples (map link_tx to an analyser channel to decode them)".into()),
+        None => {}
+    }
     Ok(TimedReport {
         ok: found.total == 0,
         edges_checked,
@@ -687,7 +713,7 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
 /// Conversion starts a stretch of the capture must fit at their times (after
 /// the lock's own) to show the pins ran this mix's schedule: then a break
 /// after it that no phase survives is the design's, not the input's.
-const SEGMENT_STARTS: u64 = 2;
+const SEGMENT_STARTS: u64 = 1;
 
 /// A stretch of the capture between a lock and the edge that broke it.
 #[derive(Debug, Clone, Copy, Default)]
@@ -782,7 +808,7 @@ fn what_was_proved(
     // Every bit of branch `b`'s lane of `r` is checked.
     let has = |r: Role, b: usize| {
         let (msb, lsb) = layout.lane_bits(r, b);
-        (lsb..=msb).all(|bit| lanes.iter().any(|l| l.role == r && l.bit == bit))
+        (lsb..=msb).all(|bit| lanes.iter().any(|l| l.is(r) && l.bit == bit))
     };
     for (b, br) in s.mix.branches.iter().enumerate() {
         if !has(Role::CsN, b) {
@@ -832,9 +858,8 @@ fn what_was_proved(
             _ => {}
         }
     }
-    if !lanes.iter().any(|l| l.role == Role::SampleValid) {
+    if !lanes.iter().any(|l| l.is(Role::SampleValid)) {
         no.push("sample stream timing (no sample_valid lane checked)".into());
     }
-    no.push("sample values and channels (the link's words are not decoded at time level)".into());
     (yes, no)
 }

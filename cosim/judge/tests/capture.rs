@@ -181,3 +181,47 @@ fn every_fault_class_is_reported_and_a_fault_before_lock_fails_the_design() {
         "{text}"
     );
 }
+
+/// The link's line in a capture (eskin34-uart, `link_tx` on the last
+/// channel): decoded, every packet's channels in the schedule's order; three
+/// bits of one character inverted fail it (a bad CRC), named as the link's.
+#[test]
+fn the_link_line_in_a_capture_is_decoded_and_checked() {
+    if !tools::require_tool("sigrok-cli") {
+        return;
+    }
+    let s = load("../../mixes/eskin34-uart.toml");
+    let f = s.grid.frame_cycles;
+    let clean = run(&s, &mut ModelDut::new(&s), 2);
+    let (lanes_v, map) = lanes(&s);
+    assert!(map.contains("=link_tx[0]"), "{map}");
+    let d = tempfile::tempdir().unwrap();
+    let window = (f / 3 + 1_234, f + f / 2);
+    let v = d.path().join("uart.vcd");
+    resample(&s, &clean, window.0, window.1, 41_667, 9_876, &v);
+    let (sr, back) = to_sigrok(&v, 41_667);
+    for file in [&sr, &back] {
+        let r = check(&s, &map, file);
+        let text = r.summary();
+        assert!(r.ok, "{text}");
+        assert!(
+            text.contains("(link_tx): ") && text.contains("packets and"),
+            "{text}"
+        );
+    }
+    let mut bad = clean.clone();
+    mutate(&s, &mut bad, Mutation::LinkBitsFlipped, f);
+    let v = d.path().join("uart-bad.vcd");
+    resample(&s, &bad, window.0, window.1, 41_667, 9_876, &v);
+    let (sr, _) = to_sigrok(&v, 41_667);
+    let r = check(&s, &map, &sr);
+    let text = r.summary();
+    assert!(!r.ok, "{text}");
+    let link = format!("D{}", lanes_v.len() - 1);
+    assert!(
+        r.violations
+            .iter()
+            .any(|v| v.channel == link && v.rule.contains("link samples")),
+        "{text}"
+    );
+}

@@ -33,7 +33,7 @@ pub fn run<D: Dut>(s: &Schedule, dut: &mut D, frames: u64) -> Vec<Pins> {
 
 /// The analyser's channels: every CS, SCLK, mux select and enable bit and
 /// sample_valid, as D0..Dn, with the `--map` that names them.
-pub fn lanes(s: &Schedule) -> (Vec<(Role, u32)>, String) {
+pub fn lanes(s: &Schedule) -> (Vec<(Option<Role>, u32)>, String) {
     let l = Layout::new(s);
     let mut v = Vec::new();
     for r in [
@@ -44,25 +44,30 @@ pub fn lanes(s: &Schedule) -> (Vec<(Role, u32)>, String) {
         Role::SampleValid,
     ] {
         for b in 0..l.width(r) {
-            v.push((r, b));
+            v.push((Some(r), b));
         }
+    }
+    // The link's line, for a mix with a link.
+    if l.link {
+        v.push((None, 0));
     }
     let map = v
         .iter()
         .enumerate()
-        .map(|(i, (r, b))| format!("D{i}={}[{b}]", r.name()))
+        .map(|(i, (r, b))| format!("D{i}={}[{b}]", r.map_or("link_tx", |r| r.name())))
         .collect::<Vec<_>>()
         .join(",");
     (v, map)
 }
 
-pub fn bit(p: &Pins, r: Role, b: u32) -> bool {
+pub fn bit(p: &Pins, r: Option<Role>, b: u32) -> bool {
     let v: u128 = match r {
-        Role::CsN => p.cs_n as u128,
-        Role::Sclk => p.sclk as u128,
-        Role::MuxSel => p.mux_sel as u128,
-        Role::MuxEn => p.mux_en,
-        _ => p.sample_valid as u128,
+        Some(Role::CsN) => p.cs_n as u128,
+        Some(Role::Sclk) => p.sclk as u128,
+        Some(Role::MuxSel) => p.mux_sel as u128,
+        Some(Role::MuxEn) => p.mux_en,
+        Some(_) => p.sample_valid as u128,
+        None => p.link_tx as u128,
     };
     v >> b & 1 == 1
 }
@@ -175,6 +180,8 @@ pub enum Mutation {
     MuxEarly,
     /// One SCLK low pulse missing.
     SclkEdgeMissing,
+    /// Three bits of one character on the link's line inverted.
+    LinkBitsFlipped,
 }
 
 pub fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {
@@ -183,6 +190,17 @@ pub fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {
         .find(|&c| pins[c].cs_n & 1 == 0 && pins[c - 1].cs_n & 1 == 1)
         .unwrap();
     let slot = s.grid.slot_cycles as usize;
+    if let Mutation::LinkBitsFlipped = m {
+        let div = lut_gen::hostlink::plan(s).unwrap().unwrap().baud_divider as usize;
+        // A start bit at or after `at`, then its bits 2-4 inverted.
+        let st = (at..pins.len())
+            .find(|&c| !pins[c].link_tx && pins[c - 1].link_tx)
+            .unwrap();
+        for p in &mut pins[st + 2 * div..st + 5 * div] {
+            p.link_tx = !p.link_tx;
+        }
+        return;
+    }
     match m {
         Mutation::OneSlotLate => {
             let orig: Vec<Pins> = pins[fall..fall + 2 * slot].to_vec();
@@ -217,5 +235,6 @@ pub fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {
                 c += 1;
             }
         }
+        Mutation::LinkBitsFlipped => unreachable!("handled above"),
     }
 }
