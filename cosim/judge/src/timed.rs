@@ -612,9 +612,10 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
                 time_ps: l.time_ps,
                 channel: lane.channel.clone(),
                 port_bit: lane.port_bit(),
-                rule: "frame phase".into(),
+                rule: lane.what().into(),
                 detail: format!(
-                    "the capture fits this mix's schedule from {:.3} to {:.3} us ({} conversion starts at their times after the first), and no frame phase fits it past there for a frame: the design left the schedule (a frame of the wrong length, a jump of phase)",
+                    "{} (this edge broke every frame phase still in the running; the capture fits this mix's schedule from {:.3} to {:.3} us, {} conversion starts at their times after the first, and no phase fits it past there for a frame: the design left the schedule)",
+                    l.errs.first().map(|e| e.2.as_str()).unwrap_or("no phase fits"),
                     best_seg.from_ps as f64 / 1e6,
                     best_seg.to_ps as f64 / 1e6,
                     best_seg.starts
