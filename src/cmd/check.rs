@@ -84,6 +84,7 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
             "phases": r.phases,
             "edges_checked": r.edges_checked,
             "conversions": r.conversions,
+            "violations_total": r.violations_total,
             "violations": r.violations.iter().map(|v| serde_json::json!({
                 "time_ps": v.time_ps, "channel": v.channel, "signal": v.port_bit,
                 "rule": v.rule, "detail": v.detail})).collect::<Vec<_>>(),

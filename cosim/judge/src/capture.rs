@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use lut_gen::ports::{Layout, Role, PORT_NAMES};
+use lut_gen::ports::{Layout, Role, LINK_PORTS, PORT_NAMES};
 use lut_gen::Schedule;
 
 use crate::timed::{Capture, Lane};
@@ -44,19 +44,34 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
             }
             None => (port, 0),
         };
-        let Some(pi) = PORT_NAMES.iter().position(|p| *p == name) else {
-            return Err(at(format!(
-                "`{name}` is not a port of slotforge_top ({})",
-                PORT_NAMES.join(", ")
-            )));
+        let link_tx = LINK_PORTS[0].name;
+        let role = if name == link_tx {
+            if !layout.link {
+                return Err(at(format!("`{link_tx}`: this mix has no [link]")));
+            }
+            if bit != 0 {
+                return Err(at(format!("`{link_tx}` has 1 bit, no bit {bit}")));
+            }
+            None
+        } else {
+            let Some(pi) = PORT_NAMES.iter().position(|p| *p == name) else {
+                return Err(at(format!(
+                    "`{name}` is not a port of slotforge_top ({}{})",
+                    PORT_NAMES.join(", "),
+                    if layout.link { ", link_tx" } else { "" }
+                )));
+            };
+            if bit >= widths[pi] {
+                return Err(at(format!(
+                    "`{name}` has {} bit(s) in this mix, no bit {bit}",
+                    widths[pi]
+                )));
+            }
+            Some(lut_gen::ports::PORTS[pi].role)
         };
-        if bit >= widths[pi] {
-            return Err(at(format!(
-                "`{name}` has {} bit(s) in this mix, no bit {bit}",
-                widths[pi]
-            )));
+        if role.is_none() && lanes.iter().any(|l| l.role.is_none()) {
+            return Err(at(format!("`{link_tx}` is mapped twice")));
         }
-        let role = lut_gen::ports::PORTS[pi].role;
         if lanes.iter().any(|l| l.channel == ch) {
             return Err(at(format!("channel `{ch}` is mapped twice")));
         }
@@ -271,7 +286,7 @@ pub fn unmapped(lanes: &[Lane]) -> Vec<&'static str> {
         Role::SampleValid,
     ]
     .into_iter()
-    .filter(|r| !lanes.iter().any(|l| l.role == *r))
+    .filter(|r| !lanes.iter().any(|l| l.role == Some(*r)))
     .map(|r| r.name())
     .collect()
 }

@@ -42,7 +42,9 @@ pub mod run;
 pub mod samples;
 pub mod switch;
 pub mod timed;
+pub mod timedlink;
 pub mod vcd;
+mod vcdlex;
 pub mod vcdout;
 
 pub use adc::{Adc, Stimulus};

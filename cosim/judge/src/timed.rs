@@ -27,29 +27,37 @@ use lut_gen::Schedule;
 
 use crate::model::CycleModel;
 
-/// One analyser channel mapped to one port bit (`adc_cs_n[0]`).
+/// One analyser channel mapped to one port bit (`adc_cs_n[0]`), or to the
+/// link's line (`link_tx`, `role` None: decoded, not timed edge by edge).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Lane {
     pub channel: String,
-    pub role: Role,
+    pub role: Option<Role>,
     pub bit: u32,
 }
 
 impl Lane {
     pub fn port_bit(&self) -> String {
-        format!("{}[{}]", self.role.name(), self.bit)
+        match self.role {
+            Some(r) => format!("{}[{}]", r.name(), self.bit),
+            None => lut_gen::ports::LINK_PORTS[0].name.to_string(),
+        }
     }
 
-    fn get(&self, l: &Layout, p: &Pins) -> bool {
+    fn is(&self, r: Role) -> bool {
+        self.role == Some(r)
+    }
+
+    fn get(&self, p: &Pins) -> bool {
         let v = match self.role {
-            Role::CsN => p.cs_n as u128,
-            Role::Sclk => p.sclk as u128,
-            Role::MuxSel => p.mux_sel as u128,
-            Role::MuxEn => p.mux_en,
-            Role::SampleValid => p.sample_valid as u128,
+            Some(Role::CsN) => p.cs_n as u128,
+            Some(Role::Sclk) => p.sclk as u128,
+            Some(Role::MuxSel) => p.mux_sel as u128,
+            Some(Role::MuxEn) => p.mux_en,
+            Some(Role::SampleValid) => p.sample_valid as u128,
+            None => p.link_tx as u128,
             _ => 0,
         };
-        let _ = l;
         v >> self.bit & 1 == 1
     }
 
@@ -57,16 +65,17 @@ impl Lane {
     fn predictable(&self) -> bool {
         matches!(
             self.role,
-            Role::CsN | Role::Sclk | Role::MuxSel | Role::MuxEn | Role::SampleValid
+            Some(Role::CsN | Role::Sclk | Role::MuxSel | Role::MuxEn | Role::SampleValid)
         )
     }
 
     fn what(&self) -> &'static str {
         match self.role {
-            Role::CsN => "conversion instant (rate, interval, slot order)",
-            Role::Sclk => "serial clock (SCLK count and period per conversion)",
-            Role::MuxSel | Role::MuxEn => "mux switching (slot order, settling before CS)",
-            Role::SampleValid => "sample stream timing",
+            Some(Role::CsN) => "conversion instant (rate, interval, slot order)",
+            Some(Role::Sclk) => "serial clock (SCLK count and period per conversion)",
+            Some(Role::MuxSel | Role::MuxEn) => "mux switching (slot order, settling before CS)",
+            Some(Role::SampleValid) => "sample stream timing",
+            None => "link samples (order on the line)",
             _ => "",
         }
     }
@@ -101,7 +110,11 @@ pub struct TimedReport {
     pub locked_at_ps: u64,
     pub slot: u64,
     pub phases: usize,
+    /// The violations found: the first [`VIOLATION_CAP`], and the first of
+    /// every class (rule and channel) beyond them.
     pub violations: Vec<TimedViolation>,
+    /// How many violations there were in all.
+    pub violations_total: u64,
     /// What the resolution and the mapped pins allowed to be proved, and not.
     pub proved: Vec<String>,
     pub not_proved: Vec<String>,
@@ -122,7 +135,7 @@ impl TimedReport {
             },
             self.edges_checked,
             self.conversions,
-            self.violations.len(),
+            self.violations_total,
             if self.ok { "PASS" } else { "FAIL" }
         );
         for v in &self.violations {
@@ -136,6 +149,14 @@ impl TimedReport {
                 v.detail
             );
         }
+        let listed = self.violations.len() as u64;
+        if self.violations_total > listed {
+            let _ = writeln!(
+                s,
+                "  ... and {} more of the classes above (the first {VIOLATION_CAP} and the first of every class are listed)",
+                self.violations_total - listed
+            );
+        }
         // A failed capture proves nothing; it says what it could have.
         let label = if self.ok { "proved" } else { "would prove" };
         for p in &self.proved {
@@ -145,6 +166,30 @@ impl TimedReport {
             let _ = writeln!(s, "  not proved: {p}");
         }
         s
+    }
+}
+
+/// Violations listed in full; later ones are counted, and listed only when
+/// their class (rule and channel) is new.
+pub const VIOLATION_CAP: usize = 32;
+
+/// Violations as they are found.
+#[derive(Default)]
+struct Found {
+    list: Vec<TimedViolation>,
+    total: u64,
+}
+
+impl Found {
+    fn push(&mut self, v: TimedViolation) {
+        self.total += 1;
+        let new_class = !self
+            .list
+            .iter()
+            .any(|w| w.rule == v.rule && w.channel == v.channel);
+        if self.list.len() < VIOLATION_CAP || new_class {
+            self.list.push(v);
+        }
     }
 }
 
@@ -173,7 +218,7 @@ fn template(s: &Schedule, lanes: &[Lane]) -> Tpl {
     let l = Layout::new(s);
     let f = s.grid.frame_cycles;
     let mut m = CycleModel::at(s, f - 1);
-    let mut prev: Vec<bool> = lanes.iter().map(|x| x.get(&l, m.pins())).collect();
+    let mut prev: Vec<bool> = lanes.iter().map(|x| x.get(m.pins())).collect();
     let mut edges = vec![Vec::new(); lanes.len()];
     let nb = l.branches;
     let mut last_mux = vec![0u64; nb];
@@ -184,7 +229,7 @@ fn template(s: &Schedule, lanes: &[Lane]) -> Tpl {
     while m.cycle() < 2 * f {
         let p = *m.pins();
         for (i, lane) in lanes.iter().enumerate() {
-            let v = lane.get(&l, &p);
+            let v = lane.get(&p);
             if v != prev[i] {
                 edges[i].push((m.cycle() - f, v));
                 prev[i] = v;
@@ -239,6 +284,9 @@ struct Cand {
     hi: i128,
     /// Per lane: the next template edge (frame wrap, index), once started.
     ptr: Vec<Option<(u64, usize)>>,
+    /// Per lane: after a violation, its edges are matched afresh near their
+    /// own time (not reported again until one fits).
+    resync: Vec<bool>,
     c0: u64,
 }
 
@@ -279,15 +327,26 @@ impl Ctx<'_> {
         true
     }
 
-    /// The first observed edge of a lane after the lock: the first template
-    /// edge of its level near enough.
-    fn start(&self, c: &mut Cand, lane: usize, t: i128, v: bool) -> bool {
+    /// The first observed edge of a lane after the lock (or after a
+    /// violation, `resync`): the first template edge of its level near
+    /// enough.  After the lock no template edge may be passed over that
+    /// came more than the resolution after the lock's edge: it would have
+    /// been seen.
+    fn start(&self, c: &mut Cand, lane: usize, t: i128, v: bool) -> Result<(), String> {
+        let level = |x: bool| if x { "rising" } else { "falling" };
+        let none = || format!("{} edge at no time the schedule has one", level(v));
         let e = &self.tpl.edges[lane];
         if e.is_empty() {
-            return false;
+            return Err(none());
         }
         let back = ((self.t + 2 * self.skew) / self.tc) as u64 + 2;
-        let from = c.c0.saturating_sub(back);
+        let from = if c.resync[lane] {
+            // The earliest model cycle an edge at `t` can be.
+            let earliest = (t - c.hi - self.t - self.skew).max(0) / self.tc;
+            (earliest as u64).saturating_sub(back)
+        } else {
+            c.c0.saturating_sub(back)
+        };
         let (mut w, mut j) = (from / self.tpl.frame, 0usize);
         let in_frame = from % self.tpl.frame;
         while j < e.len() && e[j].0 < in_frame {
@@ -304,27 +363,30 @@ impl Ctx<'_> {
                 if self.fit(&mut d, cyc, t) {
                     *c = d;
                     c.ptr[lane] = Some(self.next(lane, (w, j)));
-                    return true;
+                    return Ok(());
                 }
             }
             if cyc as i128 * self.tc + c.lo > t + self.skew {
-                return false;
+                return Err(none());
+            }
+            // Seen after the lock's edge for sure: more than the resolution later.
+            let after_lock = cyc > c.c0 && (cyc - c.c0) as i128 * self.tc > self.t + 2 * self.skew;
+            if !c.resync[lane] && after_lock {
+                return Err(format!(
+                    "{} edge where the schedule's {} edge at frame cycle {} came first: an edge is missing",
+                    level(v),
+                    level(e[j].1),
+                    cyc % self.tpl.frame
+                ));
             }
             (w, j) = self.next(lane, (w, j));
         }
-        false
+        Err(none())
     }
 
     fn step(&self, c: &mut Cand, lane: usize, t: i128, v: bool) -> Result<(), String> {
         let Some(p) = c.ptr[lane] else {
-            return if self.start(c, lane, t, v) {
-                Ok(())
-            } else {
-                Err(format!(
-                    "{} edge at no time the schedule has one",
-                    if v { "rising" } else { "falling" }
-                ))
-            };
+            return self.start(c, lane, t, v);
         };
         let cyc = self.abs(lane, p);
         let want = self.tpl.edges[lane][p.1].1;
@@ -372,6 +434,10 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
     let checked: Vec<usize> = (0..all.len())
         .filter(|&i| {
             let lane = &all[i];
+            if lane.role.is_none() {
+                // The link's line: decoded below, not timed edge by edge.
+                return false;
+            }
             if !lane.predictable() {
                 not_proved.push(format!(
                     "{} ({}): its values come from the ADC, not the schedule; not checked at time level",
@@ -396,7 +462,7 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
         .collect();
     let lanes: Vec<Lane> = checked.iter().map(|&i| all[i].clone()).collect();
     let tpl = template(s, &lanes);
-    let Some(cs_lane) = lanes.iter().position(|l| l.role == Role::CsN) else {
+    let Some(cs_lane) = lanes.iter().position(|l| l.is(Role::CsN)) else {
         return Err(TimedError(
             "no mapped CS (or CNV) lane the capture's resolution can check: the frame phase cannot be found; map adc_cs_n[N] to an analyser channel".into(),
         ));
@@ -412,15 +478,21 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
     let mut cands: Option<Vec<Cand>> = None;
     let mut first_cands = 0;
     let mut locked_at = 0u64;
-    let mut violations = Vec::new();
+    let mut found = Found::default();
+    let mut lost: Option<Lost> = None;
     let mut edges_checked = 0u64;
     let mut conv_start = None;
+    let mut relocked_at = 0u64;
+    let mut edges_at_relock = 0u64;
+    // The stretch since the last lock, and the longest that broke.
+    let mut seg = Segment::default();
+    let mut best_seg = Segment::default();
     let mut prev = cap.steps.first().map(|s| s.1).unwrap_or(0);
     let cs_idle = {
         let b = lanes[cs_lane].bit;
         cnv_mask(s) >> b & 1 == 0
     };
-    'outer: for &(t_ps, v) in cap.steps.iter().skip(1) {
+    for &(t_ps, v) in cap.steps.iter().skip(1) {
         let changed = v ^ prev;
         prev = v;
         if changed == 0 {
@@ -448,6 +520,7 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
                             lo: i128::MIN / 4,
                             hi: i128::MAX / 4,
                             ptr: vec![None; lanes.len()],
+                            resync: vec![false; lanes.len()],
                             c0: abs,
                         };
                         if ctx.fit(&mut cand, abs, t) {
@@ -455,42 +528,121 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
                             c.push(cand);
                         }
                     }
-                    first_cands = c.len();
-                    locked_at = t_ps;
-                    conv_start = Some(t_ps);
+                    if lost.is_none() {
+                        first_cands = c.len();
+                        locked_at = t_ps;
+                        conv_start = Some(t_ps);
+                    }
+                    relocked_at = t_ps;
+                    edges_at_relock = edges_checked;
+                    seg = Segment {
+                        from_ps: t_ps,
+                        to_ps: t_ps,
+                        starts: 0,
+                    };
                     cands = Some(c);
                 }
                 Some(c) => {
                     edges_checked += 1;
-                    let single = c.len() == 1;
+                    let lane = &lanes[li];
+                    let violation = |detail: String| TimedViolation {
+                        time_ps: t_ps,
+                        channel: lane.channel.clone(),
+                        port_bit: lane.port_bit(),
+                        rule: lane.what().into(),
+                        detail,
+                    };
+                    if c.len() == 1 {
+                        let cand = &mut c[0];
+                        let resyncing = cand.ptr[li].is_none() && cand.resync[li];
+                        if let Err(e) = ctx.step(cand, li, t, level) {
+                            if !resyncing {
+                                found.push(violation(e));
+                            }
+                            cand.ptr[li] = None;
+                            cand.resync[li] = true;
+                        }
+                        continue;
+                    }
                     let mut errs = Vec::new();
                     c.retain_mut(|cand| match ctx.step(cand, li, t, level) {
                         Ok(()) => true,
                         Err(e) => {
-                            errs.push(e);
+                            errs.push((cand.lo, cand.hi, e));
                             false
                         }
                     });
+                    let start_edge =
+                        lane.is(Role::CsN) && level != (cnv_mask(s) >> lane.bit & 1 == 0);
+                    if !c.is_empty() && start_edge {
+                        seg.starts += 1;
+                    }
                     if c.is_empty() {
-                        if single {
-                            let lane = &lanes[li];
-                            violations.push(TimedViolation {
-                                time_ps: t_ps,
-                                channel: lane.channel.clone(),
-                                port_bit: lane.port_bit(),
-                                rule: lane.what().into(),
-                                detail: errs.pop().unwrap_or_default(),
-                            });
-                            break 'outer;
+                        if seg.starts > best_seg.starts {
+                            best_seg = Segment { to_ps: t_ps, ..seg };
                         }
-                        return Err(TimedError(format!(
-                            "no frame phase of this mix's schedule fits the capture's edges at {:.3} us ({} fitted before): is it the right mix and map, or did the design go wrong before its phase could be found?",
-                            t_ps as f64 / 1e6,
-                            first_cands
-                        )));
+                        // Every phase that fitted so far broke here: find
+                        // the phase again from the next conversion start,
+                        // and judge at the end whether the pins prove a
+                        // fault here (`prelock_fault`).
+                        if lost.is_none() {
+                            lost = Some(Lost {
+                                time_ps: t_ps,
+                                lane: li,
+                                fitted: first_cands,
+                                errs,
+                            });
+                        }
+                        cands = None;
                     }
                 }
             }
+        }
+    }
+    let end = cap.steps.last().map(|s| s.0).unwrap_or(0) as i128 * clock;
+    if let Some(l) = lost {
+        let held = cands.as_ref().is_some_and(|c| !c.is_empty())
+            && end - relocked_at as i128 * clock >= tpl.frame as i128 * ctx.tc
+            && edges_checked > edges_at_relock;
+        if !held && best_seg.starts >= SEGMENT_STARTS {
+            // The pins ran this mix's schedule for a while, then left it.
+            let lane = &lanes[l.lane];
+            let mut first = Found::default();
+            first.push(TimedViolation {
+                time_ps: l.time_ps,
+                channel: lane.channel.clone(),
+                port_bit: lane.port_bit(),
+                rule: lane.what().into(),
+                detail: format!(
+                    "{} (this edge broke every frame phase still in the running; the capture fits this mix's schedule from {:.3} to {:.3} us, {} conversion starts at their times after the first, and no phase fits it past there for a frame: the design left the schedule)",
+                    l.errs.first().map(|e| e.2.as_str()).unwrap_or("no phase fits"),
+                    best_seg.from_ps as f64 / 1e6,
+                    best_seg.to_ps as f64 / 1e6,
+                    best_seg.starts
+                ),
+            });
+            for v in found.list {
+                first.push(v);
+            }
+            first.total = found.total + 1;
+            found = first;
+            cands = Some(Vec::new());
+        } else if !held {
+            return Err(TimedError(format!(
+                "no frame phase of this mix's schedule fits the capture's edges at {:.3} us ({} fitted before), and none found after it holds for a frame: is it the right mix and map?",
+                l.time_ps as f64 / 1e6,
+                l.fitted
+            )));
+        }
+        if held {
+            let now = &cands.as_ref().expect("held")[0];
+            let mut first = Found::default();
+            first.push(prelock_fault(&ctx, &lanes, &l, now, relocked_at));
+            for v in found.list {
+                first.push(v);
+            }
+            first.total = found.total + 1;
+            found = first;
         }
     }
     let Some(cands) = cands else {
@@ -500,21 +652,20 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
             lanes[cs_lane].port_bit()
         )));
     };
-    if edges_checked == 0 && violations.is_empty() {
+    if edges_checked == 0 && found.total == 0 {
         return Err(TimedError(format!(
             "the capture ends before any edge after its first conversion start (at {:.3} us): nothing to check",
             locked_at as f64 / 1e6
         )));
     }
     // A lane must not miss an edge the schedule puts inside the capture.
-    let end = cap.steps.last().map(|s| s.0).unwrap_or(0) as i128 * clock;
-    if violations.is_empty() && cands.len() == 1 {
+    if cands.len() == 1 {
         let c = &cands[0];
         for (li, lane) in lanes.iter().enumerate() {
             if let Some(p) = c.ptr[li] {
                 let latest = c.hi + ctx.abs(li, p) as i128 * ctx.tc + ctx.t + ctx.skew;
                 if latest < end {
-                    violations.push(TimedViolation {
+                    found.push(TimedViolation {
                         time_ps: (latest / clock) as u64,
                         channel: lane.channel.clone(),
                         port_bit: lane.port_bit(),
@@ -528,10 +679,23 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
     let span_ps = (end / clock) as u64 - conv_start.unwrap_or(0);
     let conversions =
         (span_ps as f64 / (tpl.frame as f64 * tc_ps) * tpl.conversions_per_frame as f64) as u64;
-    let (proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
+    let (mut proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
     not_proved.extend(np);
+    match cap.lanes.iter().position(|l| l.role.is_none()) {
+        Some(li) => {
+            let lk = crate::timedlink::check_link(s, cap, li);
+            for v in lk.violations {
+                found.push(v);
+            }
+            proved.extend(lk.proved);
+            not_proved.extend(lk.not_proved);
+        }
+        None if Layout::new(s).link => not_proved
+            .push("the link's samples (map link_tx to an analyser channel to decode them)".into()),
+        None => {}
+    }
     Ok(TimedReport {
-        ok: violations.is_empty(),
+        ok: found.total == 0,
         edges_checked,
         conversions,
         locked_at_ps: locked_at,
@@ -540,10 +704,80 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
             .map(|c| (c.c0 % tpl.frame) / s.grid.slot_cycles)
             .unwrap_or(0),
         phases: cands.len(),
-        violations,
+        violations: found.list,
+        violations_total: found.total,
         proved,
         not_proved,
     })
+}
+
+/// Conversion starts a stretch of the capture must fit at their times (after
+/// the lock's own) to show the pins ran this mix's schedule: then a break
+/// after it that no phase survives is the design's, not the input's.
+const SEGMENT_STARTS: u64 = 1;
+
+/// A stretch of the capture between a lock and the edge that broke it.
+#[derive(Debug, Clone, Copy, Default)]
+struct Segment {
+    from_ps: u64,
+    to_ps: u64,
+    /// Conversion starts fitted after the lock's.
+    starts: u64,
+}
+
+/// Every frame phase that fitted the capture broke at one edge.
+struct Lost {
+    time_ps: u64,
+    lane: usize,
+    /// Phases that fitted the first conversion start.
+    fitted: usize,
+    /// Each broken phase's interval and why it broke.
+    errs: Vec<(i128, i128, String)>,
+}
+
+/// The fault that broke every phase before one was unique, once a phase
+/// found again afterwards held to the end of the capture.  If that phase
+/// is one that fitted before (the same modulo a frame, within the
+/// resolution), the pins prove the design broke the schedule at that edge:
+/// it is reported with that phase's reason.  If it is another, the design's
+/// frame phase jumped there.
+fn prelock_fault(
+    ctx: &Ctx,
+    lanes: &[Lane],
+    l: &Lost,
+    now: &Cand,
+    relocked_ps: u64,
+) -> TimedViolation {
+    let frame = ctx.tpl.frame as i128 * ctx.tc;
+    let same = l.errs.iter().find(|(lo, hi, _)| {
+        let tol = (hi - lo) + (now.hi - now.lo) + ctx.t + 2 * ctx.skew;
+        let d = (now.lo - lo).rem_euclid(frame);
+        d <= tol || frame - d <= tol
+    });
+    let lane = &lanes[l.lane];
+    let relock = relocked_ps as f64 / 1e6;
+    let (rule, detail) = match same {
+        Some((_, _, e)) => (
+            lane.what().to_string(),
+            format!(
+                "{e} (before the frame phase was unique: the phase that holds from {relock:.3} us to the end fitted every edge before this one)"
+            ),
+        ),
+        None => (
+            "frame phase".to_string(),
+            format!(
+                "the edges up to here fit {} frame phase(s) of the schedule, those from {relock:.3} us to the end another one: the design's frame phase jumped",
+                l.fitted
+            ),
+        ),
+    };
+    TimedViolation {
+        time_ps: l.time_ps,
+        channel: lane.channel.clone(),
+        port_bit: lane.port_bit(),
+        rule,
+        detail,
+    }
 }
 
 /// The claims a capture at this resolution with these lanes supports.
@@ -575,7 +809,7 @@ fn what_was_proved(
     // Every bit of branch `b`'s lane of `r` is checked.
     let has = |r: Role, b: usize| {
         let (msb, lsb) = layout.lane_bits(r, b);
-        (lsb..=msb).all(|bit| lanes.iter().any(|l| l.role == r && l.bit == bit))
+        (lsb..=msb).all(|bit| lanes.iter().any(|l| l.is(r) && l.bit == bit))
     };
     for (b, br) in s.mix.branches.iter().enumerate() {
         if !has(Role::CsN, b) {
@@ -625,9 +859,8 @@ fn what_was_proved(
             _ => {}
         }
     }
-    if !lanes.iter().any(|l| l.role == Role::SampleValid) {
+    if !lanes.iter().any(|l| l.is(Role::SampleValid)) {
         no.push("sample stream timing (no sample_valid lane checked)".into());
     }
-    no.push("sample values and channels (the link's words are not decoded at time level)".into());
     (yes, no)
 }

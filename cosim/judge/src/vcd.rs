@@ -35,6 +35,7 @@ use lut_gen::Schedule;
 use crate::checker::{CheckOptions, Checker};
 use crate::lock::{Judge, LockError, LockInfo};
 use crate::report::Report;
+use crate::vcdlex::{self, At, BodyStart, Ev, Lexed};
 use lut_gen::ports::{Layout, Pins};
 
 /// Why a VCD could not be checked (exit 2).
@@ -94,6 +95,9 @@ struct Lexer<R> {
     line: Vec<u8>,
     pos: usize,
     lineno: u64,
+    /// Bytes read before the current line (where the body starts, for `vcdlex`).
+    line_start: u64,
+    read: u64,
     eof: bool,
     ends_with_newline: bool,
     file: PathBuf,
@@ -106,6 +110,8 @@ impl<R: BufRead> Lexer<R> {
             line: Vec::with_capacity(256),
             pos: 0,
             lineno: 0,
+            line_start: 0,
+            read: 0,
             eof: false,
             ends_with_newline: true,
             file: file.to_path_buf(),
@@ -142,6 +148,8 @@ impl<R: BufRead> Lexer<R> {
                 self.eof = true;
                 return Ok(None);
             }
+            self.line_start = self.read;
+            self.read += n as u64;
             self.lineno += 1;
             self.ends_with_newline = self.line.last() == Some(&b'\n');
         }
@@ -164,26 +172,6 @@ impl<R: BufRead> Lexer<R> {
             file: self.file.clone(),
             line: self.lineno,
             message: m.into(),
-        }
-    }
-
-    /// A syntax error on an incomplete last line is a truncation.
-    fn truncation(&mut self, e: VcdError) -> VcdError {
-        match e {
-            VcdError::Malformed {
-                file,
-                line,
-                message,
-            } if !self.line.ends_with(b"\n")
-                && self.rd.fill_buf().map(|b| b.is_empty()).unwrap_or(false) =>
-            {
-                VcdError::Truncated {
-                    file,
-                    line,
-                    message: format!("{message} (the last line is incomplete)"),
-                }
-            }
-            e => e,
         }
     }
 
@@ -318,17 +306,17 @@ const LINK: usize = PORTS.len();
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
 /// (or `lsb - j` when the range is ascending).
 #[derive(Debug, Clone, Copy)]
-struct Sink {
+pub(crate) struct Sink {
     port: u8,
-    width: u32,
+    pub(crate) width: u32,
     lsb: i64,
     down: bool,
 }
 
 #[derive(Debug, Clone, Copy, Default)]
-struct Val {
-    v: u128,
-    x: u128,
+pub(crate) struct Val {
+    pub(crate) v: u128,
+    pub(crate) x: u128,
 }
 
 struct Resolved {
@@ -555,9 +543,12 @@ fn resolve(
 /// Identifier code -> sinks.  Codes of up to three characters (every
 /// simulator's first 830 000 signals) index a table directly: hashing the
 /// code of every value change was a tenth of `check`'s time.
-struct Ids {
+pub(crate) struct Ids {
     short: Vec<u32>,
-    sinks: Vec<Vec<Sink>>,
+    /// Per code, its range of `flat`.
+    spans: Vec<(u32, u32)>,
+    /// Every code's sinks, one after another.
+    pub(crate) flat: Vec<Sink>,
     long: HashMap<Vec<u8>, usize>,
 }
 
@@ -567,12 +558,15 @@ impl Ids {
     fn new(map: HashMap<Vec<u8>, Vec<Sink>>) -> Ids {
         let mut ids = Ids {
             short: Vec::new(),
-            sinks: Vec::new(),
+            spans: Vec::new(),
+            flat: Vec::new(),
             long: HashMap::new(),
         };
         for (code, sinks) in map {
-            let i = ids.sinks.len();
-            ids.sinks.push(sinks);
+            let i = ids.spans.len();
+            let from = ids.flat.len() as u32;
+            ids.flat.extend(sinks);
+            ids.spans.push((from, ids.flat.len() as u32));
             match Ids::slot(&code) {
                 Some(k) => {
                     if ids.short.len() <= k {
@@ -604,15 +598,18 @@ impl Ids {
         Some(k)
     }
 
+    /// The range of `flat` a code feeds (empty for a signal not needed).
     #[inline]
-    fn get(&self, code: &[u8]) -> Option<&Vec<Sink>> {
-        match Ids::slot(code) {
+    pub(crate) fn span(&self, code: &[u8]) -> Option<std::ops::Range<usize>> {
+        let i = match Ids::slot(code) {
             Some(k) => match self.short.get(k) {
-                Some(&i) if i != NO_ID => Some(&self.sinks[i as usize]),
-                _ => None,
+                Some(&i) if i != NO_ID => i as usize,
+                _ => return None,
             },
-            None => self.long.get(code).map(|&i| &self.sinks[i]),
-        }
+            None => *self.long.get(code)?,
+        };
+        let (a, b) = self.spans[i];
+        Some(a as usize..b as usize)
     }
 }
 
@@ -620,7 +617,7 @@ impl Ids {
 
 /// Parses a vector/scalar value into (value, x/z mask), left-extended to `width`.
 #[inline]
-fn parse_value(s: &[u8], width: u32) -> Option<Val> {
+pub(crate) fn parse_value(s: &[u8], width: u32) -> Option<Val> {
     let mut v = 0u128;
     let mut x = 0u128;
     let n = s.len();
@@ -773,8 +770,148 @@ fn gcd(a: u64, b: u64) -> u64 {
     }
 }
 
-fn body<R: BufRead>(
-    lx: &mut Lexer<R>,
+/// A cycle waiting for the next edge, which tells the MISO it carried.
+type Pending = Option<(Option<bool>, Pins, Pins)>;
+
+/// Applies the body's events in file order: port values, timesteps, and
+/// the clock edges (dumped or inferred) that hand cycles to the sink.
+struct Applier<'a> {
+    res: &'a Resolved,
+    clocking: Option<Clocking>,
+    sink: &'a mut dyn CycleSink,
+    st: State,
+    before: [Val; 12],
+    time: u64,
+    seen_time: bool,
+    out_changed: bool,
+    first_step: bool,
+    info: BodyInfo,
+    pending: Pending,
+}
+
+impl Applier<'_> {
+    fn edge(&mut self, rst: Option<bool>, pins: Pins, xz: Pins, miso: Val) {
+        if let Some((r, p, x)) = self.pending.take() {
+            self.sink.cycle(r, &p, &x, miso.v as u64, miso.x as u64);
+        }
+        self.info.cycles += 1;
+        self.pending = Some((rst, pins, xz));
+    }
+
+    fn rst_of(&self, v: &Val) -> Option<bool> {
+        if !self.res.has_rst {
+            Some(false)
+        } else if v.x & 1 != 0 {
+            None
+        } else {
+            Some(v.v & 1 == 1)
+        }
+    }
+
+    /// Closes timestep `t` (the next one at `next`).
+    fn close(&mut self, t: u64, next: Option<u64>) {
+        let info = &mut self.info;
+        if self.out_changed && !self.first_step {
+            match info.phase {
+                None => info.phase = Some(t),
+                Some(p0) => info.period = gcd(info.period, t - p0),
+            }
+            if let Some(prev) = info.last_out {
+                let g = t - prev;
+                info.min_out_gap = if info.min_out_gap == 0 {
+                    g
+                } else {
+                    info.min_out_gap.min(g)
+                };
+            }
+            info.last_out = Some(t);
+        }
+        match self.clocking {
+            None => {}
+            Some(Clocking::Clk) => {
+                let (b, a) = (self.before[CLK], self.st.port[CLK]);
+                if b.x & 1 == 0 && a.x & 1 == 0 && b.v & 1 == 0 && a.v & 1 == 1 {
+                    // Only at an edge: half the timesteps are falling edges.
+                    let (pins, xz) = self.st.pins();
+                    let rst = self.rst_of(&self.before[RST]);
+                    self.edge(rst, pins, xz, self.before[MISO]);
+                }
+            }
+            Some(Clocking::Inferred { period, phase }) => {
+                let (pins, xz) = self.st.pins();
+                if t >= phase && (t - phase) % period == 0 {
+                    let rst = self.rst_of(&self.before[RST]);
+                    self.edge(rst, pins, xz, self.before[MISO]);
+                }
+                if let Some(n) = next {
+                    let mut e = if t < phase {
+                        phase
+                    } else {
+                        t - (t - phase) % period + period
+                    };
+                    let rst = self.rst_of(&self.st.port[RST]);
+                    while e < n {
+                        self.edge(rst, pins, xz, self.st.port[MISO]);
+                        e = e.saturating_add(period);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Applies one chunk's events.
+    fn chunk(&mut self, lexed: &Lexed, at: &At, file: &Path) -> Result<(), VcdError> {
+        for ev in &lexed.evs {
+            match *ev {
+                Ev::Set { sink, v, x } => {
+                    let s = &self.res.ids.flat[sink as usize];
+                    let val = Val {
+                        v: v as u128,
+                        x: x as u128,
+                    };
+                    self.out_changed |= self.st.apply(s, val) && s.port as usize >= CS;
+                }
+                Ev::Wide { sink, idx } => {
+                    let s = &self.res.ids.flat[sink as usize];
+                    self.out_changed |=
+                        self.st.apply(s, lexed.wide[idx as usize]) && s.port as usize >= CS;
+                }
+                Ev::Time { t: nt, line } => self.timestamp(nt, at.line0 + line as u64, file)?,
+            }
+        }
+        Ok(())
+    }
+
+    fn timestamp(&mut self, nt: u64, line: u64, file: &Path) -> Result<(), VcdError> {
+        let time = self.time;
+        if self.seen_time && nt < time {
+            return Err(VcdError::Malformed {
+                file: file.to_path_buf(),
+                line,
+                message: format!("time goes backwards from {time} to {nt}"),
+            });
+        }
+        if !self.seen_time || nt > time {
+            if self.seen_time {
+                self.info.max_gap = self.info.max_gap.max(nt - time);
+            }
+            if self.seen_time || self.out_changed {
+                self.close(time, Some(nt));
+                self.first_step = false;
+            }
+            self.before = self.st.port;
+            self.out_changed = false;
+            self.time = nt;
+            self.seen_time = true;
+        }
+        Ok(())
+    }
+}
+
+/// Reads the body (from `start`) into `sink` through the parallel lexer.
+fn body(
+    path: &Path,
+    start: BodyStart,
     res: &Resolved,
     clocking: Option<Clocking>,
     sink: &mut dyn CycleSink,
@@ -793,240 +930,36 @@ fn body<R: BufRead>(
             (1u128 << w) - 1
         };
     }
-    let mut before = st.port;
-    let mut time = 0u64;
-    let mut seen_time = false;
-    let mut out_changed = false;
-    let mut first_step = true;
-    let mut info = BodyInfo::default();
-    // A cycle is handed on at the next edge, when the MISO it carried (the
-    // value just before that edge) is known.
-    let mut pending: Option<(Option<bool>, Pins, Pins)> = None;
-    fn edge(
-        pending: &mut Option<(Option<bool>, Pins, Pins)>,
-        sink: &mut dyn CycleSink,
-        info: &mut BodyInfo,
-        rst: Option<bool>,
-        pins: Pins,
-        xz: Pins,
-        miso: Val,
-    ) {
-        if let Some((r, p, x)) = pending.take() {
-            sink.cycle(r, &p, &x, miso.v as u64, miso.x as u64);
-        }
-        info.cycles += 1;
-        *pending = Some((rst, pins, xz));
-    }
-    let mut close = |st: &State,
-                     before: &[Val; 12],
-                     t: u64,
-                     next: Option<u64>,
-                     out_changed: bool,
-                     first: bool,
-                     info: &mut BodyInfo| {
-        if out_changed && !first {
-            match info.phase {
-                None => info.phase = Some(t),
-                Some(p0) => info.period = gcd(info.period, t - p0),
-            }
-            if let Some(prev) = info.last_out {
-                let g = t - prev;
-                info.min_out_gap = if info.min_out_gap == 0 {
-                    g
-                } else {
-                    info.min_out_gap.min(g)
-                };
-            }
-            info.last_out = Some(t);
-        }
-        let (pins, xz) = st.pins();
-        let rst_of = |v: &Val| {
-            if !res.has_rst {
-                Some(false)
-            } else if v.x & 1 != 0 {
-                None
-            } else {
-                Some(v.v & 1 == 1)
-            }
-        };
-        match clocking {
-            None => {}
-            Some(Clocking::Clk) => {
-                let (b, a) = (before[CLK], st.port[CLK]);
-                if b.x & 1 == 0 && a.x & 1 == 0 && b.v & 1 == 0 && a.v & 1 == 1 {
-                    edge(
-                        &mut pending,
-                        sink,
-                        info,
-                        rst_of(&before[RST]),
-                        pins,
-                        xz,
-                        before[MISO],
-                    );
-                }
-            }
-            Some(Clocking::Inferred { period, phase }) => {
-                if t >= phase && (t - phase) % period == 0 {
-                    edge(
-                        &mut pending,
-                        sink,
-                        info,
-                        rst_of(&before[RST]),
-                        pins,
-                        xz,
-                        before[MISO],
-                    );
-                }
-                if let Some(n) = next {
-                    let mut e = if t < phase {
-                        phase
-                    } else {
-                        t - (t - phase) % period + period
-                    };
-                    while e < n {
-                        edge(
-                            &mut pending,
-                            sink,
-                            info,
-                            rst_of(&st.port[RST]),
-                            pins,
-                            xz,
-                            st.port[MISO],
-                        );
-                        e = e.saturating_add(period);
-                    }
-                }
-            }
-        }
+    let mut ap = Applier {
+        res,
+        clocking,
+        sink,
+        before: st.port,
+        st,
+        time: 0,
+        seen_time: false,
+        out_changed: false,
+        first_step: true,
+        info: BodyInfo::default(),
+        pending: None,
     };
-    while let Some(r) = lx.next()? {
-        let t = lx.tok(r);
-        match t[0] {
-            b'#' => {
-                let nt: u64 = std::str::from_utf8(&t[1..])
-                    .ok()
-                    .and_then(|s| s.parse().ok())
-                    .ok_or_else(|| {
-                        lx.malformed(format!("bad timestamp `{}`", String::from_utf8_lossy(t)))
-                    })?;
-                if seen_time && nt < time {
-                    return Err(lx.malformed(format!("time goes backwards from {time} to {nt}")));
-                }
-                if !seen_time || nt > time {
-                    if seen_time {
-                        info.max_gap = info.max_gap.max(nt - time);
-                    }
-                    if seen_time || out_changed {
-                        close(
-                            &st,
-                            &before,
-                            time,
-                            Some(nt),
-                            out_changed,
-                            first_step,
-                            &mut info,
-                        );
-                        first_step = false;
-                    }
-                    before = st.port;
-                    out_changed = false;
-                    time = nt;
-                    seen_time = true;
-                }
-            }
-            b'$' => {
-                // $dumpvars / $dumpall / $dumpon / $dumpoff / $end: values follow as usual.
-                if t == b"$comment" {
-                    lx.until_end("$comment")?;
-                }
-            }
-            b'b' | b'B' | b'r' | b'R' | b's' | b'S' => {
-                let kind = t[0].to_ascii_lowercase();
-                // Copied before the next token: the identifier code may sit on
-                // the next line, which replaces the line buffer.
-                let val = t[1..].to_vec();
-                let Some(idr) = lx.next()? else {
-                    return Err(lx.truncated(
-                        "value change without an identifier code at the end of the file",
-                    ));
-                };
-                let id = lx.tok(idr);
-                let Some(sinks) = res.ids.get(id) else {
-                    return Err(lx.malformed(format!(
-                        "value change for undeclared identifier code `{}`",
-                        String::from_utf8_lossy(id)
-                    )));
-                };
-                if kind == b'b' && !sinks.is_empty() {
-                    for s in sinks {
-                        let v = parse_value(&val, s.width).ok_or_else(|| {
-                            lx.malformed(format!(
-                                "bad vector value `b{}`",
-                                String::from_utf8_lossy(&val)
-                            ))
-                        })?;
-                        out_changed |= st.apply(s, v) && s.port as usize >= CS;
-                    }
-                } else if kind == b'b' && parse_value(&val, 1).is_none() && val.len() <= 64 {
-                    return Err(lx.malformed(format!(
-                        "bad vector value `b{}`",
-                        String::from_utf8_lossy(&val)
-                    )));
-                }
-            }
-            c => {
-                if !matches!(
-                    c,
-                    b'0' | b'1'
-                        | b'x'
-                        | b'X'
-                        | b'z'
-                        | b'Z'
-                        | b'u'
-                        | b'U'
-                        | b'w'
-                        | b'W'
-                        | b'l'
-                        | b'L'
-                        | b'h'
-                        | b'H'
-                        | b'-'
-                ) {
-                    return Err(
-                        lx.malformed(format!("unexpected `{}`", String::from_utf8_lossy(t)))
-                    );
-                }
-                if t.len() < 2 {
-                    return Err(lx.malformed("scalar value change without an identifier code"));
-                }
-                let Some(sinks) = res.ids.get(&t[1..]) else {
-                    return Err(lx.malformed(format!(
-                        "value change for undeclared identifier code `{}`",
-                        String::from_utf8_lossy(&t[1..])
-                    )));
-                };
-                if !sinks.is_empty() {
-                    let v = parse_value(&t[..1], 1).unwrap();
-                    for s in sinks {
-                        let v = Val {
-                            v: v.v,
-                            x: if v.x != 0 { u128::MAX } else { 0 },
-                        };
-                        out_changed |= st.apply(s, v) && s.port as usize >= CS;
-                    }
-                }
-            }
-        }
+    let (last_line, newline) =
+        vcdlex::for_each_chunk(path, start, &res.ids, |lexed, at| ap.chunk(lexed, at, path))?;
+    if !newline {
+        return Err(VcdError::Truncated {
+            file: path.to_path_buf(),
+            line: last_line,
+            message: "the last line is incomplete".into(),
+        });
     }
-    if !lx.ends_with_newline {
-        return Err(lx.truncated("the last line is incomplete"));
+    let time = ap.time;
+    ap.close(time, None);
+    if let Some((r, p, x)) = ap.pending.take() {
+        let miso = ap.st.port[MISO];
+        ap.sink.cycle(r, &p, &x, miso.v as u64, miso.x as u64);
     }
-    close(&st, &before, time, None, out_changed, first_step, &mut info);
-    if let Some((r, p, x)) = pending.take() {
-        sink.cycle(r, &p, &x, st.port[MISO].v as u64, st.port[MISO].x as u64);
-    }
-    info.last_time = time;
-    Ok(info)
+    ap.info.last_time = time;
+    Ok(ap.info)
 }
 
 /// Without a dumped `clk`, at most this many frames (of at least 2^16
@@ -1112,13 +1045,15 @@ fn read_vcd_cycles(
     let mut lx = open(path)?;
     let h = parse_header(&mut lx)?;
     let res = resolve(&h, &layout, scope, path)?;
+    let start = BodyStart {
+        offset: lx.line_start + lx.pos as u64,
+        line: lx.lineno,
+        header_newline: lx.line.ends_with(b"\n"),
+    };
     let clocking = if res.has_clk {
         Clocking::Clk
     } else {
-        let mut pre = open(path)?;
-        parse_header(&mut pre)?;
-        let info =
-            body(&mut pre, &res, None, &mut CountCycles(0)).map_err(|e| pre.truncation(e))?;
+        let info = body(path, start, &res, None, &mut CountCycles(0))?;
         // One timestamp off the clock grid makes the gcd (the period) tiny
         // and the cycle count enormous: refuse a period that no two output
         // changes are close to (a sample gives two one cycle apart; SCLK
@@ -1157,7 +1092,7 @@ fn read_vcd_cycles(
             }
         }
     };
-    let info = body(&mut lx, &res, Some(clocking), sink).map_err(|e| lx.truncation(e))?;
+    let info = body(path, start, &res, Some(clocking), sink)?;
     Ok(VcdInfo {
         scope: res.scope,
         timescale: h.timescale,
@@ -1205,4 +1140,97 @@ pub fn parse_only(s: &Schedule, path: &Path, scope: Option<&str>) -> Result<u64,
     let mut c = CountCycles(0);
     read_cycles(s, path, scope, &mut c)?;
     Ok(c.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::{run_dut, ModelDut, RunOptions};
+    use crate::vcdout::VcdWriter;
+
+    /// Every cycle handed on, as text.
+    #[derive(Default)]
+    struct Log(Vec<String>);
+
+    impl CycleSink for Log {
+        fn cycle(&mut self, rst: Option<bool>, p: &Pins, x: &Pins, miso: u64, mx: u64) {
+            self.0.push(format!("{rst:?} {p:?} {x:?} {miso} {mx}"));
+        }
+    }
+
+    fn read(s: &Schedule, path: &Path, chunk: usize) -> Result<Vec<String>, String> {
+        vcdlex::set_chunk_bytes(chunk);
+        let mut log = Log::default();
+        let r = read_cycles(s, path, None, &mut log).map_err(|e| e.to_string());
+        vcdlex::set_chunk_bytes(1 << 18);
+        r.map(|_| log.0)
+    }
+
+    /// Cutting the body anywhere (inside a `$comment`, between a vector
+    /// value and its code on the next line) reads the same cycles and gives
+    /// the same errors as one piece.
+    #[test]
+    fn chunks_cut_anywhere_read_the_same() {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml");
+        let s = lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap();
+        let d = tempfile::tempdir().unwrap();
+        let vcd = d.path().join("w.vcd");
+        let mut w = VcdWriter::create(&vcd, &s, 0, 1_000).unwrap();
+        run_dut(
+            &s,
+            &mut ModelDut::new(&s),
+            1,
+            &RunOptions::default(),
+            "gen",
+            Some(&mut w),
+        );
+        w.finish().unwrap();
+        let text = std::fs::read_to_string(&vcd).unwrap();
+        let body = text.find("$enddefinitions").unwrap();
+        let (head, tail) = text.split_at(body);
+        // A comment over lines, and a vector's code on the next line.
+        let tail = tail.replacen("\n#", "\n$comment a\n#5 b\n$end\n#", 3);
+        let at = tail.find("\nb").unwrap() + 1;
+        let sp = at + tail[at..].find(' ').unwrap();
+        let tail = format!("{}\n{}", &tail[..sp], &tail[sp + 1..]);
+        let odd = d.path().join("odd.vcd");
+        std::fs::write(&odd, format!("{head}{tail}")).unwrap();
+        let whole = read(&s, &odd, 1 << 18).unwrap();
+        assert!(whole.len() > 500);
+        for chunk in [1, 7, 64, 1000] {
+            assert_eq!(read(&s, &odd, chunk).unwrap(), whole, "chunk {chunk}");
+        }
+        // Broken files: the same error, at the same line.
+        let n = head.len() + tail.len();
+        for (name, t) in [
+            ("cut", format!("{head}{}", &tail[..tail.len() * 2 / 3])),
+            ("open comment", format!("{head}{tail}$comment x\n")),
+            ("dangling", format!("{head}{tail}b1\n")),
+            (
+                "bad",
+                format!(
+                    "{head}{}\n#999999999999 q!\n{}",
+                    &tail[..tail.len() / 2],
+                    &tail[tail.len() / 2..]
+                ),
+            ),
+        ] {
+            let f = d.path().join("broken.vcd");
+            std::fs::write(&f, &t).unwrap();
+            let want = read(&s, &f, 1 << 18).unwrap_err();
+            let kind = if name == "bad" {
+                "malformed"
+            } else {
+                "truncated"
+            };
+            assert!(want.contains(kind), "{name}: {want}");
+            for chunk in [1, 7, 64, 1000] {
+                assert_eq!(
+                    read(&s, &f, chunk).unwrap_err(),
+                    want,
+                    "{name}, chunk {chunk} of {n}"
+                );
+            }
+        }
+    }
 }

@@ -5,13 +5,15 @@
 //! the same capture of faulty gateware (a conversion one slot late, a mux
 //! moved early, one SCLK edge missing) fails with the fault named.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
-use judge::run::{run_dut, ModelDut, Observer, RunOptions};
-use judge::timed::{check_capture, TimedReport};
-use lut_gen::ports::{Layout, Pins, Role};
+use judge::run::ModelDut;
+use judge::timed::check_capture;
+use lut_gen::ports::Pins;
 use lut_gen::Schedule;
+
+mod analyser;
+use analyser::{check, lanes, mutate, resample, to_sigrok, Mutation};
 
 #[path = "../../../tests/common/tools.rs"]
 mod tools;
@@ -21,218 +23,8 @@ fn load(mix: &str) -> Schedule {
     lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap()
 }
 
-/// Every cycle's pins after reset.
-#[derive(Default)]
-struct Rec(Vec<Pins>);
-
-impl Observer for Rec {
-    fn cycle(&mut self, _: u64, rst: bool, p: &Pins, _: u64) {
-        if !rst {
-            self.0.push(*p);
-        }
-    }
-}
-
-fn run(s: &Schedule, frames: u64) -> Vec<Pins> {
-    let mut r = Rec::default();
-    run_dut(
-        s,
-        &mut ModelDut::new(s),
-        frames,
-        &RunOptions::default(),
-        "gen",
-        Some(&mut r),
-    );
-    r.0
-}
-
-/// The analyser's channels: every CS, SCLK, mux select and enable bit and
-/// sample_valid, as D0..Dn, with the `--map` that names them.
-fn lanes(s: &Schedule) -> (Vec<(Role, u32)>, String) {
-    let l = Layout::new(s);
-    let mut v = Vec::new();
-    for r in [
-        Role::CsN,
-        Role::Sclk,
-        Role::MuxSel,
-        Role::MuxEn,
-        Role::SampleValid,
-    ] {
-        for b in 0..l.width(r) {
-            v.push((r, b));
-        }
-    }
-    let map = v
-        .iter()
-        .enumerate()
-        .map(|(i, (r, b))| format!("D{i}={}[{b}]", r.name()))
-        .collect::<Vec<_>>()
-        .join(",");
-    (v, map)
-}
-
-fn bit(p: &Pins, r: Role, b: u32) -> bool {
-    let v: u128 = match r {
-        Role::CsN => p.cs_n as u128,
-        Role::Sclk => p.sclk as u128,
-        Role::MuxSel => p.mux_sel as u128,
-        Role::MuxEn => p.mux_en,
-        _ => p.sample_valid as u128,
-    };
-    v >> b & 1 == 1
-}
-
-/// Samples cycles `[from, to)` every `ts_ps` from `from`'s start plus
-/// `phase_ps`, and writes them as a 1 ps VCD of channels D0..Dn.
-fn resample(
-    s: &Schedule,
-    pins: &[Pins],
-    from: u64,
-    to: u64,
-    ts_ps: u64,
-    phase_ps: u64,
-    out: &Path,
-) {
-    let (lanes, _) = lanes(s);
-    let tc = 1e12 / s.mix.clock_hz as f64;
-    let mut text = String::from("$timescale 1 ps $end\n$scope module libsigrok $end\n");
-    for (i, _) in lanes.iter().enumerate() {
-        text += &format!("$var wire 1 {} D{i} $end\n", code(i));
-    }
-    text += "$upscope $end\n$enddefinitions $end\n";
-    let start = from as f64 * tc + phase_ps as f64;
-    let mut prev: Option<Vec<bool>> = None;
-    let mut n = 0u64;
-    loop {
-        let t = start + (n * ts_ps) as f64;
-        let c = (t / tc) as u64;
-        if c >= to {
-            break;
-        }
-        let v: Vec<bool> = lanes
-            .iter()
-            .map(|(r, b)| bit(&pins[c as usize], *r, *b))
-            .collect();
-        if prev.as_ref() != Some(&v) {
-            text += &format!("#{}\n", n * ts_ps);
-            for (i, x) in v.iter().enumerate() {
-                if prev.as_ref().map(|p| p[i]) != Some(*x) {
-                    text += &format!("{}{}\n", *x as u8, code(i));
-                }
-            }
-            prev = Some(v);
-        }
-        n += 1;
-    }
-    text += &format!("#{}\n", n * ts_ps);
-    std::fs::write(out, text).unwrap();
-}
-
-fn code(i: usize) -> String {
-    let mut s = String::new();
-    let mut n = i;
-    loop {
-        s.push((b'!' + (n % 94) as u8) as char);
-        n /= 94;
-        if n == 0 {
-            return s;
-        }
-    }
-}
-
-/// The capture as `.sr` (sigrok-cli from the 1 ps VCD, downsampled to the
-/// analyser's rate) and as sigrok-cli's VCD of that session.
-fn to_sigrok(vcd: &Path, ts_ps: u64) -> (PathBuf, PathBuf) {
-    let sr = vcd.with_extension("sr");
-    let st = Command::new("sigrok-cli")
-        .arg("-i")
-        .arg(vcd)
-        .arg("-I")
-        .arg(format!("vcd:downsample={ts_ps}"))
-        .arg("-o")
-        .arg(&sr)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
-    let back = vcd.with_extension("sigrok.vcd");
-    let st = Command::new("sigrok-cli")
-        .arg("-i")
-        .arg(&sr)
-        .args(["-O", "vcd", "-o"])
-        .arg(&back)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
-    (sr, back)
-}
-
-fn check(s: &Schedule, map: &str, file: &Path) -> TimedReport {
-    let lanes = judge::capture::parse_map(map, s).unwrap();
-    let cap = judge::capture::read(file, lanes).unwrap();
-    check_capture(s, &cap, 0).unwrap()
-}
-
-/// A fault made on the recorded pins of branch 0 at the first conversion at
-/// or after cycle `at`.
-#[derive(Debug, Clone, Copy)]
-enum Mutation {
-    /// The conversion (CS and SCLK) one slot late.
-    OneSlotLate,
-    /// The mux switches 8 cycles before its time.
-    MuxEarly,
-    /// One SCLK low pulse missing.
-    SclkEdgeMissing,
-}
-
-fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {
-    let at = at as usize;
-    let fall = (at..pins.len())
-        .find(|&c| pins[c].cs_n & 1 == 0 && pins[c - 1].cs_n & 1 == 1)
-        .unwrap();
-    let slot = s.grid.slot_cycles as usize;
-    match m {
-        Mutation::OneSlotLate => {
-            let orig: Vec<Pins> = pins[fall..fall + 2 * slot].to_vec();
-            for k in 0..2 * slot {
-                let (cs, sclk) = if k < slot {
-                    (1, 1)
-                } else {
-                    (orig[k - slot].cs_n & 1, orig[k - slot].sclk & 1)
-                };
-                pins[fall + k].cs_n = (pins[fall + k].cs_n & !1) | cs;
-                pins[fall + k].sclk = (pins[fall + k].sclk & !1) | sclk;
-            }
-        }
-        Mutation::MuxEarly => {
-            let ch = (fall + 1..pins.len())
-                .find(|&c| {
-                    pins[c].mux_sel != pins[c - 1].mux_sel || pins[c].mux_en != pins[c - 1].mux_en
-                })
-                .unwrap();
-            for c in ch - 8..ch {
-                pins[c].mux_sel = pins[ch].mux_sel;
-                pins[c].mux_en = pins[ch].mux_en;
-            }
-        }
-        Mutation::SclkEdgeMissing => {
-            let f = (fall + 1..pins.len())
-                .find(|&c| pins[c].sclk & 1 == 0 && pins[c - 1].sclk & 1 == 1)
-                .unwrap();
-            let mut c = f;
-            while pins[c].sclk & 1 == 0 {
-                pins[c].sclk |= 1;
-                c += 1;
-            }
-        }
-    }
+fn run(s: &Schedule, dut: &mut ModelDut, frames: u64) -> Vec<Pins> {
+    analyser::run(s, dut, frames)
 }
 
 fn evidence(mix: &str, frames: u64, window: (u64, u64), rates: &[(u64, u64)]) {
@@ -240,7 +32,7 @@ fn evidence(mix: &str, frames: u64, window: (u64, u64), rates: &[(u64, u64)]) {
         return;
     }
     let s = load(mix);
-    let clean = run(&s, frames);
+    let clean = run(&s, &mut ModelDut::new(&s), frames);
     let (_, map) = lanes(&s);
     let d = tempfile::tempdir().unwrap();
     for &(ts, phase) in rates {
@@ -306,7 +98,7 @@ fn a_subset_of_pins_names_what_it_cannot_check() {
         return;
     }
     let s = load("../tests/data/tiny.toml");
-    let clean = run(&s, 3);
+    let clean = run(&s, &mut ModelDut::new(&s), 3);
     let d = tempfile::tempdir().unwrap();
     let v = d.path().join("all.vcd");
     resample(&s, &clean, 4_100, 11_000, 10_000, 1_234, &v);
@@ -334,4 +126,102 @@ fn a_subset_of_pins_names_what_it_cannot_check() {
     std::fs::write(&f, "# probes\nD0 = adc_cs_n[0]\nD1 = adc_clk[0]\n").unwrap();
     let e = judge::capture::parse_map(f.to_str().unwrap(), &s).unwrap_err();
     assert!(e.contains("map.txt:3") && e.contains("adc_clk"), "{e}");
+}
+
+/// Three faults in one capture: every class is reported, not only the
+/// first; and a fault in the first conversion, while several frame phases
+/// still fit, is the design's failure (the phase found after it fitted
+/// every edge before), not an input problem.
+#[test]
+fn every_fault_class_is_reported_and_a_fault_before_lock_fails_the_design() {
+    if !tools::require_tool("sigrok-cli") {
+        return;
+    }
+    let s = load("../tests/data/tiny.toml");
+    let clean = run(&s, &mut ModelDut::new(&s), 3);
+    let (_, map) = lanes(&s);
+    let d = tempfile::tempdir().unwrap();
+    let (from, to, ts) = (5_317, 11_900, 10_000);
+    let mut bad = clean.clone();
+    mutate(&s, &mut bad, Mutation::OneSlotLate, 6_500);
+    mutate(&s, &mut bad, Mutation::MuxEarly, 8_500);
+    mutate(&s, &mut bad, Mutation::SclkEdgeMissing, 10_500);
+    let v = d.path().join("three.vcd");
+    resample(&s, &bad, from, to, ts, 3_717, &v);
+    let (sr, _) = to_sigrok(&v, ts);
+    let r = check(&s, &map, &sr);
+    let text = r.summary();
+    assert!(!r.ok, "{text}");
+    for class in ["conversion instant", "mux switching", "serial clock"] {
+        assert!(
+            r.violations.iter().any(|v| v.rule.contains(class)),
+            "{class} missing: {text}"
+        );
+    }
+    assert!(r.violations_total >= 3, "{text}");
+
+    // Branch fast's CS and SCLK only: the seven phases that fit the first
+    // CS edge look alike until the next conversion, so an SCLK edge missing
+    // in the first conversion breaks them all at once.
+    let mut early = clean.clone();
+    mutate(&s, &mut early, Mutation::SclkEdgeMissing, from + 1);
+    let v = d.path().join("early.vcd");
+    resample(&s, &early, from, to, ts, 3_717, &v);
+    let (sr, _) = to_sigrok(&v, ts);
+    let lanes = judge::capture::parse_map("D0=adc_cs_n[0],D2=adc_sclk[0]", &s).unwrap();
+    let cap = judge::capture::read(&sr, lanes).unwrap();
+    let r = check_capture(&s, &cap, 0).expect("a design failure, not an input problem");
+    let text = r.summary();
+    assert!(!r.ok, "{text}");
+    assert!(r.violations[0].rule.contains("serial clock"), "{text}");
+    assert!(
+        r.violations[0]
+            .detail
+            .contains("before the frame phase was unique"),
+        "{text}"
+    );
+}
+
+/// The link's line in a capture (eskin34-uart, `link_tx` on the last
+/// channel): decoded, every packet's channels in the schedule's order; three
+/// bits of one character inverted fail it (a bad CRC), named as the link's.
+#[test]
+fn the_link_line_in_a_capture_is_decoded_and_checked() {
+    if !tools::require_tool("sigrok-cli") {
+        return;
+    }
+    let s = load("../../mixes/eskin34-uart.toml");
+    let f = s.grid.frame_cycles;
+    let clean = run(&s, &mut ModelDut::new(&s), 2);
+    let (lanes_v, map) = lanes(&s);
+    assert!(map.contains("=link_tx[0]"), "{map}");
+    let d = tempfile::tempdir().unwrap();
+    let window = (f / 3 + 1_234, f + f / 2);
+    let v = d.path().join("uart.vcd");
+    resample(&s, &clean, window.0, window.1, 41_667, 9_876, &v);
+    let (sr, back) = to_sigrok(&v, 41_667);
+    for file in [&sr, &back] {
+        let r = check(&s, &map, file);
+        let text = r.summary();
+        assert!(r.ok, "{text}");
+        assert!(
+            text.contains("(link_tx): ") && text.contains("packets and"),
+            "{text}"
+        );
+    }
+    let mut bad = clean.clone();
+    mutate(&s, &mut bad, Mutation::LinkBitsFlipped, f);
+    let v = d.path().join("uart-bad.vcd");
+    resample(&s, &bad, window.0, window.1, 41_667, 9_876, &v);
+    let (sr, _) = to_sigrok(&v, 41_667);
+    let r = check(&s, &map, &sr);
+    let text = r.summary();
+    assert!(!r.ok, "{text}");
+    let link = format!("D{}", lanes_v.len() - 1);
+    assert!(
+        r.violations
+            .iter()
+            .any(|v| v.channel == link && v.rule.contains("link samples")),
+        "{text}"
+    );
 }

@@ -1,0 +1,240 @@
+//! What a logic analyser records of a run, for the capture tests of the
+//! judge and of cosim (random mixes): every cycle's pins resampled at the
+//! analyser's rate with an arbitrary phase, from the middle of a run, no
+//! clock or reset, channels D0..Dn; sigrok-cli's `.sr` and VCD of it; and
+//! faults made on the recorded pins.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use judge::run::{run_dut, Dut, Observer, RunOptions};
+use judge::timed::{check_capture, TimedReport};
+use lut_gen::ports::{Layout, Pins, Role};
+use lut_gen::Schedule;
+
+/// Every cycle's pins after reset.
+#[derive(Default)]
+pub struct Rec(pub Vec<Pins>);
+
+impl Observer for Rec {
+    fn cycle(&mut self, _: u64, rst: bool, p: &Pins, _: u64) {
+        if !rst {
+            self.0.push(*p);
+        }
+    }
+}
+
+pub fn run<D: Dut>(s: &Schedule, dut: &mut D, frames: u64) -> Vec<Pins> {
+    let mut r = Rec::default();
+    run_dut(s, dut, frames, &RunOptions::default(), "gen", Some(&mut r));
+    r.0
+}
+
+/// The analyser's channels: every CS, SCLK, mux select and enable bit and
+/// sample_valid, as D0..Dn, with the `--map` that names them.
+pub fn lanes(s: &Schedule) -> (Vec<(Option<Role>, u32)>, String) {
+    let l = Layout::new(s);
+    let mut v = Vec::new();
+    for r in [
+        Role::CsN,
+        Role::Sclk,
+        Role::MuxSel,
+        Role::MuxEn,
+        Role::SampleValid,
+    ] {
+        for b in 0..l.width(r) {
+            v.push((Some(r), b));
+        }
+    }
+    // The link's line, for a mix with a link.
+    if l.link {
+        v.push((None, 0));
+    }
+    let map = v
+        .iter()
+        .enumerate()
+        .map(|(i, (r, b))| format!("D{i}={}[{b}]", r.map_or("link_tx", |r| r.name())))
+        .collect::<Vec<_>>()
+        .join(",");
+    (v, map)
+}
+
+pub fn bit(p: &Pins, r: Option<Role>, b: u32) -> bool {
+    let v: u128 = match r {
+        Some(Role::CsN) => p.cs_n as u128,
+        Some(Role::Sclk) => p.sclk as u128,
+        Some(Role::MuxSel) => p.mux_sel as u128,
+        Some(Role::MuxEn) => p.mux_en,
+        Some(_) => p.sample_valid as u128,
+        None => p.link_tx as u128,
+    };
+    v >> b & 1 == 1
+}
+
+/// Samples cycles `[from, to)` every `ts_ps` from `from`'s start plus
+/// `phase_ps`, and writes them as a 1 ps VCD of channels D0..Dn.
+pub fn resample(
+    s: &Schedule,
+    pins: &[Pins],
+    from: u64,
+    to: u64,
+    ts_ps: u64,
+    phase_ps: u64,
+    out: &Path,
+) {
+    let (lanes, _) = lanes(s);
+    let tc = 1e12 / s.mix.clock_hz as f64;
+    let mut text = String::from("$timescale 1 ps $end\n$scope module libsigrok $end\n");
+    for (i, _) in lanes.iter().enumerate() {
+        text += &format!("$var wire 1 {} D{i} $end\n", code(i));
+    }
+    text += "$upscope $end\n$enddefinitions $end\n";
+    let start = from as f64 * tc + phase_ps as f64;
+    let mut prev: Option<Vec<bool>> = None;
+    let mut n = 0u64;
+    loop {
+        let t = start + (n * ts_ps) as f64;
+        let c = (t / tc) as u64;
+        if c >= to {
+            break;
+        }
+        let v: Vec<bool> = lanes
+            .iter()
+            .map(|(r, b)| bit(&pins[c as usize], *r, *b))
+            .collect();
+        if prev.as_ref() != Some(&v) {
+            text += &format!("#{}\n", n * ts_ps);
+            for (i, x) in v.iter().enumerate() {
+                if prev.as_ref().map(|p| p[i]) != Some(*x) {
+                    text += &format!("{}{}\n", *x as u8, code(i));
+                }
+            }
+            prev = Some(v);
+        }
+        n += 1;
+    }
+    text += &format!("#{}\n", n * ts_ps);
+    std::fs::write(out, text).unwrap();
+}
+
+pub fn code(i: usize) -> String {
+    let mut s = String::new();
+    let mut n = i;
+    loop {
+        s.push((b'!' + (n % 94) as u8) as char);
+        n /= 94;
+        if n == 0 {
+            return s;
+        }
+    }
+}
+
+/// The capture as `.sr` (sigrok-cli from the 1 ps VCD, downsampled to the
+/// analyser's rate) and as sigrok-cli's VCD of that session.
+pub fn to_sigrok(vcd: &Path, ts_ps: u64) -> (PathBuf, PathBuf) {
+    let sr = vcd.with_extension("sr");
+    let st = Command::new("sigrok-cli")
+        .arg("-i")
+        .arg(vcd)
+        .arg("-I")
+        .arg(format!("vcd:downsample={ts_ps}"))
+        .arg("-o")
+        .arg(&sr)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let back = vcd.with_extension("sigrok.vcd");
+    let st = Command::new("sigrok-cli")
+        .arg("-i")
+        .arg(&sr)
+        .args(["-O", "vcd", "-o"])
+        .arg(&back)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    (sr, back)
+}
+
+pub fn check(s: &Schedule, map: &str, file: &Path) -> TimedReport {
+    let lanes = judge::capture::parse_map(map, s).unwrap();
+    let cap = judge::capture::read(file, lanes).unwrap();
+    check_capture(s, &cap, 0).unwrap()
+}
+
+/// A fault made on the recorded pins of branch 0 at the first conversion at
+/// or after cycle `at`.
+#[derive(Debug, Clone, Copy)]
+pub enum Mutation {
+    /// The conversion (CS and SCLK) one slot late.
+    OneSlotLate,
+    /// The mux switches 8 cycles before its time.
+    MuxEarly,
+    /// One SCLK low pulse missing.
+    SclkEdgeMissing,
+    /// Three bits of one character on the link's line inverted.
+    LinkBitsFlipped,
+}
+
+pub fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {
+    let at = at as usize;
+    let fall = (at..pins.len())
+        .find(|&c| pins[c].cs_n & 1 == 0 && pins[c - 1].cs_n & 1 == 1)
+        .unwrap();
+    let slot = s.grid.slot_cycles as usize;
+    if let Mutation::LinkBitsFlipped = m {
+        let div = lut_gen::hostlink::plan(s).unwrap().unwrap().baud_divider as usize;
+        // A start bit at or after `at`, then its bits 2-4 inverted.
+        let st = (at..pins.len())
+            .find(|&c| !pins[c].link_tx && pins[c - 1].link_tx)
+            .unwrap();
+        for p in &mut pins[st + 2 * div..st + 5 * div] {
+            p.link_tx = !p.link_tx;
+        }
+        return;
+    }
+    match m {
+        Mutation::OneSlotLate => {
+            let orig: Vec<Pins> = pins[fall..fall + 2 * slot].to_vec();
+            for k in 0..2 * slot {
+                let (cs, sclk) = if k < slot {
+                    (1, 1)
+                } else {
+                    (orig[k - slot].cs_n & 1, orig[k - slot].sclk & 1)
+                };
+                pins[fall + k].cs_n = (pins[fall + k].cs_n & !1) | cs;
+                pins[fall + k].sclk = (pins[fall + k].sclk & !1) | sclk;
+            }
+        }
+        Mutation::MuxEarly => {
+            let ch = (fall + 1..pins.len())
+                .find(|&c| {
+                    pins[c].mux_sel != pins[c - 1].mux_sel || pins[c].mux_en != pins[c - 1].mux_en
+                })
+                .unwrap();
+            for c in ch - 8..ch {
+                pins[c].mux_sel = pins[ch].mux_sel;
+                pins[c].mux_en = pins[ch].mux_en;
+            }
+        }
+        Mutation::SclkEdgeMissing => {
+            let f = (fall + 1..pins.len())
+                .find(|&c| pins[c].sclk & 1 == 0 && pins[c - 1].sclk & 1 == 1)
+                .unwrap();
+            let mut c = f;
+            while pins[c].sclk & 1 == 0 {
+                pins[c].sclk |= 1;
+                c += 1;
+            }
+        }
+        Mutation::LinkBitsFlipped => unreachable!("handled above"),
+    }
+}
