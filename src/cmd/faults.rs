@@ -244,6 +244,7 @@ fn equivalence(e: &cosim::equiv::Equivalence) -> String {
         E::Differs { frame: Some(f) } => format!("differs (counterexample at frame {f})"),
         E::Differs { frame: None } => "differs".into(),
         E::Undecided { why } => format!("undecided: {why}"),
+        E::ContractProved => "the faulty design proves the whole pin contract".into(),
     }
 }
 
