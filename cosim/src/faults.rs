@@ -432,6 +432,50 @@ fn rom_cases(s: &Schedule, b: usize, site: Site) -> Vec<DesignCase> {
     ]
 }
 
+/// One design-level fault of each class, at the middle of frame 0 on the
+/// first branch that has two channels (ROM faults): what the analyser
+/// captures of faulty gateware are tested with.
+pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(&'static str, hdl::GatewareFault)> {
+    let f = s.grid.frame_cycles;
+    let mid = f / 2 + 7;
+    let site = Site {
+        name: "mid-frame",
+        cycle: mid,
+        slot: (mid % f) / s.grid.slot_cycles,
+    };
+    let mut v: Vec<(&'static str, hdl::GatewareFault)> = (0..s.branches.len())
+        .map(|b| rom_cases(s, b, site))
+        .find(|c| !c.is_empty())
+        .unwrap_or_default()
+        .into_iter()
+        .map(|c| (c.class, c.fault))
+        .collect();
+    v.push((
+        "slot-wrap-early",
+        hdl::GatewareFault::SlotWrap { delta: -1 },
+    ));
+    v.push(("slot-wrap-late", hdl::GatewareFault::SlotWrap { delta: 1 }));
+    if s.grid.slices_per_frame > 1 {
+        v.push((
+            "slice-count-short",
+            hdl::GatewareFault::SliceWrap { delta: -1 },
+        ));
+        v.push((
+            "slice-count-long",
+            hdl::GatewareFault::SliceWrap { delta: 1 },
+        ));
+    }
+    v.extend(hdl::GatewareFault::link_faults(s));
+    v
+}
+
+/// `hdl::RtlSim` with a design-level fault built in, as a [`Dut`].
+pub fn gateware_dut(s: &Schedule, f: hdl::GatewareFault) -> Result<Box<dyn Dut>, SimError> {
+    hdl::RtlSim::with_fault(s, f)
+        .map(|sim| Box::new(GatewareDut(sim)) as Box<dyn Dut>)
+        .map_err(|e| SimError::Hdl(e.to_string()))
+}
+
 /// Runs `jobs` on up to two threads (the machine's cores), in order.
 fn parallel<T: Send, R: Send>(jobs: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
     let n = std::thread::available_parallelism()

@@ -326,7 +326,9 @@ fn fault_plan(a: &Args, s: &Schedule) -> Result<cosim::faults::Plan, String> {
     // mixes) when it is asked for: --only faults, --charts all, --thorough.
     let mut plan = cosim::faults::Plan::new(target, 3, 5);
     if !full_campaign(a) {
-        let mid = cosim::faults::sites(s).into_iter().filter(|x| x.name == "mid-frame");
+        let mid = cosim::faults::sites(s)
+            .into_iter()
+            .filter(|x| x.name == "mid-frame");
         plan.sites = Some(mid.collect());
         plan.false_alarm_mixes = 1;
     }
