@@ -61,12 +61,18 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         .descendants()
         .filter(|n| n.has_tag_name("testcase"))
         .collect();
-    assert_eq!(cases.len(), 11, "{xml}");
+    assert_eq!(cases.len(), 12, "{xml}");
     let speed = cases
         .iter()
         .find(|c| c.attribute("name") == Some("speed"))
         .unwrap();
     assert!(speed.children().any(|n| n.has_tag_name("skipped")), "{xml}");
+    // the proof is opt-in too (tests/prove_cli.rs builds with it)
+    let prove = cases
+        .iter()
+        .find(|c| c.attribute("name") == Some("prove"))
+        .unwrap();
+    assert!(prove.children().any(|n| n.has_tag_name("skipped")), "{xml}");
     assert!(!xml.contains("<failure"), "{xml}");
     for f in [
         "audit.txt",

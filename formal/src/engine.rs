@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use crate::ProveError;
 
 /// The prover behind `--solver`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Solver {
     /// ABC over AIGER: `bmc3` from reset to the recurrence bound, and the

@@ -9,6 +9,7 @@
 //! A bounded result is reported as `bounded` with its depth, never as a proof.
 
 pub mod aiger;
+pub mod cache;
 pub mod engine;
 pub mod faults;
 pub mod harness;
@@ -17,7 +18,7 @@ pub mod replay;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use lut_gen::Schedule;
 
@@ -39,7 +40,7 @@ pub enum ProveError {
 }
 
 /// What was established.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Outcome {
     /// Every property holds in every reachable state, for any MISO input.
@@ -61,7 +62,7 @@ impl Outcome {
     }
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PropertyResult {
     pub name: String,
     pub result: Outcome,
@@ -69,7 +70,7 @@ pub struct PropertyResult {
 }
 
 /// A violation from reset, replayed.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Counterexample {
     /// First failing cycle, counted like `check` counts (cycle 0 = the first
     /// cycle after reset); -1 is the reset cycle.
@@ -90,7 +91,7 @@ pub struct Counterexample {
 }
 
 /// The result of `prove`, for the CLI and the build report.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Proof {
     pub mix: String,
     pub solver: Solver,
