@@ -86,3 +86,46 @@ fn proved_json_has_specs_keys_and_exit_0() {
         .iter()
         .all(|p| p["result"] == "proved" && p["name"].is_string()));
 }
+
+/// `build --only prove` proves and shows it in the report; a later default
+/// build of the same Verilog shows the remembered proof (a fresh directory
+/// without one leaves the step out).
+#[test]
+fn build_shows_the_proof_and_a_default_build_shows_it_remembered() {
+    if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("b");
+    let build = |out: &std::path::Path, steps: &[&str]| {
+        let mut c = slotforge();
+        c.env_remove("SLOTFORGE_CACHE")
+            .args(["build", "--quiet", "-o"])
+            .arg(out)
+            .args(steps)
+            .arg(tiny());
+        c.assert().success();
+        std::fs::read_to_string(out.join("report.md")).unwrap()
+    };
+    let md = build(&out, &["--only", "prove"]);
+    assert!(md.contains("Formal proof"), "{md}");
+    assert!(md.contains("proved for all time"), "{md}");
+    assert!(md.contains("stream.value"), "{md}");
+    assert!(!md.contains("remembered"), "{md}");
+    let cache: Vec<_> = std::fs::read_dir(out.join("prove/cache"))
+        .unwrap()
+        .collect();
+    assert_eq!(cache.len(), 1);
+    // The default build leaves the proof out unless it is remembered.
+    let quick = [
+        "--skip",
+        "audit,lut,sim,golden,faults,synth,timing,figure7,schedulability",
+    ];
+    let md = build(&out, &quick);
+    assert!(md.contains("proved for all time"), "{md}");
+    assert!(md.contains("remembered"), "{md}");
+    let fresh = dir.path().join("fresh");
+    let md = build(&fresh, &quick);
+    assert!(!md.contains("Formal proof"), "{md}");
+    assert!(md.contains("--only prove"), "{md}");
+}

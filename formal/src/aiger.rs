@@ -20,6 +20,8 @@ pub struct Aig {
     /// (latch literal, next literal, init: 0, 1 or the latch itself = free).
     pub latches: Vec<(u32, u32, u32)>,
     pub ands: Vec<(u32, u32, u32)>,
+    /// Bad-state literals (yosys `write_aiger -B`: the harness's assertions).
+    pub bad: Vec<u32>,
 }
 
 pub fn parse(text: &str) -> Result<Aig, String> {
@@ -63,6 +65,7 @@ pub fn parse(text: &str) -> Result<Aig, String> {
         inputs: Vec::new(),
         latches: Vec::new(),
         ands: Vec::new(),
+        bad: Vec::new(),
     };
     for _ in 0..i {
         g.inputs.push(nums(1)?[0]);
@@ -71,9 +74,15 @@ pub fn parse(text: &str) -> Result<Aig, String> {
         let v = nums(2)?;
         g.latches.push((v[0], v[1], v.get(2).copied().unwrap_or(0)));
     }
-    // Outputs, bad states, constraints, justice and fairness are not used:
-    // the miter has its own bad state.
-    for _ in 0..(o + b + c) {
+    // Outputs and constraints are not used; bad states are the harness's
+    // assertions (the combined miter checks them on copy A).
+    for _ in 0..o {
+        nums(1)?;
+    }
+    for _ in 0..b {
+        g.bad.push(nums(1)?[0]);
+    }
+    for _ in 0..c {
         nums(1)?;
     }
     if j + f > 0 {
@@ -139,6 +148,19 @@ impl Builder {
 /// `check_step`, some latch of copy A differs from copy B", with copy B
 /// frozen for the first `delay` steps.
 pub fn recurrence_miter(g: &Aig, shared: &[usize], delay: u64, check_step: u64) -> Vec<u8> {
+    miter(g, shared, delay, check_step, false)
+}
+
+/// The recurrence miter with the search from reset folded in: its bad state
+/// is also "some assertion of copy A fails" (copy A runs from power-on, so
+/// its steps are those of the plain search).  One `bmc3` to `check_step`
+/// then does both checks: a violation before `check_step` is the design's;
+/// one at `check_step` may be either.
+pub fn combined_miter(g: &Aig, shared: &[usize], delay: u64, check_step: u64) -> Vec<u8> {
+    miter(g, shared, delay, check_step, true)
+}
+
+fn miter(g: &Aig, shared: &[usize], delay: u64, check_step: u64, with_base: bool) -> Vec<u8> {
     let m = g.max_var;
     let mut b = Builder {
         next_var: 2 * m,
@@ -196,7 +218,13 @@ pub fn recurrence_miter(g: &Aig, shared: &[usize], delay: u64, check_step: u64) 
         diffs.push(b.xor(l, lb_l));
     }
     let differ = b.any(&diffs);
-    let bad = b.and(at_check, differ);
+    let recur_bad = b.and(at_check, differ);
+    let bad = if with_base {
+        let base_bad = b.any(&g.bad);
+        b.or(recur_bad, base_bad)
+    } else {
+        recur_bad
+    };
     binary(&b, bad)
 }
 

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use crate::ProveError;
 
 /// The prover behind `--solver`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Solver {
     /// ABC over AIGER: `bmc3` from reset to the recurrence bound, and the
@@ -249,6 +249,53 @@ pub fn recurrence(p: &Prepared, frame_cycles: u64, secs: u64) -> Result<Option<b
     Ok(match parse_abc(&out, frames)? {
         Verdict::Violated { .. } => Some(false),
         Verdict::Bounded { steps } if steps > check => Some(true),
+        _ => None,
+    })
+}
+
+/// What the combined miter (`aiger::combined_miter`) found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Combined {
+    /// No violation from reset within `2F + 2` steps and the state recurs:
+    /// proved for all time.
+    Holds,
+    /// An assertion fails from reset at this step (before the recurrence step).
+    Fails { step: u64 },
+    /// A violation at the recurrence step: either check; the caller decides.
+    AtCheck,
+}
+
+/// The search from reset and the recurrence check in one `bmc3` run on the
+/// combined miter: the two copies' unrolling is shared with the search
+/// instead of repeated.  `None`: ABC did not finish in `secs`.
+pub fn combined(
+    p: &Prepared,
+    frame_cycles: u64,
+    secs: u64,
+) -> Result<Option<Combined>, ProveError> {
+    let aag = std::fs::read_to_string(p.dir.join("design.aag"))
+        .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
+    let g = crate::aiger::parse(&aag).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
+    let shared = miso_inputs(p)?
+        .iter()
+        .map(|&(idx, _)| idx)
+        .collect::<Vec<_>>();
+    let check = 2 * frame_cycles + 2;
+    let miter = crate::aiger::combined_miter(&g, &shared, frame_cycles, check);
+    std::fs::write(p.dir.join("combined.aig"), miter)
+        .map_err(|e| ProveError::Tool(format!("combined.aig: {e}")))?;
+    let frames = check + 2;
+    let cmd = format!("read_aiger combined.aig; strash; bmc3 -F {frames} -T {secs}");
+    let out = run_tool(
+        &p.dir,
+        "yosys-abc",
+        &["-c", &cmd],
+        Duration::from_secs(secs),
+    )?;
+    Ok(match parse_abc(&out, frames)? {
+        Verdict::Violated { step } if step < check => Some(Combined::Fails { step }),
+        Verdict::Violated { .. } => Some(Combined::AtCheck),
+        Verdict::Bounded { steps } if steps > check => Some(Combined::Holds),
         _ => None,
     })
 }

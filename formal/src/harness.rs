@@ -127,6 +127,9 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
         branch(&mut v, &mut props, s, &layout, b);
     }
     merger(&mut v, &mut props, s, &layout);
+    if layout.link {
+        link(&mut v, &mut props);
+    }
     let _ = writeln!(v, "  wire ok = {};", {
         let w: Vec<&str> = props
             .iter()
@@ -168,11 +171,18 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout) {
         w(Role::SampleChannel) - 1,
         w(Role::SampleValue) - 1
     );
+    // A mix with a link has its two ports after the contract's (LINK_PORTS).
+    let link_ports = if layout.link {
+        v.push_str("  wire link_tx, link_overflow;\n");
+        ",\n    .link_tx(link_tx), .link_overflow(link_overflow)"
+    } else {
+        ""
+    };
     let _ = writeln!(
         v,
         "  {TOP_MODULE} dut (.clk(clk), .rst(rst), .adc_miso(adc_miso), .adc_cs_n(adc_cs_n),\n    \
          .adc_sclk(adc_sclk), .mux_sel(mux_sel), .mux_en(mux_en), .sample_valid(sample_valid),\n    \
-         .sample_channel(sample_channel), .sample_value(sample_value));"
+         .sample_channel(sample_channel), .sample_value(sample_value){link_ports});"
     );
     let (cb, sb) = (width(g.slot_cycles), width(g.frame_slots));
     let _ = writeln!(
@@ -452,6 +462,22 @@ fn merger(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
             what: what.into(),
         });
     }
+}
+
+/// The link to the host (a mix with `[link]`): its FIFO never overflows.
+/// The UART line's bit stream (packets, CRC) is not asserted: `link_tx` is
+/// connected so the design keeps its link, but only `link_overflow` is
+/// checked (docs/formal.md, Limits).
+fn link(v: &mut String, props: &mut Vec<PropertyDef>) {
+    v.push_str(
+        "\n  // The link's FIFO never drops a token: link_overflow stays low.\n  \
+         wire ok_link_overflow = link_overflow == 1'b0;\n",
+    );
+    props.push(PropertyDef {
+        name: "link.overflow".into(),
+        wire: "ok_link_overflow".into(),
+        what: "the link's FIFO never overflows: link_overflow stays low for any input".into(),
+    });
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@
 //! A bounded result is reported as `bounded` with its depth, never as a proof.
 
 pub mod aiger;
+pub mod cache;
 pub mod engine;
 pub mod faults;
 pub mod harness;
@@ -17,7 +18,7 @@ pub mod replay;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use lut_gen::Schedule;
 
@@ -39,7 +40,7 @@ pub enum ProveError {
 }
 
 /// What was established.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Outcome {
     /// Every property holds in every reachable state, for any MISO input.
@@ -61,7 +62,7 @@ impl Outcome {
     }
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct PropertyResult {
     pub name: String,
     pub result: Outcome,
@@ -69,7 +70,7 @@ pub struct PropertyResult {
 }
 
 /// A violation from reset, replayed.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Counterexample {
     /// First failing cycle, counted like `check` counts (cycle 0 = the first
     /// cycle after reset); -1 is the reset cycle.
@@ -90,7 +91,7 @@ pub struct Counterexample {
 }
 
 /// The result of `prove`, for the CLI and the build report.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Proof {
     pub mix: String,
     pub solver: Solver,
@@ -189,19 +190,31 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
             ),
         )
     };
+    let proved_note = format!(
+        "proved for all time: no violation from reset within {base} steps, and for every input the state at step {base} recurs at step {} of a copy started a frame later, so those steps reach every reachable state (state recurrence, ABC bmc3)",
+        base - f
+    );
     let (result, depth, note) = match opts.solver {
-        Solver::Abc => match engine::bmc(&prep, depth, opts.bmc_timeout_s)? {
+        // Both checks in one run first (the common cases: proved, or a
+        // violation from reset); the separate checks only when it cannot tell.
+        Solver::Abc => match engine::combined(&prep, f, opts.timeout_s)? {
+            Some(engine::Combined::Holds) => (Outcome::Proved, base, proved_note),
+            Some(engine::Combined::Fails { step }) => {
+                // the miter's witness is in its own inputs: the design's, from the plain search
+                match engine::bmc(&prep, step + 2, opts.bmc_timeout_s)? {
+                    engine::Verdict::Violated { step } => failed(step),
+                    engine::Verdict::Bounded { steps } => bmc_only(
+                        "the plain search did not reproduce the combined search's violation".into(),
+                        steps,
+                    ),
+                    engine::Verdict::Proved => unreachable!("bmc3 proves nothing"),
+                }
+            }
+            _ => match engine::bmc(&prep, depth, opts.bmc_timeout_s)? {
             engine::Verdict::Violated { step } => failed(step),
             engine::Verdict::Bounded { steps } if steps > base => {
                 match engine::recurrence(&prep, f, opts.timeout_s)? {
-                    Some(true) => (
-                        Outcome::Proved,
-                        base,
-                        format!(
-                            "proved for all time: no violation from reset within {base} steps, and for every input the state at step {base} recurs at step {} of a copy started a frame later, so those steps reach every reachable state (state recurrence, ABC bmc3)",
-                            base - f
-                        ),
-                    ),
+                    Some(true) => (Outcome::Proved, base, proved_note),
                     // No argument for all time: search deeper for a violation.
                     r => {
                         let why = if r.is_some() {
@@ -223,6 +236,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
                 steps,
             ),
             engine::Verdict::Proved => unreachable!("bmc3 proves nothing"),
+        },
         },
         Solver::Pdr | Solver::Cvc5 => {
             let closed = if opts.solver == Solver::Pdr {

@@ -4,10 +4,11 @@
 //! Verilog mutant that changes an output fails with a counterexample whose
 //! VCD the checker rejects at the same cycle; a fault that shows only after
 //! several frames fails too (the recurrence check sees the design keeps
-//! state across frames and the search goes deeper).
+//! state across frames and the search goes deeper); a random mix from
+//! `cosim::mixgen` proves.
 //! Long (`make test-long`): every preset and the 16-branch / 1,024-channel
-//! test mixes prove; the mutant campaign; the deep fault classes against a
-//! three-frame simulation.
+//! test mixes prove; six random mixes prove; the mutant campaign; the deep
+//! fault classes against a three-frame simulation.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -146,6 +147,64 @@ fn a_fault_after_five_frames_fails_and_is_never_called_proved() {
     );
 }
 
+/// Random mixes from the one generator (`cosim::mixgen`), on a 4 MHz clock
+/// and a 1 ms frame (4,000 cycles) so each proof takes seconds: one to
+/// three branches, one or two mux devices, SCLK, settling and rates drawn.
+fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
+    let shape = cosim::mixgen::Shape {
+        clock_hz: 4_000_000,
+        frame_us: 1_000,
+        slice_us: 500,
+        branches: (1, 3),
+        mux_devices: (1, 2),
+        sclk_hz: vec![1_000_000, 2_000_000],
+        settle_ns: vec![0, 1_000, 2_000],
+        channels: (2, 8),
+        rates_hz: vec![1_000, 2_000, 4_000],
+    };
+    let mut found = Vec::new();
+    for seed in 1..200u64 {
+        let text = cosim::mixgen::random_mix(seed, &shape);
+        let path = Path::new("random.toml");
+        let Ok(mix) = lut_gen::parse(path, &text) else {
+            continue;
+        };
+        // An overloaded draw has no schedule; one beyond the harness's
+        // limits has no proof to give: both are skipped, not proved.
+        let Ok(s) = lut_gen::synthesize(&mix) else {
+            continue;
+        };
+        if formal::generate(&s).is_err() {
+            continue;
+        }
+        found.push((seed, s));
+        if found.len() == count {
+            break;
+        }
+    }
+    assert_eq!(found.len(), count, "too few feasible random mixes");
+    found
+}
+
+fn assert_unseen_mix_proves(seed: u64, s: &lut_gen::Schedule) {
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(s, &emitted(s), dir.path());
+    eprintln!("random mix {seed}: {}", p.summary());
+    assert_eq!(p.result, Outcome::Proved, "seed {seed}: {}", p.summary());
+    assert_eq!(p.depth, 2 * s.grid.frame_cycles + 2);
+    assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
+}
+
+/// A mix no test was written for proves for all time (seconds).
+#[test]
+fn an_unseen_random_mix_proves() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let (seed, s) = unseen_mixes(1).remove(0);
+    assert_unseen_mix_proves(seed, &s);
+}
+
 #[test]
 fn harness_is_deterministic_and_names_every_contract_property() {
     let s = schedule("mixes/eskin34.toml");
@@ -198,6 +257,18 @@ fn every_preset_and_the_largest_test_mixes_prove() {
             p.summary()
         );
         assert_eq!(p.result, Outcome::Proved, "{m}: {}", p.summary());
+    }
+}
+
+/// Six random mixes (one to three branches each) prove for all time.
+#[test]
+#[ignore = "long: make test-long"]
+fn unseen_random_mixes_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    for (seed, s) in unseen_mixes(6) {
+        assert_unseen_mix_proves(seed, &s);
     }
 }
 

@@ -7,11 +7,13 @@
 //! - [`timing`]: a steady-state slice's timing diagram and WaveDrom JSON;
 //! - [`speed`]: speed against accuracy ([`speed::MethodScore`]);
 //! - [`schedulability`]: where scheduling breaks around the mix;
+//! - [`proof`]: the formal proof of the gateware (or its cached result);
 //! - [`tables`]: the audit, the slot table (Table 1), per-channel intervals
 //!   and the fault campaign as report tables.
 
 pub mod dft;
 pub mod figure7;
+pub mod proof;
 pub mod schedulability;
 pub mod speed;
 pub mod synth;

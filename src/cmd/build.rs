@@ -49,7 +49,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', value_name = "STEP,...")]
     pub only: Vec<String>,
     /// Leave out these steps (comma-separated): audit, lut, verilog, sim,
-    /// golden, faults, synth, timing, figure7, schedulability, speed.
+    /// golden, faults, prove, synth, timing, figure7, schedulability, speed.
     #[arg(long, value_delimiter = ',', value_name = "STEP,...")]
     pub skip: Vec<String>,
     /// Also write the steps as JUnit XML (one test case per step).
@@ -110,6 +110,7 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: {}: cannot create directory: {e}", a.out.display());
         return 2;
     }
+    let plan = steps::with_remembered_proof(plan, &s, &a.out);
     let mut job = Job::new(&a, &s, plan.iter().filter(|p| p.1).count());
     steps::run_all(&mut job, &a, &s, &plan);
     if let Err(e) = job.finish() {

@@ -11,13 +11,14 @@ use super::job::{Done, Job};
 use super::{Args, Charts};
 
 /// Every step: its name on the command line and in the report.
-pub const STEPS: [(&str, &str); 11] = [
+pub const STEPS: [(&str, &str); 12] = [
     ("audit", "audit"),
     ("lut", "slot LUT"),
     ("verilog", "Verilog, ports.json, constraints"),
     ("sim", "co-simulation"),
     ("golden", "golden comparison"),
     ("faults", "fault campaign"),
+    ("prove", "formal proof (all time)"),
     ("synth", "synthesis estimate (iCE40 HX8K)"),
     ("timing", "chart: timing of a slice"),
     ("figure7", "chart: Figure 7 for this mix's rates"),
@@ -26,6 +27,11 @@ pub const STEPS: [(&str, &str); 11] = [
 ];
 
 const MIX_CHARTS: [&str; 4] = ["timing", "figure7", "schedulability", "speed"];
+
+/// Why `prove` is left out by default; a remembered proof of the same
+/// Verilog is still shown (`run_all`).
+const PROVE_OPT_IN: &str =
+    "proves for all time (minutes): --charts all or --only prove; a cached proof of the same Verilog is shown";
 
 /// Which steps run: every step with whether it runs, or why a name given
 /// is unknown (checked before anything runs).
@@ -47,6 +53,8 @@ pub fn plan(a: &Args) -> Result<Vec<(&'static str, bool, &'static str)>, String>
                 (named(&a.only, id), "not in --only")
             } else if named(&a.skip, id) {
                 (false, "--skip")
+            } else if id == "prove" && a.charts != Charts::All {
+                (false, PROVE_OPT_IN)
             } else if MIX_CHARTS.contains(&id) && a.charts == Charts::None {
                 (false, "--charts none")
             } else {
@@ -55,6 +63,25 @@ pub fn plan(a: &Args) -> Result<Vec<(&'static str, bool, &'static str)>, String>
             (id, run, why)
         })
         .collect())
+}
+
+/// The plan's `why` of a proof left out by default but remembered.
+const REMEMBERED: &str = "remembered";
+
+/// A proof left out by default is still shown when one of the same Verilog
+/// and harness is remembered (`measure::proof::cached`).
+pub fn with_remembered_proof(
+    mut plan: Vec<(&'static str, bool, &'static str)>,
+    s: &Schedule,
+    out: &std::path::Path,
+) -> Vec<(&'static str, bool, &'static str)> {
+    for p in &mut plan {
+        if p.0 == "prove" && !p.1 && p.2 == PROVE_OPT_IN && measure::proof::cached(s, out).is_some()
+        {
+            *p = ("prove", true, REMEMBERED);
+        }
+    }
+    plan
 }
 
 /// The simulator of the co-simulation and the charts: Verilator when it is
@@ -108,6 +135,10 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(&'static str, boo
             "sim" => sim(j, a, s, &mut sim_report),
             "golden" => golden(j, a, s),
             "faults" => faults(j, a, s, &mut campaign),
+            "prove" if why == REMEMBERED => proved(
+                measure::proof::cached(s, &j.out).ok_or("the remembered proof went away".into()),
+            ),
+            "prove" => prove(j, s),
             "synth" => synth(s, background.take()),
             "timing" => timing(j, s),
             "figure7" => figure7(s),
@@ -405,6 +436,32 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<cosim::faults::
     };
     *keep = Some(c);
     written(w, d.files(&["faults.json"]).section(sec))
+}
+
+fn prove(j: &mut Job, s: &Schedule) -> Done {
+    if let Some(t) = ["yosys", "yosys-abc", "iverilog"]
+        .into_iter()
+        .find(|t| !measure::synth::tool_present(t))
+    {
+        return Done::skipped(format!("{t} not installed (make tools)"));
+    }
+    proved(measure::proof::prove(s, &j.out))
+}
+
+/// A proof's step: proved is ok; bounded (not a proof) and failed fail.
+fn proved(r: Result<measure::proof::Shown, String>) -> Done {
+    let shown = match r {
+        Ok(x) => x,
+        Err(e) => return Done::failed("the proof could not run", e),
+    };
+    let files: Vec<String> = shown.section.links.iter().map(|(f, _)| f.clone()).collect();
+    let files: Vec<&str> = files.iter().map(String::as_str).collect();
+    let d = if shown.proof.result == formal::Outcome::Proved {
+        Done::ok(shown.line)
+    } else {
+        Done::failed(shown.line, shown.proof.summary())
+    };
+    d.files(&files).section(shown.section)
 }
 
 fn synth(s: &Schedule, background: Option<Background>) -> Done {

@@ -1,0 +1,153 @@
+//! The formal proof of the emitted gateware as a report section:
+//! `formal::prove` (minutes for a 48 MHz preset), or the proof of the same
+//! Verilog and harness remembered by `formal::cache` (in the build
+//! directory's `prove/cache/`, and under `$SLOTFORGE_CACHE/proofs` when set).
+//! A bounded result is shown as bounded, never as proved.
+
+use std::path::{Path, PathBuf};
+
+use formal::{Outcome, Proof, ProveOptions};
+use lut_gen::Schedule;
+use report::{Section, Table};
+
+/// Where the build keeps its proof (relative to the build directory): the
+/// cache and a counterexample's VCD and `.gtkw`.
+pub const DIR: &str = "prove";
+
+/// A proof to show: how it came (`cached`) and the report's section.
+pub struct Shown {
+    pub proof: Proof,
+    pub cached: bool,
+    pub section: Section,
+    /// The step's one line.
+    pub line: String,
+}
+
+/// The emitted Verilog and the cache key of proving it against `s`'s harness.
+fn keyed(s: &Schedule) -> Result<(String, String), String> {
+    let design = hdl::emit(s, None)
+        .map_err(|e| e.to_string())?
+        .verilog()
+        .to_string();
+    let h = formal::generate(s).map_err(|e| e.to_string())?;
+    let key = formal::cache::key(&h.verilog, &design, formal::Solver::Abc);
+    Ok((design, key))
+}
+
+fn cache_dirs(out: &Path) -> Vec<PathBuf> {
+    let mut d = vec![out.join(DIR).join("cache")];
+    d.extend(formal::cache::shared_dir());
+    d
+}
+
+/// The remembered proof of `s`'s emitted gateware, if one exists.
+pub fn cached(s: &Schedule, out: &Path) -> Option<Shown> {
+    let (_, key) = keyed(s).ok()?;
+    let p = formal::cache::load(&cache_dirs(out), &key)?;
+    Some(shown(p, true))
+}
+
+/// Proves `s`'s emitted gateware (or shows the remembered proof) and keeps
+/// a proof in the caches.  `Err`: the proof could not run (a tool missing
+/// or failing, a mix beyond the harness).
+pub fn prove(s: &Schedule, out: &Path) -> Result<Shown, String> {
+    let (design, key) = keyed(s)?;
+    let dirs = cache_dirs(out);
+    if let Some(p) = formal::cache::load(&dirs, &key) {
+        return Ok(shown(p, true));
+    }
+    let p =
+        formal::prove(s, &design, &ProveOptions::new(out.join(DIR))).map_err(|e| e.to_string())?;
+    for d in &dirs {
+        formal::cache::store(d, &key, &p)?;
+    }
+    Ok(shown(p, false))
+}
+
+fn word(o: Outcome) -> &'static str {
+    match o {
+        Outcome::Proved => "proved",
+        Outcome::Bounded => "bounded only (not a proof)",
+        Outcome::Failed => "FAILED",
+    }
+}
+
+/// The section and line of `p`.
+pub fn shown(p: Proof, cached: bool) -> Shown {
+    let line = match p.result {
+        Outcome::Proved => format!(
+            "proved for all time: {} properties, depth {} steps, solver {:.1} s{}",
+            p.properties.len(),
+            p.depth,
+            p.solver_seconds,
+            if cached {
+                " (remembered: same Verilog and harness)"
+            } else {
+                ""
+            }
+        ),
+        Outcome::Bounded => format!(
+            "BOUNDED ONLY, not a proof: no violation within {} steps of reset",
+            p.depth
+        ),
+        Outcome::Failed => format!(
+            "FAILED: a trace from reset violates the contract at cycle {}",
+            p.cycle.unwrap_or(-1)
+        ),
+    };
+    let mut t = Table::new(&["property", "result", "what it asserts"]);
+    for q in &p.properties {
+        t.push(vec![q.name.clone(), word(q.result).into(), q.what.clone()]);
+    }
+    let mut paragraphs = vec![
+        format!(
+            "`slotforge prove` ({}, docs/formal.md): the pin contract asserted at the ports of \
+             the emitted `slotforge_top` for any MISO input, one reset cycle assumed. Result: {}, \
+             depth {} steps, {:.1} s in all, solver {:.1} s.",
+            p.solver.name(),
+            word(p.result),
+            p.depth,
+            p.seconds,
+            p.solver_seconds
+        ),
+        p.note.clone(),
+    ];
+    if cached {
+        paragraphs.push(
+            "Shown from the proof cache: an earlier run proved this same Verilog against this \
+             same harness with this same engine (the key hashes all three); times are that run's."
+                .into(),
+        );
+    }
+    let mut links = Vec::new();
+    if let Some(c) = &p.counterexample {
+        paragraphs.push(format!(
+            "Counterexample at cycle {}; the checker on its trace: {}",
+            c.cycle,
+            c.diagnosis.lines().next().unwrap_or("")
+        ));
+        let name = |f: &Path| {
+            format!(
+                "{DIR}/{}",
+                f.file_name()
+                    .map(|n| n.to_string_lossy())
+                    .unwrap_or_default()
+            )
+        };
+        links.push((name(&c.vcd), "the counterexample (VCD)".into()));
+        links.push((name(&c.gtkw), "its GTKWave save file".into()));
+    }
+    let section = Section {
+        title: "Formal proof".into(),
+        paragraphs,
+        tables: vec![("Properties".into(), t)],
+        links,
+        ..Section::default()
+    };
+    Shown {
+        proof: p,
+        cached,
+        section,
+        line,
+    }
+}
