@@ -164,7 +164,7 @@ impl EventLog {
         let n = (trace.len() - z).min(cycles as usize);
         // The link's line read back as a receiver would, one event per byte.
         let mut rx = match lut_gen::hostlink::plan(s) {
-            Some(Ok(lp)) => Some(link::rx::UartRx::new(lp.uart())),
+            Some(Ok(lp)) => lp.uart().map(link::rx::UartRx::new),
             _ => None,
         };
         for (c, (_, p, _)) in trace.cycles[z..z + n].iter().enumerate() {

@@ -29,7 +29,7 @@ use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use lut_gen::ports::{Role, LINK_PORTS, PORT_NAMES as PORTS, TOP_MODULE};
+use lut_gen::ports::{LinkPort, Role, AXIS_PORTS, PORT_NAMES as PORTS, TOP_MODULE};
 use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker};
@@ -314,6 +314,8 @@ const CHAN: usize = Role::SampleChannel as usize;
 const VALUE: usize = Role::SampleValue as usize;
 /// The first of the link's ports in [`State`].
 const LINK: usize = PORTS.len();
+/// Port slots: [`PORTS`], then the most link ports a mix has ([`AXIS_PORTS`]).
+const NPORT: usize = LINK + AXIS_PORTS.len();
 
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
 /// (or `lsb - j` when the range is ascending).
@@ -339,8 +341,8 @@ struct Resolved {
     has_rst: bool,
     scope: String,
     widths: [u32; 10],
-    /// The link's ports are read too.
-    link: bool,
+    /// The link's ports, read after [`PORTS`] (none without a link).
+    link: &'static [LinkPort],
 }
 
 fn resolve(
@@ -522,12 +524,12 @@ fn resolve(
             has_clk = true;
         }
     }
-    if layout.link {
-        for (k, lp) in LINK_PORTS.iter().enumerate() {
+    {
+        for (k, lp) in layout.link_ports().iter().enumerate() {
             let v = h
                 .vars
                 .iter()
-                .find(|v| v.scope == scope && v.name == lp.name && v.width == 1)
+                .find(|v| v.scope == scope && v.name == lp.name && v.width == lp.width)
                 .ok_or_else(|| {
                     perr(format!(
                         "port `{}` (the mix's link) not found in scope `{scope}`",
@@ -536,7 +538,7 @@ fn resolve(
                 })?;
             ids.get_mut(&v.id).unwrap().push(Sink {
                 port: (LINK + k) as u8,
-                width: 1,
+                width: lp.width,
                 lsb: 0,
                 down: true,
             });
@@ -548,7 +550,7 @@ fn resolve(
         has_rst,
         scope: scope.to_string(),
         widths,
-        link: layout.link,
+        link: layout.link_ports(),
     })
 }
 
@@ -671,9 +673,11 @@ fn parse_value(s: &[u8], width: u32) -> Option<Val> {
     Some(Val { v, x })
 }
 
-/// The ports of [`PORTS`], then the link's ([`LINK_PORTS`]).
+/// The ports of [`PORTS`], then the link's (`Layout::link_ports`).
 struct State {
-    port: [Val; 12],
+    port: [Val; NPORT],
+    /// The link is AXI4-Stream: its slots are [`AXIS_PORTS`]'s.
+    axis: bool,
 }
 
 impl State {
@@ -714,8 +718,12 @@ impl State {
                 sample_valid: g(VALID) & 1 == 1,
                 sample_channel: g(CHAN) as u16,
                 sample_value: g(VALUE) as u16,
-                link_tx: g(LINK) & 1 == 1,
-                link_overflow: g(LINK + 1) & 1 == 1,
+                link_tx: !self.axis && g(LINK) & 1 == 1,
+                link_overflow: g(if self.axis { LINK + 4 } else { LINK + 1 }) & 1 == 1,
+                axis_tdata: if self.axis { g(LINK) as u8 } else { 0 },
+                axis_tvalid: self.axis && g(LINK + 1) & 1 == 1,
+                axis_tlast: self.axis && g(LINK + 2) & 1 == 1,
+                axis_tready: self.axis && g(LINK + 3) & 1 == 1,
             }
         };
         (pick(|p| p.v), pick(|p| p.x))
@@ -780,11 +788,11 @@ fn body<R: BufRead>(
     sink: &mut dyn CycleSink,
 ) -> Result<BodyInfo, VcdError> {
     let mut st = State {
-        port: [Val { v: 0, x: 0 }; 12],
+        port: [Val { v: 0, x: 0 }; NPORT],
+        axis: res.link.len() == AXIS_PORTS.len(),
     };
-    if res.link {
-        st.port[LINK].x = 1;
-        st.port[LINK + 1].x = 1;
+    for (k, lp) in res.link.iter().enumerate() {
+        st.port[LINK + k].x = (1u128 << lp.width) - 1;
     }
     for (i, w) in res.widths.iter().enumerate() {
         st.port[i].x = if *w >= 128 {
@@ -810,15 +818,22 @@ fn body<R: BufRead>(
         pins: Pins,
         xz: Pins,
         miso: Val,
+        tready: Option<Val>,
     ) {
-        if let Some((r, p, x)) = pending.take() {
+        if let Some((r, mut p, mut x)) = pending.take() {
+            // tready is an input like MISO: the cycle's value is the one
+            // the edge ending it samples
+            if let Some(t) = tready {
+                p.axis_tready = t.v & 1 == 1;
+                x.axis_tready = t.x & 1 == 1;
+            }
             sink.cycle(r, &p, &x, miso.v as u64, miso.x as u64);
         }
         info.cycles += 1;
         *pending = Some((rst, pins, xz));
     }
     let mut close = |st: &State,
-                     before: &[Val; 12],
+                     before: &[Val; NPORT],
                      t: u64,
                      next: Option<u64>,
                      out_changed: bool,
@@ -862,6 +877,7 @@ fn body<R: BufRead>(
                         pins,
                         xz,
                         before[MISO],
+                        st.axis.then_some(before[LINK + 3]),
                     );
                 }
             }
@@ -875,6 +891,7 @@ fn body<R: BufRead>(
                         pins,
                         xz,
                         before[MISO],
+                        st.axis.then_some(before[LINK + 3]),
                     );
                 }
                 if let Some(n) = next {
@@ -892,6 +909,7 @@ fn body<R: BufRead>(
                             pins,
                             xz,
                             st.port[MISO],
+                            st.axis.then_some(st.port[LINK + 3]),
                         );
                         e = e.saturating_add(period);
                     }
@@ -1022,7 +1040,11 @@ fn body<R: BufRead>(
         return Err(lx.truncated("the last line is incomplete"));
     }
     close(&st, &before, time, None, out_changed, first_step, &mut info);
-    if let Some((r, p, x)) = pending.take() {
+    if let Some((r, mut p, mut x)) = pending.take() {
+        if st.axis {
+            p.axis_tready = st.port[LINK + 3].v & 1 == 1;
+            x.axis_tready = st.port[LINK + 3].x & 1 == 1;
+        }
         sink.cycle(r, &p, &x, st.port[MISO].v as u64, st.port[MISO].x as u64);
     }
     info.last_time = time;
