@@ -724,7 +724,7 @@ pub fn manifest(s: &Schedule) -> String {
             o.insert(lp.key.into(), json!(lp.name));
         }
         if let Some(a) = p.axis() {
-            o.insert("tlast".into(), json!(a.tlast.name()));
+            o.insert("tlast_at".into(), json!(a.tlast.name()));
             o.insert("ready_within".into(), json!(a.ready_within));
         } else {
             o.insert("baud".into(), json!(p.baud));
