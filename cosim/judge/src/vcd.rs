@@ -817,8 +817,9 @@ fn body<R: BufRead>(
         rst: Option<bool>,
         pins: Pins,
         xz: Pins,
-        miso: Val,
-        tready: Option<Val>,
+        // the inputs the edge ending the pending cycle samples: MISO and,
+        // for an AXIS link, tready
+        (miso, tready): (Val, Option<Val>),
     ) {
         if let Some((r, mut p, mut x)) = pending.take() {
             // tready is an input like MISO: the cycle's value is the one
@@ -876,8 +877,7 @@ fn body<R: BufRead>(
                         rst_of(&before[RST]),
                         pins,
                         xz,
-                        before[MISO],
-                        st.axis.then_some(before[LINK + 3]),
+                        (before[MISO], st.axis.then_some(before[LINK + 3])),
                     );
                 }
             }
@@ -890,8 +890,7 @@ fn body<R: BufRead>(
                         rst_of(&before[RST]),
                         pins,
                         xz,
-                        before[MISO],
-                        st.axis.then_some(before[LINK + 3]),
+                        (before[MISO], st.axis.then_some(before[LINK + 3])),
                     );
                 }
                 if let Some(n) = next {
@@ -908,8 +907,7 @@ fn body<R: BufRead>(
                             rst_of(&st.port[RST]),
                             pins,
                             xz,
-                            st.port[MISO],
-                            st.axis.then_some(st.port[LINK + 3]),
+                            (st.port[MISO], st.axis.then_some(st.port[LINK + 3])),
                         );
                         e = e.saturating_add(period);
                     }
