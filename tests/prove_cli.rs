@@ -41,6 +41,16 @@ fn a_bad_mix_exits_2_naming_the_file() {
 }
 
 #[test]
+fn an_axi_stream_link_is_refused_with_the_reason() {
+    let mix = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("mixes/eskin34-axis.toml");
+    slotforge()
+        .args(["prove", mix.to_str().unwrap()])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("AXI4-Stream link"));
+}
+
+#[test]
 fn rtl_off_the_port_contract_exits_2() {
     let dir = tempfile::tempdir().unwrap();
     let v = dir.path().join("x.v");

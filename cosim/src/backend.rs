@@ -168,7 +168,8 @@ fn in_process(
         trace.map(|t| &mut *t as &mut dyn Observer),
     );
     let obs = (tee.0.is_some() || tee.1.is_some()).then_some(&mut tee as &mut dyn Observer);
-    let report = run_dut(s, dut, frames, &ro, source, obs);
+    let mut dut = judge::run::with_slave(s, dut, opts.tready);
+    let report = run_dut(s, &mut *dut, frames, &ro, source, obs);
     if let Some(w) = writer {
         w.finish().map_err(|e| SimError::Io(e.to_string()))?;
     }

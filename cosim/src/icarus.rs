@@ -25,7 +25,7 @@ use judge::vcd::CycleSink;
 use judge::vcdout::edge_ps;
 use judge::Report;
 use lut_gen::parts::Start;
-use lut_gen::ports::{Layout, Pins, Role, LINK_PORTS, PORTS, TOP_MODULE};
+use lut_gen::ports::{Dir, Layout, Pins, Role, AXIS_PORTS, PORTS, TOP_MODULE};
 
 use crate::error::{BackendError, SimError};
 use crate::options::{SimOptions, VcdOut};
@@ -43,6 +43,24 @@ pub struct Testbench {
 
 /// The testbench for `cycles` cycles after reset with `stimulus`.
 pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u64) -> Testbench {
+    testbench_with(
+        s,
+        stimulus,
+        reset_cycles,
+        cycles,
+        link::ReadyPattern::Always,
+    )
+}
+
+/// [`testbench`] with the AXI4-Stream slave driving `tready` as `pattern`
+/// (a mix with an `axis` link; ignored otherwise).
+pub fn testbench_with(
+    s: &Schedule,
+    stimulus: Stimulus,
+    reset_cycles: u64,
+    cycles: u64,
+    tready: link::ReadyPattern,
+) -> Testbench {
     let l = Layout::new(s);
     let analog = Analog::new(s, stimulus);
     let nch = s.channels.len() as u64;
@@ -135,18 +153,23 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
             _ => writeln!(decls, "  wire {range}{};", p.name),
         };
     }
-    let link_ports: &[&str] = if l.link {
-        &[LINK_PORTS[0].name, LINK_PORTS[1].name]
-    } else {
-        &[]
-    };
-    for name in link_ports {
-        let _ = writeln!(decls, "  wire {name};");
+    for p in l.link_ports() {
+        let _ = match (p.dir, p.width) {
+            (Dir::In, _) => writeln!(decls, "  reg {} = 1;", p.name),
+            (_, 1) => writeln!(decls, "  wire {};", p.name),
+            (_, w) => writeln!(decls, "  wire [{}:0] {};", w - 1, p.name),
+        };
+    }
+    if let Some(a) = lut_gen::hostlink::plan(s)
+        .and_then(|p| p.ok())
+        .and_then(|p| p.axis())
+    {
+        adcs.push_str(&axis_slave(tready, a.ready_within));
     }
     let connect = PORTS
         .iter()
         .map(|p| p.name)
-        .chain(link_ports.iter().copied())
+        .chain(l.link_ports().iter().map(|p| p.name))
         .map(|n| format!(".{n}({n})"))
         .collect::<Vec<_>>()
         .join(",\n    ");
@@ -169,6 +192,29 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         tables,
         reset_cycles,
     }
+}
+
+/// The AXI4-Stream slave of `link::ReadyDriver` in Verilog: `tready` for
+/// each cycle from the pattern and `tvalid` of that cycle, set just after
+/// the edge that begins the cycle; high during reset, the pattern restarting.
+fn axis_slave(pattern: link::ReadyPattern, within: u32) -> String {
+    let [_, tv, _, tr, _] = AXIS_PORTS.map(|p| p.name);
+    let (seed, r) = match pattern {
+        link::ReadyPattern::Always => (1, "1'b1".to_string()),
+        link::ReadyPattern::WorstCase => (1, "due".to_string()),
+        link::ReadyPattern::Random { seed } => (seed.max(1), "xs[0] | due".to_string()),
+    };
+    let step = if matches!(pattern, link::ReadyPattern::Random { .. }) {
+        "      xs = xs ^ (xs << 13);\n      xs = xs ^ (xs >> 17);\n      xs = xs ^ (xs << 5);\n"
+    } else {
+        ""
+    };
+    format!(
+        "  // AXI4-Stream slave ({}): every beat accepted within {within} cycle(s)\n  reg [31:0] xs = 32'd{seed};\n  reg [31:0] waited = 32'd0;\n  reg due;\n  always @(posedge {clk}) begin\n    #1;\n    if ({rst}) begin\n      xs = 32'd{seed};\n      waited = 32'd0;\n      {tr} = 1'b1;\n    end else begin\n      due = waited + 32'd1 >= 32'd{within};\n{step}      {tr} = {r};\n      waited = ({tv} & !{tr}) ? waited + 32'd1 : 32'd0;\n    end\n  end\n\n",
+        pattern.name(),
+        clk = Role::Clock.name(),
+        rst = Role::Reset.name(),
+    )
 }
 
 /// A `case` setting `id<b>` to the input id cosim's ADC model gives each
@@ -380,7 +426,7 @@ pub fn run(
     let d = dir.path();
     let reset = judge::run::reset_cycles(s, opts.reset_cycles);
     let cycles = frames * s.grid.frame_cycles;
-    let tb = testbench(s, opts.stimulus, reset, cycles);
+    let tb = testbench_with(s, opts.stimulus, reset, cycles, opts.tready);
     match &opts.rtl {
         // outside Verilog (checked against the contract) in the emitted file's place
         Some(path) => {

@@ -87,6 +87,9 @@ pub struct SimOptions {
     /// icarus only); its `slotforge_top` must honour the pin contract
     /// ([`crate::rtl::load_rtl`]).
     pub rtl: Option<PathBuf>,
+    /// How the AXI4-Stream slave drives `m_axis_tready` (a mix with an
+    /// `axis` link only).
+    pub tready: link::ReadyPattern,
 }
 
 impl Default for SimOptions {
@@ -97,6 +100,7 @@ impl Default for SimOptions {
             vcd: None,
             reset_cycles: 4,
             rtl: None,
+            tready: link::ReadyPattern::Always,
         }
     }
 }

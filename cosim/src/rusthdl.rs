@@ -23,6 +23,10 @@ impl Dut for RustHdlDut {
     fn step(&mut self, rst: bool, miso: u64) -> Pins {
         self.0.step(rst, miso)
     }
+
+    fn set_tready(&mut self, ready: bool) {
+        self.0.set_tready(ready)
+    }
 }
 
 /// The emitted Verilog of a schedule.

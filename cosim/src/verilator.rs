@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use judge::run::Dut;
-use lut_gen::ports::{Pins, Role, LINK_PORTS, TOP_MODULE};
+use lut_gen::ports::{LinkPort, Pins, Role, AXIS_PORTS, LINK_PORTS, TOP_MODULE};
 
 use crate::error::BackendError;
 
@@ -37,7 +37,12 @@ struct SfPins {
     uint8_t sample_valid;
     uint8_t link_tx;
     uint8_t link_overflow;
-    uint8_t pad[5];
+    uint8_t axis_tdata;
+    uint8_t axis_tvalid;
+    uint8_t axis_tlast;
+    // an input: the AXIS slave's tready, set by the caller before the edge
+    uint8_t axis_tready;
+    uint8_t pad[1];
 };
 static_assert(sizeof(SfPins) == 40, "SfPins must match the Rust layout");
 
@@ -75,7 +80,7 @@ extern "C" void sf_step(void* p, uint8_t rst, uint64_t miso, SfPins* o) {
     SfModel* m = (SfModel*)p;
     V@TOP@* t = m->top;
     t->@reset@ = rst;
-    t->@miso@ = miso;
+    t->@miso@ = miso;@LINKIN@
     t->@clock@ = 1;
     t->eval();
     o->cs_n = t->@cs_n@;
@@ -99,16 +104,26 @@ extern "C" void sf_free(void* p) {
 "#;
 
 /// The shim's C++ text with the contract's module and port names; `link`:
-/// the top has the link's ports ([`LINK_PORTS`]).
-fn shim(link: bool) -> String {
-    let link_pins = if link {
+/// the top's link ports ([`LINK_PORTS`], [`AXIS_PORTS`] or none).
+fn shim(link: &[LinkPort]) -> String {
+    let (link_in, link_pins) = if link == AXIS_PORTS {
+        let [td, tv, tl, tr, ovf] = AXIS_PORTS.map(|p| p.name);
+        (
+            format!("\n    t->{tr} = o->axis_tready;"),
+            format!("\n    o->axis_tdata = t->{td};\n    o->axis_tvalid = t->{tv};\n    o->axis_tlast = t->{tl};\n    o->link_overflow = t->{ovf};"),
+        )
+    } else if link == LINK_PORTS {
         let [tx, ovf] = LINK_PORTS.map(|p| p.name);
-        format!("\n    o->link_tx = t->{tx};\n    o->link_overflow = t->{ovf};")
+        (
+            String::new(),
+            format!("\n    o->link_tx = t->{tx};\n    o->link_overflow = t->{ovf};"),
+        )
     } else {
-        String::new()
+        (String::new(), String::new())
     };
     let mut t = SHIM_TEMPLATE
         .replace("@TOP@", TOP_MODULE)
+        .replace("@LINKIN@", &link_in)
         .replace("@LINK@", &link_pins);
     for r in Role::ALL {
         t = t.replace(&format!("@{}@", r.key()), r.name());
@@ -131,7 +146,12 @@ struct SfPins {
     sample_valid: u8,
     link_tx: u8,
     link_overflow: u8,
-    pad: [u8; 5],
+    axis_tdata: u8,
+    axis_tvalid: u8,
+    axis_tlast: u8,
+    /// An input: set before each step.
+    axis_tready: u8,
+    pad: [u8; 1],
 }
 
 const _: () = assert!(std::mem::size_of::<SfPins>() == 40);
@@ -210,7 +230,13 @@ pub struct Built {
 pub fn build(verilog: &str) -> Result<Built, BackendError> {
     // A top with the link declares its line (emitted Verilog without a
     // link never names it).
-    let shim = shim(verilog.contains(LINK_PORTS[0].name));
+    let shim = shim(if verilog.contains(AXIS_PORTS[0].name) {
+        &AXIS_PORTS
+    } else if verilog.contains(LINK_PORTS[0].name) {
+        &LINK_PORTS
+    } else {
+        &[]
+    });
     let vv = tool_version("verilator", "apt-get install -y verilator")?;
     let gv = tool_version("g++", "apt-get install -y g++")?;
     let key = format!(
@@ -414,7 +440,15 @@ impl Dut for VerilatedDut {
             sample_value: self.out.sample_value,
             link_tx: self.out.link_tx != 0,
             link_overflow: self.out.link_overflow != 0,
+            axis_tdata: self.out.axis_tdata,
+            axis_tvalid: self.out.axis_tvalid != 0,
+            axis_tlast: self.out.axis_tlast != 0,
+            axis_tready: false,
         }
+    }
+
+    fn set_tready(&mut self, ready: bool) {
+        self.out.axis_tready = ready as u8;
     }
 }
 

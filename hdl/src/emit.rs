@@ -13,7 +13,7 @@ use rust_hdl::prelude::*;
 use serde::Deserialize;
 
 use crate::core::Core;
-use crate::link::UartLink;
+use crate::link::{AxisLink, UartLink};
 use crate::plan::{plan_with, LutForm, Plan};
 use crate::widths::{CH_BITS, EN_TOTAL, MAX_BRANCHES, VALUE_BITS};
 use crate::HdlError;
@@ -303,11 +303,7 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     let _ = writeln!(v, "`default_nettype none");
     let _ = writeln!(v);
     let _ = writeln!(v, "module {TOP_MODULE} (");
-    let link_ports = if p.link.is_some() {
-        &ports::LINK_PORTS[..]
-    } else {
-        &[]
-    };
+    let link_ports = l.link_ports();
     let nports = PORTS.len() + link_ports.len();
     for (i, port) in PORTS.iter().enumerate() {
         let dir = match port.dir {
@@ -328,7 +324,17 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
         } else {
             ""
         };
-        let _ = writeln!(v, "    {} wire {}{sep}", port.dir.verilog(), port.name);
+        let range = if port.width > 1 {
+            format!("[{}:0] ", port.width - 1)
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            v,
+            "    {} wire {range}{}{sep}",
+            port.dir.verilog(),
+            port.name
+        );
     }
     let _ = writeln!(v, ");");
     let _ = writeln!(v);
@@ -386,7 +392,21 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
         let _ = writeln!(v, "        .{}({to}){sep}", core_port_name(port.role));
     }
     let _ = writeln!(v, "    );");
-    if p.link.is_some() {
+    if p.link.is_some_and(|lp| lp.axis.is_some()) {
+        let [td, tv, tl, tr, ovf] = ports::AXIS_PORTS.map(|p| p.name);
+        let _ = writeln!(v);
+        let _ = writeln!(
+            v,
+            "    // the link to the host: packets of the merged sample stream as AXI4-Stream beats (docs/packet-format.md)"
+        );
+        let _ = writeln!(
+            v,
+            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .tready({tr}),\n        .tdata({td}),\n        .tvalid({tv}),\n        .tlast({tl}),\n        .ovf({ovf})\n    );",
+            Role::Clock.name(),
+            Role::Reset.name(),
+            Role::SampleValid.name()
+        );
+    } else if p.link.is_some() {
         let [tx, ovf] = ports::LINK_PORTS.map(|p| p.name);
         let _ = writeln!(v);
         let _ = writeln!(
@@ -413,9 +433,16 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     );
     v.push_str(&body);
     if let Some(lp) = p.link {
-        let mut link = UartLink::new(lp);
-        link.connect_all();
-        let text = generate_verilog(&link)
+        let text = if lp.axis.is_some() {
+            let mut link = AxisLink::new(lp);
+            link.connect_all();
+            generate_verilog(&link)
+        } else {
+            let mut link = UartLink::new(lp);
+            link.connect_all();
+            generate_verilog(&link)
+        };
+        let text = text
             .replace("module top(", &format!("module {LINK}("))
             .replace("endmodule // top", &format!("endmodule // {LINK}"));
         let _ = writeln!(v, "\n// ---- link stage (hdl/src/link.rs) ----");

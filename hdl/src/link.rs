@@ -28,6 +28,9 @@ pub struct LinkParams {
     pub depth: usize,
     /// CRC-16/MODBUS initial value (0xFFFF; another only as a fault).
     pub crc_init: u16,
+    /// An AXI4-Stream master instead of the UART (`div`, `parity` and
+    /// `stop_bits` unused): where `tlast` goes.
+    pub axis: Option<link::Tlast>,
 }
 
 impl LinkParams {
@@ -39,7 +42,8 @@ impl LinkParams {
         Ok(Some(LinkParams {
             slice_cycles: s.grid.slice_cycles,
             slices_per_frame: s.grid.slices_per_frame,
-            div: p.baud_divider,
+            div: p.baud_divider.max(1),
+            axis: p.axis().map(|a| a.tlast),
             parity: match p.parity {
                 "even" => 1,
                 "odd" => 2,
@@ -102,6 +106,9 @@ struct Regs {
     dv: u32,
     chr: u16,
     tx: bool,
+    /// AXIS: the byte offered and its `tlast` (`busy` is `tvalid`).
+    tdata: u8,
+    tlast: bool,
 }
 
 #[derive(LogicBlock)]
@@ -115,6 +122,90 @@ pub struct UartLink {
     pub ovf: Signal<Out, Bit>,
     _p: LinkParams,
     _r: Regs,
+}
+
+/// The AXI4-Stream form of the link: the same packetizer, FIFO and
+/// serializer, one byte per beat (docs/packet-format.md, "AXI4-Stream").
+#[derive(LogicBlock)]
+pub struct AxisLink {
+    pub clock: Signal<In, Clock>,
+    pub rst: Signal<In, Bit>,
+    pub valid: Signal<In, Bit>,
+    pub ch: Signal<In, Bits<CH_BITS>>,
+    pub val: Signal<In, Bits<VALUE_BITS>>,
+    pub tready: Signal<In, Bit>,
+    pub tdata: Signal<Out, Bits<8>>,
+    pub tvalid: Signal<Out, Bit>,
+    pub tlast: Signal<Out, Bit>,
+    pub ovf: Signal<Out, Bit>,
+    _p: LinkParams,
+    _r: Regs,
+}
+
+impl AxisLink {
+    pub fn new(p: LinkParams) -> AxisLink {
+        let mut l = AxisLink {
+            clock: Default::default(),
+            rst: Default::default(),
+            valid: Default::default(),
+            ch: Default::default(),
+            val: Default::default(),
+            tready: Default::default(),
+            tdata: Default::default(),
+            tvalid: Default::default(),
+            tlast: Default::default(),
+            ovf: Default::default(),
+            _p: p,
+            _r: Regs::default(),
+        };
+        l._r.mem = vec![0; p.depth];
+        reset_regs(&p, &mut l._r);
+        l
+    }
+}
+
+impl Logic for AxisLink {
+    fn update(&mut self) {
+        if self.clock.pos_edge() {
+            if self.rst.val() {
+                reset_regs(&self._p, &mut self._r);
+            } else {
+                let (v, c, x) = (
+                    self.valid.val(),
+                    self.ch.val().to_u64() as u32,
+                    self.val.val().to_u64() as u32,
+                );
+                edge(&self._p, &mut self._r, v, c, x, self.tready.val());
+            }
+        }
+        self.tdata.next = (self._r.tdata as u64).into();
+        self.tvalid.next = self._r.busy;
+        self.tlast.next = self._r.tlast;
+        self.ovf.next = self._r.ovf;
+    }
+
+    fn connect(&mut self) {
+        self.tdata.connect();
+        self.tvalid.connect();
+        self.tlast.connect();
+        self.ovf.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        Verilog::Custom(link_verilog(&self._p))
+    }
+}
+
+/// The registers' values after reset (the FIFO's memory keeps its contents).
+fn reset_regs(p: &LinkParams, r: &mut Regs) {
+    let mem = std::mem::take(&mut r.mem);
+    *r = Regs {
+        pos: p.slice_cycles - 1,
+        mem,
+        crc: 0xFFFF,
+        tx: true,
+        ..Default::default()
+    };
 }
 
 fn crc8(mut c: u16, d: u8) -> u16 {
@@ -150,12 +241,22 @@ impl UartLink {
     }
 
     fn edge(&mut self, valid: bool, ch: u32, val: u32) {
-        let p = self._p;
-        let r = &mut self._r;
+        edge(&self._p, &mut self._r, valid, ch, val, false);
+    }
+}
+
+/// The registers after one clock edge (the UART's, or with `p.axis` the
+/// AXIS master's, whose slave drives `tready` in the cycle the edge ends).
+fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bool) {
+    {
+        let p = *p;
         let bnd = r.pos == 0;
         let push = bnd || valid;
         let last_tick = r.dv + 1 == p.div;
-        let ready = !r.busy || (last_tick && r.bitn + 1 == p.char_bits());
+        let ready = match p.axis {
+            None => !r.busy || (last_tick && r.bitn + 1 == p.char_bits()),
+            Some(_) => !r.busy || tready,
+        };
         let load = ready && r.have;
         let pop = !r.have && r.n != 0;
         let room = r.n < p.depth || pop;
@@ -203,7 +304,9 @@ impl UartLink {
             }
         }
         nx.n = r.n + (push && room) as usize - pop as usize;
-        if r.busy {
+        if r.busy && p.axis.is_some() {
+            nx.busy = !tready;
+        } else if r.busy {
             if last_tick {
                 nx.dv = 0;
                 if r.bitn + 1 == p.char_bits() {
@@ -223,7 +326,11 @@ impl UartLink {
             nx.busy = true;
             nx.bitn = 0;
             nx.dv = 0;
-            nx.tx = false;
+            nx.tx = p.axis.is_some();
+            nx.tdata = byte;
+            // the trailer of a frame's last slice goes out when the next
+            // header's slice has wrapped to 0
+            nx.tlast = slot == 3 && (p.axis == Some(link::Tlast::Slice) || r.hslice == 0);
             nx.mask = rest;
             nx.have = rest != 0;
             match slot {
@@ -243,17 +350,11 @@ impl UartLink {
         }
         *r = nx;
     }
+}
 
+impl UartLink {
     fn reset(&mut self) {
-        let p = self._p;
-        let mem = std::mem::take(&mut self._r.mem);
-        self._r = Regs {
-            pos: p.slice_cycles - 1,
-            mem,
-            crc: 0xFFFF,
-            tx: true,
-            ..Default::default()
-        };
+        reset_regs(&self._p, &mut self._r);
     }
 }
 
@@ -300,11 +401,20 @@ fn link_verilog(p: &LinkParams) -> String {
     let bw = width(cb as u64 - 1);
     let tb = TOKEN_BITS;
     let last = |w: usize, v: u64| format!("{w}'d{v}");
-    let _ = writeln!(
-        s,
-        "// UART link: {} cycles per bit, {cb} bits per character, FIFO of {} tokens\n// (the schedule's worst-case backlog); packets: docs/packet-format.md",
-        p.div, p.depth
-    );
+    let axis = p.axis.is_some();
+    if axis {
+        let _ = writeln!(
+            s,
+            "// AXI4-Stream link: one byte per beat, FIFO of {} tokens (the schedule's\n// worst-case backlog under the slave's guarantee); packets: docs/packet-format.md",
+            p.depth
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "// UART link: {} cycles per bit, {cb} bits per character, FIFO of {} tokens\n// (the schedule's worst-case backlog); packets: docs/packet-format.md",
+            p.div, p.depth
+        );
+    }
     let _ = writeln!(s, "reg [{}:0] pos;\ninitial pos = {};", pw - 1, last(pw, 0));
     let _ = writeln!(s, "reg [{}:0] mem [0:{}];", tb - 1, p.depth - 1);
     for (n, w) in [("wr", aw), ("rd", aw), ("n", nw)] {
@@ -324,25 +434,37 @@ fn link_verilog(p: &LinkParams) -> String {
         s,
         "reg [15:0] crc;\ninitial crc = 16'hffff;\nreg [7:0] ovfc;\ninitial ovfc = 8'd0;\nreg ovf_r;\ninitial ovf_r = 1'b0;"
     );
-    let _ = writeln!(
-        s,
-        "reg busy;\ninitial busy = 1'b0;\nreg [{}:0] bitn;\ninitial bitn = {bw}'d0;\nreg [{}:0] dv;\ninitial dv = {dw}'d0;",
-        bw - 1,
-        dw - 1
-    );
-    let _ = writeln!(
-        s,
-        "reg [{}:0] chr;\ninitial chr = {cb}'d0;\nreg tx_r;\ninitial tx_r = 1'b1;\n",
-        cb - 1
-    );
+    if axis {
+        let _ = writeln!(
+            s,
+            "// busy: a byte is offered (tvalid)\nreg busy;\ninitial busy = 1'b0;\nreg [7:0] tdata_r;\ninitial tdata_r = 8'd0;\nreg tlast_r;\ninitial tlast_r = 1'b0;\n"
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "reg busy;\ninitial busy = 1'b0;\nreg [{}:0] bitn;\ninitial bitn = {bw}'d0;\nreg [{}:0] dv;\ninitial dv = {dw}'d0;",
+            bw - 1,
+            dw - 1
+        );
+        let _ = writeln!(
+            s,
+            "reg [{}:0] chr;\ninitial chr = {cb}'d0;\nreg tx_r;\ninitial tx_r = 1'b1;\n",
+            cb - 1
+        );
+    }
     let _ = writeln!(s, "wire bnd = pos == {};", last(pw, 0));
     let _ = writeln!(s, "wire push = bnd | valid;");
-    let _ = writeln!(s, "wire last_tick = dv == {};", last(dw, p.div as u64 - 1));
-    let _ = writeln!(
-        s,
-        "wire ready = !busy | (last_tick & (bitn == {}));",
-        last(bw, cb as u64 - 1)
-    );
+    if axis {
+        // a beat is taken at an edge where tvalid and tready are high
+        let _ = writeln!(s, "wire ready = !busy | tready;");
+    } else {
+        let _ = writeln!(s, "wire last_tick = dv == {};", last(dw, p.div as u64 - 1));
+        let _ = writeln!(
+            s,
+            "wire ready = !busy | (last_tick & (bitn == {}));",
+            last(bw, cb as u64 - 1)
+        );
+    }
     let _ = writeln!(s, "wire load = ready & have;");
     let _ = writeln!(s, "wire pop = !have & (n != {nw}'d0);");
     let _ = writeln!(s, "wire room = (n < {}) | pop;", last(nw, p.depth as u64));
@@ -405,16 +527,23 @@ fn link_verilog(p: &LinkParams) -> String {
         2 => "~^byte_out, ",
         _ => "",
     };
-    let _ = writeln!(
-        s,
-        "wire [{}:0] chr_load = {{{stops}{parity}byte_out, 1'b0}};\n",
-        cb - 1
-    );
+    if !axis {
+        let _ = writeln!(
+            s,
+            "wire [{}:0] chr_load = {{{stops}{parity}byte_out, 1'b0}};\n",
+            cb - 1
+        );
+    }
     let _ = writeln!(s, "always @(posedge clock) begin\n  if (rst) begin");
     let _ = writeln!(s, "    pos <= {};", last(pw, p.slice_cycles - 1));
+    let out_reset = if axis {
+        "    tdata_r <= 8'd0;\n    tlast_r <= 1'b0;".to_string()
+    } else {
+        format!("    bitn <= {bw}'d0;\n    dv <= {dw}'d0;\n    tx_r <= 1'b1;")
+    };
     let _ = writeln!(
         s,
-        "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    mask <= 12'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= 16'd0;\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n    bitn <= {bw}'d0;\n    dv <= {dw}'d0;\n    tx_r <= 1'b1;\n  end else begin"
+        "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    mask <= 12'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= 16'd0;\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n{out_reset}\n  end else begin"
     );
     let _ = writeln!(
         s,
@@ -448,17 +577,39 @@ fn link_verilog(p: &LinkParams) -> String {
         "    n <= n + {{{}'d0, push & room}} - {{{0}'d0, pop}};",
         nw - 1
     );
-    let _ = writeln!(
+    if axis {
+        let _ = writeln!(s, "    if (busy & tready) busy <= 1'b0;");
+    } else {
+        let _ = writeln!(
         s,
         "    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (bitn == {}) begin\n          busy <= 1'b0;\n          tx_r <= 1'b1;\n        end else begin\n          bitn <= bitn + {bw}'d1;\n          tx_r <= chr[1];\n          chr <= chr >> 1;\n        end\n      end else dv <= dv + {dw}'d1;\n    end",
         last(bw, cb as u64 - 1)
     );
+    }
+    let load_out = match p.axis {
+        Some(t) => format!(
+            "      tdata_r <= byte_out;\n      tlast_r <= {};",
+            if t == link::Tlast::Slice {
+                "slot == 4'd3"
+            } else {
+                "(slot == 4'd3) & (hslice == 16'd0)"
+            }
+        ),
+        None => format!("      chr <= chr_load;\n      bitn <= {bw}'d0;\n      dv <= {dw}'d0;\n      tx_r <= 1'b0;"),
+    };
     let _ = writeln!(
         s,
-        "    if (load) begin\n      chr <= chr_load;\n      busy <= 1'b1;\n      bitn <= {bw}'d0;\n      dv <= {dw}'d0;\n      tx_r <= 1'b0;\n      mask <= rest;\n      have <= rest != 12'd0;\n      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == 16'd{}) begin\n          hslice <= 16'd0;\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + 16'd1;\n      end\n    end",
+        "    if (load) begin\n{load_out}\n      busy <= 1'b1;\n      mask <= rest;\n      have <= rest != 12'd0;\n      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == 16'd{}) begin\n          hslice <= 16'd0;\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + 16'd1;\n      end\n    end",
         p.slices_per_frame - 1
     );
     let _ = writeln!(s, "  end\nend\n");
-    let _ = writeln!(s, "always @(*) begin\n  tx = tx_r;\n  ovf = ovf_r;\nend");
+    if axis {
+        let _ = writeln!(
+            s,
+            "always @(*) begin\n  tdata = tdata_r;\n  tvalid = busy;\n  tlast = tlast_r;\n  ovf = ovf_r;\nend"
+        );
+    } else {
+        let _ = writeln!(s, "always @(*) begin\n  tx = tx_r;\n  ovf = ovf_r;\nend");
+    }
     s
 }

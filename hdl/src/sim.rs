@@ -6,7 +6,7 @@ use rust_hdl::prelude::*;
 use lut_gen::ports::Pins;
 
 use crate::core::Core;
-use crate::link::UartLink;
+use crate::link::{AxisLink, UartLink};
 use crate::{plan, HdlError};
 
 /// Cycle-accurate simulator of the emitted gateware.
@@ -30,6 +30,10 @@ pub struct RtlSim {
     core: Box<Core>,
     /// The link stage (`slotforge_link`), fed the core's sample stream.
     link: Option<Box<UartLink>>,
+    /// The AXI4-Stream form of the link stage, and the slave's `tready`
+    /// during the cycle the last step returned ([`RtlSim::set_tready`]).
+    axis: Option<Box<AxisLink>>,
+    tready: bool,
     passes: u64,
     reader: PinReader,
 }
@@ -66,6 +70,10 @@ pub(crate) fn read_pins(c: &Core, r: &PinReader) -> Pins {
         sample_value: c.sample_value.val().to_u64() as u16,
         link_tx: false,
         link_overflow: false,
+        axis_tdata: 0,
+        axis_tvalid: false,
+        axis_tlast: false,
+        axis_tready: false,
     }
 }
 
@@ -99,7 +107,14 @@ impl RtlSim {
         core.connect_all();
         core.clock.next = Clock::from(false);
         simulate(&mut *core, 1000);
-        let link = p.link.map(|lp| {
+        let axis = p.link.filter(|lp| lp.axis.is_some()).map(|lp| {
+            let mut l = Box::new(AxisLink::new(lp));
+            l.connect_all();
+            l.clock.next = Clock::from(false);
+            simulate(&mut *l, 1000);
+            l
+        });
+        let link = p.link.filter(|lp| lp.axis.is_none()).map(|lp| {
             let mut l = Box::new(UartLink::new(lp));
             l.connect_all();
             l.clock.next = Clock::from(false);
@@ -109,6 +124,8 @@ impl RtlSim {
         RtlSim {
             core,
             link,
+            axis,
+            tready: true,
             passes: 0,
             reader: PinReader::new(p),
         }
@@ -124,9 +141,27 @@ impl RtlSim {
         self.passes
     }
 
+    /// An AXI4-Stream link's `m_axis_tready` during the cycle the last
+    /// [`RtlSim::step`] returned (sampled by the next step, like `miso`).
+    pub fn set_tready(&mut self, ready: bool) {
+        self.tready = ready;
+    }
+
     /// Apply one rising clock edge; see the type's documentation.
     pub fn step(&mut self, rst: bool, miso: u64) -> Pins {
         let miso = miso & self.reader.lanes as u64;
+        if let Some(l) = self.axis.as_deref_mut() {
+            let c = &*self.core;
+            l.clock.next = Clock::from(false);
+            l.rst.next = rst;
+            l.valid.next = c.sample_valid.val();
+            l.ch.next = c.sample_channel.val();
+            l.val.next = c.sample_value.val();
+            l.tready.next = self.tready;
+            settle(l, &mut self.passes);
+            l.clock.next = Clock::from(true);
+            settle(l, &mut self.passes);
+        }
         if let Some(l) = self.link.as_deref_mut() {
             // The link samples the core's outputs of the cycle this edge ends.
             let c = &*self.core;
@@ -158,6 +193,12 @@ impl RtlSim {
         let mut pins = read_pins(c, &self.reader);
         if let Some(l) = &self.link {
             pins.link_tx = l.tx.val();
+            pins.link_overflow = l.ovf.val();
+        }
+        if let Some(l) = &self.axis {
+            pins.axis_tdata = l.tdata.val().to_u64() as u8;
+            pins.axis_tvalid = l.tvalid.val();
+            pins.axis_tlast = l.tlast.val();
             pins.link_overflow = l.ovf.val();
         }
         pins

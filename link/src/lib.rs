@@ -8,19 +8,23 @@
 //! - [`tx`]: the transmitter's cycle model (packetizer, FIFO, serializer,
 //!   UART), which the judge uses to predict the line bit by bit and the
 //!   audit to measure the backlog and the latency;
+//! - [`axis`]: the AXI4-Stream form (byte beats, `tlast`, the slave's
+//!   guarantee and the `tready` patterns back ends drive);
 //! - [`decode`]: a streaming decoder of the bytes a host received, with
 //!   counts of lost packets, CRC errors and resyncs;
 //! - [`rx`]: a UART receiver that turns a sampled line back into bytes.
 //!
 //! No dependencies, so a host application can embed the decoder.
 
+pub mod axis;
 pub mod decode;
 pub mod format;
 pub mod rx;
 pub mod tx;
 pub mod uart;
 
+pub use axis::{AxisFormat, ReadyDriver, ReadyPattern, Tlast};
 pub use decode::{Decoded, Decoder, Stats};
 pub use format::Token;
-pub use tx::{TxConfig, TxModel};
+pub use tx::{Line, TxConfig, TxModel};
 pub use uart::{Parity, UartFormat};

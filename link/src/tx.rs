@@ -6,13 +6,32 @@
 
 use std::collections::VecDeque;
 
+use crate::axis::{AxisFormat, ReadyDriver, ReadyPattern, Tlast};
 use crate::format::{self, Token, WordKind, CRC_INIT, END, SYNC};
 use crate::uart::UartFormat;
+
+/// The physical side of the link: a UART line or an AXI4-Stream master.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Line {
+    Uart(UartFormat),
+    Axis(AxisFormat),
+}
+
+impl Line {
+    /// Cycles one byte occupies the line at worst: a UART character, or
+    /// the AXIS slave's guarantee (`ready_within`).
+    pub fn char_cycles(&self) -> u64 {
+        match self {
+            Line::Uart(u) => u.char_cycles(),
+            Line::Axis(a) => a.ready_within as u64,
+        }
+    }
+}
 
 /// What the transmitter is built for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TxConfig {
-    pub uart: UartFormat,
+    pub line: Line,
     /// Cycles per slice: a packet closes and the next opens every slice.
     pub slice_cycles: u64,
     pub slices_per_frame: u64,
@@ -57,6 +76,9 @@ pub struct TxModel {
     div: u32,
     byte: u8,
     tx: bool,
+    /// AXIS: `tlast` of the byte offered, and `tready` in the current cycle.
+    tlast: bool,
+    tready: bool,
     cur: Option<ByteOnLine>,
     /// Largest FIFO occupancy seen.
     pub max_backlog: usize,
@@ -87,6 +109,8 @@ impl TxModel {
             div: 0,
             byte: 0,
             tx: true,
+            tlast: false,
+            tready: true,
             cur: None,
             max_backlog: 0,
             trailer_ends: None,
@@ -110,6 +134,8 @@ impl TxModel {
         self.bit = 0;
         self.div = 0;
         self.tx = true;
+        self.tlast = false;
+        self.byte = 0;
         self.cur = None;
     }
 
@@ -120,6 +146,26 @@ impl TxModel {
     /// The line (`link_tx`) in the current cycle.
     pub fn line(&self) -> bool {
         self.tx
+    }
+
+    /// AXIS `tvalid` in the current cycle (a byte is offered).
+    pub fn tvalid(&self) -> bool {
+        self.busy
+    }
+
+    /// AXIS `tdata` in the current cycle (the last byte offered).
+    pub fn tdata(&self) -> u8 {
+        self.byte
+    }
+
+    /// AXIS `tlast` in the current cycle.
+    pub fn tlast(&self) -> bool {
+        self.tlast
+    }
+
+    /// AXIS: the slave's `tready` in the current cycle, before [`TxModel::clock`].
+    pub fn set_tready(&mut self, r: bool) {
+        self.tready = r;
     }
 
     /// The sticky overflow flag (`link_overflow`) in the current cycle.
@@ -154,13 +200,14 @@ impl TxModel {
             self.reset();
             return;
         }
-        let u = self.cfg.uart;
         let token = Token {
             boundary: self.pos == 0,
             sample,
         };
-        let last_tick = self.div + 1 == u.div;
-        let ready = !self.busy || (last_tick && self.bit + 1 == u.bits());
+        let ready = match self.cfg.line {
+            Line::Uart(u) => !self.busy || (self.div + 1 == u.div && self.bit + 1 == u.bits()),
+            Line::Axis(_) => !self.busy || self.tready,
+        };
         let load = ready && self.have;
         let pop = !self.have && !self.fifo.is_empty();
         let popped = if pop { self.fifo.pop_front() } else { None };
@@ -175,17 +222,10 @@ impl TxModel {
         }
         self.max_backlog = self.max_backlog.max(self.fifo.len());
         if self.busy {
-            if last_tick {
-                self.div = 0;
-                if self.bit + 1 == u.bits() {
-                    self.busy = false;
-                    self.tx = true;
-                } else {
-                    self.bit += 1;
-                    self.tx = u.bit(self.byte, self.bit);
-                }
-            } else {
-                self.div += 1;
+            match self.cfg.line {
+                Line::Uart(u) => self.uart_tick(u),
+                // a beat is taken at an edge where tvalid and tready are high
+                Line::Axis(_) => self.busy = !self.tready,
             }
         }
         if load {
@@ -201,6 +241,22 @@ impl TxModel {
         } else {
             self.pos + 1
         };
+    }
+
+    /// One clock of the UART's bit timer while a character is on the line.
+    fn uart_tick(&mut self, u: UartFormat) {
+        if self.div + 1 == u.div {
+            self.div = 0;
+            if self.bit + 1 == u.bits() {
+                self.busy = false;
+                self.tx = true;
+            } else {
+                self.bit += 1;
+                self.tx = u.bit(self.byte, self.bit);
+            }
+        } else {
+            self.div += 1;
+        }
     }
 
     /// The byte slots (bit `i` = slot `i` of 12) a token sends: the previous
@@ -251,7 +307,7 @@ impl TxModel {
         }
         if slot == 3 {
             if let Some(v) = self.trailer_ends.as_mut() {
-                v.push(self.cycle + self.cfg.uart.char_cycles());
+                v.push(self.cycle + self.cfg.line.char_cycles());
             }
         }
         if slot == 7 {
@@ -266,7 +322,13 @@ impl TxModel {
         self.busy = true;
         self.bit = 0;
         self.div = 0;
-        self.tx = false;
+        match self.cfg.line {
+            Line::Uart(_) => self.tx = false,
+            Line::Axis(a) => {
+                let last_slice = packet.1 as u64 + 1 == self.cfg.slices_per_frame;
+                self.tlast = slot == 3 && (a.tlast == Tlast::Slice || last_slice);
+            }
+        }
         self.cur = Some(ByteOnLine {
             byte,
             kind,
@@ -315,6 +377,11 @@ pub fn measure(cfg: TxConfig, frame: &[(u64, u64, u16)], max_frames: u64) -> Opt
     let mut t = TxModel::new(cfg);
     t.trailer_ends = Some(Vec::new());
     t.clock(true, None);
+    // AXIS: the slowest slave the guarantee allows
+    let mut slave = match cfg.line {
+        Line::Axis(a) => Some(ReadyDriver::new(ReadyPattern::WorstCase, a.ready_within)),
+        Line::Uart(_) => None,
+    };
     let mut valid: std::collections::BTreeMap<u64, u16> = Default::default();
     let mut windows: Vec<u64> = Vec::new(); // earliest instant per window
     let mut prev_state = None;
@@ -356,6 +423,10 @@ pub fn measure(cfg: TxConfig, frame: &[(u64, u64, u16)], max_frames: u64) -> Opt
         prev_state = Some(state);
         for c in base..base + frame_cycles {
             let s = valid.remove(&c).map(|ch| (ch, 0));
+            if let Some(d) = slave.as_mut() {
+                let r = d.ready(t.tvalid());
+                t.set_tready(r);
+            }
             t.clock(false, s);
         }
     }
@@ -369,11 +440,11 @@ mod tests {
 
     fn cfg(div: u32, depth: Option<usize>) -> TxConfig {
         TxConfig {
-            uart: UartFormat {
+            line: Line::Uart(UartFormat {
                 div,
                 parity: Parity::None,
                 stop_bits: 1,
-            },
+            }),
             slice_cycles: 1000,
             slices_per_frame: 2,
             depth,
@@ -382,7 +453,10 @@ mod tests {
 
     /// Sample the model's line at mid-bit and collect the bytes.
     fn run(t: &mut TxModel, cycles: u64, samples: &[(u64, u16, u16)]) -> Vec<u8> {
-        let mut rx = crate::rx::UartRx::new(t.config().uart);
+        let Line::Uart(u) = t.config().line else {
+            panic!("a UART")
+        };
+        let mut rx = crate::rx::UartRx::new(u);
         let mut out = Vec::new();
         t.clock(true, None);
         for c in 0..cycles {
@@ -415,6 +489,75 @@ mod tests {
         want.extend(format::header(1, 0));
         assert_eq!(bytes, want);
         assert!(!t.overflow());
+    }
+
+    /// The bytes an AXIS slave driven by `pattern` takes, and `tlast`'s beats.
+    fn run_axis(pattern: ReadyPattern, tlast: Tlast, cycles: u64) -> (Vec<u8>, Vec<usize>) {
+        let axis = AxisFormat {
+            tlast,
+            ready_within: 4,
+        };
+        let mut t = TxModel::new(TxConfig {
+            line: Line::Axis(axis),
+            ..cfg(4, Some(16))
+        });
+        let mut d = ReadyDriver::new(pattern, axis.ready_within);
+        let (mut out, mut lasts) = (Vec::new(), Vec::new());
+        let mut held: Option<(u8, bool)> = None;
+        t.clock(true, None);
+        for c in 0..cycles {
+            let r = d.ready(t.tvalid());
+            if let Some(h) = held {
+                assert!(t.tvalid(), "cycle {c}: tvalid dropped under back-pressure");
+                assert_eq!(
+                    h,
+                    (t.tdata(), t.tlast()),
+                    "cycle {c}: data changed while stalled"
+                );
+            }
+            held = (t.tvalid() && !r).then_some((t.tdata(), t.tlast()));
+            if t.tvalid() && r {
+                out.push(t.tdata());
+                if t.tlast() {
+                    lasts.push(out.len() - 1);
+                }
+            }
+            t.set_tready(r);
+            let s = [(10, 3, 0x1234), (11, 1000, 0x3FFF)]
+                .iter()
+                .find(|s| s.0 == c)
+                .map(|&(_, ch, v)| (ch, v));
+            t.clock(false, s);
+        }
+        assert!(!t.overflow());
+        (out, lasts)
+    }
+
+    #[test]
+    fn axis_carries_the_uart_bytes_under_any_ready_pattern() {
+        let mut u = TxModel::new(cfg(4, Some(8)));
+        let uart = run(&mut u, 4100, &[(10, 3, 0x1234), (11, 1000, 0x3FFF)]);
+        let (always, lasts) = run_axis(ReadyPattern::Always, Tlast::Slice, 4100);
+        // the UART is slower: its bytes so far are a prefix of the stream
+        assert!(always.starts_with(&uart) && always.len() > uart.len());
+        let (rand, _) = run_axis(ReadyPattern::Random { seed: 3 }, Tlast::Slice, 4100);
+        let (worst, _) = run_axis(ReadyPattern::WorstCase, Tlast::Slice, 4100);
+        assert_eq!(rand, always);
+        assert_eq!(worst, always);
+        let uart = always;
+        // tlast on every trailer's last byte: the packets of slices 0..3
+        // (slices of 1000 cycles, 2 per frame; the fifth is still open)
+        let trailers: Vec<usize> = (0..uart.len())
+            .filter(|&i| i >= 3 && uart[i - 3] == END && i % 4 == 3)
+            .collect();
+        assert_eq!(lasts, trailers);
+        assert_eq!(lasts.len(), 4);
+        let (_, frame_lasts) = run_axis(ReadyPattern::Always, Tlast::Frame, 4100);
+        assert_eq!(
+            frame_lasts,
+            vec![trailers[1], trailers[3]],
+            "only a frame's last slice"
+        );
     }
 
     #[test]

@@ -739,7 +739,26 @@ impl AuditReport {
                 "interval, first: cycles (first = first sampling instant after cycle 0); dev.sel = mux device.select; alias = where a tone at bw shows when bw is above Nyquist"
             );
         }
-        if let Some(l) = &self.link {
+        if let Some(l) = self.link.as_ref().filter(|l| l.ready_within.is_some()) {
+            let _ = writeln!(
+                o,
+                "link axis: 8-bit beats, tlast at the end of each {}; the FIFO is sized for a slave that accepts every beat within {} cycle(s) (tready duty >= 1/{}); the mix needs it within {} cycles at most",
+                l.tlast.unwrap_or("slice"),
+                l.ready_within.unwrap_or(1),
+                l.ready_within.unwrap_or(1),
+                l.max_ready_within.map_or("?".into(), |m| m.to_string())
+            );
+            let _ = writeln!(
+                o,
+                "link: {} words ({} bytes) per frame, stream {:.1} % busy at worst; FIFO depth {} tokens (worst-case backlog); worst latency instant -> last beat of its packet {} cycles ({:.1} us)",
+                l.words_per_frame,
+                l.bytes_per_frame,
+                l.utilization * 100.0,
+                l.fifo_depth,
+                l.latency_cycles,
+                l.latency_us
+            );
+        } else if let Some(l) = &self.link {
             let _ = writeln!(
                 o,
                 "link {}: {:.0} baud (divider {}, {} asked), {} bits per byte ({} parity, {} stop)",

@@ -10,11 +10,11 @@
 use std::collections::{BTreeMap, VecDeque};
 
 use link::format;
-use link::tx::{self, TxConfig};
-use link::UartFormat;
+use link::tx::{self, Line, TxConfig};
+use link::{AxisFormat, UartFormat};
 use serde::Serialize;
 
-use crate::mix::LinkSpec;
+use crate::mix::{LinkKind, LinkSpec};
 use crate::schedule::Schedule;
 
 /// The most tokens the gateware's FIFO holds.
@@ -45,6 +45,18 @@ pub struct LinkPlan {
     pub latency_us: f64,
     /// The lowest baud (a divider of the clock) that carries the mix.
     pub min_baud: f64,
+    /// AXI4-Stream only: where `tlast` goes, the slave's guarantee the FIFO
+    /// depth is computed for (every beat accepted within `ready_within`
+    /// cycles), and the weakest guarantee that would still carry the mix.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tlast: Option<&'static str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ready_within: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_ready_within: Option<u32>,
+    /// The line the transmitter drives (UART or AXIS).
+    #[serde(skip)]
+    pub line: Line,
 }
 
 /// Why the link cannot carry the mix.
@@ -55,18 +67,26 @@ pub struct LinkInfeasible {
 }
 
 impl LinkPlan {
-    pub fn uart(&self) -> UartFormat {
-        UartFormat {
-            div: self.baud_divider,
-            parity: link::Parity::parse(self.parity).expect("parity name"),
-            stop_bits: self.stop_bits,
+    /// The UART's character; `None` for an AXI4-Stream link.
+    pub fn uart(&self) -> Option<UartFormat> {
+        match self.line {
+            Line::Uart(u) => Some(u),
+            Line::Axis(_) => None,
+        }
+    }
+
+    /// The AXI4-Stream format; `None` for a UART.
+    pub fn axis(&self) -> Option<AxisFormat> {
+        match self.line {
+            Line::Axis(a) => Some(a),
+            Line::Uart(_) => None,
         }
     }
 
     /// The transmitter the gateware builds (FIFO of [`LinkPlan::fifo_depth`]).
     pub fn tx_config(&self, s: &Schedule) -> TxConfig {
         TxConfig {
-            uart: self.uart(),
+            line: self.line,
             slice_cycles: s.grid.slice_cycles,
             slices_per_frame: s.grid.slices_per_frame,
             depth: Some(self.fifo_depth),
@@ -77,7 +97,70 @@ impl LinkPlan {
 /// The mix's link plan; `None` without `[link]`.
 pub fn plan(s: &Schedule) -> Option<Result<LinkPlan, LinkInfeasible>> {
     let spec = s.mix.link?;
-    Some(plan_spec(s, &spec))
+    Some(match spec.kind {
+        LinkKind::Uart => plan_spec(s, &spec),
+        LinkKind::Axis => plan_axis(s, &spec),
+    })
+}
+
+fn axis_of(spec: &LinkSpec, ready_within: u32) -> Line {
+    Line::Axis(AxisFormat {
+        tlast: spec.tlast,
+        ready_within,
+    })
+}
+
+/// An AXI4-Stream link: one byte per beat, the FIFO sized for the slowest
+/// slave the guarantee allows (every beat taken in its `ready_within`-th
+/// cycle), refused with the weakest guarantee that fits when it cannot.
+fn plan_axis(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> {
+    let g = &s.grid;
+    let n = spec.ready_within;
+    let bytes = format::bytes_per_frame(s.samples_per_frame(), g.slices_per_frame);
+    let stream = merged_frame(s);
+    let top = (g.frame_cycles / bytes).min(u32::MAX as u64) as u32;
+    let max_n = slowest_line(top, 1, |d| measure(s, axis_of(spec, d), &stream).is_some());
+    let refuse = |why: String| {
+        LinkInfeasible {
+        message: match max_n {
+            Some(m) => format!("{why}; this mix needs every beat accepted within {m} cycles (tready duty >= 1/{m})"),
+            None => format!("{why}; not even an always-ready slave carries this mix"),
+        },
+        min_baud: None,
+    }
+    };
+    let line_cycles = bytes * n as u64;
+    if line_cycles > g.frame_cycles {
+        return Err(refuse(format!(
+            "link: {bytes} bytes per frame, one per {n} cycles at worst (link.ready_within), need {line_cycles} cycles, the frame has {}",
+            g.frame_cycles
+        )));
+    }
+    let m = measure(s, axis_of(spec, n), &stream).ok_or_else(|| {
+        refuse(format!(
+            "link: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens when every beat waits {n} cycles"
+        ))
+    })?;
+    Ok(LinkPlan {
+        kind: spec.kind.name(),
+        baud_requested: 0,
+        baud_divider: 0,
+        baud: 0.0,
+        parity: "none",
+        stop_bits: 0,
+        bits_per_byte: 8,
+        words_per_frame: format::words_per_frame(s.samples_per_frame(), g.slices_per_frame),
+        bytes_per_frame: bytes,
+        utilization: line_cycles as f64 / g.frame_cycles as f64,
+        fifo_depth: m.backlog.max(1),
+        latency_cycles: m.latency_cycles,
+        latency_us: m.latency_cycles as f64 * 1e6 / g.clock_hz as f64,
+        min_baud: f64::NAN,
+        tlast: Some(spec.tlast.name()),
+        ready_within: Some(n),
+        max_ready_within: max_n,
+        line: axis_of(spec, n),
+    })
 }
 
 fn uart_of(spec: &LinkSpec, div: u32) -> UartFormat {
@@ -112,7 +195,7 @@ fn plan_spec(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> 
             g.frame_cycles
         )));
     }
-    let m = measure(s, uart, &stream).ok_or_else(|| {
+    let m = measure(s, Line::Uart(uart), &stream).ok_or_else(|| {
         refuse(format!(
             "link: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens at {:.0} baud",
             UartFormat::real_baud(g.clock_hz, div)
@@ -133,13 +216,17 @@ fn plan_spec(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> 
         latency_cycles: m.latency_cycles,
         latency_us: m.latency_cycles as f64 * 1e6 / g.clock_hz as f64,
         min_baud: min_baud.unwrap_or(f64::NAN),
+        tlast: None,
+        ready_within: None,
+        max_ready_within: None,
+        line: Line::Uart(uart),
     })
 }
 
 /// The backlog and latency at one divider, if the FIFO stays within its limit.
-fn measure(s: &Schedule, uart: UartFormat, stream: &[(u64, u64, u16)]) -> Option<tx::Measured> {
+fn measure(s: &Schedule, line: Line, stream: &[(u64, u64, u16)]) -> Option<tx::Measured> {
     let cfg = TxConfig {
-        uart,
+        line,
         slice_cycles: s.grid.slice_cycles,
         slices_per_frame: s.grid.slices_per_frame,
         depth: None,
@@ -157,14 +244,22 @@ fn min_divider(
 ) -> Option<u32> {
     let per_char = uart_of(spec, 1).bits() as u64;
     let top = (s.grid.frame_cycles / (bytes * per_char)).min(u32::MAX as u64) as u32;
+    slowest_line(top, crate::mix::MIN_BAUD_DIVIDER, |d| {
+        measure(s, Line::Uart(uart_of(spec, d)), stream).is_some()
+    })
+}
+
+/// The largest cycles-per-unit `d <= top` (and `>= least`) that `fits`,
+/// from the slowest line that carries the frame's bytes: a line that is
+/// just fast enough may still need more FIFO than the gateware has, so step
+/// towards faster lines until the backlog fits.
+fn slowest_line(top: u32, least: u32, fits: impl Fn(u32) -> bool) -> Option<u32> {
     let mut d = top;
-    // A line that is just fast enough may still need more FIFO than the
-    // gateware has: step towards faster lines until the backlog fits.
     for _ in 0..64 {
-        if d < crate::mix::MIN_BAUD_DIVIDER {
+        if d < least {
             return None;
         }
-        if measure(s, uart_of(spec, d), stream).is_some() {
+        if fits(d) {
             return Some(d);
         }
         d -= (d / 16).max(1);
@@ -302,6 +397,41 @@ mod tests {
         let e = plan(&s).unwrap().unwrap_err();
         assert_eq!(e.min_baud, Some(1_500_000.0));
         assert!(e.message.contains("1500000"), "{}", e.message);
+    }
+
+    fn eskin_axis(keys: &str) -> Schedule {
+        let text = include_str!("../../mixes/eskin34.toml").to_string()
+            + &format!("\n[link]\nkind = \"axis\"\n{keys}\n");
+        let m = crate::mix::parse(std::path::Path::new("t.toml"), &text).unwrap();
+        crate::synthesize(&m).unwrap()
+    }
+
+    #[test]
+    fn axis_depth_grows_with_the_slaves_guarantee() {
+        let fast = plan(&eskin_axis("")).unwrap().unwrap();
+        assert_eq!(fast.bytes_per_frame, 1476);
+        assert_eq!(fast.ready_within, Some(1));
+        let slow = plan(&eskin_axis("ready_within = 200")).unwrap().unwrap();
+        assert!(
+            slow.fifo_depth > fast.fifo_depth,
+            "{} vs {}",
+            slow.fifo_depth,
+            fast.fifo_depth
+        );
+        assert!((slow.utilization - 1476.0 * 200.0 / 480_000.0).abs() < 1e-9);
+        // 1476 bytes in 480,000 cycles: at most 325 cycles per byte
+        let max = fast.max_ready_within.unwrap();
+        assert!(max <= 325 && max > 200, "{max}");
+        assert_eq!(fast.max_ready_within, slow.max_ready_within);
+    }
+
+    #[test]
+    fn axis_with_too_slow_a_slave_is_refused_with_the_guarantee_it_needs() {
+        let e = plan(&eskin_axis("ready_within = 400"))
+            .unwrap()
+            .unwrap_err();
+        assert!(e.message.contains("accepted within"), "{}", e.message);
+        assert!(e.message.contains("ready_within"), "{}", e.message);
     }
 
     #[test]

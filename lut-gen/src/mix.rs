@@ -67,6 +67,10 @@ pub struct Mix {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LinkSpec {
     pub kind: LinkKind,
+    /// `axis`: where `tlast` goes and the slave's guarantee (cycles within
+    /// which it accepts an offered beat); unused for a UART.
+    pub tlast: link::Tlast,
+    pub ready_within: u32,
     /// Requested baud (`uart`); the divider's real baud is reported.
     pub baud: u64,
     pub parity: link::Parity,
@@ -77,12 +81,14 @@ pub struct LinkSpec {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LinkKind {
     Uart,
+    Axis,
 }
 
 impl LinkKind {
     pub fn name(self) -> &'static str {
         match self {
             LinkKind::Uart => "uart",
+            LinkKind::Axis => "axis",
         }
     }
 }
@@ -198,6 +204,8 @@ struct RawLink {
     baud: Option<Spanned<i64>>,
     parity: Option<Spanned<String>>,
     stop_bits: Option<Spanned<i64>>,
+    tlast: Option<Spanned<String>>,
+    ready_within: Option<Spanned<i64>>,
 }
 
 #[derive(Deserialize)]
@@ -950,21 +958,30 @@ impl Cx<'_> {
         let r = l.get_ref();
         let kind = match r.kind.get_ref().as_str() {
             "uart" => LinkKind::Uart,
-            "axis" => {
-                return Err(self.at(
-                    r.kind.span(),
-                    "link.kind",
-                    "\"axis\" (AXI4-Stream) is not implemented yet; \"uart\" is",
-                ))
-            }
+            "axis" => return self.axis_link(r),
             other => {
                 return Err(self.at(
                     r.kind.span(),
                     "link.kind",
-                    format!("unknown link kind `{other}` (known: \"uart\")"),
+                    format!("unknown link kind `{other}` (known: \"uart\", \"axis\")"),
                 ))
             }
         };
+        for (v, k) in [
+            (r.tlast.as_ref().map(|x| x.span()), "link.tlast"),
+            (
+                r.ready_within.as_ref().map(|x| x.span()),
+                "link.ready_within",
+            ),
+        ] {
+            if let Some(sp) = v {
+                return Err(self.at(
+                    sp,
+                    k,
+                    "only an AXI4-Stream link (kind = \"axis\") has this key",
+                ));
+            }
+        }
         let baud_raw = r
             .baud
             .as_ref()
@@ -1020,9 +1037,61 @@ impl Cx<'_> {
         };
         Ok(LinkSpec {
             kind,
+            tlast: link::Tlast::Slice,
+            ready_within: 1,
             baud,
             parity,
             stop_bits,
+        })
+    }
+
+    /// `[link]` with `kind = "axis"`: `tlast` (`"slice"` or `"frame"`) and
+    /// `ready_within` (cycles, default 1: an always-ready slave); the UART's
+    /// keys are refused.
+    fn axis_link(&self, r: &RawLink) -> Result<LinkSpec, MixError> {
+        for (v, k) in [
+            (r.baud.as_ref().map(|x| x.span()), "link.baud"),
+            (r.parity.as_ref().map(|x| x.span()), "link.parity"),
+            (r.stop_bits.as_ref().map(|x| x.span()), "link.stop_bits"),
+        ] {
+            if let Some(sp) = v {
+                return Err(self.at(
+                    sp,
+                    k,
+                    "an AXI4-Stream link has no baud, parity or stop bits",
+                ));
+            }
+        }
+        let tlast = match &r.tlast {
+            None => link::Tlast::Slice,
+            Some(t) => link::Tlast::parse(t.get_ref()).ok_or_else(|| {
+                self.at(
+                    t.span(),
+                    "link.tlast",
+                    format!("unknown tlast `{}` (\"slice\" or \"frame\")", t.get_ref()),
+                )
+            })?,
+        };
+        let ready_within = match &r.ready_within {
+            None => 1,
+            Some(v) => {
+                let n = self.positive(v, "link.ready_within")?;
+                u32::try_from(n).map_err(|_| {
+                    self.at(
+                        v.span(),
+                        "link.ready_within",
+                        format!("{n} cycles is too many"),
+                    )
+                })?
+            }
+        };
+        Ok(LinkSpec {
+            kind: LinkKind::Axis,
+            tlast,
+            ready_within,
+            baud: 0,
+            parity: link::Parity::None,
+            stop_bits: 0,
         })
     }
 }

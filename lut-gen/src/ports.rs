@@ -209,6 +209,12 @@ pub struct Pins {
     pub link_tx: bool,
     /// The link FIFO's sticky overflow flag (`link_overflow`).
     pub link_overflow: bool,
+    /// An AXI4-Stream link's master outputs and the slave's `tready` (an
+    /// input, recorded so the judge sees the handshake of every cycle).
+    pub axis_tdata: u8,
+    pub axis_tvalid: bool,
+    pub axis_tlast: bool,
+    pub axis_tready: bool,
 }
 
 /// A port of the link to the host: present only when the mix has a
@@ -220,6 +226,10 @@ pub struct LinkPort {
     pub dir: Dir,
     /// The port's key under `"link"` in `ports.json`.
     pub key: &'static str,
+    /// Bits (1: a scalar port).
+    pub width: u32,
+    /// The signal it carries.
+    pub signal: Signal,
 }
 
 /// The UART link's ports: the serial line and the FIFO's overflow flag.
@@ -228,11 +238,55 @@ pub const LINK_PORTS: [LinkPort; 2] = [
         name: "link_tx",
         dir: Dir::Out,
         key: "tx",
+        width: 1,
+        signal: Signal::LinkTx,
     },
     LinkPort {
         name: "link_overflow",
         dir: Dir::Out,
         key: "overflow",
+        width: 1,
+        signal: Signal::LinkOverflow,
+    },
+];
+
+/// The AXI4-Stream link's ports (docs/packet-format.md, "AXI4-Stream"):
+/// byte beats, the handshake, and the FIFO's overflow flag.
+pub const AXIS_PORTS: [LinkPort; 5] = [
+    LinkPort {
+        name: "m_axis_tdata",
+        dir: Dir::Out,
+        key: "tdata",
+        width: 8,
+        signal: Signal::AxisTdata,
+    },
+    LinkPort {
+        name: "m_axis_tvalid",
+        dir: Dir::Out,
+        key: "tvalid",
+        width: 1,
+        signal: Signal::AxisTvalid,
+    },
+    LinkPort {
+        name: "m_axis_tlast",
+        dir: Dir::Out,
+        key: "tlast",
+        width: 1,
+        signal: Signal::AxisTlast,
+    },
+    LinkPort {
+        name: "m_axis_tready",
+        dir: Dir::In,
+        key: "tready",
+        width: 1,
+        signal: Signal::AxisTready,
+    },
+    LinkPort {
+        name: "link_overflow",
+        dir: Dir::Out,
+        key: "overflow",
+        width: 1,
+        signal: Signal::LinkOverflow,
     },
 ];
 
@@ -267,6 +321,11 @@ pub enum Signal {
     LinkTx,
     /// `link_overflow`.
     LinkOverflow,
+    /// `m_axis_tdata`, `m_axis_tvalid`, `m_axis_tlast`, `m_axis_tready`.
+    AxisTdata,
+    AxisTvalid,
+    AxisTlast,
+    AxisTready,
 }
 
 impl Signal {
@@ -281,7 +340,12 @@ impl Signal {
             Signal::SampleValid => Role::SampleValid,
             Signal::SampleChannel => Role::SampleChannel,
             Signal::SampleValue => Role::SampleValue,
-            Signal::LinkTx | Signal::LinkOverflow => return None,
+            Signal::LinkTx
+            | Signal::LinkOverflow
+            | Signal::AxisTdata
+            | Signal::AxisTvalid
+            | Signal::AxisTlast
+            | Signal::AxisTready => return None,
         })
     }
 
@@ -290,8 +354,12 @@ impl Signal {
         match (self.branch(), self.role()) {
             (Some(b), Some(r)) => layout.lane(r, b),
             (_, Some(r)) => r.name().to_string(),
-            (_, None) if *self == Signal::LinkTx => LINK_PORTS[0].name.to_string(),
-            (_, None) => LINK_PORTS[1].name.to_string(),
+            (_, None) => LINK_PORTS
+                .iter()
+                .chain(&AXIS_PORTS)
+                .find(|p| p.signal == *self)
+                .map_or("", |p| p.name)
+                .to_string(),
         }
     }
 
@@ -308,6 +376,10 @@ impl Signal {
             Signal::SampleValue => p.sample_value as u64,
             Signal::LinkTx => p.link_tx as u64,
             Signal::LinkOverflow => p.link_overflow as u64,
+            Signal::AxisTdata => p.axis_tdata as u64,
+            Signal::AxisTvalid => p.axis_tvalid as u64,
+            Signal::AxisTlast => p.axis_tlast as u64,
+            Signal::AxisTready => p.axis_tready as u64,
         }
     }
 
@@ -344,8 +416,10 @@ pub struct Layout {
     pub starts: Vec<Start>,
     /// `(branch, device, select)` -> channel, as `lookup[branch][device * 8 + select]`.
     pub lookup: Vec<Vec<Option<u16>>>,
-    /// The mix has a link to the host: [`LINK_PORTS`] follow [`PORTS`].
+    /// The mix has a link to the host: [`Layout::link_ports`] follow [`PORTS`].
     pub link: bool,
+    /// The link is AXI4-Stream ([`AXIS_PORTS`]), not a UART ([`LINK_PORTS`]).
+    pub axis: bool,
 }
 
 impl Layout {
@@ -388,6 +462,19 @@ impl Layout {
             starts: s.mix.branches.iter().map(|b| b.adc.start).collect(),
             lookup,
             link: s.mix.link.is_some(),
+            axis: s
+                .mix
+                .link
+                .is_some_and(|l| l.kind == crate::mix::LinkKind::Axis),
+        }
+    }
+
+    /// The link's ports after [`PORTS`]: none without a `[link]`.
+    pub fn link_ports(&self) -> &'static [LinkPort] {
+        match (self.link, self.axis) {
+            (false, _) => &[],
+            (true, false) => &LINK_PORTS,
+            (true, true) => &AXIS_PORTS,
         }
     }
 
@@ -481,8 +568,12 @@ impl Layout {
                 v.push((p.name.to_string(), p.dir));
             }
         }
-        if self.link {
-            v.extend(LINK_PORTS.iter().map(|p| (p.name.to_string(), p.dir)));
+        for p in self.link_ports() {
+            if p.width == 1 {
+                v.push((p.name.to_string(), p.dir));
+            } else {
+                v.extend((0..p.width).map(|i| (format!("{}[{i}]", p.name), p.dir)));
+            }
         }
         v
     }
@@ -535,9 +626,13 @@ impl Layout {
             Signal::SampleChannel,
             Signal::SampleValue,
         ]);
-        if self.link {
-            v.extend([Signal::LinkTx, Signal::LinkOverflow]);
-        }
+        // an input (the AXIS slave's tready) is the environment's, not the design's
+        v.extend(
+            self.link_ports()
+                .iter()
+                .filter(|p| p.dir == Dir::Out)
+                .map(|p| p.signal),
+        );
         v
     }
 }
@@ -602,13 +697,11 @@ pub fn manifest(s: &Schedule) -> String {
         .iter()
         .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": l.width(p.role)}))
         .collect();
-    if l.link {
-        ports.extend(
-            LINK_PORTS
-                .iter()
-                .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": 1})),
-        );
-    }
+    ports.extend(
+        l.link_ports()
+            .iter()
+            .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": p.width})),
+    );
     let mut doc = json!({
         "top": TOP_MODULE,
         "mix": s.mix.name,
@@ -627,13 +720,18 @@ pub fn manifest(s: &Schedule) -> String {
     if let Some(Ok(p)) = crate::hostlink::plan(s) {
         let mut o = serde_json::Map::new();
         o.insert("kind".into(), json!(p.kind));
-        for lp in &LINK_PORTS {
+        for lp in l.link_ports() {
             o.insert(lp.key.into(), json!(lp.name));
         }
-        o.insert("baud".into(), json!(p.baud));
-        o.insert("baud_divider".into(), json!(p.baud_divider));
-        o.insert("parity".into(), json!(p.parity));
-        o.insert("stop_bits".into(), json!(p.stop_bits));
+        if let Some(a) = p.axis() {
+            o.insert("tlast_at".into(), json!(a.tlast.name()));
+            o.insert("ready_within".into(), json!(a.ready_within));
+        } else {
+            o.insert("baud".into(), json!(p.baud));
+            o.insert("baud_divider".into(), json!(p.baud_divider));
+            o.insert("parity".into(), json!(p.parity));
+            o.insert("stop_bits".into(), json!(p.stop_bits));
+        }
         o.insert("fifo_depth".into(), json!(p.fifo_depth));
         o.insert("packet_format".into(), json!("docs/packet-format.md"));
         doc["link"] = serde_json::Value::Object(o);

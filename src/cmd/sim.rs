@@ -59,6 +59,17 @@ pub struct Args {
     /// its top module must honour the pin contract for the mix.
     #[arg(long, value_name = "FILE.v")]
     pub rtl: Option<PathBuf>,
+    /// An AXI4-Stream link's slave: `always` (ready in every cycle),
+    /// `random` or `random:SEED` (seeded, within the mix's
+    /// `link.ready_within`), `worst` (every beat taken in its
+    /// `ready_within`-th cycle, the case the FIFO depth is computed for).
+    #[arg(long, default_value = "always", value_parser = parse_tready)]
+    pub tready: link::ReadyPattern,
+}
+
+fn parse_tready(s: &str) -> Result<link::ReadyPattern, String> {
+    link::ReadyPattern::parse(s)
+        .ok_or_else(|| format!("`{s}`: always, worst, random or random:SEED (SEED > 0)"))
 }
 
 /// `path` made absolute, its folder created.
@@ -195,6 +206,7 @@ pub fn run(a: Args) -> u8 {
             gtkw: true,
         }),
         rtl: a.rtl,
+        tready: a.tready,
         ..SimOptions::default()
     };
     let mut log = judge::samples::SampleLog::new();

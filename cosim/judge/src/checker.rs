@@ -163,6 +163,10 @@ const NO_XZ: Pins = Pins {
     sample_value: 0,
     link_tx: false,
     link_overflow: false,
+    axis_tdata: 0,
+    axis_tvalid: false,
+    axis_tlast: false,
+    axis_tready: false,
 };
 
 impl Checker {
@@ -397,6 +401,8 @@ impl Checker {
         let c = self.c;
         let mut expected = None;
         if let Some(m) = &mut self.model {
+            // tready is the slave's: the model takes it from the pins
+            m.set_tready(p.axis_tready);
             let e = *m.pins();
             if e != *p || *xz != NO_XZ || self.div_active {
                 self.compare(c, &e, p, xz);
@@ -418,6 +424,9 @@ impl Checker {
         if *p != self.prev || p.sample_valid || *xz != NO_XZ {
             self.edges(c, p, xz);
         }
+        if self.layout.link {
+            self.link_rules(c, p);
+        }
         if c + 1 == self.next_frame_at {
             self.inv.close_frames(c + 1);
             self.next_frame_at += self.grid.frame_cycles;
@@ -427,6 +436,46 @@ impl Checker {
         self.prev_miso = miso;
         self.prev_miso_xz = miso_xz;
         self.c = c + 1;
+    }
+
+    /// AXI4-Stream's rule, without the model: once `tvalid` is high it
+    /// stays high, with `tdata` and `tlast` unchanged, until the edge where
+    /// `tready` is high too; and the link's FIFO never overflows.
+    fn link_rules(&mut self, c: u64, p: &Pins) {
+        let q = self.prev;
+        if c > 0 && q.axis_tvalid && !q.axis_tready {
+            let held =
+                p.axis_tvalid && p.axis_tdata == q.axis_tdata && p.axis_tlast == q.axis_tlast;
+            if !held {
+                let what = if !p.axis_tvalid {
+                    "tvalid fell"
+                } else if p.axis_tdata != q.axis_tdata {
+                    "tdata changed"
+                } else {
+                    "tlast changed"
+                };
+                self.inv.violation(
+                    c,
+                    "axis-stable",
+                    Some("m_axis_tvalid/tdata/tlast".into()),
+                    Some(json!(format!("tvalid=1 tdata={:#04x} tlast={}", q.axis_tdata, q.axis_tlast as u8))),
+                    Some(json!(format!("tvalid={} tdata={:#04x} tlast={}", p.axis_tvalid as u8, p.axis_tdata, p.axis_tlast as u8))),
+                    None,
+                    format!("{what} while the beat waited for tready (AXI4-Stream: a master holds tvalid, tdata and tlast until the handshake)"),
+                );
+            }
+        }
+        if p.link_overflow && !q.link_overflow {
+            self.inv.violation(
+                c,
+                "link-overflow",
+                Some("link_overflow".into()),
+                Some(json!(0)),
+                Some(json!(1)),
+                None,
+                "the link's FIFO overflowed: a token was dropped (its depth is the schedule's worst-case backlog under the slave's guarantee)".into(),
+            );
+        }
     }
 
     fn compare(&mut self, c: u64, e: &Pins, p: &Pins, xz: &Pins) {
@@ -891,6 +940,12 @@ fn fmt_pins(p: &Pins) -> String {
         "cs_n={:b} sclk={:b} mux_sel={:#x} mux_en={:#x} valid={} ch={} value={:#06x}",
         p.cs_n, p.sclk, p.mux_sel, p.mux_en, p.sample_valid as u8, p.sample_channel, p.sample_value
     );
+    if p.axis_tvalid || p.axis_tready || p.axis_tdata != 0 {
+        t.push_str(&format!(
+            " tdata={:#04x} tvalid={} tlast={} tready={}",
+            p.axis_tdata, p.axis_tvalid as u8, p.axis_tlast as u8, p.axis_tready as u8
+        ));
+    }
     // the link's pins (all zero without a link: nothing added)
     if p.link_tx || p.link_overflow {
         t.push_str(&format!(

@@ -120,12 +120,26 @@ pub const LINK_SCOPE: &str = "link";
 /// stop bit's middle sample), a change of the overflow flag.
 fn link_events(
     events: &mut Vec<Event>,
-    rx: &mut link::rx::UartRx,
+    rx: Option<&mut link::rx::UartRx>,
     c: u64,
     p: &Pins,
     prev: Option<&Pins>,
 ) {
-    if let Some(b) = rx.sample(p.link_tx) {
+    // an AXI4-Stream beat: the byte a slave took at the edge ending `c`
+    if rx.is_none() && p.axis_tvalid && p.axis_tready {
+        events.push(Event {
+            cycle: c,
+            scope: LINK_SCOPE.into(),
+            signal: "beat".into(),
+            value: format!("{:#04x}", p.axis_tdata),
+            note: if p.axis_tlast {
+                "tlast".into()
+            } else {
+                String::new()
+            },
+        });
+    }
+    if let Some(b) = rx.and_then(|rx| rx.sample(p.link_tx)) {
         events.push(Event {
             cycle: c,
             scope: LINK_SCOPE.into(),
@@ -163,14 +177,15 @@ impl EventLog {
         };
         let n = (trace.len() - z).min(cycles as usize);
         // The link's line read back as a receiver would, one event per byte.
-        let mut rx = match lut_gen::hostlink::plan(s) {
-            Some(Ok(lp)) => Some(link::rx::UartRx::new(lp.uart())),
-            _ => None,
-        };
+        let plan = lut_gen::hostlink::plan(s).and_then(|p| p.ok());
+        let mut rx = plan
+            .as_ref()
+            .and_then(|lp| lp.uart())
+            .map(link::rx::UartRx::new);
         for (c, (_, p, _)) in trace.cycles[z..z + n].iter().enumerate() {
             let c = c as u64;
-            if let Some(rx) = rx.as_mut() {
-                link_events(&mut events, rx, c, p, prev.as_ref());
+            if plan.is_some() {
+                link_events(&mut events, rx.as_mut(), c, p, prev.as_ref());
             }
             for (b, bname) in branches.iter().enumerate() {
                 for r in LANES {

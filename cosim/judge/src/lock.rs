@@ -555,6 +555,10 @@ const NO_XZ: Pins = Pins {
     sample_value: 0,
     link_tx: false,
     link_overflow: false,
+    axis_tdata: 0,
+    axis_tvalid: false,
+    axis_tlast: false,
+    axis_tready: false,
 };
 
 fn fmt_ctl(c: &Ctl) -> String {

@@ -221,6 +221,8 @@ pub struct CycleModel {
     /// The link's transmitter, fed the predicted sample stream (a mix with
     /// a `[link]`).
     tx: Option<link::TxModel>,
+    /// The link is AXI4-Stream: its pins are `axis_*`, not `link_tx`.
+    axis: bool,
 }
 
 impl CycleModel {
@@ -292,14 +294,14 @@ impl CycleModel {
             .filter(|(_, m)| !m.cnv)
             .fold(0u16, |a, (b, _)| a | 1 << b);
         // The transmitter after its reset edge: line idle (high).
-        let tx = match lut_gen::hostlink::plan(s) {
-            Some(Ok(p)) => Some(link::TxModel::new(p.tx_config(s))),
-            _ => None,
+        let (tx, axis) = match lut_gen::hostlink::plan(s) {
+            Some(Ok(p)) => (Some(link::TxModel::new(p.tx_config(s))), p.axis().is_some()),
+            _ => (None, false),
         };
         let mut reset = Pins {
             cs_n: cs_idle,
             sclk: cs_idle,
-            link_tx: tx.is_some(),
+            link_tx: tx.is_some() && !axis,
             ..Pins::default()
         };
         for (b, m) in br.iter().enumerate() {
@@ -321,6 +323,7 @@ impl CycleModel {
             capture: 0,
             groups: s.groups.clone(),
             tx,
+            axis,
         };
         model.process();
         // The edge into cycle 0 samples the reset cycle's stream: no sample.
@@ -334,9 +337,25 @@ impl CycleModel {
     fn step_link(&mut self, valid: bool, ch: u16, v: u16) {
         if let Some(t) = &mut self.tx {
             t.clock(false, valid.then_some((ch, v)));
-            self.pins.link_tx = t.line();
             self.pins.link_overflow = t.overflow();
+            if self.axis {
+                self.pins.axis_tdata = t.tdata();
+                self.pins.axis_tvalid = t.tvalid();
+                self.pins.axis_tlast = t.tlast();
+            } else {
+                self.pins.link_tx = t.line();
+            }
         }
+    }
+
+    /// The AXI4-Stream slave's `tready` in the current cycle (an input the
+    /// model takes from the pins it is compared with), before [`CycleModel::step`].
+    #[inline]
+    pub fn set_tready(&mut self, ready: bool) {
+        if let Some(t) = &mut self.tx {
+            t.set_tready(ready);
+        }
+        self.pins.axis_tready = ready;
     }
 
     /// What the link's line carries in the current cycle, for reports:

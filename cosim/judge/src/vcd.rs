@@ -29,7 +29,7 @@ use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use lut_gen::ports::{Role, LINK_PORTS, PORT_NAMES as PORTS, TOP_MODULE};
+use lut_gen::ports::{LinkPort, Role, AXIS_PORTS, PORT_NAMES as PORTS, TOP_MODULE};
 use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker};
@@ -302,6 +302,8 @@ const CHAN: usize = Role::SampleChannel as usize;
 const VALUE: usize = Role::SampleValue as usize;
 /// The first of the link's ports in [`State`].
 const LINK: usize = PORTS.len();
+/// Port slots: [`PORTS`], then the most link ports a mix has ([`AXIS_PORTS`]).
+const NPORT: usize = LINK + AXIS_PORTS.len();
 
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
 /// (or `lsb - j` when the range is ascending).
@@ -327,8 +329,8 @@ struct Resolved {
     has_rst: bool,
     scope: String,
     widths: [u32; 10],
-    /// The link's ports are read too.
-    link: bool,
+    /// The link's ports, read after [`PORTS`] (none without a link).
+    link: &'static [LinkPort],
 }
 
 fn resolve(
@@ -510,12 +512,12 @@ fn resolve(
             has_clk = true;
         }
     }
-    if layout.link {
-        for (k, lp) in LINK_PORTS.iter().enumerate() {
+    {
+        for (k, lp) in layout.link_ports().iter().enumerate() {
             let v = h
                 .vars
                 .iter()
-                .find(|v| v.scope == scope && v.name == lp.name && v.width == 1)
+                .find(|v| v.scope == scope && v.name == lp.name && v.width == lp.width)
                 .ok_or_else(|| {
                     perr(format!(
                         "port `{}` (the mix's link) not found in scope `{scope}`",
@@ -524,7 +526,7 @@ fn resolve(
                 })?;
             ids.get_mut(&v.id).unwrap().push(Sink {
                 port: (LINK + k) as u8,
-                width: 1,
+                width: lp.width,
                 lsb: 0,
                 down: true,
             });
@@ -536,7 +538,7 @@ fn resolve(
         has_rst,
         scope: scope.to_string(),
         widths,
-        link: layout.link,
+        link: layout.link_ports(),
     })
 }
 
@@ -668,9 +670,11 @@ pub(crate) fn parse_value(s: &[u8], width: u32) -> Option<Val> {
     Some(Val { v, x })
 }
 
-/// The ports of [`PORTS`], then the link's ([`LINK_PORTS`]).
+/// The ports of [`PORTS`], then the link's (`Layout::link_ports`).
 struct State {
-    port: [Val; 12],
+    port: [Val; NPORT],
+    /// The link is AXI4-Stream: its slots are [`AXIS_PORTS`]'s.
+    axis: bool,
 }
 
 impl State {
@@ -711,8 +715,12 @@ impl State {
                 sample_valid: g(VALID) & 1 == 1,
                 sample_channel: g(CHAN) as u16,
                 sample_value: g(VALUE) as u16,
-                link_tx: g(LINK) & 1 == 1,
-                link_overflow: g(LINK + 1) & 1 == 1,
+                link_tx: !self.axis && g(LINK) & 1 == 1,
+                link_overflow: g(if self.axis { LINK + 4 } else { LINK + 1 }) & 1 == 1,
+                axis_tdata: if self.axis { g(LINK) as u8 } else { 0 },
+                axis_tvalid: self.axis && g(LINK + 1) & 1 == 1,
+                axis_tlast: self.axis && g(LINK + 2) & 1 == 1,
+                axis_tready: self.axis && g(LINK + 3) & 1 == 1,
             }
         };
         (pick(|p| p.v), pick(|p| p.x))
@@ -780,7 +788,7 @@ struct Applier<'a> {
     clocking: Option<Clocking>,
     sink: &'a mut dyn CycleSink,
     st: State,
-    before: [Val; 12],
+    before: [Val; NPORT],
     time: u64,
     seen_time: bool,
     out_changed: bool,
@@ -789,9 +797,23 @@ struct Applier<'a> {
     pending: Pending,
 }
 
+/// The inputs an edge samples: MISO and, with an AXIS link, tready.
+type Inputs = (Val, Option<Val>);
+
 impl Applier<'_> {
-    fn edge(&mut self, rst: Option<bool>, pins: Pins, xz: Pins, miso: Val) {
-        if let Some((r, p, x)) = self.pending.take() {
+    fn inputs(&self, port: &[Val; NPORT]) -> Inputs {
+        (port[MISO], self.st.axis.then_some(port[LINK + 3]))
+    }
+
+    /// Hands on the pending cycle with the inputs the edge ending it
+    /// samples: MISO and, for an AXIS link, tready (an input like MISO: the
+    /// cycle's value is the one that edge samples).
+    fn edge(&mut self, rst: Option<bool>, pins: Pins, xz: Pins, (miso, tready): Inputs) {
+        if let Some((r, mut p, mut x)) = self.pending.take() {
+            if let Some(t) = tready {
+                p.axis_tready = t.v & 1 == 1;
+                x.axis_tready = t.x & 1 == 1;
+            }
             self.sink.cycle(r, &p, &x, miso.v as u64, miso.x as u64);
         }
         self.info.cycles += 1;
@@ -834,14 +856,14 @@ impl Applier<'_> {
                     // Only at an edge: half the timesteps are falling edges.
                     let (pins, xz) = self.st.pins();
                     let rst = self.rst_of(&self.before[RST]);
-                    self.edge(rst, pins, xz, self.before[MISO]);
+                    self.edge(rst, pins, xz, self.inputs(&self.before));
                 }
             }
             Some(Clocking::Inferred { period, phase }) => {
                 let (pins, xz) = self.st.pins();
                 if t >= phase && (t - phase) % period == 0 {
                     let rst = self.rst_of(&self.before[RST]);
-                    self.edge(rst, pins, xz, self.before[MISO]);
+                    self.edge(rst, pins, xz, self.inputs(&self.before));
                 }
                 if let Some(n) = next {
                     let mut e = if t < phase {
@@ -851,7 +873,7 @@ impl Applier<'_> {
                     };
                     let rst = self.rst_of(&self.st.port[RST]);
                     while e < n {
-                        self.edge(rst, pins, xz, self.st.port[MISO]);
+                        self.edge(rst, pins, xz, self.inputs(&self.st.port));
                         e = e.saturating_add(period);
                     }
                 }
@@ -917,11 +939,11 @@ fn body(
     sink: &mut dyn CycleSink,
 ) -> Result<BodyInfo, VcdError> {
     let mut st = State {
-        port: [Val { v: 0, x: 0 }; 12],
+        port: [Val { v: 0, x: 0 }; NPORT],
+        axis: res.link.len() == AXIS_PORTS.len(),
     };
-    if res.link {
-        st.port[LINK].x = 1;
-        st.port[LINK + 1].x = 1;
+    for (k, lp) in res.link.iter().enumerate() {
+        st.port[LINK + k].x = (1u128 << lp.width) - 1;
     }
     for (i, w) in res.widths.iter().enumerate() {
         st.port[i].x = if *w >= 128 {
@@ -954,8 +976,12 @@ fn body(
     }
     let time = ap.time;
     ap.close(time, None);
-    if let Some((r, p, x)) = ap.pending.take() {
-        let miso = ap.st.port[MISO];
+    if let Some((r, mut p, mut x)) = ap.pending.take() {
+        let (miso, tready) = ap.inputs(&ap.st.port);
+        if let Some(t) = tready {
+            p.axis_tready = t.v & 1 == 1;
+            x.axis_tready = t.x & 1 == 1;
+        }
         ap.sink.cycle(r, &p, &x, miso.v as u64, miso.x as u64);
     }
     ap.info.last_time = time;

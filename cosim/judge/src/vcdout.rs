@@ -8,7 +8,7 @@ use std::path::Path;
 use lut_gen::Schedule;
 
 use crate::run::Observer;
-use lut_gen::ports::{Layout, Pins, Role, LINK_PORTS, PORTS, TOP_MODULE};
+use lut_gen::ports::{Layout, Pins, Role, PORTS, TOP_MODULE};
 
 /// The time in picoseconds of clock edge `n` of a run (edge `2k + 1` falls
 /// before cycle `k` (counted from the first reset cycle), edge `2k + 2`
@@ -78,9 +78,18 @@ impl VcdWriter {
         }
         // The link's ports follow the branch views in the value list.
         let link_at = PORTS.len() + BRANCH_VIEW.len() * s.branches.len();
-        if l.link {
-            for (k, lp) in LINK_PORTS.iter().enumerate() {
+        for (k, lp) in l.link_ports().iter().enumerate() {
+            if lp.width == 1 {
                 writeln!(w, "$var wire 1 {} {} $end", id_code(link_at + k), lp.name)?;
+            } else {
+                writeln!(
+                    w,
+                    "$var wire {} {} {} [{}:0] $end",
+                    lp.width,
+                    id_code(link_at + k),
+                    lp.name,
+                    lp.width - 1
+                )?;
             }
         }
         for (b, br) in s.branches.iter().enumerate() {
@@ -104,9 +113,7 @@ impl VcdWriter {
             }
             writeln!(w, "$upscope $end")?;
         }
-        if l.link {
-            widths.extend([1; LINK_PORTS.len()]);
-        }
+        widths.extend(l.link_ports().iter().map(|lp| lp.width));
         writeln!(w, "$upscope $end")?;
         writeln!(w, "$enddefinitions $end")?;
         let ids = (0..widths.len()).map(id_code).collect();
@@ -147,10 +154,9 @@ impl VcdWriter {
                 self.cur.push((v >> lo) & ((1u128 << (hi - lo + 1)) - 1));
             }
         }
-        if self.layout.link {
-            self.cur
-                .extend([p.link_tx as u128, p.link_overflow as u128]);
-        }
+        let l = &self.layout;
+        self.cur
+            .extend(l.link_ports().iter().map(|lp| lp.signal.get(l, p) as u128));
         // rst is sampled at the edge that begins cycle k: it changes half a
         // period before it; the outputs and MISO of cycle k change at the edge.
         let first = self.prev.is_empty();
