@@ -210,14 +210,22 @@ fn unknown_steps_are_refused_before_anything_runs() {
     let d = tempfile::tempdir().unwrap();
     let out = d.path().join("b");
     slotforge()
-        .args(["build", "--only", "audit,prove", "-o"])
+        .args(["build", "--only", "audit,proof", "-o"])
         .arg(&out)
         .arg(tiny())
         .assert()
         .code(2)
         .stderr(predicates::str::contains(
-            "--only: there is no step `prove`; the steps are audit, lut,",
+            "--only: there is no step `proof`; the steps are audit, lut,",
         ));
+    assert!(!out.exists());
+    slotforge()
+        .args(["build", "--only", "speed", "-o"])
+        .arg(&out)
+        .arg(tiny())
+        .assert()
+        .code(2)
+        .stderr(predicates::str::contains("--only faults,speed"));
     assert!(!out.exists());
     slotforge()
         .args(["build", "--junit", "/nonexistent/dir/x.xml", "-o"])
@@ -421,11 +429,15 @@ fn a_skipped_step_fails_strict_and_ci() {
     let build = |dir: &str, strict: bool, ci: &str| {
         let out = d.path().join(dir);
         let mut cmd = slotforge();
-        cmd.args(["build", "--quiet", "--only", "speed", "-o"])
+        // synthesis with no yosys on the PATH: the step is skipped
+        let empty = d.path().join("no-tools");
+        std::fs::create_dir_all(&empty).unwrap();
+        cmd.args(["build", "--quiet", "--only", "synth", "-o"])
             .arg(&out)
             .arg("--junit")
             .arg(out.with_extension("xml"))
             .arg(tiny())
+            .env("PATH", &empty)
             .env("CI", ci);
         if strict {
             cmd.arg("--strict");
@@ -437,7 +449,10 @@ fn a_skipped_step_fails_strict_and_ci() {
     let (o, xml) = build("strict", true, "false");
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success(), "{err}");
-    assert!(err.contains("skipped") && err.contains("speed"), "{err}");
+    assert!(
+        err.contains("skipped") && err.contains("synthesis"),
+        "{err}"
+    );
     assert!(xml.contains("<skipped"), "{xml}");
     let (o, _) = build("ci", false, "true");
     assert!(!o.status.success(), "CI=true fails a skipped step too");
@@ -445,7 +460,7 @@ fn a_skipped_step_fails_strict_and_ci() {
     let (o, xml) = build("plain", false, "false");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(
-        xml.contains("<skipped") && xml.contains("faults step did not run"),
+        xml.contains("<skipped") && xml.contains("not installed"),
         "{xml}"
     );
 }

@@ -46,7 +46,13 @@ pub fn plan(a: &Args) -> Result<Vec<(&'static str, bool, &'static str)>, String>
         }
     }
     let named = |v: &Vec<String>, id: &str| v.iter().any(|n| n.trim() == id);
-    Ok(STEPS
+    if named(&a.only, "speed") && !named(&a.only, "faults") {
+        return Err(
+            "--only speed: the chart draws this build's fault campaign; ask for both: --only faults,speed"
+                .into(),
+        );
+    }
+    let plan = STEPS
         .iter()
         .map(|&(id, _)| {
             let (run, why) = if !a.only.is_empty() {
@@ -62,7 +68,21 @@ pub fn plan(a: &Args) -> Result<Vec<(&'static str, bool, &'static str)>, String>
             };
             (id, run, why)
         })
-        .collect())
+        .collect();
+    Ok(speed_needs_faults(plan))
+}
+
+/// The speed chart draws this build's fault campaign: without the faults
+/// step it is left out (said why), not skipped as if something failed.
+fn speed_needs_faults(
+    mut plan: Vec<(&'static str, bool, &'static str)>,
+) -> Vec<(&'static str, bool, &'static str)> {
+    let faults = plan.iter().any(|p| p.0 == "faults" && p.1);
+    for p in plan.iter_mut().filter(|p| p.0 == "speed" && p.1 && !faults) {
+        p.1 = false;
+        p.2 = "draws this build's fault campaign, which is left out";
+    }
+    plan
 }
 
 /// The plan's `why` of a proof left out by default but remembered.
