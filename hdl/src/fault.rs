@@ -44,14 +44,18 @@ impl GatewareFault {
 
     /// One fault of each link class, for a mix with a `[link]` (none without).
     pub fn link_faults(s: &lut_gen::Schedule) -> Vec<(&'static str, GatewareFault)> {
-        if s.mix.link.is_none() {
+        let Some(link) = &s.mix.link else {
             return Vec::new();
-        }
-        vec![
+        };
+        let mut v = vec![
             ("link-fifo-short", GatewareFault::LinkFifoShort),
-            ("link-baud-fast", GatewareFault::LinkBaud { delta: -1 }),
             ("link-crc-init", GatewareFault::LinkCrcInit),
-        ]
+        ];
+        // an AXI4-Stream link has no baud divider to get wrong
+        if link.kind == lut_gen::mix::LinkKind::Uart {
+            v.insert(1, ("link-baud-fast", GatewareFault::LinkBaud { delta: -1 }));
+        }
+        v
     }
 
     pub(crate) fn apply(&self, p: &mut Plan) -> Result<(), HdlError> {

@@ -236,3 +236,38 @@ proptest! {
         }
     }
 }
+
+/// A mix the property test's generator drew (random seed, 2026-11-24): it
+/// has a jitter-free schedule by construction (at 96 slots per slice, b2's
+/// 600 Hz channel fits on the residues its two 16 kHz channels leave), but
+/// the exact search stops at its node bound without one. An open bug of the
+/// synthesizer, kept here so it is seen; `make test` draws a fixed seed.
+#[test]
+#[ignore = "open bug: the exact search's node bound misses a feasible mix (make test-long)"]
+fn a_feasible_mix_the_bounded_search_misses() {
+    let mut text = String::from(
+        "name = \"prop\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n",
+    );
+    for b in 0..3 {
+        text += &format!(
+            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 4\n"
+        );
+    }
+    let channels = [
+        ("c0", "b2", 16_000),
+        ("c1", "b2", 600),
+        ("c2", "b0", 12_000),
+        ("c3", "b0", 3_000),
+        ("c4", "b2", 16_000),
+        ("c5", "b0", 1_500),
+        ("c6", "b1", 2_400),
+    ];
+    for (name, branch, rate) in channels {
+        text +=
+            &format!("[[channel]]\nname = \"{name}\"\nbranch = \"{branch}\"\nrate_hz = {rate}\n");
+    }
+    let mix = lut_gen::parse(Path::new("prop.toml"), &text).expect("parses");
+    if let Err(e) = lut_gen::synthesize(&mix) {
+        panic!("{e}\n{text}");
+    }
+}
