@@ -1,0 +1,17 @@
+//! All of this crate's integration tests in one binary: each test file is
+//! a module here, so the workspace is linked once, not once per file.
+
+#[path = "capture.rs"]
+mod capture;
+
+#[path = "fuzz_regressions.rs"]
+mod fuzz_regressions;
+
+#[path = "lock.rs"]
+mod lock;
+
+#[path = "model_check.rs"]
+mod model_check;
+
+#[path = "vcd.rs"]
+mod vcd;

@@ -1,0 +1,44 @@
+//! All of this crate's integration tests in one binary: each test file is
+//! a module here, so the workspace is linked once, not once per file.
+
+#[path = "build.rs"]
+mod build;
+
+#[path = "capture.rs"]
+mod capture;
+
+#[path = "cli.rs"]
+mod cli;
+
+#[path = "docs.rs"]
+mod docs;
+
+#[path = "golden.rs"]
+mod golden;
+
+#[path = "golden_rtl.rs"]
+mod golden_rtl;
+
+#[path = "icarus.rs"]
+mod icarus;
+
+#[path = "link.rs"]
+mod link;
+
+#[path = "prove_cli.rs"]
+mod prove_cli;
+
+#[path = "rtl.rs"]
+mod rtl;
+
+#[path = "samples.rs"]
+mod samples;
+
+#[path = "sigrok.rs"]
+mod sigrok;
+
+#[path = "sim_cli.rs"]
+mod sim_cli;
+
+#[path = "tool_policy.rs"]
+mod tool_policy;
