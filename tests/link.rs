@@ -209,6 +209,13 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
         t.contains("the minimum baud that carries this mix is 1500000"),
         "{t}"
     );
+    // file, line and key of the refused baud, on stderr
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("slow.toml: line 326: link.baud: 1476 bytes per frame need 708480 cycles")
+            && e.contains("the minimum baud that carries this mix is 1500000"),
+        "{e}"
+    );
     slotforge()
         .arg("verilog")
         .arg(&slow)
@@ -223,6 +230,69 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
     assert_eq!(o.status.code(), Some(2));
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("link.baud") && e.contains(":326:"), "{e}");
+
+    // every new key's bad value: file, line, column and key, exit 2
+    for (from, to, key, words) in [
+        (
+            "kind = \"uart\"",
+            "kind = \"serial\"",
+            "link.kind",
+            "unknown link kind `serial`",
+        ),
+        (
+            "baud = 3_000_000",
+            "baud = 0",
+            "link.baud",
+            "must be positive, got 0",
+        ),
+        (
+            "baud = 3_000_000",
+            "baud = 3_000_000\nparity = \"odd-ish\"",
+            "link.parity",
+            "unknown parity `odd-ish`",
+        ),
+        (
+            "baud = 3_000_000",
+            "baud = 3_000_000\nstop_bits = 3",
+            "link.stop_bits",
+            "3 stop bits: 1 or 2",
+        ),
+        (
+            "kind = \"uart\"\nbaud = 3_000_000",
+            "kind = \"axis\"\ntlast = \"sometimes\"",
+            "link.tlast",
+            "unknown tlast `sometimes` (\"slice\" or \"frame\")",
+        ),
+        (
+            "kind = \"uart\"\nbaud = 3_000_000",
+            "kind = \"axis\"\nbaud = 3_000_000",
+            "link.baud",
+            "an AXI4-Stream link has no baud",
+        ),
+        (
+            "kind = \"uart\"\nbaud = 3_000_000",
+            "kind = \"axis\"\nready_within = 0",
+            "link.ready_within",
+            "must be positive, got 0",
+        ),
+    ] {
+        assert!(text.contains(from), "{from}");
+        let bad = dir.path().join("bad.toml");
+        std::fs::write(&bad, text.replace(from, to)).unwrap();
+        let o = slotforge().arg("audit").arg(&bad).output().unwrap();
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{to}: {e}");
+        // the key's line in the edited file
+        let first = text[..text.find(from).unwrap()].lines().count() + 1;
+        let key_at = to.lines().position(|l| l.starts_with(&key[5..]));
+        let line = first + key_at.unwrap();
+        let at = format!("bad.toml:{line}:");
+        assert!(
+            e.contains(&at) && e.contains(&format!(": {key}: {words}")),
+            "{to}: {e}"
+        );
+        assert!(!e.contains("panicked"), "{e}");
+    }
 
     let o = slotforge()
         .arg("decode")

@@ -78,6 +78,8 @@ impl Detector {
                 "mux-late" | "two-mux-en" | "wrong-mux" | "select-swap",
             ) => Some("the SPI decode reads CS, SCLK and MISO only: mux pins are outside its view, and the design emits whatever code MISO carried"),
             (Detector::Prove, _) if level == "pins" || level == "reset" => Some("the fault is injected into a simulation's pins, not built into a design: prove reads a design, so it has nothing to prove it against"),
+            (Detector::Sigrok, c) if c.starts_with("link-") || c.starts_with("axis-") => Some("the SPI decode reads CS, SCLK and MISO only: the link's pins are outside its view"),
+            (Detector::Invariants, "link-bit-flip" | "link-drop-byte" | "link-stuck-high" | "link-stuck-low") => Some("the model-free checks do not decode the UART line: only the model predicts its bits"),
             _ => None,
         }
     }
@@ -213,6 +215,9 @@ pub struct Campaign {
     /// Frames per run (the simulated time one injection covers).
     pub frames: u64,
     pub clock_hz: u64,
+    /// The AXI4-Stream slave's `tready` pattern in every run ([`TREADY`];
+    /// `None` without an AXI4-Stream link).
+    pub tready: Option<String>,
     pub classes: Vec<ClassOutcome>,
     pub injected: u64,
     pub detected: u64,
@@ -469,10 +474,11 @@ pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(&'static str, hdl::Gat
     v
 }
 
-/// `hdl::RtlSim` with a design-level fault built in, as a [`Dut`].
+/// `hdl::RtlSim` with a design-level fault built in, as a [`Dut`] (behind
+/// the campaign's slave for an AXI4-Stream link).
 pub fn gateware_dut(s: &Schedule, f: hdl::GatewareFault) -> Result<Box<dyn Dut>, SimError> {
     hdl::RtlSim::with_fault(s, f)
-        .map(|sim| Box::new(GatewareDut(sim)) as Box<dyn Dut>)
+        .map(|sim| slave(s, Box::new(GatewareDut(sim))))
         .map_err(|e| SimError::Hdl(e.to_string()))
 }
 
@@ -557,6 +563,27 @@ fn not_run(d: Detector, plan: &Plan) -> Option<String> {
 /// detectors besides the checker.
 type Judgement = (String, &'static str, Injection, Cost);
 
+/// The AXI4-Stream slave of every in-process run of the campaign: the worst
+/// case the mix's guarantee allows (every beat accepted in its
+/// `ready_within`-th cycle), so the FIFO reaches the backlog its depth is
+/// computed for (an always-ready slave would hide a FIFO one token short)
+/// and every beat waits (where the stall faults land).
+pub const TREADY: link::ReadyPattern = link::ReadyPattern::WorstCase;
+
+/// `dut` behind the campaign's slave when `s`'s link is AXI4-Stream.
+fn slave(s: &Schedule, dut: Box<dyn Dut>) -> Box<dyn Dut> {
+    judge::run::with_slave(s, dut, TREADY)
+}
+
+/// The design the faults go into, built for `s`, behind the campaign's slave.
+fn target_dut(s: &Schedule, target: Target) -> Result<Box<dyn Dut>, SimError> {
+    let d: Box<dyn Dut> = match target {
+        Target::Model => Box::new(ModelDut::new(s)),
+        Target::Rusthdl => Box::new(RustHdlDut::new(s)?),
+    };
+    Ok(slave(s, d))
+}
+
 /// The engine name of a target.
 fn engine_name(t: Target) -> &'static str {
     match t {
@@ -580,10 +607,7 @@ fn pin_injections(
         }
     }
     let runs = parallel(jobs, |(f, site)| -> Result<Option<Judgement>, String> {
-        let inner: Box<dyn Dut> = match target {
-            Target::Model => Box::new(ModelDut::new(s)),
-            Target::Rusthdl => Box::new(RustHdlDut::new(s).map_err(|e| e.to_string())?),
-        };
+        let inner = target_dut(s, target).map_err(|e| e.to_string())?;
         let mut dut = FaultyDut::new(s, inner, f, site.cycle);
         let j = judge_run(s, &mut dut, frames, sigrok)?;
         let level = if f == Fault::ResetGlitch {
@@ -661,7 +685,7 @@ fn gateware_injections(
             let Ok(sim) = hdl::RtlSim::with_fault(s, c.fault) else {
                 return Ok(None);
             };
-            let mut dut = GatewareDut(sim);
+            let mut dut = slave(s, Box::new(GatewareDut(sim)));
             let mut j = judge_run(s, &mut dut, frames, sigrok)?;
             let mut inj = outcome(name, &c.site, &j, "rusthdl");
             let pair = hdl::verilog_pair(s, c.fault).map_err(|e| e.to_string());
@@ -777,12 +801,8 @@ fn columns(
 /// model, timed: [(cycles, seconds) with the model, without].
 fn clean_target_runs(s: &Schedule, target: Target, frames: u64) -> [(u64, f64); 2] {
     let timed = |model: bool| -> (u64, f64) {
-        let mut dut: Box<dyn Dut> = match target {
-            Target::Model => Box::new(ModelDut::new(s)),
-            Target::Rusthdl => match RustHdlDut::new(s) {
-                Ok(d) => Box::new(d),
-                Err(_) => return (0, 0.0),
-            },
+        let Ok(mut dut) = target_dut(s, target) else {
+            return (0, 0.0);
         };
         let mut opts = RunOptions::default();
         opts.check.model = model;
@@ -888,6 +908,11 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
         engines,
         frames,
         clock_hz: s.grid.clock_hz,
+        tready: s
+            .mix
+            .link
+            .filter(|l| l.kind == lut_gen::mix::LinkKind::Axis)
+            .map(|_| TREADY.name()),
         injected: sum(|c| c.injected),
         detected: sum(|c| c.detected),
         undetected: sum(|c| c.undetected.len() as u64),
@@ -903,6 +928,9 @@ struct GatewareDut(hdl::RtlSim);
 impl Dut for GatewareDut {
     fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
         self.0.step(rst, miso)
+    }
+    fn set_tready(&mut self, ready: bool) {
+        self.0.set_tready(ready)
     }
 }
 
@@ -929,15 +957,10 @@ pub fn false_alarms(target: Target, n: u64, sigrok: bool) -> FalseAlarms {
         if lut_gen::ports::Layout::fits(&s).is_err() {
             continue;
         }
-        let dut: Box<dyn Dut> = match target {
-            Target::Model => Box::new(ModelDut::new(&s)),
-            Target::Rusthdl => match RustHdlDut::new(&s) {
-                Ok(d) => Box::new(d),
-                Err(_) => continue,
-            },
+        let Ok(mut dut) = target_dut(&s, target) else {
+            continue;
         };
         fa.mixes += 1;
-        let mut dut = dut;
         let j = judge_run(&s, &mut dut, 2, sigrok);
         fa.runs += 1;
         let why = match &j {

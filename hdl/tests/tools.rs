@@ -43,6 +43,12 @@ fn gates(s: &Schedule, tag: &str) {
 }
 
 fn gates_in(dir: &Path, tag: &str) {
+    lint_in(dir, tag);
+    synth_in(dir, tag);
+}
+
+/// Verilator and Icarus on the Verilog in `dir`.
+fn lint_in(dir: &Path, tag: &str) {
     let dir = dir.to_path_buf();
     // Verilator: clean under -Wall (the only waiver is inline: DECLFILENAME).
     let (ok, text) = run(
@@ -68,7 +74,11 @@ fn gates_in(dir: &Path, tag: &str) {
         ok && text.trim().is_empty(),
         "iverilog -g2005 -Wall on {tag}:\n{text}"
     );
-    // Yosys: synthesizes for iCE40, passes check -assert, no latches.
+}
+
+/// Yosys on the Verilog in `dir`: synthesizes for iCE40, passes
+/// check -assert, no latches.
+fn synth_in(dir: &Path, tag: &str) {
     let (ok, text) = run(
         &dir,
         Command::new(tool("yosys")).args([
@@ -135,6 +145,30 @@ fn gates_uart_link() {
     assert!(v.verilog().contains("module slotforge_link("));
     assert_eq!(v, hdl::emit(&s, None).unwrap(), "deterministic");
     gates(&s, "eskin34-uart");
+}
+
+fn eskin34_axis() -> Schedule {
+    let path = common::root().join("mixes/eskin34-axis.toml");
+    lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap()
+}
+
+/// The AXI4-Stream link (`kind = "axis"`): `slotforge_link`'s AXIS output
+/// and the `m_axis_*` ports lint clean under Verilator -Wall and Icarus
+/// -Wall (yosys in the long suite: the UART's synthesis above covers the
+/// shared FIFO and packetizer).
+#[test]
+fn lints_axis_link() {
+    let s = eskin34_axis();
+    let dir = emit_to(&s, "eskin34-axis");
+    let v = std::fs::read_to_string(dir.join("slotforge_top.v")).unwrap();
+    assert!(v.contains("module slotforge_link(") && v.contains("m_axis_tready"));
+    lint_in(&dir, "eskin34-axis");
+}
+
+#[test]
+#[ignore = "long: make test-long"]
+fn gates_axis_link() {
+    gates(&eskin34_axis(), "eskin34-axis");
 }
 
 #[test]

@@ -132,13 +132,15 @@ fn plan_axis(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> 
     let line_cycles = bytes * n as u64;
     if line_cycles > g.frame_cycles {
         return Err(refuse(format!(
-            "link: {bytes} bytes per frame, one per {n} cycles at worst (link.ready_within), need {line_cycles} cycles, the frame has {}",
+            "line {}: link.ready_within: {bytes} bytes per frame, one per {n} cycles at worst, need {line_cycles} cycles, the frame has {}",
+            spec.line,
             g.frame_cycles
         )));
     }
     let m = measure(s, axis_of(spec, n), &stream).ok_or_else(|| {
         refuse(format!(
-            "link: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens when every beat waits {n} cycles"
+            "line {}: link.ready_within: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens when every beat waits {n} cycles",
+            spec.line
         ))
     })?;
     Ok(LinkPlan {
@@ -190,14 +192,16 @@ fn plan_spec(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> 
     };
     if line_cycles > g.frame_cycles {
         return Err(refuse(format!(
-            "link: {bytes} bytes per frame need {line_cycles} cycles of a {:.0}-baud line, the frame has {}",
+            "line {}: link.baud: {bytes} bytes per frame need {line_cycles} cycles of a {:.0}-baud line, the frame has {}",
+            spec.line,
             UartFormat::real_baud(g.clock_hz, div),
             g.frame_cycles
         )));
     }
     let m = measure(s, Line::Uart(uart), &stream).ok_or_else(|| {
         refuse(format!(
-            "link: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens at {:.0} baud",
+            "line {}: link.baud: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens at {:.0} baud",
+            spec.line,
             UartFormat::real_baud(g.clock_hz, div)
         ))
     })?;

@@ -75,6 +75,10 @@ pub struct LinkSpec {
     pub baud: u64,
     pub parity: link::Parity,
     pub stop_bits: u8,
+    /// The mix file's line of the key a refusal of the link names
+    /// (`baud`; for AXI4-Stream `ready_within`, or `[link]` without it), so
+    /// a line too slow for the mix is reported where the user wrote it.
+    pub line: usize,
 }
 
 /// `[link].kind`.
@@ -958,7 +962,7 @@ impl Cx<'_> {
         let r = l.get_ref();
         let kind = match r.kind.get_ref().as_str() {
             "uart" => LinkKind::Uart,
-            "axis" => return self.axis_link(r),
+            "axis" => return self.axis_link(l),
             other => {
                 return Err(self.at(
                     r.kind.span(),
@@ -1042,13 +1046,15 @@ impl Cx<'_> {
             baud,
             parity,
             stop_bits,
+            line: line_col(self.text, baud_raw.span().start).0,
         })
     }
 
     /// `[link]` with `kind = "axis"`: `tlast` (`"slice"` or `"frame"`) and
     /// `ready_within` (cycles, default 1: an always-ready slave); the UART's
     /// keys are refused.
-    fn axis_link(&self, r: &RawLink) -> Result<LinkSpec, MixError> {
+    fn axis_link(&self, l: &Spanned<RawLink>) -> Result<LinkSpec, MixError> {
+        let r = l.get_ref();
         for (v, k) in [
             (r.baud.as_ref().map(|x| x.span()), "link.baud"),
             (r.parity.as_ref().map(|x| x.span()), "link.parity"),
@@ -1092,6 +1098,11 @@ impl Cx<'_> {
             baud: 0,
             parity: link::Parity::None,
             stop_bits: 0,
+            line: line_col(
+                self.text,
+                r.ready_within.as_ref().map_or(l.span(), |v| v.span()).start,
+            )
+            .0,
         })
     }
 }

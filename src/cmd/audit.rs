@@ -22,7 +22,14 @@ pub fn run(args: Args) -> u8 {
         }
     };
     let (report, diagnosis) = match lut_gen::synthesize(&mix) {
-        Ok(s) => (AuditReport::of_schedule(&s), None),
+        Ok(s) => {
+            // a line too slow for the mix: named on stderr with the file
+            // (the message names the key and its line)
+            if let Some(Err(e)) = lut_gen::hostlink::plan(&s) {
+                eprintln!("error: {}: {}", args.mix.display(), e.message);
+            }
+            (AuditReport::of_schedule(&s), None)
+        }
         Err(why) => (AuditReport::of_infeasible(&mix, &why), Some(why)),
     };
     if args.json {

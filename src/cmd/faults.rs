@@ -134,13 +134,19 @@ fn text(c: &Campaign) -> String {
         c.target,
         sites.join(", ")
     );
-    let _ = write!(o, "  {:<18} {:<8}", "class", "level");
+    if let Some(p) = &c.tready {
+        let _ = writeln!(
+            o,
+            "  every run's AXI4-Stream slave: tready {p} (every beat waits the longest the mix's guarantee allows)"
+        );
+    }
+    let _ = write!(o, "  {:<20} {:<8}", "class", "level");
     for d in &c.detectors {
         let _ = write!(o, " {:>12}", d.name());
     }
     let _ = writeln!(o, " {:>10} {:>10}", "undetected", "proved-eq");
     for k in &c.classes {
-        let _ = write!(o, "  {:<18} {:<8}", k.name, k.level);
+        let _ = write!(o, "  {:<20} {:<8}", k.name, k.level);
         for d in &c.detectors {
             let cell = match (k.detected_by.get(d), k.cannot_see.get(d)) {
                 (_, Some(_)) => "cannot see".to_string(),

@@ -48,6 +48,28 @@ pub enum Fault {
     SclkSlow { branch: usize },
     /// One sample leaves with the code of the conversion emitted before it.
     NeighbourCode,
+    // Faults of the link to the host, on its pins (a mix with a `[link]`):
+    // what a noisy wire, a lost character, a broken driver or a full FIFO
+    // shows at the FPGA's edge.  The gateware's own link faults (a FIFO one
+    // token short, a wrong divider, a wrong CRC start) are
+    // `hdl::GatewareFault`s.
+    /// UART: data bit 3 of the first character starting at or after the
+    /// site inverted for its whole bit time.
+    LinkBitFlip,
+    /// UART: the first character starting at or after the site replaced by
+    /// an idle line (start to last stop bit): a byte lost on the wire.
+    LinkDropByte,
+    /// UART: the line stuck at `high` from the site to the end of the run.
+    LinkStuck { high: bool },
+    /// Any link: the FIFO's sticky overflow flag raised from the site on,
+    /// as the design shows a dropped token.
+    LinkOverflow,
+    /// AXI4-Stream: the first beat at or after the site that waits for
+    /// `tready` has `tvalid` dropped in the next cycle (a beat withdrawn).
+    AxisTvalidDrop,
+    /// AXI4-Stream: the first beat at or after the site that waits for
+    /// `tready` has `tdata` bit 0 changed in the next cycle.
+    AxisTdataChange,
 }
 
 /// Cycles a [`Fault::ResetGlitch`] holds the design in reset.
@@ -71,6 +93,13 @@ impl Fault {
             Fault::SelectSwap { .. } => "select-swap",
             Fault::SclkSlow { .. } => "sclk-slow",
             Fault::NeighbourCode => "neighbour-code",
+            Fault::LinkBitFlip => "link-bit-flip",
+            Fault::LinkDropByte => "link-drop-byte",
+            Fault::LinkStuck { high: true } => "link-stuck-high",
+            Fault::LinkStuck { high: false } => "link-stuck-low",
+            Fault::LinkOverflow => "link-fifo-overflow",
+            Fault::AxisTvalidDrop => "axis-tvalid-drop",
+            Fault::AxisTdataChange => "axis-tdata-change",
         }
     }
 
@@ -90,7 +119,13 @@ impl Fault {
             | Fault::WrongSampleBit
             | Fault::DropSample
             | Fault::ResetGlitch
-            | Fault::NeighbourCode => None,
+            | Fault::NeighbourCode
+            | Fault::LinkBitFlip
+            | Fault::LinkDropByte
+            | Fault::LinkStuck { .. }
+            | Fault::LinkOverflow
+            | Fault::AxisTvalidDrop
+            | Fault::AxisTdataChange => None,
         }
     }
 
@@ -130,7 +165,42 @@ impl Fault {
             }
         }
         v.push(Fault::NeighbourCode);
+        v.extend(Fault::link(s));
         v
+    }
+
+    /// The link's pin faults of the schedule's link (none without one):
+    /// the UART's line faults, or AXI4-Stream's faults under back-pressure,
+    /// and the overflow flag of either.
+    pub fn link(s: &Schedule) -> Vec<Fault> {
+        match s.mix.link.map(|l| l.kind) {
+            None => vec![],
+            Some(lut_gen::mix::LinkKind::Uart) => vec![
+                Fault::LinkBitFlip,
+                Fault::LinkDropByte,
+                Fault::LinkStuck { high: true },
+                Fault::LinkStuck { high: false },
+                Fault::LinkOverflow,
+            ],
+            Some(lut_gen::mix::LinkKind::Axis) => vec![
+                Fault::AxisTvalidDrop,
+                Fault::AxisTdataChange,
+                Fault::LinkOverflow,
+            ],
+        }
+    }
+
+    /// Whether this is a fault of the link's pins.
+    pub fn is_link(&self) -> bool {
+        matches!(
+            self,
+            Fault::LinkBitFlip
+                | Fault::LinkDropByte
+                | Fault::LinkStuck { .. }
+                | Fault::LinkOverflow
+                | Fault::AxisTvalidDrop
+                | Fault::AxisTdataChange
+        )
     }
 }
 
@@ -189,6 +259,14 @@ pub struct FaultyDut<D> {
     frame: u64,
     /// Every channel's mux (device, select).
     addresses: Vec<(u32, u32)>,
+    /// The UART's character (link faults), the cycle the character on the
+    /// line ends (its next start bit is a falling edge at or after it), and
+    /// the start of the character a fault hits.
+    uart: Option<link::UartFormat>,
+    char_end: u64,
+    hit: Option<u64>,
+    /// AXI4-Stream: a beat waited for `tready` in the previous cycle.
+    stalled: bool,
 }
 
 impl<D: Dut> FaultyDut<D> {
@@ -247,6 +325,12 @@ impl<D: Dut> FaultyDut<D> {
             last_value: None,
             frame: s.grid.frame_cycles,
             addresses: s.channels.iter().map(|c| (c.device, c.select)).collect(),
+            uart: lut_gen::hostlink::plan(s)
+                .and_then(|p| p.ok())
+                .and_then(|p| p.uart()),
+            char_end: 0,
+            hit: None,
+            stalled: false,
         }
     }
 }
@@ -387,6 +471,28 @@ impl<D: Dut> Dut for FaultyDut<D> {
                     self.last_value = Some(orig.sample_value);
                 }
             }
+            Fault::LinkBitFlip | Fault::LinkDropByte => self.uart_char(c, &mut p),
+            Fault::LinkStuck { high } => {
+                if c >= self.at {
+                    p.link_tx = high;
+                }
+            }
+            Fault::LinkOverflow => {
+                if c >= self.at {
+                    p.link_overflow = true;
+                }
+            }
+            Fault::AxisTvalidDrop | Fault::AxisTdataChange => {
+                if self.stalled && !self.done && c >= self.at {
+                    self.done = true;
+                    if self.fault == Fault::AxisTdataChange {
+                        p.axis_tdata ^= 0x01;
+                    } else {
+                        p.axis_tvalid = false;
+                    }
+                }
+                self.stalled = orig.axis_tvalid && !orig.axis_tready;
+            }
         }
         let frozen = matches!(self.fault, Fault::PhaseShift { .. })
             && c >= self.t
@@ -440,6 +546,28 @@ impl<D> FaultyDut<D> {
             let bit = 1u16 << b;
             p.cs_n = (p.cs_n & !bit) | (o.cs_n & bit);
             p.sclk = (p.sclk & !bit) | (o.sclk & bit);
+        }
+    }
+
+    /// [`Fault::LinkBitFlip`], [`Fault::LinkDropByte`]: the UART's
+    /// characters followed on the design's own line from cycle 0 (a start
+    /// bit is a falling edge once the previous character has ended), and
+    /// the first one starting at or after the site corrupted.
+    fn uart_char(&mut self, c: u64, p: &mut Pins) {
+        let Some(u) = self.uart else { return };
+        if self.hit.is_none() && c >= self.char_end && !p.link_tx {
+            self.char_end = c + u.char_cycles();
+            if c >= self.at {
+                self.hit = Some(c);
+            }
+        }
+        let Some(t) = self.hit else { return };
+        let d = u.div as u64;
+        match self.fault {
+            // the line's bit 4 is data bit 3 (bit 0 is the start bit)
+            Fault::LinkBitFlip if c >= t + 4 * d && c < t + 5 * d => p.link_tx = !p.link_tx,
+            Fault::LinkDropByte if c < t + u.char_cycles() => p.link_tx = true,
+            _ => {}
         }
     }
 

@@ -82,9 +82,9 @@ impl<D: Dut> Dut for AxisSlave<D> {
 
 /// `dut`, behind an AXI4-Stream slave driving `pattern` when `s`'s link is
 /// AXIS (the design itself otherwise).
-pub fn with_slave<'a>(
+pub fn with_slave<'a, D: Dut + 'a>(
     s: &Schedule,
-    dut: &'a mut dyn Dut,
+    dut: D,
     pattern: link::ReadyPattern,
 ) -> Box<dyn Dut + 'a> {
     match lut_gen::hostlink::plan(s)

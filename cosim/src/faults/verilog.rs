@@ -120,6 +120,7 @@ pub(super) fn judge_verilog(
     std::fs::write(&rtl, verilog).map_err(|e| e.to_string())?;
     let opts = SimOptions {
         rtl: Some(rtl),
+        tready: super::TREADY,
         ..SimOptions::default()
     };
     let mut cap = SpiCapture::new(s, reset_cycles(s, opts.reset_cycles));
