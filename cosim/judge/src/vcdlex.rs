@@ -123,10 +123,7 @@ fn lex(text: Vec<u8>, ids: &Ids) -> Lexed {
         let t = &b[s..e];
         match t[0] {
             b'#' => {
-                let Some(nt) = std::str::from_utf8(&t[1..])
-                    .ok()
-                    .and_then(|x| x.parse::<u64>().ok())
-                else {
+                let Some(nt) = timestamp(&t[1..]) else {
                     fail(&mut out, line, format!("bad timestamp `{}`", lossy(t)));
                     break;
                 };
@@ -247,6 +244,17 @@ fn lex(text: Vec<u8>, ids: &Ids) -> Lexed {
     out.lines = line + b[i..].iter().filter(|&&c| c == b'\n').count() as u64;
     out.text = text;
     out
+}
+
+/// A timestamp's digits as `u64`: plain digits directly (most of a body's
+/// tokens), anything else as `str::parse` reads it, so what is accepted and
+/// refused does not change.
+#[inline]
+fn timestamp(d: &[u8]) -> Option<u64> {
+    if !d.is_empty() && d.len() <= 19 && d.iter().all(u8::is_ascii_digit) {
+        return Some(d.iter().fold(0u64, |n, &c| n * 10 + (c - b'0') as u64));
+    }
+    std::str::from_utf8(d).ok()?.parse::<u64>().ok()
 }
 
 #[inline]
