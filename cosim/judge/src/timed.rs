@@ -268,7 +268,7 @@ fn template(s: &Schedule, lanes: &[Lane]) -> Tpl {
     }
 }
 
-fn cnv_mask(s: &Schedule) -> u16 {
+pub(crate) fn cnv_mask(s: &Schedule) -> u16 {
     s.mix
         .branches
         .iter()
@@ -439,10 +439,16 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
                 return false;
             }
             if !lane.predictable() {
+                let linked = lane.is(Role::Miso) && all.iter().any(|l| l.role.is_none());
                 not_proved.push(format!(
-                    "{} ({}): its values come from the ADC, not the schedule; not checked at time level",
+                    "{} ({}): its values come from the ADC, not the schedule; not checked at time level{}",
                     lane.channel,
-                    lane.port_bit()
+                    lane.port_bit(),
+                    if linked {
+                        " (read at the edges that capture it, for the link's sample codes)"
+                    } else {
+                        ""
+                    }
                 ));
                 return false;
             }
@@ -691,7 +697,13 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
     not_proved.extend(np);
     match cap.lanes.iter().position(|l| l.role.is_none()) {
         Some(li) => {
-            let lk = crate::timedlink::check_link(s, cap, li);
+            let phase = (cands.len() == 1).then(|| crate::timedlink::LinkPhase {
+                lo: cands[0].lo,
+                hi: cands[0].hi,
+                t: ctx.t,
+                skew: ctx.skew,
+            });
+            let lk = crate::timedlink::check_link(s, cap, li, phase);
             for v in lk.violations {
                 found.push(v);
             }
