@@ -228,7 +228,13 @@ fn lex(text: Vec<u8>, ids: &Ids) -> Lexed {
                     break;
                 };
                 if !span.is_empty() {
-                    let v = parse_value(&t[..1], 1).expect("a checked scalar value");
+                    // The scalar's one character, checked above (what
+                    // `parse_value` gives for it, without its loop).
+                    let v = match t[0] {
+                        b'0' | b'l' | b'L' => Val { v: 0, x: 0 },
+                        b'1' | b'h' | b'H' => Val { v: 1, x: 0 },
+                        _ => Val { v: 0, x: 1 },
+                    };
                     for k in span {
                         let sink = ids.flat[k];
                         let v = Val {
