@@ -782,24 +782,34 @@ fn gcd(a: u64, b: u64) -> u64 {
 type Pending = Option<(Option<bool>, Pins, Pins)>;
 
 /// The ports an edge reads as they were before its timestep (clk, rst,
-/// MISO, an AXIS link's tready): kept apart so that closing a timestep
-/// copies four values, not every port.
+/// MISO, an AXIS link's tready): kept apart, and narrow (MISO has a bit per
+/// branch, at most 16; the others one), so that closing a timestep copies
+/// 32 bytes, not every port.
 #[derive(Clone, Copy)]
 struct Before {
-    clk: Val,
-    rst: Val,
-    miso: Val,
-    tready: Val,
+    clk: (u32, u32),
+    rst: (u32, u32),
+    miso: (u32, u32),
+    tready: (u32, u32),
 }
 
 impl Before {
     fn of(port: &[Val; NPORT]) -> Before {
+        let n = |v: &Val| (v.v as u32, v.x as u32);
         Before {
-            clk: port[CLK],
-            rst: port[RST],
-            miso: port[MISO],
-            tready: port[LINK + 3],
+            clk: n(&port[CLK]),
+            rst: n(&port[RST]),
+            miso: n(&port[MISO]),
+            tready: n(&port[LINK + 3]),
         }
+    }
+}
+
+/// A narrow value back as a port value.
+fn val((v, x): (u32, u32)) -> Val {
+    Val {
+        v: v as u128,
+        x: x as u128,
     }
 }
 
@@ -828,7 +838,7 @@ type Inputs = (Val, Option<Val>);
 
 impl Applier<'_> {
     fn inputs(&self, b: &Before) -> Inputs {
-        (b.miso, self.st.axis.then_some(b.tready))
+        (val(b.miso), self.st.axis.then_some(val(b.tready)))
     }
 
     /// The outputs now, and their x/z masks.
@@ -887,18 +897,18 @@ impl Applier<'_> {
         match self.clocking {
             None => {}
             Some(Clocking::Clk) => {
-                let (b, a) = (self.before.clk, self.st.port[CLK]);
+                let (b, a) = (val(self.before.clk), self.st.port[CLK]);
                 if b.x & 1 == 0 && a.x & 1 == 0 && b.v & 1 == 0 && a.v & 1 == 1 {
                     // Only at an edge: half the timesteps are falling edges.
                     let (pins, xz) = self.pins();
-                    let rst = self.rst_of(&self.before.rst);
+                    let rst = self.rst_of(&val(self.before.rst));
                     self.edge(rst, pins, xz, self.inputs(&self.before));
                 }
             }
             Some(Clocking::Inferred { period, phase }) => {
                 let (pins, xz) = self.pins();
                 if t >= phase && (t - phase) % period == 0 {
-                    let rst = self.rst_of(&self.before.rst);
+                    let rst = self.rst_of(&val(self.before.rst));
                     self.edge(rst, pins, xz, self.inputs(&self.before));
                 }
                 if let Some(n) = next {
