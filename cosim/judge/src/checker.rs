@@ -7,8 +7,6 @@
 //!   and exclusivity, and MISO decoding);
 //! - cycle-exact equality with the [`CycleModel`] built from the schedule.
 
-use std::collections::VecDeque;
-
 use lut_gen::parts::ns_to_cycles;
 use lut_gen::{FrameGrid, Schedule};
 use serde_json::{json, Value};
@@ -95,6 +93,50 @@ enum Phase {
 }
 
 const CONTEXT_BEFORE: usize = 3;
+
+/// The last `CONTEXT_BEFORE + 1` cycles (cycle, actual, expected), oldest
+/// first: a fixed ring, as every checked cycle writes one.
+#[derive(Debug, Clone, Default)]
+struct History {
+    buf: [(u64, Pins, Option<Pins>); CONTEXT_BEFORE + 1],
+    next: usize,
+    len: usize,
+}
+
+impl History {
+    #[inline]
+    fn push(&mut self, e: (u64, Pins, Option<Pins>)) {
+        const N: usize = CONTEXT_BEFORE + 1;
+        self.buf[self.next] = e;
+        self.next = (self.next + 1) % N;
+        self.len = (self.len + 1).min(N);
+    }
+
+    fn iter(&self) -> impl Iterator<Item = &(u64, Pins, Option<Pins>)> {
+        const N: usize = CONTEXT_BEFORE + 1;
+        let start = (self.next + N - self.len) % N;
+        (0..self.len).map(move |i| &self.buf[(start + i) % N])
+    }
+}
+
+/// `a == b` without a branch per field: the checker compares pins several
+/// times in every cycle, and they are almost always equal.
+#[inline]
+fn same(a: &Pins, b: &Pins) -> bool {
+    let words = (a.mux_en ^ b.mux_en)
+        | ((a.mux_sel ^ b.mux_sel) as u128)
+        | (((a.cs_n ^ b.cs_n) as u128) << 64)
+        | (((a.sclk ^ b.sclk) as u128) << 80)
+        | (((a.sample_channel ^ b.sample_channel) as u128) << 96)
+        | (((a.sample_value ^ b.sample_value) as u128) << 112);
+    let flags = (a.sample_valid ^ b.sample_valid)
+        | (a.link_tx ^ b.link_tx)
+        | (a.link_overflow ^ b.link_overflow)
+        | (a.axis_tvalid ^ b.axis_tvalid)
+        | (a.axis_tlast ^ b.axis_tlast)
+        | (a.axis_tready ^ b.axis_tready);
+    words == 0 && (a.axis_tdata ^ b.axis_tdata) == 0 && !flags
+}
 const CONTEXT_AFTER: u8 = 2;
 
 /// The cycle-level streaming checker.
@@ -125,7 +167,7 @@ pub struct Checker {
     groups: Vec<Vec<Option<usize>>>,
     next_frame_at: u64,
     /// Last cycles (cycle, actual, expected) for divergence context.
-    hist: VecDeque<(u64, Pins, Option<Pins>)>,
+    hist: History,
     ctx_open: Vec<(usize, u8)>,
     diverging: Vec<bool>,
     divergence_count: u64,
@@ -222,7 +264,7 @@ impl Checker {
             br: vec![BranchState::default(); layout.branches],
             layout,
             next_frame_at: s.grid.frame_cycles,
-            hist: VecDeque::with_capacity(CONTEXT_BEFORE + 1),
+            hist: History::default(),
             ctx_open: Vec::new(),
             diverging: vec![false; nsig],
             divergence_count: 0,
@@ -404,7 +446,7 @@ impl Checker {
             // tready is the slave's: the model takes it from the pins
             m.set_tready(p.axis_tready);
             let e = *m.pins();
-            if e != *p || *xz != NO_XZ || self.div_active {
+            if !same(&e, p) || !same(xz, &NO_XZ) || self.div_active {
                 self.compare(c, &e, p, xz);
             }
             expected = Some(e);
@@ -413,15 +455,12 @@ impl Checker {
         if !self.ctx_open.is_empty() {
             self.add_context(c, p, expected);
         }
-        if self.hist.len() > CONTEXT_BEFORE {
-            self.hist.pop_front();
-        }
-        self.hist.push_back((c, *p, expected));
+        self.hist.push((c, *p, expected));
 
-        if *xz != self.prev_xz {
+        if !same(xz, &self.prev_xz) {
             self.xz_changes(c, p, xz);
         }
-        if *p != self.prev || p.sample_valid || *xz != NO_XZ {
+        if !same(p, &self.prev) || p.sample_valid || !same(xz, &NO_XZ) {
             self.edges(c, p, xz);
         }
         if self.layout.link {
@@ -960,5 +999,63 @@ fn ctx_line(c: u64, p: &Pins, e: Option<&Pins>) -> String {
     match e {
         Some(e) if e != p => format!("cycle {c}: {} | expected {}", fmt_pins(p), fmt_pins(e)),
         _ => format!("cycle {c}: {}", fmt_pins(p)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `same` agrees with `==` for a change of every field (the literal
+    /// names every field: a new one fails to compile here until `same`
+    /// knows it).
+    #[test]
+    fn same_sees_every_field() {
+        let a = Pins {
+            cs_n: 0,
+            sclk: 0,
+            mux_sel: 0,
+            mux_en: 0,
+            sample_valid: false,
+            sample_channel: 0,
+            sample_value: 0,
+            link_tx: false,
+            link_overflow: false,
+            axis_tdata: 0,
+            axis_tvalid: false,
+            axis_tlast: false,
+            axis_tready: false,
+        };
+        let changes: [fn(&mut Pins); 13] = [
+            |p| p.cs_n = 1 << 15,
+            |p| p.sclk = 1 << 15,
+            |p| p.mux_sel = 1 << 63,
+            |p| p.mux_en = 1 << 127,
+            |p| p.sample_valid = true,
+            |p| p.sample_channel = 1 << 15,
+            |p| p.sample_value = 1 << 15,
+            |p| p.link_tx = true,
+            |p| p.link_overflow = true,
+            |p| p.axis_tdata = 1 << 7,
+            |p| p.axis_tvalid = true,
+            |p| p.axis_tlast = true,
+            |p| p.axis_tready = true,
+        ];
+        assert!(same(&a, &a));
+        for (i, f) in changes.iter().enumerate() {
+            let mut b = a;
+            f(&mut b);
+            assert!(a != b && !same(&a, &b) && !same(&b, &a), "field {i}");
+        }
+    }
+
+    #[test]
+    fn history_keeps_the_last_four_oldest_first() {
+        let mut h = History::default();
+        for c in 0..6u64 {
+            h.push((c, Pins::default(), None));
+        }
+        let got: Vec<u64> = h.iter().map(|e| e.0).collect();
+        assert_eq!(got, [2, 3, 4, 5]);
     }
 }

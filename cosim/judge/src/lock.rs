@@ -570,7 +570,9 @@ fn fmt_ctl(c: &Ctl) -> String {
 
 impl CycleSink for Judge<'_> {
     fn cycle(&mut self, rst: Option<bool>, pins: &Pins, xz: &Pins, miso: u64, miso_xz: u64) {
-        let r = Rec {
+        // Built only where the search keeps it: once joined, a cycle is
+        // the checker's alone.
+        let r = || Rec {
             rst,
             pins: *pins,
             xz: *xz,
@@ -597,12 +599,12 @@ impl CycleSink for Judge<'_> {
                         first_candidates: 0,
                         buf: Buffer::default(),
                     }));
-                    self.search_step(r);
+                    self.search_step(r());
                 }
             }
-            Mode::Search(_) => self.search_step(r),
+            Mode::Search(_) => self.search_step(r()),
             Mode::Pending { search, .. } => {
-                search.buf.push(self.i, r);
+                search.buf.push(self.i, r());
                 self.try_join();
             }
         }

@@ -358,6 +358,18 @@ impl CycleModel {
         self.pins.axis_tready = ready;
     }
 
+    /// The byte on the link's line in the current cycle and which of its
+    /// bits (0: the start bit): what a capture's line is held against.
+    pub fn link_byte(&self) -> Option<(link::tx::ByteOnLine, u32)> {
+        self.tx.as_ref()?.on_line()
+    }
+
+    /// The branches (bit b) whose MISO is read at the edge ending the
+    /// current cycle.
+    pub fn capturing(&self) -> u16 {
+        self.capture
+    }
+
     /// What the link's line carries in the current cycle, for reports:
     /// the byte, its bit, its word and packet, and the sample of a record.
     pub fn link_context(&self) -> Option<String> {

@@ -6,8 +6,8 @@
 //! periodic template (cycles).  A capture edge seen at time `t` happened in
 //! `(t - T, t]` (T: the sample period), give or take the user's skew, so
 //! with `phi` the time of model cycle 0 every edge says
-//! `t - T - skew <= phi + cycle * Tc <= t + skew`.  The first CS edge of the
-//! first mapped CS lane fits some frame positions (candidates); each later
+//! `t - T - skew <= phi + cycle * Tc <= t + skew`.  The first conversion start
+//! on any mapped CS lane fits some frame positions (candidates); each later
 //! edge of each lane must be that lane's next template edge, with the same
 //! level, and narrows `phi`'s interval; a candidate whose interval empties
 //! is gone.  One candidate left: every later edge that does not fit is a
@@ -268,7 +268,7 @@ fn template(s: &Schedule, lanes: &[Lane]) -> Tpl {
     }
 }
 
-fn cnv_mask(s: &Schedule) -> u16 {
+pub(crate) fn cnv_mask(s: &Schedule) -> u16 {
     s.mix
         .branches
         .iter()
@@ -439,10 +439,16 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
                 return false;
             }
             if !lane.predictable() {
+                let linked = lane.is(Role::Miso) && all.iter().any(|l| l.role.is_none());
                 not_proved.push(format!(
-                    "{} ({}): its values come from the ADC, not the schedule; not checked at time level",
+                    "{} ({}): its values come from the ADC, not the schedule; not checked at time level{}",
                     lane.channel,
-                    lane.port_bit()
+                    lane.port_bit(),
+                    if linked {
+                        " (read at the edges that capture it, for the link's sample codes)"
+                    } else {
+                        ""
+                    }
                 ));
                 return false;
             }
@@ -462,11 +468,17 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
         .collect();
     let lanes: Vec<Lane> = checked.iter().map(|&i| all[i].clone()).collect();
     let tpl = template(s, &lanes);
-    let Some(cs_lane) = lanes.iter().position(|l| l.is(Role::CsN)) else {
+    // The lock waits for the first conversion start on any CS lane: the
+    // earliest evidence of the frame phase (a lane whose branch converts
+    // late, or is not probed, does not delay it).
+    let cs_lanes: Vec<usize> = (0..lanes.len())
+        .filter(|&i| lanes[i].is(Role::CsN))
+        .collect();
+    if cs_lanes.is_empty() {
         return Err(TimedError(
             "no mapped CS (or CNV) lane the capture's resolution can check: the frame phase cannot be found; map adc_cs_n[N] to an analyser channel".into(),
         ));
-    };
+    }
     let ctx = Ctx {
         tpl: &tpl,
         t: cap.period_ps as i128 * clock,
@@ -488,10 +500,10 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
     let mut seg = Segment::default();
     let mut best_seg = Segment::default();
     let mut prev = cap.steps.first().map(|s| s.1).unwrap_or(0);
-    let cs_idle = {
-        let b = lanes[cs_lane].bit;
-        cnv_mask(s) >> b & 1 == 0
-    };
+    // A conversion starts when CS falls (a CNV lane: rises).
+    let cnv = cnv_mask(s);
+    let starts =
+        |lane: &Lane, level: bool| lane.is(Role::CsN) && level == (cnv >> lane.bit & 1 == 1);
     for &(t_ps, v) in cap.steps.iter().skip(1) {
         let changed = v ^ prev;
         prev = v;
@@ -506,8 +518,8 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
             let level = v >> ai & 1 == 1;
             match &mut cands {
                 None => {
-                    // Lock on the first conversion start of the CS lane.
-                    if li != cs_lane || level == cs_idle {
+                    // Lock on the first conversion start of any CS lane.
+                    if !starts(&lanes[li], level) {
                         continue;
                     }
                     let mut c = Vec::new();
@@ -572,8 +584,7 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
                             false
                         }
                     });
-                    let start_edge =
-                        lane.is(Role::CsN) && level != (cnv_mask(s) >> lane.bit & 1 == 0);
+                    let start_edge = starts(lane, level);
                     if !c.is_empty() && start_edge {
                         seg.starts += 1;
                     }
@@ -646,10 +657,13 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
         }
     }
     let Some(cands) = cands else {
+        let probed: Vec<String> = cs_lanes
+            .iter()
+            .map(|&i| format!("{} ({})", lanes[i].channel, lanes[i].port_bit()))
+            .collect();
         return Err(TimedError(format!(
-            "no conversion start on {} ({}) in the capture: the frame phase cannot be found",
-            lanes[cs_lane].channel,
-            lanes[cs_lane].port_bit()
+            "no conversion start on {} in the capture: the frame phase cannot be found",
+            probed.join(", ")
         )));
     };
     if edges_checked == 0 && found.total == 0 {
@@ -683,7 +697,13 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
     not_proved.extend(np);
     match cap.lanes.iter().position(|l| l.role.is_none()) {
         Some(li) => {
-            let lk = crate::timedlink::check_link(s, cap, li);
+            let phase = (cands.len() == 1).then(|| crate::timedlink::LinkPhase {
+                lo: cands[0].lo,
+                hi: cands[0].hi,
+                t: ctx.t,
+                skew: ctx.skew,
+            });
+            let lk = crate::timedlink::check_link(s, cap, li, phase);
             for v in lk.violations {
                 found.push(v);
             }

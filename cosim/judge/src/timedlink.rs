@@ -3,16 +3,39 @@
 //! and its host decoder, the same a host runs), and every packet's samples
 //! must be the schedule's channels in the schedule's order for its slice
 //! (`lut_gen::hostlink::merged_frame`), with good CRCs and no packet lost.
-//! The values are the ADC's, which the schedule does not predict.
+//!
+//! Once the edge check has found the frame phase (`LinkPhase`), the cycle
+//! model runs along the capture and predicts the line: every byte's start
+//! bit must fall within the capture's resolution of the model's time (the
+//! packet format has no escapes, so the timing does not depend on the
+//! values), and where a branch's `adc_miso` is captured too, the model is
+//! fed the bits MISO carried, so each record byte of that branch's channels
+//! must be the code MISO carried.
 
+use lut_gen::ports::Role;
 use lut_gen::Schedule;
 
+use crate::model::CycleModel;
 use crate::timed::{Capture, TimedViolation};
+
+/// The frame phase the edge check found: model cycle 0 at a time in
+/// `[lo, hi]`; all in units of 1 / clock_hz ps (`timed`'s exact times), with
+/// the sample period `t` and the skew.
+#[derive(Debug, Clone, Copy)]
+pub struct LinkPhase {
+    pub lo: i128,
+    pub hi: i128,
+    pub t: i128,
+    pub skew: i128,
+}
+
+/// One cycle in units.
+const TC: i128 = 1_000_000_000_000;
 
 /// What the line showed.
 pub struct LinkCheck {
     pub violations: Vec<TimedViolation>,
-    pub proved: Option<String>,
+    pub proved: Vec<String>,
     pub not_proved: Vec<String>,
 }
 
@@ -27,12 +50,13 @@ fn packet_order(s: &Schedule) -> Vec<Vec<u16>> {
     per_slice
 }
 
-/// Decodes lane `li` of `cap` (the line) and checks it against `s`.
-pub fn check_link(s: &Schedule, cap: &Capture, li: usize) -> LinkCheck {
+/// Decodes lane `li` of `cap` (the line) and checks it against `s`; with
+/// the frame phase, also every byte's timing and the sample codes.
+pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhase>) -> LinkCheck {
     let lane = &cap.lanes[li];
     let mut out = LinkCheck {
         violations: Vec::new(),
-        proved: None,
+        proved: Vec::new(),
         not_proved: Vec::new(),
     };
     let plan = match lut_gen::hostlink::plan(s) {
@@ -82,19 +106,45 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize) -> LinkCheck {
     let mut packets: Vec<(f64, u64, u16, Vec<u16>)> = Vec::new();
     let mut framing = 0u64;
     let (mut crc, mut lost) = (0u64, 0u64);
+    // Every character read: (the capture's time of its start bit's edge, byte).
+    let mut chars: Vec<(u64, u8)> = Vec::new();
+    // Falls of the line seen at a cycle's sample: (sample, edge time).
+    let mut falls: std::collections::VecDeque<(u64, u64)> = Default::default();
+    let mut level = true;
+    let mut fall_ps = 0u64;
     loop {
         let t = t0 + n as f64 * tc;
         if t > end {
             break;
         }
         while k + 1 < cap.steps.len() && (cap.steps[k + 1].0 as f64) <= t {
+            if cap.steps[k].1 >> li & 1 == 1 && cap.steps[k + 1].1 >> li & 1 == 0 {
+                fall_ps = cap.steps[k + 1].0;
+            }
             k += 1;
         }
+        let now = cap.steps[k].1 >> li & 1 == 1;
+        if level && !now {
+            falls.push_back((n, fall_ps));
+        }
+        level = now;
         n += 1;
-        let Some(b) = rx.sample(cap.steps[k].1 >> li & 1 == 1) else {
+        let Some(b) = rx.sample(now) else {
             continue;
         };
+        while falls.front().is_some_and(|f| f.0 < b.start) {
+            falls.pop_front();
+        }
+        if let Some(&(at, edge)) = falls.front() {
+            if at == b.start && !b.error {
+                chars.push((edge, b.byte));
+            }
+        }
         if b.error {
+            if packets.is_empty() {
+                // Out of step: the capture opened inside a character.
+                continue;
+            }
             framing += 1;
             if framing == 1 {
                 out.violations.push(violation(
@@ -165,13 +215,318 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize) -> LinkCheck {
         ));
     }
     let samples: usize = packets.iter().map(|p| p.3.len()).sum();
-    out.proved = Some(format!(
+    out.proved.push(format!(
         "{} (link_tx): {} packets and {samples} samples decoded at {:.0} baud, each packet's channels in the schedule's order for its slice, CRCs good, none lost",
         lane.channel,
         packets.len(),
         plan.baud
     ));
-    out.not_proved
-        .push("the link's sample values: the ADC's, not the schedule's".into());
+    match phase {
+        Some(ph) => hold_bytes(s, cap, li, ph, &chars, &mut out),
+        None => out.not_proved.push(format!(
+            "{} (link_tx): the bytes' timing and the sample codes (no unique frame phase to time them against)",
+            lane.channel
+        )),
+    }
     out
+}
+
+/// A byte the model puts on the line: its start bit's first cycle (in the
+/// capture's cycles from the phase), the byte, and for a record byte the
+/// channel it carries and whether every MISO read of its conversion was
+/// resolved in the capture (else the model's code is not the board's).
+struct Predicted {
+    cycle: i128,
+    byte: u8,
+    record: Option<(u16, bool)>,
+}
+
+/// The branches whose MISO is captured (bit b: branch b) and the capture's
+/// lane of each.
+fn miso_lanes(cap: &Capture) -> Vec<(usize, u32)> {
+    (0..cap.lanes.len())
+        .filter(|&i| cap.lanes[i].role == Some(Role::Miso))
+        .map(|i| (i, cap.lanes[i].bit))
+        .collect()
+}
+
+/// MISO of one branch as the capture shows it around the edges that read
+/// it: known only where no sample in the edge's window of uncertainty (the
+/// phase's spread, a sample period and the skew either side) changes it.
+struct MisoReader<'a> {
+    cap: &'a Capture,
+    lane: usize,
+    /// The first step not before the last window's start.
+    k: usize,
+}
+
+impl MisoReader<'_> {
+    /// The level over `[a, b]` (ps), if the capture shows it constant there.
+    fn level(&mut self, a: u64, b: u64) -> Option<bool> {
+        let steps = &self.cap.steps;
+        while self.k + 1 < steps.len() && steps[self.k + 1].0 <= a {
+            self.k += 1;
+        }
+        if steps.first().is_none_or(|x| x.0 > a) {
+            // Before the capture began.
+            return None;
+        }
+        let bit = |i: usize| steps[i].1 >> self.lane & 1 == 1;
+        let v = bit(self.k);
+        let mut i = self.k + 1;
+        while i < steps.len() && steps[i].0 <= b {
+            if bit(i) != v {
+                return None;
+            }
+            i += 1;
+        }
+        Some(v)
+    }
+}
+
+/// What the model predicts of the line along the capture.
+struct Prediction {
+    bytes: Vec<Predicted>,
+}
+
+/// Which samples' codes the capture resolved: a conversion is known when
+/// every MISO read in it was (`cur`), a sample when its conversion was, and
+/// a record on the line when its sample was (queued per channel, as the
+/// transmitter sends them in order).  Conversions before the capture began
+/// are unknown.
+struct Known {
+    cur: Vec<bool>,
+    done: Vec<bool>,
+    queued: Vec<std::collections::VecDeque<bool>>,
+    record: Vec<bool>,
+}
+
+/// Runs the cycle model along the capture (a whole number of frames on,
+/// in steady state: the capture may start before the phase's cycle 0 is a
+/// frame old) and collects the bytes it puts on the line.  MISO, where it is
+/// captured, is fed as read at each edge that reads it (0 where unknown).
+fn predict(s: &Schedule, cap: &Capture, ph: LinkPhase, clock: i128) -> Prediction {
+    let f = s.grid.frame_cycles as i128;
+    let mid = (ph.lo + ph.hi) / 2;
+    let t0 = cap.steps.first().map_or(0, |x| x.0) as i128 * clock;
+    let end = cap.steps.last().map_or(0, |x| x.0) as i128 * clock;
+    let first = (t0 - mid).div_euclid(TC) - 1;
+    let last = (end - mid).div_euclid(TC) + 1;
+    // The least whole number of frames that puts `first` in frame 1 or later.
+    let shift = f * (((f - first).max(0) + f - 1) / f).max(1);
+    let mut m = CycleModel::at(s, (first + shift) as u64);
+    let mut readers: Vec<(u32, MisoReader)> = miso_lanes(cap)
+        .into_iter()
+        .map(|(lane, b)| (b, MisoReader { cap, lane, k: 0 }))
+        .collect();
+    let nb = s.mix.branches.len();
+    let mut known = Known {
+        cur: vec![false; nb],
+        done: vec![false; nb],
+        queued: vec![Default::default(); s.mix.channels.len()],
+        record: vec![false; s.mix.channels.len()],
+    };
+    let cnv = crate::timed::cnv_mask(s);
+    let mut out = Vec::new();
+    let mut prev = *m.pins();
+    for c in first..=last {
+        let p = *m.pins();
+        let (was, now) = (prev.cs_n ^ cnv, p.cs_n ^ cnv);
+        for b in 0..nb {
+            match (was >> b & 1, now >> b & 1) {
+                (1, 0) => known.cur[b] = true,
+                (0, 1) => known.done[b] = known.cur[b],
+                _ => {}
+            }
+        }
+        if p.sample_valid {
+            let ch = p.sample_channel as usize;
+            if let Some(q) = known.queued.get_mut(ch) {
+                q.push_back(known.done[s.mix.channels[ch].branch]);
+            }
+        }
+        if prev.link_tx && !p.link_tx {
+            if let Some((b, 0)) = m.link_byte() {
+                let record = match (b.kind, b.sample) {
+                    (link::format::WordKind::Record, Some((ch, _))) => {
+                        let k = ch as usize;
+                        if b.index == 0 {
+                            known.record[k] = known.queued[k].pop_front().unwrap_or(false);
+                        }
+                        Some((ch, known.record[k]))
+                    }
+                    _ => None,
+                };
+                out.push(Predicted {
+                    cycle: c,
+                    byte: b.byte,
+                    record,
+                });
+            }
+        }
+        prev = p;
+        let mut miso = 0u64;
+        let reading = m.capturing();
+        if reading != 0 {
+            // The edge ending cycle c, at phi + (c + 1) TC with phi in [lo, hi].
+            let e = (c + 1) * TC;
+            let a = (ph.lo + e - ph.skew - ph.t).div_euclid(clock).max(0) as u64;
+            let b = (ph.hi + e + ph.skew + ph.t).div_euclid(clock).max(0) as u64 + 1;
+            for (br, rd) in &mut readers {
+                if reading >> *br & 1 == 0 {
+                    continue;
+                }
+                match rd.level(a, b) {
+                    Some(v) => miso |= (v as u64) << *br,
+                    None => known.cur[*br as usize] = false,
+                }
+            }
+        }
+        m.step(miso);
+    }
+    Prediction { bytes: out }
+}
+
+/// Holds every character read from the line against the model's bytes:
+/// its start bit within the resolution of the model's start bit, and, for a
+/// record of a branch whose MISO is captured, the same byte.
+fn hold_bytes(
+    s: &Schedule,
+    cap: &Capture,
+    li: usize,
+    ph: LinkPhase,
+    chars: &[(u64, u8)],
+    out: &mut LinkCheck,
+) {
+    let lane = &cap.lanes[li];
+    let clock = s.mix.clock_hz as i128;
+    let Prediction { bytes: pred } = predict(s, cap, ph, clock);
+    let misos = miso_lanes(cap);
+    let captured = |ch: u16| {
+        let b = s.mix.channels[ch as usize].branch;
+        misos.iter().any(|m| m.1 as usize == b)
+    };
+    let unc = ph.hi - ph.lo + ph.t + 2 * ph.skew;
+    // Record bytes compared with the model's, and those whose code the
+    // capture did not resolve.
+    let (mut compared, mut unresolved) = (0u64, 0u64);
+    let mid = (ph.lo + ph.hi) / 2;
+    let violation = |t: u64, rule: &str, detail: String| TimedViolation {
+        time_ps: t,
+        channel: lane.channel.clone(),
+        port_bit: lane.port_bit(),
+        rule: rule.into(),
+        detail,
+    };
+    let (mut late, mut wrong, mut held) = (0u64, 0u64, 0u64);
+    let mut used = 0usize;
+    // A capture that opens inside a character reads the line out of step
+    // until a fall that is a start bit: like a host's receiver, the check
+    // is in step from the first character that starts at one of the
+    // schedule's start bits.
+    let mut synced = false;
+    let mut skipped = 0u64;
+    for &(edge_ps, byte) in chars {
+        let x = edge_ps as i128 * clock;
+        // The model's start bit nearest the edge, not one matched before.
+        let c = (x - mid).div_euclid(TC);
+        let i = pred[used..].partition_point(|p| p.cycle < c) + used;
+        let near = [i.checked_sub(1), Some(i)]
+            .into_iter()
+            .flatten()
+            .filter(|&j| j >= used && j < pred.len())
+            .min_by_key(|&j| (pred[j].cycle * TC + mid - x).abs());
+        let fits = near.filter(|&j| {
+            let ct = pred[j].cycle * TC;
+            ph.lo + ct <= x + ph.skew && ph.hi + ct >= x - ph.t - ph.skew
+        });
+        let Some(j) = fits else {
+            if !synced {
+                skipped += 1;
+                continue;
+            }
+            late += 1;
+            if late <= 3 {
+                let want = near.map_or("none near".to_string(), |j| {
+                    format!(
+                        "{:.3} us",
+                        ((pred[j].cycle * TC + mid) / clock) as f64 / 1e6
+                    )
+                });
+                out.violations.push(violation(
+                    edge_ps,
+                    "link timing (start bit)",
+                    format!(
+                        "character 0x{byte:02x} starts at {:.3} us; the schedule's nearest start bit is at {want}, not within the capture's resolution ({:.1} ns)",
+                        edge_ps as f64 / 1e6,
+                        (unc / clock) as f64 / 1e3
+                    ),
+                ));
+            }
+            continue;
+        };
+        synced = true;
+        used = j + 1;
+        held += 1;
+        let p = &pred[j];
+        if let Some((ch, resolved)) = p.record {
+            if !captured(ch) {
+                continue;
+            }
+            if !resolved {
+                unresolved += 1;
+                continue;
+            }
+            compared += 1;
+            if byte != p.byte {
+                wrong += 1;
+                if wrong <= 3 {
+                    out.violations.push(violation(
+                        edge_ps,
+                        "link samples (values)",
+                        format!(
+                            "a byte of channel {}'s record is 0x{byte:02x}; the code MISO carried gives 0x{:02x}",
+                            s.mix.channels[ch as usize].name, p.byte
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    if late == 0 && held > 0 {
+        out.proved.push(format!(
+            "{} (link_tx): every one of {held} characters' start bits within {:.1} ns of the schedule's time (sample period, skew and the phase's spread){}",
+            lane.channel,
+            (unc / clock) as f64 / 1e3,
+            if skipped > 0 {
+                format!(", from the first in step with the line ({skipped} read out of step before it)")
+            } else {
+                String::new()
+            }
+        ));
+    }
+    let branches: Vec<&str> = misos
+        .iter()
+        .map(|m| s.mix.branches[m.1 as usize].name.as_str())
+        .collect();
+    if misos.is_empty() {
+        out.not_proved.push(format!(
+            "{} (link_tx): the sample codes on the line (map adc_miso[N] to check them against the bits MISO carried)",
+            lane.channel
+        ));
+    } else if compared > 0 && wrong == 0 {
+        out.proved.push(format!(
+            "{} (link_tx): the sample codes on the line equal the codes MISO carried: {compared} record bytes of branch {}",
+            lane.channel,
+            branches.join(", ")
+        ));
+    }
+    if unresolved > 0 {
+        out.not_proved.push(format!(
+            "{} (link_tx): {unresolved} record bytes of branch {}: their conversion's MISO reads are not all in the capture, or MISO changed within the resolution ({:.1} ns) of a read",
+            lane.channel,
+            branches.join(", "),
+            (unc / clock) as f64 / 1e3
+        ));
+    }
 }

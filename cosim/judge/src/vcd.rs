@@ -781,6 +781,38 @@ fn gcd(a: u64, b: u64) -> u64 {
 /// A cycle waiting for the next edge, which tells the MISO it carried.
 type Pending = Option<(Option<bool>, Pins, Pins)>;
 
+/// The ports an edge reads as they were before its timestep (clk, rst,
+/// MISO, an AXIS link's tready): kept apart, and narrow (MISO has a bit per
+/// branch, at most 16; the others one), so that closing a timestep copies
+/// 32 bytes, not every port.
+#[derive(Clone, Copy)]
+struct Before {
+    clk: (u32, u32),
+    rst: (u32, u32),
+    miso: (u32, u32),
+    tready: (u32, u32),
+}
+
+impl Before {
+    fn of(port: &[Val; NPORT]) -> Before {
+        let n = |v: &Val| (v.v as u32, v.x as u32);
+        Before {
+            clk: n(&port[CLK]),
+            rst: n(&port[RST]),
+            miso: n(&port[MISO]),
+            tready: n(&port[LINK + 3]),
+        }
+    }
+}
+
+/// A narrow value back as a port value.
+fn val((v, x): (u32, u32)) -> Val {
+    Val {
+        v: v as u128,
+        x: x as u128,
+    }
+}
+
 /// Applies the body's events in file order: port values, timesteps, and
 /// the clock edges (dumped or inferred) that hand cycles to the sink.
 struct Applier<'a> {
@@ -788,7 +820,11 @@ struct Applier<'a> {
     clocking: Option<Clocking>,
     sink: &'a mut dyn CycleSink,
     st: State,
-    before: [Val; NPORT],
+    before: Before,
+    /// `st.pins()`, recomputed only after an output changed (`dirty`): most
+    /// edges of a dump change nothing but the clock.
+    pins: (Pins, Pins),
+    dirty: bool,
     time: u64,
     seen_time: bool,
     out_changed: bool,
@@ -801,8 +837,18 @@ struct Applier<'a> {
 type Inputs = (Val, Option<Val>);
 
 impl Applier<'_> {
-    fn inputs(&self, port: &[Val; NPORT]) -> Inputs {
-        (port[MISO], self.st.axis.then_some(port[LINK + 3]))
+    fn inputs(&self, b: &Before) -> Inputs {
+        (val(b.miso), self.st.axis.then_some(val(b.tready)))
+    }
+
+    /// The outputs now, and their x/z masks.
+    #[inline]
+    fn pins(&mut self) -> (Pins, Pins) {
+        if self.dirty {
+            self.pins = self.st.pins();
+            self.dirty = false;
+        }
+        self.pins
     }
 
     /// Hands on the pending cycle with the inputs the edge ending it
@@ -851,18 +897,18 @@ impl Applier<'_> {
         match self.clocking {
             None => {}
             Some(Clocking::Clk) => {
-                let (b, a) = (self.before[CLK], self.st.port[CLK]);
+                let (b, a) = (val(self.before.clk), self.st.port[CLK]);
                 if b.x & 1 == 0 && a.x & 1 == 0 && b.v & 1 == 0 && a.v & 1 == 1 {
                     // Only at an edge: half the timesteps are falling edges.
-                    let (pins, xz) = self.st.pins();
-                    let rst = self.rst_of(&self.before[RST]);
+                    let (pins, xz) = self.pins();
+                    let rst = self.rst_of(&val(self.before.rst));
                     self.edge(rst, pins, xz, self.inputs(&self.before));
                 }
             }
             Some(Clocking::Inferred { period, phase }) => {
-                let (pins, xz) = self.st.pins();
+                let (pins, xz) = self.pins();
                 if t >= phase && (t - phase) % period == 0 {
-                    let rst = self.rst_of(&self.before[RST]);
+                    let rst = self.rst_of(&val(self.before.rst));
                     self.edge(rst, pins, xz, self.inputs(&self.before));
                 }
                 if let Some(n) = next {
@@ -872,8 +918,9 @@ impl Applier<'_> {
                         t - (t - phase) % period + period
                     };
                     let rst = self.rst_of(&self.st.port[RST]);
+                    let now = Before::of(&self.st.port);
                     while e < n {
-                        self.edge(rst, pins, xz, self.inputs(&self.st.port));
+                        self.edge(rst, pins, xz, self.inputs(&now));
                         e = e.saturating_add(period);
                     }
                 }
@@ -891,12 +938,15 @@ impl Applier<'_> {
                         v: v as u128,
                         x: x as u128,
                     };
-                    self.out_changed |= self.st.apply(s, val) && s.port as usize >= CS;
+                    let out = self.st.apply(s, val) && s.port as usize >= CS;
+                    self.out_changed |= out;
+                    self.dirty |= out;
                 }
                 Ev::Wide { sink, idx } => {
                     let s = &self.res.ids.flat[sink as usize];
-                    self.out_changed |=
-                        self.st.apply(s, lexed.wide[idx as usize]) && s.port as usize >= CS;
+                    let out = self.st.apply(s, lexed.wide[idx as usize]) && s.port as usize >= CS;
+                    self.out_changed |= out;
+                    self.dirty |= out;
                 }
                 Ev::Time { t: nt, line } => self.timestamp(nt, at.line0 + line as u64, file)?,
             }
@@ -921,7 +971,7 @@ impl Applier<'_> {
                 self.close(time, Some(nt));
                 self.first_step = false;
             }
-            self.before = self.st.port;
+            self.before = Before::of(&self.st.port);
             self.out_changed = false;
             self.time = nt;
             self.seen_time = true;
@@ -956,7 +1006,9 @@ fn body(
         res,
         clocking,
         sink,
-        before: st.port,
+        before: Before::of(&st.port),
+        pins: st.pins(),
+        dirty: false,
         st,
         time: 0,
         seen_time: false,
@@ -977,7 +1029,7 @@ fn body(
     let time = ap.time;
     ap.close(time, None);
     if let Some((r, mut p, mut x)) = ap.pending.take() {
-        let (miso, tready) = ap.inputs(&ap.st.port);
+        let (miso, tready) = ap.inputs(&Before::of(&ap.st.port));
         if let Some(t) = tready {
             p.axis_tready = t.v & 1 == 1;
             x.axis_tready = t.x & 1 == 1;

@@ -123,10 +123,7 @@ fn lex(text: Vec<u8>, ids: &Ids) -> Lexed {
         let t = &b[s..e];
         match t[0] {
             b'#' => {
-                let Some(nt) = std::str::from_utf8(&t[1..])
-                    .ok()
-                    .and_then(|x| x.parse::<u64>().ok())
-                else {
+                let Some(nt) = timestamp(&t[1..]) else {
                     fail(&mut out, line, format!("bad timestamp `{}`", lossy(t)));
                     break;
                 };
@@ -231,7 +228,13 @@ fn lex(text: Vec<u8>, ids: &Ids) -> Lexed {
                     break;
                 };
                 if !span.is_empty() {
-                    let v = parse_value(&t[..1], 1).expect("a checked scalar value");
+                    // The scalar's one character, checked above (what
+                    // `parse_value` gives for it, without its loop).
+                    let v = match t[0] {
+                        b'0' | b'l' | b'L' => Val { v: 0, x: 0 },
+                        b'1' | b'h' | b'H' => Val { v: 1, x: 0 },
+                        _ => Val { v: 0, x: 1 },
+                    };
                     for k in span {
                         let sink = ids.flat[k];
                         let v = Val {
@@ -247,6 +250,17 @@ fn lex(text: Vec<u8>, ids: &Ids) -> Lexed {
     out.lines = line + b[i..].iter().filter(|&&c| c == b'\n').count() as u64;
     out.text = text;
     out
+}
+
+/// A timestamp's digits as `u64`: plain digits directly (most of a body's
+/// tokens), anything else as `str::parse` reads it, so what is accepted and
+/// refused does not change.
+#[inline]
+fn timestamp(d: &[u8]) -> Option<u64> {
+    if !d.is_empty() && d.len() <= 19 && d.iter().all(u8::is_ascii_digit) {
+        return Some(d.iter().fold(0u64, |n, &c| n * 10 + (c - b'0') as u64));
+    }
+    std::str::from_utf8(d).ok()?.parse::<u64>().ok()
 }
 
 #[inline]

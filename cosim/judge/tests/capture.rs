@@ -9,11 +9,13 @@ use std::path::Path;
 
 use judge::run::ModelDut;
 use judge::timed::check_capture;
-use lut_gen::ports::Pins;
+use lut_gen::ports::{Pins, Role};
 use lut_gen::Schedule;
 
 mod analyser;
-use analyser::{check, lanes, mutate, resample, to_sigrok, Mutation};
+use analyser::{
+    check, lanes, mutate, resample, resample_lanes, run_with_miso, to_sigrok, Mutation,
+};
 
 #[path = "../../../tests/common/tools.rs"]
 mod tools;
@@ -222,6 +224,185 @@ fn the_link_line_in_a_capture_is_decoded_and_checked() {
         r.violations
             .iter()
             .any(|v| v.channel == link && v.rule.contains("link samples")),
+        "{text}"
+    );
+}
+
+/// The lock takes the first conversion start on any CS lane.  The tiny
+/// mix with its branches swapped: branch 0 (slow) converts in two of every
+/// four slots, branch 1 (fast) in all four.  A window that opens just before
+/// a conversion of fast in a slot where slow is idle locks there, so a fault
+/// in that first conversion (one SCLK pulse missing) is caught; before, the
+/// lock waited for branch 0's CS and never looked at it.  Without branch
+/// 0's CS probed at all, the capture still locks and passes.
+#[test]
+fn the_lock_takes_the_first_conversion_start_on_any_lane() {
+    if !tools::require_tool("sigrok-cli") {
+        return;
+    }
+    let tiny = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml"),
+    )
+    .unwrap();
+    let (head, rest) = tiny.split_once("[[branch]]").unwrap();
+    let (fast, rest) = rest.split_once("[[branch]]").unwrap();
+    let (slow, chans) = rest.split_once("[[channel]]").unwrap();
+    let swapped = format!("{head}[[branch]]{slow}[[branch]]{fast}[[channel]]{chans}");
+    let d = tempfile::tempdir().unwrap();
+    let mix = d.path().join("swapped.toml");
+    std::fs::write(&mix, swapped).unwrap();
+    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    assert_eq!(s.mix.branches[0].name, "slow");
+    let clean = run(&s, &mut ModelDut::new(&s), 3);
+    let (lanes_v, map) = lanes(&s);
+    let fall = |b: u32, from: usize| {
+        (from..clean.len())
+            .find(|&c| clean[c].cs_n >> b & 1 == 0 && clean[c - 1].cs_n >> b & 1 == 1)
+    };
+    // A conversion of branch 1 (from frame 1 on) with branch 0's later.
+    let f = s.grid.frame_cycles as usize;
+    let (f1, f0) = (f..2 * f)
+        .filter_map(|c| {
+            let f1 = fall(1, c)?;
+            let f0 = fall(0, f1 - 20)?;
+            (f1 == c && f0 > f1 + 20).then_some((f1, f0))
+        })
+        .next()
+        .expect("a conversion of branch 1 before branch 0's next");
+    let (from, to, ts, phase) = (f1 - 20, 2 * f + f / 2, 10_000u64, 3_717u64);
+    let tc = 1_000_000_000_000 / s.mix.clock_hz;
+    let v = d.path().join("late.vcd");
+    resample(&s, &clean, from as u64, to as u64, ts, phase, &v);
+    let (sr, _) = to_sigrok(&v, ts);
+    let r = check(&s, &map, &sr);
+    assert!(r.ok, "{}", r.summary());
+    let first_at = (f1 - from) as u64 * tc;
+    assert!(
+        r.locked_at_ps + phase >= first_at && r.locked_at_ps <= first_at + ts,
+        "locked at {} ps, branch 1's conversion starts at {first_at} ps (branch 0's at {} ps): {}",
+        r.locked_at_ps,
+        (f0 - from) as u64 * tc,
+        r.summary()
+    );
+    // Branch 0's CS not probed: D0 is adc_cs_n[0] in `lanes`' order.
+    assert_eq!(lanes_v[0], (Some(lut_gen::ports::Role::CsN), 0));
+    let without_cs0: Vec<&str> = map.split(',').skip(1).collect();
+    let r = check(&s, &without_cs0.join(","), &sr);
+    assert!(r.ok, "{}", r.summary());
+    assert!(r.locked_at_ps <= first_at + ts, "{}", r.summary());
+
+    // One SCLK low pulse of branch 1's first conversion missing.
+    let mut bad = clean.clone();
+    let k = (f1 + 1..f0)
+        .find(|&c| bad[c].sclk >> 1 & 1 == 0 && bad[c - 1].sclk >> 1 & 1 == 1)
+        .expect("an SCLK fall of branch 1's conversion before branch 0's");
+    let mut c = k;
+    while bad[c].sclk >> 1 & 1 == 0 {
+        bad[c].sclk |= 2;
+        c += 1;
+    }
+    let v = d.path().join("late-bad.vcd");
+    resample(&s, &bad, from as u64, to as u64, ts, phase, &v);
+    let (sr, _) = to_sigrok(&v, ts);
+    let r = check(&s, &map, &sr);
+    let text = r.summary();
+    assert!(!r.ok, "{text}");
+    assert!(
+        r.violations
+            .iter()
+            .any(|v| v.port_bit == "adc_sclk[1]" && v.rule.contains("serial clock")),
+        "{text}"
+    );
+}
+
+/// The link's bytes are held to the model's time and, with MISO captured,
+/// to the codes MISO carried (the tiny mix with a 1 Mbaud UART, a 100 MHz
+/// analyser, the 1 ps VCD read directly to keep it fast): clean passes and
+/// says so; the line from one start bit on two bit times late (every byte
+/// intact, CRCs good) fails on timing; MISO of branch 0 inverted over one
+/// slot (the line unchanged) fails on the codes.
+#[test]
+fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
+    let tiny = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml"),
+    )
+    .unwrap();
+    let d = tempfile::tempdir().unwrap();
+    let mix = d.path().join("tiny-uart.toml");
+    std::fs::write(
+        &mix,
+        format!("{tiny}\n[link]\nkind = \"uart\"\nbaud = 1_000_000\n"),
+    )
+    .unwrap();
+    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    let f = s.grid.frame_cycles as usize;
+    let (pins, miso) = run_with_miso(&s, &mut ModelDut::new(&s), 3);
+    let (mut lanes_v, mut map) = lanes(&s);
+    let link = format!("D{}", lanes_v.len() - 1);
+    let branches = lut_gen::ports::Layout::new(&s).branches;
+    for b in 0..branches as u32 {
+        map += &format!(",D{}=adc_miso[{b}]", lanes_v.len());
+        lanes_v.push((Some(Role::Miso), b));
+    }
+    let window = ((f / 2 + 123) as u64, (2 * f + f / 2) as u64);
+    let (ts, phase) = (10_000, 4_321);
+    let capture = |pins: &[Pins], miso: &[u64], name: &str| {
+        let level = |c: usize, r: Option<Role>, b: u32| match r {
+            Some(Role::Miso) => miso[c] >> b & 1 == 1,
+            _ => analyser::bit(&pins[c], r, b),
+        };
+        let v = d.path().join(name);
+        resample_lanes(&s, &lanes_v, &level, window, ts, phase, &v);
+        // The sample rate, as sigrok-cli's VCD says it.
+        let text = std::fs::read_to_string(&v).unwrap().replace(
+            "$enddefinitions $end\n",
+            "$comment\n  Acquisition at 100 MHz\n$end\n$enddefinitions $end\n",
+        );
+        std::fs::write(&v, text).unwrap();
+        check(&s, &map, &v)
+    };
+    let r = capture(&pins, &miso, "clean.vcd");
+    let text = r.summary();
+    assert!(r.ok, "{text}");
+    assert!(text.contains("characters' start bits within"), "{text}");
+    assert!(text.contains("equal the codes MISO carried"), "{text}");
+
+    // The line two bit times late from the first start bit after frame 1.
+    let div = lut_gen::hostlink::plan(&s).unwrap().unwrap().baud_divider as usize;
+    let st = (f..pins.len())
+        .find(|&c| !pins[c].link_tx && pins[c - 1].link_tx)
+        .unwrap();
+    let mut late = pins.clone();
+    for c in st..late.len() {
+        late[c].link_tx = if c < st + 2 * div {
+            true
+        } else {
+            pins[c - 2 * div].link_tx
+        };
+    }
+    let r = capture(&late, &miso, "late.vcd");
+    let text = r.summary();
+    assert!(!r.ok, "{text}");
+    assert!(
+        r.violations
+            .iter()
+            .any(|v| v.channel == link && v.rule.contains("link timing")),
+        "{text}"
+    );
+    assert!(!text.contains("bad CRC"), "{text}");
+
+    // MISO of branch 0 inverted over one slot from frame 1 on.
+    let mut bad = miso.clone();
+    for m in &mut bad[f..f + s.grid.slot_cycles as usize] {
+        *m ^= 1;
+    }
+    let r = capture(&pins, &bad, "miso.vcd");
+    let text = r.summary();
+    assert!(!r.ok, "{text}");
+    assert!(
+        r.violations
+            .iter()
+            .any(|v| v.channel == link && v.rule.contains("link samples (values)")),
         "{text}"
     );
 }

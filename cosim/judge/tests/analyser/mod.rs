@@ -31,6 +31,25 @@ pub fn run<D: Dut>(s: &Schedule, dut: &mut D, frames: u64) -> Vec<Pins> {
     r.0
 }
 
+/// Every cycle's pins and MISO word (bit b: branch b) after reset.
+#[derive(Default)]
+pub struct RecMiso(pub Vec<Pins>, pub Vec<u64>);
+
+impl Observer for RecMiso {
+    fn cycle(&mut self, _: u64, rst: bool, p: &Pins, miso: u64) {
+        if !rst {
+            self.0.push(*p);
+            self.1.push(miso);
+        }
+    }
+}
+
+pub fn run_with_miso<D: Dut>(s: &Schedule, dut: &mut D, frames: u64) -> (Vec<Pins>, Vec<u64>) {
+    let mut r = RecMiso::default();
+    run_dut(s, dut, frames, &RunOptions::default(), "gen", Some(&mut r));
+    (r.0, r.1)
+}
+
 /// The analyser's channels: every CS, SCLK, mux select and enable bit and
 /// sample_valid, as D0..Dn, with the `--map` that names them.
 pub fn lanes(s: &Schedule) -> (Vec<(Option<Role>, u32)>, String) {
@@ -84,6 +103,21 @@ pub fn resample(
     out: &Path,
 ) {
     let (lanes, _) = lanes(s);
+    let level = |c: usize, r: Option<Role>, b: u32| bit(&pins[c], r, b);
+    resample_lanes(s, &lanes, &level, (from, to), ts_ps, phase_ps, out);
+}
+
+/// [`resample`] of any lanes, each cycle's level given by `level(cycle,
+/// role, bit)`.
+pub fn resample_lanes(
+    s: &Schedule,
+    lanes: &[(Option<Role>, u32)],
+    level: &dyn Fn(usize, Option<Role>, u32) -> bool,
+    (from, to): (u64, u64),
+    ts_ps: u64,
+    phase_ps: u64,
+    out: &Path,
+) {
     let tc = 1e12 / s.mix.clock_hz as f64;
     let mut text = String::from("$timescale 1 ps $end\n$scope module libsigrok $end\n");
     for (i, _) in lanes.iter().enumerate() {
@@ -101,7 +135,7 @@ pub fn resample(
         }
         let v: Vec<bool> = lanes
             .iter()
-            .map(|(r, b)| bit(&pins[c as usize], *r, *b))
+            .map(|(r, b)| level(c as usize, *r, *b))
             .collect();
         if prev.as_ref() != Some(&v) {
             text += &format!("#{}\n", n * ts_ps);
