@@ -293,8 +293,14 @@ pub fn candidate_slots_per_slice(mix: &Mix, min_slot_cycles: u64) -> Vec<u64> {
         .collect()
 }
 
-/// Synthesizes a jitter-free schedule, or explains why none exists.
+/// Synthesizes a jitter-free schedule, or explains why none exists (or, if
+/// the exact search's bound ran out, that none was found).
 pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
+    synthesize_within(mix, SEARCH_BUDGET)
+}
+
+/// [`synthesize`] with `budget` placements per slot grid for the exact search.
+fn synthesize_within(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible> {
     let fail = |reasons: Vec<String>, suggestions: Vec<String>| Infeasible {
         mix: mix.name.clone(),
         verdict: Verdict::Infeasible,
@@ -371,7 +377,7 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
             continue;
         }
         let units = units_of(mix, slots);
-        match attempt(&units, mix.branches.len(), slots, sps, SEARCH_BUDGET) {
+        match attempt(&units, mix.branches.len(), slots, sps, budget) {
             Attempt::Placed(offsets, placement) => {
                 let schedule = build(mix, plans, sps, &units, &offsets, placement);
                 if let Err(problems) = crate::validate::validate(&schedule) {
@@ -390,7 +396,7 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
             Attempt::Failed { bounded: b, .. } => bounded |= b,
         }
     }
-    Err(diagnose(mix, &candidates, bounded))
+    Err(diagnose(mix, &candidates, bounded.then_some(budget)))
 }
 
 fn build(
@@ -484,7 +490,8 @@ fn over_capacity(branch: &str, per_frame: u64, sps: u64, slices: u64) -> String 
     )
 }
 
-fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
+/// `bound`: the exact search's budget, if it ran out on some grid.
+fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
     let k = mix.slices_per_frame();
     // The roomiest grid whose periods are all whole; else simply the roomiest.
     let whole = |sps: u64| {
@@ -581,8 +588,8 @@ fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
             reasons.push("first-fit placed every channel at this grid, but no grid admitted all of them with one rate each".into());
         }
         if !overfull && unplaced.iter().any(|u| !u.is_empty()) {
-            reasons.push(if bounded {
-                format!("rates that are not harmonic collide; the exact search stopped at its bound of {SEARCH_BUDGET} placements per grid with neither a schedule nor a proof that none exists: the mix may fit")
+            reasons.push(if let Some(budget) = bound {
+                format!("rates that are not harmonic collide; the exact search stopped at its bound of {budget} placements per grid with neither a schedule nor a proof that none exists: the mix may fit")
             } else {
                 "rates that are not harmonic collide: two progressions of periods p and q meet unless their offsets differ modulo gcd(p, q), and no choice of offsets separates them all".into()
             });
@@ -661,14 +668,67 @@ fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
         .collect();
     Infeasible {
         mix: mix.name.clone(),
-        verdict: if bounded {
-            Verdict::Unknown
-        } else {
-            Verdict::Infeasible
+        verdict: match bound {
+            Some(_) => Verdict::Unknown,
+            None => Verdict::Infeasible,
         },
         slots_per_slice: Some(sps),
         reasons,
         branches,
         suggestions,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Three branches; b2's two 16 kHz channels and its 600 Hz one fit only
+    /// at 96 slots per slice (at 48 the 600 Hz progression meets every
+    /// residue mod 3): a proof at 48, a schedule at 96.
+    fn three_branches() -> Mix {
+        let mut t = String::from(
+            "name = \"m\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n",
+        );
+        for b in 0..3 {
+            t += &format!("[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n");
+        }
+        let channels = [
+            ("b2", 16_000),
+            ("b2", 600),
+            ("b0", 12_000),
+            ("b0", 3_000),
+            ("b2", 16_000),
+            ("b0", 1_500),
+            ("b1", 2_400),
+        ];
+        for (i, (branch, rate)) in channels.iter().enumerate() {
+            t +=
+                &format!("[[channel]]\nname = \"c{i}\"\nbranch = \"{branch}\"\nrate_hz = {rate}\n");
+        }
+        crate::parse(std::path::Path::new("m.toml"), &t).unwrap()
+    }
+
+    #[test]
+    fn a_bound_that_runs_out_is_unknown_not_infeasible() {
+        let mix = three_branches();
+        let why = synthesize_within(&mix, 2).unwrap_err();
+        assert_eq!(why.verdict, Verdict::Unknown);
+        let text = why.to_string();
+        assert!(text.starts_with("mix `m`: unknown"), "{text}");
+        assert!(text.contains("bound of 2 placements"), "{text}");
+        assert!(!text.contains("has no jitter-free schedule"), "{text}");
+        let s = synthesize_within(&mix, SEARCH_BUDGET).unwrap();
+        assert_eq!(s.grid.slots_per_slice, 96);
+    }
+
+    #[test]
+    fn an_exhausted_grid_is_a_proof() {
+        let mut mix = three_branches();
+        mix.slots_per_slice = Some(48);
+        let why = synthesize_within(&mix, SEARCH_BUDGET).unwrap_err();
+        assert_eq!(why.verdict, Verdict::Infeasible);
+        assert!(why.to_string().contains("no choice of offsets"), "{why}");
+        assert_eq!(why.branches[2].unplaced, vec!["c1".to_string()]);
     }
 }
