@@ -18,6 +18,10 @@ use crate::synth::Infeasible;
 pub struct AuditReport {
     pub mix: String,
     pub feasible: bool,
+    /// For a mix without a schedule: `infeasible` (proved) or `unknown` (the
+    /// exact search's bound ran out first; exit code 3).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<crate::Verdict>,
     pub clock_hz: u64,
     pub frame_cycles: u64,
     pub slice_cycles: u64,
@@ -437,6 +441,7 @@ impl AuditReport {
         AuditReport {
             mix: mix.name.clone(),
             feasible: errors.is_empty(),
+            verdict: None,
             link,
             clock_hz: g.clock_hz,
             frame_cycles: g.frame_cycles,
@@ -492,6 +497,7 @@ impl AuditReport {
         AuditReport {
             mix: mix.name.clone(),
             feasible: false,
+            verdict: Some(why.verdict),
             clock_hz: mix.clock_hz,
             frame_cycles: mix.frame_cycles(),
             slice_cycles,

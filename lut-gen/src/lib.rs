@@ -19,7 +19,7 @@ pub mod validate;
 
 pub use mix::{load, parse, Mix, MixError};
 pub use schedule::{FrameGrid, SamplingInstant, Schedule};
-pub use synth::{synthesize, Infeasible};
+pub use synth::{synthesize, Infeasible, Verdict};
 pub mod audit;
 pub mod lut;
 

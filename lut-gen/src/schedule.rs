@@ -79,7 +79,7 @@ pub struct ChannelSlots {
 pub enum Placement {
     /// Greedy first-fit in period order; exact for harmonic rates.
     Constructive,
-    /// Bounded backtracking search.
+    /// The exact search (`synth`): placements it tried on the chosen grid.
     Search { nodes: u64 },
 }
 

@@ -5,7 +5,9 @@
 //! the frame's `N` slots.  When a branch's periods form a divisibility chain
 //! (harmonic rates) first-fit in increasing period order never fails while
 //! the branch's density is at most 1, so it is used first; otherwise (and for
-//! sync groups, which couple branches) a bounded backtracking search decides.
+//! sync groups, which couple branches) an exact search decides (`search`):
+//! it finds a schedule, or proves there is none, or says it could not tell
+//! within its bound ([`Verdict::Unknown`]), never "infeasible" without a proof.
 //! Every result is re-checked by [`crate::validate`], which shares no code
 //! with this module.
 
@@ -17,18 +19,44 @@ use crate::mix::Mix;
 use crate::parts::{ns_to_cycles, SpiTiming};
 use crate::schedule::{BranchPlan, ChannelSlots, FrameGrid, Placement, Schedule};
 
-/// Backtracking nodes allowed per slot-grid candidate.
+mod search;
+
+/// Placements the exact search may try per slot-grid candidate.
 pub const SEARCH_BUDGET: u64 = 400_000;
 
-/// A mix that admits no jitter-free schedule, and why.
+/// A mix without a schedule, and why: proved to have none, or not found
+/// within the search's bound.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Infeasible {
     pub mix: String,
+    pub verdict: Verdict,
     /// The slot grid the diagnosis refers to (the roomiest legal one), if any.
     pub slots_per_slice: Option<u64>,
     pub reasons: Vec<String>,
     pub branches: Vec<BranchDiagnosis>,
     pub suggestions: Vec<String>,
+}
+
+/// How sure the "no schedule" is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// Proved: a count (demand over capacity, periods that are not whole
+    /// slots, slots too short) or an exhausted search of every grid.
+    Infeasible,
+    /// The exact search stopped at its bound on some grid without a
+    /// schedule and without a proof: the mix may or may not fit.
+    Unknown,
+}
+
+impl Verdict {
+    /// The word the CLI and the JSON use.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Infeasible => "infeasible",
+            Verdict::Unknown => "unknown",
+        }
+    }
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -48,9 +76,18 @@ impl fmt::Display for Infeasible {
             .reasons
             .iter()
             .find(|r| r.contains("conversions per slice"));
-        match lead {
-            Some(r) => writeln!(f, "{r}: mix `{}` has no jitter-free schedule", self.mix)?,
-            None => writeln!(f, "mix `{}` has no jitter-free schedule", self.mix)?,
+        match (self.verdict, lead) {
+            (Verdict::Unknown, _) => writeln!(
+                f,
+                "mix `{}`: unknown: no jitter-free schedule found within the search bound, and none proved impossible",
+                self.mix
+            )?,
+            (Verdict::Infeasible, Some(r)) => {
+                writeln!(f, "{r}: mix `{}` has no jitter-free schedule", self.mix)?
+            }
+            (Verdict::Infeasible, None) => {
+                writeln!(f, "mix `{}` has no jitter-free schedule", self.mix)?
+            }
         }
         if let Some(s) = self.slots_per_slice {
             writeln!(
@@ -97,14 +134,12 @@ struct Unit {
 /// Per-branch slot occupancy of one frame.
 struct Occupancy {
     words: Vec<Vec<u64>>,
-    free: Vec<u64>,
 }
 
 impl Occupancy {
     fn new(branches: usize, slots: u64) -> Self {
         Occupancy {
             words: vec![vec![0; slots.div_ceil(64) as usize]; branches],
-            free: vec![slots; branches],
         }
     }
     fn taken(&self, b: usize, s: u64) -> bool {
@@ -117,16 +152,10 @@ impl Occupancy {
                 .all(|s| !self.taken(b, s))
         })
     }
-    fn set(&mut self, u: &Unit, offset: u64, slots: u64, on: bool) {
-        let n = slots / u.period;
+    fn take(&mut self, u: &Unit, offset: u64, slots: u64) {
         for &b in &u.branches {
             for s in (offset..slots).step_by(u.period as usize) {
-                self.words[b][(s / 64) as usize] ^= 1 << (s % 64);
-            }
-            if on {
-                self.free[b] -= n;
-            } else {
-                self.free[b] += n;
+                self.words[b][(s / 64) as usize] |= 1 << (s % 64);
             }
         }
     }
@@ -201,81 +230,11 @@ fn greedy(units: &[Unit], branches: usize, slots: u64, sps: u64) -> (Vec<Option<
     for u in units {
         let found = candidate_offsets(u.period, sps).find(|&o| occ.fits(u, o, slots));
         if let Some(o) = found {
-            occ.set(u, o, slots, true);
+            occ.take(u, o, slots);
         }
         offsets.push(found);
     }
     (offsets, occ)
-}
-
-struct Search<'a> {
-    units: &'a [Unit],
-    slots: u64,
-    sps: u64,
-    occ: Occupancy,
-    /// Demand (slots per frame) not yet placed, per branch.
-    remaining: Vec<u64>,
-    offsets: Vec<u64>,
-    /// Rank of each placed unit's offset in its candidate order (for symmetry breaking).
-    ranks: Vec<usize>,
-    nodes: u64,
-    budget: u64,
-}
-
-impl Search<'_> {
-    fn interchangeable(&self, i: usize) -> bool {
-        i > 0 && {
-            let (a, b) = (&self.units[i - 1], &self.units[i]);
-            a.period == b.period && a.branches == b.branches
-        }
-    }
-
-    fn run(&mut self, i: usize) -> bool {
-        if i == self.units.len() {
-            return true;
-        }
-        self.nodes += 1;
-        if self.nodes > self.budget {
-            return false;
-        }
-        if (0..self.remaining.len()).any(|b| self.remaining[b] > self.occ.free[b]) {
-            return false;
-        }
-        let u = &self.units[i];
-        let n = self.slots / u.period;
-        let min_rank = if self.interchangeable(i) {
-            self.ranks[i - 1] + 1
-        } else {
-            0
-        };
-        // Translation symmetry: the very first unit may sit at offset 0.
-        let limit = if i == 0 { 1 } else { usize::MAX };
-        let candidates: Vec<u64> = candidate_offsets(u.period, self.sps).collect();
-        for (rank, &o) in candidates.iter().enumerate().skip(min_rank).take(limit) {
-            if !self.occ.fits(u, o, self.slots) {
-                continue;
-            }
-            self.occ.set(u, o, self.slots, true);
-            for &b in &u.branches {
-                self.remaining[b] -= n;
-            }
-            self.offsets.push(o);
-            self.ranks.push(rank);
-            if self.run(i + 1) {
-                return true;
-            }
-            self.offsets.pop();
-            self.ranks.pop();
-            for &b in &u.branches {
-                self.remaining[b] += n;
-            }
-            self.occ.set(u, o, self.slots, false);
-            if self.nodes > self.budget {
-                return false;
-            }
-        }
-        false
-    }
 }
 
 fn attempt(units: &[Unit], branches: usize, slots: u64, sps: u64, budget: u64) -> Attempt {
@@ -286,28 +245,12 @@ fn attempt(units: &[Unit], branches: usize, slots: u64, sps: u64, budget: u64) -
             Placement::Constructive,
         );
     }
-    let mut remaining = vec![0; branches];
-    for u in units {
-        for &b in &u.branches {
-            remaining[b] += slots / u.period;
+    match search::search(units, branches, sps, budget) {
+        search::Outcome::Placed(offsets, nodes) => {
+            Attempt::Placed(offsets, Placement::Search { nodes })
         }
-    }
-    let mut s = Search {
-        units,
-        slots,
-        sps,
-        occ: Occupancy::new(branches, slots),
-        remaining,
-        offsets: Vec::new(),
-        ranks: Vec::new(),
-        nodes: 0,
-        budget,
-    };
-    if s.run(0) {
-        return Attempt::Placed(s.offsets, Placement::Search { nodes: s.nodes });
-    }
-    Attempt::Failed {
-        bounded: s.nodes > s.budget,
+        search::Outcome::Exhausted => Attempt::Failed { bounded: false },
+        search::Outcome::Bounded => Attempt::Failed { bounded: true },
     }
 }
 
@@ -350,10 +293,17 @@ pub fn candidate_slots_per_slice(mix: &Mix, min_slot_cycles: u64) -> Vec<u64> {
         .collect()
 }
 
-/// Synthesizes a jitter-free schedule, or explains why none exists.
+/// Synthesizes a jitter-free schedule, or explains why none exists (or, if
+/// the exact search's bound ran out, that none was found).
 pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
+    synthesize_within(mix, SEARCH_BUDGET)
+}
+
+/// [`synthesize`] with `budget` placements per slot grid for the exact search.
+fn synthesize_within(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible> {
     let fail = |reasons: Vec<String>, suggestions: Vec<String>| Infeasible {
         mix: mix.name.clone(),
+        verdict: Verdict::Infeasible,
         slots_per_slice: None,
         reasons,
         branches: Vec::new(),
@@ -427,7 +377,7 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
             continue;
         }
         let units = units_of(mix, slots);
-        match attempt(&units, mix.branches.len(), slots, sps, SEARCH_BUDGET) {
+        match attempt(&units, mix.branches.len(), slots, sps, budget) {
             Attempt::Placed(offsets, placement) => {
                 let schedule = build(mix, plans, sps, &units, &offsets, placement);
                 if let Err(problems) = crate::validate::validate(&schedule) {
@@ -446,7 +396,7 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
             Attempt::Failed { bounded: b, .. } => bounded |= b,
         }
     }
-    Err(diagnose(mix, &candidates, bounded))
+    Err(diagnose(mix, &candidates, bounded.then_some(budget)))
 }
 
 fn build(
@@ -540,7 +490,8 @@ fn over_capacity(branch: &str, per_frame: u64, sps: u64, slices: u64) -> String 
     )
 }
 
-fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
+/// `bound`: the exact search's budget, if it ran out on some grid.
+fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
     let k = mix.slices_per_frame();
     // The roomiest grid whose periods are all whole; else simply the roomiest.
     let whole = |sps: u64| {
@@ -637,8 +588,8 @@ fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
             reasons.push("first-fit placed every channel at this grid, but no grid admitted all of them with one rate each".into());
         }
         if !overfull && unplaced.iter().any(|u| !u.is_empty()) {
-            reasons.push(if bounded {
-                format!("rates that are not harmonic collide; the exact search stopped after its bound of {SEARCH_BUDGET} nodes per grid without a schedule")
+            reasons.push(if let Some(budget) = bound {
+                format!("rates that are not harmonic collide; the exact search stopped at its bound of {budget} placements per grid with neither a schedule nor a proof that none exists: the mix may fit")
             } else {
                 "rates that are not harmonic collide: two progressions of periods p and q meet unless their offsets differ modulo gcd(p, q), and no choice of offsets separates them all".into()
             });
@@ -717,9 +668,67 @@ fn diagnose(mix: &Mix, candidates: &[u64], bounded: bool) -> Infeasible {
         .collect();
     Infeasible {
         mix: mix.name.clone(),
+        verdict: match bound {
+            Some(_) => Verdict::Unknown,
+            None => Verdict::Infeasible,
+        },
         slots_per_slice: Some(sps),
         reasons,
         branches,
         suggestions,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Three branches; b2's two 16 kHz channels and its 600 Hz one fit only
+    /// at 96 slots per slice (at 48 the 600 Hz progression meets every
+    /// residue mod 3): a proof at 48, a schedule at 96.
+    fn three_branches() -> Mix {
+        let mut t = String::from(
+            "name = \"m\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n",
+        );
+        for b in 0..3 {
+            t += &format!("[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n");
+        }
+        let channels = [
+            ("b2", 16_000),
+            ("b2", 600),
+            ("b0", 12_000),
+            ("b0", 3_000),
+            ("b2", 16_000),
+            ("b0", 1_500),
+            ("b1", 2_400),
+        ];
+        for (i, (branch, rate)) in channels.iter().enumerate() {
+            t +=
+                &format!("[[channel]]\nname = \"c{i}\"\nbranch = \"{branch}\"\nrate_hz = {rate}\n");
+        }
+        crate::parse(std::path::Path::new("m.toml"), &t).unwrap()
+    }
+
+    #[test]
+    fn a_bound_that_runs_out_is_unknown_not_infeasible() {
+        let mix = three_branches();
+        let why = synthesize_within(&mix, 2).unwrap_err();
+        assert_eq!(why.verdict, Verdict::Unknown);
+        let text = why.to_string();
+        assert!(text.starts_with("mix `m`: unknown"), "{text}");
+        assert!(text.contains("bound of 2 placements"), "{text}");
+        assert!(!text.contains("has no jitter-free schedule"), "{text}");
+        let s = synthesize_within(&mix, SEARCH_BUDGET).unwrap();
+        assert_eq!(s.grid.slots_per_slice, 96);
+    }
+
+    #[test]
+    fn an_exhausted_grid_is_a_proof() {
+        let mut mix = three_branches();
+        mix.slots_per_slice = Some(48);
+        let why = synthesize_within(&mix, SEARCH_BUDGET).unwrap_err();
+        assert_eq!(why.verdict, Verdict::Infeasible);
+        assert!(why.to_string().contains("no choice of offsets"), "{why}");
+        assert_eq!(why.branches[2].unplaced, vec!["c1".to_string()]);
     }
 }

@@ -39,9 +39,9 @@ pub fn run(args: Args) -> u8 {
     } else {
         print!("{}", report.to_text());
     }
-    if report.feasible {
-        0
-    } else {
-        1
+    match (report.feasible, report.verdict) {
+        (true, _) => 0,
+        (false, Some(v)) => super::verdict_exit(v),
+        (false, None) => 1,
     }
 }

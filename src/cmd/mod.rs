@@ -22,9 +22,18 @@ pub fn schedule(path: &Path) -> Result<lut_gen::Schedule, u8> {
         2u8
     })?;
     lut_gen::synthesize(&mix).map_err(|e| {
-        eprint!("infeasible: {e}");
-        1u8
+        eprint!("{}: {e}", e.verdict.as_str());
+        verdict_exit(e.verdict)
     })
+}
+
+/// Exit code of a mix without a schedule: 1 proved infeasible, 3 unknown
+/// (the exact search's bound ran out: not a proof, as `prove`'s 3).
+pub fn verdict_exit(v: lut_gen::Verdict) -> u8 {
+    match v {
+        lut_gen::Verdict::Infeasible => 1,
+        lut_gen::Verdict::Unknown => 3,
+    }
 }
 
 /// The `--backend` value parser: the names `cosim::Backend` knows.
