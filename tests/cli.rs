@@ -200,6 +200,12 @@ fn lut_refuses_to_replace_a_file_with_a_directory() {
 /// switched off (the test-only switch, judge/src/switch.rs): the JSON and
 /// the exit code.
 fn campaign(mix: &Path, backend: &str, off: &str) -> (serde_json::Value, i32) {
+    let (v, code, _) = campaign_logged(mix, backend, off);
+    (v, code)
+}
+
+/// [`campaign`] with its stderr (the progress lines: not a terminal).
+fn campaign_logged(mix: &Path, backend: &str, off: &str) -> (serde_json::Value, i32, String) {
     let out = slotforge()
         .args([
             "faults",
@@ -215,7 +221,8 @@ fn campaign(mix: &Path, backend: &str, off: &str) -> (serde_json::Value, i32) {
         .unwrap();
     let v: serde_json::Value = serde_json::from_slice(&out.stdout)
         .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
-    (v, out.status.code().unwrap())
+    let log = String::from_utf8_lossy(&out.stderr).into_owned();
+    (v, out.status.code().unwrap(), log)
 }
 
 fn tiny() -> PathBuf {
@@ -279,9 +286,25 @@ fn faults_report_a_matrix_of_classes_and_detectors() {
     if !tools::require_tool("sigrok-cli") {
         return;
     }
-    let (v, code) = campaign(&tiny(), "model", "");
+    let (v, code, log) = campaign_logged(&tiny(), "model", "");
     assert_eq!(code, 0, "{v}");
     assert_eq!(v["ok"], true);
+    // off a terminal, the progress is a line per tenth of the runs, with
+    // counts: rising to all of them (every injection and the clean run)
+    let counts: Vec<(u64, u64)> = log
+        .lines()
+        .filter_map(|l| {
+            let (done, rest) = l.strip_prefix("fault campaign: ")?.split_once(" of ")?;
+            let total = rest.split_once(" runs (")?.0;
+            Some((done.parse().ok()?, total.parse().ok()?))
+        })
+        .collect();
+    assert!(counts.len() >= 5, "{log}");
+    assert!(counts.windows(2).all(|w| w[0].0 < w[1].0), "{log}");
+    let (done, total) = *counts.last().unwrap();
+    assert_eq!(done, total, "{log}");
+    assert!(total > v["injected"].as_u64().unwrap(), "{log}");
+    assert!(!log.contains("Target") && !log.contains("Some("), "{log}");
     assert_eq!(
         v["detectors"],
         serde_json::json!(["model", "invariants", "sigrok", "prove"])

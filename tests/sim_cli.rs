@@ -193,6 +193,57 @@ fn check_json(wave: &Path, code: i32) -> serde_json::Value {
     serde_json::from_slice(&out.get_output().stdout).unwrap()
 }
 
+/// `check` off a terminal tells how far it read a waveform of several
+/// MB, a line per tenth with the counts; `--quiet` tells nothing.
+#[test]
+fn check_shows_its_progress_in_plain_lines_off_a_terminal() {
+    let d = tempfile::tempdir().unwrap();
+    let wave = d.path().join("long.vcd");
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--frames", "20", "--from", "0", "--to", "20", "--vcd"])
+        .arg(&wave)
+        .assert()
+        .code(0);
+    let size = std::fs::metadata(&wave).unwrap().len();
+    assert!(size > 2 << 20, "{size} bytes: too small to show progress");
+    let out = slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&wave)
+        .assert()
+        .code(0);
+    let log = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+    let prefix = format!("checking {}: ", wave.display());
+    let counts: Vec<(f64, f64)> = log
+        .lines()
+        .filter_map(|l| {
+            let (done, rest) = l.strip_prefix(&prefix)?.split_once(" of ")?;
+            let total = rest.split_once(" MB read (")?.0;
+            Some((done.parse().ok()?, total.parse().ok()?))
+        })
+        .collect();
+    assert!(counts.len() >= 5, "{log}");
+    assert!(counts.windows(2).all(|w| w[0].0 < w[1].0), "{log}");
+    let (done, total) = *counts.last().unwrap();
+    assert_eq!(done, total, "{log}");
+    // the whole body, which is the file less its header of a few kB
+    let mb = size as f64 / 1e6;
+    assert!(
+        total <= mb + 0.05 && total > mb - 0.2,
+        "{total} of {mb}: {log}"
+    );
+    let out = slotforge()
+        .arg("check")
+        .arg(tiny())
+        .arg(&wave)
+        .arg("--quiet")
+        .assert()
+        .code(0);
+    assert!(out.get_output().stderr.is_empty());
+}
+
 #[test]
 fn check_passes_a_sim_vcd_and_fails_corrupted_copies() {
     let d = tempfile::tempdir().unwrap();

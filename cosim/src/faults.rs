@@ -137,6 +137,16 @@ pub enum Target {
     Rusthdl,
 }
 
+impl Target {
+    /// The target in words, for reports.
+    pub fn describe(&self) -> &'static str {
+        match self {
+            Target::Model => "the cycle model's pins",
+            Target::Rusthdl => "the gateware in rust-hdl's simulator",
+        }
+    }
+}
+
 /// A place in the frame where faults land.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct Site {
@@ -482,8 +492,37 @@ pub fn gateware_dut(s: &Schedule, f: hdl::GatewareFault) -> Result<Box<dyn Dut>,
         .map_err(|e| SimError::Hdl(e.to_string()))
 }
 
-/// Runs `jobs` on up to two threads (the machine's cores), in order.
-fn parallel<T: Send, R: Send>(jobs: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
+/// A progress display's hook ([`Plan::on_run`]): called with (runs done,
+/// runs in all) after every run of the campaign (an injection, a clean run,
+/// a false-alarm mix), from whichever worker thread finished it.
+#[derive(Clone)]
+pub struct OnRun(pub std::sync::Arc<dyn Fn(u64, u64) + Send + Sync>);
+
+impl std::fmt::Debug for OnRun {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("OnRun")
+    }
+}
+
+/// The campaign's run count, told to [`Plan::on_run`].
+struct Runs<'a> {
+    hook: Option<&'a OnRun>,
+    done: std::sync::atomic::AtomicU64,
+    total: u64,
+}
+
+impl Runs<'_> {
+    fn one(&self) {
+        let done = 1 + self.done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        if let Some(h) = self.hook {
+            (h.0)(done.min(self.total), self.total);
+        }
+    }
+}
+
+/// Runs `jobs` on up to two threads (the machine's cores), in order,
+/// counting each finished job in `runs`.
+fn parallel<T: Send, R: Send>(jobs: Vec<T>, runs: &Runs, f: impl Fn(T) -> R + Sync) -> Vec<R> {
     let n = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1)
@@ -497,6 +536,7 @@ fn parallel<T: Send, R: Send>(jobs: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R>
                 let job = queue.lock().expect("queue").pop();
                 let Some((i, j)) = job else { break };
                 let r = f(j);
+                runs.one();
                 results.lock().expect("results")[i] = Some(r);
             });
         }
@@ -530,6 +570,8 @@ pub struct Plan {
     /// Where faults land (`None`: every site of [`sites`]; `build`'s quick
     /// default runs every class at the mid-frame site only).
     pub sites: Option<Vec<Site>>,
+    /// Told every finished run, for a progress display (runs done of N).
+    pub on_run: Option<OnRun>,
 }
 
 impl Plan {
@@ -543,6 +585,7 @@ impl Plan {
             verilog_engines: vec![],
             prove: false,
             sites: None,
+            on_run: None,
         }
     }
 }
@@ -599,6 +642,7 @@ fn pin_injections(
     sites: &[Site],
     frames: u64,
     sigrok: bool,
+    count: &Runs,
 ) -> Result<Vec<Judgement>, String> {
     let mut jobs = Vec::new();
     for site in sites {
@@ -606,25 +650,29 @@ fn pin_injections(
             jobs.push((f, *site));
         }
     }
-    let runs = parallel(jobs, |(f, site)| -> Result<Option<Judgement>, String> {
-        let inner = target_dut(s, target).map_err(|e| e.to_string())?;
-        let mut dut = FaultyDut::new(s, inner, f, site.cycle);
-        let j = judge_run(s, &mut dut, frames, sigrok)?;
-        let level = if f == Fault::ResetGlitch {
-            "reset"
-        } else {
-            "pins"
-        };
-        // a fault that found nothing to change was not injected
-        Ok(dut.injected().then(|| {
-            (
-                f.class().to_string(),
-                level,
-                outcome(f.name(), &site, &j, engine_name(target)),
-                j.cost,
-            )
-        }))
-    });
+    let runs = parallel(
+        jobs,
+        count,
+        |(f, site)| -> Result<Option<Judgement>, String> {
+            let inner = target_dut(s, target).map_err(|e| e.to_string())?;
+            let mut dut = FaultyDut::new(s, inner, f, site.cycle);
+            let j = judge_run(s, &mut dut, frames, sigrok)?;
+            let level = if f == Fault::ResetGlitch {
+                "reset"
+            } else {
+                "pins"
+            };
+            // a fault that found nothing to change was not injected
+            Ok(dut.injected().then(|| {
+                (
+                    f.class().to_string(),
+                    level,
+                    outcome(f.name(), &site, &j, engine_name(target)),
+                    j.cost,
+                )
+            }))
+        },
+    );
     Ok(runs
         .into_iter()
         .collect::<Result<Vec<_>, _>>()?
@@ -676,9 +724,11 @@ fn gateware_injections(
     frames: u64,
     sigrok: bool,
     prove: bool,
+    count: &Runs,
 ) -> Result<Vec<Judgement>, String> {
     let runs = parallel(
         design_cases(s, sites),
+        count,
         |c| -> Result<Option<Judgement>, String> {
             let name = format!("{}: {:?}", c.class, c.fault);
             // a fault the mix's gateware cannot hold (e.g. a frame too long for the full LUT)
@@ -856,23 +906,32 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
         .collect();
     let sigrok = ran.contains(&Detector::Sigrok);
     let prove = ran.contains(&Detector::Prove);
+    let count = Runs {
+        hook: plan.on_run.as_ref(),
+        done: 0.into(),
+        total: planned_runs(s, plan, &sites),
+    };
     let mut judged = Vec::new();
     if plan.builtin {
-        judged = pin_injections(s, target, &sites, frames, sigrok).map_err(SimError::Io)?;
+        judged = pin_injections(s, target, &sites, frames, sigrok, &count).map_err(SimError::Io)?;
     }
     if plan.builtin && target == Target::Rusthdl {
-        judged.extend(gateware_injections(s, &sites, frames, sigrok, prove).map_err(SimError::Io)?);
+        judged.extend(
+            gateware_injections(s, &sites, frames, sigrok, prove, &count).map_err(SimError::Io)?,
+        );
     }
     let clean = clean_target_runs(s, target, frames);
+    count.one();
     let mut engine_costs = Vec::new();
     if plan.builtin {
         engine_costs.push((engine_name(target), clean[0].0, clean[0].1));
     }
-    let mut false_alarms = false_alarms(target, plan.false_alarm_mixes, sigrok);
+    let mut false_alarms = counted_false_alarms(target, plan.false_alarm_mixes, sigrok, &count);
     if !plan.verilog_faults.is_empty() {
         for &e in &plan.verilog_engines {
             let (cycles, secs, why) =
                 verilog::clean_engine_run(s, e, frames, sigrok).map_err(SimError::Io)?;
+            count.one();
             engine_costs.push((e.name(), cycles, secs));
             false_alarms.runs += 1;
             if let Some(why) = why {
@@ -890,6 +949,7 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
                 frames,
                 sigrok,
                 prove,
+                &count,
             )
             .map_err(SimError::Io)?,
         );
@@ -922,6 +982,24 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
     })
 }
 
+/// The runs `campaign_with` makes for `plan`, counted the way [`Runs`]
+/// counts them: every injection job, the target's clean runs as one, each
+/// false-alarm mix, and each Verilog engine's clean run.
+fn planned_runs(s: &Schedule, plan: &Plan, sites: &[Site]) -> u64 {
+    let mut n = 1 + plan.false_alarm_mixes;
+    if plan.builtin {
+        n += (sites.len() * Fault::all(s).len()) as u64;
+        if plan.target == Target::Rusthdl {
+            n += design_cases(s, sites).len() as u64;
+        }
+    }
+    if !plan.verilog_faults.is_empty() {
+        let e = plan.verilog_engines.len() as u64;
+        n += e + e * plan.verilog_faults.len() as u64;
+    }
+    n
+}
+
 /// `hdl::RtlSim` with a fault built in, as a [`Dut`].
 struct GatewareDut(hdl::RtlSim);
 
@@ -938,6 +1016,16 @@ impl Dut for GatewareDut {
 /// [`random_mix`], judged by every detector (sigrok with `sigrok`); every
 /// rejection is a false alarm.
 pub fn false_alarms(target: Target, n: u64, sigrok: bool) -> FalseAlarms {
+    let none = Runs {
+        hook: None,
+        done: 0.into(),
+        total: n,
+    };
+    counted_false_alarms(target, n, sigrok, &none)
+}
+
+/// [`false_alarms`], each mix run counted in `count`.
+fn counted_false_alarms(target: Target, n: u64, sigrok: bool, count: &Runs) -> FalseAlarms {
     let mut fa = FalseAlarms {
         mixes: 0,
         runs: 0,
@@ -962,6 +1050,7 @@ pub fn false_alarms(target: Target, n: u64, sigrok: bool) -> FalseAlarms {
         };
         fa.mixes += 1;
         let j = judge_run(&s, &mut dut, 2, sigrok);
+        count.one();
         fa.runs += 1;
         let why = match &j {
             Err(e) => Some(format!("sigrok-cli failed: {e}")),

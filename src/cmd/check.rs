@@ -33,7 +33,8 @@ pub struct Args {
     /// With --map: the analyser's channel-to-channel skew allowed (`5ns`).
     #[arg(long, default_value = "0ns")]
     pub skew: String,
-    /// No progress display.
+    /// No progress display (on stderr: a bar on a terminal; otherwise a
+    /// line per tenth of a waveform of 2 MiB or more).
     #[arg(long)]
     pub quiet: bool,
     /// Also write JUnit XML: one test case for the waveform, a failure
@@ -124,12 +125,18 @@ pub fn run(a: Args) -> u8 {
         model: !a.no_model,
         ..CheckOptions::default()
     };
-    let spin =
-        super::progress::spinner(&format!("checking {}", a.wave.display()), a.quiet || a.json);
-    let checked = judge::vcd::check_vcd_with(&s, &a.wave, a.scope.as_deref(), opts);
-    if let Some(b) = spin {
-        b.finish_and_clear();
-    }
+    // plain lines off a terminal only for a file of several chunks
+    let progress = super::progress::Counter::new(
+        &format!("checking {}", a.wave.display()),
+        super::progress::Unit::Bytes,
+        2 << 20,
+        a.quiet,
+    );
+    let checked =
+        judge::vcd::check_vcd_progress(&s, &a.wave, a.scope.as_deref(), opts, &|done, total| {
+            progress.set(done, total)
+        });
+    progress.finish();
     let (report, info) = match checked {
         Ok(r) => r,
         Err(e) => {

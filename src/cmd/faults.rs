@@ -42,7 +42,8 @@ pub struct Args {
     /// Print the campaign as JSON.
     #[arg(long)]
     pub json: bool,
-    /// No progress display.
+    /// No progress display (on stderr: a bar on a terminal, a line per
+    /// tenth of the runs otherwise).
     #[arg(long)]
     pub quiet: bool,
 }
@@ -92,11 +93,19 @@ pub fn run(a: Args) -> u8 {
             }
         };
     }
-    let spin = super::progress::spinner("fault campaign", a.quiet || a.json);
+    // Progress goes to stderr, so `--json` on stdout keeps it.
+    let progress = std::sync::Arc::new(super::progress::Counter::new(
+        "fault campaign",
+        super::progress::Unit::Runs,
+        1,
+        a.quiet,
+    ));
+    let shown = std::sync::Arc::clone(&progress);
+    plan.on_run = Some(cosim::faults::OnRun(std::sync::Arc::new(
+        move |done, total| shown.set(done, total),
+    )));
     let c = campaign_with(&s, &plan);
-    if let Some(b) = spin {
-        b.finish_and_clear();
-    }
+    progress.finish();
     let c = match c {
         Ok(c) => c,
         Err(e) => {
@@ -129,9 +138,9 @@ fn text(c: &Campaign) -> String {
         .collect();
     let _ = writeln!(
         o,
-        "faults on {} ({:?}), sites: {}",
+        "faults on {} (into {}), sites: {}",
         c.mix,
-        c.target,
+        c.target.describe(),
         sites.join(", ")
     );
     if let Some(p) = &c.tready {

@@ -164,17 +164,118 @@ impl judge::vcd::CycleSink for CycleProgress<'_> {
     }
 }
 
-/// A spinner with the elapsed time for work that reports no counts (the
-/// fault campaign, reading a VCD); nothing off a terminal or with `--quiet`.
-pub fn spinner(what: &str, quiet: bool) -> Option<indicatif::ProgressBar> {
-    (!quiet && std::io::stderr().is_terminal()).then(|| {
-        let b = indicatif::ProgressBar::new_spinner();
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} {msg} [{elapsed}]")
+/// What a [`Counter`] counts.
+#[derive(Clone, Copy, PartialEq)]
+pub enum Unit {
+    /// Runs of a fault campaign.
+    Runs,
+    /// Bytes of a file read.
+    Bytes,
+}
+
+/// Work that reports "done of N" from any thread (the fault campaign's
+/// runs, the bytes of a waveform read): an indicatif bar with the counts
+/// and ETA on a terminal; off one, a plain line at every tenth (only when
+/// the work is more than a few pieces: `min_total`); nothing with
+/// `--quiet`.
+pub struct Counter {
+    what: String,
+    unit: Unit,
+    bar: Option<indicatif::ProgressBar>,
+    plain: bool,
+    min_total: u64,
+    started: std::time::Instant,
+    /// The last tenth printed off a terminal.
+    tenth: std::sync::atomic::AtomicU64,
+}
+
+impl Counter {
+    pub fn new(what: &str, unit: Unit, min_total: u64, quiet: bool) -> Counter {
+        let tty = std::io::stderr().is_terminal();
+        let bar = (!quiet && tty).then(|| {
+            let counts = match unit {
+                Unit::Runs => "{pos}/{len} runs",
+                Unit::Bytes => "{bytes}/{total_bytes}",
+            };
+            let b = indicatif::ProgressBar::new(0);
+            b.set_style(
+                indicatif::ProgressStyle::with_template(&format!(
+                    "{{msg}} {{bar:30}} {counts}  [{{elapsed}}, about {{eta}} left]"
+                ))
                 .expect("template"),
-        );
-        b.set_message(what.to_string());
-        b.enable_steady_tick(std::time::Duration::from_millis(150));
-        b
-    })
+            );
+            b.set_message(what.to_string());
+            b.enable_steady_tick(std::time::Duration::from_millis(200));
+            b
+        });
+        Counter {
+            what: what.to_string(),
+            unit,
+            bar,
+            plain: !quiet && !tty,
+            min_total,
+            started: std::time::Instant::now(),
+            tenth: 0.into(),
+        }
+    }
+
+    /// `done` of `total` are done.
+    pub fn set(&self, done: u64, total: u64) {
+        if let Some(b) = &self.bar {
+            b.set_length(total);
+            b.set_position(done);
+            return;
+        }
+        if !self.plain || total < self.min_total || total == 0 {
+            return;
+        }
+        let tenth = done * 10 / total;
+        let last = self
+            .tenth
+            .fetch_max(tenth, std::sync::atomic::Ordering::Relaxed);
+        if tenth > last {
+            eprintln!("{}", self.line(done, total));
+        }
+    }
+
+    /// The plain line: counts, elapsed time and the time left at this pace.
+    fn line(&self, done: u64, total: u64) -> String {
+        let secs = self.started.elapsed().as_secs_f64();
+        let left = secs * (total - done.min(total)) as f64 / done.max(1) as f64;
+        let counts = match self.unit {
+            Unit::Runs => format!("{done} of {total} runs"),
+            Unit::Bytes => format!(
+                "{:.1} of {:.1} MB read",
+                done as f64 / 1e6,
+                total as f64 / 1e6
+            ),
+        };
+        format!(
+            "{}: {counts} ({}%, {secs:.0} s, about {left:.0} s left)",
+            self.what,
+            done * 100 / total.max(1)
+        )
+    }
+
+    pub fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Counter, Unit};
+
+    #[test]
+    fn a_plain_line_names_the_counts_and_the_time_left() {
+        let c = Counter::new("fault campaign", Unit::Runs, 1, true);
+        let l = c.line(3, 12);
+        assert!(l.starts_with("fault campaign: 3 of 12 runs (25%, "), "{l}");
+        assert!(l.ends_with(" s left)"), "{l}");
+        let c = Counter::new("checking w.vcd", Unit::Bytes, 1, true);
+        let l = c.line(2_500_000, 10_000_000);
+        assert!(l.contains("2.5 of 10.0 MB read (25%"), "{l}");
+    }
 }

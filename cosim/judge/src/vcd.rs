@@ -987,6 +987,7 @@ fn body(
     res: &Resolved,
     clocking: Option<Clocking>,
     sink: &mut dyn CycleSink,
+    read: &dyn Fn(u64),
 ) -> Result<BodyInfo, VcdError> {
     let mut st = State {
         port: [Val { v: 0, x: 0 }; NPORT],
@@ -1017,8 +1018,9 @@ fn body(
         info: BodyInfo::default(),
         pending: None,
     };
-    let (last_line, newline) =
-        vcdlex::for_each_chunk(path, start, &res.ids, |lexed, at| ap.chunk(lexed, at, path))?;
+    let (last_line, newline) = vcdlex::for_each_chunk(path, start, &res.ids, read, |lexed, at| {
+        ap.chunk(lexed, at, path)
+    })?;
     if !newline {
         return Err(VcdError::Truncated {
             file: path.to_path_buf(),
@@ -1067,6 +1069,12 @@ fn open(path: &Path) -> Result<Lexer<BufReader<File>>, VcdError> {
     Ok(Lexer::new(BufReader::with_capacity(1 << 20, f), path))
 }
 
+/// A progress display's hook: told (bytes read, bytes in all) as the
+/// waveform's body is read.  A VCD without `clk` is read twice (the first
+/// pass infers the clock) and both passes count; an FST counts the bytes of
+/// its VCD transcoding.
+pub type OnBytes<'a> = &'a dyn Fn(u64, u64);
+
 /// Streams the cycles of a VCD, or of an FST (through its VCD
 /// transcoding, `fst.rs`), into `sink`.
 pub fn read_cycles(
@@ -1075,8 +1083,19 @@ pub fn read_cycles(
     scope: Option<&str>,
     sink: &mut dyn CycleSink,
 ) -> Result<VcdInfo, VcdError> {
+    read_cycles_with(s, path, scope, sink, &|_, _| {})
+}
+
+/// [`read_cycles`], telling `on_bytes` how far it is.
+pub fn read_cycles_with(
+    s: &Schedule,
+    path: &Path,
+    scope: Option<&str>,
+    sink: &mut dyn CycleSink,
+    on_bytes: OnBytes,
+) -> Result<VcdInfo, VcdError> {
     if !crate::fst::is_fst(path) {
-        return read_vcd_cycles(s, path, scope, sink);
+        return read_vcd_cycles(s, path, scope, sink, on_bytes);
     }
     let fst_err = |message: String| VcdError::Ports {
         file: path.to_path_buf(),
@@ -1089,7 +1108,8 @@ pub fn read_cycles(
     crate::fst::to_vcd(path, tmp.as_file_mut()).map_err(fst_err)?;
     // Errors name the FST, not the temporary file.
     let named = format!("{} (as VCD)", path.display());
-    read_vcd_cycles(s, tmp.path(), scope, sink).map_err(|e| e.with_file(Path::new(&named)))
+    read_vcd_cycles(s, tmp.path(), scope, sink, on_bytes)
+        .map_err(|e| e.with_file(Path::new(&named)))
 }
 
 impl VcdError {
@@ -1118,6 +1138,7 @@ fn read_vcd_cycles(
     path: &Path,
     scope: Option<&str>,
     sink: &mut dyn CycleSink,
+    on_bytes: OnBytes,
 ) -> Result<VcdInfo, VcdError> {
     let layout = Layout::new(s);
     let mut lx = open(path)?;
@@ -1128,10 +1149,16 @@ fn read_vcd_cycles(
         line: lx.lineno,
         header_newline: lx.line.ends_with(b"\n"),
     };
+    let size = std::fs::metadata(path)
+        .map(|m| m.len().saturating_sub(start.offset))
+        .unwrap_or(0);
+    // without `clk` the body is read twice
+    let passes = if res.has_clk { 1 } else { 2 };
     let clocking = if res.has_clk {
         Clocking::Clk
     } else {
-        let info = body(path, start, &res, None, &mut CountCycles(0))?;
+        let first = |b: u64| on_bytes(b, passes * size);
+        let info = body(path, start, &res, None, &mut CountCycles(0), &first)?;
         // One timestamp off the clock grid makes the gcd (the period) tiny
         // and the cycle count enormous: refuse a period that no two output
         // changes are close to (a sample gives two one cycle apart; SCLK
@@ -1170,7 +1197,8 @@ fn read_vcd_cycles(
             }
         }
     };
-    let info = body(path, start, &res, Some(clocking), sink)?;
+    let last = |b: u64| on_bytes((passes - 1) * size + b, passes * size);
+    let info = body(path, start, &res, Some(clocking), sink, &last)?;
     Ok(VcdInfo {
         scope: res.scope,
         timescale: h.timescale,
@@ -1194,8 +1222,19 @@ pub fn check_vcd_with(
     scope: Option<&str>,
     opts: CheckOptions,
 ) -> Result<(Report, VcdInfo), VcdError> {
+    check_vcd_progress(s, path, scope, opts, &|_, _| {})
+}
+
+/// [`check_vcd_with`], telling `on_bytes` how far the reading is.
+pub fn check_vcd_progress(
+    s: &Schedule,
+    path: &Path,
+    scope: Option<&str>,
+    opts: CheckOptions,
+    on_bytes: OnBytes,
+) -> Result<(Report, VcdInfo), VcdError> {
     let mut judge = Judge::new(s, opts);
-    let mut info = read_cycles(s, path, scope, &mut judge)?;
+    let mut info = read_cycles_with(s, path, scope, &mut judge, on_bytes)?;
     let (report, lock) = judge.finish("vcd").map_err(|error| VcdError::Phase {
         file: path.to_path_buf(),
         error,

@@ -306,11 +306,13 @@ pub(crate) struct At {
 /// hands each chunk's events to `apply` in file order.  A lexing error of a
 /// chunk comes after its valid events were applied, as `VcdError` with the
 /// file's line.  Returns the line of the file's last character and whether
-/// the file ends with a newline.
+/// the file ends with a newline.  `read` is told the bytes of the body
+/// applied so far after every chunk (a progress display).
 pub(crate) fn for_each_chunk(
     path: &Path,
     start: BodyStart,
     ids: &Ids,
+    read: &dyn Fn(u64),
     mut apply: impl FnMut(&Lexed, &At) -> Result<(), VcdError>,
 ) -> Result<(u64, bool), VcdError> {
     let io = |e| VcdError::Io(path.to_path_buf(), e);
@@ -348,6 +350,7 @@ pub(crate) fn for_each_chunk(
         // Text of unclean chunks, to be lexed again with what follows.
         let mut carry: Vec<u8> = Vec::new();
         let mut last = (start.line, start.header_newline);
+        let mut applied = 0u64;
         loop {
             while sent - next < IN_FLIGHT as u64 && !reader.eof {
                 let text = reader.chunk().map_err(io)?;
@@ -392,6 +395,8 @@ pub(crate) fn for_each_chunk(
                 return Err(truncation(e, incomplete, last_line));
             }
             let text = &lexed.text;
+            applied += text.len() as u64;
+            read(applied);
             if let Some(&c) = text.last() {
                 let trailing = (c == b'\n') as u64;
                 last = (line0 + lexed.lines - trailing, c == b'\n');

@@ -15,7 +15,7 @@ use judge::run::reset_cycles;
 use lut_gen::Schedule;
 use serde::Serialize;
 
-use super::{parallel, Cost, Detector, Injection, Judged, Judgement};
+use super::{parallel, Cost, Detector, Injection, Judged, Judgement, Runs};
 use crate::equiv::Equivalence;
 use crate::options::{Backend, SimOptions};
 use crate::sigrok::SpiCapture;
@@ -153,6 +153,7 @@ pub(super) fn verilog_injections(
     frames: u64,
     sigrok: bool,
     prove: bool,
+    count: &Runs,
 ) -> Result<Vec<Judgement>, String> {
     let clean = crate::rusthdl::verilog(s).map_err(|e| e.to_string())?;
     let mut jobs = Vec::new();
@@ -161,7 +162,7 @@ pub(super) fn verilog_injections(
             jobs.push((f, e));
         }
     }
-    let runs = parallel(jobs, |(f, e)| -> Result<Option<Judgement>, String> {
+    let runs = parallel(jobs, count, |(f, e)| -> Result<Option<Judgement>, String> {
         let Ok(j) = judge_verilog(s, e, &f.verilog, frames, sigrok) else {
             return Ok(None);
         };
