@@ -349,3 +349,43 @@ fn a_short_axis_fifo_overflows_under_the_campaigns_slave() {
         assert_eq!(overflow, caught, "{}: {}", pattern.name(), r.summary());
     }
 }
+
+/// The campaign's matrix on the presets with a link (what `slotforge faults
+/// mixes/eskin34-uart.toml` and `eskin34-axis.toml` print), at the
+/// mid-frame site: every link class is injected, every injection caught,
+/// the model catches each, the invariants the classes they can see, and
+/// sigrok is declared blind to them.
+#[test]
+#[ignore = "long: make test-long"]
+fn the_presets_campaigns_report_every_link_class_caught() {
+    use cosim::faults::{campaign_with, sites, Detector, Plan, Target};
+    for s in [preset(), axis_preset()] {
+        let mut plan = Plan::new(Target::Model, 3, 0);
+        plan.sites = Some(
+            sites(&s)
+                .into_iter()
+                .filter(|x| x.name == "mid-frame")
+                .collect(),
+        );
+        let c = campaign_with(&s, &plan).unwrap();
+        assert!(c.ok(), "{}: {} undetected", s.mix.name, c.undetected);
+        let want: Vec<&str> = judge::faults::Fault::link(&s)
+            .iter()
+            .map(|f| f.class())
+            .collect();
+        for class in want {
+            let k = c
+                .classes
+                .iter()
+                .find(|k| k.name == class)
+                .unwrap_or_else(|| panic!("{}: {class} not in the matrix", s.mix.name));
+            assert!(k.injected > 0 && k.detected == k.injected, "{class}");
+            assert_eq!(k.detected_by[&Detector::Model], k.injected, "{class}");
+            if !k.cannot_see.contains_key(&Detector::Invariants) {
+                assert_eq!(k.detected_by[&Detector::Invariants], k.injected, "{class}");
+            }
+            assert!(k.cannot_see.contains_key(&Detector::Sigrok), "{class}");
+        }
+        assert_eq!(c.tready.is_some(), s.mix.name.ends_with("axis"));
+    }
+}
