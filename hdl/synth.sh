@@ -8,11 +8,14 @@
 # measure::synth::place_and_route, the same one `slotforge build` runs; this
 # script only loops over mixes.  Work files go to target/synth/<mix>/.
 set -euo pipefail
+# mixes named on the command line are the caller's paths: made absolute
+# before the script moves to the repository root
+mixes=()
+for m in "$@"; do mixes+=("$(realpath "$m")"); done
 cd "$(dirname "$0")/.."
 for t in yosys nextpnr-ice40; do
   command -v "$t" >/dev/null || { echo "synth.sh: $t is not installed (make installs it)" >&2; exit 2; }
 done
-mixes=("$@")
 [ ${#mixes[@]} -gt 0 ] || mixes=(mixes/*.toml hdl/tests/data/*.toml)
 board=constraints/ice40-hx8k-breakout.toml
 cargo build -q -p measure --example synth

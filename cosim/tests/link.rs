@@ -158,88 +158,32 @@ fn axis_runs_clean_on_verilator_and_icarus_under_back_pressure() {
     }
 }
 
-/// An AXIS pin fault after the slave: the first time a beat waits, the
-/// next cycle's `tdata` is changed (`data`) or `tvalid` dropped.
-struct StallFault<D> {
-    dut: D,
-    data: bool,
-    stalled: bool,
-    done: bool,
-}
-
-impl<D: Dut> Dut for StallFault<D> {
-    fn step(&mut self, rst: bool, miso: u64) -> Pins {
-        let mut p = self.dut.step(rst, miso);
-        if self.stalled && !self.done && !rst {
-            self.done = true;
-            if self.data {
-                p.axis_tdata ^= 0x01;
-            } else {
-                p.axis_tvalid = false;
-            }
-        }
-        self.stalled = !rst && p.axis_tvalid && !p.axis_tready;
-        p
-    }
-}
-
-#[test]
-fn axis_beats_under_the_worst_slave_decode_to_the_sample_stream() {
-    let s = axis_preset();
-    let mut sim = Sim(hdl::RtlSim::new(&s).unwrap());
-    let mut dut = judge::run::with_slave(&s, &mut sim, link::ReadyPattern::WorstCase);
-    let mut beats = Beats::default();
-    let r = run_dut(
-        &s,
-        &mut *dut,
-        1,
-        &RunOptions::default(),
-        "test",
-        Some(&mut beats),
-    );
-    assert!(r.ok, "{}", r.summary());
-    assert!(
-        beats.stalls > 1000,
-        "the slave held beats back: {}",
-        beats.stalls
-    );
-    let mut dec = link::Decoder::new(s.grid.slices_per_frame);
-    let mut out = Vec::new();
-    dec.push(&beats.bytes, &mut out);
-    let got: Vec<(u16, u16)> = out.iter().map(|d| (d.channel, d.value)).collect();
-    // slices 0..8 are closed by the next header within the frame
-    assert!(got.len() > 300, "{} samples decoded", got.len());
-    assert_eq!(got[..], beats.samples[..got.len()]);
-    assert_eq!(dec.stats().crc_errors, 0);
-}
-
+/// The campaign's AXIS classes on the preset under a random slave (the
+/// campaign itself runs the worst case): the first waiting beat withdrawn
+/// or changed breaks the model-free stability rule and diverges from the
+/// model on the pin it touched.
 #[test]
 fn axis_pin_faults_under_back_pressure_break_the_stability_rule() {
+    use judge::faults::{Fault, FaultyDut};
     let s = axis_preset();
-    for data in [true, false] {
-        let mut sim = Sim(hdl::RtlSim::new(&s).unwrap());
-        let slave = judge::run::with_slave(&s, &mut sim, link::ReadyPattern::Random { seed: 5 });
-        let mut dut = StallFault {
-            dut: slave,
-            data,
-            stalled: false,
-            done: false,
-        };
+    for (f, signal) in [
+        (Fault::AxisTdataChange, "m_axis_tdata"),
+        (Fault::AxisTvalidDrop, "m_axis_tvalid"),
+    ] {
+        let sim = Sim(hdl::RtlSim::new(&s).unwrap());
+        let slave = judge::run::with_slave(&s, sim, link::ReadyPattern::Random { seed: 5 });
+        let mut dut = FaultyDut::new(&s, slave, f, 0);
         let r = run_dut(&s, &mut dut, 1, &RunOptions::default(), "test", None);
-        assert!(!r.ok, "data={data}: not caught");
+        let class = f.class();
+        assert!(dut.injected() && !r.ok, "{class}: not caught");
         assert!(
             r.violations.iter().any(|v| v.rule == "axis-stable"),
-            "data={data}: {:?}",
+            "{class}: {:?}",
             r.violations
         );
-        let signal = if data {
-            "m_axis_tdata"
-        } else {
-            "m_axis_tvalid"
-        };
         assert!(
             r.divergences.iter().any(|d| d.signal == signal),
-            "data={data}: {:?}",
+            "{class}: {:?}",
             r.divergences
         );
     }
@@ -347,5 +291,45 @@ fn a_short_axis_fifo_overflows_under_the_campaigns_slave() {
         let r = run_dut(&s, &mut *dut, 3, &opts, "test", None);
         let overflow = r.violations.iter().any(|v| v.rule == "link-overflow");
         assert_eq!(overflow, caught, "{}: {}", pattern.name(), r.summary());
+    }
+}
+
+/// The campaign's matrix on the presets with a link (what `slotforge faults
+/// mixes/eskin34-uart.toml` and `eskin34-axis.toml` print), at the
+/// mid-frame site: every link class is injected, every injection caught,
+/// the model catches each, the invariants the classes they can see, and
+/// sigrok is declared blind to them.
+#[test]
+#[ignore = "long: make test-long"]
+fn the_presets_campaigns_report_every_link_class_caught() {
+    use cosim::faults::{campaign_with, sites, Detector, Plan, Target};
+    for s in [preset(), axis_preset()] {
+        let mut plan = Plan::new(Target::Model, 3, 0);
+        plan.sites = Some(
+            sites(&s)
+                .into_iter()
+                .filter(|x| x.name == "mid-frame")
+                .collect(),
+        );
+        let c = campaign_with(&s, &plan).unwrap();
+        assert!(c.ok(), "{}: {} undetected", s.mix.name, c.undetected);
+        let want: Vec<&str> = judge::faults::Fault::link(&s)
+            .iter()
+            .map(|f| f.class())
+            .collect();
+        for class in want {
+            let k = c
+                .classes
+                .iter()
+                .find(|k| k.name == class)
+                .unwrap_or_else(|| panic!("{}: {class} not in the matrix", s.mix.name));
+            assert!(k.injected > 0 && k.detected == k.injected, "{class}");
+            assert_eq!(k.detected_by[&Detector::Model], k.injected, "{class}");
+            if !k.cannot_see.contains_key(&Detector::Invariants) {
+                assert_eq!(k.detected_by[&Detector::Invariants], k.injected, "{class}");
+            }
+            assert!(k.cannot_see.contains_key(&Detector::Sigrok), "{class}");
+        }
+        assert_eq!(c.tready.is_some(), s.mix.name.ends_with("axis"));
     }
 }

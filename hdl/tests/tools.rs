@@ -80,7 +80,7 @@ fn lint_in(dir: &Path, tag: &str) {
 /// check -assert, no latches.
 fn synth_in(dir: &Path, tag: &str) {
     let (ok, text) = run(
-        &dir,
+        dir,
         Command::new(tool("yosys")).args([
             "-p",
             "read_verilog slotforge_top.v; synth_ice40 -top slotforge_top; check -assert; select -assert-none t:$dlatch t:$_DLATCH_* t:SB_DLATCH*; stat",

@@ -65,7 +65,11 @@ pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<
         .arg("--freq")
         .arg(format!("{}", clock_hz as f64 / 1e6));
     match pcf {
-        Some(p) => n.arg("--pcf").arg(p),
+        // nextpnr runs in `dir`: a relative path is the caller's, so it
+        // goes absolute first (hdl/synth.sh passes target/synth/<mix>/...)
+        Some(p) => n
+            .arg("--pcf")
+            .arg(std::path::absolute(p).map_err(|e| format!("{}: {e}", p.display()))?),
         None => n.arg("--pcf-allow-unconstrained"),
     };
     let n = n
