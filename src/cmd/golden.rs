@@ -149,7 +149,7 @@ fn window_cycles(s: &Schedule, w: &Window, reset: u64, file: &Path) -> Result<(u
 }
 
 /// Writes the window `[k0, k1)` of `trace` as a VCD, or as an FST when
-/// `fst` (a VCD converted by GTKWave's `vcd2fst`, which `make tools` installs).
+/// `fst` (the VCD converted through `fst-writer`).
 fn write_window(
     s: &Schedule,
     trace: &Trace,
