@@ -69,7 +69,7 @@ fn one() -> u64 {
 #[serde(deny_unknown_fields)]
 struct Window {
     /// File name in the golden folder (`.vcd`, or `.fst` written through
-    /// GTKWave's `vcd2fst`; the `.gtkw` goes beside it).
+    /// the `fst-writer` crate; the `.gtkw` goes beside it).
     file: String,
     /// Bounds as for `sim --from/--to`: a frame number or a time (`3ms`).
     from: String,
