@@ -6,8 +6,9 @@ SLOTFORGE = $(CARGO) run --quiet --release --bin slotforge --
 
 # System tools the flows need; installed with apt-get only when missing.
 # cvc5: the SMT solver of `prove` (Debian's z3 and boolector fail on yosys 0.23's
-# output); chromium: the report's browser test; gtkwave: vcd2fst for FST tests.
-TOOLS = verilator g++ iverilog yosys nextpnr-ice40 sigrok-cli cvc5 chromium vcd2fst
+# output); chromium: the report's browser test; gtkwave: vcd2fst and fst2vcd, GTKWave's
+# own FST writer and reader, which the FST tests hold slotforge's FST against.
+TOOLS = verilator g++ iverilog yosys nextpnr-ice40 sigrok-cli cvc5 chromium vcd2fst fst2vcd
 APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm sigrok-cli cvc5 chromium gtkwave
 
 # CI builds once from a fresh clone: incremental artefacts would only take disk.

@@ -78,12 +78,28 @@ fn assert_chart_is_the_matrix(out: &Path) {
     assert!(got.iter().any(|g| g.0 == "model" && g.4 > 0), "{got:?}");
     let svg = std::fs::read_to_string(out.join("speed-accuracy.svg")).unwrap();
     assert!(svg.contains("real time"), "{svg}");
+    // every method is named in a point's label with its counts; methods
+    // at one point (same cost, same count) share a label naming each
+    let texts: Vec<&str> = svg
+        .split("</text>")
+        .filter_map(|t| t.rsplit_once('>').map(|x| x.1.trim()))
+        .collect();
     for w in &want {
+        let counts = format!("({} of {})", w.3, w.4);
         assert!(
-            svg.contains(&format!("{} ({} of {})", w.0, w.3, w.4)),
-            "{}: no label in the chart",
+            texts
+                .iter()
+                .any(|t| t.ends_with(&counts) && t.split(" and ").any(|n| n.starts_with(&w.0))),
+            "{}: no label in the chart: {texts:?}",
             w.0
         );
+    }
+    let at = |name: &str| want.iter().find(|w| w.0 == name).map(|w| (w.2, w.3, w.4));
+    if let (Some(m), Some(e)) = (at("model"), at("engine: cycle model")) {
+        if m == e {
+            let merged = format!("model and engine: cycle model ({} of {})", m.1, m.2);
+            assert!(texts.contains(&merged.as_str()), "{texts:?}");
+        }
     }
 }
 
@@ -171,6 +187,26 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         quick["injected"].as_u64().unwrap() >= 14,
         "every class once"
     );
+    // judged by the model and the invariants; sigrok's decodes are the
+    // full campaign's, and the page says so
+    let col = |v: &serde_json::Value, d: &str| -> serde_json::Value {
+        v["columns"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["detector"] == d)
+            .unwrap()
+            .clone()
+    };
+    let sigrok = col(&quick, "sigrok");
+    assert!(
+        sigrok["not_run"]
+            .as_str()
+            .unwrap()
+            .contains("quick campaign"),
+        "{sigrok}"
+    );
+    assert_eq!(col(&quick, "model")["detected"], quick["injected"]);
     // the speed-against-accuracy chart is the fault matrix of this run
     assert_chart_is_the_matrix(&out);
     // the timing diagram's table has every branch's CS edges
@@ -332,6 +368,17 @@ fn a_failing_step_fails_the_build_and_the_others_still_run() {
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("faults.json")).unwrap()).unwrap();
     assert!(v["sites"].as_array().unwrap().len() > 1, "{}", v["sites"]);
+    let sigrok = v["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["detector"] == "sigrok")
+        .unwrap();
+    let why = sigrok["not_run"].as_str().unwrap_or("");
+    assert!(
+        !why.contains("quick"),
+        "the full campaign runs sigrok: {why}"
+    );
 }
 
 fn skin28() -> PathBuf {

@@ -572,6 +572,10 @@ pub struct Plan {
     pub sites: Option<Vec<Site>>,
     /// Told every finished run, for a progress display (runs done of N).
     pub on_run: Option<OnRun>,
+    /// sigrok's SPI decode as a detector (when sigrok-cli is installed);
+    /// `build`'s quick campaign leaves it out: its decodes were most of the
+    /// campaign's time, and the model and the invariants judge every run.
+    pub sigrok: bool,
 }
 
 impl Plan {
@@ -586,6 +590,7 @@ impl Plan {
             prove: false,
             sites: None,
             on_run: None,
+            sigrok: true,
         }
     }
 }
@@ -594,6 +599,9 @@ impl Plan {
 fn not_run(d: Detector, plan: &Plan) -> Option<String> {
     match d {
         Detector::Model | Detector::Invariants => None,
+        Detector::Sigrok if !plan.sigrok => Some(
+            "not run: left out of the quick campaign (`build --thorough`, `--charts all` or `slotforge faults` run it)".into(),
+        ),
         Detector::Sigrok => crate::sigrok::available().err().map(|e| e.to_string()),
         Detector::Prove if !plan.prove => Some(
             "not run: opt-in (`faults --prove`; a proof takes seconds on a small-frame mix, minutes on a 48 MHz one)".into(),

@@ -148,7 +148,10 @@ fn aliasing(s: &Schedule, rate: f64, ch: usize) -> Result<(Figure, Figure, Strin
         title: format!("A {f} Hz tone sampled at {rate} Hz"),
         caption: format!("the continuous {f} Hz input of {name} (blue) and its samples (dots, joined in red): they trace a {want} Hz sine"),
         svg: draw(
-            &Axes::new(&format!("{f} Hz on {name}, sampled at {rate} Hz"), "time (ms)", "ADC code"),
+            &legend_room(
+                Axes::new(&format!("{f} Hz on {name}, sampled at {rate} Hz"), "time (ms)", "ADC code"),
+                cont.iter().chain(&shown),
+            ),
             &[
                 Series::line(&format!("{f} Hz input"), ms(&cont)),
                 Series::line(&format!("samples joined: {want} Hz"), ms(&shown)),
@@ -198,6 +201,17 @@ fn aliasing(s: &Schedule, rate: f64, ch: usize) -> Result<(Figure, Figure, Strin
 /// The step fails when the measured apparent frequency `seen` of an `f` Hz
 /// tone sampled at `rate` is not where aliasing puts it (`want`), within
 /// two bins of the 241-point spectrum up to the Nyquist frequency.
+/// The y range of `points` with room above for the legend (three rows in
+/// the upper right of a 340-pixel chart), so it hides no part of a trace.
+fn legend_room<'a>(mut axes: Axes, points: impl Iterator<Item = &'a (f64, f64)>) -> Axes {
+    let (lo, hi) = points.fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+    if lo < hi {
+        let span = hi - lo;
+        axes.y_range = Some((lo - 0.04 * span, hi + 0.5 * span));
+    }
+    axes
+}
+
 fn where_aliasing_puts_it(f: f64, rate: f64, seen: f64, want: f64) -> Result<(), String> {
     let tol = rate / 240.0;
     if (seen - want).abs() <= tol {
@@ -280,10 +294,13 @@ fn slow(s: &Schedule) -> Result<(Figure, String), String> {
             pts.len()
         ),
         svg: draw(
-            &Axes::new(
-                &format!("{f} Hz on {name}, sampled at {rate} Hz"),
-                "time (ms)",
-                "ADC code",
+            &legend_room(
+                Axes::new(
+                    &format!("{f} Hz on {name}, sampled at {rate} Hz"),
+                    "time (ms)",
+                    "ADC code",
+                ),
+                cont.iter().chain(&pts),
             ),
             &[
                 Series::line(&format!("{name}'s input"), ms(&cont)),

@@ -90,9 +90,11 @@ pub fn chart(c: &Campaign) -> Figure {
         "faults_reaching_it",
         "what was timed",
     ]);
-    let mut series = Vec::new();
-    let mut placed: Vec<(f64, f64)> = Vec::new();
-    for (i, m) in scores.iter().enumerate() {
+    // Methods with the same cost and the same count (the model detector
+    // and the cycle-model engine time the same clean run) share one point
+    // and one label naming both: one marker drawn over the other would hide it.
+    let mut points: Vec<(f64, u64, u64, Vec<String>)> = Vec::new();
+    for m in &scores {
         table.push(vec![
             m.method.clone(),
             m.runs.to_string(),
@@ -106,8 +108,19 @@ pub fn chart(c: &Campaign) -> Figure {
             continue; // nothing reaches it: no accuracy to place
         }
         let x = m.seconds_per_run().max(1e-6);
-        let pct = 100.0 * m.detected as f64 / m.of as f64;
-        let label = format!("{} ({} of {})", m.method, m.detected, m.of);
+        let same = points
+            .iter_mut()
+            .find(|p| (p.0 / x).log10().abs() < 0.005 && (p.1, p.2) == (m.detected, m.of));
+        match same {
+            Some(p) => p.3.push(m.method.clone()),
+            None => points.push((x, m.detected, m.of, vec![m.method.clone()])),
+        }
+    }
+    let mut series = Vec::new();
+    let mut placed: Vec<(f64, f64)> = Vec::new();
+    for (i, (x, detected, of, names)) in points.into_iter().enumerate() {
+        let pct = 100.0 * detected as f64 / of as f64;
+        let label = format!("{} ({detected} of {of})", names.join(" and "));
         let mut sr =
             Series::scatter(&label, vec![(x, pct)]).with_marker(MARKERS[i % MARKERS.len()]);
         // labels of points close together step down, so none hides another

@@ -202,16 +202,26 @@ pub fn draw(axes: &Axes, series: &[Series], w: u32, h: u32) -> String {
                 mesh.x_desc(axes.x.as_str())
                     .y_desc(axes.y.as_str())
                     .light_line_style(RGBColor(246, 246, 246));
+                let log_y = axes.log_y;
                 let fmt = move |v: &f64| {
                     let i = v.round();
                     if (v - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
                         names[i as usize].clone()
-                    } else if names.is_empty() {
-                        format!("{}", plotters_num(*v))
+                    } else if names.is_empty() && (!log_y || log_labelled(*v)) {
+                        plotters_num(*v)
                     } else {
                         String::new()
                     }
                 };
+                let log_x = axes.log_x;
+                let xfmt = move |v: &f64| {
+                    if !log_x || log_labelled(*v) {
+                        plotters_num(*v)
+                    } else {
+                        String::new()
+                    }
+                };
+                mesh.x_label_formatter(&xfmt);
                 if !axes.y_names.is_empty() {
                     mesh.y_labels(axes.y_names.len() * 2 + 1);
                 }
@@ -348,6 +358,18 @@ fn legend_path(m: Marker) -> Vec<(i32, i32)> {
     shape(m).into_iter().map(|(x, y)| (x + 8, y)).collect()
 }
 
+/// Whether a log axis labels the tick at `v`: 1, 2 and 5 times a power of
+/// ten.  Labelling all nine ticks of a decade crowds them together at its
+/// top, and a tick a rounding error below a power of ten (0.0999...)
+/// would print "0.1" a second time over the decade's own.
+fn log_labelled(v: f64) -> bool {
+    if v <= 0.0 || !v.is_finite() {
+        return false;
+    }
+    let m = v / 10f64.powf(v.log10().floor());
+    [1.0, 2.0, 5.0].iter().any(|k| (m - k).abs() < 1e-6)
+}
+
 /// A short number for axis labels.
 fn plotters_num(v: f64) -> String {
     let a = v.abs();
@@ -366,6 +388,17 @@ fn plotters_num(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_log_axis_labels_one_two_and_five_once_a_decade() {
+        let labelled: Vec<f64> = (1..=9)
+            .flat_map(|k| [k as f64 * 0.01, k as f64 * 0.1])
+            .filter(|v| super::log_labelled(*v))
+            .collect();
+        assert_eq!(labelled, vec![0.01, 0.1, 0.02, 0.2, 0.05, 0.5]);
+        assert!(!super::log_labelled(0.09999999));
+        assert!(super::log_labelled(1000.0));
+    }
 
     #[test]
     fn csv_quotes_what_needs_it() {

@@ -69,7 +69,7 @@ fn one() -> u64 {
 #[serde(deny_unknown_fields)]
 struct Window {
     /// File name in the golden folder (`.vcd`, or `.fst` written through
-    /// GTKWave's `vcd2fst`; the `.gtkw` goes beside it).
+    /// the `fst-writer` crate; the `.gtkw` goes beside it).
     file: String,
     /// Bounds as for `sim --from/--to`: a frame number or a time (`3ms`).
     from: String,
@@ -149,7 +149,7 @@ fn window_cycles(s: &Schedule, w: &Window, reset: u64, file: &Path) -> Result<(u
 }
 
 /// Writes the window `[k0, k1)` of `trace` as a VCD, or as an FST when
-/// `fst` (a VCD converted by GTKWave's `vcd2fst`, which `make tools` installs).
+/// `fst` (the VCD converted through `fst-writer`).
 fn write_window(
     s: &Schedule,
     trace: &Trace,

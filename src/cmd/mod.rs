@@ -155,22 +155,15 @@ pub fn write_files(dir: &Path, files: &[(&str, String)]) -> Result<(), u8> {
     Ok(())
 }
 
-/// Converts `vcd` to FST at `fst` with GTKWave's own `vcd2fst` (`make
-/// tools` installs it): the FST GTKWave writes is the one it reads; a Rust
-/// FST writer crate has not been evaluated yet.
+/// Converts `vcd` to FST at `fst` through `fst-writer` (`judge::fst`),
+/// written beside it under a temporary name and renamed, so a failure
+/// leaves no partial FST.
 pub fn vcd_to_fst(vcd: &Path, fst: &Path) -> std::io::Result<()> {
-    let out = std::process::Command::new("vcd2fst")
-        .arg(vcd)
-        .arg(fst)
-        .output();
-    match out {
-        Ok(o) if o.status.success() => Ok(()),
-        Ok(o) => Err(std::io::Error::other(format!(
-            "vcd2fst failed: {}",
-            String::from_utf8_lossy(&o.stderr).trim()
-        ))),
-        Err(e) => Err(std::io::Error::other(format!(
-            "FST needs GTKWave's vcd2fst (`make tools` installs it): {e}"
-        ))),
+    let tmp = fst.with_extension("fst.part");
+    let r = judge::fst::from_vcd(vcd, &tmp);
+    if let Err(e) = r {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(std::io::Error::other(e));
     }
+    std::fs::rename(&tmp, fst)
 }

@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long)]
     pub vcd: Option<PathBuf>,
     /// Write the --vcd window as FST instead (as a name ending in `.fst`
-    /// does), through GTKWave's vcd2fst; `check` reads it back.
+    /// does), through the fst-writer crate; `check` reads it back.
     #[arg(long, requires = "vcd")]
     pub fst: bool,
     /// Start of the VCD window: a frame number, or a time after cycle 0 (the
@@ -165,16 +165,12 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
-    // FST: the run writes a VCD beside it, converted at the end; the
-    // converter is looked for now, not found missing after the run.
+    // FST: the run writes a VCD beside it, converted at the end (in
+    // process, through fst-writer).
     let fst = vcd.as_ref().and_then(|v| {
         let named = v.extension().is_some_and(|x| x == "fst");
         (a.fst || named).then(|| v.with_extension("fst"))
     });
-    if fst.is_some() && !measure::synth::tool_present("vcd2fst") {
-        eprintln!("error: --vcd: FST needs GTKWave's vcd2fst, which is not installed (make tools)");
-        return 2;
-    }
     let vcd = match &fst {
         Some(f) => Some(f.with_extension("fst.vcd")),
         None => vcd,

@@ -1,5 +1,7 @@
 //! FST waveforms (Verilator's `--trace-fst`, GTKWave's `vcd2fst`), read
-//! through the `wellen` crate and handed to the one VCD reader as VCD text.
+//! through the `wellen` crate and handed to the one VCD reader as VCD text;
+//! and written (`sim --fst`, golden FST windows) from the VCD the run
+//! wrote, through `fst-writer` (by wellen's author): no external tool.
 //!
 //! Why transcode rather than read FST natively: every rule of `vcd.rs`
 //! (scope detection, vector extension, edges, x/z, inferred clocks, mid-run
@@ -148,6 +150,134 @@ fn unit_name(u: TimescaleUnit) -> Option<&'static str> {
         TimescaleUnit::MicroSeconds => "us",
         TimescaleUnit::MilliSeconds => "ms",
         TimescaleUnit::Seconds => "s",
+        TimescaleUnit::Unknown => return None,
+    })
+}
+
+/// Writes the VCD at `vcd` as an FST at `fst`: wellen streams the VCD's
+/// changes, `fst-writer` writes them (flushed every few MB, so memory
+/// stays flat).  The same VCD gives the same bytes (no date is written).
+/// Errors are messages naming the file.
+pub fn from_vcd(vcd: &Path, fst: &Path) -> Result<(), String> {
+    let v = vcd.to_path_buf();
+    let f = fst.to_path_buf();
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| write_fst(&v, &f))).unwrap_or_else(
+        |_| {
+            Err(format!(
+                "{}: the wellen reader failed on it while writing {}",
+                vcd.display(),
+                fst.display()
+            ))
+        },
+    )
+}
+
+fn write_fst(vcd: &Path, fst: &Path) -> Result<(), String> {
+    use fst_writer::{
+        FstFileType, FstInfo, FstScopeType, FstSignalType, FstVarDirection, FstVarType,
+    };
+    let bad = |e: String| format!("{}: cannot read VCD: {e}", vcd.display());
+    let out = |e: fst_writer::FstWriteError| format!("{}: writing FST: {e}", fst.display());
+    let opts = LoadOptions {
+        multi_thread: false,
+        remove_scopes_with_empty_name: false,
+    };
+    let mut wave = wellen::stream::read_from_file(vcd, &opts).map_err(|e| bad(e.to_string()))?;
+    let h = wave.hierarchy();
+    let exponent = h
+        .timescale()
+        .and_then(|t| Some(unit_exponent(t.unit)? + (t.factor as f64).log10().round() as i8))
+        .unwrap_or(0);
+    let info = FstInfo {
+        start_time: 0,
+        timescale_exponent: exponent,
+        version: "slotforge".into(),
+        date: String::new(),
+        file_type: FstFileType::Verilog,
+    };
+    let mut head = fst_writer::open_fst(fst, &info).map_err(out)?;
+    // wellen's signal index -> the FST's id (a signal under several names is one id)
+    let mut ids: Vec<Option<fst_writer::FstSignalId>> = Vec::new();
+    fn walk<W: std::io::Write + std::io::Seek>(
+        h: &Hierarchy,
+        s: ScopeRef,
+        head: &mut fst_writer::FstHeaderWriter<W>,
+        ids: &mut Vec<Option<fst_writer::FstSignalId>>,
+    ) -> Result<(), fst_writer::FstWriteError> {
+        let sc = &h[s];
+        head.scope(sc.name(h), "", FstScopeType::Module)?;
+        for v in sc.vars(h) {
+            let v = &h[v];
+            let Some(width) = v.length(h) else { continue };
+            let k = v.signal_ref().index();
+            if ids.len() <= k {
+                ids.resize(k + 1, None);
+            }
+            let name = match v.index() {
+                Some(i) if width > 1 || i.msb() != i.lsb() || i.msb() != 0 => {
+                    format!("{} [{}:{}]", v.name(h), i.msb(), i.lsb())
+                }
+                _ => v.name(h).to_string(),
+            };
+            let id = head.var(
+                name,
+                FstSignalType::bit_vec(width),
+                FstVarType::Wire,
+                FstVarDirection::Implicit,
+                ids[k],
+            )?;
+            ids[k] = Some(id);
+        }
+        for c in sc.scopes(h) {
+            walk(h, c, head, ids)?;
+        }
+        head.up_scope()
+    }
+    for s in h.scopes() {
+        walk(h, s, &mut head, &mut ids).map_err(out)?;
+    }
+    let mut body = head.finish().map_err(out)?;
+    let mut time = None;
+    let r = wave.stream_changes(
+        wellen::stream::Filter::all(),
+        |t, sig, val| -> std::io::Result<()> {
+            let io = |e: fst_writer::FstWriteError| std::io::Error::other(e.to_string());
+            let Some(Some(id)) = ids.get(sig.index()) else {
+                return Ok(());
+            };
+            let Some(bits) = val.to_bit_string() else {
+                return Ok(()); // reals and strings are not ports of slotforge_top
+            };
+            if time != Some(t) {
+                body.time_change(t).map_err(io)?;
+                time = Some(t);
+            }
+            body.signal_change(*id, bits.as_bytes()).map_err(io)?;
+            if body.size() > 8 << 20 {
+                body.flush().map_err(io)?;
+            }
+            Ok(())
+        },
+    );
+    r.map_err(|e| match e {
+        wellen::stream::StreamError::Wellen(e) => bad(e.to_string()),
+        wellen::stream::StreamError::Callback(e) => format!("{}: writing FST: {e}", fst.display()),
+    })?;
+    body.finish().map_err(out)?;
+    Ok(())
+}
+
+/// The power of ten of a timescale unit.
+fn unit_exponent(u: TimescaleUnit) -> Option<i8> {
+    Some(match u {
+        TimescaleUnit::ZeptoSeconds => -21,
+        TimescaleUnit::AttoSeconds => -18,
+        TimescaleUnit::FemtoSeconds => -15,
+        TimescaleUnit::PicoSeconds => -12,
+        TimescaleUnit::NanoSeconds => -9,
+        TimescaleUnit::MicroSeconds => -6,
+        TimescaleUnit::MilliSeconds => -3,
+        TimescaleUnit::Seconds => 0,
         TimescaleUnit::Unknown => return None,
     })
 }

@@ -373,8 +373,9 @@ fn fault_plan(a: &Args, s: &Schedule) -> Result<cosim::faults::Plan, String> {
         cosim::faults::Target::Model
     };
     // A fresh mix gets every class at one site (mid-frame) and one clean
-    // random mix, in seconds; the full campaign (every site, five clean
-    // mixes) when it is asked for: --only faults, --charts all, --thorough.
+    // random mix, judged by the model and the invariants, in seconds; the
+    // full campaign (every site, five clean mixes, sigrok's decode) when it
+    // is asked for: --only faults, --charts all, --thorough.
     let mut plan = cosim::faults::Plan::new(target, 3, 5);
     if !full_campaign(a) {
         let mid = cosim::faults::sites(s)
@@ -382,6 +383,7 @@ fn fault_plan(a: &Args, s: &Schedule) -> Result<cosim::faults::Plan, String> {
             .filter(|x| x.name == "mid-frame");
         plan.sites = Some(mid.collect());
         plan.false_alarm_mixes = 1;
+        plan.sigrok = false;
     }
     if a.charts == Charts::All {
         plan.verilog_engines = [
@@ -405,9 +407,11 @@ fn full_campaign(a: &Args) -> bool {
 
 fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<cosim::faults::Campaign>) -> Done {
     let full = full_campaign(a);
-    let c = match fault_plan(a, s)
-        .and_then(|p| cosim::faults::campaign_with(s, &p).map_err(|e| e.to_string()))
-    {
+    let hook = j.runs_hook("fault campaign");
+    let c = match fault_plan(a, s).and_then(|mut p| {
+        p.on_run = hook;
+        cosim::faults::campaign_with(s, &p).map_err(|e| e.to_string())
+    }) {
         Ok(c) => c,
         Err(e) => return Done::failed(e, ""),
     };
