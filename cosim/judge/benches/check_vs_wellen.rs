@@ -27,9 +27,26 @@ fn peak_mb() -> f64 {
         .unwrap_or(0.0)
 }
 
-/// Child mode: do one job on `path`, print "seconds peak_mb".
+/// CPU seconds (user + system, every thread) of this process so far: on a
+/// shared machine the wall time depends on the other jobs, the work not.
+fn cpu_s() -> f64 {
+    let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // The fields after the command name (which may hold spaces).
+    let rest = s.rsplit_once(')').map(|x| x.1).unwrap_or("");
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .map(|x| x.parse().unwrap_or(0.0))
+        .collect();
+    // utime and stime are fields 14 and 15 of the line, in clock ticks.
+    f.get(11)
+        .zip(f.get(12))
+        .map_or(0.0, |(u, s)| (u + s) / 100.0)
+}
+
+/// Child mode: do one job on `path`, print "seconds peak_mb cpu_seconds".
 fn child(job: &str, path: &Path) {
     let s = schedule();
+    let cpu0 = cpu_s();
     let t = Instant::now();
     match job {
         "check" => {
@@ -48,10 +65,16 @@ fn child(job: &str, path: &Path) {
         }
         _ => panic!("unknown job {job}"),
     }
-    println!("{} {}", t.elapsed().as_secs_f64(), peak_mb());
+    println!(
+        "{} {} {}",
+        t.elapsed().as_secs_f64(),
+        peak_mb(),
+        cpu_s() - cpu0
+    );
 }
 
-fn run(job: &str, path: &Path) -> (f64, f64) {
+/// (wall seconds, peak MB, CPU seconds) of one job in a child process.
+fn run(job: &str, path: &Path) -> (f64, f64, f64) {
     let out = Command::new(std::env::current_exe().unwrap())
         .args(["--child", job])
         .arg(path)
@@ -64,7 +87,7 @@ fn run(job: &str, path: &Path) -> (f64, f64) {
     );
     let text = String::from_utf8(out.stdout).unwrap();
     let mut it = text.split_whitespace().map(|x| x.parse::<f64>().unwrap());
-    (it.next().unwrap(), it.next().unwrap())
+    (it.next().unwrap(), it.next().unwrap(), it.next().unwrap())
 }
 
 fn main() {
@@ -91,10 +114,10 @@ fn main() {
         );
         w.finish().unwrap();
         let mb = std::fs::metadata(&p).unwrap().len() as f64 / 1e6;
-        let (tc, mc) = run("check", &p);
-        let (tw, mw) = run("wellen", &p);
+        let (tc, mc, cc) = run("check", &p);
+        let (tw, mw, cw) = run("wellen", &p);
         println!(
-            "eskin34 {f} frames, {mb:.1} MB VCD: check {:.0} MB/s ({mc:.0} MB peak), wellen multi-threaded load {:.0} MB/s ({mw:.0} MB peak); check / wellen = {:.2} (goal >= 1.0)",
+            "eskin34 {f} frames, {mb:.1} MB VCD: check {:.0} MB/s ({mc:.0} MB peak, {cc:.2} CPU s), wellen multi-threaded load {:.0} MB/s ({mw:.0} MB peak, {cw:.2} CPU s); check / wellen = {:.2} (goal >= 1.0)",
             mb / tc,
             mb / tw,
             tw / tc

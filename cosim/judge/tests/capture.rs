@@ -210,6 +210,10 @@ fn the_link_line_in_a_capture_is_decoded_and_checked() {
             text.contains("(link_tx): ") && text.contains("packets and"),
             "{text}"
         );
+        // Timed through sigrok's `.sr` and VCD too; no MISO probed: the
+        // codes are named as not checked.
+        assert!(text.contains("characters' start bits within"), "{text}");
+        assert!(text.contains("map adc_miso[N]"), "{text}");
     }
     let mut bad = clean.clone();
     mutate(&s, &mut bad, Mutation::LinkBitsFlipped, f);
