@@ -307,3 +307,59 @@ fn a_feasible_mix_the_bounded_search_missed() {
     assert_eq!(s.grid.slots_per_slice, 96);
     assert!(matches!(s.placement, lut_gen::schedule::Placement::Search { nodes } if nodes < 100));
 }
+
+/// The campaign behind "never infeasible without a proof, rarely unknown":
+/// 16 x 4 000 mixes near capacity (feasible by construction plus one to
+/// three channels of a random rate on b0, half on a forced grid; 1-5
+/// branches, a third of the draws sync groups across branches): every one
+/// is scheduled (and validated) or proved infeasible, none left unknown.
+/// Measured: ~65 % scheduled (~13 % through the search), ~35 % proved
+/// infeasible, worst 0.4 s per mix (debug profile, loaded machine).
+#[test]
+#[ignore = "long: make test-long"]
+fn mixes_near_capacity_are_all_decided() {
+    for seed in 1..=16u64 {
+        let mut x = seed;
+        let mut rnd = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for _ in 0..4000 {
+            let grid = [6usize, 7, 9, 10, 11][(rnd() % 5) as usize];
+            let branches = 1 + (rnd() % 5) as usize;
+            let n = 8 + (rnd() % 40) as usize;
+            let draws: Vec<_> = (0..n)
+                .map(|_| {
+                    let d = (rnd() % 8, rnd() % 64, rnd() % 10_000, rnd() % 3 == 0);
+                    (d.0 as usize, d.1 as usize, d.2, d.3)
+                })
+                .collect();
+            let mut spec = feasible_spec(grid, branches, draws);
+            let extra = [
+                100u64, 200, 300, 400, 500, 600, 800, 1000, 1200, 1500, 1600, 2000, 2400, 3000,
+                4000, 4800, 6000, 8000,
+            ][(rnd() % 18) as usize];
+            for _ in 0..(1 + rnd() % 3) {
+                spec.channels.push((0, extra, None));
+            }
+            if spec.channels.iter().filter(|c| c.0 == 0).count() > 32 {
+                continue;
+            }
+            if rnd() % 2 == 0 {
+                spec.slots_per_slice = Some(GRIDS[grid]);
+            }
+            let text = to_toml(&spec);
+            let mix = lut_gen::parse(Path::new("near.toml"), &text).expect("generated mix parses");
+            match lut_gen::synthesize(&mix) {
+                Ok(s) => assert!(lut_gen::validate::validate(&s).is_ok(), "{text}"),
+                Err(e) => assert_eq!(
+                    e.verdict,
+                    lut_gen::Verdict::Infeasible,
+                    "seed {seed}: {e}\n{text}"
+                ),
+            }
+        }
+    }
+}

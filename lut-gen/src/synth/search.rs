@@ -45,14 +45,35 @@ pub(super) fn search(units: &[Unit], branches: usize, sps: u64, budget: u64) -> 
     let mut offsets = vec![0; units.len()];
     let mut nodes = 0;
     let mut bounded = false;
-    for members in components(units, branches) {
+    let parts = components(units, branches);
+    // A component spanning branches has no schedule if one of its branches
+    // alone (its units, each constraining only that branch) has none: such
+    // proofs are small and cheap, whereas the joint search would rediscover
+    // the dead branch under every placement of the others.
+    for members in parts.iter().filter(|m| spans_branches(units, m)) {
+        for b in branches_of(units, members) {
+            let on_b: Vec<usize> = members
+                .iter()
+                .copied()
+                .filter(|&u| units[u].branches.contains(&b))
+                .collect();
+            let share = LEXICOGRAPHIC_SHARE.min(budget.saturating_sub(nodes));
+            let mut c = Component::new(units, &on_b, Some(b), sps, Order::FailFirst, share);
+            let verdict = c.solve();
+            nodes += c.nodes;
+            if verdict == Some(false) {
+                return Outcome::Exhausted;
+            }
+        }
+    }
+    for members in parts {
         let mut found = None;
         for order in [Order::Lexicographic, Order::FailFirst] {
             let share = match order {
                 Order::Lexicographic => LEXICOGRAPHIC_SHARE.min(budget.saturating_sub(nodes)),
                 Order::FailFirst => budget.saturating_sub(nodes),
             };
-            let mut c = Component::new(units, &members, sps, order, share);
+            let mut c = Component::new(units, &members, None, sps, order, share);
             let verdict = c.solve();
             nodes += c.nodes;
             match verdict {
@@ -112,6 +133,20 @@ fn components(units: &[Unit], branches: usize) -> Vec<Vec<usize>> {
     by_root.into_iter().map(|(_, m)| m).collect()
 }
 
+fn spans_branches(units: &[Unit], members: &[usize]) -> bool {
+    branches_of(units, members).len() > 1
+}
+
+fn branches_of(units: &[Unit], members: &[usize]) -> Vec<usize> {
+    let mut b: Vec<usize> = members
+        .iter()
+        .flat_map(|&u| units[u].branches.iter().copied())
+        .collect();
+    b.sort_unstable();
+    b.dedup();
+    b
+}
+
 #[derive(Clone, Copy, PartialEq)]
 enum Order {
     Lexicographic,
@@ -141,10 +176,22 @@ struct Component {
 }
 
 impl Component {
-    fn new(units: &[Unit], members: &[usize], sps: u64, order: Order, budget: u64) -> Self {
+    /// `only`: a relaxation where units constrain one another on this branch only.
+    fn new(
+        units: &[Unit],
+        members: &[usize],
+        only: Option<usize>,
+        sps: u64,
+        order: Order,
+        budget: u64,
+    ) -> Self {
         let us: Vec<&Unit> = members.iter().map(|&m| &units[m]).collect();
         let n = us.len();
-        let shares = |a: &Unit, b: &Unit| a.branches.iter().any(|x| b.branches.contains(x));
+        let shares = |a: &Unit, b: &Unit| {
+            a.branches
+                .iter()
+                .any(|x| b.branches.contains(x) && only.is_none_or(|o| o == *x))
+        };
         let neighbours = (0..n)
             .map(|i| {
                 (0..n)
@@ -201,7 +248,12 @@ impl Component {
         });
         match self.order {
             Order::Lexicographic => ready.min(),
-            Order::FailFirst => ready.min_by_key(|&i| self.free[i]),
+            Order::FailFirst => ready.min_by_key(|&i| {
+                (
+                    self.free[i] * 64 / self.period[i],
+                    std::cmp::Reverse(self.neighbours[i].len()),
+                )
+            }),
         }
     }
 
