@@ -59,35 +59,6 @@ fn synthesis_and_audit(c: &mut Criterion) {
     g.finish();
 }
 
-/// The mix `properties.rs` keeps as `a_feasible_mix_the_bounded_search_missed`.
-fn missed_mix() -> lut_gen::Mix {
-    let mut t = String::from(
-        "name = \"missed\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n",
-    );
-    for b in 0..3 {
-        let _ = write!(
-            t,
-            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 4\n"
-        );
-    }
-    let channels = [
-        ("b2", 16_000),
-        ("b2", 600),
-        ("b0", 12_000),
-        ("b0", 3_000),
-        ("b2", 16_000),
-        ("b0", 1_500),
-        ("b1", 2_400),
-    ];
-    for (i, (branch, rate)) in channels.iter().enumerate() {
-        let _ = write!(
-            t,
-            "[[channel]]\nname = \"c{i}\"\nbranch = \"{branch}\"\nrate_hz = {rate}\n"
-        );
-    }
-    lut_gen::parse(Path::new("missed.toml"), &t).expect("bench mix parses")
-}
-
 fn presets(c: &mut Criterion) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut mixes: Vec<(String, lut_gen::Mix)> = std::fs::read_dir(root.join("mixes"))
@@ -105,7 +76,12 @@ fn presets(c: &mut Criterion) {
         "ch1024".into(),
         lut_gen::load(&ch1024).expect("ch1024 loads"),
     ));
-    mixes.push(("missed".into(), missed_mix()));
+    // The mix the old exact search called infeasible (`tests/data/missed.toml`).
+    let missed = root.join("lut-gen/tests/data/missed.toml");
+    mixes.push((
+        "missed".into(),
+        lut_gen::load(&missed).expect("missed loads"),
+    ));
     let mut g = c.benchmark_group("presets");
     g.sample_size(10);
     for (name, mix) in &mixes {

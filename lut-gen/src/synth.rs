@@ -687,26 +687,8 @@ mod tests {
     /// at 96 slots per slice (at 48 the 600 Hz progression meets every
     /// residue mod 3): a proof at 48, a schedule at 96.
     fn three_branches() -> Mix {
-        let mut t = String::from(
-            "name = \"m\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n",
-        );
-        for b in 0..3 {
-            t += &format!("[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n");
-        }
-        let channels = [
-            ("b2", 16_000),
-            ("b2", 600),
-            ("b0", 12_000),
-            ("b0", 3_000),
-            ("b2", 16_000),
-            ("b0", 1_500),
-            ("b1", 2_400),
-        ];
-        for (i, (branch, rate)) in channels.iter().enumerate() {
-            t +=
-                &format!("[[channel]]\nname = \"c{i}\"\nbranch = \"{branch}\"\nrate_hz = {rate}\n");
-        }
-        crate::parse(std::path::Path::new("m.toml"), &t).unwrap()
+        let text = include_str!("../tests/data/missed.toml");
+        crate::parse(std::path::Path::new("missed.toml"), text).unwrap()
     }
 
     #[test]
@@ -715,7 +697,7 @@ mod tests {
         let why = synthesize_within(&mix, 2).unwrap_err();
         assert_eq!(why.verdict, Verdict::Unknown);
         let text = why.to_string();
-        assert!(text.starts_with("mix `m`: unknown"), "{text}");
+        assert!(text.starts_with("mix `missed`: unknown"), "{text}");
         assert!(text.contains("bound of 2 placements"), "{text}");
         assert!(!text.contains("has no jitter-free schedule"), "{text}");
         let s = synthesize_within(&mix, SEARCH_BUDGET).unwrap();

@@ -277,33 +277,15 @@ proptest! {
 /// has a jitter-free schedule by construction (at 96 slots per slice, b2's
 /// 600 Hz channel fits on the residues its two 16 kHz channels leave). The
 /// exact search used to search the three independent branches as one tree
-/// and stop at its node bound on the 48-slot grid, where b2 has no room
-/// (the 600 Hz progression meets every residue mod 3), without reaching 96.
+/// and stopped at its node bound on both grids: at 48, where b2 has no room
+/// (the 600 Hz progression meets every residue mod 3), and at 96, where a
+/// bad offset of b2's second 16 kHz channel showed only at the 600 Hz one,
+/// placed last, after every placement of b0's and b1's channels.
 #[test]
 fn a_feasible_mix_the_bounded_search_missed() {
-    let mut text = String::from(
-        "name = \"prop\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n",
-    );
-    for b in 0..3 {
-        text += &format!(
-            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 4\n"
-        );
-    }
-    let channels = [
-        ("c0", "b2", 16_000),
-        ("c1", "b2", 600),
-        ("c2", "b0", 12_000),
-        ("c3", "b0", 3_000),
-        ("c4", "b2", 16_000),
-        ("c5", "b0", 1_500),
-        ("c6", "b1", 2_400),
-    ];
-    for (name, branch, rate) in channels {
-        text +=
-            &format!("[[channel]]\nname = \"{name}\"\nbranch = \"{branch}\"\nrate_hz = {rate}\n");
-    }
-    let mix = lut_gen::parse(Path::new("prop.toml"), &text).expect("parses");
-    let s = lut_gen::synthesize(&mix).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/missed.toml");
+    let mix = lut_gen::load(Path::new(path)).expect("parses");
+    let s = lut_gen::synthesize(&mix).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.grid.slots_per_slice, 96);
     assert!(matches!(s.placement, lut_gen::schedule::Placement::Search { nodes } if nodes < 100));
 }

@@ -287,9 +287,23 @@ impl Component {
 
     /// Places unit `i` at `o`; false if some unplaced unit is left with no free offset.
     fn place(&mut self, i: usize, o: u64, rank: usize) -> bool {
-        self.offsets[i] = Some(o);
         self.ranks[i] = rank;
         self.placed += 1;
+        let alive = self.block(i, o, true);
+        self.offsets[i] = Some(o);
+        alive
+    }
+
+    /// Undoes `place(i, o, _)`; the unplaced units are the same as then.
+    fn unplace(&mut self, i: usize, o: u64) {
+        self.offsets[i] = None;
+        self.placed -= 1;
+        self.block(i, o, false);
+    }
+
+    /// Counts (`on`) or uncounts unit `i` at `o` against every unplaced
+    /// neighbour's offsets that would meet it; false if one is left with none.
+    fn block(&mut self, i: usize, o: u64, on: bool) -> bool {
         let mut alive = true;
         for k in 0..self.neighbours[i].len() {
             let (j, g) = self.neighbours[i][k];
@@ -298,33 +312,17 @@ impl Component {
             }
             for x in (o % g..self.period[j]).step_by(g as usize) {
                 let b = &mut self.blocked[j][x as usize];
-                if *b == 0 {
-                    self.free[j] -= 1;
+                let was_free = *b == 0;
+                *b = if on { *b + 1 } else { *b - 1 };
+                match (was_free, *b == 0) {
+                    (true, false) => self.free[j] -= 1,
+                    (false, true) => self.free[j] += 1,
+                    _ => {}
                 }
-                *b += 1;
             }
             alive &= self.free[j] > 0;
         }
         alive
-    }
-
-    /// Undoes `place(i, o, _)`; the unplaced units are the same as then.
-    fn unplace(&mut self, i: usize, o: u64) {
-        self.offsets[i] = None;
-        self.placed -= 1;
-        for k in 0..self.neighbours[i].len() {
-            let (j, g) = self.neighbours[i][k];
-            if self.offsets[j].is_some() {
-                continue;
-            }
-            for x in (o % g..self.period[j]).step_by(g as usize) {
-                let b = &mut self.blocked[j][x as usize];
-                *b -= 1;
-                if *b == 0 {
-                    self.free[j] += 1;
-                }
-            }
-        }
     }
 }
 
