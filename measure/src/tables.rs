@@ -160,21 +160,49 @@ pub fn slot_table(s: &Schedule) -> Vec<(String, Table)> {
         t,
     )];
     if !lut.rotations.is_empty() {
-        let mut cols = vec!["group".to_string()];
-        cols.extend((0..s.grid.slices_per_frame).map(|j| format!("slice {j}")));
-        let refs: Vec<&str> = cols.iter().map(String::as_str).collect();
-        let mut t = Table::new(&refs);
-        for (g, group) in lut.rotations.iter().enumerate() {
-            let mut r = vec![format!("R{g}")];
-            r.extend(group.iter().map(|e| e.map_or("-".into(), name)));
-            t.push(r);
-        }
         out.push((
             "Rotation groups: the channel of each slice of the frame".into(),
-            t,
+            rotation_table(s, &lut),
         ));
     }
     out
+}
+
+/// The rotation groups: a row per group and a column per slice, or, with
+/// more slices than groups (a 20 ms frame of 1 ms slices has 20), a row
+/// per slice and a column per group, so the table fits the page's width.
+fn rotation_table(s: &Schedule, lut: &CompactLut) -> Table {
+    let name = |c: u16| s.mix.channels[c as usize].name.clone();
+    let cell = |e: &Option<u16>| e.map_or("-".into(), name);
+    let slices = s.grid.slices_per_frame as usize;
+    let groups = &lut.rotations;
+    let by_slice = slices > groups.len();
+    let (corner, heads): (&str, Vec<String>) = if by_slice {
+        (
+            "slice",
+            (0..groups.len()).map(|g| format!("R{g}")).collect(),
+        )
+    } else {
+        ("group", (0..slices).map(|j| format!("slice {j}")).collect())
+    };
+    let mut cols = vec![corner.to_string()];
+    cols.extend(heads);
+    let refs: Vec<&str> = cols.iter().map(String::as_str).collect();
+    let mut t = Table::new(&refs);
+    if by_slice {
+        for j in 0..slices {
+            let mut r = vec![j.to_string()];
+            r.extend(groups.iter().map(|g| g.get(j).map_or("-".into(), cell)));
+            t.push(r);
+        }
+    } else {
+        for (g, group) in groups.iter().enumerate() {
+            let mut r = vec![format!("R{g}")];
+            r.extend(group.iter().map(cell));
+            t.push(r);
+        }
+    }
+    t
 }
 
 /// Per-channel sample counts and intervals a run measured.
@@ -239,6 +267,25 @@ pub fn faults(c: &cosim::faults::Campaign) -> Table {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// 20 slices and fewer rotation groups: a row per slice, a column per
+    /// group (a column per slice, 21 wide, overflowed the report's page).
+    #[test]
+    fn many_slices_give_the_rotation_table_a_row_per_slice() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/skin28.toml");
+        let mix = lut_gen::parse(&path, &std::fs::read_to_string(&path).unwrap()).unwrap();
+        let s = lut_gen::synthesize(&mix).unwrap();
+        let tables = slot_table(&s);
+        let (_, rot) = tables.last().unwrap();
+        let csv = rot.csv();
+        let head = csv.lines().next().unwrap();
+        assert!(head.starts_with("slice,R0"), "{head}");
+        let groups = CompactLut::from_schedule(&s).rotations.len();
+        assert!(groups < s.grid.slices_per_frame as usize);
+        assert_eq!(head.split(',').count(), 1 + groups, "{head}");
+        assert_eq!(csv.lines().count(), 1 + s.grid.slices_per_frame as usize);
+    }
 
     #[test]
     fn the_audit_becomes_tables_with_every_channel() {

@@ -72,6 +72,29 @@ const HIGH: f64 = 0.55;
 /// that back-to-back strobes of two branches do not print over each other.
 const STROBE_MERGE: f64 = 0.03;
 
+/// The second line of strobe labels sits this far (in rows) below the
+/// first: a 12-pixel text on 34-pixel rows.
+const STAGGER: f64 = 0.36;
+
+/// A line (0 or 1) for each label along a row, left to right: the first
+/// line whose last label ends left of this one (about 7 pixels a character
+/// on the plot's ~860), else the one whose last label ends first; so
+/// strobes a slot apart (30 in eskin34's slice) do not print over each other.
+fn stagger(labels: &[(f64, String)], span: f64) -> Vec<usize> {
+    let width = |t: &str| (t.len() as f64 * 7.0 + 8.0) / 860.0 * span;
+    let mut ends = [f64::MIN; 2];
+    labels
+        .iter()
+        .map(|(x, t)| {
+            let line = (0..2)
+                .find(|&k| ends[k] <= *x)
+                .unwrap_or(if ends[0] <= ends[1] { 0 } else { 1 });
+            ends[line] = x + width(t);
+            line
+        })
+        .collect()
+}
+
 /// A diagram row: its name, `(cycle, value)` at each change, full scale.
 type Row = (String, Vec<(u64, u64)>, f64);
 
@@ -197,10 +220,15 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
             }
         }
     }
-    for (c, names) in strobes {
+    let texts: Vec<(f64, String)> = strobes
+        .into_iter()
+        .map(|(c, names)| (us(c), names.join(",")))
+        .collect();
+    let levels = stagger(&texts, us(to) - us(from));
+    for ((x, text), level) in texts.into_iter().zip(levels) {
         labels
             .labels
-            .push((us(c), 0.05 - HIGH / 2.0, names.join(",")));
+            .push((x, 0.05 - HIGH / 2.0 - STAGGER * level as f64, text));
     }
     series.push(labels);
     let mut axes = Axes::new(
@@ -348,4 +376,16 @@ fn wavedrom(s: &Schedule, l: &Layout, w: &Window, _nb: usize) -> Result<(String,
         None => "WaveDrom: a conversion (its strobe falls outside the window)".into(),
     };
     Ok((text, line))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn strobe_labels_a_slot_apart_alternate_lines() {
+        let l: Vec<(f64, String)> = (0..6).map(|k| (k as f64, "CH10".to_string())).collect();
+        // 30 slots in the window: a label is wider than a slot
+        assert_eq!(super::stagger(&l, 30.0), vec![0, 1, 0, 1, 0, 1]);
+        // far apart: all on the first line
+        assert_eq!(super::stagger(&l, 3.0), vec![0; 6]);
+    }
 }
