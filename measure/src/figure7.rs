@@ -123,23 +123,11 @@ fn aliasing(s: &Schedule, rate: f64, ch: usize) -> Result<(Figure, Figure, Strin
     let (seen, _) = dft::peak(&spec).ok_or("too few samples for a spectrum")?;
     where_aliasing_puts_it(f, rate, seen, want)?;
     let shown: Vec<(f64, f64)> = tr.points.iter().copied().skip(2).take(13).collect();
-    let (t0, t1) = (
-        shown.first().map_or(0.0, |p| p.0),
-        shown.last().map_or(0.0, |p| p.0),
-    );
-    let analog = Analog::new(s, Stimulus::Sine(Some(f)));
-    let cont = continuous(s, &analog, ch, t0, t1);
+    let (_, cont) = input_over(s, f, ch, &shown);
     let stem = format!("figure7-{}hz", rate as u64);
-    let mut table = Table::new(&["channel", "rate_hz", "tone_hz", "time_s", "code"]);
-    for p in &tr.points {
-        table.push(vec![
-            name.clone(),
-            format!("{rate}"),
-            format!("{f}"),
-            format!("{:.9}", p.0),
-            format!("{}", p.1),
-        ]);
-    }
+    let table = tone_table(["time_s", "code"], name, rate, f, &tr.points, |p| {
+        [format!("{:.9}", p.0), format!("{}", p.1)]
+    });
     let mut samples = Series::scatter(&format!("{name}'s samples at {rate} Hz"), ms(&shown))
         .with_marker(Marker::Circle);
     samples.labels = Vec::new();
@@ -162,22 +150,14 @@ fn aliasing(s: &Schedule, rate: f64, ch: usize) -> Result<(Figure, Figure, Strin
         ),
         table,
     };
-    let mut st = Table::new(&[
-        "channel",
-        "rate_hz",
-        "tone_hz",
-        "frequency_hz",
-        "magnitude_codes",
-    ]);
-    for p in &spec {
-        st.push(vec![
-            name.clone(),
-            format!("{rate}"),
-            format!("{f}"),
-            format!("{:.3}", p.0),
-            format!("{:.3}", p.1),
-        ]);
-    }
+    let st = tone_table(
+        ["frequency_hz", "magnitude_codes"],
+        name,
+        rate,
+        f,
+        &spec,
+        |p| [format!("{:.3}", p.0), format!("{:.3}", p.1)],
+    );
     let mut ax = Axes::new(
         &format!(
             "Spectrum of {} samples of {name} at {rate} Hz",
@@ -196,6 +176,42 @@ fn aliasing(s: &Schedule, rate: f64, ch: usize) -> Result<(Figure, Figure, Strin
     };
     let line = format!("{f} Hz at {rate} Hz appears at {seen:.0} Hz");
     Ok((time, spectrum, line))
+}
+
+/// The CSV of a panel of the `f` Hz tone on `name` at `rate`: one row per
+/// point, its two values in `columns` as `cell` writes them.
+fn tone_table(
+    columns: [&str; 2],
+    name: &str,
+    rate: f64,
+    f: f64,
+    points: &[(f64, f64)],
+    cell: impl Fn((f64, f64)) -> [String; 2],
+) -> Table {
+    let mut t = Table::new(&["channel", "rate_hz", "tone_hz", columns[0], columns[1]]);
+    for &p in points {
+        let [x, y] = cell(p);
+        t.push(vec![
+            name.to_string(),
+            format!("{rate}"),
+            format!("{f}"),
+            x,
+            y,
+        ]);
+    }
+    t
+}
+
+/// Channel `ch`'s input, an `f` Hz sine, over the span of the samples `pts`:
+/// the model that makes it and the continuous curve.
+fn input_over(s: &Schedule, f: f64, ch: usize, pts: &[(f64, f64)]) -> (Analog, Vec<(f64, f64)>) {
+    let (t0, t1) = (
+        pts.first().map_or(0.0, |p| p.0),
+        pts.last().map_or(0.0, |p| p.0),
+    );
+    let analog = Analog::new(s, Stimulus::Sine(Some(f)));
+    let cont = continuous(s, &analog, ch, t0, t1);
+    (analog, cont)
 }
 
 /// The step fails when the measured apparent frequency `seen` of an `f` Hz
@@ -233,12 +249,7 @@ fn slow(s: &Schedule) -> Result<(Figure, String), String> {
     let tr = run(s, f, frames_for(s, 2.0 / f), ch);
     let name = &s.mix.channels[ch].name;
     let pts: Vec<(f64, f64)> = tr.points.iter().copied().skip(1).take(21).collect();
-    let (t0, t1) = (
-        pts.first().map_or(0.0, |p| p.0),
-        pts.last().map_or(0.0, |p| p.0),
-    );
-    let analog = Analog::new(s, Stimulus::Sine(Some(f)));
-    let cont = continuous(s, &analog, ch, t0, t1);
+    let (analog, cont) = input_over(s, f, ch, &pts);
     // the samples, linearly interpolated, against the input itself
     let interp = |t: f64| -> Option<f64> {
         let i = pts.iter().position(|p| p.0 >= t)?;
