@@ -1,8 +1,10 @@
 //! Where scheduling breaks, around the user's mix: random mixes of its own
 //! clock, frame, branches and rates (the one generator,
 //! `cosim::mixgen`), from one channel to about twice its demand, each
-//! synthesized; feasible and infeasible ones drawn with different markers,
-//! the mix itself marked.
+//! synthesized; scheduled, proved infeasible and undecided (the exact
+//! search's bound hit: `lut_gen::Verdict::Unknown`) ones drawn with different
+//! markers, the mix itself marked. An undecided mix is never counted as one
+//! without a schedule.
 
 use std::path::Path;
 use std::time::Instant;
@@ -33,14 +35,8 @@ pub fn schedulability(s: &Schedule) -> (Section, String) {
     let n0 = mix.channels.len() as f64;
     let max = ((n0 * (2.0f64).max(1.2 / u0.max(1e-3))).ceil() as u64).clamp(4, 512);
     let shape = Shape::around(mix, max);
-    let mut table = Table::new(&[
-        "seed",
-        "channels",
-        "utilization",
-        "feasible",
-        "synthesis_ms",
-    ]);
-    let (mut ok, mut no) = (Vec::new(), Vec::new());
+    let mut table = Table::new(&["seed", "channels", "utilization", "verdict", "synthesis_ms"]);
+    let (mut ok, mut no, mut unknown) = (Vec::new(), Vec::new(), Vec::new());
     for seed in 1..=MIXES {
         let text = random_mix(seed, &shape);
         let Ok(m) = lut_gen::parse(Path::new("random.toml"), &text) else {
@@ -48,27 +44,43 @@ pub fn schedulability(s: &Schedule) -> (Section, String) {
         };
         let u = utilization(&m);
         let t = Instant::now();
-        let feasible = lut_gen::synthesize(&m).is_ok();
+        let verdict = match lut_gen::synthesize(&m) {
+            Ok(_) => "scheduled",
+            Err(e) => e.verdict.as_str(),
+        };
         let ms = (t.elapsed().as_secs_f64() * 1e3).max(1e-3);
         table.push(vec![
             seed.to_string(),
             m.channels.len().to_string(),
             format!("{u:.4}"),
-            feasible.to_string(),
+            verdict.to_string(),
             format!("{ms:.4}"),
         ]);
-        if feasible { &mut ok } else { &mut no }.push((u * 100.0, ms));
+        match verdict {
+            "scheduled" => &mut ok,
+            "infeasible" => &mut no,
+            _ => &mut unknown,
+        }
+        .push((u * 100.0, ms));
     }
     let best = ok.iter().map(|p| p.0).fold(0.0f64, f64::max);
     let worst = no.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
     let t = Instant::now();
     let _ = lut_gen::synthesize(mix);
     let own = (t.elapsed().as_secs_f64() * 1e3).max(1e-3);
+    let undecided = if unknown.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; {} undecided (the search's bound hit, no proof either way)",
+            unknown.len()
+        )
+    };
     let line = format!(
-        "{} of {} random mixes around this one have an exact schedule, up to {best:.0} % ADC utilization{}; this mix: {:.0} %",
+        "{} of {} random mixes around this one have an exact schedule, up to {best:.0} % ADC utilization{}{undecided}; this mix: {:.0} %",
         ok.len(),
-        ok.len() + no.len(),
-        if worst.is_finite() { format!(", the least loaded without one at {worst:.0} %") } else { String::new() },
+        ok.len() + no.len() + unknown.len(),
+        if worst.is_finite() { format!(", the least loaded proved without one at {worst:.0} %") } else { String::new() },
         u0 * 100.0
     );
     let mut me = Series::scatter(
@@ -77,11 +89,17 @@ pub fn schedulability(s: &Schedule) -> (Section, String) {
     )
     .with_marker(Marker::Square);
     me.labels = vec![(u0 * 100.0, own, mix.name.clone())];
-    let series = vec![
+    let mut series = vec![
         Series::scatter(&format!("exact schedule ({})", ok.len()), ok).with_marker(Marker::Circle),
         Series::scatter(&format!("none exists ({})", no.len()), no).with_marker(Marker::Cross),
-        me,
     ];
+    if !unknown.is_empty() {
+        let n = unknown.len();
+        series.push(
+            Series::scatter(&format!("undecided ({n})"), unknown).with_marker(Marker::Triangle),
+        );
+    }
+    series.push(me);
     let mut axes = Axes::new(
         "Where scheduling breaks around this mix",
         "ADC utilization (% of the converters' throughput)",
@@ -96,7 +114,7 @@ pub fn schedulability(s: &Schedule) -> (Section, String) {
         Section {
             title: "Where scheduling breaks".into(),
             paragraphs: vec![
-                format!("{MIXES} random mixes around this one: its clock ({} Hz), frame ({} us) and slice ({} us), its {} branches (AD7940) and its rates ({}), with 1 to {max} channels. Dots: an exact schedule exists; crosses: none does (synthesis proves it); the square is this mix.", mix.clock_hz, mix.frame_us, mix.slice_us, mix.branches.len(), rates.join(", ")),
+                format!("{MIXES} random mixes around this one: its clock ({} Hz), frame ({} us) and slice ({} us), its {} branches (AD7940) and its rates ({}), with 1 to {max} channels. Dots: an exact schedule exists; crosses: none does (synthesis proves it); triangles, if any: undecided (the exact search hit its bound); the square is this mix.", mix.clock_hz, mix.frame_us, mix.slice_us, mix.branches.len(), rates.join(", ")),
                 format!("{line}."),
             ],
             figures: vec![Figure {
