@@ -29,6 +29,35 @@ pub enum GatewareFault {
     LinkCrcInit,
 }
 
+/// The fault in a report's words (fault campaigns name each injection by it).
+impl std::fmt::Display for GatewareFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            GatewareFault::RomWord { branch, slot, from } => write!(
+                f,
+                "branch {branch}'s ROM word for slot {slot} holds slot {from}'s"
+            ),
+            GatewareFault::RomSwap { branch, a, b } => {
+                write!(
+                    f,
+                    "branch {branch}'s ROM words of slots {a} and {b} swapped"
+                )
+            }
+            GatewareFault::SlotWrap { delta } => {
+                write!(f, "slot counter wraps {delta:+} slots off the frame")
+            }
+            GatewareFault::SliceWrap { delta } => {
+                write!(f, "slice counter wraps {delta:+} slices off the frame")
+            }
+            GatewareFault::LinkFifoShort => write!(f, "link FIFO one token too shallow"),
+            GatewareFault::LinkBaud { delta } => {
+                write!(f, "link baud divider {delta:+} cycles per bit")
+            }
+            GatewareFault::LinkCrcInit => write!(f, "link CRC starts from 0"),
+        }
+    }
+}
+
 impl GatewareFault {
     /// The LUT form the fault lives in.
     pub fn lut_form(&self) -> LutForm {

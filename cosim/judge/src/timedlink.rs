@@ -149,7 +149,9 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize) -> LinkCheck {
                 out.violations.push(violation(
                     *t,
                     format!(
-                        "the packet of frame {frame} slice {slice} carries channels {chans:?}; the schedule's order is {want:?}"
+                        "the packet of frame {frame} slice {slice} carries channels {}; the schedule's order is {}",
+                        channel_list(chans),
+                        channel_list(&want)
                     ),
                 ));
             }
@@ -174,4 +176,16 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize) -> LinkCheck {
     out.not_proved
         .push("the link's sample values: the ADC's, not the schedule's".into());
     out
+}
+
+/// Channel numbers as a report lists them: `3, 4, 7` (or "none").
+fn channel_list<T: std::fmt::Display>(chans: &[T]) -> String {
+    if chans.is_empty() {
+        return "none".into();
+    }
+    chans
+        .iter()
+        .map(|c| c.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
