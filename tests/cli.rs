@@ -243,6 +243,35 @@ fn wrong_toml_types_are_told_in_the_mix_formats_words() {
     }
 }
 
+/// Numeric options refused in the user's words too (clap's own parser
+/// speaks of "digits found in string" and "target type").
+#[test]
+fn bad_numeric_options_are_told_in_plain_words() {
+    let mix = preset("eskin34.toml");
+    for args in [
+        vec!["sim", "--frames", "abc"],
+        vec!["sim", "--frames", "99999999999999999999999"],
+        vec!["faults", "--false-alarm-mixes", "1.5"],
+        vec!["prove", "--depth", "x"],
+        vec!["sim", "--to", "3 parsecs"],
+    ] {
+        let out = slotforge()
+            .args(&args[..1])
+            .arg(&mix)
+            .args(&args[1..])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let text = String::from_utf8_lossy(&out.stderr);
+        assert!(text.contains(args[1]), "{args:?}: names the option: {text}");
+        for line in text.lines() {
+            let bad = rust_words(line);
+            assert!(bad.is_empty(), "{args:?}: {bad:?} in the message: {line}");
+            assert!(!line.contains("in string"), "{args:?}: {line}");
+        }
+    }
+}
+
 #[test]
 fn lut_writes_three_files_deterministically() {
     let a = tempfile::tempdir().unwrap();
