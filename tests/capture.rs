@@ -212,3 +212,51 @@ fn check_map_errors_name_the_entry_and_exit_2() {
         .stderr(predicate::str::contains("cap.vcd"))
         .stderr(predicate::str::contains("panicked").not());
 }
+
+/// `check --map` off a terminal tells how far it read a capture of several
+/// MB (bytes of the file), a line per tenth; `--quiet` tells nothing.
+#[test]
+fn check_map_shows_its_progress_in_plain_lines_off_a_terminal() {
+    let d = tempfile::tempdir().unwrap();
+    let cap = d.path().join("big.vcd");
+    let mut text = String::from(
+        "$comment Acquisition with 1/8 channels at 24 MHz $end\n$timescale 1 ns $end\n\
+         $var wire 1 ! D0 $end\n$enddefinitions $end\n#0\n1!\n",
+    );
+    // CS toggling every 10 us: a long capture the checker can lock onto or not
+    let mut t = 0u64;
+    while text.len() < 3 << 20 {
+        t += 10_000;
+        text.push_str(&format!("#{t}\n{}!\n", (t / 10_000) % 2));
+    }
+    std::fs::write(&cap, &text).unwrap();
+    let size = text.len() as f64 / 1e6;
+    let run = |quiet: bool| {
+        let mut c = slotforge();
+        c.arg("check")
+            .arg(tiny())
+            .arg(&cap)
+            .args(["--map", "D0=adc_cs_n[0]"]);
+        if quiet {
+            c.arg("--quiet");
+        }
+        let out = c.output().unwrap();
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let log = run(false);
+    let prefix = format!("reading {}: ", cap.display());
+    let counts: Vec<(f64, f64)> = log
+        .lines()
+        .filter_map(|l| {
+            let (done, rest) = l.strip_prefix(&prefix)?.split_once(" of ")?;
+            let total = rest.split_once(" MB read (")?.0;
+            Some((done.parse().ok()?, total.parse().ok()?))
+        })
+        .collect();
+    assert!(counts.len() >= 5, "{log}");
+    assert!(counts.windows(2).all(|w| w[0].0 < w[1].0), "{log}");
+    let (done, total) = *counts.last().unwrap();
+    assert_eq!(done, total, "{log}");
+    assert!((total - size).abs() < 0.05, "{total} of {size} MB: {log}");
+    assert!(!run(true).contains("MB read"));
+}

@@ -158,6 +158,120 @@ fn bad_input_names_file_line_and_field_and_exits_2() {
         .stderr(predicate::str::contains("cannot read"));
 }
 
+/// Words of Rust's types and serde's phrasing, which a user of the mix
+/// format never wrote and should never read.
+fn rust_words(line: &str) -> Vec<String> {
+    const WORDS: [&str; 20] = [
+        "i8", "i16", "i32", "i64", "u8", "u16", "u32", "u64", "usize", "f32", "f64", "Option",
+        "Some", "None", "String", "Vec", "struct", "enum", "PathBuf", "sequence",
+    ];
+    const PHRASES: [&str; 5] = [
+        "invalid type",
+        "{:?}",
+        "got string",
+        "got integer",
+        "target type",
+    ];
+    let mut found: Vec<String> = line
+        .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .filter(|w| WORDS.contains(w))
+        .map(String::from)
+        .collect();
+    found.extend(
+        PHRASES
+            .iter()
+            .filter(|p| line.contains(*p))
+            .map(|p| p.to_string()),
+    );
+    found
+}
+
+#[test]
+fn wrong_toml_types_are_told_in_the_mix_formats_words() {
+    let dir = tempfile::tempdir().unwrap();
+    // (what SMALL has, what a user wrote instead, the field the message must name)
+    let cases = [
+        ("hz = 48_000_000", "hz = \"fast\"", "clock.hz"),
+        ("hz = 48_000_000", "hz = 4.8e7", "clock.hz"),
+        ("rate_hz = 1_000", "rate_hz = [1000]", "channel[0].rate_hz"),
+        (
+            "rate_hz = 1_000",
+            "rate_hz = { hz = 1 }",
+            "channel[0].rate_hz",
+        ),
+        (
+            "rate_hz = 1_000",
+            "rate_hz = 99999999999999999999",
+            "channel[0].rate_hz",
+        ),
+        (
+            "rate_hz = 1_000",
+            "rate_hz = 1_000\nbandwidth_hz = \"2\"",
+            "bandwidth_hz",
+        ),
+        (
+            "rate_hz = 1_000",
+            "rate_hz = 1_000\nbandwidth_hz = [2]",
+            "bandwidth_hz",
+        ),
+        ("adc = \"ad7940\"", "adc = 7940", "branch[0].adc"),
+        ("adc = \"ad7940\"", "adc = true", "branch[0].adc"),
+        ("name = \"x\"", "name = { a = 1 }", "channel[0].name"),
+        ("[clock]", "[[clock]]", "clock"),
+        (
+            "[[branch]]\nname = \"a\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n",
+            "branch = 3\n",
+            "branch",
+        ),
+        ("[frame]", "[frame.x]", "frame"),
+    ];
+    for (was, now, field) in cases {
+        assert!(SMALL.contains(was), "{was}");
+        let p = write_mix(dir.path(), &SMALL.replacen(was, now, 1));
+        let out = slotforge().arg("audit").arg(&p).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{now}");
+        let text = String::from_utf8_lossy(&out.stderr).to_string()
+            + &String::from_utf8_lossy(&out.stdout);
+        assert!(
+            text.contains(field),
+            "{now}: the message names {field}: {text}"
+        );
+        for line in text.lines() {
+            let bad = rust_words(line);
+            assert!(bad.is_empty(), "{now}: {bad:?} in the message: {line}");
+        }
+    }
+}
+
+/// Numeric options refused in the user's words too (clap's own parser
+/// speaks of "digits found in string" and "target type").
+#[test]
+fn bad_numeric_options_are_told_in_plain_words() {
+    let mix = preset("eskin34.toml");
+    for args in [
+        vec!["sim", "--frames", "abc"],
+        vec!["sim", "--frames", "99999999999999999999999"],
+        vec!["faults", "--false-alarm-mixes", "1.5"],
+        vec!["prove", "--depth", "x"],
+        vec!["sim", "--to", "3 parsecs"],
+    ] {
+        let out = slotforge()
+            .args(&args[..1])
+            .arg(&mix)
+            .args(&args[1..])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let text = String::from_utf8_lossy(&out.stderr);
+        assert!(text.contains(args[1]), "{args:?}: names the option: {text}");
+        for line in text.lines() {
+            let bad = rust_words(line);
+            assert!(bad.is_empty(), "{args:?}: {bad:?} in the message: {line}");
+            assert!(!line.contains("in string"), "{args:?}: {line}");
+        }
+    }
+}
+
 #[test]
 fn lut_writes_three_files_deterministically() {
     let a = tempfile::tempdir().unwrap();

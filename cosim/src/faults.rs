@@ -738,7 +738,7 @@ fn gateware_injections(
         design_cases(s, sites),
         count,
         |c| -> Result<Option<Judgement>, String> {
-            let name = format!("{}: {:?}", c.class, c.fault);
+            let name = format!("{}: {}", c.class, c.fault);
             // a fault the mix's gateware cannot hold (e.g. a frame too long for the full LUT)
             let Ok(sim) = hdl::RtlSim::with_fault(s, c.fault) else {
                 return Ok(None);

@@ -29,6 +29,35 @@ pub enum GatewareFault {
     LinkCrcInit,
 }
 
+/// The fault in a report's words (fault campaigns name each injection by it).
+impl std::fmt::Display for GatewareFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            GatewareFault::RomWord { branch, slot, from } => write!(
+                f,
+                "branch {branch}'s ROM word for slot {slot} holds slot {from}'s"
+            ),
+            GatewareFault::RomSwap { branch, a, b } => {
+                write!(
+                    f,
+                    "branch {branch}'s ROM words of slots {a} and {b} swapped"
+                )
+            }
+            GatewareFault::SlotWrap { delta } => {
+                write!(f, "slot counter wraps {delta:+} slots off the frame")
+            }
+            GatewareFault::SliceWrap { delta } => {
+                write!(f, "slice counter wraps {delta:+} slices off the frame")
+            }
+            GatewareFault::LinkFifoShort => write!(f, "link FIFO one token too shallow"),
+            GatewareFault::LinkBaud { delta } => {
+                write!(f, "link baud divider {delta:+} cycles per bit")
+            }
+            GatewareFault::LinkCrcInit => write!(f, "link CRC starts from 0"),
+        }
+    }
+}
+
 impl GatewareFault {
     /// The LUT form the fault lives in.
     pub fn lut_form(&self) -> LutForm {
@@ -134,4 +163,41 @@ fn rom(p: &mut Plan, b: usize) -> Result<&mut Vec<u32>, String> {
         .get_mut(b)
         .map(|r| &mut r.words)
         .ok_or_else(|| format!("no branch {b}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::GatewareFault;
+
+    /// Campaign reports name faults in words, not as Rust's Debug form.
+    #[test]
+    fn faults_are_named_in_words() {
+        let f = GatewareFault::RomWord {
+            branch: 1,
+            slot: 7,
+            from: 3,
+        };
+        assert_eq!(
+            f.to_string(),
+            "branch 1's ROM word for slot 7 holds slot 3's"
+        );
+        assert_eq!(
+            GatewareFault::SlotWrap { delta: -1 }.to_string(),
+            "slot counter wraps -1 slots off the frame"
+        );
+        for f in [
+            GatewareFault::RomSwap {
+                branch: 0,
+                a: 1,
+                b: 2,
+            },
+            GatewareFault::SliceWrap { delta: 1 },
+            GatewareFault::LinkFifoShort,
+            GatewareFault::LinkBaud { delta: -1 },
+            GatewareFault::LinkCrcInit,
+        ] {
+            let t = f.to_string();
+            assert!(!t.contains('{') && !t.contains("Link"), "{t}");
+        }
+    }
 }

@@ -320,7 +320,15 @@ impl Cx<'_> {
             .map(|s| line_col(self.text, s.start))
             .unwrap_or((0, 0));
         let field = field_from_toml_message(e.message(), self.text, e.span());
-        let message = plain(e.message(), &field);
+        // missing and unknown fields point at their table's header too, and
+        // already say what is wrong
+        let named = ["missing field", "unknown field"]
+            .iter()
+            .any(|p| e.message().starts_with(p));
+        let message = (!named)
+            .then(|| header_message(self.text, e.span(), &field))
+            .flatten()
+            .unwrap_or_else(|| plain(e.message(), &field));
         MixError {
             file: self.file.to_path_buf(),
             line,
@@ -799,7 +807,7 @@ impl Cx<'_> {
                             return Err(self.at(
                                 b.span(),
                                 f("bandwidth_hz"),
-                                format!("must be a number, got {}", other.type_str()),
+                                format!("got {}, expected a number of Hz", value_words(other)),
                             ))
                         }
                     };
@@ -1145,6 +1153,13 @@ fn field_from_toml_message(message: &str, text: &str, span: Option<Range<usize>>
             .map(|p| p + 1)
             .unwrap_or(0);
         let line = text[start..].lines().next().unwrap_or("");
+        // A table header (`[clock]`, `[[branch]]`) names the table itself.
+        let header = line.trim().trim_start_matches('[');
+        if line.trim().starts_with('[') {
+            if let Some(name) = header.split(']').next().filter(|n| !n.trim().is_empty()) {
+                return name.trim().to_string();
+            }
+        }
         if let Some((k, _)) = line.split_once('=') {
             if !k.trim().is_empty() {
                 return format!("{}{}", table_prefix(text, Some(s)), k.trim());
@@ -1152,6 +1167,27 @@ fn field_from_toml_message(message: &str, text: &str, span: Option<Range<usize>>
         }
     }
     "(syntax)".into()
+}
+
+/// The message for an error that points at a table header, where serde's
+/// words would describe its own machinery: `[[clock]]` for the one `[clock]`
+/// table, or `[frame.x]`, a table the mix format does not have.
+fn header_message(text: &str, span: Option<Range<usize>>, field: &str) -> Option<String> {
+    let s = span?;
+    let start = text[..s.start.min(text.len())]
+        .rfind('\n')
+        .map_or(0, |p| p + 1);
+    let line = text[start..].lines().next()?.trim();
+    if !line.starts_with('[') {
+        return None;
+    }
+    if line.starts_with("[[") && !field.contains('.') {
+        return Some(format!(
+            "`[[{field}]]` makes a list of tables; a mix has one table, written `[{field}]`"
+        ));
+    }
+    let (table, key) = field.rsplit_once('.')?;
+    Some(format!("`[{table}]` has no table `{key}`"))
 }
 
 /// `channel[3].` for a position inside the fourth `[[channel]]` table.
@@ -1211,6 +1247,19 @@ fn gcd(a: u64, b: u64) -> u64 {
     }
 }
 
+/// A TOML value as the user wrote it, for "got ..." in a message.
+fn value_words(v: &toml::Value) -> String {
+    match v {
+        toml::Value::String(t) => format!("the text \"{t}\""),
+        toml::Value::Integer(i) => format!("the number `{i}`"),
+        toml::Value::Float(x) => format!("the number `{x}`"),
+        toml::Value::Boolean(b) => format!("`{b}`"),
+        toml::Value::Datetime(d) => format!("the date `{d}`"),
+        toml::Value::Array(_) => "a list".into(),
+        toml::Value::Table(_) => "a table".into(),
+    }
+}
+
 /// A TOML error message in the words of the mix format, not of Rust's
 /// types: `expected i64` becomes "expected a whole number", of Hz, us or ns
 /// by the unit of `field`.
@@ -1244,6 +1293,14 @@ pub fn plain(m: &str, field: &str) -> String {
         ("expected a string", "expected a name in quotes"),
         ("expected struct ", "expected the table "),
         ("expected a sequence", "expected a list"),
+        (
+            "number too large to fit in target type",
+            "the number is too large (at most 9223372036854775807)",
+        ),
+        (
+            "number too small to fit in target type",
+            "the number is too small",
+        ),
     ] {
         out = out.replace(rust, words);
     }

@@ -68,29 +68,62 @@ pub fn busiest_slice(s: &Schedule) -> u64 {
 /// channel names, clear of the row above.
 const HIGH: f64 = 0.55;
 
+/// Lines the strobe names take below the strobe row: three, as merged
+/// names of several branches are wider than two slots.
+const STROBE_LINES: usize = 3;
+
 /// Strobe labels closer than this share of the window are one label, so
 /// that back-to-back strobes of two branches do not print over each other.
 const STROBE_MERGE: f64 = 0.03;
 
-/// The second line of strobe labels sits this far (in rows) below the
-/// first: a 12-pixel text on 34-pixel rows.
+/// Lines of strobe labels sit this far (in rows) apart: a 12-pixel text on
+/// rows of about 37 pixels.
 const STAGGER: f64 = 0.36;
 
-/// A line (0 or 1) for each label along a row, left to right: the first
-/// line whose last label ends left of this one (about 7 pixels a character
-/// on the plot's ~860), else the one whose last label ends first; so
-/// strobes a slot apart (30 in eskin34's slice) do not print over each other.
-fn stagger(labels: &[(f64, String)], span: f64) -> Vec<usize> {
-    let width = |t: &str| (t.len() as f64 * 7.0 + 8.0) / 860.0 * span;
-    let mut ends = [f64::MIN; 2];
+/// The height of a label's text in rows (with a little room), for a line
+/// that must clear a trace.
+const TEXT_ROWS: f64 = 0.40;
+
+/// The y of strobe label line `k`: the first beside the strobes, above the
+/// row's low level; the others below that level, clear of the trace.
+fn strobe_line_y(k: usize) -> f64 {
+    if k == 0 {
+        0.05 - HIGH / 2.0
+    } else {
+        -HIGH / 2.0 - TEXT_ROWS - STAGGER * (k - 1) as f64
+    }
+}
+
+/// Where a select's second line of names sits, below its own trace's low
+/// level and above the high level of the row below (in rows from the row).
+const SELECT_LOW: f64 = -0.69;
+
+/// The width of a label in the plot's x units: about 7.5 pixels a character
+/// of the 12-pixel sans-serif (capitals and `_` are wide), plus its 6-pixel
+/// offset, on the plot's ~860 pixels across `span`.
+fn label_width(t: &str, span: f64) -> f64 {
+    (t.len() as f64 * 7.5 + 10.0) / 860.0 * span
+}
+
+/// Places labels along a row, left to right: each pulled left so that it
+/// ends inside the window (`x0 + span`), and on the first of `lines` lines
+/// whose last label ends left of it, else the one whose last label ends
+/// first; so names a slot apart (30 in eskin34's slice) do not print over
+/// each other, nor past the plot's right edge.
+fn stagger(labels: &[(f64, String)], x0: f64, span: f64, lines: usize) -> Vec<(f64, usize)> {
+    let mut ends = vec![f64::MIN; lines];
     labels
         .iter()
         .map(|(x, t)| {
-            let line = (0..2)
-                .find(|&k| ends[k] <= *x)
-                .unwrap_or(if ends[0] <= ends[1] { 0 } else { 1 });
-            ends[line] = x + width(t);
-            line
+            let w = label_width(t, span);
+            let x = x.min(x0 + span - w);
+            let line = (0..lines).find(|&k| ends[k] <= x).unwrap_or_else(|| {
+                (0..lines)
+                    .min_by(|&a, &b| ends[a].total_cmp(&ends[b]))
+                    .unwrap_or(0)
+            });
+            ends[line] = x + w;
+            (x, line)
         })
         .collect()
 }
@@ -203,11 +236,19 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
     // a select's name sits just above its own trace's high level, the
     // strobes' names low in their row beside the strobe
     let mut labels = Series::line("", vec![]);
-    for i in s.instants(3).filter(|i| (from..to).contains(&i.cycle)) {
-        let r = row_of(&format!("{} mux_sel", s.branches[i.branch].name));
-        labels
-            .labels
-            .push((us(i.cycle), r + HIGH / 2.0 + 0.05, name(i.channel)));
+    let (x0, span) = (us(from), us(to) - us(from));
+    for (b, br) in s.branches.iter().enumerate() {
+        let r = row_of(&format!("{} mux_sel", br.name));
+        let texts: Vec<(f64, String)> = s
+            .instants(3)
+            .filter(|i| i.branch == b && (from..to).contains(&i.cycle))
+            .map(|i| (us(i.cycle), name(i.channel)))
+            .collect();
+        // above the trace's high level, or below its low level
+        for ((x, line), (_, text)) in stagger(&texts, x0, span, 2).into_iter().zip(texts) {
+            let y = [r + HIGH / 2.0 + 0.05, r + SELECT_LOW][line];
+            labels.labels.push((x, y, text));
+        }
     }
     let merge = ((to - from) as f64 * STROBE_MERGE) as u64;
     let mut strobes: Vec<(u64, Vec<String>)> = Vec::new();
@@ -224,11 +265,11 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         .into_iter()
         .map(|(c, names)| (us(c), names.join(",")))
         .collect();
-    let levels = stagger(&texts, us(to) - us(from));
-    for ((x, text), level) in texts.into_iter().zip(levels) {
-        labels
-            .labels
-            .push((x, 0.05 - HIGH / 2.0 - STAGGER * level as f64, text));
+    for ((x, level), (_, text)) in stagger(&texts, x0, span, STROBE_LINES)
+        .into_iter()
+        .zip(texts)
+    {
+        labels.labels.push((x, strobe_line_y(level), text));
     }
     series.push(labels);
     let mut axes = Axes::new(
@@ -241,7 +282,9 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
     );
     axes.y_names = names;
     axes.x_range = Some((us(from), us(to)));
-    axes.y_range = Some((-0.6, rows.len() as f64 - 0.3));
+    // room below the strobe row for its lines of names
+    let bottom = strobe_line_y(STROBE_LINES - 1) - 0.06;
+    axes.y_range = Some((bottom, rows.len() as f64 - 0.3));
     // the window ends one slot into the next slice (the last word leaves
     // there): that slot is closed by a boundary too, not cut at the edge
     for k in 0..=g.slots_per_slice + 1 {
@@ -255,7 +298,7 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         };
         axes.vlines.push((us(c), label));
     }
-    let svg = draw(&axes, &series, 1000, 140 + 34 * rows.len() as u32);
+    let svg = draw(&axes, &series, 1000, 170 + 34 * rows.len() as u32);
     let (wavedrom, wd_line) = wavedrom(s, &l, &w, nb)?;
     let line = format!(
         "slice {j} of frame 1 ({} slots of {} cycles), {} conversions; {wd_line}",
@@ -384,8 +427,22 @@ mod tests {
     fn strobe_labels_a_slot_apart_alternate_lines() {
         let l: Vec<(f64, String)> = (0..6).map(|k| (k as f64, "CH10".to_string())).collect();
         // 30 slots in the window: a label is wider than a slot
-        assert_eq!(super::stagger(&l, 30.0), vec![0, 1, 0, 1, 0, 1]);
+        let lines = |v: Vec<(f64, usize)>| v.into_iter().map(|p| p.1).collect::<Vec<_>>();
+        assert_eq!(lines(super::stagger(&l, 0.0, 30.0, 2)), [0, 1, 0, 1, 0, 1]);
+        // wider labels take a third line where there is one
+        let w: Vec<(f64, String)> = (0..6).map(|k| (k as f64, "CH1,CH26".into())).collect();
+        assert_eq!(lines(super::stagger(&w, 0.0, 30.0, 3)), [0, 1, 2, 0, 1, 2]);
         // far apart: all on the first line
-        assert_eq!(super::stagger(&l, 3.0), vec![0; 6]);
+        let far: Vec<(f64, String)> = l.iter().map(|(x, t)| (x * 10.0, t.clone())).collect();
+        assert_eq!(lines(super::stagger(&far, 0.0, 60.0, 2)), [0; 6]);
+    }
+
+    #[test]
+    fn a_label_at_the_right_edge_ends_inside_the_window() {
+        let l = vec![(9.0, "CH1".to_string()), (29.9, "CH1,CH26".to_string())];
+        let placed = super::stagger(&l, 0.0, 30.0, 2);
+        assert_eq!(placed[0].0, 9.0, "a label with room stays at its strobe");
+        let end = placed[1].0 + super::label_width("CH1,CH26", 30.0);
+        assert!(end <= 30.0 + 1e-9 && placed[1].0 < 29.9, "{placed:?}");
     }
 }

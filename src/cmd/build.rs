@@ -30,7 +30,7 @@ pub struct Args {
     #[arg(short = 'o', long = "out")]
     pub out: PathBuf,
     /// Frames the co-simulation runs, fully checked.
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, value_parser = super::whole_number, default_value_t = 3)]
     pub frames: u64,
     /// Run the fault campaign on the gateware (rust-hdl: also faults built
     /// into its slot ROM and counters; slower) instead of the model's pins.

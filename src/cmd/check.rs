@@ -66,7 +66,17 @@ fn parse_skew(v: &str) -> Result<u64, String> {
 fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
     let prepared = parse_skew(&a.skew).and_then(|skew| {
         let lanes = judge::capture::parse_map(map, s)?;
-        let cap = judge::capture::read(&a.wave, lanes)?;
+        // plain lines off a terminal only for a capture of several chunks
+        let progress = super::progress::Counter::new(
+            &format!("reading {}", a.wave.display()),
+            super::progress::Unit::Bytes,
+            2 << 20,
+            a.quiet,
+        );
+        let cap =
+            judge::capture::read_progress(&a.wave, lanes, &|done, total| progress.set(done, total));
+        progress.finish();
+        let cap = cap?;
         judge::timed::check_capture(s, &cap, skew).map_err(|e| format!("{}: {e}", a.wave.display()))
     });
     let r = match prepared {

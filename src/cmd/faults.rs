@@ -23,10 +23,10 @@ pub struct Args {
     #[arg(long, default_value = "model", value_parser = super::backend)]
     pub backend: cosim::Backend,
     /// Frames per run (at least 3; faults land in frame 1).
-    #[arg(long, default_value_t = 3)]
+    #[arg(long, value_parser = super::whole_number, default_value_t = 3)]
     pub frames: u64,
     /// Random feasible mixes run clean to count false alarms.
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, value_parser = super::whole_number, default_value_t = 10)]
     pub false_alarm_mixes: u64,
     /// Also run `formal`'s deep fault classes (edits of the emitted
     /// Verilog: a counter that misbehaves after the run's last frame, a

@@ -189,12 +189,31 @@ fn first_window_difference(a: &Trace, b: &Trace) -> Option<String> {
     for (i, (x, y)) in a.cycles.iter().zip(&b.cycles).enumerate() {
         if x != y {
             return Some(format!(
-                "window cycle {i}: expected rst={} {:?} miso={:#b}, actual rst={} {:?} miso={:#b}",
-                x.0, x.1, x.2, y.0, y.1, y.2
+                "window cycle {i}: expected rst={} {} miso={:#b}, actual rst={} {} miso={:#b}",
+                x.0,
+                pins_text(&x.1),
+                x.2,
+                y.0,
+                pins_text(&y.1),
+                y.2
             ));
         }
     }
     (a.len() != b.len()).then(|| format!("{} cycles expected, {} found", a.len(), b.len()))
+}
+
+/// A cycle's pins by their port names, as the VCD names them.
+fn pins_text(p: &lut_gen::ports::Pins) -> String {
+    format!(
+        "cs_n={:#b} sclk={:#b} mux_sel={:#x} mux_en={:#b} sample_valid={} sample_channel={} sample_value={}",
+        p.cs_n,
+        p.sclk,
+        p.mux_sel,
+        p.mux_en,
+        u8::from(p.sample_valid),
+        p.sample_channel,
+        p.sample_value
+    )
 }
 
 pub fn run(a: Args) -> u8 {

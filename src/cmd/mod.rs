@@ -167,3 +167,14 @@ pub fn vcd_to_fst(vcd: &Path, fst: &Path) -> std::io::Result<()> {
     }
     std::fs::rename(&tmp, fst)
 }
+
+/// A whole-number option (`--frames 3`), refused in the user's words:
+/// clap's own parser would say "invalid digit found in string".
+pub fn whole_number(v: &str) -> Result<u64, String> {
+    let t = v.trim().replace('_', "");
+    if t.is_empty() || !t.bytes().all(|b| b.is_ascii_digit()) {
+        return Err("expected a whole number, like 3".into());
+    }
+    t.parse()
+        .map_err(|_| format!("too large: at most {}", u64::MAX))
+}

@@ -19,10 +19,10 @@ pub struct Args {
     #[arg(long, default_value = "abc", value_parser = solver)]
     pub solver: Solver,
     /// Seconds each engine run may take (the search from reset, the recurrence check, pdr or cvc5).
-    #[arg(long, default_value_t = 1800)]
+    #[arg(long, value_parser = super::whole_number, default_value_t = 1800)]
     pub timeout: u64,
     /// Steps from reset the bounded search covers when the proof does not close (default: two frames).
-    #[arg(long)]
+    #[arg(long, value_parser = super::whole_number)]
     pub depth: Option<u64>,
     /// Directory for a counterexample's VCD and .gtkw (created if missing).
     #[arg(short = 'o', long = "out", default_value = "prove-out")]

@@ -19,7 +19,7 @@ pub struct Args {
     #[arg(long, default_value = "model", value_parser = super::backend)]
     pub backend: Backend,
     /// Frames to simulate.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, value_parser = super::whole_number, default_value_t = 2)]
     pub frames: u64,
     /// Write a VCD of the window --from..--to (plus a GTKWave .gtkw beside
     /// it); times in it are exact (each edge rounded once to 1 ps).

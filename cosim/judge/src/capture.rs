@@ -95,6 +95,16 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
 
 /// Reads a capture: sigrok-cli's VCD, or a `.sr` session through sigrok-cli.
 pub fn read(path: &Path, lanes: Vec<Lane>) -> Result<Capture, String> {
+    read_progress(path, lanes, &|_, _| {})
+}
+
+/// [`read`], telling `progress(bytes parsed, bytes in all)` of the VCD as
+/// it goes: an analyser's capture runs to hundreds of MB.
+pub fn read_progress(
+    path: &Path,
+    lanes: Vec<Lane>,
+    progress: &dyn Fn(u64, u64),
+) -> Result<Capture, String> {
     let mut head = [0u8; 2];
     let is_zip = std::fs::File::open(path)
         .and_then(|mut f| std::io::Read::read_exact(&mut f, &mut head))
@@ -102,7 +112,7 @@ pub fn read(path: &Path, lanes: Vec<Lane>) -> Result<Capture, String> {
         .unwrap_or(false);
     if !is_zip {
         let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-        return parse_vcd(&text, path, lanes);
+        return parse_vcd(&text, path, lanes, progress);
     }
     let tmp = tempfile::Builder::new()
         .suffix(".vcd")
@@ -129,7 +139,7 @@ pub fn read(path: &Path, lanes: Vec<Lane>) -> Result<Capture, String> {
     }
     let text =
         std::fs::read_to_string(tmp.path()).map_err(|e| format!("{}: {e}", path.display()))?;
-    parse_vcd(&text, path, lanes)
+    parse_vcd(&text, path, lanes, progress)
 }
 
 fn unit_ps(u: &str) -> Option<f64> {
@@ -146,8 +156,25 @@ fn unit_ps(u: &str) -> Option<f64> {
 
 /// sigrok-cli's VCD: 1-bit `$var`s named by the analyser's channels, the
 /// sample rate in `$comment ... at 24 MHz $end`.
-fn parse_vcd(text: &str, path: &Path, lanes: Vec<Lane>) -> Result<Capture, String> {
+fn parse_vcd(
+    text: &str,
+    path: &Path,
+    lanes: Vec<Lane>,
+    progress: &dyn Fn(u64, u64),
+) -> Result<Capture, String> {
     let err = |line: usize, m: String| format!("{}:{line}: {m}", path.display());
+    let total = text.len() as u64;
+    // told at every 256 kB, not every line: a call per line would cost more
+    // than the parsing
+    let step = 1u64 << 18;
+    let next = std::cell::Cell::new(step);
+    let told = |line: &str| {
+        let at = (line.as_ptr() as usize - text.as_ptr() as usize) as u64;
+        if at >= next.get() {
+            next.set(at + step);
+            progress(at, total);
+        }
+    };
     let mut ids: Vec<(String, usize)> = Vec::new();
     let mut scale_ps = 1.0;
     let mut rate_hz: Option<f64> = None;
@@ -159,6 +186,7 @@ fn parse_vcd(text: &str, path: &Path, lanes: Vec<Lane>) -> Result<Capture, Strin
     let mut toks = text
         .lines()
         .enumerate()
+        .inspect(|(_, l)| told(l))
         .flat_map(|(n, l)| l.split_whitespace().map(move |w| (n + 1, w)))
         .peekable();
     while let Some((n, w)) = toks.next() {
@@ -257,6 +285,7 @@ fn parse_vcd(text: &str, path: &Path, lanes: Vec<Lane>) -> Result<Capture, Strin
         }
     }
     steps.push(((t as f64 * scale_ps) as u64, cur));
+    progress(total, total);
     // Without the rate comment, the smallest step between timestamps.
     // With the rate known, one timescale unit is added: sigrok rounds each
     // sample's time to it.

@@ -378,7 +378,9 @@ impl CycleModel {
             (link::format::WordKind::Record, Some((ch, v))) => {
                 format!("record of channel {ch} = {v}")
             }
-            (k, _) => format!("{k:?}").to_lowercase(),
+            (link::format::WordKind::Record, None) => "record".into(),
+            (link::format::WordKind::Header, _) => "header".into(),
+            (link::format::WordKind::Trailer, _) => "trailer".into(),
         };
         Some(format!(
             "link: bit {bit} of byte {:#04x} (byte {} of the {what}) of packet frame {} slice {} (mod 256 frames)",

@@ -199,7 +199,9 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
                 out.violations.push(violation(
                     *t,
                     format!(
-                        "the packet of frame {frame} slice {slice} carries channels {chans:?}; the schedule's order is {want:?}"
+                        "the packet of frame {frame} slice {slice} carries channels {}; the schedule's order is {}",
+                        channel_list(chans),
+                        channel_list(&want)
                     ),
                 ));
             }
@@ -529,4 +531,16 @@ fn hold_bytes(
             (unc / clock) as f64 / 1e3
         ));
     }
+}
+
+/// Channel numbers as a report lists them: `3, 4, 7` (or "none").
+fn channel_list<T: std::fmt::Display>(chans: &[T]) -> String {
+    if chans.is_empty() {
+        return "none".into();
+    }
+    chans
+        .iter()
+        .map(|c| c.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
