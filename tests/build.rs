@@ -6,8 +6,7 @@ use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
 
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
 #[path = "common/browser.rs"]
 mod browser;

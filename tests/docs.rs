@@ -4,8 +4,7 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -9,15 +9,13 @@ use std::path::{Path, PathBuf};
 use assert_cmd::Command;
 use predicates::prelude::*;
 
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
 fn slotforge() -> Command {
     Command::cargo_bin("slotforge").unwrap()
 }
 
-#[path = "common/presets.rs"]
-mod common_presets;
+use crate::common_presets;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

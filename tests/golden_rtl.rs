@@ -7,8 +7,7 @@ use std::path::{Path, PathBuf};
 
 use assert_cmd::Command;
 
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
 fn slotforge() -> Command {
     Command::cargo_bin("slotforge").unwrap()

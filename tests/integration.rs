@@ -42,3 +42,11 @@ mod sim_cli;
 
 #[path = "tool_policy.rs"]
 mod tool_policy;
+
+// Shared by several test files (one copy in this binary).
+#[path = "common/tools.rs"]
+mod tools;
+
+// Shared by several test files (one copy in this binary).
+#[path = "common/presets.rs"]
+mod common_presets;

@@ -11,8 +11,7 @@ use std::process::Command as Process;
 use assert_cmd::Command;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -13,8 +13,7 @@ use lut_gen::ports::{Dir, Layout, PORTS, TOP_MODULE};
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
 fn slotforge() -> Command {
     Command::cargo_bin("slotforge").unwrap()

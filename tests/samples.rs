@@ -9,8 +9,7 @@ use std::path::{Path, PathBuf};
 use assert_cmd::Command;
 use predicates::prelude::*;
 
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
 fn slotforge() -> Command {
     Command::cargo_bin("slotforge").unwrap()

@@ -25,11 +25,9 @@ use lut_gen::ports::Pins;
 use lut_gen::Schedule;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
-#[path = "common/presets.rs"]
-mod common_presets;
+use crate::common_presets;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

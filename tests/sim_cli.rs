@@ -26,8 +26,7 @@ fn tiny() -> PathBuf {
 }
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
 /// Runs `sim --json` and checks SPEC's fields; returns the report.
 fn sim_json(mix: &Path, backend: &str, frames: u64) -> serde_json::Value {

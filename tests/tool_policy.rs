@@ -2,8 +2,7 @@
 //! tests): a missing tool fails under CI and skips loudly elsewhere; it can
 //! never pass silently.
 
-#[path = "common/tools.rs"]
-mod tools;
+use crate::tools;
 
 use tools::{ci_is_set, decide, gate, tool_present, Decision};
 

@@ -16,8 +16,7 @@ fn schedule(p: &Path) -> lut_gen::Schedule {
 }
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "../../tests/common/tools.rs"]
-mod tools;
+use crate::tools;
 
 /// The gateware is correct for any reset of one cycle or more (docs/timing.md, "Start-up").
 fn one_cycle_reset() -> SimOptions {

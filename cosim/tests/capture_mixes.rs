@@ -12,8 +12,7 @@ use judge::timed::check_capture;
 
 #[path = "../judge/tests/analyser/mod.rs"]
 mod analyser;
-#[path = "../../tests/common/tools.rs"]
-mod tools;
+use crate::tools;
 
 use analyser::{check, lanes, mutate, resample, run, to_sigrok, Mutation};
 

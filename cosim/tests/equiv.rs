@@ -8,8 +8,7 @@ use cosim::equiv::{check, Equivalence};
 use hdl::GatewareFault;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "../../tests/common/tools.rs"]
-mod tools;
+use crate::tools;
 
 fn schedule(name: &str) -> lut_gen::Schedule {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))

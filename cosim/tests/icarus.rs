@@ -10,8 +10,7 @@ use judge::vcd::{read_cycles, CycleSink};
 use judge::Pins;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "../../tests/common/tools.rs"]
-mod tools;
+use crate::tools;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -24,3 +24,7 @@ mod random_mixes;
 
 #[path = "verilator_shim.rs"]
 mod verilator_shim;
+
+// Shared by several test files (one copy in this binary).
+#[path = "../../tests/common/tools.rs"]
+mod tools;

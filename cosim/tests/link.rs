@@ -61,8 +61,7 @@ fn the_link_runs_clean_and_every_link_fault_is_caught() {
     }
 }
 
-#[path = "../../tests/common/tools.rs"]
-mod tools;
+use crate::tools;
 
 /// The link in Icarus (the emitted Verilog's `slotforge_link`, its line read
 /// back from Icarus's VCD); verilator and rusthdl run every preset in

@@ -28,8 +28,7 @@ mod judge;
 use judge::judge;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "../../tests/common/tools.rs"]
-mod tools;
+use crate::tools;
 
 /// Sites per operator: 36 mutants on the test mix.
 const PER_OP: [(Operator, usize); 8] = [

@@ -8,8 +8,7 @@ use cosim::verilator::VerilatedDut;
 use judge::run::{run_dut, RunOptions};
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "../../tests/common/tools.rs"]
-mod tools;
+use crate::tools;
 
 const STANDIN: &str = r#"
 module slotforge_top(input clk, input rst, input [1:0] adc_miso,

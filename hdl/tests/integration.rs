@@ -6,3 +6,7 @@ mod rtlsim;
 
 #[path = "tools.rs"]
 mod tools;
+
+// Shared by several test files (one copy in this binary).
+#[path = "common/mod.rs"]
+mod common;

@@ -1,5 +1,5 @@
 //! The in-process simulator against docs/timing.md, cycle by cycle.
-mod common;
+use crate::common;
 
 use common::*;
 

@@ -1,6 +1,6 @@
 //! Quality gates on the emitted Verilog, with the real tools:
 //! `verilator --lint-only -Wall`, `iverilog -g2005 -Wall`, `yosys synth_ice40`.
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
