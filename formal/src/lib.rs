@@ -225,10 +225,10 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
             let st = strong.as_ref().expect("checked");
             (
                 Outcome::Proved,
-                1,
+                strengthen::K,
                 format!(
-                    "proved for all time by induction: the contract and {} invariants that tie the design's registers to the harness's frame position ({} registers in harness + design; mined from a simulation, each proved, none assumed) are inductive together (ABC pdr, {:.1} s)",
-                    st.invariants, st.registers, st.solver_seconds
+                    "proved for all time by k-induction (k <= {}): the contract and {} invariants that tie the design's registers to the harness's frame position ({} registers in harness + design; mined from a simulation, each proved, none assumed) are inductive together (ABC ind for the step, bmc3 from reset for the base; {:.1} s)",
+                    strengthen::K, st.invariants, st.registers, st.solver_seconds
                 ),
             )
         }

@@ -63,7 +63,7 @@ pub struct Strengthened {
     pub invariants: usize,
     /// Registers of harness + design.
     pub registers: usize,
-    /// Engine seconds (pdr), after mining.
+    /// Engine seconds (induction step and base case), after mining.
     pub solver_seconds: f64,
     pub proved: bool,
 }
@@ -448,9 +448,15 @@ pub fn mine(dir: &Path, s: &Schedule) -> Result<Mined, ProveError> {
     }
     // One assertion each: ABC's output index names the invariant that fails.
     // The harness's own start: `st` never 3, the position at zero until it runs.
-    v.push_str(
+    // The position's registers in range (unreachable wide values would let
+    // a run of invariant-keeping states wrap into a bad one).
+    let _ = writeln!(
+        v,
         "`ifdef FORMAL\n  always @* assert (st != 2'd3);\n  \
-         always @* if (st != 2'd2) assert (cyc == 0 && slot == 0 && first);\n",
+         always @* if (st != 2'd2) assert (cyc == 0 && slot == 0 && first);\n  \
+         always @* assert (cyc <= {cb}'d{} && slot <= {sb}'d{});",
+        g.slot_cycles - 1,
+        g.frame_slots - 1
     );
     for n in &names {
         let _ = writeln!(v, "  always @* if (st == 2'd2) assert ({n});");
@@ -570,23 +576,43 @@ pub fn prove(dir: &Path, s: &Schedule, h: &Harness, secs: u64) -> Result<Strengt
         &["-q", "-s", "strong.ys"],
         Duration::from_secs(600),
     )?;
+    // k-induction: ABC's `ind` is the inductive step (any K consecutive
+    // states that keep every assertion are followed by one that does), and
+    // `bmc3` from reset over more than K steps is the base case.
     let t = Instant::now();
-    let out = run_tool(
+    let step = run_tool(
         dir,
         "yosys-abc",
         &[
             "-c",
-            &format!("read_aiger strong.aig; fold; strash; pdr -T {secs}"),
+            &format!("read_aiger strong.aig; fold; strash; orpos; ind -F {K} -T {secs}"),
         ],
         Duration::from_secs(secs),
     )?;
+    let base_steps = K + 2;
+    let base = run_tool(
+        dir,
+        "yosys-abc",
+        &[
+            "-c",
+            &format!("read_aiger strong.aig; fold; strash; bmc3 -F {base_steps} -T {secs}"),
+        ],
+        Duration::from_secs(secs),
+    )?;
+    let base_ok = matches!(
+        crate::engine::parse_abc(&base, base_steps)?,
+        crate::engine::Verdict::Bounded { steps } if steps >= base_steps
+    );
     Ok(Strengthened {
         invariants: m.invariants,
         registers: m.registers,
         solver_seconds: t.elapsed().as_secs_f64(),
-        proved: out.contains("Property proved"),
+        proved: base_ok && step.contains("Networks are equivalent"),
     })
 }
+
+/// The induction depth: ABC's `ind` tries k = 1 ..= K.
+pub const K: u64 = 16;
 
 #[cfg(test)]
 mod tests {
