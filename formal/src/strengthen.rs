@@ -113,7 +113,7 @@ pub fn probes(dir: &Path) -> Result<Vec<Probe>, ProveError> {
             .map(|a| a.iter().map(|b| b.as_i64()).collect::<Option<Vec<i64>>>())
             .unwrap_or(None);
         let Some(bits) = bits else { continue };
-        if bits.is_empty() || bits.len() > 128 || !bits.iter().all(|b| q_bits.contains(b)) {
+        if bits.is_empty() || bits.len() >= 128 || !bits.iter().all(|b| q_bits.contains(b)) {
             continue;
         }
         if !name.split('.').all(plain_identifier) {
@@ -184,8 +184,12 @@ fn mining_bench(s: &Schedule, probes: &[Probe], steps: u64) -> String {
     v
 }
 
-/// Each probe's value at every step from 2 (cycle 0) to `steps`, or None
-/// where the simulation showed an unknown bit.
+/// A value with an unknown bit in the simulation (registers narrower than
+/// 128 bits only, so no real value is this).
+const UNKNOWN: u128 = u128::MAX;
+
+/// Each probe's value at every step from 2 (cycle 0) to `steps`
+/// ([`UNKNOWN`] where the simulation showed an unknown bit).
 fn read_log(text: &str, n: usize, steps: u64) -> Vec<Option<Vec<u128>>> {
     let mut changes: Vec<Vec<(u64, Option<u128>)>> = vec![Vec::new(); n];
     for line in text.lines() {
@@ -197,7 +201,10 @@ fn read_log(text: &str, n: usize, steps: u64) -> Vec<Option<Vec<u128>>> {
             continue;
         };
         if idx < n {
-            changes[idx].push((step, u128::from_str_radix(val, 16).ok()));
+            // an unknown bit (power-on, no reset): UNKNOWN, which no
+            // control table takes and every data bit disagrees with
+            let v = u128::from_str_radix(val, 16).ok().or(Some(UNKNOWN));
+            changes[idx].push((step, v));
         }
     }
     changes
@@ -393,7 +400,7 @@ pub fn mine(dir: &Path, s: &Schedule) -> Result<Mined, ProveError> {
     let mut names = Vec::new();
     for (i, (p, pv)) in probes.iter().zip(vals).enumerate() {
         let Some(pv) = pv else { continue };
-        let control = other[i].as_ref() == Some(pv);
+        let control = other[i].as_ref() == Some(pv) && !pv.contains(&UNKNOWN);
         let w = p.width;
         let iv = format!("iv{i}");
         let decl = if p.in_design() {
@@ -415,7 +422,13 @@ pub fn mine(dir: &Path, s: &Schedule) -> Result<Mined, ProveError> {
                 body.replace("@E", &format!("ie{i}"))
             );
             format!("iv{i} == ie{i}")
-        } else if let Some((j, m, masks, from)) = (p.in_design() && !control)
+        } else if let Some(Agreement {
+            j,
+            lo,
+            m,
+            masks,
+            from,
+        }) = (p.in_design() && !control)
             .then(|| agreement(i, &probes, vals, other, &pos))
             .flatten()
         {
@@ -432,10 +445,10 @@ pub fn mine(dir: &Path, s: &Schedule) -> Result<Mined, ProveError> {
                 m - 1
             );
             format!(
-                "((iv{i}[{}:0] ^ {}[{}:0]) & ie{i}) == {m}'d0",
+                "((iv{i}[{}:0] ^ {}[{}:{lo}]) & ie{i}) == {m}'d0",
                 m - 1,
                 probes[j].path,
-                m - 1
+                lo + m - 1
             )
         } else {
             if p.in_design() {
@@ -475,18 +488,29 @@ pub fn mine(dir: &Path, s: &Schedule) -> Result<Mined, ProveError> {
 /// cycle in the slot, over both runs, apart for the start-up slot (frame 0,
 /// slot 0: a skipped conversion still shifts the design's register): the
 /// harness register with the most agreement, the bits compared and the masks.
+/// A design register's agreement with harness register `j`: its bits
+/// `[lo + m - 1 : lo]` against the design's `[m - 1 : 0]`, where `masks`
+/// (per cycle in the slot) say, from position `from` of the first frame on.
+struct Agreement {
+    j: usize,
+    lo: usize,
+    m: usize,
+    masks: Vec<u128>,
+    from: u64,
+}
+
 fn agreement(
     i: usize,
     probes: &[Probe],
     vals: &[Option<Vec<u128>>],
     other: &[Option<Vec<u128>>],
     p: &Pos,
-) -> Option<(usize, usize, Vec<u128>, u64)> {
+) -> Option<Agreement> {
     let w = probes[i].width;
     let (Some(x0), Some(x1)) = (&vals[i], &other[i]) else {
         return None;
     };
-    let mut best: Option<(u32, usize, usize, Vec<u128>, u64)> = None;
+    let mut best: Option<(u32, usize, usize, usize, Vec<u128>, u64)> = None;
     for (j, q) in probes.iter().enumerate() {
         let (Some(y0), Some(y1)) = (&vals[j], &other[j]) else {
             continue;
@@ -494,35 +518,45 @@ fn agreement(
         if q.in_design() || y0 == y1 {
             continue; // only the harness's data registers
         }
-        let m = q.width.min(w);
-        let full = if m >= 128 {
-            u128::MAX
-        } else {
-            (1u128 << m) - 1
-        };
-        // Masks per cycle from the frames after the first; in the first
-        // frame they hold only from the position where the power-on and
-        // start-up contents (a skipped conversion still shifts) are gone.
-        let mut masks = vec![full; p.c as usize];
-        for (x, y) in [(x0, y0), (x1, y1)] {
-            for (t, (a, b)) in x.iter().zip(y).enumerate().skip(p.f as usize) {
-                masks[(t as u64 % p.c) as usize] &= !(a ^ b);
-            }
-        }
-        let mut from = 0u64;
-        for (x, y) in [(x0, y0), (x1, y1)] {
-            for (t, (a, b)) in x.iter().zip(y).enumerate().take(p.f as usize) {
-                if (a ^ b) & masks[(t as u64 % p.c) as usize] != 0 {
-                    from = from.max(t as u64 + 1);
+        // the design's bits may sit anywhere in the harness's register
+        // (leading or trailing bits around the data)
+        for lo in 0..q.width {
+            let m = (q.width - lo).min(w);
+            let full = if m >= 128 {
+                u128::MAX
+            } else {
+                (1u128 << m) - 1
+            };
+            // Masks per cycle from the frames after the first; in the first
+            // frame they hold only from the position where the power-on and
+            // start-up contents (a skipped conversion still shifts) are gone.
+            let mut masks = vec![full; p.c as usize];
+            for (x, y) in [(x0, y0), (x1, y1)] {
+                for (t, (a, b)) in x.iter().zip(y).enumerate().skip(p.f as usize) {
+                    masks[(t as u64 % p.c) as usize] &= !(a ^ (b >> lo));
                 }
             }
-        }
-        let total: u32 = masks.iter().map(|k| k.count_ones()).sum();
-        if total > 0 && best.as_ref().is_none_or(|b| total > b.0) {
-            best = Some((total, j, m, masks, from));
+            let mut from = 0u64;
+            for (x, y) in [(x0, y0), (x1, y1)] {
+                for (t, (a, b)) in x.iter().zip(y).enumerate().take(p.f as usize) {
+                    if (a ^ (b >> lo)) & masks[(t as u64 % p.c) as usize] != 0 {
+                        from = from.max(t as u64 + 1);
+                    }
+                }
+            }
+            let total: u32 = masks.iter().map(|k| k.count_ones()).sum();
+            if total > 0 && best.as_ref().is_none_or(|b| total > b.0) {
+                best = Some((total, j, lo, m, masks, from));
+            }
         }
     }
-    best.map(|(_, j, m, masks, from)| (j, m, masks, from))
+    best.map(|(_, j, lo, m, masks, from)| Agreement {
+        j,
+        lo,
+        m,
+        masks,
+        from,
+    })
 }
 
 /// A case on the cycle in the slot, the most common value as the default.
@@ -688,9 +722,9 @@ mod tests {
             vec![Some(sh), Some(w)]
         };
         let (a, b) = (run(1), run(2));
-        let (j, m, masks, from) = agreement(0, &probes, &a, &b, &P).unwrap();
-        assert_eq!((j, m, from), (1, 4, 0));
-        assert_eq!(masks, vec![15, 15, 7, 15]);
+        let g = agreement(0, &probes, &a, &b, &P).unwrap();
+        assert_eq!((g.j, g.lo, g.m, g.from), (1, 0, 4, 0));
+        assert_eq!(g.masks, vec![15, 15, 7, 15]);
         // a harness register the same in both runs is control, not data
         assert!(agreement(0, &probes, &a, &a, &P).is_none());
         let control = vec![Some(vec![0u128; 24]), Some(vec![0u128; 24])];
