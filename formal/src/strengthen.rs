@@ -398,6 +398,7 @@ pub fn mine(dir: &Path, s: &Schedule) -> Result<Mined, ProveError> {
     );
     let mut connects = Vec::new();
     let mut names = Vec::new();
+    let partitions = slot_classes(s);
     for (i, (p, pv)) in probes.iter().zip(vals).enumerate() {
         let Some(pv) = pv else { continue };
         let control = other[i].as_ref() == Some(pv) && !pv.contains(&UNKNOWN);
@@ -422,30 +423,27 @@ pub fn mine(dir: &Path, s: &Schedule) -> Result<Mined, ProveError> {
                 body.replace("@E", &format!("ie{i}"))
             );
             format!("iv{i} == ie{i}")
-        } else if let Some(Agreement {
-            j,
-            lo,
-            m,
-            masks,
-            from,
-        }) = (p.in_design() && !control)
-            .then(|| agreement(i, &probes, vals, other, &pos))
+        } else if let Some(a) = (p.in_design() && !control)
+            .then(|| agreement(i, &probes, vals, other, &pos, &partitions))
             .flatten()
         {
+            let (j, lo, m, from) = (a.j, a.lo, a.m, a.from);
             // Nothing claimed in the first frame before `from`.
             let (fs, fc) = (from / g.slot_cycles, from % g.slot_cycles);
-            let body = format!(
-                "if (first && (slot < {sb}'d{fs} || (slot == {sb}'d{fs} && cyc < {cb}'d{fc}))) @E = {m}'d0;\n    else {}",
-                cycle_case(&masks, m, cb)
-            )
-            .replace("@E", &format!("ie{i}"));
+            let early =
+                format!("first && (slot < {sb}'d{fs} || (slot == {sb}'d{fs} && cyc < {cb}'d{fc}))");
             let _ = write!(
                 v,
-                "{decl}  reg [{}:0] ie{i};\n  always @* begin\n    {body}\n  end\n",
-                m - 1
+                "{decl}  reg [{}:0] ie{i};\n  reg [{}:0] iz{i};\n  always @* begin\n    \
+                 if ({early}) ie{i} = {m}'d0;\n    else {}\n    \
+                 if ({early}) iz{i} = {w}'d0;\n    else {}\n  end\n",
+                m - 1,
+                w - 1,
+                class_case(&a.class, &a.masks, m, cb, sb).replace("@E", &format!("ie{i}")),
+                class_case(&a.class, &a.zeros, w, cb, sb).replace("@E", &format!("iz{i}")),
             );
             format!(
-                "((iv{i}[{}:0] ^ {}[{}:{lo}]) & ie{i}) == {m}'d0",
+                "((iv{i}[{}:0] ^ {}[{}:{lo}]) & ie{i}) == {m}'d0 && (iv{i} & iz{i}) == {w}'d0",
                 m - 1,
                 probes[j].path,
                 lo + m - 1
@@ -483,34 +481,65 @@ pub fn mine(dir: &Path, s: &Schedule) -> Result<Mined, ProveError> {
     })
 }
 
-/// The bits in which a design register always agrees with a harness data
-/// register (a shift register and the MISO bits the harness recorded), per
-/// cycle in the slot, over both runs, apart for the start-up slot (frame 0,
-/// slot 0: a skipped conversion still shifts the design's register): the
-/// harness register with the most agreement, the bits compared and the masks.
 /// A design register's agreement with harness register `j`: its bits
-/// `[lo + m - 1 : lo]` against the design's `[m - 1 : 0]`, where `masks`
-/// (per cycle in the slot) say, from position `from` of the first frame on.
+/// `[lo + m - 1 : lo]` against the design's `[m - 1 : 0]`, where the masks
+/// say, from position `from` of the first frame on.  The masks are per
+/// cycle in the slot and per slot class: `class[slot]` picks the row of
+/// `masks`.  A class is whether one branch converts in the slot and in the
+/// slot before (the shared SPI sequencer shifts a branch's register in
+/// every slot, but the harness records its bits only in the branch's own
+/// slots, so the bits agree in other cycles of an active slot than of an
+/// idle one).
 struct Agreement {
     j: usize,
     lo: usize,
     m: usize,
-    masks: Vec<u128>,
+    class: Vec<usize>,
+    masks: Vec<Vec<u128>>,
+    /// Per class and cycle, the design's bits that are always 0 there (a
+    /// shift register cleared when its conversion starts: the harness's
+    /// register still holds the previous word in those bits).
+    zeros: Vec<Vec<u128>>,
     from: u64,
 }
 
+/// The slot classes the masks may be split by: one partition per branch
+/// (active or idle in the slot and in the one before), each as the class
+/// of every slot of a frame.
+fn slot_classes(s: &Schedule) -> Vec<Vec<usize>> {
+    let fs = s.grid.frame_slots;
+    (0..s.branches.len())
+        .map(|b| {
+            (0..fs)
+                .map(|slot| {
+                    let prev = (slot + fs - 1) % fs;
+                    2 * usize::from(s.at(slot, b).is_some()) + usize::from(s.at(prev, b).is_some())
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The bits in which a design register always agrees with a harness data
+/// register (a shift register and the MISO bits the harness recorded), per
+/// cycle in the slot and slot class, over both runs, from the frames after
+/// the first; in the first frame claimed only from the position where the
+/// power-on and start-up contents (a skipped conversion still shifts) are
+/// gone.  The harness register, bits and partition with the most agreeing
+/// bits over a frame win.
 fn agreement(
     i: usize,
     probes: &[Probe],
     vals: &[Option<Vec<u128>>],
     other: &[Option<Vec<u128>>],
     p: &Pos,
+    partitions: &[Vec<usize>],
 ) -> Option<Agreement> {
     let w = probes[i].width;
     let (Some(x0), Some(x1)) = (&vals[i], &other[i]) else {
         return None;
     };
-    let mut best: Option<(u32, usize, usize, usize, Vec<u128>, u64)> = None;
+    let mut best: Option<(u64, Agreement)> = None;
     for (j, q) in probes.iter().enumerate() {
         let (Some(y0), Some(y1)) = (&vals[j], &other[j]) else {
             continue;
@@ -527,36 +556,108 @@ fn agreement(
             } else {
                 (1u128 << m) - 1
             };
-            // Masks per cycle from the frames after the first; in the first
-            // frame they hold only from the position where the power-on and
-            // start-up contents (a skipped conversion still shifts) are gone.
-            let mut masks = vec![full; p.c as usize];
+            // the agreeing bits per position of the frame, after the first
+            let mut at = vec![full; p.f as usize];
             for (x, y) in [(x0, y0), (x1, y1)] {
                 for (t, (a, b)) in x.iter().zip(y).enumerate().skip(p.f as usize) {
-                    masks[(t as u64 % p.c) as usize] &= !(a ^ (b >> lo));
+                    at[t % p.f as usize] &= !(a ^ (b >> lo));
                 }
             }
-            let mut from = 0u64;
-            for (x, y) in [(x0, y0), (x1, y1)] {
-                for (t, (a, b)) in x.iter().zip(y).enumerate().take(p.f as usize) {
-                    if (a ^ (b >> lo)) & masks[(t as u64 % p.c) as usize] != 0 {
-                        from = from.max(t as u64 + 1);
+            for class in partitions {
+                let mut masks = vec![vec![full; p.c as usize]; 4];
+                for (t, &k) in at.iter().enumerate() {
+                    let t = t as u64;
+                    masks[class[(t / p.c) as usize]][(t % p.c) as usize] &= k;
+                }
+                let mask_at = |t: u64| masks[class[(t / p.c) as usize]][(t % p.c) as usize];
+                let total: u64 = (0..p.f).map(|t| u64::from(mask_at(t).count_ones())).sum();
+                if total == 0 || best.as_ref().is_some_and(|b| total <= b.0) {
+                    continue;
+                }
+                let mut from = 0u64;
+                for (x, y) in [(x0, y0), (x1, y1)] {
+                    for (t, (a, b)) in x.iter().zip(y).enumerate().take(p.f as usize) {
+                        if (a ^ (b >> lo)) & mask_at(t as u64) != 0 {
+                            from = from.max(t as u64 + 1);
+                        }
                     }
                 }
-            }
-            let total: u32 = masks.iter().map(|k| k.count_ones()).sum();
-            if total > 0 && best.as_ref().is_none_or(|b| total > b.0) {
-                best = Some((total, j, lo, m, masks, from));
+                let a = Agreement {
+                    j,
+                    lo,
+                    m,
+                    class: class.clone(),
+                    masks,
+                    zeros: Vec::new(),
+                    from,
+                };
+                best = Some((total, a));
             }
         }
     }
-    best.map(|(_, j, lo, m, masks, from)| Agreement {
-        j,
-        lo,
-        m,
-        masks,
-        from,
-    })
+    best.map(|(_, a)| with_zeros(a, w, [x0, x1], p))
+}
+
+/// `a` with the design register's bits that are 0 in every sample of a
+/// slot class and cycle (both runs, the frames after the first), and `from`
+/// late enough that the first frame keeps them too.
+fn with_zeros(mut a: Agreement, w: usize, runs: [&Vec<u128>; 2], p: &Pos) -> Agreement {
+    let full = if w >= 128 {
+        u128::MAX
+    } else {
+        (1u128 << w) - 1
+    };
+    let mut zeros = vec![vec![full; p.c as usize]; 4];
+    for x in runs {
+        for (t, v) in x.iter().enumerate().skip(p.f as usize) {
+            let t = (t as u64) % p.f;
+            zeros[a.class[(t / p.c) as usize]][(t % p.c) as usize] &= !v;
+        }
+    }
+    let zero_at = |t: u64| zeros[a.class[(t / p.c) as usize]][(t % p.c) as usize];
+    for x in runs {
+        for (t, v) in x.iter().enumerate().take(p.f as usize) {
+            if v & zero_at(t as u64) != 0 {
+                a.from = a.from.max(t as u64 + 1);
+            }
+        }
+    }
+    a.zeros = zeros;
+    a
+}
+
+/// The masks as Verilog: a case on the slot (slots with the same masks
+/// together, the most common as the default) of cases on the cycle.
+fn class_case(class: &[usize], masks: &[Vec<u128>], w: usize, cb: u32, sb: u32) -> String {
+    let mut rows: BTreeMap<&[u128], Vec<usize>> = BTreeMap::new();
+    for (slot, &k) in class.iter().enumerate() {
+        rows.entry(&masks[k]).or_default().push(slot);
+    }
+    let default = rows
+        .iter()
+        .max_by_key(|(_, v)| v.len())
+        .map(|(k, _)| *k)
+        .unwrap_or(&[]);
+    let indent = |c: String| c.replace('\n', "\n    ");
+    let mut s = String::from("case (slot)\n");
+    for (row, v) in &rows {
+        if *row == default {
+            continue;
+        }
+        let labels: Vec<String> = v.iter().map(|slot| format!("{sb}'d{slot}")).collect();
+        let _ = writeln!(
+            s,
+            "      {}: {}",
+            labels.join(", "),
+            indent(cycle_case(row, w, cb))
+        );
+    }
+    let _ = write!(
+        s,
+        "      default: {}\n    endcase",
+        indent(cycle_case(default, w, cb))
+    );
+    s
 }
 
 /// A case on the cycle in the slot, the most common value as the default.
@@ -711,23 +812,83 @@ mod tests {
                 width: 5,
             },
         ];
-        // w0 the recorded bits; sh equals its low 4 bits except bit 3 in cycle 2
+        // w0 the recorded bits; sh equals its low 4 bits except bit 3 in
+        // cycle 2, and bit 0 in every cycle of slot 1 (the branch is idle
+        // there: its register shifts bits the harness does not record)
         let run = |seed: u128| {
             let w: Vec<u128> = (0..24u128).map(|t| (t * 7 + seed * 13) % 32).collect();
             let sh: Vec<u128> = w
                 .iter()
                 .enumerate()
-                .map(|(t, &x)| if t % 4 == 2 { (x & 15) ^ 8 } else { x & 15 })
+                .map(|(t, &x)| {
+                    let x = if t % 4 == 2 { (x & 15) ^ 8 } else { x & 15 };
+                    if (t / 4) % 3 == 1 {
+                        x ^ 1
+                    } else {
+                        x
+                    }
+                })
                 .collect();
             vec![Some(sh), Some(w)]
         };
         let (a, b) = (run(1), run(2));
-        let g = agreement(0, &probes, &a, &b, &P).unwrap();
+        // one class for every slot: bit 0 never agrees anywhere
+        let one = vec![vec![0, 0, 0]];
+        let g = agreement(0, &probes, &a, &b, &P, &one).unwrap();
         assert_eq!((g.j, g.lo, g.m, g.from), (1, 0, 4, 0));
-        assert_eq!(g.masks, vec![15, 15, 7, 15]);
+        assert_eq!(g.masks[0], vec![14, 14, 6, 14]);
+        // active in slots 0 and 2 (classes: active after active, idle after
+        // active, active after idle): bit 0 is claimed where it agrees, and
+        // this partition wins over the single class
+        let classes = vec![vec![0, 0, 0], vec![3, 1, 2]];
+        let g = agreement(0, &probes, &a, &b, &P, &classes).unwrap();
+        assert_eq!(g.class, vec![3, 1, 2]);
+        assert_eq!(g.masks[1], vec![14, 14, 6, 14]);
+        assert_eq!(g.masks[2], vec![15, 15, 7, 15]);
+        assert_eq!(g.masks[3], vec![15, 15, 7, 15]);
+        let v = class_case(&g.class, &g.masks, g.m, 2, 2);
+        assert!(v.contains("2'd1: case (cyc)"), "{v}");
+        assert!(
+            v.contains("2'd1: case (cyc)\n          2'd2: @E = 4'h6;"),
+            "{v}"
+        );
+        assert!(
+            v.contains("default: case (cyc)\n          2'd2: @E = 4'h7;"),
+            "{v}"
+        );
         // a harness register the same in both runs is control, not data
-        assert!(agreement(0, &probes, &a, &a, &P).is_none());
+        assert!(agreement(0, &probes, &a, &a, &P, &classes).is_none());
         let control = vec![Some(vec![0u128; 24]), Some(vec![0u128; 24])];
-        assert!(agreement(0, &probes, &control, &control, &P).is_none());
+        assert!(agreement(0, &probes, &control, &control, &P, &classes).is_none());
+    }
+
+    #[test]
+    fn bits_always_zero_in_a_slot_class_are_claimed_there_only() {
+        // every bit set except bit 2, which is 0 throughout slot 1 of every
+        // frame (a register cleared when an idle slot starts)
+        let run: Vec<u128> = (0..24u64)
+            .map(|t| if (t / 4) % 3 == 1 { 0b1011 } else { 0b1111 })
+            .collect();
+        let a = Agreement {
+            j: 1,
+            lo: 0,
+            m: 4,
+            class: vec![3, 1, 2],
+            masks: vec![vec![0; 4]; 4],
+            zeros: Vec::new(),
+            from: 0,
+        };
+        let z = with_zeros(a, 4, [&run, &run], &P);
+        assert_eq!(z.zeros[1], vec![0b0100; 4]);
+        assert_eq!(z.zeros[3], vec![0; 4]);
+        assert_eq!(z.from, 0);
+        // a first frame that breaks the claim: nothing claimed before it
+        let mut late = run.clone();
+        late[5] = 0b1111;
+        let a = Agreement {
+            zeros: Vec::new(),
+            ..z
+        };
+        assert_eq!(with_zeros(a, 4, [&late, &run], &P).from, 6);
     }
 }
