@@ -520,6 +520,17 @@ fn slot_classes(s: &Schedule) -> Vec<Vec<usize>> {
         .collect()
 }
 
+/// The partitions tried against harness register `path`: a branch's
+/// capture register (`w{b}`) only by its own branch's slots (another
+/// branch's partition could fit two runs by chance and not be inductive),
+/// any other register (the merged stream's word) by every branch's.
+fn own_partition<'a>(path: &str, partitions: &'a [Vec<usize>]) -> &'a [Vec<usize>] {
+    match path.strip_prefix('w').map(str::parse::<usize>) {
+        Some(Ok(b)) if b < partitions.len() => &partitions[b..=b],
+        _ => partitions,
+    }
+}
+
 /// The bits in which a design register always agrees with a harness data
 /// register (a shift register and the MISO bits the harness recorded), per
 /// cycle in the slot and slot class, over both runs, from the frames after
@@ -563,7 +574,7 @@ fn agreement(
                     at[t % p.f as usize] &= !(a ^ (b >> lo));
                 }
             }
-            for class in partitions {
+            for class in own_partition(&q.path, partitions) {
                 let mut masks = vec![vec![full; p.c as usize]; 4];
                 for (t, &k) in at.iter().enumerate() {
                     let t = t as u64;
@@ -621,6 +632,16 @@ fn with_zeros(mut a: Agreement, w: usize, runs: [&Vec<u128>; 2], p: &Pos) -> Agr
                 a.from = a.from.max(t as u64 + 1);
             }
         }
+    }
+    // The claims start where nothing is claimed (an idle slot): starting
+    // them at any other position makes a cliff no induction step crosses
+    // (the state before claims nothing, the state after claims bits).
+    let empty = |t: u64| {
+        let (k, c) = (a.class[(t / p.c) as usize], (t % p.c) as usize);
+        a.masks[k][c] == 0 && zeros[k][c] == 0
+    };
+    if a.from > 0 {
+        a.from = (a.from..p.f).find(|&t| empty(t)).unwrap_or(p.f);
     }
     a.zeros = zeros;
     a
@@ -808,11 +829,11 @@ mod tests {
                 width: 4,
             },
             Probe {
-                path: "w0".into(),
+                path: "exp_val".into(),
                 width: 5,
             },
         ];
-        // w0 the recorded bits; sh equals its low 4 bits except bit 3 in
+        // exp_val the recorded bits; sh equals its low 4 bits except bit 3 in
         // cycle 2, and bit 0 in every cycle of slot 1 (the branch is idle
         // there: its register shifts bits the harness does not record)
         let run = |seed: u128| {
@@ -856,6 +877,10 @@ mod tests {
             v.contains("default: case (cyc)\n          2'd2: @E = 4'h7;"),
             "{v}"
         );
+        // a branch's capture register is split by its own branch's slots only
+        assert_eq!(own_partition("w1", &classes), &classes[1..]);
+        assert_eq!(own_partition("w0", &classes), &classes[..1]);
+        assert_eq!(own_partition("exp_val", &classes), &classes[..]);
         // a harness register the same in both runs is control, not data
         assert!(agreement(0, &probes, &a, &a, &P, &classes).is_none());
         let control = vec![Some(vec![0u128; 24]), Some(vec![0u128; 24])];
@@ -882,13 +907,15 @@ mod tests {
         assert_eq!(z.zeros[1], vec![0b0100; 4]);
         assert_eq!(z.zeros[3], vec![0; 4]);
         assert_eq!(z.from, 0);
-        // a first frame that breaks the claim: nothing claimed before it
+        // a first frame that breaks the claim (position 5): nothing claimed
+        // before it, and the claims start at the next position that claims
+        // nothing (8, slot 2), not at 6 where claims would appear from none
         let mut late = run.clone();
         late[5] = 0b1111;
         let a = Agreement {
             zeros: Vec::new(),
             ..z
         };
-        assert_eq!(with_zeros(a, 4, [&late, &run], &P).from, 6);
+        assert_eq!(with_zeros(a, 4, [&late, &run], &P).from, 8);
     }
 }
