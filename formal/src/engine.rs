@@ -179,7 +179,7 @@ pub fn pdr(p: &Prepared, secs: u64) -> Result<Option<Verdict>, ProveError> {
 
 /// Reads ABC's verdict: "Output 0 of miter ... was asserted in frame N." or
 /// "No output asserted in N frames.".
-fn parse_abc(out: &str, frames: u64) -> Result<Verdict, ProveError> {
+pub(crate) fn parse_abc(out: &str, frames: u64) -> Result<Verdict, ProveError> {
     for line in out.lines() {
         if let Some(i) = line.find("was asserted in frame ") {
             let n: String = line[i + 22..]

@@ -45,7 +45,7 @@ pub struct Harness {
 pub struct HarnessError(pub String);
 
 /// Bits to hold `0..n` (at least one).
-fn width(n: u64) -> u32 {
+pub(crate) fn width(n: u64) -> u32 {
     (64 - n.saturating_sub(1).leading_zeros()).max(1)
 }
 

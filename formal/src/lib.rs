@@ -14,6 +14,7 @@ pub mod engine;
 pub mod faults;
 pub mod harness;
 pub mod replay;
+pub mod strengthen;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -127,6 +128,11 @@ pub struct ProveOptions {
     pub out_dir: PathBuf,
     /// The design is slotforge's own Verilog (reported; the harness is the same).
     pub own_design: bool,
+    /// For slotforge's own Verilog with the `abc` engine: try induction
+    /// strengthened with invariants of the design's registers first
+    /// ([`strengthen`]; off by default: it does not close yet, see
+    /// docs/formal.md); off, or for `--rtl`, the recurrence argument runs alone.
+    pub strengthen: bool,
 }
 
 impl ProveOptions {
@@ -138,6 +144,7 @@ impl ProveOptions {
             bmc_timeout_s: 1800,
             out_dir: out_dir.into(),
             own_design: true,
+            strengthen: false,
         }
     }
 }
@@ -145,6 +152,10 @@ impl ProveOptions {
 /// Frames the bounded search covers when the recurrence argument fails
 /// (a design that keeps state across frames: look for its violation deeper).
 pub const DEEP_FRAMES: u64 = 8;
+
+/// Seconds the strengthened induction's `pdr` may take before `prove`
+/// falls back to the recurrence argument (it closes in seconds when it closes).
+pub const STRENGTHENED_PDR_S: u64 = 600;
 
 /// The work directory's files: the harness and the design.
 fn write_inputs(dir: &Path, h: &Harness, design: &str) -> Result<(), ProveError> {
@@ -160,8 +171,13 @@ fn write_inputs(dir: &Path, h: &Harness, design: &str) -> Result<(), ProveError>
 pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, ProveError> {
     let t0 = Instant::now();
     let h = harness::generate(s)?;
-    let work =
+    let mut work =
         tempfile::tempdir().map_err(|e| ProveError::Tool(format!("temporary directory: {e}")))?;
+    if std::env::var_os("SLOTFORGE_FORMAL_KEEP").is_some() {
+        // for inspection: the engines' files stay
+        eprintln!("formal work directory: {}", work.path().display());
+        work.disable_cleanup(true);
+    }
     write_inputs(work.path(), &h, design)?;
     let prep = engine::prepare(work.path(), opts.solver)?;
     let t1 = Instant::now();
@@ -194,7 +210,28 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         "proved for all time: no violation from reset within {base} steps, and for every input the state at step {base} recurs at step {} of a copy started a frame later, so those steps reach every reachable state (state recurrence, ABC bmc3)",
         base - f
     );
+    let strong = if opts.solver == Solver::Abc && opts.own_design && opts.strengthen {
+        Some(strengthen::prove(
+            work.path(),
+            s,
+            &h,
+            opts.timeout_s.min(STRENGTHENED_PDR_S),
+        )?)
+    } else {
+        None
+    };
     let (result, depth, note) = match opts.solver {
+        _ if strong.as_ref().is_some_and(|st| st.proved) => {
+            let st = strong.as_ref().expect("checked");
+            (
+                Outcome::Proved,
+                strengthen::K,
+                format!(
+                    "proved for all time by k-induction (k <= {}): the contract and {} invariants that tie the design's registers to the harness's frame position ({} registers in harness + design; mined from a simulation, each proved, none assumed) are inductive together (ABC ind for the step, bmc3 from reset for the base; {:.1} s)",
+                    strengthen::K, st.invariants, st.registers, st.solver_seconds
+                ),
+            )
+        }
         // Both checks in one run first (the common cases: proved, or a
         // violation from reset); the separate checks only when it cannot tell.
         Solver::Abc => match engine::combined(&prep, f, opts.timeout_s)? {
