@@ -227,6 +227,28 @@ pub(crate) fn parse_abc(out: &str, frames: u64) -> Result<Verdict, ProveError> {
 /// input breaks it (no design bug: only the argument fails); `None`: ABC
 /// did not finish.
 pub fn recurrence(p: &Prepared, frame_cycles: u64, secs: u64) -> Result<Option<bool>, ProveError> {
+    let check = 2 * frame_cycles + 2;
+    let build = crate::aiger::recurrence_miter;
+    Ok(
+        match bmc_on_miter(p, "recur.aig", build, frame_cycles, secs)? {
+            Verdict::Violated { .. } => Some(false),
+            Verdict::Bounded { steps } if steps > check => Some(true),
+            _ => None,
+        },
+    )
+}
+
+/// Builds a two-copy miter of the design (`build(aig, shared MISO inputs,
+/// F, 2F + 2)`), writes it as `name` and runs `bmc3` on it two steps past
+/// the recurrence step: the one ABC run behind [`recurrence`] and
+/// [`combined`].
+fn bmc_on_miter(
+    p: &Prepared,
+    name: &str,
+    build: fn(&crate::aiger::Aig, &[usize], u64, u64) -> Vec<u8>,
+    frame_cycles: u64,
+    secs: u64,
+) -> Result<Verdict, ProveError> {
     let aag = std::fs::read_to_string(p.dir.join("design.aag"))
         .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
     let g = crate::aiger::parse(&aag).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
@@ -235,22 +257,17 @@ pub fn recurrence(p: &Prepared, frame_cycles: u64, secs: u64) -> Result<Option<b
         .map(|&(idx, _)| idx)
         .collect::<Vec<_>>();
     let check = 2 * frame_cycles + 2;
-    let miter = crate::aiger::recurrence_miter(&g, &shared, frame_cycles, check);
-    std::fs::write(p.dir.join("recur.aig"), miter)
-        .map_err(|e| ProveError::Tool(format!("recur.aig: {e}")))?;
+    std::fs::write(p.dir.join(name), build(&g, &shared, frame_cycles, check))
+        .map_err(|e| ProveError::Tool(format!("{name}: {e}")))?;
     let frames = check + 2;
-    let cmd = format!("read_aiger recur.aig; strash; bmc3 -F {frames} -T {secs}");
+    let cmd = format!("read_aiger {name}; strash; bmc3 -F {frames} -T {secs}");
     let out = run_tool(
         &p.dir,
         "yosys-abc",
         &["-c", &cmd],
         Duration::from_secs(secs),
     )?;
-    Ok(match parse_abc(&out, frames)? {
-        Verdict::Violated { .. } => Some(false),
-        Verdict::Bounded { steps } if steps > check => Some(true),
-        _ => None,
-    })
+    parse_abc(&out, frames)
 }
 
 /// What the combined miter (`aiger::combined_miter`) found.
@@ -273,31 +290,16 @@ pub fn combined(
     frame_cycles: u64,
     secs: u64,
 ) -> Result<Option<Combined>, ProveError> {
-    let aag = std::fs::read_to_string(p.dir.join("design.aag"))
-        .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
-    let g = crate::aiger::parse(&aag).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
-    let shared = miso_inputs(p)?
-        .iter()
-        .map(|&(idx, _)| idx)
-        .collect::<Vec<_>>();
     let check = 2 * frame_cycles + 2;
-    let miter = crate::aiger::combined_miter(&g, &shared, frame_cycles, check);
-    std::fs::write(p.dir.join("combined.aig"), miter)
-        .map_err(|e| ProveError::Tool(format!("combined.aig: {e}")))?;
-    let frames = check + 2;
-    let cmd = format!("read_aiger combined.aig; strash; bmc3 -F {frames} -T {secs}");
-    let out = run_tool(
-        &p.dir,
-        "yosys-abc",
-        &["-c", &cmd],
-        Duration::from_secs(secs),
-    )?;
-    Ok(match parse_abc(&out, frames)? {
-        Verdict::Violated { step } if step < check => Some(Combined::Fails { step }),
-        Verdict::Violated { .. } => Some(Combined::AtCheck),
-        Verdict::Bounded { steps } if steps > check => Some(Combined::Holds),
-        _ => None,
-    })
+    let build = crate::aiger::combined_miter;
+    Ok(
+        match bmc_on_miter(p, "combined.aig", build, frame_cycles, secs)? {
+            Verdict::Violated { step } if step < check => Some(Combined::Fails { step }),
+            Verdict::Violated { .. } => Some(Combined::AtCheck),
+            Verdict::Bounded { steps } if steps > check => Some(Combined::Holds),
+            _ => None,
+        },
+    )
 }
 
 /// `(input index, bit)` of every `adc_miso` bit in the AIG (yosys's map).
