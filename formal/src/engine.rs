@@ -14,6 +14,9 @@ use crate::ProveError;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Solver {
+    /// Exact symbolic simulation of the AIG from reset with a state
+    /// recurrence check (`symsim.rs`): the default.
+    Symbolic,
     /// ABC over AIGER: `bmc3` from reset to the recurrence bound, and the
     /// recurrence miter (`aiger.rs`) that makes that bound cover all time.
     Abc,
@@ -27,15 +30,16 @@ impl std::str::FromStr for Solver {
     type Err = String;
     fn from_str(s: &str) -> Result<Solver, String> {
         match s {
+            "symbolic" => Ok(Solver::Symbolic),
             "abc" => Ok(Solver::Abc),
             "pdr" => Ok(Solver::Pdr),
             "cvc5" => Ok(Solver::Cvc5),
             "z3" | "boolector" => Err(format!(
                 "solver `{s}` is not supported: Debian's {s} fails on yosys 0.23's SMT-LIB \
                  output of this design (z3 never finishes reading it, boolector breaks the \
-                 pipe); use `abc` (the default), `pdr` or `cvc5`"
+                 pipe); use `symbolic` (the default), `abc`, `pdr` or `cvc5`"
             )),
-            _ => Err(format!("unknown solver `{s}` (abc, pdr, cvc5)")),
+            _ => Err(format!("unknown solver `{s}` (symbolic, abc, pdr, cvc5)")),
         }
     }
 }
@@ -43,6 +47,7 @@ impl std::str::FromStr for Solver {
 impl Solver {
     pub fn name(self) -> &'static str {
         match self {
+            Solver::Symbolic => "symbolic",
             Solver::Abc => "abc",
             Solver::Pdr => "pdr",
             Solver::Cvc5 => "cvc5",
@@ -127,7 +132,7 @@ pub fn prepare(dir: &Path, solver: Solver) -> Result<Prepared, ProveError> {
                 prep -flatten -top slotforge_formal; memory_map; opt -full; async2sync;";
     let script = match solver {
         // As SymbiYosys's `abc pdr` engine prepares an AIG (docs/formal.md).
-        Solver::Abc | Solver::Pdr => format!(
+        Solver::Symbolic | Solver::Abc | Solver::Pdr => format!(
             "{read} chformal -assume -early; setundef -anyseq; opt -full; techmap; opt -fast; \
              dffunmap; abc -g AND -fast; opt_clean; write_aiger -I -B -zinit -map design.aim design.aig; \
              write_aiger -ascii -I -B -zinit design.aag"

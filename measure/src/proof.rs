@@ -30,7 +30,7 @@ fn keyed(s: &Schedule) -> Result<(String, String), String> {
         .verilog()
         .to_string();
     let h = formal::generate(s).map_err(|e| e.to_string())?;
-    let key = formal::cache::key(&h.verilog, &design, formal::Solver::Abc);
+    let key = formal::cache::key(&h.verilog, &design, ProveOptions::new("").solver);
     Ok((design, key))
 }
 

@@ -1,4 +1,4 @@
-//! `slotforge prove MIX [--rtl FILE.v] [--solver pdr|cvc5] [--json]`
+//! `slotforge prove MIX [--rtl FILE.v] [--solver symbolic|abc|pdr|cvc5] [--json]`
 //!
 //! Exit 0: proved for all time; 1: a counterexample (its VCD, `.gtkw` and
 //! the checker's diagnosis); 2: bad input or a tool that cannot run;
@@ -15,8 +15,8 @@ pub struct Args {
     /// Prove this Verilog (a `slotforge_top` on the port contract) instead of the emitted gateware.
     #[arg(long)]
     pub rtl: Option<PathBuf>,
-    /// The engine: `abc` (bounded search to the recurrence bound + the recurrence check, default), `pdr` (ABC IC3) or `cvc5` (k-induction through yosys-smtbmc).
-    #[arg(long, default_value = "abc", value_parser = solver)]
+    /// The engine: `symbolic` (exact symbolic simulation from reset until the state recurs a frame later, default), `abc` (ABC's bounded search to the recurrence bound + the two-copy recurrence miter), `pdr` (ABC IC3) or `cvc5` (k-induction through yosys-smtbmc).
+    #[arg(long, default_value = "symbolic", value_parser = solver)]
     pub solver: Solver,
     /// Seconds each engine run may take (the search from reset, the recurrence check, pdr or cvc5).
     #[arg(long, value_parser = super::whole_number, default_value_t = 1800)]
