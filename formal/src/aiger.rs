@@ -22,6 +22,9 @@ pub struct Aig {
     pub ands: Vec<(u32, u32, u32)>,
     /// Bad-state literals (yosys `write_aiger -B`: the harness's assertions).
     pub bad: Vec<u32>,
+    /// Invariant constraints (assumptions): the engines here support none,
+    /// and refuse an AIG that has any rather than ignore them.
+    pub constraints: Vec<u32>,
 }
 
 pub fn parse(text: &str) -> Result<Aig, String> {
@@ -66,6 +69,7 @@ pub fn parse(text: &str) -> Result<Aig, String> {
         latches: Vec::new(),
         ands: Vec::new(),
         bad: Vec::new(),
+        constraints: Vec::new(),
     };
     for _ in 0..i {
         g.inputs.push(nums(1)?[0]);
@@ -74,7 +78,7 @@ pub fn parse(text: &str) -> Result<Aig, String> {
         let v = nums(2)?;
         g.latches.push((v[0], v[1], v.get(2).copied().unwrap_or(0)));
     }
-    // Outputs and constraints are not used; bad states are the harness's
+    // Outputs are not used; bad states are the harness's
     // assertions (the combined miter checks them on copy A).
     for _ in 0..o {
         nums(1)?;
@@ -83,7 +87,7 @@ pub fn parse(text: &str) -> Result<Aig, String> {
         g.bad.push(nums(1)?[0]);
     }
     for _ in 0..c {
-        nums(1)?;
+        g.constraints.push(nums(1)?[0]);
     }
     if j + f > 0 {
         return Err("justice/fairness properties are not supported".into());

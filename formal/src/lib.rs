@@ -14,7 +14,6 @@ pub mod engine;
 pub mod faults;
 pub mod harness;
 pub mod replay;
-pub mod strengthen;
 pub mod symsim;
 
 use std::path::{Path, PathBuf};
@@ -129,11 +128,6 @@ pub struct ProveOptions {
     pub out_dir: PathBuf,
     /// The design is slotforge's own Verilog (reported; the harness is the same).
     pub own_design: bool,
-    /// For slotforge's own Verilog with the `abc` engine: try induction
-    /// strengthened with invariants of the design's registers first
-    /// ([`strengthen`]; off by default: it does not close yet, see
-    /// docs/formal.md); off, or for `--rtl`, the recurrence argument runs alone.
-    pub strengthen: bool,
 }
 
 impl ProveOptions {
@@ -145,7 +139,6 @@ impl ProveOptions {
             bmc_timeout_s: 1800,
             out_dir: out_dir.into(),
             own_design: true,
-            strengthen: false,
         }
     }
 }
@@ -153,10 +146,6 @@ impl ProveOptions {
 /// Frames the bounded search covers when the recurrence argument fails
 /// (a design that keeps state across frames: look for its violation deeper).
 pub const DEEP_FRAMES: u64 = 8;
-
-/// Seconds the strengthened induction's `pdr` may take before `prove`
-/// falls back to the recurrence argument (it closes in seconds when it closes).
-pub const STRENGTHENED_PDR_S: u64 = 600;
 
 /// The work directory's files: the harness and the design.
 fn write_inputs(dir: &Path, h: &Harness, design: &str) -> Result<(), ProveError> {
@@ -211,28 +200,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         "proved for all time: no violation from reset within {base} steps, and for every input the state at step {base} recurs at step {} of a copy started a frame later, so those steps reach every reachable state (state recurrence, ABC bmc3)",
         base - f
     );
-    let strong = if opts.solver == Solver::Abc && opts.own_design && opts.strengthen {
-        Some(strengthen::prove(
-            work.path(),
-            s,
-            &h,
-            opts.timeout_s.min(STRENGTHENED_PDR_S),
-        )?)
-    } else {
-        None
-    };
     let (result, depth, note) = match opts.solver {
-        _ if strong.as_ref().is_some_and(|st| st.proved) => {
-            let st = strong.as_ref().expect("checked");
-            (
-                Outcome::Proved,
-                strengthen::K,
-                format!(
-                    "proved for all time by k-induction (k <= {}): the contract and {} invariants that tie the design's registers to the harness's frame position ({} registers in harness + design; mined from a simulation, each proved, none assumed) are inductive together (ABC ind for the step, bmc3 from reset for the base; {:.1} s)",
-                    strengthen::K, st.invariants, st.registers, st.solver_seconds
-                ),
-            )
-        }
         Solver::Symbolic => symbolic(&prep, f, opts)?,
         // Both checks in one run first (the common cases: proved, or a
         // violation from reset); the separate checks only when it cannot tell.
@@ -380,17 +348,23 @@ fn symbolic(
     let text = std::fs::read_to_string(prep.dir.join("design.aag"))
         .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
     let g = aiger::parse(&text).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
+    if !g.constraints.is_empty() {
+        // every input is free in every step: an assumption would be ignored
+        return Err(ProveError::Tool(
+            "the harness assumes something about its inputs, which the symbolic engine cannot honour; use --solver abc".into(),
+        ));
+    }
     let limit = opts.depth.unwrap_or(0).max(DEEP_FRAMES * f + 2);
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
     let (found, st) = symsim::run(&g, f, 2, limit, Some(deadline));
     Ok(match found {
-        symsim::Found::Proved { steps } => (
+        symsim::Found::Proved { steps, since } => (
             Outcome::Proved,
             steps,
             format!(
-                "proved for all time: every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} assertions needed a SAT call), and the state at step {steps} is the state at step {} with every input a frame later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
+                "proved for all time: every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} assertions needed a SAT call), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
                 st.sat_calls,
-                steps - f,
+                (steps - since) / f,
                 st.state_nodes
             ),
         ),
@@ -412,7 +386,7 @@ fn symbolic(
             format!(
                 "NOT a proof: {}; no violation from reset within {steps} steps ({} cycles after reset, {:.2} frames)",
                 if steps >= limit {
-                    "the design's state does not recur a frame later (it keeps state older than a frame), so no bound covers all time".to_string()
+                    format!("the design's state does not come round after whole frames (it keeps state older than a frame: {}), so no bound covers all time", latch_names(prep, &st.kept))
                 } else {
                     format!("the simulation stopped at its time limit ({} s)", opts.timeout_s)
                 },
@@ -421,6 +395,21 @@ fn symbolic(
             ),
         ),
     })
+}
+
+/// The register names of AIG latches (yosys's map), each once.
+fn latch_names(prep: &engine::Prepared, latches: &[usize]) -> String {
+    let aim = std::fs::read_to_string(prep.dir.join("design.aim")).unwrap_or_default();
+    let mut names: Vec<&str> = aim
+        .lines()
+        .filter_map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            let j: usize = f.get(1)?.parse().ok()?;
+            (f.len() == 4 && f[0] == "latch" && latches.contains(&j)).then_some(f[3])
+        })
+        .collect();
+    names.dedup();
+    names.join(", ")
 }
 
 /// The cycle at which the judge rejects a trace: its first divergence from

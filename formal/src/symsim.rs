@@ -16,13 +16,14 @@
 //!
 //! Soundness of "proved": the state at step `T` is a function `G_T` of the
 //! power-on inputs `P` (step 0) and of input variables of earlier steps.  If
-//! the state at `T + F` is the *same graph* as at `T` with every input of
-//! step `s >= 1` renamed to step `s + F` (checked exactly by a canonical
-//! serialization, not a hash), then `G_{T+F}(P, w) = G_T(P, w')` with the
-//! window `w` shifted by `F`; as every input variable ranges freely, the sets
-//! of states reachable at `T` and `T + F` are equal.  The machine being
-//! deterministic given its inputs, every step after `T + F` reaches only
-//! states reached at some step in `T .. T + F`.  Every step before `T + F`
+//! the state at `T + D` (`D` a whole number of frames) is the *same graph*
+//! as at `T` with every input of step `s >= 1` renamed to step `s + D`
+//! (checked exactly by a canonical serialization, not a hash), then
+//! `G_{T+D}(P, w) = G_T(P, w')` with the window `w` shifted by `D`; as every
+//! input variable ranges freely, the sets of states reachable at `T` and
+//! `T + D` are equal.  The machine being deterministic given its inputs,
+//! every step after `T + D` reaches only states reached at some step in
+//! `T .. T + D`.  Every step before `T + D`
 //! was checked exactly (a non-constant assertion goes to a SAT solver), so
 //! the assertions hold in every reachable state: a proof for all time.  A
 //! satisfiable assertion is a real trace from reset (the simulation is
@@ -105,7 +106,7 @@ impl Graph {
         let mut map = vec![0u32; n];
         let (mut a, mut b) = (vec![0u32], vec![0u32]);
         let mut table = FxHashMap::default();
-        let lit = |map: &[u32], l: u32| map[(l >> 1) as usize] * 2 | (l & 1);
+        let lit = |map: &[u32], l: u32| (map[(l >> 1) as usize] * 2) | (l & 1);
         for i in 1..n {
             if !live[i] {
                 continue;
@@ -270,8 +271,9 @@ impl Graph {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Found {
     /// No assertion fails in steps `0..steps`, and the state at step
-    /// `steps` recurs (up to renaming) that at `steps - period`.
-    Proved { steps: u64 },
+    /// `steps` is (up to renaming) the state at step `since`, a whole
+    /// number of periods earlier.
+    Proved { steps: u64, since: u64 },
     /// An assertion fails at `step`; `inputs[s][i]` is input `i` at step `s`.
     Violated { step: u64, inputs: Vec<Vec<bool>> },
     /// No assertion fails in steps `0..steps`; nothing is said beyond.
@@ -287,12 +289,16 @@ pub struct Stats {
     pub peak_nodes: usize,
     /// Live nodes of the state at the recurrence (its size).
     pub state_nodes: usize,
+    /// Without a recurrence: the latches (AIG order) whose value at the
+    /// last comparison differed from a period earlier, the state the
+    /// design keeps across frames.
+    pub kept: Vec<usize>,
 }
 
-/// Simulates `g` from power-on: the state is compared (up to renaming) at
-/// steps `offset + k * period` for `k >= 1` with the one a period earlier;
-/// the run stops at a recurrence, a failing assertion, `max_steps` or
-/// `deadline`.
+/// Simulates `g` from power-on: the state at each step `offset + k *
+/// period` is compared (up to renaming) with those of the earlier such
+/// steps; the run stops at a recurrence, a failing assertion, `max_steps`
+/// or `deadline`.
 pub fn run(
     g: &Aig,
     period: u64,
@@ -318,20 +324,26 @@ pub fn run(
         })
         .collect();
     let bad_lits: Vec<u32> = g.bad.clone();
-    let mut prev: Option<Vec<u64>> = None;
+    // every period boundary's state, canonical: a state at `offset + k *
+    // period` equal to an earlier boundary's closes the search (a FIFO's
+    // pointers may need several frames to come round)
+    let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
+    let mut prev_state: Vec<u32> = Vec::new();
     let mut gc_at = 1usize << 20;
     for step in 0..max_steps {
-        if step >= offset + period && (step - offset) % period == 0 {
+        if step >= offset && (step - offset).is_multiple_of(period) {
             let now = canonical_state(&gr, &state, step);
-            if prev.as_ref() == Some(&now) {
+            if let Some(&since) = seen.get(&now) {
                 stats.state_nodes = live_nodes(&gr, &state);
-                return (Found::Proved { steps: step }, stats);
+                return (Found::Proved { steps: step, since }, stats);
             }
-            prev = Some(now);
-        } else if step == offset {
-            prev = Some(canonical_state(&gr, &state, step));
+            if step > offset {
+                stats.kept = kept(&gr, &prev_state, &state, step, period);
+            }
+            seen.insert(now, step);
+            prev_state.clone_from(&state);
         }
-        if step % 4096 == 0 && deadline.is_some_and(|d| Instant::now() > d) {
+        if step.is_multiple_of(4096) && deadline.is_some_and(|d| Instant::now() > d) {
             return (Found::Bounded { steps: step }, stats);
         }
         let st = step as u32;
@@ -370,7 +382,10 @@ pub fn run(
         }
         if gr.a.len() > gc_at {
             stats.peak_nodes = stats.peak_nodes.max(gr.a.len());
+            let n = state.len();
+            state.append(&mut prev_state);
             gr.collect(&mut state);
+            prev_state = state.split_off(n);
             gc_at = (1 << 20).max(4 * gr.a.len());
         }
     }
@@ -380,6 +395,18 @@ pub fn run(
 
 fn canonical_state(gr: &Graph, state: &[u32], step: u64) -> Vec<u64> {
     gr.canonical(state, step as u32)
+}
+
+/// The latches whose value at `step` is not their value a period earlier
+/// (up to the renaming of the inputs).
+fn kept(gr: &Graph, before: &[u32], now: &[u32], step: u64, period: u64) -> Vec<usize> {
+    (0..now.len())
+        .filter(|&j| {
+            before.get(j).is_none_or(|&b| {
+                gr.canonical(&[b], (step - period) as u32) != gr.canonical(&[now[j]], step as u32)
+            })
+        })
+        .collect()
 }
 
 fn live_nodes(gr: &Graph, state: &[u32]) -> usize {
@@ -453,7 +480,13 @@ mod tests {
     #[test]
     fn a_forgetting_design_proves_at_its_recurrence() {
         let (f, st) = run(&counter_and_shift(false), 4, 2, 100, None);
-        assert_eq!(f, Found::Proved { steps: 10 });
+        assert_eq!(
+            f,
+            Found::Proved {
+                steps: 10,
+                since: 6
+            }
+        );
         assert_eq!(st.sat_calls, 0, "the equal bits fold to a constant");
     }
 
@@ -472,12 +505,19 @@ mod tests {
     }
 
     #[test]
-    fn a_design_that_never_recurs_is_only_bounded() {
-        // one latch toggled by itself keeps period 2; with period 3 given,
-        // the states at steps 5 and 8 differ (0 and 1... ) as do all later
+    fn a_state_that_comes_round_after_several_periods_proves_there() {
+        // one latch toggled every step has period 2; compared every 3
+        // steps from step 2, it differs at 5 and equals step 2's at 8
         let g = parse("aag 1 0 1 0 0 0\n2 3 0\n").unwrap();
-        let (f, _) = run(&g, 3, 2, 50, None);
-        assert_eq!(f, Found::Bounded { steps: 50 });
+        let (f, st) = run(&g, 3, 2, 50, None);
+        assert_eq!(f, Found::Proved { steps: 8, since: 2 });
+        assert_eq!(st.kept, vec![0], "the latch that changed over a period");
+        let (f, _) = run(&g, 3, 2, 8, None);
+        assert_eq!(
+            f,
+            Found::Bounded { steps: 8 },
+            "no claim before the recurrence"
+        );
     }
 
     #[test]

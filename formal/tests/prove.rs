@@ -8,8 +8,8 @@
 //! `cosim::mixgen` proves.
 //! Long (`make test-long`): every preset and the 16-branch / 1,024-channel
 //! test mixes prove; six random mixes prove; the mutant campaign; the deep
-//! fault classes against a three-frame simulation; `--invariants` proves
-//! softslip1k by k-induction and not the frame-5 fault.
+//! fault classes against a three-frame simulation; the `symbolic` and `abc`
+//! engines agree.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -146,38 +146,6 @@ fn a_fault_after_five_frames_fails_and_is_never_called_proved() {
         "{}",
         p.summary()
     );
-}
-
-/// `--invariants`: contract + mined invariants close by k-induction on the
-/// smallest preset (a branch that converts in every slot), and the same
-/// strengthening does not prove a design that breaks the contract after
-/// five frames (mined from two clean frames, its candidates are not
-/// inductive there: the engine falls back, never "proved").  About three
-/// minutes (two mining runs of two 120,000-cycle frames each, twice).
-#[test]
-#[ignore = "long: make test-long"]
-fn strengthened_induction_proves_the_clean_design_and_not_a_late_fault() {
-    if !tools::require_tools(&TOOLS) {
-        return;
-    }
-    let s = schedule("mixes/softslip1k.toml");
-    let dir = tempfile::tempdir().unwrap();
-    let mut o = ProveOptions::new(dir.path());
-    o.strengthen = true;
-    let p = formal::prove(&s, &emitted(&s), &o).expect("prove runs");
-    eprintln!("{}", p.summary());
-    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
-    assert!(p.note.contains("k-induction"), "{}", p.summary());
-    let h = formal::generate(&s).unwrap();
-    let late = DeepFault::LateCounter { frames: 5 }
-        .apply(&s, &emitted(&s))
-        .unwrap();
-    let work = tempfile::tempdir().unwrap();
-    std::fs::write(work.path().join("harness.v"), &h.verilog).unwrap();
-    std::fs::write(work.path().join("design.v"), &late).unwrap();
-    let st = formal::strengthen::prove(work.path(), &s, &h, 120).expect("runs");
-    assert!(!st.proved, "a design that fails in frame 5 is never proved");
-    assert!(st.invariants > 0);
 }
 
 /// Random mixes from the one generator (`cosim::mixgen`), on a 4 MHz clock
@@ -369,5 +337,41 @@ fn deep_faults_escape_three_frames_of_simulation_and_fail_prove() {
         let p = prove(&s, &design, dir.path());
         eprintln!("{}: simulation passes; prove:\n{}", f.name(), p.summary());
         assert_counterexample(&s, &p);
+    }
+}
+
+/// The two engines that prove for all time, by different arguments, agree:
+/// on the clean design both prove at the same recurrence depth; on the
+/// frame-5 late counter and on an output mutant both fail at the same step
+/// (both search from reset step by step, so both find the first violation).
+#[test]
+#[ignore = "long: make test-long"]
+fn the_symbolic_and_abc_engines_agree() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("cosim/tests/data/mutants.toml");
+    let stuck = mutants(&s)
+        .into_iter()
+        .find(|m| m.site.op == mutate::Operator::Stuck)
+        .expect("a stuck-output mutant")
+        .text;
+    let late = DeepFault::LateCounter { frames: 5 }
+        .apply(&s, &emitted(&s))
+        .unwrap();
+    for (what, design) in [("clean", emitted(&s)), ("stuck", stuck), ("late", late)] {
+        let run = |solver: formal::Solver| {
+            let dir = tempfile::tempdir().unwrap();
+            let mut o = ProveOptions::new(dir.path());
+            o.solver = solver;
+            let p = formal::prove(&s, &design, &o).expect("prove runs");
+            eprintln!("{what}: {}", p.summary());
+            (p.result, p.depth, p.cycle)
+        };
+        assert_eq!(
+            run(formal::Solver::Symbolic),
+            run(formal::Solver::Abc),
+            "{what}"
+        );
     }
 }

@@ -30,11 +30,6 @@ pub struct Args {
     /// Also write the generated harness here.
     #[arg(long)]
     pub harness: Option<PathBuf>,
-    /// Experimental (abc, slotforge's own Verilog): first try induction strengthened with
-    /// invariants of the design's registers mined from a simulation (docs/formal.md); it does
-    /// not close yet, and the recurrence argument then runs as without it.
-    #[arg(long)]
-    pub invariants: bool,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -94,7 +89,6 @@ pub fn run(a: Args) -> u8 {
     opts.bmc_timeout_s = a.timeout;
     opts.depth = a.depth;
     opts.own_design = own;
-    opts.strengthen = a.invariants;
     let proof = match formal::prove(&s, &design, &opts) {
         Ok(p) => p,
         Err(e) => {
