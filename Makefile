@@ -102,6 +102,7 @@ bench:
 	$(CARGO) bench -p judge --bench check_vs_wellen
 	$(CARGO) bench -p lut-gen --bench synthesis
 	$(CARGO) bench -p cosim --bench cosim
+	$(CARGO) bench -p formal --bench engines
 
 # Long-running fuzzing of the mix parser and the VCD reader (not part of `make test`;
 # docs/fuzzing.md).  Crashes and hangs land in fuzz/crashes/; exit 1 if any.

@@ -62,8 +62,17 @@ impl Graph {
         (self.a.len() as u32 - 1) * 2
     }
 
-    #[inline]
+    /// Nearly every gate's fanins are constants once the control has left
+    /// reset: that case is one well-predicted branch.
+    #[inline(always)]
     fn and(&mut self, x: u32, y: u32) -> u32 {
+        if (x | y) < 2 {
+            return x & y;
+        }
+        self.and_symbolic(x, y)
+    }
+
+    fn and_symbolic(&mut self, x: u32, y: u32) -> u32 {
         if x == 0 || y == 0 || x == y ^ 1 {
             return 0;
         }
