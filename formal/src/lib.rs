@@ -362,7 +362,9 @@ fn symbolic(
             Outcome::Proved,
             steps,
             format!(
-                "proved for all time: every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} assertions needed a SAT call), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
+                "proved for all time: every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} latches, {} gates; {} assertions needed a SAT call), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
+                g.latches.len(),
+                g.ands.len(),
                 st.sat_calls,
                 (steps - since) / f,
                 st.state_nodes
