@@ -1197,4 +1197,118 @@ mod adversarial {
     fn text_of(g: &Aig) -> String {
         format!("{g:?}")
     }
+
+    /// A random graph over inputs 0..3 of steps 0..6; returns the literals
+    /// of its variables by (input, step) and of every node made.
+    fn random_graph(rng: &mut Rng) -> (Graph, HashMap<(u32, u32), u32>, Vec<u32>) {
+        let mut gr = Graph::new();
+        let mut vars = HashMap::new();
+        let mut lits = Vec::new();
+        for s in 0..7 {
+            for i in 0..3 {
+                let v = gr.var(i, s);
+                vars.insert((i, s), v);
+                lits.push(v);
+            }
+        }
+        for _ in 0..300 {
+            let pick = |rng: &mut Rng, lits: &[u32]| {
+                lits[rng.below(lits.len() as u64) as usize] ^ rng.below(2) as u32
+            };
+            let (x, y) = (pick(rng, &lits), pick(rng, &lits));
+            let a = gr.and(x, y);
+            lits.push(a);
+        }
+        (gr, vars, lits)
+    }
+
+    /// `lit` with every variable of step `s >= 1` moved to step `s + 1`.
+    fn shifted(gr: &mut Graph, vars: &HashMap<(u32, u32), u32>, lit: u32) -> Option<u32> {
+        let n = (lit >> 1) as usize;
+        let c = lit & 1;
+        if n == 0 {
+            return Some(lit);
+        }
+        if gr.is_var(n) {
+            let (i, s) = (gr.a[n] & !VAR, gr.b[n]);
+            let s = if s == 0 { 0 } else { s + 1 };
+            return vars.get(&(i, s)).map(|&v| v ^ c);
+        }
+        let (x, y) = (gr.a[n], gr.b[n]);
+        let (x, y) = (shifted(gr, vars, x)?, shifted(gr, vars, y)?);
+        Some(gr.and(x, y) ^ c)
+    }
+
+    #[test]
+    fn the_canonical_form_equates_only_renamings() {
+        // sound: equal forms at `now` and `now + 1` only for a literal and
+        // its shift by one step (and one form at one step for one literal);
+        // complete here: a literal and its shift always give equal forms
+        let mut rng = Rng(0xDEAD_BEEF_CAFE_F00D);
+        let mut renamings = 0;
+        for _ in 0..20 {
+            let (mut gr, vars, lits) = random_graph(&mut rng);
+            let mut sample: Vec<u32> = (0..30)
+                .map(|_| lits[rng.below(lits.len() as u64) as usize] ^ rng.below(2) as u32)
+                .collect();
+            let shifts: Vec<Option<u32>> =
+                sample.iter().map(|&a| shifted(&mut gr, &vars, a)).collect();
+            sample.extend(shifts.iter().flatten());
+            let forms: Vec<(Vec<u64>, Vec<u64>)> = sample
+                .iter()
+                .map(|&l| (gr.canonical(&[l], 8), gr.canonical(&[l], 9)))
+                .collect();
+            for (i, &a) in sample.iter().enumerate() {
+                let sa = shifts
+                    .get(i)
+                    .copied()
+                    .unwrap_or_else(|| shifted(&mut gr, &vars, a));
+                if let Some(sa) = sa {
+                    assert_eq!(gr.canonical(&[sa], 9), forms[i].0, "incomplete");
+                }
+                for (j, &b) in sample.iter().enumerate() {
+                    if forms[i].0 == forms[j].0 {
+                        assert_eq!(a, b, "two literals, one form at the same step");
+                    }
+                    if forms[i].0 == forms[j].1 {
+                        assert_eq!(sa, Some(b), "equal forms, not a renaming");
+                        renamings += 1;
+                    }
+                }
+            }
+        }
+        assert!(renamings > 200, "too few renamings compared: {renamings}");
+    }
+
+    #[test]
+    fn collection_keeps_random_states_and_their_forms() {
+        let mut rng = Rng(0x0123_4567_89AB_CDEF);
+        for _ in 0..50 {
+            let (mut gr, _, lits) = random_graph(&mut rng);
+            let mut roots: Vec<u32> = (0..8)
+                .map(|_| lits[rng.below(lits.len() as u64) as usize] ^ rng.below(2) as u32)
+                .collect();
+            let before = gr.canonical(&roots, 9);
+            let old = roots.clone();
+            gr.collect(&mut roots);
+            assert_eq!(gr.canonical(&roots, 9), before);
+            // the rebuilt table hash-conses: rebuilding a root's gate finds it
+            for &r in &roots {
+                let n = (r >> 1) as usize;
+                if n != 0 && !gr.is_var(n) {
+                    let len = gr.a.len();
+                    let (x, y) = (gr.a[n], gr.b[n]);
+                    assert_eq!(gr.and(x, y), r & !1);
+                    assert_eq!(gr.a.len(), len, "a duplicate node after collection");
+                }
+            }
+            // fanins below their node (topological)
+            for n in 1..gr.a.len() {
+                if !gr.is_var(n) {
+                    assert!((gr.a[n] >> 1) < n as u32 && (gr.b[n] >> 1) < n as u32);
+                }
+            }
+            assert_eq!(old.len(), roots.len());
+        }
+    }
 }
