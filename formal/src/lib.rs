@@ -354,7 +354,7 @@ fn symbolic(
             "the harness assumes something about its inputs, which the symbolic engine cannot honour; use --solver abc".into(),
         ));
     }
-    let limit = opts.depth.unwrap_or(0).max(DEEP_FRAMES * f + 2);
+    let limit = opts.depth.unwrap_or(DEEP_FRAMES * f + 2);
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
     let (found, st) = symsim::run(&g, f, 2, limit, Some(deadline));
     Ok(match found {
