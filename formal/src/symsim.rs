@@ -36,6 +36,9 @@ use rustc_hash::FxHashMap;
 
 use crate::aiger::Aig;
 
+/// A variable's value in a SAT model: (input, step, value).
+type Assigned = (u32, u32, bool);
+
 /// Marks a variable node: `a = VAR | input`, `b = step`.
 const VAR: u32 = 1 << 31;
 
@@ -227,7 +230,7 @@ impl Graph {
     /// An assignment of the variables under `lit` that makes it true,
     /// `Ok(None)` if none does (Tseitin encoding of its cone, splr), `Err`
     /// if the solver gave no answer (never read as "holds").
-    fn satisfy(&self, lit: u32) -> Result<Option<Vec<(u32, u32, bool)>>, String> {
+    fn satisfy(&self, lit: u32) -> Result<Option<Vec<Assigned>>, String> {
         let mut index: HashMap<usize, i32> = HashMap::new();
         let mut stack = vec![(lit >> 1) as usize];
         let mut cone = Vec::new();
