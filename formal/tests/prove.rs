@@ -242,6 +242,10 @@ fn every_preset_and_the_largest_test_mixes_prove() {
         .unwrap()
         .map(|e| format!("mixes/{}", e.unwrap().file_name().to_string_lossy()))
         .filter(|n| n.ends_with(".toml"))
+        // An AXI4-Stream link is not proved for all time yet (docs/formal.md,
+        // Limits): its free `tready` makes the FIFO's state depend on the
+        // slave, and `tdata` carries the 8-bit frame counter.
+        .filter(|n| !n.contains("-axis"))
         .collect();
     mixes.sort();
     mixes.push("hdl/tests/data/b16.toml".into());
