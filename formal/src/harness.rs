@@ -16,6 +16,9 @@ use lut_gen::parts::Start;
 use lut_gen::ports::{Layout, Role, TOP_MODULE};
 use lut_gen::Schedule;
 
+mod link;
+pub use link::TREADY_ANY;
+
 /// The module name of the harness.
 pub const HARNESS_MODULE: &str = "slotforge_formal";
 
@@ -30,11 +33,22 @@ pub struct PropertyDef {
     pub what: String,
 }
 
+/// A free input of the harness module (besides `clk`): what the engine
+/// may choose in every step.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FreeInput {
+    pub name: String,
+    pub width: u32,
+}
+
 /// A generated harness.
 #[derive(Debug, Clone)]
 pub struct Harness {
     pub verilog: String,
     pub properties: Vec<PropertyDef>,
+    /// The module's free inputs in port order: `adc_miso` first, then the
+    /// AXI4-Stream slave's [`TREADY_ANY`] for a mix with that link.
+    pub inputs: Vec<FreeInput>,
     /// Cycles of one frame (the period of the control path).
     pub frame_cycles: u64,
 }
@@ -89,6 +103,17 @@ fn branch_tables(s: &Schedule, layout: &Layout, b: usize) -> BranchTables {
     BranchTables { lead, mux0, mux1 }
 }
 
+/// The harness module's free inputs for `s` (see [`Harness::inputs`]);
+/// `s` must be within the contract's limits.
+pub fn free_inputs(s: &Schedule) -> Vec<FreeInput> {
+    let mut inputs = vec![FreeInput {
+        name: "adc_miso".into(),
+        width: s.branches.len() as u32,
+    }];
+    inputs.extend(link::inputs(&Layout::new(s)));
+    inputs
+}
+
 /// Generates the harness for `s`.
 pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
     Layout::fits(s).map_err(HarnessError)?;
@@ -98,14 +123,6 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
             "mix `{}`: a frame of {} slots is beyond the formal harness's {MAX_FRAME_SLOTS}",
             s.mix.name, g.frame_slots
         )));
-    }
-    if let Some(l) = &s.mix.link {
-        if l.kind == lut_gen::mix::LinkKind::Axis {
-            return Err(HarnessError(format!(
-                "mix `{}`: an AXI4-Stream link (its `tready` input and beats) is not in the formal harness yet; prove the same mix without `[link]`, or with a UART link",
-                s.mix.name
-            )));
-        }
     }
     let layout = Layout::new(s);
     let nb = s.branches.len();
@@ -136,7 +153,7 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
     }
     merger(&mut v, &mut props, s, &layout);
     if layout.link {
-        link(&mut v, &mut props);
+        link::properties(&mut v, &mut props, s, &layout);
     }
     let _ = writeln!(v, "  wire ok = {};", {
         let w: Vec<&str> = props
@@ -150,6 +167,7 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
     Ok(Harness {
         verilog: v,
         properties: props,
+        inputs: free_inputs(s),
         frame_cycles: g.frame_cycles,
     })
 }
@@ -158,12 +176,16 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout) {
     let g = &s.grid;
     let nb = s.branches.len();
     let w = |r: Role| layout.width(r);
+    let extra: String = link::inputs(layout)
+        .iter()
+        .map(|i| format!(",\n  input {}", i.name))
+        .collect();
     let _ = writeln!(
         v,
         "// slotforge prove: formal harness of mix `{}`, generated from its schedule.\n\
          // rst is high in step 0 only; adc_miso is free; every output is asserted\n\
          // equal to docs/timing.md's value from the reset cycle (step 1) on.\n\
-         module {HARNESS_MODULE} (\n  input clk,\n  input [{}:0] adc_miso\n);",
+         module {HARNESS_MODULE} (\n  input clk,\n  input [{}:0] adc_miso{extra}\n);",
         s.mix.name,
         nb - 1
     );
@@ -179,13 +201,9 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout) {
         w(Role::SampleChannel) - 1,
         w(Role::SampleValue) - 1
     );
-    // A mix with a link has its two ports after the contract's (LINK_PORTS).
-    let link_ports = if layout.link {
-        v.push_str("  wire link_tx, link_overflow;\n");
-        ",\n    .link_tx(link_tx), .link_overflow(link_overflow)"
-    } else {
-        ""
-    };
+    // A mix with a link has its ports after the contract's (Layout::link_ports).
+    link::declare(v, s, layout);
+    let link_ports = link::connections(layout);
     let _ = writeln!(
         v,
         "  {TOP_MODULE} dut (.clk(clk), .rst(rst), .adc_miso(adc_miso), .adc_cs_n(adc_cs_n),\n    \
@@ -470,22 +488,6 @@ fn merger(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
             what: what.into(),
         });
     }
-}
-
-/// The link to the host (a mix with `[link]`): its FIFO never overflows.
-/// The UART line's bit stream (packets, CRC) is not asserted: `link_tx` is
-/// connected so the design keeps its link, but only `link_overflow` is
-/// checked (docs/formal.md, Limits).
-fn link(v: &mut String, props: &mut Vec<PropertyDef>) {
-    v.push_str(
-        "\n  // The link's FIFO never drops a token: link_overflow stays low.\n  \
-         wire ok_link_overflow = link_overflow == 1'b0;\n",
-    );
-    props.push(PropertyDef {
-        name: "link.overflow".into(),
-        wire: "ok_link_overflow".into(),
-        what: "the link's FIFO never overflows: link_overflow stays low for any input".into(),
-    });
 }
 
 #[cfg(test)]

@@ -152,12 +152,27 @@ fn mining_steps(s: &Schedule) -> u64 {
 /// The Icarus bench that logs every change of every probe with its step.
 fn mining_bench(s: &Schedule, probes: &[Probe], steps: u64) -> String {
     let nb = s.branches.len();
+    // The harness's other free inputs (the AXI4-Stream slave's early tready)
+    // are drawn like MISO.
+    let others = crate::harness::free_inputs(s).split_off(1);
+    let regs: String = others
+        .iter()
+        .map(|i| format!("  reg [{}:0] {} = 0;\n", i.width - 1, i.name))
+        .collect();
+    let ports: String = others
+        .iter()
+        .map(|i| format!(", .{0}({0})", i.name))
+        .collect();
+    let draw: String = others
+        .iter()
+        .map(|i| format!(" {} = $random(seed);", i.name))
+        .collect();
     let mut v = String::new();
     let _ = writeln!(
         v,
-        "`timescale 1ns/1ns\nmodule mine_tb;\n  reg clk = 1'b0;\n  reg [{}:0] adc_miso = 0;\n  \
+        "`timescale 1ns/1ns\nmodule mine_tb;\n  reg clk = 1'b0;\n  reg [{}:0] adc_miso = 0;\n{regs}  \
          integer edges = 0;\n  integer fd;\n  integer i;\n  integer seed;\n  \
-         slotforge_formal h (.clk(clk), .adc_miso(adc_miso));",
+         slotforge_formal h (.clk(clk), .adc_miso(adc_miso){ports});",
         nb - 1
     );
     for (i, p) in probes.iter().enumerate() {
@@ -177,7 +192,7 @@ fn mining_bench(s: &Schedule, probes: &[Probe], steps: u64) -> String {
     }
     let _ = writeln!(
         v,
-        "    for (i = 0; i < {steps}; i = i + 1) begin\n      adc_miso = $random(seed);\n      \
+        "    for (i = 0; i < {steps}; i = i + 1) begin\n      adc_miso = $random(seed);{draw}\n      \
          #1 edges = edges + 1; clk = 1'b1;\n      #1 clk = 1'b0;\n    end\n    \
          $fclose(fd);\n    $finish;\n  end\nendmodule"
     );

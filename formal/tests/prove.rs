@@ -262,6 +262,131 @@ fn harness_is_deterministic_and_names_every_contract_property() {
     );
 }
 
+/// A small AXI4-Stream mix: `tiny` (4 MHz, 4,000-cycle frame) with a
+/// slave that takes every beat within 8 cycles.
+fn tiny_axis() -> lut_gen::Schedule {
+    let path = root().join("cosim/tests/data/tiny.toml");
+    let text = std::fs::read_to_string(&path).unwrap()
+        + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 8\n";
+    let mix = lut_gen::parse(Path::new("tiny-axis.toml"), &text).expect("parses");
+    lut_gen::synthesize(&mix).expect("feasible")
+}
+
+/// ABC's bounded search from reset of harness + `design`, `steps` deep.
+fn bmc(s: &lut_gen::Schedule, design: &str, steps: u64) -> formal::engine::Verdict {
+    let h = formal::generate(s).expect("a harness");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("harness.v"), &h.verilog).unwrap();
+    std::fs::write(dir.path().join("design.v"), design).unwrap();
+    let prep = formal::engine::prepare(dir.path(), formal::Solver::Abc).expect("yosys");
+    formal::engine::bmc(&prep, steps, 300).expect("bmc3 runs")
+}
+
+/// `design` with `from` replaced by `to` exactly once (the test fails if
+/// the emitted link no longer has the line, rather than testing nothing).
+fn edit(design: &str, from: &str, to: &str) -> String {
+    assert_eq!(
+        design.matches(from).count(),
+        1,
+        "`{from}` in the emitted link"
+    );
+    design.replacen(from, to, 1)
+}
+
+#[test]
+fn axis_harness_models_the_slave_and_names_the_link_properties() {
+    let s = schedule("mixes/eskin34-axis.toml");
+    let h = formal::generate(&s).expect("an AXI4-Stream mix has a harness");
+    let names: Vec<&str> = h.properties.iter().map(|p| p.name.as_str()).collect();
+    for want in [
+        "link.overflow",
+        "axis.tvalid",
+        "axis.payload",
+        "stream.value",
+    ] {
+        assert!(names.contains(&want), "{want} missing from {names:?}");
+    }
+    let overflow = h
+        .properties
+        .iter()
+        .find(|p| p.name == "link.overflow")
+        .unwrap();
+    assert!(
+        overflow.what.contains("within 64 cycles"),
+        "{}",
+        overflow.what
+    );
+    // tready is the harness's choice within the guarantee, never assumed.
+    let inputs: Vec<&str> = h.inputs.iter().map(|i| i.name.as_str()).collect();
+    assert_eq!(inputs, ["adc_miso", formal::harness::TREADY_ANY]);
+    assert!(
+        h.verilog.contains("waited >= 6'd63"),
+        "deadline: 63 cycles waited"
+    );
+    assert!(
+        !h.verilog.contains("assume"),
+        "the slave is modelled, not assumed"
+    );
+    assert!(h.verilog.contains(".m_axis_tready(m_axis_tready)"));
+}
+
+/// The clean AXI4-Stream gateware: no violation of any property (the
+/// link's three included) in 300 steps from reset, under every slave the
+/// guarantee allows: beats start in cycle 0 (the first header) and wait.
+#[test]
+fn axis_gateware_has_no_violation_in_a_bounded_search() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = tiny_axis();
+    let v = bmc(&s, &emitted(&s), 300);
+    assert_eq!(v, formal::engine::Verdict::Bounded { steps: 300 }, "{v:?}");
+}
+
+/// Mutants of the AXI4-Stream master fail the proof with a counterexample
+/// whose trace `check` rejects at the same cycle: a beat withdrawn after
+/// one cycle whether taken or not (tvalid falls while tready is low), and
+/// the overflow flag tied high (the long suite has more).
+#[test]
+fn axis_mutants_fail_with_counterexamples_check_rejects() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = tiny_axis();
+    let clean = emitted(&s);
+    for (from, to, property) in [
+        (
+            "if (busy & tready) busy <= 1'b0;",
+            "if (busy) busy <= 1'b0;",
+            "axis.tvalid",
+        ),
+        ("  ovf = ovf_r;", "  ovf = 1'b1;", "link.overflow"),
+    ] {
+        assert_mutant_fails(&s, &edit(&clean, from, to), property);
+    }
+}
+
+/// `design` fails `prove` with a counterexample `check` rejects, and
+/// `property` is among the failing ones.
+fn assert_mutant_fails(s: &lut_gen::Schedule, design: &str, property: &str) {
+    {
+        let dir = tempfile::tempdir().unwrap();
+        let p = prove(s, design, dir.path());
+        eprintln!("{}", p.summary());
+        assert_counterexample(s, &p);
+        let failed: Vec<&str> = p
+            .properties
+            .iter()
+            .filter(|q| q.result == Outcome::Failed)
+            .map(|q| q.name.as_str())
+            .collect();
+        assert!(
+            failed.contains(&property),
+            "fails {failed:?}, not {property}"
+        );
+    }
+}
+
 // ---- long: make test-long -------------------------------------------------
 
 #[test]
@@ -370,4 +495,30 @@ fn deep_faults_escape_three_frames_of_simulation_and_fail_prove() {
         eprintln!("{}: simulation passes; prove:\n{}", f.name(), p.summary());
         assert_counterexample(&s, &p);
     }
+}
+
+/// The AXI4-Stream link under every slave the guarantee allows: the clean
+/// gateware has no violation in two frames of the tiny mix; a new byte
+/// loaded over a waiting one fails `axis.payload`; a FIFO one token short
+/// of the planned depth overflows (the engine finds the slow slave), each
+/// with a counterexample `check` rejects.
+#[test]
+#[ignore = "long: make test-long"]
+fn axis_link_holds_for_every_slave_and_its_faults_fail() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = tiny_axis();
+    let clean = emitted(&s);
+    let payload = edit(&clean, "wire ready = !busy | tready;", "wire ready = 1'b1;");
+    assert_mutant_fails(&s, &payload, "axis.payload");
+    let (_, short) = hdl::verilog_pair(&s, hdl::GatewareFault::LinkFifoShort).unwrap();
+    assert_mutant_fails(&s, &short, "link.overflow");
+    // A whole slice (the link's period: a header and its records) and the
+    // next slice's start; a free tready makes each step costly for bmc3.
+    let steps = s.grid.slice_cycles + 4;
+    let t = Instant::now();
+    let v = bmc(&s, &clean, steps);
+    eprintln!("clean: {v:?} in {:.1} s", t.elapsed().as_secs_f64());
+    assert_eq!(v, formal::engine::Verdict::Bounded { steps }, "{v:?}");
 }
