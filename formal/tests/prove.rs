@@ -608,7 +608,8 @@ fn deep_faults_escape_three_frames_of_simulation_and_fail_prove() {
 }
 
 /// The AXI4-Stream link under every slave the guarantee allows: the clean
-/// gateware has no violation in two frames of the tiny mix; a new byte
+/// gateware has no violation over a slice of the tiny mix (and 300 steps
+/// of eskin34-axis); a new byte
 /// loaded over a waiting one fails `axis.payload`; a FIFO one token short
 /// of the planned depth overflows (the engine finds the slow slave), each
 /// with a counterexample `check` rejects.
@@ -631,4 +632,10 @@ fn axis_link_holds_for_every_slave_and_its_faults_fail() {
     let v = bmc(&s, &clean, steps);
     eprintln!("clean: {v:?} in {:.1} s", t.elapsed().as_secs_f64());
     assert_eq!(v, formal::engine::Verdict::Bounded { steps }, "{v:?}");
+    // The preset: its first beats wait up to 63 cycles behind any slave.
+    let s = schedule("mixes/eskin34-axis.toml");
+    let t = Instant::now();
+    let v = bmc(&s, &emitted(&s), 300);
+    eprintln!("eskin34-axis: {v:?} in {:.1} s", t.elapsed().as_secs_f64());
+    assert_eq!(v, formal::engine::Verdict::Bounded { steps: 300 }, "{v:?}");
 }
