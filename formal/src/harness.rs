@@ -5,10 +5,13 @@
 //! `docs/timing.md` says it must be.
 //!
 //! The expected values come from a shadow position (cycle in slot, slot in
-//! frame, first frame or not) and tables of the frame table; the expected
-//! sample words come from the MISO bits the harness itself records at the
-//! contract's capture edges.  Nothing here reads `hdl`: like the judge's
-//! model, the harness is a second reading of the schedule.
+//! frame, first frame or not) and tables of the frame table (full, or
+//! compact for long frames: `harness/compact.rs`); the expected sample words come
+//! from the MISO bits the harness itself records at the contract's capture
+//! edges.  A mix with a link to the host gets the link's properties, and
+//! for AXI4-Stream the slave its guarantee allows (`harness/link.rs`).  Nothing here
+//! reads `hdl`: like the judge's model, the harness is a second reading of
+//! the schedule.
 
 use std::fmt::Write;
 
@@ -66,7 +69,7 @@ pub(crate) fn width(n: u64) -> u32 {
 
 /// The largest frame the full tables cover (one case arm per slot and
 /// branch); a longer frame gets the compact tables, held to the same
-/// number of case arms per branch ([`compact`]).
+/// number of case arms per branch (`harness/compact.rs`).
 pub const MAX_FRAME_SLOTS: u64 = 65_536;
 
 /// How the harness writes its per-branch slot tables.
