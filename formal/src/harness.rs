@@ -5,16 +5,23 @@
 //! `docs/timing.md` says it must be.
 //!
 //! The expected values come from a shadow position (cycle in slot, slot in
-//! frame, first frame or not) and tables of the frame table; the expected
-//! sample words come from the MISO bits the harness itself records at the
-//! contract's capture edges.  Nothing here reads `hdl`: like the judge's
-//! model, the harness is a second reading of the schedule.
+//! frame, first frame or not) and tables of the frame table (full, or
+//! compact for long frames: `harness/compact.rs`); the expected sample words come
+//! from the MISO bits the harness itself records at the contract's capture
+//! edges.  A mix with a link to the host gets the link's properties, and
+//! for AXI4-Stream the slave its guarantee allows (`harness/link.rs`).  Nothing here
+//! reads `hdl`: like the judge's model, the harness is a second reading of
+//! the schedule.
 
 use std::fmt::Write;
 
 use lut_gen::parts::Start;
 use lut_gen::ports::{Layout, Role, TOP_MODULE};
 use lut_gen::Schedule;
+
+mod compact;
+mod link;
+pub use link::TREADY_ANY;
 
 /// The module name of the harness.
 pub const HARNESS_MODULE: &str = "slotforge_formal";
@@ -30,11 +37,22 @@ pub struct PropertyDef {
     pub what: String,
 }
 
+/// A free input of the harness module (besides `clk`): what the engine
+/// may choose in every step.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FreeInput {
+    pub name: String,
+    pub width: u32,
+}
+
 /// A generated harness.
 #[derive(Debug, Clone)]
 pub struct Harness {
     pub verilog: String,
     pub properties: Vec<PropertyDef>,
+    /// The module's free inputs in port order: `adc_miso` first, then the
+    /// AXI4-Stream slave's [`TREADY_ANY`] for a mix with that link.
+    pub inputs: Vec<FreeInput>,
     /// Cycles of one frame (the period of the control path).
     pub frame_cycles: u64,
 }
@@ -49,24 +67,71 @@ pub(crate) fn width(n: u64) -> u32 {
     (64 - n.saturating_sub(1).leading_zeros()).max(1)
 }
 
-/// The largest frame the harness tables cover (one case arm per slot and branch).
+/// The largest frame the full tables cover (one case arm per slot and
+/// branch); a longer frame gets the compact tables, held to the same
+/// number of case arms per branch (`harness/compact.rs`).
 pub const MAX_FRAME_SLOTS: u64 = 65_536;
 
-struct BranchTables {
-    /// Per slot: lead channel converted (None: idle).
-    lead: Vec<Option<usize>>,
-    /// Per slot: mux address `(en one-hot, sel)` in the slot's first cycle and after it.
-    mux0: Vec<(u64, u32)>,
-    mux1: Vec<(u64, u32)>,
+/// How the harness writes its per-branch slot tables.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TableForm {
+    /// One case arm per frame slot (indexed by the shadow `slot`).
+    Full,
+    /// One row per slot of the slice, fixed or a rotation group indexed by
+    /// the slice in the frame: `lut_gen::lut::CompactLut`'s idea applied to
+    /// the harness's rows, for frames beyond [`MAX_FRAME_SLOTS`].
+    Compact,
 }
 
-fn branch_tables(s: &Schedule, layout: &Layout, b: usize) -> BranchTables {
+impl TableForm {
+    /// The form [`generate`] uses for `s`: full while the frame fits.
+    pub fn for_schedule(s: &Schedule) -> TableForm {
+        if s.grid.frame_slots <= MAX_FRAME_SLOTS {
+            TableForm::Full
+        } else {
+            TableForm::Compact
+        }
+    }
+}
+
+/// One slot of a branch's table: the lead channel it converts (`None`:
+/// idle) and the mux address `(device, select)` in the slot's first cycle
+/// (`mux0`) and after it (`mux1`: the next instant's channel).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub(crate) struct Row {
+    lead: Option<u32>,
+    mux0: (u8, u8),
+    mux1: (u8, u8),
+}
+
+/// Bits of a [`Row`] constant: `{act, lead, en0, sel0, en1, sel1}`.
+fn row_bits(chb: u32, en_n: u32) -> u32 {
+    1 + chb + 2 * (en_n + 3)
+}
+
+impl Row {
+    /// `{act, lead, en0, sel0, en1, sel1}` as a Verilog constant.
+    fn verilog(&self, chb: u32, en_n: u32) -> String {
+        let (act, lead) = self.lead.map_or((0, 0), |l| (1, l));
+        let en = |d: u8| 1u128 << d;
+        let ((d0, s0), (d1, s1)) = (self.mux0, self.mux1);
+        format!(
+            "{{1'b{act}, {chb}'d{lead}, {en_n}'d{}, 3'd{s0}, {en_n}'d{}, 3'd{s1}}}",
+            en(d0),
+            en(d1)
+        )
+    }
+}
+
+/// Branch `b`'s row for every slot of the frame.
+fn branch_rows(s: &Schedule, b: usize) -> Vec<Row> {
     let fs = s.grid.frame_slots as usize;
-    let lead: Vec<Option<usize>> = (0..fs).map(|slot| s.at(slot as u64, b)).collect();
-    let addr = |ch: usize| {
-        let c = &s.channels[ch];
-        let _ = layout;
-        (1u64 << c.device, c.select)
+    let lead: Vec<Option<u32>> = (0..fs)
+        .map(|slot| s.at(slot as u64, b).map(|c| c as u32))
+        .collect();
+    let addr = |ch: u32| {
+        let c = &s.channels[ch as usize];
+        (c.device as u8, c.select as u8)
     };
     // next[slot]: the lead of the first instant in a later slot (cyclic).
     let mut next = vec![None; fs];
@@ -81,31 +146,46 @@ fn branch_tables(s: &Schedule, layout: &Layout, b: usize) -> BranchTables {
             }
         }
     }
-    let idle = (1u64, 0u32);
-    let mux1: Vec<(u64, u32)> = next.iter().map(|n| n.map_or(idle, addr)).collect();
-    let mux0: Vec<(u64, u32)> = (0..fs)
-        .map(|slot| lead[slot].map_or(mux1[slot], addr))
-        .collect();
-    BranchTables { lead, mux0, mux1 }
+    let idle = (0u8, 0u8);
+    (0..fs)
+        .map(|slot| {
+            let mux1 = next[slot].map_or(idle, addr);
+            Row {
+                lead: lead[slot],
+                mux0: lead[slot].map_or(mux1, addr),
+                mux1,
+            }
+        })
+        .collect()
 }
 
-/// Generates the harness for `s`.
+/// The harness module's free inputs for `s` (see [`Harness::inputs`]);
+/// `s` must be within the contract's limits.
+pub fn free_inputs(s: &Schedule) -> Vec<FreeInput> {
+    let mut inputs = vec![FreeInput {
+        name: "adc_miso".into(),
+        width: s.branches.len() as u32,
+    }];
+    inputs.extend(link::inputs(&Layout::new(s)));
+    inputs
+}
+
+/// Generates the harness for `s`, its slot tables in the form
+/// [`TableForm::for_schedule`] picks.
 pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
+    generate_with(s, TableForm::for_schedule(s))
+}
+
+/// Generates the harness for `s` with its slot tables in `form` (both forms
+/// describe the same schedule; a test holds them to it).
+pub fn generate_with(s: &Schedule, form: TableForm) -> Result<Harness, HarnessError> {
     Layout::fits(s).map_err(HarnessError)?;
     let g = &s.grid;
-    if g.frame_slots > MAX_FRAME_SLOTS {
+    if form == TableForm::Full && g.frame_slots > MAX_FRAME_SLOTS {
         return Err(HarnessError(format!(
-            "mix `{}`: a frame of {} slots is beyond the formal harness's {MAX_FRAME_SLOTS}",
+            "mix `{}`: a frame of {} slots is beyond the formal harness's full tables ({MAX_FRAME_SLOTS})",
             s.mix.name, g.frame_slots
         )));
-    }
-    if let Some(l) = &s.mix.link {
-        if l.kind == lut_gen::mix::LinkKind::Axis {
-            return Err(HarnessError(format!(
-                "mix `{}`: an AXI4-Stream link (its `tready` input and beats) is not in the formal harness yet; prove the same mix without `[link]`, or with a UART link",
-                s.mix.name
-            )));
-        }
     }
     let layout = Layout::new(s);
     let nb = s.branches.len();
@@ -128,15 +208,18 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
             )));
         }
     }
+    let tables = (0..nb)
+        .map(|b| slot_table(s, &layout, b, form))
+        .collect::<Result<Vec<String>, HarnessError>>()?;
     let mut v = String::new();
     let mut props = Vec::new();
-    header(&mut v, s, &layout);
-    for b in 0..nb {
-        branch(&mut v, &mut props, s, &layout, b);
+    header(&mut v, s, &layout, form);
+    for (b, table) in tables.iter().enumerate() {
+        branch(&mut v, &mut props, s, &layout, b, table);
     }
     merger(&mut v, &mut props, s, &layout);
     if layout.link {
-        link(&mut v, &mut props);
+        link::properties(&mut v, &mut props, s, &layout);
     }
     let _ = writeln!(v, "  wire ok = {};", {
         let w: Vec<&str> = props
@@ -150,20 +233,25 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
     Ok(Harness {
         verilog: v,
         properties: props,
+        inputs: free_inputs(s),
         frame_cycles: g.frame_cycles,
     })
 }
 
-fn header(v: &mut String, s: &Schedule, layout: &Layout) {
+fn header(v: &mut String, s: &Schedule, layout: &Layout, form: TableForm) {
     let g = &s.grid;
     let nb = s.branches.len();
     let w = |r: Role| layout.width(r);
+    let extra: String = link::inputs(layout)
+        .iter()
+        .map(|i| format!(",\n  input {}", i.name))
+        .collect();
     let _ = writeln!(
         v,
         "// slotforge prove: formal harness of mix `{}`, generated from its schedule.\n\
          // rst is high in step 0 only; adc_miso is free; every output is asserted\n\
          // equal to docs/timing.md's value from the reset cycle (step 1) on.\n\
-         module {HARNESS_MODULE} (\n  input clk,\n  input [{}:0] adc_miso\n);",
+         module {HARNESS_MODULE} (\n  input clk,\n  input [{}:0] adc_miso{extra}\n);",
         s.mix.name,
         nb - 1
     );
@@ -179,13 +267,9 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout) {
         w(Role::SampleChannel) - 1,
         w(Role::SampleValue) - 1
     );
-    // A mix with a link has its two ports after the contract's (LINK_PORTS).
-    let link_ports = if layout.link {
-        v.push_str("  wire link_tx, link_overflow;\n");
-        ",\n    .link_tx(link_tx), .link_overflow(link_overflow)"
-    } else {
-        ""
-    };
+    // A mix with a link has its ports after the contract's (Layout::link_ports).
+    link::declare(v, s, layout);
+    let link_ports = link::connections(layout);
     let _ = writeln!(
         v,
         "  {TOP_MODULE} dut (.clk(clk), .rst(rst), .adc_miso(adc_miso), .adc_cs_n(adc_cs_n),\n    \
@@ -207,6 +291,9 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout) {
         g.slot_cycles - 1,
         g.frame_slots - 1
     );
+    if form == TableForm::Compact {
+        compact::counters(v, g);
+    }
 }
 
 /// `cyc` within any of the half-open ranges.
@@ -221,11 +308,62 @@ fn ranges(cb: u32, rs: &[(u64, u64)]) -> String {
     t.join(" || ")
 }
 
-fn branch(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &Layout, b: usize) {
+/// Branch `b`'s slot table in `form`: the body that sets `tab{b}` from the
+/// shadow position.
+fn slot_table(
+    s: &Schedule,
+    layout: &Layout,
+    b: usize,
+    form: TableForm,
+) -> Result<String, HarnessError> {
+    let rows = branch_rows(s, b);
+    let (chb, en_n) = (layout.channel_bits, layout.en_n[b]);
+    let word = |r: &Row| r.verilog(chb, en_n);
+    match form {
+        TableForm::Full => Ok(full_table(s, b, &rows, &word)),
+        TableForm::Compact => compact::table(s, b, &rows, &word, row_bits(chb, en_n)),
+    }
+}
+
+/// One case arm per frame slot; the most common row is the default arm.
+fn full_table(s: &Schedule, b: usize, rows: &[Row], word: &dyn Fn(&Row) -> String) -> String {
+    let sb = width(s.grid.frame_slots);
+    let rows: Vec<String> = rows.iter().map(word).collect();
+    let default = most_common(&rows);
+    let mut v = String::from("  always @* case (slot)\n");
+    for (slot, row) in rows.iter().enumerate() {
+        if *row != default {
+            let _ = writeln!(v, "    {sb}'d{slot}: tab{b} = {row};");
+        }
+    }
+    let _ = writeln!(v, "    default: tab{b} = {default};\n  endcase");
+    v
+}
+
+/// The most frequent of `rows` (ties: the least text), for a default arm.
+pub(crate) fn most_common(rows: &[String]) -> String {
+    let mut counts = std::collections::BTreeMap::new();
+    for r in rows {
+        *counts.entry(r.as_str()).or_insert(0usize) += 1;
+    }
+    counts
+        .iter()
+        .max_by_key(|(r, n)| (**n, std::cmp::Reverse(**r)))
+        .map(|(r, _)| r.to_string())
+        .unwrap_or_default()
+}
+
+fn branch(
+    v: &mut String,
+    props: &mut Vec<PropertyDef>,
+    s: &Schedule,
+    layout: &Layout,
+    b: usize,
+    table: &str,
+) {
     let g = &s.grid;
     let p = &s.branches[b];
     let spi = &p.spi;
-    let t = branch_tables(s, layout, b);
     let (cb, sb) = (width(g.slot_cycles), width(g.frame_slots));
     let chb = layout.channel_bits;
     let en_n = layout.en_n[b];
@@ -245,31 +383,8 @@ fn branch(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
         if cnv { "CNV active high, SCK idles low" } else { "CS active low, SCLK idles high" }
     );
     // Slot table: {act, lead, en0, sel0, en1, sel1}.
-    let ew = 1 + chb + 2 * (en_n + 3);
-    let _ = writeln!(v, "  reg [{}:0] tab{b};\n  always @* case (slot)", ew - 1);
-    let word = |slot: usize| {
-        let (act, lead) = t.lead[slot].map_or((0, 0), |l| (1u64, l as u64));
-        let (e0, s0) = t.mux0[slot];
-        let (e1, s1) = t.mux1[slot];
-        format!("{{1'b{act}, {chb}'d{lead}, {en_n}'d{e0}, 3'd{s0}, {en_n}'d{e1}, 3'd{s1}}}")
-    };
-    // The most common row becomes the default arm.
-    let rows: Vec<String> = (0..g.frame_slots as usize).map(word).collect();
-    let mut counts = std::collections::BTreeMap::new();
-    for r in &rows {
-        *counts.entry(r.as_str()).or_insert(0usize) += 1;
-    }
-    let default = counts
-        .iter()
-        .max_by_key(|(r, n)| (**n, std::cmp::Reverse(**r)))
-        .map(|(r, _)| r.to_string())
-        .unwrap_or_default();
-    for (slot, row) in rows.iter().enumerate() {
-        if *row != default {
-            let _ = writeln!(v, "    {sb}'d{slot}: tab{b} = {row};");
-        }
-    }
-    let _ = writeln!(v, "    default: tab{b} = {default};\n  endcase");
+    let _ = writeln!(v, "  reg [{}:0] tab{b};", row_bits(chb, en_n) - 1);
+    v.push_str(table);
     let lo1 = 0;
     let lo_e1 = 3;
     let lo0 = 3 + en_n;
@@ -470,22 +585,6 @@ fn merger(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
             what: what.into(),
         });
     }
-}
-
-/// The link to the host (a mix with `[link]`): its FIFO never overflows.
-/// The UART line's bit stream (packets, CRC) is not asserted: `link_tx` is
-/// connected so the design keeps its link, but only `link_overflow` is
-/// checked (docs/formal.md, Limits).
-fn link(v: &mut String, props: &mut Vec<PropertyDef>) {
-    v.push_str(
-        "\n  // The link's FIFO never drops a token: link_overflow stays low.\n  \
-         wire ok_link_overflow = link_overflow == 1'b0;\n",
-    );
-    props.push(PropertyDef {
-        name: "link.overflow".into(),
-        wire: "ok_link_overflow".into(),
-        what: "the link's FIFO never overflows: link_overflow stays low for any input".into(),
-    });
 }
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 //! A counterexample as a person reads it: the MISO bits of the engine's
-//! witness replayed through harness + design in Icarus (the RTL, not the
+//! witness (and the harness's other free inputs, the AXI4-Stream slave's
+//! early `tready`) replayed through harness + design in Icarus (the RTL, not the
 //! AIG the engine saw, so the replay also confirms the witness), dumped as
 //! a VCD with a `.gtkw`, and judged by the same checker `slotforge check`
 //! runs, which must fail at the same cycle.
@@ -14,6 +15,8 @@ use lut_gen::Schedule;
 use crate::engine::run_tool;
 use crate::harness::Harness;
 use crate::ProveError;
+
+pub mod witness;
 
 /// Scope of the design's ports in the replay VCD (for `check --scope`).
 pub const DUT_SCOPE: &str = "replay_tb.h.dut";
@@ -33,23 +36,37 @@ pub struct Replay {
     pub gtkw: PathBuf,
 }
 
-fn testbench(s: &Schedule, h: &Harness, steps: u64, period_ps: u64) -> String {
-    let nb = s.branches.len();
+/// The bench: every free input of the harness from one vector per step
+/// (`stim.mem`, the inputs concatenated with `adc_miso` in the low bits).
+fn testbench(h: &Harness, steps: u64, period_ps: u64) -> String {
+    let total: u32 = h.inputs.iter().map(|i| i.width).sum();
     let mut v = String::new();
     let _ = writeln!(
         v,
-        "`timescale 1ps/1ps\nmodule replay_tb;\n  reg clk = 1'b0;\n  reg [{}:0] adc_miso = 0;\n  \
-         reg [{}:0] miso [0:{}];\n  integer i;\n  slotforge_formal h (.clk(clk), .adc_miso(adc_miso));\n  \
+        "`timescale 1ps/1ps\nmodule replay_tb;\n  reg clk = 1'b0;"
+    );
+    for i in &h.inputs {
+        let _ = writeln!(v, "  reg [{}:0] {} = 0;", i.width - 1, i.name);
+    }
+    let ports: String = h
+        .inputs
+        .iter()
+        .map(|i| format!(", .{0}({0})", i.name))
+        .collect();
+    let concat: Vec<&str> = h.inputs.iter().rev().map(|i| i.name.as_str()).collect();
+    let _ = writeln!(
+        v,
+        "  reg [{}:0] stim [0:{}];\n  integer i;\n  slotforge_formal h (.clk(clk){ports});\n  \
          // Rising edges at k * period (k >= 1) only: an X-to-1 start would be one.\n  \
-         always begin #{} clk = 1'b0; #{} clk = 1'b1; end\n  initial begin\n    $readmemb(\"miso.mem\", miso);\n    \
+         always begin #{} clk = 1'b0; #{} clk = 1'b1; end\n  initial begin\n    $readmemb(\"stim.mem\", stim);\n    \
          $dumpfile(\"trace.vcd\");\n    $dumpvars(1, h.dut);\n    $dumpvars(1, h);\n    \
-         for (i = 0; i < {steps}; i = i + 1) begin\n      #{} adc_miso = miso[i];\n      #{};",
-        nb - 1,
-        nb - 1,
+         for (i = 0; i < {steps}; i = i + 1) begin\n      #{} {{{}}} = stim[i];\n      #{};",
+        total - 1,
         steps.max(1) - 1,
         period_ps / 2,
         period_ps - period_ps / 2,
         period_ps / 4,
+        concat.join(", "),
         period_ps / 2,
     );
     let wires: Vec<&str> = h.properties.iter().map(|p| p.wire.as_str()).collect();
@@ -86,6 +103,14 @@ fn gtkw(s: &Schedule, h: &Harness, vcd: &Path) -> String {
     for r in [Role::SampleChannel, Role::SampleValue] {
         let _ = writeln!(g, "{DUT_SCOPE}.{}[{}:0]", r.name(), layout.width(r) - 1);
     }
+    for p in layout.link_ports() {
+        let (fmt, range) = if p.width == 1 {
+            ("@28", String::new())
+        } else {
+            ("@22", format!("[{}:0]", p.width - 1))
+        };
+        let _ = writeln!(g, "{fmt}\n{DUT_SCOPE}.{}{range}", p.name);
+    }
     let _ = writeln!(g, "@28");
     for p in &h.properties {
         let _ = writeln!(g, "replay_tb.h.{}", p.wire);
@@ -103,18 +128,32 @@ pub fn replay(
     out_dir: &Path,
 ) -> Result<Replay, ProveError> {
     let steps = miso.len() as u64 + AFTER;
-    let mut mem = String::with_capacity(miso.len() * (s.branches.len() + 1));
-    for i in 0..steps {
-        let m = miso.get(i as usize).copied().unwrap_or(0);
-        let _ = writeln!(mem, "{:0w$b}", m, w = s.branches.len());
+    // The other free inputs from the same witness (absent: 0, the slave
+    // then takes each beat at its deadline).
+    let mut values = vec![miso.to_vec()];
+    for i in h.inputs.iter().skip(1) {
+        let from_witness = work.join("cex.aiw").exists();
+        values.push(if from_witness {
+            witness::input(work, &i.name, i.width)?
+        } else {
+            Vec::new()
+        });
+    }
+    let mut mem = String::new();
+    for step in 0..steps as usize {
+        for (i, vals) in h.inputs.iter().zip(&values).rev() {
+            let x = vals.get(step).copied().unwrap_or(0);
+            let _ = write!(mem, "{:0w$b}", x, w = i.width as usize);
+        }
+        mem.push('\n');
     }
     let period_ps = (1_000_000_000_000u64 / s.grid.clock_hz).max(4) / 4 * 4;
     let write = |name: &str, text: &str| {
         std::fs::write(work.join(name), text)
             .map_err(|e| ProveError::Tool(format!("{}: {e}", work.join(name).display())))
     };
-    write("miso.mem", &mem)?;
-    write("replay_tb.v", &testbench(s, h, steps, period_ps))?;
+    write("stim.mem", &mem)?;
+    write("replay_tb.v", &testbench(h, steps, period_ps))?;
     run_tool(
         work,
         "iverilog",

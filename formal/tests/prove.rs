@@ -5,11 +5,13 @@
 //! VCD the checker rejects at the same cycle; a fault that shows only after
 //! several frames fails too (the recurrence check sees the design keeps
 //! state across frames and the search goes deeper); a random mix from
-//! `cosim::mixgen` proves.
+//! `cosim::mixgen` proves; an AXI4-Stream link's harness, a bounded search
+//! of its clean gateware and two link mutants.
 //! Long (`make test-long`): every preset and the 16-branch / 1,024-channel
 //! test mixes prove; six random mixes prove; the mutant campaign; the deep
 //! fault classes against a three-frame simulation; the `symbolic` and `abc`
-//! engines agree.
+//! engines agree; the AXI4-Stream link over a slice and its payload and
+//! FIFO faults.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -230,6 +232,315 @@ fn harness_is_deterministic_and_names_every_contract_property() {
     );
 }
 
+/// A small AXI4-Stream mix: `tiny` (4 MHz, 4,000-cycle frame) with a
+/// slave that takes every beat within 8 cycles.
+fn tiny_axis() -> lut_gen::Schedule {
+    let path = root().join("cosim/tests/data/tiny.toml");
+    let text = std::fs::read_to_string(&path).unwrap()
+        + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 8\n";
+    let mix = lut_gen::parse(Path::new("tiny-axis.toml"), &text).expect("parses");
+    lut_gen::synthesize(&mix).expect("feasible")
+}
+
+/// ABC's bounded search from reset of harness + `design`, `steps` deep.
+fn bmc(s: &lut_gen::Schedule, design: &str, steps: u64) -> formal::engine::Verdict {
+    let h = formal::generate(s).expect("a harness");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("harness.v"), &h.verilog).unwrap();
+    std::fs::write(dir.path().join("design.v"), design).unwrap();
+    let prep = formal::engine::prepare(dir.path(), formal::Solver::Abc).expect("yosys");
+    formal::engine::bmc(&prep, steps, 300).expect("bmc3 runs")
+}
+
+/// `design` with `from` replaced by `to` exactly once (the test fails if
+/// the emitted link no longer has the line, rather than testing nothing).
+fn edit(design: &str, from: &str, to: &str) -> String {
+    assert_eq!(
+        design.matches(from).count(),
+        1,
+        "`{from}` in the emitted link"
+    );
+    design.replacen(from, to, 1)
+}
+
+#[test]
+fn axis_harness_models_the_slave_and_names_the_link_properties() {
+    let s = schedule("mixes/eskin34-axis.toml");
+    let h = formal::generate(&s).expect("an AXI4-Stream mix has a harness");
+    let names: Vec<&str> = h.properties.iter().map(|p| p.name.as_str()).collect();
+    for want in [
+        "link.overflow",
+        "axis.tvalid",
+        "axis.payload",
+        "stream.value",
+    ] {
+        assert!(names.contains(&want), "{want} missing from {names:?}");
+    }
+    let overflow = h
+        .properties
+        .iter()
+        .find(|p| p.name == "link.overflow")
+        .unwrap();
+    assert!(
+        overflow.what.contains("within 64 cycles"),
+        "{}",
+        overflow.what
+    );
+    // tready is the harness's choice within the guarantee, never assumed.
+    let inputs: Vec<&str> = h.inputs.iter().map(|i| i.name.as_str()).collect();
+    assert_eq!(inputs, ["adc_miso", formal::harness::TREADY_ANY]);
+    assert!(
+        h.verilog.contains("waited >= 6'd63"),
+        "deadline: 63 cycles waited"
+    );
+    assert!(
+        !h.verilog.contains("assume"),
+        "the slave is modelled, not assumed"
+    );
+    assert!(h.verilog.contains(".m_axis_tready(m_axis_tready)"));
+}
+
+/// The harness's slave when it is never early (`tready_any` low) is the
+/// simulations' worst-case slave: `judge::run::AxisSlave` with
+/// `link::ReadyPattern::WorstCase`, fed the same `tvalid`, raises `tready`
+/// in exactly the same cycles (each beat taken in its `ready_within`-th
+/// cycle), so the harness's slaves are the guarantee's, to the cycle.
+#[test]
+fn the_harness_slave_never_early_is_the_worst_case_slave() {
+    if !tools::require_tools(&["iverilog", "vvp"]) {
+        return;
+    }
+    let s = tiny_axis();
+    let h = formal::generate(&s).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("harness.v"), &h.verilog).unwrap();
+    std::fs::write(dir.path().join("design.v"), emitted(&s)).unwrap();
+    let tb = format!(
+        "`timescale 1ns/1ns\nmodule tb;\n  reg clk = 1'b0;\n  reg [{}:0] adc_miso = 0;\n  \
+         integer i, seed;\n  slotforge_formal h (.clk(clk), .adc_miso(adc_miso), .{}(1'b0));\n  \
+         initial begin\n    seed = 3;\n    for (i = 0; i < 800; i = i + 1) begin\n      \
+         adc_miso = $random(seed);\n      #1 clk = 1'b1;\n      #1 clk = 1'b0;\n      \
+         if (h.st == 2'd2) $display(\"C %b %b\", h.m_axis_tvalid, h.m_axis_tready);\n    end\n    \
+         $finish;\n  end\nendmodule\n",
+        s.branches.len() - 1,
+        formal::harness::TREADY_ANY
+    );
+    std::fs::write(dir.path().join("tb.v"), tb).unwrap();
+    let ok = std::process::Command::new("iverilog")
+        .args(["-g2005", "-o", "tb.vvp", "tb.v", "harness.v", "design.v"])
+        .current_dir(dir.path())
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    let out = std::process::Command::new("vvp")
+        .args(["-n", "tb.vvp"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let trace: Vec<(bool, bool)> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .filter_map(|l| l.strip_prefix("C "))
+        .map(|l| (l.as_bytes()[0] == b'1', l.as_bytes()[2] == b'1'))
+        .collect();
+    // A design that shows the harness's tvalid, cycle by cycle.
+    struct Trace(std::vec::IntoIter<bool>);
+    impl judge::Dut for Trace {
+        fn step(&mut self, rst: bool, _miso: u64) -> lut_gen::ports::Pins {
+            lut_gen::ports::Pins {
+                axis_tvalid: !rst && self.0.next().unwrap_or(false),
+                ..Default::default()
+            }
+        }
+    }
+    let tvalid: Vec<bool> = trace.iter().map(|&(v, _)| v).collect();
+    let within = s.mix.link.unwrap().ready_within;
+    let mut slave = judge::run::AxisSlave::new(
+        Trace(tvalid.into_iter()),
+        link::ReadyPattern::WorstCase,
+        within,
+    );
+    use judge::Dut;
+    slave.step(true, 0);
+    let (mut waits, mut taken) = (0, 0);
+    for (c, &(valid, ready)) in trace.iter().enumerate() {
+        let p = slave.step(false, 0);
+        assert_eq!(p.axis_tready, ready, "cycle {c}: tvalid {valid}");
+        waits += (valid && !ready) as usize;
+        taken += (valid && ready) as usize;
+    }
+    // Every beat taken waited its ready_within - 1 cycles first.
+    assert!(
+        trace.len() >= 790 && taken >= 10 && waits >= (within as usize - 1) * taken,
+        "{} cycles, {taken} beats taken, {waits} cycles waited",
+        trace.len()
+    );
+}
+
+/// The clean AXI4-Stream gateware: no violation of any property (the
+/// link's three included) in 300 steps from reset, under every slave the
+/// guarantee allows: beats start in cycle 0 (the first header) and wait.
+#[test]
+fn axis_gateware_has_no_violation_in_a_bounded_search() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = tiny_axis();
+    let v = bmc(&s, &emitted(&s), 300);
+    assert_eq!(v, formal::engine::Verdict::Bounded { steps: 300 }, "{v:?}");
+}
+
+/// Mutants of the AXI4-Stream master fail the proof with a counterexample
+/// whose trace `check` rejects at the same cycle: a beat withdrawn after
+/// one cycle whether taken or not (tvalid falls while tready is low), and
+/// the overflow flag tied high (the long suite has more).
+#[test]
+fn axis_mutants_fail_with_counterexamples_check_rejects() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = tiny_axis();
+    let clean = emitted(&s);
+    for (from, to, property) in [
+        (
+            "if (busy & tready) busy <= 1'b0;",
+            "if (busy) busy <= 1'b0;",
+            "axis.tvalid",
+        ),
+        ("  ovf = ovf_r;", "  ovf = 1'b1;", "link.overflow"),
+    ] {
+        assert_mutant_fails(&s, &edit(&clean, from, to), property);
+    }
+}
+
+/// `design` fails `prove` with a counterexample `check` rejects, and
+/// `property` is among the failing ones.
+fn assert_mutant_fails(s: &lut_gen::Schedule, design: &str, property: &str) {
+    {
+        let dir = tempfile::tempdir().unwrap();
+        let p = prove(s, design, dir.path());
+        eprintln!("{}", p.summary());
+        assert_counterexample(s, &p);
+        let failed: Vec<&str> = p
+            .properties
+            .iter()
+            .filter(|q| q.result == Outcome::Failed)
+            .map(|q| q.name.as_str())
+            .collect();
+        assert!(
+            failed.contains(&property),
+            "fails {failed:?}, not {property}"
+        );
+    }
+}
+
+/// Icarus runs `harnesses` (module names made unique) around one copy of
+/// `design` on the same random MISO for `steps` cycles; returns the
+/// mismatches it printed: a cycle where some harness's `ok` is low after
+/// reset, or where `signals` (harness wires) differ between the first
+/// harness and another.
+fn icarus_compare(
+    s: &lut_gen::Schedule,
+    harnesses: &[&formal::Harness],
+    design: &str,
+    signals: &[String],
+    steps: u64,
+) -> Vec<String> {
+    let dir = tempfile::tempdir().unwrap();
+    let mut files = vec!["tb.v".to_string(), "design.v".to_string()];
+    std::fs::write(dir.path().join("design.v"), design).unwrap();
+    let mut tb = format!(
+        "`timescale 1ns/1ns\nmodule tb;\n  reg clk = 1'b0;\n  reg [{}:0] adc_miso = 0;\n  integer i, seed, bad;\n",
+        s.branches.len() - 1
+    );
+    for (k, h) in harnesses.iter().enumerate() {
+        let name = format!("h{k}");
+        let text = h.verilog.replace(
+            "module slotforge_formal (",
+            &format!("module slotforge_formal_{k} ("),
+        );
+        std::fs::write(dir.path().join(format!("{name}.v")), text).unwrap();
+        files.push(format!("{name}.v"));
+        tb += &format!("  slotforge_formal_{k} {name} (.clk(clk), .adc_miso(adc_miso));\n");
+    }
+    let mut checks = Vec::new();
+    for k in 0..harnesses.len() {
+        checks.push(format!("(h{k}.st != 2'd0 && h{k}.ok !== 1'b1)"));
+        for sig in signals.iter().filter(|_| k > 0) {
+            checks.push(format!("h0.{sig} !== h{k}.{sig}"));
+        }
+    }
+    tb += &format!(
+        "  initial begin\n    seed = 7; bad = 0;\n    for (i = 0; i < {steps}; i = i + 1) begin\n      \
+         adc_miso = $random(seed);\n      #1 clk = 1'b1;\n      #1 clk = 1'b0;\n      \
+         if ({}) begin\n        bad = bad + 1;\n        if (bad <= 5) $display(\"MISMATCH %0d\", i);\n      end\n    end\n    \
+         $display(\"DONE %0d\", bad);\n    $finish;\n  end\nendmodule\n",
+        checks.join(" || ")
+    );
+    std::fs::write(dir.path().join("tb.v"), tb).unwrap();
+    let run = |cmd: &mut std::process::Command| {
+        let out = cmd.current_dir(dir.path()).output().expect("runs");
+        let text = String::from_utf8_lossy(&out.stdout).into_owned()
+            + &String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{text}");
+        text
+    };
+    let mut args = vec!["-g2005".to_string(), "-o".into(), "tb.vvp".into()];
+    args.extend(files);
+    run(std::process::Command::new("iverilog").args(&args));
+    let log = run(std::process::Command::new("vvp").args(["-n", "tb.vvp"]));
+    assert!(log.contains("DONE"), "{log}");
+    log.lines()
+        .filter(|l| l.starts_with("MISMATCH"))
+        .map(str::to_string)
+        .collect()
+}
+
+/// The compact slot tables (for frames beyond the full tables) describe
+/// the same schedule as the full ones: on a mix that fits both, with
+/// rotation groups, every branch's table row and every property wire agree
+/// in every cycle of two frames, and the clean design keeps `ok` high in
+/// both.
+#[test]
+fn compact_and_full_harness_tables_agree_cycle_by_cycle() {
+    if !tools::require_tools(&["iverilog", "vvp"]) {
+        return;
+    }
+    let s = schedule("cosim/tests/data/tiny.toml");
+    let full = formal::harness::generate_with(&s, formal::harness::TableForm::Full).unwrap();
+    let compact = formal::harness::generate_with(&s, formal::harness::TableForm::Compact).unwrap();
+    assert!(compact.verilog.contains("case (sis)") && compact.verilog.contains("rot0_0"));
+    assert!(!full.verilog.contains("case (sis)"));
+    let mut signals: Vec<String> = (0..s.branches.len()).map(|b| format!("tab{b}")).collect();
+    signals.extend(full.properties.iter().map(|p| p.wire.clone()));
+    let bad = icarus_compare(
+        &s,
+        &[&full, &compact],
+        &emitted(&s),
+        &signals,
+        2 * s.grid.frame_cycles + 2,
+    );
+    assert!(bad.is_empty(), "{bad:?}");
+}
+
+/// A frame of 80,000 slots (beyond the full tables) gets the compact
+/// tables, and the emitted gateware (its compact slot LUT) keeps every
+/// property through the first three slices, the 1 Hz channels' rotation
+/// entries included.
+#[test]
+fn a_frame_beyond_the_full_tables_gets_the_compact_harness() {
+    let s = schedule("formal/tests/data/frame80k.toml");
+    assert!(s.grid.frame_slots > formal::harness::MAX_FRAME_SLOTS);
+    let h = formal::generate(&s).expect("a compact harness");
+    assert!(h.verilog.contains("case (sis)"), "compact tables");
+    let full = formal::harness::generate_with(&s, formal::harness::TableForm::Full);
+    assert!(full.unwrap_err().to_string().contains("full tables"));
+    if !tools::require_tools(&["iverilog", "vvp"]) {
+        return;
+    }
+    let bad = icarus_compare(&s, &[&h], &emitted(&s), &[], 3 * s.grid.slice_cycles);
+    assert!(bad.is_empty(), "{bad:?}");
+}
+
 // ---- long: make test-long -------------------------------------------------
 
 #[test]
@@ -378,4 +689,37 @@ fn the_symbolic_and_abc_engines_agree() {
             "{what}"
         );
     }
+}
+
+/// The AXI4-Stream link under every slave the guarantee allows: the clean
+/// gateware has no violation over a slice of the tiny mix (and 300 steps
+/// of eskin34-axis); a new byte
+/// loaded over a waiting one fails `axis.payload`; a FIFO one token short
+/// of the planned depth overflows (the engine finds the slow slave), each
+/// with a counterexample `check` rejects.
+#[test]
+#[ignore = "long: make test-long"]
+fn axis_link_holds_for_every_slave_and_its_faults_fail() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = tiny_axis();
+    let clean = emitted(&s);
+    let payload = edit(&clean, "wire ready = !busy | tready;", "wire ready = 1'b1;");
+    assert_mutant_fails(&s, &payload, "axis.payload");
+    let (_, short) = hdl::verilog_pair(&s, hdl::GatewareFault::LinkFifoShort).unwrap();
+    assert_mutant_fails(&s, &short, "link.overflow");
+    // A whole slice (the link's period: a header and its records) and the
+    // next slice's start; a free tready makes each step costly for bmc3.
+    let steps = s.grid.slice_cycles + 4;
+    let t = Instant::now();
+    let v = bmc(&s, &clean, steps);
+    eprintln!("clean: {v:?} in {:.1} s", t.elapsed().as_secs_f64());
+    assert_eq!(v, formal::engine::Verdict::Bounded { steps }, "{v:?}");
+    // The preset: its first beats wait up to 63 cycles behind any slave.
+    let s = schedule("mixes/eskin34-axis.toml");
+    let t = Instant::now();
+    let v = bmc(&s, &emitted(&s), 300);
+    eprintln!("eskin34-axis: {v:?} in {:.1} s", t.elapsed().as_secs_f64());
+    assert_eq!(v, formal::engine::Verdict::Bounded { steps: 300 }, "{v:?}");
 }

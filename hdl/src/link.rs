@@ -572,11 +572,16 @@ fn link_verilog(p: &LinkParams) -> String {
         "    if (push) begin\n      if (room) begin\n        mem[wr] <= token;\n        wr <= {};\n      end else begin\n        if (ovfc != 8'hff) ovfc <= ovfc + 8'd1;\n        ovf_r <= 1'b1;\n      end\n    end",
         wrap("wr")
     );
-    let _ = writeln!(
-        s,
-        "    n <= n + {{{}'d0, push & room}} - {{{0}'d0, pop}};",
-        nw - 1
-    );
+    // A one-bit count (a FIFO of one token) has no padding bits: `{0'd0, x}`
+    // is not Verilog.
+    let zext = |bit: &str| {
+        if nw == 1 {
+            format!("({bit})")
+        } else {
+            format!("{{{}'d0, {bit}}}", nw - 1)
+        }
+    };
+    let _ = writeln!(s, "    n <= n + {} - {};", zext("push & room"), zext("pop"));
     if axis {
         let _ = writeln!(s, "    if (busy & tready) busy <= 1'b0;");
     } else {

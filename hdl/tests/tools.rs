@@ -155,7 +155,8 @@ fn eskin34_axis() -> Schedule {
 /// The AXI4-Stream link (`kind = "axis"`): `slotforge_link`'s AXIS output
 /// and the `m_axis_*` ports lint clean under Verilator -Wall and Icarus
 /// -Wall (yosys in the long suite: the UART's synthesis above covers the
-/// shared FIFO and packetizer).
+/// shared FIFO and packetizer); so does a FIFO of one token (an
+/// always-ready slave on a small mix), whose count is one bit wide.
 #[test]
 fn lints_axis_link() {
     let s = eskin34_axis();
@@ -163,6 +164,14 @@ fn lints_axis_link() {
     let v = std::fs::read_to_string(dir.join("slotforge_top.v")).unwrap();
     assert!(v.contains("module slotforge_link(") && v.contains("m_axis_tready"));
     lint_in(&dir, "eskin34-axis");
+    let tiny = std::fs::read_to_string(common::root().join("cosim/tests/data/tiny.toml")).unwrap()
+        + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 1\n";
+    let mix = lut_gen::parse(Path::new("tiny-axis1.toml"), &tiny).unwrap();
+    let s = lut_gen::synthesize(&mix).unwrap();
+    let dir = emit_to(&s, "tiny-axis1");
+    let v = std::fs::read_to_string(dir.join("slotforge_top.v")).unwrap();
+    assert!(v.contains("FIFO of 1 tokens"), "a one-token FIFO");
+    lint_in(&dir, "tiny-axis1");
 }
 
 #[test]

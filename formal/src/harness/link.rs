@@ -1,0 +1,137 @@
+//! The link to the host in the harness (a mix with `[link]`): its ports on
+//! the design, the AXI4-Stream slave the mix guarantees, and the link's
+//! properties.
+//!
+//! The slave is modelled, not assumed: `m_axis_tready` is a free harness
+//! input OR "this beat has waited `ready_within - 1` cycles", which is
+//! exactly the set of slaves `link::ReadyDriver` draws from (its `due`:
+//! a beat is taken at the latest in its `ready_within`-th cycle of `tvalid`;
+//! `ReadyPattern::WorstCase` is the member that is never early).  So every
+//! engine, including one that ignores `assume`, sees every slave that
+//! honours the guarantee and no other.  The FIFO's depth is the worst-case
+//! backlog under that guarantee (`lut_gen::hostlink`), so `link.overflow`
+//! is the claim that the depth is enough for every such slave, not only
+//! for the worst-case pattern a simulation drives.
+
+use std::fmt::Write;
+
+use lut_gen::ports::{Dir, Layout};
+use lut_gen::Schedule;
+
+use super::{width, FreeInput, PropertyDef};
+
+/// The harness input that lets the slave take a beat early (any cycle).
+pub const TREADY_ANY: &str = "tready_any";
+
+/// The guarantee of an AXI4-Stream mix's slave (`ready_within`, >= 1);
+/// `None` for a UART link or none.
+fn ready_within(s: &Schedule, layout: &Layout) -> Option<u32> {
+    let l = s.mix.link.as_ref()?;
+    layout.axis.then_some(l.ready_within.max(1))
+}
+
+/// The harness's free inputs for the link (after `adc_miso`).
+pub(super) fn inputs(layout: &Layout) -> Vec<FreeInput> {
+    if layout.axis {
+        vec![FreeInput {
+            name: TREADY_ANY.into(),
+            width: 1,
+        }]
+    } else {
+        Vec::new()
+    }
+}
+
+/// Wires for the link's ports (named as on the design) and, for
+/// AXI4-Stream, the slave that drives `m_axis_tready`.
+pub(super) fn declare(v: &mut String, s: &Schedule, layout: &Layout) {
+    for p in layout.link_ports() {
+        if p.width == 1 {
+            let _ = writeln!(v, "  wire {};", p.name);
+        } else {
+            let _ = writeln!(v, "  wire [{}:0] {};", p.width - 1, p.name);
+        }
+    }
+    let Some(within) = ready_within(s, layout) else {
+        return;
+    };
+    let wb = width(u64::from(within));
+    let _ = writeln!(
+        v,
+        "  // The slave the mix guarantees: tready in any cycle, and at the latest when\n  \
+         // a beat has waited ready_within - 1 = {} cycles (it is then taken in its\n  \
+         // {within}-th cycle of tvalid). Not an assumption: every slave that honours\n  \
+         // the guarantee, and only those, is a choice of `{TREADY_ANY}`.\n  \
+         reg [{}:0] waited = 0;\n  \
+         assign m_axis_tready = {TREADY_ANY} || waited >= {wb}'d{};\n  \
+         always @(posedge clk)\n    \
+         waited <= (st != 2'd0 && m_axis_tvalid && !m_axis_tready) ? waited + {wb}'d1 : {wb}'d0;",
+        within - 1,
+        wb - 1,
+        within - 1,
+    );
+}
+
+/// `.port(port)` for every link port, after the contract's.
+pub(super) fn connections(layout: &Layout) -> String {
+    layout
+        .link_ports()
+        .iter()
+        .map(|p| format!(", .{0}({0})", p.name))
+        .collect()
+}
+
+/// The link's properties: the FIFO never overflows; for AXI4-Stream, a
+/// waiting beat keeps `tvalid`, `tdata` and `tlast` until it is taken.
+pub(super) fn properties(
+    v: &mut String,
+    props: &mut Vec<PropertyDef>,
+    s: &Schedule,
+    layout: &Layout,
+) {
+    debug_assert!(layout
+        .link_ports()
+        .iter()
+        .any(|p| p.name == "link_overflow" && p.dir == Dir::Out));
+    let within = ready_within(s, layout);
+    v.push_str(
+        "\n  // The link's FIFO never drops a token: link_overflow stays low.\n  \
+         wire ok_link_overflow = link_overflow == 1'b0;\n",
+    );
+    props.push(PropertyDef {
+        name: "link.overflow".into(),
+        wire: "ok_link_overflow".into(),
+        what: match within {
+            Some(n) => format!(
+                "the link's FIFO never overflows: link_overflow stays low for any input and \
+                 any slave that takes every beat within {n} cycles"
+            ),
+            None => "the link's FIFO never overflows: link_overflow stays low for any input".into(),
+        },
+    });
+    if within.is_none() {
+        return;
+    }
+    v.push_str(
+        "  // AXI4-Stream: a beat offered and not taken (tvalid && !tready) at an edge\n  \
+         // is offered again after it, with the same tdata and tlast.\n  \
+         reg beat_waits = 1'b0;\n  reg [7:0] waiting_tdata = 8'd0;\n  reg waiting_tlast = 1'b0;\n  \
+         always @(posedge clk) begin\n    \
+         beat_waits <= st != 2'd0 && m_axis_tvalid && !m_axis_tready;\n    \
+         waiting_tdata <= m_axis_tdata;\n    waiting_tlast <= m_axis_tlast;\n  end\n  \
+         wire ok_axis_tvalid = !beat_waits || m_axis_tvalid;\n  \
+         wire ok_axis_payload = !beat_waits || (m_axis_tdata == waiting_tdata && m_axis_tlast == waiting_tlast);\n",
+    );
+    props.push(PropertyDef {
+        name: "axis.tvalid".into(),
+        wire: "ok_axis_tvalid".into(),
+        what: "a beat offered on m_axis_tvalid stays offered until the slave takes it \
+               (AXI4-Stream: tvalid never falls while tready is low)"
+            .into(),
+    });
+    props.push(PropertyDef {
+        name: "axis.payload".into(),
+        wire: "ok_axis_payload".into(),
+        what: "m_axis_tdata and m_axis_tlast do not change while a beat waits for tready".into(),
+    });
+}
