@@ -292,3 +292,53 @@ fn user_declared_part_model_passes_the_checker() {
     let r = run_dut(&s, &mut dut, 2, &RunOptions::default(), "model-dut", None);
     assert!(r.ok, "{}", r.summary());
 }
+
+/// `cosim/tests/data/tiny.toml` (4 MHz, 1 ms frames of two slices) over a
+/// 1 Mbaud UART (4 cycles a bit): a link mix whose runs take milliseconds.
+fn tiny_uart() -> lut_gen::Schedule {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml");
+    let text =
+        std::fs::read_to_string(&p).unwrap() + "\n[link]\nkind = \"uart\"\nbaud = 1_000_000\n";
+    let mix = lut_gen::parse(Path::new("tiny-uart.toml"), &text).unwrap();
+    lut_gen::synthesize(&mix).unwrap()
+}
+
+/// The UART line is one of the invariants: with the model off, a clean run
+/// passes and each of the four line faults of the campaign is caught by a
+/// `link-*` rule of its own kind, at or after the fault.
+#[test]
+fn the_uart_line_is_judged_without_the_model() {
+    use judge::faults::{Fault, FaultyDut};
+    let s = tiny_uart();
+    let opts = RunOptions {
+        check: judge::CheckOptions {
+            model: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let clean = run_dut(&s, &mut ModelDut::new(&s), 3, &opts, "clean", None);
+    assert!(clean.ok && !clean.model_compared, "{}", clean.summary());
+    let at = s.grid.frame_cycles + s.grid.frame_cycles / 2 + 7;
+    for (f, rule) in [
+        (Fault::LinkBitFlip, "link-crc"),
+        (Fault::LinkDropByte, "link-crc"),
+        (Fault::LinkStuck { high: true }, "link-packet-missing"),
+        (Fault::LinkStuck { high: false }, "link-framing"),
+    ] {
+        let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
+        let r = run_dut(&s, &mut dut, 3, &opts, "faulty", None);
+        let class = f.class();
+        assert!(dut.injected(), "{class}: found nothing to change");
+        eprintln!("{class}: {}", r.summary());
+        assert!(!r.ok && r.divergence_count == 0, "{class}: {}", r.summary());
+        let rules: Vec<&str> = r.violations.iter().map(|v| v.rule.as_str()).collect();
+        assert!(rules.contains(&rule), "{class}: {rules:?}");
+        for v in &r.violations {
+            assert!(
+                v.rule.starts_with("link-") && v.cycle >= at,
+                "{class}: {v:?}"
+            );
+        }
+    }
+}
