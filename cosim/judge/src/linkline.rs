@@ -211,10 +211,12 @@ impl LinkLine {
             return;
         };
         let t = c - s;
+        // as reports count cycles (a check that joined counts from there)
+        let at = inv.place(s).0;
         let fault = if started {
-            (t < len).then(|| format!("a start bit falls {t} cycles after the previous character's start bit (cycle {s}), before its last stop bit ended ({len} cycles: {} bits of {div} cycles)", self.fmt.bits()))
+            (t < len).then(|| format!("a start bit falls {t} cycles after the previous character's start bit (cycle {at}), before its last stop bit ended ({len} cycles: {} bits of {div} cycles)", self.fmt.bits()))
         } else {
-            (t < len && !t.is_multiple_of(div)).then(|| format!("{LINE} changed {t} cycles into the character that started at cycle {s}, off its bit boundaries (every bit lasts {div} cycles at the declared baud)"))
+            (t < len && !t.is_multiple_of(div)).then(|| format!("{LINE} changed {t} cycles into the character that started at cycle {at}, off its bit boundaries (every bit lasts {div} cycles at the declared baud)"))
         };
         if let Some(detail) = fault {
             if self.synced && !(self.char_flagged && !started) {
@@ -249,7 +251,7 @@ impl LinkLine {
                     None,
                     format!(
                         "the character that started at cycle {} (data 0x{:02x}) has a low stop bit{} at the declared baud",
-                        b.start + self.rx_origin,
+                        inv.place(b.start + self.rx_origin).0,
                         b.byte,
                         if self.fmt.parity == link::Parity::None { "" } else { " or a wrong parity bit" }
                     ),

@@ -295,7 +295,7 @@ fn user_declared_part_model_passes_the_checker() {
 
 /// `cosim/tests/data/tiny.toml` (4 MHz, 1 ms frames of two slices) over a
 /// 1 Mbaud UART (4 cycles a bit): a link mix whose runs take milliseconds.
-fn tiny_uart() -> lut_gen::Schedule {
+pub(crate) fn tiny_uart() -> lut_gen::Schedule {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml");
     let text =
         std::fs::read_to_string(&p).unwrap() + "\n[link]\nkind = \"uart\"\nbaud = 1_000_000\n";
