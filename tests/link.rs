@@ -208,20 +208,43 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
         t.contains("the minimum baud that carries this mix is 1500000"),
         "{t}"
     );
-    // file, line and key of the refused baud, on stderr
+    // file, line, column and key of the refused baud, on stderr, as the
+    // parser names a bad key; every command that would run or build the
+    // link refuses it before it starts (exit 1, infeasible), the same way
+    let refusal = format!(
+        "{}:326:8: link.baud: 1476 bytes per frame need 708480 cycles of a 1000000-baud line",
+        slow.display()
+    );
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
-        e.contains("slow.toml: line 326: link.baud: 1476 bytes per frame need 708480 cycles")
-            && e.contains("the minimum baud that carries this mix is 1500000"),
+        e.contains(&refusal) && e.contains("the minimum baud that carries this mix is 1500000"),
         "{e}"
     );
-    slotforge()
-        .arg("verilog")
-        .arg(&slow)
-        .arg("-o")
-        .arg(dir.path().join("v"))
-        .assert()
-        .code(1);
+    let v = dir.path().join("v");
+    let vcd = dir.path().join("none.vcd");
+    for args in [
+        vec!["sim", "--frames", "1"],
+        vec!["sim", "--frames", "1", "--backend", "rusthdl"],
+        vec!["verilog", "-o", v.to_str().unwrap()],
+        vec!["check", vcd.to_str().unwrap()],
+        vec!["faults", "--false-alarm-mixes", "0"],
+    ] {
+        let o = slotforge()
+            .arg(args[0])
+            .arg(&slow)
+            .args(&args[1..])
+            .output()
+            .unwrap();
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {e}");
+        assert!(
+            e.starts_with(&format!("error: {refusal}"))
+                && e.contains("the minimum baud that carries this mix is 1500000")
+                && e.lines().count() == 1,
+            "{args:?}: {e}"
+        );
+    }
+    assert!(!v.exists(), "nothing written");
 
     let odd = dir.path().join("odd.toml");
     std::fs::write(&odd, text.replace("baud = 3_000_000", "baud = 2_900_000")).unwrap();
