@@ -219,7 +219,8 @@ impl LinkLine {
             (t < len && !t.is_multiple_of(div)).then(|| format!("{LINE} changed {t} cycles into the character that started at cycle {at}, off its bit boundaries (every bit lasts {div} cycles at the declared baud)"))
         };
         if let Some(detail) = fault {
-            if self.synced && !(self.char_flagged && !started) {
+            // an early start bit always; an edge off the grid once a character
+            if self.synced && (started || !self.char_flagged) {
                 inv.violation(
                     c,
                     "link-bit-timing",
