@@ -296,9 +296,13 @@ fn user_declared_part_model_passes_the_checker() {
 /// `cosim/tests/data/tiny.toml` (4 MHz, 1 ms frames of two slices) over a
 /// 1 Mbaud UART (4 cycles a bit): a link mix whose runs take milliseconds.
 pub(crate) fn tiny_uart() -> lut_gen::Schedule {
+    tiny_with_link("baud = 1_000_000\n")
+}
+
+/// `cosim/tests/data/tiny.toml` with a UART link of these keys.
+fn tiny_with_link(keys: &str) -> lut_gen::Schedule {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml");
-    let text =
-        std::fs::read_to_string(&p).unwrap() + "\n[link]\nkind = \"uart\"\nbaud = 1_000_000\n";
+    let text = std::fs::read_to_string(&p).unwrap() + "\n[link]\nkind = \"uart\"\n" + keys;
     let mix = lut_gen::parse(Path::new("tiny-uart.toml"), &text).unwrap();
     lut_gen::synthesize(&mix).unwrap()
 }
@@ -319,6 +323,18 @@ fn the_uart_line_is_judged_without_the_model() {
     };
     let clean = run_dut(&s, &mut ModelDut::new(&s), 3, &opts, "clean", None);
     assert!(clean.ok && !clean.model_compared, "{}", clean.summary());
+    // clean at other character shapes: bits of 4 to 10 cycles, parity,
+    // two stop bits
+    for keys in [
+        "baud = 1_000_000\nstop_bits = 2\n",
+        "baud = 800_000\nparity = \"even\"\n",
+        "baud = 400_000\nparity = \"odd\"\nstop_bits = 2\n",
+        "baud = 571_429\n",
+    ] {
+        let t = tiny_with_link(keys);
+        let r = run_dut(&t, &mut ModelDut::new(&t), 3, &opts, "clean", None);
+        assert!(r.ok, "{keys}: {}", r.summary());
+    }
     let at = s.grid.frame_cycles + s.grid.frame_cycles / 2 + 7;
     for (f, rule) in [
         (Fault::LinkBitFlip, "link-crc"),
