@@ -299,22 +299,69 @@ impl LinkLine {
     /// A good packet arrived in cycle `c`.
     fn packet(&mut self, c: u64, p: Packet, inv: &mut Invariants) {
         self.lost_place = false;
-        let seq = (p.frame * self.slices + p.slice as u64) as i64;
         // A packet closes when the next slice's header is sent: its slice
         // ended before this cycle's.
         let closed = (c / self.slice_cycles) as i64 - 1;
-        let offset = match self.offset {
-            Some(o) => o,
-            None => {
-                // Joined: the latest closed slice with this number.
-                let back = (closed - p.slice as i64).rem_euclid(self.slices as i64);
-                let o = closed - back - seq;
-                self.offset = Some(o);
-                self.synced = true;
-                o
-            }
-        };
-        let w = seq + offset;
+        let w = self.window_of(closed, &p);
+        self.overflow(c, &p, inv);
+        if w < self.first as i64 {
+            return; // its slice began before the check joined
+        }
+        let (frame8, slice) = (p.frame % 256, p.slice);
+        if w < self.base as i64 || w > closed {
+            let when = if w > closed {
+                "before its slice ended: the frame counter or slice is wrong"
+            } else {
+                "again, or after a later one"
+            };
+            let (s, f) = self.slice_frame(self.base, inv);
+            inv.violation(
+                c,
+                "link-sequence",
+                Some(LINE.into()),
+                Some(json!(format!("the packet of frame {f} slice {s}"))),
+                Some(json!(format!("frame counter {frame8} slice {slice}"))),
+                None,
+                format!("the packet with frame counter {frame8} slice {slice} arrived {when}"),
+            );
+            return;
+        }
+        let w = w as u64;
+        while self.base < w {
+            let (s, f) = self.slice_frame(self.base, inv);
+            self.windows.pop_front();
+            self.base += 1;
+            inv.violation(
+                c,
+                "link-packet-lost",
+                Some(LINE.into()),
+                Some(json!(format!("frame {f} slice {s}"))),
+                Some(json!(format!("frame counter {frame8} slice {slice}"))),
+                None,
+                format!("the packet of frame {f} slice {s} never came: the next good packet on the line is frame counter {frame8} slice {slice}"),
+            );
+        }
+        let win = self.windows.pop_front().unwrap_or_default();
+        self.base += 1;
+        self.compare(c, w, &win, &p.records, inv);
+    }
+
+    /// The slice (window) a packet is of, when the last slice closed is
+    /// `closed`: from the frame counter and slice, through the offset a
+    /// joined check learns from its first good packet (the latest closed
+    /// slice with that number).
+    fn window_of(&mut self, closed: i64, p: &Packet) -> i64 {
+        let seq = (p.frame * self.slices + p.slice as u64) as i64;
+        let offset = *self.offset.get_or_insert_with(|| {
+            let back = (closed - p.slice as i64).rem_euclid(self.slices as i64);
+            closed - back - seq
+        });
+        self.synced = true;
+        seq + offset
+    }
+
+    /// A trailer's overflow count must be 0 (reported once).
+    fn overflow(&mut self, c: u64, p: &Packet, inv: &mut Invariants) {
         if p.overflows > 0 && !self.overflow_reported {
             self.overflow_reported = true;
             inv.violation(
@@ -330,49 +377,6 @@ impl LinkLine {
                 ),
             );
         }
-        if w < self.first as i64 {
-            return; // its slice began before the check joined
-        }
-        let (frame8, slice) = (p.frame % 256, p.slice);
-        if w < self.base as i64 || w > closed {
-            let when = if w > closed {
-                "before its slice ended: the frame counter or slice is wrong"
-            } else {
-                "again, or after a later one"
-            };
-            inv.violation(
-                c,
-                "link-sequence",
-                Some(LINE.into()),
-                Some(json!(format!(
-                    "the packet of slice {}",
-                    (closed.max(0) as u64) % self.slices
-                ))),
-                Some(json!(format!("frame counter {frame8} slice {slice}"))),
-                None,
-                format!("the packet with frame counter {frame8} slice {slice} arrived {when}"),
-            );
-            return;
-        }
-        let w = w as u64;
-        while self.base < w {
-            let lost = self.base;
-            self.windows.pop_front();
-            self.base += 1;
-            let (s, f) = self.slice_frame(lost, inv);
-            inv.violation(
-                c,
-                "link-packet-lost",
-                Some(LINE.into()),
-                Some(json!(format!("frame {f} slice {s}"))),
-                Some(json!(format!("frame counter {frame8} slice {slice}"))),
-                None,
-                format!("the packet of frame {f} slice {s} never came: the next good packet on the line is frame counter {frame8} slice {slice}"),
-            );
-        }
-        let win = self.windows.pop_front().unwrap_or_default();
-        self.base += 1;
-        self.compare(c, w, &win, &p.records, inv);
     }
 
     /// A packet's records against the samples its slice emitted.

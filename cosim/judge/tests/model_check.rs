@@ -310,9 +310,37 @@ fn tiny_with_link(keys: &str) -> lut_gen::Schedule {
     s
 }
 
+/// The model's pins with `link_tx` inverted for one cycle: the cycle after
+/// the first start bit's fall at or after cycle `at` (a glitch inside a bit).
+struct Glitch {
+    inner: ModelDut,
+    at: u64,
+    c: u64,
+    fall: Option<u64>,
+}
+
+impl judge::run::Dut for Glitch {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+        let mut p = self.inner.step(rst, miso);
+        if rst {
+            return p;
+        }
+        if self.fall.is_none() && self.c >= self.at && !p.link_tx {
+            self.fall = Some(self.c);
+        }
+        if self.fall.map(|f| f + 1) == Some(self.c) {
+            p.link_tx = !p.link_tx;
+        }
+        self.c += 1;
+        p
+    }
+}
+
 /// The UART line is one of the invariants: with the model off, a clean run
 /// passes and each of the four line faults of the campaign is caught by a
-/// `link-*` rule of its own kind, at or after the fault.
+/// `link-*` rule of its own kind, at or after the fault; a one-cycle glitch
+/// inside a bit breaks `link-bit-timing`, and a sample changed or dropped
+/// on the sample pins alone breaks `link-samples`.
 #[test]
 fn the_uart_line_is_judged_without_the_model() {
     use judge::faults::{Fault, FaultyDut};
@@ -359,5 +387,26 @@ fn the_uart_line_is_judged_without_the_model() {
                 "{class}: {v:?}"
             );
         }
+    }
+    // a glitch inside a bit: off the bit grid
+    let mut dut = Glitch {
+        inner: ModelDut::new(&s),
+        at,
+        c: 0,
+        fall: None,
+    };
+    let r = run_dut(&s, &mut dut, 3, &opts, "glitch", None);
+    assert_eq!(r.violations[0].rule, "link-bit-timing", "{}", r.summary());
+    // the stream and the line disagree: a sample changed or dropped on the
+    // sample pins only (the line carries what the gateware sent)
+    for f in [Fault::NeighbourCode, Fault::DropSample] {
+        let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
+        let r = run_dut(&s, &mut dut, 3, &opts, "faulty", None);
+        assert!(
+            r.violations.iter().any(|v| v.rule == "link-samples"),
+            "{}: {}",
+            f.class(),
+            r.summary()
+        );
     }
 }
