@@ -222,6 +222,7 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
     );
     let v = dir.path().join("v");
     let b = dir.path().join("b");
+    let pr = dir.path().join("prove-out");
     let vcd = dir.path().join("none.vcd");
     for args in [
         vec!["sim", "--frames", "1"],
@@ -230,6 +231,7 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
         vec!["check", vcd.to_str().unwrap()],
         vec!["faults", "--false-alarm-mixes", "0"],
         vec!["build", "-o", b.to_str().unwrap()],
+        vec!["prove", "-o", pr.to_str().unwrap()],
     ] {
         let o = slotforge()
             .arg(args[0])
@@ -246,7 +248,10 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
             "{args:?}: {e}"
         );
     }
-    assert!(!v.exists() && !b.exists(), "nothing written");
+    assert!(
+        !v.exists() && !b.exists() && !pr.exists(),
+        "nothing written"
+    );
 
     let odd = dir.path().join("odd.toml");
     std::fs::write(&odd, text.replace("baud = 3_000_000", "baud = 2_900_000")).unwrap();
