@@ -154,7 +154,7 @@ pub struct Checker {
     grid: FrameGrid,
     model: Option<CycleModel>,
     inv: Invariants,
-    /// The UART line decoded without the model (a UART link only).
+    /// The link (UART line or AXIS beats) decoded without the model.
     line: Option<LinkLine>,
     phase: Phase,
     c: u64,
@@ -469,7 +469,7 @@ impl Checker {
         }
         // before the samples of this cycle: a slice that begins in it opens
         if let Some(l) = &mut self.line {
-            l.cycle(c, p.link_tx, &mut self.inv);
+            l.cycle(c, p, &mut self.inv);
         }
         if !same(p, &self.prev) || p.sample_valid || !same(xz, &NO_XZ) {
             self.edges(c, p, xz);

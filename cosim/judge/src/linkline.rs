@@ -1,15 +1,20 @@
-//! The UART line (`link_tx`) judged without the reference model: one of
-//! the checker's invariants, so that a waveform checked with the model off
-//! (`check --no-model`, the fault campaign's `invariants` column) still
-//! sees a broken line.
+//! The link to the host judged without the reference model: the UART line
+//! (`link_tx`) or the AXI4-Stream beats (`m_axis_tdata`/`tvalid`/`tready`/
+//! `tlast`); one of the checker's invariants, so that a waveform checked
+//! with the model off (`check --no-model`, the fault campaign's
+//! `invariants` column) still sees a broken link.
 //!
 //! From the mix alone (`docs/packet-format.md`):
-//! - **framing**: every character is a low start bit, 8 data bits, the
+//! - **beats** (AXIS): a byte is the `tdata` of a cycle with `tvalid` and
+//!   `tready` both high; `tlast` is high on exactly the beats that end a
+//!   packet (every trailer, or a frame's last slice's with `tlast = "frame"`);
+//!   the handshake's stability is the checker's `axis-stable`;
+//! - **framing** (UART): every character is a low start bit, 8 data bits, the
 //!   parity bit if any and high stop bits, each bit `div` cycles at the
 //!   declared baud; the line changes only on a bit boundary of the
 //!   character being sent (a cycle is a VCD's resolution), and a start bit
 //!   never begins before the previous character's last stop bit ended;
-//! - **packets**: the characters go through `link`'s own receiver and host
+//! - **packets**: the characters (or beats) go through `link`'s own receiver and host
 //!   decoder (the packet format has one home): every packet's CRC is good
 //!   and no byte falls outside a packet;
 //! - **sequence**: the packets are the slices in order, frame counter and
@@ -26,13 +31,15 @@
 use std::collections::VecDeque;
 
 use link::rx::{RxByte, UartRx};
-use link::{Decoder, Packet, Stats, UartFormat};
+use link::{AxisFormat, Decoder, Packet, Stats, Tlast, UartFormat};
+use lut_gen::ports::Pins;
 use lut_gen::Schedule;
 use serde_json::json;
 
 use crate::invariants::Invariants;
 
-const LINE: &str = "link_tx";
+const UART_LINE: &str = "link_tx";
+const AXIS_BEATS: &str = "m_axis_tdata";
 
 /// The samples the stream emitted in one slice: (channel, value, cycle).
 #[derive(Debug, Clone, Default)]
@@ -40,9 +47,9 @@ struct Window {
     samples: Vec<(u16, u16, u64)>,
 }
 
-/// The line's checks (a UART link only).
+/// The UART line's receiver and bit timing.
 #[derive(Debug, Clone)]
-pub(crate) struct LinkLine {
+struct Uart {
     fmt: UartFormat,
     rx: UartRx,
     /// The receiver's sample 0 is this cycle.
@@ -53,6 +60,21 @@ pub(crate) struct LinkLine {
     /// timing fault in it was already reported.
     char_start: Option<u64>,
     char_flagged: bool,
+}
+
+/// Where the bytes come from: a serial line or AXI4-Stream beats.
+#[derive(Debug, Clone)]
+enum Wire {
+    Uart(Uart),
+    Axis(AxisFormat),
+}
+
+/// The link's checks (a mix with a `[link]`).
+#[derive(Debug, Clone)]
+pub(crate) struct LinkLine {
+    wire: Wire,
+    /// The port violations name: `link_tx` or `m_axis_tdata`.
+    port: &'static str,
     dec: Decoder,
     packets: Vec<Packet>,
     seen: Stats,
@@ -79,17 +101,27 @@ pub(crate) struct LinkLine {
 }
 
 impl LinkLine {
-    /// The line's checks for a mix whose link is a UART; `None` otherwise.
+    /// The link's checks for a mix with a feasible `[link]`; `None` otherwise.
     pub(crate) fn new(s: &Schedule) -> Option<LinkLine> {
         let plan = lut_gen::hostlink::plan(s)?.ok()?;
-        let fmt = plan.uart()?;
+        let (wire, port) = match (plan.uart(), plan.axis()) {
+            (Some(fmt), _) => (
+                Wire::Uart(Uart {
+                    fmt,
+                    rx: UartRx::new(fmt),
+                    rx_origin: 0,
+                    level: true,
+                    char_start: None,
+                    char_flagged: false,
+                }),
+                UART_LINE,
+            ),
+            (None, Some(fmt)) => (Wire::Axis(fmt), AXIS_BEATS),
+            (None, None) => return None,
+        };
         Some(LinkLine {
-            fmt,
-            rx: UartRx::new(fmt),
-            rx_origin: 0,
-            level: true,
-            char_start: None,
-            char_flagged: false,
+            wire,
+            port,
             dec: Decoder::new(s.grid.slices_per_frame),
             packets: Vec::new(),
             seen: Stats::default(),
@@ -112,8 +144,10 @@ impl LinkLine {
     /// slices from the first that starts at or after it are checked, and
     /// the line from the first good packet on.
     pub(crate) fn join_at(&mut self, origin: u64, level: bool) {
-        self.rx_origin = origin;
-        self.level = level;
+        if let Wire::Uart(u) = &mut self.wire {
+            u.rx_origin = origin;
+            u.level = level;
+        }
         self.first = origin.div_ceil(self.slice_cycles);
         self.base = self.first;
         self.next_boundary = self.first * self.slice_cycles;
@@ -121,19 +155,30 @@ impl LinkLine {
         self.synced = false;
     }
 
-    /// The line in cycle `c` (every cycle, in order).
+    /// The link's pins in cycle `c` (every cycle, in order).
     #[inline]
-    pub(crate) fn cycle(&mut self, c: u64, tx: bool, inv: &mut Invariants) {
+    pub(crate) fn cycle(&mut self, c: u64, p: &Pins, inv: &mut Invariants) {
         if c >= self.next_boundary {
             self.boundary(c, inv);
         }
-        let got = self.rx.sample(tx);
-        if tx != self.level {
-            self.edge(c, inv);
-        }
-        self.level = tx;
-        if let Some(b) = got {
-            self.character(c, b, inv);
+        match &mut self.wire {
+            Wire::Uart(u) => {
+                let tx = p.link_tx;
+                let got = u.rx.sample(tx);
+                let changed = tx != u.level;
+                u.level = tx;
+                if changed {
+                    self.edge(c, inv);
+                }
+                if let Some(b) = got {
+                    self.character(c, b, inv);
+                }
+            }
+            Wire::Axis(_) => {
+                if p.axis_tvalid && p.axis_tready {
+                    self.beat(c, p.axis_tdata as u8, p.axis_tlast, inv);
+                }
+            }
         }
     }
 
@@ -178,15 +223,16 @@ impl LinkLine {
             inv.violation(
                 self.due(w),
                 "link-packet-missing",
-                Some(LINE.into()),
+                Some(self.port.into()),
                 Some(json!(format!("frame {frame} slice {slice}"))),
                 Some(json!("none")),
                 win.samples
                     .first()
                     .and_then(|x| self.names.get(x.0 as usize).cloned()),
                 format!(
-                    "the packet of frame {frame} slice {slice} ({} samples) has not arrived on {LINE} {} cycles after its slice ended (the audit's worst-case latency, {} cycles, plus a slice)",
+                    "the packet of frame {frame} slice {slice} ({} samples) has not arrived on {} {} cycles after its slice ended (the audit's worst-case latency, {} cycles, plus a slice)",
                     win.samples.len(),
+                    self.port,
                     self.latency + self.slice_cycles,
                     self.latency
                 ),
@@ -202,11 +248,15 @@ impl LinkLine {
     /// The line changed in cycle `c`: on a bit boundary of the character
     /// being sent, or the start bit of the next one after it ended.
     fn edge(&mut self, c: u64, inv: &mut Invariants) {
-        let (div, len) = (self.fmt.div as u64, self.fmt.char_cycles());
-        let started = self.rx.reading().map(|s| s + self.rx_origin) == Some(c);
-        let Some(s) = self.char_start else {
+        let synced = self.synced;
+        let Wire::Uart(u) = &mut self.wire else {
+            return;
+        };
+        let (div, len) = (u.fmt.div as u64, u.fmt.char_cycles());
+        let started = u.rx.reading().map(|s| s + u.rx_origin) == Some(c);
+        let Some(s) = u.char_start else {
             if started {
-                self.char_start = Some(c);
+                u.char_start = Some(c);
             }
             return;
         };
@@ -214,60 +264,102 @@ impl LinkLine {
         // as reports count cycles (a check that joined counts from there)
         let at = inv.place(s).0;
         let fault = if started {
-            (t < len).then(|| format!("a start bit falls {t} cycles after the previous character's start bit (cycle {at}), before its last stop bit ended ({len} cycles: {} bits of {div} cycles)", self.fmt.bits()))
+            (t < len).then(|| format!("a start bit falls {t} cycles after the previous character's start bit (cycle {at}), before its last stop bit ended ({len} cycles: {} bits of {div} cycles)", u.fmt.bits()))
         } else {
-            (t < len && !t.is_multiple_of(div)).then(|| format!("{LINE} changed {t} cycles into the character that started at cycle {at}, off its bit boundaries (every bit lasts {div} cycles at the declared baud)"))
+            (t < len && !t.is_multiple_of(div)).then(|| format!("{UART_LINE} changed {t} cycles into the character that started at cycle {at}, off its bit boundaries (every bit lasts {div} cycles at the declared baud)"))
         };
         if let Some(detail) = fault {
             // an early start bit always; an edge off the grid once a character
-            if self.synced && (started || !self.char_flagged) {
+            if synced && (started || !u.char_flagged) {
                 inv.violation(
                     c,
                     "link-bit-timing",
-                    Some(LINE.into()),
+                    Some(UART_LINE.into()),
                     Some(json!(format!("a multiple of {div} cycles"))),
                     Some(json!(t)),
                     None,
                     detail,
                 );
             }
-            self.char_flagged = true;
+            u.char_flagged = true;
         }
         if started {
-            self.char_start = Some(c);
-            self.char_flagged = false;
+            u.char_start = Some(c);
+            u.char_flagged = false;
         }
     }
 
     /// The receiver read a character (at the middle of its last stop bit).
     fn character(&mut self, c: u64, b: RxByte, inv: &mut Invariants) {
+        let Wire::Uart(u) = &self.wire else {
+            return;
+        };
         if b.error {
             if self.synced {
+                let (origin, parity) = (u.rx_origin, u.fmt.parity);
                 inv.violation(
                     c,
                     "link-framing",
-                    Some(LINE.into()),
+                    Some(UART_LINE.into()),
                     Some(json!("stop bit high")),
                     Some(json!(0)),
                     None,
                     format!(
                         "the character that started at cycle {} (data 0x{:02x}) has a low stop bit{} at the declared baud",
-                        inv.place(b.start + self.rx_origin).0,
+                        inv.place(b.start + origin).0,
                         b.byte,
-                        if self.fmt.parity == link::Parity::None { "" } else { " or a wrong parity bit" }
+                        if parity == link::Parity::None { "" } else { " or a wrong parity bit" }
                     ),
                 );
             }
             return;
         }
-        self.dec.push_packets(&[b.byte], &mut self.packets);
+        self.byte(c, b.byte, inv);
+    }
+
+    /// An AXI4-Stream beat in cycle `c`: its byte, and `tlast` where the
+    /// packet format ends a packet.
+    fn beat(&mut self, c: u64, byte: u8, tlast: bool, inv: &mut Invariants) {
+        let Wire::Axis(fmt) = self.wire else { return };
+        let before = self.seen;
+        let ends = self.byte(c, byte, inv);
+        let clean = self.seen.crc_errors == before.crc_errors
+            && self.seen.skipped_bytes == before.skipped_bytes;
+        let want =
+            ends.is_some_and(|slice| fmt.tlast == Tlast::Slice || slice as u64 + 1 == self.slices);
+        if self.synced && clean && !self.lost_place && tlast != want {
+            inv.violation(
+                c,
+                "axis-tlast",
+                Some("m_axis_tlast".into()),
+                Some(json!(want as u8)),
+                Some(json!(tlast as u8)),
+                None,
+                format!(
+                    "tlast is {} on the beat of byte {byte:#04x}, which {} (tlast = \"{}\")",
+                    tlast as u8,
+                    if ends.is_some() {
+                        "ends a packet"
+                    } else {
+                        "does not end a packet"
+                    },
+                    fmt.tlast.name()
+                ),
+            );
+        }
+    }
+
+    /// A byte off the link in cycle `c` through the host decoder; the slice
+    /// of the last packet it completed, if any.
+    fn byte(&mut self, c: u64, byte: u8, inv: &mut Invariants) -> Option<u16> {
+        self.dec.push_packets(&[byte], &mut self.packets);
         let st = *self.dec.stats();
         if self.synced && st.crc_errors > self.seen.crc_errors {
             self.lost_place = true;
             inv.violation(
                 c,
                 "link-crc",
-                Some(LINE.into()),
+                Some(self.port.into()),
                 None,
                 None,
                 None,
@@ -278,22 +370,23 @@ impl LinkLine {
             inv.violation(
                 c,
                 "link-resync",
-                Some(LINE.into()),
+                Some(self.port.into()),
                 Some(json!(format!("0x{:02x} (a header)", link::format::SYNC))),
-                Some(json!(format!("0x{:02x}", b.byte))),
+                Some(json!(format!("0x{byte:02x}"))),
                 None,
                 format!(
-                    "byte 0x{:02x} is not where the packet format puts a word: the decoder lost its place and searches for a header",
-                    b.byte
+                    "byte 0x{byte:02x} is not where the packet format puts a word: the decoder lost its place and searches for a header"
                 ),
             );
         }
         self.seen = st;
         let mut packets = std::mem::take(&mut self.packets);
+        let ended = packets.last().map(|p| p.slice);
         for p in packets.drain(..) {
             self.packet(c, p, inv);
         }
         self.packets = packets;
+        ended
     }
 
     /// A good packet arrived in cycle `c`.
@@ -318,7 +411,7 @@ impl LinkLine {
             inv.violation(
                 c,
                 "link-sequence",
-                Some(LINE.into()),
+                Some(self.port.into()),
                 Some(json!(format!("the packet of frame {f} slice {s}"))),
                 Some(json!(format!("frame counter {frame8} slice {slice}"))),
                 None,
@@ -334,7 +427,7 @@ impl LinkLine {
             inv.violation(
                 c,
                 "link-packet-lost",
-                Some(LINE.into()),
+                Some(self.port.into()),
                 Some(json!(format!("frame {f} slice {s}"))),
                 Some(json!(format!("frame counter {frame8} slice {slice}"))),
                 None,
@@ -367,7 +460,7 @@ impl LinkLine {
             inv.violation(
                 c,
                 "link-overflow-count",
-                Some(LINE.into()),
+                Some(self.port.into()),
                 Some(json!(0)),
                 Some(json!(p.overflows)),
                 None,
@@ -405,7 +498,7 @@ impl LinkLine {
         inv.violation(
             c,
             "link-samples",
-            Some(LINE.into()),
+            Some(self.port.into()),
             Some(json!(had)),
             Some(json!(got)),
             want.get(i)
