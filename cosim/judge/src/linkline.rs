@@ -176,7 +176,7 @@ impl LinkLine {
             }
             Wire::Axis(_) => {
                 if p.axis_tvalid && p.axis_tready {
-                    self.beat(c, p.axis_tdata as u8, p.axis_tlast, inv);
+                    self.beat(c, p.axis_tdata, p.axis_tlast, inv);
                 }
             }
         }
@@ -440,17 +440,27 @@ impl LinkLine {
     }
 
     /// The slice (window) a packet is of, when the last slice closed is
-    /// `closed`: from the frame counter and slice, through the offset a
-    /// joined check learns from its first good packet (the latest closed
-    /// slice with that number).
+    /// `closed`: from the 8-bit frame counter and slice, through the offset
+    /// a joined check learns from its first good packet (the latest closed
+    /// slice with that number), taken as the window of that number nearest
+    /// the one expected next. The decoder's own count of frames past 255 is
+    /// not used: a packet repeated or out of order looks like a wrap to it.
     fn window_of(&mut self, closed: i64, p: &Packet) -> i64 {
-        let seq = (p.frame * self.slices + p.slice as u64) as i64;
+        let slices = self.slices as i64;
+        let period = 256 * slices;
+        let seq = (p.frame % 256) as i64 * slices + p.slice as i64;
         let offset = *self.offset.get_or_insert_with(|| {
-            let back = (closed - p.slice as i64).rem_euclid(self.slices as i64);
+            let back = (closed - p.slice as i64).rem_euclid(slices);
             closed - back - seq
         });
         self.synced = true;
-        seq + offset
+        let ahead = (seq + offset - self.base as i64).rem_euclid(period);
+        self.base as i64
+            + if ahead > period / 2 {
+                ahead - period
+            } else {
+                ahead
+            }
     }
 
     /// A trailer's overflow count must be 0 (reported once).

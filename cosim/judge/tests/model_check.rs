@@ -521,3 +521,81 @@ impl judge::run::Dut for Beat<'_> {
         p
     }
 }
+
+/// A packet sent twice: the bytes of the first whole packet taken after
+/// cycle `at` sent again in place of the bytes of the packet of the same
+/// slice a frame later (same length: the schedule repeats every frame), so
+/// framing, CRC and `tlast` stay good and only the sequence is wrong.
+struct Repeat<'a> {
+    inner: Box<dyn judge::run::Dut + 'a>,
+    at: u64,
+    c: u64,
+    slices: usize,
+    /// Packets ended (`tlast` taken) since `at`.
+    ended: usize,
+    beats: Vec<u8>,
+    sent: usize,
+}
+
+impl judge::run::Dut for Repeat<'_> {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+        let mut p = self.inner.step(rst, miso);
+        if rst {
+            return p;
+        }
+        if self.c >= self.at && p.axis_tvalid {
+            let taken = p.axis_tready;
+            if self.ended == 1 && taken {
+                self.beats.push(p.axis_tdata);
+            } else if self.ended == 1 + self.slices && self.sent < self.beats.len() {
+                // every cycle the beat is offered: tdata stays stable
+                p.axis_tdata = self.beats[self.sent];
+                self.sent += taken as usize;
+            }
+            self.ended += (taken && p.axis_tlast) as usize;
+        }
+        self.c += 1;
+        p
+    }
+}
+
+/// `link-sequence`: a packet that arrives again (its frame counter and
+/// slice those of a packet already taken) is out of sequence; nothing else
+/// is wrong within the run (CRCs, `tlast`, the handshake, every other
+/// packet's samples; the packet it replaced would be reported lost when the
+/// next one arrives, after the run's end).
+#[test]
+fn a_packet_sent_twice_breaks_the_sequence() {
+    use link::ReadyPattern::WorstCase;
+    let s = tiny_with("kind = \"axis\"\nready_within = 8\n", "");
+    let opts = RunOptions {
+        check: judge::CheckOptions {
+            model: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let mut dut = Repeat {
+        inner: judge::run::with_slave(&s, ModelDut::new(&s), WorstCase),
+        at: s.grid.frame_cycles + 7,
+        c: 0,
+        slices: s.grid.slices_per_frame as usize,
+        ended: 0,
+        beats: Vec::new(),
+        sent: 0,
+    };
+    let r = run_dut(&s, &mut dut, 3, &opts, "repeat", None);
+    assert!(
+        dut.sent > 0 && dut.sent == dut.beats.len(),
+        "not sent again"
+    );
+    let rules: Vec<&str> = r.violations.iter().map(|v| v.rule.as_str()).collect();
+    assert_eq!(rules, ["link-sequence"], "{}", r.summary());
+    assert!(
+        r.violations[0]
+            .detail
+            .contains("arrived again, or after a later one"),
+        "{}",
+        r.summary()
+    );
+}
