@@ -333,3 +333,65 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("has no [link]"));
 }
+
+/// `check --no-model` judges an AXI4-Stream run's beats from its VCD: a
+/// `sim` behind the worst-case slave passes; the same VCD with `tlast`
+/// never raised fails on `axis-tlast` (exit 1), the model off.
+#[test]
+fn check_without_the_model_judges_the_axis_beats_of_a_vcd() {
+    let dir = tempfile::tempdir().unwrap();
+    let tiny = root().join("cosim/tests/data/tiny.toml");
+    let text =
+        std::fs::read_to_string(tiny).unwrap() + "\n[link]\nkind = \"axis\"\nready_within = 8\n";
+    let mix = dir.path().join("tiny-axis.toml");
+    std::fs::write(&mix, text).unwrap();
+    let vcd = dir.path().join("a.vcd");
+    slotforge()
+        .arg("sim")
+        .arg(&mix)
+        .args(["--frames", "2", "--tready", "worst", "--vcd"])
+        .arg(&vcd)
+        .assert()
+        .code(0);
+    let check = |vcd: &Path| {
+        let o = slotforge()
+            .arg("check")
+            .arg(&mix)
+            .arg(vcd)
+            .args(["--no-model", "--json"])
+            .output()
+            .unwrap();
+        let out = String::from_utf8_lossy(&o.stdout).to_string();
+        (o.status.code(), out)
+    };
+    let (code, out) = check(&vcd);
+    assert_eq!(code, Some(0), "{out}");
+    let src = std::fs::read_to_string(&vcd).unwrap();
+    let id = src
+        .lines()
+        .find(|l| l.starts_with("$var") && l.split_whitespace().nth(4) == Some("m_axis_tlast"))
+        .and_then(|l| l.split_whitespace().nth(3))
+        .expect("m_axis_tlast in the VCD")
+        .to_string();
+    let body = src.find("$enddefinitions").unwrap();
+    let cut: String = src[body..]
+        .lines()
+        .filter(|l| *l != format!("1{id}"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let bad = dir.path().join("no-tlast.vcd");
+    std::fs::write(&bad, format!("{}{cut}", &src[..body])).unwrap();
+    let (code, out) = check(&bad);
+    assert_eq!(code, Some(1), "{out}");
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let rules: Vec<&str> = r["violations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["rule"].as_str().unwrap())
+        .collect();
+    assert!(
+        !rules.is_empty() && rules.iter().all(|&x| x == "axis-tlast"),
+        "{rules:?}"
+    );
+}
