@@ -208,20 +208,50 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
         t.contains("the minimum baud that carries this mix is 1500000"),
         "{t}"
     );
-    // file, line and key of the refused baud, on stderr
+    // file, line, column and key of the refused baud, on stderr, as the
+    // parser names a bad key; every command that would run or build the
+    // link refuses it before it starts (exit 1, infeasible), the same way
+    let refusal = format!(
+        "{}:326:8: link.baud: 1476 bytes per frame need 708480 cycles of a 1000000-baud line",
+        slow.display()
+    );
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
-        e.contains("slow.toml: line 326: link.baud: 1476 bytes per frame need 708480 cycles")
-            && e.contains("the minimum baud that carries this mix is 1500000"),
+        e.contains(&refusal) && e.contains("the minimum baud that carries this mix is 1500000"),
         "{e}"
     );
-    slotforge()
-        .arg("verilog")
-        .arg(&slow)
-        .arg("-o")
-        .arg(dir.path().join("v"))
-        .assert()
-        .code(1);
+    let v = dir.path().join("v");
+    let b = dir.path().join("b");
+    let pr = dir.path().join("prove-out");
+    let vcd = dir.path().join("none.vcd");
+    for args in [
+        vec!["sim", "--frames", "1"],
+        vec!["sim", "--frames", "1", "--backend", "rusthdl"],
+        vec!["verilog", "-o", v.to_str().unwrap()],
+        vec!["check", vcd.to_str().unwrap()],
+        vec!["faults", "--false-alarm-mixes", "0"],
+        vec!["build", "-o", b.to_str().unwrap()],
+        vec!["prove", "-o", pr.to_str().unwrap()],
+    ] {
+        let o = slotforge()
+            .arg(args[0])
+            .arg(&slow)
+            .args(&args[1..])
+            .output()
+            .unwrap();
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {e}");
+        assert!(
+            e.starts_with(&format!("error: {refusal}"))
+                && e.contains("the minimum baud that carries this mix is 1500000")
+                && e.lines().count() == 1,
+            "{args:?}: {e}"
+        );
+    }
+    assert!(
+        !v.exists() && !b.exists() && !pr.exists(),
+        "nothing written"
+    );
 
     let odd = dir.path().join("odd.toml");
     std::fs::write(&odd, text.replace("baud = 3_000_000", "baud = 2_900_000")).unwrap();
@@ -302,4 +332,66 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
         .unwrap();
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("has no [link]"));
+}
+
+/// `check --no-model` judges an AXI4-Stream run's beats from its VCD: a
+/// `sim` behind the worst-case slave passes; the same VCD with `tlast`
+/// never raised fails on `axis-tlast` (exit 1), the model off.
+#[test]
+fn check_without_the_model_judges_the_axis_beats_of_a_vcd() {
+    let dir = tempfile::tempdir().unwrap();
+    let tiny = root().join("cosim/tests/data/tiny.toml");
+    let text =
+        std::fs::read_to_string(tiny).unwrap() + "\n[link]\nkind = \"axis\"\nready_within = 8\n";
+    let mix = dir.path().join("tiny-axis.toml");
+    std::fs::write(&mix, text).unwrap();
+    let vcd = dir.path().join("a.vcd");
+    slotforge()
+        .arg("sim")
+        .arg(&mix)
+        .args(["--frames", "2", "--tready", "worst", "--vcd"])
+        .arg(&vcd)
+        .assert()
+        .code(0);
+    let check = |vcd: &Path| {
+        let o = slotforge()
+            .arg("check")
+            .arg(&mix)
+            .arg(vcd)
+            .args(["--no-model", "--json"])
+            .output()
+            .unwrap();
+        let out = String::from_utf8_lossy(&o.stdout).to_string();
+        (o.status.code(), out)
+    };
+    let (code, out) = check(&vcd);
+    assert_eq!(code, Some(0), "{out}");
+    let src = std::fs::read_to_string(&vcd).unwrap();
+    let id = src
+        .lines()
+        .find(|l| l.starts_with("$var") && l.split_whitespace().nth(4) == Some("m_axis_tlast"))
+        .and_then(|l| l.split_whitespace().nth(3))
+        .expect("m_axis_tlast in the VCD")
+        .to_string();
+    let body = src.find("$enddefinitions").unwrap();
+    let cut: String = src[body..]
+        .lines()
+        .filter(|l| *l != format!("1{id}"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let bad = dir.path().join("no-tlast.vcd");
+    std::fs::write(&bad, format!("{}{cut}", &src[..body])).unwrap();
+    let (code, out) = check(&bad);
+    assert_eq!(code, Some(1), "{out}");
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let rules: Vec<&str> = r["violations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v["rule"].as_str().unwrap())
+        .collect();
+    assert!(
+        !rules.is_empty() && rules.iter().all(|&x| x == "axis-tlast"),
+        "{rules:?}"
+    );
 }

@@ -79,7 +79,6 @@ impl Detector {
             ) => Some("the SPI decode reads CS, SCLK and MISO only: mux pins are outside its view, and the design emits whatever code MISO carried"),
             (Detector::Prove, _) if level == "pins" || level == "reset" => Some("the fault is injected into a simulation's pins, not built into a design: prove reads a design, so it has nothing to prove it against"),
             (Detector::Sigrok, c) if c.starts_with("link-") || c.starts_with("axis-") => Some("the SPI decode reads CS, SCLK and MISO only: the link's pins are outside its view"),
-            (Detector::Invariants, "link-bit-flip" | "link-drop-byte" | "link-stuck-high" | "link-stuck-low") => Some("the model-free checks do not decode the UART line: only the model predicts its bits"),
             _ => None,
         }
     }

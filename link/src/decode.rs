@@ -22,6 +22,19 @@ pub struct Decoded {
     pub value: u16,
 }
 
+/// One good packet (its trailer's CRC matched): what a checker that knows
+/// which samples the packet should carry compares, an empty packet included.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Packet {
+    /// The header's frame counter unwrapped as in [`Decoded::frame`].
+    pub frame: u64,
+    pub slice: u16,
+    /// (channel, value) of every record, in order.
+    pub records: Vec<(u16, u16)>,
+    /// The trailer's overflow count.
+    pub overflows: u8,
+}
+
 /// What the decoder saw.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Stats {
@@ -94,6 +107,21 @@ impl Decoder {
 
     /// Feed received bytes; `out` gets the samples of every packet they complete.
     pub fn push(&mut self, bytes: &[u8], out: &mut Vec<Decoded>) {
+        let mut packets = Vec::new();
+        self.push_packets(bytes, &mut packets);
+        for p in packets {
+            out.extend(p.records.iter().map(|&(channel, value)| Decoded {
+                frame: p.frame,
+                slice: p.slice,
+                channel,
+                value,
+            }));
+        }
+    }
+
+    /// Feed received bytes; `out` gets every packet they complete, whole
+    /// (so a packet without records is seen too).
+    pub fn push_packets(&mut self, bytes: &[u8], out: &mut Vec<Packet>) {
         self.stats.bytes += bytes.len() as u64;
         self.pending.extend(bytes);
         while let Some(b) = self.pending.pop_front() {
@@ -111,7 +139,7 @@ impl Decoder {
         self.stats
     }
 
-    fn byte(&mut self, b: u8, out: &mut Vec<Decoded>) {
+    fn byte(&mut self, b: u8, out: &mut Vec<Packet>) {
         if self.buf.is_empty() {
             if b == SYNC {
                 self.buf.push(b);
@@ -162,7 +190,7 @@ impl Decoder {
         self.skip(1);
     }
 
-    fn trailer(&mut self, out: &mut Vec<Decoded>) {
+    fn trailer(&mut self, out: &mut Vec<Packet>) {
         let n = self.buf.len();
         let want = format::crc(&self.buf[..n - 2]);
         let got = u16::from_le_bytes([self.buf[n - 2], self.buf[n - 1]]);
@@ -185,17 +213,25 @@ impl Decoder {
             }
         };
         self.last = Some(seq);
-        self.stats.overflows = self.stats.overflows.max(self.buf[n - 3]);
+        let overflows = self.buf[n - 3];
+        self.stats.overflows = self.stats.overflows.max(overflows);
         self.stats.packets += 1;
-        for r in self.buf[WORD_BYTES..n - WORD_BYTES].chunks(WORD_BYTES) {
-            out.push(Decoded {
-                frame: seq / self.slices,
-                slice: (seq % self.slices) as u16,
-                channel: u16::from_be_bytes([r[0], r[1]]),
-                value: u16::from_be_bytes([r[2], r[3]]),
-            });
-            self.stats.samples += 1;
-        }
+        let records: Vec<(u16, u16)> = self.buf[WORD_BYTES..n - WORD_BYTES]
+            .chunks(WORD_BYTES)
+            .map(|r| {
+                (
+                    u16::from_be_bytes([r[0], r[1]]),
+                    u16::from_be_bytes([r[2], r[3]]),
+                )
+            })
+            .collect();
+        self.stats.samples += records.len() as u64;
+        out.push(Packet {
+            frame: seq / self.slices,
+            slice: (seq % self.slices) as u16,
+            records,
+            overflows,
+        });
         self.synced_once = true;
         self.searching = false;
         self.buf.clear();
@@ -258,6 +294,20 @@ mod tests {
         assert_eq!(st.crc_errors, 1);
         assert_eq!(st.lost_packets, 2);
         assert!(st.cut && st.resyncs >= 1 && st.skipped_bytes >= 4);
+    }
+
+    #[test]
+    fn packets_come_out_whole_empty_ones_too() {
+        let mut s = packet(3, 9, &[(1, 0xA5A5)]);
+        s.extend(packet(4, 0, &[]));
+        let mut d = Decoder::new(10);
+        let mut out = Vec::new();
+        d.push_packets(&s, &mut out);
+        assert_eq!(out.len(), 2);
+        assert_eq!((out[0].frame, out[0].slice), (3, 9));
+        assert_eq!(out[0].records, [(1, 0xA5A5)]);
+        assert_eq!((out[1].frame, out[1].slice), (4, 0));
+        assert!(out[1].records.is_empty());
     }
 
     #[test]

@@ -24,7 +24,7 @@ pub mod tx;
 pub mod uart;
 
 pub use axis::{AxisFormat, ReadyDriver, ReadyPattern, Tlast};
-pub use decode::{Decoded, Decoder, Stats};
+pub use decode::{Decoded, Decoder, Packet, Stats};
 pub use format::Token;
 pub use tx::{Line, TxConfig, TxModel};
 pub use uart::{Parity, UartFormat};

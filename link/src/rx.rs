@@ -38,6 +38,14 @@ impl UartRx {
         }
     }
 
+    /// The cycle (count of samples before it) at which the character being
+    /// read started: its start bit's falling edge; `None` when idle (after
+    /// the middle of the last stop bit, or a start bit found high at its
+    /// middle).
+    pub fn reading(&self) -> Option<u64> {
+        self.start
+    }
+
     /// Feed the line's level in the next cycle; a character when its last
     /// stop bit has been sampled (at the middle of each bit).
     pub fn sample(&mut self, level: bool) -> Option<RxByte> {

@@ -62,8 +62,38 @@ pub struct LinkPlan {
 /// Why the link cannot carry the mix.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinkInfeasible {
+    /// `line N: link.<key>: words` (the audit's form).
     pub message: String,
+    /// Where the refused key is in the mix file, and what is wrong with
+    /// it (`link.<key>: words`).
+    pub line: usize,
+    pub column: usize,
+    pub detail: String,
     pub min_baud: Option<f64>,
+}
+
+impl LinkInfeasible {
+    fn new(spec: &LinkSpec, detail: String, min_baud: Option<f64>) -> LinkInfeasible {
+        LinkInfeasible {
+            message: format!("line {}: {detail}", spec.line),
+            line: spec.line,
+            column: spec.column,
+            detail,
+            min_baud,
+        }
+    }
+
+    /// The refusal as the mix parser's errors read:
+    /// `file:line:col: link.<key>: words`.
+    pub fn at(&self, file: &std::path::Path) -> String {
+        format!(
+            "{}:{}:{}: {}",
+            file.display(),
+            self.line,
+            self.column,
+            self.detail
+        )
+    }
 }
 
 impl LinkPlan {
@@ -121,26 +151,22 @@ fn plan_axis(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> 
     let top = (g.frame_cycles / bytes).min(u32::MAX as u64) as u32;
     let max_n = slowest_line(top, 1, |d| measure(s, axis_of(spec, d), &stream).is_some());
     let refuse = |why: String| {
-        LinkInfeasible {
-        message: match max_n {
+        let detail = match max_n {
             Some(m) => format!("{why}; this mix needs every beat accepted within {m} cycles (tready duty >= 1/{m})"),
             None => format!("{why}; not even an always-ready slave carries this mix"),
-        },
-        min_baud: None,
-    }
+        };
+        LinkInfeasible::new(spec, detail, None)
     };
     let line_cycles = bytes * n as u64;
     if line_cycles > g.frame_cycles {
         return Err(refuse(format!(
-            "line {}: link.ready_within: {bytes} bytes per frame, one per {n} cycles at worst, need {line_cycles} cycles, the frame has {}",
-            spec.line,
+            "link.ready_within: {bytes} bytes per frame, one per {n} cycles at worst, need {line_cycles} cycles, the frame has {}",
             g.frame_cycles
         )));
     }
     let m = measure(s, axis_of(spec, n), &stream).ok_or_else(|| {
         refuse(format!(
-            "line {}: link.ready_within: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens when every beat waits {n} cycles",
-            spec.line
+            "link.ready_within: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens when every beat waits {n} cycles"
         ))
     })?;
     Ok(LinkPlan {
@@ -183,25 +209,23 @@ fn plan_spec(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> 
     let stream = merged_frame(s);
     let min = min_divider(s, spec, &stream, bytes);
     let min_baud = min.map(|d| UartFormat::real_baud(g.clock_hz, d));
-    let refuse = |why: String| LinkInfeasible {
-        message: match min_baud {
+    let refuse = |why: String| {
+        let detail = match min_baud {
             Some(b) => format!("{why}; the minimum baud that carries this mix is {b:.0}"),
             None => format!("{why}; no baud from this clock carries this mix"),
-        },
-        min_baud,
+        };
+        LinkInfeasible::new(spec, detail, min_baud)
     };
     if line_cycles > g.frame_cycles {
         return Err(refuse(format!(
-            "line {}: link.baud: {bytes} bytes per frame need {line_cycles} cycles of a {:.0}-baud line, the frame has {}",
-            spec.line,
+            "link.baud: {bytes} bytes per frame need {line_cycles} cycles of a {:.0}-baud line, the frame has {}",
             UartFormat::real_baud(g.clock_hz, div),
             g.frame_cycles
         )));
     }
     let m = measure(s, Line::Uart(uart), &stream).ok_or_else(|| {
         refuse(format!(
-            "line {}: link.baud: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens at {:.0} baud",
-            spec.line,
+            "link.baud: the FIFO's backlog exceeds {MAX_FIFO_DEPTH} tokens at {:.0} baud",
             UartFormat::real_baud(g.clock_hz, div)
         ))
     })?;

@@ -77,8 +77,10 @@ pub struct LinkSpec {
     pub stop_bits: u8,
     /// The mix file's line of the key a refusal of the link names
     /// (`baud`; for AXI4-Stream `ready_within`, or `[link]` without it), so
-    /// a line too slow for the mix is reported where the user wrote it.
+    /// a line too slow for the mix is reported where the user wrote it;
+    /// and its column.
     pub line: usize,
+    pub column: usize,
 }
 
 /// `[link].kind`.
@@ -1055,6 +1057,7 @@ impl Cx<'_> {
             parity,
             stop_bits,
             line: line_col(self.text, baud_raw.span().start).0,
+            column: line_col(self.text, baud_raw.span().start).1,
         })
     }
 
@@ -1099,6 +1102,10 @@ impl Cx<'_> {
                 })?
             }
         };
+        let key = line_col(
+            self.text,
+            r.ready_within.as_ref().map_or(l.span(), |v| v.span()).start,
+        );
         Ok(LinkSpec {
             kind: LinkKind::Axis,
             tlast,
@@ -1106,11 +1113,8 @@ impl Cx<'_> {
             baud: 0,
             parity: link::Parity::None,
             stop_bits: 0,
-            line: line_col(
-                self.text,
-                r.ready_within.as_ref().map_or(l.span(), |v| v.span()).start,
-            )
-            .0,
+            line: key.0,
+            column: key.1,
         })
     }
 }

@@ -23,10 +23,10 @@ pub fn run(args: Args) -> u8 {
     };
     let (report, diagnosis) = match lut_gen::synthesize(&mix) {
         Ok(s) => {
-            // a line too slow for the mix: named on stderr with the file
-            // (the message names the key and its line)
+            // a line too slow for the mix: named on stderr as the parser
+            // names a bad key (the report says it too, and exits 1)
             if let Some(Err(e)) = lut_gen::hostlink::plan(&s) {
-                eprintln!("error: {}: {}", args.mix.display(), e.message);
+                eprintln!("error: {}", e.at(&args.mix));
             }
             (AuditReport::of_schedule(&s), None)
         }

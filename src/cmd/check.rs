@@ -121,6 +121,9 @@ pub fn run(a: Args) -> u8 {
     if let Err(code) = super::fits_pins(&s) {
         return code;
     }
+    if let Err(code) = super::link_fits(&s, &a.mix) {
+        return code;
+    }
     if let Some(j) = &a.junit {
         if let Err(e) = super::junit::check_writable(j) {
             eprintln!("error: {e}");

@@ -56,6 +56,9 @@ pub fn run(a: Args) -> u8 {
     if let Err(code) = super::fits_pins(&s) {
         return code;
     }
+    if let Err(code) = super::link_fits(&s, &a.mix) {
+        return code;
+    }
     // One back-end name everywhere (cosim::Backend); the campaign injects
     // into the designs it can build in process.
     let target = match a.backend {

@@ -121,6 +121,19 @@ pub fn fits_pins(s: &lut_gen::Schedule) -> Result<(), u8> {
     })
 }
 
+/// Refuses, before any run, a mix whose link to the host cannot carry it
+/// (the audit's "infeasible"): the key named as the parser names a bad
+/// one, `file:line:col: link.<key>: ...`, with the minimum that fits; exit 1.
+pub fn link_fits(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
+    match lut_gen::hostlink::plan(s) {
+        Some(Err(e)) => {
+            eprintln!("error: {}", e.at(file));
+            Err(1)
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Writes `text` to `dir/name` through a temporary file and a rename, so an
 /// interrupted run never leaves a half-written file.
 pub fn write_atomic(dir: &Path, name: &str, text: &str) -> Result<(), String> {

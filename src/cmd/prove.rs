@@ -1,7 +1,8 @@
 //! `slotforge prove MIX [--rtl FILE.v] [--solver symbolic|abc|pdr|cvc5] [--json]`
 //!
 //! Exit 0: proved for all time; 1: a counterexample (its VCD, `.gtkw` and
-//! the checker's diagnosis); 2: bad input or a tool that cannot run;
+//! the checker's diagnosis), or a link too slow for the mix; 2: bad input
+//! or a tool that cannot run;
 //! 3: bounded only (no violation within the depth, not a proof).
 
 use std::path::PathBuf;
@@ -45,6 +46,11 @@ pub fn run(a: Args) -> u8 {
         Err(code) => return code,
     };
     if let Err(code) = super::fits_pins(&s) {
+        return code;
+    }
+    // a link too slow for the mix: refused as sim, check, faults, build and
+    // verilog refuse it (file:line:col: link.<key>: ..., exit 1)
+    if let Err(code) = super::link_fits(&s, &a.mix) {
         return code;
     }
     let (design, own) = match &a.rtl {

@@ -136,6 +136,9 @@ pub fn run(a: Args) -> u8 {
     if let Err(code) = super::fits_pins(&s) {
         return code;
     }
+    if let Err(code) = super::link_fits(&s, &a.mix) {
+        return code;
+    }
     let from = a.from.cycles(&s);
     let to = match a.to {
         Some(b) => b.cycles(&s),

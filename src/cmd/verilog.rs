@@ -20,6 +20,9 @@ pub fn run(args: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
+    if let Err(code) = super::link_fits(&s, &args.mix) {
+        return code;
+    }
     let emitted = match hdl::emit(&s, args.board.as_deref()) {
         Ok(e) => e,
         Err(e @ hdl::HdlError::Unsupported(_)) => {

@@ -14,6 +14,7 @@ use serde_json::{json, Value};
 use lut_gen::ports::{Layout, Pins, Role, Signal};
 
 use crate::invariants::Invariants;
+use crate::linkline::LinkLine;
 use crate::model::CycleModel;
 use crate::report::{Divergence, Report};
 
@@ -153,6 +154,8 @@ pub struct Checker {
     grid: FrameGrid,
     model: Option<CycleModel>,
     inv: Invariants,
+    /// The link (UART line or AXIS beats) decoded without the model.
+    line: Option<LinkLine>,
     phase: Phase,
     c: u64,
     prev: Pins,
@@ -254,6 +257,7 @@ impl Checker {
             grid: s.grid,
             model: opts.model.then(|| CycleModel::new(s)),
             inv: Invariants::new(s, opts.max_records),
+            line: LinkLine::new(s),
             phase: Phase::PreReset,
             c: 0,
             prev: Pins::default(),
@@ -292,6 +296,9 @@ impl Checker {
         chk.c = c;
         chk.origin = c;
         chk.inv.join_at(c, j.capture_cycle);
+        if let Some(l) = &mut chk.line {
+            l.join_at(c, j.prev.link_tx);
+        }
         chk.next_frame_at = (c / s.grid.frame_cycles + 1) * s.grid.frame_cycles;
         chk.prev = j.prev;
         chk.prev_xz = j.prev_xz;
@@ -459,6 +466,10 @@ impl Checker {
 
         if !same(xz, &self.prev_xz) {
             self.xz_changes(c, p, xz);
+        }
+        // before the samples of this cycle: a slice that begins in it opens
+        if let Some(l) = &mut self.line {
+            l.cycle(c, p, &mut self.inv);
         }
         if !same(p, &self.prev) || p.sample_valid || !same(xz, &NO_XZ) {
             self.edges(c, p, xz);
@@ -707,6 +718,9 @@ impl Checker {
                 self.inv.emitted(c, p.sample_channel, p.sample_value);
             } else {
                 self.inv.emitted(c, p.sample_channel, p.sample_value);
+            }
+            if let Some(l) = &mut self.line {
+                l.sample(c, p.sample_channel, p.sample_value);
             }
         }
     }
@@ -959,6 +973,9 @@ impl Checker {
         let cycles = self.c - self.origin;
         if self.phase == Phase::PreReset || (self.phase == Phase::Reset && cycles == 0) {
             self.inv.violation(0, "no-cycles", Some(Role::Reset.name().into()), None, None, None, "no cycle after a released reset was seen (rst must be high, then low, at rising clock edges)".into());
+        }
+        if let Some(l) = &mut self.line {
+            l.finish(self.c, &mut self.inv);
         }
         let (frames, channels) = self.inv.finish(self.c);
         let samples = self.inv.emitted_count();

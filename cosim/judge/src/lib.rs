@@ -18,6 +18,7 @@
 //! - [`timed`] / [`capture`]: logic-analyser captures (no clock, any
 //!   sample rate) checked at time level, the channel map, sigrok input;
 //! - [`fst`]: FST input, through the `wellen` crate;
+//! - `linkline`: the link (UART line or AXI4-Stream beats) decoded and judged without the model;
 //! - [`lock`]: finding the frame phase of a capture that did not start at
 //!   reset, and checking it from there;
 //! - [`events`]: a run's pins as a reviewable event log, and the
@@ -35,6 +36,7 @@ pub mod events;
 pub mod faults;
 pub mod fst;
 pub mod invariants;
+mod linkline;
 pub mod lock;
 pub mod model;
 pub mod report;

@@ -292,3 +292,310 @@ fn user_declared_part_model_passes_the_checker() {
     let r = run_dut(&s, &mut dut, 2, &RunOptions::default(), "model-dut", None);
     assert!(r.ok, "{}", r.summary());
 }
+
+/// `cosim/tests/data/tiny.toml` (4 MHz, 1 ms frames of two slices) over a
+/// 1 Mbaud UART (4 cycles a bit): a link mix whose runs take milliseconds.
+pub(crate) fn tiny_uart() -> lut_gen::Schedule {
+    tiny_with_link("baud = 1_000_000\n")
+}
+
+/// `cosim/tests/data/tiny.toml` with a UART link of these keys.
+fn tiny_with_link(keys: &str) -> lut_gen::Schedule {
+    tiny_with("kind = \"uart\"\n", keys)
+}
+
+/// `cosim/tests/data/tiny.toml` with a `[link]` of this kind and keys.
+fn tiny_with(kind: &str, keys: &str) -> lut_gen::Schedule {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml");
+    let text = std::fs::read_to_string(&p).unwrap() + "\n[link]\n" + kind + keys;
+    let mix = lut_gen::parse(Path::new("tiny-uart.toml"), &text).unwrap();
+    let s = lut_gen::synthesize(&mix).unwrap();
+    // a line that cannot carry the mix has no link to check
+    assert!(matches!(lut_gen::hostlink::plan(&s), Some(Ok(_))), "{keys}");
+    s
+}
+
+/// The model's pins with `link_tx` inverted for one cycle: the cycle after
+/// the first start bit's fall at or after cycle `at` (a glitch inside a bit).
+struct Glitch {
+    inner: ModelDut,
+    at: u64,
+    c: u64,
+    fall: Option<u64>,
+}
+
+impl judge::run::Dut for Glitch {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+        let mut p = self.inner.step(rst, miso);
+        if rst {
+            return p;
+        }
+        if self.fall.is_none() && self.c >= self.at && !p.link_tx {
+            self.fall = Some(self.c);
+        }
+        if self.fall.map(|f| f + 1) == Some(self.c) {
+            p.link_tx = !p.link_tx;
+        }
+        self.c += 1;
+        p
+    }
+}
+
+/// The UART line is one of the invariants: with the model off, a clean run
+/// passes and each of the four line faults of the campaign is caught by a
+/// `link-*` rule of its own kind, at or after the fault; a one-cycle glitch
+/// inside a bit breaks `link-bit-timing`, and a sample changed or dropped
+/// on the sample pins alone breaks `link-samples`.
+#[test]
+fn the_uart_line_is_judged_without_the_model() {
+    use judge::faults::{Fault, FaultyDut};
+    let s = tiny_uart();
+    let opts = RunOptions {
+        check: judge::CheckOptions {
+            model: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let clean = run_dut(&s, &mut ModelDut::new(&s), 3, &opts, "clean", None);
+    assert!(clean.ok && !clean.model_compared, "{}", clean.summary());
+    // clean at other character shapes: bits of 4 and 5 cycles, parity,
+    // two stop bits
+    for keys in [
+        "baud = 1_000_000\nstop_bits = 2\n",
+        "baud = 800_000\nparity = \"even\"\n",
+        "baud = 800_000\nparity = \"odd\"\nstop_bits = 2\n",
+        "baud = 1_000_000\nparity = \"odd\"\n",
+    ] {
+        let t = tiny_with_link(keys);
+        let r = run_dut(&t, &mut ModelDut::new(&t), 3, &opts, "clean", None);
+        assert!(r.ok, "{keys}: {}", r.summary());
+    }
+    let at = s.grid.frame_cycles + s.grid.frame_cycles / 2 + 7;
+    for (f, rule) in [
+        (Fault::LinkBitFlip, "link-crc"),
+        (Fault::LinkDropByte, "link-crc"),
+        (Fault::LinkStuck { high: true }, "link-packet-missing"),
+        (Fault::LinkStuck { high: false }, "link-framing"),
+    ] {
+        let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
+        let r = run_dut(&s, &mut dut, 3, &opts, "faulty", None);
+        let class = f.class();
+        assert!(dut.injected(), "{class}: found nothing to change");
+        eprintln!("{class}: {}", r.summary());
+        assert!(!r.ok && r.divergence_count == 0, "{class}: {}", r.summary());
+        let rules: Vec<&str> = r.violations.iter().map(|v| v.rule.as_str()).collect();
+        assert!(rules.contains(&rule), "{class}: {rules:?}");
+        for v in &r.violations {
+            assert!(
+                v.rule.starts_with("link-") && v.cycle >= at,
+                "{class}: {v:?}"
+            );
+        }
+    }
+    // a glitch inside a bit: off the bit grid
+    let mut dut = Glitch {
+        inner: ModelDut::new(&s),
+        at,
+        c: 0,
+        fall: None,
+    };
+    let r = run_dut(&s, &mut dut, 3, &opts, "glitch", None);
+    assert_eq!(r.violations[0].rule, "link-bit-timing", "{}", r.summary());
+    // the stream and the line disagree: a sample changed or dropped on the
+    // sample pins only (the line carries what the gateware sent)
+    for f in [Fault::NeighbourCode, Fault::DropSample] {
+        let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
+        let r = run_dut(&s, &mut dut, 3, &opts, "faulty", None);
+        assert!(
+            r.violations.iter().any(|v| v.rule == "link-samples"),
+            "{}: {}",
+            f.class(),
+            r.summary()
+        );
+    }
+}
+
+/// The AXI4-Stream beats are one of the invariants as the UART line is:
+/// with the model off, clean runs pass behind the worst-case and a random
+/// slave (both `tlast` placements); the campaign's two AXIS classes are
+/// caught (`axis-stable`), and beats the slave takes with a changed byte,
+/// a lost beat, a misplaced `tlast` or a sample changed on the sample pins
+/// only are caught by the beats' decode (`link-*`, `axis-tlast`).
+#[test]
+fn the_axis_beats_are_judged_without_the_model() {
+    use judge::faults::{Fault, FaultyDut};
+    use judge::run::with_slave;
+    use link::ReadyPattern::{Random, WorstCase};
+    let opts = RunOptions {
+        check: judge::CheckOptions {
+            model: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let axis = |tlast: &str| tiny_with("kind = \"axis\"\nready_within = 8\n", tlast);
+    let s = axis("");
+    for (t, pattern) in [
+        (&s, WorstCase),
+        (&s, Random { seed: 7 }),
+        (&axis("tlast = \"frame\"\n"), WorstCase),
+    ] {
+        let mut dut = with_slave(t, ModelDut::new(t), pattern);
+        let r = run_dut(t, &mut dut, 3, &opts, "clean", None);
+        assert!(r.ok && !r.model_compared, "{}", r.summary());
+    }
+    let at = s.grid.frame_cycles + s.grid.frame_cycles / 2 + 7;
+    let rules = |mut dut: Box<dyn judge::run::Dut + '_>, what: &str| {
+        let r = run_dut(&s, &mut dut, 3, &opts, "faulty", None);
+        eprintln!("{what}: {}", r.summary());
+        assert!(!r.ok && r.divergence_count == 0, "{what}: {}", r.summary());
+        for v in &r.violations {
+            assert!(v.cycle >= at, "{what}: {v:?}");
+        }
+        r.violations
+            .iter()
+            .map(|v| v.rule.clone())
+            .collect::<Vec<String>>()
+    };
+    // as the campaign injects them: on the pins behind the slave
+    let faulty = |f| {
+        let slave = with_slave(&s, ModelDut::new(&s), WorstCase);
+        Box::new(FaultyDut::new(&s, slave, f, at))
+    };
+    for f in [Fault::AxisTvalidDrop, Fault::AxisTdataChange] {
+        let r = rules(faulty(f), f.class());
+        assert!(r.contains(&"axis-stable".to_string()), "{r:?}");
+    }
+    // taken beats altered after the slave's handshake: the decode sees them
+    for (what, want) in [
+        ("byte", &["link-crc", "link-resync"][..]),
+        ("lost", &["link-crc", "link-resync"][..]),
+        ("tlast", &["axis-tlast"][..]),
+    ] {
+        let dut = Beat {
+            inner: with_slave(&s, ModelDut::new(&s), WorstCase),
+            at,
+            c: 0,
+            what,
+            done: false,
+        };
+        let r = rules(Box::new(dut), what);
+        assert!(
+            r.iter().any(|x| want.contains(&x.as_str())),
+            "{what}: {r:?}"
+        );
+    }
+    for f in [Fault::NeighbourCode, Fault::DropSample] {
+        let r = rules(faulty(f), f.class());
+        assert!(r.contains(&"link-samples".to_string()), "{r:?}");
+    }
+}
+
+/// The first beat taken (tvalid and tready high) at or after cycle `at`
+/// altered: its byte changed, the beat lost (tvalid low), or its `tlast`
+/// inverted.
+struct Beat<'a> {
+    inner: Box<dyn judge::run::Dut + 'a>,
+    at: u64,
+    c: u64,
+    what: &'static str,
+    done: bool,
+}
+
+impl judge::run::Dut for Beat<'_> {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+        let mut p = self.inner.step(rst, miso);
+        if rst {
+            return p;
+        }
+        if !self.done && self.c >= self.at && p.axis_tvalid && p.axis_tready {
+            self.done = true;
+            match self.what {
+                "byte" => p.axis_tdata ^= 0x10,
+                "lost" => p.axis_tvalid = false,
+                _ => p.axis_tlast = !p.axis_tlast,
+            }
+        }
+        self.c += 1;
+        p
+    }
+}
+
+/// A packet sent twice: the bytes of the first whole packet taken after
+/// cycle `at` sent again in place of the bytes of the packet of the same
+/// slice a frame later (same length: the schedule repeats every frame), so
+/// framing, CRC and `tlast` stay good and only the sequence is wrong.
+struct Repeat<'a> {
+    inner: Box<dyn judge::run::Dut + 'a>,
+    at: u64,
+    c: u64,
+    slices: usize,
+    /// Packets ended (`tlast` taken) since `at`.
+    ended: usize,
+    beats: Vec<u8>,
+    sent: usize,
+}
+
+impl judge::run::Dut for Repeat<'_> {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+        let mut p = self.inner.step(rst, miso);
+        if rst {
+            return p;
+        }
+        if self.c >= self.at && p.axis_tvalid {
+            let taken = p.axis_tready;
+            if self.ended == 1 && taken {
+                self.beats.push(p.axis_tdata);
+            } else if self.ended == 1 + self.slices && self.sent < self.beats.len() {
+                // every cycle the beat is offered: tdata stays stable
+                p.axis_tdata = self.beats[self.sent];
+                self.sent += taken as usize;
+            }
+            self.ended += (taken && p.axis_tlast) as usize;
+        }
+        self.c += 1;
+        p
+    }
+}
+
+/// `link-sequence`: a packet that arrives again (its frame counter and
+/// slice those of a packet already taken) is out of sequence; nothing else
+/// is wrong within the run (CRCs, `tlast`, the handshake, every other
+/// packet's samples; the packet it replaced would be reported lost when the
+/// next one arrives, after the run's end).
+#[test]
+fn a_packet_sent_twice_breaks_the_sequence() {
+    use link::ReadyPattern::WorstCase;
+    let s = tiny_with("kind = \"axis\"\nready_within = 8\n", "");
+    let opts = RunOptions {
+        check: judge::CheckOptions {
+            model: false,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let mut dut = Repeat {
+        inner: judge::run::with_slave(&s, ModelDut::new(&s), WorstCase),
+        at: s.grid.frame_cycles + 7,
+        c: 0,
+        slices: s.grid.slices_per_frame as usize,
+        ended: 0,
+        beats: Vec::new(),
+        sent: 0,
+    };
+    let r = run_dut(&s, &mut dut, 3, &opts, "repeat", None);
+    assert!(
+        dut.sent > 0 && dut.sent == dut.beats.len(),
+        "not sent again"
+    );
+    let rules: Vec<&str> = r.violations.iter().map(|v| v.rule.as_str()).collect();
+    assert_eq!(rules, ["link-sequence"], "{}", r.summary());
+    assert!(
+        r.violations[0]
+            .detail
+            .contains("arrived again, or after a later one"),
+        "{}",
+        r.summary()
+    );
+}

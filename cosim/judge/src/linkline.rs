@@ -1,0 +1,525 @@
+//! The link to the host judged without the reference model: the UART line
+//! (`link_tx`) or the AXI4-Stream beats (`m_axis_tdata`/`tvalid`/`tready`/
+//! `tlast`); one of the checker's invariants, so that a waveform checked
+//! with the model off (`check --no-model`, the fault campaign's
+//! `invariants` column) still sees a broken link.
+//!
+//! From the mix alone (`docs/packet-format.md`):
+//! - **beats** (AXIS): a byte is the `tdata` of a cycle with `tvalid` and
+//!   `tready` both high; `tlast` is high on exactly the beats that end a
+//!   packet (every trailer, or a frame's last slice's with `tlast = "frame"`);
+//!   the handshake's stability is the checker's `axis-stable`;
+//! - **framing** (UART): every character is a low start bit, 8 data bits, the
+//!   parity bit if any and high stop bits, each bit `div` cycles at the
+//!   declared baud; the line changes only on a bit boundary of the
+//!   character being sent (a cycle is a VCD's resolution), and a start bit
+//!   never begins before the previous character's last stop bit ended;
+//! - **packets**: the characters (or beats) go through `link`'s own receiver and host
+//!   decoder (the packet format has one home): every packet's CRC is good
+//!   and no byte falls outside a packet;
+//! - **sequence**: the packets are the slices in order, frame counter and
+//!   slice as the stream's cycles give them (from reset the counter is the
+//!   frame number mod 256; a check that joined a run learns it from the
+//!   first good packet), none lost, none repeated, none early;
+//! - **content**: each packet carries exactly the samples whose
+//!   `sample_valid` strobe fell in its slice's cycles, in order, channel
+//!   and value; a trailer reports no FIFO overflow;
+//! - **delivery**: a slice's packet has arrived at the latest the audit's
+//!   worst-case latency (`lut_gen::hostlink`) plus one slice after the
+//!   slice ended, so a line that goes quiet is caught.
+
+use std::collections::VecDeque;
+
+use link::rx::{RxByte, UartRx};
+use link::{AxisFormat, Decoder, Packet, Stats, Tlast, UartFormat};
+use lut_gen::ports::Pins;
+use lut_gen::Schedule;
+use serde_json::json;
+
+use crate::invariants::Invariants;
+
+const UART_LINE: &str = "link_tx";
+const AXIS_BEATS: &str = "m_axis_tdata";
+
+/// The samples the stream emitted in one slice: (channel, value, cycle).
+#[derive(Debug, Clone, Default)]
+struct Window {
+    samples: Vec<(u16, u16, u64)>,
+}
+
+/// The UART line's receiver and bit timing.
+#[derive(Debug, Clone)]
+struct Uart {
+    fmt: UartFormat,
+    rx: UartRx,
+    /// The receiver's sample 0 is this cycle.
+    rx_origin: u64,
+    /// The line in the cycle before.
+    level: bool,
+    /// The start of the character the receiver took last, and whether a
+    /// timing fault in it was already reported.
+    char_start: Option<u64>,
+    char_flagged: bool,
+}
+
+/// Where the bytes come from: a serial line or AXI4-Stream beats.
+#[derive(Debug, Clone)]
+enum Wire {
+    Uart(Uart),
+    Axis(AxisFormat),
+}
+
+/// The link's checks (a mix with a `[link]`).
+#[derive(Debug, Clone)]
+pub(crate) struct LinkLine {
+    wire: Wire,
+    /// The port violations name: `link_tx` or `m_axis_tdata`.
+    port: &'static str,
+    dec: Decoder,
+    packets: Vec<Packet>,
+    seen: Stats,
+    /// The decoder lost its place and the loss was reported.
+    lost_place: bool,
+    overflow_reported: bool,
+    names: Vec<String>,
+    slice_cycles: u64,
+    slices: u64,
+    latency: u64,
+    /// Slices with their samples, from `base` on (the oldest not yet received).
+    windows: VecDeque<Window>,
+    base: u64,
+    /// The first slice whose samples the check saw whole (0 from reset).
+    first: u64,
+    next_boundary: u64,
+    /// Window of a packet = the decoder's sequence (frame * slices + slice)
+    /// + `offset`; learnt from the first good packet after a join.
+    offset: Option<i64>,
+    /// In step with the line: from reset, or since the first good packet
+    /// after joining a run mid-stream (what came before is a partial
+    /// character or packet, not a fault).
+    synced: bool,
+}
+
+impl LinkLine {
+    /// The link's checks for a mix with a feasible `[link]`; `None` otherwise.
+    pub(crate) fn new(s: &Schedule) -> Option<LinkLine> {
+        let plan = lut_gen::hostlink::plan(s)?.ok()?;
+        let (wire, port) = match (plan.uart(), plan.axis()) {
+            (Some(fmt), _) => (
+                Wire::Uart(Uart {
+                    fmt,
+                    rx: UartRx::new(fmt),
+                    rx_origin: 0,
+                    level: true,
+                    char_start: None,
+                    char_flagged: false,
+                }),
+                UART_LINE,
+            ),
+            (None, Some(fmt)) => (Wire::Axis(fmt), AXIS_BEATS),
+            (None, None) => return None,
+        };
+        Some(LinkLine {
+            wire,
+            port,
+            dec: Decoder::new(s.grid.slices_per_frame),
+            packets: Vec::new(),
+            seen: Stats::default(),
+            lost_place: false,
+            overflow_reported: false,
+            names: s.mix.channels.iter().map(|c| c.name.clone()).collect(),
+            slice_cycles: s.grid.slice_cycles,
+            slices: s.grid.slices_per_frame,
+            latency: plan.latency_cycles,
+            windows: VecDeque::new(),
+            base: 0,
+            first: 0,
+            next_boundary: 0,
+            offset: Some(0),
+            synced: true,
+        })
+    }
+
+    /// The check joins a run at cycle `origin` with the line at `level`:
+    /// slices from the first that starts at or after it are checked, and
+    /// the line from the first good packet on.
+    pub(crate) fn join_at(&mut self, origin: u64, level: bool) {
+        if let Wire::Uart(u) = &mut self.wire {
+            u.rx_origin = origin;
+            u.level = level;
+        }
+        self.first = origin.div_ceil(self.slice_cycles);
+        self.base = self.first;
+        self.next_boundary = self.first * self.slice_cycles;
+        self.offset = None;
+        self.synced = false;
+    }
+
+    /// The link's pins in cycle `c` (every cycle, in order).
+    #[inline]
+    pub(crate) fn cycle(&mut self, c: u64, p: &Pins, inv: &mut Invariants) {
+        if c >= self.next_boundary {
+            self.boundary(c, inv);
+        }
+        match &mut self.wire {
+            Wire::Uart(u) => {
+                let tx = p.link_tx;
+                let got = u.rx.sample(tx);
+                let changed = tx != u.level;
+                u.level = tx;
+                if changed {
+                    self.edge(c, inv);
+                }
+                if let Some(b) = got {
+                    self.character(c, b, inv);
+                }
+            }
+            Wire::Axis(_) => {
+                if p.axis_tvalid && p.axis_tready {
+                    self.beat(c, p.axis_tdata, p.axis_tlast, inv);
+                }
+            }
+        }
+    }
+
+    /// `sample_valid` in cycle `c` with this channel and value.
+    pub(crate) fn sample(&mut self, c: u64, channel: u16, value: u16) {
+        if c >= self.first * self.slice_cycles {
+            if let Some(w) = self.windows.back_mut() {
+                w.samples.push((channel, value, c));
+            }
+        }
+    }
+
+    /// The check ended after cycle `end - 1`: every packet due before
+    /// `end` must have arrived.
+    pub(crate) fn finish(&mut self, end: u64, inv: &mut Invariants) {
+        self.overdue(end, inv);
+    }
+
+    /// A slice begins at or before `c`: its window opens, and packets
+    /// overdue by now are reported.
+    fn boundary(&mut self, c: u64, inv: &mut Invariants) {
+        while self.next_boundary <= c {
+            self.windows.push_back(Window::default());
+            self.next_boundary += self.slice_cycles;
+        }
+        self.overdue(c, inv);
+    }
+
+    /// The last cycle in which slice `w`'s packet may arrive.
+    fn due(&self, w: u64) -> u64 {
+        (w + 2) * self.slice_cycles + self.latency
+    }
+
+    /// Reports the packets due before cycle `now` (the cycles before it
+    /// have been seen) that have not arrived.
+    fn overdue(&mut self, now: u64, inv: &mut Invariants) {
+        while !self.windows.is_empty() && self.due(self.base) < now {
+            let w = self.base;
+            let win = self.windows.pop_front().unwrap_or_default();
+            self.base += 1;
+            let (slice, frame) = self.slice_frame(w, inv);
+            inv.violation(
+                self.due(w),
+                "link-packet-missing",
+                Some(self.port.into()),
+                Some(json!(format!("frame {frame} slice {slice}"))),
+                Some(json!("none")),
+                win.samples
+                    .first()
+                    .and_then(|x| self.names.get(x.0 as usize).cloned()),
+                format!(
+                    "the packet of frame {frame} slice {slice} ({} samples) has not arrived on {} {} cycles after its slice ended (the audit's worst-case latency, {} cycles, plus a slice)",
+                    win.samples.len(),
+                    self.port,
+                    self.latency + self.slice_cycles,
+                    self.latency
+                ),
+            );
+        }
+    }
+
+    /// (slice, frame as reports count them) of window `w`.
+    fn slice_frame(&self, w: u64, inv: &Invariants) -> (u64, u64) {
+        (w % self.slices, inv.place(w * self.slice_cycles).1)
+    }
+
+    /// The line changed in cycle `c`: on a bit boundary of the character
+    /// being sent, or the start bit of the next one after it ended.
+    fn edge(&mut self, c: u64, inv: &mut Invariants) {
+        let synced = self.synced;
+        let Wire::Uart(u) = &mut self.wire else {
+            return;
+        };
+        let (div, len) = (u.fmt.div as u64, u.fmt.char_cycles());
+        let started = u.rx.reading().map(|s| s + u.rx_origin) == Some(c);
+        let Some(s) = u.char_start else {
+            if started {
+                u.char_start = Some(c);
+            }
+            return;
+        };
+        let t = c - s;
+        // as reports count cycles (a check that joined counts from there)
+        let at = inv.place(s).0;
+        let fault = if started {
+            (t < len).then(|| format!("a start bit falls {t} cycles after the previous character's start bit (cycle {at}), before its last stop bit ended ({len} cycles: {} bits of {div} cycles)", u.fmt.bits()))
+        } else {
+            (t < len && !t.is_multiple_of(div)).then(|| format!("{UART_LINE} changed {t} cycles into the character that started at cycle {at}, off its bit boundaries (every bit lasts {div} cycles at the declared baud)"))
+        };
+        if let Some(detail) = fault {
+            // an early start bit always; an edge off the grid once a character
+            if synced && (started || !u.char_flagged) {
+                inv.violation(
+                    c,
+                    "link-bit-timing",
+                    Some(UART_LINE.into()),
+                    Some(json!(format!("a multiple of {div} cycles"))),
+                    Some(json!(t)),
+                    None,
+                    detail,
+                );
+            }
+            u.char_flagged = true;
+        }
+        if started {
+            u.char_start = Some(c);
+            u.char_flagged = false;
+        }
+    }
+
+    /// The receiver read a character (at the middle of its last stop bit).
+    fn character(&mut self, c: u64, b: RxByte, inv: &mut Invariants) {
+        let Wire::Uart(u) = &self.wire else {
+            return;
+        };
+        if b.error {
+            if self.synced {
+                let (origin, parity) = (u.rx_origin, u.fmt.parity);
+                inv.violation(
+                    c,
+                    "link-framing",
+                    Some(UART_LINE.into()),
+                    Some(json!("stop bit high")),
+                    Some(json!(0)),
+                    None,
+                    format!(
+                        "the character that started at cycle {} (data 0x{:02x}) has a low stop bit{} at the declared baud",
+                        inv.place(b.start + origin).0,
+                        b.byte,
+                        if parity == link::Parity::None { "" } else { " or a wrong parity bit" }
+                    ),
+                );
+            }
+            return;
+        }
+        self.byte(c, b.byte, inv);
+    }
+
+    /// An AXI4-Stream beat in cycle `c`: its byte, and `tlast` where the
+    /// packet format ends a packet.
+    fn beat(&mut self, c: u64, byte: u8, tlast: bool, inv: &mut Invariants) {
+        let Wire::Axis(fmt) = self.wire else { return };
+        let before = self.seen;
+        let ends = self.byte(c, byte, inv);
+        let clean = self.seen.crc_errors == before.crc_errors
+            && self.seen.skipped_bytes == before.skipped_bytes;
+        let want =
+            ends.is_some_and(|slice| fmt.tlast == Tlast::Slice || slice as u64 + 1 == self.slices);
+        if self.synced && clean && !self.lost_place && tlast != want {
+            inv.violation(
+                c,
+                "axis-tlast",
+                Some("m_axis_tlast".into()),
+                Some(json!(want as u8)),
+                Some(json!(tlast as u8)),
+                None,
+                format!(
+                    "tlast is {} on the beat of byte {byte:#04x}, which {} (tlast = \"{}\")",
+                    tlast as u8,
+                    if ends.is_some() {
+                        "ends a packet"
+                    } else {
+                        "does not end a packet"
+                    },
+                    fmt.tlast.name()
+                ),
+            );
+        }
+    }
+
+    /// A byte off the link in cycle `c` through the host decoder; the slice
+    /// of the last packet it completed, if any.
+    fn byte(&mut self, c: u64, byte: u8, inv: &mut Invariants) -> Option<u16> {
+        self.dec.push_packets(&[byte], &mut self.packets);
+        let st = *self.dec.stats();
+        if self.synced && st.crc_errors > self.seen.crc_errors {
+            self.lost_place = true;
+            inv.violation(
+                c,
+                "link-crc",
+                Some(self.port.into()),
+                None,
+                None,
+                None,
+                "a packet's trailer carries a CRC that does not match its bytes".into(),
+            );
+        } else if self.synced && st.skipped_bytes > self.seen.skipped_bytes && !self.lost_place {
+            self.lost_place = true;
+            inv.violation(
+                c,
+                "link-resync",
+                Some(self.port.into()),
+                Some(json!(format!("0x{:02x} (a header)", link::format::SYNC))),
+                Some(json!(format!("0x{byte:02x}"))),
+                None,
+                format!(
+                    "byte 0x{byte:02x} is not where the packet format puts a word: the decoder lost its place and searches for a header"
+                ),
+            );
+        }
+        self.seen = st;
+        let mut packets = std::mem::take(&mut self.packets);
+        let ended = packets.last().map(|p| p.slice);
+        for p in packets.drain(..) {
+            self.packet(c, p, inv);
+        }
+        self.packets = packets;
+        ended
+    }
+
+    /// A good packet arrived in cycle `c`.
+    fn packet(&mut self, c: u64, p: Packet, inv: &mut Invariants) {
+        self.lost_place = false;
+        // A packet closes when the next slice's header is sent: its slice
+        // ended before this cycle's.
+        let closed = (c / self.slice_cycles) as i64 - 1;
+        let w = self.window_of(closed, &p);
+        self.overflow(c, &p, inv);
+        if w < self.first as i64 {
+            return; // its slice began before the check joined
+        }
+        let (frame8, slice) = (p.frame % 256, p.slice);
+        if w < self.base as i64 || w > closed {
+            let when = if w > closed {
+                "before its slice ended: the frame counter or slice is wrong"
+            } else {
+                "again, or after a later one"
+            };
+            let (s, f) = self.slice_frame(self.base, inv);
+            inv.violation(
+                c,
+                "link-sequence",
+                Some(self.port.into()),
+                Some(json!(format!("the packet of frame {f} slice {s}"))),
+                Some(json!(format!("frame counter {frame8} slice {slice}"))),
+                None,
+                format!("the packet with frame counter {frame8} slice {slice} arrived {when}"),
+            );
+            return;
+        }
+        let w = w as u64;
+        while self.base < w {
+            let (s, f) = self.slice_frame(self.base, inv);
+            self.windows.pop_front();
+            self.base += 1;
+            inv.violation(
+                c,
+                "link-packet-lost",
+                Some(self.port.into()),
+                Some(json!(format!("frame {f} slice {s}"))),
+                Some(json!(format!("frame counter {frame8} slice {slice}"))),
+                None,
+                format!("the packet of frame {f} slice {s} never came: the next good packet on the line is frame counter {frame8} slice {slice}"),
+            );
+        }
+        let win = self.windows.pop_front().unwrap_or_default();
+        self.base += 1;
+        self.compare(c, w, &win, &p.records, inv);
+    }
+
+    /// The slice (window) a packet is of, when the last slice closed is
+    /// `closed`: from the 8-bit frame counter and slice, through the offset
+    /// a joined check learns from its first good packet (the latest closed
+    /// slice with that number), taken as the window of that number nearest
+    /// the one expected next. The decoder's own count of frames past 255 is
+    /// not used: a packet repeated or out of order looks like a wrap to it.
+    fn window_of(&mut self, closed: i64, p: &Packet) -> i64 {
+        let slices = self.slices as i64;
+        let period = 256 * slices;
+        let seq = (p.frame % 256) as i64 * slices + p.slice as i64;
+        let offset = *self.offset.get_or_insert_with(|| {
+            let back = (closed - p.slice as i64).rem_euclid(slices);
+            closed - back - seq
+        });
+        self.synced = true;
+        let ahead = (seq + offset - self.base as i64).rem_euclid(period);
+        self.base as i64
+            + if ahead > period / 2 {
+                ahead - period
+            } else {
+                ahead
+            }
+    }
+
+    /// A trailer's overflow count must be 0 (reported once).
+    fn overflow(&mut self, c: u64, p: &Packet, inv: &mut Invariants) {
+        if p.overflows > 0 && !self.overflow_reported {
+            self.overflow_reported = true;
+            inv.violation(
+                c,
+                "link-overflow-count",
+                Some(self.port.into()),
+                Some(json!(0)),
+                Some(json!(p.overflows)),
+                None,
+                format!(
+                    "a trailer reports {} token(s) dropped by the link's FIFO",
+                    p.overflows
+                ),
+            );
+        }
+    }
+
+    /// A packet's records against the samples its slice emitted.
+    fn compare(&self, c: u64, w: u64, win: &Window, records: &[(u16, u16)], inv: &mut Invariants) {
+        let want = &win.samples;
+        let i = (0..want.len().max(records.len()))
+            .find(|&i| want.get(i).map(|x| (x.0, x.1)) != records.get(i).copied());
+        let Some(i) = i else { return };
+        let (slice, frame) = self.slice_frame(w, inv);
+        let name = |ch: u16| {
+            self.names
+                .get(ch as usize)
+                .cloned()
+                .unwrap_or_else(|| format!("channel index {ch}"))
+        };
+        let got = records.get(i).map_or("nothing".into(), |&(ch, v)| {
+            format!("{} = {v:#06x}", name(ch))
+        });
+        let had = want.get(i).map_or("nothing".into(), |&(ch, v, at)| {
+            format!(
+                "{} = {v:#06x} (sample_valid in cycle {})",
+                name(ch),
+                inv.place(at).0
+            )
+        });
+        inv.violation(
+            c,
+            "link-samples",
+            Some(self.port.into()),
+            Some(json!(had)),
+            Some(json!(got)),
+            want.get(i)
+                .map(|x| x.0)
+                .or(records.get(i).map(|x| x.0))
+                .map(name),
+            format!(
+                "the packet of frame {frame} slice {slice} carries {} records where the sample stream emitted {} in that slice; record {i} is {got}, the stream's sample {i} is {had}",
+                records.len(),
+                want.len()
+            ),
+        );
+    }
+}
