@@ -50,3 +50,7 @@ mod tools;
 // Shared by several test files (one copy in this binary).
 #[path = "common/presets.rs"]
 mod common_presets;
+
+// Shared by several test files (one copy in this binary).
+#[path = "common/progress.rs"]
+mod progress;

@@ -35,9 +35,7 @@ fn link_vcd(src: &str) -> String {
         .expect("link_tx in the VCD")
         .to_string();
     assert!(src.contains("$timescale 1ps $end"));
-    let mut out = String::from(
-        "$timescale 10ns $end\n$scope module top $end\n$var wire 1 ! tx $end\n$upscope $end\n$enddefinitions $end\n",
-    );
+    let mut out = judge::vcdout::wire_header("10ns", "top", &["tx"]);
     let mut t = 0u64;
     let mut last = None;
     for l in src

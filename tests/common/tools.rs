@@ -13,7 +13,6 @@
 #![allow(dead_code)]
 
 use std::io::Write;
-use std::process::{Command, Stdio};
 
 /// What a test does about one tool.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,16 +44,8 @@ pub fn decide(present: bool, ci: Option<&str>) -> Decision {
     }
 }
 
-/// Is `tool` on PATH (can it be spawned at all)?
-pub fn tool_present(tool: &str) -> bool {
-    Command::new(tool)
-        .arg("--version")
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok()
-}
+/// Is `tool` on PATH (can it be spawned at all)? The library's one test.
+pub use judge::tools::present as tool_present;
 
 /// Applies the decision: `true` = run, `false` = skip (after a loud
 /// warning); panics when the tool is missing under CI.

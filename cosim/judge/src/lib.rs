@@ -43,6 +43,7 @@ pub mod samples;
 pub mod switch;
 pub mod timed;
 pub mod timedlink;
+pub mod tools;
 pub mod vcd;
 mod vcdlex;
 pub mod vcdout;

@@ -10,6 +10,7 @@ use std::process::Command;
 
 use judge::run::{run_dut, Dut, Observer, RunOptions};
 use judge::timed::{check_capture, TimedReport};
+use judge::vcdout::{id_code, wire_header};
 use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
 
@@ -119,11 +120,9 @@ pub fn resample_lanes(
     out: &Path,
 ) {
     let tc = 1e12 / s.mix.clock_hz as f64;
-    let mut text = String::from("$timescale 1 ps $end\n$scope module libsigrok $end\n");
-    for (i, _) in lanes.iter().enumerate() {
-        text += &format!("$var wire 1 {} D{i} $end\n", code(i));
-    }
-    text += "$upscope $end\n$enddefinitions $end\n";
+    let names: Vec<String> = (0..lanes.len()).map(|i| format!("D{i}")).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut text = wire_header("1 ps", "libsigrok", &names);
     let start = from as f64 * tc + phase_ps as f64;
     let mut prev: Option<Vec<bool>> = None;
     let mut n = 0u64;
@@ -141,7 +140,7 @@ pub fn resample_lanes(
             text += &format!("#{}\n", n * ts_ps);
             for (i, x) in v.iter().enumerate() {
                 if prev.as_ref().map(|p| p[i]) != Some(*x) {
-                    text += &format!("{}{}\n", *x as u8, code(i));
+                    text += &format!("{}{}\n", *x as u8, id_code(i));
                 }
             }
             prev = Some(v);
@@ -150,18 +149,6 @@ pub fn resample_lanes(
     }
     text += &format!("#{}\n", n * ts_ps);
     std::fs::write(out, text).unwrap();
-}
-
-pub fn code(i: usize) -> String {
-    let mut s = String::new();
-    let mut n = i;
-    loop {
-        s.push((b'!' + (n % 94) as u8) as char);
-        n /= 94;
-        if n == 0 {
-            return s;
-        }
-    }
 }
 
 /// The capture as `.sr` (sigrok-cli from the 1 ps VCD, downsampled to the
