@@ -436,6 +436,102 @@ fn bad_input_exits_2() {
         );
 }
 
+/// A file the user named that is not there is told in words ("no such
+/// file", or "no such folder" for an output), with its name, exit 2, and
+/// never the OS's "(os error 2)": the mix, a capture (VCD, `--map`'s, a
+/// `.sr` session, `decode`'s), the `--map` file, `--rtl` and `--samples`.
+#[test]
+fn missing_user_files_are_told_in_words() {
+    let d = tempfile::tempdir().unwrap();
+    let gone = |name: &str| d.path().join(name).display().to_string();
+    let tiny = tiny().display().to_string();
+    let cases: Vec<(Vec<String>, String, &str)> = vec![
+        (
+            vec!["audit".into(), gone("nope.toml")],
+            gone("nope.toml"),
+            "no such file",
+        ),
+        (
+            vec!["sim".into(), gone("nope.toml")],
+            gone("nope.toml"),
+            "no such file",
+        ),
+        (
+            vec!["check".into(), tiny.clone(), gone("nope.vcd")],
+            gone("nope.vcd"),
+            "no such file",
+        ),
+        (
+            vec![
+                "check".into(),
+                tiny.clone(),
+                gone("nope.sr"),
+                "--map".into(),
+                "D0=adc_cs_n[0]".into(),
+            ],
+            gone("nope.sr"),
+            "no such file",
+        ),
+        (
+            vec![
+                "check".into(),
+                tiny.clone(),
+                gone("nope.vcd"),
+                "--map".into(),
+                gone("probes.txt"),
+            ],
+            gone("probes.txt"),
+            "no such file",
+        ),
+        (
+            vec![
+                "sim".into(),
+                tiny.clone(),
+                "--backend".into(),
+                "icarus".into(),
+                "--rtl".into(),
+                gone("top.v"),
+            ],
+            gone("top.v"),
+            "no such file",
+        ),
+        (
+            vec![
+                "sim".into(),
+                tiny.clone(),
+                "--samples".into(),
+                gone("no-dir/s.csv"),
+            ],
+            gone("no-dir/s.csv"),
+            "no such folder",
+        ),
+        (
+            vec![
+                "decode".into(),
+                root().join("mixes/eskin34-uart.toml").display().to_string(),
+                gone("line.bin"),
+                "-o".into(),
+                gone("out.csv"),
+            ],
+            gone("line.bin"),
+            "no such file",
+        ),
+    ];
+    for (args, name, words) in cases {
+        let out = slotforge().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(&name) && err.contains(words),
+            "{args:?}: {err}"
+        );
+        assert!(
+            !err.contains("os error") && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+}
+
 #[test]
 fn vcd_into_a_missing_folder_is_created_and_its_gtkw_finds_it_from_anywhere() {
     let d = tempfile::tempdir().unwrap();

@@ -119,7 +119,8 @@ impl PortDecl {
 /// Reads `path`, checks its `slotforge_top` against `s`'s pin contract and
 /// returns the Verilog text.
 pub fn load_rtl(s: &Schedule, path: &Path) -> Result<String, SimError> {
-    let bytes = std::fs::read(path).map_err(|e| SimError::Rtl(err(path, None, e.to_string())))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| SimError::Rtl(err(path, None, lut_gen::io_words(&e))))?;
     let text = String::from_utf8_lossy(&bytes).into_owned();
     check_ports(s, path, &text).map_err(SimError::Rtl)?;
     Ok(text)

@@ -107,7 +107,8 @@ pub fn run(a: Args) -> u8 {
         return 2;
     }
     if let Err(e) = std::fs::create_dir_all(&a.out) {
-        eprintln!("error: {}: cannot create directory: {e}", a.out.display());
+        let why = lut_gen::io_words(&e);
+        eprintln!("error: {}: cannot create directory: {why}", a.out.display());
         return 2;
     }
     let plan = steps::with_remembered_proof(plan, &s, &a.out);

@@ -99,7 +99,7 @@ fn load_manifest(path: &Path) -> Result<Manifest, String> {
         });
     }
     let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        .map_err(|e| format!("{}: cannot read: {}", path.display(), lut_gen::io_words(&e)))?;
     let m: Manifest = toml::from_str(&text).map_err(|e| {
         let line = e
             .span()
@@ -293,7 +293,8 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         let text = match std::fs::read_to_string(&events_path) {
             Ok(t) => t,
             Err(e) => {
-                errln!(o, "error: {}: cannot read: {e}", events_path.display());
+                let why = lut_gen::io_words(&e);
+                errln!(o, "error: {}: cannot read: {why}", events_path.display());
                 return 2;
             }
         };

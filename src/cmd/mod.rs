@@ -130,7 +130,11 @@ pub fn write_atomic(dir: &Path, name: &str, text: &str) -> Result<(), String> {
         .and_then(|()| std::fs::rename(&tmp, &path))
         .map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
-            format!("{}: cannot write: {e}", path.display())
+            format!(
+                "{}: cannot write: {}",
+                path.display(),
+                lut_gen::write_words(&e)
+            )
         })
 }
 
@@ -143,7 +147,8 @@ pub fn write_files(dir: &Path, files: &[(&str, String)]) -> Result<(), u8> {
         return Err(2);
     }
     std::fs::create_dir_all(dir).map_err(|e| {
-        eprintln!("error: {}: cannot create directory: {e}", dir.display());
+        let why = lut_gen::io_words(&e);
+        eprintln!("error: {}: cannot create directory: {why}", dir.display());
         2u8
     })?;
     for (name, text) in files {

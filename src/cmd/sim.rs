@@ -240,7 +240,8 @@ pub fn run(a: Args) -> u8 {
     }
     if let Some(p) = &a.samples {
         if let Err(e) = log.write_csv(&s, p) {
-            eprintln!("error: --samples {}: {e}", p.display());
+            let why = lut_gen::write_words(&e);
+            eprintln!("error: --samples {}: {why}", p.display());
             return 2;
         }
     }

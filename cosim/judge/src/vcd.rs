@@ -69,7 +69,7 @@ pub enum VcdError {
 impl fmt::Display for VcdError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            VcdError::Io(p, e) => write!(f, "{}: {e}", p.display()),
+            VcdError::Io(p, e) => write!(f, "{}: {}", p.display(), lut_gen::io_words(e)),
             VcdError::Malformed {
                 file,
                 line,
