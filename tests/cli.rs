@@ -124,6 +124,54 @@ fn infeasible_mix_exits_1_with_a_diagnosis() {
     assert!(!v["errors"].as_array().unwrap().is_empty());
 }
 
+/// Exit 3, "unknown": the exact search stopped at its bound with neither a
+/// schedule nor a proof. `--search-limit 2` reaches it on the mix that only
+/// fits at 96 slots per slice (`missed.toml`), which the default bound
+/// schedules; no files are written for a mix without a schedule.
+#[test]
+fn a_search_cut_short_by_search_limit_is_unknown_exit_3() {
+    let missed = Path::new(env!("CARGO_MANIFEST_DIR")).join("lut-gen/tests/data/missed.toml");
+    slotforge()
+        .arg("audit")
+        .arg(&missed)
+        .args(["--search-limit", "2"])
+        .assert()
+        .code(3)
+        .stdout(predicate::str::starts_with("mix `missed`: unknown"))
+        .stdout(predicate::str::contains("bound of 2 placements"))
+        .stdout(predicate::str::contains("has no jitter-free schedule").not());
+    let out = slotforge()
+        .args(["audit", "--json", "--search-limit", "2"])
+        .arg(&missed)
+        .assert()
+        .code(3);
+    let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    assert_eq!(v["feasible"], false, "{v}");
+    assert_eq!(v["verdict"], "unknown", "{v}");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("lut");
+    slotforge()
+        .arg("lut")
+        .arg(&missed)
+        .args(["--search-limit", "2", "-o"])
+        .arg(&out)
+        .assert()
+        .code(3)
+        .stderr(predicate::str::starts_with("unknown: mix `missed`"));
+    assert!(!out.exists(), "nothing written for an unknown mix");
+    // the default bound finds its schedule; a bad limit is refused in words
+    slotforge().arg("audit").arg(&missed).assert().code(0);
+    slotforge()
+        .arg("lut")
+        .arg(&missed)
+        .args(["--search-limit", "many", "-o"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--search-limit"))
+        .stderr(predicate::str::contains("whole number"));
+}
+
 #[test]
 fn bad_input_names_file_line_and_field_and_exits_2() {
     let dir = tempfile::tempdir().unwrap();

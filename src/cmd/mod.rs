@@ -17,14 +17,32 @@ use std::path::Path;
 
 /// Loads and schedules a mix, printing the error and returning the exit code on failure.
 pub fn schedule(path: &Path) -> Result<lut_gen::Schedule, u8> {
+    schedule_within(path, lut_gen::synth::SEARCH_BUDGET)
+}
+
+/// [`schedule`] with the exact search capped at `budget` placements per
+/// slot grid (`--search-limit`).
+pub fn schedule_within(path: &Path, budget: u64) -> Result<lut_gen::Schedule, u8> {
     let mix = lut_gen::load(path).map_err(|e| {
         eprintln!("error: {e}");
         2u8
     })?;
-    lut_gen::synthesize(&mix).map_err(|e| {
+    lut_gen::synthesize_within(&mix, budget).map_err(|e| {
         eprint!("{}: {e}", e.verdict.as_str());
         verdict_exit(e.verdict)
     })
+}
+
+/// `--search-limit N` of the commands that synthesize for their own output
+/// (`audit`, `lut`).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct SearchLimit {
+    /// Placements the exact scheduling search may try per slot grid before
+    /// it gives up: a mix it stops on is "unknown" (exit 3), not infeasible.
+    /// Smaller answers sooner; larger decides more mixes.
+    #[arg(long = "search-limit", value_name = "N", value_parser = whole_number,
+          default_value_t = lut_gen::synth::SEARCH_BUDGET)]
+    pub nodes: u64,
 }
 
 /// Exit code of a mix without a schedule: 1 proved infeasible, 3 unknown
