@@ -4,20 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
-
+use crate::common_cli::{slotforge, tiny};
 use crate::tools;
 
 #[path = "common/browser.rs"]
 mod browser;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-fn tiny() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml")
-}
 
 fn csv(path: &Path) -> Vec<Vec<String>> {
     std::fs::read_to_string(path)

@@ -4,46 +4,11 @@
 use std::path::{Path, PathBuf};
 use std::process::Command as Process;
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
+use crate::common_cli::{sim_window, slotforge, tiny};
 use crate::{progress, tools};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn tiny() -> PathBuf {
-    root().join("cosim/tests/data/tiny.toml")
-}
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-/// `sim --vcd` of the tiny mix over `[from, to)` (SPEC's bounds).
-fn sim_window(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
-    let wave = dir.join(name);
-    slotforge()
-        .arg("sim")
-        .arg(tiny())
-        .args([
-            "--backend",
-            "rusthdl",
-            "--frames",
-            "3",
-            "--from",
-            from,
-            "--to",
-            to,
-        ])
-        .arg("--vcd")
-        .arg(&wave)
-        .assert()
-        .code(0);
-    wave
-}
 
 fn vcd2fst(vcd: &Path) -> PathBuf {
     let fst = vcd.with_extension("fst");

@@ -2,15 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
+use crate::common_cli::{slotforge, tiny};
 use crate::{progress, tools};
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
 
 fn preset(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -384,10 +380,6 @@ fn campaign_logged(mix: &Path, backend: &str, off: &str) -> (serde_json::Value, 
         .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
     let log = String::from_utf8_lossy(&out.stderr).into_owned();
     (v, out.status.code().unwrap(), log)
-}
-
-fn tiny() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml")
 }
 
 /// Every injection no detector caught, as (fault, site): the undetected

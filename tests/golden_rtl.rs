@@ -3,19 +3,10 @@
 //! emitted Verilog wrapped in a top that flips one output pin from a chosen
 //! cycle on; the golden must name that pin (by role) at that cycle.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use assert_cmd::Command;
-
+use crate::common_cli::{slotforge, tiny};
 use crate::tools;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-fn tiny() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml")
-}
 
 /// Widths of the ports of `ports.json`, by name.
 fn widths(ports_json: &Path) -> Vec<(String, String, u64)> {

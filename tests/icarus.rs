@@ -4,15 +4,12 @@
 //! and every output sample; this test compares the log with lut-gen's
 //! schedule.  It uses neither the hdl crate's simulator nor cosim's checker.
 
-use std::path::{Path, PathBuf};
+use crate::common_cli::root;
+use std::path::Path;
 use std::process::Command;
 
 #[path = "tb/judge.rs"]
 mod judge;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn require(tool: &str) {
     let ok = Command::new(tool).arg("-V").output().is_ok();

@@ -54,3 +54,7 @@ mod common_presets;
 // Shared by several test files (one copy in this binary).
 #[path = "common/progress.rs"]
 mod progress;
+
+// Shared by several test files (one copy in this binary).
+#[path = "common/cli.rs"]
+mod common_cli;

@@ -8,21 +8,12 @@
 use std::path::{Path, PathBuf};
 use std::process::Command as Process;
 
-use assert_cmd::Command;
-
 // Missing tools fail under CI=true, skip loudly elsewhere.
+use crate::common_cli::{root, slotforge};
 use crate::tools;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn preset() -> PathBuf {
     root().join("mixes/eskin34-uart.toml")
-}
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
 }
 
 /// `link_tx` of a slotforge VCD (1 ps timescale) as a one-signal VCD in

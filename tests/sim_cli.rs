@@ -5,27 +5,14 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
 use predicates::prelude::*;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn eskin34() -> PathBuf {
     root().join("mixes/eskin34.toml")
 }
 
-/// A two-branch mix with a 4000-cycle frame (fast in every simulator).
-fn tiny() -> PathBuf {
-    root().join("cosim/tests/data/tiny.toml")
-}
-
 // Missing tools fail under CI=true, skip loudly elsewhere.
+use crate::common_cli::{root, sim_window, slotforge, tiny};
 use crate::{progress, tools};
 
 /// Runs `sim --json` and checks SPEC's fields; returns the report.
@@ -139,24 +126,7 @@ fn sim_icarus_names_the_missing_tool() {
 
 /// A VCD of 3 frames of the tiny mix (with reset), written by `sim --vcd`.
 fn sim_vcd(dir: &Path) -> PathBuf {
-    let wave = dir.join("wave.vcd");
-    slotforge()
-        .arg("sim")
-        .arg(tiny())
-        .args([
-            "--backend",
-            "rusthdl",
-            "--frames",
-            "3",
-            "--from",
-            "0",
-            "--to",
-            "3",
-        ])
-        .arg("--vcd")
-        .arg(&wave)
-        .assert()
-        .code(0);
+    let wave = sim_window(dir, "wave.vcd", "0", "3");
     assert!(dir.join("wave.gtkw").exists());
     wave
 }
@@ -627,16 +597,11 @@ fn a_fst_name_writes_fst_that_check_reads_back() {
         return;
     }
     let back = d.path().join("gtkwave.vcd");
-    let st = std::process::Command::new("fst2vcd")
-        .arg(&fst)
-        .arg("-o")
-        .arg(&back)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
+    tools::run_ok(
+        std::process::Command::new("fst2vcd")
+            .arg(&fst)
+            .arg("-o")
+            .arg(&back),
     );
     let v = check_json(&back, 0);
     assert_eq!(v["ok"], true, "{v}");

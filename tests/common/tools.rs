@@ -71,6 +71,15 @@ pub fn gate(tool: &str, present: bool, ci: Option<&str>, test: &str) -> bool {
     }
 }
 
+/// Runs `cmd` (a tool, or a script of them) to completion and returns its
+/// output; a failure panics with the command and its stderr.
+pub fn run_ok(cmd: &mut std::process::Command) -> std::process::Output {
+    let out = cmd.output().unwrap_or_else(|e| panic!("{cmd:?}: {e}"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{cmd:?} failed: {err}");
+    out
+}
+
 /// The name libtest gives the current test's thread.
 fn current_test() -> String {
     std::thread::current()
