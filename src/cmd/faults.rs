@@ -49,13 +49,10 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::schedule(&a.mix) {
+    let s = match super::schedule_on_pins(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
-        return code;
-    }
     // One back-end name everywhere (cosim::Backend); the campaign injects
     // into the designs it can build in process.
     let target = match a.backend {

@@ -217,11 +217,8 @@ fn pins_text(p: &lut_gen::ports::Pins) -> String {
 }
 
 pub fn run(a: Args) -> u8 {
-    if let Some(j) = &a.junit {
-        if let Err(e) = super::junit::check_writable(j) {
-            eprintln!("error: {e}");
-            return 2;
-        }
+    if let Err(code) = super::junit::check_writable(a.junit.as_deref()) {
+        return code;
     }
     let bar = super::progress::Progress::new(a.mix.len() as u64, "mixes", a.quiet);
     let mut worst = 0;
@@ -272,13 +269,10 @@ pub struct Output {
 /// The golden command, its messages collected in `o` (the `build` job
 /// puts them in its report).
 pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
-    let s = match super::schedule(mix) {
+    let s = match super::schedule_on_pins(mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
-        return code;
-    }
     let dir = a.dir.join(&s.mix.name);
     let manifest_path = dir.join(MANIFEST);
     let manifest = match load_manifest(&manifest_path) {

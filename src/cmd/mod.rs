@@ -130,6 +130,14 @@ impl Bound {
     }
 }
 
+/// [`schedule`], then the contract's limits checked ([`fits_pins`]): what
+/// every command that simulates, checks or proves starts with.
+pub fn schedule_on_pins(path: &Path) -> Result<lut_gen::Schedule, u8> {
+    let s = schedule(path)?;
+    fits_pins(&s)?;
+    Ok(s)
+}
+
 /// Checks that a schedule fits the pin contract's limits (the checker and
 /// the engines size their pins from them), else prints why: exit 2.
 pub fn fits_pins(s: &lut_gen::Schedule) -> Result<(), u8> {

@@ -45,13 +45,10 @@ fn solver(s: &str) -> Result<Solver, String> {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::schedule(&a.mix) {
+    let s = match super::schedule_on_pins(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
-        return code;
-    }
     let (design, own) = match &a.rtl {
         Some(path) => match cosim::rtl::load_rtl(&s, path) {
             Ok(text) => (text, false),

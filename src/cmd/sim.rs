@@ -129,13 +129,10 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: --frames must be at least 1");
         return 2;
     }
-    let s = match super::schedule(&a.mix) {
+    let s = match super::schedule_on_pins(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
-        return code;
-    }
     let from = a.from.cycles(&s);
     let to = match a.to {
         Some(b) => b.cycles(&s),
