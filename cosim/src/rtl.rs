@@ -287,6 +287,18 @@ const DIRECTIVES: [&str; 16] = [
     "nounconnected_drive",
 ];
 
+/// The index just past the first `close` at or after `i` (a block
+/// comment's or an attribute's end), counting the lines it spans.
+fn past(b: &[u8], mut i: usize, close: &[u8], line: &mut usize) -> usize {
+    while i < b.len() && !b[i..].starts_with(close) {
+        if b[i] == b'\n' {
+            *line += 1;
+        }
+        i += 1;
+    }
+    i + close.len()
+}
+
 fn lex(text: &str) -> Vec<Token> {
     let b = text.as_bytes();
     let mut i = 0;
@@ -305,24 +317,10 @@ fn lex(text: &str) -> Vec<Token> {
                 i += 1;
             }
         } else if b[i..].starts_with(b"/*") {
-            i += 2;
-            while i < b.len() && !b[i..].starts_with(b"*/") {
-                if b[i] == b'\n' {
-                    line += 1;
-                }
-                i += 1;
-            }
-            i += 2;
+            i = past(b, i + 2, b"*/", &mut line);
         } else if b[i..].starts_with(b"(*") && !b[i..].starts_with(b"(*)") {
             // attribute instance
-            i += 2;
-            while i < b.len() && !b[i..].starts_with(b"*)") {
-                if b[i] == b'\n' {
-                    line += 1;
-                }
-                i += 1;
-            }
-            i += 2;
+            i = past(b, i + 2, b"*)", &mut line);
         } else if c == b'"' {
             i += 1;
             while i < b.len() && b[i] != b'"' && b[i] != b'\n' {
