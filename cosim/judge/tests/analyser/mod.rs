@@ -151,38 +151,51 @@ pub fn resample_lanes(
     std::fs::write(out, text).unwrap();
 }
 
+/// What an analyser at `ts_ps` (its first sample `phase_ps` into cycle
+/// `window.0`) records of cycles `window` of `pins`: [`resample`] into
+/// `vcd`, then [`to_sigrok`]'s `.sr` and sigrok-cli's VCD of it.
+pub fn capture(
+    s: &Schedule,
+    pins: &[Pins],
+    window: (u64, u64),
+    (ts_ps, phase_ps): (u64, u64),
+    vcd: &Path,
+) -> (PathBuf, PathBuf) {
+    resample(s, pins, window.0, window.1, ts_ps, phase_ps, vcd);
+    to_sigrok(vcd, ts_ps)
+}
+
 /// The capture as `.sr` (sigrok-cli from the 1 ps VCD, downsampled to the
 /// analyser's rate) and as sigrok-cli's VCD of that session.
 pub fn to_sigrok(vcd: &Path, ts_ps: u64) -> (PathBuf, PathBuf) {
     let sr = vcd.with_extension("sr");
-    let st = Command::new("sigrok-cli")
-        .arg("-i")
-        .arg(vcd)
-        .arg("-I")
-        .arg(format!("vcd:downsample={ts_ps}"))
-        .arg("-o")
-        .arg(&sr)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
+    let downsample = format!("vcd:downsample={ts_ps}");
+    sigrok_cli(
+        Command::new("sigrok-cli")
+            .arg("-i")
+            .arg(vcd)
+            .args(["-I", &downsample, "-o"])
+            .arg(&sr),
     );
     let back = vcd.with_extension("sigrok.vcd");
-    let st = Command::new("sigrok-cli")
-        .arg("-i")
-        .arg(&sr)
-        .args(["-O", "vcd", "-o"])
-        .arg(&back)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
+    sigrok_cli(
+        Command::new("sigrok-cli")
+            .arg("-i")
+            .arg(&sr)
+            .args(["-O", "vcd", "-o"])
+            .arg(&back),
     );
     (sr, back)
+}
+
+/// Runs a sigrok-cli command to completion; a failure shows its stderr.
+fn sigrok_cli(cmd: &mut Command) {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 pub fn check(s: &Schedule, map: &str, file: &Path) -> TimedReport {
@@ -203,6 +216,16 @@ pub enum Mutation {
     SclkEdgeMissing,
     /// Three bits of one character on the link's line inverted.
     LinkBitsFlipped,
+}
+
+impl Mutation {
+    /// The faults on a branch's SPI and mux pins, each with the rule a
+    /// capture of it must break.
+    pub const PINS: [(Mutation, &'static str); 3] = [
+        (Mutation::OneSlotLate, "conversion instant"),
+        (Mutation::MuxEarly, "mux switching"),
+        (Mutation::SclkEdgeMissing, "serial clock"),
+    ];
 }
 
 pub fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {
