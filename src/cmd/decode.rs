@@ -107,16 +107,7 @@ impl Sink {
 
     fn finish(self) -> Result<(), String> {
         if let Sink::File { tmp, path, mut f } = self {
-            f.flush()
-                .and_then(|()| std::fs::rename(&tmp, &path))
-                .map_err(|e| {
-                    let _ = std::fs::remove_file(&tmp);
-                    format!(
-                        "{}: cannot write: {}",
-                        path.display(),
-                        lut_gen::write_words(&e)
-                    )
-                })?;
+            super::put_in_place(&tmp, &path, f.flush())?;
         }
         Ok(())
     }

@@ -152,15 +152,19 @@ pub fn fits_pins(s: &lut_gen::Schedule) -> Result<(), u8> {
 pub fn write_atomic(dir: &Path, name: &str, text: &str) -> Result<(), String> {
     let path = dir.join(name);
     let tmp = dir.join(format!(".{name}.tmp"));
-    std::fs::write(&tmp, text)
-        .and_then(|()| std::fs::rename(&tmp, &path))
+    let written = std::fs::write(&tmp, text);
+    put_in_place(&tmp, &path, written)
+}
+
+/// Renames the temporary file `tmp`, once `written` says it is complete,
+/// to `path`; on any failure `tmp` is removed and the message names `path`.
+pub fn put_in_place(tmp: &Path, path: &Path, written: std::io::Result<()>) -> Result<(), String> {
+    written
+        .and_then(|()| std::fs::rename(tmp, path))
         .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            format!(
-                "{}: cannot write: {}",
-                path.display(),
-                lut_gen::write_words(&e)
-            )
+            let _ = std::fs::remove_file(tmp);
+            let why = lut_gen::write_words(&e);
+            format!("{}: cannot write: {why}", path.display())
         })
 }
 
