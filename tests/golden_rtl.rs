@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use crate::common_cli::{slotforge, tiny};
+use crate::common_cli::{record_golden, slotforge, tiny};
 use crate::tools;
 
 /// Widths of the ports of `ports.json`, by name.
@@ -71,12 +71,7 @@ fn a_design_that_differs_on_any_pin_fails_its_golden_at_that_pin() {
     }
     let d = tempfile::tempdir().unwrap();
     let gold = d.path().join("golden");
-    slotforge()
-        .args(["golden", "--backend", "rusthdl", "--update", "--dir"])
-        .arg(&gold)
-        .arg(tiny())
-        .assert()
-        .success();
+    record_golden(&gold);
     let v = d.path().join("v");
     slotforge()
         .arg("verilog")

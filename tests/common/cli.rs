@@ -20,6 +20,17 @@ pub fn tiny() -> PathBuf {
     root().join("cosim/tests/data/tiny.toml")
 }
 
+/// `golden --update` of the tiny mix (rusthdl) into `dir`: a golden that
+/// a later `golden` or `build` of it checks against.
+pub fn record_golden(dir: &Path) {
+    slotforge()
+        .args(["golden", "--backend", "rusthdl", "--update", "--dir"])
+        .arg(dir)
+        .arg(tiny())
+        .assert()
+        .success();
+}
+
 /// `dir/name`: `sim --vcd` of 3 frames of the tiny mix on the rusthdl back
 /// end over `[from, to)` (SPEC's bounds).
 pub fn sim_window(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
