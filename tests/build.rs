@@ -4,20 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
-
+use crate::common_cli::{record_golden, slotforge, tiny};
 use crate::tools;
 
 #[path = "common/browser.rs"]
 mod browser;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-fn tiny() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml")
-}
 
 fn csv(path: &Path) -> Vec<Vec<String>> {
     std::fs::read_to_string(path)
@@ -110,12 +101,7 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
     let d = tempfile::tempdir().unwrap();
     // a golden for the mix, so that no step asked for is skipped (--strict)
     let gold = d.path().join("golden");
-    slotforge()
-        .args(["golden", "--backend", "rusthdl", "--update", "--dir"])
-        .arg(&gold)
-        .arg(tiny())
-        .assert()
-        .success();
+    record_golden(&gold);
     let out = d.path().join("b");
     let junit = d.path().join("build.xml");
     slotforge()
@@ -319,12 +305,7 @@ fn a_failing_step_fails_the_build_and_the_others_still_run() {
     let d = tempfile::tempdir().unwrap();
     // a golden that cannot match: recorded, then corrupted
     let gold = d.path().join("golden");
-    slotforge()
-        .args(["golden", "--backend", "rusthdl", "--update", "--dir"])
-        .arg(&gold)
-        .arg(tiny())
-        .assert()
-        .success();
+    record_golden(&gold);
     let log = gold.join("tiny/events.log");
     let text = std::fs::read_to_string(&log).unwrap();
     std::fs::write(&log, text.replacen(" sample ", " sample_x ", 1)).unwrap();

@@ -4,46 +4,11 @@
 use std::path::{Path, PathBuf};
 use std::process::Command as Process;
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-use crate::tools;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn tiny() -> PathBuf {
-    root().join("cosim/tests/data/tiny.toml")
-}
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-/// `sim --vcd` of the tiny mix over `[from, to)` (SPEC's bounds).
-fn sim_window(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
-    let wave = dir.join(name);
-    slotforge()
-        .arg("sim")
-        .arg(tiny())
-        .args([
-            "--backend",
-            "rusthdl",
-            "--frames",
-            "3",
-            "--from",
-            from,
-            "--to",
-            to,
-        ])
-        .arg("--vcd")
-        .arg(&wave)
-        .assert()
-        .code(0);
-    wave
-}
+use crate::common_cli::{sim_window, slotforge, tiny};
+use crate::{progress, tools};
 
 fn vcd2fst(vcd: &Path) -> PathBuf {
     let fst = vcd.with_extension("fst");
@@ -168,7 +133,7 @@ fn check_map_errors_name_the_entry_and_exit_2() {
     let cap = d.path().join("cap.vcd");
     std::fs::write(
         &cap,
-        "$timescale 1 ns $end\n$var wire 1 ! D0 $end\n$enddefinitions $end\n#0\n0!\n",
+        judge::vcdout::wire_header("1 ns", "libsigrok", &["D0"]) + "#0\n0!\n",
     )
     .unwrap();
     slotforge()
@@ -218,10 +183,9 @@ fn check_map_errors_name_the_entry_and_exit_2() {
 fn check_map_shows_its_progress_in_plain_lines_off_a_terminal() {
     let d = tempfile::tempdir().unwrap();
     let cap = d.path().join("big.vcd");
-    let mut text = String::from(
-        "$comment Acquisition with 1/8 channels at 24 MHz $end\n$timescale 1 ns $end\n\
-         $var wire 1 ! D0 $end\n$enddefinitions $end\n#0\n1!\n",
-    );
+    let mut text = "$comment Acquisition with 1/8 channels at 24 MHz $end\n".to_string()
+        + &judge::vcdout::wire_header("1 ns", "libsigrok", &["D0"])
+        + "#0\n1!\n";
     // CS toggling every 10 us: a long capture the checker can lock onto or not
     let mut t = 0u64;
     while text.len() < 3 << 20 {
@@ -244,18 +208,7 @@ fn check_map_shows_its_progress_in_plain_lines_off_a_terminal() {
     };
     let log = run(false);
     let prefix = format!("reading {}: ", cap.display());
-    let counts: Vec<(f64, f64)> = log
-        .lines()
-        .filter_map(|l| {
-            let (done, rest) = l.strip_prefix(&prefix)?.split_once(" of ")?;
-            let total = rest.split_once(" MB read (")?.0;
-            Some((done.parse().ok()?, total.parse().ok()?))
-        })
-        .collect();
-    assert!(counts.len() >= 5, "{log}");
-    assert!(counts.windows(2).all(|w| w[0].0 < w[1].0), "{log}");
-    let (done, total) = *counts.last().unwrap();
-    assert_eq!(done, total, "{log}");
+    let total = progress::rises_to_total(&log, &prefix, " MB read");
     assert!((total - size).abs() < 0.05, "{total} of {size} MB: {log}");
     assert!(!run(true).contains("MB read"));
 }

@@ -2,15 +2,11 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-use crate::tools;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
+use crate::common_cli::{slotforge, tiny};
+use crate::{progress, tools};
 
 fn preset(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -122,6 +118,54 @@ fn infeasible_mix_exits_1_with_a_diagnosis() {
     let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
     assert_eq!(v["feasible"], false);
     assert!(!v["errors"].as_array().unwrap().is_empty());
+}
+
+/// Exit 3, "unknown": the exact search stopped at its bound with neither a
+/// schedule nor a proof. `--search-limit 2` reaches it on the mix that only
+/// fits at 96 slots per slice (`missed.toml`), which the default bound
+/// schedules; no files are written for a mix without a schedule.
+#[test]
+fn a_search_cut_short_by_search_limit_is_unknown_exit_3() {
+    let missed = Path::new(env!("CARGO_MANIFEST_DIR")).join("lut-gen/tests/data/missed.toml");
+    slotforge()
+        .arg("audit")
+        .arg(&missed)
+        .args(["--search-limit", "2"])
+        .assert()
+        .code(3)
+        .stdout(predicate::str::starts_with("mix `missed`: unknown"))
+        .stdout(predicate::str::contains("bound of 2 placements"))
+        .stdout(predicate::str::contains("has no jitter-free schedule").not());
+    let out = slotforge()
+        .args(["audit", "--json", "--search-limit", "2"])
+        .arg(&missed)
+        .assert()
+        .code(3);
+    let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    assert_eq!(v["feasible"], false, "{v}");
+    assert_eq!(v["verdict"], "unknown", "{v}");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("lut");
+    slotforge()
+        .arg("lut")
+        .arg(&missed)
+        .args(["--search-limit", "2", "-o"])
+        .arg(&out)
+        .assert()
+        .code(3)
+        .stderr(predicate::str::starts_with("unknown: mix `missed`"));
+    assert!(!out.exists(), "nothing written for an unknown mix");
+    // the default bound finds its schedule; a bad limit is refused in words
+    slotforge().arg("audit").arg(&missed).assert().code(0);
+    slotforge()
+        .arg("lut")
+        .arg(&missed)
+        .args(["--search-limit", "many", "-o"])
+        .arg(&out)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--search-limit"))
+        .stderr(predicate::str::contains("whole number"));
 }
 
 #[test]
@@ -338,10 +382,6 @@ fn campaign_logged(mix: &Path, backend: &str, off: &str) -> (serde_json::Value, 
     (v, out.status.code().unwrap(), log)
 }
 
-fn tiny() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml")
-}
-
 /// Every injection no detector caught, as (fault, site): the undetected
 /// and the proved-equivalent ones.
 fn injections(v: &serde_json::Value) -> Vec<(String, String)> {
@@ -404,19 +444,8 @@ fn faults_report_a_matrix_of_classes_and_detectors() {
     assert_eq!(v["ok"], true);
     // off a terminal, the progress is a line per tenth of the runs, with
     // counts: rising to all of them (every injection and the clean run)
-    let counts: Vec<(u64, u64)> = log
-        .lines()
-        .filter_map(|l| {
-            let (done, rest) = l.strip_prefix("fault campaign: ")?.split_once(" of ")?;
-            let total = rest.split_once(" runs (")?.0;
-            Some((done.parse().ok()?, total.parse().ok()?))
-        })
-        .collect();
-    assert!(counts.len() >= 5, "{log}");
-    assert!(counts.windows(2).all(|w| w[0].0 < w[1].0), "{log}");
-    let (done, total) = *counts.last().unwrap();
-    assert_eq!(done, total, "{log}");
-    assert!(total > v["injected"].as_u64().unwrap(), "{log}");
+    let total = progress::rises_to_total(&log, "fault campaign: ", " runs");
+    assert!(total > v["injected"].as_f64().unwrap(), "{log}");
     assert!(!log.contains("Target") && !log.contains("Some("), "{log}");
     assert_eq!(
         v["detectors"],

@@ -1,14 +1,10 @@
 //! Figures in the docs that the binary computes must be what it prints
 //! (issue 19, item 5): a document that drifts from the tool fails here.
 
-use std::path::PathBuf;
 use std::process::Command;
 
+use crate::common_cli::root;
 use crate::tools;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn doc(path: &str) -> String {
     std::fs::read_to_string(root().join(path)).unwrap()
@@ -43,17 +39,21 @@ fn the_reference_design_sample_count_is_the_binarys() {
     assert_eq!(wrong, None);
 }
 
+/// eskin34's row of the current synthesis table of docs/performance.md.
+fn eskin34_row() -> String {
+    let perf = doc("docs/performance.md");
+    let current = perf.split("### Converter parts").nth(1).unwrap();
+    let row = current.lines().find(|l| l.starts_with("| eskin34 |"));
+    row.expect("an eskin34 row in docs/performance.md")
+        .to_string()
+}
+
 /// eskin34's logic cells are stated once, in the current table of
 /// docs/performance.md, and ARCHITECTURE.md and README state no other
 /// count; the table's row is what `hdl/synth.sh` measures now.
 #[test]
 fn the_reference_design_logic_cells_are_stated_once() {
-    let perf = doc("docs/performance.md");
-    let current = perf.split("### Converter parts").nth(1).unwrap();
-    let row = current
-        .lines()
-        .find(|l| l.starts_with("| eskin34 |"))
-        .unwrap();
+    let row = eskin34_row();
     let lcs: u64 = row.split('|').nth(4).unwrap().trim().parse().unwrap();
     for f in ["ARCHITECTURE.md", "README.md"] {
         let t = doc(f);
@@ -71,23 +71,13 @@ fn the_current_logic_cell_figure_is_what_synthesis_gives() {
     if !tools::require_tools(&["yosys", "nextpnr-ice40"]) {
         return;
     }
-    let perf = doc("docs/performance.md");
-    let current = perf.split("### Converter parts").nth(1).unwrap();
-    let row = current
-        .lines()
-        .find(|l| l.starts_with("| eskin34 |"))
-        .unwrap();
+    let row = eskin34_row();
     let want: Vec<String> = row.split('|').map(|c| c.trim().to_string()).collect();
-    let out = Command::new("bash")
-        .arg(root().join("hdl/synth.sh"))
-        .arg(root().join("mixes/eskin34.toml"))
-        .current_dir(root())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let out = tools::run_ok(
+        Command::new("bash")
+            .arg(root().join("hdl/synth.sh"))
+            .arg(root().join("mixes/eskin34.toml"))
+            .current_dir(root()),
     );
     let text = String::from_utf8_lossy(&out.stdout);
     let got: Vec<&str> = text

@@ -6,20 +6,12 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
 use crate::tools;
 
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
+use crate::common_cli::{root, slotforge};
 use crate::common_presets;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn presets() -> Vec<PathBuf> {
     common_presets::presets(&root())

@@ -3,19 +3,10 @@
 //! emitted Verilog wrapped in a top that flips one output pin from a chosen
 //! cycle on; the golden must name that pin (by role) at that cycle.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use assert_cmd::Command;
-
+use crate::common_cli::{record_golden, slotforge, tiny};
 use crate::tools;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-fn tiny() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml")
-}
 
 /// Widths of the ports of `ports.json`, by name.
 fn widths(ports_json: &Path) -> Vec<(String, String, u64)> {
@@ -80,12 +71,7 @@ fn a_design_that_differs_on_any_pin_fails_its_golden_at_that_pin() {
     }
     let d = tempfile::tempdir().unwrap();
     let gold = d.path().join("golden");
-    slotforge()
-        .args(["golden", "--backend", "rusthdl", "--update", "--dir"])
-        .arg(&gold)
-        .arg(tiny())
-        .assert()
-        .success();
+    record_golden(&gold);
     let v = d.path().join("v");
     slotforge()
         .arg("verilog")

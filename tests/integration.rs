@@ -50,3 +50,11 @@ mod tools;
 // Shared by several test files (one copy in this binary).
 #[path = "common/presets.rs"]
 mod common_presets;
+
+// Shared by several test files (one copy in this binary).
+#[path = "common/progress.rs"]
+mod progress;
+
+// Shared by several test files (one copy in this binary).
+#[path = "common/cli.rs"]
+mod common_cli;

@@ -8,21 +8,12 @@
 use std::path::{Path, PathBuf};
 use std::process::Command as Process;
 
-use assert_cmd::Command;
-
 // Missing tools fail under CI=true, skip loudly elsewhere.
+use crate::common_cli::{root, slotforge};
 use crate::tools;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn preset() -> PathBuf {
     root().join("mixes/eskin34-uart.toml")
-}
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
 }
 
 /// `link_tx` of a slotforge VCD (1 ps timescale) as a one-signal VCD in
@@ -35,9 +26,7 @@ fn link_vcd(src: &str) -> String {
         .expect("link_tx in the VCD")
         .to_string();
     assert!(src.contains("$timescale 1ps $end"));
-    let mut out = String::from(
-        "$timescale 10ns $end\n$scope module top $end\n$var wire 1 ! tx $end\n$upscope $end\n$enddefinitions $end\n",
-    );
+    let mut out = judge::vcdout::wire_header("10ns", "top", &["tx"]);
     let mut t = 0u64;
     let mut last = None;
     for l in src

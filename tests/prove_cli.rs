@@ -4,19 +4,11 @@
 
 use std::path::PathBuf;
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
+use crate::common_cli::{slotforge, tiny};
 use crate::tools;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-fn tiny() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml")
-}
 
 #[test]
 fn solvers_that_fail_on_our_netlists_are_refused_with_the_reason() {

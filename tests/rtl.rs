@@ -8,21 +8,12 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
 use lut_gen::ports::{Dir, Layout, PORTS, TOP_MODULE};
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
+use crate::common_cli::{slotforge, tiny};
 use crate::tools;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-/// A two-branch mix with a 4000-cycle frame (fast in every simulator).
-fn tiny() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/tiny.toml")
-}
 
 fn schedule() -> lut_gen::Schedule {
     lut_gen::synthesize(&lut_gen::load(&tiny()).unwrap()).unwrap()

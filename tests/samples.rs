@@ -4,20 +4,12 @@
 //! back end writes the same samples.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use assert_cmd::Command;
 use predicates::prelude::*;
 
+use crate::common_cli::{root, slotforge};
 use crate::tools;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// Runs `sim --json ... --samples`; returns the report and the CSV text.
 fn sim_samples(
@@ -34,14 +26,9 @@ fn sim_samples(
         .args(["--backend", backend, "--frames", &frames.to_string()])
         .args(["--stimulus", stimulus, "--json", "--samples"])
         .arg(&csv)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        .assert()
+        .success();
+    let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
     (v, std::fs::read_to_string(&csv).unwrap())
 }
 

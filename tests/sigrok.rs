@@ -27,11 +27,8 @@ use lut_gen::Schedule;
 // Missing tools fail under CI=true, skip loudly elsewhere.
 use crate::tools;
 
+use crate::common_cli::root;
 use crate::common_presets;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn presets() -> Vec<PathBuf> {
     common_presets::presets(&root())

@@ -5,28 +5,15 @@
 
 use std::path::{Path, PathBuf};
 
-use assert_cmd::Command;
 use predicates::prelude::*;
-
-fn slotforge() -> Command {
-    Command::cargo_bin("slotforge").unwrap()
-}
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 fn eskin34() -> PathBuf {
     root().join("mixes/eskin34.toml")
 }
 
-/// A two-branch mix with a 4000-cycle frame (fast in every simulator).
-fn tiny() -> PathBuf {
-    root().join("cosim/tests/data/tiny.toml")
-}
-
 // Missing tools fail under CI=true, skip loudly elsewhere.
-use crate::tools;
+use crate::common_cli::{root, sim_window, slotforge, tiny};
+use crate::{progress, tools};
 
 /// Runs `sim --json` and checks SPEC's fields; returns the report.
 fn sim_json(mix: &Path, backend: &str, frames: u64) -> serde_json::Value {
@@ -139,24 +126,7 @@ fn sim_icarus_names_the_missing_tool() {
 
 /// A VCD of 3 frames of the tiny mix (with reset), written by `sim --vcd`.
 fn sim_vcd(dir: &Path) -> PathBuf {
-    let wave = dir.join("wave.vcd");
-    slotforge()
-        .arg("sim")
-        .arg(tiny())
-        .args([
-            "--backend",
-            "rusthdl",
-            "--frames",
-            "3",
-            "--from",
-            "0",
-            "--to",
-            "3",
-        ])
-        .arg("--vcd")
-        .arg(&wave)
-        .assert()
-        .code(0);
+    let wave = sim_window(dir, "wave.vcd", "0", "3");
     assert!(dir.join("wave.gtkw").exists());
     wave
 }
@@ -215,18 +185,7 @@ fn check_shows_its_progress_in_plain_lines_off_a_terminal() {
         .code(0);
     let log = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
     let prefix = format!("checking {}: ", wave.display());
-    let counts: Vec<(f64, f64)> = log
-        .lines()
-        .filter_map(|l| {
-            let (done, rest) = l.strip_prefix(&prefix)?.split_once(" of ")?;
-            let total = rest.split_once(" MB read (")?.0;
-            Some((done.parse().ok()?, total.parse().ok()?))
-        })
-        .collect();
-    assert!(counts.len() >= 5, "{log}");
-    assert!(counts.windows(2).all(|w| w[0].0 < w[1].0), "{log}");
-    let (done, total) = *counts.last().unwrap();
-    assert_eq!(done, total, "{log}");
+    let total = progress::rises_to_total(&log, &prefix, " MB read");
     // the whole body, which is the file less its header of a few kB
     let mb = size as f64 / 1e6;
     assert!(
@@ -447,6 +406,102 @@ fn bad_input_exits_2() {
         );
 }
 
+/// A file the user named that is not there is told in words ("no such
+/// file", or "no such folder" for an output), with its name, exit 2, and
+/// never the OS's "(os error 2)": the mix, a capture (VCD, `--map`'s, a
+/// `.sr` session, `decode`'s), the `--map` file, `--rtl` and `--samples`.
+#[test]
+fn missing_user_files_are_told_in_words() {
+    let d = tempfile::tempdir().unwrap();
+    let gone = |name: &str| d.path().join(name).display().to_string();
+    let tiny = tiny().display().to_string();
+    let cases: Vec<(Vec<String>, String, &str)> = vec![
+        (
+            vec!["audit".into(), gone("nope.toml")],
+            gone("nope.toml"),
+            "no such file",
+        ),
+        (
+            vec!["sim".into(), gone("nope.toml")],
+            gone("nope.toml"),
+            "no such file",
+        ),
+        (
+            vec!["check".into(), tiny.clone(), gone("nope.vcd")],
+            gone("nope.vcd"),
+            "no such file",
+        ),
+        (
+            vec![
+                "check".into(),
+                tiny.clone(),
+                gone("nope.sr"),
+                "--map".into(),
+                "D0=adc_cs_n[0]".into(),
+            ],
+            gone("nope.sr"),
+            "no such file",
+        ),
+        (
+            vec![
+                "check".into(),
+                tiny.clone(),
+                gone("nope.vcd"),
+                "--map".into(),
+                gone("probes.txt"),
+            ],
+            gone("probes.txt"),
+            "no such file",
+        ),
+        (
+            vec![
+                "sim".into(),
+                tiny.clone(),
+                "--backend".into(),
+                "icarus".into(),
+                "--rtl".into(),
+                gone("top.v"),
+            ],
+            gone("top.v"),
+            "no such file",
+        ),
+        (
+            vec![
+                "sim".into(),
+                tiny.clone(),
+                "--samples".into(),
+                gone("no-dir/s.csv"),
+            ],
+            gone("no-dir/s.csv"),
+            "no such folder",
+        ),
+        (
+            vec![
+                "decode".into(),
+                root().join("mixes/eskin34-uart.toml").display().to_string(),
+                gone("line.bin"),
+                "-o".into(),
+                gone("out.csv"),
+            ],
+            gone("line.bin"),
+            "no such file",
+        ),
+    ];
+    for (args, name, words) in cases {
+        let out = slotforge().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(&name) && err.contains(words),
+            "{args:?}: {err}"
+        );
+        assert!(
+            !err.contains("os error") && !err.contains("panicked"),
+            "{args:?}: {err}"
+        );
+    }
+}
+
 #[test]
 fn vcd_into_a_missing_folder_is_created_and_its_gtkw_finds_it_from_anywhere() {
     let d = tempfile::tempdir().unwrap();
@@ -542,16 +597,11 @@ fn a_fst_name_writes_fst_that_check_reads_back() {
         return;
     }
     let back = d.path().join("gtkwave.vcd");
-    let st = std::process::Command::new("fst2vcd")
-        .arg(&fst)
-        .arg("-o")
-        .arg(&back)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
+    tools::run_ok(
+        std::process::Command::new("fst2vcd")
+            .arg(&fst)
+            .arg("-o")
+            .arg(&back),
     );
     let v = check_json(&back, 0);
     assert_eq!(v["ok"], true, "{v}");

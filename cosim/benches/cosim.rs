@@ -17,7 +17,7 @@ use cosim::rusthdl::{verilog, RustHdlDut};
 use cosim::verilator::VerilatedDut;
 use cosim::Stimulus;
 use judge::run::{run_dut, run_model, run_unchecked, ModelDut, RunOptions};
-use judge::vcdout::VcdWriter;
+use judge::vcdout::write_run;
 
 fn secs<T>(f: impl FnOnce() -> T) -> (f64, T) {
     let t = Instant::now();
@@ -109,9 +109,7 @@ fn main() {
     std::fs::create_dir_all(&dir).unwrap();
     let vcd = dir.join("bench.vcd");
     let vf = (frames / 2).max(1);
-    let mut w = VcdWriter::create(&vcd, &s, 0, u64::MAX).unwrap();
-    let _ = run_dut(&s, &mut ModelDut::new(&s), vf, &opts, "gen", Some(&mut w));
-    w.finish().unwrap();
+    write_run(&vcd, &s, &mut ModelDut::new(&s), vf, &opts, (0, u64::MAX)).unwrap();
     let size = std::fs::metadata(&vcd).unwrap().len() as f64;
     let (tp, n) = secs(|| judge::vcd::parse_only(&s, &vcd, None).unwrap());
     let (tk, r) = secs(|| judge::check_vcd(&s, &vcd, None).unwrap());

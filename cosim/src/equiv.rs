@@ -21,7 +21,7 @@ use std::time::Duration;
 
 use serde::Serialize;
 
-use crate::tools::{self, ToolError};
+use judge::tools::{self, ToolError};
 
 /// What the check found.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -31,7 +31,6 @@ pub mod options;
 pub mod rtl;
 pub mod rusthdl;
 pub mod sigrok;
-pub mod tools;
 pub mod verilator;
 
 pub use backend::{run, run_observed, run_traced, Tracer};

@@ -119,7 +119,8 @@ impl PortDecl {
 /// Reads `path`, checks its `slotforge_top` against `s`'s pin contract and
 /// returns the Verilog text.
 pub fn load_rtl(s: &Schedule, path: &Path) -> Result<String, SimError> {
-    let bytes = std::fs::read(path).map_err(|e| SimError::Rtl(err(path, None, e.to_string())))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| SimError::Rtl(err(path, None, lut_gen::io_words(&e))))?;
     let text = String::from_utf8_lossy(&bytes).into_owned();
     check_ports(s, path, &text).map_err(SimError::Rtl)?;
     Ok(text)
@@ -286,6 +287,18 @@ const DIRECTIVES: [&str; 16] = [
     "nounconnected_drive",
 ];
 
+/// The index just past the first `close` at or after `i` (a block
+/// comment's or an attribute's end), counting the lines it spans.
+fn past(b: &[u8], mut i: usize, close: &[u8], line: &mut usize) -> usize {
+    while i < b.len() && !b[i..].starts_with(close) {
+        if b[i] == b'\n' {
+            *line += 1;
+        }
+        i += 1;
+    }
+    i + close.len()
+}
+
 fn lex(text: &str) -> Vec<Token> {
     let b = text.as_bytes();
     let mut i = 0;
@@ -304,24 +317,10 @@ fn lex(text: &str) -> Vec<Token> {
                 i += 1;
             }
         } else if b[i..].starts_with(b"/*") {
-            i += 2;
-            while i < b.len() && !b[i..].starts_with(b"*/") {
-                if b[i] == b'\n' {
-                    line += 1;
-                }
-                i += 1;
-            }
-            i += 2;
+            i = past(b, i + 2, b"*/", &mut line);
         } else if b[i..].starts_with(b"(*") && !b[i..].starts_with(b"(*)") {
             // attribute instance
-            i += 2;
-            while i < b.len() && !b[i..].starts_with(b"*)") {
-                if b[i] == b'\n' {
-                    line += 1;
-                }
-                i += 1;
-            }
-            i += 2;
+            i = past(b, i + 2, b"*)", &mut line);
         } else if c == b'"' {
             i += 1;
             while i < b.len() && b[i] != b'"' && b[i] != b'\n' {

@@ -18,7 +18,7 @@ use lut_gen::parts::{AdcPart, Start};
 use lut_gen::ports::Pins;
 use lut_gen::Schedule;
 
-use crate::tools::{self, ToolError};
+use judge::tools::{self, ToolError};
 
 /// Every branch's CS/SCLK/MISO changes and the sample stream, from frame 1.
 pub struct SpiCapture {
@@ -112,9 +112,7 @@ impl PartDecoder {
 
 /// The branch's lanes as a VCD sigrok reads (1-bit signals `cs`, `sclk`, `miso`).
 fn vcd(changes: &[(u64, u8)], end: u64) -> String {
-    let mut out = String::from(
-        "$timescale 1 ns $end\n$scope module top $end\n$var wire 1 ! cs $end\n$var wire 1 \" sclk $end\n$var wire 1 # miso $end\n$upscope $end\n$enddefinitions $end\n",
-    );
+    let mut out = judge::vcdout::wire_header("1 ns", "top", &["cs", "sclk", "miso"]);
     let mut prev: Option<u8> = None;
     for &(t, v) in changes {
         let _ = writeln!(out, "#{t}");

@@ -14,7 +14,7 @@ use judge::timed::check_capture;
 mod analyser;
 use crate::tools;
 
-use analyser::{check, lanes, mutate, resample, run, to_sigrok, Mutation};
+use analyser::{capture, check, lanes, mutate, resample, run, to_sigrok, Mutation};
 
 /// The first `n` random mixes from `seed` on that synthesize, fit the pin
 /// contract and convert on every branch.
@@ -60,8 +60,7 @@ fn captures_of_random_mixes(seed: u64, n: usize, classes: usize) {
             (41_667, k * 104_729 % 41_000),
         ] {
             let v = d.path().join(format!("clean{k}-{ts}.vcd"));
-            resample(&s, &clean, window.0, window.1, ts, phase, &v);
-            let (sr, back) = to_sigrok(&v, ts);
+            let (sr, back) = capture(&s, &clean, window, (ts, phase), &v);
             for file in [&sr, &back] {
                 let r = check(&s, &map, file);
                 assert!(
@@ -108,11 +107,7 @@ fn captures_of_random_mixes(seed: u64, n: usize, classes: usize) {
         }
         // Faults on the recorded pins, named by class.
         let mid = (window.0 + window.1) / 2;
-        for (m, want) in [
-            (Mutation::OneSlotLate, "conversion instant"),
-            (Mutation::MuxEarly, "mux switching"),
-            (Mutation::SclkEdgeMissing, "serial clock"),
-        ] {
+        for (m, want) in Mutation::PINS {
             // A mix whose muxes never switch (one channel a branch) has
             // no mux change to move.
             let switches = clean[mid as usize..]
@@ -124,8 +119,7 @@ fn captures_of_random_mixes(seed: u64, n: usize, classes: usize) {
             let mut bad = clean.clone();
             mutate(&s, &mut bad, m, mid);
             let v = d.path().join(format!("{m:?}{k}.vcd"));
-            resample(&s, &bad, window.0, window.1, 41_667, 12_345, &v);
-            let (sr, _) = to_sigrok(&v, 41_667);
+            let (sr, _) = capture(&s, &bad, window, (41_667, 12_345), &v);
             let r = check(&s, &map, &sr);
             assert!(!r.ok, "mix {k}: {m:?} passed: {}", r.summary());
             assert!(

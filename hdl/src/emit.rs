@@ -116,7 +116,7 @@ impl Board {
             path: path.display().to_string(),
             message: m,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+        let text = std::fs::read_to_string(path).map_err(|e| err(lut_gen::io_words(&e)))?;
         toml::from_str(&text).map_err(|e| err(lut_gen::mix::plain(&e.to_string(), "")))
     }
 }

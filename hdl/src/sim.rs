@@ -9,6 +9,35 @@ use crate::core::Core;
 use crate::link::{AxisLink, UartLink};
 use crate::{plan, HdlError};
 
+/// A block connected and settled with its clock low, before any edge.
+/// (A macro, not a function: the blocks share the field name `clock`, not
+/// a trait that reaches it.)
+macro_rules! started {
+    ($block:expr) => {{
+        let mut b = $block;
+        b.connect_all();
+        b.clock.next = Clock::from(false);
+        simulate(&mut *b, 1000);
+        b
+    }};
+}
+
+/// One rising edge of a link stage (`UartLink` or `AxisLink`, whose inputs
+/// have the same names), sampling `core`'s sample stream as it is now.
+macro_rules! clock_link {
+    ($link:expr, $rst:expr, $core:expr, $passes:expr) => {{
+        let (l, c) = ($link, $core);
+        l.clock.next = Clock::from(false);
+        l.rst.next = $rst;
+        l.valid.next = c.sample_valid.val();
+        l.ch.next = c.sample_channel.val();
+        l.val.next = c.sample_value.val();
+        settle(l, $passes);
+        l.clock.next = Clock::from(true);
+        settle(l, $passes);
+    }};
+}
+
 /// Cycle-accurate simulator of the emitted gateware.
 ///
 /// Each [`RtlSim::step`] applies exactly one rising clock edge.  The two
@@ -103,28 +132,12 @@ impl RtlSim {
     }
 
     fn from_plan(p: &plan::Plan) -> RtlSim {
-        let mut core = Box::new(Core::new(p));
-        core.connect_all();
-        core.clock.next = Clock::from(false);
-        simulate(&mut *core, 1000);
-        let axis = p.link.filter(|lp| lp.axis.is_some()).map(|lp| {
-            let mut l = Box::new(AxisLink::new(lp));
-            l.connect_all();
-            l.clock.next = Clock::from(false);
-            simulate(&mut *l, 1000);
-            l
-        });
-        let link = p.link.filter(|lp| lp.axis.is_none()).map(|lp| {
-            let mut l = Box::new(UartLink::new(lp));
-            l.connect_all();
-            l.clock.next = Clock::from(false);
-            simulate(&mut *l, 1000);
-            l
-        });
+        let axis = p.link.filter(|lp| lp.axis.is_some());
+        let link = p.link.filter(|lp| lp.axis.is_none());
         RtlSim {
-            core,
-            link,
-            axis,
+            core: started!(Box::new(Core::new(p))),
+            link: link.map(|lp| started!(Box::new(UartLink::new(lp)))),
+            axis: axis.map(|lp| started!(Box::new(AxisLink::new(lp)))),
             tready: true,
             passes: 0,
             reader: PinReader::new(p),
@@ -150,29 +163,13 @@ impl RtlSim {
     /// Apply one rising clock edge; see the type's documentation.
     pub fn step(&mut self, rst: bool, miso: u64) -> Pins {
         let miso = miso & self.reader.lanes as u64;
+        // The link samples the core's outputs of the cycle this edge ends.
         if let Some(l) = self.axis.as_deref_mut() {
-            let c = &*self.core;
-            l.clock.next = Clock::from(false);
-            l.rst.next = rst;
-            l.valid.next = c.sample_valid.val();
-            l.ch.next = c.sample_channel.val();
-            l.val.next = c.sample_value.val();
             l.tready.next = self.tready;
-            settle(l, &mut self.passes);
-            l.clock.next = Clock::from(true);
-            settle(l, &mut self.passes);
+            clock_link!(l, rst, &*self.core, &mut self.passes);
         }
         if let Some(l) = self.link.as_deref_mut() {
-            // The link samples the core's outputs of the cycle this edge ends.
-            let c = &*self.core;
-            l.clock.next = Clock::from(false);
-            l.rst.next = rst;
-            l.valid.next = c.sample_valid.val();
-            l.ch.next = c.sample_channel.val();
-            l.val.next = c.sample_value.val();
-            settle(l, &mut self.passes);
-            l.clock.next = Clock::from(true);
-            settle(l, &mut self.passes);
+            clock_link!(l, rst, &*self.core, &mut self.passes);
         }
         let c = &mut *self.core;
         // Falling edge: no logic reacts to it, so it only has to reach every

@@ -7,6 +7,10 @@ mod rtlsim;
 #[path = "tools.rs"]
 mod tools;
 
+// The workspace's one tool policy (missing tools fail under CI=true).
+#[path = "../../tests/common/tools.rs"]
+mod policy;
+
 // Shared by several test files (one copy in this binary).
 #[path = "common/mod.rs"]
 mod common;

@@ -7,10 +7,12 @@
 //! - [`lut`]: the slot LUT as a full frame table and in compact form;
 //! - [`ports`]: the pin contract of `slotforge_top` (names, roles, widths, lanes, limits, `ports.json`);
 //! - [`hostlink`]: the link to the host planned from the schedule (divider, bytes per frame, FIFO depth, latency, minimum baud);
+//! - [`oswords`]: what the OS says about a user's file, in words;
 //! - [`audit`]: rates, intervals, headroom, settling and Nyquist, as text or JSON.
 
 pub mod hostlink;
 pub mod mix;
+pub mod oswords;
 pub mod parts;
 pub mod ports;
 pub mod schedule;
@@ -18,8 +20,9 @@ pub mod synth;
 pub mod validate;
 
 pub use mix::{load, parse, Mix, MixError};
+pub use oswords::{io_words, write_words};
 pub use schedule::{FrameGrid, SamplingInstant, Schedule};
-pub use synth::{synthesize, Infeasible, Verdict};
+pub use synth::{synthesize, synthesize_within, Infeasible, Verdict};
 pub mod audit;
 pub mod lut;
 

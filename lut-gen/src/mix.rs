@@ -27,6 +27,10 @@ pub struct MixError {
 
 impl fmt::Display for MixError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line == 0 && self.field.is_empty() {
+            // The file itself (it cannot be read): no line, no field.
+            return write!(f, "{}: {}", self.file.display(), self.message);
+        }
         write!(
             f,
             "{}:{}:{}: {}: {}",
@@ -281,8 +285,8 @@ pub fn load(path: &Path) -> Result<Mix, MixError> {
         file: path.to_path_buf(),
         line: 0,
         column: 0,
-        field: "(file)".into(),
-        message: format!("cannot read: {e}"),
+        field: String::new(),
+        message: format!("cannot read: {}", crate::io_words(&e)),
     })?;
     parse(path, &text)
 }

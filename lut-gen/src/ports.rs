@@ -232,6 +232,15 @@ pub struct LinkPort {
     pub signal: Signal,
 }
 
+/// The FIFO's sticky overflow flag, a port of either link.
+const OVERFLOW: LinkPort = LinkPort {
+    name: "link_overflow",
+    dir: Dir::Out,
+    key: "overflow",
+    width: 1,
+    signal: Signal::LinkOverflow,
+};
+
 /// The UART link's ports: the serial line and the FIFO's overflow flag.
 pub const LINK_PORTS: [LinkPort; 2] = [
     LinkPort {
@@ -241,13 +250,7 @@ pub const LINK_PORTS: [LinkPort; 2] = [
         width: 1,
         signal: Signal::LinkTx,
     },
-    LinkPort {
-        name: "link_overflow",
-        dir: Dir::Out,
-        key: "overflow",
-        width: 1,
-        signal: Signal::LinkOverflow,
-    },
+    OVERFLOW,
 ];
 
 /// The AXI4-Stream link's ports (docs/packet-format.md, "AXI4-Stream"):
@@ -281,13 +284,7 @@ pub const AXIS_PORTS: [LinkPort; 5] = [
         width: 1,
         signal: Signal::AxisTready,
     },
-    LinkPort {
-        name: "link_overflow",
-        dir: Dir::Out,
-        key: "overflow",
-        width: 1,
-        signal: Signal::LinkOverflow,
-    },
+    OVERFLOW,
 ];
 
 const _: () = {

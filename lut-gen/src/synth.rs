@@ -299,8 +299,10 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
     synthesize_within(mix, SEARCH_BUDGET)
 }
 
-/// [`synthesize`] with `budget` placements per slot grid for the exact search.
-fn synthesize_within(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible> {
+/// [`synthesize`] with `budget` placements per slot grid for the exact
+/// search (`--search-limit`): a smaller budget answers sooner, and a mix
+/// whose search it cuts short is [`Verdict::Unknown`], never infeasible.
+pub fn synthesize_within(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible> {
     let fail = |reasons: Vec<String>, suggestions: Vec<String>| Infeasible {
         mix: mix.name.clone(),
         verdict: Verdict::Infeasible,

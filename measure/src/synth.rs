@@ -19,16 +19,6 @@ pub struct Synth {
     pub fmax_mhz: f64,
 }
 
-/// Whether `tool` can be started.
-pub fn tool_present(tool: &str) -> bool {
-    Command::new(tool)
-        .arg("-V")
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .status()
-        .is_ok()
-}
-
 /// yosys `synth_ice40` then nextpnr-ice40 on `dir/slotforge_top.v`, work
 /// files and logs (`yosys.log`, `stat.txt`, `nextpnr.log`) in `dir`.  With
 /// `pcf` the pins are placed as the board file says; without, IO is left

@@ -68,9 +68,11 @@ pub fn busiest_slice(s: &Schedule) -> u64 {
 /// channel names, clear of the row above.
 const HIGH: f64 = 0.55;
 
-/// Lines the strobe names take below the strobe row: three, as merged
-/// names of several branches are wider than two slots.
-const STROBE_LINES: usize = 3;
+/// Lines the strobe names take: one among the strobes' ticks (for a name
+/// that fits before the next tick) and three below the trace, as merged
+/// names of several branches are wider than two slots, and a name wider
+/// than a slot (eskin34's) never fits among the ticks.
+const STROBE_LINES: usize = 4;
 
 /// Strobe labels closer than this share of the window are one label, so
 /// that back-to-back strobes of two branches do not print over each other.
@@ -109,19 +111,35 @@ fn label_width(t: &str, span: f64) -> f64 {
 /// ends inside the window (`x0 + span`), and on the first of `lines` lines
 /// whose last label ends left of it, else the one whose last label ends
 /// first; so names a slot apart (30 in eskin34's slice) do not print over
-/// each other, nor past the plot's right edge.
-fn stagger(labels: &[(f64, String)], x0: f64, span: f64, lines: usize) -> Vec<(f64, usize)> {
+/// each other, nor past the plot's right edge.  Line 0 sits among
+/// vertical `ticks` (the strobes): a label goes there only if no tick lies
+/// under its text, which starts 6 pixels right of its strobe (so the ticks
+/// of strobes a few cycles apart that share one label do not count).
+fn stagger(
+    labels: &[(f64, String)],
+    ticks: &[f64],
+    x0: f64,
+    span: f64,
+    lines: usize,
+) -> Vec<(f64, usize)> {
     let mut ends = vec![f64::MIN; lines];
+    let own = 6.0 / 860.0 * span;
     labels
         .iter()
         .map(|(x, t)| {
             let w = label_width(t, span);
             let x = x.min(x0 + span - w);
-            let line = (0..lines).find(|&k| ends[k] <= x).unwrap_or_else(|| {
-                (0..lines)
-                    .min_by(|&a, &b| ends[a].total_cmp(&ends[b]))
-                    .unwrap_or(0)
-            });
+            let crosses = ticks.iter().any(|&k| k > x + own && k < x + w);
+            let free = |k: &usize| !(*k == 0 && crosses);
+            let line = (0..lines)
+                .filter(free)
+                .find(|&k| ends[k] <= x)
+                .unwrap_or_else(|| {
+                    (0..lines)
+                        .filter(free)
+                        .min_by(|&a, &b| ends[a].total_cmp(&ends[b]))
+                        .unwrap_or(lines - 1)
+                });
             ends[line] = x + w;
             (x, line)
         })
@@ -245,16 +263,18 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
             .map(|i| (us(i.cycle), name(i.channel)))
             .collect();
         // above the trace's high level, or below its low level
-        for ((x, line), (_, text)) in stagger(&texts, x0, span, 2).into_iter().zip(texts) {
+        for ((x, line), (_, text)) in stagger(&texts, &[], x0, span, 2).into_iter().zip(texts) {
             let y = [r + HIGH / 2.0 + 0.05, r + SELECT_LOW][line];
             labels.labels.push((x, y, text));
         }
     }
     let merge = ((to - from) as f64 * STROBE_MERGE) as u64;
     let mut strobes: Vec<(u64, Vec<String>)> = Vec::new();
+    let mut ticks = Vec::new();
     for (k, (p, _)) in w.cycles.iter().enumerate() {
         if p.sample_valid {
             let (c, n) = (from + k as u64, name(p.sample_channel as usize));
+            ticks.push(us(c));
             match strobes.last_mut() {
                 Some((c0, names)) if c - *c0 <= merge => names.push(n),
                 _ => strobes.push((c, vec![n])),
@@ -265,7 +285,7 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         .into_iter()
         .map(|(c, names)| (us(c), names.join(",")))
         .collect();
-    for ((x, level), (_, text)) in stagger(&texts, x0, span, STROBE_LINES)
+    for ((x, level), (_, text)) in stagger(&texts, &ticks, x0, span, STROBE_LINES)
         .into_iter()
         .zip(texts)
     {
@@ -428,19 +448,49 @@ mod tests {
         let l: Vec<(f64, String)> = (0..6).map(|k| (k as f64, "CH10".to_string())).collect();
         // 30 slots in the window: a label is wider than a slot
         let lines = |v: Vec<(f64, usize)>| v.into_iter().map(|p| p.1).collect::<Vec<_>>();
-        assert_eq!(lines(super::stagger(&l, 0.0, 30.0, 2)), [0, 1, 0, 1, 0, 1]);
+        assert_eq!(
+            lines(super::stagger(&l, &[], 0.0, 30.0, 2)),
+            [0, 1, 0, 1, 0, 1]
+        );
         // wider labels take a third line where there is one
         let w: Vec<(f64, String)> = (0..6).map(|k| (k as f64, "CH1,CH26".into())).collect();
-        assert_eq!(lines(super::stagger(&w, 0.0, 30.0, 3)), [0, 1, 2, 0, 1, 2]);
+        assert_eq!(
+            lines(super::stagger(&w, &[], 0.0, 30.0, 3)),
+            [0, 1, 2, 0, 1, 2]
+        );
         // far apart: all on the first line
         let far: Vec<(f64, String)> = l.iter().map(|(x, t)| (x * 10.0, t.clone())).collect();
-        assert_eq!(lines(super::stagger(&far, 0.0, 60.0, 2)), [0; 6]);
+        assert_eq!(lines(super::stagger(&far, &[], 0.0, 60.0, 2)), [0; 6]);
+    }
+
+    /// A strobe's tick under a name on the first line (which sits among
+    /// the ticks) sends the name to a line below the trace: eskin34's
+    /// merged "CH1,CH26,CH35" crossed the next two strobes' ticks.
+    #[test]
+    fn no_strobe_tick_crosses_a_name_on_the_first_line() {
+        let width = super::label_width("CH1,CH26,CH35", 30.0);
+        let ticks = [0.0, 0.0 + width / 2.0, 5.0];
+        let l = vec![
+            (0.0, "CH1,CH26,CH35".to_string()),
+            (width / 2.0, "CH2".to_string()),
+            (5.0, "CH3".to_string()),
+        ];
+        let placed = super::stagger(&l, &ticks, 0.0, 30.0, 3);
+        assert_eq!(placed.iter().map(|p| p.1).collect::<Vec<_>>(), [1, 0, 0]);
+        for ((x, line), (_, t)) in placed.iter().zip(&l) {
+            let end = x + super::label_width(t, 30.0);
+            let under = ticks.iter().any(|&k| k > *x + 0.21 && k < end);
+            assert!(*line > 0 || !under, "{t} on line 0 over a tick");
+        }
+        // its own strobes' ticks, left of its text, do not count
+        let alone = super::stagger(&l[..1], &[0.0, 0.1], 0.0, 30.0, 3);
+        assert_eq!(alone[0].1, 0);
     }
 
     #[test]
     fn a_label_at_the_right_edge_ends_inside_the_window() {
         let l = vec![(9.0, "CH1".to_string()), (29.9, "CH1,CH26".to_string())];
-        let placed = super::stagger(&l, 0.0, 30.0, 2);
+        let placed = super::stagger(&l, &[], 0.0, 30.0, 2);
         assert_eq!(placed[0].0, 9.0, "a label with room stays at its strobe");
         let end = placed[1].0 + super::label_width("CH1,CH26", 30.0);
         assert!(end <= 30.0 + 1e-9 && placed[1].0 < 29.9, "{placed:?}");

@@ -11,6 +11,8 @@ pub struct Args {
     /// Print the SPEC's JSON report instead of the table.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub search: super::SearchLimit,
 }
 
 pub fn run(args: Args) -> u8 {
@@ -21,7 +23,7 @@ pub fn run(args: Args) -> u8 {
             return 2;
         }
     };
-    let (report, diagnosis) = match lut_gen::synthesize(&mix) {
+    let (report, diagnosis) = match lut_gen::synthesize_within(&mix, args.search.nodes) {
         Ok(s) => {
             // a line too slow for the mix: named on stderr as the parser
             // names a bad key (the report says it too, and exits 1)

@@ -89,28 +89,23 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
-    let s = match super::schedule(&a.mix) {
+    let s = match super::schedule_on_pins(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
+    if let Err(code) = super::junit::check_writable(a.junit.as_deref()) {
         return code;
     }
     if let Err(code) = super::link_fits(&s, &a.mix) {
         return code;
-    }
-    if let Some(j) = &a.junit {
-        if let Err(e) = super::junit::check_writable(j) {
-            eprintln!("error: {e}");
-            return 2;
-        }
     }
     if a.out.exists() && !a.out.is_dir() {
         eprintln!("error: {}: exists and is not a directory", a.out.display());
         return 2;
     }
     if let Err(e) = std::fs::create_dir_all(&a.out) {
-        eprintln!("error: {}: cannot create directory: {e}", a.out.display());
+        let why = lut_gen::io_words(&e);
+        eprintln!("error: {}: cannot create directory: {why}", a.out.display());
         return 2;
     }
     let plan = steps::with_remembered_proof(plan, &s, &a.out);

@@ -114,21 +114,15 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::schedule(&a.mix) {
+    let s = match super::schedule_on_pins(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
+    if let Err(code) = super::junit::check_writable(a.junit.as_deref()) {
         return code;
     }
     if let Err(code) = super::link_fits(&s, &a.mix) {
         return code;
-    }
-    if let Some(j) = &a.junit {
-        if let Err(e) = super::junit::check_writable(j) {
-            eprintln!("error: {e}");
-            return 2;
-        }
     }
     let started = std::time::Instant::now();
     if let Some(map) = &a.map {

@@ -80,8 +80,13 @@ impl Sink {
             .file_name()
             .ok_or_else(|| format!("{}: not a file name", path.display()))?;
         let tmp = path.with_file_name(format!(".{}.tmp", name.to_string_lossy()));
-        let f = std::fs::File::create(&tmp)
-            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        let f = std::fs::File::create(&tmp).map_err(|e| {
+            format!(
+                "{}: cannot write: {}",
+                path.display(),
+                lut_gen::write_words(&e)
+            )
+        })?;
         Ok(Sink::File {
             tmp,
             path: path.to_path_buf(),
@@ -102,12 +107,7 @@ impl Sink {
 
     fn finish(self) -> Result<(), String> {
         if let Sink::File { tmp, path, mut f } = self {
-            f.flush()
-                .and_then(|()| std::fs::rename(&tmp, &path))
-                .map_err(|e| {
-                    let _ = std::fs::remove_file(&tmp);
-                    format!("{}: cannot write: {e}", path.display())
-                })?;
+            super::put_in_place(&tmp, &path, f.flush())?;
         }
         Ok(())
     }
@@ -132,8 +132,9 @@ pub fn run(a: Args) -> u8 {
             Ok(f) => Box::new(f),
             Err(e) => {
                 eprintln!(
-                    "error: {}: cannot read the capture: {e}",
-                    a.capture.display()
+                    "error: {}: cannot read the capture: {}",
+                    a.capture.display(),
+                    lut_gen::io_words(&e)
                 );
                 return 2;
             }
@@ -161,7 +162,8 @@ pub fn run(a: Args) -> u8 {
             Ok(n) => n,
             Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
             Err(e) => {
-                eprintln!("error: {}: reading the capture: {e}", a.capture.display());
+                let why = lut_gen::io_words(&e);
+                eprintln!("error: {}: reading the capture: {why}", a.capture.display());
                 return 2;
             }
         };
@@ -170,7 +172,8 @@ pub fn run(a: Args) -> u8 {
         rows.write(&got, &mut text);
         if !text.is_empty() {
             if let Err(e) = sink.put(&text) {
-                eprintln!("error: {}: cannot write: {e}", a.out.display());
+                let why = lut_gen::write_words(&e);
+                eprintln!("error: {}: cannot write: {why}", a.out.display());
                 return 2;
             }
             text.clear();

@@ -49,13 +49,10 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::schedule(&a.mix) {
+    let s = match super::schedule_on_pins(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
-        return code;
-    }
     if let Err(code) = super::link_fits(&s, &a.mix) {
         return code;
     }

@@ -99,7 +99,7 @@ fn load_manifest(path: &Path) -> Result<Manifest, String> {
         });
     }
     let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        .map_err(|e| format!("{}: cannot read: {}", path.display(), lut_gen::io_words(&e)))?;
     let m: Manifest = toml::from_str(&text).map_err(|e| {
         let line = e
             .span()
@@ -217,11 +217,8 @@ fn pins_text(p: &lut_gen::ports::Pins) -> String {
 }
 
 pub fn run(a: Args) -> u8 {
-    if let Some(j) = &a.junit {
-        if let Err(e) = super::junit::check_writable(j) {
-            eprintln!("error: {e}");
-            return 2;
-        }
+    if let Err(code) = super::junit::check_writable(a.junit.as_deref()) {
+        return code;
     }
     let bar = super::progress::Progress::new(a.mix.len() as u64, "mixes", a.quiet);
     let mut worst = 0;
@@ -272,13 +269,10 @@ pub struct Output {
 /// The golden command, its messages collected in `o` (the `build` job
 /// puts them in its report).
 pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
-    let s = match super::schedule(mix) {
+    let s = match super::schedule_on_pins(mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
-        return code;
-    }
     let dir = a.dir.join(&s.mix.name);
     let manifest_path = dir.join(MANIFEST);
     let manifest = match load_manifest(&manifest_path) {
@@ -293,7 +287,8 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         let text = match std::fs::read_to_string(&events_path) {
             Ok(t) => t,
             Err(e) => {
-                errln!(o, "error: {}: cannot read: {e}", events_path.display());
+                let why = lut_gen::io_words(&e);
+                errln!(o, "error: {}: cannot read: {why}", events_path.display());
                 return 2;
             }
         };

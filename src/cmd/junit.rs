@@ -36,9 +36,19 @@ impl Case {
     }
 }
 
-/// Refuses, before any work, a path whose folder does not exist or that is
-/// a directory.
-pub fn check_writable(path: &Path) -> Result<(), String> {
+/// Refuses, before any work, a `--junit` path whose folder does not exist
+/// or that is a directory: the message printed, exit 2.
+pub fn check_writable(path: Option<&Path>) -> Result<(), u8> {
+    let Some(path) = path else {
+        return Ok(());
+    };
+    unwritable(path).map_err(|e| {
+        eprintln!("error: {e}");
+        2
+    })
+}
+
+fn unwritable(path: &Path) -> Result<(), String> {
     if path.is_dir() {
         return Err(format!(
             "--junit {}: is a directory, not a file",

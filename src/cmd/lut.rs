@@ -11,10 +11,12 @@ pub struct Args {
     /// Output directory (created if missing; only slots.* files are written).
     #[arg(short = 'o', long = "out")]
     pub out: PathBuf,
+    #[command(flatten)]
+    pub search: super::SearchLimit,
 }
 
 pub fn run(args: Args) -> u8 {
-    let s = match super::schedule(&args.mix) {
+    let s = match super::schedule_within(&args.mix, args.search.nodes) {
         Ok(s) => s,
         Err(code) => return code,
     };

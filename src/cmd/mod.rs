@@ -17,14 +17,32 @@ use std::path::Path;
 
 /// Loads and schedules a mix, printing the error and returning the exit code on failure.
 pub fn schedule(path: &Path) -> Result<lut_gen::Schedule, u8> {
+    schedule_within(path, lut_gen::synth::SEARCH_BUDGET)
+}
+
+/// [`schedule`] with the exact search capped at `budget` placements per
+/// slot grid (`--search-limit`).
+pub fn schedule_within(path: &Path, budget: u64) -> Result<lut_gen::Schedule, u8> {
     let mix = lut_gen::load(path).map_err(|e| {
         eprintln!("error: {e}");
         2u8
     })?;
-    lut_gen::synthesize(&mix).map_err(|e| {
+    lut_gen::synthesize_within(&mix, budget).map_err(|e| {
         eprint!("{}: {e}", e.verdict.as_str());
         verdict_exit(e.verdict)
     })
+}
+
+/// `--search-limit N` of the commands that synthesize for their own output
+/// (`audit`, `lut`).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct SearchLimit {
+    /// Placements the exact scheduling search may try per slot grid before
+    /// it gives up: a mix it stops on is "unknown" (exit 3), not infeasible.
+    /// Smaller answers sooner; larger decides more mixes.
+    #[arg(long = "search-limit", value_name = "N", value_parser = whole_number,
+          default_value_t = lut_gen::synth::SEARCH_BUDGET)]
+    pub nodes: u64,
 }
 
 /// Exit code of a mix without a schedule: 1 proved infeasible, 3 unknown
@@ -112,6 +130,14 @@ impl Bound {
     }
 }
 
+/// [`schedule`], then the contract's limits checked ([`fits_pins`]): what
+/// every command that simulates, checks or proves starts with.
+pub fn schedule_on_pins(path: &Path) -> Result<lut_gen::Schedule, u8> {
+    let s = schedule(path)?;
+    fits_pins(&s)?;
+    Ok(s)
+}
+
 /// Checks that a schedule fits the pin contract's limits (the checker and
 /// the engines size their pins from them), else prints why: exit 2.
 pub fn fits_pins(s: &lut_gen::Schedule) -> Result<(), u8> {
@@ -139,11 +165,19 @@ pub fn link_fits(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
 pub fn write_atomic(dir: &Path, name: &str, text: &str) -> Result<(), String> {
     let path = dir.join(name);
     let tmp = dir.join(format!(".{name}.tmp"));
-    std::fs::write(&tmp, text)
-        .and_then(|()| std::fs::rename(&tmp, &path))
+    let written = std::fs::write(&tmp, text);
+    put_in_place(&tmp, &path, written)
+}
+
+/// Renames the temporary file `tmp`, once `written` says it is complete,
+/// to `path`; on any failure `tmp` is removed and the message names `path`.
+pub fn put_in_place(tmp: &Path, path: &Path, written: std::io::Result<()>) -> Result<(), String> {
+    written
+        .and_then(|()| std::fs::rename(tmp, path))
         .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            format!("{}: cannot write: {e}", path.display())
+            let _ = std::fs::remove_file(tmp);
+            let why = lut_gen::write_words(&e);
+            format!("{}: cannot write: {why}", path.display())
         })
 }
 
@@ -156,7 +190,8 @@ pub fn write_files(dir: &Path, files: &[(&str, String)]) -> Result<(), u8> {
         return Err(2);
     }
     std::fs::create_dir_all(dir).map_err(|e| {
-        eprintln!("error: {}: cannot create directory: {e}", dir.display());
+        let why = lut_gen::io_words(&e);
+        eprintln!("error: {}: cannot create directory: {why}", dir.display());
         2u8
     })?;
     for (name, text) in files {

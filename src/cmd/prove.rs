@@ -41,13 +41,10 @@ fn solver(s: &str) -> Result<Solver, String> {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::schedule(&a.mix) {
+    let s = match super::schedule_on_pins(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
-        return code;
-    }
     // a link too slow for the mix: refused as sim, check, faults, build and
     // verilog refuse it (file:line:col: link.<key>: ..., exit 1)
     if let Err(code) = super::link_fits(&s, &a.mix) {

@@ -129,13 +129,10 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: --frames must be at least 1");
         return 2;
     }
-    let s = match super::schedule(&a.mix) {
+    let s = match super::schedule_on_pins(&a.mix) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::fits_pins(&s) {
-        return code;
-    }
     if let Err(code) = super::link_fits(&s, &a.mix) {
         return code;
     }
@@ -243,7 +240,8 @@ pub fn run(a: Args) -> u8 {
     }
     if let Some(p) = &a.samples {
         if let Err(e) = log.write_csv(&s, p) {
-            eprintln!("error: --samples {}: {e}", p.display());
+            let why = lut_gen::write_words(&e);
+            eprintln!("error: --samples {}: {why}", p.display());
             return 2;
         }
     }

@@ -7,13 +7,14 @@
 //! - tool missing outside CI: a loud multi-line warning on stderr, then the
 //!   test skips (returns early).
 //!
-//! Shared by the root tests (`#[path = "common/tools.rs"]`) and cosim's
-//! (`#[path = "../../tests/common/tools.rs"]`); the decision table itself is
-//! tested in `tests/tool_policy.rs`.
+//! Shared by the root tests (`#[path = "common/tools.rs"]`) and those of
+//! cosim, the judge, hdl and formal (`#[path = "../../tests/common/tools.rs"]`
+//! or deeper); whether a tool is there is `judge::tools::present`, the
+//! library's one test. The decision table itself is tested in
+//! `tests/tool_policy.rs`.
 #![allow(dead_code)]
 
 use std::io::Write;
-use std::process::{Command, Stdio};
 
 /// What a test does about one tool.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,16 +46,8 @@ pub fn decide(present: bool, ci: Option<&str>) -> Decision {
     }
 }
 
-/// Is `tool` on PATH (can it be spawned at all)?
-pub fn tool_present(tool: &str) -> bool {
-    Command::new(tool)
-        .arg("--version")
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok()
-}
+/// Is `tool` on PATH (can it be spawned at all)? The library's one test.
+pub use judge::tools::present as tool_present;
 
 /// Applies the decision: `true` = run, `false` = skip (after a loud
 /// warning); panics when the tool is missing under CI.
@@ -78,6 +71,15 @@ pub fn gate(tool: &str, present: bool, ci: Option<&str>, test: &str) -> bool {
             false
         }
     }
+}
+
+/// Runs `cmd` (a tool, or a script of them) to completion and returns its
+/// output; a failure panics with the command and its stderr.
+pub fn run_ok(cmd: &mut std::process::Command) -> std::process::Output {
+    let out = cmd.output().unwrap_or_else(|e| panic!("{cmd:?}: {e}"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{cmd:?} failed: {err}");
+    out
 }
 
 /// The name libtest gives the current test's thread.

@@ -9,8 +9,8 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
-use judge::run::{run_dut, ModelDut, RunOptions};
-use judge::vcdout::VcdWriter;
+use judge::run::{ModelDut, RunOptions};
+use judge::vcdout::write_run;
 
 fn schedule() -> lut_gen::Schedule {
     let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../mixes/eskin34.toml");
@@ -103,16 +103,8 @@ fn main() {
     // Two sizes: memory flat in file size shows as equal peaks.
     for f in [frames.div_ceil(4).max(1), frames] {
         let p = dir.path().join(format!("bench{f}.vcd"));
-        let mut w = VcdWriter::create(&p, &s, 0, u64::MAX).unwrap();
-        run_dut(
-            &s,
-            &mut ModelDut::new(&s),
-            f,
-            &RunOptions::default(),
-            "gen",
-            Some(&mut w),
-        );
-        w.finish().unwrap();
+        let opts = RunOptions::default();
+        write_run(&p, &s, &mut ModelDut::new(&s), f, &opts, (0, u64::MAX)).unwrap();
         let mb = std::fs::metadata(&p).unwrap().len() as f64 / 1e6;
         let (tc, mc, cc) = run("check", &p);
         let (tw, mw, cw) = run("wellen", &p);

@@ -14,9 +14,13 @@ use crate::timed::{Capture, Lane};
 /// Parses `--map`: `CH=PORT[BIT],...` inline, or the path of a file with one
 /// `CH = PORT[BIT]` per line (`#` comments).  Errors name the line and field.
 pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
-    let (text, file) = match std::fs::read_to_string(spec) {
-        Ok(t) if !spec.contains('=') => (t, Some(spec)),
-        _ => (spec.replace(',', "\n"), None),
+    // Every inline entry has a `=`: without one, the map is a file's name.
+    let (text, file) = if spec.contains('=') {
+        (spec.replace(',', "\n"), None)
+    } else {
+        let t = std::fs::read_to_string(spec)
+            .map_err(|e| format!("--map {spec}: {}", lut_gen::io_words(&e)))?;
+        (t, Some(spec))
     };
     let layout = Layout::new(s);
     let widths = layout.port_widths();
@@ -111,7 +115,8 @@ pub fn read_progress(
         .map(|_| &head == b"PK")
         .unwrap_or(false);
     if !is_zip {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("{}: {}", path.display(), lut_gen::io_words(&e)))?;
         return parse_vcd(&text, path, lanes, progress);
     }
     let tmp = tempfile::Builder::new()

@@ -17,6 +17,8 @@ use std::path::Path;
 
 use wellen::{FileFormat, Hierarchy, LoadOptions, ScopeRef, TimescaleUnit};
 
+use crate::vcdout::id_code;
+
 /// Whether the file is an FST (by its contents, not its name).  A file that
 /// starts with text is a VCD (or not a waveform) and is left to the VCD
 /// reader, which names what is wrong with it.
@@ -90,7 +92,7 @@ fn transcode(path: &Path, w: &mut dyn Write) -> Result<(), String> {
         }
         match val.to_bit_string() {
             Some(bits) => {
-                let _ = writeln!(line, "b{bits} {}", id(sig.index()));
+                let _ = writeln!(line, "b{bits} {}", id_code(sig.index()));
             }
             // Reals, strings and events are not ports of slotforge_top.
             None => return Ok(()),
@@ -118,7 +120,7 @@ fn scope(h: &Hierarchy, s: ScopeRef, out: &mut String) {
         let _ = writeln!(
             out,
             "$var wire {width} {} {}{range} $end",
-            id(v.signal_ref().index()),
+            id_code(v.signal_ref().index()),
             v.name(h)
         );
     }
@@ -126,18 +128,6 @@ fn scope(h: &Hierarchy, s: ScopeRef, out: &mut String) {
         scope(h, c, out);
     }
     out.push_str("$upscope $end\n");
-}
-
-/// A VCD identifier code for a signal index (printable ASCII, base 94).
-fn id(mut n: usize) -> String {
-    let mut s = String::new();
-    loop {
-        s.push((b'!' + (n % 94) as u8) as char);
-        n /= 94;
-        if n == 0 {
-            return s;
-        }
-    }
 }
 
 fn unit_name(u: TimescaleUnit) -> Option<&'static str> {

@@ -45,6 +45,7 @@ pub mod samples;
 pub mod switch;
 pub mod timed;
 pub mod timedlink;
+pub mod tools;
 pub mod vcd;
 mod vcdlex;
 pub mod vcdout;

@@ -69,7 +69,7 @@ pub enum VcdError {
 impl fmt::Display for VcdError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            VcdError::Io(p, e) => write!(f, "{}: {e}", p.display()),
+            VcdError::Io(p, e) => write!(f, "{}: {}", p.display(), lut_gen::io_words(e)),
             VcdError::Malformed {
                 file,
                 line,
@@ -1262,8 +1262,8 @@ pub fn parse_only(s: &Schedule, path: &Path, scope: Option<&str>) -> Result<u64,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::{run_dut, ModelDut, RunOptions};
-    use crate::vcdout::VcdWriter;
+    use crate::run::{ModelDut, RunOptions};
+    use crate::vcdout::write_run;
 
     /// Every cycle handed on, as text.
     #[derive(Default)]
@@ -1292,16 +1292,8 @@ mod tests {
         let s = lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap();
         let d = tempfile::tempdir().unwrap();
         let vcd = d.path().join("w.vcd");
-        let mut w = VcdWriter::create(&vcd, &s, 0, 1_000).unwrap();
-        run_dut(
-            &s,
-            &mut ModelDut::new(&s),
-            1,
-            &RunOptions::default(),
-            "gen",
-            Some(&mut w),
-        );
-        w.finish().unwrap();
+        let opts = RunOptions::default();
+        write_run(&vcd, &s, &mut ModelDut::new(&s), 1, &opts, (0, 1_000)).unwrap();
         let text = std::fs::read_to_string(&vcd).unwrap();
         let body = text.find("$enddefinitions").unwrap();
         let (head, tail) = text.split_at(body);

@@ -13,9 +13,7 @@ use lut_gen::ports::{Pins, Role};
 use lut_gen::Schedule;
 
 mod analyser;
-use analyser::{
-    check, lanes, mutate, resample, resample_lanes, run_with_miso, to_sigrok, Mutation,
-};
+use analyser::{capture, check, lanes, mutate, resample_lanes, run_with_miso, Mutation};
 
 #[path = "../../../tests/common/tools.rs"]
 mod tools;
@@ -39,24 +37,18 @@ fn evidence(mix: &str, frames: u64, window: (u64, u64), rates: &[(u64, u64)]) {
     let d = tempfile::tempdir().unwrap();
     for &(ts, phase) in rates {
         let v = d.path().join(format!("clean{ts}.vcd"));
-        resample(&s, &clean, window.0, window.1, ts, phase, &v);
-        let (sr, back) = to_sigrok(&v, ts);
+        let (sr, back) = capture(&s, &clean, window, (ts, phase), &v);
         for f in [&sr, &back] {
             let r = check(&s, &map, f);
             assert!(r.ok, "{} at {ts} ps: {}", f.display(), r.summary());
             assert!(r.edges_checked > 50, "{}", r.summary());
         }
         let mid = (window.0 + window.1) / 2;
-        for (m, want) in [
-            (Mutation::OneSlotLate, "conversion instant"),
-            (Mutation::MuxEarly, "mux switching"),
-            (Mutation::SclkEdgeMissing, "serial clock"),
-        ] {
+        for (m, want) in Mutation::PINS {
             let mut bad = clean.clone();
             mutate(&s, &mut bad, m, mid);
             let v = d.path().join(format!("bad{ts}.vcd"));
-            resample(&s, &bad, window.0, window.1, ts, phase, &v);
-            let (sr, _) = to_sigrok(&v, ts);
+            let (sr, _) = capture(&s, &bad, window, (ts, phase), &v);
             let r = check(&s, &map, &sr);
             assert!(!r.ok, "{m:?} at {ts} ps passed: {}", r.summary());
             assert!(
@@ -103,8 +95,7 @@ fn a_subset_of_pins_names_what_it_cannot_check() {
     let clean = run(&s, &mut ModelDut::new(&s), 3);
     let d = tempfile::tempdir().unwrap();
     let v = d.path().join("all.vcd");
-    resample(&s, &clean, 4_100, 11_000, 10_000, 1_234, &v);
-    let (sr, _) = to_sigrok(&v, 10_000);
+    let (sr, _) = capture(&s, &clean, (4_100, 11_000), (10_000, 1_234), &v);
     // D0 = adc_cs_n[0], D2 = adc_sclk[0] in `lanes`' order.
     let r = check(&s, "D0=adc_cs_n[0],D2=adc_sclk[0]", &sr);
     assert!(r.ok, "{}", r.summary());
@@ -149,8 +140,7 @@ fn every_fault_class_is_reported_and_a_fault_before_lock_fails_the_design() {
     mutate(&s, &mut bad, Mutation::MuxEarly, 8_500);
     mutate(&s, &mut bad, Mutation::SclkEdgeMissing, 10_500);
     let v = d.path().join("three.vcd");
-    resample(&s, &bad, from, to, ts, 3_717, &v);
-    let (sr, _) = to_sigrok(&v, ts);
+    let (sr, _) = capture(&s, &bad, (from, to), (ts, 3_717), &v);
     let r = check(&s, &map, &sr);
     let text = r.summary();
     assert!(!r.ok, "{text}");
@@ -168,8 +158,7 @@ fn every_fault_class_is_reported_and_a_fault_before_lock_fails_the_design() {
     let mut early = clean.clone();
     mutate(&s, &mut early, Mutation::SclkEdgeMissing, from + 1);
     let v = d.path().join("early.vcd");
-    resample(&s, &early, from, to, ts, 3_717, &v);
-    let (sr, _) = to_sigrok(&v, ts);
+    let (sr, _) = capture(&s, &early, (from, to), (ts, 3_717), &v);
     let lanes = judge::capture::parse_map("D0=adc_cs_n[0],D2=adc_sclk[0]", &s).unwrap();
     let cap = judge::capture::read(&sr, lanes).unwrap();
     let r = check_capture(&s, &cap, 0).expect("a design failure, not an input problem");
@@ -200,8 +189,7 @@ fn the_link_line_in_a_capture_is_decoded_and_checked() {
     let d = tempfile::tempdir().unwrap();
     let window = (f / 3 + 1_234, f + f / 2);
     let v = d.path().join("uart.vcd");
-    resample(&s, &clean, window.0, window.1, 41_667, 9_876, &v);
-    let (sr, back) = to_sigrok(&v, 41_667);
+    let (sr, back) = capture(&s, &clean, window, (41_667, 9_876), &v);
     for file in [&sr, &back] {
         let r = check(&s, &map, file);
         let text = r.summary();
@@ -218,8 +206,7 @@ fn the_link_line_in_a_capture_is_decoded_and_checked() {
     let mut bad = clean.clone();
     mutate(&s, &mut bad, Mutation::LinkBitsFlipped, f);
     let v = d.path().join("uart-bad.vcd");
-    resample(&s, &bad, window.0, window.1, 41_667, 9_876, &v);
-    let (sr, _) = to_sigrok(&v, 41_667);
+    let (sr, _) = capture(&s, &bad, window, (41_667, 9_876), &v);
     let r = check(&s, &map, &sr);
     let text = r.summary();
     assert!(!r.ok, "{text}");
@@ -276,8 +263,7 @@ fn the_lock_takes_the_first_conversion_start_on_any_lane() {
     let (from, to, ts, phase) = (f1 - 20, 2 * f + f / 2, 10_000u64, 3_717u64);
     let tc = 1_000_000_000_000 / s.mix.clock_hz;
     let v = d.path().join("late.vcd");
-    resample(&s, &clean, from as u64, to as u64, ts, phase, &v);
-    let (sr, _) = to_sigrok(&v, ts);
+    let (sr, _) = capture(&s, &clean, (from as u64, to as u64), (ts, phase), &v);
     let r = check(&s, &map, &sr);
     assert!(r.ok, "{}", r.summary());
     let first_at = (f1 - from) as u64 * tc;
@@ -306,8 +292,7 @@ fn the_lock_takes_the_first_conversion_start_on_any_lane() {
         c += 1;
     }
     let v = d.path().join("late-bad.vcd");
-    resample(&s, &bad, from as u64, to as u64, ts, phase, &v);
-    let (sr, _) = to_sigrok(&v, ts);
+    let (sr, _) = capture(&s, &bad, (from as u64, to as u64), (ts, phase), &v);
     let r = check(&s, &map, &sr);
     let text = r.summary();
     assert!(!r.ok, "{text}");
@@ -350,7 +335,7 @@ fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
     }
     let window = ((f / 2 + 123) as u64, (2 * f + f / 2) as u64);
     let (ts, phase) = (10_000, 4_321);
-    let capture = |pins: &[Pins], miso: &[u64], name: &str| {
+    let judged = |pins: &[Pins], miso: &[u64], name: &str| {
         let level = |c: usize, r: Option<Role>, b: u32| match r {
             Some(Role::Miso) => miso[c] >> b & 1 == 1,
             _ => analyser::bit(&pins[c], r, b),
@@ -365,7 +350,7 @@ fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
         std::fs::write(&v, text).unwrap();
         check(&s, &map, &v)
     };
-    let r = capture(&pins, &miso, "clean.vcd");
+    let r = judged(&pins, &miso, "clean.vcd");
     let text = r.summary();
     assert!(r.ok, "{text}");
     assert!(text.contains("characters' start bits within"), "{text}");
@@ -384,7 +369,7 @@ fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
             pins[c - 2 * div].link_tx
         };
     }
-    let r = capture(&late, &miso, "late.vcd");
+    let r = judged(&late, &miso, "late.vcd");
     let text = r.summary();
     assert!(!r.ok, "{text}");
     assert!(
@@ -400,7 +385,7 @@ fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
     for m in &mut bad[f..f + s.grid.slot_cycles as usize] {
         *m ^= 1;
     }
-    let r = capture(&pins, &bad, "miso.vcd");
+    let r = judged(&pins, &bad, "miso.vcd");
     let text = r.summary();
     assert!(!r.ok, "{text}");
     assert!(

@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use judge::faults::{Fault, FaultyDut};
-use judge::run::{run_dut, Dut, ModelDut, RunOptions};
-use judge::vcdout::VcdWriter;
+use judge::run::{Dut, ModelDut, RunOptions};
+use judge::vcdout::write_run;
 use judge::{CheckOptions, LockError, VcdError};
 
 fn tiny() -> lut_gen::Schedule {
@@ -16,9 +16,7 @@ fn tiny() -> lut_gen::Schedule {
 /// A VCD of cycles `[from, to)` (counted from the first reset cycle) of a run.
 fn window<D: Dut>(s: &lut_gen::Schedule, dut: &mut D, from: u64, to: u64, path: &Path) {
     let frames = to / s.grid.frame_cycles + 1;
-    let mut w = VcdWriter::create(path, s, from, to).unwrap();
-    run_dut(s, dut, frames, &RunOptions::default(), "gen", Some(&mut w));
-    w.finish().unwrap();
+    write_run(path, s, dut, frames, &RunOptions::default(), (from, to)).unwrap();
 }
 
 fn check(

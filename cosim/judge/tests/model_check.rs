@@ -1,6 +1,28 @@
 use judge::run::{run_dut, run_model, ModelDut, RunOptions};
 use std::path::Path;
 
+/// Every fault of `s` injected into the model at cycle `at` for two
+/// frames: `judge` sees each one that changed something (a fault with
+/// nothing to change there, e.g. no idle slot to move a conversion into,
+/// was not injected); returns how many did.
+fn each_injected_fault(
+    s: &lut_gen::Schedule,
+    at: u64,
+    judge: impl Fn(&judge::faults::Fault, &judge::Report),
+) -> usize {
+    use judge::faults::{Fault, FaultyDut};
+    let mut injected = 0;
+    for f in Fault::all(s) {
+        let mut dut = FaultyDut::new(s, ModelDut::new(s), f, at);
+        let r = run_dut(s, &mut dut, 2, &RunOptions::default(), "faulty", None);
+        if dut.injected() {
+            injected += 1;
+            judge(&f, &r);
+        }
+    }
+    injected
+}
+
 fn eskin() -> lut_gen::Schedule {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../mixes/eskin34.toml");
     lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap()
@@ -31,19 +53,9 @@ fn slot_model_passes() {
 
 #[test]
 fn every_fault_is_caught() {
-    use judge::faults::{Fault, FaultyDut};
     let s = eskin();
     let at = s.grid.frame_cycles / 2 + 7;
-    let mut injected = 0;
-    for f in Fault::all(&s) {
-        let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
-        let r = run_dut(&s, &mut dut, 2, &RunOptions::default(), "faulty", None);
-        // a fault that found nothing to change here (e.g. no idle slot to
-        // move a conversion into on a busy branch) was not injected
-        if !dut.injected() {
-            continue;
-        }
-        injected += 1;
+    let injected = each_injected_fault(&s, at, |f, r| {
         assert!(!r.ok, "fault {} not caught", f.name());
         assert!(r.divergence_count > 0, "fault {}: no divergence", f.name());
         assert!(
@@ -69,9 +81,10 @@ fn every_fault_is_caught() {
             d.channel,
             r.violations[0].rule
         );
-    }
+    });
     // every class but the slot-moving ones lands on every branch
-    assert!(injected + 3 >= Fault::all(&s).len(), "{injected}");
+    let all = judge::faults::Fault::all(&s).len();
+    assert!(injected + 3 >= all, "{injected} of {all}");
 }
 
 /// Drives the checker by hand: `reset` reset cycles, then `cycles` cycles of the model's pins.
@@ -264,24 +277,13 @@ fn ad7685_chain_model_passes_the_checker() {
 
 #[test]
 fn ad7685_chain_faults_are_caught() {
-    use judge::faults::{Fault, FaultyDut};
     let s = preset("mixes/vibrotactile8k");
     let at = s.grid.frame_cycles / 2 + 7;
-    let mut injected = 0;
-    for f in Fault::all(&s) {
-        let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
-        let r = run_dut(&s, &mut dut, 2, &RunOptions::default(), "faulty", None);
-        // a fault that found nothing to change (every slot of the chain's
-        // branch converts, so no idle slot to move a conversion into) was
-        // not injected
-        if !dut.injected() {
-            continue;
-        }
-        injected += 1;
-        // (The mux lanes of a `mux = "none"` branch connect to nothing:
-        // a fault there shows as a divergence from the model only.)
+    // (The mux lanes of a `mux = "none"` branch connect to nothing: a
+    // fault there shows as a divergence from the model only.)
+    let injected = each_injected_fault(&s, at, |f, r| {
         assert!(!r.ok, "fault {} not caught", f.name());
-    }
+    });
     assert!(injected >= 10, "only {injected} faults injected");
 }
 

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use judge::faults::{Fault, FaultyDut};
-use judge::run::{run_dut, Dut, ModelDut, RunOptions};
-use judge::vcdout::VcdWriter;
+use judge::run::{Dut, ModelDut, RunOptions};
+use judge::vcdout::write_run;
 use judge::VcdError;
 
 fn tiny() -> lut_gen::Schedule {
@@ -13,11 +13,7 @@ fn tiny() -> lut_gen::Schedule {
 }
 
 fn write_vcd<D: Dut>(s: &lut_gen::Schedule, dut: &mut D, frames: u64, path: &Path) {
-    let opts = RunOptions::default();
-    let mut w = VcdWriter::create(path, s, 0, u64::MAX).unwrap();
-    let r = run_dut(s, dut, frames, &opts, "gen", Some(&mut w));
-    w.finish().unwrap();
-    let _ = r;
+    write_run(path, s, dut, frames, &RunOptions::default(), (0, u64::MAX)).unwrap();
 }
 
 fn good_vcd(dir: &Path) -> (lut_gen::Schedule, PathBuf) {

@@ -95,14 +95,7 @@ pub fn prove(s: &Schedule, design: &str) -> (ProveVerdict, f64) {
 pub fn prove_unavailable() -> Option<String> {
     ["yosys", "yosys-abc", "iverilog", "vvp"]
         .into_iter()
-        .find(|t| {
-            std::process::Command::new(t)
-                .arg("-V")
-                .stdout(std::process::Stdio::null())
-                .stderr(std::process::Stdio::null())
-                .status()
-                .is_err()
-        })
+        .find(|t| !judge::tools::present(t))
         .map(|t| format!("{t} is not installed (make tools)"))
 }
 

@@ -107,7 +107,7 @@ pub fn with_remembered_proof(
 /// The simulator of the co-simulation and the charts: Verilator when it is
 /// installed (the emitted Verilog), else rust-hdl.
 fn sim_backend() -> Backend {
-    if measure::synth::tool_present("verilator") {
+    if judge::tools::present("verilator") {
         Backend::Verilator
     } else {
         Backend::RustHdl
@@ -119,7 +119,7 @@ fn sim_backend() -> Backend {
 type Background = std::thread::JoinHandle<(Result<measure::synth::Synth, String>, f64)>;
 
 fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
-    if !measure::synth::tool_present("yosys") || !measure::synth::tool_present("nextpnr-ice40") {
+    if !judge::tools::present("yosys") || !judge::tools::present("nextpnr-ice40") {
         return None;
     }
     let dir = out.join("synth");
@@ -391,7 +391,7 @@ fn fault_plan(a: &Args, s: &Schedule) -> Result<cosim::faults::Plan, String> {
             ("iverilog", Backend::Icarus),
         ]
         .into_iter()
-        .filter(|(tool, _)| measure::synth::tool_present(tool))
+        .filter(|(tool, _)| judge::tools::present(tool))
         .map(|(_, b)| b)
         .collect();
         plan.verilog_faults = cosim::faults::deep_faults(s, plan.frames)?;
@@ -465,7 +465,7 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<cosim::faults::
 fn prove(j: &mut Job, s: &Schedule) -> Done {
     if let Some(t) = ["yosys", "yosys-abc", "iverilog"]
         .into_iter()
-        .find(|t| !measure::synth::tool_present(t))
+        .find(|t| !judge::tools::present(t))
     {
         return Done::skipped(format!("{t} not installed (make tools)"));
     }

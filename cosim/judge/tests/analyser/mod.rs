@@ -10,6 +10,7 @@ use std::process::Command;
 
 use judge::run::{run_dut, Dut, Observer, RunOptions};
 use judge::timed::{check_capture, TimedReport};
+use judge::vcdout::{id_code, wire_header};
 use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
 
@@ -119,11 +120,9 @@ pub fn resample_lanes(
     out: &Path,
 ) {
     let tc = 1e12 / s.mix.clock_hz as f64;
-    let mut text = String::from("$timescale 1 ps $end\n$scope module libsigrok $end\n");
-    for (i, _) in lanes.iter().enumerate() {
-        text += &format!("$var wire 1 {} D{i} $end\n", code(i));
-    }
-    text += "$upscope $end\n$enddefinitions $end\n";
+    let names: Vec<String> = (0..lanes.len()).map(|i| format!("D{i}")).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut text = wire_header("1 ps", "libsigrok", &names);
     let start = from as f64 * tc + phase_ps as f64;
     let mut prev: Option<Vec<bool>> = None;
     let mut n = 0u64;
@@ -141,7 +140,7 @@ pub fn resample_lanes(
             text += &format!("#{}\n", n * ts_ps);
             for (i, x) in v.iter().enumerate() {
                 if prev.as_ref().map(|p| p[i]) != Some(*x) {
-                    text += &format!("{}{}\n", *x as u8, code(i));
+                    text += &format!("{}{}\n", *x as u8, id_code(i));
                 }
             }
             prev = Some(v);
@@ -152,50 +151,51 @@ pub fn resample_lanes(
     std::fs::write(out, text).unwrap();
 }
 
-pub fn code(i: usize) -> String {
-    let mut s = String::new();
-    let mut n = i;
-    loop {
-        s.push((b'!' + (n % 94) as u8) as char);
-        n /= 94;
-        if n == 0 {
-            return s;
-        }
-    }
+/// What an analyser at `ts_ps` (its first sample `phase_ps` into cycle
+/// `window.0`) records of cycles `window` of `pins`: [`resample`] into
+/// `vcd`, then [`to_sigrok`]'s `.sr` and sigrok-cli's VCD of it.
+pub fn capture(
+    s: &Schedule,
+    pins: &[Pins],
+    window: (u64, u64),
+    (ts_ps, phase_ps): (u64, u64),
+    vcd: &Path,
+) -> (PathBuf, PathBuf) {
+    resample(s, pins, window.0, window.1, ts_ps, phase_ps, vcd);
+    to_sigrok(vcd, ts_ps)
 }
 
 /// The capture as `.sr` (sigrok-cli from the 1 ps VCD, downsampled to the
 /// analyser's rate) and as sigrok-cli's VCD of that session.
 pub fn to_sigrok(vcd: &Path, ts_ps: u64) -> (PathBuf, PathBuf) {
     let sr = vcd.with_extension("sr");
-    let st = Command::new("sigrok-cli")
-        .arg("-i")
-        .arg(vcd)
-        .arg("-I")
-        .arg(format!("vcd:downsample={ts_ps}"))
-        .arg("-o")
-        .arg(&sr)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
+    let downsample = format!("vcd:downsample={ts_ps}");
+    sigrok_cli(
+        Command::new("sigrok-cli")
+            .arg("-i")
+            .arg(vcd)
+            .args(["-I", &downsample, "-o"])
+            .arg(&sr),
     );
     let back = vcd.with_extension("sigrok.vcd");
-    let st = Command::new("sigrok-cli")
-        .arg("-i")
-        .arg(&sr)
-        .args(["-O", "vcd", "-o"])
-        .arg(&back)
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
+    sigrok_cli(
+        Command::new("sigrok-cli")
+            .arg("-i")
+            .arg(&sr)
+            .args(["-O", "vcd", "-o"])
+            .arg(&back),
     );
     (sr, back)
+}
+
+/// Runs a sigrok-cli command to completion; a failure shows its stderr.
+fn sigrok_cli(cmd: &mut Command) {
+    let out = cmd.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 pub fn check(s: &Schedule, map: &str, file: &Path) -> TimedReport {
@@ -216,6 +216,16 @@ pub enum Mutation {
     SclkEdgeMissing,
     /// Three bits of one character on the link's line inverted.
     LinkBitsFlipped,
+}
+
+impl Mutation {
+    /// The faults on a branch's SPI and mux pins, each with the rule a
+    /// capture of it must break.
+    pub const PINS: [(Mutation, &'static str); 3] = [
+        (Mutation::OneSlotLate, "conversion instant"),
+        (Mutation::MuxEarly, "mux switching"),
+        (Mutation::SclkEdgeMissing, "serial clock"),
+    ];
 }
 
 pub fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {

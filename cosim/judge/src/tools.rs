@@ -1,6 +1,10 @@
 //! The one runner of the external checking tools (yosys, yosys-abc,
 //! sigrok-cli): spawn with a time limit, tell "not installed" apart from "ran
-//! and failed", keep the output for the report.
+//! and failed", keep the output for the report; and [`present`], the one
+//! test of whether a tool is installed (the build's steps, `prove`'s
+//! engines and the tests' tool policy, `tests/common/tools.rs`, ask it).
+//! It lives in the judge, the lowest crate that runs a tool (sigrok-cli for
+//! `.sr` captures), so every crate above and every test binary can reach it.
 
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -35,7 +39,8 @@ impl std::fmt::Display for ToolError {
     }
 }
 
-/// Whether `tool` can be spawned.
+/// Whether `tool` can be spawned (installed and on PATH); its answer to
+/// `--version` does not matter.
 pub fn present(tool: &str) -> bool {
     Command::new(tool)
         .arg("--version")

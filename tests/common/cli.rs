@@ -1,0 +1,47 @@
+//! What the root crate's CLI tests share: the binary, the repository, the
+//! small two-branch mix, and a `sim --vcd` window of it.
+
+use std::path::{Path, PathBuf};
+
+use assert_cmd::Command;
+
+/// The `slotforge` binary under test.
+pub fn slotforge() -> Command {
+    Command::cargo_bin("slotforge").unwrap()
+}
+
+/// The repository's root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A two-branch mix with a 4000-cycle frame (fast in every simulator).
+pub fn tiny() -> PathBuf {
+    root().join("cosim/tests/data/tiny.toml")
+}
+
+/// `golden --update` of the tiny mix (rusthdl) into `dir`: a golden that
+/// a later `golden` or `build` of it checks against.
+pub fn record_golden(dir: &Path) {
+    slotforge()
+        .args(["golden", "--backend", "rusthdl", "--update", "--dir"])
+        .arg(dir)
+        .arg(tiny())
+        .assert()
+        .success();
+}
+
+/// `dir/name`: `sim --vcd` of 3 frames of the tiny mix on the rusthdl back
+/// end over `[from, to)` (SPEC's bounds).
+pub fn sim_window(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
+    let wave = dir.join(name);
+    slotforge()
+        .arg("sim")
+        .arg(tiny())
+        .args(["--backend", "rusthdl", "--frames", "3"])
+        .args(["--from", from, "--to", to, "--vcd"])
+        .arg(&wave)
+        .assert()
+        .code(0);
+    wave
+}
