@@ -257,7 +257,9 @@ fn bmc_on_miter(
     let aag = std::fs::read_to_string(p.dir.join("design.aag"))
         .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
     let g = crate::aiger::parse(&aag).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
-    let shared = miso_inputs(p)?
+    // the outside world (MISO, an AXI4-Stream slave's choices) is one for
+    // both copies; their power-on values (unnamed -zinit inputs) are not
+    let shared = named_inputs(p, None)?
         .iter()
         .map(|&(idx, _)| idx)
         .collect::<Vec<_>>();
@@ -307,14 +309,15 @@ pub fn combined(
     )
 }
 
-/// `(input index, bit)` of every `adc_miso` bit in the AIG (yosys's map).
-fn miso_inputs(p: &Prepared) -> Result<Vec<(usize, usize)>, ProveError> {
+/// `(input index, bit)` of every bit of the input `name` (every named
+/// input with None) in the AIG (yosys's map).
+fn named_inputs(p: &Prepared, name: Option<&str>) -> Result<Vec<(usize, usize)>, ProveError> {
     let aim = std::fs::read_to_string(p.dir.join("design.aim"))
         .map_err(|e| ProveError::Tool(format!("design.aim: {e}")))?;
     let mut v = Vec::new();
     for line in aim.lines() {
         let f: Vec<&str> = line.split_whitespace().collect();
-        if f.len() == 4 && f[0] == "input" && f[3] == "adc_miso" {
+        if f.len() == 4 && f[0] == "input" && name.is_none_or(|n| f[3] == n) {
             if let (Ok(idx), Ok(bit)) = (f[1].parse(), f[2].parse()) {
                 v.push((idx, bit));
             }
@@ -356,7 +359,7 @@ pub fn smt_induction(p: &Prepared, k: u64, secs: u64) -> Result<Option<Verdict>,
 /// The MISO values of a counterexample, per step, from ABC's AIGER witness
 /// and the yosys map (`input <index> <bit> <name>`).
 pub fn witness_miso(p: &Prepared, branches: usize) -> Result<Vec<u64>, ProveError> {
-    let miso_inputs: Vec<(usize, usize)> = miso_inputs(p)?
+    let miso_inputs: Vec<(usize, usize)> = named_inputs(p, Some("adc_miso"))?
         .into_iter()
         .filter(|&(_, bit)| bit < branches)
         .collect();
