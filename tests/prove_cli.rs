@@ -2,7 +2,6 @@
 //! 2 bad input, 3 bounded only; `result`, `depth`, `properties`, `seconds`,
 //! `counterexample`, `cycle`).  On the tiny mix (a 4,000-cycle frame).
 
-
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.

@@ -347,6 +347,7 @@ pub fn run(
     let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
     let mut prev_state: Vec<u32> = Vec::new();
     let mut gc_at = 1usize << 20;
+    let mut sat_seen = 0;
     for step in 0..max_steps {
         if step >= offset && (step - offset).is_multiple_of(period) {
             let now = canonical_state(&gr, &state, step);
@@ -360,9 +361,14 @@ pub fn run(
             seen.insert(now, step);
             prev_state.clone_from(&state);
         }
-        if step.is_multiple_of(4096) && deadline.is_some_and(|d| Instant::now() > d) {
+        // every 256 steps, and after every SAT call (a free slave can make
+        // each step's assertion a SAT problem)
+        if (step.is_multiple_of(256) || stats.sat_calls > sat_seen)
+            && deadline.is_some_and(|d| Instant::now() > d)
+        {
             return (Found::Bounded { steps: step }, stats);
         }
+        sat_seen = stats.sat_calls;
         let st = step as u32;
         for (k, &i) in g.inputs.iter().enumerate() {
             val[(i >> 1) as usize] = gr.var(k as u32, st);
