@@ -87,15 +87,16 @@ fn testbench_log(
     (mix, s, text, cycles)
 }
 
-/// The judge checks every sample: one of a channel id the mix does not
-/// have, or one more than a channel's conversions, fails (on a real log of
-/// the small two-branch mix).
+/// The small two-branch mix passes the testbench with a one-cycle reset (no
+/// conversion samples an unsettled mux), and the judge checks every sample:
+/// one of a channel id the mix does not have, or one more than a channel's
+/// conversions, fails.
 #[test]
 fn the_testbench_judge_rejects_unknown_and_extra_samples() {
     if !icarus() {
         return;
     }
-    let (mix, s, text, cycles) = testbench_log(&tiny(), 25, 4);
+    let (mix, s, text, cycles) = testbench_log(&tiny(), 25, 1);
     judge::judge(&mix, &s, &text, cycles).unwrap();
     let last = text
         .lines()
@@ -120,7 +121,11 @@ fn icarus_reference_mix_matches_the_schedule() {
 /// eskin34 settles its muxes for 2 us (96 cycles at 48 MHz) and samples all
 /// three branches in the first slot: a reset of 1 cycle (6 above) must not
 /// make any conversion sample an unsettled mux (the judge's settle check).
+/// 1.1 frames in Icarus take two minutes, so it is long: `prove` asserts the
+/// same with a one-cycle reset for all time, and proves eskin34 in the long
+/// suite too; the default suite keeps Icarus in the golden and mutant tests.
 #[test]
+#[ignore = "long: make test-long"]
 fn icarus_one_cycle_reset_samples_no_unsettled_mux() {
     run_testbench(&root().join("mixes/eskin34.toml"), 11, 1);
 }

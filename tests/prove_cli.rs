@@ -8,6 +8,33 @@ use predicates::prelude::*;
 use crate::common_cli::{slotforge, tiny};
 use crate::tools;
 
+/// `slotforge prove ARGS --json EXTRA -o OUT`: its JSON, after checking the
+/// exit code (stdout and stderr shown when it differs).
+fn prove_json(
+    args: &[&str],
+    extra: &[&str],
+    out: &std::path::Path,
+    code: i32,
+) -> serde_json::Value {
+    let o = slotforge()
+        .arg("prove")
+        .args(args)
+        .arg("--json")
+        .args(extra)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(code),
+        "{text}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    serde_json::from_str(&text).unwrap()
+}
+
 #[test]
 fn solvers_that_fail_on_our_netlists_are_refused_with_the_reason() {
     slotforge()
@@ -44,20 +71,12 @@ fn an_axi_stream_mix_is_in_the_harness_and_a_cut_search_is_bounded() {
         + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 8\n";
     std::fs::write(&mix, text).unwrap();
     let harness = dir.path().join("harness.v");
-    let out = slotforge()
-        .args(["prove", mix.to_str().unwrap(), "--json", "--timeout", "1"])
-        .args(["--harness", harness.to_str().unwrap(), "-o"])
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(
-        out.status.code(),
-        Some(3),
-        "{text}\n{}",
-        String::from_utf8_lossy(&out.stderr)
+    let v = prove_json(
+        &[mix.to_str().unwrap(), "--timeout", "1"],
+        &["--harness", harness.to_str().unwrap()],
+        dir.path(),
+        3,
     );
-    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
     assert_eq!(v["result"], "bounded");
     let names: Vec<&str> = v["properties"]
         .as_array()
@@ -95,19 +114,7 @@ fn proved_json_has_specs_keys_and_exit_0() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let out = slotforge()
-        .args(["prove", tiny().to_str().unwrap(), "--json", "-o"])
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{text}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let v = prove_json(&[tiny().to_str().unwrap()], &[], dir.path(), 0);
     assert_eq!(v["result"], "proved");
     assert_eq!(v["depth"], 2 * 4000 + 2);
     assert!(v["seconds"].as_f64().unwrap() > 0.0);
