@@ -100,7 +100,7 @@ synth: tools
 
 bench:
 	$(CARGO) bench -p judge --bench check_vs_wellen
-	$(CARGO) bench -p lut-gen --bench synthesis
+	$(CARGO) bench -p lut-gen --features bench --bench synthesis
 	$(CARGO) bench -p cosim --bench cosim
 	$(CARGO) bench -p formal --bench engines
 

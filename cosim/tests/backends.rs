@@ -90,12 +90,23 @@ fn largest_mixes_one_frame() {
 /// three engines that run the gateware.
 ///
 /// The default suite runs `cnvmix2ms` (the same branches and channels in a
-/// 2 ms frame: Icarus takes seconds, not minutes); `make test-long` runs
-/// cnvmix's 10 ms frame too.
+/// 2 ms frame) on rust-hdl and Verilator; `make test-long` adds Icarus
+/// (most of the time: other tests keep Icarus in the default suite) and
+/// cnvmix's 10 ms frame.
 #[test]
+fn cnv_chain_and_cs_parts_on_rusthdl_and_verilator() {
+    cnv_chain_and_cs_parts(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cnvmix2ms.toml"),
+        false,
+    );
+}
+
+#[test]
+#[ignore = "long: make test-long"]
 fn cnv_chain_and_cs_parts_on_every_engine() {
     cnv_chain_and_cs_parts(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cnvmix2ms.toml"),
+        true,
     );
 }
 
@@ -104,17 +115,18 @@ fn cnv_chain_and_cs_parts_on_every_engine() {
 fn cnv_chain_and_cs_parts_on_every_engine_10ms_frame() {
     cnv_chain_and_cs_parts(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join("../hdl/tests/data/cnvmix.toml"),
+        true,
     );
 }
 
-fn cnv_chain_and_cs_parts(p: &Path) {
+fn cnv_chain_and_cs_parts(p: &Path, icarus: bool) {
     let s = schedule(p);
     assert_eq!(s.mix.branches[0].chain, 2);
     let mut backends = vec![Backend::RustHdl];
     if tools::require_tools(&["verilator", "g++"]) {
         backends.push(Backend::Verilator);
     }
-    if tools::require_tool("iverilog") {
+    if icarus && tools::require_tool("iverilog") {
         backends.push(Backend::Icarus);
     }
     let opts = SimOptions {

@@ -89,7 +89,9 @@ fn synth_in(dir: &Path, tag: &str) {
     assert!(text.contains("SB_LUT4"), "no logic synthesized for {tag}");
 }
 
+/// Long: eskin34's core is in the link tests' designs below.
 #[test]
+#[ignore = "long: make test-long"]
 fn gates_eskin34() {
     gates(&eskin34(), "eskin34");
 }
@@ -99,7 +101,9 @@ fn gates_tiny() {
     gates(&tiny(), "tiny");
 }
 
+/// Long: eight branches; the branch-count mixes go wider.
 #[test]
+#[ignore = "long: make test-long"]
 fn gates_wide8() {
     gates(&wide(), "wide8");
 }

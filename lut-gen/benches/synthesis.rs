@@ -1,6 +1,6 @@
 //! Synthesis + audit of large mixes: 100 channels per branch at harmonic
 //! rates (40 x 100 Hz, 40 x 500 Hz, 20 x 1 kHz), from 10 to 100 branches
-//! (1k to 10k channels).  `cargo bench -p lut-gen --bench synthesis`.
+//! (1k to 10k channels).  `cargo bench -p lut-gen --features bench --bench synthesis`.
 //!
 //! `presets`: `synthesize` alone on every preset in `mixes/`, the
 //! 1 024-channel mix, and the mix the exact search used to miss (its time is
