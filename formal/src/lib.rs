@@ -358,16 +358,28 @@ fn symbolic(
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
     let (found, st) = symsim::run(&g, f, 2, limit, Some(deadline));
     Ok(match found {
-        symsim::Found::Proved { steps, since } => (
+        symsim::Found::Proved {
+            steps,
+            since,
+            abstracted,
+        } => (
             Outcome::Proved,
             steps,
             format!(
-                "proved for all time: every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} latches, {} gates; {} assertions needed a SAT call), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
+                "proved for all time: every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} latches, {} gates; {} assertion checks went to a SAT solver), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation){}",
                 g.latches.len(),
                 g.ands.len(),
                 st.sat_calls,
                 (steps - since) / f,
-                st.state_nodes
+                st.state_nodes,
+                if abstracted.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; the registers the design keeps across frames ({}) were given every value at each frame start, which only adds behaviours",
+                        latch_names(prep, &abstracted)
+                    )
+                }
             ),
         ),
         symsim::Found::Violated { step, inputs } => {

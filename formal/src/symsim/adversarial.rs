@@ -1,4 +1,3 @@
-
 use super::*;
 use crate::aiger::parse;
 use std::collections::BTreeSet;
@@ -227,11 +226,15 @@ impl<'a> Concrete<'a> {
 /// Runs the engine and checks its verdict against the truth and its
 /// witness on the concrete simulator; returns the verdict.
 fn judged(g: &Aig, period: u64, offset: u64, max_steps: u64) -> Found {
-    let (f, _) = run(g, period, offset, max_steps, None);
+    judged_with_stats(g, period, offset, max_steps).0
+}
+
+fn judged_with_stats(g: &Aig, period: u64, offset: u64, max_steps: u64) -> (Found, Stats) {
+    let (f, st) = run(g, period, offset, max_steps, None);
     let c = Concrete::new(g);
     let truth = c.first_bad();
     match &f {
-        Found::Proved { steps, since } => {
+        Found::Proved { steps, since, .. } => {
             assert_eq!(truth, None, "PROVED but a bad state is reachable");
             assert!(since >= &offset && (steps - since) % period == 0 && steps > since);
         }
@@ -251,7 +254,7 @@ fn judged(g: &Aig, period: u64, offset: u64, max_steps: u64) -> Found {
             );
         }
     }
-    f
+    (f, st)
 }
 
 #[test]
@@ -300,7 +303,8 @@ fn a_counter_that_wraps_at_five_proves_and_one_that_wraps_at_six_fails() {
                 f,
                 Found::Proved {
                     steps: 22,
-                    since: 2
+                    since: 2,
+                    abstracted: vec![],
                 }
             );
         }
@@ -341,7 +345,14 @@ fn captured(at: u64, bad_when_held_and_count: bool) -> Aig {
 fn state_held_in_a_step_zero_input_proves_and_its_violation_is_found() {
     // held x0 is named by its step at every boundary: recurrence
     let f = judged(&captured(0, false), 4, 2, 200);
-    assert_eq!(f, Found::Proved { steps: 6, since: 2 });
+    assert_eq!(
+        f,
+        Found::Proved {
+            steps: 6,
+            since: 2,
+            abstracted: vec![],
+        }
+    );
     let f = judged(&captured(0, true), 4, 2, 200);
     let Found::Violated { step: 3, inputs } = f else {
         panic!("{f:?}")
@@ -446,7 +457,8 @@ fn a_violation_at_a_boundary_step_where_the_state_is_new() {
         judged(&b.aig(), 4, 2, 100),
         Found::Proved {
             steps: 14,
-            since: 10
+            since: 10,
+            abstracted: vec![],
         }
     );
 }
@@ -546,6 +558,7 @@ fn a_state_kept_across_a_collection_proves_and_fails_where_it_should() {
             let proved = Found::Proved {
                 steps: 2 + (1 << 18),
                 since: 2,
+                abstracted: vec![],
             };
             assert!(f == proved, "not proved at 2 + 2^18");
         }
@@ -606,19 +619,23 @@ fn random_design(rng: &mut Rng, free: bool) -> Aig {
 #[test]
 fn random_designs_agree_with_an_explicit_state_search() {
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
-    let mut tally = [0usize; 3];
+    // proved exactly, proved with latches cut, violated, bounded, and
+    // runs whose cut gave a violation the exact machine does not have
+    let mut tally = [0usize; 5];
     for _ in 0..4000 {
         let g = random_design(&mut rng, false);
         let (period, offset) = (1 + rng.below(4), rng.below(4));
-        let f = judged(&g, period, offset, 40);
+        let (f, st) = judged_with_stats(&g, period, offset, 40);
         tally[match f {
-            Found::Proved { .. } => 0,
-            Found::Violated { .. } => 1,
-            Found::Bounded { .. } => 2,
+            Found::Proved { abstracted, .. } if abstracted.is_empty() => 0,
+            Found::Proved { .. } => 1,
+            Found::Violated { .. } => 2,
+            Found::Bounded { .. } => 3,
         }] += 1;
+        tally[4] += usize::from(st.spurious.is_some());
     }
     // the check is only as good as the mix of verdicts it saw
-    assert!(tally.iter().all(|&n| n > 100), "{tally:?}");
+    assert!(tally.iter().all(|&n| n > 10), "{tally:?}");
 }
 
 #[test]

@@ -34,7 +34,10 @@ use std::time::Instant;
 
 use crate::aiger::Aig;
 
+pub mod cone;
+pub mod explicit;
 mod graph;
+pub mod induction;
 use graph::Graph;
 #[cfg(test)]
 use graph::VAR;
@@ -44,8 +47,13 @@ use graph::VAR;
 pub enum Found {
     /// No assertion fails in steps `0..steps`, and the state at step
     /// `steps` is (up to renaming) the state at step `since`, a whole
-    /// number of periods earlier.
-    Proved { steps: u64, since: u64 },
+    /// number of periods earlier.  `abstracted` lists the latches given a
+    /// free value at every period boundary (empty: the exact machine).
+    Proved {
+        steps: u64,
+        since: u64,
+        abstracted: Vec<usize>,
+    },
     /// An assertion fails at `step`; `inputs[s][i]` is input `i` at step
     /// `s`, and `inputs[0]` goes on with each latch's power-on value (0 for
     /// a latch whose power-on value is fixed).
@@ -57,7 +65,8 @@ pub enum Found {
 /// Figures of a run, for the report and the benchmark.
 #[derive(Debug, Clone, Default)]
 pub struct Stats {
-    /// Steps whose assertion did not fold to a constant (SAT calls).
+    /// Satisfiability checks of the assertions (a window's disjunction, or
+    /// one step of a window that had a violation).
     pub sat_calls: u64,
     /// Largest graph held between collections.
     pub peak_nodes: usize,
@@ -67,12 +76,34 @@ pub struct Stats {
     /// last comparison differed from a period earlier, the state the
     /// design keeps across frames.
     pub kept: Vec<usize>,
+    /// An abstraction tried and given up: its latches and the step of
+    /// the violation the exact machine does not have.
+    pub spurious: Option<(Vec<usize>, u64)>,
+    /// With choice inputs (`prove`): the parts of the assertion proved by
+    /// symbolic simulation, by 2-induction and by explicit-state search.
+    pub parts: [usize; 3],
 }
+
+/// Steps between the checks of the assertions that did not fold (one SAT
+/// call on their disjunction), from each period's first step.
+const CHECK: u64 = 256;
+
+/// Periods simulated exactly before the latches kept across them are
+/// abstracted.
+const EXACT_PERIODS: u64 = 4;
 
 /// Simulates `g` from power-on: the state at each step `offset + k *
 /// period` is compared (up to renaming) with those of the earlier such
 /// steps; the run stops at a recurrence, a failing assertion, `max_steps`
 /// or `deadline`.
+///
+/// A design that keeps a value across periods (a frame number) recurs
+/// only after many periods.  After `EXACT_PERIODS` without a recurrence,
+/// the latches it keeps are given a fresh free value at every boundary
+/// (each boundary's state set grows to include every value of theirs):
+/// a recurrence of that over-approximation proves the exact machine too;
+/// a violation of it is replayed on the exact machine, and if that
+/// machine does not fail there, the exact simulation goes on from reset.
 pub fn run(
     g: &Aig,
     period: u64,
@@ -80,61 +111,312 @@ pub fn run(
     max_steps: u64,
     deadline: Option<Instant>,
 ) -> (Found, Stats) {
-    let mut stats = Stats::default();
-    let mut gr = Graph::new();
-    let ands = in_dependency_order(g);
-    let nv = g.max_var as usize + 1;
-    let mut val = vec![0u32; nv];
-    let ni = g.inputs.len() as u32;
-    // power-on values: 0, 1, or free (a variable of step 0 after the inputs)
-    let mut state: Vec<u32> = g
-        .latches
-        .iter()
-        .enumerate()
-        .map(|(j, &(l, _, init))| match init {
-            0 => 0,
-            1 => 1,
-            _ if init == l => gr.var(ni + j as u32, 0),
-            _ => 0,
+    let limits = Limits {
+        period,
+        offset,
+        max_steps,
+        deadline,
+    };
+    let (found, stats) = Sim::new(g, &[]).run(&limits, Some(EXACT_PERIODS));
+    let cut = match &found {
+        Found::Bounded { steps } if *steps < max_steps && !stats.kept.is_empty() => {
+            stats.kept.clone()
+        }
+        _ => return (found, stats),
+    };
+    if deadline.is_some_and(|d| Instant::now() > d) {
+        return (found, stats);
+    }
+    let (abstracted, mut astats) = Sim::new(g, &cut).run(&limits, None);
+    astats.kept = stats.kept.clone();
+    let step = match abstracted {
+        Found::Violated { step, inputs } => match first_violation(g, &inputs) {
+            Some(real) => return (real, astats),
+            None => step,
+        },
+        other => return (other, astats),
+    };
+    let (found, mut stats) = Sim::new(g, &[]).run(&limits, None);
+    stats.spurious = Some((cut, step));
+    (found, stats)
+}
+
+/// Proves `g`'s assertion part by part when some inputs are an
+/// environment's choices (`choices`, input indices) rather than data.
+///
+/// A part whose cone reads no choice goes to `run` with the other such
+/// parts.  A part that reads a choice is tried by k-induction (k <= 2: a
+/// harness's one-step relation, "a waiting beat keeps its data", holds
+/// whatever the state), with its base case from reset; else by
+/// explicit-state search (`explicit`), and if that cannot decide it, by
+/// `run`.  Every part holding in every reachable state is the
+/// whole assertion holding; a part's violation is the assertion's.
+pub fn prove(
+    g: &Aig,
+    choices: &[usize],
+    period: u64,
+    offset: u64,
+    max_steps: u64,
+    deadline: Option<Instant>,
+) -> (Found, Stats) {
+    if choices.is_empty() {
+        let (f, mut st) = run(g, period, offset, max_steps, deadline);
+        st.parts = [1, 0, 0];
+        return (f, st);
+    }
+    let mut g = g.clone();
+    let parts = cone::disjuncts(&mut g);
+    let (mut symbolic, mut inductive, mut explicit) = (Vec::new(), Vec::new(), Vec::new());
+    for part in parts {
+        let c = cone::cone(&g, &[part]);
+        if !c.inputs.iter().any(|i| choices.contains(i)) {
+            symbolic.push(part);
+            continue;
+        }
+        let alone = cone::restrict(&g, &[part], &c);
+        if (1..=2).any(|k| induction::step_case(&alone, k) == Ok(true)) {
+            inductive.push(part);
+        } else {
+            explicit.push(part);
+        }
+    }
+    let mut stats = Stats {
+        parts: [symbolic.len(), inductive.len(), explicit.len()],
+        ..Stats::default()
+    };
+    let mut results = Vec::new();
+    let lim = |steps| (period, offset, steps, deadline);
+    // the base case of 2-induction: no violation in the first steps
+    for (parts, how) in [(inductive, 1), (explicit, 2), (symbolic, 0)] {
+        if parts.is_empty() {
+            continue;
+        }
+        let c = cone::cone(&g, &parts);
+        let sub = cone::restrict(&g, &parts, &c);
+        let (period, offset, steps, deadline) = lim(match how {
+            1 => offset + 2,
+            _ => max_steps,
+        });
+        let (found, st) = match how {
+            2 => match explicit::run(&sub, choices, period, offset, steps, deadline) {
+                Some(f) => (f, Stats::default()),
+                None => run(&sub, period, offset, steps, deadline),
+            },
+            _ => run(&sub, period, offset, steps, deadline),
+        };
+        let found = lift(found, &c.latches, g.inputs.len(), g.latches.len());
+        stats.sat_calls += st.sat_calls;
+        stats.peak_nodes = stats.peak_nodes.max(st.peak_nodes);
+        if how == 0 {
+            stats.state_nodes = st.state_nodes;
+            stats.kept = st.kept.iter().map(|&j| c.latches[j]).collect();
+            stats.spurious = st.spurious;
+        }
+        // the inductive parts' base case is a bounded search: it holds if
+        // it found no violation
+        let found = match (how, found) {
+            (1, Found::Bounded { .. }) => Found::Proved {
+                steps: offset + 2,
+                since: offset,
+                abstracted: Vec::new(),
+            },
+            (_, f) => f,
+        };
+        results.push(found);
+    }
+    (combine(results), stats)
+}
+
+/// A part's verdict in the whole AIG's terms: latch `j` of the part is
+/// latch `latches[j]` of the whole (its power-on value in a witness, a
+/// latch it abstracted).
+fn lift(found: Found, latches: &[usize], ni: usize, nl: usize) -> Found {
+    match found {
+        Found::Violated { step, mut inputs } => {
+            let at = ni.min(inputs[0].len());
+            let init: Vec<bool> = inputs[0].split_off(at);
+            inputs[0].resize(ni + nl, false);
+            for (j, v) in init.into_iter().enumerate() {
+                inputs[0][ni + latches[j]] = v;
+            }
+            Found::Violated { step, inputs }
+        }
+        Found::Proved {
+            steps,
+            since,
+            abstracted,
+        } => Found::Proved {
+            steps,
+            since,
+            abstracted: abstracted.iter().map(|&j| latches[j]).collect(),
+        },
+        b => b,
+    }
+}
+
+/// The whole assertion's verdict from its parts': the earliest violation,
+/// else proved if every part is (the last proof's steps: the symbolic
+/// parts' when there are any), else the shortest bound.
+fn combine(results: Vec<Found>) -> Found {
+    let violation = (results.iter())
+        .filter(|f| matches!(f, Found::Violated { .. }))
+        .min_by_key(|f| match f {
+            Found::Violated { step, .. } => *step,
+            _ => u64::MAX,
+        });
+    if let Some(v) = violation {
+        return v.clone();
+    }
+    let bound = (results.iter())
+        .filter_map(|f| match f {
+            Found::Bounded { steps } => Some(*steps),
+            _ => None,
         })
-        .collect();
-    let bad_lits: Vec<u32> = g.bad.clone();
-    // every period boundary's state, canonical: a state at `offset + k *
-    // period` equal to an earlier boundary's closes the search (a FIFO's
-    // pointers may need several frames to come round)
-    let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
-    let mut prev_state: Vec<u32> = Vec::new();
-    let mut gc_at = 1usize << 20;
-    let mut sat_seen = 0;
-    for step in 0..max_steps {
-        if step >= offset && (step - offset).is_multiple_of(period) {
-            let now = canonical_state(&gr, &state, step);
-            if let Some(&since) = seen.get(&now) {
-                stats.state_nodes = live_nodes(&gr, &state);
-                return (Found::Proved { steps: step, since }, stats);
-            }
-            if step > offset {
-                stats.kept = kept(&gr, &prev_state, &state, step, period);
-            }
-            seen.insert(now, step);
-            prev_state.clone_from(&state);
+        .min();
+    match (bound, results.last()) {
+        (Some(steps), _) => Found::Bounded { steps },
+        (None, Some(last)) => last.clone(),
+        (None, None) => Found::Bounded { steps: 0 },
+    }
+}
+
+/// Where a run stops and compares.
+struct Limits {
+    period: u64,
+    offset: u64,
+    max_steps: u64,
+    deadline: Option<Instant>,
+}
+
+/// The simulation's state: the graph, each latch's value, and the
+/// assertions of the steps since the last check.
+struct Sim<'a> {
+    g: &'a Aig,
+    ands: Vec<(u32, u32, u32)>,
+    gr: Graph,
+    val: Vec<u32>,
+    state: Vec<u32>,
+    /// The state at the last boundary (for `kept`).
+    prev_state: Vec<u32>,
+    /// Latches given a free value at every boundary.
+    cut: Vec<usize>,
+    /// Steps whose assertion did not fold to "holds", not yet checked,
+    /// and their disjunction.
+    pending: Vec<(u64, u32)>,
+    pending_any: u32,
+    stats: Stats,
+    gc_at: usize,
+}
+
+impl<'a> Sim<'a> {
+    fn new(g: &'a Aig, cut: &[usize]) -> Sim<'a> {
+        let mut gr = Graph::new();
+        let ni = g.inputs.len() as u32;
+        // power-on values: 0, 1, or free (a variable of step 0 after the inputs)
+        let state = g
+            .latches
+            .iter()
+            .enumerate()
+            .map(|(j, &(l, _, init))| match init {
+                0 => 0,
+                1 => 1,
+                _ if init == l => gr.var(ni + j as u32, 0),
+                _ => 0,
+            })
+            .collect();
+        Sim {
+            g,
+            ands: in_dependency_order(g),
+            gr,
+            val: vec![0u32; g.max_var as usize + 1],
+            state,
+            prev_state: Vec::new(),
+            cut: cut.to_vec(),
+            pending: Vec::new(),
+            pending_any: 0,
+            stats: Stats::default(),
+            gc_at: 1 << 20,
         }
-        // every 256 steps, and after every SAT call (a free slave can make
-        // each step's assertion a SAT problem)
-        if (step.is_multiple_of(256) || stats.sat_calls > sat_seen)
-            && deadline.is_some_and(|d| Instant::now() > d)
-        {
-            return (Found::Bounded { steps: step }, stats);
+    }
+
+    /// Runs to a verdict, `lim.max_steps`, the deadline or, with
+    /// `periods`, that many boundaries without a recurrence.
+    fn run(mut self, lim: &Limits, periods: Option<u64>) -> (Found, Stats) {
+        // every boundary's state, canonical: a state equal to an earlier
+        // boundary's closes the search (a FIFO's pointers may need several
+        // periods to come round)
+        let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
+        for step in 0..lim.max_steps {
+            let phase = step.checked_sub(lim.offset).map(|p| p % lim.period);
+            if phase.is_some_and(|p| p % CHECK == 0) {
+                if let Some(f) = self.check_pending() {
+                    return (f, self.stats);
+                }
+            }
+            if phase == Some(0) {
+                if let Some(found) = self.boundary(step, lim, &mut seen, periods) {
+                    return (found, self.stats);
+                }
+            }
+            if step.is_multiple_of(256) && lim.deadline.is_some_and(|d| Instant::now() > d) {
+                let found = self.check_pending();
+                return (found.unwrap_or(Found::Bounded { steps: step }), self.stats);
+            }
+            self.step(step);
+            self.collect_if_large();
         }
-        sat_seen = stats.sat_calls;
+        let found = self.check_pending();
+        self.stats.peak_nodes = self.stats.peak_nodes.max(self.gr.a.len());
+        let end = Found::Bounded {
+            steps: lim.max_steps,
+        };
+        (found.unwrap_or(end), self.stats)
+    }
+
+    /// At a period boundary: the cut latches get fresh values, then the
+    /// state is compared with the earlier boundaries'.
+    fn boundary(
+        &mut self,
+        step: u64,
+        lim: &Limits,
+        seen: &mut HashMap<Vec<u64>, u64>,
+        periods: Option<u64>,
+    ) -> Option<Found> {
+        let ni = self.g.inputs.len() as u32;
+        for &j in &self.cut {
+            self.state[j] = self.gr.var(ni + j as u32, step as u32);
+        }
+        let now = self.gr.canonical(&self.state, step as u32);
+        if let Some(&since) = seen.get(&now) {
+            self.stats.state_nodes = live_nodes(&self.gr, &self.state);
+            let abstracted = self.cut.clone();
+            return Some(Found::Proved {
+                steps: step,
+                since,
+                abstracted,
+            });
+        }
+        if step > lim.offset {
+            self.stats.kept = kept(&self.gr, &self.prev_state, &self.state, step, lim.period);
+        }
+        seen.insert(now, step);
+        self.prev_state.clone_from(&self.state);
+        let done = periods.is_some_and(|n| (step - lim.offset) / lim.period >= n);
+        done.then_some(Found::Bounded { steps: step })
+    }
+
+    /// One clock step: the inputs' variables, the gates, the assertion
+    /// (kept for the next check unless it folds to "holds"), the latches.
+    fn step(&mut self, step: u64) {
+        let (g, val, gr) = (self.g, &mut self.val, &mut self.gr);
         let st = step as u32;
         for (k, &i) in g.inputs.iter().enumerate() {
             val[(i >> 1) as usize] = gr.var(k as u32, st);
         }
         for (j, &(l, _, _)) in g.latches.iter().enumerate() {
-            val[(l >> 1) as usize] = state[j];
+            val[(l >> 1) as usize] = self.state[j];
         }
-        for &(lhs, x, y) in &ands {
+        for &(lhs, x, y) in &self.ands {
             let (x, y) = (
                 val[(x >> 1) as usize] ^ (x & 1),
                 val[(y >> 1) as usize] ^ (y & 1),
@@ -143,40 +425,120 @@ pub fn run(
         }
         let lit = |l: u32| val[(l >> 1) as usize] ^ (l & 1);
         let mut bad = 0u32;
-        for &b in &bad_lits {
+        for &b in &g.bad {
             bad = gr.and(bad ^ 1, lit(b) ^ 1) ^ 1;
         }
         if bad != 0 {
-            stats.sat_calls += 1;
-            match gr.satisfy(bad) {
-                Ok(Some(assign)) => {
-                    let mut inputs = vec![vec![false; g.inputs.len()]; step as usize + 1];
-                    // after step 0's inputs, each latch's power-on value
-                    inputs[0].resize(g.inputs.len() + g.latches.len(), false);
-                    for (input, s, v) in assign {
-                        inputs[s as usize][input as usize] = v;
-                    }
-                    return (Found::Violated { step, inputs }, stats);
-                }
-                Ok(None) => {}
-                // no answer is no verdict: nothing is claimed from this step on
-                Err(_) => return (Found::Bounded { steps: step }, stats),
-            }
+            self.pending.push((step, bad));
+            self.pending_any = gr.and(self.pending_any ^ 1, bad ^ 1) ^ 1;
         }
         for (j, &(_, next, _)) in g.latches.iter().enumerate() {
-            state[j] = lit(next);
-        }
-        if gr.a.len() > gc_at {
-            stats.peak_nodes = stats.peak_nodes.max(gr.a.len());
-            let n = state.len();
-            state.append(&mut prev_state);
-            gr.collect(&mut state);
-            prev_state = state.split_off(n);
-            gc_at = (1 << 20).max(4 * gr.a.len());
+            self.state[j] = lit(next);
         }
     }
-    stats.peak_nodes = stats.peak_nodes.max(gr.a.len());
-    (Found::Bounded { steps: max_steps }, stats)
+
+    /// Checks the pending steps' assertions (one SAT call on their
+    /// disjunction; on a violation, each step in turn for the earliest).
+    fn check_pending(&mut self) -> Option<Found> {
+        if self.pending.is_empty() {
+            return None;
+        }
+        let pending = std::mem::take(&mut self.pending);
+        let any = std::mem::replace(&mut self.pending_any, 0);
+        let first = pending[0].0;
+        self.stats.sat_calls += 1;
+        match self.gr.satisfy(any) {
+            Ok(None) => return None,
+            Ok(Some(_)) => {}
+            // no answer is no verdict: nothing is claimed from here on
+            Err(_) => return Some(Found::Bounded { steps: first }),
+        }
+        for (step, bad) in pending {
+            self.stats.sat_calls += 1;
+            match self.gr.satisfy(bad) {
+                Ok(Some(assign)) => return Some(self.violation(step, assign)),
+                Ok(None) => {}
+                Err(_) => return Some(Found::Bounded { steps: step }),
+            }
+        }
+        // the disjunction was satisfiable and no step is: no verdict
+        Some(Found::Bounded { steps: first })
+    }
+
+    /// The witness of a violation at `step`: the model's inputs (a cut
+    /// latch's free value is not an input: it is left out).
+    fn violation(&self, step: u64, assign: Vec<graph::Assigned>) -> Found {
+        let ni = self.g.inputs.len();
+        let mut inputs = vec![vec![false; ni]; step as usize + 1];
+        // after step 0's inputs, each latch's power-on value
+        inputs[0].resize(ni + self.g.latches.len(), false);
+        for (input, s, v) in assign {
+            if s == 0 || (input as usize) < ni {
+                inputs[s as usize][input as usize] = v;
+            }
+        }
+        Found::Violated { step, inputs }
+    }
+
+    /// Collects the graph when it has grown fourfold since the last time.
+    fn collect_if_large(&mut self) {
+        if self.gr.a.len() <= self.gc_at {
+            return;
+        }
+        self.stats.peak_nodes = self.stats.peak_nodes.max(self.gr.a.len());
+        let (n, m) = (self.state.len(), self.prev_state.len());
+        let mut roots = std::mem::take(&mut self.state);
+        roots.append(&mut self.prev_state);
+        roots.extend(self.pending.iter().map(|&(_, b)| b));
+        roots.push(self.pending_any);
+        self.gr.collect(&mut roots);
+        self.pending_any = roots.pop().unwrap_or(0);
+        for (p, r) in self.pending.iter_mut().zip(&roots[n + m..]) {
+            p.1 = *r;
+        }
+        roots.truncate(n + m);
+        self.prev_state = roots.split_off(n);
+        self.state = roots;
+        self.gc_at = (1 << 20).max(4 * self.gr.a.len());
+    }
+}
+
+/// The first step at which the exact machine's assertion fails under
+/// `inputs` (a concrete simulation), as a witness.
+fn first_violation(g: &Aig, inputs: &[Vec<bool>]) -> Option<Found> {
+    let ni = g.inputs.len();
+    let ands = in_dependency_order(g);
+    let mut val = vec![false; g.max_var as usize + 1];
+    let mut state: Vec<bool> = (g.latches.iter().enumerate())
+        .map(|(j, &(l, _, init))| match init {
+            1 => true,
+            _ if init == l => inputs[0].get(ni + j).copied().unwrap_or(false),
+            _ => false,
+        })
+        .collect();
+    for (step, ins) in inputs.iter().enumerate() {
+        for (k, &i) in g.inputs.iter().enumerate() {
+            val[(i >> 1) as usize] = ins.get(k).copied().unwrap_or(false);
+        }
+        for (j, &(l, _, _)) in g.latches.iter().enumerate() {
+            val[(l >> 1) as usize] = state[j];
+        }
+        for &(lhs, x, y) in &ands {
+            let v = |l: u32| val[(l >> 1) as usize] ^ (l & 1 == 1);
+            val[(lhs >> 1) as usize] = v(x) && v(y);
+        }
+        let v = |l: u32| val[(l >> 1) as usize] ^ (l & 1 == 1);
+        if g.bad.iter().any(|&b| v(b)) {
+            return Some(Found::Violated {
+                step: step as u64,
+                inputs: inputs[..=step].to_vec(),
+            });
+        }
+        for (j, &(_, next, _)) in g.latches.iter().enumerate() {
+            state[j] = v(next);
+        }
+    }
+    None
 }
 
 /// The AND gates, each after its fanins (ASCII AIGER allows any order;
@@ -215,10 +577,6 @@ fn in_dependency_order(g: &Aig) -> Vec<(u32, u32, u32)> {
         }
     }
     out
-}
-
-fn canonical_state(gr: &Graph, state: &[u32], step: u64) -> Vec<u64> {
-    gr.canonical(state, step as u32)
 }
 
 /// The latches whose value at `step` is not their value a period earlier
