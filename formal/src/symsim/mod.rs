@@ -200,7 +200,11 @@ pub fn prove(
         let (found, st) = match how {
             2 => match explicit::run(&sub, choices, period, offset, steps, deadline) {
                 Some(f) => (f, Stats::default()),
-                None => run(&sub, period, offset, steps, deadline),
+                None => {
+                    // too many inputs to enumerate: simulated symbolically
+                    stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
+                    run(&sub, period, offset, steps, deadline)
+                }
             },
             _ => run(&sub, period, offset, steps, deadline),
         };
@@ -215,7 +219,7 @@ pub fn prove(
         // the inductive parts' base case is a bounded search: it holds if
         // it found no violation
         let found = match (how, found) {
-            (1, Found::Bounded { .. }) => Found::Proved {
+            (1, Found::Bounded { steps }) if steps >= 2 => Found::Proved {
                 steps: offset + 2,
                 since: offset,
                 abstracted: Vec::new(),
