@@ -431,7 +431,7 @@ fn parts_note(parts: &[usize; 3]) -> String {
     match parts {
         [_, 0, 0] => String::new(),
         [s, i, e] => format!(
-            "the assertion split into {} parts by their inputs: {i} that read the slave's choices hold by 2-induction (a relation one step long, whatever the state) with no violation in the first steps from reset; {e} that read the slave's choices and no data by explicit-state search from reset (every set of states reachable at a step, every choice enumerated) until the set at a frame start recurs; for the other {s}, ",
+            "the assertion split into {} parts by their inputs: {i} that read the slave's choices hold by 2-induction (a relation one step long, whatever the state) with no violation in the first steps from reset; {e} by explicit-state search from reset (the set of states reachable at each step, every choice of the slave enumerated, any other input the part reads enumerated where a step depends on it) until the set at a frame start recurs; for the other {s}, ",
             s + i + e
         ),
     }
