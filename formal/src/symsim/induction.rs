@@ -10,7 +10,7 @@
 //! rest of the state.
 
 use super::graph::Graph;
-use super::in_dependency_order;
+use super::{evaluate, in_dependency_order};
 use crate::aiger::Aig;
 
 /// Whether the assertions are `k`-inductive: `Ok(true)` if no path of
@@ -25,33 +25,11 @@ pub fn step_case(g: &Aig, k: u64) -> Result<bool, String> {
     let ands = in_dependency_order(g);
     let mut val = vec![0u32; g.max_var as usize + 1];
     let mut held = 1u32;
-    for step in 0..=k {
-        for (i, &l) in g.inputs.iter().enumerate() {
-            val[(l >> 1) as usize] = gr.var(i as u32, step as u32 + 1);
-        }
-        for (j, &(l, _, _)) in g.latches.iter().enumerate() {
-            val[(l >> 1) as usize] = state[j];
-        }
-        for &(lhs, x, y) in &ands {
-            let (x, y) = (
-                val[(x >> 1) as usize] ^ (x & 1),
-                val[(y >> 1) as usize] ^ (y & 1),
-            );
-            val[(lhs >> 1) as usize] = gr.and(x, y);
-        }
-        let lit = |l: u32| val[(l >> 1) as usize] ^ (l & 1);
-        let mut bad = 0u32;
-        for &b in &g.bad {
-            bad = gr.and(bad ^ 1, lit(b) ^ 1) ^ 1;
-        }
-        if step == k {
-            let fails = gr.and(held, bad);
-            return Ok(gr.satisfy(fails)?.is_none());
-        }
+    for step in 0..k {
+        let bad = evaluate(g, &ands, &mut gr, &mut val, &mut state, step + 1);
         held = gr.and(held, bad ^ 1);
-        for (j, &(_, next, _)) in g.latches.iter().enumerate() {
-            state[j] = lit(next);
-        }
     }
-    unreachable!("the loop returns at step k")
+    let bad = evaluate(g, &ands, &mut gr, &mut val, &mut state, k + 1);
+    let fails = gr.and(held, bad);
+    Ok(gr.satisfy(fails)?.is_none())
 }

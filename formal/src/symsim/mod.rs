@@ -412,32 +412,11 @@ impl<'a> Sim<'a> {
     /// One clock step: the inputs' variables, the gates, the assertion
     /// (kept for the next check unless it folds to "holds"), the latches.
     fn step(&mut self, step: u64) {
-        let (g, val, gr) = (self.g, &mut self.val, &mut self.gr);
-        let st = step as u32;
-        for (k, &i) in g.inputs.iter().enumerate() {
-            val[(i >> 1) as usize] = gr.var(k as u32, st);
-        }
-        for (j, &(l, _, _)) in g.latches.iter().enumerate() {
-            val[(l >> 1) as usize] = self.state[j];
-        }
-        for &(lhs, x, y) in &self.ands {
-            let (x, y) = (
-                val[(x >> 1) as usize] ^ (x & 1),
-                val[(y >> 1) as usize] ^ (y & 1),
-            );
-            val[(lhs >> 1) as usize] = gr.and(x, y);
-        }
-        let lit = |l: u32| val[(l >> 1) as usize] ^ (l & 1);
-        let mut bad = 0u32;
-        for &b in &g.bad {
-            bad = gr.and(bad ^ 1, lit(b) ^ 1) ^ 1;
-        }
+        let (g, gr) = (self.g, &mut self.gr);
+        let bad = evaluate(g, &self.ands, gr, &mut self.val, &mut self.state, step);
         if bad != 0 {
             self.pending.push((step, bad));
             self.pending_any = gr.and(self.pending_any ^ 1, bad ^ 1) ^ 1;
-        }
-        for (j, &(_, next, _)) in g.latches.iter().enumerate() {
-            self.state[j] = lit(next);
         }
     }
 
@@ -543,6 +522,41 @@ fn first_violation(g: &Aig, inputs: &[Vec<bool>]) -> Option<Found> {
         }
     }
     None
+}
+
+/// One step of `g` on the graph: input `k` is variable `(k, step)`,
+/// every latch starts from `state` and leaves it with its next value;
+/// returns the disjunction of the assertions (`val`: each gate's value).
+fn evaluate(
+    g: &Aig,
+    ands: &[(u32, u32, u32)],
+    gr: &mut Graph,
+    val: &mut [u32],
+    state: &mut [u32],
+    step: u64,
+) -> u32 {
+    for (k, &i) in g.inputs.iter().enumerate() {
+        val[(i >> 1) as usize] = gr.var(k as u32, step as u32);
+    }
+    for (j, &(l, _, _)) in g.latches.iter().enumerate() {
+        val[(l >> 1) as usize] = state[j];
+    }
+    for &(lhs, x, y) in ands {
+        let (x, y) = (
+            val[(x >> 1) as usize] ^ (x & 1),
+            val[(y >> 1) as usize] ^ (y & 1),
+        );
+        val[(lhs >> 1) as usize] = gr.and(x, y);
+    }
+    let lit = |l: u32| val[(l >> 1) as usize] ^ (l & 1);
+    let mut bad = 0u32;
+    for &b in &g.bad {
+        bad = gr.and(bad ^ 1, lit(b) ^ 1) ^ 1;
+    }
+    for (j, &(_, next, _)) in g.latches.iter().enumerate() {
+        state[j] = lit(next);
+    }
+    bad
 }
 
 /// The AND gates, each after its fanins (ASCII AIGER allows any order;
