@@ -359,29 +359,17 @@ fn symbolic(
     let choices = choice_inputs(prep);
     let (found, st) = symsim::prove(&g, &choices, f, 2, limit, Some(deadline));
     Ok(match found {
-        symsim::Found::Proved {
-            steps,
-            since,
-            abstracted,
-        } => (
+        symsim::Found::Proved { steps, since } => (
             Outcome::Proved,
             steps,
             format!(
-                "proved for all time: {}every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} latches, {} gates; {} assertion checks went to a SAT solver), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation){}",
+                "proved for all time: {}every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} latches, {} gates; {} assertion checks went to a SAT solver), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
                 parts_note(&st.parts),
                 g.latches.len(),
                 g.ands.len(),
                 st.sat_calls,
                 (steps - since) / f,
-                st.state_nodes,
-                if abstracted.is_empty() {
-                    String::new()
-                } else {
-                    format!(
-                        "; the registers the design keeps across frames ({}) were given every value at each frame start, which only adds behaviours",
-                        latch_names(prep, &abstracted)
-                    )
-                }
+                st.state_nodes
             ),
         ),
         symsim::Found::Violated { step, inputs } => {

@@ -320,7 +320,6 @@ fn a_counter_that_wraps_at_five_proves_and_one_that_wraps_at_six_fails() {
                 Found::Proved {
                     steps: 22,
                     since: 2,
-                    abstracted: vec![],
                 }
             );
         }
@@ -361,14 +360,7 @@ fn captured(at: u64, bad_when_held_and_count: bool) -> Aig {
 fn state_held_in_a_step_zero_input_proves_and_its_violation_is_found() {
     // held x0 is named by its step at every boundary: recurrence
     let f = judged(&captured(0, false), 4, 2, 200);
-    assert_eq!(
-        f,
-        Found::Proved {
-            steps: 6,
-            since: 2,
-            abstracted: vec![],
-        }
-    );
+    assert_eq!(f, Found::Proved { steps: 6, since: 2 });
     let f = judged(&captured(0, true), 4, 2, 200);
     let Found::Violated { step: 3, inputs } = f else {
         panic!("{f:?}")
@@ -474,7 +466,6 @@ fn a_violation_at_a_boundary_step_where_the_state_is_new() {
         Found::Proved {
             steps: 14,
             since: 10,
-            abstracted: vec![],
         }
     );
 }
@@ -574,7 +565,6 @@ fn a_state_kept_across_a_collection_proves_and_fails_where_it_should() {
             let proved = Found::Proved {
                 steps: 2 + (1 << 18),
                 since: 2,
-                abstracted: vec![],
             };
             assert!(f == proved, "not proved at 2 + 2^18");
         }
@@ -635,23 +625,19 @@ fn random_design(rng: &mut Rng, free: bool) -> Aig {
 #[test]
 fn random_designs_agree_with_an_explicit_state_search() {
     let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
-    // proved exactly, proved with latches cut, violated, bounded, and
-    // runs whose cut gave a violation the exact machine does not have
-    let mut tally = [0usize; 5];
+    let mut tally = [0usize; 3];
     for _ in 0..4000 {
         let g = random_design(&mut rng, false);
         let (period, offset) = (1 + rng.below(4), rng.below(4));
-        let (f, st) = judged_with_stats(&g, period, offset, 40);
+        let f = judged(&g, period, offset, 40);
         tally[match f {
-            Found::Proved { abstracted, .. } if abstracted.is_empty() => 0,
-            Found::Proved { .. } => 1,
-            Found::Violated { .. } => 2,
-            Found::Bounded { .. } => 3,
+            Found::Proved { .. } => 0,
+            Found::Violated { .. } => 1,
+            Found::Bounded { .. } => 2,
         }] += 1;
-        tally[4] += usize::from(st.spurious.is_some());
     }
     // the check is only as good as the mix of verdicts it saw
-    assert!(tally.iter().all(|&n| n > 10), "{tally:?}");
+    assert!(tally.iter().all(|&n| n > 100), "{tally:?}");
 }
 
 #[test]
@@ -812,9 +798,9 @@ fn random_designs_split_by_a_choice_input_agree_with_an_explicit_state_search() 
         }] += 1;
     }
     assert!(parts.iter().all(|&n| n > 100), "parts {parts:?}");
-    // few stay bounded: a kept register's abstraction proves most
+    // designs with free power-on values: fewer stay bounded
     assert!(
-        verdicts[0] > 100 && verdicts[1] > 100 && verdicts[2] > 0,
+        verdicts[0] > 100 && verdicts[1] > 100 && verdicts[2] > 10,
         "verdicts {verdicts:?}"
     );
 }

@@ -47,13 +47,8 @@ use graph::VAR;
 pub enum Found {
     /// No assertion fails in steps `0..steps`, and the state at step
     /// `steps` is (up to renaming) the state at step `since`, a whole
-    /// number of periods earlier.  `abstracted` lists the latches given a
-    /// free value at every period boundary (empty: the exact machine).
-    Proved {
-        steps: u64,
-        since: u64,
-        abstracted: Vec<usize>,
-    },
+    /// number of periods earlier.
+    Proved { steps: u64, since: u64 },
     /// An assertion fails at `step`; `inputs[s][i]` is input `i` at step
     /// `s`, and `inputs[0]` goes on with each latch's power-on value (0 for
     /// a latch whose power-on value is fixed).
@@ -76,9 +71,6 @@ pub struct Stats {
     /// last comparison differed from a period earlier, the state the
     /// design keeps across frames.
     pub kept: Vec<usize>,
-    /// An abstraction tried and given up: its latches and the step of
-    /// the violation the exact machine does not have.
-    pub spurious: Option<(Vec<usize>, u64)>,
     /// With choice inputs (`prove`): the parts of the assertion proved by
     /// symbolic simulation, by 2-induction and by explicit-state search.
     pub parts: [usize; 3],
@@ -88,22 +80,10 @@ pub struct Stats {
 /// call on their disjunction), from each period's first step.
 const CHECK: u64 = 256;
 
-/// Periods simulated exactly before the latches kept across them are
-/// abstracted.
-const EXACT_PERIODS: u64 = 4;
-
 /// Simulates `g` from power-on: the state at each step `offset + k *
 /// period` is compared (up to renaming) with those of the earlier such
 /// steps; the run stops at a recurrence, a failing assertion, `max_steps`
 /// or `deadline`.
-///
-/// A design that keeps a value across periods (a frame number) recurs
-/// only after many periods.  After `EXACT_PERIODS` without a recurrence,
-/// the latches it keeps are given a fresh free value at every boundary
-/// (each boundary's state set grows to include every value of theirs):
-/// a recurrence of that over-approximation proves the exact machine too;
-/// a violation of it is replayed on the exact machine, and if that
-/// machine does not fail there, the exact simulation goes on from reset.
 pub fn run(
     g: &Aig,
     period: u64,
@@ -117,28 +97,7 @@ pub fn run(
         max_steps,
         deadline,
     };
-    let (found, stats) = Sim::new(g, &[]).run(&limits, Some(EXACT_PERIODS));
-    let cut = match &found {
-        Found::Bounded { steps } if *steps < max_steps && !stats.kept.is_empty() => {
-            stats.kept.clone()
-        }
-        _ => return (found, stats),
-    };
-    if deadline.is_some_and(|d| Instant::now() > d) {
-        return (found, stats);
-    }
-    let (abstracted, mut astats) = Sim::new(g, &cut).run(&limits, None);
-    astats.kept = stats.kept.clone();
-    let step = match abstracted {
-        Found::Violated { step, inputs } => match first_violation(g, &inputs) {
-            Some(real) => return (real, astats),
-            None => step,
-        },
-        other => return (other, astats),
-    };
-    let (found, mut stats) = Sim::new(g, &[]).run(&limits, None);
-    stats.spurious = Some((cut, step));
-    (found, stats)
+    Sim::new(g).run(&limits)
 }
 
 /// Proves `g`'s assertion part by part when some inputs are an
@@ -214,7 +173,6 @@ pub fn prove(
         if how == 0 {
             stats.state_nodes = st.state_nodes;
             stats.kept = st.kept.iter().map(|&j| c.latches[j]).collect();
-            stats.spurious = st.spurious;
         }
         // the inductive parts' base case is a bounded search: it holds if
         // it found no violation
@@ -222,7 +180,6 @@ pub fn prove(
             (1, Found::Bounded { steps }) if steps >= 2 => Found::Proved {
                 steps: offset + 2,
                 since: offset,
-                abstracted: Vec::new(),
             },
             (_, f) => f,
         };
@@ -245,16 +202,7 @@ fn lift(found: Found, latches: &[usize], ni: usize, nl: usize) -> Found {
             }
             Found::Violated { step, inputs }
         }
-        Found::Proved {
-            steps,
-            since,
-            abstracted,
-        } => Found::Proved {
-            steps,
-            since,
-            abstracted: abstracted.iter().map(|&j| latches[j]).collect(),
-        },
-        b => b,
+        other => other,
     }
 }
 
@@ -302,8 +250,6 @@ struct Sim<'a> {
     state: Vec<u32>,
     /// The state at the last boundary (for `kept`).
     prev_state: Vec<u32>,
-    /// Latches given a free value at every boundary.
-    cut: Vec<usize>,
     /// Steps whose assertion did not fold to "holds", not yet checked,
     /// and their disjunction.
     pending: Vec<(u64, u32)>,
@@ -313,7 +259,7 @@ struct Sim<'a> {
 }
 
 impl<'a> Sim<'a> {
-    fn new(g: &'a Aig, cut: &[usize]) -> Sim<'a> {
+    fn new(g: &'a Aig) -> Sim<'a> {
         let mut gr = Graph::new();
         let ni = g.inputs.len() as u32;
         // power-on values: 0, 1, or free (a variable of step 0 after the inputs)
@@ -335,7 +281,6 @@ impl<'a> Sim<'a> {
             val: vec![0u32; g.max_var as usize + 1],
             state,
             prev_state: Vec::new(),
-            cut: cut.to_vec(),
             pending: Vec::new(),
             pending_any: 0,
             stats: Stats::default(),
@@ -343,9 +288,8 @@ impl<'a> Sim<'a> {
         }
     }
 
-    /// Runs to a verdict, `lim.max_steps`, the deadline or, with
-    /// `periods`, that many boundaries without a recurrence.
-    fn run(mut self, lim: &Limits, periods: Option<u64>) -> (Found, Stats) {
+    /// Runs to a verdict, `lim.max_steps` or the deadline.
+    fn run(mut self, lim: &Limits) -> (Found, Stats) {
         // every boundary's state, canonical: a state equal to an earlier
         // boundary's closes the search (a FIFO's pointers may need several
         // periods to come round)
@@ -358,7 +302,7 @@ impl<'a> Sim<'a> {
                 }
             }
             if phase == Some(0) {
-                if let Some(found) = self.boundary(step, lim, &mut seen, periods) {
+                if let Some(found) = self.boundary(step, lim, &mut seen) {
                     return (found, self.stats);
                 }
             }
@@ -377,36 +321,25 @@ impl<'a> Sim<'a> {
         (found.unwrap_or(end), self.stats)
     }
 
-    /// At a period boundary: the cut latches get fresh values, then the
-    /// state is compared with the earlier boundaries'.
+    /// At a period boundary: the state compared with the earlier
+    /// boundaries'.
     fn boundary(
         &mut self,
         step: u64,
         lim: &Limits,
         seen: &mut HashMap<Vec<u64>, u64>,
-        periods: Option<u64>,
     ) -> Option<Found> {
-        let ni = self.g.inputs.len() as u32;
-        for &j in &self.cut {
-            self.state[j] = self.gr.var(ni + j as u32, step as u32);
-        }
         let now = self.gr.canonical(&self.state, step as u32);
         if let Some(&since) = seen.get(&now) {
             self.stats.state_nodes = live_nodes(&self.gr, &self.state);
-            let abstracted = self.cut.clone();
-            return Some(Found::Proved {
-                steps: step,
-                since,
-                abstracted,
-            });
+            return Some(Found::Proved { steps: step, since });
         }
         if step > lim.offset {
             self.stats.kept = kept(&self.gr, &self.prev_state, &self.state, step, lim.period);
         }
         seen.insert(now, step);
         self.prev_state.clone_from(&self.state);
-        let done = periods.is_some_and(|n| (step - lim.offset) / lim.period >= n);
-        done.then_some(Found::Bounded { steps: step })
+        None
     }
 
     /// One clock step: the inputs' variables, the gates, the assertion
@@ -448,17 +381,14 @@ impl<'a> Sim<'a> {
         Some(Found::Bounded { steps: first })
     }
 
-    /// The witness of a violation at `step`: the model's inputs (a cut
-    /// latch's free value is not an input: it is left out).
+    /// The witness of a violation at `step`: the model's inputs.
     fn violation(&self, step: u64, assign: Vec<graph::Assigned>) -> Found {
         let ni = self.g.inputs.len();
         let mut inputs = vec![vec![false; ni]; step as usize + 1];
         // after step 0's inputs, each latch's power-on value
         inputs[0].resize(ni + self.g.latches.len(), false);
         for (input, s, v) in assign {
-            if s == 0 || (input as usize) < ni {
-                inputs[s as usize][input as usize] = v;
-            }
+            inputs[s as usize][input as usize] = v;
         }
         Found::Violated { step, inputs }
     }
@@ -484,44 +414,6 @@ impl<'a> Sim<'a> {
         self.state = roots;
         self.gc_at = (1 << 20).max(4 * self.gr.a.len());
     }
-}
-
-/// The first step at which the exact machine's assertion fails under
-/// `inputs` (a concrete simulation), as a witness.
-fn first_violation(g: &Aig, inputs: &[Vec<bool>]) -> Option<Found> {
-    let ni = g.inputs.len();
-    let ands = in_dependency_order(g);
-    let mut val = vec![false; g.max_var as usize + 1];
-    let mut state: Vec<bool> = (g.latches.iter().enumerate())
-        .map(|(j, &(l, _, init))| match init {
-            1 => true,
-            _ if init == l => inputs[0].get(ni + j).copied().unwrap_or(false),
-            _ => false,
-        })
-        .collect();
-    for (step, ins) in inputs.iter().enumerate() {
-        for (k, &i) in g.inputs.iter().enumerate() {
-            val[(i >> 1) as usize] = ins.get(k).copied().unwrap_or(false);
-        }
-        for (j, &(l, _, _)) in g.latches.iter().enumerate() {
-            val[(l >> 1) as usize] = state[j];
-        }
-        for &(lhs, x, y) in &ands {
-            let v = |l: u32| val[(l >> 1) as usize] ^ (l & 1 == 1);
-            val[(lhs >> 1) as usize] = v(x) && v(y);
-        }
-        let v = |l: u32| val[(l >> 1) as usize] ^ (l & 1 == 1);
-        if g.bad.iter().any(|&b| v(b)) {
-            return Some(Found::Violated {
-                step: step as u64,
-                inputs: inputs[..=step].to_vec(),
-            });
-        }
-        for (j, &(_, next, _)) in g.latches.iter().enumerate() {
-            state[j] = v(next);
-        }
-    }
-    None
 }
 
 /// One step of `g` on the graph: input `k` is variable `(k, step)`,
