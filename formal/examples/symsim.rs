@@ -1,0 +1,57 @@
+//! Runs the symbolic engine on an AIGER file and prints its verdict and
+//! figures: `cargo run --release -p formal --example symsim -- DESIGN.aag
+//! PERIOD [MAX_STEPS [SECONDS]]` (a work directory kept with
+//! `SLOTFORGE_FORMAL_KEEP=1 slotforge prove MIX` holds `design.aag`).
+
+use std::time::{Duration, Instant};
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [path, period, rest @ ..] = &args[..] else {
+        eprintln!("usage: symsim DESIGN.aag PERIOD [MAX_STEPS [SECONDS]]");
+        std::process::exit(2);
+    };
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| {
+        eprintln!("{path}: {e}");
+        std::process::exit(1)
+    });
+    let g = formal::aiger::parse(&text).unwrap_or_else(|e| {
+        eprintln!("{path}: {e}");
+        std::process::exit(1)
+    });
+    let num = |s: &str, what: &str| -> u64 {
+        s.parse().unwrap_or_else(|_| {
+            eprintln!("{what}: not a whole number: {s}");
+            std::process::exit(2)
+        })
+    };
+    let period = num(period, "PERIOD");
+    let max = rest
+        .first()
+        .map_or(16 * period + 2, |s| num(s, "MAX_STEPS"));
+    let secs = rest.get(1).map_or(1800, |s| num(s, "SECONDS"));
+    if let Ok(k) = std::env::var("SYMSIM_INDUCTION") {
+        let t0 = Instant::now();
+        let k = num(&k, "SYMSIM_INDUCTION");
+        let r = formal::symsim::induction::step_case(&g, k);
+        println!(
+            "{k}-induction step case: {r:?} ({:.2} s)",
+            t0.elapsed().as_secs_f64()
+        );
+        return;
+    }
+    let t0 = Instant::now();
+    let deadline = t0 + Duration::from_secs(secs);
+    // CHOICES=i,j: input indices that are an environment's choices
+    let choices: Vec<usize> = std::env::var("CHOICES")
+        .map(|c| c.split(',').map(|x| num(x, "CHOICES") as usize).collect())
+        .unwrap_or_default();
+    let (found, st) = formal::symsim::prove(&g, &choices, period, 2, max, Some(deadline));
+    let verdict = match &found {
+        formal::symsim::Found::Violated { step, .. } => format!("violated at step {step}"),
+        other => format!("{other:?}"),
+    };
+    println!("{verdict}");
+    println!("{st:?}");
+    println!("{:.1} s", t0.elapsed().as_secs_f64());
+}

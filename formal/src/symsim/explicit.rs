@@ -1,0 +1,338 @@
+//! Explicit-state search for a cone whose only free inputs are choices of
+//! the environment (an AXI4-Stream slave's `tready`), not data.
+//!
+//! Such a cone (the link FIFO's fill level) is a control machine: the set
+//! of its states reachable at a step is small, but as a symbolic function
+//! of every earlier choice it is large and hard for SAT (a counting
+//! argument).  Here the set is kept as it is, one bit-vector per state,
+//! and each step's successors are computed 64 (state, choice) pairs at a
+//! time with bitwise AIG evaluation.  The search is exact: a violation is
+//! a real trace from reset, and when the set at a period boundary equals
+//! the set at an earlier one, the steps simulated reach every reachable
+//! state (the machine is deterministic given its inputs): a proof for all
+//! time.
+//!
+//! Inputs of the cone other than the choices (yosys's `anyseq` bits for a
+//! read outside a memory, which no reachable state makes) are evaluated as
+//! unknown (three-valued logic): a step whose successors or assertion
+//! would depend on one gives no verdict here (`None`, another engine's
+//! turn), so the search never rests on a value it chose.
+
+use std::collections::HashMap;
+use std::time::Instant;
+
+use super::{in_dependency_order, Found};
+use crate::aiger::Aig;
+
+/// At most this many input bits are enumerated per step, and this many
+/// latches may have a free power-on value.
+pub const MAX_CHOICE_BITS: usize = 6;
+/// At most this many other input bits are enumerated when a step
+/// depends on them.
+const MAX_OTHER_BITS: usize = 10;
+const MAX_FREE_INIT: usize = 12;
+
+/// Searches `g` (a cone) from power-on, every input in `choices`
+/// enumerated at every step; `None` if the cone has too many choice bits
+/// or free power-on values for enumeration, or a step depends on another
+/// input.
+pub fn run(
+    g: &Aig,
+    choices: &[usize],
+    period: u64,
+    offset: u64,
+    max_steps: u64,
+    deadline: Option<Instant>,
+) -> Option<Found> {
+    let free: Vec<usize> = (0..g.latches.len())
+        .filter(|&j| g.latches[j].2 != 0 && g.latches[j].2 != 1)
+        .collect();
+    if choices.len() > MAX_CHOICE_BITS || free.len() > MAX_FREE_INIT {
+        return None;
+    }
+    let mut m = Machine::new(g, choices);
+    // the power-on set: every value of the free latches
+    let mut set = States::new(m.words);
+    for v in 0..1u64 << free.len() {
+        let mut s = vec![0u64; m.words];
+        for (j, &(_, _, init)) in g.latches.iter().enumerate() {
+            let bit = match free.iter().position(|&f| f == j) {
+                Some(k) => v >> k & 1 == 1,
+                None => init == 1,
+            };
+            s[j / 64] |= u64::from(bit) << (j % 64);
+        }
+        set.insert(&s, (u32::MAX, v as u32));
+    }
+    // every step's (predecessor, inputs) per state, one flat list
+    let mut history = History::default();
+    let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
+    for step in 0..max_steps {
+        if step >= offset && (step - offset).is_multiple_of(period) {
+            if let Some(&since) = seen.get(&set.sorted()) {
+                return Some(Found::Proved { steps: step, since });
+            }
+            seen.insert(set.sorted(), step);
+        }
+        if step.is_multiple_of(1024) && deadline.is_some_and(|d| Instant::now() > d) {
+            return Some(Found::Bounded { steps: step });
+        }
+        let (next, bad) = m.step(&set)?;
+        if let Some((state, combo)) = bad {
+            history.push(&set.parents);
+            return Some(m.witness(&history, step, state, combo, &free));
+        }
+        history.push(&set.parents);
+        set = next;
+    }
+    Some(Found::Bounded { steps: max_steps })
+}
+
+/// How each state of each step was first reached: (predecessor in the
+/// step before, input code), all steps in one list.
+#[derive(Default)]
+struct History {
+    parents: Vec<(u32, u32)>,
+    starts: Vec<usize>,
+}
+
+impl History {
+    fn push(&mut self, step: &[(u32, u32)]) {
+        self.starts.push(self.parents.len());
+        self.parents.extend_from_slice(step);
+    }
+
+    fn get(&self, step: usize, state: u32) -> (u32, u32) {
+        self.parents[self.starts[step] + state as usize]
+    }
+}
+
+/// A set of states, each `words` long, in insertion order, with the
+/// (predecessor, choice) that first reached each.
+struct States {
+    words: usize,
+    flat: Vec<u64>,
+    index: HashMap<Vec<u64>, u32>,
+    parents: Vec<(u32, u32)>,
+}
+
+impl States {
+    fn new(words: usize) -> States {
+        States {
+            words,
+            flat: Vec::new(),
+            index: HashMap::new(),
+            parents: Vec::new(),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.parents.len()
+    }
+
+    fn get(&self, i: usize) -> &[u64] {
+        &self.flat[i * self.words..(i + 1) * self.words]
+    }
+
+    fn insert(&mut self, s: &[u64], from: (u32, u32)) {
+        if !self.index.contains_key(s) {
+            self.index.insert(s.to_vec(), self.parents.len() as u32);
+            self.flat.extend_from_slice(s);
+            self.parents.push(from);
+        }
+    }
+
+    /// The set's canonical form: its states in order.
+    fn sorted(&self) -> Vec<u64> {
+        let mut v: Vec<&[u64]> = (0..self.len()).map(|i| self.get(i)).collect();
+        v.sort_unstable();
+        v.concat()
+    }
+}
+
+/// The cone's gates, evaluated 64 lanes at a time.
+struct Machine<'a> {
+    g: &'a Aig,
+    ands: Vec<(u32, u32, u32)>,
+    choices: Vec<usize>,
+    words: usize,
+    /// Each gate's value in each lane, and whether it is unknown there.
+    val: Vec<u64>,
+    unknown: Vec<u64>,
+    /// The inputs that are not choices (their variables): unknown unless a
+    /// lane enumerates them.
+    others: Vec<u32>,
+}
+
+impl<'a> Machine<'a> {
+    fn new(g: &'a Aig, choices: &[usize]) -> Machine<'a> {
+        Machine {
+            g,
+            ands: in_dependency_order(g),
+            choices: choices.to_vec(),
+            words: g.latches.len().div_ceil(64).max(1),
+            val: vec![0u64; g.max_var as usize + 1],
+            unknown: vec![0u64; g.max_var as usize + 1],
+            others: {
+                // the other inputs the cone reads
+                let read: std::collections::HashSet<u32> = (g.ands.iter())
+                    .flat_map(|&(_, x, y)| [x >> 1, y >> 1])
+                    .chain(g.latches.iter().map(|&(_, nx, _)| nx >> 1))
+                    .chain(g.bad.iter().map(|&b| b >> 1))
+                    .collect();
+                (g.inputs.iter().enumerate())
+                    .filter(|&(i, l)| !choices.contains(&i) && read.contains(&(l >> 1)))
+                    .map(|(_, &l)| l >> 1)
+                    .collect()
+            },
+        }
+    }
+
+    /// Every successor of `set` under every choice; or the first (state,
+    /// input code) whose step violates an assertion; `None` if a step
+    /// depends on more inputs that are not choices than can be enumerated.
+    ///
+    /// A lane is a state and an input code: the choices in its low bits,
+    /// the other inputs above.  Lanes first run with the other inputs
+    /// unknown; a lane whose successor or assertion depends on them runs
+    /// again once for each of their values.
+    fn step(&mut self, set: &States) -> Option<(States, Option<(u32, u32)>)> {
+        let nc = self.choices.len();
+        let mut lanes: Vec<(u32, u32, bool)> = (0..set.len() as u32)
+            .flat_map(|s| (0..1u32 << nc).map(move |c| (s, c, false)))
+            .collect();
+        let mut next = States::new(self.words);
+        let mut at = 0;
+        while at < lanes.len() {
+            let chunk: Vec<(u32, u32, bool)> = lanes[at..lanes.len().min(at + 64)].to_vec();
+            at += chunk.len();
+            let (bad, unknown, nexts) = self.eval(set, &chunk);
+            for (k, &(s, code, exact)) in chunk.iter().enumerate() {
+                if unknown >> k & 1 == 1 {
+                    if exact || self.others.len() > MAX_OTHER_BITS {
+                        return None;
+                    }
+                    let expanded =
+                        (0..1u32 << self.others.len()).map(|o| (s, code | o << nc, true));
+                    lanes.extend(expanded);
+                } else if bad >> k & 1 == 1 {
+                    return Some((next, Some((s, code))));
+                } else {
+                    let st: Vec<u64> = (nexts.chunks(64))
+                        .map(|ws| {
+                            let bits = ws.iter().enumerate();
+                            bits.fold(0, |a, (j, &w)| a | (w >> k & 1) << j)
+                        })
+                        .collect();
+                    next.insert(&st, (s, code));
+                }
+            }
+        }
+        Some((next, None))
+    }
+
+    /// Evaluates up to 64 lanes: the lanes whose assertion fails, those
+    /// whose successor or assertion is unknown, and each latch's next
+    /// value per lane.
+    fn eval(&mut self, set: &States, chunk: &[(u32, u32, bool)]) -> (u64, u64, Vec<u64>) {
+        let nc = self.choices.len();
+        let (val, unknown) = (&mut self.val, &mut self.unknown);
+        for &(l, _, _) in &self.g.latches {
+            (val[(l >> 1) as usize], unknown[(l >> 1) as usize]) = (0, 0);
+        }
+        for &i in &self.choices {
+            (
+                val[(self.g.inputs[i] >> 1) as usize],
+                unknown[(self.g.inputs[i] >> 1) as usize],
+            ) = (0, 0);
+        }
+        for &v in &self.others {
+            (val[v as usize], unknown[v as usize]) = (0, !0);
+        }
+        let states: Vec<&[u64]> = chunk.iter().map(|&(s, _, _)| set.get(s as usize)).collect();
+        for (j, &(l, _, _)) in self.g.latches.iter().enumerate() {
+            let bits = states.iter().enumerate();
+            val[(l >> 1) as usize] =
+                bits.fold(0, |a, (k, st)| a | (st[j / 64] >> (j % 64) & 1) << k);
+        }
+        for (k, &(_, code, exact)) in chunk.iter().enumerate() {
+            for (b, &i) in self.choices.iter().enumerate() {
+                val[(self.g.inputs[i] >> 1) as usize] |= u64::from(code >> b & 1) << k;
+            }
+            if exact {
+                for (b, &v) in self.others.iter().enumerate() {
+                    val[v as usize] |= u64::from(code >> (nc + b) & 1) << k;
+                    unknown[v as usize] &= !(1 << k);
+                }
+            }
+        }
+        for &(lhs, x, y) in &self.ands {
+            let w = |l: u32| val[(l >> 1) as usize] ^ 0u64.wrapping_sub(u64::from(l & 1));
+            let u = |l: u32| unknown[(l >> 1) as usize];
+            // known 0 if either side is; known 1 if both are
+            let zero = (!w(x) & !u(x)) | (!w(y) & !u(y));
+            let one = w(x) & !u(x) & w(y) & !u(y);
+            val[(lhs >> 1) as usize] = one;
+            unknown[(lhs >> 1) as usize] = !(zero | one);
+        }
+        let w = |l: u32| val[(l >> 1) as usize] ^ 0u64.wrapping_sub(u64::from(l & 1));
+        let u = |l: u32| unknown[(l >> 1) as usize];
+        let lanes = if chunk.len() == 64 {
+            !0
+        } else {
+            (1u64 << chunk.len()) - 1
+        };
+        let outs = self
+            .g
+            .bad
+            .iter()
+            .chain(self.g.latches.iter().map(|(_, nx, _)| nx));
+        let unknown_any = outs.fold(0, |a, &l| a | u(l)) & lanes;
+        let bad = self.g.bad.iter().fold(0, |a, &b| a | w(b)) & lanes;
+        let nexts = self.g.latches.iter().map(|&(_, nx, _)| w(nx)).collect();
+        (bad, unknown_any, nexts)
+    }
+
+    /// The inputs from reset to a violation at `step` from `state` under
+    /// `combo` (inputs outside the choices are 0; `inputs[0]` goes on with
+    /// each latch's power-on value).
+    fn witness(
+        &self,
+        history: &History,
+        step: u64,
+        state: u32,
+        combo: u32,
+        free: &[usize],
+    ) -> Found {
+        let ni = self.g.inputs.len();
+        let mut inputs = vec![vec![false; ni]; step as usize + 1];
+        let nc = self.choices.len();
+        let input_of = |v: u32| self.g.inputs.iter().position(|&l| l >> 1 == v);
+        let set_choice = |row: &mut Vec<bool>, c: u32| {
+            for (b, &i) in self.choices.iter().enumerate() {
+                row[i] = c >> b & 1 == 1;
+            }
+            for (b, &v) in self.others.iter().enumerate() {
+                if let Some(i) = input_of(v) {
+                    row[i] = c >> (nc + b) & 1 == 1;
+                }
+            }
+        };
+        set_choice(&mut inputs[step as usize], combo);
+        let mut at = state;
+        for s in (0..=step as usize).rev() {
+            let (from, c) = history.get(s, at);
+            if s == 0 {
+                // a power-on state: `c` is the free latches' values
+                inputs[0].resize(ni + self.g.latches.len(), false);
+                for (k, &j) in free.iter().enumerate() {
+                    inputs[0][ni + j] = c >> k & 1 == 1;
+                }
+                break;
+            }
+            set_choice(&mut inputs[s - 1], c);
+            at = from;
+        }
+        Found::Violated { step, inputs }
+    }
+}

@@ -1,0 +1,250 @@
+//! The hash-consed and-inverter graph the symbolic simulation builds.
+
+use std::collections::HashMap;
+
+use rustc_hash::FxHashMap;
+
+/// A variable's value in a SAT model: (input, step, value).
+pub(super) type Assigned = (u32, u32, bool);
+
+/// Marks a variable node: `a = VAR | input`, `b = step`.
+pub(super) const VAR: u32 = 1 << 31;
+
+/// Hash-consed and-inverter graph over the input variables of every step.
+/// Literal `2n + c`: node `n`, complemented if `c`; node 0 is constant false.
+pub(super) struct Graph {
+    pub(super) a: Vec<u32>,
+    pub(super) b: Vec<u32>,
+    table: FxHashMap<u64, u32>,
+}
+
+impl Graph {
+    pub(super) fn new() -> Graph {
+        Graph {
+            a: vec![0],
+            b: vec![0],
+            table: FxHashMap::default(),
+        }
+    }
+
+    pub(super) fn var(&mut self, input: u32, step: u32) -> u32 {
+        self.a.push(VAR | input);
+        self.b.push(step);
+        (self.a.len() as u32 - 1) * 2
+    }
+
+    /// Nearly every gate's fanins are constants once the control has left
+    /// reset: that case is one well-predicted branch.
+    #[inline(always)]
+    pub(super) fn and(&mut self, x: u32, y: u32) -> u32 {
+        if (x | y) < 2 {
+            return x & y;
+        }
+        self.and_symbolic(x, y)
+    }
+
+    pub(super) fn and_symbolic(&mut self, x: u32, y: u32) -> u32 {
+        if x == 0 || y == 0 || x == y ^ 1 {
+            return 0;
+        }
+        if x == 1 || x == y {
+            return y;
+        }
+        if y == 1 {
+            return x;
+        }
+        let (x, y) = if x < y { (x, y) } else { (y, x) };
+        let key = (u64::from(x) << 32) | u64::from(y);
+        let a = &mut self.a;
+        let b = &mut self.b;
+        *self.table.entry(key).or_insert_with(|| {
+            a.push(x);
+            b.push(y);
+            (a.len() as u32 - 1) * 2
+        })
+    }
+
+    pub(super) fn is_var(&self, n: usize) -> bool {
+        self.a[n] & VAR != 0
+    }
+
+    /// Keeps only the nodes `roots` reach (renumbered in creation order, so
+    /// a node's fanins stay below it) and rewrites `roots` in place.
+    pub(super) fn collect(&mut self, roots: &mut [u32]) {
+        let n = self.a.len();
+        let mut live = vec![false; n];
+        live[0] = true;
+        for &r in roots.iter() {
+            live[(r >> 1) as usize] = true;
+        }
+        for i in (1..n).rev() {
+            if live[i] && !self.is_var(i) {
+                live[(self.a[i] >> 1) as usize] = true;
+                live[(self.b[i] >> 1) as usize] = true;
+            }
+        }
+        let mut map = vec![0u32; n];
+        let (mut a, mut b) = (vec![0u32], vec![0u32]);
+        let mut table = FxHashMap::default();
+        let lit = |map: &[u32], l: u32| (map[(l >> 1) as usize] * 2) | (l & 1);
+        for i in 1..n {
+            if !live[i] {
+                continue;
+            }
+            map[i] = a.len() as u32;
+            if self.is_var(i) {
+                a.push(self.a[i]);
+                b.push(self.b[i]);
+            } else {
+                let (x, y) = (lit(&map, self.a[i]), lit(&map, self.b[i]));
+                table.insert((u64::from(x) << 32) | u64::from(y), map[i] * 2);
+                a.push(x);
+                b.push(y);
+            }
+        }
+        for r in roots.iter_mut() {
+            *r = lit(&map, *r);
+        }
+        self.a = a;
+        self.b = b;
+        self.table = table;
+    }
+
+    /// The state `roots` as a canonical word sequence, inputs of step 0 by
+    /// their step and of later steps by their age at `now`: two states give
+    /// the same sequence only if they are the same graph up to that renaming
+    /// (children are ordered by a structural hash; a tie or a collision can
+    /// only make equal states differ, never different states equal).
+    pub(super) fn canonical(&self, roots: &[u32], now: u32) -> Vec<u64> {
+        let leaf = |n: usize| -> u64 {
+            let (input, step) = (u64::from(self.a[n] & !VAR), self.b[n]);
+            if step == 0 {
+                input << 33
+            } else {
+                (input << 33) | (1 << 32) | u64::from(now - step)
+            }
+        };
+        let mix = |x: u64| {
+            let x = (x ^ (x >> 31)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            x ^ (x >> 29)
+        };
+        // structural hashes, bottom-up over the cone (nodes are topological)
+        let mut hash: HashMap<usize, u64> = HashMap::new();
+        let mut stack: Vec<usize> = roots.iter().map(|&r| (r >> 1) as usize).collect();
+        let mut cone = Vec::new();
+        while let Some(n) = stack.pop() {
+            if n == 0 || hash.contains_key(&n) {
+                continue;
+            }
+            hash.insert(n, 0);
+            cone.push(n);
+            if !self.is_var(n) {
+                stack.push((self.a[n] >> 1) as usize);
+                stack.push((self.b[n] >> 1) as usize);
+            }
+        }
+        cone.sort_unstable();
+        hash.insert(0, 0x5151);
+        let lh = |hash: &HashMap<usize, u64>, l: u32| hash[&((l >> 1) as usize)] ^ u64::from(l & 1);
+        for &n in &cone {
+            let h = if self.is_var(n) {
+                mix(leaf(n) ^ 0xABCD)
+            } else {
+                let (x, y) = (lh(&hash, self.a[n]), lh(&hash, self.b[n]));
+                mix(mix(x.min(y)) ^ y.max(x).rotate_left(17))
+            };
+            hash.insert(n, h);
+        }
+        // serialization in depth-first order, children by hash
+        let mut id: HashMap<usize, u64> = HashMap::from([(0, 0)]);
+        let mut out = Vec::new();
+        for &r in roots {
+            let mut st = vec![((r >> 1) as usize, false)];
+            while let Some((n, expanded)) = st.pop() {
+                if id.contains_key(&n) {
+                    continue;
+                }
+                if self.is_var(n) {
+                    out.extend([1, leaf(n)]);
+                } else if !expanded {
+                    st.push((n, true));
+                    let (x, y) = self.ordered(n, &hash);
+                    st.push(((y >> 1) as usize, false));
+                    st.push(((x >> 1) as usize, false));
+                    continue;
+                } else {
+                    let (x, y) = self.ordered(n, &hash);
+                    let c = |l: u32| id[&((l >> 1) as usize)] * 2 + u64::from(l & 1);
+                    out.extend([2, c(x), c(y)]);
+                }
+                id.insert(n, id.len() as u64);
+            }
+            out.push(3);
+            out.push(id[&((r >> 1) as usize)] * 2 + u64::from(r & 1));
+        }
+        out
+    }
+
+    pub(super) fn ordered(&self, n: usize, hash: &HashMap<usize, u64>) -> (u32, u32) {
+        let (x, y) = (self.a[n], self.b[n]);
+        let k = |l: u32| (hash[&((l >> 1) as usize)] ^ u64::from(l & 1), l & 1);
+        if k(y) < k(x) {
+            (y, x)
+        } else {
+            (x, y)
+        }
+    }
+
+    /// An assignment of the variables under `lit` that makes it true,
+    /// `Ok(None)` if none does (Tseitin encoding of its cone, splr), `Err`
+    /// if the solver gave no answer (never read as "holds").
+    pub(super) fn satisfy(&self, lit: u32) -> Result<Option<Vec<Assigned>>, String> {
+        let mut index: HashMap<usize, i32> = HashMap::new();
+        let mut stack = vec![(lit >> 1) as usize];
+        let mut cone = Vec::new();
+        while let Some(n) = stack.pop() {
+            if index.contains_key(&n) {
+                continue;
+            }
+            index.insert(n, index.len() as i32 + 1);
+            cone.push(n);
+            if n != 0 && !self.is_var(n) {
+                stack.push((self.a[n] >> 1) as usize);
+                stack.push((self.b[n] >> 1) as usize);
+            }
+        }
+        let v = |l: u32| {
+            let x = index[&((l >> 1) as usize)];
+            if l & 1 == 1 {
+                -x
+            } else {
+                x
+            }
+        };
+        let mut clauses: Vec<Vec<i32>> = vec![vec![v(lit)]];
+        for &n in &cone {
+            let o = index[&n];
+            if n == 0 {
+                clauses.push(vec![-o]);
+            } else if !self.is_var(n) {
+                let (x, y) = (v(self.a[n]), v(self.b[n]));
+                clauses.push(vec![-o, x]);
+                clauses.push(vec![-o, y]);
+                clauses.push(vec![o, -x, -y]);
+            }
+        }
+        match splr::Certificate::try_from(clauses) {
+            Ok(splr::Certificate::SAT(model)) => {
+                let value: HashMap<i32, bool> = model.iter().map(|&m| (m.abs(), m > 0)).collect();
+                Ok(Some(
+                    cone.iter()
+                        .filter(|&&n| n != 0 && self.is_var(n))
+                        .map(|&n| (self.a[n] & !VAR, self.b[n], value[&index[&n]]))
+                        .collect(),
+                ))
+            }
+            Ok(splr::Certificate::UNSAT) => Ok(None),
+            Err(e) => Err(format!("{e:?}")),
+        }
+    }
+}
