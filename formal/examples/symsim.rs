@@ -1,7 +1,9 @@
 //! Runs the symbolic engine on an AIGER file and prints its verdict and
-//! figures: `cargo run --release -p formal --example symsim -- DESIGN.aag
-//! PERIOD [MAX_STEPS [SECONDS]]` (a work directory kept with
-//! `SLOTFORGE_FORMAL_KEEP=1 slotforge prove MIX` holds `design.aag`).
+//! figures: `CHOICES=I,J cargo run --release -p formal --example symsim --
+//! DESIGN.aag PERIOD [MAX_STEPS [SECONDS]]` (a work directory kept with
+//! `SLOTFORGE_FORMAL_KEEP=1 slotforge prove MIX` holds `design.aag`;
+//! `CHOICES` are the indices of inputs that are an environment's choices,
+//! `tready_any` in its `design.aim`).
 
 use std::time::{Duration, Instant};
 
@@ -30,16 +32,6 @@ fn main() {
         .first()
         .map_or(16 * period + 2, |s| num(s, "MAX_STEPS"));
     let secs = rest.get(1).map_or(1800, |s| num(s, "SECONDS"));
-    if let Ok(k) = std::env::var("SYMSIM_INDUCTION") {
-        let t0 = Instant::now();
-        let k = num(&k, "SYMSIM_INDUCTION");
-        let r = formal::symsim::induction::step_case(&g, k);
-        println!(
-            "{k}-induction step case: {r:?} ({:.2} s)",
-            t0.elapsed().as_secs_f64()
-        );
-        return;
-    }
     let t0 = Instant::now();
     let deadline = t0 + Duration::from_secs(secs);
     // CHOICES=i,j: input indices that are an environment's choices

@@ -21,7 +21,7 @@
 use std::collections::HashMap;
 use std::time::Instant;
 
-use super::{in_dependency_order, Found};
+use super::{in_dependency_order, Found, Limits};
 use crate::aiger::Aig;
 
 /// At most this many input bits are enumerated per step, and this many
@@ -36,14 +36,13 @@ const MAX_FREE_INIT: usize = 12;
 /// enumerated at every step; `None` if the cone has too many choice bits
 /// or free power-on values for enumeration, or a step depends on another
 /// input.
-pub fn run(
-    g: &Aig,
-    choices: &[usize],
-    period: u64,
-    offset: u64,
-    max_steps: u64,
-    deadline: Option<Instant>,
-) -> Option<Found> {
+pub(super) fn run(g: &Aig, choices: &[usize], lim: &Limits) -> Option<Found> {
+    let Limits {
+        period,
+        offset,
+        max_steps,
+        deadline,
+    } = *lim;
     let free: Vec<usize> = (0..g.latches.len())
         .filter(|&j| g.latches[j].2 != 0 && g.latches[j].2 != 1)
         .collect();

@@ -34,10 +34,10 @@ use std::time::Instant;
 
 use crate::aiger::Aig;
 
-pub mod cone;
-pub mod explicit;
+mod cone;
+mod explicit;
 mod graph;
-pub mod induction;
+mod induction;
 use graph::Graph;
 #[cfg(test)]
 use graph::VAR;
@@ -144,7 +144,12 @@ pub fn prove(
         ..Stats::default()
     };
     let mut results = Vec::new();
-    let lim = |steps| (period, offset, steps, deadline);
+    let whole = Limits {
+        period,
+        offset,
+        max_steps,
+        deadline,
+    };
     // the base case of 2-induction: no violation in the first steps
     for (parts, how) in [(inductive, 1), (explicit, 2), (symbolic, 0)] {
         if parts.is_empty() {
@@ -152,20 +157,20 @@ pub fn prove(
         }
         let c = cone::cone(&g, &parts);
         let sub = cone::restrict(&g, &parts, &c);
-        let (period, offset, steps, deadline) = lim(match how {
-            1 => offset + 2,
-            _ => max_steps,
-        });
+        let lim = Limits {
+            max_steps: if how == 1 { offset + 2 } else { max_steps },
+            ..whole
+        };
         let (found, st) = match how {
-            2 => match explicit::run(&sub, choices, period, offset, steps, deadline) {
+            2 => match explicit::run(&sub, choices, &lim) {
                 Some(f) => (f, Stats::default()),
                 None => {
                     // too many inputs to enumerate: simulated symbolically
                     stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
-                    run(&sub, period, offset, steps, deadline)
+                    Sim::new(&sub).run(&lim)
                 }
             },
-            _ => run(&sub, period, offset, steps, deadline),
+            _ => Sim::new(&sub).run(&lim),
         };
         let found = lift(found, &c.latches, g.inputs.len(), g.latches.len());
         stats.sat_calls += st.sat_calls;
@@ -233,6 +238,7 @@ fn combine(results: Vec<Found>) -> Found {
 }
 
 /// Where a run stops and compares.
+#[derive(Clone, Copy)]
 struct Limits {
     period: u64,
     offset: u64,
