@@ -5,8 +5,7 @@
 //! these and not z3 or boolector.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use crate::ProveError;
 
@@ -67,49 +66,25 @@ pub enum Verdict {
 }
 
 /// Runs `program args`, in `dir`, returning stdout+stderr; a missing program
-/// is named.
+/// is named (through the one tool runner, `judge::tools`).
 pub fn run_tool(
     dir: &Path,
     program: &str,
     args: &[&str],
     timeout: Duration,
 ) -> Result<String, ProveError> {
-    let mut child = Command::new(program)
-        .args(args)
-        .current_dir(dir)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .map_err(|e| {
-            ProveError::Tool(format!(
-                "cannot run `{program}`: {e} (install it with `make tools`)"
-            ))
-        })?;
-    let start = Instant::now();
     // The engines take their own time limits; this one only guards a hung tool.
     // (generous: a loaded machine stretches wall time well past CPU time)
     let guard = timeout * 4 + Duration::from_secs(120);
-    loop {
-        match child.try_wait() {
-            Ok(Some(_)) => break,
-            Ok(None) if start.elapsed() > guard => {
-                let _ = child.kill();
-                let _ = child.wait();
-                return Err(ProveError::Tool(format!(
-                    "`{program}` did not finish in {} s",
-                    guard.as_secs()
-                )));
-            }
-            Ok(None) => std::thread::sleep(Duration::from_millis(20)),
-            Err(e) => return Err(ProveError::Tool(format!("`{program}`: {e}"))),
-        }
-    }
-    let out = child
-        .wait_with_output()
-        .map_err(|e| ProveError::Tool(format!("`{program}`: {e}")))?;
-    let mut text = String::from_utf8_lossy(&out.stdout).into_owned();
-    text.push_str(&String::from_utf8_lossy(&out.stderr));
-    if !out.status.success() {
+    let out = judge::tools::run(program, args, dir, guard).map_err(|e| match e {
+        judge::tools::ToolError::Missing(_) => ProveError::Tool(format!(
+            "cannot run `{program}`: not installed (install it with `make tools`)"
+        )),
+        other => ProveError::Tool(format!("`{program}`: {other}")),
+    })?;
+    let mut text = out.stdout;
+    text.push_str(&out.stderr);
+    if !out.success {
         let tail: Vec<&str> = text.lines().rev().take(12).collect();
         let tail: Vec<&str> = tail.into_iter().rev().collect();
         return Err(ProveError::Tool(format!(

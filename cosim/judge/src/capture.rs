@@ -119,32 +119,52 @@ pub fn read_progress(
             .map_err(|e| format!("{}: {}", path.display(), lut_gen::io_words(&e)))?;
         return parse_vcd(&text, path, lanes, progress);
     }
-    let tmp = tempfile::Builder::new()
-        .suffix(".vcd")
-        .tempfile()
-        .map_err(|e| format!("temporary file: {e}"))?;
-    let out = std::process::Command::new("sigrok-cli")
-        .arg("-i")
-        .arg(path)
-        .args(["-O", "vcd", "-o"])
-        .arg(tmp.path())
-        .output()
-        .map_err(|e| {
-            format!(
-                "{}: a sigrok session (.sr) is read through sigrok-cli (`make tools` installs it): {e}",
+    let vcd = sigrok_to_vcd(path)?;
+    let text = std::fs::read_to_string(&vcd).map_err(|e| format!("{}: {e}", path.display()))?;
+    parse_vcd(&text, path, lanes, progress)
+}
+
+/// Longest a `.sr` conversion may take (a capture of hundreds of MB takes
+/// tens of seconds).
+const SIGROK_LIMIT: std::time::Duration = std::time::Duration::from_secs(900);
+
+/// A `.sr` session converted to a VCD by sigrok-cli (through the one tool
+/// runner, with a time limit), in a temporary directory kept with it.
+fn sigrok_to_vcd(path: &Path) -> Result<TempVcd, String> {
+    let at = std::path::absolute(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let dir = tempfile::tempdir().map_err(|e| format!("temporary directory: {e}"))?;
+    let vcd = dir.path().join("capture.vcd");
+    let (input, output) = (at.to_string_lossy(), vcd.to_string_lossy());
+    let args = ["-i", input.as_ref(), "-O", "vcd", "-o", output.as_ref()];
+    let out = crate::tools::run("sigrok-cli", &args, dir.path(), SIGROK_LIMIT).map_err(|e| {
+        match e {
+            crate::tools::ToolError::Missing(_) => format!(
+                "{}: a sigrok session (.sr) is read through sigrok-cli, which is not installed (`make tools` installs it)",
                 path.display()
-            )
-        })?;
-    if !out.status.success() {
+            ),
+            other => format!("{}: {other}", path.display()),
+        }
+    })?;
+    if !out.success {
         return Err(format!(
             "{}: sigrok-cli cannot read it: {}",
             path.display(),
-            String::from_utf8_lossy(&out.stderr).trim()
+            out.stderr.trim()
         ));
     }
-    let text =
-        std::fs::read_to_string(tmp.path()).map_err(|e| format!("{}: {e}", path.display()))?;
-    parse_vcd(&text, path, lanes, progress)
+    Ok(TempVcd { _dir: dir, vcd })
+}
+
+/// A converted VCD and the temporary directory that holds it.
+struct TempVcd {
+    _dir: tempfile::TempDir,
+    vcd: std::path::PathBuf,
+}
+
+impl AsRef<Path> for TempVcd {
+    fn as_ref(&self) -> &Path {
+        &self.vcd
+    }
 }
 
 fn unit_ps(u: &str) -> Option<f64> {
