@@ -68,10 +68,11 @@ pub(super) fn run(g: &Aig, choices: &[usize], lim: &Limits) -> Option<Found> {
     let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
     for step in 0..max_steps {
         if step >= offset && (step - offset).is_multiple_of(period) {
-            if let Some(&since) = seen.get(&set.sorted()) {
+            let now = set.sorted();
+            if let Some(&since) = seen.get(&now) {
                 return Some(Found::Proved { steps: step, since });
             }
-            seen.insert(set.sorted(), step);
+            seen.insert(now, step);
         }
         if step.is_multiple_of(1024) && deadline.is_some_and(|d| Instant::now() > d) {
             return Some(Found::Bounded { steps: step });
