@@ -101,7 +101,7 @@ synth: tools
 bench:
 	$(CARGO) bench -p judge --bench check_vs_wellen
 	$(CARGO) bench -p lut-gen --features bench --bench synthesis
-	$(CARGO) bench -p cosim --bench cosim
+	$(CARGO) bench -p engines --bench cosim
 	$(CARGO) bench -p formal --bench engines
 
 # Long-running fuzzing of the mix parser and the VCD reader (not part of `make test`;

@@ -1,4 +1,4 @@
-//! `slotforge`: a thin CLI over the lut-gen, hdl and cosim crates.
+//! `slotforge`: a thin CLI over the lut-gen, hdl, engines and campaign crates.
 //!
 //! Exit codes follow SPEC: 0 success, 1 infeasible / divergence / difference,
 //! 2 bad input (always with file, line and field where there is one).

@@ -421,7 +421,7 @@ fn charts_all_compares_every_method_on_the_same_faults() {
             "-o",
         ])
         .arg(&out)
-        .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/mutants.toml"))
+        .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("testkit/mixes/mutants.toml"))
         .assert()
         .success();
     assert_chart_is_the_matrix(&out);

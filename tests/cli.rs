@@ -709,7 +709,7 @@ fn deep_faults_escape_every_simulation_column_and_prove_catches_them() {
     if !tools::require_tools(&["verilator", "iverilog", "yosys", "yosys-abc", "sigrok-cli"]) {
         return;
     }
-    let mix = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("cosim/tests/data/mutants.toml");
+    let mix = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("testkit/mixes/mutants.toml");
     let run = |prove: bool| {
         let mut cmd = slotforge();
         cmd.args([

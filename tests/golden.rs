@@ -328,22 +328,23 @@ fn rusthdl_verilator_and_icarus_give_identical_event_logs_on_every_preset() {
 
 fn identical_event_logs(mixes: &[PathBuf]) {
     use judge::events::{compare, EventLog, Trace};
-    let mut backends = vec![cosim::Backend::RustHdl];
+    let mut backends = vec![engines::Backend::RustHdl];
     if tools::require_tool("verilator") && tools::require_tool("g++") {
-        backends.push(cosim::Backend::Verilator);
+        backends.push(engines::Backend::Verilator);
     }
     if tools::require_tool("iverilog") {
-        backends.push(cosim::Backend::Icarus);
+        backends.push(engines::Backend::Icarus);
     }
     for mix in mixes {
         let s = lut_gen::synthesize(&lut_gen::load(mix).unwrap()).unwrap();
         let f = s.grid.frame_cycles;
-        let logs: Vec<(cosim::Backend, EventLog)> = backends
+        let logs: Vec<(engines::Backend, EventLog)> = backends
             .iter()
             .map(|&b| {
                 let mut t = Trace::default();
-                let r = cosim::run_traced(&s, b, 1, &cosim::SimOptions::default(), Some(&mut t))
-                    .unwrap();
+                let r =
+                    engines::run_traced(&s, b, 1, &engines::SimOptions::default(), Some(&mut t))
+                        .unwrap();
                 assert!(r.ok, "{} on {}: {}", s.mix.name, b.name(), r.summary());
                 (b, EventLog::from_trace(&s, &t, f))
             })

@@ -2,14 +2,13 @@
 //! `tests/tb/adc_tb.v` (a datasheet-timed AD7940 per branch, with x on MISO
 //! from 10 ns to 80 ns after every SCLK falling edge) and logs every CS fall
 //! and every output sample; this test compares the log with lut-gen's
-//! schedule.  It uses neither the hdl crate's simulator nor cosim's checker.
+//! schedule.  It uses neither the hdl crate's simulator nor the engines' checker.
 
 use crate::common_cli::{root, tiny};
 use std::path::Path;
 use std::process::Command;
 
-#[path = "tb/judge.rs"]
-mod judge;
+use testkit::tb_judge as judge;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
 use crate::tools;
@@ -132,7 +131,7 @@ fn icarus_one_cycle_reset_samples_no_unsettled_mux() {
 
 /// The presets read by AD7940s (this testbench's part); the AD7685 chain of
 /// `vibrotactile8k` is checked independently by sigrok (tests/sigrok.rs) and
-/// simulated by cosim's icarus back end with its chain model.
+/// simulated by the icarus engine with its chain model.
 #[test]
 #[ignore = "long: make test-long"]
 fn icarus_other_presets_match_the_schedule() {

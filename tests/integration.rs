@@ -44,12 +44,10 @@ mod sim_cli;
 mod tool_policy;
 
 // Shared by several test files (one copy in this binary).
-#[path = "common/tools.rs"]
-mod tools;
+use testkit::tools;
 
 // Shared by several test files (one copy in this binary).
-#[path = "common/presets.rs"]
-mod common_presets;
+use testkit::presets as common_presets;
 
 // Shared by several test files (one copy in this binary).
 #[path = "common/progress.rs"]

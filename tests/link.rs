@@ -329,7 +329,7 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
 #[test]
 fn check_without_the_model_judges_the_axis_beats_of_a_vcd() {
     let dir = tempfile::tempdir().unwrap();
-    let tiny = root().join("cosim/tests/data/tiny.toml");
+    let tiny = root().join("testkit/mixes/tiny.toml");
     let text =
         std::fs::read_to_string(tiny).unwrap() + "\n[link]\nkind = \"axis\"\nready_within = 8\n";
     let mix = dir.path().join("tiny-axis.toml");

@@ -116,7 +116,7 @@ fn a_600_hz_sine_aliases_in_the_samples() {
 #[test]
 fn every_back_end_writes_the_same_samples() {
     let dir = tempfile::tempdir().unwrap();
-    let tiny = root().join("cosim/tests/data/tiny.toml");
+    let tiny = root().join("testkit/mixes/tiny.toml");
     let (v, reference) = sim_samples(&tiny, "rusthdl", 3, "sine:1.5e3", dir.path());
     assert_eq!(
         lines_of(&reference),
@@ -142,7 +142,7 @@ fn lines_of(s: &str) -> usize {
 #[test]
 fn bad_stimulus_and_samples_paths_exit_2() {
     let dir = tempfile::tempdir().unwrap();
-    let tiny = root().join("cosim/tests/data/tiny.toml");
+    let tiny = root().join("testkit/mixes/tiny.toml");
     for (stim, msg) in [
         ("sine:", "is not a frequency"),
         ("sine:abc", "is not a frequency"),

@@ -1,4 +1,4 @@
-//! The tool-test policy of `tests/common/tools.rs` (shared with cosim's
+//! The tool-test policy of `testkit::tools` (shared with every crate's
 //! tests): a missing tool fails under CI and skips loudly elsewhere; it can
 //! never pass silently.
 

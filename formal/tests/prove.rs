@@ -5,7 +5,7 @@
 //! VCD the checker rejects at the same cycle; a fault that shows only after
 //! several frames fails too (the recurrence check sees the design keeps
 //! state across frames and the search goes deeper); a random mix from
-//! `cosim::mixgen` proves; an AXI4-Stream link's harness, a bounded search
+//! `campaign::mixgen` proves; an AXI4-Stream link's harness, a bounded search
 //! of its clean gateware and two link mutants.
 //! Long (`make test-long`): every preset and the 16-branch / 1,024-channel
 //! test mixes prove; six random mixes prove; the mutant campaign; the deep
@@ -19,13 +19,10 @@ use std::time::Instant;
 use formal::faults::DeepFault;
 use formal::{Outcome, Proof, ProveOptions};
 
-#[path = "../../cosim/tests/mutate/mod.rs"]
-#[allow(dead_code)]
-mod mutate;
+use testkit::mutate;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-#[path = "../../tests/common/tools.rs"]
-mod tools;
+use testkit::tools;
 
 const TOOLS: [&str; 4] = ["yosys", "yosys-abc", "iverilog", "vvp"];
 
@@ -117,7 +114,7 @@ fn an_output_mutant_fails_with_a_counterexample_check_rejects() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
-    let s = schedule("cosim/tests/data/mutants.toml");
+    let s = schedule("testkit/mixes/mutants.toml");
     // A stuck output: it changes a pin whatever the schedule.
     let m = mutants(&s)
         .into_iter()
@@ -134,7 +131,7 @@ fn a_fault_after_five_frames_fails_and_is_never_called_proved() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
-    let s = schedule("cosim/tests/data/mutants.toml");
+    let s = schedule("testkit/mixes/mutants.toml");
     let f = DeepFault::LateCounter { frames: 5 };
     let design = f.apply(&s, &emitted(&s)).unwrap();
     let dir = tempfile::tempdir().unwrap();
@@ -150,11 +147,11 @@ fn a_fault_after_five_frames_fails_and_is_never_called_proved() {
     );
 }
 
-/// Random mixes from the one generator (`cosim::mixgen`), on a 4 MHz clock
+/// Random mixes from the one generator (`campaign::mixgen`), on a 4 MHz clock
 /// and a 1 ms frame (4,000 cycles) so each proof takes seconds: one to
 /// three branches, one or two mux devices, SCLK, settling and rates drawn.
 fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
-    let shape = cosim::mixgen::Shape {
+    let shape = campaign::mixgen::Shape {
         clock_hz: 4_000_000,
         frame_us: 1_000,
         slice_us: 500,
@@ -167,7 +164,7 @@ fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
     };
     let mut found = Vec::new();
     for seed in 1..200u64 {
-        let text = cosim::mixgen::random_mix(seed, &shape);
+        let text = campaign::mixgen::random_mix(seed, &shape);
         let path = Path::new("random.toml");
         let Ok(mix) = lut_gen::parse(path, &text) else {
             continue;
@@ -235,7 +232,7 @@ fn harness_is_deterministic_and_names_every_contract_property() {
 /// A small AXI4-Stream mix: `tiny` (4 MHz, 4,000-cycle frame) with a
 /// slave that takes every beat within 8 cycles.
 fn tiny_axis() -> lut_gen::Schedule {
-    let path = root().join("cosim/tests/data/tiny.toml");
+    let path = root().join("testkit/mixes/tiny.toml");
     let text = std::fs::read_to_string(&path).unwrap()
         + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 8\n";
     let mix = lut_gen::parse(Path::new("tiny-axis.toml"), &text).expect("parses");
@@ -527,7 +524,7 @@ fn compact_and_full_harness_tables_agree_cycle_by_cycle() {
     if !tools::require_tools(&["iverilog", "vvp"]) {
         return;
     }
-    let s = schedule("cosim/tests/data/tiny.toml");
+    let s = schedule("testkit/mixes/tiny.toml");
     let full = formal::harness::generate_with(&s, formal::harness::TableForm::Full).unwrap();
     let compact = formal::harness::generate_with(&s, formal::harness::TableForm::Compact).unwrap();
     assert!(compact.verilog.contains("case (sis)") && compact.verilog.contains("rot0_0"));
@@ -612,7 +609,7 @@ fn mutant_campaign_every_output_changing_mutant_fails() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
-    let s = schedule("cosim/tests/data/mutants.toml");
+    let s = schedule("testkit/mixes/mutants.toml");
     let (mut failed, mut proved, mut bounded, mut power_on) = (0, 0, 0, 0);
     for m in mutants(&s) {
         let dir = tempfile::tempdir().unwrap();
@@ -648,7 +645,7 @@ fn deep_faults_escape_three_frames_of_simulation_and_fail_prove() {
     if !tools::require_tools(&["yosys", "yosys-abc", "iverilog", "vvp", "verilator"]) {
         return;
     }
-    let s = schedule("cosim/tests/data/mutants.toml");
+    let s = schedule("testkit/mixes/mutants.toml");
     for f in [
         DeepFault::LateCounter { frames: 4 },
         DeepFault::RareCollision,
@@ -657,11 +654,11 @@ fn deep_faults_escape_three_frames_of_simulation_and_fail_prove() {
         let dir = tempfile::tempdir().unwrap();
         let rtl = dir.path().join("faulty.v");
         std::fs::write(&rtl, &design).unwrap();
-        let opts = cosim::SimOptions {
+        let opts = engines::SimOptions {
             rtl: Some(rtl),
             ..Default::default()
         };
-        let sim = cosim::run(&s, cosim::Backend::Verilator, 3, &opts).expect("simulates");
+        let sim = engines::run(&s, engines::Backend::Verilator, 3, &opts).expect("simulates");
         assert!(
             sim.ok,
             "{}: three frames of simulation already catch it",
@@ -683,7 +680,7 @@ fn the_symbolic_and_abc_engines_agree() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
-    let s = schedule("cosim/tests/data/mutants.toml");
+    let s = schedule("testkit/mixes/mutants.toml");
     let stuck = mutants(&s)
         .into_iter()
         .find(|m| m.site.op == mutate::Operator::Stuck)

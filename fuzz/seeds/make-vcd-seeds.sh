@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the VCD seeds of `slotforge-fuzz vcd` from real waveforms
 # written by `slotforge sim` (model back end).  `<mix>__<window>.vcd` is
-# checked against `<mix>.toml` (looked up in mixes/, cosim/tests/data/).
+# checked against `<mix>.toml` (looked up in mixes/, testkit/mixes).
 # Usage: fuzz/seeds/make-vcd-seeds.sh [path/to/slotforge]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -12,7 +12,7 @@ trap 'rm -rf "$TMP"' EXIT
 mkdir -p "$OUT"
 
 # tiny: one whole 4000-cycle frame, clk dumped.
-"$SF" sim cosim/tests/data/tiny.toml --backend model --frames 1 --vcd "$TMP/tiny.vcd" >/dev/null
+"$SF" sim testkit/mixes/tiny.toml --backend model --frames 1 --vcd "$TMP/tiny.vcd" >/dev/null
 cp "$TMP/tiny.vcd" "$OUT/tiny__frame0.vcd"
 
 # tiny without clk: the reader infers the clock from output changes.

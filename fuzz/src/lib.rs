@@ -98,15 +98,10 @@ fn files_with_ext(dir: &Path, ext: &str, recurse: bool, out: &mut Vec<PathBuf>) 
 }
 
 /// Where the mix seeds come from: the presets and every test fixture mix.
-pub const MIX_SEED_DIRS: &[&str] = &[
-    "mixes",
-    "lut-gen/tests",
-    "hdl/tests/data",
-    "cosim/tests/data",
-];
+pub const MIX_SEED_DIRS: &[&str] = &["mixes", "lut-gen/tests", "hdl/tests/data", "testkit/mixes/"];
 
 /// Where a VCD seed's mix is looked up: `<stem>__<window>.vcd` belongs to `<stem>.toml`.
-pub const MIX_DIRS: &[&str] = &["mixes", "cosim/tests/data", "hdl/tests/data"];
+pub const MIX_DIRS: &[&str] = &["mixes", "testkit/mixes/", "hdl/tests/data"];
 
 /// The mix of a VCD named `<mix>__<anything>.vcd`.
 pub fn mix_of_vcd(root: &Path, vcd: &Path) -> Option<PathBuf> {

@@ -8,8 +8,7 @@ mod rtlsim;
 mod tools;
 
 // The workspace's one tool policy (missing tools fail under CI=true).
-#[path = "../../tests/common/tools.rs"]
-mod policy;
+use testkit::tools as policy;
 
 // Shared by several test files (one copy in this binary).
 #[path = "common/mod.rs"]

@@ -162,7 +162,7 @@ fn lints_axis_link() {
     let v = std::fs::read_to_string(dir.join("slotforge_top.v")).unwrap();
     assert!(v.contains("module slotforge_link(") && v.contains("m_axis_tready"));
     lint_in(&dir, "eskin34-axis");
-    let tiny = std::fs::read_to_string(common::root().join("cosim/tests/data/tiny.toml")).unwrap()
+    let tiny = std::fs::read_to_string(common::root().join("testkit/mixes/tiny.toml")).unwrap()
         + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 1\n";
     let mix = lut_gen::parse(Path::new("tiny-axis1.toml"), &tiny).unwrap();
     let s = lut_gen::synthesize(&mix).unwrap();

@@ -1,6 +1,6 @@
 //! Where scheduling breaks, around the user's mix: random mixes of its own
 //! clock, frame, branches and rates (the one generator,
-//! `cosim::mixgen`), from one channel to about twice its demand, each
+//! `campaign::mixgen`), from one channel to about twice its demand, each
 //! synthesized; scheduled, proved infeasible and undecided (the exact
 //! search's bound hit: `lut_gen::Verdict::Unknown`) ones drawn with different
 //! markers, the mix itself marked. An undecided mix is never counted as one
@@ -9,7 +9,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use cosim::mixgen::{random_mix, Shape};
+use campaign::mixgen::{random_mix, Shape};
 use lut_gen::Schedule;
 use report::{draw, Axes, Figure, Marker, Section, Series, Table};
 

@@ -5,7 +5,7 @@
 //! the slot boundaries; and WaveDrom JSON of one conversion with its
 //! `sample_valid` strobe.
 
-use cosim::{Backend, SimOptions};
+use engines::{Backend, SimOptions};
 use judge::run::Observer;
 use judge::vcd::CycleSink;
 use lut_gen::ports::{Layout, Pins, Role};
@@ -169,7 +169,7 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         zero: None,
         cycles: Vec::new(),
     };
-    cosim::run_observed(s, backend, 3, &SimOptions::default(), Some(&mut w))
+    engines::run_observed(s, backend, 3, &SimOptions::default(), Some(&mut w))
         .map_err(|e| e.to_string())?;
     if w.cycles.is_empty() {
         return Err("the run gave no cycles in the window".into());

@@ -1,5 +1,5 @@
 //! `slotforge faults MIX [--backend B] [--json]`: inject every class of
-//! fault at many sites across the frame (`cosim::faults`) and report what the
+//! fault at many sites across the frame (`campaign::faults`) and report what the
 //! checker caught, plus clean runs over random feasible mixes that it must
 //! not reject.
 //!
@@ -11,7 +11,7 @@
 
 use std::path::PathBuf;
 
-use cosim::faults::{campaign_with, deep_faults, Campaign, Plan, Target};
+use campaign::faults::{campaign_with, deep_faults, Campaign, Plan, Target};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -21,7 +21,7 @@ pub struct Args {
     /// model's pins: pin faults and reset glitches) or rusthdl (the
     /// gateware: also faults built into its slot ROM and counters).
     #[arg(long, default_value = "model", value_parser = super::backend)]
-    pub backend: cosim::Backend,
+    pub backend: engines::Backend,
     /// Frames per run (at least 3; faults land in frame 1).
     #[arg(long, value_parser = super::whole_number, default_value_t = 3)]
     pub frames: u64,
@@ -33,7 +33,7 @@ pub struct Args {
     /// merger collision no stimulus drives) on these Verilog engines
     /// (comma-separated: verilator, icarus).
     #[arg(long, value_delimiter = ',', value_parser = super::backend)]
-    pub engines: Vec<cosim::Backend>,
+    pub engines: Vec<engines::Backend>,
     /// `prove` as a detector of every fault that is a design (gateware and
     /// Verilog faults): seconds per fault on a small-frame mix, minutes on
     /// a 48 MHz one.
@@ -56,11 +56,11 @@ pub fn run(a: Args) -> u8 {
     if let Err(code) = super::link_fits(&s, &a.mix) {
         return code;
     }
-    // One back-end name everywhere (cosim::Backend); the campaign injects
+    // One back-end name everywhere (engines::Backend); the campaign injects
     // into the designs it can build in process.
     let target = match a.backend {
-        cosim::Backend::Model => Target::Model,
-        cosim::Backend::RustHdl => Target::Rusthdl,
+        engines::Backend::Model => Target::Model,
+        engines::Backend::RustHdl => Target::Rusthdl,
         other => {
             eprintln!(
                 "error: --backend {}: the fault campaign injects into model or rusthdl (faults built into the gateware need the design in process)",
@@ -72,7 +72,7 @@ pub fn run(a: Args) -> u8 {
     if let Some(e) = a
         .engines
         .iter()
-        .find(|e| !matches!(e, cosim::Backend::Verilator | cosim::Backend::Icarus))
+        .find(|e| !matches!(e, engines::Backend::Verilator | engines::Backend::Icarus))
     {
         eprintln!(
             "error: --engines {}: the deep faults are Verilog; they run on verilator or icarus",
@@ -101,7 +101,7 @@ pub fn run(a: Args) -> u8 {
         a.quiet,
     ));
     let shown = std::sync::Arc::clone(&progress);
-    plan.on_run = Some(cosim::faults::OnRun(std::sync::Arc::new(
+    plan.on_run = Some(campaign::faults::OnRun(std::sync::Arc::new(
         move |done, total| shown.set(done, total),
     )));
     let c = campaign_with(&s, &plan);
@@ -222,7 +222,7 @@ fn text(c: &Campaign) -> String {
         }
         for m in &k.proved_equivalent {
             let why = match m.equivalence {
-                Some(cosim::equiv::Equivalence::ContractProved) => {
+                Some(campaign::equiv::Equivalence::ContractProved) => {
                     "the faulty design proves the full pin contract for all time (prove)"
                 }
                 _ => "every output equals the clean gateware's for every input, for all time",
@@ -252,8 +252,8 @@ fn text(c: &Campaign) -> String {
 }
 
 /// The equivalence check's answer in words (not the enum's Debug form).
-fn equivalence(e: &cosim::equiv::Equivalence) -> String {
-    use cosim::equiv::Equivalence as E;
+fn equivalence(e: &campaign::equiv::Equivalence) -> String {
+    use campaign::equiv::Equivalence as E;
     match e {
         E::Proved { seconds } => format!("proved ({seconds:.1} s)"),
         E::Differs { frame: Some(f) } => format!("differs (counterexample at frame {f})"),
@@ -266,7 +266,7 @@ fn equivalence(e: &cosim::equiv::Equivalence) -> String {
 #[cfg(test)]
 mod tests {
     use super::equivalence;
-    use cosim::equiv::Equivalence;
+    use campaign::equiv::Equivalence;
 
     #[test]
     fn the_equivalence_verdict_is_words_not_the_enum() {

@@ -15,7 +15,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use cosim::{Backend, SimOptions};
+use engines::{Backend, SimOptions};
 use judge::events::{compare, EventLog, Trace};
 use judge::vcdout::{write_gtkw, VcdWriter};
 use lut_gen::Schedule;
@@ -139,7 +139,7 @@ fn window_cycles(s: &Schedule, w: &Window, reset: u64, file: &Path) -> Result<(u
             w.file
         ));
     }
-    let v = cosim::VcdOut {
+    let v = engines::VcdOut {
         path: file.to_path_buf(),
         from,
         to,
@@ -339,7 +339,7 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         .unwrap_or(0)
         .max(manifest.frames);
     let mut trace = Trace::default();
-    let report = match cosim::run_traced(&s, a.backend, frames, &opts, Some(&mut trace)) {
+    let report = match engines::run_traced(&s, a.backend, frames, &opts, Some(&mut trace)) {
         Ok(r) => r,
         Err(e) => {
             errln!(o, "error: {e}");

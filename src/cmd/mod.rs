@@ -54,8 +54,8 @@ pub fn verdict_exit(v: lut_gen::Verdict) -> u8 {
     }
 }
 
-/// The `--backend` value parser: the names `cosim::Backend` knows.
-pub fn backend(s: &str) -> Result<cosim::Backend, String> {
+/// The `--backend` value parser: the names `engines::Backend` knows.
+pub fn backend(s: &str) -> Result<engines::Backend, String> {
     s.parse()
 }
 

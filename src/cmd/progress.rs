@@ -81,7 +81,7 @@ pub struct CycleProgress<'a> {
     frame_cycles: u64,
     total: u64,
     seen: u64,
-    inner: Option<&'a mut dyn cosim::Tracer>,
+    inner: Option<&'a mut dyn engines::Tracer>,
 }
 
 impl<'a> CycleProgress<'a> {
@@ -90,7 +90,7 @@ impl<'a> CycleProgress<'a> {
         frames: u64,
         frame_cycles: u64,
         quiet: bool,
-        inner: Option<&'a mut dyn cosim::Tracer>,
+        inner: Option<&'a mut dyn engines::Tracer>,
     ) -> Self {
         let tty = std::io::stderr().is_terminal();
         let bar = (!quiet && tty).then(|| {

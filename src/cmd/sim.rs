@@ -1,15 +1,15 @@
 //! `slotforge sim MIX --backend B --frames N [--vcd F --from A --to B] [--json] [--stimulus S] [--samples F.csv] [--rtl FILE.v]`
 //!
-//! Back ends: model, rusthdl, verilator, icarus (see `cosim::Backend`);
+//! Back ends: model, rusthdl, verilator, icarus (see `engines::Backend`);
 //! `--rtl` (verilator, icarus) simulates outside Verilog whose top honours
-//! the pin contract (`cosim::rtl`).
+//! the pin contract (`engines::rtl`).
 //!
 //! Exit 0: every cycle passed; 1: a divergence or violation; 2: bad input or
 //! a missing tool.
 
 use std::path::PathBuf;
 
-use cosim::{Backend, SimOptions, Stimulus, VcdOut};
+use engines::{Backend, SimOptions, Stimulus, VcdOut};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -209,19 +209,19 @@ pub fn run(a: Args) -> u8 {
     // The slot-level model runs hours per second: no progress to show, and
     // an observer would make it run the cycle model instead.
     let result = if backend == Backend::Model && a.samples.is_none() {
-        cosim::run(&s, backend, a.frames, &opts)
+        engines::run(&s, backend, a.frames, &opts)
     } else {
         let inner = a
             .samples
             .is_some()
-            .then_some(&mut log as &mut dyn cosim::Tracer);
+            .then_some(&mut log as &mut dyn engines::Tracer);
         let mut p = super::progress::CycleProgress::new(
             a.frames,
             s.grid.frame_cycles,
             a.quiet || a.json,
             inner,
         );
-        let r = cosim::run_observed(&s, backend, a.frames, &opts, Some(&mut p));
+        let r = engines::run_observed(&s, backend, a.frames, &opts, Some(&mut p));
         p.finish();
         r
     };

@@ -17,7 +17,7 @@ pub fn root() -> PathBuf {
 
 /// A two-branch mix with a 4000-cycle frame (fast in every simulator).
 pub fn tiny() -> PathBuf {
-    root().join("cosim/tests/data/tiny.toml")
+    root().join("testkit/mixes/tiny.toml")
 }
 
 /// `golden --update` of the tiny mix (rusthdl) into `dir`: a golden that

@@ -1288,7 +1288,7 @@ mod tests {
     /// the same errors as one piece.
     #[test]
     fn chunks_cut_anywhere_read_the_same() {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml");
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/tiny.toml");
         let s = lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap();
         let d = tempfile::tempdir().unwrap();
         let vcd = d.path().join("w.vcd");

@@ -12,11 +12,10 @@ use judge::timed::check_capture;
 use lut_gen::ports::{Pins, Role};
 use lut_gen::Schedule;
 
-mod analyser;
 use analyser::{capture, check, lanes, mutate, resample_lanes, run_with_miso, Mutation};
+use testkit::analyser;
 
-#[path = "../../../tests/common/tools.rs"]
-mod tools;
+use testkit::tools;
 
 fn load(mix: &str) -> Schedule {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(mix);
@@ -64,7 +63,7 @@ fn evidence(mix: &str, frames: u64, window: (u64, u64), rates: &[(u64, u64)]) {
 #[test]
 fn analyser_captures_of_tiny_pass_and_faults_fail() {
     evidence(
-        "../tests/data/tiny.toml",
+        "../../testkit/mixes/tiny.toml",
         3,
         (5_317, 11_900),
         &[(10_000, 3_717), (41_667, 29_001)],
@@ -91,7 +90,7 @@ fn a_subset_of_pins_names_what_it_cannot_check() {
     if !tools::require_tool("sigrok-cli") {
         return;
     }
-    let s = load("../tests/data/tiny.toml");
+    let s = load("../../testkit/mixes/tiny.toml");
     let clean = run(&s, &mut ModelDut::new(&s), 3);
     let d = tempfile::tempdir().unwrap();
     let v = d.path().join("all.vcd");
@@ -130,7 +129,7 @@ fn every_fault_class_is_reported_and_a_fault_before_lock_fails_the_design() {
     if !tools::require_tool("sigrok-cli") {
         return;
     }
-    let s = load("../tests/data/tiny.toml");
+    let s = load("../../testkit/mixes/tiny.toml");
     let clean = run(&s, &mut ModelDut::new(&s), 3);
     let (_, map) = lanes(&s);
     let d = tempfile::tempdir().unwrap();
@@ -232,7 +231,7 @@ fn the_lock_takes_the_first_conversion_start_on_any_lane() {
         return;
     }
     let tiny = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/tiny.toml"),
     )
     .unwrap();
     let (head, rest) = tiny.split_once("[[branch]]").unwrap();
@@ -313,7 +312,7 @@ fn the_lock_takes_the_first_conversion_start_on_any_lane() {
 #[test]
 fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
     let tiny = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/tiny.toml"),
     )
     .unwrap();
     let d = tempfile::tempdir().unwrap();

@@ -9,7 +9,7 @@ fn mix_for(vcd: &Path) -> PathBuf {
     let name = vcd.file_name().unwrap().to_str().unwrap();
     let stem = name.split("__").next().unwrap();
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
-    [here.join("../../mixes"), here.join("../tests/data")]
+    [here.join("../../mixes"), here.join("../../testkit/mixes")]
         .iter()
         .map(|d| d.join(format!("{stem}.toml")))
         .find(|p| p.is_file())

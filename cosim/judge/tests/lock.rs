@@ -9,7 +9,7 @@ use judge::vcdout::write_run;
 use judge::{CheckOptions, LockError, VcdError};
 
 fn tiny() -> lut_gen::Schedule {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml");
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/tiny.toml");
     lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap()
 }
 

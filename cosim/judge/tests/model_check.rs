@@ -295,20 +295,20 @@ fn user_declared_part_model_passes_the_checker() {
     assert!(r.ok, "{}", r.summary());
 }
 
-/// `cosim/tests/data/tiny.toml` (4 MHz, 1 ms frames of two slices) over a
+/// `testkit/mixes/tiny.toml` (4 MHz, 1 ms frames of two slices) over a
 /// 1 Mbaud UART (4 cycles a bit): a link mix whose runs take milliseconds.
 pub(crate) fn tiny_uart() -> lut_gen::Schedule {
     tiny_with_link("baud = 1_000_000\n")
 }
 
-/// `cosim/tests/data/tiny.toml` with a UART link of these keys.
+/// `testkit/mixes/tiny.toml` with a UART link of these keys.
 fn tiny_with_link(keys: &str) -> lut_gen::Schedule {
     tiny_with("kind = \"uart\"\n", keys)
 }
 
-/// `cosim/tests/data/tiny.toml` with a `[link]` of this kind and keys.
+/// `testkit/mixes/tiny.toml` with a `[link]` of this kind and keys.
 fn tiny_with(kind: &str, keys: &str) -> lut_gen::Schedule {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/tiny.toml");
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/tiny.toml");
     let text = std::fs::read_to_string(&p).unwrap() + "\n[link]\n" + kind + keys;
     let mix = lut_gen::parse(Path::new("tiny-uart.toml"), &text).unwrap();
     let s = lut_gen::synthesize(&mix).unwrap();

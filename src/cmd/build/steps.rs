@@ -1,8 +1,8 @@
 //! The steps of `build`, by the names `--only` and `--skip` take, each a
-//! call into a library (`lut-gen`, `hdl`, `cosim`, `measure`) and the
+//! call into a library (`lut-gen`, `hdl`, `engines`, `campaign`, `measure`) and the
 //! writing of its files.
 
-use cosim::{Backend, SimOptions, VcdOut};
+use engines::{Backend, SimOptions, VcdOut};
 use lut_gen::{AuditReport, Schedule};
 use measure::tables;
 use report::Section;
@@ -285,7 +285,7 @@ fn sim(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<judge::Report>) ->
         }),
         ..SimOptions::default()
     };
-    let r = match cosim::run(s, backend, frames, &opts) {
+    let r = match engines::run(s, backend, frames, &opts) {
         Ok(r) => r,
         Err(e) => return Done::failed(format!("{e}"), ""),
     };
@@ -366,19 +366,19 @@ fn golden(j: &mut Job, a: &Args, s: &Schedule) -> Done {
 /// The campaign's plan: the model's pins (the gateware with `--thorough`);
 /// with `--charts all`, also the deep Verilog faults on every installed
 /// Verilog engine and `prove`, so the speed chart compares every method.
-fn fault_plan(a: &Args, s: &Schedule) -> Result<cosim::faults::Plan, String> {
+fn fault_plan(a: &Args, s: &Schedule) -> Result<campaign::faults::Plan, String> {
     let target = if a.thorough {
-        cosim::faults::Target::Rusthdl
+        campaign::faults::Target::Rusthdl
     } else {
-        cosim::faults::Target::Model
+        campaign::faults::Target::Model
     };
     // A fresh mix gets every class at one site (mid-frame) and one clean
     // random mix, judged by the model and the invariants, in seconds; the
     // full campaign (every site, five clean mixes, sigrok's decode) when it
     // is asked for: --only faults, --charts all, --thorough.
-    let mut plan = cosim::faults::Plan::new(target, 3, 5);
+    let mut plan = campaign::faults::Plan::new(target, 3, 5);
     if !full_campaign(a) {
-        let mid = cosim::faults::sites(s)
+        let mid = campaign::faults::sites(s)
             .into_iter()
             .filter(|x| x.name == "mid-frame");
         plan.sites = Some(mid.collect());
@@ -394,7 +394,7 @@ fn fault_plan(a: &Args, s: &Schedule) -> Result<cosim::faults::Plan, String> {
         .filter(|(tool, _)| judge::tools::present(tool))
         .map(|(_, b)| b)
         .collect();
-        plan.verilog_faults = cosim::faults::deep_faults(s, plan.frames)?;
+        plan.verilog_faults = campaign::faults::deep_faults(s, plan.frames)?;
         plan.prove = true;
     }
     Ok(plan)
@@ -405,12 +405,17 @@ fn full_campaign(a: &Args) -> bool {
     a.thorough || a.charts == Charts::All || a.only.iter().any(|n| n.trim() == "faults")
 }
 
-fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<cosim::faults::Campaign>) -> Done {
+fn faults(
+    j: &mut Job,
+    a: &Args,
+    s: &Schedule,
+    keep: &mut Option<campaign::faults::Campaign>,
+) -> Done {
     let full = full_campaign(a);
     let hook = j.runs_hook("fault campaign");
     let c = match fault_plan(a, s).and_then(|mut p| {
         p.on_run = hook;
-        cosim::faults::campaign_with(s, &p).map_err(|e| e.to_string())
+        campaign::faults::campaign_with(s, &p).map_err(|e| e.to_string())
     }) {
         Ok(c) => c,
         Err(e) => return Done::failed(e, ""),
@@ -545,7 +550,7 @@ fn figure7(s: &Schedule) -> Done {
 }
 
 /// Drawn from the fault step's campaign of this build, nothing else.
-fn speed(c: Option<&cosim::faults::Campaign>) -> Done {
+fn speed(c: Option<&campaign::faults::Campaign>) -> Done {
     let Some(c) = c else {
         return Done::skipped(
             "draws the fault campaign of this build, and the faults step did not run",

@@ -17,15 +17,14 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use cosim::faults::{campaign_with, Campaign, Detector, Plan, Target, VerilogFault};
+use campaign::faults::{campaign_with, Campaign, Detector, Plan, Target, VerilogFault};
 
-mod mutate;
 use mutate::Operator;
+use testkit::mutate;
 
 // The independent testbench's verdict, shared with the root tests/icarus.rs.
-#[path = "../../tests/tb/judge.rs"]
-mod judge;
 use judge::judge;
+use testkit::tb_judge as judge;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
 use crate::tools;
@@ -157,11 +156,11 @@ fn every_mutant_the_independent_testbench_rejects_is_rejected_by_check() {
         return;
     }
     let t0 = Instant::now();
-    let mix = lut_gen::load(&manifest().join("tests/data/mutants.toml")).unwrap();
+    let mix = lut_gen::load(&manifest().join("../../testkit/mixes/mutants.toml")).unwrap();
     let s = lut_gen::synthesize(&mix).unwrap();
     let bench = Bench {
         cycles: s.grid.frame_cycles * 5 / 2 + 50,
-        tb: manifest().join("../tests/tb/adc_tb.v"),
+        tb: manifest().join("../../tests/tb/adc_tb.v"),
         mix,
         s,
     };
@@ -281,10 +280,10 @@ fn every_mutant_the_independent_testbench_rejects_is_rejected_by_check() {
 fn mutant_plan(
     s: &lut_gen::Schedule,
     per_op: &[(Operator, usize)],
-    engines: &[cosim::Backend],
+    engines: &[engines::Backend],
     prove: bool,
 ) -> Plan {
-    let original = cosim::rusthdl::verilog(s).unwrap();
+    let original = engines::rusthdl::verilog(s).unwrap();
     let mut plan = Plan::new(Target::Model, 3, 0);
     plan.builtin = false;
     plan.prove = prove;
@@ -336,15 +335,16 @@ fn a_few_mutants_run_through_the_campaign_on_icarus() {
     if !tools::require_tools(&["iverilog", "yosys", "yosys-abc"]) {
         return;
     }
-    let s =
-        lut_gen::synthesize(&lut_gen::load(&manifest().join("tests/data/mutants.toml")).unwrap())
-            .unwrap();
+    let s = lut_gen::synthesize(
+        &lut_gen::load(&manifest().join("../../testkit/mixes/mutants.toml")).unwrap(),
+    )
+    .unwrap();
     // stuck outputs: they change a pin whatever the schedule, so no
     // equivalence check (up to 90 s each) runs in the default suite
     let plan = mutant_plan(
         &s,
         &[(Operator::Stuck, 2)],
-        &[cosim::Backend::Icarus],
+        &[engines::Backend::Icarus],
         false,
     );
     assert_eq!(plan.verilog_faults.len(), 2);
@@ -362,7 +362,7 @@ fn a_few_mutants_run_through_the_campaign_on_icarus() {
     assert_eq!(stuck.proved_equivalent.len(), 1, "{stuck:?}");
     assert!(matches!(
         stuck.proved_equivalent[0].equivalence,
-        Some(cosim::equiv::Equivalence::Proved { .. })
+        Some(campaign::equiv::Equivalence::Proved { .. })
     ));
     assert!(c.column(Detector::Prove).unwrap().not_run.is_some());
 }
@@ -375,13 +375,14 @@ fn the_mutant_campaign_through_every_detector_and_prove() {
     if !tools::require_tools(&["verilator", "iverilog", "yosys", "yosys-abc", "sigrok-cli"]) {
         return;
     }
-    let s =
-        lut_gen::synthesize(&lut_gen::load(&manifest().join("tests/data/mutants.toml")).unwrap())
-            .unwrap();
+    let s = lut_gen::synthesize(
+        &lut_gen::load(&manifest().join("../../testkit/mixes/mutants.toml")).unwrap(),
+    )
+    .unwrap();
     let plan = mutant_plan(
         &s,
         &PER_OP,
-        &[cosim::Backend::Verilator, cosim::Backend::Icarus],
+        &[engines::Backend::Verilator, engines::Backend::Icarus],
         true,
     );
     let t = Instant::now();

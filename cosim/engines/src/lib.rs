@@ -1,36 +1,29 @@
-//! cosim: the simulation engines that run slotforge's gateware and hand
+//! engines: the simulation engines that run slotforge's gateware and hand
 //! its pins to the judge.
 //!
-//! The judge (reference model, ADC model, checker, VCD I/O) is the `judge`
-//! crate beside this one, which never sees `hdl`; this crate depends on both
-//! and holds the back ends:
+//! The judge (reference model, ADC model, checker, waveform I/O) is the
+//! `judge` crate beside this one, which never sees `hdl`; this crate depends
+//! on both and holds the back ends:
 //!
 //! - [`run`] ([`backend`]): one dispatch over [`Backend`]: `model` (the
 //!   judge's slot-level model), `rusthdl` ([`rusthdl`]: `hdl::RtlSim` in
 //!   process), `verilator` ([`verilator`]: the emitted Verilog verilated at
 //!   run time), `icarus` ([`icarus`]: the emitted Verilog in Icarus with a
 //!   Verilog ADC, its VCD read by the judge);
-//! - [`faults`]: the fault campaign (pin faults, reset glitches and faults
-//!   built into the gateware, at many sites; false alarms over random mixes),
-//!   judged by each detector apart: a matrix of fault class x detector;
-//! - [`sigrok`]: sigrok-cli's SPI decode of the pins as a detector;
-//! - [`equiv`]: a faulty gateware proved equivalent to the clean one at the
-//!   ports (yosys miter, ABC), or not; [`tools`]: the one runner of those tools;
 //! - [`rtl`]: outside Verilog for the verilator and icarus back ends
 //!   (`SimOptions::rtl`), its top's ports checked against the pin contract;
 //! - [`SimOptions`] / [`SimError`]: what a run is asked to do and why it
 //!   could not run.
+//!
+//! The fault campaign and the detectors that are not engines (sigrok, port
+//! equivalence) are the `campaign` crate above this one.
 
 pub mod backend;
-pub mod equiv;
 pub mod error;
-pub mod faults;
 pub mod icarus;
-pub mod mixgen;
 pub mod options;
 pub mod rtl;
 pub mod rusthdl;
-pub mod sigrok;
 pub mod verilator;
 
 pub use backend::{run, run_observed, run_traced, Tracer};

@@ -7,9 +7,7 @@
 //! - tool missing outside CI: a loud multi-line warning on stderr, then the
 //!   test skips (returns early).
 //!
-//! Shared by the root tests (`#[path = "common/tools.rs"]`) and those of
-//! cosim, the judge, hdl and formal (`#[path = "../../tests/common/tools.rs"]`
-//! or deeper); whether a tool is there is `judge::tools::present`, the
+//! Shared by the tests of every crate (`testkit::tools`); whether a tool is there is `judge::tools::present`, the
 //! library's one test. The decision table itself is tested in
 //! `tests/tool_policy.rs`.
 #![allow(dead_code)]

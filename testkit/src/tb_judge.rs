@@ -1,6 +1,6 @@
 //! The verdict of the independent Icarus testbench (`tests/tb/adc_tb.v`) on
-//! its log, shared by `tests/icarus.rs` and `cosim/tests/mutants.rs`.  It
-//! reads only the mix and lut-gen's schedule: nothing from `hdl` or `cosim`.
+//! its log, shared by `tests/icarus.rs` and `cosim/campaign/tests/mutants.rs`.  It
+//! reads only the mix and lut-gen's schedule: nothing from `hdl` or the engines.
 
 use std::collections::BTreeMap;
 

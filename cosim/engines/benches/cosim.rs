@@ -13,9 +13,9 @@
 use std::path::Path;
 use std::time::Instant;
 
-use cosim::rusthdl::{verilog, RustHdlDut};
-use cosim::verilator::VerilatedDut;
-use cosim::Stimulus;
+use engines::rusthdl::{verilog, RustHdlDut};
+use engines::verilator::VerilatedDut;
+use engines::Stimulus;
 use judge::run::{run_dut, run_model, run_unchecked, ModelDut, RunOptions};
 use judge::vcdout::write_run;
 
@@ -30,7 +30,7 @@ fn main() {
         .skip(1)
         .find_map(|a| a.parse().ok())
         .unwrap_or(10);
-    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml");
+    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../mixes/eskin34.toml");
     let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
     let cycles = frames * s.grid.frame_cycles;
     let real = frames as f64 * s.mix.frame_us as f64 * 1e-6;

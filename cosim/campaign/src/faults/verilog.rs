@@ -17,8 +17,8 @@ use serde::Serialize;
 
 use super::{parallel, Cost, Detector, Injection, Judged, Judgement, Runs};
 use crate::equiv::Equivalence;
-use crate::options::{Backend, SimOptions};
 use crate::sigrok::SpiCapture;
+use engines::options::{Backend, SimOptions};
 
 /// A faulty design as Verilog text (a `slotforge_top` on the pin contract).
 #[derive(Debug, Clone)]
@@ -34,7 +34,7 @@ pub struct VerilogFault {
 /// frame `frames` (just past a run of `frames` frames), `rare-collision`
 /// needs two equal codes back to back, which the stimuli never give.
 pub fn deep_faults(s: &Schedule, frames: u64) -> Result<Vec<VerilogFault>, String> {
-    let clean = crate::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+    let clean = engines::rusthdl::verilog(s).map_err(|e| e.to_string())?;
     [
         formal::faults::DeepFault::LateCounter { frames },
         formal::faults::DeepFault::RareCollision,
@@ -117,12 +117,12 @@ pub(super) fn judge_verilog(
         ..SimOptions::default()
     };
     let mut cap = SpiCapture::new(s, reset_cycles(s, opts.reset_cycles));
-    let report = crate::run_observed(
+    let report = engines::run_observed(
         s,
         engine,
         frames,
         &opts,
-        sigrok.then_some(&mut cap as &mut dyn crate::Tracer),
+        sigrok.then_some(&mut cap as &mut dyn engines::Tracer),
     )
     .map_err(|e| e.to_string())?;
     let mut j = Judged {
@@ -148,7 +148,7 @@ pub(super) fn verilog_injections(
     prove: bool,
     count: &Runs,
 ) -> Result<Vec<Judgement>, String> {
-    let clean = crate::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+    let clean = engines::rusthdl::verilog(s).map_err(|e| e.to_string())?;
     let mut jobs = Vec::new();
     for f in faults {
         for &e in engines {
@@ -242,7 +242,7 @@ pub(super) fn clean_engine_run(
     frames: u64,
     sigrok: bool,
 ) -> Result<(u64, f64, Option<String>), String> {
-    let clean = crate::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+    let clean = engines::rusthdl::verilog(s).map_err(|e| e.to_string())?;
     let j = judge_verilog(s, engine, &clean, frames, sigrok)?;
     let why = if !j.report.ok {
         Some(j.report.summary())

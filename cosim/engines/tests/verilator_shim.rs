@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use cosim::verilator::VerilatedDut;
+use engines::verilator::VerilatedDut;
 use judge::run::{run_dut, RunOptions};
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
@@ -32,8 +32,10 @@ fn standin_builds_loads_caches_and_is_checked() {
     let cache = tempfile::tempdir().unwrap();
     std::env::set_var("SLOTFORGE_CACHE", cache.path());
     let s = lut_gen::synthesize(
-        &lut_gen::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/tiny.toml"))
-            .unwrap(),
+        &lut_gen::load(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/tiny.toml"),
+        )
+        .unwrap(),
     )
     .unwrap();
     let (mut dut, built) = VerilatedDut::new(STANDIN).unwrap();

@@ -29,10 +29,10 @@ use lut_gen::Schedule;
 use serde::Serialize;
 
 use crate::equiv::Equivalence;
-use crate::error::SimError;
-use crate::options::Backend;
-use crate::rusthdl::RustHdlDut;
 use crate::sigrok::SpiCapture;
+use engines::error::SimError;
+use engines::options::Backend;
+use engines::rusthdl::RustHdlDut;
 
 mod verilog;
 pub use verilog::{deep_faults, prove, prove_unavailable, ProveVerdict, VerilogFault};

@@ -1,5 +1,5 @@
 //! Issue 17's judgement on unseen mixes: captures of the gateware (hdl's
-//! RtlSim) of random mixes (`cosim::mixgen`), as a logic analyser records
+//! RtlSim) of random mixes (`campaign::mixgen`), as a logic analyser records
 //! them (resampled at 24 and 100 MHz with an arbitrary phase, from the
 //! middle of a frame, no clock or reset, channels D0..Dn), pass the
 //! time-level check as sigrok `.sr` sessions and as sigrok-cli's VCD; the
@@ -10,9 +10,8 @@ use std::path::Path;
 
 use judge::timed::check_capture;
 
-#[path = "../judge/tests/analyser/mod.rs"]
-mod analyser;
 use crate::tools;
+use testkit::analyser;
 
 use analyser::{capture, check, lanes, mutate, resample, run, to_sigrok, Mutation};
 
@@ -23,7 +22,7 @@ fn mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
     let mut k = seed;
     while v.len() < n {
         k += 1;
-        let text = cosim::faults::random_mix(k);
+        let text = campaign::faults::random_mix(k);
         let Ok(mix) = lut_gen::parse(Path::new("random.toml"), &text) else {
             continue;
         };
@@ -51,7 +50,7 @@ fn captures_of_random_mixes(seed: u64, n: usize, classes: usize) {
         // Over two frame boundaries: a branch may start converting late in
         // the window, and a fault of the frame's length shows at a boundary.
         let window = (f * 37 / 100 + k % 97, f * 293 / 100);
-        let mut dut = cosim::rusthdl::RustHdlDut::new(&s).unwrap();
+        let mut dut = engines::rusthdl::RustHdlDut::new(&s).unwrap();
         let clean = run(&s, &mut dut, 3);
         let (_, map) = lanes(&s);
         // 100 MHz and 24 MHz analysers, their phases drawn from the seed.
@@ -75,10 +74,10 @@ fn captures_of_random_mixes(seed: u64, n: usize, classes: usize) {
         // Mutated gateware: one design-level fault of every class.
         let reference = d.path().join(format!("ref{k}.vcd"));
         resample(&s, &clean, window.0, window.1, 10_000, 3_333, &reference);
-        let faults = cosim::faults::one_gateware_fault_per_class(&s);
+        let faults = campaign::faults::one_gateware_fault_per_class(&s);
         assert!(!faults.is_empty(), "mix {k}: no gateware fault");
         for (class, fault) in faults.into_iter().take(classes) {
-            let Ok(mut bad) = cosim::faults::gateware_dut(&s, fault) else {
+            let Ok(mut bad) = campaign::faults::gateware_dut(&s, fault) else {
                 continue;
             };
             let pins = run(&s, &mut bad, 3);

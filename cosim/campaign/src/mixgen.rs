@@ -122,7 +122,8 @@ mod tests {
     /// are mixes (they parse), so the schedulability chart has points.
     #[test]
     fn mixes_around_the_reference_design_parse() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml");
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../mixes/eskin34.toml");
         let text = std::fs::read_to_string(&path).unwrap();
         let mix = lut_gen::parse(&path, &text).unwrap();
         let shape = Shape::around(&mix, 423);

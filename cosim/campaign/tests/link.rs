@@ -20,7 +20,7 @@ impl Dut for Sim {
 }
 
 fn preset() -> Schedule {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../mixes/eskin34-uart.toml");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../mixes/eskin34-uart.toml");
     lut_gen::synthesize(&lut_gen::load(std::path::Path::new(path)).unwrap()).unwrap()
 }
 
@@ -81,13 +81,19 @@ fn the_link_runs_clean_in_icarus() {
         return;
     }
     let s = preset();
-    let r = cosim::run(&s, cosim::Backend::Icarus, 1, &cosim::SimOptions::default()).unwrap();
+    let r = engines::run(
+        &s,
+        engines::Backend::Icarus,
+        1,
+        &engines::SimOptions::default(),
+    )
+    .unwrap();
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.samples, s.samples_per_frame() - s.startup_skips());
 }
 
 fn axis_preset() -> Schedule {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../mixes/eskin34-axis.toml");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../mixes/eskin34-axis.toml");
     lut_gen::synthesize(&lut_gen::load(std::path::Path::new(path)).unwrap()).unwrap()
 }
 
@@ -137,20 +143,20 @@ fn axis_runs_clean_on_verilator_and_icarus_under_back_pressure() {
     ];
     let mut runs = Vec::new();
     if tools::require_tools(&["verilator", "g++"]) {
-        runs.push((cosim::Backend::Verilator, axis_preset(), 1));
+        runs.push((engines::Backend::Verilator, axis_preset(), 1));
     }
     if tools::require_tool("iverilog") {
-        runs.push((cosim::Backend::Icarus, tiny_axis(), 2));
+        runs.push((engines::Backend::Icarus, tiny_axis(), 2));
     }
     for (engine, s, frames) in runs {
         for tready in patterns {
             let what = format!("{} tready {}", engine.name(), tready.name());
-            let opts = cosim::SimOptions {
+            let opts = engines::SimOptions {
                 tready,
-                ..cosim::SimOptions::default()
+                ..engines::SimOptions::default()
             };
             let mut beats = Beats::default();
-            let r = cosim::run_observed(&s, engine, frames, &opts, Some(&mut beats)).unwrap();
+            let r = engines::run_observed(&s, engine, frames, &opts, Some(&mut beats)).unwrap();
             assert!(r.ok, "{what}: {}", r.summary());
             assert!(r.model_compared, "{what}");
             assert!(beats.stalls > 10, "{what}: {} stalls", beats.stalls);
@@ -196,10 +202,10 @@ fn axis_pin_faults_under_back_pressure_break_the_stability_rule() {
     }
 }
 
-/// `cosim/tests/data/tiny.toml` (4 MHz, 1 ms frames) with `link`
+/// `testkit/mixes/tiny.toml` (4 MHz, 1 ms frames) with `link`
 /// appended: a link mix whose runs take milliseconds.
 fn tiny_with(link: &str) -> Schedule {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/tiny.toml");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testkit/mixes/tiny.toml");
     let text = std::fs::read_to_string(path).unwrap() + "\n[link]\n" + link;
     let mix = lut_gen::parse(std::path::Path::new("tiny-link.toml"), &text).unwrap();
     lut_gen::synthesize(&mix).unwrap()
@@ -228,7 +234,7 @@ fn is_link_port(name: &str) -> bool {
 /// rules only).  The same run without the fault passes.
 #[test]
 fn every_link_pin_fault_is_caught_by_its_detector() {
-    use cosim::faults::{Detector, TREADY};
+    use campaign::faults::{Detector, TREADY};
     use judge::faults::{Fault, FaultyDut};
     for s in [tiny_uart(), tiny_axis()] {
         let opts = RunOptions::default();
@@ -297,7 +303,7 @@ fn a_short_axis_fifo_overflows_under_the_campaigns_slave() {
     let s = tiny_axis();
     let opts = RunOptions::default();
     for (pattern, caught) in [
-        (cosim::faults::TREADY, true),
+        (campaign::faults::TREADY, true),
         (link::ReadyPattern::Always, false),
     ] {
         let sim = Sim(hdl::RtlSim::with_fault(&s, hdl::GatewareFault::LinkFifoShort).unwrap());
@@ -316,7 +322,7 @@ fn a_short_axis_fifo_overflows_under_the_campaigns_slave() {
 #[test]
 #[ignore = "long: make test-long"]
 fn the_presets_campaigns_report_every_link_class_caught() {
-    use cosim::faults::{campaign_with, sites, Detector, Plan, Target};
+    use campaign::faults::{campaign_with, sites, Detector, Plan, Target};
     for s in [preset(), axis_preset()] {
         let mut plan = Plan::new(Target::Model, 3, 0);
         plan.sites = Some(

@@ -2,13 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
-use cosim::{run, Backend, SimOptions};
+use engines::{run, Backend, SimOptions};
 
-#[path = "../../tests/common/presets.rs"]
-mod common_presets;
+use testkit::presets as common_presets;
 
 fn mixes() -> Vec<PathBuf> {
-    common_presets::presets(&Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+    common_presets::presets(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
 }
 
 fn schedule(p: &Path) -> lut_gen::Schedule {
@@ -70,7 +69,7 @@ fn largest_mixes_one_frame() {
     let verilator = tools::require_tools(&["verilator", "g++"]);
     for name in ["full300", "b16", "ch1024"] {
         let p =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../hdl/tests/data/{name}.toml"));
+            Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../hdl/tests/data/{name}.toml"));
         let s = schedule(&p);
         let mut backends = vec![Backend::RustHdl];
         if verilator {
@@ -96,7 +95,7 @@ fn largest_mixes_one_frame() {
 #[test]
 fn cnv_chain_and_cs_parts_on_rusthdl_and_verilator() {
     cnv_chain_and_cs_parts(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cnvmix2ms.toml"),
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/cnvmix2ms.toml"),
         false,
     );
 }
@@ -105,7 +104,7 @@ fn cnv_chain_and_cs_parts_on_rusthdl_and_verilator() {
 #[ignore = "long: make test-long"]
 fn cnv_chain_and_cs_parts_on_every_engine() {
     cnv_chain_and_cs_parts(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/cnvmix2ms.toml"),
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/cnvmix2ms.toml"),
         true,
     );
 }
@@ -114,7 +113,7 @@ fn cnv_chain_and_cs_parts_on_every_engine() {
 #[ignore = "long: make test-long"]
 fn cnv_chain_and_cs_parts_on_every_engine_10ms_frame() {
     cnv_chain_and_cs_parts(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../hdl/tests/data/cnvmix.toml"),
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../hdl/tests/data/cnvmix.toml"),
         true,
     );
 }

@@ -1,5 +1,5 @@
 //! What a logic analyser records of a run, for the capture tests of the
-//! judge and of cosim (random mixes): every cycle's pins resampled at the
+//! judge and of the campaign (random mixes): every cycle's pins resampled at the
 //! analyser's rate with an arbitrary phase, from the middle of a run, no
 //! clock or reset, channels D0..Dn; sigrok-cli's `.sr` and VCD of it; and
 //! faults made on the recorded pins.

@@ -1,10 +1,10 @@
-//! The equivalence check behind "proved equivalent" (`cosim::equiv`): it
+//! The equivalence check behind "proved equivalent" (`campaign::equiv`): it
 //! must prove what is equivalent and refute what is not, or the campaign's
 //! "proved equivalent" column would excuse misses.
 
 use std::path::PathBuf;
 
-use cosim::equiv::{check, Equivalence};
+use campaign::equiv::{check, Equivalence};
 use hdl::GatewareFault;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
@@ -12,7 +12,7 @@ use crate::tools;
 
 fn schedule(name: &str) -> lut_gen::Schedule {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
+        .join("../../testkit/mixes")
         .join(name);
     lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap()
 }
@@ -64,7 +64,7 @@ fn a_wrong_rom_word_is_not_equivalent() {
 /// ABC's answers as the campaign reads them.
 #[test]
 fn abc_output_is_read_as_proved_differs_or_undecided() {
-    use cosim::equiv::verdict;
+    use campaign::equiv::verdict;
     assert!(matches!(
         verdict("Property proved.  Time = 0.02 sec\n", 0.1),
         Equivalence::Proved { .. }

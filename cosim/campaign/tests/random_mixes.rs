@@ -22,7 +22,7 @@ fn random_feasible_mixes_from(seeds: std::ops::Range<u64>) {
     let drawn = (seeds.end - seeds.start) as usize;
     let mut tested = 0;
     for seed in seeds {
-        let text = cosim::faults::random_mix(seed);
+        let text = campaign::faults::random_mix(seed);
         let Ok(mix) = lut_gen::parse(Path::new("rand.toml"), &text) else {
             continue;
         };
@@ -38,9 +38,15 @@ fn random_feasible_mixes_from(seeds: std::ops::Range<u64>) {
         let r = run_dut(&s, &mut ModelDut::new(&s), 2, &opts, "model", None);
         assert!(r.ok, "seed {seed}:\n{text}\n{}", r.summary());
         assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
-        let m = cosim::run(&s, cosim::Backend::Model, 10, &cosim::SimOptions::default()).unwrap();
+        let m = engines::run(
+            &s,
+            engines::Backend::Model,
+            10,
+            &engines::SimOptions::default(),
+        )
+        .unwrap();
         assert!(m.ok, "seed {seed}: {}", m.summary());
-        if let Ok(mut dut) = cosim::RustHdlDut::new(&s) {
+        if let Ok(mut dut) = engines::RustHdlDut::new(&s) {
             let r = run_dut(&s, &mut dut, 2, &opts, "rusthdl", None);
             assert!(r.ok, "seed {seed} rusthdl:\n{text}\n{}", r.summary());
         }

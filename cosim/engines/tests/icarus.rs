@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use cosim::{Backend, SimOptions, Stimulus, VcdOut};
+use engines::{Backend, SimOptions, Stimulus, VcdOut};
 use judge::run::{run_dut, Observer, RunOptions};
 use judge::vcd::{read_cycles, CycleSink};
 use judge::Pins;
@@ -14,7 +14,7 @@ use crate::tools;
 
 fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
+        .join("../../testkit/mixes")
         .join(name)
 }
 
@@ -65,7 +65,7 @@ fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
             }),
             ..SimOptions::default()
         };
-        let r = cosim::run(&s, Backend::Icarus, 3, &opts).unwrap();
+        let r = engines::run(&s, Backend::Icarus, 3, &opts).unwrap();
         assert!(r.ok, "{stimulus:?}: {}", r.summary());
         assert_eq!(r.source, "icarus");
         assert!(r.model_compared);
@@ -75,7 +75,7 @@ fn icarus_backend_matches_cosims_adc_model_on_a_small_mix() {
         let mut ic = Samples::default();
         read_cycles(&s, &wave, None, &mut ic).unwrap();
         let mut rh = Samples::default();
-        let mut dut = cosim::RustHdlDut::new(&s).unwrap();
+        let mut dut = engines::RustHdlDut::new(&s).unwrap();
         let ro = RunOptions {
             stimulus,
             ..RunOptions::default()
@@ -112,7 +112,7 @@ fn icarus_backend_vcd_windows() {
             }),
             ..SimOptions::default()
         };
-        let r = cosim::run(&s, Backend::Icarus, 3, &opts).unwrap();
+        let r = engines::run(&s, Backend::Icarus, 3, &opts).unwrap();
         assert!(r.ok, "{}", r.summary());
         let cycles = judge::vcd::parse_only(&s, &wave, None).unwrap();
         let reset = judge::run::reset_cycles(&s, opts.reset_cycles);
@@ -134,13 +134,13 @@ fn icarus_backend_eskin34_one_frame() {
     if !tools::require_tool("iverilog") {
         return;
     }
-    let s = schedule(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../mixes/eskin34.toml"));
+    let s = schedule(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../mixes/eskin34.toml"));
     // a one-cycle reset (docs/timing.md, "Start-up")
     let opts = SimOptions {
         reset_cycles: 1,
         ..SimOptions::default()
     };
-    let r = cosim::run(&s, Backend::Icarus, 1, &opts).unwrap();
+    let r = engines::run(&s, Backend::Icarus, 1, &opts).unwrap();
     assert!(r.ok, "{}", r.summary());
     assert_eq!(r.frames, 1);
     assert_eq!(r.samples, s.samples_per_frame() - s.startup_skips());

@@ -1,0 +1,14 @@
+//! All of this crate's integration tests in one binary: each test file is
+//! a module here, so the workspace is linked once, not once per file.
+
+#[path = "backends.rs"]
+mod backends;
+
+#[path = "icarus.rs"]
+mod icarus;
+
+#[path = "verilator_shim.rs"]
+mod verilator_shim;
+
+// Shared by several test files (one copy in this binary).
+use testkit::tools;

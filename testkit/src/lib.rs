@@ -1,0 +1,31 @@
+//! testkit: the test helpers several of slotforge's crates share, so no test
+//! includes another crate's file by path.
+//!
+//! - [`tools`]: the rule for tests that drive external tools (run, skip
+//!   loudly, or fail under `CI`);
+//! - [`presets`]: every preset mix;
+//! - [`mix`]: the shared test mixes in `testkit/mixes/`;
+//! - [`tb_judge`]: the verdict of the independent Icarus testbench
+//!   (`tests/tb/adc_tb.v`) on its log;
+//! - [`mutate`]: the Verilog mutator (mutation testing of the checkers);
+//! - [`analyser`]: logic-analyser captures made from a run's pins.
+
+pub mod analyser;
+pub mod mutate;
+pub mod presets;
+pub mod tb_judge;
+pub mod tools;
+
+use std::path::{Path, PathBuf};
+
+/// The repository's root.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// A shared test mix, `testkit/mixes/<name>.toml`.
+pub fn mix(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("mixes")
+        .join(format!("{name}.toml"))
+}
