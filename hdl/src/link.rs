@@ -248,107 +248,116 @@ impl UartLink {
 /// The registers after one clock edge (the UART's, or with `p.axis` the
 /// AXIS master's, whose slave drives `tready` in the cycle the edge ends).
 fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bool) {
-    {
-        let p = *p;
-        let bnd = r.pos == 0;
-        let push = bnd || valid;
-        let last_tick = r.dv + 1 == p.div;
-        let ready = match p.axis {
-            None => !r.busy || (last_tick && r.bitn + 1 == p.char_bits()),
-            Some(_) => !r.busy || tready,
-        };
-        let load = ready && r.have;
-        let pop = !r.have && r.n != 0;
-        let room = r.n < p.depth || pop;
-        let slot = r.mask.trailing_zeros();
-        let rest = r.mask & r.mask.wrapping_sub(1);
-        let byte = match slot {
-            0 => 0x5A,
-            1 => r.ovfc,
-            2 => r.crc as u8,
-            3 => (r.crc >> 8) as u8,
-            4 => 0xA5,
-            5 => r.hframe,
-            6 => (r.hslice >> 8) as u8,
-            7 => r.hslice as u8,
-            8 => ((r.tok >> 24) & 3) as u8,
-            9 => (r.tok >> 16) as u8,
-            10 => (r.tok >> 8) as u8,
-            _ => r.tok as u8,
-        };
-        // next state, from the values before the edge
-        let mut nx = r.clone();
-        nx.pos = if r.pos + 1 == p.slice_cycles {
-            0
+    let p = *p;
+    let bnd = r.pos == 0;
+    let push = bnd || valid;
+    let last_tick = r.dv + 1 == p.div;
+    let ready = match p.axis {
+        None => !r.busy || (last_tick && r.bitn + 1 == p.char_bits()),
+        Some(_) => !r.busy || tready,
+    };
+    let load = ready && r.have;
+    let pop = !r.have && r.n != 0;
+    let room = r.n < p.depth || pop;
+    // next state, from the values before the edge
+    let mut nx = r.clone();
+    nx.pos = if r.pos + 1 == p.slice_cycles {
+        0
+    } else {
+        r.pos + 1
+    };
+    if pop {
+        let t = r.mem[r.rd];
+        nx.tok = t;
+        nx.rd = (r.rd + 1) % p.depth;
+        nx.have = true;
+        let b = t >> 27 & 1 == 1;
+        let s = t >> 26 & 1 == 1;
+        nx.mask = (if s { 0xF00 } else { 0 })
+            | (if b { 0x0F0 } else { 0 })
+            | (if b && r.started { 0x00F } else { 0 });
+    }
+    if push {
+        if room {
+            nx.mem[r.wr] = (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
+            nx.wr = (r.wr + 1) % p.depth;
         } else {
-            r.pos + 1
-        };
-        if pop {
-            let t = r.mem[r.rd];
-            nx.tok = t;
-            nx.rd = (r.rd + 1) % p.depth;
-            nx.have = true;
-            let b = t >> 27 & 1 == 1;
-            let s = t >> 26 & 1 == 1;
-            nx.mask = (if s { 0xF00 } else { 0 })
-                | (if b { 0x0F0 } else { 0 })
-                | (if b && r.started { 0x00F } else { 0 });
+            nx.ovfc = r.ovfc.saturating_add(1);
+            nx.ovf = true;
         }
-        if push {
-            if room {
-                nx.mem[r.wr] = (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
-                nx.wr = (r.wr + 1) % p.depth;
-            } else {
-                nx.ovfc = r.ovfc.saturating_add(1);
-                nx.ovf = true;
-            }
-        }
-        nx.n = r.n + (push && room) as usize - pop as usize;
-        if r.busy && p.axis.is_some() {
-            nx.busy = !tready;
-        } else if r.busy {
-            if last_tick {
-                nx.dv = 0;
-                if r.bitn + 1 == p.char_bits() {
-                    nx.busy = false;
-                    nx.tx = true;
-                } else {
-                    nx.bitn = r.bitn + 1;
-                    nx.tx = r.chr >> 1 & 1 == 1;
-                    nx.chr = r.chr >> 1;
-                }
-            } else {
-                nx.dv = r.dv + 1;
-            }
-        }
-        if load {
-            nx.chr = p.frame(byte);
-            nx.busy = true;
-            nx.bitn = 0;
+    }
+    nx.n = r.n + (push && room) as usize - pop as usize;
+    shift(&p, r, &mut nx, tready, last_tick);
+    if load {
+        load_byte(&p, r, &mut nx);
+    }
+    *r = nx;
+}
+
+/// The byte in transit: one more bit period (UART) or the beat taken (AXIS).
+fn shift(p: &LinkParams, r: &Regs, nx: &mut Regs, tready: bool, last_tick: bool) {
+    if r.busy && p.axis.is_some() {
+        nx.busy = !tready;
+    } else if r.busy {
+        if last_tick {
             nx.dv = 0;
-            nx.tx = p.axis.is_some();
-            nx.tdata = byte;
-            // the trailer of a frame's last slice goes out when the next
-            // header's slice has wrapped to 0
-            nx.tlast = slot == 3 && (p.axis == Some(link::Tlast::Slice) || r.hslice == 0);
-            nx.mask = rest;
-            nx.have = rest != 0;
-            match slot {
-                2 | 3 => {}
-                4 => nx.crc = crc8(p.crc_init, byte),
-                _ => nx.crc = crc8(r.crc, byte),
+            if r.bitn + 1 == p.char_bits() {
+                nx.busy = false;
+                nx.tx = true;
+            } else {
+                nx.bitn = r.bitn + 1;
+                nx.tx = r.chr >> 1 & 1 == 1;
+                nx.chr = r.chr >> 1;
             }
-            if slot == 7 {
-                nx.started = true;
-                if r.hslice as u64 + 1 == p.slices_per_frame {
-                    nx.hslice = 0;
-                    nx.hframe = r.hframe.wrapping_add(1);
-                } else {
-                    nx.hslice = r.hslice + 1;
-                }
-            }
+        } else {
+            nx.dv = r.dv + 1;
         }
-        *r = nx;
+    }
+}
+
+/// The next byte of the packet (the lowest slot left in `r.mask`) starts
+/// out; the CRC and the header's frame/slice counters follow it.
+fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
+    let slot = r.mask.trailing_zeros();
+    let rest = r.mask & r.mask.wrapping_sub(1);
+    let byte = match slot {
+        0 => 0x5A,
+        1 => r.ovfc,
+        2 => r.crc as u8,
+        3 => (r.crc >> 8) as u8,
+        4 => 0xA5,
+        5 => r.hframe,
+        6 => (r.hslice >> 8) as u8,
+        7 => r.hslice as u8,
+        8 => ((r.tok >> 24) & 3) as u8,
+        9 => (r.tok >> 16) as u8,
+        10 => (r.tok >> 8) as u8,
+        _ => r.tok as u8,
+    };
+    nx.chr = p.frame(byte);
+    nx.busy = true;
+    nx.bitn = 0;
+    nx.dv = 0;
+    nx.tx = p.axis.is_some();
+    nx.tdata = byte;
+    // the trailer of a frame's last slice goes out when the next
+    // header's slice has wrapped to 0
+    nx.tlast = slot == 3 && (p.axis == Some(link::Tlast::Slice) || r.hslice == 0);
+    nx.mask = rest;
+    nx.have = rest != 0;
+    match slot {
+        2 | 3 => {}
+        4 => nx.crc = crc8(p.crc_init, byte),
+        _ => nx.crc = crc8(r.crc, byte),
+    }
+    if slot == 7 {
+        nx.started = true;
+        if r.hslice as u64 + 1 == p.slices_per_frame {
+            nx.hslice = 0;
+            nx.hframe = r.hframe.wrapping_add(1);
+        } else {
+            nx.hslice = r.hslice + 1;
+        }
     }
 }
 
@@ -391,16 +400,66 @@ fn width(n: u64) -> usize {
     (64 - n.leading_zeros() as usize).max(1)
 }
 
+/// The link's register and counter widths.
+#[derive(Clone, Copy)]
+struct Widths {
+    /// Slice position, FIFO address, FIFO count.
+    pw: usize,
+    aw: usize,
+    nw: usize,
+    /// UART only: bit-period divider, bits per character, bit counter.
+    dw: usize,
+    cb: usize,
+    bw: usize,
+}
+
+/// A `w`-bit decimal literal.
+fn lit(w: usize, v: u64) -> String {
+    format!("{w}'d{v}")
+}
+
 fn link_verilog(p: &LinkParams) -> String {
     let mut s = String::new();
-    let pw = width(p.slice_cycles - 1);
-    let aw = width(p.depth as u64 - 1);
-    let nw = width(p.depth as u64);
-    let dw = width(p.div as u64 - 1);
     let cb = p.char_bits() as usize;
-    let bw = width(cb as u64 - 1);
+    let w = Widths {
+        pw: width(p.slice_cycles - 1),
+        aw: width(p.depth as u64 - 1),
+        nw: width(p.depth as u64),
+        dw: width(p.div as u64 - 1),
+        cb,
+        bw: width(cb as u64 - 1),
+    };
+    declarations(&mut s, p, w);
+    wires(&mut s, p, w);
+    byte_out(&mut s);
+    crc_and_character(&mut s, p, w);
+    let _ = writeln!(s, "always @(posedge clock) begin\n  if (rst) begin");
+    register_reset(&mut s, p, w);
+    fifo_update(&mut s, p, w);
+    transmitter_update(&mut s, p, w);
+    let _ = writeln!(s, "  end\nend\n");
+    if p.axis.is_some() {
+        let _ = writeln!(
+            s,
+            "always @(*) begin\n  tdata = tdata_r;\n  tvalid = busy;\n  tlast = tlast_r;\n  ovf = ovf_r;\nend"
+        );
+    } else {
+        let _ = writeln!(s, "always @(*) begin\n  tx = tx_r;\n  ovf = ovf_r;\nend");
+    }
+    s
+}
+
+/// What the link is, then its registers with their initial values.
+fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
+    let Widths {
+        pw,
+        aw,
+        nw,
+        dw,
+        cb,
+        bw,
+    } = w;
     let tb = TOKEN_BITS;
-    let last = |w: usize, v: u64| format!("{w}'d{v}");
     let axis = p.axis.is_some();
     if axis {
         let _ = writeln!(
@@ -415,7 +474,7 @@ fn link_verilog(p: &LinkParams) -> String {
             p.div, p.depth
         );
     }
-    let _ = writeln!(s, "reg [{}:0] pos;\ninitial pos = {};", pw - 1, last(pw, 0));
+    let _ = writeln!(s, "reg [{}:0] pos;\ninitial pos = {};", pw - 1, lit(pw, 0));
     let _ = writeln!(s, "reg [{}:0] mem [0:{}];", tb - 1, p.depth - 1);
     for (n, w) in [("wr", aw), ("rd", aw), ("n", nw)] {
         let _ = writeln!(s, "reg [{}:0] {n};\ninitial {n} = {w}'d0;", w - 1);
@@ -452,26 +511,37 @@ fn link_verilog(p: &LinkParams) -> String {
             cb - 1
         );
     }
-    let _ = writeln!(s, "wire bnd = pos == {};", last(pw, 0));
+}
+
+/// The handshake and FIFO wires of one cycle.
+fn wires(s: &mut String, p: &LinkParams, w: Widths) {
+    let Widths {
+        pw, nw, dw, cb, bw, ..
+    } = w;
+    let tb = TOKEN_BITS;
+    let _ = writeln!(s, "wire bnd = pos == {};", lit(pw, 0));
     let _ = writeln!(s, "wire push = bnd | valid;");
-    if axis {
+    if p.axis.is_some() {
         // a beat is taken at an edge where tvalid and tready are high
         let _ = writeln!(s, "wire ready = !busy | tready;");
     } else {
-        let _ = writeln!(s, "wire last_tick = dv == {};", last(dw, p.div as u64 - 1));
+        let _ = writeln!(s, "wire last_tick = dv == {};", lit(dw, p.div as u64 - 1));
         let _ = writeln!(
             s,
             "wire ready = !busy | (last_tick & (bitn == {}));",
-            last(bw, cb as u64 - 1)
+            lit(bw, cb as u64 - 1)
         );
     }
     let _ = writeln!(s, "wire load = ready & have;");
     let _ = writeln!(s, "wire pop = !have & (n != {nw}'d0);");
-    let _ = writeln!(s, "wire room = (n < {}) | pop;", last(nw, p.depth as u64));
+    let _ = writeln!(s, "wire room = (n < {}) | pop;", lit(nw, p.depth as u64));
     let _ = writeln!(s, "wire [11:0] rest = mask & (mask - 12'd1);");
     let _ = writeln!(s, "wire [{}:0] head = mem[rd];", tb - 1);
     let _ = writeln!(s, "wire [{}:0] token = {{bnd, valid, ch, val}};", tb - 1);
-    // the lowest byte slot still to send
+}
+
+/// The lowest byte slot still to send, and that byte.
+fn byte_out(s: &mut String) {
     let _ = writeln!(s, "reg [3:0] slot;\nalways @(*) begin\n  casez (mask)");
     for i in 0..12 {
         let pat: String = (0..12)
@@ -511,6 +581,11 @@ fn link_verilog(p: &LinkParams) -> String {
         s,
         "    4'd9: byte_out = tok[23:16];\n    4'd10: byte_out = tok[15:8];\n    default: byte_out = tok[7:0];\n  endcase\nend\n"
     );
+}
+
+/// The CRC after the outgoing byte, and (UART) its character with start,
+/// parity and stop bits.
+fn crc_and_character(s: &mut String, p: &LinkParams, w: Widths) {
     // CRC-16/MODBUS of one byte
     let _ = writeln!(
         s,
@@ -527,16 +602,22 @@ fn link_verilog(p: &LinkParams) -> String {
         2 => "~^byte_out, ",
         _ => "",
     };
-    if !axis {
+    if p.axis.is_none() {
         let _ = writeln!(
             s,
             "wire [{}:0] chr_load = {{{stops}{parity}byte_out, 1'b0}};\n",
-            cb - 1
+            w.cb - 1
         );
     }
-    let _ = writeln!(s, "always @(posedge clock) begin\n  if (rst) begin");
-    let _ = writeln!(s, "    pos <= {};", last(pw, p.slice_cycles - 1));
-    let out_reset = if axis {
+}
+
+/// The reset branch of the register update.
+fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
+    let Widths {
+        pw, aw, nw, dw, bw, ..
+    } = w;
+    let _ = writeln!(s, "    pos <= {};", lit(pw, p.slice_cycles - 1));
+    let out_reset = if p.axis.is_some() {
         "    tdata_r <= 8'd0;\n    tlast_r <= 1'b0;".to_string()
     } else {
         format!("    bitn <= {bw}'d0;\n    dv <= {dw}'d0;\n    tx_r <= 1'b1;")
@@ -545,17 +626,23 @@ fn link_verilog(p: &LinkParams) -> String {
         s,
         "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    mask <= 12'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= 16'd0;\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n{out_reset}\n  end else begin"
     );
+}
+
+/// The slice position and the token FIFO: push, pop, overflow, count.
+fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
+    let Widths { pw, aw, nw, .. } = w;
+    let tb = TOKEN_BITS;
     let _ = writeln!(
         s,
         "    pos <= (pos == {}) ? {} : pos + {};",
-        last(pw, p.slice_cycles - 1),
-        last(pw, 0),
-        last(pw, 1)
+        lit(pw, p.slice_cycles - 1),
+        lit(pw, 0),
+        lit(pw, 1)
     );
     let wrap = |r: &str| {
         format!(
             "({r} == {}) ? {aw}'d0 : {r} + {aw}'d1",
-            last(aw, p.depth as u64 - 1)
+            lit(aw, p.depth as u64 - 1)
         )
     };
     let _ = writeln!(
@@ -582,13 +669,19 @@ fn link_verilog(p: &LinkParams) -> String {
         }
     };
     let _ = writeln!(s, "    n <= n + {} - {};", zext("push & room"), zext("pop"));
-    if axis {
+}
+
+/// The byte in transit (bit periods or the beat taken), and the next byte's
+/// load with the CRC and header counters.
+fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
+    let Widths { dw, cb, bw, .. } = w;
+    if p.axis.is_some() {
         let _ = writeln!(s, "    if (busy & tready) busy <= 1'b0;");
     } else {
         let _ = writeln!(
         s,
         "    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (bitn == {}) begin\n          busy <= 1'b0;\n          tx_r <= 1'b1;\n        end else begin\n          bitn <= bitn + {bw}'d1;\n          tx_r <= chr[1];\n          chr <= chr >> 1;\n        end\n      end else dv <= dv + {dw}'d1;\n    end",
-        last(bw, cb as u64 - 1)
+        lit(bw, cb as u64 - 1)
     );
     }
     let load_out = match p.axis {
@@ -607,14 +700,4 @@ fn link_verilog(p: &LinkParams) -> String {
         "    if (load) begin\n{load_out}\n      busy <= 1'b1;\n      mask <= rest;\n      have <= rest != 12'd0;\n      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == 16'd{}) begin\n          hslice <= 16'd0;\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + 16'd1;\n      end\n    end",
         p.slices_per_frame - 1
     );
-    let _ = writeln!(s, "  end\nend\n");
-    if axis {
-        let _ = writeln!(
-            s,
-            "always @(*) begin\n  tdata = tdata_r;\n  tvalid = busy;\n  tlast = tlast_r;\n  ovf = ovf_r;\nend"
-        );
-    } else {
-        let _ = writeln!(s, "always @(*) begin\n  tx = tx_r;\n  ovf = ovf_r;\nend");
-    }
-    s
 }

@@ -221,6 +221,34 @@ impl CompactRom {
 /// Like [`plan`], with the slot LUT form chosen by the caller.
 pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
     let g = &s.grid;
+    let compact = check_grid(s, form)?;
+    // words per round of the merger: one per chained part of every branch
+    let words: u64 = s.mix.branches.iter().map(|b| b.chain as u64).sum();
+    let mut seqs: Vec<SeqTiming> = Vec::new();
+    let mut branches = Vec::with_capacity(s.branches.len());
+    let mut en_offset = 0usize;
+    for b in 0..s.branches.len() {
+        let rom = branch_rom(s, b, compact, words, en_offset, &mut seqs)?;
+        en_offset += rom.devices;
+        branches.push(rom);
+    }
+    Ok(Plan {
+        compact,
+        slots_per_slice: g.slots_per_slice,
+        slices_per_frame: g.slices_per_frame,
+        slot_cycles: g.slot_cycles,
+        frame_slots: g.frame_slots,
+        channel_bits: s.channel_bits(),
+        seqs,
+        branches,
+        link: crate::link::LinkParams::of(s).map_err(unsupported)?,
+    })
+}
+
+/// The grid against the gateware's counters and ROMs; whether the slot LUT
+/// is compact (`form`, or for `Auto` whether the full one would be too big).
+fn check_grid(s: &Schedule, form: LutForm) -> Result<bool, HdlError> {
+    let g = &s.grid;
     let nb = s.branches.len();
     // branch, channel and device counts: the pin contract's limits
     lut_gen::ports::Layout::fits(s).map_err(unsupported)?;
@@ -267,215 +295,251 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
             "frame table size does not match the grid".into(),
         ));
     }
-    let aw = addr_bits(g.frame_slots);
-    // words per round of the merger: one per chained part of every branch
-    let words: u64 = s.mix.branches.iter().map(|b| b.chain as u64).sum();
-    let mut seqs: Vec<SeqTiming> = Vec::new();
-    let mut branches = Vec::with_capacity(nb);
-    let mut en_offset = 0usize;
-    for (b, bp) in s.branches.iter().enumerate() {
-        let adc = &s.mix.branches[b].adc;
-        let chain = s.mix.branches[b].chain;
-        let cnv = adc.start == lut_gen::parts::Start::Cnv;
-        let spi = &bp.spi;
-        let sclks = adc.word_sclks() as u64 * chain as u64;
-        // What the sequencer's counters and the word reader can hold.
-        if adc.bits < 1 || adc.bits > lut_gen::ports::SAMPLE_VALUE_BITS {
+    Ok(compact)
+}
+
+/// Branch `b`'s ROM image and reset values; its SPI timing joins `seqs`
+/// (one sequencer per distinct timing).  `words`: the merger's words per
+/// round; `en_offset`: its first mux enable among all branches'.
+fn branch_rom(
+    s: &Schedule,
+    b: usize,
+    compact: bool,
+    words: u64,
+    en_offset: usize,
+    seqs: &mut Vec<SeqTiming>,
+) -> Result<BranchRom, HdlError> {
+    let g = &s.grid;
+    let bp = &s.branches[b];
+    let adc = &s.mix.branches[b].adc;
+    let chain = s.mix.branches[b].chain;
+    let cnv = adc.start == lut_gen::parts::Start::Cnv;
+    let spi = &bp.spi;
+    check_spi(s, b, words)?;
+    let devices = bp.mux_devices.max(1) as usize;
+    let timing = SeqTiming {
+        sclk_div: spi.sclk_div,
+        sclk_half: spi.sclk_half,
+        setup_cycles: spi.setup_cycles,
+        read_cycles: spi.read_cycles,
+        cnv,
+        sclks: adc.word_sclks() as u64 * chain as u64,
+        word_sclks: adc.word_sclks() as u64,
+        leading_bits: adc.leading_bits as u64,
+        bits: adc.bits as u64,
+    };
+    let seq = match seqs.iter().position(|t| *t == timing) {
+        Some(i) => i,
+        None => {
+            seqs.push(timing);
+            seqs.len() - 1
+        }
+    };
+    let slots: Vec<Option<usize>> = (0..g.frame_slots).map(|t| s.at(t, b)).collect();
+    for c in slots.iter().flatten() {
+        let ch = &s.channels[*c];
+        if ch.select > 7 || ch.device as usize >= devices {
             return Err(unsupported(format!(
-                "branch {}: ADC {} has {} data bits: the gateware carries 1 to {}",
-                bp.name,
-                adc.name,
-                adc.bits,
-                lut_gen::ports::SAMPLE_VALUE_BITS
+                "branch {}: channel device {} select {} outside the branch's muxes",
+                bp.name, ch.device, ch.select
             )));
         }
-        if adc.word_sclks() > MAX_WORD_SCLKS as u32 {
-            return Err(unsupported(format!(
-                "branch {}: ADC {} takes {} serial clocks per word: the gateware counts at most {MAX_WORD_SCLKS}",
-                bp.name,
-                adc.name,
-                adc.word_sclks()
-            )));
-        }
-        if chain < 1 || chain as u64 > MAX_CHAIN || sclks > MAX_SCLKS {
-            return Err(unsupported(format!(
-                "branch {}: a chain of {chain} x {} serial clocks: the gateware reads at most {MAX_CHAIN} words and {MAX_SCLKS} clocks per conversion",
-                bp.name,
-                adc.word_sclks()
-            )));
-        }
-        if !cnv && adc.leading_bits < 1 {
-            // A CS part drives its first bit before any SCLK edge: the
-            // master has no edge to capture it at (docs/timing.md).
-            return Err(unsupported(format!(
-                "branch {}: CS-style ADC {} needs at least one leading bit before its MSB",
-                bp.name, adc.name
-            )));
-        }
-        if spi.sclk_div < 2 || spi.sclk_div > MAX_SCLK_DIV || spi.sclk_div % 2 != 0 {
-            return Err(unsupported(format!(
-                "branch {}: SCLK divider {} must be even and in 2..={MAX_SCLK_DIV}",
-                bp.name, spi.sclk_div
-            )));
-        }
-        if spi.sclk_half * 2 != spi.sclk_div {
-            return Err(unsupported(format!(
-                "branch {}: sclk_half {} is not sclk_div/2",
-                bp.name, spi.sclk_half
-            )));
-        }
-        if spi.setup_cycles < 1 || spi.setup_cycles > MAX_SETUP_CYCLES {
-            return Err(unsupported(format!(
-                "branch {}: conversion start to first SCLK of {} cycles must be within 1..={MAX_SETUP_CYCLES}",
-                bp.name, spi.setup_cycles
-            )));
-        }
-        if spi.read_cycles != spi.setup_cycles + sclks * spi.sclk_div {
-            return Err(unsupported(format!(
-                "branch {}: read_cycles {} != setup + {sclks} * sclk_div",
-                bp.name, spi.read_cycles
-            )));
-        }
-        // The branch's shift register and channel register hold a result
-        // until the merger has taken every word (at most one word of every
-        // branch's chain before each of this branch's words, after the
-        // completion at t + R); the next slot must not start before.
-        if spi.read_cycles + words > g.slot_cycles {
-            return Err(unsupported(format!(
-                "branch {}: a conversion ({} cycles) plus the merger's {words} cycles does not fit in a slot ({} cycles)",
-                bp.name, spi.read_cycles, g.slot_cycles
-            )));
-        }
-        let devices = bp.mux_devices.max(1) as usize;
-        let timing = SeqTiming {
-            sclk_div: spi.sclk_div,
-            sclk_half: spi.sclk_half,
-            setup_cycles: spi.setup_cycles,
-            read_cycles: spi.read_cycles,
-            cnv,
-            sclks,
-            word_sclks: adc.word_sclks() as u64,
-            leading_bits: adc.leading_bits as u64,
-            bits: adc.bits as u64,
-        };
-        let seq = match seqs.iter().position(|t| *t == timing) {
-            Some(i) => i,
-            None => {
-                seqs.push(timing);
-                seqs.len() - 1
+    }
+    let members = chain_members(s, b, &slots)?;
+    let next = next_instants(&slots);
+    let mut rom = BranchRom {
+        words: vec![],
+        addr_bits: addr_bits(g.frame_slots),
+        ch_bits: s.channel_bits().max(1) as usize,
+        dev_bits: addr_bits(devices as u64),
+        seq,
+        reset_sel: 0,
+        reset_en: 0,
+        // docs/timing.md, "Start-up": the mux takes its reset value at
+        // the first reset edge, one cycle before cycle 0 at the least;
+        // an instant at cycle 0 it cannot have settled for is skipped.
+        conv0: slots[0].is_some() && bp.settle_cycles <= 1,
+        devices,
+        en_offset,
+        cnv,
+        bits: adc.bits,
+        chain,
+        members,
+        compact: None,
+    };
+    fill_rom(s, &mut rom, &slots, &next, compact);
+    if let Some(c) = next[0] {
+        rom.reset_sel = s.channels[c].select;
+        rom.reset_en = 1u64 << s.channels[c].device;
+    }
+    Ok(rom)
+}
+
+/// Branch `b`'s part and SPI timing against what the sequencer's counters,
+/// the word reader and the slot can hold.
+fn check_spi(s: &Schedule, b: usize, words: u64) -> Result<(), HdlError> {
+    let g = &s.grid;
+    let bp = &s.branches[b];
+    let adc = &s.mix.branches[b].adc;
+    let chain = s.mix.branches[b].chain;
+    let cnv = adc.start == lut_gen::parts::Start::Cnv;
+    let spi = &bp.spi;
+    let sclks = adc.word_sclks() as u64 * chain as u64;
+    if adc.bits < 1 || adc.bits > lut_gen::ports::SAMPLE_VALUE_BITS {
+        return Err(unsupported(format!(
+            "branch {}: ADC {} has {} data bits: the gateware carries 1 to {}",
+            bp.name,
+            adc.name,
+            adc.bits,
+            lut_gen::ports::SAMPLE_VALUE_BITS
+        )));
+    }
+    if adc.word_sclks() > MAX_WORD_SCLKS as u32 {
+        return Err(unsupported(format!(
+            "branch {}: ADC {} takes {} serial clocks per word: the gateware counts at most {MAX_WORD_SCLKS}",
+            bp.name,
+            adc.name,
+            adc.word_sclks()
+        )));
+    }
+    if chain < 1 || chain as u64 > MAX_CHAIN || sclks > MAX_SCLKS {
+        return Err(unsupported(format!(
+            "branch {}: a chain of {chain} x {} serial clocks: the gateware reads at most {MAX_CHAIN} words and {MAX_SCLKS} clocks per conversion",
+            bp.name,
+            adc.word_sclks()
+        )));
+    }
+    if !cnv && adc.leading_bits < 1 {
+        // A CS part drives its first bit before any SCLK edge: the
+        // master has no edge to capture it at (docs/timing.md).
+        return Err(unsupported(format!(
+            "branch {}: CS-style ADC {} needs at least one leading bit before its MSB",
+            bp.name, adc.name
+        )));
+    }
+    if spi.sclk_div < 2 || spi.sclk_div > MAX_SCLK_DIV || !spi.sclk_div.is_multiple_of(2) {
+        return Err(unsupported(format!(
+            "branch {}: SCLK divider {} must be even and in 2..={MAX_SCLK_DIV}",
+            bp.name, spi.sclk_div
+        )));
+    }
+    if spi.sclk_half * 2 != spi.sclk_div {
+        return Err(unsupported(format!(
+            "branch {}: sclk_half {} is not sclk_div/2",
+            bp.name, spi.sclk_half
+        )));
+    }
+    if spi.setup_cycles < 1 || spi.setup_cycles > MAX_SETUP_CYCLES {
+        return Err(unsupported(format!(
+            "branch {}: conversion start to first SCLK of {} cycles must be within 1..={MAX_SETUP_CYCLES}",
+            bp.name, spi.setup_cycles
+        )));
+    }
+    if spi.read_cycles != spi.setup_cycles + sclks * spi.sclk_div {
+        return Err(unsupported(format!(
+            "branch {}: read_cycles {} != setup + {sclks} * sclk_div",
+            bp.name, spi.read_cycles
+        )));
+    }
+    // The branch's shift register and channel register hold a result
+    // until the merger has taken every word (at most one word of every
+    // branch's chain before each of this branch's words, after the
+    // completion at t + R); the next slot must not start before.
+    if spi.read_cycles + words > g.slot_cycles {
+        return Err(unsupported(format!(
+            "branch {}: a conversion ({} cycles) plus the merger's {words} cycles does not fit in a slot ({} cycles)",
+            bp.name, spi.read_cycles, g.slot_cycles
+        )));
+    }
+    Ok(())
+}
+
+/// A chained conversion delivers one word per member, every one named by a
+/// channel (the word reader has no way to skip a word): per lead channel of
+/// branch `b` (its conversions in `slots`), the channels of its members.
+fn chain_members(
+    s: &Schedule,
+    b: usize,
+    slots: &[Option<usize>],
+) -> Result<Vec<(u32, Vec<u32>)>, HdlError> {
+    let chain = s.mix.branches[b].chain;
+    let mut members: Vec<(u32, Vec<u32>)> = Vec::new();
+    if chain > 1 {
+        for &lead in slots.iter().flatten() {
+            if members.iter().any(|(l, _)| *l as usize == lead) {
+                continue;
             }
-        };
-        let slots: Vec<Option<usize>> = (0..g.frame_slots).map(|t| s.at(t, b)).collect();
-        for c in slots.iter().flatten() {
-            let ch = &s.channels[*c];
-            if ch.select > 7 || ch.device as usize >= devices {
+            let group = &s.groups[lead];
+            let chans: Vec<u32> = (0..chain as usize)
+                .filter_map(|m| group.get(m).copied().flatten().map(|c| c as u32))
+                .collect();
+            if chans.len() != chain as usize {
                 return Err(unsupported(format!(
-                    "branch {}: channel device {} select {} outside the branch's muxes",
-                    bp.name, ch.device, ch.select
+                    "branch {}: the conversion of channel {} reads {chain} chained words but only {} of them are declared channels: the gateware needs a channel for every member",
+                    s.branches[b].name,
+                    s.mix.channels[lead].name,
+                    chans.len()
                 )));
             }
+            members.push((lead as u32, chans));
         }
-        // A chained conversion delivers one word per member, every one
-        // named by a channel (the word reader has no way to skip a word).
-        let mut members: Vec<(u32, Vec<u32>)> = Vec::new();
-        if chain > 1 {
-            for &lead in slots.iter().flatten() {
-                if members.iter().any(|(l, _)| *l as usize == lead) {
-                    continue;
-                }
-                let group = &s.groups[lead];
-                let chans: Vec<u32> = (0..chain as usize)
-                    .filter_map(|m| group.get(m).copied().flatten().map(|c| c as u32))
-                    .collect();
-                if chans.len() != chain as usize {
-                    return Err(unsupported(format!(
-                        "branch {}: the conversion of channel {} reads {chain} chained words but only {} of them are declared channels: the gateware needs a channel for every member",
-                        bp.name,
-                        s.mix.channels[lead].name,
-                        chans.len()
-                    )));
-                }
-                members.push((lead as u32, chans));
-            }
-            members.sort();
-        }
-        // next[u]: the channel of the first instant at slot u or later (cyclic).
-        let n = slots.len();
-        let mut next: Vec<Option<usize>> = vec![None; n];
-        let mut cur: Option<usize> = None;
-        for u in (0..2 * n).rev() {
-            if let Some(c) = slots[u % n] {
-                cur = Some(c);
-            }
-            if u < n {
-                next[u] = cur;
-            }
-        }
-        let mut rom = BranchRom {
-            words: vec![],
-            addr_bits: aw,
-            ch_bits: cw,
-            dev_bits: addr_bits(devices as u64),
-            seq,
-            reset_sel: 0,
-            reset_en: 0,
-            // docs/timing.md, "Start-up": the mux takes its reset value at
-            // the first reset edge, one cycle before cycle 0 at the least;
-            // an instant at cycle 0 it cannot have settled for is skipped.
-            conv0: slots[0].is_some() && bp.settle_cycles <= 1,
-            devices,
-            en_offset,
-            cnv,
-            bits: adc.bits,
-            chain,
-            members,
-            compact: None,
-        };
-        let mux = |c: Option<usize>| match c {
-            Some(c) => (s.channels[c].select, s.channels[c].device),
-            None => (0, 0),
-        };
-        if compact {
-            // The word of slot u carries the mux field of the next instant
-            // *after* slot u: the branch moves it to the mux one slot later.
-            let table: Vec<u32> = (0..n)
-                .map(|u| {
-                    let (sel, dev) = mux(next[(u + 1) % n]);
-                    rom.word(slots[u].is_some(), slots[u].unwrap_or(0) as u32, sel, dev)
-                })
-                .collect();
-            let c = compact_words(&table, sps as usize, k as usize, rom.word_bits());
-            debug_assert!((0..n).all(|u| c.word(
-                u % sps as usize,
-                u / sps as usize,
-                rom.word_bits()
-            ) == table[u]));
-            rom.compact = Some(c);
-        } else {
-            let mut words = vec![0u32; 1 << aw];
-            for u in 0..n {
-                let (sel, dev) = mux(next[u]);
-                let ch = slots[u].unwrap_or(0) as u32;
-                words[u] = rom.word(slots[u].is_some(), ch, sel, dev);
-            }
-            rom.words = words;
-        }
-        if let Some(c) = next[0] {
-            rom.reset_sel = s.channels[c].select;
-            rom.reset_en = 1u64 << s.channels[c].device;
-        }
-        branches.push(rom);
-        en_offset += devices;
+        members.sort();
     }
-    Ok(Plan {
-        compact,
-        slots_per_slice: sps,
-        slices_per_frame: k,
-        slot_cycles: g.slot_cycles,
-        frame_slots: g.frame_slots,
-        channel_bits: s.channel_bits(),
-        seqs,
-        branches,
-        link: crate::link::LinkParams::of(s).map_err(unsupported)?,
-    })
+    Ok(members)
+}
+
+/// `next[u]`: the channel of the first instant at slot `u` or later (cyclic).
+fn next_instants(slots: &[Option<usize>]) -> Vec<Option<usize>> {
+    let n = slots.len();
+    let mut next: Vec<Option<usize>> = vec![None; n];
+    let mut cur: Option<usize> = None;
+    for u in (0..2 * n).rev() {
+        if let Some(c) = slots[u % n] {
+            cur = Some(c);
+        }
+        if u < n {
+            next[u] = cur;
+        }
+    }
+    next
+}
+
+/// The ROM's words: the full frame table, or its compact form.
+fn fill_rom(
+    s: &Schedule,
+    rom: &mut BranchRom,
+    slots: &[Option<usize>],
+    next: &[Option<usize>],
+    compact: bool,
+) {
+    let g = &s.grid;
+    let (sps, k) = (g.slots_per_slice, g.slices_per_frame);
+    let n = slots.len();
+    let mux = |c: Option<usize>| match c {
+        Some(c) => (s.channels[c].select, s.channels[c].device),
+        None => (0, 0),
+    };
+    if compact {
+        // The word of slot u carries the mux field of the next instant
+        // *after* slot u: the branch moves it to the mux one slot later.
+        let table: Vec<u32> = (0..n)
+            .map(|u| {
+                let (sel, dev) = mux(next[(u + 1) % n]);
+                rom.word(slots[u].is_some(), slots[u].unwrap_or(0) as u32, sel, dev)
+            })
+            .collect();
+        let c = compact_words(&table, sps as usize, k as usize, rom.word_bits());
+        debug_assert!(
+            (0..n).all(|u| c.word(u % sps as usize, u / sps as usize, rom.word_bits()) == table[u])
+        );
+        rom.compact = Some(c);
+    } else {
+        let mut words = vec![0u32; 1 << rom.addr_bits];
+        for u in 0..n {
+            let (sel, dev) = mux(next[u]);
+            let ch = slots[u].unwrap_or(0) as u32;
+            words[u] = rom.word(slots[u].is_some(), ch, sel, dev);
+        }
+        rom.words = words;
+    }
 }

@@ -1,6 +1,6 @@
 //! Register widths of the fixed-maximum core, in one place that both the
 //! planner (`plan.rs`, which checks a schedule against them) and the
-//! rust-hdl blocks (`core.rs`, which are built at them) read.  The lane
+//! rust-hdl blocks (`core/`, which are built at them) read.  The lane
 //! counts come from the pin contract's limits (`lut_gen::ports::limits`).
 
 pub use lut_gen::ports::limits::{MAX_BRANCHES, MAX_CHANNELS, MAX_DEVICES, MAX_DEVICES_PER_BRANCH};

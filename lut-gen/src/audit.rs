@@ -5,14 +5,14 @@
 //! Everything here is measured on the frame table itself (not on the
 //! synthesizer's intentions), so the audit doubles as a second opinion.
 
-use std::fmt::Write as _;
-
 use serde::Serialize;
 
 use crate::lut::CompactLut;
 use crate::parts::cycles_to_ns;
 use crate::schedule::{Placement, Schedule};
 use crate::synth::Infeasible;
+
+mod text;
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AuditReport {
@@ -222,7 +222,6 @@ impl AuditReport {
         let mix = &s.mix;
         let mut warnings = Vec::new();
         let mut errors = Vec::new();
-        let mut notes = Vec::new();
 
         // Instants per branch over one frame, straight from the table.
         let branch_slots: Vec<Vec<u64>> = (0..nb)
@@ -233,195 +232,18 @@ impl AuditReport {
             })
             .collect();
 
-        let mut channels = Vec::new();
-        for (c, ch) in mix.channels.iter().enumerate() {
-            let slots: Vec<u64> = branch_slots[ch.branch]
-                .iter()
-                .copied()
-                // A chain member is read in its lead's conversions.
-                .filter(|&t| s.at(t, ch.branch) == Some(mix.lead_of(c)))
-                .collect();
-            let n = slots.len();
-            let intervals: Vec<u64> = (0..n)
-                .map(|i| {
-                    let next = if i + 1 < n {
-                        slots[i + 1]
-                    } else {
-                        slots[0] + g.frame_slots
-                    };
-                    (next - slots[i]) * g.slot_cycles
-                })
-                .collect();
-            let (lo, hi) = (
-                intervals.iter().min().copied().unwrap_or(0),
-                intervals.iter().max().copied().unwrap_or(0),
-            );
-            // Settling: the mux switches one cycle after the previous CS fall on the branch.
-            let bs = &branch_slots[ch.branch];
-            let settle_cycles = slots
-                .iter()
-                .map(|&t| {
-                    let i = bs.binary_search(&t).unwrap();
-                    let prev = if i > 0 { bs[i - 1] } else { bs[bs.len() - 1] };
-                    let gap = if prev < t {
-                        t - prev
-                    } else {
-                        t + g.frame_slots - prev
-                    };
-                    gap * g.slot_cycles - 1
-                })
-                .min()
-                .unwrap_or(0);
-            let settle_available_ns = cycles_to_ns(settle_cycles, g.clock_hz);
-            let required = mix.branches[ch.branch].settle_ns;
-            if settle_available_ns < required as f64 {
-                errors.push(format!(
-                    "`{}`: mux settles for {:.0} ns before a sampling instant, {} ns required",
-                    ch.name, settle_available_ns, required
-                ));
-            }
-            let nyquist = ch.rate_hz as f64 / 2.0;
-            let mut alias = None;
-            if let Some(bw) = ch.bandwidth_hz {
-                if bw > nyquist {
-                    alias = Some(alias_hz(bw, ch.rate_hz as f64));
-                }
-                if bw >= nyquist {
-                    warnings.push(format!(
-                        "`{}`: bandwidth {bw} Hz is not below Nyquist ({nyquist} Hz at {} Hz): it will alias{}; sample at more than {} Hz",
-                        ch.name,
-                        ch.rate_hz,
-                        match alias {
-                            Some(a) => format!(" (a {bw} Hz tone shows as {} Hz)", fmt_hz(a)),
-                            None => String::new(),
-                        },
-                        2.0 * bw
-                    ));
-                }
-            }
-            if hi != lo || lo != s.channels[c].interval_cycles {
-                errors.push(format!(
-                    "`{}`: intervals {lo}..{hi} cycles, {} promised",
-                    ch.name, s.channels[c].interval_cycles
-                ));
-            }
-            channels.push(ChannelAudit {
-                name: ch.name.clone(),
-                sample_channel: c,
-                branch: mix.branches[ch.branch].name.clone(),
-                requested_hz: ch.rate_hz,
-                achieved_hz: if lo > 0 {
-                    g.clock_hz as f64 / lo as f64
-                } else {
-                    0.0
-                },
-                samples_per_frame: n as u64,
-                interval_cycles: lo,
-                jitter_cycles: hi - lo,
-                first_sample_cycle: slots.first().copied().unwrap_or(0) * g.slot_cycles,
-                device: s.channels[c].device,
-                select: s.channels[c].select,
-                settle_available_ns,
-                settle_required_ns: required,
-                bandwidth_hz: ch.bandwidth_hz,
-                nyquist_hz: nyquist,
-                alias_hz: alias,
-            });
-        }
+        let channels = (0..mix.channels.len())
+            .map(|c| ChannelAudit::of(s, c, &branch_slots, &mut errors, &mut warnings))
+            .collect();
 
         let mut rates: Vec<u64> = mix.channels.iter().map(|c| c.rate_hz).collect();
         rates.sort_unstable();
         rates.dedup();
         let finer = FinerGrids::of(s);
         let branches: Vec<BranchAudit> = (0..nb)
-            .map(|b| {
-                let used = branch_slots[b].len() as u64;
-                let free: Vec<bool> = (0..g.frame_slots).map(|t| s.at(t, b).is_none()).collect();
-                let br = &mix.branches[b];
-                let inputs = br.mux_devices * br.mux.inputs;
-                let taken = mix
-                    .channels
-                    .iter()
-                    .filter(|c| c.branch == b)
-                    .map(|c| c.input)
-                    .collect::<std::collections::BTreeSet<_>>()
-                    .len() as u32;
-                // A chain of N parts gives N samples per conversion.
-                let adc_max_sps = br.adc.max_sps * br.chain as u64;
-                let free_inputs = inputs.saturating_sub(taken);
-                let demand_sps: u64 = mix
-                    .channels
-                    .iter()
-                    .filter(|c| c.branch == b)
-                    .map(|c| c.rate_hz)
-                    .sum();
-                let headroom = rates
-                    .iter()
-                    .map(|&r| {
-                        let by_grid = more_that_fit(
-                            &mut free.clone(),
-                            g.frame_slots,
-                            mix.samples_per_frame(r),
-                        );
-                        let by_adc = adc_max_sps.saturating_sub(demand_sps) / r;
-                        let (more, binding) = least(free_inputs as u64, by_adc, by_grid);
-                        let finer_grid = finer
-                            .best(
-                                b,
-                                mix.samples_per_frame(r),
-                                more,
-                                free_inputs as u64,
-                                by_adc,
-                            )
-                            .filter(|f| f.more_channels > more);
-                        Headroom {
-                            rate_hz: r,
-                            more_channels: more,
-                            binding,
-                            by_mux_inputs: free_inputs as u64,
-                            by_adc_throughput: by_adc,
-                            by_slot_grid: by_grid,
-                            finer_grid,
-                        }
-                    })
-                    .collect();
-                let spi = &s.branches[b].spi;
-                BranchAudit {
-                    name: br.name.clone(),
-                    utilization: used as f64 / g.frame_slots as f64,
-                    conversions_per_frame: used,
-                    slots_per_frame: g.frame_slots,
-                    demand_sps,
-                    adc_max_sps,
-                    adc_utilization: demand_sps as f64 / adc_max_sps as f64,
-                    sclk_requested_hz: br.sclk_hz,
-                    sclk_explicit: br.sclk_explicit,
-                    sclk_hz: spi.sclk_hz,
-                    sclk_div: spi.sclk_div,
-                    min_slot_cycles: s.branches[b].min_slot_cycles,
-                    free_mux_inputs: free_inputs,
-                    headroom,
-                }
-            })
+            .map(|b| BranchAudit::of(s, b, &branch_slots[b], &rates, &finer))
             .collect();
-
-        for b in &branches {
-            if b.sclk_hz != b.sclk_requested_hz as f64 {
-                notes.push(format!(
-                    "branch `{}`: SCLK {} Hz {}, {} Hz used = {} Hz / {} (SCLK comes from even dividers of the clock only)",
-                    b.name,
-                    b.sclk_requested_hz,
-                    if b.sclk_explicit {
-                        "requested"
-                    } else {
-                        "asked by default (the ADC's maximum; no sclk_hz in the mix)"
-                    },
-                    fmt_hz(b.sclk_hz),
-                    g.clock_hz,
-                    b.sclk_div
-                ));
-            }
-        }
+        let notes = sclk_notes(&branches, g.clock_hz);
 
         let aggregate_hz: u64 = mix.channels.iter().map(|c| c.rate_hz).sum();
         let adc_limit_hz: u64 = mix
@@ -558,247 +380,247 @@ impl AuditReport {
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("audit serializes") + "\n"
     }
+}
 
-    /// The human-readable table.
-    pub fn to_text(&self) -> String {
-        let mut o = String::new();
-        let _ = writeln!(
-            o,
-            "mix {}: {}",
-            self.mix,
-            if self.feasible {
-                "FEASIBLE, zero jitter"
+impl ChannelAudit {
+    /// Channel `c` measured on the table: its intervals, its mux settling and
+    /// its bandwidth against Nyquist.  What is wrong goes to `errors` and
+    /// `warnings`.
+    fn of(
+        s: &Schedule,
+        c: usize,
+        branch_slots: &[Vec<u64>],
+        errors: &mut Vec<String>,
+        warnings: &mut Vec<String>,
+    ) -> ChannelAudit {
+        let g = &s.grid;
+        let mix = &s.mix;
+        let ch = &mix.channels[c];
+        let slots: Vec<u64> = branch_slots[ch.branch]
+            .iter()
+            .copied()
+            // A chain member is read in its lead's conversions.
+            .filter(|&t| s.at(t, ch.branch) == Some(mix.lead_of(c)))
+            .collect();
+        let n = slots.len();
+        let intervals: Vec<u64> = (0..n)
+            .map(|i| {
+                let next = if i + 1 < n {
+                    slots[i + 1]
+                } else {
+                    slots[0] + g.frame_slots
+                };
+                (next - slots[i]) * g.slot_cycles
+            })
+            .collect();
+        let (lo, hi) = (
+            intervals.iter().min().copied().unwrap_or(0),
+            intervals.iter().max().copied().unwrap_or(0),
+        );
+        let settle_cycles = settle_cycles(s, &slots, &branch_slots[ch.branch]);
+        let settle_available_ns = cycles_to_ns(settle_cycles, g.clock_hz);
+        let required = mix.branches[ch.branch].settle_ns;
+        if settle_available_ns < required as f64 {
+            errors.push(format!(
+                "`{}`: mux settles for {:.0} ns before a sampling instant, {} ns required",
+                ch.name, settle_available_ns, required
+            ));
+        }
+        let nyquist = ch.rate_hz as f64 / 2.0;
+        let alias = nyquist_check(ch, nyquist, warnings);
+        if hi != lo || lo != s.channels[c].interval_cycles {
+            errors.push(format!(
+                "`{}`: intervals {lo}..{hi} cycles, {} promised",
+                ch.name, s.channels[c].interval_cycles
+            ));
+        }
+        ChannelAudit {
+            name: ch.name.clone(),
+            sample_channel: c,
+            branch: mix.branches[ch.branch].name.clone(),
+            requested_hz: ch.rate_hz,
+            achieved_hz: if lo > 0 {
+                g.clock_hz as f64 / lo as f64
             } else {
-                "INFEASIBLE"
-            }
-        );
-        if self.slots_per_slice > 0 {
-            let _ = writeln!(
-                o,
-                "clock {} Hz; frame {} cycles; slice {} cycles; {} slots/slice of {} cycles ({:.3} us); {}",
-                self.clock_hz,
-                self.frame_cycles,
-                self.slice_cycles,
-                self.slots_per_slice,
-                self.slot_cycles,
-                self.slot_cycles as f64 * 1e6 / self.clock_hz as f64,
-                self.placement
-            );
+                0.0
+            },
+            samples_per_frame: n as u64,
+            interval_cycles: lo,
+            jitter_cycles: hi - lo,
+            first_sample_cycle: slots.first().copied().unwrap_or(0) * g.slot_cycles,
+            device: s.channels[c].device,
+            select: s.channels[c].select,
+            settle_available_ns,
+            settle_required_ns: required,
+            bandwidth_hz: ch.bandwidth_hz,
+            nyquist_hz: nyquist,
+            alias_hz: alias,
         }
-        let _ = writeln!(
-            o,
-            "{} samples/frame; aggregate {} samples/s of {} the ADCs can do ({:.1} %)",
-            self.samples_per_frame,
-            self.aggregate_hz,
-            self.adc_limit_hz,
-            self.adc_utilization * 100.0
-        );
-        if self.lut_entries_full > 0 {
-            let _ = writeln!(
-                o,
-                "LUT: {} entries compact, {} as a full frame table",
-                self.lut_entries_compact, self.lut_entries_full
-            );
-        }
-        if !self.branches.is_empty() {
-            let _ = writeln!(
-                o,
-                "\n{:<16} {:>11} {:>11} {:>8} {:>11} {:>8} {:>10} {:>11}",
-                "branch",
-                "demand S/s",
-                "ADC max S/s",
-                "of ADC %",
-                "conv/frame",
-                "of grid %",
-                "SCLK Hz",
-                "free inputs"
-            );
-            for b in &self.branches {
-                let _ = writeln!(
-                    o,
-                    "{:<16} {:>11} {:>11} {:>8.1} {:>11} {:>8.1} {:>10} {:>11}",
-                    b.name,
-                    b.demand_sps,
-                    b.adc_max_sps,
-                    b.adc_utilization * 100.0,
-                    format!("{}/{}", b.conversions_per_frame, b.slots_per_frame),
-                    b.utilization * 100.0,
-                    fmt_hz(b.sclk_hz),
-                    b.free_mux_inputs
-                );
-            }
-            let _ = writeln!(
-                o,
-                "of ADC = demanded samples/s over the ADC's maximum; of grid = conversions over the slots of the slot grid"
-            );
-            let _ = writeln!(
-                o,
-                "\nheadroom: more channels per rate = the least of what the free mux inputs, the ADC throughput and the slot grid allow"
-            );
-            for b in &self.branches {
-                for h in &b.headroom {
-                    let mut line = format!(
-                        "  {:<16} {:>7} Hz: {:>4} more (limit: {}; inputs {}, ADC {}, grid {})",
-                        b.name,
-                        h.rate_hz,
-                        h.more_channels,
-                        h.binding.describe(),
-                        h.by_mux_inputs,
-                        h.by_adc_throughput,
-                        h.by_slot_grid
-                    );
-                    if let Some(f) = &h.finer_grid {
-                        let _ = write!(
-                            line,
-                            "; up to {} more with a {}-slot slice (limit: {}; that grid: {})",
-                            f.more_channels,
-                            f.slots_per_slice,
-                            f.binding.describe(),
-                            f.by_slot_grid
-                        );
-                    }
-                    let _ = writeln!(o, "{line}");
-                }
-            }
-        }
-        if !self.parts.is_empty() {
-            let _ = writeln!(
-                o,
-                "\n{:<16} {:<10} {:>5} {:>5} {:>6} {:>9} {:>10} {:>9} {:>13} {:>13}",
-                "branch",
-                "adc",
-                "start",
-                "bits",
-                "chain",
-                "max SPS",
-                "SCLK max",
-                "t_conv",
-                "conv/s max",
-                "samples/s max"
-            );
-            for p in &self.parts {
-                let _ = writeln!(
-                    o,
-                    "{:<16} {:<10} {:>5} {:>5} {:>6} {:>9} {:>10} {:>9} {:>13.0} {:>13.0}",
-                    p.branch,
-                    p.adc,
-                    match p.start {
-                        crate::parts::Start::Cs => "cs",
-                        crate::parts::Start::Cnv => "cnv",
-                    },
-                    p.bits,
-                    format!("{}/{}", p.chain, p.chain_max),
-                    p.max_sps,
-                    p.sclk_max_hz,
-                    format!("{}ns", p.conversion_ns),
-                    p.max_conversions_hz,
-                    p.max_samples_hz
-                );
-            }
-        }
-        if !self.channels.is_empty() {
-            let _ = writeln!(
-                o,
-                "\n{:<12} {:>3} {:<12} {:>8} {:>11} {:>6} {:>10} {:>6} {:>9} {:>8} {:>12} {:>9} {:>6}",
-                "channel",
-                "#",
-                "branch",
-                "rate Hz",
-                "achieved",
-                "n/frm",
-                "interval",
-                "jitter",
-                "first",
-                "dev.sel",
-                "settle ns",
-                "bw/nyq",
-                "alias"
-            );
-            for c in &self.channels {
-                let _ = writeln!(
-                    o,
-                    "{:<12} {:>3} {:<12} {:>8} {:>11.3} {:>6} {:>10} {:>6} {:>9} {:>8} {:>12} {:>9} {:>6}",
-                    c.name,
-                    c.sample_channel,
-                    c.branch,
-                    c.requested_hz,
-                    c.achieved_hz,
-                    c.samples_per_frame,
-                    c.interval_cycles,
-                    c.jitter_cycles,
-                    c.first_sample_cycle,
-                    format!("{}.{}", c.device, c.select),
-                    format!("{:.0}/{}", c.settle_available_ns, c.settle_required_ns),
-                    match c.bandwidth_hz {
-                        Some(bw) => format!("{bw}/{}", c.nyquist_hz),
-                        None => "-".into(),
-                    },
-                    c.alias_hz.map_or("-".into(), fmt_hz)
-                );
-            }
-            let _ = writeln!(
-                o,
-                "# = the value `sample_channel` carries for the channel: its index in the mix file, 0-based, in [[channel]] order"
-            );
-            let _ = writeln!(
-                o,
-                "interval, first: cycles (first = first sampling instant after cycle 0); dev.sel = mux device.select; alias = where a tone at bw shows when bw is above Nyquist"
-            );
-        }
-        if let Some(l) = self.link.as_ref().filter(|l| l.ready_within.is_some()) {
-            let _ = writeln!(
-                o,
-                "link axis: 8-bit beats, tlast at the end of each {}; the FIFO is sized for a slave that accepts every beat within {} cycle(s) (tready duty >= 1/{}); the mix needs it within {} cycles at most",
-                l.tlast.unwrap_or("slice"),
-                l.ready_within.unwrap_or(1),
-                l.ready_within.unwrap_or(1),
-                l.max_ready_within.map_or("?".into(), |m| m.to_string())
-            );
-            let _ = writeln!(
-                o,
-                "link: {} words ({} bytes) per frame, stream {:.1} % busy at worst; FIFO depth {} tokens (worst-case backlog); worst latency instant -> last beat of its packet {} cycles ({:.1} us)",
-                l.words_per_frame,
-                l.bytes_per_frame,
-                l.utilization * 100.0,
-                l.fifo_depth,
-                l.latency_cycles,
-                l.latency_us
-            );
-        } else if let Some(l) = &self.link {
-            let _ = writeln!(
-                o,
-                "link {}: {:.0} baud (divider {}, {} asked), {} bits per byte ({} parity, {} stop)",
-                l.kind,
-                l.baud,
-                l.baud_divider,
-                l.baud_requested,
-                l.bits_per_byte,
-                l.parity,
-                l.stop_bits
-            );
-            let _ = writeln!(
-                o,
-                "link: {} words ({} bytes) per frame, line {:.1} % used; FIFO depth {} tokens (worst-case backlog); worst latency instant -> last bit of its packet {} cycles ({:.1} us); minimum baud {:.0}",
-                l.words_per_frame,
-                l.bytes_per_frame,
-                l.utilization * 100.0,
-                l.fifo_depth,
-                l.latency_cycles,
-                l.latency_us,
-                l.min_baud
-            );
-        }
-        for n in &self.notes {
-            let _ = writeln!(o, "note: {n}");
-        }
-        for w in &self.warnings {
-            let _ = writeln!(o, "warning: {w}");
-        }
-        for e in &self.errors {
-            let _ = writeln!(o, "error: {e}");
-        }
-        o
     }
+}
+
+/// The shortest settling before any of `slots`: the mux switches one cycle
+/// after the previous CS fall on the branch (`bs`, its conversions).
+fn settle_cycles(s: &Schedule, slots: &[u64], bs: &[u64]) -> u64 {
+    let g = &s.grid;
+    slots
+        .iter()
+        .map(|&t| {
+            let i = bs.binary_search(&t).unwrap();
+            let prev = if i > 0 { bs[i - 1] } else { bs[bs.len() - 1] };
+            let gap = if prev < t {
+                t - prev
+            } else {
+                t + g.frame_slots - prev
+            };
+            gap * g.slot_cycles - 1
+        })
+        .min()
+        .unwrap_or(0)
+}
+
+/// A warning when the channel's bandwidth is not below Nyquist; the alias
+/// frequency when it is above.
+fn nyquist_check(
+    ch: &crate::mix::Channel,
+    nyquist: f64,
+    warnings: &mut Vec<String>,
+) -> Option<f64> {
+    let mut alias = None;
+    if let Some(bw) = ch.bandwidth_hz {
+        if bw > nyquist {
+            alias = Some(alias_hz(bw, ch.rate_hz as f64));
+        }
+        if bw >= nyquist {
+            warnings.push(format!(
+                "`{}`: bandwidth {bw} Hz is not below Nyquist ({nyquist} Hz at {} Hz): it will alias{}; sample at more than {} Hz",
+                ch.name,
+                ch.rate_hz,
+                match alias {
+                    Some(a) => format!(" (a {bw} Hz tone shows as {} Hz)", fmt_hz(a)),
+                    None => String::new(),
+                },
+                2.0 * bw
+            ));
+        }
+    }
+    alias
+}
+
+impl BranchAudit {
+    /// Branch `b` measured on the table (`used_slots`, its conversions), with
+    /// the headroom left at each of the mix's `rates`.
+    fn of(
+        s: &Schedule,
+        b: usize,
+        used_slots: &[u64],
+        rates: &[u64],
+        finer: &FinerGrids,
+    ) -> BranchAudit {
+        let g = &s.grid;
+        let mix = &s.mix;
+        let used = used_slots.len() as u64;
+        let br = &mix.branches[b];
+        let inputs = br.mux_devices * br.mux.inputs;
+        let taken = mix
+            .channels
+            .iter()
+            .filter(|c| c.branch == b)
+            .map(|c| c.input)
+            .collect::<std::collections::BTreeSet<_>>()
+            .len() as u32;
+        // A chain of N parts gives N samples per conversion.
+        let adc_max_sps = br.adc.max_sps * br.chain as u64;
+        let free_inputs = inputs.saturating_sub(taken);
+        let demand_sps: u64 = mix
+            .channels
+            .iter()
+            .filter(|c| c.branch == b)
+            .map(|c| c.rate_hz)
+            .sum();
+        let room = Room {
+            free_inputs: free_inputs as u64,
+            adc_spare_sps: adc_max_sps.saturating_sub(demand_sps),
+        };
+        let headroom = rates
+            .iter()
+            .map(|&r| headroom(s, b, r, &room, finer))
+            .collect();
+        let spi = &s.branches[b].spi;
+        BranchAudit {
+            name: br.name.clone(),
+            utilization: used as f64 / g.frame_slots as f64,
+            conversions_per_frame: used,
+            slots_per_frame: g.frame_slots,
+            demand_sps,
+            adc_max_sps,
+            adc_utilization: demand_sps as f64 / adc_max_sps as f64,
+            sclk_requested_hz: br.sclk_hz,
+            sclk_explicit: br.sclk_explicit,
+            sclk_hz: spi.sclk_hz,
+            sclk_div: spi.sclk_div,
+            min_slot_cycles: s.branches[b].min_slot_cycles,
+            free_mux_inputs: free_inputs,
+            headroom,
+        }
+    }
+}
+
+/// What a branch has left besides table slots.
+struct Room {
+    free_inputs: u64,
+    adc_spare_sps: u64,
+}
+
+/// How many more channels at `rate_hz` branch `b` takes, and what binds.
+fn headroom(s: &Schedule, b: usize, rate_hz: u64, room: &Room, finer: &FinerGrids) -> Headroom {
+    let g = &s.grid;
+    let mix = &s.mix;
+    let mut free: Vec<bool> = (0..g.frame_slots).map(|t| s.at(t, b).is_none()).collect();
+    let by_grid = more_that_fit(&mut free, g.frame_slots, mix.samples_per_frame(rate_hz));
+    let by_adc = room.adc_spare_sps / rate_hz;
+    let (more, binding) = least(room.free_inputs, by_adc, by_grid);
+    let finer_grid = finer
+        .best(
+            b,
+            mix.samples_per_frame(rate_hz),
+            more,
+            room.free_inputs,
+            by_adc,
+        )
+        .filter(|f| f.more_channels > more);
+    Headroom {
+        rate_hz,
+        more_channels: more,
+        binding,
+        by_mux_inputs: room.free_inputs,
+        by_adc_throughput: by_adc,
+        by_slot_grid: by_grid,
+        finer_grid,
+    }
+}
+
+/// A note per branch whose SCLK is not the one asked for.
+fn sclk_notes(branches: &[BranchAudit], clock_hz: u64) -> Vec<String> {
+    let mut notes = Vec::new();
+    for b in branches {
+        if b.sclk_hz != b.sclk_requested_hz as f64 {
+            notes.push(format!(
+                "branch `{}`: SCLK {} Hz {}, {} Hz used = {} Hz / {} (SCLK comes from even dividers of the clock only)",
+                b.name,
+                b.sclk_requested_hz,
+                if b.sclk_explicit {
+                    "requested"
+                } else {
+                    "asked by default (the ADC's maximum; no sclk_hz in the mix)"
+                },
+                fmt_hz(b.sclk_hz),
+                clock_hz,
+                b.sclk_div
+            ));
+        }
+    }
+    notes
 }
 
 /// First-fit count of further progressions of `n` samples per frame that the

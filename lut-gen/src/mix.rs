@@ -303,6 +303,28 @@ struct Cx<'a> {
     text: &'a str,
 }
 
+/// The clock and frame numbers every later check measures against.
+struct Timing {
+    clock_hz: u64,
+    /// Where `clock.hz` is written, for errors that blame the clock.
+    clock_span: Range<usize>,
+    frame_us: u64,
+    slice_us: u64,
+    slots_per_slice: Option<u64>,
+}
+
+/// The channels as read, before automatic inputs are assigned.
+struct ChannelDraft {
+    channels: Vec<Channel>,
+    /// Per branch: (input, chain member) -> the channel that has it, to name
+    /// it in a clash.
+    used_inputs: Vec<BTreeMap<(u32, u32), String>>,
+    /// Channels without an explicit input, in file order.
+    pending_auto: Vec<usize>,
+    /// Sync tag -> (channel, where its `sync` is written).
+    sync_groups: BTreeMap<String, Vec<(usize, Range<usize>)>>,
+}
+
 impl Cx<'_> {
     fn at(
         &self,
@@ -370,17 +392,7 @@ impl Cx<'_> {
     /// A `[[adc_part]]` table, checked like every other field.
     fn adc_part(&self, i: usize, p: &RawAdcPart) -> Result<AdcPart, MixError> {
         let f = |k: &str| format!("adc_part[{i}].{k}");
-        let name = p.name.get_ref().trim().to_ascii_lowercase();
-        if name.is_empty() {
-            return Err(self.at(p.name.span(), f("name"), "must not be empty"));
-        }
-        if AdcPart::by_name(&name).is_some() {
-            return Err(self.at(
-                p.name.span(),
-                f("name"),
-                format!("`{name}` is a built-in part; give the declared part its own name"),
-            ));
-        }
+        let name = self.adc_part_name(i, p)?;
         let bits = self.positive(&p.bits, &f("bits"))?;
         if bits > 16 {
             return Err(self.at(
@@ -392,13 +404,7 @@ impl Cx<'_> {
         let start = match p.start.get_ref().as_str() {
             "cs" => Start::Cs,
             "cnv" => Start::Cnv,
-            other => {
-                return Err(self.at(
-                    p.start.span(),
-                    f("start"),
-                    format!("unknown start `{other}` (\"cs\": CS falling starts the conversion, \"cnv\": CNV rising)"),
-                ))
-            }
+            other => return Err(self.unknown_start(i, p, other)),
         };
         let leading_bits = self.nonneg(&p.leading_bits, &f("leading_bits"), 0)?;
         let trailing_bits = self.nonneg(&p.trailing_bits, &f("trailing_bits"), 0)?;
@@ -445,20 +451,7 @@ impl Cx<'_> {
             ));
         }
         let max_sps = self.positive(&p.max_sps, &f("max_sps"))?;
-        let chain_max = match &p.chain_max {
-            None => 1,
-            Some(c) => {
-                let v = self.positive(c, &f("chain_max"))?;
-                if v > 1 && start == Start::Cs {
-                    return Err(self.at(
-                        c.span(),
-                        f("chain_max"),
-                        "chains are read in one CNV-high window: only \"cnv\" parts chain here",
-                    ));
-                }
-                v
-            }
-        };
+        let chain_max = self.adc_part_chain(i, p, start)?;
         Ok(AdcPart {
             name,
             bits: bits as u32,
@@ -478,12 +471,103 @@ impl Cx<'_> {
         })
     }
 
+    /// `adc_part.name`: lower case, not blank, not a built-in part's.
+    fn adc_part_name(&self, i: usize, p: &RawAdcPart) -> Result<String, MixError> {
+        let name = p.name.get_ref().trim().to_ascii_lowercase();
+        if name.is_empty() {
+            return Err(self.at(
+                p.name.span(),
+                format!("adc_part[{i}].name"),
+                "must not be empty",
+            ));
+        }
+        if AdcPart::by_name(&name).is_some() {
+            return Err(self.at(
+                p.name.span(),
+                format!("adc_part[{i}].name"),
+                format!("`{name}` is a built-in part; give the declared part its own name"),
+            ));
+        }
+        Ok(name)
+    }
+
+    fn unknown_start(&self, i: usize, p: &RawAdcPart, other: &str) -> MixError {
+        self.at(
+            p.start.span(),
+            format!("adc_part[{i}].start"),
+            format!("unknown start `{other}` (\"cs\": CS falling starts the conversion, \"cnv\": CNV rising)"),
+        )
+    }
+
+    /// `adc_part.chain_max`: 1 unless given; only "cnv" parts chain.
+    fn adc_part_chain(&self, i: usize, p: &RawAdcPart, start: Start) -> Result<u64, MixError> {
+        let Some(c) = &p.chain_max else { return Ok(1) };
+        let v = self.positive(c, &format!("adc_part[{i}].chain_max"))?;
+        if v > 1 && start == Start::Cs {
+            return Err(self.at(
+                c.span(),
+                format!("adc_part[{i}].chain_max"),
+                "chains are read in one CNV-high window: only \"cnv\" parts chain here",
+            ));
+        }
+        Ok(v)
+    }
+
     fn validate(&self, raw: RawMix) -> Result<Mix, MixError> {
-        let name = match &raw.name {
-            Some(n) if !n.get_ref().trim().is_empty() => n.get_ref().clone(),
-            Some(n) => return Err(self.at(n.span(), "name", "must not be empty")),
-            None => return Err(self.at(0..0, "name", "missing: every mix has a name")),
+        let name = self.mix_name(&raw)?;
+        let t = self.timing(&raw)?;
+        if raw.branch.is_empty() {
+            return Err(self.at(0..0, "branch", "the mix declares no [[branch]]"));
+        }
+        if raw.channel.is_empty() {
+            return Err(self.at(
+                0..0,
+                "channel",
+                "the mix declares no [[channel]]: nothing to sample",
+            ));
+        }
+        let parts = self.declared_parts(&raw)?;
+        let branches = self.branches(&raw, &parts, &t)?;
+        let mut draft = self.channels(&raw, &branches, &t)?;
+        self.assign_auto_inputs(&raw, &branches, &mut draft)?;
+        let channels = draft.channels;
+        self.check_chain_rates(&raw, &branches, &channels)?;
+        self.check_sync_groups(&branches, &channels, &draft.sync_groups)?;
+        self.check_chain_sync(&raw, &channels)?;
+        self.check_branches_used(&raw, &branches, &channels)?;
+        if channels.len() > u16::MAX as usize {
+            return Err(self.at(0..0, "channel", "more than 65535 channels"));
+        }
+
+        let link = match &raw.link {
+            None => None,
+            Some(l) => Some(self.link(l, t.clock_hz)?),
         };
+        Ok(Mix {
+            name,
+            description: raw.description.unwrap_or_default(),
+            clock_hz: t.clock_hz,
+            frame_us: t.frame_us,
+            slice_us: t.slice_us,
+            slots_per_slice: t.slots_per_slice,
+            parts,
+            branches,
+            channels,
+            link,
+        })
+    }
+
+    /// `name`: present and not blank.
+    fn mix_name(&self, raw: &RawMix) -> Result<String, MixError> {
+        match &raw.name {
+            Some(n) if !n.get_ref().trim().is_empty() => Ok(n.get_ref().clone()),
+            Some(n) => Err(self.at(n.span(), "name", "must not be empty")),
+            None => Err(self.at(0..0, "name", "missing: every mix has a name")),
+        }
+    }
+
+    /// `[clock]` and `[frame]`: whole cycles per frame and per slice.
+    fn timing(&self, raw: &RawMix) -> Result<Timing, MixError> {
         let clock = raw
             .clock
             .as_ref()
@@ -506,25 +590,18 @@ impl Cx<'_> {
                 format!("a {frame_us} us frame is not a whole number of {slice_us} us slices"),
             ));
         }
-        if !(clock_hz as u128 * frame_us as u128).is_multiple_of(1_000_000) {
-            return Err(self.at(
-                clock.get_ref().hz.span(),
-                "clock.hz",
-                format!(
-                    "{clock_hz} Hz gives {:.3} cycles per {frame_us} us frame, not a whole number",
-                    clock_hz as f64 * frame_us as f64 / 1e6
-                ),
-            ));
-        }
-        if !(clock_hz as u128 * slice_us as u128).is_multiple_of(1_000_000) {
-            return Err(self.at(
-                clock.get_ref().hz.span(),
-                "clock.hz",
-                format!(
-                    "{clock_hz} Hz gives {:.3} cycles per {slice_us} us slice, not a whole number",
-                    clock_hz as f64 * slice_us as f64 / 1e6
-                ),
-            ));
+        let clock_span = clock.get_ref().hz.span();
+        for (us, what) in [(frame_us, "frame"), (slice_us, "slice")] {
+            if !(clock_hz as u128 * us as u128).is_multiple_of(1_000_000) {
+                return Err(self.at(
+                    clock_span.clone(),
+                    "clock.hz",
+                    format!(
+                        "{clock_hz} Hz gives {:.3} cycles per {us} us {what}, not a whole number",
+                        clock_hz as f64 * us as f64 / 1e6
+                    ),
+                ));
+            }
         }
         let slice_cycles = clock_hz * slice_us / 1_000_000;
         let slots_per_slice = match &fr.slots_per_slice {
@@ -541,18 +618,17 @@ impl Cx<'_> {
                 Some(v)
             }
         };
+        Ok(Timing {
+            clock_hz,
+            clock_span,
+            frame_us,
+            slice_us,
+            slots_per_slice,
+        })
+    }
 
-        if raw.branch.is_empty() {
-            return Err(self.at(0..0, "branch", "the mix declares no [[branch]]"));
-        }
-        if raw.channel.is_empty() {
-            return Err(self.at(
-                0..0,
-                "channel",
-                "the mix declares no [[channel]]: nothing to sample",
-            ));
-        }
-
+    /// Every `[[adc_part]]`, each checked, names unique.
+    fn declared_parts(&self, raw: &RawMix) -> Result<Vec<AdcPart>, MixError> {
         let mut parts: Vec<AdcPart> = Vec::new();
         for (i, p) in raw.adc_part.iter().enumerate() {
             let part = self.adc_part(i, p.get_ref())?;
@@ -565,9 +641,18 @@ impl Cx<'_> {
             }
             parts.push(part);
         }
+        Ok(parts)
+    }
+
+    /// Every `[[branch]]`, names unique.
+    fn branches(
+        &self,
+        raw: &RawMix,
+        parts: &[AdcPart],
+        t: &Timing,
+    ) -> Result<Vec<Branch>, MixError> {
         let mut known_parts: Vec<String> = AdcPart::known().iter().map(|s| s.to_string()).collect();
         known_parts.extend(parts.iter().map(|p| p.name.clone()));
-
         let mut branches = Vec::new();
         let mut branch_names: BTreeMap<String, usize> = BTreeMap::new();
         for (i, b) in raw.branch.iter().enumerate() {
@@ -584,124 +669,154 @@ impl Cx<'_> {
                     format!("duplicate branch name `{bname}`"),
                 ));
             }
-            let wanted = b.adc.get_ref().to_ascii_lowercase();
-            let adc = AdcPart::by_name(&wanted)
-                .or_else(|| parts.iter().find(|p| p.name == wanted).cloned())
-                .ok_or_else(|| {
-                    self.at(
-                        b.adc.span(),
-                        f("adc"),
-                        format!(
-                            "unknown ADC `{}` (known: {})",
-                            b.adc.get_ref(),
-                            known_parts.join(", ")
-                        ),
-                    )
-                })?;
-            let chain = match &b.chain {
-                None => 1,
-                Some(c) => {
-                    let v = self.positive(c, &f("chain"))?;
-                    if v > adc.chain_max as u64 {
-                        return Err(self.at(
-                            c.span(),
-                            f("chain"),
-                            format!(
-                                "{v} parts in a chain: `{}` allows at most {}",
-                                adc.name, adc.chain_max
-                            ),
-                        ));
-                    }
-                    v as u32
-                }
-            };
-            let mux = MuxPart::by_name(b.mux.get_ref()).ok_or_else(|| {
+            branches.push(self.branch(i, b, bname, parts, &known_parts, t)?);
+        }
+        Ok(branches)
+    }
+
+    /// One `[[branch]]` past its name: ADC, chain, mux, SCLK, settling.
+    fn branch(
+        &self,
+        i: usize,
+        b: &RawBranch,
+        name: String,
+        parts: &[AdcPart],
+        known_parts: &[String],
+        t: &Timing,
+    ) -> Result<Branch, MixError> {
+        let f = |k: &str| format!("branch[{i}].{k}");
+        let wanted = b.adc.get_ref().to_ascii_lowercase();
+        let adc = AdcPart::by_name(&wanted)
+            .or_else(|| parts.iter().find(|p| p.name == wanted).cloned())
+            .ok_or_else(|| {
                 self.at(
-                    b.mux.span(),
-                    f("mux"),
+                    b.adc.span(),
+                    f("adc"),
                     format!(
-                        "unknown mux `{}` (known: {})",
-                        b.mux.get_ref(),
-                        MuxPart::known().join(", ")
+                        "unknown ADC `{}` (known: {})",
+                        b.adc.get_ref(),
+                        known_parts.join(", ")
                     ),
                 )
             })?;
-            let sclk_hz = match &b.sclk_hz {
-                None => adc.sclk_max_hz,
-                Some(s) => {
-                    let v = self.positive(s, &f("sclk_hz"))?;
-                    if v > adc.sclk_max_hz || v < adc.sclk_min_hz {
-                        return Err(self.at(
-                            s.span(),
-                            f("sclk_hz"),
-                            format!(
-                                "{v} Hz is outside the {} SCLK range {}..={} Hz",
-                                adc.name, adc.sclk_min_hz, adc.sclk_max_hz
-                            ),
-                        ));
-                    }
-                    v
-                }
-            };
-            if clock_hz < 2 * adc.sclk_min_hz {
-                return Err(self.at(
-                    clock.get_ref().hz.span(),
-                    "clock.hz",
-                    format!(
-                        "{clock_hz} Hz is too slow to generate the {} minimum SCLK",
-                        adc.name
-                    ),
-                ));
+        let chain = self.branch_chain(i, b, &adc)?;
+        let mux = MuxPart::by_name(b.mux.get_ref()).ok_or_else(|| {
+            self.at(
+                b.mux.span(),
+                f("mux"),
+                format!(
+                    "unknown mux `{}` (known: {})",
+                    b.mux.get_ref(),
+                    MuxPart::known().join(", ")
+                ),
+            )
+        })?;
+        let sclk_hz = self.branch_sclk(i, b, &adc)?;
+        if t.clock_hz < 2 * adc.sclk_min_hz {
+            return Err(self.at(
+                t.clock_span.clone(),
+                "clock.hz",
+                format!(
+                    "{} Hz is too slow to generate the {} minimum SCLK",
+                    t.clock_hz, adc.name
+                ),
+            ));
+        }
+        let mux_devices = self.branch_mux_devices(i, b, &mux)?;
+        let settle_ns = match &b.settle_ns {
+            None => 0,
+            Some(s) if *s.get_ref() < 0 => {
+                return Err(self.at(s.span(), f("settle_ns"), "must not be negative"));
             }
-            let mux_devices = match &b.mux_devices {
-                None => 1,
-                Some(m) if mux == MuxPart::NONE => {
+            Some(s) => *s.get_ref() as u64,
+        };
+        Ok(Branch {
+            name,
+            adc,
+            sclk_hz,
+            sclk_explicit: b.sclk_hz.is_some(),
+            mux,
+            mux_devices,
+            settle_ns,
+            chain,
+        })
+    }
+
+    /// `branch.chain`: how many parts, within the part's limit.
+    fn branch_chain(&self, i: usize, b: &RawBranch, adc: &AdcPart) -> Result<u32, MixError> {
+        let Some(c) = &b.chain else { return Ok(1) };
+        let v = self.positive(c, &format!("branch[{i}].chain"))?;
+        if v > adc.chain_max as u64 {
+            return Err(self.at(
+                c.span(),
+                format!("branch[{i}].chain"),
+                format!(
+                    "{v} parts in a chain: `{}` allows at most {}",
+                    adc.name, adc.chain_max
+                ),
+            ));
+        }
+        Ok(v as u32)
+    }
+
+    /// `branch.sclk_hz`: the part's maximum unless given, and within its range.
+    fn branch_sclk(&self, i: usize, b: &RawBranch, adc: &AdcPart) -> Result<u64, MixError> {
+        let Some(s) = &b.sclk_hz else {
+            return Ok(adc.sclk_max_hz);
+        };
+        let v = self.positive(s, &format!("branch[{i}].sclk_hz"))?;
+        if v > adc.sclk_max_hz || v < adc.sclk_min_hz {
+            return Err(self.at(
+                s.span(),
+                format!("branch[{i}].sclk_hz"),
+                format!(
+                    "{v} Hz is outside the {} SCLK range {}..={} Hz",
+                    adc.name, adc.sclk_min_hz, adc.sclk_max_hz
+                ),
+            ));
+        }
+        Ok(v)
+    }
+
+    /// `branch.mux_devices`: 1 to 32, and only with a mux.
+    fn branch_mux_devices(&self, i: usize, b: &RawBranch, mux: &MuxPart) -> Result<u32, MixError> {
+        let f = |k: &str| format!("branch[{i}].{k}");
+        match &b.mux_devices {
+            None => Ok(1),
+            Some(m) if *mux == MuxPart::NONE => Err(self.at(
+                m.span(),
+                f("mux_devices"),
+                "a branch with mux = \"none\" has no mux devices",
+            )),
+            Some(m) => {
+                let v = self.positive(m, &f("mux_devices"))?;
+                if v > 32 {
                     return Err(self.at(
                         m.span(),
                         f("mux_devices"),
-                        "a branch with mux = \"none\" has no mux devices",
+                        "at most 32 mux devices per branch",
                     ));
                 }
-                Some(m) => {
-                    let v = self.positive(m, &f("mux_devices"))?;
-                    if v > 32 {
-                        return Err(self.at(
-                            m.span(),
-                            f("mux_devices"),
-                            "at most 32 mux devices per branch",
-                        ));
-                    }
-                    v as u32
-                }
-            };
-            let settle_ns = match &b.settle_ns {
-                None => 0,
-                Some(s) if *s.get_ref() < 0 => {
-                    return Err(self.at(s.span(), f("settle_ns"), "must not be negative"));
-                }
-                Some(s) => *s.get_ref() as u64,
-            };
-            branches.push(Branch {
-                name: bname,
-                adc,
-                sclk_hz,
-                sclk_explicit: b.sclk_hz.is_some(),
-                mux,
-                mux_devices,
-                settle_ns,
-                chain,
-            });
+                Ok(v as u32)
+            }
         }
+    }
 
-        let mut channels = Vec::new();
+    /// Every `[[channel]]`; explicit inputs are taken here, automatic ones
+    /// later so that they fill the gaps deterministically.
+    fn channels(
+        &self,
+        raw: &RawMix,
+        branches: &[Branch],
+        t: &Timing,
+    ) -> Result<ChannelDraft, MixError> {
+        let mut draft = ChannelDraft {
+            channels: Vec::new(),
+            used_inputs: vec![BTreeMap::new(); branches.len()],
+            pending_auto: Vec::new(),
+            sync_groups: BTreeMap::new(),
+        };
         let mut channel_names = BTreeSet::new();
-        // (input, member) pairs in use per branch.
-        // (input, chain member) -> the channel that has it, to name it in a clash
-        let mut used_inputs: Vec<BTreeMap<(u32, u32), String>> =
-            vec![BTreeMap::new(); branches.len()];
-        // Explicit inputs first, so that automatic ones fill the gaps deterministically.
-        let mut pending_auto = Vec::new();
-        let mut sync_groups: BTreeMap<String, Vec<(usize, Range<usize>)>> = BTreeMap::new();
         for (i, c) in raw.channel.iter().enumerate() {
             let c = c.get_ref();
             let f = |k: &str| format!("channel[{i}].{k}");
@@ -716,10 +831,93 @@ impl Cx<'_> {
                     format!("duplicate channel name `{cname}`"),
                 ));
             }
-            let branch = *branch_names.get(c.branch.get_ref()).ok_or_else(|| {
+            let channel = self.channel(i, c, cname, branches, t, &mut draft)?;
+            draft.channels.push(channel);
+        }
+        Ok(draft)
+    }
+
+    /// One `[[channel]]` past its name.
+    fn channel(
+        &self,
+        i: usize,
+        c: &RawChannel,
+        name: String,
+        branches: &[Branch],
+        t: &Timing,
+        draft: &mut ChannelDraft,
+    ) -> Result<Channel, MixError> {
+        let f = |k: &str| format!("channel[{i}].{k}");
+        let branch = self.channel_branch(i, c, branches)?;
+        let rate_hz = self.positive(&c.rate_hz, &f("rate_hz"))?;
+        let frame_us = t.frame_us;
+        if !(rate_hz as u128 * frame_us as u128).is_multiple_of(1_000_000) {
+            return Err(self.at(
+                c.rate_hz.span(),
+                f("rate_hz"),
+                format!(
+                    "{rate_hz} Hz gives {:.3} samples per {frame_us} us frame, not a whole number \
+                     (rates must be multiples of {} Hz){}",
+                    rate_hz as f64 * frame_us as f64 / 1e6,
+                    hz_text(1e6 / frame_us as f64),
+                    frames_that_fit(rate_hz, t.slice_us)
+                ),
+            ));
+        }
+        let member = self.channel_member(i, c, &branches[branch])?;
+        let input = match &c.input {
+            None => {
+                draft.pending_auto.push(i);
+                u32::MAX
+            }
+            Some(v) => {
+                let b = &branches[branch];
+                let used = &mut draft.used_inputs[branch];
+                self.channel_input(i, v, &name, member, b, used)?
+            }
+        };
+        let bandwidth_hz = self.channel_bandwidth(i, c)?;
+        let sync = match &c.sync {
+            None => None,
+            Some(s) => {
+                if s.get_ref().trim().is_empty() {
+                    return Err(self.at(s.span(), f("sync"), "must not be empty"));
+                }
+                draft
+                    .sync_groups
+                    .entry(s.get_ref().clone())
+                    .or_default()
+                    .push((i, s.span()));
+                Some(s.get_ref().clone())
+            }
+        };
+        Ok(Channel {
+            name,
+            branch,
+            rate_hz,
+            input,
+            kind: c.kind.clone(),
+            bandwidth_hz,
+            sync,
+            member,
+        })
+    }
+
+    /// `channel.branch`: a declared branch, by name.
+    fn channel_branch(
+        &self,
+        i: usize,
+        c: &RawChannel,
+        branches: &[Branch],
+    ) -> Result<usize, MixError> {
+        // Branch names are unique by now, so the first match is the one.
+        branches
+            .iter()
+            .position(|b| b.name == *c.branch.get_ref())
+            .ok_or_else(|| {
                 self.at(
                     c.branch.span(),
-                    f("branch"),
+                    format!("channel[{i}].branch"),
                     format!(
                         "unknown branch `{}` (declared: {})",
                         c.branch.get_ref(),
@@ -730,131 +928,112 @@ impl Cx<'_> {
                             .join(", ")
                     ),
                 )
-            })?;
-            let rate_hz = self.positive(&c.rate_hz, &f("rate_hz"))?;
-            if !(rate_hz as u128 * frame_us as u128).is_multiple_of(1_000_000) {
-                return Err(self.at(
-                    c.rate_hz.span(),
-                    f("rate_hz"),
-                    format!(
-                        "{rate_hz} Hz gives {:.3} samples per {frame_us} us frame, not a whole number \
-                         (rates must be multiples of {} Hz){}",
-                        rate_hz as f64 * frame_us as f64 / 1e6,
-                        hz_text(1e6 / frame_us as f64),
-                        frames_that_fit(rate_hz, slice_us)
-                    ),
-                ));
-            }
-            let capacity = branches[branch].mux.inputs * branches[branch].mux_devices;
-            let chain = branches[branch].chain;
-            let member = match &c.member {
-                None => 0,
-                Some(m) => {
-                    if *m.get_ref() < 0 || *m.get_ref() >= chain as i64 {
-                        return Err(self.at(
-                            m.span(),
-                            f("member"),
-                            format!(
-                                "member {} is beyond branch `{}`: its chain of {chain} part(s) has members 0..={}",
-                                m.get_ref(),
-                                branches[branch].name,
-                                chain - 1
-                            ),
-                        ));
-                    }
-                    *m.get_ref() as u32
-                }
-            };
-            let input = match &c.input {
-                None => {
-                    pending_auto.push(i);
-                    u32::MAX
-                }
-                Some(v) => {
-                    if *v.get_ref() < 0 || *v.get_ref() >= capacity as i64 {
-                        return Err(self.at(
-                            v.span(),
-                            f("input"),
-                            format!(
-                                "input {} is beyond branch `{}`: {} mux device(s) give inputs 0..={}",
-                                v.get_ref(),
-                                branches[branch].name,
-                                branches[branch].mux_devices,
-                                capacity - 1
-                            ),
-                        ));
-                    }
-                    let inp = *v.get_ref() as u32;
-                    if let Some(other) = used_inputs[branch].insert((inp, member), cname.clone()) {
-                        let which = if chain > 1 {
-                            format!(" (chain member {member})")
-                        } else {
-                            String::new()
-                        };
-                        return Err(self.at(
-                            v.span(),
-                            f("input"),
-                            format!(
-                                "input {inp}{which} of branch `{}` is already taken by channel `{other}`",
-                                branches[branch].name
-                            ),
-                        ));
-                    }
-                    inp
-                }
-            };
-            let bandwidth_hz = match &c.bandwidth_hz {
-                None => None,
-                Some(b) => {
-                    let v = match b.get_ref() {
-                        toml::Value::Integer(i) => *i as f64,
-                        toml::Value::Float(x) => *x,
-                        other => {
-                            return Err(self.at(
-                                b.span(),
-                                f("bandwidth_hz"),
-                                format!("got {}, expected a number of Hz", value_words(other)),
-                            ))
-                        }
-                    };
-                    if !(v > 0.0 && v.is_finite()) {
-                        return Err(self.at(
-                            b.span(),
-                            f("bandwidth_hz"),
-                            format!("must be positive, got {v}"),
-                        ));
-                    }
-                    Some(v)
-                }
-            };
-            let sync = match &c.sync {
-                None => None,
-                Some(s) => {
-                    if s.get_ref().trim().is_empty() {
-                        return Err(self.at(s.span(), f("sync"), "must not be empty"));
-                    }
-                    sync_groups
-                        .entry(s.get_ref().clone())
-                        .or_default()
-                        .push((i, s.span()));
-                    Some(s.get_ref().clone())
-                }
-            };
-            channels.push(Channel {
-                name: cname,
-                branch,
-                rate_hz,
-                input,
-                kind: c.kind.clone(),
-                bandwidth_hz,
-                sync,
-                member,
-            });
+            })
+    }
+
+    /// `channel.member`: which part of the branch's chain, 0 unless given.
+    fn channel_member(&self, i: usize, c: &RawChannel, b: &Branch) -> Result<u32, MixError> {
+        let Some(m) = &c.member else { return Ok(0) };
+        let chain = b.chain;
+        if *m.get_ref() < 0 || *m.get_ref() >= chain as i64 {
+            return Err(self.at(
+                m.span(),
+                format!("channel[{i}].member"),
+                format!(
+                    "member {} is beyond branch `{}`: its chain of {chain} part(s) has members 0..={}",
+                    m.get_ref(),
+                    b.name,
+                    chain - 1
+                ),
+            ));
         }
-        for i in pending_auto {
+        Ok(*m.get_ref() as u32)
+    }
+
+    /// An explicit `channel.input`: on the branch's muxes and not taken by
+    /// another channel of the same chain member.
+    fn channel_input(
+        &self,
+        i: usize,
+        v: &Spanned<i64>,
+        name: &str,
+        member: u32,
+        b: &Branch,
+        used: &mut BTreeMap<(u32, u32), String>,
+    ) -> Result<u32, MixError> {
+        let capacity = b.mux.inputs * b.mux_devices;
+        if *v.get_ref() < 0 || *v.get_ref() >= capacity as i64 {
+            return Err(self.at(
+                v.span(),
+                format!("channel[{i}].input"),
+                format!(
+                    "input {} is beyond branch `{}`: {} mux device(s) give inputs 0..={}",
+                    v.get_ref(),
+                    b.name,
+                    b.mux_devices,
+                    capacity - 1
+                ),
+            ));
+        }
+        let inp = *v.get_ref() as u32;
+        if let Some(other) = used.insert((inp, member), name.to_string()) {
+            let which = if b.chain > 1 {
+                format!(" (chain member {member})")
+            } else {
+                String::new()
+            };
+            return Err(self.at(
+                v.span(),
+                format!("channel[{i}].input"),
+                format!(
+                    "input {inp}{which} of branch `{}` is already taken by channel `{other}`",
+                    b.name
+                ),
+            ));
+        }
+        Ok(inp)
+    }
+
+    /// `channel.bandwidth_hz`: an integer or a float, positive and finite.
+    fn channel_bandwidth(&self, i: usize, c: &RawChannel) -> Result<Option<f64>, MixError> {
+        let Some(b) = &c.bandwidth_hz else {
+            return Ok(None);
+        };
+        let v = match b.get_ref() {
+            toml::Value::Integer(i) => *i as f64,
+            toml::Value::Float(x) => *x,
+            other => {
+                return Err(self.at(
+                    b.span(),
+                    format!("channel[{i}].bandwidth_hz"),
+                    format!("got {}, expected a number of Hz", value_words(other)),
+                ))
+            }
+        };
+        if !(v > 0.0 && v.is_finite()) {
+            return Err(self.at(
+                b.span(),
+                format!("channel[{i}].bandwidth_hz"),
+                format!("must be positive, got {v}"),
+            ));
+        }
+        Ok(Some(v))
+    }
+
+    /// Channels without an input take the lowest free one of their chain
+    /// member, in file order.
+    fn assign_auto_inputs(
+        &self,
+        raw: &RawMix,
+        branches: &[Branch],
+        draft: &mut ChannelDraft,
+    ) -> Result<(), MixError> {
+        let channels = &mut draft.channels;
+        for &i in &draft.pending_auto {
             let b = channels[i].branch;
             let capacity = branches[b].mux.inputs * branches[b].mux_devices;
             let m = channels[i].member;
+            let used_inputs = &mut draft.used_inputs;
             let free = (0..capacity).find(|k| !used_inputs[b].contains_key(&(*k, m))).ok_or_else(|| {
                 self.at(
                     raw.channel[i].get_ref().name.span(),
@@ -868,8 +1047,17 @@ impl Cx<'_> {
             used_inputs[b].insert((free, m), channels[i].name.clone());
             channels[i].input = free;
         }
-        // Channels of one branch on one mux input are read in one conversion
-        // (one per chain member): they share every sampling instant.
+        Ok(())
+    }
+
+    /// Channels of one branch on one mux input are read in one conversion
+    /// (one per chain member): they share every sampling instant.
+    fn check_chain_rates(
+        &self,
+        raw: &RawMix,
+        branches: &[Branch],
+        channels: &[Channel],
+    ) -> Result<(), MixError> {
         for i in 0..channels.len() {
             for j in 0..i {
                 let (a, c) = (&channels[j], &channels[i]);
@@ -886,7 +1074,17 @@ impl Cx<'_> {
                 }
             }
         }
-        for (tag, members) in &sync_groups {
+        Ok(())
+    }
+
+    /// A sync group has one rate and at most one conversion per branch.
+    fn check_sync_groups(
+        &self,
+        branches: &[Branch],
+        channels: &[Channel],
+        sync_groups: &BTreeMap<String, Vec<(usize, Range<usize>)>>,
+    ) -> Result<(), MixError> {
+        for (tag, members) in sync_groups {
             let mut seen = BTreeMap::new();
             let rate = channels[members[0].0].rate_hz;
             for (i, span) in members {
@@ -917,6 +1115,11 @@ impl Cx<'_> {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Members of one chained conversion are in one sync group or none.
+    fn check_chain_sync(&self, raw: &RawMix, channels: &[Channel]) -> Result<(), MixError> {
         for i in 0..channels.len() {
             for j in 0..i {
                 let (a, c) = (&channels[j], &channels[i]);
@@ -938,6 +1141,16 @@ impl Cx<'_> {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Every branch samples at least one channel.
+    fn check_branches_used(
+        &self,
+        raw: &RawMix,
+        branches: &[Branch],
+        channels: &[Channel],
+    ) -> Result<(), MixError> {
         for (bi, b) in branches.iter().enumerate() {
             if !channels.iter().any(|c| c.branch == bi) {
                 let span = raw.branch[bi].get_ref().name.span();
@@ -948,26 +1161,7 @@ impl Cx<'_> {
                 ));
             }
         }
-        if channels.len() > u16::MAX as usize {
-            return Err(self.at(0..0, "channel", "more than 65535 channels"));
-        }
-
-        let link = match &raw.link {
-            None => None,
-            Some(l) => Some(self.link(l, clock_hz)?),
-        };
-        Ok(Mix {
-            name,
-            description: raw.description.unwrap_or_default(),
-            clock_hz,
-            frame_us,
-            slice_us,
-            slots_per_slice,
-            parts,
-            branches,
-            channels,
-            link,
-        })
+        Ok(())
     }
 
     /// `[link]`: the kind, and for a UART a baud the clock can divide to

@@ -492,6 +492,21 @@ fn over_capacity(branch: &str, per_frame: u64, sps: u64, slices: u64) -> String 
     )
 }
 
+/// What a diagnosis has found so far, on one grid.
+struct Findings {
+    reasons: Vec<String>,
+    suggestions: Vec<String>,
+    /// Per branch: the channels that found no place.
+    unplaced: Vec<Vec<String>>,
+}
+
+/// The grid a diagnosis is made on: `sps` slots per slice, `slots` per frame.
+#[derive(Clone, Copy)]
+struct DiagGrid {
+    sps: u64,
+    slots: u64,
+}
+
 /// `bound`: the exact search's budget, if it ran out on some grid.
 fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
     let k = mix.slices_per_frame();
@@ -508,13 +523,15 @@ fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
         .find(|&s| whole(s))
         .unwrap_or(*candidates.last().unwrap());
     let slots = k * sps;
+    let dg = DiagGrid { sps, slots };
     let grid = FrameGrid::new(mix, sps);
-    let mut reasons = Vec::new();
-    let mut suggestions = Vec::new();
-
     let nb = mix.branches.len();
     let demand = demand_per_frame(mix);
-    let mut unplaced: Vec<Vec<String>> = vec![Vec::new(); nb];
+    let mut f = Findings {
+        reasons: Vec::new(),
+        suggestions: Vec::new(),
+        unplaced: vec![Vec::new(); nb],
+    };
 
     let not_whole: Vec<&str> = mix
         .channels
@@ -523,132 +540,23 @@ fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
         .map(|c| c.name.as_str())
         .collect();
     if !not_whole.is_empty() {
-        reasons.push(format!(
+        f.reasons.push(format!(
             "no legal slot grid (at most {} slots per slice) spaces {} evenly: their samples per frame do not divide the frame's slots",
             candidates.last().unwrap(),
             not_whole.join(", ")
         ));
-        for c in mix
-            .channels
-            .iter()
-            .filter(|c| !slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
-        {
-            unplaced[c.branch].push(c.name.clone());
-            suggestions.push(format!(
-                "`{}`: rates that fit {} slots per slice exactly: {}",
-                c.name,
-                sps,
-                nearest(grid_rates(mix, slots).map(|(_, r)| r), c.rate_hz)
-            ));
-        }
+        periods_not_whole(mix, dg, &mut f);
     } else {
         for (b, &d) in demand.iter().enumerate() {
             if d > slots {
-                reasons.push(over_capacity(&mix.branches[b].name, d, sps, k));
+                f.reasons
+                    .push(over_capacity(&mix.branches[b].name, d, sps, k));
             }
         }
-        let units = units_of(mix, slots);
-        let (offsets, occ) = greedy(&units, nb, slots, sps);
-        let overfull = demand.iter().any(|&d| d > slots);
-        // (rate, nearest fitting rates) -> channels, so identical advice is given once.
-        let mut collisions: Vec<((u64, String), Vec<String>)> = Vec::new();
-        for (u, o) in units.iter().zip(&offsets) {
-            if o.is_none() {
-                for &c in &u.channels {
-                    unplaced[mix.channels[c].branch].push(mix.channels[c].name.clone());
-                }
-                if !overfull {
-                    let c = &mix.channels[u.channels[0]];
-                    let fits = grid_rates(mix, slots)
-                        .filter(|&(n, _)| {
-                            let p = slots / n;
-                            let probe = Unit {
-                                period: p,
-                                ..u.clone()
-                            };
-                            candidate_offsets(p, sps).any(|o| occ.fits(&probe, o, slots))
-                        })
-                        .map(|(_, r)| r);
-                    let near = nearest(fits, c.rate_hz);
-                    if !near.is_empty() {
-                        let key = (c.rate_hz, near);
-                        match collisions.iter_mut().find(|(k, _)| *k == key) {
-                            Some((_, names)) => names.push(c.name.clone()),
-                            None => collisions.push((key, vec![c.name.clone()])),
-                        }
-                    }
-                }
-            }
-        }
-        for ((rate, near), names) in collisions {
-            suggestions.push(format!(
-                "{} ({rate} Hz) collide with the other channels' progressions; nearest rates that fit beside them, one channel at a time: {near}",
-                names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
-            ));
-        }
-        if !overfull && unplaced.iter().all(Vec::is_empty) {
-            reasons.push("first-fit placed every channel at this grid, but no grid admitted all of them with one rate each".into());
-        }
-        if !overfull && unplaced.iter().any(|u| !u.is_empty()) {
-            reasons.push(if let Some(budget) = bound {
-                format!("rates that are not harmonic collide; the exact search stopped at its bound of {budget} placements per grid with neither a schedule nor a proof that none exists: the mix may fit")
-            } else {
-                "rates that are not harmonic collide: two progressions of periods p and q meet unless their offsets differ modulo gcd(p, q), and no choice of offsets separates them all".into()
-            });
-        }
-        // Move channels from over-full branches to branches with room.
+        collisions(mix, dg, &demand, bound, &mut f);
         for b in 0..nb {
-            if demand[b] <= slots {
-                continue;
-            }
-            let excess = demand[b] - slots;
-            let mut rates: Vec<u64> = mix
-                .channels
-                .iter()
-                .filter(|c| c.branch == b)
-                .map(|c| c.rate_hz)
-                .collect();
-            rates.sort_unstable();
-            rates.dedup();
-            let mut moved = false;
-            for &r in rates.iter().rev() {
-                let n = mix.samples_per_frame(r);
-                let count = excess.div_ceil(n);
-                let have = mix
-                    .channels
-                    .iter()
-                    .filter(|c| c.branch == b && c.rate_hz == r)
-                    .count() as u64;
-                if count > have {
-                    continue;
-                }
-                if let Some(t) = (0..nb)
-                    .filter(|&t| t != b)
-                    .max_by_key(|&t| slots.saturating_sub(demand[t]))
-                {
-                    let room = slots.saturating_sub(demand[t]) / n;
-                    if room >= count {
-                        suggestions.push(format!(
-                            "move {count} of the {r} Hz channels from `{}` to `{}` (room there for {room} more at {r} Hz)",
-                            mix.branches[b].name, mix.branches[t].name
-                        ));
-                        moved = true;
-                        break;
-                    }
-                }
-            }
-            if !moved {
-                suggestions.push(format!(
-                    "add a branch: the other branches cannot absorb {excess} more conversions per frame"
-                ));
-            }
-            if let Some(&fast) = rates.last() {
-                let n = mix.samples_per_frame(fast);
-                let reduce = excess.div_ceil(n);
-                suggestions.push(format!(
-                    "or lower the rate of {reduce} of the {fast} Hz channels on `{}`",
-                    mix.branches[b].name
-                ));
+            if demand[b] > slots {
+                rebalance(mix, b, slots, &demand, &mut f.suggestions);
             }
         }
     }
@@ -665,7 +573,7 @@ fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
             capacity_hz: mix.clock_hz as f64 / grid.slot_cycles as f64,
             demand_slots_per_frame: demand[b],
             capacity_slots_per_frame: slots,
-            unplaced: std::mem::take(&mut unplaced[b]),
+            unplaced: std::mem::take(&mut f.unplaced[b]),
         })
         .collect();
     Infeasible {
@@ -675,9 +583,139 @@ fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
             None => Verdict::Infeasible,
         },
         slots_per_slice: Some(sps),
-        reasons,
+        reasons: f.reasons,
         branches,
-        suggestions,
+        suggestions: f.suggestions,
+    }
+}
+
+/// Channels whose period is not whole slots on the grid: each is unplaced,
+/// with the rates that would fit.
+fn periods_not_whole(mix: &Mix, dg: DiagGrid, f: &mut Findings) {
+    for c in mix
+        .channels
+        .iter()
+        .filter(|c| !dg.slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
+    {
+        f.unplaced[c.branch].push(c.name.clone());
+        f.suggestions.push(format!(
+            "`{}`: rates that fit {} slots per slice exactly: {}",
+            c.name,
+            dg.sps,
+            nearest(grid_rates(mix, dg.slots).map(|(_, r)| r), c.rate_hz)
+        ));
+    }
+}
+
+/// First-fit on the grid: who is left unplaced, the nearest rates that would
+/// fit beside the others, and why it failed.
+fn collisions(mix: &Mix, dg: DiagGrid, demand: &[u64], bound: Option<u64>, f: &mut Findings) {
+    let DiagGrid { sps, slots } = dg;
+    let units = units_of(mix, slots);
+    let (offsets, occ) = greedy(&units, mix.branches.len(), slots, sps);
+    let overfull = demand.iter().any(|&d| d > slots);
+    // (rate, nearest fitting rates) -> channels, so identical advice is given once.
+    let mut collisions: Vec<((u64, String), Vec<String>)> = Vec::new();
+    for (u, o) in units.iter().zip(&offsets) {
+        if o.is_some() {
+            continue;
+        }
+        for &c in &u.channels {
+            f.unplaced[mix.channels[c].branch].push(mix.channels[c].name.clone());
+        }
+        if overfull {
+            continue;
+        }
+        let c = &mix.channels[u.channels[0]];
+        let fits = grid_rates(mix, slots)
+            .filter(|&(n, _)| {
+                let p = slots / n;
+                let probe = Unit {
+                    period: p,
+                    ..u.clone()
+                };
+                candidate_offsets(p, sps).any(|o| occ.fits(&probe, o, slots))
+            })
+            .map(|(_, r)| r);
+        let near = nearest(fits, c.rate_hz);
+        if !near.is_empty() {
+            let key = (c.rate_hz, near);
+            match collisions.iter_mut().find(|(k, _)| *k == key) {
+                Some((_, names)) => names.push(c.name.clone()),
+                None => collisions.push((key, vec![c.name.clone()])),
+            }
+        }
+    }
+    for ((rate, near), names) in collisions {
+        f.suggestions.push(format!(
+            "{} ({rate} Hz) collide with the other channels' progressions; nearest rates that fit beside them, one channel at a time: {near}",
+            names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+        ));
+    }
+    if !overfull && f.unplaced.iter().all(Vec::is_empty) {
+        f.reasons.push("first-fit placed every channel at this grid, but no grid admitted all of them with one rate each".into());
+    }
+    if !overfull && f.unplaced.iter().any(|u| !u.is_empty()) {
+        f.reasons.push(if let Some(budget) = bound {
+            format!("rates that are not harmonic collide; the exact search stopped at its bound of {budget} placements per grid with neither a schedule nor a proof that none exists: the mix may fit")
+        } else {
+            "rates that are not harmonic collide: two progressions of periods p and q meet unless their offsets differ modulo gcd(p, q), and no choice of offsets separates them all".into()
+        });
+    }
+}
+
+/// Over-full branch `b`: move channels to the branch with the most room,
+/// else add a branch; or lower its fastest rate.
+fn rebalance(mix: &Mix, b: usize, slots: u64, demand: &[u64], suggestions: &mut Vec<String>) {
+    let nb = mix.branches.len();
+    let excess = demand[b] - slots;
+    let mut rates: Vec<u64> = mix
+        .channels
+        .iter()
+        .filter(|c| c.branch == b)
+        .map(|c| c.rate_hz)
+        .collect();
+    rates.sort_unstable();
+    rates.dedup();
+    let mut moved = false;
+    for &r in rates.iter().rev() {
+        let n = mix.samples_per_frame(r);
+        let count = excess.div_ceil(n);
+        let have = mix
+            .channels
+            .iter()
+            .filter(|c| c.branch == b && c.rate_hz == r)
+            .count() as u64;
+        if count > have {
+            continue;
+        }
+        if let Some(t) = (0..nb)
+            .filter(|&t| t != b)
+            .max_by_key(|&t| slots.saturating_sub(demand[t]))
+        {
+            let room = slots.saturating_sub(demand[t]) / n;
+            if room >= count {
+                suggestions.push(format!(
+                    "move {count} of the {r} Hz channels from `{}` to `{}` (room there for {room} more at {r} Hz)",
+                    mix.branches[b].name, mix.branches[t].name
+                ));
+                moved = true;
+                break;
+            }
+        }
+    }
+    if !moved {
+        suggestions.push(format!(
+            "add a branch: the other branches cannot absorb {excess} more conversions per frame"
+        ));
+    }
+    if let Some(&fast) = rates.last() {
+        let n = mix.samples_per_frame(fast);
+        let reduce = excess.div_ceil(n);
+        suggestions.push(format!(
+            "or lower the rate of {reduce} of the {fast} Hz channels on `{}`",
+            mix.branches[b].name
+        ));
     }
 }
 

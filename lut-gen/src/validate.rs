@@ -13,10 +13,28 @@ use crate::schedule::Schedule;
 /// Returns every broken promise, or `Ok(())`.
 pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
     let mut bad = Vec::new();
+    if !check_grid(s, &mut bad) {
+        return Err(bad);
+    }
+    check_datasheets(s, &mut bad);
+    let slots_of = slots_of(s, &mut bad);
+    for (c, got) in slots_of.iter().enumerate() {
+        check_channel(s, c, got, &mut bad);
+    }
+    check_sync(s, &slots_of, &mut bad);
+    if bad.is_empty() {
+        Ok(())
+    } else {
+        Err(bad)
+    }
+}
+
+/// The grid's numbers against the mix and against each other; false when the
+/// table does not even have the grid's size (nothing else can be read then).
+fn check_grid(s: &Schedule, bad: &mut Vec<String>) -> bool {
     let mix = &s.mix;
     let g = &s.grid;
     let nb = mix.branches.len();
-
     if g.clock_hz != mix.clock_hz {
         bad.push(format!(
             "grid clock {} != mix clock {}",
@@ -51,10 +69,15 @@ pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
     }
     if s.frame_table.len() as u64 != g.frame_slots * nb as u64 {
         bad.push("frame table has the wrong size".into());
-        return Err(bad);
+        return false;
     }
+    true
+}
 
-    // Datasheet limits, checked against the numbers the gateware will use.
+/// Datasheet limits, checked against the numbers the gateware will use.
+fn check_datasheets(s: &Schedule, bad: &mut Vec<String>) {
+    let mix = &s.mix;
+    let g = &s.grid;
     for (b, plan) in s.branches.iter().enumerate() {
         let adc = &mix.branches[b].adc;
         let ns = |cycles: u64| cycles as f64 * 1e9 / mix.clock_hz as f64;
@@ -128,8 +151,13 @@ pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
             ));
         }
     }
+}
 
-    // Per-channel slot lists straight from the table.
+/// Per-channel slot lists straight from the table.
+fn slots_of(s: &Schedule, bad: &mut Vec<String>) -> Vec<Vec<u64>> {
+    let mix = &s.mix;
+    let g = &s.grid;
+    let nb = mix.branches.len();
     let mut slots_of: Vec<Vec<u64>> = vec![Vec::new(); mix.channels.len()];
     for slot in 0..g.frame_slots {
         for b in 0..nb {
@@ -157,59 +185,69 @@ pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
             }
         }
     }
-    for (c, ch) in mix.channels.iter().enumerate() {
-        let want = (ch.rate_hz as u128 * mix.frame_us as u128 / 1_000_000) as usize;
-        let got = &slots_of[c];
-        if got.len() != want {
-            bad.push(format!(
-                "`{}`: {} samples per frame, {} expected",
-                ch.name,
-                got.len(),
-                want
-            ));
-            continue;
-        }
-        if !mix.clock_hz.is_multiple_of(ch.rate_hz) {
-            bad.push(format!("`{}`: clock/rate is not whole", ch.name));
-            continue;
-        }
-        let interval = mix.clock_hz / ch.rate_hz;
-        for i in 0..got.len() {
-            let next = if i + 1 < got.len() {
-                got[i + 1]
-            } else {
-                got[0] + g.frame_slots
-            };
-            let cycles = (next - got[i]) * g.slot_cycles;
-            if cycles != interval {
-                bad.push(format!(
-                    "`{}`: interval from slot {} is {cycles} cycles, {interval} expected",
-                    ch.name, got[i]
-                ));
-                break;
-            }
-        }
-        if let Some(cs) = s.channels.get(c) {
-            if Some(&cs.offset_slot) != got.first()
-                || cs.interval_cycles != interval
-                || cs.samples_per_frame != want as u64
-            {
-                bad.push(format!(
-                    "`{}`: channel summary disagrees with the table",
-                    ch.name
-                ));
-            }
-            if cs.device * 8 + cs.select != ch.input {
-                bad.push(format!(
-                    "`{}`: mux address disagrees with input {}",
-                    ch.name, ch.input
-                ));
-            }
+    slots_of
+}
+
+/// Channel `c`'s count, intervals and summary against the slots it was
+/// sampled in (`got`).
+fn check_channel(s: &Schedule, c: usize, got: &[u64], bad: &mut Vec<String>) {
+    let mix = &s.mix;
+    let g = &s.grid;
+    let ch = &mix.channels[c];
+    let want = (ch.rate_hz as u128 * mix.frame_us as u128 / 1_000_000) as usize;
+    if got.len() != want {
+        bad.push(format!(
+            "`{}`: {} samples per frame, {} expected",
+            ch.name,
+            got.len(),
+            want
+        ));
+        return;
+    }
+    if !mix.clock_hz.is_multiple_of(ch.rate_hz) {
+        bad.push(format!("`{}`: clock/rate is not whole", ch.name));
+        return;
+    }
+    let interval = mix.clock_hz / ch.rate_hz;
+    for i in 0..got.len() {
+        let next = if i + 1 < got.len() {
+            got[i + 1]
         } else {
-            bad.push(format!("`{}`: missing from the channel summary", ch.name));
+            got[0] + g.frame_slots
+        };
+        let cycles = (next - got[i]) * g.slot_cycles;
+        if cycles != interval {
+            bad.push(format!(
+                "`{}`: interval from slot {} is {cycles} cycles, {interval} expected",
+                ch.name, got[i]
+            ));
+            break;
         }
     }
+    if let Some(cs) = s.channels.get(c) {
+        if Some(&cs.offset_slot) != got.first()
+            || cs.interval_cycles != interval
+            || cs.samples_per_frame != want as u64
+        {
+            bad.push(format!(
+                "`{}`: channel summary disagrees with the table",
+                ch.name
+            ));
+        }
+        if cs.device * 8 + cs.select != ch.input {
+            bad.push(format!(
+                "`{}`: mux address disagrees with input {}",
+                ch.name, ch.input
+            ));
+        }
+    } else {
+        bad.push(format!("`{}`: missing from the channel summary", ch.name));
+    }
+}
 
+/// Members of a sync group share every sampling instant.
+fn check_sync(s: &Schedule, slots_of: &[Vec<u64>], bad: &mut Vec<String>) {
+    let mix = &s.mix;
     let mut groups: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
     for (c, ch) in mix.channels.iter().enumerate() {
         if let Some(t) = &ch.sync {
@@ -225,11 +263,5 @@ pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
                 ));
             }
         }
-    }
-
-    if bad.is_empty() {
-        Ok(())
-    } else {
-        Err(bad)
     }
 }

@@ -1,0 +1,130 @@
+//! The Verilog twin of `Core::update`.
+
+use crate::widths::*;
+
+/// The Verilog twin of `Core::update`: pure wiring, generated per mix.
+pub(super) fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> String {
+    let mut s = String::new();
+    s.push_str("always @(*) begin\n");
+    child_inputs(&mut s, nb, seq_of, nseq);
+    lanes(&mut s, nb, devices);
+    s.push_str(
+        "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\nend\n",
+    );
+    unused_wires(&mut s, nb, devices);
+    s
+}
+
+/// Clock, reset, slot strobes and sequencer levels into every child.
+fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize) {
+    for (who, _) in [("timing", 0), ("merge", 0)] {
+        s.push_str(&format!("  {who}$clock = clock;\n  {who}$rst = rst;\n"));
+    }
+    for i in 0..nseq {
+        let q = format!("seqs${i}");
+        s.push_str(&format!(
+            "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = timing$start2;\n"
+        ));
+    }
+    for (b, seq) in seq_of.iter().enumerate().take(nb) {
+        let u = format!("branches${b}");
+        let q = format!("seqs${seq}");
+        s.push_str(&format!(
+            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = timing$start0;\n  {u}$addr = timing$addr;\n  {u}$slice = timing$slice;\n"
+        ));
+        s.push_str(&format!(
+            "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$miso = adc_miso[{b}];\n  {u}$grant = merge$grant[{b}];\n"
+        ));
+    }
+}
+
+/// The branches' lanes gathered into the fixed-maximum ports and the
+/// merger's inputs; lanes the mix does not have are tied off.
+fn lanes(s: &mut String, nb: usize, devices: &[usize]) {
+    let cat = |f: &dyn Fn(usize) -> String, pad: Option<String>| -> String {
+        let mut parts: Vec<String> = (0..nb).rev().map(f).collect();
+        if let Some(p) = pad {
+            parts.insert(0, p);
+        }
+        format!("{{{}}}", parts.join(", "))
+    };
+    let pad_lanes = |v: &str| {
+        if nb < MAX_BRANCHES {
+            Some(format!("{{{}{{{v}}}}}", MAX_BRANCHES - nb))
+        } else {
+            None
+        }
+    };
+    s.push_str(&format!(
+        "  adc_cs_n = {};\n",
+        cat(&|b| format!("branches${b}$cs_n"), pad_lanes("1'b1"))
+    ));
+    s.push_str(&format!(
+        "  adc_sclk = {};\n",
+        cat(&|b| format!("branches${b}$sclk"), pad_lanes("1'b1"))
+    ));
+    s.push_str(&format!(
+        "  mux_sel = {};\n",
+        cat(
+            &|b| format!("branches${b}$mux_sel"),
+            if nb < MAX_BRANCHES {
+                Some(format!("{}'h0", 3 * (MAX_BRANCHES - nb)))
+            } else {
+                None
+            }
+        )
+    ));
+    let total: usize = devices.iter().sum();
+    s.push_str(&format!(
+        "  mux_en = {};\n",
+        cat(
+            &|b| format!("branches${b}$mux_en[{}:0]", devices[b] - 1),
+            if total < EN_TOTAL {
+                Some(format!("{}'h0", EN_TOTAL - total))
+            } else {
+                None
+            }
+        )
+    ));
+    s.push_str(&format!(
+        "  merge$done = {};\n",
+        cat(&|b| format!("branches${b}$done"), pad_lanes("1'b0"))
+    ));
+    s.push_str(&format!(
+        "  merge$more = {};\n",
+        cat(&|b| format!("branches${b}$more"), pad_lanes("1'b0"))
+    ));
+    for b in 0..MAX_BRANCHES {
+        if b < nb {
+            s.push_str(&format!(
+                "  merge$ch${b} = branches${b}$res_ch;\n  merge$v${b} = branches${b}$res_val;\n"
+            ));
+        } else {
+            s.push_str(&format!(
+                "  merge$ch${b} = {CH_BITS}'h0;\n  merge$v${b} = {VALUE_BITS}'h0;\n"
+            ));
+        }
+    }
+}
+
+/// Inputs the mix leaves unused, OR-reduced into named wires so that lint
+/// sees them read.
+fn unused_wires(s: &mut String, nb: usize, devices: &[usize]) {
+    let unused: Vec<String> = (0..nb)
+        .filter(|&b| devices[b] < EN_BITS)
+        .map(|b| format!("branches${b}$mux_en[{}:{}]", EN_BITS - 1, devices[b]))
+        .collect();
+    if !unused.is_empty() {
+        s.push_str(&format!(
+            "\n// enables of devices a branch does not have are always zero\nwire unused_mux_en = |{{{}}};\n",
+            unused.join(", ")
+        ));
+    }
+    if nb < MAX_BRANCHES {
+        s.push_str(&format!(
+            "// lanes of branches the mix does not have\nwire unused_miso = |adc_miso[{}:{}];\nwire unused_grant = |merge$grant[{0}:{1}];\n",
+            MAX_BRANCHES - 1,
+            nb
+        ));
+    }
+}

@@ -1,0 +1,152 @@
+//! Merged sample stream.
+
+use rust_hdl::prelude::*;
+
+use crate::widths::*;
+
+/// P(c) = pending completions plus this cycle's; the lowest branch in it
+/// leaves in the next cycle (docs/timing.md, "Merged sample stream").
+/// Fixed-maximum lanes (`MAX_BRANCHES`); the update is a loop and the
+/// Verilog a priority chain over the mix's branches only, generated per mix,
+/// so the lanes a mix does not have cost nothing.
+#[derive(LogicBlock)]
+pub struct Merger {
+    pub clock: Signal<In, Clock>,
+    pub rst: Signal<In, Bit>,
+    pub done: Signal<In, Bits<MAX_BRANCHES>>,
+    /// Lane `b` has more words of the same conversion after the one offered.
+    pub more: Signal<In, Bits<MAX_BRANCHES>>,
+    pub ch: [Signal<In, Bits<CH_BITS>>; MAX_BRANCHES],
+    pub v: [Signal<In, Bits<VALUE_BITS>>; MAX_BRANCHES],
+    /// The lane whose word is taken at the end of this cycle (one-hot).
+    pub grant: Signal<Out, Bits<MAX_BRANCHES>>,
+    pub valid: Signal<Out, Bit>,
+    pub channel: Signal<Out, Bits<CH_BITS>>,
+    pub value: Signal<Out, Bits<VALUE_BITS>>,
+    pub(super) r_valid: DFF<Bit>,
+    pub(super) r_ch: DFF<Bits<CH_BITS>>,
+    pub(super) r_val: DFF<Bits<VALUE_BITS>>,
+    pub(super) pend: DFF<Bits<MAX_BRANCHES>>,
+    /// Branches of the mix (lanes `0..nb` are used).
+    _nb: usize,
+}
+
+impl Merger {
+    pub(super) fn new(nb: usize) -> Merger {
+        Merger {
+            clock: Default::default(),
+            rst: Default::default(),
+            done: Default::default(),
+            more: Default::default(),
+            ch: std::array::from_fn(|_| Default::default()),
+            v: std::array::from_fn(|_| Default::default()),
+            grant: Default::default(),
+            valid: Default::default(),
+            channel: Default::default(),
+            value: Default::default(),
+            r_valid: Default::default(),
+            r_ch: Default::default(),
+            r_val: Default::default(),
+            pend: Default::default(),
+            _nb: nb,
+        }
+    }
+}
+
+impl Logic for Merger {
+    fn update(&mut self) {
+        dff_setup!(self, clock, r_valid, r_ch, r_val, pend);
+        let p = self.pend.q.val().to_u64() | self.done.val().to_u64();
+        self.r_valid.d.next = p != 0;
+        self.pend.d.next = 0u64.into();
+        self.grant.next = 0u64.into();
+        if p != 0 {
+            let b = p.trailing_zeros() as usize;
+            let more = self.more.val().to_u64() & (1 << b);
+            self.r_ch.d.next = self.ch[b].val();
+            self.r_val.d.next = self.v[b].val();
+            // A chained conversion stays pending until its last word leaves.
+            self.pend.d.next = ((p & (p - 1)) | more).into();
+            self.grant.next = (1u64 << b).into();
+        }
+        if self.rst.val() {
+            self.r_valid.d.next = false;
+            self.r_ch.d.next = 0u64.into();
+            self.r_val.d.next = 0u64.into();
+            self.pend.d.next = 0u64.into();
+        }
+        self.valid.next = self.r_valid.q.val();
+        self.channel.next = self.r_ch.q.val();
+        self.value.next = self.r_val.q.val();
+    }
+
+    fn connect(&mut self) {
+        self.r_valid.clock.connect();
+        self.r_valid.d.connect();
+        self.r_ch.clock.connect();
+        self.r_ch.d.connect();
+        self.r_val.clock.connect();
+        self.r_val.d.connect();
+        self.pend.clock.connect();
+        self.pend.d.connect();
+        self.grant.connect();
+        self.valid.connect();
+        self.channel.connect();
+        self.value.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        let nb = self._nb;
+        let w = MAX_BRANCHES;
+        let mut s = format!(
+            "// P(c) of the mix's {nb} lanes: pending plus this cycle's completions\nwire [{}:0] p = pend$q[{0}:0] | done[{0}:0];\n\n",
+            nb - 1
+        );
+        s.push_str("always @(*) begin\n");
+        for f in ["r_valid", "r_ch", "r_val", "pend"] {
+            s.push_str(&format!("  {f}$clock = clock;\n"));
+        }
+        s.push_str(&format!(
+            "  r_valid$d = |p;\n  r_ch$d = r_ch$q;\n  r_val$d = r_val$q;\n  pend$d = {w}'h0;\n  grant = {w}'h0;\n"
+        ));
+        for b in 0..nb {
+            let kw = if b == 0 { "if" } else { "else if" };
+            let mut rest = String::new();
+            if nb > 1 {
+                rest = format!("p & {nb}'h{:x}", ((1u64 << nb) - 1) & !(1u64 << b));
+            }
+            let pend = if nb == 1 {
+                format!("{w}'h0")
+            } else if nb < w {
+                format!("{{{}'h0, {rest}}}", w - nb)
+            } else {
+                rest
+            };
+            s.push_str(&format!(
+                "  {kw} (p[{b}]) begin\n    r_ch$d = ch${b};\n    r_val$d = v${b};\n    pend$d = {pend};\n    pend$d[{b}] = more[{b}];\n    grant = {w}'h{:x};\n  end\n",
+                1u64 << b
+            ));
+        }
+        s.push_str(&format!(
+            "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = {VALUE_BITS}'h0;\n    pend$d = {w}'h0;\n  end\n"
+        ));
+        s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
+        let mut unused: Vec<String> = Vec::new();
+        if nb < w {
+            unused.push(format!("done[{}:{nb}]", w - 1));
+            unused.push(format!("more[{}:{nb}]", w - 1));
+            unused.push(format!("pend$q[{}:{nb}]", w - 1));
+            for b in nb..w {
+                unused.push(format!("ch${b}"));
+                unused.push(format!("v${b}"));
+            }
+        }
+        if !unused.is_empty() {
+            s.push_str(&format!(
+                "\n// lanes of branches the mix does not have (tied to zero by the core)\nwire unused_lanes = |{{{}}};\n",
+                unused.join(", ")
+            ));
+        }
+        Verilog::Custom(s)
+    }
+}

@@ -1,0 +1,169 @@
+//! SPI sequencer: one per distinct SPI timing, shared by its branches.
+
+use rust_hdl::prelude::*;
+
+use super::c;
+use crate::plan::SeqTiming;
+use crate::widths::*;
+
+/// Every conversion starts at a slot start, so CS/SCLK/capture timing
+/// inside a slot is the same for every branch with the same SPI timing.
+/// The sequencer runs one cycle ahead of the branches' output registers and
+/// starts a (virtual) conversion in every slot: in cycle `c`, `cs_n` (the
+/// conversion pin, active low whatever its polarity on the board) and
+/// `sclk` are the levels a converting branch has in cycle `c + 1`, `cap` is
+/// high iff a converting branch captures a data bit from MISO at the edge
+/// that ends cycle `c`, and `done` is high in cycle `t + R - 1`.
+///
+/// One phase counter times both the setup (for CNV parts the conversion
+/// time too) and the SCLK periods: it starts at `sclk_div - setup` modulo
+/// `2^PH_BITS`, so it reaches the end of a period exactly `setup` cycles
+/// after the start, however long the setup.
+#[derive(LogicBlock)]
+pub struct SpiSeq {
+    pub clock: Signal<In, Clock>,
+    pub rst: Signal<In, Bit>,
+    pub start2: Signal<In, Bit>,
+    pub cs_n: Signal<Out, Bit>,
+    pub sclk: Signal<Out, Bit>,
+    pub cap: Signal<Out, Bit>,
+    pub done: Signal<Out, Bit>,
+    pub(super) r_cs_n: DFF<Bit>,
+    pub(super) r_sclk: DFF<Bit>,
+    pub(super) ph: DFF<Bits<PH_BITS>>,
+    pub(super) nfall: DFF<Bits<NFALL_BITS>>,
+    /// Index within its word of the serial bit the next rising edge reads.
+    pub(super) wbit: DFF<Bits<WORD_BIT_BITS>>,
+    pub(super) r_cap: DFF<Bit>,
+    pub(super) r_done: DFF<Bit>,
+    wrap: Signal<Local, Bit>,
+    half: Signal<Local, Bit>,
+    k_ph_last: Constant<Bits<PH_BITS>>,
+    k_ph_half: Constant<Bits<PH_BITS>>,
+    k_ph_start: Constant<Bits<PH_BITS>>,
+    k_ph_zero: Constant<Bits<PH_BITS>>,
+    k_ph_one: Constant<Bits<PH_BITS>>,
+    k_nf_zero: Constant<Bits<NFALL_BITS>>,
+    k_nf_one: Constant<Bits<NFALL_BITS>>,
+    k_nf_end: Constant<Bits<NFALL_BITS>>,
+    k_wb_first: Constant<Bits<WORD_BIT_BITS>>,
+    k_wb_last: Constant<Bits<WORD_BIT_BITS>>,
+    k_wb_zero: Constant<Bits<WORD_BIT_BITS>>,
+    k_wb_one: Constant<Bits<WORD_BIT_BITS>>,
+    k_data_lo: Constant<Bits<WORD_BIT_BITS>>,
+    k_data_n: Constant<Bits<WORD_BIT_BITS>>,
+    /// SCLK level between conversions (CS parts high, CNV parts low).
+    k_sclk_idle: Constant<Bit>,
+    /// The last rising edge reads a bit (CNV parts; a CS part's last edge
+    /// comes after its last bit).
+    k_cap_last: Constant<Bit>,
+}
+
+impl SpiSeq {
+    pub(super) fn new(t: &SeqTiming) -> SpiSeq {
+        let ph_mod = 1u64 << PH_BITS;
+        SpiSeq {
+            clock: Default::default(),
+            rst: Default::default(),
+            start2: Default::default(),
+            cs_n: Default::default(),
+            sclk: Default::default(),
+            cap: Default::default(),
+            done: Default::default(),
+            r_cs_n: Default::default(),
+            r_sclk: Default::default(),
+            ph: Default::default(),
+            nfall: Default::default(),
+            wbit: Default::default(),
+            r_cap: Default::default(),
+            r_done: Default::default(),
+            wrap: Default::default(),
+            half: Default::default(),
+            k_ph_last: c(t.sclk_div - 1),
+            k_ph_half: c(t.sclk_half - 1),
+            k_ph_start: c((t.sclk_div + ph_mod - t.setup_cycles) % ph_mod),
+            k_ph_zero: c(0),
+            k_ph_one: c(1),
+            k_nf_zero: c(0),
+            k_nf_one: c(1),
+            k_nf_end: c(t.sclks),
+            k_wb_first: c(t.first_bit()),
+            k_wb_last: c(t.word_sclks - 1),
+            k_wb_zero: c(0),
+            k_wb_one: c(1),
+            k_data_lo: c(t.leading_bits),
+            k_data_n: c(t.bits),
+            k_sclk_idle: Constant::new(!t.cnv),
+            k_cap_last: Constant::new(t.cnv),
+        }
+    }
+}
+
+impl Logic for SpiSeq {
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(self, clock, r_cs_n, r_sclk, ph, nfall, wbit, r_cap, r_done);
+        self.wrap.next = self.ph.q.val() == self.k_ph_last.val();
+        self.half.next = self.ph.q.val() == self.k_ph_half.val();
+        self.r_cap.d.next = false;
+        self.r_done.d.next = false;
+        if self.start2.val() {
+            // Cycle t - 2: a converting branch's conversion pin becomes
+            // active at the edge that begins t.
+            self.r_cs_n.d.next = false;
+            self.r_sclk.d.next = self.k_sclk_idle.val();
+            self.ph.d.next = self.k_ph_start.val();
+            self.nfall.d.next = self.k_nf_zero.val();
+            self.wbit.d.next = self.k_wb_first.val();
+        } else if !self.r_cs_n.q.val() {
+            if self.wrap.val() {
+                self.ph.d.next = self.k_ph_zero.val();
+            } else {
+                self.ph.d.next = self.ph.q.val() + self.k_ph_one.val();
+            }
+            if self.wrap.val() {
+                if self.nfall.q.val() == self.k_nf_end.val() {
+                    // Cycle t + R - 2: the pin is released (and SCLK back at
+                    // idle) at the edge that begins t + R.
+                    self.r_cs_n.d.next = true;
+                    self.r_sclk.d.next = self.k_sclk_idle.val();
+                    self.r_done.d.next = true;
+                } else {
+                    self.nfall.d.next = self.nfall.q.val() + self.k_nf_one.val();
+                    self.r_sclk.d.next = false;
+                }
+            }
+            if self.half.val() & (self.nfall.q.val() != self.k_nf_zero.val()) {
+                // SCLK rising edge `nfall` begins the next cycle + 1: capture
+                // the serial bit it reads at the end of the next cycle, if
+                // that bit is a data bit.
+                self.r_sclk.d.next = true;
+                if self.wbit.q.val() == self.k_wb_last.val() {
+                    self.wbit.d.next = self.k_wb_zero.val();
+                } else {
+                    self.wbit.d.next = self.wbit.q.val() + self.k_wb_one.val();
+                }
+                // (wbit - leading) wraps to >= 32 below the window.
+                if ((self.wbit.q.val() - self.k_data_lo.val()) < self.k_data_n.val())
+                    & ((self.nfall.q.val() != self.k_nf_end.val()) | self.k_cap_last.val())
+                {
+                    self.r_cap.d.next = true;
+                }
+            }
+        }
+        if self.rst.val() {
+            // The state of cycle t - 1 for an instant t at cycle 0.
+            self.r_cs_n.d.next = false;
+            self.r_sclk.d.next = self.k_sclk_idle.val();
+            self.ph.d.next = self.k_ph_start.val();
+            self.nfall.d.next = self.k_nf_zero.val();
+            self.wbit.d.next = self.k_wb_first.val();
+            self.r_cap.d.next = false;
+            self.r_done.d.next = false;
+        }
+        self.cs_n.next = self.r_cs_n.q.val();
+        self.sclk.next = self.r_sclk.q.val();
+        self.cap.next = self.r_cap.q.val();
+        self.done.next = self.r_done.q.val();
+    }
+}

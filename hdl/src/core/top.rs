@@ -1,0 +1,266 @@
+//! Core: fixed-maximum ports, per-mix children, generated glue.
+
+use rust_hdl::prelude::*;
+
+use super::glue::core_glue;
+use super::{BranchUnit, Merger, SpiSeq, TimingGen};
+use crate::plan::Plan;
+use crate::widths::*;
+
+#[derive(LogicBlock)]
+pub struct Core {
+    pub clock: Signal<In, Clock>,
+    pub rst: Signal<In, Bit>,
+    pub adc_miso: Signal<In, Bits<MAX_BRANCHES>>,
+    pub adc_cs_n: Signal<Out, Bits<MAX_BRANCHES>>,
+    pub adc_sclk: Signal<Out, Bits<MAX_BRANCHES>>,
+    pub mux_sel: Signal<Out, Bits<{ 3 * MAX_BRANCHES }>>,
+    pub mux_en: Signal<Out, Bits<EN_TOTAL>>,
+    pub sample_valid: Signal<Out, Bit>,
+    pub sample_channel: Signal<Out, Bits<CH_BITS>>,
+    pub sample_value: Signal<Out, Bits<VALUE_BITS>>,
+    pub timing: TimingGen,
+    pub seqs: Vec<SpiSeq>,
+    pub branches: Vec<BranchUnit>,
+    pub merge: Merger,
+    /// Devices per branch (the glue's per-mix parameters besides the count).
+    _devices: Vec<usize>,
+    /// Sequencer of each branch.
+    _seq_of: Vec<usize>,
+    /// The value last written to `mux_en.next` (simulation only).
+    _mux_en: u128,
+    /// The value last written to `mux_sel.next` (simulation only).
+    _mux_sel: u64,
+}
+
+impl Core {
+    pub fn new(plan: &Plan) -> Core {
+        Core {
+            clock: Default::default(),
+            rst: Default::default(),
+            adc_miso: Default::default(),
+            adc_cs_n: Default::default(),
+            adc_sclk: Default::default(),
+            mux_sel: Default::default(),
+            mux_en: Default::default(),
+            sample_valid: Default::default(),
+            sample_channel: Default::default(),
+            sample_value: Default::default(),
+            timing: TimingGen::new(plan),
+            seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
+            branches: plan.branches.iter().map(BranchUnit::new).collect(),
+            merge: Merger::new(plan.branches.len()),
+            _devices: plan.branches.iter().map(|b| b.devices).collect(),
+            _seq_of: plan.branches.iter().map(|b| b.seq).collect(),
+            _mux_en: 0,
+            _mux_sel: 0,
+        }
+    }
+}
+
+/// Drive one clock signal to `level` now (as its own `update_all` would).
+#[inline(always)]
+fn drive(sig: &mut Signal<In, Clock>, level: Clock) {
+    sig.next = level;
+    sig.update_all();
+}
+
+impl Core {
+    /// `mux_en` as a number (the value of the `mux_en` signal).
+    pub fn mux_en_u128(&self) -> u128 {
+        self._mux_en
+    }
+
+    /// `mux_sel` as a number (the value of the `mux_sel` signal).
+    pub fn mux_sel_u64(&self) -> u64 {
+        self._mux_sel
+    }
+
+    /// Put `level` on every clock signal of the hierarchy at once: the
+    /// zero-skew clock net of the emitted Verilog.
+    ///
+    /// rust-hdl's own propagation moves the clock one hierarchy level per
+    /// evaluation pass (`Core.clock` -> `timing.clock` -> `timing.cnt.clock`),
+    /// which costs three passes per clock level before any flip-flop can
+    /// react. After this call the next pass sees the edge at every flip-flop
+    /// and ROM together, and the per-pass copies that the blocks' own
+    /// `update` (`clock!`/`dff_setup!` wiring) make are no-ops.  Only the
+    /// clock moves here; data still propagates through rust-hdl's passes.
+    pub fn drive_clock(&mut self, level: bool) {
+        let k = Clock::from(level);
+        drive(&mut self.clock, k);
+        let t = &mut self.timing;
+        drive(&mut t.clock, k);
+        drive(&mut t.cnt.clock, k);
+        drive(&mut t.st.clock, k);
+        drive(&mut t.st2.clock, k);
+        drive(&mut t.st0.clock, k);
+        drive(&mut t.slot.clock, k);
+        drive(&mut t.sl.clock, k);
+        for q in self.seqs.iter_mut() {
+            drive(&mut q.clock, k);
+            drive(&mut q.r_cs_n.clock, k);
+            drive(&mut q.r_sclk.clock, k);
+            drive(&mut q.ph.clock, k);
+            drive(&mut q.nfall.clock, k);
+            drive(&mut q.wbit.clock, k);
+            drive(&mut q.r_cap.clock, k);
+            drive(&mut q.r_done.clock, k);
+        }
+        for u in self.branches.iter_mut() {
+            drive(&mut u.clock, k);
+            drive(&mut u.rom.clock, k);
+            drive(&mut u.act.clock, k);
+            drive(&mut u.r_cs_n.clock, k);
+            drive(&mut u.r_sclk.clock, k);
+            drive(&mut u.reader.clock, k);
+            drive(&mut u.cur_ch.clock, k);
+            drive(&mut u.r_sel.clock, k);
+            drive(&mut u.r_en.clock, k);
+            drive(&mut u.r_done.clock, k);
+            drive(&mut u.p_sel.clock, k);
+            drive(&mut u.p_dev.clock, k);
+        }
+        let m = &mut self.merge;
+        drive(&mut m.clock, k);
+        drive(&mut m.r_valid.clock, k);
+        drive(&mut m.r_ch.clock, k);
+        drive(&mut m.r_val.clock, k);
+        drive(&mut m.pend.clock, k);
+    }
+}
+
+impl Logic for Core {
+    fn update(&mut self) {
+        let clk = self.clock.val();
+        let rst = self.rst.val();
+        self.timing.clock.next = clk;
+        self.timing.rst.next = rst;
+        self.merge.clock.next = clk;
+        self.merge.rst.next = rst;
+        let start = self.timing.start2.val();
+        let start1 = self.timing.start1.val();
+        let start0 = self.timing.start0.val();
+        let addr = self.timing.addr.val();
+        let slice = self.timing.slice.val();
+        let mut seq = [(false, false, false, false); MAX_BRANCHES];
+        for (i, q) in self.seqs.iter_mut().enumerate() {
+            q.clock.next = clk;
+            q.rst.next = rst;
+            q.start2.next = start;
+            seq[i] = (q.cs_n.val(), q.sclk.val(), q.cap.val(), q.done.val());
+        }
+        let miso = self.adc_miso.val().to_u64();
+        let grant = self.merge.grant.val().to_u64();
+        let (mut cs, mut sclk, mut sel, mut en, mut done) = (0u64, 0u64, 0u64, 0u128, 0u64);
+        let mut more = 0u64;
+        let mut en_off = 0usize;
+        let mut chs = [0u64; MAX_BRANCHES];
+        let mut vals = [0u64; MAX_BRANCHES];
+        for (b, u) in self.branches.iter_mut().enumerate() {
+            u.clock.next = clk;
+            u.rst.next = rst;
+            u.start2.next = start;
+            u.start1.next = start1;
+            u.start0.next = start0;
+            u.addr.next = addr;
+            u.slice.next = slice;
+            let (q_cs, q_sclk, q_cap, q_done) = seq[self._seq_of[b]];
+            u.seq_cs_n.next = q_cs;
+            u.seq_sclk.next = q_sclk;
+            u.seq_cap.next = q_cap;
+            u.seq_done.next = q_done;
+            u.miso.next = (miso >> b) & 1 == 1;
+            u.grant.next = (grant >> b) & 1 == 1;
+            more |= (u.more.val() as u64) << b;
+            cs |= (u.cs_n.val() as u64) << b;
+            sclk |= (u.sclk.val() as u64) << b;
+            sel |= u.mux_sel.val().to_u64() << (3 * b);
+            let d = self._devices[b];
+            let mask = if d >= 64 { u64::MAX } else { (1u64 << d) - 1 };
+            en |= ((u.mux_en.val().to_u64() & mask) as u128) << en_off;
+            en_off += d;
+            done |= (u.done.val() as u64) << b;
+            chs[b] = u.res_ch.val().to_u64();
+            vals[b] = u.res_val.val().to_u64();
+        }
+        // Unused lanes read as all ones on CS/SCLK (idle level) in the core;
+        // the wrapper only exposes the mix's branches.
+        let nb = self.branches.len();
+        let idle: u64 = ((1u64 << MAX_BRANCHES) - 1) & !((1u64 << nb) - 1);
+        self.adc_cs_n.next = (cs | idle).into();
+        self.adc_sclk.next = (sclk | idle).into();
+        // `mux_sel` (48 bits) and `mux_en` (128 bits) are wider than rust-hdl's
+        // short bit vectors (32 bits), so it stores them as `[bool; N]`:
+        // converting them on every evaluation pass dominated the simulation,
+        // so they are written only when their value changes (same signal value).
+        if sel != self._mux_sel {
+            self._mux_sel = sel;
+            self.mux_sel.next = sel.into();
+        }
+        if en != self._mux_en {
+            self._mux_en = en;
+            self.mux_en.next = en.to_bits();
+        }
+        self.merge.done.next = done.into();
+        self.merge.more.next = more.into();
+        // Lanes >= nb keep their default 0 (the glue ties them to zero).
+        let m = &mut self.merge;
+        for b in 0..nb {
+            m.ch[b].next = chs[b].into();
+            m.v[b].next = vals[b].into();
+        }
+        self.sample_valid.next = self.merge.valid.val();
+        self.sample_channel.next = self.merge.channel.val();
+        self.sample_value.next = self.merge.value.val();
+    }
+
+    fn connect(&mut self) {
+        self.timing.clock.connect();
+        self.timing.rst.connect();
+        self.merge.clock.connect();
+        self.merge.rst.connect();
+        for q in self.seqs.iter_mut() {
+            q.clock.connect();
+            q.rst.connect();
+            q.start2.connect();
+        }
+        for u in self.branches.iter_mut() {
+            u.clock.connect();
+            u.rst.connect();
+            u.start2.connect();
+            u.start1.connect();
+            u.start0.connect();
+            u.addr.connect();
+            u.slice.connect();
+            u.seq_cs_n.connect();
+            u.seq_sclk.connect();
+            u.seq_cap.connect();
+            u.seq_done.connect();
+            u.miso.connect();
+            u.grant.connect();
+        }
+        self.merge.done.connect();
+        self.merge.more.connect();
+        for b in 0..MAX_BRANCHES {
+            self.merge.ch[b].connect();
+            self.merge.v[b].connect();
+        }
+        self.adc_cs_n.connect();
+        self.adc_sclk.connect();
+        self.mux_sel.connect();
+        self.mux_en.connect();
+        self.sample_valid.connect();
+        self.sample_channel.connect();
+        self.sample_value.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        Verilog::Custom(core_glue(
+            self.branches.len(),
+            &self._devices,
+            &self._seq_of,
+            self.seqs.len(),
+        ))
+    }
+}
