@@ -29,7 +29,7 @@ use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use lut_gen::ports::{LinkPort, Role, AXIS_PORTS, PORT_NAMES as PORTS, TOP_MODULE};
+use lut_gen::ports::{LinkPort, Role, AXIS_PORTS, PORT_NAMES, TOP_MODULE};
 use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker};
@@ -301,8 +301,8 @@ const VALID: usize = Role::SampleValid as usize;
 const CHAN: usize = Role::SampleChannel as usize;
 const VALUE: usize = Role::SampleValue as usize;
 /// The first of the link's ports in [`State`].
-const LINK: usize = PORTS.len();
-/// Port slots: [`PORTS`], then the most link ports a mix has ([`AXIS_PORTS`]).
+const LINK: usize = PORT_NAMES.len();
+/// Port slots: [`PORT_NAMES`], then the most link ports a mix has ([`AXIS_PORTS`]).
 const NPORT: usize = LINK + AXIS_PORTS.len();
 
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
@@ -329,7 +329,7 @@ struct Resolved {
     has_rst: bool,
     scope: String,
     widths: [u32; 10],
-    /// The link's ports, read after [`PORTS`] (none without a link).
+    /// The link's ports, read after [`PORT_NAMES`] (none without a link).
     link: &'static [LinkPort],
 }
 
@@ -349,7 +349,7 @@ fn resolve(
     let has = |sc: &str, name: &str| h.vars.iter().any(|v| v.scope == sc && v.name == name);
     // `clk` and `rst` may be absent (a capture without them: cycles are then
     // inferred, and the frame phase found from the pins, `lock.rs`).
-    let required: Vec<&str> = PORTS
+    let required: Vec<&str> = PORT_NAMES
         .iter()
         .enumerate()
         .filter(|(i, _)| *i != CLK && *i != RST)
@@ -393,18 +393,24 @@ fn resolve(
     // An absent `rst` fits any mix.
     let fits = |c: &str, p: &str, w: u32| {
         let got = width_of(c, p);
-        got == w || (p == PORTS[RST] && got == 0)
+        got == w || (p == PORT_NAMES[RST] && got == 0)
     };
     let exact: Vec<&str> = candidates
         .iter()
         .copied()
-        .filter(|c| PORTS.iter().zip(widths).skip(1).all(|(p, w)| fits(c, p, w)))
+        .filter(|c| {
+            PORT_NAMES
+                .iter()
+                .zip(widths)
+                .skip(1)
+                .all(|(p, w)| fits(c, p, w))
+        })
         .collect();
     if !exact.is_empty() {
         candidates = exact;
     } else if candidates.len() > 1 {
         let c = candidates[0];
-        let (p, w) = PORTS
+        let (p, w) = PORT_NAMES
             .iter()
             .zip(widths)
             .skip(1)
@@ -434,7 +440,7 @@ fn resolve(
         )));
     };
     let ids_of = |sc: &str| -> Vec<Vec<Vec<u8>>> {
-        PORTS
+        PORT_NAMES
             .iter()
             .map(|p| {
                 h.vars
@@ -461,7 +467,7 @@ fn resolve(
     }
     let mut has_clk = false;
     let mut has_rst = true;
-    for (p, name) in PORTS.iter().enumerate() {
+    for (p, name) in PORT_NAMES.iter().enumerate() {
         let vs: Vec<&Var> = h
             .vars
             .iter()
@@ -670,7 +676,7 @@ pub(crate) fn parse_value(s: &[u8], width: u32) -> Option<Val> {
     Some(Val { v, x })
 }
 
-/// The ports of [`PORTS`], then the link's (`Layout::link_ports`).
+/// The ports of [`PORT_NAMES`], then the link's (`Layout::link_ports`).
 struct State {
     port: [Val; NPORT],
     /// The link is AXI4-Stream: its slots are [`AXIS_PORTS`]'s.
