@@ -751,34 +751,7 @@ impl Checker {
                 None
             }
         };
-        let st = &self.br[b];
-        if st.mux_from_reset && c + st.reset_held < lim.settle_min {
-            // The first conversion after reset: the mux value has settled
-            // through the last `reset_held` reset cycles (those since it
-            // last moved; the first reset cycle seen counts as a move, as
-            // the pins' values before the first reset edge are not the
-            // gateware's) and cycles 0..c.  A short reset is no excuse: the
-            // gateware must be correct for any reset of one cycle or more.
-            let held = st.reset_held;
-            self.inv.record(
-                Violation::new(Rule::MuxSettle, c)
-                    .signal(name(Signal::MuxSel(b), &self.layout))
-                    .expected(json!(lim.settle_min))
-                    .actual(json!(c + held))
-                    .channel(ch.and_then(|ch| self.names.get(ch as usize).cloned()))
-                    .detail(format!("first conversion after reset: the mux value held through {held} reset cycles and {c} cycles after reset; settling needs {}", lim.settle_min)),
-            );
-        } else if !st.mux_from_reset && !st.mux_unknown && c - st.mux_since < lim.settle_min {
-            let since = st.mux_since;
-            self.inv.record(
-                Violation::new(Rule::MuxSettle, c)
-                    .signal(name(Signal::MuxSel(b), &self.layout))
-                    .expected(json!(lim.settle_min))
-                    .actual(json!(c - since))
-                    .channel(ch.and_then(|ch| self.names.get(ch as usize).cloned()))
-                    .detail(format!("mux switched in cycle {since}, {} cycles before the sampling instant; settling needs {}", c - since, lim.settle_min)),
-            );
-        }
+        self.mux_settle(b, c, ch);
         let st = &mut self.br[b];
         st.low = true;
         st.t = c;
@@ -797,6 +770,40 @@ impl Checker {
                 }
                 None => self.inv.instant(c, b, ch),
             }
+        }
+    }
+
+    /// The mux must have settled for `settle_min` cycles at the sampling
+    /// instant `c` of branch `b` (channel `ch`, if known).
+    fn mux_settle(&mut self, b: usize, c: u64, ch: Option<u16>) {
+        let settle_min = self.limits[b].settle_min;
+        let st = &self.br[b];
+        if st.mux_from_reset && c + st.reset_held < settle_min {
+            // The first conversion after reset: the mux value has settled
+            // through the last `reset_held` reset cycles (those since it
+            // last moved; the first reset cycle seen counts as a move, as
+            // the pins' values before the first reset edge are not the
+            // gateware's) and cycles 0..c.  A short reset is no excuse: the
+            // gateware must be correct for any reset of one cycle or more.
+            let held = st.reset_held;
+            self.inv.record(
+                Violation::new(Rule::MuxSettle, c)
+                    .signal(Signal::MuxSel(b).name(&self.layout))
+                    .expected(json!(settle_min))
+                    .actual(json!(c + held))
+                    .channel(ch.and_then(|ch| self.names.get(ch as usize).cloned()))
+                    .detail(format!("first conversion after reset: the mux value held through {held} reset cycles and {c} cycles after reset; settling needs {}", settle_min)),
+            );
+        } else if !st.mux_from_reset && !st.mux_unknown && c - st.mux_since < settle_min {
+            let since = st.mux_since;
+            self.inv.record(
+                Violation::new(Rule::MuxSettle, c)
+                    .signal(Signal::MuxSel(b).name(&self.layout))
+                    .expected(json!(settle_min))
+                    .actual(json!(c - since))
+                    .channel(ch.and_then(|ch| self.names.get(ch as usize).cloned()))
+                    .detail(format!("mux switched in cycle {since}, {} cycles before the sampling instant; settling needs {}", c - since, settle_min)),
+            );
         }
     }
 
