@@ -187,7 +187,6 @@ fn parse_vcd(
     lanes: Vec<Lane>,
     progress: &dyn Fn(u64, u64),
 ) -> Result<Capture, String> {
-    let err = |line: usize, m: String| format!("{}:{line}: {m}", path.display());
     let total = text.len() as u64;
     // told at every 256 kB, not every line: a call per line would cost more
     // than the parsing
@@ -200,92 +199,151 @@ fn parse_vcd(
             progress(at, total);
         }
     };
-    let mut ids: Vec<(String, usize)> = Vec::new();
-    let mut scale_ps = 1.0;
-    let mut rate_hz: Option<f64> = None;
-    let mut names = Vec::new();
-    let mut steps: Vec<(u64, u64)> = Vec::new();
-    let mut cur = 0u64;
-    let mut t = 0u64;
-    let mut in_body = false;
     let mut toks = text
         .lines()
         .enumerate()
         .inspect(|(_, l)| told(l))
-        .flat_map(|(n, l)| l.split_whitespace().map(move |w| (n + 1, w)))
-        .peekable();
+        .flat_map(|(n, l)| l.split_whitespace().map(move |w| (n + 1, w)));
+    let head = read_header(&mut toks, path, &lanes)?;
+    let steps = read_body(&mut toks, path, &head)?;
+    progress(total, total);
+    // Without the rate comment, the smallest step between timestamps.
+    // With the rate known, one timescale unit is added: sigrok rounds each
+    // sample's time to it.
+    let period_ps = match head.rate_hz {
+        Some(r) => (1e12 / r).round() as u64 + head.scale_ps.ceil() as u64,
+        None => steps
+            .windows(2)
+            .map(|w| w[1].0 - w[0].0)
+            .filter(|d| *d > 0)
+            .min()
+            .ok_or_else(|| format!("{}: no sample rate and too few samples", path.display()))?,
+    };
+    Ok(Capture {
+        lanes,
+        period_ps,
+        steps,
+    })
+}
+
+/// An error at line `line` of the capture.
+fn at_line(path: &Path, line: usize, m: String) -> String {
+    format!("{}:{line}: {m}", path.display())
+}
+
+/// What the capture's header declares.
+struct CaptureHeader {
+    /// Identifier code -> lane, for the channels the map names.
+    ids: Vec<(String, usize)>,
+    scale_ps: f64,
+    rate_hz: Option<f64>,
+}
+
+/// The header's tokens (`(line, token)`), up to `$enddefinitions`: every
+/// channel the map names must be declared.
+fn read_header<'t>(
+    toks: &mut impl Iterator<Item = (usize, &'t str)>,
+    path: &Path,
+    lanes: &[Lane],
+) -> Result<CaptureHeader, String> {
+    let mut head = CaptureHeader {
+        ids: Vec::new(),
+        scale_ps: 1.0,
+        rate_hz: None,
+    };
+    let mut names = Vec::new();
     while let Some((n, w)) = toks.next() {
-        if !in_body {
-            let mut group = vec![];
-            if w.starts_with('$') && w != "$end" {
-                for (_, x) in toks.by_ref() {
-                    if x == "$end" {
-                        break;
-                    }
-                    group.push(x);
+        let mut group = vec![];
+        if w.starts_with('$') && w != "$end" {
+            for (_, x) in toks.by_ref() {
+                if x == "$end" {
+                    break;
                 }
+                group.push(x);
             }
-            match w {
-                "$timescale" => {
-                    let s: String = group.concat();
-                    let i = s.find(|c: char| !c.is_ascii_digit()).unwrap_or(s.len());
-                    let k: f64 = s[..i].parse().unwrap_or(1.0);
-                    scale_ps =
-                        k * unit_ps(&s[i..]).ok_or_else(|| err(n, format!("timescale `{s}`")))?;
-                }
-                "$comment" => {
-                    if let Some(i) = group.iter().position(|x| *x == "at") {
-                        if let (Some(v), Some(u)) = (group.get(i + 1), group.get(i + 2)) {
-                            let m = match *u {
-                                "Hz" => 1.0,
-                                "kHz" => 1e3,
-                                "MHz" => 1e6,
-                                "GHz" => 1e9,
-                                _ => 0.0,
-                            };
-                            rate_hz = v.parse::<f64>().ok().map(|v| v * m).filter(|r| *r > 0.0);
-                        }
-                    }
-                }
-                "$var" => {
-                    if group.len() < 4 {
-                        return Err(err(n, "$var needs type, width, code and name".into()));
-                    }
-                    let name = group[3].to_string();
-                    names.push(name.clone());
-                    if let Some(li) = lanes.iter().position(|l| l.channel == name) {
-                        ids.push((group[2].to_string(), li));
-                    }
-                }
-                "$enddefinitions" => {
-                    in_body = true;
-                    let missing: Vec<&str> = lanes
-                        .iter()
-                        .filter(|l| !names.contains(&l.channel))
-                        .map(|l| l.channel.as_str())
-                        .collect();
-                    if !missing.is_empty() {
-                        return Err(format!(
-                            "{}: --map names channel(s) {} that the capture does not have (it has {})",
-                            path.display(),
-                            missing.join(", "),
-                            names.join(", ")
-                        ));
-                    }
-                }
-                _ => {}
-            }
-            continue;
         }
+        match w {
+            "$timescale" => {
+                let s: String = group.concat();
+                let i = s.find(|c: char| !c.is_ascii_digit()).unwrap_or(s.len());
+                let k: f64 = s[..i].parse().unwrap_or(1.0);
+                head.scale_ps = k * unit_ps(&s[i..])
+                    .ok_or_else(|| at_line(path, n, format!("timescale `{s}`")))?;
+            }
+            "$comment" => {
+                if let Some(i) = group.iter().position(|x| *x == "at") {
+                    if let (Some(v), Some(u)) = (group.get(i + 1), group.get(i + 2)) {
+                        let m = match *u {
+                            "Hz" => 1.0,
+                            "kHz" => 1e3,
+                            "MHz" => 1e6,
+                            "GHz" => 1e9,
+                            _ => 0.0,
+                        };
+                        head.rate_hz = v.parse::<f64>().ok().map(|v| v * m).filter(|r| *r > 0.0);
+                    }
+                }
+            }
+            "$var" => {
+                if group.len() < 4 {
+                    return Err(at_line(
+                        path,
+                        n,
+                        "$var needs type, width, code and name".into(),
+                    ));
+                }
+                let name = group[3].to_string();
+                names.push(name.clone());
+                if let Some(li) = lanes.iter().position(|l| l.channel == name) {
+                    head.ids.push((group[2].to_string(), li));
+                }
+            }
+            "$enddefinitions" => {
+                let missing: Vec<&str> = lanes
+                    .iter()
+                    .filter(|l| !names.contains(&l.channel))
+                    .map(|l| l.channel.as_str())
+                    .collect();
+                if !missing.is_empty() {
+                    return Err(format!(
+                        "{}: --map names channel(s) {} that the capture does not have (it has {})",
+                        path.display(),
+                        missing.join(", "),
+                        names.join(", ")
+                    ));
+                }
+                return Ok(head);
+            }
+            _ => {}
+        }
+    }
+    Ok(head)
+}
+
+/// The body's tokens: the mapped lanes' levels as (time in ps, bits) at
+/// every timestamp where they changed, and at the end.
+fn read_body<'t>(
+    toks: &mut impl Iterator<Item = (usize, &'t str)>,
+    path: &Path,
+    head: &CaptureHeader,
+) -> Result<Vec<(u64, u64)>, String> {
+    let mut steps: Vec<(u64, u64)> = Vec::new();
+    let mut cur = 0u64;
+    let mut t = 0u64;
+    while let Some((n, w)) = toks.next() {
         if let Some(ts) = w.strip_prefix('#') {
             let nt: u64 = ts
                 .parse()
-                .map_err(|_| err(n, format!("bad timestamp `{w}`")))?;
+                .map_err(|_| at_line(path, n, format!("bad timestamp `{w}`")))?;
             if nt < t {
-                return Err(err(n, format!("time goes backwards from {t} to {nt}")));
+                return Err(at_line(
+                    path,
+                    n,
+                    format!("time goes backwards from {t} to {nt}"),
+                ));
             }
             if steps.last().map(|s| s.1) != Some(cur) || steps.is_empty() {
-                steps.push(((t as f64 * scale_ps) as u64, cur));
+                steps.push(((t as f64 * head.scale_ps) as u64, cur));
             }
             t = nt;
             continue;
@@ -299,9 +357,9 @@ fn parse_vcd(
                 let c = toks.next().map(|x| x.1).unwrap_or("");
                 (*w.as_bytes().last().unwrap_or(&b'0'), c)
             }
-            _ => return Err(err(n, format!("unexpected `{w}`"))),
+            _ => return Err(at_line(path, n, format!("unexpected `{w}`"))),
         };
-        if let Some((_, li)) = ids.iter().find(|(c, _)| c == code) {
+        if let Some((_, li)) = head.ids.iter().find(|(c, _)| c == code) {
             if val == b'1' {
                 cur |= 1 << li;
             } else {
@@ -309,25 +367,8 @@ fn parse_vcd(
             }
         }
     }
-    steps.push(((t as f64 * scale_ps) as u64, cur));
-    progress(total, total);
-    // Without the rate comment, the smallest step between timestamps.
-    // With the rate known, one timescale unit is added: sigrok rounds each
-    // sample's time to it.
-    let period_ps = match rate_hz {
-        Some(r) => (1e12 / r).round() as u64 + scale_ps.ceil() as u64,
-        None => steps
-            .windows(2)
-            .map(|w| w[1].0 - w[0].0)
-            .filter(|d| *d > 0)
-            .min()
-            .ok_or_else(|| format!("{}: no sample rate and too few samples", path.display()))?,
-    };
-    Ok(Capture {
-        lanes,
-        period_ps,
-        steps,
-    })
+    steps.push(((t as f64 * head.scale_ps) as u64, cur));
+    Ok(steps)
 }
 
 /// Roles the lanes do not cover at all (for the report).

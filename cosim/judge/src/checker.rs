@@ -16,7 +16,8 @@ use lut_gen::ports::{Layout, Pins, Role, Signal};
 use crate::invariants::Invariants;
 use crate::linkline::LinkLine;
 use crate::model::CycleModel;
-use crate::report::{Divergence, Report};
+use crate::report::{Divergence, Report, Violation};
+use crate::rule::Rule;
 
 /// How much the checker records (it always counts everything).
 #[derive(Debug, Clone, Copy)]
@@ -346,26 +347,19 @@ impl Checker {
             (None, Phase::Run) => {
                 if !self.rst_x_seen {
                     self.rst_x_seen = true;
-                    self.inv.violation(
-                        self.c,
-                        "x-or-z",
-                        Some(Role::Reset.name().into()),
-                        None,
-                        Some(json!("x")),
-                        None,
-                        "rst is x/z after reset was released".into(),
+                    self.inv.record(
+                        Violation::new(Rule::XOrZ, self.c)
+                            .signal(Role::Reset.name().to_string())
+                            .actual(json!("x"))
+                            .detail("rst is x/z after reset was released"),
                     );
                 }
             }
             (Some(true), Phase::Run) => {
-                self.inv.violation(
-                    self.c,
-                    "reset",
-                    Some(Role::Reset.name().into()),
-                    None,
-                    None,
-                    None,
-                    "reset asserted again: checking stops here".into(),
+                self.inv.record(
+                    Violation::new(Rule::Reset, self.c)
+                        .signal(Role::Reset.name().to_string())
+                        .detail("reset asserted again: checking stops here"),
                 );
                 self.phase = Phase::Stopped;
                 return;
@@ -504,26 +498,22 @@ impl Checker {
                 } else {
                     "tlast changed"
                 };
-                self.inv.violation(
-                    c,
-                    "axis-stable",
-                    Some("m_axis_tvalid/tdata/tlast".into()),
-                    Some(json!(format!("tvalid=1 tdata={:#04x} tlast={}", q.axis_tdata, q.axis_tlast as u8))),
-                    Some(json!(format!("tvalid={} tdata={:#04x} tlast={}", p.axis_tvalid as u8, p.axis_tdata, p.axis_tlast as u8))),
-                    None,
-                    format!("{what} while the beat waited for tready (AXI4-Stream: a master holds tvalid, tdata and tlast until the handshake)"),
+                self.inv.record(
+                    Violation::new(Rule::AxisStable, c)
+                        .signal("m_axis_tvalid/tdata/tlast".to_string())
+                        .expected(json!(format!("tvalid=1 tdata={:#04x} tlast={}", q.axis_tdata, q.axis_tlast as u8)))
+                        .actual(json!(format!("tvalid={} tdata={:#04x} tlast={}", p.axis_tvalid as u8, p.axis_tdata, p.axis_tlast as u8)))
+                        .detail(format!("{what} while the beat waited for tready (AXI4-Stream: a master holds tvalid, tdata and tlast until the handshake)")),
                 );
             }
         }
         if p.link_overflow && !q.link_overflow {
-            self.inv.violation(
-                c,
-                "link-overflow",
-                Some("link_overflow".into()),
-                Some(json!(0)),
-                Some(json!(1)),
-                None,
-                "the link's FIFO overflowed: a token was dropped (its depth is the schedule's worst-case backlog under the slave's guarantee)".into(),
+            self.inv.record(
+                Violation::new(Rule::LinkOverflow, c)
+                    .signal("link_overflow".to_string())
+                    .expected(json!(0))
+                    .actual(json!(1))
+                    .detail("the link's FIFO overflowed: a token was dropped (its depth is the schedule's worst-case backlog under the slave's guarantee)"),
             );
         }
     }
@@ -611,14 +601,11 @@ impl Checker {
             let matters =
                 !matches!(s, Signal::SampleChannel | Signal::SampleValue) || p.sample_valid;
             if now != 0 && was == 0 && matters {
-                self.inv.violation(
-                    c,
-                    "x-or-z",
-                    Some(s.name(&self.layout)),
-                    None,
-                    Some(json!("x")),
-                    None,
-                    format!("{} is x/z (mask {now:#b})", s.name(&self.layout)),
+                self.inv.record(
+                    Violation::new(Rule::XOrZ, c)
+                        .signal(s.name(&self.layout))
+                        .actual(json!("x"))
+                        .detail(format!("{} is x/z (mask {now:#b})", s.name(&self.layout))),
                 );
             }
         }
@@ -640,14 +627,13 @@ impl Checker {
     fn capture(&mut self, b: usize, c: u64, idx: u32) {
         if self.prev_miso_xz >> b & 1 != 0 {
             self.br[b].word_bad = true;
-            self.inv.violation(
-                c,
-                "x-or-z",
-                Some(Signal::Miso(b).name(&self.layout)),
-                None,
-                Some(json!("x")),
-                None,
-                format!("MISO is x/z when the serial clock reads it ({c}, bit {idx})"),
+            self.inv.record(
+                Violation::new(Rule::XOrZ, c)
+                    .signal(Signal::Miso(b).name(&self.layout))
+                    .actual(json!("x"))
+                    .detail(format!(
+                        "MISO is x/z when the serial clock reads it ({c}, bit {idx})"
+                    )),
             );
         }
         let st = &mut self.br[b];
@@ -669,18 +655,16 @@ impl Checker {
                 st.mux_unknown = false;
                 let multi = en.count_ones() > 1;
                 if multi && !st.en_multi {
-                    self.inv.violation(
-                        c,
-                        "mux-exclusive",
-                        Some(Signal::MuxEn(b).name(&self.layout)),
-                        Some(json!("at most one bit set")),
-                        Some(json!(en)),
-                        None,
-                        format!(
-                            "branch {}: {} mux devices enabled at once",
-                            self.branch_names[b],
-                            en.count_ones()
-                        ),
+                    self.inv.record(
+                        Violation::new(Rule::MuxExclusive, c)
+                            .signal(Signal::MuxEn(b).name(&self.layout))
+                            .expected(json!("at most one bit set"))
+                            .actual(json!(en))
+                            .detail(format!(
+                                "branch {}: {} mux devices enabled at once",
+                                self.branch_names[b],
+                                en.count_ones()
+                            )),
                     );
                 }
                 self.br[b].en_multi = multi;
@@ -697,14 +681,11 @@ impl Checker {
                         self.sclk_rise(b, c);
                     }
                 } else {
-                    self.inv.violation(
-                        c,
-                        "sclk-idle",
-                        Some(Signal::Sclk(b).name(&self.layout)),
-                        None,
-                        Some(json!(p.sclk >> b & 1)),
-                        None,
-                        "SCLK toggles while CS is high".into(),
+                    self.inv.record(
+                        Violation::new(Rule::SclkIdle, c)
+                            .signal(Signal::Sclk(b).name(&self.layout))
+                            .actual(json!(p.sclk >> b & 1))
+                            .detail("SCLK toggles while CS is high"),
                     );
                 }
             }
@@ -730,35 +711,30 @@ impl Checker {
         let name = |s: Signal, l: &Layout| Some(s.name(l));
         if let Some(r) = self.br[b].cs_rise {
             if c - r < lim.quiet_min {
-                self.inv.violation(
-                    c,
-                    "cs-quiet",
-                    name(Signal::CsN(b), &self.layout),
-                    Some(json!(lim.quiet_min)),
-                    Some(json!(c - r)),
-                    None,
-                    format!(
-                        "CS high for {} cycles between conversions, the ADC needs {} (t_quiet)",
-                        c - r,
-                        lim.quiet_min
-                    ),
+                self.inv.record(
+                    Violation::new(Rule::CsQuiet, c)
+                        .signal(name(Signal::CsN(b), &self.layout))
+                        .expected(json!(lim.quiet_min))
+                        .actual(json!(c - r))
+                        .detail(format!(
+                            "CS high for {} cycles between conversions, the ADC needs {} (t_quiet)",
+                            c - r,
+                            lim.quiet_min
+                        )),
                 );
             }
         }
         if p.sclk >> b & 1 == 0 {
-            self.inv.violation(
-                c,
-                "sclk-idle",
-                name(Signal::Sclk(b), &self.layout),
-                Some(json!(1)),
-                Some(json!(0)),
-                None,
-                if self.limits[b].cnv {
-                    "SCK is high when CNV rises (chain mode needs SCK low)"
-                } else {
-                    "SCLK is low when CS falls (CPOL=1 idles high)"
-                }
-                .into(),
+            self.inv.record(
+                Violation::new(Rule::SclkIdle, c)
+                    .signal(name(Signal::Sclk(b), &self.layout))
+                    .expected(json!(1))
+                    .actual(json!(0))
+                    .detail(if self.limits[b].cnv {
+                        "SCK is high when CNV rises (chain mode needs SCK low)"
+                    } else {
+                        "SCLK is low when CS falls (CPOL=1 idles high)"
+                    }),
             );
         }
         let sel_x = self.layout.sel(xz, b) != 0 || self.layout.en(xz, b) != 0;
@@ -766,48 +742,16 @@ impl Checker {
             Ok(ch) if !sel_x => Some(ch),
             Ok(_) => None,
             Err(e) => {
-                self.inv.violation(
-                    c,
-                    "mux-select",
-                    name(Signal::MuxEn(b), &self.layout),
-                    None,
-                    Some(json!(self.layout.en(p, b))),
-                    None,
-                    format!("at the sampling instant: {e}"),
+                self.inv.record(
+                    Violation::new(Rule::MuxSelect, c)
+                        .signal(name(Signal::MuxEn(b), &self.layout))
+                        .actual(json!(self.layout.en(p, b)))
+                        .detail(format!("at the sampling instant: {e}")),
                 );
                 None
             }
         };
-        let st = &self.br[b];
-        if st.mux_from_reset && c + st.reset_held < lim.settle_min {
-            // The first conversion after reset: the mux value has settled
-            // through the last `reset_held` reset cycles (those since it
-            // last moved; the first reset cycle seen counts as a move, as
-            // the pins' values before the first reset edge are not the
-            // gateware's) and cycles 0..c.  A short reset is no excuse: the
-            // gateware must be correct for any reset of one cycle or more.
-            let held = st.reset_held;
-            self.inv.violation(
-                c,
-                "mux-settle",
-                name(Signal::MuxSel(b), &self.layout),
-                Some(json!(lim.settle_min)),
-                Some(json!(c + held)),
-                ch.and_then(|ch| self.names.get(ch as usize).cloned()),
-                format!("first conversion after reset: the mux value held through {held} reset cycles and {c} cycles after reset; settling needs {}", lim.settle_min),
-            );
-        } else if !st.mux_from_reset && !st.mux_unknown && c - st.mux_since < lim.settle_min {
-            let since = st.mux_since;
-            self.inv.violation(
-                c,
-                "mux-settle",
-                name(Signal::MuxSel(b), &self.layout),
-                Some(json!(lim.settle_min)),
-                Some(json!(c - since)),
-                ch.and_then(|ch| self.names.get(ch as usize).cloned()),
-                format!("mux switched in cycle {since}, {} cycles before the sampling instant; settling needs {}", c - since, lim.settle_min),
-            );
-        }
+        self.mux_settle(b, c, ch);
         let st = &mut self.br[b];
         st.low = true;
         st.t = c;
@@ -829,6 +773,40 @@ impl Checker {
         }
     }
 
+    /// The mux must have settled for `settle_min` cycles at the sampling
+    /// instant `c` of branch `b` (channel `ch`, if known).
+    fn mux_settle(&mut self, b: usize, c: u64, ch: Option<u16>) {
+        let settle_min = self.limits[b].settle_min;
+        let st = &self.br[b];
+        if st.mux_from_reset && c + st.reset_held < settle_min {
+            // The first conversion after reset: the mux value has settled
+            // through the last `reset_held` reset cycles (those since it
+            // last moved; the first reset cycle seen counts as a move, as
+            // the pins' values before the first reset edge are not the
+            // gateware's) and cycles 0..c.  A short reset is no excuse: the
+            // gateware must be correct for any reset of one cycle or more.
+            let held = st.reset_held;
+            self.inv.record(
+                Violation::new(Rule::MuxSettle, c)
+                    .signal(Signal::MuxSel(b).name(&self.layout))
+                    .expected(json!(settle_min))
+                    .actual(json!(c + held))
+                    .channel(ch.and_then(|ch| self.names.get(ch as usize).cloned()))
+                    .detail(format!("first conversion after reset: the mux value held through {held} reset cycles and {c} cycles after reset; settling needs {}", settle_min)),
+            );
+        } else if !st.mux_from_reset && !st.mux_unknown && c - st.mux_since < settle_min {
+            let since = st.mux_since;
+            self.inv.record(
+                Violation::new(Rule::MuxSettle, c)
+                    .signal(Signal::MuxSel(b).name(&self.layout))
+                    .expected(json!(settle_min))
+                    .actual(json!(c - since))
+                    .channel(ch.and_then(|ch| self.names.get(ch as usize).cloned()))
+                    .detail(format!("mux switched in cycle {since}, {} cycles before the sampling instant; settling needs {}", c - since, settle_min)),
+            );
+        }
+    }
+
     fn sclk_fall(&mut self, b: usize, c: u64) {
         let lim = self.limits[b].clone();
         self.br[b].falls += 1;
@@ -838,11 +816,11 @@ impl Checker {
             self.capture(b, c, falls - 1);
         }
         let st = &mut self.br[b];
-        let mut v: Vec<(&str, Option<Value>, Option<Value>, String)> = Vec::new();
+        let mut v: Vec<(Rule, Option<Value>, Option<Value>, String)> = Vec::new();
         if st.falls == 1 {
             if c - st.t < lim.setup_min {
                 v.push((
-                    "cs-setup",
+                    Rule::CsSetup,
                     Some(json!(lim.setup_min)),
                     Some(json!(c - st.t)),
                     format!(
@@ -858,7 +836,7 @@ impl Checker {
             let high = c - st.last_rise;
             if period * lim.sclk_max_hz < self.clock_hz {
                 v.push((
-                    "sclk-frequency",
+                    Rule::SclkFrequency,
                     Some(json!(lim.sclk_max_hz)),
                     Some(json!(self.clock_hz / period.max(1))),
                     format!(
@@ -869,7 +847,7 @@ impl Checker {
             }
             if period * lim.sclk_min_hz > self.clock_hz {
                 v.push((
-                    "sclk-frequency",
+                    Rule::SclkFrequency,
                     Some(json!(lim.sclk_min_hz)),
                     Some(json!(self.clock_hz / period.max(1))),
                     format!(
@@ -883,7 +861,7 @@ impl Checker {
                 || high * 100 < period * lim.duty_min_pct
             {
                 v.push((
-                    "sclk-duty",
+                    Rule::SclkDuty,
                     Some(json!(format!(">= {} %", lim.duty_min_pct))),
                     Some(json!(format!("low {low} / high {high} cycles"))),
                     format!("SCLK period {period}: low {low}, high {high} cycles"),
@@ -893,8 +871,13 @@ impl Checker {
         st.last_fall = c;
         let signal = Signal::Sclk(b).name(&self.layout);
         for (rule, e, a, d) in v {
-            self.inv
-                .violation(c, rule, Some(signal.clone()), e, a, None, d);
+            self.inv.record(
+                Violation::new(rule, c)
+                    .signal(signal.clone())
+                    .expected(e)
+                    .actual(a)
+                    .detail(d),
+            );
         }
     }
 
@@ -919,30 +902,27 @@ impl Checker {
         let lim = self.limits[b].clone();
         let n = lim.sclks;
         if st.falls != n || st.rises != n {
-            self.inv.violation(
-                c,
-                "sclk-count",
-                Some(Signal::Sclk(b).name(&self.layout)),
-                Some(json!(n)),
-                Some(json!(st.falls)),
-                chname.clone(),
-                format!("{} SCLK falling and {} rising edges in the conversion window from cycle {}, expected {n}", st.falls, st.rises, st.t),
+            self.inv.record(
+                Violation::new(Rule::SclkCount, c)
+                    .signal(Signal::Sclk(b).name(&self.layout))
+                    .expected(json!(n))
+                    .actual(json!(st.falls))
+                    .channel(chname.clone())
+                    .detail(format!("{} SCLK falling and {} rising edges in the conversion window from cycle {}, expected {n}", st.falls, st.rises, st.t)),
             );
         }
         if p.sclk >> b & 1 == 0 {
-            self.inv.violation(
-                c,
-                "sclk-idle",
-                Some(Signal::Sclk(b).name(&self.layout)),
-                Some(json!(1)),
-                Some(json!(0)),
-                chname,
-                if lim.cnv {
-                    "SCK is high when CNV falls"
-                } else {
-                    "SCLK is low when CS rises"
-                }
-                .into(),
+            self.inv.record(
+                Violation::new(Rule::SclkIdle, c)
+                    .signal(Signal::Sclk(b).name(&self.layout))
+                    .expected(json!(1))
+                    .actual(json!(0))
+                    .channel(chname)
+                    .detail(if lim.cnv {
+                        "SCK is high when CNV falls"
+                    } else {
+                        "SCLK is low when CS rises"
+                    }),
             );
         }
         // Bit j of the serial stream sits at sclks-1-j of `word` (CS parts
@@ -972,7 +952,11 @@ impl Checker {
     pub fn finish(mut self, source: &str) -> Report {
         let cycles = self.c - self.origin;
         if self.phase == Phase::PreReset || (self.phase == Phase::Reset && cycles == 0) {
-            self.inv.violation(0, "no-cycles", Some(Role::Reset.name().into()), None, None, None, "no cycle after a released reset was seen (rst must be high, then low, at rising clock edges)".into());
+            self.inv.record(
+                Violation::new(Rule::NoCycles, 0)
+                    .signal(Role::Reset.name().to_string())
+                    .detail("no cycle after a released reset was seen (rst must be high, then low, at rising clock edges)"),
+            );
         }
         if let Some(l) = &mut self.line {
             l.finish(self.c, &mut self.inv);

@@ -386,21 +386,70 @@ impl<D: Dut> Dut for FaultyDut<D> {
         }
         match self.fault {
             Fault::ResetGlitch => {}
-            Fault::WrongChannel | Fault::WrongSampleBit | Fault::DropSample => {
-                if !self.done && c >= self.at && p.sample_valid {
-                    self.done = true;
-                    match self.fault {
-                        Fault::WrongChannel => p.sample_channel ^= 1,
-                        Fault::WrongSampleBit => p.sample_value ^= 1 << 5,
-                        _ => p.sample_valid = false,
-                    }
+            Fault::WrongChannel
+            | Fault::WrongSampleBit
+            | Fault::DropSample
+            | Fault::NeighbourCode => self.sample_fault(c, &mut p, &orig),
+            Fault::CsLate { .. } | Fault::SclkExtraEdge { .. } | Fault::PhaseShift { .. } => {
+                self.serial_fault(c, &mut p)
+            }
+            Fault::MuxLate { .. }
+            | Fault::TwoMuxEn { .. }
+            | Fault::WrongMux { .. }
+            | Fault::SelectSwap { .. } => self.mux_fault(c, &mut p),
+            Fault::ConversionMoved { branch } => self.move_conversion(c, &mut p, branch),
+            Fault::SclkSlow { branch } => self.slow_sclk(c, &mut p, branch),
+            Fault::LinkBitFlip | Fault::LinkDropByte => self.uart_char(c, &mut p),
+            Fault::LinkStuck { .. }
+            | Fault::LinkOverflow
+            | Fault::AxisTvalidDrop
+            | Fault::AxisTdataChange => self.link_fault(c, &mut p, &orig),
+        }
+        let frozen = matches!(self.fault, Fault::PhaseShift { .. })
+            && c >= self.t
+            && c <= self.t.saturating_add(self.r);
+        if !frozen {
+            self.prev_cs = orig_cs;
+            self.prev_sclk = orig_sclk;
+        }
+        self.changed |= glitch || p != orig;
+        p
+    }
+}
+
+impl<D> FaultyDut<D> {
+    /// Cycle `c` under the sample stream's faults.
+    #[inline]
+    fn sample_fault(&mut self, c: u64, p: &mut Pins, orig: &Pins) {
+        match self.fault {
+            Fault::WrongChannel | Fault::WrongSampleBit | Fault::DropSample
+                if !self.done && c >= self.at && p.sample_valid =>
+            {
+                self.done = true;
+                match self.fault {
+                    Fault::WrongChannel => p.sample_channel ^= 1,
+                    Fault::WrongSampleBit => p.sample_value ^= 1 << 5,
+                    _ => p.sample_valid = false,
                 }
             }
-            Fault::CsLate { branch } => {
-                if c >= self.t && c <= self.t.saturating_add(self.r) {
-                    let bit = 1u16 << branch;
-                    p.cs_n = (p.cs_n & !bit) | (self.prev_cs & bit);
+            Fault::NeighbourCode if p.sample_valid => {
+                if let (false, true, Some(v)) = (self.done, c >= self.at, self.last_value) {
+                    p.sample_value = v;
+                    self.done = true;
                 }
+                self.last_value = Some(orig.sample_value);
+            }
+            _ => {}
+        }
+    }
+
+    /// Cycle `c` under the serial lanes' faults (CS and SCLK).
+    #[inline]
+    fn serial_fault(&mut self, c: u64, p: &mut Pins) {
+        match self.fault {
+            Fault::CsLate { branch } if c >= self.t && c <= self.t.saturating_add(self.r) => {
+                let bit = 1u16 << branch;
+                p.cs_n = (p.cs_n & !bit) | (self.prev_cs & bit);
             }
             Fault::SclkExtraEdge { branch } => {
                 // a one-cycle low pulse in a high phase of SCLK, two periods
@@ -418,29 +467,6 @@ impl<D: Dut> Dut for FaultyDut<D> {
                     self.done = true;
                 }
             }
-            Fault::MuxLate { branch } => {
-                if c == self.t_prev.saturating_add(1) {
-                    self.held = Some(pins_before(&self.layout, &p, branch, self.t_prev));
-                }
-                if c > self.t_prev && c + 2 < self.t {
-                    if let Some(h) = self.held {
-                        copy_mux(&self.layout, &mut p, &h, branch);
-                    }
-                }
-            }
-            Fault::TwoMuxEn { branch } => {
-                if c >= self.t && c < self.t.saturating_add(5) {
-                    let n = self.layout.en_n[branch];
-                    p.mux_en |= ((1u128 << n) - 1) << self.layout.en_lo[branch];
-                }
-            }
-            Fault::WrongMux { branch } => {
-                if c > self.t_prev && c <= self.t {
-                    p.mux_sel ^= 1 << (3 * branch);
-                }
-            }
-            Fault::ConversionMoved { branch } => self.move_conversion(c, &mut p, branch),
-            Fault::SclkSlow { branch } => self.slow_sclk(c, &mut p, branch),
             Fault::PhaseShift { branch } => {
                 let bit = 1u16 << branch;
                 if c >= self.t && c <= self.t.saturating_add(self.r) {
@@ -457,30 +483,47 @@ impl<D: Dut> Dut for FaultyDut<D> {
                     self.done = true;
                 }
             }
-            Fault::SelectSwap { branch } => {
-                if c >= self.at && c < self.at + self.frame {
-                    self.swap_selects(&mut p, branch);
+            _ => {}
+        }
+    }
+
+    /// Cycle `c` under the mux lanes' faults.
+    #[inline]
+    fn mux_fault(&mut self, c: u64, p: &mut Pins) {
+        match self.fault {
+            Fault::MuxLate { branch } => {
+                if c == self.t_prev.saturating_add(1) {
+                    self.held = Some(pins_before(&self.layout, p, branch, self.t_prev));
                 }
-            }
-            Fault::NeighbourCode => {
-                if p.sample_valid {
-                    if let (false, true, Some(v)) = (self.done, c >= self.at, self.last_value) {
-                        p.sample_value = v;
-                        self.done = true;
+                if c > self.t_prev && c + 2 < self.t {
+                    if let Some(h) = self.held {
+                        copy_mux(&self.layout, p, &h, branch);
                     }
-                    self.last_value = Some(orig.sample_value);
                 }
             }
-            Fault::LinkBitFlip | Fault::LinkDropByte => self.uart_char(c, &mut p),
-            Fault::LinkStuck { high } => {
-                if c >= self.at {
-                    p.link_tx = high;
-                }
+            Fault::TwoMuxEn { branch } if c >= self.t && c < self.t.saturating_add(5) => {
+                let n = self.layout.en_n[branch];
+                p.mux_en |= ((1u128 << n) - 1) << self.layout.en_lo[branch];
             }
-            Fault::LinkOverflow => {
-                if c >= self.at {
-                    p.link_overflow = true;
-                }
+            Fault::WrongMux { branch } if c > self.t_prev && c <= self.t => {
+                p.mux_sel ^= 1 << (3 * branch);
+            }
+            Fault::SelectSwap { branch } if c >= self.at && c < self.at + self.frame => {
+                self.swap_selects(p, branch);
+            }
+            _ => {}
+        }
+    }
+
+    /// Cycle `c` under the link's faults but the UART character's.
+    #[inline]
+    fn link_fault(&mut self, c: u64, p: &mut Pins, orig: &Pins) {
+        match self.fault {
+            Fault::LinkStuck { high } if c >= self.at => {
+                p.link_tx = high;
+            }
+            Fault::LinkOverflow if c >= self.at => {
+                p.link_overflow = true;
             }
             Fault::AxisTvalidDrop | Fault::AxisTdataChange => {
                 if self.stalled && !self.done && c >= self.at {
@@ -493,20 +536,10 @@ impl<D: Dut> Dut for FaultyDut<D> {
                 }
                 self.stalled = orig.axis_tvalid && !orig.axis_tready;
             }
+            _ => {}
         }
-        let frozen = matches!(self.fault, Fault::PhaseShift { .. })
-            && c >= self.t
-            && c <= self.t.saturating_add(self.r);
-        if !frozen {
-            self.prev_cs = orig_cs;
-            self.prev_sclk = orig_sclk;
-        }
-        self.changed |= glitch || p != orig;
-        p
     }
-}
 
-impl<D> FaultyDut<D> {
     /// The original pins `k` cycles ago (0: this cycle).
     fn orig(&self, k: u64) -> Option<&Pins> {
         let n = self.hist.len() as u64;

@@ -7,9 +7,10 @@ use std::collections::VecDeque;
 
 use lut_gen::ports::Role;
 use lut_gen::{FrameGrid, Schedule};
-use serde_json::{json, Value};
+use serde_json::json;
 
 use crate::report::{ChannelStats, Report, Violation};
+use crate::rule::Rule;
 
 /// Collects violations; shared by both layers.
 #[derive(Debug, Clone)]
@@ -31,34 +32,15 @@ impl Recorder {
         (c - self.shift, frame - self.frame_base, slot)
     }
 
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn violation(
-        &mut self,
-        cycle: u64,
-        rule: &str,
-        signal: Option<String>,
-        expected: Option<Value>,
-        actual: Option<Value>,
-        channel: Option<String>,
-        detail: String,
-    ) {
+    /// Counts `v` (built at a model cycle) and lists it while the list has room.
+    pub(crate) fn record(&mut self, mut v: Violation) {
         if crate::switch::disabled("invariants") {
             return;
         }
         self.violation_count += 1;
         if self.violations.len() < self.max {
-            let (cycle, frame, slot) = self.place(cycle);
-            self.violations.push(Violation {
-                cycle,
-                frame,
-                slot,
-                rule: rule.into(),
-                signal,
-                expected,
-                actual,
-                channel,
-                detail,
-            });
+            (v.cycle, v.frame, v.slot) = self.place(v.cycle);
+            self.violations.push(v);
         }
     }
 }
@@ -193,19 +175,17 @@ impl Invariants {
                 let n = self.in_frame[ch];
                 if (partial && n > want) || (!partial && n != want) {
                     let name = self.names[ch].clone();
-                    self.rec.violation(
-                        end,
-                        "samples-per-frame",
-                        None,
-                        Some(json!(want)),
-                        Some(json!(self.in_frame[ch])),
-                        Some(name.clone()),
-                        format!(
-                            "{name} sampled {} times in frame {}, expected {}{want}",
-                            self.in_frame[ch],
-                            self.frame - self.rec.frame_base,
-                            if partial { "at most " } else { "" }
-                        ),
+                    self.rec.record(
+                        Violation::new(Rule::SamplesPerFrame, end)
+                            .expected(json!(want))
+                            .actual(json!(self.in_frame[ch]))
+                            .channel(name.clone())
+                            .detail(format!(
+                                "{name} sampled {} times in frame {}, expected {}{want}",
+                                self.in_frame[ch],
+                                self.frame - self.rec.frame_base,
+                                if partial { "at most " } else { "" }
+                            )),
                     );
                 }
                 self.in_frame[ch] = 0;
@@ -222,27 +202,21 @@ impl Invariants {
             self.close_frames(t);
         }
         if ch >= self.names.len() {
-            self.rec.violation(
-                t,
-                "channel",
-                None,
-                None,
-                Some(json!(ch)),
-                None,
-                format!("channel index {ch} is not in the mix"),
+            self.rec.record(
+                Violation::new(Rule::Channel, t)
+                    .actual(json!(ch))
+                    .detail(format!("channel index {ch} is not in the mix")),
             );
             return;
         }
         if self.ch_branch[ch] != branch {
             let name = self.names[ch].clone();
-            self.rec.violation(
-                t,
-                "branch",
-                None,
-                Some(json!(self.branch_names[self.ch_branch[ch]])),
-                Some(json!(self.branch_names[branch])),
-                Some(name.clone()),
-                format!("{name} sampled on the wrong branch"),
+            self.rec.record(
+                Violation::new(Rule::Branch, t)
+                    .expected(json!(self.branch_names[self.ch_branch[ch]]))
+                    .actual(json!(self.branch_names[branch]))
+                    .channel(name.clone())
+                    .detail(format!("{name} sampled on the wrong branch")),
             );
         }
         self.in_frame[ch] += 1;
@@ -253,14 +227,12 @@ impl Invariants {
             self.imax[ch] = self.imax[ch].max(d);
             if d != self.interval[ch] {
                 let name = self.names[ch].clone();
-                self.rec.violation(
-                    t,
-                    "interval",
-                    None,
-                    Some(json!(self.interval[ch])),
-                    Some(json!(d)),
-                    Some(name.clone()),
-                    format!("{name} sampled {d} cycles after its previous instant (cycle {}), expected {}", self.last[ch], self.interval[ch]),
+                self.rec.record(
+                    Violation::new(Rule::Interval, t)
+                        .expected(json!(self.interval[ch]))
+                        .actual(json!(d))
+                        .channel(name.clone())
+                        .detail(format!("{name} sampled {d} cycles after its previous instant (cycle {}), expected {}", self.last[ch], self.interval[ch])),
                 );
             }
         }
@@ -275,17 +247,16 @@ impl Invariants {
             }
             let p = *p;
             self.queue.pop_front();
-            self.rec.violation(
-                p.complete,
-                "sample-missing",
-                Some(Role::SampleValid.name().into()),
-                Some(json!(1)),
-                Some(json!(0)),
-                self.name(p.channel),
-                format!(
-                    "conversion of branch {} sampled at cycle {} completed at cycle {} but was never emitted",
-                    self.branch_names[p.branch], p.instant, p.complete
-                ),
+            self.rec.record(
+                Violation::new(Rule::SampleMissing, p.complete)
+                    .signal(Role::SampleValid.name().to_string())
+                    .expected(json!(1))
+                    .actual(json!(0))
+                    .channel(self.name(p.channel))
+                    .detail(format!(
+                        "conversion of branch {} sampled at cycle {} completed at cycle {} but was never emitted",
+                        self.branch_names[p.branch], p.instant, p.complete
+                    )),
             );
         }
     }
@@ -329,63 +300,57 @@ impl Invariants {
             .map(|(i, _)| i)
             .unwrap_or(0);
         let Some(p) = self.queue.remove(pick) else {
-            self.rec.violation(
-                c,
-                "sample-unexpected",
-                Some(Role::SampleValid.name().into()),
-                Some(json!(0)),
-                Some(json!(1)),
-                self.name(Some(channel)),
-                format!(
-                    "{} with channel {channel} value {value} but no conversion is waiting",
-                    Role::SampleValid.name()
-                ),
+            self.rec.record(
+                Violation::new(Rule::SampleUnexpected, c)
+                    .signal(Role::SampleValid.name().to_string())
+                    .expected(json!(0))
+                    .actual(json!(1))
+                    .channel(self.name(Some(channel)))
+                    .detail(format!(
+                        "{} with channel {channel} value {value} but no conversion is waiting",
+                        Role::SampleValid.name()
+                    )),
             );
             return;
         };
         if p.complete >= c {
-            self.rec.violation(
-                c,
-                "sample-early",
-                Some(Role::SampleValid.name().into()),
-                None,
-                None,
-                self.name(p.channel),
-                format!(
-                    "sample emitted in cycle {c}, before its conversion completed (cycle {})",
-                    p.complete
-                ),
+            self.rec.record(
+                Violation::new(Rule::SampleEarly, c)
+                    .signal(Role::SampleValid.name().to_string())
+                    .channel(self.name(p.channel))
+                    .detail(format!(
+                        "sample emitted in cycle {c}, before its conversion completed (cycle {})",
+                        p.complete
+                    )),
             );
         }
         if let Some(ch) = p.channel {
             if ch != channel {
-                self.rec.violation(
-                    c,
-                    "sample-channel",
-                    Some(Role::SampleChannel.name().into()),
-                    Some(json!(ch)),
-                    Some(json!(channel)),
-                    self.name(Some(ch)),
-                    format!(
-                        "{} {channel} but the mux selected {} ({}) at the sampling instant (cycle {})",
-                        Role::SampleChannel.name(),
-                        ch,
-                        self.names.get(ch as usize).map(String::as_str).unwrap_or("?"),
-                        p.instant
-                    ),
+                self.rec.record(
+                    Violation::new(Rule::SampleChannel, c)
+                        .signal(Role::SampleChannel.name().to_string())
+                        .expected(json!(ch))
+                        .actual(json!(channel))
+                        .channel(self.name(Some(ch)))
+                        .detail(format!(
+                            "{} {channel} but the mux selected {} ({}) at the sampling instant (cycle {})",
+                            Role::SampleChannel.name(),
+                            ch,
+                            self.names.get(ch as usize).map(String::as_str).unwrap_or("?"),
+                            p.instant
+                        )),
                 );
             }
         }
         if let Some(code) = p.code {
             if code != value {
-                self.rec.violation(
-                    c,
-                    "sample-value",
-                    Some(Role::SampleValue.name().into()),
-                    Some(json!(code)),
-                    Some(json!(value)),
-                    self.name(p.channel),
-                    format!("{} {value:#06x} but MISO carried {code:#06x} (conversion sampled at cycle {})", Role::SampleValue.name(), p.instant),
+                self.rec.record(
+                    Violation::new(Rule::SampleValue, c)
+                        .signal(Role::SampleValue.name().to_string())
+                        .expected(json!(code))
+                        .actual(json!(value))
+                        .channel(self.name(p.channel))
+                        .detail(format!("{} {value:#06x} but MISO carried {code:#06x} (conversion sampled at cycle {})", Role::SampleValue.name(), p.instant)),
                 );
             }
         }
@@ -407,19 +372,17 @@ impl Invariants {
             for (ch, &most) in spf.iter().enumerate() {
                 if self.in_frame[ch] > most {
                     let name = self.names[ch].clone();
-                    self.rec.violation(
-                        cycles - 1,
-                        "samples-per-frame",
-                        None,
-                        Some(json!(most)),
-                        Some(json!(self.in_frame[ch])),
-                        Some(name.clone()),
-                        format!(
-                            "{name} sampled {} times in the first {} cycles of frame {}, expected {most} in the whole frame",
-                            self.in_frame[ch],
-                            cycles % self.frame_cycles,
-                            frames - self.rec.frame_base,
-                        ),
+                    self.rec.record(
+                        Violation::new(Rule::SamplesPerFrame, cycles - 1)
+                            .expected(json!(most))
+                            .actual(json!(self.in_frame[ch]))
+                            .channel(name.clone())
+                            .detail(format!(
+                                "{name} sampled {} times in the first {} cycles of frame {}, expected {most} in the whole frame",
+                                self.in_frame[ch],
+                                cycles % self.frame_cycles,
+                                frames - self.rec.frame_base,
+                            )),
                     );
                 }
             }
@@ -440,19 +403,8 @@ impl Invariants {
     }
 
     /// Records a violation found outside the conversion-level checks.
-    #[allow(clippy::too_many_arguments)]
-    pub fn violation(
-        &mut self,
-        cycle: u64,
-        rule: &str,
-        signal: Option<String>,
-        expected: Option<Value>,
-        actual: Option<Value>,
-        channel: Option<String>,
-        detail: String,
-    ) {
-        self.rec
-            .violation(cycle, rule, signal, expected, actual, channel, detail)
+    pub fn record(&mut self, v: Violation) {
+        self.rec.record(v)
     }
 
     pub fn violation_count(&self) -> u64 {

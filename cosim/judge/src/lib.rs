@@ -10,7 +10,7 @@
 //!   hours, [`CycleModel`] for every pin at every cycle);
 //! - [`adc`]: the AD7940 model and stimuli;
 //! - [`checker`] / [`invariants`]: the streaming cycle-exact comparison and
-//!   the mix's invariants;
+//!   the mix's invariants, whose [`Rule`]s a violation names;
 //! - [`run`]: a [`Dut`] driven with the ADC model into the checker, and the
 //!   slot-level model run;
 //! - [`faults`]: faults injected into any [`Dut`]'s pins;
@@ -40,6 +40,7 @@ mod linkline;
 pub mod lock;
 pub mod model;
 pub mod report;
+pub mod rule;
 pub mod run;
 pub mod samples;
 pub mod switch;
@@ -57,5 +58,6 @@ pub use lock::{LockError, LockInfo};
 pub use lut_gen::ports::{Layout, Pins, Signal};
 pub use model::{CycleModel, SlotModel};
 pub use report::Report;
+pub use rule::Rule;
 pub use run::{Dut, ModelDut, Observer};
 pub use vcd::{check_vcd, VcdError};

@@ -37,6 +37,8 @@ use lut_gen::Schedule;
 use serde_json::json;
 
 use crate::invariants::Invariants;
+use crate::report::Violation;
+use crate::rule::Rule;
 
 const UART_LINE: &str = "link_tx";
 const AXIS_BEATS: &str = "m_axis_tdata";
@@ -220,22 +222,23 @@ impl LinkLine {
             let win = self.windows.pop_front().unwrap_or_default();
             self.base += 1;
             let (slice, frame) = self.slice_frame(w, inv);
-            inv.violation(
-                self.due(w),
-                "link-packet-missing",
-                Some(self.port.into()),
-                Some(json!(format!("frame {frame} slice {slice}"))),
-                Some(json!("none")),
-                win.samples
-                    .first()
-                    .and_then(|x| self.names.get(x.0 as usize).cloned()),
-                format!(
-                    "the packet of frame {frame} slice {slice} ({} samples) has not arrived on {} {} cycles after its slice ended (the audit's worst-case latency, {} cycles, plus a slice)",
-                    win.samples.len(),
-                    self.port,
-                    self.latency + self.slice_cycles,
-                    self.latency
-                ),
+            inv.record(
+                Violation::new(Rule::LinkPacketMissing, self.due(w))
+                    .signal(self.port.to_string())
+                    .expected(json!(format!("frame {frame} slice {slice}")))
+                    .actual(json!("none"))
+                    .channel(
+                        win.samples
+                            .first()
+                            .and_then(|x| self.names.get(x.0 as usize).cloned()),
+                    )
+                    .detail(format!(
+                        "the packet of frame {frame} slice {slice} ({} samples) has not arrived on {} {} cycles after its slice ended (the audit's worst-case latency, {} cycles, plus a slice)",
+                        win.samples.len(),
+                        self.port,
+                        self.latency + self.slice_cycles,
+                        self.latency
+                    )),
             );
         }
     }
@@ -271,14 +274,12 @@ impl LinkLine {
         if let Some(detail) = fault {
             // an early start bit always; an edge off the grid once a character
             if synced && (started || !u.char_flagged) {
-                inv.violation(
-                    c,
-                    "link-bit-timing",
-                    Some(UART_LINE.into()),
-                    Some(json!(format!("a multiple of {div} cycles"))),
-                    Some(json!(t)),
-                    None,
-                    detail,
+                inv.record(
+                    Violation::new(Rule::LinkBitTiming, c)
+                        .signal(UART_LINE.to_string())
+                        .expected(json!(format!("a multiple of {div} cycles")))
+                        .actual(json!(t))
+                        .detail(detail),
                 );
             }
             u.char_flagged = true;
@@ -297,19 +298,17 @@ impl LinkLine {
         if b.error {
             if self.synced {
                 let (origin, parity) = (u.rx_origin, u.fmt.parity);
-                inv.violation(
-                    c,
-                    "link-framing",
-                    Some(UART_LINE.into()),
-                    Some(json!("stop bit high")),
-                    Some(json!(0)),
-                    None,
-                    format!(
-                        "the character that started at cycle {} (data 0x{:02x}) has a low stop bit{} at the declared baud",
-                        inv.place(b.start + origin).0,
-                        b.byte,
-                        if parity == link::Parity::None { "" } else { " or a wrong parity bit" }
-                    ),
+                inv.record(
+                    Violation::new(Rule::LinkFraming, c)
+                        .signal(UART_LINE.to_string())
+                        .expected(json!("stop bit high"))
+                        .actual(json!(0))
+                        .detail(format!(
+                            "the character that started at cycle {} (data 0x{:02x}) has a low stop bit{} at the declared baud",
+                            inv.place(b.start + origin).0,
+                            b.byte,
+                            if parity == link::Parity::None { "" } else { " or a wrong parity bit" }
+                        )),
                 );
             }
             return;
@@ -328,23 +327,21 @@ impl LinkLine {
         let want =
             ends.is_some_and(|slice| fmt.tlast == Tlast::Slice || slice as u64 + 1 == self.slices);
         if self.synced && clean && !self.lost_place && tlast != want {
-            inv.violation(
-                c,
-                "axis-tlast",
-                Some("m_axis_tlast".into()),
-                Some(json!(want as u8)),
-                Some(json!(tlast as u8)),
-                None,
-                format!(
-                    "tlast is {} on the beat of byte {byte:#04x}, which {} (tlast = \"{}\")",
-                    tlast as u8,
-                    if ends.is_some() {
-                        "ends a packet"
-                    } else {
-                        "does not end a packet"
-                    },
-                    fmt.tlast.name()
-                ),
+            inv.record(
+                Violation::new(Rule::AxisTlast, c)
+                    .signal("m_axis_tlast".to_string())
+                    .expected(json!(want as u8))
+                    .actual(json!(tlast as u8))
+                    .detail(format!(
+                        "tlast is {} on the beat of byte {byte:#04x}, which {} (tlast = \"{}\")",
+                        tlast as u8,
+                        if ends.is_some() {
+                            "ends a packet"
+                        } else {
+                            "does not end a packet"
+                        },
+                        fmt.tlast.name()
+                    )),
             );
         }
     }
@@ -356,27 +353,21 @@ impl LinkLine {
         let st = *self.dec.stats();
         if self.synced && st.crc_errors > self.seen.crc_errors {
             self.lost_place = true;
-            inv.violation(
-                c,
-                "link-crc",
-                Some(self.port.into()),
-                None,
-                None,
-                None,
-                "a packet's trailer carries a CRC that does not match its bytes".into(),
+            inv.record(
+                Violation::new(Rule::LinkCrc, c)
+                    .signal(self.port.to_string())
+                    .detail("a packet's trailer carries a CRC that does not match its bytes"),
             );
         } else if self.synced && st.skipped_bytes > self.seen.skipped_bytes && !self.lost_place {
             self.lost_place = true;
-            inv.violation(
-                c,
-                "link-resync",
-                Some(self.port.into()),
-                Some(json!(format!("0x{:02x} (a header)", link::format::SYNC))),
-                Some(json!(format!("0x{byte:02x}"))),
-                None,
-                format!(
-                    "byte 0x{byte:02x} is not where the packet format puts a word: the decoder lost its place and searches for a header"
-                ),
+            inv.record(
+                Violation::new(Rule::LinkResync, c)
+                    .signal(self.port.to_string())
+                    .expected(json!(format!("0x{:02x} (a header)", link::format::SYNC)))
+                    .actual(json!(format!("0x{byte:02x}")))
+                    .detail(format!(
+                        "byte 0x{byte:02x} is not where the packet format puts a word: the decoder lost its place and searches for a header"
+                    )),
             );
         }
         self.seen = st;
@@ -408,14 +399,14 @@ impl LinkLine {
                 "again, or after a later one"
             };
             let (s, f) = self.slice_frame(self.base, inv);
-            inv.violation(
-                c,
-                "link-sequence",
-                Some(self.port.into()),
-                Some(json!(format!("the packet of frame {f} slice {s}"))),
-                Some(json!(format!("frame counter {frame8} slice {slice}"))),
-                None,
-                format!("the packet with frame counter {frame8} slice {slice} arrived {when}"),
+            inv.record(
+                Violation::new(Rule::LinkSequence, c)
+                    .signal(self.port.to_string())
+                    .expected(json!(format!("the packet of frame {f} slice {s}")))
+                    .actual(json!(format!("frame counter {frame8} slice {slice}")))
+                    .detail(format!(
+                        "the packet with frame counter {frame8} slice {slice} arrived {when}"
+                    )),
             );
             return;
         }
@@ -424,14 +415,12 @@ impl LinkLine {
             let (s, f) = self.slice_frame(self.base, inv);
             self.windows.pop_front();
             self.base += 1;
-            inv.violation(
-                c,
-                "link-packet-lost",
-                Some(self.port.into()),
-                Some(json!(format!("frame {f} slice {s}"))),
-                Some(json!(format!("frame counter {frame8} slice {slice}"))),
-                None,
-                format!("the packet of frame {f} slice {s} never came: the next good packet on the line is frame counter {frame8} slice {slice}"),
+            inv.record(
+                Violation::new(Rule::LinkPacketLost, c)
+                    .signal(self.port.to_string())
+                    .expected(json!(format!("frame {f} slice {s}")))
+                    .actual(json!(format!("frame counter {frame8} slice {slice}")))
+                    .detail(format!("the packet of frame {f} slice {s} never came: the next good packet on the line is frame counter {frame8} slice {slice}")),
             );
         }
         let win = self.windows.pop_front().unwrap_or_default();
@@ -467,17 +456,15 @@ impl LinkLine {
     fn overflow(&mut self, c: u64, p: &Packet, inv: &mut Invariants) {
         if p.overflows > 0 && !self.overflow_reported {
             self.overflow_reported = true;
-            inv.violation(
-                c,
-                "link-overflow-count",
-                Some(self.port.into()),
-                Some(json!(0)),
-                Some(json!(p.overflows)),
-                None,
-                format!(
-                    "a trailer reports {} token(s) dropped by the link's FIFO",
-                    p.overflows
-                ),
+            inv.record(
+                Violation::new(Rule::LinkOverflowCount, c)
+                    .signal(self.port.to_string())
+                    .expected(json!(0))
+                    .actual(json!(p.overflows))
+                    .detail(format!(
+                        "a trailer reports {} token(s) dropped by the link's FIFO",
+                        p.overflows
+                    )),
             );
         }
     }
@@ -505,21 +492,22 @@ impl LinkLine {
                 inv.place(at).0
             )
         });
-        inv.violation(
-            c,
-            "link-samples",
-            Some(self.port.into()),
-            Some(json!(had)),
-            Some(json!(got)),
-            want.get(i)
-                .map(|x| x.0)
-                .or(records.get(i).map(|x| x.0))
-                .map(name),
-            format!(
-                "the packet of frame {frame} slice {slice} carries {} records where the sample stream emitted {} in that slice; record {i} is {got}, the stream's sample {i} is {had}",
-                records.len(),
-                want.len()
-            ),
+        inv.record(
+            Violation::new(Rule::LinkSamples, c)
+                .signal(self.port.to_string())
+                .expected(json!(had))
+                .actual(json!(got))
+                .channel(
+                    want.get(i)
+                        .map(|x| x.0)
+                        .or(records.get(i).map(|x| x.0))
+                        .map(name),
+                )
+                .detail(format!(
+                    "the packet of frame {frame} slice {slice} carries {} records where the sample stream emitted {} in that slice; record {i} is {got}, the stream's sample {i} is {had}",
+                    records.len(),
+                    want.len()
+                )),
         );
     }
 }

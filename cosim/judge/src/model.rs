@@ -187,6 +187,66 @@ struct BranchModel {
 }
 
 impl BranchModel {
+    /// Branch `b`'s model, before its first instant (`addr`: each channel's
+    /// (device, select)).
+    fn new(s: &Schedule, b: usize, addr: &[(u32, u32)]) -> BranchModel {
+        let g = &s.grid;
+        let plan = &s.branches[b];
+        let spi = &plan.spi;
+        let (su, d, h, r) = (
+            spi.setup_cycles,
+            spi.sclk_div,
+            spi.sclk_half,
+            spi.read_cycles,
+        );
+        let cnv = spi.style == lut_gen::parts::Start::Cnv;
+        let sclks = spi.sclks();
+        let caps = if cnv { sclks } else { sclks - 1 };
+        let mut offs = vec![1, r];
+        for i in 0..sclks {
+            let fall = su + i * d;
+            offs.push(fall);
+            offs.push(fall + h);
+            if i < caps {
+                offs.push(fall + h - 1);
+            }
+        }
+        offs.retain(|&o| o > 0);
+        offs.sort_unstable();
+        offs.dedup();
+        let inst: Vec<(u64, u16)> = (0..g.frame_slots)
+            .filter_map(|slot| s.at(slot, b).map(|ch| (slot * g.slot_cycles, ch as u16)))
+            .collect();
+        let mut m = BranchModel {
+            inst,
+            t: None,
+            tch: 0,
+            ni: 0,
+            nf: 0,
+            tn: u64::MAX,
+            tnch: 0,
+            offs,
+            oi: 0,
+            next: 0,
+            conv: false,
+            settle: plan.settle_cycles,
+            word: 0,
+            su,
+            d,
+            h,
+            r,
+            cnv,
+            caps,
+            sclks,
+            word_sclks: spi.word_sclks as u64,
+            bits: spi.bits,
+            leading: spi.leading_bits as u64,
+            addr: addr.to_vec(),
+        };
+        m.advance_next_instant(g.frame_cycles);
+        m
+    }
+
     fn advance_next_instant(&mut self, frame_cycles: u64) {
         if self.inst.is_empty() {
             self.tn = u64::MAX;
@@ -231,62 +291,9 @@ impl CycleModel {
         let layout = Layout::new(s);
         let g = &s.grid;
         let addr: Vec<(u32, u32)> = s.channels.iter().map(|c| (c.device, c.select)).collect();
-        let mut br = Vec::new();
-        for (b, plan) in s.branches.iter().enumerate() {
-            let spi = &plan.spi;
-            let (su, d, h, r) = (
-                spi.setup_cycles,
-                spi.sclk_div,
-                spi.sclk_half,
-                spi.read_cycles,
-            );
-            let cnv = spi.style == lut_gen::parts::Start::Cnv;
-            let sclks = spi.sclks();
-            let caps = if cnv { sclks } else { sclks - 1 };
-            let mut offs = vec![1, r];
-            for i in 0..sclks {
-                let fall = su + i * d;
-                offs.push(fall);
-                offs.push(fall + h);
-                if i < caps {
-                    offs.push(fall + h - 1);
-                }
-            }
-            offs.retain(|&o| o > 0);
-            offs.sort_unstable();
-            offs.dedup();
-            let inst: Vec<(u64, u16)> = (0..g.frame_slots)
-                .filter_map(|slot| s.at(slot, b).map(|ch| (slot * g.slot_cycles, ch as u16)))
-                .collect();
-            let mut m = BranchModel {
-                inst,
-                t: None,
-                tch: 0,
-                ni: 0,
-                nf: 0,
-                tn: u64::MAX,
-                tnch: 0,
-                offs,
-                oi: 0,
-                next: 0,
-                conv: false,
-                settle: plan.settle_cycles,
-                word: 0,
-                su,
-                d,
-                h,
-                r,
-                cnv,
-                caps,
-                sclks,
-                word_sclks: spi.word_sclks as u64,
-                bits: spi.bits,
-                leading: spi.leading_bits as u64,
-                addr: addr.clone(),
-            };
-            m.advance_next_instant(g.frame_cycles);
-            br.push(m);
-        }
+        let br: Vec<BranchModel> = (0..s.branches.len())
+            .map(|b| BranchModel::new(s, b, &addr))
+            .collect();
         // Idle levels: CS high / SCLK high, CNV low / SCK low.
         let cs_idle = br
             .iter()

@@ -3,6 +3,8 @@
 use serde::Serialize;
 use serde_json::Value;
 
+use crate::rule::Rule;
+
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct ChannelStats {
     pub name: String,
@@ -41,6 +43,49 @@ pub struct Violation {
     pub actual: Option<Value>,
     pub channel: Option<String>,
     pub detail: String,
+}
+
+/// Built at a model cycle (`Violation::new(rule, cycle).signal(..)...`);
+/// recording it turns that cycle into the report's cycle, frame and slot.
+impl Violation {
+    pub fn new(rule: Rule, cycle: u64) -> Violation {
+        Violation {
+            cycle,
+            frame: 0,
+            slot: 0,
+            rule: rule.as_str().into(),
+            signal: None,
+            expected: None,
+            actual: None,
+            channel: None,
+            detail: String::new(),
+        }
+    }
+
+    pub fn signal(mut self, signal: impl Into<Option<String>>) -> Violation {
+        self.signal = signal.into();
+        self
+    }
+
+    pub fn expected(mut self, expected: impl Into<Option<Value>>) -> Violation {
+        self.expected = expected.into();
+        self
+    }
+
+    pub fn actual(mut self, actual: impl Into<Option<Value>>) -> Violation {
+        self.actual = actual.into();
+        self
+    }
+
+    pub fn channel(mut self, channel: impl Into<Option<String>>) -> Violation {
+        self.channel = channel.into();
+        self
+    }
+
+    pub fn detail(mut self, detail: impl Into<String>) -> Violation {
+        self.detail = detail.into();
+        self
+    }
 }
 
 #[derive(Debug, Clone, Serialize, PartialEq)]

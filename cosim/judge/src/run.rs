@@ -9,6 +9,8 @@ use crate::checker::{CheckOptions, Checker};
 use crate::invariants::Invariants;
 use crate::model::{CycleModel, SlotModel};
 use crate::report::Report;
+use crate::report::Violation;
+use crate::rule::Rule;
 use lut_gen::ports::Pins;
 
 /// Anything that behaves like `slotforge_top`: one call per rising clock
@@ -298,39 +300,35 @@ fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
         let d = spi.sclk_div;
         let sig = Some(Signal::Sclk(b).name(&layout));
         if d * adc.sclk_max_hz < clock || d * adc.sclk_min_hz > clock {
-            inv.violation(
-                0,
-                "sclk-frequency",
-                sig.clone(),
-                Some(json!(adc.sclk_max_hz)),
-                Some(json!(clock / d)),
-                None,
-                format!("branch {}: SCLK divider {d}", plan.name),
+            inv.record(
+                Violation::new(Rule::SclkFrequency, 0)
+                    .signal(sig.clone())
+                    .expected(json!(adc.sclk_max_hz))
+                    .actual(json!(clock / d))
+                    .detail(format!("branch {}: SCLK divider {d}", plan.name)),
             );
         }
         let (lo, hi) = (spi.sclk_half, d - spi.sclk_half);
         if lo * 100 < d * adc.duty_min_pct as u64 || hi * 100 < d * adc.duty_min_pct as u64 {
-            inv.violation(
-                0,
-                "sclk-duty",
-                sig.clone(),
-                None,
-                None,
-                None,
-                format!("branch {}: SCLK low {lo} / high {hi} cycles", plan.name),
+            inv.record(
+                Violation::new(Rule::SclkDuty, 0)
+                    .signal(sig.clone())
+                    .detail(format!(
+                        "branch {}: SCLK low {lo} / high {hi} cycles",
+                        plan.name
+                    )),
             );
         }
         if spi.setup_cycles
             < ns_to_cycles(adc.conversion_ns, clock) + ns_to_cycles(adc.setup_ns, clock).max(1)
         {
-            inv.violation(
-                0,
-                "cs-setup",
-                Some(Signal::CsN(b).name(&layout)),
-                None,
-                None,
-                None,
-                format!("branch {}: setup {} cycles", plan.name, spi.setup_cycles),
+            inv.record(
+                Violation::new(Rule::CsSetup, 0)
+                    .signal(Signal::CsN(b).name(&layout))
+                    .detail(format!(
+                        "branch {}: setup {} cycles",
+                        plan.name, spi.setup_cycles
+                    )),
             );
         }
         let quiet = ns_to_cycles(adc.quiet_ns, clock).max(1);
@@ -349,25 +347,28 @@ fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
             };
             let gap = next - t;
             if gap < spi.read_cycles + quiet {
-                inv.violation(
-                    next % s.grid.frame_cycles,
-                    "cs-quiet",
-                    Some(Signal::CsN(b).name(&layout)),
-                    Some(json!(spi.read_cycles + quiet)),
-                    Some(json!(gap)),
-                    None,
-                    format!("branch {}: conversions {gap} cycles apart", plan.name),
+                inv.record(
+                    Violation::new(Rule::CsQuiet, next % s.grid.frame_cycles)
+                        .signal(Signal::CsN(b).name(&layout))
+                        .expected(json!(spi.read_cycles + quiet))
+                        .actual(json!(gap))
+                        .detail(format!(
+                            "branch {}: conversions {gap} cycles apart",
+                            plan.name
+                        )),
                 );
             }
             if gap.saturating_sub(1) < settle {
-                inv.violation(
-                    next % s.grid.frame_cycles,
-                    "mux-settle",
-                    Some(Signal::MuxSel(b).name(&layout)),
-                    Some(json!(settle)),
-                    Some(json!(gap - 1)),
-                    None,
-                    format!("branch {}: mux has {} cycles to settle", plan.name, gap - 1),
+                inv.record(
+                    Violation::new(Rule::MuxSettle, next % s.grid.frame_cycles)
+                        .signal(Signal::MuxSel(b).name(&layout))
+                        .expected(json!(settle))
+                        .actual(json!(gap - 1))
+                        .detail(format!(
+                            "branch {}: mux has {} cycles to settle",
+                            plan.name,
+                            gap - 1
+                        )),
                 );
             }
         }

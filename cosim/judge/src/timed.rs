@@ -191,6 +191,17 @@ impl Found {
             self.list.push(v);
         }
     }
+
+    /// Lists `v` before the violations found so far (it happened before them).
+    fn put_first(&mut self, v: TimedViolation) {
+        let mut first = Found::default();
+        first.push(v);
+        for w in std::mem::take(&mut self.list) {
+            first.push(w);
+        }
+        first.total = self.total + 1;
+        *self = first;
+    }
 }
 
 /// Why a capture could not be checked (an input problem).
@@ -426,12 +437,90 @@ impl Ctx<'_> {
 pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedReport, TimedError> {
     let clock = s.mix.clock_hz as i128;
     let tc_ps = 1e12 / s.mix.clock_hz as f64;
+    let mut not_proved = Vec::new();
+    let checked = checked_lanes(s, cap, skew_ps, &mut not_proved);
+    let lanes: Vec<Lane> = checked.iter().map(|&i| cap.lanes[i].clone()).collect();
+    let tpl = template(s, &lanes);
+    // The lock waits for the first conversion start on any CS lane: the
+    // earliest evidence of the frame phase (a lane whose branch converts
+    // late, or is not probed, does not delay it).
+    let cs_lanes: Vec<usize> = (0..lanes.len())
+        .filter(|&i| lanes[i].is(Role::CsN))
+        .collect();
+    if cs_lanes.is_empty() {
+        return Err(TimedError(
+            "no mapped CS (or CNV) lane the capture's resolution can check: the frame phase cannot be found; map adc_cs_n[N] to an analyser channel".into(),
+        ));
+    }
+    let ctx = Ctx {
+        tpl: &tpl,
+        t: cap.period_ps as i128 * clock,
+        skew: skew_ps as i128 * clock,
+        tc: 1_000_000_000_000,
+        clock,
+    };
+    let mut scan = Scan::default();
+    scan.run(&ctx, &lanes, &checked, cap, cnv_mask(s));
+    let end = cap.steps.last().map(|s| s.0).unwrap_or(0) as i128 * clock;
+    scan.settle_lost(&ctx, &lanes, end)?;
+    let Some(cands) = scan.cands.take() else {
+        return Err(no_conversion_start(&lanes, &cs_lanes));
+    };
+    let mut found = scan.found;
+    if scan.edges_checked == 0 && found.total == 0 {
+        return Err(TimedError(format!(
+            "the capture ends before any edge after its first conversion start (at {:.3} us): nothing to check",
+            scan.locked_at as f64 / 1e6
+        )));
+    }
+    // A lane must not miss an edge the schedule puts inside the capture.
+    if cands.len() == 1 {
+        missing_edges(&ctx, &lanes, &cands[0], end, &mut found);
+    }
+    let span_ps = (end / clock) as u64 - scan.conv_start.unwrap_or(0);
+    let conversions =
+        (span_ps as f64 / (tpl.frame as f64 * tc_ps) * tpl.conversions_per_frame as f64) as u64;
+    let (mut proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
+    not_proved.extend(np);
+    check_link_lane(
+        s,
+        cap,
+        &ctx,
+        &cands,
+        &mut found,
+        &mut proved,
+        &mut not_proved,
+    );
+    Ok(TimedReport {
+        ok: found.total == 0,
+        edges_checked: scan.edges_checked,
+        conversions,
+        locked_at_ps: scan.locked_at,
+        slot: cands
+            .first()
+            .map(|c| (c.c0 % tpl.frame) / s.grid.slot_cycles)
+            .unwrap_or(0),
+        phases: cands.len(),
+        violations: found.list,
+        violations_total: found.total,
+        proved,
+        not_proved,
+    })
+}
+
+/// The capture's lanes the resolution lets us check edge by edge; why each
+/// other one is not goes to `not_proved`.
+fn checked_lanes(
+    s: &Schedule,
+    cap: &Capture,
+    skew_ps: u64,
+    not_proved: &mut Vec<String>,
+) -> Vec<usize> {
+    let tc_ps = 1e12 / s.mix.clock_hz as f64;
     let res_ps = cap.period_ps + 2 * skew_ps;
     let all = &cap.lanes;
     let tpl_all = template(s, all);
-    // Lanes the resolution lets us check edge by edge.
-    let mut not_proved = Vec::new();
-    let checked: Vec<usize> = (0..all.len())
+    (0..all.len())
         .filter(|&i| {
             let lane = &all[i];
             if lane.role.is_none() {
@@ -465,236 +554,279 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
             }
             true
         })
-        .collect();
-    let lanes: Vec<Lane> = checked.iter().map(|&i| all[i].clone()).collect();
-    let tpl = template(s, &lanes);
-    // The lock waits for the first conversion start on any CS lane: the
-    // earliest evidence of the frame phase (a lane whose branch converts
-    // late, or is not probed, does not delay it).
-    let cs_lanes: Vec<usize> = (0..lanes.len())
-        .filter(|&i| lanes[i].is(Role::CsN))
-        .collect();
-    if cs_lanes.is_empty() {
-        return Err(TimedError(
-            "no mapped CS (or CNV) lane the capture's resolution can check: the frame phase cannot be found; map adc_cs_n[N] to an analyser channel".into(),
-        ));
-    }
-    let ctx = Ctx {
-        tpl: &tpl,
-        t: cap.period_ps as i128 * clock,
-        skew: skew_ps as i128 * clock,
-        tc: 1_000_000_000_000,
-        clock,
-    };
-    let idx: Vec<usize> = checked.clone();
-    let mut cands: Option<Vec<Cand>> = None;
-    let mut first_cands = 0;
-    let mut locked_at = 0u64;
-    let mut found = Found::default();
-    let mut lost: Option<Lost> = None;
-    let mut edges_checked = 0u64;
-    let mut conv_start = None;
-    let mut relocked_at = 0u64;
-    let mut edges_at_relock = 0u64;
-    // The stretch since the last lock, and the longest that broke.
-    let mut seg = Segment::default();
-    let mut best_seg = Segment::default();
-    let mut prev = cap.steps.first().map(|s| s.1).unwrap_or(0);
-    // A conversion starts when CS falls (a CNV lane: rises).
-    let cnv = cnv_mask(s);
-    let starts =
-        |lane: &Lane, level: bool| lane.is(Role::CsN) && level == (cnv >> lane.bit & 1 == 1);
-    for &(t_ps, v) in cap.steps.iter().skip(1) {
-        let changed = v ^ prev;
-        prev = v;
-        if changed == 0 {
-            continue;
-        }
-        let t = t_ps as i128 * clock;
-        for (li, &ai) in idx.iter().enumerate() {
-            if changed >> ai & 1 == 0 {
+        .collect()
+}
+
+/// Whether `level` on `lane` starts a conversion: CS falling (a CNV lane:
+/// rising).
+#[inline]
+fn starts(cnv: u16, lane: &Lane, level: bool) -> bool {
+    lane.is(Role::CsN) && level == (cnv >> lane.bit & 1 == 1)
+}
+
+/// An edge of checked lane `lane` at `t_ps` (`t`: in units of 1/clock ps)
+/// to `level`.
+#[derive(Clone, Copy)]
+struct Edge {
+    lane: usize,
+    t: i128,
+    t_ps: u64,
+    level: bool,
+}
+
+/// The scan of a capture's edges against the schedule's frame phases.
+#[derive(Default)]
+struct Scan {
+    /// The phases still fitting; `None` until a conversion start locks the
+    /// scan (again, after every phase broke).
+    cands: Option<Vec<Cand>>,
+    first_cands: usize,
+    locked_at: u64,
+    found: Found,
+    lost: Option<Lost>,
+    edges_checked: u64,
+    conv_start: Option<u64>,
+    relocked_at: u64,
+    edges_at_relock: u64,
+    /// The stretch since the last lock, and the longest that broke.
+    seg: Segment,
+    best_seg: Segment,
+}
+
+impl Scan {
+    /// Every edge of the checked lanes (`checked[li]` is lane `li`'s bit in
+    /// the capture), in time order.
+    fn run(&mut self, ctx: &Ctx, lanes: &[Lane], checked: &[usize], cap: &Capture, cnv: u16) {
+        let mut prev = cap.steps.first().map(|s| s.1).unwrap_or(0);
+        for &(t_ps, v) in cap.steps.iter().skip(1) {
+            let changed = v ^ prev;
+            prev = v;
+            if changed == 0 {
                 continue;
             }
-            let level = v >> ai & 1 == 1;
-            match &mut cands {
-                None => {
-                    // Lock on the first conversion start of any CS lane.
-                    if !starts(&lanes[li], level) {
-                        continue;
-                    }
-                    let mut c = Vec::new();
-                    for (j, &(cyc, lv)) in tpl.edges[li].iter().enumerate() {
-                        if lv != level {
-                            continue;
-                        }
-                        let abs = tpl.frame + cyc;
-                        let mut cand = Cand {
-                            lo: i128::MIN / 4,
-                            hi: i128::MAX / 4,
-                            ptr: vec![None; lanes.len()],
-                            resync: vec![false; lanes.len()],
-                            c0: abs,
-                        };
-                        if ctx.fit(&mut cand, abs, t) {
-                            cand.ptr[li] = Some(ctx.next(li, (1, j)));
-                            c.push(cand);
-                        }
-                    }
-                    if lost.is_none() {
-                        first_cands = c.len();
-                        locked_at = t_ps;
-                        conv_start = Some(t_ps);
-                    }
-                    relocked_at = t_ps;
-                    edges_at_relock = edges_checked;
-                    seg = Segment {
-                        from_ps: t_ps,
-                        to_ps: t_ps,
-                        starts: 0,
-                    };
-                    cands = Some(c);
+            let t = t_ps as i128 * ctx.clock;
+            for (li, &ai) in checked.iter().enumerate() {
+                if changed >> ai & 1 == 0 {
+                    continue;
                 }
-                Some(c) => {
-                    edges_checked += 1;
-                    let lane = &lanes[li];
-                    let violation = |detail: String| TimedViolation {
+                let at = Edge {
+                    lane: li,
+                    t,
+                    t_ps,
+                    level: v >> ai & 1 == 1,
+                };
+                if self.cands.is_none() {
+                    // Lock on the first conversion start of any CS lane.
+                    if starts(cnv, &lanes[li], at.level) {
+                        self.lock(ctx, lanes.len(), at);
+                    }
+                } else {
+                    self.edge(ctx, lanes, at, cnv);
+                }
+            }
+        }
+    }
+
+    /// A conversion start `at` locks the scan: every phase
+    /// that puts a template edge of that level there is a candidate.
+    fn lock(&mut self, ctx: &Ctx, nlanes: usize, at: Edge) {
+        let Edge {
+            lane: li,
+            t,
+            t_ps,
+            level,
+        } = at;
+        let tpl = ctx.tpl;
+        let mut c = Vec::new();
+        for (j, &(cyc, lv)) in tpl.edges[li].iter().enumerate() {
+            if lv != level {
+                continue;
+            }
+            let abs = tpl.frame + cyc;
+            let mut cand = Cand {
+                lo: i128::MIN / 4,
+                hi: i128::MAX / 4,
+                ptr: vec![None; nlanes],
+                resync: vec![false; nlanes],
+                c0: abs,
+            };
+            if ctx.fit(&mut cand, abs, t) {
+                cand.ptr[li] = Some(ctx.next(li, (1, j)));
+                c.push(cand);
+            }
+        }
+        if self.lost.is_none() {
+            self.first_cands = c.len();
+            self.locked_at = t_ps;
+            self.conv_start = Some(t_ps);
+        }
+        self.relocked_at = t_ps;
+        self.edges_at_relock = self.edges_checked;
+        self.seg = Segment {
+            from_ps: t_ps,
+            to_ps: t_ps,
+            starts: 0,
+        };
+        self.cands = Some(c);
+    }
+
+    /// An edge on lane `li` once locked: a unique phase reports it if it
+    /// does not fit; several phases keep those it fits.
+    fn edge(&mut self, ctx: &Ctx, lanes: &[Lane], at: Edge, cnv: u16) {
+        let Edge {
+            lane: li,
+            t,
+            t_ps,
+            level,
+        } = at;
+        let Some(c) = &mut self.cands else {
+            return;
+        };
+        self.edges_checked += 1;
+        let lane = &lanes[li];
+        if c.len() == 1 {
+            let cand = &mut c[0];
+            let resyncing = cand.ptr[li].is_none() && cand.resync[li];
+            if let Err(e) = ctx.step(cand, li, t, level) {
+                if !resyncing {
+                    self.found.push(TimedViolation {
                         time_ps: t_ps,
                         channel: lane.channel.clone(),
                         port_bit: lane.port_bit(),
                         rule: lane.what().into(),
-                        detail,
-                    };
-                    if c.len() == 1 {
-                        let cand = &mut c[0];
-                        let resyncing = cand.ptr[li].is_none() && cand.resync[li];
-                        if let Err(e) = ctx.step(cand, li, t, level) {
-                            if !resyncing {
-                                found.push(violation(e));
-                            }
-                            cand.ptr[li] = None;
-                            cand.resync[li] = true;
-                        }
-                        continue;
-                    }
-                    let mut errs = Vec::new();
-                    c.retain_mut(|cand| match ctx.step(cand, li, t, level) {
-                        Ok(()) => true,
-                        Err(e) => {
-                            errs.push((cand.lo, cand.hi, e));
-                            false
-                        }
+                        detail: e,
                     });
-                    let start_edge = starts(lane, level);
-                    if !c.is_empty() && start_edge {
-                        seg.starts += 1;
-                    }
-                    if c.is_empty() {
-                        if seg.starts > best_seg.starts {
-                            best_seg = Segment { to_ps: t_ps, ..seg };
-                        }
-                        // Every phase that fitted so far broke here: find
-                        // the phase again from the next conversion start,
-                        // and judge at the end whether the pins prove a
-                        // fault here (`prelock_fault`).
-                        if lost.is_none() {
-                            lost = Some(Lost {
-                                time_ps: t_ps,
-                                lane: li,
-                                fitted: first_cands,
-                                errs,
-                            });
-                        }
-                        cands = None;
-                    }
                 }
+                cand.ptr[li] = None;
+                cand.resync[li] = true;
             }
+            return;
+        }
+        let mut errs = Vec::new();
+        c.retain_mut(|cand| match ctx.step(cand, li, t, level) {
+            Ok(()) => true,
+            Err(e) => {
+                errs.push((cand.lo, cand.hi, e));
+                false
+            }
+        });
+        let start_edge = starts(cnv, lane, level);
+        if !c.is_empty() && start_edge {
+            self.seg.starts += 1;
+        }
+        if c.is_empty() {
+            if self.seg.starts > self.best_seg.starts {
+                self.best_seg = Segment {
+                    to_ps: t_ps,
+                    ..self.seg
+                };
+            }
+            // Every phase that fitted so far broke here: find the phase
+            // again from the next conversion start, and judge at the end
+            // whether the pins prove a fault here (`prelock_fault`).
+            if self.lost.is_none() {
+                self.lost = Some(Lost {
+                    time_ps: t_ps,
+                    lane: li,
+                    fitted: self.first_cands,
+                    errs,
+                });
+            }
+            self.cands = None;
         }
     }
-    let end = cap.steps.last().map(|s| s.0).unwrap_or(0) as i128 * clock;
-    if let Some(l) = lost {
-        let held = cands.as_ref().is_some_and(|c| !c.is_empty())
-            && end - relocked_at as i128 * clock >= tpl.frame as i128 * ctx.tc
-            && edges_checked > edges_at_relock;
-        if !held && best_seg.starts >= SEGMENT_STARTS {
+
+    /// After the scan, if every phase broke at some edge: a phase found
+    /// again that holds to the end (`end`) proves a fault at that edge; a
+    /// capture that fitted the schedule for a while shows the design left
+    /// it; otherwise the capture does not fit this mix (an error).
+    fn settle_lost(&mut self, ctx: &Ctx, lanes: &[Lane], end: i128) -> Result<(), TimedError> {
+        let Some(l) = self.lost.take() else {
+            return Ok(());
+        };
+        let held = self.cands.as_ref().is_some_and(|c| !c.is_empty())
+            && end - self.relocked_at as i128 * ctx.clock >= ctx.tpl.frame as i128 * ctx.tc
+            && self.edges_checked > self.edges_at_relock;
+        if held {
+            let now = &self.cands.as_ref().expect("held")[0];
+            let v = prelock_fault(ctx, lanes, &l, now, self.relocked_at);
+            self.found.put_first(v);
+        } else if self.best_seg.starts >= SEGMENT_STARTS {
             // The pins ran this mix's schedule for a while, then left it.
-            let lane = &lanes[l.lane];
-            let mut first = Found::default();
-            first.push(TimedViolation {
-                time_ps: l.time_ps,
-                channel: lane.channel.clone(),
-                port_bit: lane.port_bit(),
-                rule: lane.what().into(),
-                detail: format!(
-                    "{} (this edge broke every frame phase still in the running; the capture fits this mix's schedule from {:.3} to {:.3} us, {} conversion starts at their times after the first, and no phase fits it past there for a frame: the design left the schedule)",
-                    l.errs.first().map(|e| e.2.as_str()).unwrap_or("no phase fits"),
-                    best_seg.from_ps as f64 / 1e6,
-                    best_seg.to_ps as f64 / 1e6,
-                    best_seg.starts
-                ),
-            });
-            for v in found.list {
-                first.push(v);
-            }
-            first.total = found.total + 1;
-            found = first;
-            cands = Some(Vec::new());
-        } else if !held {
+            self.found
+                .put_first(left_schedule(lanes, &l, &self.best_seg));
+            self.cands = Some(Vec::new());
+        } else {
             return Err(TimedError(format!(
                 "no frame phase of this mix's schedule fits the capture's edges at {:.3} us ({} fitted before), and none found after it holds for a frame: is it the right mix and map?",
                 l.time_ps as f64 / 1e6,
                 l.fitted
             )));
         }
-        if held {
-            let now = &cands.as_ref().expect("held")[0];
-            let mut first = Found::default();
-            first.push(prelock_fault(&ctx, &lanes, &l, now, relocked_at));
-            for v in found.list {
-                first.push(v);
+        Ok(())
+    }
+}
+
+/// The edge where the capture, after fitting the schedule through `best`,
+/// broke every phase for good.
+fn left_schedule(lanes: &[Lane], l: &Lost, best: &Segment) -> TimedViolation {
+    let lane = &lanes[l.lane];
+    TimedViolation {
+        time_ps: l.time_ps,
+        channel: lane.channel.clone(),
+        port_bit: lane.port_bit(),
+        rule: lane.what().into(),
+        detail: format!(
+            "{} (this edge broke every frame phase still in the running; the capture fits this mix's schedule from {:.3} to {:.3} us, {} conversion starts at their times after the first, and no phase fits it past there for a frame: the design left the schedule)",
+            l.errs.first().map(|e| e.2.as_str()).unwrap_or("no phase fits"),
+            best.from_ps as f64 / 1e6,
+            best.to_ps as f64 / 1e6,
+            best.starts
+        ),
+    }
+}
+
+fn no_conversion_start(lanes: &[Lane], cs_lanes: &[usize]) -> TimedError {
+    let probed: Vec<String> = cs_lanes
+        .iter()
+        .map(|&i| format!("{} ({})", lanes[i].channel, lanes[i].port_bit()))
+        .collect();
+    TimedError(format!(
+        "no conversion start on {} in the capture: the frame phase cannot be found",
+        probed.join(", ")
+    ))
+}
+
+/// The schedule's edges the unique phase `c` still waits for that should
+/// have come before the capture's end.
+fn missing_edges(ctx: &Ctx, lanes: &[Lane], c: &Cand, end: i128, found: &mut Found) {
+    for (li, lane) in lanes.iter().enumerate() {
+        if let Some(p) = c.ptr[li] {
+            let latest = c.hi + ctx.abs(li, p) as i128 * ctx.tc + ctx.t + ctx.skew;
+            if latest < end {
+                found.push(TimedViolation {
+                    time_ps: (latest / ctx.clock) as u64,
+                    channel: lane.channel.clone(),
+                    port_bit: lane.port_bit(),
+                    rule: lane.what().into(),
+                    detail: "the schedule's edge never came: an edge is missing".into(),
+                });
             }
-            first.total = found.total + 1;
-            found = first;
         }
     }
-    let Some(cands) = cands else {
-        let probed: Vec<String> = cs_lanes
-            .iter()
-            .map(|&i| format!("{} ({})", lanes[i].channel, lanes[i].port_bit()))
-            .collect();
-        return Err(TimedError(format!(
-            "no conversion start on {} in the capture: the frame phase cannot be found",
-            probed.join(", ")
-        )));
-    };
-    if edges_checked == 0 && found.total == 0 {
-        return Err(TimedError(format!(
-            "the capture ends before any edge after its first conversion start (at {:.3} us): nothing to check",
-            locked_at as f64 / 1e6
-        )));
-    }
-    // A lane must not miss an edge the schedule puts inside the capture.
-    if cands.len() == 1 {
-        let c = &cands[0];
-        for (li, lane) in lanes.iter().enumerate() {
-            if let Some(p) = c.ptr[li] {
-                let latest = c.hi + ctx.abs(li, p) as i128 * ctx.tc + ctx.t + ctx.skew;
-                if latest < end {
-                    found.push(TimedViolation {
-                        time_ps: (latest / clock) as u64,
-                        channel: lane.channel.clone(),
-                        port_bit: lane.port_bit(),
-                        rule: lane.what().into(),
-                        detail: "the schedule's edge never came: an edge is missing".into(),
-                    });
-                }
-            }
-        }
-    }
-    let span_ps = (end / clock) as u64 - conv_start.unwrap_or(0);
-    let conversions =
-        (span_ps as f64 / (tpl.frame as f64 * tc_ps) * tpl.conversions_per_frame as f64) as u64;
-    let (mut proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
-    not_proved.extend(np);
+}
+
+/// The link's line, decoded when a lane carries it (timed by the unique
+/// phase, if one).
+fn check_link_lane(
+    s: &Schedule,
+    cap: &Capture,
+    ctx: &Ctx,
+    cands: &[Cand],
+    found: &mut Found,
+    proved: &mut Vec<String>,
+    not_proved: &mut Vec<String>,
+) {
     match cap.lanes.iter().position(|l| l.role.is_none()) {
         Some(li) => {
             let phase = (cands.len() == 1).then(|| crate::timedlink::LinkPhase {
@@ -714,21 +846,6 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
             .push("the link's samples (map link_tx to an analyser channel to decode them)".into()),
         None => {}
     }
-    Ok(TimedReport {
-        ok: found.total == 0,
-        edges_checked,
-        conversions,
-        locked_at_ps: locked_at,
-        slot: cands
-            .first()
-            .map(|c| (c.c0 % tpl.frame) / s.grid.slot_cycles)
-            .unwrap_or(0),
-        phases: cands.len(),
-        violations: found.list,
-        violations_total: found.total,
-        proved,
-        not_proved,
-    })
 }
 
 /// Conversion starts a stretch of the capture must fit at their times (after

@@ -16,7 +16,7 @@ use lut_gen::ports::Role;
 use lut_gen::Schedule;
 
 use crate::model::CycleModel;
-use crate::timed::{Capture, TimedViolation};
+use crate::timed::{Capture, Lane, TimedViolation};
 
 /// The frame phase the edge check found: model cycle 0 at a time in
 /// `[lo, hi]`; all in units of 1 / clock_hz ps (`timed`'s exact times), with
@@ -85,58 +85,151 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
         ));
         return out;
     }
-    let violation = |t: f64, detail: String| TimedViolation {
+    let line = read_line(s, cap, li, fmt, &mut out);
+    let end = cap.steps.last().map(|x| x.0).unwrap_or(0) as f64;
+    if line.stats.overflows > 0 {
+        out.violations.push(order_violation(
+            lane,
+            end,
+            format!(
+                "a trailer reports {} token(s) dropped by the FIFO",
+                line.stats.overflows
+            ),
+        ));
+    }
+    check_order(s, lane, &line.packets, &mut out);
+    let packets = &line.packets;
+    if packets.is_empty() {
+        out.violations.push(order_violation(
+            lane,
+            end,
+            format!(
+                "no good packet decoded from the line ({} bytes read at {:.0} baud)",
+                line.stats.bytes, plan.baud
+            ),
+        ));
+    }
+    let samples: usize = packets.iter().map(|p| p.3.len()).sum();
+    out.proved.push(format!(
+        "{} (link_tx): {} packets and {samples} samples decoded at {:.0} baud, each packet's channels in the schedule's order for its slice, CRCs good, none lost",
+        lane.channel,
+        packets.len(),
+        plan.baud
+    ));
+    match phase {
+        Some(ph) => hold_bytes(s, cap, li, ph, &line.chars, &mut out),
+        None => out.not_proved.push(format!(
+            "{} (link_tx): the bytes' timing and the sample codes (no unique frame phase to time them against)",
+            lane.channel
+        )),
+    }
+    out
+}
+
+/// A violation of the packets' order on the line, at `t` ps.
+fn order_violation(lane: &Lane, t: f64, detail: String) -> TimedViolation {
+    TimedViolation {
         time_ps: t as u64,
         channel: lane.channel.clone(),
         port_bit: lane.port_bit(),
         rule: "link samples (order on the line)".into(),
         detail,
-    };
-    // The line read once per clock cycle from the capture's first sample:
-    // the receiver a host runs, over the analyser's samples.
+    }
+}
+
+/// A decoded packet: (time, frame, slice, channels).
+type LinePacket = (f64, u64, u16, Vec<u16>);
+
+/// What the host's receiver and decoder read from the line.
+struct LineRead {
+    packets: Vec<LinePacket>,
+    /// Every character read: (the capture's time of its start bit's edge, byte).
+    chars: Vec<(u64, u8)>,
+    stats: link::Stats,
+}
+
+/// Lane `li` of the capture as the receiver samples it, once per clock
+/// cycle from the capture's first sample, with the time of each fall.
+struct LineSampler {
+    /// The capture's step in force.
+    k: usize,
+    level: bool,
+    fall_ps: u64,
+    /// Falls of the line seen at a cycle's sample: (sample, edge time).
+    falls: std::collections::VecDeque<(u64, u64)>,
+}
+
+impl LineSampler {
+    /// The line at sample `n`, time `t` (ps).
+    #[inline]
+    fn sample(&mut self, cap: &Capture, li: usize, n: u64, t: f64) -> bool {
+        let steps = &cap.steps;
+        while self.k + 1 < steps.len() && (steps[self.k + 1].0 as f64) <= t {
+            if steps[self.k].1 >> li & 1 == 1 && steps[self.k + 1].1 >> li & 1 == 0 {
+                self.fall_ps = steps[self.k + 1].0;
+            }
+            self.k += 1;
+        }
+        let now = steps[self.k].1 >> li & 1 == 1;
+        if self.level && !now {
+            self.falls.push_back((n, self.fall_ps));
+        }
+        self.level = now;
+        now
+    }
+
+    /// The edge time of the fall at sample `start`, if one was seen there.
+    fn fall_at(&mut self, start: u64) -> Option<u64> {
+        while self.falls.front().is_some_and(|f| f.0 < start) {
+            self.falls.pop_front();
+        }
+        self.falls
+            .front()
+            .filter(|f| f.0 == start)
+            .map(|&(_, edge)| edge)
+    }
+}
+
+/// The line read once per clock cycle from the capture's first sample:
+/// the receiver a host runs, over the analyser's samples.  Framing, CRC and
+/// lost-packet faults go to `out`.
+fn read_line(
+    s: &Schedule,
+    cap: &Capture,
+    li: usize,
+    fmt: link::UartFormat,
+    out: &mut LinkCheck,
+) -> LineRead {
+    let lane = &cap.lanes[li];
     let tc = 1e12 / s.mix.clock_hz as f64;
     let t0 = cap.steps.first().map(|x| x.0).unwrap_or(0) as f64;
     let end = cap.steps.last().map(|x| x.0).unwrap_or(0) as f64;
     let mut rx = link::rx::UartRx::new(fmt);
     let mut dec = link::Decoder::new(s.grid.slices_per_frame);
-    let mut k = 0usize;
+    let mut line = LineSampler {
+        k: 0,
+        level: true,
+        fall_ps: 0,
+        falls: Default::default(),
+    };
     let mut n = 0u64;
     let mut decoded = Vec::new();
-    // (time, frame, slice, channels) of every packet decoded.
-    let mut packets: Vec<(f64, u64, u16, Vec<u16>)> = Vec::new();
+    let mut packets: Vec<LinePacket> = Vec::new();
     let mut framing = 0u64;
     let (mut crc, mut lost) = (0u64, 0u64);
-    // Every character read: (the capture's time of its start bit's edge, byte).
     let mut chars: Vec<(u64, u8)> = Vec::new();
-    // Falls of the line seen at a cycle's sample: (sample, edge time).
-    let mut falls: std::collections::VecDeque<(u64, u64)> = Default::default();
-    let mut level = true;
-    let mut fall_ps = 0u64;
     loop {
         let t = t0 + n as f64 * tc;
         if t > end {
             break;
         }
-        while k + 1 < cap.steps.len() && (cap.steps[k + 1].0 as f64) <= t {
-            if cap.steps[k].1 >> li & 1 == 1 && cap.steps[k + 1].1 >> li & 1 == 0 {
-                fall_ps = cap.steps[k + 1].0;
-            }
-            k += 1;
-        }
-        let now = cap.steps[k].1 >> li & 1 == 1;
-        if level && !now {
-            falls.push_back((n, fall_ps));
-        }
-        level = now;
+        let now = line.sample(cap, li, n, t);
         n += 1;
         let Some(b) = rx.sample(now) else {
             continue;
         };
-        while falls.front().is_some_and(|f| f.0 < b.start) {
-            falls.pop_front();
-        }
-        if let Some(&(at, edge)) = falls.front() {
-            if at == b.start && !b.error {
+        if let Some(edge) = line.fall_at(b.start) {
+            if !b.error {
                 chars.push((edge, b.byte));
             }
         }
@@ -147,7 +240,8 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
             }
             framing += 1;
             if framing == 1 {
-                out.violations.push(violation(
+                out.violations.push(order_violation(
+                    lane,
                     t,
                     format!("character 0x{:02x} with a bad stop or parity bit", b.byte),
                 ));
@@ -166,10 +260,11 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
         if st.crc_errors > crc {
             crc = st.crc_errors;
             out.violations
-                .push(violation(t, "a packet with a bad CRC".into()));
+                .push(order_violation(lane, t, "a packet with a bad CRC".into()));
         }
         if st.lost_packets > lost && !packets.is_empty() {
-            out.violations.push(violation(
+            out.violations.push(order_violation(
+                lane,
                 t,
                 format!(
                     "{} packet(s) missing before this one",
@@ -179,24 +274,25 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
         }
         lost = st.lost_packets;
     }
-    let st = dec.finish();
-    if st.overflows > 0 {
-        out.violations.push(violation(
-            end,
-            format!(
-                "a trailer reports {} token(s) dropped by the FIFO",
-                st.overflows
-            ),
-        ));
+    LineRead {
+        packets,
+        chars,
+        stats: dec.finish(),
     }
+}
+
+/// Every packet's channels must be the schedule's for its slice (the first
+/// three that are not are listed).
+fn check_order(s: &Schedule, lane: &Lane, packets: &[LinePacket], out: &mut LinkCheck) {
     let order = packet_order(s);
     let mut wrong = 0;
-    for (t, frame, slice, chans) in &packets {
+    for (t, frame, slice, chans) in packets {
         let want = order.get(*slice as usize).cloned().unwrap_or_default();
         if *chans != want {
             wrong += 1;
             if wrong <= 3 {
-                out.violations.push(violation(
+                out.violations.push(order_violation(
+                    lane,
                     *t,
                     format!(
                         "the packet of frame {frame} slice {slice} carries channels {}; the schedule's order is {}",
@@ -207,30 +303,6 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
             }
         }
     }
-    if packets.is_empty() {
-        out.violations.push(violation(
-            end,
-            format!(
-                "no good packet decoded from the line ({} bytes read at {:.0} baud)",
-                st.bytes, plan.baud
-            ),
-        ));
-    }
-    let samples: usize = packets.iter().map(|p| p.3.len()).sum();
-    out.proved.push(format!(
-        "{} (link_tx): {} packets and {samples} samples decoded at {:.0} baud, each packet's channels in the schedule's order for its slice, CRCs good, none lost",
-        lane.channel,
-        packets.len(),
-        plan.baud
-    ));
-    match phase {
-        Some(ph) => hold_bytes(s, cap, li, ph, &chars, &mut out),
-        None => out.not_proved.push(format!(
-            "{} (link_tx): the bytes' timing and the sample codes (no unique frame phase to time them against)",
-            lane.channel
-        )),
-    }
-    out
 }
 
 /// A byte the model puts on the line: its start bit's first cycle (in the
@@ -404,104 +476,24 @@ fn hold_bytes(
     let clock = s.mix.clock_hz as i128;
     let Prediction { bytes: pred } = predict(s, cap, ph, clock);
     let misos = miso_lanes(cap);
-    let captured = |ch: u16| {
-        let b = s.mix.channels[ch as usize].branch;
-        misos.iter().any(|m| m.1 as usize == b)
-    };
-    let unc = ph.hi - ph.lo + ph.t + 2 * ph.skew;
-    // Record bytes compared with the model's, and those whose code the
-    // capture did not resolve.
-    let (mut compared, mut unresolved) = (0u64, 0u64);
-    let mid = (ph.lo + ph.hi) / 2;
-    let violation = |t: u64, rule: &str, detail: String| TimedViolation {
-        time_ps: t,
-        channel: lane.channel.clone(),
-        port_bit: lane.port_bit(),
-        rule: rule.into(),
-        detail,
-    };
-    let (mut late, mut wrong, mut held) = (0u64, 0u64, 0u64);
-    let mut used = 0usize;
-    // A capture that opens inside a character reads the line out of step
-    // until a fall that is a start bit: like a host's receiver, the check
-    // is in step from the first character that starts at one of the
-    // schedule's start bits.
-    let mut synced = false;
-    let mut skipped = 0u64;
-    for &(edge_ps, byte) in chars {
-        let x = edge_ps as i128 * clock;
-        // The model's start bit nearest the edge, not one matched before.
-        let c = (x - mid).div_euclid(TC);
-        let i = pred[used..].partition_point(|p| p.cycle < c) + used;
-        let near = [i.checked_sub(1), Some(i)]
-            .into_iter()
-            .flatten()
-            .filter(|&j| j >= used && j < pred.len())
-            .min_by_key(|&j| (pred[j].cycle * TC + mid - x).abs());
-        let fits = near.filter(|&j| {
-            let ct = pred[j].cycle * TC;
-            ph.lo + ct <= x + ph.skew && ph.hi + ct >= x - ph.t - ph.skew
-        });
-        let Some(j) = fits else {
-            if !synced {
-                skipped += 1;
-                continue;
-            }
-            late += 1;
-            if late <= 3 {
-                let want = near.map_or("none near".to_string(), |j| {
-                    format!(
-                        "{:.3} us",
-                        ((pred[j].cycle * TC + mid) / clock) as f64 / 1e6
-                    )
-                });
-                out.violations.push(violation(
-                    edge_ps,
-                    "link timing (start bit)",
-                    format!(
-                        "character 0x{byte:02x} starts at {:.3} us; the schedule's nearest start bit is at {want}, not within the capture's resolution ({:.1} ns)",
-                        edge_ps as f64 / 1e6,
-                        (unc / clock) as f64 / 1e3
-                    ),
-                ));
-            }
-            continue;
-        };
-        synced = true;
-        used = j + 1;
-        held += 1;
-        let p = &pred[j];
-        if let Some((ch, resolved)) = p.record {
-            if !captured(ch) {
-                continue;
-            }
-            if !resolved {
-                unresolved += 1;
-                continue;
-            }
-            compared += 1;
-            if byte != p.byte {
-                wrong += 1;
-                if wrong <= 3 {
-                    out.violations.push(violation(
-                        edge_ps,
-                        "link samples (values)",
-                        format!(
-                            "a byte of channel {}'s record is 0x{byte:02x}; the code MISO carried gives 0x{:02x}",
-                            s.mix.channels[ch as usize].name, p.byte
-                        ),
-                    ));
-                }
-            }
-        }
+    let held = Holding {
+        s,
+        lane,
+        ph,
+        clock,
+        pred: &pred,
+        misos: &misos,
     }
-    if late == 0 && held > 0 {
+    .hold(chars, out);
+    let unc = ph.hi - ph.lo + ph.t + 2 * ph.skew;
+    if held.late == 0 && held.held > 0 {
         out.proved.push(format!(
-            "{} (link_tx): every one of {held} characters' start bits within {:.1} ns of the schedule's time (sample period, skew and the phase's spread){}",
+            "{} (link_tx): every one of {} characters' start bits within {:.1} ns of the schedule's time (sample period, skew and the phase's spread){}",
             lane.channel,
+            held.held,
             (unc / clock) as f64 / 1e3,
-            if skipped > 0 {
-                format!(", from the first in step with the line ({skipped} read out of step before it)")
+            if held.skipped > 0 {
+                format!(", from the first in step with the line ({} read out of step before it)", held.skipped)
             } else {
                 String::new()
             }
@@ -516,20 +508,168 @@ fn hold_bytes(
             "{} (link_tx): the sample codes on the line (map adc_miso[N] to check them against the bits MISO carried)",
             lane.channel
         ));
-    } else if compared > 0 && wrong == 0 {
+    } else if held.compared > 0 && held.wrong == 0 {
         out.proved.push(format!(
-            "{} (link_tx): the sample codes on the line equal the codes MISO carried: {compared} record bytes of branch {}",
+            "{} (link_tx): the sample codes on the line equal the codes MISO carried: {} record bytes of branch {}",
             lane.channel,
+            held.compared,
             branches.join(", ")
         ));
     }
-    if unresolved > 0 {
+    if held.unresolved > 0 {
         out.not_proved.push(format!(
-            "{} (link_tx): {unresolved} record bytes of branch {}: their conversion's MISO reads are not all in the capture, or MISO changed within the resolution ({:.1} ns) of a read",
+            "{} (link_tx): {} record bytes of branch {}: their conversion's MISO reads are not all in the capture, or MISO changed within the resolution ({:.1} ns) of a read",
             lane.channel,
+            held.unresolved,
             branches.join(", "),
             (unc / clock) as f64 / 1e3
         ));
+    }
+}
+
+/// The characters read, held against the model's bytes.
+struct Holding<'a> {
+    s: &'a Schedule,
+    lane: &'a Lane,
+    ph: LinkPhase,
+    clock: i128,
+    pred: &'a [Predicted],
+    /// The captured MISO lanes ([`miso_lanes`]).
+    misos: &'a [(usize, u32)],
+}
+
+/// Counts of [`Holding::hold`].
+#[derive(Default)]
+struct Held {
+    /// Characters in step whose start bit is off the schedule's.
+    late: u64,
+    /// Record bytes unlike the model's.
+    wrong: u64,
+    /// Characters whose start bit is the schedule's.
+    held: u64,
+    /// Characters read out of step before the first that was in step.
+    skipped: u64,
+    /// Record bytes compared with the model's.
+    compared: u64,
+    /// Record bytes whose code the capture did not resolve.
+    unresolved: u64,
+}
+
+impl Holding<'_> {
+    fn violation(&self, t: u64, rule: &str, detail: String) -> TimedViolation {
+        TimedViolation {
+            time_ps: t,
+            channel: self.lane.channel.clone(),
+            port_bit: self.lane.port_bit(),
+            rule: rule.into(),
+            detail,
+        }
+    }
+
+    /// Whether channel `ch`'s branch has its MISO captured.
+    fn captured(&self, ch: u16) -> bool {
+        let b = self.s.mix.channels[ch as usize].branch;
+        self.misos.iter().any(|m| m.1 as usize == b)
+    }
+
+    /// The model's start bit nearest the edge at `x` (units), among those
+    /// from `used` on (not one matched before).
+    fn nearest(&self, x: i128, used: usize) -> Option<usize> {
+        let (pred, mid) = (self.pred, (self.ph.lo + self.ph.hi) / 2);
+        let c = (x - mid).div_euclid(TC);
+        let i = pred[used..].partition_point(|p| p.cycle < c) + used;
+        [i.checked_sub(1), Some(i)]
+            .into_iter()
+            .flatten()
+            .filter(|&j| j >= used && j < pred.len())
+            .min_by_key(|&j| (pred[j].cycle * TC + mid - x).abs())
+    }
+
+    fn hold(&self, chars: &[(u64, u8)], out: &mut LinkCheck) -> Held {
+        let (ph, clock, pred) = (self.ph, self.clock, self.pred);
+        let unc = ph.hi - ph.lo + ph.t + 2 * ph.skew;
+        let mid = (ph.lo + ph.hi) / 2;
+        let mut n = Held::default();
+        let mut used = 0usize;
+        // A capture that opens inside a character reads the line out of step
+        // until a fall that is a start bit: like a host's receiver, the check
+        // is in step from the first character that starts at one of the
+        // schedule's start bits.
+        let mut synced = false;
+        for &(edge_ps, byte) in chars {
+            let x = edge_ps as i128 * clock;
+            let near = self.nearest(x, used);
+            let fits = near.filter(|&j| {
+                let ct = pred[j].cycle * TC;
+                ph.lo + ct <= x + ph.skew && ph.hi + ct >= x - ph.t - ph.skew
+            });
+            let Some(j) = fits else {
+                if !synced {
+                    n.skipped += 1;
+                    continue;
+                }
+                n.late += 1;
+                if n.late <= 3 {
+                    let want = near.map_or("none near".to_string(), |j| {
+                        format!(
+                            "{:.3} us",
+                            ((pred[j].cycle * TC + mid) / clock) as f64 / 1e6
+                        )
+                    });
+                    out.violations.push(self.violation(
+                        edge_ps,
+                        "link timing (start bit)",
+                        format!(
+                            "character 0x{byte:02x} starts at {:.3} us; the schedule's nearest start bit is at {want}, not within the capture's resolution ({:.1} ns)",
+                            edge_ps as f64 / 1e6,
+                            (unc / clock) as f64 / 1e3
+                        ),
+                    ));
+                }
+                continue;
+            };
+            synced = true;
+            used = j + 1;
+            n.held += 1;
+            self.hold_record(&pred[j], edge_ps, byte, &mut n, out);
+        }
+        n
+    }
+
+    /// A record byte of a branch whose MISO is captured must be the
+    /// model's, where the capture resolved its code.
+    fn hold_record(
+        &self,
+        p: &Predicted,
+        edge_ps: u64,
+        byte: u8,
+        n: &mut Held,
+        out: &mut LinkCheck,
+    ) {
+        let Some((ch, resolved)) = p.record else {
+            return;
+        };
+        if !self.captured(ch) {
+            return;
+        }
+        if !resolved {
+            n.unresolved += 1;
+            return;
+        }
+        n.compared += 1;
+        if byte != p.byte {
+            n.wrong += 1;
+            if n.wrong <= 3 {
+                out.violations.push(self.violation(
+                    edge_ps,
+                    "link samples (values)",
+                    format!(
+                        "a byte of channel {}'s record is 0x{byte:02x}; the code MISO carried gives 0x{:02x}",
+                        self.s.mix.channels[ch as usize].name, p.byte
+                    ),
+                ));
+            }
+        }
     }
 }
 

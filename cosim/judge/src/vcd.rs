@@ -29,7 +29,7 @@ use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use lut_gen::ports::{LinkPort, Role, AXIS_PORTS, PORT_NAMES as PORTS, TOP_MODULE};
+use lut_gen::ports::{LinkPort, Role, AXIS_PORTS, PORT_NAMES, TOP_MODULE};
 use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker};
@@ -301,8 +301,8 @@ const VALID: usize = Role::SampleValid as usize;
 const CHAN: usize = Role::SampleChannel as usize;
 const VALUE: usize = Role::SampleValue as usize;
 /// The first of the link's ports in [`State`].
-const LINK: usize = PORTS.len();
-/// Port slots: [`PORTS`], then the most link ports a mix has ([`AXIS_PORTS`]).
+const LINK: usize = PORT_NAMES.len();
+/// Port slots: [`PORT_NAMES`], then the most link ports a mix has ([`AXIS_PORTS`]).
 const NPORT: usize = LINK + AXIS_PORTS.len();
 
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
@@ -329,7 +329,7 @@ struct Resolved {
     has_rst: bool,
     scope: String,
     widths: [u32; 10],
-    /// The link's ports, read after [`PORTS`] (none without a link).
+    /// The link's ports, read after [`PORT_NAMES`] (none without a link).
     link: &'static [LinkPort],
 }
 
@@ -339,187 +339,274 @@ fn resolve(
     want: Option<&str>,
     file: &Path,
 ) -> Result<Resolved, VcdError> {
-    let perr = |m: String| VcdError::Ports {
-        file: file.to_path_buf(),
-        message: m,
-    };
-    let mut scopes: Vec<&str> = h.vars.iter().map(|v| v.scope.as_str()).collect();
-    scopes.sort_unstable();
-    scopes.dedup();
-    let has = |sc: &str, name: &str| h.vars.iter().any(|v| v.scope == sc && v.name == name);
-    // `clk` and `rst` may be absent (a capture without them: cycles are then
-    // inferred, and the frame phase found from the pins, `lock.rs`).
-    let required: Vec<&str> = PORTS
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| *i != CLK && *i != RST)
-        .map(|(_, p)| *p)
-        .collect();
-    let required = &required[..];
-    let mut candidates: Vec<&str> = match want {
-        Some(w) => {
-            let m: Vec<&str> = scopes
-                .iter()
-                .copied()
-                .filter(|s| *s == w || s.ends_with(&format!(".{w}")))
-                .collect();
-            if m.is_empty() {
-                return Err(perr(format!(
-                    "no scope `{w}` in the VCD (scopes: {})",
-                    scopes.join(", ")
-                )));
-            }
-            if m.len() > 1 {
-                return Err(perr(format!("scope `{w}` is ambiguous: {}", m.join(", "))));
-            }
-            m
-        }
-        None => scopes
-            .iter()
-            .copied()
-            .filter(|s| required.iter().all(|p| has(s, p)))
-            .collect(),
-    };
-    // A design's inner modules may carry ports of the same names (the gateware's
-    // fixed-width core does): keep the scopes whose widths are the mix's.
+    let ps = PortSearch { h, file };
     let widths = layout.port_widths();
-    let width_of = |sc: &str, p: &str| -> u32 {
-        h.vars
-            .iter()
-            .filter(|v| v.scope == sc && v.name == p)
-            .map(|v| v.width)
-            .sum()
-    };
-    // An absent `rst` fits any mix.
-    let fits = |c: &str, p: &str, w: u32| {
-        let got = width_of(c, p);
-        got == w || (p == PORTS[RST] && got == 0)
-    };
-    let exact: Vec<&str> = candidates
-        .iter()
-        .copied()
-        .filter(|c| PORTS.iter().zip(widths).skip(1).all(|(p, w)| fits(c, p, w)))
-        .collect();
-    if !exact.is_empty() {
-        candidates = exact;
-    } else if candidates.len() > 1 {
-        let c = candidates[0];
-        let (p, w) = PORTS
-            .iter()
-            .zip(widths)
-            .skip(1)
-            .find(|(p, w)| !fits(c, p, *w))
-            .expect("a candidate whose widths differ");
-        return Err(perr(format!(
-            "the scopes with {TOP_MODULE}'s ports ({}) do not have this mix's widths (`{p}`: {w} bit(s) expected, {} in `{c}`): is the VCD from another mix?",
-            candidates.join(", "),
-            width_of(c, p)
-        )));
-    }
-    let Some(&scope) = candidates.last() else {
-        let best = scopes
-            .iter()
-            .map(|s| (required.iter().filter(|p| has(s, p)).count(), *s))
-            .max();
-        let hint = match best {
-            Some((n, s)) if n > 0 => {
-                let missing: Vec<&str> = required.iter().copied().filter(|p| !has(s, p)).collect();
-                format!("; scope `{s}` lacks {}", missing.join(", "))
-            }
-            _ => String::new(),
-        };
-        return Err(perr(format!(
-            "no scope has all the ports of {TOP_MODULE} ({}){hint}",
-            required.join(", ")
-        )));
-    };
-    let ids_of = |sc: &str| -> Vec<Vec<Vec<u8>>> {
-        PORTS
-            .iter()
-            .map(|p| {
-                h.vars
-                    .iter()
-                    .filter(|v| v.scope == sc && v.name == *p)
-                    .map(|v| v.id.clone())
-                    .collect()
-            })
-            .collect()
-    };
-    if candidates.len() > 1 {
-        let first = ids_of(candidates[0]);
-        if candidates.iter().any(|c| ids_of(c)[1..] != first[1..]) {
-            return Err(perr(format!(
-                "several scopes have the ports of {TOP_MODULE}: {}; choose one with --scope",
-                candidates.join(", ")
-            )));
-        }
-    }
-    // clk may sit in an enclosing scope (a testbench) if the DUT's is not dumped.
+    let scope = ps.scope(want, widths)?;
     let mut ids: HashMap<Vec<u8>, Vec<Sink>> = HashMap::new();
     for v in &h.vars {
         ids.entry(v.id.clone()).or_default();
     }
-    let mut has_clk = false;
-    let mut has_rst = true;
-    for (p, name) in PORTS.iter().enumerate() {
-        let vs: Vec<&Var> = h
-            .vars
-            .iter()
-            .filter(|v| v.scope == scope && v.name == *name)
-            .collect();
-        if vs.is_empty() {
-            if p == CLK {
-                continue;
-            }
-            if p == RST {
-                has_rst = false;
-                continue;
-            }
-            return Err(perr(format!("port `{name}` not found in scope `{scope}`")));
-        }
-        let mut covered = 0u32;
-        for v in vs {
-            let (msb, lsb) = v.range.unwrap_or((v.width as i64 - 1, 0));
-            let down = msb >= lsb;
-            let low = msb.min(lsb);
-            if low < 0
-                || msb.max(lsb) >= widths[p] as i64
-                || (msb - lsb).unsigned_abs() + 1 != v.width as u64
-            {
-                return Err(perr(format!(
-                    "port `{name}` in `{scope}` is declared {}{} but the mix needs {} bit(s) [{}:0]",
-                    v.width,
-                    v.range.map(|(a, b)| format!(" [{a}:{b}]")).unwrap_or_default(),
-                    widths[p],
-                    widths[p] - 1
-                )));
-            }
-            covered += v.width;
-            ids.get_mut(&v.id).unwrap().push(Sink {
-                port: p as u8,
-                width: v.width,
-                lsb,
-                down,
-            });
-        }
-        if covered != widths[p] {
-            return Err(perr(format!(
-                "port `{name}` in `{scope}` has {covered} bit(s), the mix needs {}",
-                widths[p]
-            )));
-        }
-        if p == CLK {
-            has_clk = true;
+    let (has_clk, has_rst) = ps.port_sinks(scope, widths, &mut ids)?;
+    ps.link_sinks(scope, layout, &mut ids)?;
+    Ok(Resolved {
+        ids: Ids::new(ids),
+        has_clk,
+        has_rst,
+        scope: scope.to_string(),
+        widths,
+        link: layout.link_ports(),
+    })
+}
+
+/// The header's scopes, searched for the design's ports.
+struct PortSearch<'a> {
+    h: &'a Header,
+    file: &'a Path,
+}
+
+impl<'a> PortSearch<'a> {
+    fn err(&self, message: String) -> VcdError {
+        VcdError::Ports {
+            file: self.file.to_path_buf(),
+            message,
         }
     }
-    {
-        for (k, lp) in layout.link_ports().iter().enumerate() {
-            let v = h
-                .vars
+
+    fn vars(&self, sc: &'a str, name: &'a str) -> impl Iterator<Item = &'a Var> {
+        self.h
+            .vars
+            .iter()
+            .filter(move |v| v.scope == sc && v.name == name)
+    }
+
+    fn has(&self, sc: &str, name: &str) -> bool {
+        self.vars(sc, name).next().is_some()
+    }
+
+    fn width_of(&self, sc: &str, p: &str) -> u32 {
+        self.vars(sc, p).map(|v| v.width).sum()
+    }
+
+    /// Whether port `p` has width `w` in scope `c` (an absent `rst` fits any mix).
+    fn fits(&self, c: &str, p: &str, w: u32) -> bool {
+        let got = self.width_of(c, p);
+        got == w || (p == PORT_NAMES[RST] && got == 0)
+    }
+
+    /// The scope holding the design's ports: the one named `want`, or the
+    /// one with all of them at this mix's widths.
+    fn scope(&self, want: Option<&str>, widths: [u32; 10]) -> Result<&'a str, VcdError> {
+        let mut scopes: Vec<&str> = self.h.vars.iter().map(|v| v.scope.as_str()).collect();
+        scopes.sort_unstable();
+        scopes.dedup();
+        // `clk` and `rst` may be absent (a capture without them: cycles are then
+        // inferred, and the frame phase found from the pins, `lock.rs`).
+        let required: Vec<&str> = PORT_NAMES
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != CLK && *i != RST)
+            .map(|(_, p)| *p)
+            .collect();
+        let candidates: Vec<&str> = match want {
+            Some(w) => self.named_scope(&scopes, w)?,
+            None => scopes
                 .iter()
-                .find(|v| v.scope == scope && v.name == lp.name && v.width == lp.width)
+                .copied()
+                .filter(|s| required.iter().all(|p| self.has(s, p)))
+                .collect(),
+        };
+        let candidates = self.of_mix_widths(candidates, widths)?;
+        let Some(&scope) = candidates.last() else {
+            return Err(self.no_scope(&scopes, &required));
+        };
+        let ids_of = |sc: &str| -> Vec<Vec<Vec<u8>>> {
+            PORT_NAMES
+                .iter()
+                .map(|p| self.vars(sc, p).map(|v| v.id.clone()).collect())
+                .collect()
+        };
+        if candidates.len() > 1 {
+            let first = ids_of(candidates[0]);
+            if candidates.iter().any(|c| ids_of(c)[1..] != first[1..]) {
+                return Err(self.err(format!(
+                    "several scopes have the ports of {TOP_MODULE}: {}; choose one with --scope",
+                    candidates.join(", ")
+                )));
+            }
+        }
+        Ok(scope)
+    }
+
+    /// The one scope named `w` (or ending in `.w`).
+    fn named_scope(&self, scopes: &[&'a str], w: &str) -> Result<Vec<&'a str>, VcdError> {
+        let m: Vec<&str> = scopes
+            .iter()
+            .copied()
+            .filter(|s| *s == w || s.ends_with(&format!(".{w}")))
+            .collect();
+        if m.is_empty() {
+            return Err(self.err(format!(
+                "no scope `{w}` in the VCD (scopes: {})",
+                scopes.join(", ")
+            )));
+        }
+        if m.len() > 1 {
+            return Err(self.err(format!("scope `{w}` is ambiguous: {}", m.join(", "))));
+        }
+        Ok(m)
+    }
+
+    /// A design's inner modules may carry ports of the same names (the
+    /// gateware's fixed-width core does): keep the scopes whose widths are
+    /// the mix's.
+    fn of_mix_widths(
+        &self,
+        candidates: Vec<&'a str>,
+        widths: [u32; 10],
+    ) -> Result<Vec<&'a str>, VcdError> {
+        let exact: Vec<&str> = candidates
+            .iter()
+            .copied()
+            .filter(|c| {
+                PORT_NAMES
+                    .iter()
+                    .zip(widths)
+                    .skip(1)
+                    .all(|(p, w)| self.fits(c, p, w))
+            })
+            .collect();
+        if !exact.is_empty() {
+            return Ok(exact);
+        }
+        if candidates.len() > 1 {
+            let c = candidates[0];
+            let (p, w) = PORT_NAMES
+                .iter()
+                .zip(widths)
+                .skip(1)
+                .find(|(p, w)| !self.fits(c, p, *w))
+                .expect("a candidate whose widths differ");
+            return Err(self.err(format!(
+                "the scopes with {TOP_MODULE}'s ports ({}) do not have this mix's widths (`{p}`: {w} bit(s) expected, {} in `{c}`): is the VCD from another mix?",
+                candidates.join(", "),
+                self.width_of(c, p)
+            )));
+        }
+        Ok(candidates)
+    }
+
+    /// No scope has the ports: name the closest one's missing ports.
+    fn no_scope(&self, scopes: &[&str], required: &[&str]) -> VcdError {
+        let best = scopes
+            .iter()
+            .map(|s| (required.iter().filter(|p| self.has(s, p)).count(), *s))
+            .max();
+        let hint = match best {
+            Some((n, s)) if n > 0 => {
+                let missing: Vec<&str> = required
+                    .iter()
+                    .copied()
+                    .filter(|p| !self.has(s, p))
+                    .collect();
+                format!("; scope `{s}` lacks {}", missing.join(", "))
+            }
+            _ => String::new(),
+        };
+        self.err(format!(
+            "no scope has all the ports of {TOP_MODULE} ({}){hint}",
+            required.join(", ")
+        ))
+    }
+
+    /// The sinks of the pin contract's ports in `scope`; whether `clk` and
+    /// `rst` are dumped there.
+    fn port_sinks(
+        &self,
+        scope: &str,
+        widths: [u32; 10],
+        ids: &mut HashMap<Vec<u8>, Vec<Sink>>,
+    ) -> Result<(bool, bool), VcdError> {
+        // clk may sit in an enclosing scope (a testbench) if the DUT's is not dumped.
+        let mut has_clk = false;
+        let mut has_rst = true;
+        for (p, name) in PORT_NAMES.iter().enumerate() {
+            let vs: Vec<&Var> = self.vars(scope, name).collect();
+            if vs.is_empty() {
+                if p == CLK {
+                    continue;
+                }
+                if p == RST {
+                    has_rst = false;
+                    continue;
+                }
+                return Err(self.err(format!("port `{name}` not found in scope `{scope}`")));
+            }
+            let mut covered = 0u32;
+            for v in vs {
+                let sink = self.sink(scope, name, p, v, widths[p])?;
+                covered += v.width;
+                ids.get_mut(&v.id).unwrap().push(sink);
+            }
+            if covered != widths[p] {
+                return Err(self.err(format!(
+                    "port `{name}` in `{scope}` has {covered} bit(s), the mix needs {}",
+                    widths[p]
+                )));
+            }
+            if p == CLK {
+                has_clk = true;
+            }
+        }
+        Ok((has_clk, has_rst))
+    }
+
+    /// How var `v` (of port `name`, slot `p`, `width` bits) feeds its port.
+    fn sink(
+        &self,
+        scope: &str,
+        name: &str,
+        p: usize,
+        v: &Var,
+        width: u32,
+    ) -> Result<Sink, VcdError> {
+        let (msb, lsb) = v.range.unwrap_or((v.width as i64 - 1, 0));
+        let down = msb >= lsb;
+        let low = msb.min(lsb);
+        if low < 0
+            || msb.max(lsb) >= width as i64
+            || (msb - lsb).unsigned_abs() + 1 != v.width as u64
+        {
+            return Err(self.err(format!(
+                "port `{name}` in `{scope}` is declared {}{} but the mix needs {} bit(s) [{}:0]",
+                v.width,
+                v.range
+                    .map(|(a, b)| format!(" [{a}:{b}]"))
+                    .unwrap_or_default(),
+                width,
+                width - 1
+            )));
+        }
+        Ok(Sink {
+            port: p as u8,
+            width: v.width,
+            lsb,
+            down,
+        })
+    }
+
+    /// The sinks of the mix's link ports in `scope`.
+    fn link_sinks(
+        &self,
+        scope: &str,
+        layout: &Layout,
+        ids: &mut HashMap<Vec<u8>, Vec<Sink>>,
+    ) -> Result<(), VcdError> {
+        for (k, lp) in layout.link_ports().iter().enumerate() {
+            let v = self
+                .vars(scope, lp.name)
+                .find(|v| v.width == lp.width)
                 .ok_or_else(|| {
-                    perr(format!(
+                    self.err(format!(
                         "port `{}` (the mix's link) not found in scope `{scope}`",
                         lp.name
                     ))
@@ -531,15 +618,8 @@ fn resolve(
                 down: true,
             });
         }
+        Ok(())
     }
-    Ok(Resolved {
-        ids: Ids::new(ids),
-        has_clk,
-        has_rst,
-        scope: scope.to_string(),
-        widths,
-        link: layout.link_ports(),
-    })
 }
 
 /// Identifier code -> sinks.  Codes of up to three characters (every
@@ -670,7 +750,7 @@ pub(crate) fn parse_value(s: &[u8], width: u32) -> Option<Val> {
     Some(Val { v, x })
 }
 
-/// The ports of [`PORTS`], then the link's (`Layout::link_ports`).
+/// The ports of [`PORT_NAMES`], then the link's (`Layout::link_ports`).
 struct State {
     port: [Val; NPORT],
     /// The link is AXI4-Stream: its slots are [`AXIS_PORTS`]'s.

@@ -94,162 +94,188 @@ fn lex(text: Vec<u8>, ids: &Ids) -> Lexed {
         err: None,
         text: Vec::new(),
     };
-    let b = &text[..];
-    let n = b.len();
-    let mut i = 0usize;
-    let mut line = 0u64;
-    // The next token as [s, e), counting lines.
-    let next = |i: &mut usize, line: &mut u64| -> Option<(usize, usize)> {
-        while *i < n && ws(b[*i]) {
-            if b[*i] == b'\n' {
-                *line += 1;
-            }
-            *i += 1;
-        }
-        if *i == n {
-            return None;
-        }
-        let s = *i;
-        while *i < n && !ws(b[*i]) {
-            *i += 1;
-        }
-        Some((s, *i))
+    let mut cur = Cursor {
+        b: &text,
+        i: 0,
+        line: 0,
     };
-    let fail = |out: &mut Lexed, line: u64, m: String| {
-        out.err = Some(LexError { line, message: m });
-    };
-    let lossy = |r: &[u8]| String::from_utf8_lossy(r).into_owned();
-    'tokens: while let Some((s, e)) = next(&mut i, &mut line) {
-        let t = &b[s..e];
-        match t[0] {
-            b'#' => {
-                let Some(nt) = timestamp(&t[1..]) else {
-                    fail(&mut out, line, format!("bad timestamp `{}`", lossy(t)));
-                    break;
-                };
-                out.evs.push(Ev::Time {
-                    t: nt,
-                    line: line as u32,
+    while let Some((s, e)) = cur.next() {
+        let t = &text[s..e];
+        let r = match t[0] {
+            b'#' => time(&mut out, t, cur.line),
+            b'$' => skip_comment(&mut cur, t),
+            b'b' | b'B' | b'r' | b'R' | b's' | b'S' => vector(&mut out, &mut cur, t, ids),
+            _ => scalar(&mut out, t, ids),
+        };
+        match r {
+            Ok(()) => {}
+            Err(Stop::Error(message)) => {
+                out.err = Some(LexError {
+                    line: cur.line,
+                    message,
                 });
+                break;
             }
-            b'$' => {
-                if t == b"$comment" {
-                    loop {
-                        match next(&mut i, &mut line) {
-                            None => {
-                                out.end = End::InComment;
-                                break 'tokens;
-                            }
-                            Some((s, e)) if &b[s..e] == b"$end" => break,
-                            Some(_) => {}
-                        }
-                    }
-                }
-            }
-            b'b' | b'B' | b'r' | b'R' | b's' | b'S' => {
-                let is_b = t[0] == b'b' || t[0] == b'B';
-                let val = &b[s + 1..e];
-                let Some((is, ie)) = next(&mut i, &mut line) else {
-                    out.end = End::Dangling;
-                    break;
-                };
-                let id = &b[is..ie];
-                let Some(span) = ids.span(id) else {
-                    fail(
-                        &mut out,
-                        line,
-                        format!(
-                            "value change for undeclared identifier code `{}`",
-                            lossy(id)
-                        ),
-                    );
-                    break;
-                };
-                if is_b && !span.is_empty() {
-                    for k in span {
-                        let sink = ids.flat[k];
-                        let Some(v) = parse_value(val, sink.width) else {
-                            fail(
-                                &mut out,
-                                line,
-                                format!("bad vector value `b{}`", lossy(val)),
-                            );
-                            break 'tokens;
-                        };
-                        push(&mut out, k as u32, v, sink.width);
-                    }
-                } else if is_b && parse_value(val, 1).is_none() && val.len() <= 64 {
-                    fail(
-                        &mut out,
-                        line,
-                        format!("bad vector value `b{}`", lossy(val)),
-                    );
-                    break;
-                }
-            }
-            c => {
-                if !matches!(
-                    c,
-                    b'0' | b'1'
-                        | b'x'
-                        | b'X'
-                        | b'z'
-                        | b'Z'
-                        | b'u'
-                        | b'U'
-                        | b'w'
-                        | b'W'
-                        | b'l'
-                        | b'L'
-                        | b'h'
-                        | b'H'
-                        | b'-'
-                ) {
-                    fail(&mut out, line, format!("unexpected `{}`", lossy(t)));
-                    break;
-                }
-                if t.len() < 2 {
-                    fail(
-                        &mut out,
-                        line,
-                        "scalar value change without an identifier code".into(),
-                    );
-                    break;
-                }
-                let Some(span) = ids.span(&t[1..]) else {
-                    fail(
-                        &mut out,
-                        line,
-                        format!(
-                            "value change for undeclared identifier code `{}`",
-                            lossy(&t[1..])
-                        ),
-                    );
-                    break;
-                };
-                if !span.is_empty() {
-                    // The scalar's one character, checked above (what
-                    // `parse_value` gives for it, without its loop).
-                    let v = match t[0] {
-                        b'0' | b'l' | b'L' => Val { v: 0, x: 0 },
-                        b'1' | b'h' | b'H' => Val { v: 1, x: 0 },
-                        _ => Val { v: 0, x: 1 },
-                    };
-                    for k in span {
-                        let sink = ids.flat[k];
-                        let v = Val {
-                            v: v.v,
-                            x: if v.x != 0 { u128::MAX } else { 0 },
-                        };
-                        push(&mut out, k as u32, v, sink.width);
-                    }
-                }
+            Err(Stop::End(end)) => {
+                out.end = end;
+                break;
             }
         }
     }
-    out.lines = line + b[i..].iter().filter(|&&c| c == b'\n').count() as u64;
+    out.lines = cur.line + text[cur.i..].iter().filter(|&&c| c == b'\n').count() as u64;
     out.text = text;
     out
+}
+
+/// Why lexing a chunk stopped before its end.
+enum Stop {
+    /// A syntax error (on the cursor's line).
+    Error(String),
+    /// The chunk ends in a state that is not clean.
+    End(End),
+}
+
+/// The position in a chunk's text, counting lines.
+struct Cursor<'a> {
+    b: &'a [u8],
+    i: usize,
+    line: u64,
+}
+
+impl Cursor<'_> {
+    /// The next token as [s, e).
+    #[inline]
+    fn next(&mut self) -> Option<(usize, usize)> {
+        let (b, n) = (self.b, self.b.len());
+        while self.i < n && ws(b[self.i]) {
+            if b[self.i] == b'\n' {
+                self.line += 1;
+            }
+            self.i += 1;
+        }
+        if self.i == n {
+            return None;
+        }
+        let s = self.i;
+        while self.i < n && !ws(b[self.i]) {
+            self.i += 1;
+        }
+        Some((s, self.i))
+    }
+}
+
+fn lossy(r: &[u8]) -> String {
+    String::from_utf8_lossy(r).into_owned()
+}
+
+/// `#t`: a timestamp.
+#[inline]
+fn time(out: &mut Lexed, t: &[u8], line: u64) -> Result<(), Stop> {
+    let Some(nt) = timestamp(&t[1..]) else {
+        return Err(Stop::Error(format!("bad timestamp `{}`", lossy(t))));
+    };
+    out.evs.push(Ev::Time {
+        t: nt,
+        line: line as u32,
+    });
+    Ok(())
+}
+
+/// A `$` keyword: a `$comment` is skipped to its `$end`, others ignored.
+fn skip_comment(cur: &mut Cursor, t: &[u8]) -> Result<(), Stop> {
+    if t != b"$comment" {
+        return Ok(());
+    }
+    loop {
+        match cur.next() {
+            None => return Err(Stop::End(End::InComment)),
+            Some((s, e)) if &cur.b[s..e] == b"$end" => return Ok(()),
+            Some(_) => {}
+        }
+    }
+}
+
+/// A vector (or real, or string) value `t` and, next, its identifier code:
+/// vectors are parsed for the sinks the code feeds; others are skipped.
+#[inline]
+fn vector(out: &mut Lexed, cur: &mut Cursor, t: &[u8], ids: &Ids) -> Result<(), Stop> {
+    let is_b = t[0] == b'b' || t[0] == b'B';
+    let val = &t[1..];
+    let Some((is, ie)) = cur.next() else {
+        return Err(Stop::End(End::Dangling));
+    };
+    let id = &cur.b[is..ie];
+    let Some(span) = ids.span(id) else {
+        return Err(Stop::Error(format!(
+            "value change for undeclared identifier code `{}`",
+            lossy(id)
+        )));
+    };
+    if is_b && !span.is_empty() {
+        for k in span {
+            let sink = ids.flat[k];
+            let Some(v) = parse_value(val, sink.width) else {
+                return Err(Stop::Error(format!("bad vector value `b{}`", lossy(val))));
+            };
+            push(out, k as u32, v, sink.width);
+        }
+    } else if is_b && parse_value(val, 1).is_none() && val.len() <= 64 {
+        return Err(Stop::Error(format!("bad vector value `b{}`", lossy(val))));
+    }
+    Ok(())
+}
+
+/// A scalar value change `t`: its value character, then its identifier code.
+#[inline]
+fn scalar(out: &mut Lexed, t: &[u8], ids: &Ids) -> Result<(), Stop> {
+    if !matches!(
+        t[0],
+        b'0' | b'1'
+            | b'x'
+            | b'X'
+            | b'z'
+            | b'Z'
+            | b'u'
+            | b'U'
+            | b'w'
+            | b'W'
+            | b'l'
+            | b'L'
+            | b'h'
+            | b'H'
+            | b'-'
+    ) {
+        return Err(Stop::Error(format!("unexpected `{}`", lossy(t))));
+    }
+    if t.len() < 2 {
+        return Err(Stop::Error(
+            "scalar value change without an identifier code".into(),
+        ));
+    }
+    let Some(span) = ids.span(&t[1..]) else {
+        return Err(Stop::Error(format!(
+            "value change for undeclared identifier code `{}`",
+            lossy(&t[1..])
+        )));
+    };
+    if !span.is_empty() {
+        // The scalar's one character, checked above (what `parse_value`
+        // gives for it, without its loop).
+        let v = match t[0] {
+            b'0' | b'l' | b'L' => Val { v: 0, x: 0 },
+            b'1' | b'h' | b'H' => Val { v: 1, x: 0 },
+            _ => Val { v: 0, x: 1 },
+        };
+        for k in span {
+            let sink = ids.flat[k];
+            let v = Val {
+                v: v.v,
+                x: if v.x != 0 { u128::MAX } else { 0 },
+            };
+            push(out, k as u32, v, sink.width);
+        }
+    }
+    Ok(())
 }
 
 /// A timestamp's digits as `u64`: plain digits directly (most of a body's
@@ -318,62 +344,25 @@ pub(crate) fn for_each_chunk(
     let io = |e| VcdError::Io(path.to_path_buf(), e);
     let mut f = File::open(path).map_err(io)?;
     f.seek(SeekFrom::Start(start.offset)).map_err(io)?;
-    let workers = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
-        .clamp(1, 4);
     std::thread::scope(|scope| {
-        let (work_tx, work_rx) = mpsc::channel::<(u64, Vec<u8>)>();
-        let work_rx = Arc::new(Mutex::new(work_rx));
-        let (done_tx, done_rx) = mpsc::channel::<(u64, Lexed)>();
-        for _ in 0..workers {
-            let rx = Arc::clone(&work_rx);
-            let tx = done_tx.clone();
-            scope.spawn(move || loop {
-                let job = rx.lock().expect("a lexer thread panicked").recv();
-                let Ok((seq, text)) = job else { return };
-                if tx.send((seq, lex(text, ids))).is_err() {
-                    return;
-                }
-            });
-        }
-        drop(done_tx);
+        let mut queue = spawn_lexers(scope, ids);
         let mut reader = Chunker {
             size: CHUNK_BYTES.with(|c| c.get()),
             f: &mut f,
             rest: Vec::new(),
             eof: false,
         };
-        let (mut sent, mut next) = (0u64, 0u64);
-        let mut waiting: Vec<Option<Lexed>> = Vec::new();
         let mut line0 = start.line;
         // Text of unclean chunks, to be lexed again with what follows.
         let mut carry: Vec<u8> = Vec::new();
         let mut last = (start.line, start.header_newline);
         let mut applied = 0u64;
         loop {
-            while sent - next < IN_FLIGHT as u64 && !reader.eof {
-                let text = reader.chunk().map_err(io)?;
-                if text.is_empty() {
-                    break;
-                }
-                work_tx.send((sent, text)).expect("lexer threads alive");
-                sent += 1;
-            }
-            if next == sent {
+            queue.fill(&mut reader).map_err(io)?;
+            let Some(mut lexed) = queue.take() else {
                 break;
-            }
-            let slot = (next % IN_FLIGHT as u64) as usize;
-            if waiting.len() < IN_FLIGHT {
-                waiting.resize_with(IN_FLIGHT, || None);
-            }
-            while waiting[slot].is_none() {
-                let (seq, lexed) = done_rx.recv().expect("lexer threads alive");
-                waiting[(seq % IN_FLIGHT as u64) as usize] = Some(lexed);
-            }
-            let mut lexed = waiting[slot].take().expect("just received");
-            next += 1;
-            let is_last = next == sent && reader.eof;
+            };
+            let is_last = queue.next == queue.sent && reader.eof;
             if !carry.is_empty() {
                 carry.extend_from_slice(&lexed.text);
                 lexed = lex(std::mem::take(&mut carry), ids);
@@ -402,21 +391,102 @@ pub(crate) fn for_each_chunk(
                 last = (line0 + lexed.lines - trailing, c == b'\n');
             }
             if lexed.end != End::Clean {
-                let line = last.0;
-                let message = match lexed.end {
-                    End::InComment => "end of file inside $comment",
-                    _ => "value change without an identifier code at the end of the file",
-                };
-                return Err(VcdError::Truncated {
-                    file: path.to_path_buf(),
-                    line,
-                    message: message.into(),
-                });
+                return Err(unclean_end(path, lexed.end, last.0));
             }
             line0 += lexed.lines;
         }
         Ok(last)
     })
+}
+
+/// The file ends inside a `$comment` or after a vector value.
+fn unclean_end(path: &Path, end: End, line: u64) -> VcdError {
+    let message = match end {
+        End::InComment => "end of file inside $comment",
+        _ => "value change without an identifier code at the end of the file",
+    };
+    VcdError::Truncated {
+        file: path.to_path_buf(),
+        line,
+        message: message.into(),
+    }
+}
+
+/// Chunks handed to the lexer threads, and taken back in file order.
+struct LexQueue {
+    work_tx: mpsc::Sender<(u64, Vec<u8>)>,
+    done_rx: mpsc::Receiver<(u64, Lexed)>,
+    /// Chunks sent, and the next to take back (in file order).
+    sent: u64,
+    next: u64,
+    /// Lexed chunks come back in any order: each waits in its slot.
+    waiting: Vec<Option<Lexed>>,
+}
+
+/// Starts the lexer threads (at most four).
+fn spawn_lexers<'scope>(
+    scope: &'scope std::thread::Scope<'scope, '_>,
+    ids: &'scope Ids,
+) -> LexQueue {
+    let workers = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .clamp(1, 4);
+    let (work_tx, work_rx) = mpsc::channel::<(u64, Vec<u8>)>();
+    let work_rx = Arc::new(Mutex::new(work_rx));
+    let (done_tx, done_rx) = mpsc::channel::<(u64, Lexed)>();
+    for _ in 0..workers {
+        let rx = Arc::clone(&work_rx);
+        let tx = done_tx.clone();
+        scope.spawn(move || loop {
+            let job = rx.lock().expect("a lexer thread panicked").recv();
+            let Ok((seq, text)) = job else { return };
+            if tx.send((seq, lex(text, ids))).is_err() {
+                return;
+            }
+        });
+    }
+    LexQueue {
+        work_tx,
+        done_rx,
+        sent: 0,
+        next: 0,
+        waiting: Vec::new(),
+    }
+}
+
+impl LexQueue {
+    /// Sends chunks until [`IN_FLIGHT`] are out or the file is read.
+    fn fill(&mut self, reader: &mut Chunker) -> std::io::Result<()> {
+        while self.sent - self.next < IN_FLIGHT as u64 && !reader.eof {
+            let text = reader.chunk()?;
+            if text.is_empty() {
+                break;
+            }
+            self.work_tx
+                .send((self.sent, text))
+                .expect("lexer threads alive");
+            self.sent += 1;
+        }
+        Ok(())
+    }
+
+    /// The next chunk in file order, once lexed (`None`: all taken).
+    fn take(&mut self) -> Option<Lexed> {
+        if self.next == self.sent {
+            return None;
+        }
+        let slot = (self.next % IN_FLIGHT as u64) as usize;
+        if self.waiting.len() < IN_FLIGHT {
+            self.waiting.resize_with(IN_FLIGHT, || None);
+        }
+        while self.waiting[slot].is_none() {
+            let (seq, lexed) = self.done_rx.recv().expect("lexer threads alive");
+            self.waiting[(seq % IN_FLIGHT as u64) as usize] = Some(lexed);
+        }
+        self.next += 1;
+        Some(self.waiting[slot].take().expect("just received"))
+    }
 }
 
 /// A syntax error on the file's incomplete last line is a truncation.
