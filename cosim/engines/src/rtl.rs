@@ -299,128 +299,141 @@ fn past(b: &[u8], mut i: usize, close: &[u8], line: &mut usize) -> usize {
     i + close.len()
 }
 
+fn ident_char(c: u8) -> bool {
+    c.is_ascii_alphanumeric() || c == b'_' || c == b'$'
+}
+
+/// The index just past the identifier characters from `i`.
+fn past_ident(b: &[u8], mut i: usize) -> usize {
+    while i < b.len() && ident_char(b[i]) {
+        i += 1;
+    }
+    i
+}
+
+/// The index just past the string literal opening at `i` (or its line's end).
+fn past_string(b: &[u8], mut i: usize) -> usize {
+    i += 1;
+    while i < b.len() && b[i] != b'"' && b[i] != b'\n' {
+        if b[i] == b'\\' {
+            i += 1;
+        }
+        i += 1;
+    }
+    i + 1
+}
+
+/// The end of a directive's line (with `\` continuations), counting them.
+fn past_directive(b: &[u8], mut i: usize, line: &mut usize) -> usize {
+    while i < b.len() && b[i] != b'\n' {
+        if b[i] == b'\\' && i + 1 < b.len() && b[i + 1] == b'\n' {
+            *line += 1;
+            i += 1;
+        }
+        i += 1;
+    }
+    i
+}
+
+/// The index just past the number starting at `s`:
+/// `[size] ['[s]base digits] | decimal` (reals kept as text).
+fn past_number(b: &[u8], s: usize) -> usize {
+    let mut i = s;
+    while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'_') {
+        i += 1;
+    }
+    let mut j = i;
+    while j < b.len() && (b[j] == b' ' || b[j] == b'\t') {
+        j += 1;
+    }
+    if j < b.len() && b[j] == b'\'' {
+        i = j + 1;
+        if i < b.len() && (b[i] == b's' || b[i] == b'S') {
+            i += 1;
+        }
+        if i < b.len() && b"bBoOdDhH".contains(&b[i]) {
+            i += 1;
+        }
+        while i < b.len() && (b[i] == b' ' || b[i] == b'\t') {
+            i += 1;
+        }
+        while i < b.len() && (b[i].is_ascii_hexdigit() || b"_xXzZ?".contains(&b[i])) {
+            i += 1;
+        }
+    } else if i < b.len() && (b[i] == b'.' || b[i] == b'e' || b[i] == b'E') {
+        while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'.' || b[i] == b'_') {
+            i += 1;
+        }
+    }
+    if i == s {
+        i += 1;
+    }
+    i
+}
+
 fn lex(text: &str) -> Vec<Token> {
     let b = text.as_bytes();
     let mut i = 0;
     let mut line = 1;
     let mut out = Vec::new();
-    let ident_char = |c: u8| c.is_ascii_alphanumeric() || c == b'_' || c == b'$';
     while i < b.len() {
         let c = b[i];
-        if c == b'\n' {
+        let start = i;
+        let t = if c == b'\n' {
             line += 1;
             i += 1;
+            None
         } else if c.is_ascii_whitespace() {
             i += 1;
+            None
         } else if b[i..].starts_with(b"//") {
             while i < b.len() && b[i] != b'\n' {
                 i += 1;
             }
+            None
         } else if b[i..].starts_with(b"/*") {
             i = past(b, i + 2, b"*/", &mut line);
+            None
         } else if b[i..].starts_with(b"(*") && !b[i..].starts_with(b"(*)") {
             // attribute instance
             i = past(b, i + 2, b"*)", &mut line);
+            None
         } else if c == b'"' {
-            i += 1;
-            while i < b.len() && b[i] != b'"' && b[i] != b'\n' {
-                if b[i] == b'\\' {
-                    i += 1;
-                }
-                i += 1;
-            }
-            i += 1;
-            out.push(Token { t: Tok::Str, line });
+            i = past_string(b, i);
+            Some(Tok::Str)
         } else if c == b'`' {
-            let s = i + 1;
-            i += 1;
-            while i < b.len() && ident_char(b[i]) {
-                i += 1;
-            }
-            let name = &text[s..i];
+            i = past_ident(b, i + 1);
+            let name = &text[start + 1..i];
             if DIRECTIVES.contains(&name) {
-                // the rest of the line (with `\` continuations)
-                while i < b.len() && b[i] != b'\n' {
-                    if b[i] == b'\\' && i + 1 < b.len() && b[i + 1] == b'\n' {
-                        line += 1;
-                        i += 1;
-                    }
-                    i += 1;
-                }
+                // the rest of the line
+                i = past_directive(b, i, &mut line);
+                None
             } else {
-                out.push(Token {
-                    t: Tok::Macro(name.to_string()),
-                    line,
-                });
+                Some(Tok::Macro(name.to_string()))
             }
         } else if c == b'\\' {
-            let s = i + 1;
             while i < b.len() && !b[i].is_ascii_whitespace() {
                 i += 1;
             }
-            out.push(Token {
-                t: Tok::Ident(text[s..i].to_string()),
-                line,
-            });
+            Some(Tok::Ident(text[start + 1..i].to_string()))
         } else if c.is_ascii_alphabetic() || c == b'_' || c == b'$' {
-            let s = i;
-            while i < b.len() && ident_char(b[i]) {
-                i += 1;
-            }
-            out.push(Token {
-                t: Tok::Ident(text[s..i].to_string()),
-                line,
-            });
+            i = past_ident(b, i);
+            Some(Tok::Ident(text[start..i].to_string()))
         } else if c.is_ascii_digit() || c == b'\'' {
-            // [size] ['[s]base digits] | decimal (reals kept as text)
-            let s = i;
-            while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'_') {
-                i += 1;
-            }
-            let mut j = i;
-            while j < b.len() && (b[j] == b' ' || b[j] == b'\t') {
-                j += 1;
-            }
-            if j < b.len() && b[j] == b'\'' {
-                i = j + 1;
-                if i < b.len() && (b[i] == b's' || b[i] == b'S') {
-                    i += 1;
-                }
-                if i < b.len() && b"bBoOdDhH".contains(&b[i]) {
-                    i += 1;
-                }
-                while i < b.len() && (b[i] == b' ' || b[i] == b'\t') {
-                    i += 1;
-                }
-                while i < b.len() && (b[i].is_ascii_hexdigit() || b"_xXzZ?".contains(&b[i])) {
-                    i += 1;
-                }
-            } else if i < b.len() && (b[i] == b'.' || b[i] == b'e' || b[i] == b'E') {
-                while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'.' || b[i] == b'_')
-                {
-                    i += 1;
-                }
-            }
-            if i == s {
-                i += 1;
-            }
-            out.push(Token {
-                t: Tok::Num(text[s..i].to_string()),
-                line,
-            });
+            i = past_number(b, i);
+            Some(Tok::Num(text[start..i].to_string()))
         } else if let Some(op) = OPS.iter().find(|o| b[i..].starts_with(o.as_bytes())) {
             i += op.len();
-            out.push(Token {
-                t: Tok::Op(op),
-                line,
-            });
+            Some(Tok::Op(op))
         } else {
             let ch = text[i..].chars().next().unwrap_or('?');
             i += ch.len_utf8();
-            let t = match OPS1.find(ch) {
+            Some(match OPS1.find(ch) {
                 Some(k) => Tok::Op(&OPS1[k..k + 1]),
                 None => Tok::Other(ch),
-            };
+            })
+        };
+        if let Some(t) = t {
             out.push(Token { t, line });
         }
     }
