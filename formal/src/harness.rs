@@ -15,7 +15,7 @@
 
 use std::fmt::Write;
 
-use lut_gen::parts::Start;
+use lut_gen::parts::{SpiTiming, Start};
 use lut_gen::ports::{Layout, Role, TOP_MODULE};
 use lut_gen::Schedule;
 
@@ -353,6 +353,33 @@ pub(crate) fn most_common(rows: &[String]) -> String {
         .unwrap_or_default()
 }
 
+/// Bit positions of a branch's slot-table row `{act, lead, en0, sel0, en1, sel1}`
+/// (lowest bit of each field; `act` is one bit).
+struct RowFields {
+    sel1: u32,
+    en1: u32,
+    sel0: u32,
+    en0: u32,
+    lead: u32,
+    act: u32,
+}
+
+impl RowFields {
+    fn new(chb: u32, en_n: u32) -> RowFields {
+        let sel0 = 3 + en_n;
+        let en0 = sel0 + 3;
+        let lead = en0 + en_n;
+        RowFields {
+            sel1: 0,
+            en1: 3,
+            sel0,
+            en0,
+            lead,
+            act: lead + chb,
+        }
+    }
+}
+
 fn branch(
     v: &mut String,
     props: &mut Vec<PropertyDef>,
@@ -361,50 +388,71 @@ fn branch(
     b: usize,
     table: &str,
 ) {
-    let g = &s.grid;
     let p = &s.branches[b];
     let spi = &p.spi;
-    let (cb, sb) = (width(g.slot_cycles), width(g.frame_slots));
-    let chb = layout.channel_bits;
-    let en_n = layout.en_n[b];
-    let (su, d, h, r) = (
+    let n = spi.sclks();
+    let cnv = spi.style == Start::Cnv;
+    let _ = writeln!(
+        v,
+        "\n  // Branch {b} `{}`: setup {}, SCLK period {} (half {}), {n} SCLKs, read {} cycles, {}.",
+        p.name,
         spi.setup_cycles,
         spi.sclk_div,
         spi.sclk_half,
         spi.read_cycles,
-    );
-    let n = spi.sclks();
-    let cnv = spi.style == Start::Cnv;
-    let caps = if cnv { n } else { n - 1 };
-    let _ = writeln!(
-        v,
-        "\n  // Branch {b} `{}`: setup {su}, SCLK period {d} (half {h}), {n} SCLKs, read {r} cycles, {}.",
-        p.name,
         if cnv { "CNV active high, SCK idles low" } else { "CS active low, SCLK idles high" }
     );
     // Slot table: {act, lead, en0, sel0, en1, sel1}.
-    let _ = writeln!(v, "  reg [{}:0] tab{b};", row_bits(chb, en_n) - 1);
+    let _ = writeln!(
+        v,
+        "  reg [{}:0] tab{b};",
+        row_bits(layout.channel_bits, layout.en_n[b]) - 1
+    );
     v.push_str(table);
-    let lo1 = 0;
-    let lo_e1 = 3;
-    let lo0 = 3 + en_n;
-    let lo_e0 = lo0 + 3;
-    let lo_lead = lo_e0 + en_n;
-    let act_bit = lo_lead + chb;
+    branch_conversion(v, s, layout, b);
+    branch_expectations(v, s, layout, b);
+    branch_properties(props, b, &p.name);
+}
+
+/// The row's `act` and `lead` fields, and when branch `b` converts.
+fn branch_conversion(v: &mut String, s: &Schedule, layout: &Layout, b: usize) {
+    let (cb, sb) = (width(s.grid.slot_cycles), width(s.grid.frame_slots));
+    let chb = layout.channel_bits;
+    let row = RowFields::new(chb, layout.en_n[b]);
+    let r = s.branches[b].spi.read_cycles;
     let skip = s.skipped_at_startup(b, 0);
     let _ = writeln!(
         v,
-        "  wire act{b} = tab{b}[{act_bit}];\n  wire [{}:0] lead{b} = tab{b}[{}:{lo_lead}];\n  \
+        "  wire act{b} = tab{b}[{}];\n  wire [{}:0] lead{b} = tab{b}[{}:{}];\n  \
          // Instants at cycle 0 whose mux cannot have settled are skipped (Start-up).\n  \
          wire conv{b} = run && act{b}{};\n  wire busy{b} = conv{b} && cyc < {cb}'d{r};",
+        row.act,
         chb - 1,
-        act_bit - 1,
+        row.act - 1,
+        row.lead,
         if skip {
             format!(" && !(first && slot == {sb}'d0)")
         } else {
             String::new()
         }
     );
+}
+
+/// SCLK's low and high phases within the slot, and the cycles MISO is
+/// captured in (the last cycle of each low phase; a CNV part's first bit
+/// is out before the first SCLK).
+struct SclkPhases {
+    /// `[from, to)` cycle ranges of the slot.
+    low: Vec<(u64, u64)>,
+    high: Vec<(u64, u64)>,
+    /// `cyc == ...` conditions of the capture cycles.
+    capture: Vec<String>,
+}
+
+fn sclk_phases(spi: &SpiTiming, cb: u32) -> SclkPhases {
+    let (su, d, h) = (spi.setup_cycles, spi.sclk_div, spi.sclk_half);
+    let n = spi.sclks();
+    let caps = if spi.style == Start::Cnv { n } else { n - 1 };
     let mut low = Vec::new();
     let mut high = Vec::new();
     let mut capc = Vec::new();
@@ -416,7 +464,27 @@ fn branch(
             capc.push(format!("cyc == {cb}'d{}", fall + h - 1));
         }
     }
-    let (cs_exp, sclk_exp) = if cnv {
+    SclkPhases {
+        low,
+        high,
+        capture: capc,
+    }
+}
+
+/// What branch `b`'s pins must be in every cycle, the MISO bits it
+/// captures, and the wires comparing the two.
+fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) {
+    let spi = &s.branches[b].spi;
+    let cb = width(s.grid.slot_cycles);
+    let en_n = layout.en_n[b];
+    let row = RowFields::new(layout.channel_bits, en_n);
+    let (r, n) = (spi.read_cycles, spi.sclks());
+    let SclkPhases {
+        low,
+        high,
+        capture: capc,
+    } = sclk_phases(spi, cb);
+    let (cs_exp, sclk_exp) = if spi.style == Start::Cnv {
         (
             format!("busy{b}"),
             format!("conv{b} && ({})", ranges(cb, &high)),
@@ -429,6 +497,7 @@ fn branch(
     };
     let (sel_hi, sel_lo) = layout.lane_bits(Role::MuxSel, b);
     let (en_hi, en_lo) = layout.lane_bits(Role::MuxEn, b);
+    let (lo1, lo_e1, lo0, lo_e0) = (row.sel1, row.en1, row.sel0, row.en0);
     let _ = writeln!(
         v,
         "  wire exp_cs{b} = {cs_exp};\n  wire exp_sclk{b} = {sclk_exp};\n  \
@@ -447,7 +516,10 @@ fn branch(
         n - 1,
         n.saturating_sub(2),
     );
-    let name = &p.name;
+}
+
+/// The properties of branch `b`, called `name`.
+fn branch_properties(props: &mut Vec<PropertyDef>, b: usize, name: &str) {
     props.push(PropertyDef {
         name: format!("conversion[{name}]"),
         wire: format!("ok_cs{b}"),
@@ -472,8 +544,6 @@ fn branch(
 
 fn merger(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &Layout) {
     let nb = s.branches.len();
-    let chb = layout.channel_bits;
-    let vb = layout.value_bits;
     let _ = writeln!(
         v,
         "\n  // Merged stream: a finished conversion's words wait per branch; the lowest\n  \
@@ -481,64 +551,85 @@ fn merger(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
          // recorded above, whatever they were)."
     );
     for b in 0..nb {
-        let spi = &s.branches[b].spi;
-        let n = spi.sclks();
-        let maxw = spi.words as u64;
-        let nwb = width(maxw + 1);
-        let mut leads: Vec<usize> = (0..s.grid.frame_slots)
-            .filter_map(|slot| s.at(slot, b))
-            .collect();
-        leads.sort_unstable();
-        leads.dedup();
-        // Words per lead, channel and value of each (lead, word index).
+        merger_queue(v, s, layout, b);
+    }
+    merger_output(v, nb, layout);
+    merger_properties(props);
+}
+
+/// Branch `b`'s waiting words: how many its conversion leaves, and the
+/// channel and value of each.
+fn merger_queue(v: &mut String, s: &Schedule, layout: &Layout, b: usize) {
+    let chb = layout.channel_bits;
+    let vb = layout.value_bits;
+    let spi = &s.branches[b].spi;
+    let maxw = spi.words as u64;
+    let nwb = width(maxw + 1);
+    let mut leads: Vec<usize> = (0..s.grid.frame_slots)
+        .filter_map(|slot| s.at(slot, b))
+        .collect();
+    leads.sort_unstable();
+    leads.dedup();
+    // Words per lead, channel and value of each (lead, word index).
+    let _ = writeln!(
+        v,
+        "  reg [{}:0] nw{b};\n  reg [{}:0] wch{b};\n  reg [{}:0] wval{b};\n  reg [{}:0] pw{b} = 0, wi{b} = 0;\n  \
+         reg [{}:0] pc{b} = 0;\n  wire [{}:0] pw_e{b} = done{b} ? nw{b} : pw{b};\n  \
+         wire [{}:0] wi_e{b} = done{b} ? {nwb}'d0 : wi{b};\n  wire [{}:0] pc_e{b} = done{b} ? lead{b} : pc{b};\n  \
+         wire av{b} = pw_e{b} != {nwb}'d0;",
+        nwb - 1,
+        chb - 1,
+        vb - 1,
+        nwb - 1,
+        chb - 1,
+        nwb - 1,
+        nwb - 1,
+        chb - 1,
+    );
+    let _ = writeln!(v, "  always @* case (lead{b})");
+    for &l in &leads {
         let _ = writeln!(
             v,
-            "  reg [{}:0] nw{b};\n  reg [{}:0] wch{b};\n  reg [{}:0] wval{b};\n  reg [{}:0] pw{b} = 0, wi{b} = 0;\n  \
-             reg [{}:0] pc{b} = 0;\n  wire [{}:0] pw_e{b} = done{b} ? nw{b} : pw{b};\n  \
-             wire [{}:0] wi_e{b} = done{b} ? {nwb}'d0 : wi{b};\n  wire [{}:0] pc_e{b} = done{b} ? lead{b} : pc{b};\n  \
-             wire av{b} = pw_e{b} != {nwb}'d0;",
-            nwb - 1,
-            chb - 1,
-            vb - 1,
-            nwb - 1,
-            chb - 1,
-            nwb - 1,
-            nwb - 1,
-            chb - 1,
+            "    {chb}'d{l}: nw{b} = {nwb}'d{};",
+            s.words_of(l).count()
         );
-        let _ = writeln!(v, "  always @* case (lead{b})");
-        for &l in &leads {
+    }
+    let _ = writeln!(v, "    default: nw{b} = {nwb}'d0;\n  endcase");
+    merger_words(v, s, chb, nwb, b, &leads);
+}
+
+/// The channel and value of each (lead, word index) of branch `b`: the
+/// word's bits sit in the shift register by their position in the frame.
+fn merger_words(v: &mut String, s: &Schedule, chb: u32, nwb: u32, b: usize, leads: &[usize]) {
+    let spi = &s.branches[b].spi;
+    let n = spi.sclks();
+    let _ = writeln!(
+        v,
+        "  always @* begin\n    wch{b} = 0; wval{b} = 0;\n    case ({{pc_e{b}, wi_e{b}}})"
+    );
+    for &l in leads {
+        for (i, (m, c)) in s.words_of(l).enumerate() {
+            let end = m as u64 * spi.word_sclks as u64 + spi.leading_bits as u64 + spi.bits as u64;
+            let lo = n - end;
+            let hi = lo + spi.bits as u64 - 1;
             let _ = writeln!(
                 v,
-                "    {chb}'d{l}: nw{b} = {nwb}'d{};",
-                s.words_of(l).count()
+                "      {{{chb}'d{l}, {nwb}'d{i}}}: begin wch{b} = {chb}'d{c}; wval{b} = w{b}[{hi}:{lo}]; end"
             );
         }
-        let _ = writeln!(v, "    default: nw{b} = {nwb}'d0;\n  endcase");
-        let _ = writeln!(
-            v,
-            "  always @* begin\n    wch{b} = 0; wval{b} = 0;\n    case ({{pc_e{b}, wi_e{b}}})"
-        );
-        for &l in &leads {
-            for (i, (m, c)) in s.words_of(l).enumerate() {
-                let end =
-                    m as u64 * spi.word_sclks as u64 + spi.leading_bits as u64 + spi.bits as u64;
-                let lo = n - end;
-                let hi = lo + spi.bits as u64 - 1;
-                let _ = writeln!(
-                    v,
-                    "      {{{chb}'d{l}, {nwb}'d{i}}}: begin wch{b} = {chb}'d{c}; wval{b} = w{b}[{hi}:{lo}]; end"
-                );
-            }
-        }
-        let _ = writeln!(v, "      default: ;\n    endcase\n  end");
     }
+    let _ = writeln!(v, "      default: ;\n    endcase\n  end");
+}
+
+/// The expected stream: the lowest waiting branch's next word each cycle,
+/// and the wires comparing it with the design's.
+fn merger_output(v: &mut String, nb: usize, layout: &Layout) {
     let _ = writeln!(
         v,
         "  reg exp_valid = 1'b0;\n  reg [{}:0] exp_ch = 0;\n  reg [{}:0] exp_val = 0;\n  \
          always @(posedge clk) if (run) begin",
-        chb - 1,
-        vb - 1
+        layout.channel_bits - 1,
+        layout.value_bits - 1
     );
     for b in 0..nb {
         let _ = writeln!(
@@ -562,6 +653,9 @@ fn merger(v: &mut String, props: &mut Vec<PropertyDef>, s: &Schedule, layout: &L
         "  wire ok_valid = sample_valid == exp_valid;\n  wire ok_channel = sample_channel == exp_ch;\n  \
          wire ok_value = sample_value == exp_val;"
     );
+}
+
+fn merger_properties(props: &mut Vec<PropertyDef>) {
     for (name, wire, what) in [
         (
             "stream.valid",

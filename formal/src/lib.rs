@@ -14,6 +14,7 @@ pub mod engine;
 pub mod faults;
 pub mod harness;
 pub mod replay;
+mod strategy;
 pub mod symsim;
 
 use std::path::{Path, PathBuf};
@@ -161,116 +162,15 @@ fn write_inputs(dir: &Path, h: &Harness, design: &str) -> Result<(), ProveError>
 pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, ProveError> {
     let t0 = Instant::now();
     let h = harness::generate(s)?;
-    let mut work =
-        tempfile::tempdir().map_err(|e| ProveError::Tool(format!("temporary directory: {e}")))?;
-    if std::env::var_os("SLOTFORGE_FORMAL_KEEP").is_some() {
-        // for inspection: the engines' files stay
-        eprintln!("formal work directory: {}", work.path().display());
-        work.disable_cleanup(true);
-    }
+    let work = work_dir()?;
     write_inputs(work.path(), &h, design)?;
     let prep = engine::prepare(work.path(), opts.solver)?;
     let t1 = Instant::now();
     let f = h.frame_cycles;
-    // Steps 0..=2F+1 from power-on: the recurrence bound (aiger.rs).
-    let base = 2 * f + 2;
-    let depth = opts.depth.unwrap_or(0).max(base + 2);
-    let bmc_only = |why: String, steps: u64| {
-        (
-            Outcome::Bounded,
-            steps,
-            format!(
-                "NOT a proof: {why}; no violation from reset within {steps} steps ({} cycles after reset, {:.2} frames)",
-                steps.saturating_sub(2),
-                steps.saturating_sub(2) as f64 / f as f64
-            ),
-        )
-    };
-    let failed = |step: u64| {
-        (
-            Outcome::Failed,
-            step,
-            format!(
-                "a trace from reset violates the contract at step {step} (cycle {})",
-                step as i64 - 2
-            ),
-        )
-    };
-    let proved_note = format!(
-        "proved for all time: no violation from reset within {base} steps, and for every input the state at step {base} recurs at step {} of a copy started a frame later, so those steps reach every reachable state (state recurrence, ABC bmc3)",
-        base - f
-    );
     let (result, depth, note) = match opts.solver {
         Solver::Symbolic => symbolic(&prep, f, opts)?,
-        // Both checks in one run first (the common cases: proved, or a
-        // violation from reset); the separate checks only when it cannot tell.
-        Solver::Abc => match engine::combined(&prep, f, opts.timeout_s)? {
-            Some(engine::Combined::Holds) => (Outcome::Proved, base, proved_note),
-            Some(engine::Combined::Fails { step }) => {
-                // the miter's witness is in its own inputs: the design's, from the plain search
-                match engine::bmc(&prep, step + 2, opts.bmc_timeout_s)? {
-                    engine::Verdict::Violated { step } => failed(step),
-                    engine::Verdict::Bounded { steps } => bmc_only(
-                        "the plain search did not reproduce the combined search's violation".into(),
-                        steps,
-                    ),
-                    engine::Verdict::Proved => unreachable!("bmc3 proves nothing"),
-                }
-            }
-            _ => match engine::bmc(&prep, depth, opts.bmc_timeout_s)? {
-            engine::Verdict::Violated { step } => failed(step),
-            engine::Verdict::Bounded { steps } if steps > base => {
-                match engine::recurrence(&prep, f, opts.timeout_s)? {
-                    Some(true) => (Outcome::Proved, base, proved_note),
-                    // No argument for all time: search deeper for a violation.
-                    r => {
-                        let why = if r.is_some() {
-                            "the design's state does not recur a frame later for every input (it keeps state older than a frame), so no bound covers all time".to_string()
-                        } else {
-                            format!("the recurrence check did not finish in {} s", opts.timeout_s)
-                        };
-                        let deeper = opts.depth.unwrap_or(0).max(DEEP_FRAMES * f);
-                        match engine::bmc(&prep, deeper, opts.bmc_timeout_s)? {
-                            engine::Verdict::Violated { step } => failed(step),
-                            engine::Verdict::Bounded { steps: more } => bmc_only(why, more.max(steps)),
-                            engine::Verdict::Proved => unreachable!("bmc3 proves nothing"),
-                        }
-                    }
-                }
-            }
-            engine::Verdict::Bounded { steps } => bmc_only(
-                format!("the search from reset stopped at its time limit ({} s) before the recurrence bound {base}", opts.bmc_timeout_s),
-                steps,
-            ),
-            engine::Verdict::Proved => unreachable!("bmc3 proves nothing"),
-        },
-        },
-        Solver::Pdr | Solver::Cvc5 => {
-            let closed = if opts.solver == Solver::Pdr {
-                engine::pdr(&prep, opts.timeout_s)?
-            } else {
-                engine::smt_induction(&prep, 4, opts.timeout_s)?
-            };
-            match closed {
-                Some(engine::Verdict::Proved) => (
-                    Outcome::Proved,
-                    0,
-                    format!("proved for all time by {}", opts.solver.name()),
-                ),
-                Some(engine::Verdict::Violated { step }) => failed(step),
-                _ => {
-                    let aig = engine::prepare(work.path(), Solver::Abc)?;
-                    match engine::bmc(&aig, depth, opts.bmc_timeout_s)? {
-                        engine::Verdict::Violated { step } => failed(step),
-                        engine::Verdict::Bounded { steps } => bmc_only(
-                            format!("{} did not close in {} s", opts.solver.name(), opts.timeout_s),
-                            steps,
-                        ),
-                        engine::Verdict::Proved => unreachable!("bmc3 proves nothing"),
-                    }
-                }
-            }
-        }
+        Solver::Abc => strategy::abc(&prep, f, opts)?,
+        Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work.path(), f, opts)?,
     };
     let solver_seconds = t1.elapsed().as_secs_f64();
     let mut properties: Vec<PropertyResult> = h
@@ -282,46 +182,19 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
             what: p.what.clone(),
         })
         .collect();
-    let mut counterexample = None;
-    if result == Outcome::Failed {
-        if opts.solver == Solver::Cvc5 {
-            // the witness comes from ABC: search again on the AIG
-            let aig = engine::prepare(work.path(), Solver::Abc)?;
-            engine::bmc(&aig, depth + 1, opts.bmc_timeout_s)?;
-        }
-        let miso = engine::witness_miso(&prep, s.branches.len())?;
-        let r = replay::replay(s, &h, design, &miso, work.path(), &opts.out_dir)?;
-        for p in &mut properties {
-            p.result = if r.failed.contains(&p.name) {
-                Outcome::Failed
-            } else {
-                Outcome::Bounded
-            };
-        }
-        let (report, _) = judge::vcd::check_vcd_with(
+    let counterexample = if result == Outcome::Failed {
+        let failure = Failure {
             s,
-            &r.vcd,
-            Some(replay::DUT_SCOPE),
-            judge::CheckOptions::default(),
-        )
-        .map_err(|e| ProveError::Tool(format!("checking the counterexample: {e}")))?;
-        let check_cycle = first_rejected(&report);
-        let reproduced = r.step.is_some();
-        let step = r.step.unwrap_or(depth);
-        if !reproduced {
-            for p in &mut properties {
-                p.result = Outcome::Failed;
-            }
-        }
-        counterexample = Some(Counterexample {
-            reproduced,
-            cycle: step as i64 - 2,
-            vcd: r.vcd,
-            gtkw: r.gtkw,
-            check_cycle,
-            diagnosis: report.summary(),
-        });
-    }
+            h: &h,
+            design,
+            prep: &prep,
+            work: work.path(),
+            step: depth,
+        };
+        Some(counterexample(&failure, opts, &mut properties)?)
+    } else {
+        None
+    };
     let cycle = counterexample.as_ref().map(|c| c.cycle);
     Ok(Proof {
         mix: s.mix.name.clone(),
@@ -335,6 +208,76 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         note,
         counterexample,
         cycle,
+    })
+}
+
+/// The engines' temporary directory; kept, and named on stderr, when
+/// `SLOTFORGE_FORMAL_KEEP` is set.
+fn work_dir() -> Result<tempfile::TempDir, ProveError> {
+    let mut work =
+        tempfile::tempdir().map_err(|e| ProveError::Tool(format!("temporary directory: {e}")))?;
+    if std::env::var_os("SLOTFORGE_FORMAL_KEEP").is_some() {
+        // for inspection: the engines' files stay
+        eprintln!("formal work directory: {}", work.path().display());
+        work.disable_cleanup(true);
+    }
+    Ok(work)
+}
+
+/// A failed proof's inputs, for replaying its witness.
+struct Failure<'a> {
+    s: &'a Schedule,
+    h: &'a Harness,
+    design: &'a str,
+    prep: &'a engine::Prepared,
+    work: &'a Path,
+    /// The failing step the engine reported.
+    step: u64,
+}
+
+/// Replays the engine's witness on the design, marks the properties it
+/// violates, and checks the trace with the cycle-exact checker.
+fn counterexample(
+    x: &Failure,
+    opts: &ProveOptions,
+    properties: &mut [PropertyResult],
+) -> Result<Counterexample, ProveError> {
+    if opts.solver == Solver::Cvc5 {
+        // the witness comes from ABC: search again on the AIG
+        let aig = engine::prepare(x.work, Solver::Abc)?;
+        engine::bmc(&aig, x.step + 1, opts.bmc_timeout_s)?;
+    }
+    let miso = engine::witness_miso(x.prep, x.s.branches.len())?;
+    let r = replay::replay(x.s, x.h, x.design, &miso, x.work, &opts.out_dir)?;
+    for p in properties.iter_mut() {
+        p.result = if r.failed.contains(&p.name) {
+            Outcome::Failed
+        } else {
+            Outcome::Bounded
+        };
+    }
+    let (report, _) = judge::vcd::check_vcd_with(
+        x.s,
+        &r.vcd,
+        Some(replay::DUT_SCOPE),
+        judge::CheckOptions::default(),
+    )
+    .map_err(|e| ProveError::Tool(format!("checking the counterexample: {e}")))?;
+    let check_cycle = first_rejected(&report);
+    let reproduced = r.step.is_some();
+    let step = r.step.unwrap_or(x.step);
+    if !reproduced {
+        for p in properties.iter_mut() {
+            p.result = Outcome::Failed;
+        }
+    }
+    Ok(Counterexample {
+        reproduced,
+        cycle: step as i64 - 2,
+        vcd: r.vcd,
+        gtkw: r.gtkw,
+        check_cycle,
+        diagnosis: report.summary(),
     })
 }
 

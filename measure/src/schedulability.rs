@@ -10,7 +10,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use campaign::mixgen::{random_mix, Shape};
-use lut_gen::Schedule;
+use lut_gen::{Schedule, Verdict};
 use report::{draw, Axes, Figure, Marker, Section, Series, Table};
 
 /// Random mixes drawn.
@@ -27,6 +27,20 @@ fn utilization(m: &lut_gen::Mix) -> f64 {
     demand as f64 / cap.max(1) as f64
 }
 
+/// The random mixes by outcome, each as (utilization %, synthesis ms).
+#[derive(Default)]
+struct Outcomes {
+    scheduled: Vec<(f64, f64)>,
+    infeasible: Vec<(f64, f64)>,
+    unknown: Vec<(f64, f64)>,
+}
+
+impl Outcomes {
+    fn total(&self) -> usize {
+        self.scheduled.len() + self.infeasible.len() + self.unknown.len()
+    }
+}
+
 /// The section and a one-line summary.
 pub fn schedulability(s: &Schedule) -> (Section, String) {
     let mix = &s.mix;
@@ -36,79 +50,19 @@ pub fn schedulability(s: &Schedule) -> (Section, String) {
     let max = ((n0 * (2.0f64).max(1.2 / u0.max(1e-3))).ceil() as u64).clamp(4, 512);
     let shape = Shape::around(mix, max);
     let mut table = Table::new(&["seed", "channels", "utilization", "verdict", "synthesis_ms"]);
-    let (mut ok, mut no, mut unknown) = (Vec::new(), Vec::new(), Vec::new());
-    for seed in 1..=MIXES {
-        let text = random_mix(seed, &shape);
-        let Ok(m) = lut_gen::parse(Path::new("random.toml"), &text) else {
-            continue;
-        };
-        let u = utilization(&m);
-        let t = Instant::now();
-        let verdict = match lut_gen::synthesize(&m) {
-            Ok(_) => "scheduled",
-            Err(e) => e.verdict.as_str(),
-        };
-        let ms = (t.elapsed().as_secs_f64() * 1e3).max(1e-3);
-        table.push(vec![
-            seed.to_string(),
-            m.channels.len().to_string(),
-            format!("{u:.4}"),
-            verdict.to_string(),
-            format!("{ms:.4}"),
-        ]);
-        match verdict {
-            "scheduled" => &mut ok,
-            "infeasible" => &mut no,
-            _ => &mut unknown,
-        }
-        .push((u * 100.0, ms));
-    }
-    let best = ok.iter().map(|p| p.0).fold(0.0f64, f64::max);
-    let worst = no.iter().map(|p| p.0).fold(f64::INFINITY, f64::min);
+    let outcomes = sample(&shape, &mut table);
     let t = Instant::now();
     let _ = lut_gen::synthesize(mix);
     let own = (t.elapsed().as_secs_f64() * 1e3).max(1e-3);
-    let undecided = if unknown.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "; {} undecided (the search's bound hit, no proof either way)",
-            unknown.len()
-        )
-    };
-    let line = format!(
-        "{} of {} random mixes around this one have an exact schedule, up to {best:.0} % ADC utilization{}{undecided}; this mix: {:.0} %",
-        ok.len(),
-        ok.len() + no.len() + unknown.len(),
-        if worst.is_finite() { format!(", the least loaded proved without one at {worst:.0} %") } else { String::new() },
-        u0 * 100.0
-    );
+    let line = summary(&outcomes, u0);
     let mut me = Series::scatter(
         &format!("this mix ({:.0} %)", u0 * 100.0),
         vec![(u0 * 100.0, own)],
     )
     .with_marker(Marker::Square);
     me.labels = vec![(u0 * 100.0, own, mix.name.clone())];
-    let mut series = vec![
-        Series::scatter(&format!("exact schedule ({})", ok.len()), ok).with_marker(Marker::Circle),
-        Series::scatter(&format!("none exists ({})", no.len()), no).with_marker(Marker::Cross),
-    ];
-    if !unknown.is_empty() {
-        let n = unknown.len();
-        series.push(
-            Series::scatter(&format!("undecided ({n})"), unknown).with_marker(Marker::Triangle),
-        );
-    }
+    let mut series = outcome_series(outcomes);
     series.push(me);
-    let mut axes = Axes::new(
-        "Where scheduling breaks around this mix",
-        "ADC utilization (% of the converters' throughput)",
-        "synthesis time (ms, log)",
-    );
-    axes.log_y = true;
-    // infeasible mixes sit on the right: keep the legend off them
-    axes.legend_left = true;
-    axes.vlines = vec![(100.0, "100 %".into())];
     let rates: Vec<String> = shape.rates_hz.iter().map(|r| format!("{r} Hz")).collect();
     (
         Section {
@@ -121,11 +75,101 @@ pub fn schedulability(s: &Schedule) -> (Section, String) {
                 stem: "schedulability".into(),
                 title: "Where scheduling breaks".into(),
                 caption: "each marker a random mix around this one; x: demand over the converters' throughput; y: time to synthesize (or to prove there is no exact schedule)".into(),
-                svg: draw(&axes, &series, 900, 460),
+                svg: draw(&breaks_axes(), &series, 900, 460),
                 table,
             }],
             ..Section::default()
         },
         line,
     )
+}
+
+/// Synthesizes the random mixes of `shape`, one table row each.
+fn sample(shape: &Shape, table: &mut Table) -> Outcomes {
+    let mut o = Outcomes::default();
+    for seed in 1..=MIXES {
+        let text = random_mix(seed, shape);
+        let Ok(m) = lut_gen::parse(Path::new("random.toml"), &text) else {
+            continue;
+        };
+        let u = utilization(&m);
+        let t = Instant::now();
+        // `None`: scheduled
+        let verdict = lut_gen::synthesize(&m).err().map(|e| e.verdict);
+        let ms = (t.elapsed().as_secs_f64() * 1e3).max(1e-3);
+        table.push(vec![
+            seed.to_string(),
+            m.channels.len().to_string(),
+            format!("{u:.4}"),
+            verdict.map_or("scheduled", Verdict::as_str).to_string(),
+            format!("{ms:.4}"),
+        ]);
+        match verdict {
+            None => &mut o.scheduled,
+            Some(Verdict::Infeasible) => &mut o.infeasible,
+            Some(Verdict::Unknown) => &mut o.unknown,
+        }
+        .push((u * 100.0, ms));
+    }
+    o
+}
+
+fn summary(o: &Outcomes, u0: f64) -> String {
+    let best = o.scheduled.iter().map(|p| p.0).fold(0.0f64, f64::max);
+    let worst = o
+        .infeasible
+        .iter()
+        .map(|p| p.0)
+        .fold(f64::INFINITY, f64::min);
+    let undecided = if o.unknown.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; {} undecided (the search's bound hit, no proof either way)",
+            o.unknown.len()
+        )
+    };
+    format!(
+        "{} of {} random mixes around this one have an exact schedule, up to {best:.0} % ADC utilization{}{undecided}; this mix: {:.0} %",
+        o.scheduled.len(),
+        o.total(),
+        if worst.is_finite() { format!(", the least loaded proved without one at {worst:.0} %") } else { String::new() },
+        u0 * 100.0
+    )
+}
+
+/// One marker kind per outcome (undecided only when there are some).
+fn outcome_series(o: Outcomes) -> Vec<Series> {
+    let mut series = vec![
+        Series::scatter(
+            &format!("exact schedule ({})", o.scheduled.len()),
+            o.scheduled,
+        )
+        .with_marker(Marker::Circle),
+        Series::scatter(
+            &format!("none exists ({})", o.infeasible.len()),
+            o.infeasible,
+        )
+        .with_marker(Marker::Cross),
+    ];
+    if !o.unknown.is_empty() {
+        let n = o.unknown.len();
+        series.push(
+            Series::scatter(&format!("undecided ({n})"), o.unknown).with_marker(Marker::Triangle),
+        );
+    }
+    series
+}
+
+fn breaks_axes() -> Axes {
+    let mut axes = Axes::new(
+        "Where scheduling breaks around this mix",
+        "ADC utilization (% of the converters' throughput)",
+        "synthesis time (ms, log)",
+    );
+    axes.log_y = true;
+    // infeasible mixes sit on the right: keep the legend off them
+    axes.legend_left = true;
+    axes.vlines = vec![(100.0, "100 %".into())];
+    axes
 }

@@ -154,17 +154,73 @@ fn lane(l: &Layout, p: &Pins, r: Role, b: usize) -> u64 {
     ((p.value(r) >> lo) as u64) & ((1u64 << (hi - lo + 1)) - 1)
 }
 
+/// The window drawn: frame 1's slice `j`, cycles `[from, to)` after cycle 0.
+struct View<'a> {
+    s: &'a Schedule,
+    j: u64,
+    from: u64,
+    to: u64,
+}
+
+impl View<'_> {
+    fn new(s: &Schedule) -> View<'_> {
+        let g = &s.grid;
+        let slice_cycles = g.slots_per_slice * g.slot_cycles;
+        let j = busiest_slice(s);
+        let from = g.frame_cycles + j * slice_cycles;
+        // one slot more: the last conversion's word leaves after its slot
+        let to = from + slice_cycles + g.slot_cycles;
+        View { s, j, from, to }
+    }
+
+    /// Microseconds after cycle 0.
+    fn us(&self, c: u64) -> f64 {
+        c as f64 * 1e6 / self.s.grid.clock_hz as f64
+    }
+
+    fn channel(&self, c: usize) -> String {
+        self.s.mix.channels[c].name.clone()
+    }
+
+    /// Where a label's x must end: the window's start and width in us.
+    fn span(&self) -> (f64, f64) {
+        (self.us(self.from), self.us(self.to) - self.us(self.from))
+    }
+}
+
 /// The section, the WaveDrom JSON, and a one-line summary.
 pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String), String> {
     let g = &s.grid;
+    let view = View::new(s);
+    let (j, from) = (view.j, view.from);
+    let w = simulate(s, backend, &view)?;
+    let l = Layout::new(s);
+    let rows = signal_rows(s, &l, &w, from);
+    let (table, mut series, names) = traces(&view, &rows);
+    let mut labels = Series::line("", vec![]);
+    select_labels(&view, &names, &mut labels);
+    strobe_labels(&view, &w, &mut labels);
+    series.push(labels);
+    let axes = slice_axes(&view, backend, names, rows.len());
+    let svg = draw(&axes, &series, 1000, 170 + 34 * rows.len() as u32);
+    let (wavedrom, wd_line) = wavedrom(s, &l, &w, s.branches.len())?;
     let slice_cycles = g.slots_per_slice * g.slot_cycles;
-    let j = busiest_slice(s);
-    let from = g.frame_cycles + j * slice_cycles;
-    // one slot more: the last conversion's word leaves after its slot
-    let to = from + slice_cycles + g.slot_cycles;
+    let line = format!(
+        "slice {j} of frame 1 ({} slots of {} cycles), {} conversions; {wd_line}",
+        g.slots_per_slice,
+        g.slot_cycles,
+        s.instants(3)
+            .filter(|i| (from..from + slice_cycles).contains(&i.cycle))
+            .count()
+    );
+    Ok((slice_section(j, svg, table), wavedrom, line))
+}
+
+/// Three frames on `backend`, the window's pins kept.
+fn simulate(s: &Schedule, backend: Backend, view: &View) -> Result<Window, String> {
     let mut w = Window {
-        from,
-        to,
+        from: view.from,
+        to: view.to,
         seen: 0,
         zero: None,
         cycles: Vec::new(),
@@ -174,11 +230,12 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
     if w.cycles.is_empty() {
         return Err("the run gave no cycles in the window".into());
     }
-    let l = Layout::new(s);
-    let us = |c: u64| c as f64 * 1e6 / g.clock_hz as f64;
-    let name = |c: usize| s.mix.channels[c].name.clone();
-    // (name, (cycle, value) at each change, full-scale value)
-    let mut rows: Vec<Row> = Vec::new();
+    Ok(w)
+}
+
+/// The diagram's rows, bottom up: the strobe, then per branch (last first)
+/// SCLK, CS, select and enable.
+fn signal_rows(s: &Schedule, l: &Layout, w: &Window, from: u64) -> Vec<Row> {
     let changes = |f: &dyn Fn(&Pins) -> u64| -> Vec<(u64, u64)> {
         let mut v: Vec<(u64, u64)> = Vec::new();
         for (k, (p, _)) in w.cycles.iter().enumerate() {
@@ -189,51 +246,45 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         }
         v
     };
-    rows.push((
+    let mut rows: Vec<Row> = vec![(
         Role::SampleValid.name().into(),
         changes(&|p| p.sample_valid as u64),
         1.0,
-    ));
+    )];
     for (b, br) in s.branches.iter().enumerate().rev() {
         // one-hot: the highest device's bit is the tallest step
         let (hi, lo) = l.lane_bits(Role::MuxEn, b);
         let en_max = (1u64 << (hi - lo)) as f64;
-        rows.push((
-            format!("{} sclk", br.name),
-            changes(&|p| lane(&l, p, Role::Sclk, b)),
-            1.0,
-        ));
-        rows.push((
-            format!("{} {}", br.name, Role::CsN.key()),
-            changes(&|p| lane(&l, p, Role::CsN, b)),
-            1.0,
-        ));
-        rows.push((
-            format!("{} mux_sel", br.name),
-            changes(&|p| lane(&l, p, Role::MuxSel, b)),
-            7.0,
-        ));
-        rows.push((
-            format!("{} mux_en", br.name),
-            changes(&|p| lane(&l, p, Role::MuxEn, b)),
-            en_max,
-        ));
+        let lanes = [
+            (format!("{} sclk", br.name), Role::Sclk, 1.0),
+            (format!("{} {}", br.name, Role::CsN.key()), Role::CsN, 1.0),
+            (format!("{} mux_sel", br.name), Role::MuxSel, 7.0),
+            (format!("{} mux_en", br.name), Role::MuxEn, en_max),
+        ];
+        for (name, role, scale) in lanes {
+            rows.push((name, changes(&|p| lane(l, p, role, b)), scale));
+        }
     }
+    rows
+}
+
+/// Each row's steps (centred on its name: low half a trace below, high
+/// above), the table of changes, and the rows' names.
+fn traces(view: &View, rows: &[Row]) -> (Table, Vec<Series>, Vec<String>) {
     let mut table = Table::new(&["cycle", "time_us", "signal", "value"]);
     let mut series = Vec::new();
     let mut names = Vec::new();
     for (i, (n, ch, scale)) in rows.iter().enumerate() {
-        // centred on the row's name: low half a trace below, high above
         let base = i as f64 - HIGH / 2.0;
         let mut pts: Vec<(f64, f64)> = ch
             .iter()
-            .map(|&(c, v)| (us(c), base + HIGH * (v as f64 / scale).min(1.0)))
+            .map(|&(c, v)| (view.us(c), base + HIGH * (v as f64 / scale).min(1.0)))
             .collect();
-        pts.push((us(to), pts.last().map_or(base, |p| p.1)));
+        pts.push((view.us(view.to), pts.last().map_or(base, |p| p.1)));
         for &(c, v) in ch {
             table.push(vec![
                 c.to_string(),
-                format!("{:.6}", us(c)),
+                format!("{:.6}", view.us(c)),
                 n.clone(),
                 v.to_string(),
             ]);
@@ -243,38 +294,45 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         series.push(sr);
         names.push(n.clone());
     }
-    // name the select values and the strobes by channel
-    let nb = s.branches.len();
+    (table, series, names)
+}
+
+/// Names each select value by the channel it selects, just above its own
+/// trace's high level, or below its low level.
+fn select_labels(view: &View, names: &[String], labels: &mut Series) {
+    let s = view.s;
     let row_of = |label: &str| {
         names
             .iter()
             .position(|n| n == label)
             .map_or(0.0, |i| i as f64)
     };
-    // a select's name sits just above its own trace's high level, the
-    // strobes' names low in their row beside the strobe
-    let mut labels = Series::line("", vec![]);
-    let (x0, span) = (us(from), us(to) - us(from));
+    let (x0, span) = view.span();
     for (b, br) in s.branches.iter().enumerate() {
         let r = row_of(&format!("{} mux_sel", br.name));
         let texts: Vec<(f64, String)> = s
             .instants(3)
-            .filter(|i| i.branch == b && (from..to).contains(&i.cycle))
-            .map(|i| (us(i.cycle), name(i.channel)))
+            .filter(|i| i.branch == b && (view.from..view.to).contains(&i.cycle))
+            .map(|i| (view.us(i.cycle), view.channel(i.channel)))
             .collect();
-        // above the trace's high level, or below its low level
         for ((x, line), (_, text)) in stagger(&texts, &[], x0, span, 2).into_iter().zip(texts) {
             let y = [r + HIGH / 2.0 + 0.05, r + SELECT_LOW][line];
             labels.labels.push((x, y, text));
         }
     }
+}
+
+/// Names the strobes by channel, low in their row beside the strobe;
+/// strobes close together share one label.
+fn strobe_labels(view: &View, w: &Window, labels: &mut Series) {
+    let (from, to) = (view.from, view.to);
     let merge = ((to - from) as f64 * STROBE_MERGE) as u64;
     let mut strobes: Vec<(u64, Vec<String>)> = Vec::new();
     let mut ticks = Vec::new();
     for (k, (p, _)) in w.cycles.iter().enumerate() {
         if p.sample_valid {
-            let (c, n) = (from + k as u64, name(p.sample_channel as usize));
-            ticks.push(us(c));
+            let (c, n) = (from + k as u64, view.channel(p.sample_channel as usize));
+            ticks.push(view.us(c));
             match strobes.last_mut() {
                 Some((c0, names)) if c - *c0 <= merge => names.push(n),
                 _ => strobes.push((c, vec![n])),
@@ -283,15 +341,21 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
     }
     let texts: Vec<(f64, String)> = strobes
         .into_iter()
-        .map(|(c, names)| (us(c), names.join(",")))
+        .map(|(c, names)| (view.us(c), names.join(",")))
         .collect();
+    let (x0, span) = view.span();
     for ((x, level), (_, text)) in stagger(&texts, &ticks, x0, span, STROBE_LINES)
         .into_iter()
         .zip(texts)
     {
         labels.labels.push((x, strobe_line_y(level), text));
     }
-    series.push(labels);
+}
+
+/// The axes: one named row per signal, the window, the slot boundaries.
+fn slice_axes(view: &View, backend: Backend, names: Vec<String>, rows: usize) -> Axes {
+    let g = &view.s.grid;
+    let (j, from) = (view.j, view.from);
     let mut axes = Axes::new(
         &format!(
             "Slice {j} of frame 1, per branch ({} back end)",
@@ -301,10 +365,10 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         "",
     );
     axes.y_names = names;
-    axes.x_range = Some((us(from), us(to)));
+    axes.x_range = Some((view.us(from), view.us(view.to)));
     // room below the strobe row for its lines of names
     let bottom = strobe_line_y(STROBE_LINES - 1) - 0.06;
-    axes.y_range = Some((bottom, rows.len() as f64 - 0.3));
+    axes.y_range = Some((bottom, rows as f64 - 0.3));
     // the window ends one slot into the next slice (the last word leaves
     // there): that slot is closed by a boundary too, not cut at the edge
     for k in 0..=g.slots_per_slice + 1 {
@@ -316,38 +380,28 @@ pub fn timing(s: &Schedule, backend: Backend) -> Result<(Section, String, String
         } else {
             String::new()
         };
-        axes.vlines.push((us(c), label));
+        axes.vlines.push((view.us(c), label));
     }
-    let svg = draw(&axes, &series, 1000, 170 + 34 * rows.len() as u32);
-    let (wavedrom, wd_line) = wavedrom(s, &l, &w, nb)?;
-    let line = format!(
-        "slice {j} of frame 1 ({} slots of {} cycles), {} conversions; {wd_line}",
-        g.slots_per_slice,
-        g.slot_cycles,
-        s.instants(3)
-            .filter(|i| (from..from + slice_cycles).contains(&i.cycle))
-            .count()
-    );
-    Ok((
-        Section {
-            title: "Timing of a slice".into(),
-            paragraphs: vec![
-                format!("What the paper's Figure 4 shows, drawn from simulation in steady state (frame 1, slice {j}: the slice of the frame with the most conversions). Per branch, from the bottom up: mux_en (the one-hot device enable), mux_sel (labelled with the channel it selects at each sampling instant), CS and SCLK; at the bottom the merged sample_valid strobe, labelled with sample_channel. Grey lines are slot boundaries, numbered by frame slot; the last slot drawn is the first of the next slice, where the slice's last sample leaves."),
-                "conversion.wavedrom.json holds one conversion of the first branch in WaveDrom form (one step per SCLK half period; a step shows sample_valid high if the one-cycle strobe falls in it).".into(),
-            ],
-            figures: vec![Figure {
-                stem: "timing-slice".into(),
-                title: format!("Slice {j} of frame 1"),
-                caption: "steps are the pins' levels, one row per signal; text gives the channel a select value or a strobe stands for".into(),
-                svg,
-                table,
-            }],
-            links: vec![("conversion.wavedrom.json".into(), "one conversion for WaveDrom".into())],
-            ..Section::default()
-        },
-        wavedrom,
-        line,
-    ))
+    axes
+}
+
+fn slice_section(j: u64, svg: String, table: Table) -> Section {
+    Section {
+        title: "Timing of a slice".into(),
+        paragraphs: vec![
+            format!("What the paper's Figure 4 shows, drawn from simulation in steady state (frame 1, slice {j}: the slice of the frame with the most conversions). Per branch, from the bottom up: mux_en (the one-hot device enable), mux_sel (labelled with the channel it selects at each sampling instant), CS and SCLK; at the bottom the merged sample_valid strobe, labelled with sample_channel. Grey lines are slot boundaries, numbered by frame slot; the last slot drawn is the first of the next slice, where the slice's last sample leaves."),
+            "conversion.wavedrom.json holds one conversion of the first branch in WaveDrom form (one step per SCLK half period; a step shows sample_valid high if the one-cycle strobe falls in it).".into(),
+        ],
+        figures: vec![Figure {
+            stem: "timing-slice".into(),
+            title: format!("Slice {j} of frame 1"),
+            caption: "steps are the pins' levels, one row per signal; text gives the channel a select value or a strobe stands for".into(),
+            svg,
+            table,
+        }],
+        links: vec![("conversion.wavedrom.json".into(), "one conversion for WaveDrom".into())],
+        ..Section::default()
+    }
 }
 
 /// WaveDrom JSON of the first conversion of branch 0 in the window, up to

@@ -2,6 +2,7 @@
 //! drawn from a [`Table`] that is also written as CSV, so every number in a
 //! picture can be reused.
 
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
 
 /// A table of numbers (and labels) behind a chart.
@@ -171,155 +172,223 @@ pub fn draw(axes: &Axes, series: &[Series], w: u32, h: u32) -> String {
     {
         let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
         let _ = root.fill(&WHITE);
-        let (x0, x1) = axes.x_range.unwrap_or_else(|| {
-            range(
-                series
-                    .iter()
-                    .flat_map(|s| s.points.iter().map(|p| p.0))
-                    .chain(axes.vlines.iter().map(|v| v.0)),
-                axes.log_x,
-            )
-        });
-        let (y0, y1) = axes.y_range.unwrap_or_else(|| {
-            range(
-                series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
-                axes.log_y,
-            )
-        });
+        let ((x0, x1), (y0, y1)) = ranges(axes, series);
         let mut b = ChartBuilder::on(&root);
         b.caption(&axes.title, ("sans-serif", 18))
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(if axes.y_names.is_empty() { 60 } else { 110 });
+        let p = Plot {
+            axes,
+            series,
+            y0,
+            y1,
+        };
         // four combinations of linear/log axes; plotters types them apart
-        macro_rules! body {
-            ($chart:expr) => {{
-                let mut chart = $chart;
-                let names = axes.y_names.clone();
-                let mut mesh = chart.configure_mesh();
-                // faint minor lines: dense ones (a log decade's nine)
-                // otherwise read as a grey band
-                mesh.x_desc(axes.x.as_str())
-                    .y_desc(axes.y.as_str())
-                    .light_line_style(RGBColor(246, 246, 246));
-                let log_y = axes.log_y;
-                let fmt = move |v: &f64| {
-                    let i = v.round();
-                    if (v - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
-                        names[i as usize].clone()
-                    } else if names.is_empty() && (!log_y || log_labelled(*v)) {
-                        plotters_num(*v)
-                    } else {
-                        String::new()
-                    }
-                };
-                let log_x = axes.log_x;
-                let xfmt = move |v: &f64| {
-                    if !log_x || log_labelled(*v) {
-                        plotters_num(*v)
-                    } else {
-                        String::new()
-                    }
-                };
-                mesh.x_label_formatter(&xfmt);
-                if !axes.y_names.is_empty() {
-                    mesh.y_labels(axes.y_names.len() * 2 + 1);
-                }
-                mesh.y_label_formatter(&fmt);
-                let _ = mesh.draw();
-                for (i, s) in series.iter().enumerate() {
-                    let c = PALETTE[i % PALETTE.len()];
-                    let pts: Vec<(f64, f64)> = if s.steps {
-                        let mut v = Vec::with_capacity(s.points.len() * 2);
-                        for (k, p) in s.points.iter().enumerate() {
-                            if k > 0 {
-                                v.push((p.0, s.points[k - 1].1));
-                            }
-                            v.push(*p);
-                        }
-                        v
-                    } else {
-                        s.points.clone()
-                    };
-                    let r = if s.points_only {
-                        let m = s.marker;
-                        chart.draw_series(pts.iter().map(move |p| {
-                            EmptyElement::at(*p) + Polygon::new(shape(m), c.filled())
-                        }))
-                    } else {
-                        chart.draw_series(LineSeries::new(pts, c.stroke_width(2)))
-                    };
-                    if let Ok(a) = r {
-                        if axes.y_names.is_empty() {
-                            let (m, dots) = (s.marker, s.points_only);
-                            a.label(s.name.clone()).legend(move |(x, y)| {
-                                // one element type for every legend entry:
-                                // the marker filled as on the plot, or a
-                                // line as a 2-pixel bar
-                                let pts = if dots {
-                                    legend_path(m)
-                                } else {
-                                    vec![(0, -1), (16, -1), (16, 1), (0, 1)]
-                                };
-                                EmptyElement::at((x, y)) + Polygon::new(pts, c.filled())
-                            });
-                        }
-                    }
-                    let _ = chart.draw_series(s.labels.iter().map(|(x, y, t)| {
-                        EmptyElement::at((*x, *y))
-                            + Text::new(t.clone(), (6, -14), ("sans-serif", 12).into_font())
-                    }));
-                }
-                for (x, label) in &axes.vlines {
-                    let grey = RGBColor(90, 90, 90);
-                    let _ = chart.draw_series(std::iter::once(PathElement::new(
-                        vec![(*x, y0), (*x, y1)],
-                        grey.stroke_width(1),
-                    )));
-                    let _ = chart.draw_series(std::iter::once(
-                        EmptyElement::at((*x, y1))
-                            + Text::new(label.clone(), (3, 2), ("sans-serif", 12).into_font()),
-                    ));
-                }
-                if axes.y_names.is_empty() && series.len() > 1 {
-                    let _ = chart
-                        .configure_series_labels()
-                        .position(if axes.legend_left {
-                            SeriesLabelPosition::UpperLeft
-                        } else {
-                            SeriesLabelPosition::UpperRight
-                        })
-                        .background_style(WHITE.mix(0.85))
-                        .border_style(BLACK)
-                        .draw();
-                }
-            }};
-        }
         match (axes.log_x, axes.log_y) {
             (false, false) => {
                 if let Ok(c) = b.build_cartesian_2d(x0..x1, y0..y1) {
-                    body!(c)
+                    p.body(c)
                 }
             }
             (true, false) => {
                 if let Ok(c) = b.build_cartesian_2d((x0..x1).log_scale(), y0..y1) {
-                    body!(c)
+                    p.body(c)
                 }
             }
             (false, true) => {
                 if let Ok(c) = b.build_cartesian_2d(x0..x1, (y0..y1).log_scale()) {
-                    body!(c)
+                    p.body(c)
                 }
             }
             (true, true) => {
                 if let Ok(c) = b.build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale()) {
-                    body!(c)
+                    p.body(c)
                 }
             }
         }
         let _ = root.present();
     }
     svg
+}
+
+/// The axes' fixed ranges, or the data's (x, y).
+fn ranges(axes: &Axes, series: &[Series]) -> ((f64, f64), (f64, f64)) {
+    let x = axes.x_range.unwrap_or_else(|| {
+        range(
+            series
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| p.0))
+                .chain(axes.vlines.iter().map(|v| v.0)),
+            axes.log_x,
+        )
+    });
+    let y = axes.y_range.unwrap_or_else(|| {
+        range(
+            series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+            axes.log_y,
+        )
+    });
+    (x, y)
+}
+
+/// A chart's contents, drawn the same on linear and log coordinates.
+struct Plot<'a> {
+    axes: &'a Axes,
+    series: &'a [Series],
+    /// The y range, for the vertical lines.
+    y0: f64,
+    y1: f64,
+}
+
+/// A chart on coordinates of either scale, both of `f64`.
+type Chart<'a, DB, X, Y> = ChartContext<'a, DB, Cartesian2d<X, Y>>;
+
+impl Plot<'_> {
+    fn body<'a, DB: DrawingBackend + 'a, X, Y>(&self, mut chart: Chart<'a, DB, X, Y>)
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        self.mesh(&mut chart);
+        for (i, s) in self.series.iter().enumerate() {
+            self.series_on(&mut chart, i, s);
+        }
+        self.vlines(&mut chart);
+        if self.axes.y_names.is_empty() && self.series.len() > 1 {
+            let _ = chart
+                .configure_series_labels()
+                .position(if self.axes.legend_left {
+                    SeriesLabelPosition::UpperLeft
+                } else {
+                    SeriesLabelPosition::UpperRight
+                })
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw();
+        }
+    }
+
+    /// The grid, the axis descriptions and the tick labels (a timing
+    /// diagram's signal names on y).
+    fn mesh<'a, DB: DrawingBackend + 'a, X, Y>(&self, chart: &mut Chart<'a, DB, X, Y>)
+    where
+        X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+        Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    {
+        let axes = self.axes;
+        let names = axes.y_names.clone();
+        let mut mesh = chart.configure_mesh();
+        // faint minor lines: dense ones (a log decade's nine)
+        // otherwise read as a grey band
+        mesh.x_desc(axes.x.as_str())
+            .y_desc(axes.y.as_str())
+            .light_line_style(RGBColor(246, 246, 246));
+        let log_y = axes.log_y;
+        let fmt = move |v: &f64| {
+            let i = v.round();
+            if (v - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < names.len() {
+                names[i as usize].clone()
+            } else if names.is_empty() && (!log_y || log_labelled(*v)) {
+                plotters_num(*v)
+            } else {
+                String::new()
+            }
+        };
+        let log_x = axes.log_x;
+        let xfmt = move |v: &f64| {
+            if !log_x || log_labelled(*v) {
+                plotters_num(*v)
+            } else {
+                String::new()
+            }
+        };
+        mesh.x_label_formatter(&xfmt);
+        if !axes.y_names.is_empty() {
+            mesh.y_labels(axes.y_names.len() * 2 + 1);
+        }
+        mesh.y_label_formatter(&fmt);
+        let _ = mesh.draw();
+    }
+
+    /// Series `i`: its markers or line, its legend entry and its texts.
+    fn series_on<'a, DB: DrawingBackend + 'a, X, Y>(
+        &self,
+        chart: &mut Chart<'a, DB, X, Y>,
+        i: usize,
+        s: &Series,
+    ) where
+        X: Ranged<ValueType = f64>,
+        Y: Ranged<ValueType = f64>,
+    {
+        let c = PALETTE[i % PALETTE.len()];
+        let pts = drawn_points(s);
+        let r = if s.points_only {
+            let m = s.marker;
+            chart.draw_series(
+                pts.iter()
+                    .map(move |p| EmptyElement::at(*p) + Polygon::new(shape(m), c.filled())),
+            )
+        } else {
+            chart.draw_series(LineSeries::new(pts, c.stroke_width(2)))
+        };
+        if let Ok(a) = r {
+            if self.axes.y_names.is_empty() {
+                let (m, dots) = (s.marker, s.points_only);
+                a.label(s.name.clone()).legend(move |(x, y)| {
+                    // one element type for every legend entry:
+                    // the marker filled as on the plot, or a
+                    // line as a 2-pixel bar
+                    let pts = if dots {
+                        legend_path(m)
+                    } else {
+                        vec![(0, -1), (16, -1), (16, 1), (0, 1)]
+                    };
+                    EmptyElement::at((x, y)) + Polygon::new(pts, c.filled())
+                });
+            }
+        }
+        let _ = chart.draw_series(s.labels.iter().map(|(x, y, t)| {
+            EmptyElement::at((*x, *y))
+                + Text::new(t.clone(), (6, -14), ("sans-serif", 12).into_font())
+        }));
+    }
+
+    /// The vertical reference lines, each labelled at its top.
+    fn vlines<'a, DB: DrawingBackend + 'a, X, Y>(&self, chart: &mut Chart<'a, DB, X, Y>)
+    where
+        X: Ranged<ValueType = f64>,
+        Y: Ranged<ValueType = f64>,
+    {
+        let (y0, y1) = (self.y0, self.y1);
+        for (x, label) in &self.axes.vlines {
+            let grey = RGBColor(90, 90, 90);
+            let _ = chart.draw_series(std::iter::once(PathElement::new(
+                vec![(*x, y0), (*x, y1)],
+                grey.stroke_width(1),
+            )));
+            let _ = chart.draw_series(std::iter::once(
+                EmptyElement::at((*x, y1))
+                    + Text::new(label.clone(), (3, 2), ("sans-serif", 12).into_font()),
+            ));
+        }
+    }
+}
+
+/// The points as drawn: a step series holds each value until the next
+/// point's x.
+fn drawn_points(s: &Series) -> Vec<(f64, f64)> {
+    if !s.steps {
+        return s.points.clone();
+    }
+    let mut v = Vec::with_capacity(s.points.len() * 2);
+    for (k, p) in s.points.iter().enumerate() {
+        if k > 0 {
+            v.push((p.0, s.points[k - 1].1));
+        }
+        v.push(*p);
+    }
+    v
 }
 
 /// The marker's outline, pixel offsets around its anchor.

@@ -61,83 +61,61 @@ pub fn testbench_with(
     cycles: u64,
     tready: link::ReadyPattern,
 ) -> Testbench {
-    let l = Layout::new(s);
-    let analog = Analog::new(s, stimulus);
-    let nch = s.channels.len() as u64;
-    let frames = cycles.div_ceil(s.grid.frame_cycles);
-    let mut adcs = String::new();
-    let mut tables = Vec::new();
-    for b in 0..l.branches {
-        let _ = writeln!(adcs, "  // branch {b} ({})", s.branches[b].name);
+    let mut g = Adcs {
+        s,
+        l: Layout::new(s),
+        analog: Analog::new(s, stimulus),
+        stimulus,
+        frames: cycles.div_ceil(s.grid.frame_cycles),
+        text: String::new(),
+        tables: Vec::new(),
+    };
+    for b in 0..g.l.branches {
+        let _ = writeln!(g.text, "  // branch {b} ({})", s.branches[b].name);
         if s.mix.branches[b].adc.start == Start::Cnv {
-            cnv_chain(s, &l, &analog, stimulus, b, frames, &mut adcs, &mut tables);
-            continue;
-        }
-        let _ = writeln!(
-            adcs,
-            "  reg [15:0] word{b};\n  reg [4:0] falls{b};\n  reg out{b};\n  reg drive{b} = 0;\n  \
-             reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [13:0] code{b};\n  \
-             assign {miso}[{b}] = drive{b} ? out{b} : 1'bz;",
-            miso = Role::Miso.name()
-        );
-        let id_case = id_case(&l, &analog, b);
-        let table = if stimulus == Stimulus::Pattern {
-            String::new()
+            g.cnv_chain(b);
         } else {
-            let mut hex = String::new();
-            let mut len = 0u64;
-            // the conversions the gateware makes: less those skipped at
-            // start-up (docs/timing.md, "Start-up")
-            let f = s.grid.frame_cycles;
-            let bits = s.mix.branches[b].adc.bits;
-            for i in s
-                .instants(frames)
-                .filter(|i| i.branch == b && !(i.cycle < f && s.skipped_at_startup(b, i.cycle)))
-            {
-                let code = analog.code_bits(i.channel as u64, i.cycle, bits) & 0x3fff;
-                let _ = writeln!(
-                    hex,
-                    "{:04x}{:08x}{:04x}",
-                    i.channel as u16, i.cycle as u32, code
-                );
-                len += 1;
-            }
-            if len == 0 {
-                String::new()
-            } else {
-                let name = format!("codes{b}.hex");
-                tables.push((name.clone(), hex));
-                let _ = writeln!(
-                    adcs,
-                    "  reg [63:0] tab{b} [0:{}];\n  initial $readmemh(\"{name}\", tab{b});",
-                    len - 1
-                );
-                format!(
-                    "    if (n{b} < {len} && tab{b}[n{b}][63:48] == id{b}[15:0] && tab{b}[n{b}][47:16] == cyc[31:0])\n      \
-                     code{b} = tab{b}[n{b}][13:0];\n"
-                )
-            }
-        };
-        let _ = write!(
-            adcs,
-            "  always @(negedge {cs}[{b}]) if (!{rst}) begin\n{id_case}    \
-             code{b} = pattern(cyc, id{b});\n{table}    n{b} = n{b} + 1;\n    \
-             word{b} = {{2'b00, code{b}{mask}}};\n    falls{b} = 0;\n    out{b} = word{b}[15];\n    drive{b} = 1;\n  end\n  \
-             always @(posedge {cs}[{b}]) drive{b} = 0;\n  \
-             always @(negedge {sclk}[{b}]) if (!{cs}[{b}]) begin\n    \
-             falls{b} = falls{b} + 1;\n    if (falls{b} >= 16) drive{b} = 0; else out{b} = word{b}[15 - falls{b}];\n  end\n\n",
-            // A CS part narrower than 14 bits: its extra leading bits are zeros.
-            mask = match s.mix.branches[b].adc.bits {
-                w if w < 14 => format!(" & 14'h{:x}", (1u32 << w) - 1),
-                _ => String::new(),
-            },
-            cs = Role::CsN.name(),
-            sclk = Role::Sclk.name(),
-            rst = Role::Reset.name(),
-        );
+            g.cs_part(b);
+        }
     }
-    // The DUT's ports as testbench signals: inputs driven (MISO pulled up,
-    // as the ADC model's idle line), outputs as wires.
+    if let Some(a) = lut_gen::hostlink::plan(s)
+        .and_then(|p| p.ok())
+        .and_then(|p| p.axis())
+    {
+        g.text.push_str(&axis_slave(tready, a.ready_within));
+    }
+    let connect = PORTS
+        .iter()
+        .map(|p| p.name)
+        .chain(g.l.link_ports().iter().map(|p| p.name))
+        .map(|n| format!(".{n}({n})"))
+        .collect::<Vec<_>>()
+        .join(",\n    ");
+    let nch = s.channels.len() as u64;
+    let mut tb = TEMPLATE
+        .replace("@DECLS@", port_decls(&g.l).trim_end_matches('\n'))
+        .replace("@CONNECT@", &connect)
+        .replace("@TOP@", TOP_MODULE)
+        .replace("@NB@", &g.l.branches.to_string())
+        .replace("@RESET@", &reset_cycles.to_string())
+        .replace("@CYCLES@", &cycles.to_string())
+        .replace("@HZ@", &s.grid.clock_hz.to_string())
+        .replace("@SLOT@", &s.grid.slot_cycles.to_string())
+        .replace("@NCH_PLUS_64@", &(nch + 64).to_string())
+        .replace("@ADCS@", &g.text);
+    for r in Role::ALL {
+        tb = tb.replace(&format!("@{}@", r.key()), r.name());
+    }
+    Testbench {
+        tb,
+        tables: g.tables,
+        reset_cycles,
+    }
+}
+
+/// The DUT's ports as testbench signals: inputs driven (MISO pulled up,
+/// as the ADC model's idle line), outputs as wires.
+fn port_decls(l: &Layout) -> String {
     let mut decls = String::new();
     for p in &PORTS {
         let w = l.width(p.role);
@@ -160,37 +138,200 @@ pub fn testbench_with(
             (_, w) => writeln!(decls, "  wire [{}:0] {};", w - 1, p.name),
         };
     }
-    if let Some(a) = lut_gen::hostlink::plan(s)
-        .and_then(|p| p.ok())
-        .and_then(|p| p.axis())
-    {
-        adcs.push_str(&axis_slave(tready, a.ready_within));
+    decls
+}
+
+/// The testbench's ADC models as they are written: the Verilog text and
+/// the code tables it reads.
+struct Adcs<'a> {
+    s: &'a Schedule,
+    l: Layout,
+    analog: Analog,
+    stimulus: Stimulus,
+    /// Frames the run covers (the code tables' extent).
+    frames: u64,
+    text: String,
+    tables: Vec<(String, String)>,
+}
+
+impl Adcs<'_> {
+    /// The conversions of branch `b` the gateware makes: less those skipped
+    /// at start-up (docs/timing.md, "Start-up").
+    fn conversions(&self, b: usize) -> impl Iterator<Item = lut_gen::SamplingInstant> + '_ {
+        let s = self.s;
+        let f = s.grid.frame_cycles;
+        s.instants(self.frames)
+            .filter(move |i| i.branch == b && !(i.cycle < f && s.skipped_at_startup(b, i.cycle)))
     }
-    let connect = PORTS
-        .iter()
-        .map(|p| p.name)
-        .chain(l.link_ports().iter().map(|p| p.name))
-        .map(|n| format!(".{n}({n})"))
-        .collect::<Vec<_>>()
-        .join(",\n    ");
-    let mut tb = TEMPLATE
-        .replace("@DECLS@", decls.trim_end_matches('\n'))
-        .replace("@CONNECT@", &connect)
-        .replace("@TOP@", TOP_MODULE)
-        .replace("@NB@", &l.branches.to_string())
-        .replace("@RESET@", &reset_cycles.to_string())
-        .replace("@CYCLES@", &cycles.to_string())
-        .replace("@HZ@", &s.grid.clock_hz.to_string())
-        .replace("@SLOT@", &s.grid.slot_cycles.to_string())
-        .replace("@NCH_PLUS_64@", &(nch + 64).to_string())
-        .replace("@ADCS@", &adcs);
-    for r in Role::ALL {
-        tb = tb.replace(&format!("@{}@", r.key()), r.name());
+
+    /// Adds branch `b`'s code table `codes<b>.hex` of `lines` lines, and
+    /// declares it in the testbench.
+    fn add_table(&mut self, b: usize, hex: String, lines: u64) {
+        let name = format!("codes{b}.hex");
+        self.tables.push((name.clone(), hex));
+        let _ = writeln!(
+            self.text,
+            "  reg [63:0] tab{b} [0:{}];\n  initial $readmemh(\"{name}\", tab{b});",
+            lines - 1
+        );
     }
-    Testbench {
-        tb,
-        tables,
-        reset_cycles,
+
+    /// Branch `b`'s part with an active-low CS (AD7940 style).
+    fn cs_part(&mut self, b: usize) {
+        let _ = writeln!(
+            self.text,
+            "  reg [15:0] word{b};\n  reg [4:0] falls{b};\n  reg out{b};\n  reg drive{b} = 0;\n  \
+             reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [13:0] code{b};\n  \
+             assign {miso}[{b}] = drive{b} ? out{b} : 1'bz;",
+            miso = Role::Miso.name()
+        );
+        let id_case = id_case(&self.l, &self.analog, b);
+        let table = self.cs_table(b);
+        let _ = write!(
+            self.text,
+            "  always @(negedge {cs}[{b}]) if (!{rst}) begin\n{id_case}    \
+             code{b} = pattern(cyc, id{b});\n{table}    n{b} = n{b} + 1;\n    \
+             word{b} = {{2'b00, code{b}{mask}}};\n    falls{b} = 0;\n    out{b} = word{b}[15];\n    drive{b} = 1;\n  end\n  \
+             always @(posedge {cs}[{b}]) drive{b} = 0;\n  \
+             always @(negedge {sclk}[{b}]) if (!{cs}[{b}]) begin\n    \
+             falls{b} = falls{b} + 1;\n    if (falls{b} >= 16) drive{b} = 0; else out{b} = word{b}[15 - falls{b}];\n  end\n\n",
+            // A CS part narrower than 14 bits: its extra leading bits are zeros.
+            mask = match self.s.mix.branches[b].adc.bits {
+                w if w < 14 => format!(" & 14'h{:x}", (1u32 << w) - 1),
+                _ => String::new(),
+            },
+            cs = Role::CsN.name(),
+            sclk = Role::Sclk.name(),
+            rst = Role::Reset.name(),
+        );
+    }
+
+    /// A CS part's code table, and the lines that look a conversion's code
+    /// up in it (none for the pattern, which the testbench computes).
+    fn cs_table(&mut self, b: usize) -> String {
+        if self.stimulus == Stimulus::Pattern {
+            return String::new();
+        }
+        let mut hex = String::new();
+        let mut len = 0u64;
+        let bits = self.s.mix.branches[b].adc.bits;
+        for i in self.conversions(b) {
+            let code = self.analog.code_bits(i.channel as u64, i.cycle, bits) & 0x3fff;
+            let _ = writeln!(
+                hex,
+                "{:04x}{:08x}{:04x}",
+                i.channel as u16, i.cycle as u32, code
+            );
+            len += 1;
+        }
+        if len == 0 {
+            return String::new();
+        }
+        self.add_table(b, hex, len);
+        format!(
+            "    if (n{b} < {len} && tab{b}[n{b}][63:48] == id{b}[15:0] && tab{b}[n{b}][47:16] == cyc[31:0])\n      \
+             code{b} = tab{b}[n{b}][13:0];\n"
+        )
+    }
+
+    /// Branch `b`'s parts in CNV chain mode (AD7685 style, no busy indicator),
+    /// as `judge::adc::Adc` models them: at the CNV rising edge every part of
+    /// the chain samples its own input (the chain member's channel); while CNV
+    /// is high the stream of all words leaves MSB first, member 0's first, one
+    /// bit per SCK falling edge, zeros after the last (the first part's SDI is
+    /// tied low); CNV low releases the line (pulled up).
+    fn cnv_chain(&mut self, b: usize) {
+        let part = &self.s.mix.branches[b].adc;
+        let chain = self.s.mix.branches[b].chain as usize;
+        let len = part.word_sclks() as usize * chain;
+        let _ = writeln!(
+            self.text,
+            "  // {chain} x {} in CNV chain mode: {len} serial bits per conversion\n  reg [{}:0] stream{b};\n  reg [15:0] falls{b};\n  reg drive{b} = 0;\n  reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [63:0] mid{b};\n  reg [15:0] code{b};\n  assign {miso}[{b}] = drive{b} ? (falls{b} >= 16'd{len} ? 1'b0 : stream{b}[{}-falls{b}]) : 1'bz;",
+            part.name,
+            len - 1,
+            len - 1,
+            miso = Role::Miso.name()
+        );
+        let id_case = id_case(&self.l, &self.analog, b);
+        let table = self.cnv_table(b);
+        let members: String = (0..chain).map(|m| self.cnv_member(b, m, table)).collect();
+        let _ = write!(
+            self.text,
+            "  always @(posedge {cs}[{b}]) if (!{rst}) begin\n{id_case}    stream{b} = {len}'h0;\n{members}    falls{b} = 0;\n    drive{b} = 1;\n  end\n  always @(negedge {cs}[{b}]) drive{b} = 0;\n  always @(negedge {sclk}[{b}]) if ({cs}[{b}]) falls{b} = falls{b} + 1;\n\n",
+            cs = Role::CsN.name(),
+            sclk = Role::Sclk.name(),
+            rst = Role::Reset.name(),
+        );
+    }
+
+    /// A CNV chain's table of the codes the model's stimulus gives, one
+    /// line per word; its length, if there is one.
+    fn cnv_table(&mut self, b: usize) -> Option<u64> {
+        if self.stimulus == Stimulus::Pattern {
+            return None;
+        }
+        let part = &self.s.mix.branches[b].adc;
+        let mask = (1u32 << part.bits) - 1;
+        let mut hex = String::new();
+        let mut words = 0u64;
+        for i in self.conversions(b) {
+            for (_, c) in self.s.words_of(i.channel) {
+                let code = self.analog.code_bits(c as u64, i.cycle, part.bits) as u32 & mask;
+                let _ = writeln!(hex, "{:04x}{:08x}{:04x}", c as u16, i.cycle as u32, code);
+                words += 1;
+            }
+        }
+        (words > 0).then(|| {
+            self.add_table(b, hex, words);
+            words
+        })
+    }
+
+    /// Chain member `m`'s sample: its input id (the member's channel, or
+    /// an unconnected input), its code, and its word shifted into the stream.
+    fn cnv_member(&self, b: usize, m: usize, table: Option<u64>) -> String {
+        let s = self.s;
+        let part = &s.mix.branches[b].adc;
+        let ws = part.word_sclks() as usize;
+        let len = ws * s.mix.branches[b].chain as usize;
+        let trailing = ws - part.leading_bits as usize - part.bits as usize;
+        let mask = (1u32 << part.bits) - 1;
+        let mut members = String::new();
+        // judge::adc::Adc: the member's channel, or an unconnected input
+        let _ = writeln!(members, "    case (id{b})");
+        for lead in (0..s.groups.len()).filter(|&c| s.mix.channels[c].branch == b) {
+            let mid = match s.groups[lead].get(m) {
+                Some(Some(c)) => *c as u64,
+                _ => lead as u64 + 100 + m as u64,
+            };
+            let _ = writeln!(members, "      64'd{lead}: mid{b} = 64'd{mid};");
+        }
+        let fallback = if m == 0 {
+            format!("id{b}")
+        } else {
+            format!("id{b} + 64'd{}", 100 + m)
+        };
+        let _ = writeln!(
+            members,
+            "      default: mid{b} = {fallback};\n    endcase\n    code{b} = pattern16(cyc, mid{b}) & 16'h{mask:x};"
+        );
+        if let Some(words) = table {
+            let _ = writeln!(
+                members,
+                "    if (n{b} < {words} && tab{b}[n{b}][63:48] == mid{b}[15:0] && tab{b}[n{b}][47:16] == cyc[31:0])\n      code{b} = tab{b}[n{b}][15:0];\n    n{b} = n{b} + 1;"
+            );
+        }
+        let pad = len - part.bits as usize;
+        let code = if pad > 0 {
+            format!("{{{pad}'h0, code{b}[{}:0]}}", part.bits - 1)
+        } else {
+            format!("code{b}[{}:0]", part.bits - 1)
+        };
+        let _ = writeln!(
+            members,
+            "    stream{b} = (stream{b} << {ws}) | ({code} << {trailing});"
+        );
+        members
     }
 }
 
@@ -255,115 +396,6 @@ fn id_case(l: &Layout, analog: &Analog, b: usize) -> String {
         id_of(0, 0)
     );
     s
-}
-
-/// Branch `b`'s parts in CNV chain mode (AD7685 style, no busy indicator),
-/// as `judge::adc::Adc` models them: at the CNV rising edge every part of
-/// the chain samples its own input (the chain member's channel); while CNV
-/// is high the stream of all words leaves MSB first, member 0's first, one
-/// bit per SCK falling edge, zeros after the last (the first part's SDI is
-/// tied low); CNV low releases the line (pulled up).
-#[allow(clippy::too_many_arguments)]
-fn cnv_chain(
-    s: &Schedule,
-    l: &Layout,
-    analog: &Analog,
-    stimulus: Stimulus,
-    b: usize,
-    frames: u64,
-    adcs: &mut String,
-    tables: &mut Vec<(String, String)>,
-) {
-    let part = &s.mix.branches[b].adc;
-    let chain = s.mix.branches[b].chain as usize;
-    let ws = part.word_sclks() as usize;
-    let len = ws * chain;
-    let trailing = ws - part.leading_bits as usize - part.bits as usize;
-    let mask = (1u32 << part.bits) - 1;
-    let _ = writeln!(
-        adcs,
-        "  // {chain} x {} in CNV chain mode: {len} serial bits per conversion\n  reg [{}:0] stream{b};\n  reg [15:0] falls{b};\n  reg drive{b} = 0;\n  reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [63:0] mid{b};\n  reg [15:0] code{b};\n  assign {miso}[{b}] = drive{b} ? (falls{b} >= 16'd{len} ? 1'b0 : stream{b}[{}-falls{b}]) : 1'bz;",
-        part.name,
-        len - 1,
-        len - 1,
-        miso = Role::Miso.name()
-    );
-    let id_case = id_case(l, analog, b);
-    // the table of codes the model's stimulus gives, one line per word
-    let table = if stimulus == Stimulus::Pattern {
-        None
-    } else {
-        let mut hex = String::new();
-        let mut words = 0u64;
-        let f = s.grid.frame_cycles;
-        for i in s
-            .instants(frames)
-            .filter(|i| i.branch == b && !(i.cycle < f && s.skipped_at_startup(b, i.cycle)))
-        {
-            for (_, c) in s.words_of(i.channel) {
-                let code = analog.code_bits(c as u64, i.cycle, part.bits) as u32 & mask;
-                let _ = writeln!(hex, "{:04x}{:08x}{:04x}", c as u16, i.cycle as u32, code);
-                words += 1;
-            }
-        }
-        (words > 0).then(|| {
-            let name = format!("codes{b}.hex");
-            tables.push((name.clone(), hex));
-            let _ = writeln!(
-                adcs,
-                "  reg [63:0] tab{b} [0:{}];\n  initial $readmemh(\"{name}\", tab{b});",
-                words - 1
-            );
-            words
-        })
-    };
-    let leads: Vec<usize> = (0..s.groups.len())
-        .filter(|&c| s.mix.channels[c].branch == b)
-        .collect();
-    let mut members = String::new();
-    for m in 0..chain {
-        // judge::adc::Adc: the member's channel, or an unconnected input
-        let _ = writeln!(members, "    case (id{b})");
-        for &lead in &leads {
-            let mid = match s.groups[lead].get(m) {
-                Some(Some(c)) => *c as u64,
-                _ => lead as u64 + 100 + m as u64,
-            };
-            let _ = writeln!(members, "      64'd{lead}: mid{b} = 64'd{mid};");
-        }
-        let fallback = if m == 0 {
-            format!("id{b}")
-        } else {
-            format!("id{b} + 64'd{}", 100 + m)
-        };
-        let _ = writeln!(
-            members,
-            "      default: mid{b} = {fallback};\n    endcase\n    code{b} = pattern16(cyc, mid{b}) & 16'h{mask:x};"
-        );
-        if let Some(words) = table {
-            let _ = writeln!(
-                members,
-                "    if (n{b} < {words} && tab{b}[n{b}][63:48] == mid{b}[15:0] && tab{b}[n{b}][47:16] == cyc[31:0])\n      code{b} = tab{b}[n{b}][15:0];\n    n{b} = n{b} + 1;"
-            );
-        }
-        let pad = len - part.bits as usize;
-        let code = if pad > 0 {
-            format!("{{{pad}'h0, code{b}[{}:0]}}", part.bits - 1)
-        } else {
-            format!("code{b}[{}:0]", part.bits - 1)
-        };
-        let _ = writeln!(
-            members,
-            "    stream{b} = (stream{b} << {ws}) | ({code} << {trailing});"
-        );
-    }
-    let _ = write!(
-        adcs,
-        "  always @(posedge {cs}[{b}]) if (!{rst}) begin\n{id_case}    stream{b} = {len}'h0;\n{members}    falls{b} = 0;\n    drive{b} = 1;\n  end\n  always @(negedge {cs}[{b}]) drive{b} = 0;\n  always @(negedge {sclk}[{b}]) if ({cs}[{b}]) falls{b} = falls{b} + 1;\n\n",
-        cs = Role::CsN.name(),
-        sclk = Role::Sclk.name(),
-        rst = Role::Reset.name(),
-    );
 }
 
 fn tool_missing(tool: &str) -> BackendError {

@@ -299,128 +299,141 @@ fn past(b: &[u8], mut i: usize, close: &[u8], line: &mut usize) -> usize {
     i + close.len()
 }
 
+fn ident_char(c: u8) -> bool {
+    c.is_ascii_alphanumeric() || c == b'_' || c == b'$'
+}
+
+/// The index just past the identifier characters from `i`.
+fn past_ident(b: &[u8], mut i: usize) -> usize {
+    while i < b.len() && ident_char(b[i]) {
+        i += 1;
+    }
+    i
+}
+
+/// The index just past the string literal opening at `i` (or its line's end).
+fn past_string(b: &[u8], mut i: usize) -> usize {
+    i += 1;
+    while i < b.len() && b[i] != b'"' && b[i] != b'\n' {
+        if b[i] == b'\\' {
+            i += 1;
+        }
+        i += 1;
+    }
+    i + 1
+}
+
+/// The end of a directive's line (with `\` continuations), counting them.
+fn past_directive(b: &[u8], mut i: usize, line: &mut usize) -> usize {
+    while i < b.len() && b[i] != b'\n' {
+        if b[i] == b'\\' && i + 1 < b.len() && b[i + 1] == b'\n' {
+            *line += 1;
+            i += 1;
+        }
+        i += 1;
+    }
+    i
+}
+
+/// The index just past the number starting at `s`:
+/// `[size] ['[s]base digits] | decimal` (reals kept as text).
+fn past_number(b: &[u8], s: usize) -> usize {
+    let mut i = s;
+    while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'_') {
+        i += 1;
+    }
+    let mut j = i;
+    while j < b.len() && (b[j] == b' ' || b[j] == b'\t') {
+        j += 1;
+    }
+    if j < b.len() && b[j] == b'\'' {
+        i = j + 1;
+        if i < b.len() && (b[i] == b's' || b[i] == b'S') {
+            i += 1;
+        }
+        if i < b.len() && b"bBoOdDhH".contains(&b[i]) {
+            i += 1;
+        }
+        while i < b.len() && (b[i] == b' ' || b[i] == b'\t') {
+            i += 1;
+        }
+        while i < b.len() && (b[i].is_ascii_hexdigit() || b"_xXzZ?".contains(&b[i])) {
+            i += 1;
+        }
+    } else if i < b.len() && (b[i] == b'.' || b[i] == b'e' || b[i] == b'E') {
+        while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'.' || b[i] == b'_') {
+            i += 1;
+        }
+    }
+    if i == s {
+        i += 1;
+    }
+    i
+}
+
 fn lex(text: &str) -> Vec<Token> {
     let b = text.as_bytes();
     let mut i = 0;
     let mut line = 1;
     let mut out = Vec::new();
-    let ident_char = |c: u8| c.is_ascii_alphanumeric() || c == b'_' || c == b'$';
     while i < b.len() {
         let c = b[i];
-        if c == b'\n' {
+        let start = i;
+        let t = if c == b'\n' {
             line += 1;
             i += 1;
+            None
         } else if c.is_ascii_whitespace() {
             i += 1;
+            None
         } else if b[i..].starts_with(b"//") {
             while i < b.len() && b[i] != b'\n' {
                 i += 1;
             }
+            None
         } else if b[i..].starts_with(b"/*") {
             i = past(b, i + 2, b"*/", &mut line);
+            None
         } else if b[i..].starts_with(b"(*") && !b[i..].starts_with(b"(*)") {
             // attribute instance
             i = past(b, i + 2, b"*)", &mut line);
+            None
         } else if c == b'"' {
-            i += 1;
-            while i < b.len() && b[i] != b'"' && b[i] != b'\n' {
-                if b[i] == b'\\' {
-                    i += 1;
-                }
-                i += 1;
-            }
-            i += 1;
-            out.push(Token { t: Tok::Str, line });
+            i = past_string(b, i);
+            Some(Tok::Str)
         } else if c == b'`' {
-            let s = i + 1;
-            i += 1;
-            while i < b.len() && ident_char(b[i]) {
-                i += 1;
-            }
-            let name = &text[s..i];
+            i = past_ident(b, i + 1);
+            let name = &text[start + 1..i];
             if DIRECTIVES.contains(&name) {
-                // the rest of the line (with `\` continuations)
-                while i < b.len() && b[i] != b'\n' {
-                    if b[i] == b'\\' && i + 1 < b.len() && b[i + 1] == b'\n' {
-                        line += 1;
-                        i += 1;
-                    }
-                    i += 1;
-                }
+                // the rest of the line
+                i = past_directive(b, i, &mut line);
+                None
             } else {
-                out.push(Token {
-                    t: Tok::Macro(name.to_string()),
-                    line,
-                });
+                Some(Tok::Macro(name.to_string()))
             }
         } else if c == b'\\' {
-            let s = i + 1;
             while i < b.len() && !b[i].is_ascii_whitespace() {
                 i += 1;
             }
-            out.push(Token {
-                t: Tok::Ident(text[s..i].to_string()),
-                line,
-            });
+            Some(Tok::Ident(text[start + 1..i].to_string()))
         } else if c.is_ascii_alphabetic() || c == b'_' || c == b'$' {
-            let s = i;
-            while i < b.len() && ident_char(b[i]) {
-                i += 1;
-            }
-            out.push(Token {
-                t: Tok::Ident(text[s..i].to_string()),
-                line,
-            });
+            i = past_ident(b, i);
+            Some(Tok::Ident(text[start..i].to_string()))
         } else if c.is_ascii_digit() || c == b'\'' {
-            // [size] ['[s]base digits] | decimal (reals kept as text)
-            let s = i;
-            while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'_') {
-                i += 1;
-            }
-            let mut j = i;
-            while j < b.len() && (b[j] == b' ' || b[j] == b'\t') {
-                j += 1;
-            }
-            if j < b.len() && b[j] == b'\'' {
-                i = j + 1;
-                if i < b.len() && (b[i] == b's' || b[i] == b'S') {
-                    i += 1;
-                }
-                if i < b.len() && b"bBoOdDhH".contains(&b[i]) {
-                    i += 1;
-                }
-                while i < b.len() && (b[i] == b' ' || b[i] == b'\t') {
-                    i += 1;
-                }
-                while i < b.len() && (b[i].is_ascii_hexdigit() || b"_xXzZ?".contains(&b[i])) {
-                    i += 1;
-                }
-            } else if i < b.len() && (b[i] == b'.' || b[i] == b'e' || b[i] == b'E') {
-                while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'.' || b[i] == b'_')
-                {
-                    i += 1;
-                }
-            }
-            if i == s {
-                i += 1;
-            }
-            out.push(Token {
-                t: Tok::Num(text[s..i].to_string()),
-                line,
-            });
+            i = past_number(b, i);
+            Some(Tok::Num(text[start..i].to_string()))
         } else if let Some(op) = OPS.iter().find(|o| b[i..].starts_with(o.as_bytes())) {
             i += op.len();
-            out.push(Token {
-                t: Tok::Op(op),
-                line,
-            });
+            Some(Tok::Op(op))
         } else {
             let ch = text[i..].chars().next().unwrap_or('?');
             i += ch.len_utf8();
-            let t = match OPS1.find(ch) {
+            Some(match OPS1.find(ch) {
                 Some(k) => Tok::Op(&OPS1[k..k + 1]),
                 None => Tok::Other(ch),
-            };
+            })
+        };
+        if let Some(t) = t {
             out.push(Token { t, line });
         }
     }
@@ -772,8 +785,42 @@ fn number(n: &str) -> Result<i64, String> {
 /// (`PortDecl::ranges`), so that the message can name the port.
 pub fn scan_ports(text: &str, module: &str) -> Result<Vec<PortDecl>, String> {
     let toks = lex(text);
-    // every module: (name, index of its name token, index of `endmodule`)
-    let mut mods: Vec<(String, usize, usize)> = Vec::new();
+    let (start, end) = module_span(&toks, module)?;
+    let toks = &toks[..end];
+    let mut params = Params::new();
+    let k = skip_imports(toks, start + 1);
+    let k = header_params(toks, k, module, &mut params)?;
+    if !(k < toks.len() && is_op(&toks[k], "(")) {
+        // no port list: no ports, but the body must still read
+        body_declarations(toks, k, &params, &mut [])?;
+        return Ok(Vec::new());
+    }
+    let c = close_of(toks, k)?;
+    let items = split_commas(&toks[k + 1..c]);
+    let ansi = items
+        .iter()
+        .any(|it| it.first().and_then(direction).is_some());
+    if ansi {
+        return ansi_ports(&items, module, &params);
+    }
+    // body parameters may size non-ANSI ports; ANSI ones see only the header's
+    collect_body_params(toks, c + 1, &mut params);
+    let mut ports = bare_ports(&items, module)?;
+    body_declarations(toks, c + 1, &params, &mut ports)?;
+    Ok(ports)
+}
+
+/// One module of the text: its name, the index of its name token and that
+/// of its `endmodule`.
+struct ModuleSpan {
+    name: String,
+    start: usize,
+    end: usize,
+}
+
+/// Every module of the text, in order.
+fn modules(toks: &[Token]) -> Result<Vec<ModuleSpan>, String> {
+    let mut mods = Vec::new();
     let mut k = 0;
     while k < toks.len() {
         if is_kw(&toks[k], "module") || is_kw(&toks[k], "macromodule") {
@@ -781,239 +828,276 @@ pub fn scan_ports(text: &str, module: &str) -> Result<Vec<PortDecl>, String> {
             let end = (k + 1..toks.len())
                 .find(|&j| is_kw(&toks[j], "endmodule"))
                 .ok_or_else(|| format!("module {name} (line {}) has no endmodule", toks[k].line))?;
-            mods.push((name, k + 1, end));
+            mods.push(ModuleSpan {
+                name,
+                start: k + 1,
+                end,
+            });
             k = end + 1;
         } else {
             k += 1;
         }
     }
-    let mine: Vec<_> = mods.iter().filter(|m| m.0 == module).collect();
-    let (start, end) = match mine.as_slice() {
-        [] => {
-            let found = if mods.is_empty() {
-                "no module at all".to_string()
-            } else {
-                let names: Vec<&str> = mods.iter().take(8).map(|m| m.0.as_str()).collect();
-                let more = mods.len().saturating_sub(names.len());
-                format!(
-                    "modules found: {}{}",
-                    names.join(", "),
-                    if more > 0 {
-                        format!(" and {more} more")
-                    } else {
-                        String::new()
-                    }
-                )
-            };
-            return Err(format!("no module named {module} ({found})"));
+    Ok(mods)
+}
+
+/// The name token and `endmodule` of the one module named `module`.
+fn module_span(toks: &[Token], module: &str) -> Result<(usize, usize), String> {
+    let mods = modules(toks)?;
+    let mine: Vec<_> = mods.iter().filter(|m| m.name == module).collect();
+    match mine.as_slice() {
+        [] => Err(format!(
+            "no module named {module} ({})",
+            modules_found(&mods)
+        )),
+        [m] => Ok((m.start, m.end)),
+        _ => Err(format!(
+            "module {module} is defined {} times (lines {})",
+            mine.len(),
+            mine.iter()
+                .map(|m| toks[m.start].line.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
+}
+
+/// The modules there are, for a message about one that is missing.
+fn modules_found(mods: &[ModuleSpan]) -> String {
+    if mods.is_empty() {
+        return "no module at all".to_string();
+    }
+    let names: Vec<&str> = mods.iter().take(8).map(|m| m.name.as_str()).collect();
+    let more = mods.len().saturating_sub(names.len());
+    format!(
+        "modules found: {}{}",
+        names.join(", "),
+        if more > 0 {
+            format!(" and {more} more")
+        } else {
+            String::new()
         }
-        [m] => (m.1, m.2),
-        _ => {
-            return Err(format!(
-                "module {module} is defined {} times (lines {})",
-                mine.len(),
-                mine.iter()
-                    .map(|m| toks[m.1].line.to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ))
-        }
-    };
-    let toks = &toks[..end];
-    let mut params = Params::new();
-    let mut k = start + 1;
-    // SV package imports in the header
+    )
+}
+
+/// Past the SV package imports of a module header.
+fn skip_imports(toks: &[Token], mut k: usize) -> usize {
     while k < toks.len() && is_kw(&toks[k], "import") {
         while k < toks.len() && !is_op(&toks[k], ";") {
             k += 1;
         }
         k += 1;
     }
-    if k < toks.len() && is_op(&toks[k], "#") {
-        if !toks.get(k + 1).is_some_and(|t| is_op(t, "(")) {
-            return Err(format!("module {module}: `#` without a parameter list"));
-        }
-        let c = close_of(toks, k + 1)?;
-        let mut kind_params = true;
-        for item in split_commas(&toks[k + 2..c]) {
-            let mut j = 0;
-            if item
-                .first()
-                .is_some_and(|t| is_kw(t, "parameter") || is_kw(t, "localparam"))
-            {
-                j = 1;
-                kind_params = true;
-            }
-            if item.first().is_some_and(|t| is_kw(t, "type")) {
-                kind_params = false;
-            }
-            if kind_params {
-                param_item(&item[j..], &mut params);
-            }
-        }
-        k = c + 1;
+    k
+}
+
+/// Reads the header's `#( ... )` parameter list, if there is one at `k`,
+/// into `params`; returns the index after it.
+fn header_params(
+    toks: &[Token],
+    k: usize,
+    module: &str,
+    params: &mut Params,
+) -> Result<usize, String> {
+    if !(k < toks.len() && is_op(&toks[k], "#")) {
+        return Ok(k);
     }
-    // the port list
-    let mut ports: Vec<PortDecl> = Vec::new();
-    let mut ansi = false;
-    if k < toks.len() && is_op(&toks[k], "(") {
-        let c = close_of(toks, k)?;
-        let items = split_commas(&toks[k + 1..c]);
-        ansi = items
-            .iter()
-            .any(|it| it.first().and_then(direction).is_some());
-        // body parameters may size non-ANSI ports; ANSI ones see only the header's
-        if !ansi {
-            collect_body_params(toks, c + 1, &mut params);
+    if !toks.get(k + 1).is_some_and(|t| is_op(t, "(")) {
+        return Err(format!("module {module}: `#` without a parameter list"));
+    }
+    let c = close_of(toks, k + 1)?;
+    // `type` parameters are skipped up to the next `parameter`
+    let mut kind_params = true;
+    for item in split_commas(&toks[k + 2..c]) {
+        let mut j = 0;
+        if item
+            .first()
+            .is_some_and(|t| is_kw(t, "parameter") || is_kw(t, "localparam"))
+        {
+            j = 1;
+            kind_params = true;
         }
-        let mut prev: Option<(PortDir, Head)> = None;
-        for item in items {
-            if item.is_empty() {
-                continue;
-            }
-            if !ansi {
-                match item {
-                    [t] if ident(t).is_some() => ports.push(PortDecl {
-                        name: ident(t).unwrap().to_string(),
-                        dir: None,
-                        ranges: Ok(Vec::new()),
-                        integer: false,
-                        unpacked: false,
-                        line: t.line,
-                    }),
-                    _ => {
-                        return Err(format!(
-                            "module {module}, line {}: port expression `{}` is not supported (list port names)",
-                            item[0].line,
-                            render(item)
-                        ))
-                    }
-                }
-                continue;
-            }
-            let (dir, h) = match item.first().and_then(direction) {
-                Some(d) => (d, head(item, 1, &params)?),
-                None => {
-                    let h = head(item, 0, &params)?;
-                    let Some((d, ph)) = &prev else {
-                        return Err(format!(
-                            "module {module}, line {}: port `{}` has no direction",
-                            item[0].line,
-                            render(item)
-                        ));
-                    };
-                    // a bare name inherits the previous declaration
-                    if h.end == 0 {
-                        (
-                            *d,
-                            Head {
-                                integer: ph.integer,
-                                ranges: ph.ranges.clone(),
-                                end: 0,
-                            },
-                        )
-                    } else {
-                        (*d, h)
-                    }
-                }
-            };
-            let Some(nt) = item.get(h.end) else {
+        if item.first().is_some_and(|t| is_kw(t, "type")) {
+            kind_params = false;
+        }
+        if kind_params {
+            param_item(&item[j..], params);
+        }
+    }
+    Ok(c + 1)
+}
+
+/// A non-ANSI port list: names only, directions come from the body.
+fn bare_ports(items: &[&[Token]], module: &str) -> Result<Vec<PortDecl>, String> {
+    let mut ports = Vec::new();
+    for item in items.iter().filter(|it| !it.is_empty()) {
+        match item {
+            [t] if ident(t).is_some() => ports.push(PortDecl {
+                name: ident(t).unwrap().to_string(),
+                dir: None,
+                ranges: Ok(Vec::new()),
+                integer: false,
+                unpacked: false,
+                line: t.line,
+            }),
+            _ => {
                 return Err(format!(
-                    "module {module}, line {}: a port declaration without a name: `{}`",
-                    item[0].line,
-                    render(item)
-                ));
-            };
-            let Some(name) = ident(nt) else {
-                return Err(format!(
-                    "module {module}, line {}: cannot read the port declaration `{}`",
-                    nt.line,
-                    render(item)
-                ));
-            };
-            let after = item.get(h.end + 1);
-            if after.is_some_and(|t| ident(t).is_some()) {
-                // `input my_type name`: a user type
-                let real = ident(after.unwrap()).unwrap();
-                ports.push(PortDecl {
-                    name: real.to_string(),
-                    dir: Some(dir),
-                    ranges: Err(format!(
-                        "its type `{name}` is not a net, reg, logic or integer"
-                    )),
-                    integer: false,
-                    unpacked: false,
-                    line: nt.line,
-                });
-                prev = None;
-                continue;
+                "module {module}, line {}: port expression `{}` is not supported (list port names)",
+                item[0].line,
+                render(item)
+            ))
             }
-            ports.push(PortDecl {
-                name: name.to_string(),
-                dir: Some(dir),
-                ranges: h.ranges.clone(),
-                integer: h.integer,
-                unpacked: after.is_some_and(|t| is_op(t, "[")),
-                line: nt.line,
-            });
-            prev = Some((dir, h));
         }
-        k = c + 1;
     }
-    if ansi {
-        return Ok(ports);
+    Ok(ports)
+}
+
+/// An ANSI port list: every item declares its port.
+fn ansi_ports(items: &[&[Token]], module: &str, params: &Params) -> Result<Vec<PortDecl>, String> {
+    let mut ports = Vec::new();
+    let mut prev: Option<(PortDir, Head)> = None;
+    for item in items.iter().filter(|it| !it.is_empty()) {
+        ports.push(ansi_port(item, module, params, &mut prev)?);
     }
-    // non-ANSI: directions (and ranges) from the body's declarations
+    Ok(ports)
+}
+
+/// One ANSI port declaration.  `prev` is the previous declaration, whose
+/// direction (and, for a bare name, type) the item inherits.
+fn ansi_port(
+    item: &[Token],
+    module: &str,
+    params: &Params,
+    prev: &mut Option<(PortDir, Head)>,
+) -> Result<PortDecl, String> {
+    let (dir, h) = match item.first().and_then(direction) {
+        Some(d) => (d, head(item, 1, params)?),
+        None => inherited_head(item, module, params, prev.as_ref())?,
+    };
+    let Some(nt) = item.get(h.end) else {
+        return Err(format!(
+            "module {module}, line {}: a port declaration without a name: `{}`",
+            item[0].line,
+            render(item)
+        ));
+    };
+    let Some(name) = ident(nt) else {
+        return Err(format!(
+            "module {module}, line {}: cannot read the port declaration `{}`",
+            nt.line,
+            render(item)
+        ));
+    };
+    let after = item.get(h.end + 1);
+    if let Some(real) = after.and_then(ident) {
+        // `input my_type name`: a user type
+        *prev = None;
+        return Ok(PortDecl {
+            name: real.to_string(),
+            dir: Some(dir),
+            ranges: Err(format!(
+                "its type `{name}` is not a net, reg, logic or integer"
+            )),
+            integer: false,
+            unpacked: false,
+            line: nt.line,
+        });
+    }
+    let port = PortDecl {
+        name: name.to_string(),
+        dir: Some(dir),
+        ranges: h.ranges.clone(),
+        integer: h.integer,
+        unpacked: after.is_some_and(|t| is_op(t, "[")),
+        line: nt.line,
+    };
+    *prev = Some((dir, h));
+    Ok(port)
+}
+
+/// The direction and head of an ANSI item without a direction of its own.
+fn inherited_head(
+    item: &[Token],
+    module: &str,
+    params: &Params,
+    prev: Option<&(PortDir, Head)>,
+) -> Result<(PortDir, Head), String> {
+    let h = head(item, 0, params)?;
+    let Some((d, ph)) = prev else {
+        return Err(format!(
+            "module {module}, line {}: port `{}` has no direction",
+            item[0].line,
+            render(item)
+        ));
+    };
+    // a bare name inherits the previous declaration
+    if h.end == 0 {
+        Ok((
+            *d,
+            Head {
+                integer: ph.integer,
+                ranges: ph.ranges.clone(),
+                end: 0,
+            },
+        ))
+    } else {
+        Ok((*d, h))
+    }
+}
+
+/// Past a `function` or `task` starting at `j`, if one does.
+fn skip_subroutine(toks: &[Token], j: usize) -> Option<usize> {
+    let end_kw = match ident(&toks[j]) {
+        Some("function") => "endfunction",
+        Some("task") => "endtask",
+        _ => return None,
+    };
+    Some(
+        (j..toks.len())
+            .find(|&x| is_kw(&toks[x], end_kw))
+            .unwrap_or(toks.len()),
+    )
+}
+
+/// The `;` ending the statement that starts at `from` (brackets nest).
+fn stmt_end(toks: &[Token], from: usize) -> usize {
+    let mut depth = 0i32;
+    for (x, t) in toks.iter().enumerate().skip(from) {
+        if is_op(t, "(") || is_op(t, "[") || is_op(t, "{") {
+            depth += 1;
+        } else if is_op(t, ")") || is_op(t, "]") || is_op(t, "}") {
+            depth -= 1;
+        } else if depth <= 0 && is_op(t, ";") {
+            return x;
+        }
+    }
+    toks.len()
+}
+
+/// Non-ANSI ports: directions and ranges from the body's declarations,
+/// which start at token `from`.
+fn body_declarations(
+    toks: &[Token],
+    from: usize,
+    params: &Params,
+    ports: &mut [PortDecl],
+) -> Result<(), String> {
     let mut nets: BTreeMap<String, Head> = BTreeMap::new();
-    let mut j = k;
+    let mut j = from;
     while j < toks.len() {
         let t = &toks[j];
-        if let Some(end_kw) = match ident(t) {
-            Some("function") => Some("endfunction"),
-            Some("task") => Some("endtask"),
-            _ => None,
-        } {
-            j = (j..toks.len())
-                .find(|&x| is_kw(&toks[x], end_kw))
-                .unwrap_or(toks.len());
-            continue;
-        }
-        let stmt_end = |from: usize| {
-            let mut depth = 0i32;
-            for (x, t) in toks.iter().enumerate().skip(from) {
-                if is_op(t, "(") || is_op(t, "[") || is_op(t, "{") {
-                    depth += 1;
-                } else if is_op(t, ")") || is_op(t, "]") || is_op(t, "}") {
-                    depth -= 1;
-                } else if depth <= 0 && is_op(t, ";") {
-                    return x;
-                }
-            }
-            toks.len()
-        };
-        if let Some(dir) = direction(t) {
-            let e = stmt_end(j);
-            let h = head(&toks[..e], j + 1, &params)?;
-            for item in split_commas(&toks[h.end..e]) {
-                let Some(name) = item.first().and_then(ident) else {
-                    continue;
-                };
-                if let Some(p) = ports.iter_mut().find(|p| p.name == name) {
-                    p.dir = Some(dir);
-                    p.ranges = h.ranges.clone();
-                    p.integer = h.integer;
-                    p.unpacked = item.get(1).is_some_and(|t| is_op(t, "["));
-                    p.line = item[0].line;
-                }
-            }
+        if let Some(past) = skip_subroutine(toks, j) {
+            j = past;
+        } else if let Some(dir) = direction(t) {
+            let e = stmt_end(toks, j);
+            let h = head(&toks[..e], j + 1, params)?;
+            declare_ports(&toks[h.end..e], dir, &h, ports);
             j = e + 1;
-            continue;
-        }
-        if ident(t).is_some_and(|n| NET_TYPES.contains(&n) || n == "integer")
-            && (j == 0 || is_op(&toks[j - 1], ";") || is_kw(&toks[j - 1], "end") || j == k)
+        } else if ident(t).is_some_and(|n| NET_TYPES.contains(&n) || n == "integer")
+            && (j == 0 || is_op(&toks[j - 1], ";") || is_kw(&toks[j - 1], "end") || j == from)
         {
-            let e = stmt_end(j);
-            let h = head(&toks[..e], j, &params)?;
+            let e = stmt_end(toks, j);
+            let h = head(&toks[..e], j, params)?;
             for item in split_commas(&toks[h.end..e]) {
                 if let Some(name) = item.first().and_then(ident) {
                     nets.insert(
@@ -1027,12 +1111,12 @@ pub fn scan_ports(text: &str, module: &str) -> Result<Vec<PortDecl>, String> {
                 }
             }
             j = e + 1;
-            continue;
+        } else {
+            j += 1;
         }
-        j += 1;
     }
     // `output q; reg [3:0] q;`: the range may sit on the net declaration
-    for p in &mut ports {
+    for p in ports {
         if p.ranges.as_ref().is_ok_and(|r| r.is_empty()) && !p.integer {
             if let Some(h) = nets.get(&p.name) {
                 p.ranges = h.ranges.clone();
@@ -1040,7 +1124,24 @@ pub fn scan_ports(text: &str, module: &str) -> Result<Vec<PortDecl>, String> {
             }
         }
     }
-    Ok(ports)
+    Ok(())
+}
+
+/// A body's `input [3:0] a, b;`: sets the direction and shape of the
+/// listed ports.
+fn declare_ports(names: &[Token], dir: PortDir, h: &Head, ports: &mut [PortDecl]) {
+    for item in split_commas(names) {
+        let Some(name) = item.first().and_then(ident) else {
+            continue;
+        };
+        if let Some(p) = ports.iter_mut().find(|p| p.name == name) {
+            p.dir = Some(dir);
+            p.ranges = h.ranges.clone();
+            p.integer = h.integer;
+            p.unpacked = item.get(1).is_some_and(|t| is_op(t, "["));
+            p.line = item[0].line;
+        }
+    }
 }
 
 /// `[type] [range] NAME = expr` (one item of a parameter declaration).
@@ -1081,14 +1182,8 @@ fn param_item(item: &[Token], params: &mut Params) {
 fn collect_body_params(toks: &[Token], from: usize, params: &mut Params) {
     let mut j = from;
     while j < toks.len() {
-        if let Some(end_kw) = match ident(&toks[j]) {
-            Some("function") => Some("endfunction"),
-            Some("task") => Some("endtask"),
-            _ => None,
-        } {
-            j = (j..toks.len())
-                .find(|&x| is_kw(&toks[x], end_kw))
-                .unwrap_or(toks.len());
+        if let Some(past) = skip_subroutine(toks, j) {
+            j = past;
             continue;
         }
         if is_kw(&toks[j], "parameter") || is_kw(&toks[j], "localparam") {

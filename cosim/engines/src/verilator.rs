@@ -344,64 +344,16 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
             key,
         });
     }
-    let io = |e: std::io::Error| BackendError::Io(format!("{}: {e}", dir.display()));
-    // Unique per build, so that concurrent builds of one key (parallel tests,
-    // two processes) never share a work directory; the first to finish wins.
-    static BUILDS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let tmp = cache_root().join("verilator").join(format!(
-        "{key}.tmp{}-{}",
-        std::process::id(),
-        BUILDS.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
-    ));
+    let io = io_at(&dir);
+    let tmp = build_dir(&key);
     let _ = std::fs::remove_dir_all(&tmp);
     std::fs::create_dir_all(&tmp).map_err(io)?;
     std::fs::write(tmp.join(format!("{TOP_MODULE}.v")), verilog).map_err(io)?;
     std::fs::write(tmp.join("shim.cpp"), &shim).map_err(io)?;
     let obj = tmp.join("obj");
-    run(
-        Command::new("verilator")
-            .args([
-                "--cc",
-                "-O3",
-                "--x-assign",
-                "fast",
-                "--x-initial",
-                "fast",
-                "-Wno-fatal",
-                "-Wno-lint",
-                "-Wno-style",
-                "--top-module",
-                TOP_MODULE,
-                "-Mdir",
-            ])
-            .arg(&obj)
-            .arg(tmp.join(format!("{TOP_MODULE}.v"))),
-        "verilator",
-    )?;
-    let root = Command::new("verilator")
-        .args(["--getenv", "VERILATOR_ROOT"])
-        .output()
-        .map_err(|e| BackendError::Io(e.to_string()))?;
-    let root = PathBuf::from(String::from_utf8_lossy(&root.stdout).trim());
-    let inc = root.join("include");
-    let mut generated: Vec<PathBuf> = std::fs::read_dir(&obj)
-        .map_err(io)?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "cpp"))
-        .collect();
-    generated.sort();
-    // One translation unit for the model, as Verilator's own makefile does
-    // without parallel builds (`__ALL.cpp`): each generated file alone
-    // parses verilated.h again, which was most of their compile time
-    // (12 s of CPU as nine units, 4 s as one, on a 28-channel mix).
-    let all = obj.join(format!("V{TOP_MODULE}__ALL.cpp"));
-    let includes: String = generated
-        .iter()
-        .filter_map(|p| p.file_name())
-        .map(|f| format!("#include \"{}\"\n", f.to_string_lossy()))
-        .collect();
-    std::fs::write(&all, includes).map_err(io)?;
-    let sources = vec![all, tmp.join("shim.cpp")];
+    verilate(&tmp, &obj)?;
+    let inc = verilator_include()?;
+    let sources = vec![model_source(&obj, &dir)?, tmp.join("shim.cpp")];
     let objects: Vec<PathBuf> = sources
         .iter()
         .enumerate()
@@ -420,9 +372,88 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
             .arg("-pthread"),
         "g++ -shared",
     )?;
+    install(&tmp, &dir, key)
+}
+
+/// An I/O error's message, naming the cache directory `dir`.
+fn io_at(dir: &Path) -> impl Fn(std::io::Error) -> BackendError + Copy + '_ {
+    move |e| BackendError::Io(format!("{}: {e}", dir.display()))
+}
+
+/// A work directory unique per build, so that concurrent builds of one key
+/// (parallel tests, two processes) never share one; the first to finish wins.
+fn build_dir(key: &str) -> PathBuf {
+    static BUILDS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    cache_root().join("verilator").join(format!(
+        "{key}.tmp{}-{}",
+        std::process::id(),
+        BUILDS.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+    ))
+}
+
+/// Verilator's C++ model of `tmp`'s top, into `obj`.
+fn verilate(tmp: &Path, obj: &Path) -> Result<(), BackendError> {
+    run(
+        Command::new("verilator")
+            .args([
+                "--cc",
+                "-O3",
+                "--x-assign",
+                "fast",
+                "--x-initial",
+                "fast",
+                "-Wno-fatal",
+                "-Wno-lint",
+                "-Wno-style",
+                "--top-module",
+                TOP_MODULE,
+                "-Mdir",
+            ])
+            .arg(obj)
+            .arg(tmp.join(format!("{TOP_MODULE}.v"))),
+        "verilator",
+    )
+}
+
+/// Verilator's `include` directory.
+fn verilator_include() -> Result<PathBuf, BackendError> {
+    let root = Command::new("verilator")
+        .args(["--getenv", "VERILATOR_ROOT"])
+        .output()
+        .map_err(|e| BackendError::Io(e.to_string()))?;
+    let root = PathBuf::from(String::from_utf8_lossy(&root.stdout).trim());
+    Ok(root.join("include"))
+}
+
+/// One translation unit for the model in `obj`, as Verilator's own makefile
+/// does without parallel builds (`__ALL.cpp`): each generated file alone
+/// parses verilated.h again, which was most of their compile time (12 s of
+/// CPU as nine units, 4 s as one, on a 28-channel mix).
+fn model_source(obj: &Path, dir: &Path) -> Result<PathBuf, BackendError> {
+    let io = io_at(dir);
+    let mut generated: Vec<PathBuf> = std::fs::read_dir(obj)
+        .map_err(io)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "cpp"))
+        .collect();
+    generated.sort();
+    let all = obj.join(format!("V{TOP_MODULE}__ALL.cpp"));
+    let includes: String = generated
+        .iter()
+        .filter_map(|p| p.file_name())
+        .map(|f| format!("#include \"{}\"\n", f.to_string_lossy()))
+        .collect();
+    std::fs::write(&all, includes).map_err(io)?;
+    Ok(all)
+}
+
+/// Moves the finished build `tmp` to its cache directory `dir`, unless
+/// another build of the same key got there first.
+fn install(tmp: &Path, dir: &Path, key: String) -> Result<Built, BackendError> {
+    let lib = dir.join(format!("lib{TOP_MODULE}.so"));
     if lib.exists() {
         // Another build of the same key finished first: use it.
-        let _ = std::fs::remove_dir_all(&tmp);
+        let _ = std::fs::remove_dir_all(tmp);
         return Ok(Built {
             library: lib,
             cached: true,
@@ -430,11 +461,11 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
         });
     }
     // A directory without the library is the remains of an interrupted build.
-    let _ = std::fs::remove_dir_all(&dir);
-    if let Err(e) = std::fs::rename(&tmp, &dir) {
-        let _ = std::fs::remove_dir_all(&tmp);
+    let _ = std::fs::remove_dir_all(dir);
+    if let Err(e) = std::fs::rename(tmp, dir) {
+        let _ = std::fs::remove_dir_all(tmp);
         if !lib.exists() {
-            return Err(io(e));
+            return Err(io_at(dir)(e));
         }
         return Ok(Built {
             library: lib,
