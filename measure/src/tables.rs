@@ -249,7 +249,11 @@ pub fn faults(c: &campaign::faults::Campaign) -> Table {
     let head: Vec<&str> = head.iter().map(String::as_str).collect();
     let mut t = Table::new(&head);
     for k in &c.classes {
-        let mut row = vec![k.name.clone(), k.level.into(), k.injected.to_string()];
+        let mut row = vec![
+            k.name.to_string(),
+            k.level.to_string(),
+            k.injected.to_string(),
+        ];
         for d in &c.detectors {
             row.push(match (k.detected_by.get(d), k.cannot_see.get(d)) {
                 (Some(n), _) => format!("{n} of {}", k.injected),

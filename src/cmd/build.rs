@@ -16,6 +16,7 @@
 //! failed; 2: bad input (the mix, the output directory, a step name).
 
 mod job;
+mod plan;
 mod steps;
 
 use std::path::PathBuf;
@@ -82,21 +83,18 @@ pub enum Charts {
 }
 
 pub fn run(a: Args) -> u8 {
-    let plan = match steps::plan(&a) {
+    let plan = match plan::plan(&a) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("error: {e}");
             return 2;
         }
     };
-    let s = match super::schedule_on_pins(&a.mix) {
+    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
     if let Err(code) = super::junit::check_writable(a.junit.as_deref()) {
-        return code;
-    }
-    if let Err(code) = super::link_fits(&s, &a.mix) {
         return code;
     }
     if a.out.exists() && !a.out.is_dir() {
@@ -108,8 +106,8 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: {}: cannot create directory: {why}", a.out.display());
         return 2;
     }
-    let plan = steps::with_remembered_proof(plan, &s, &a.out);
-    let mut job = Job::new(&a, &s, plan.iter().filter(|p| p.1).count());
+    let plan = plan::with_remembered_proof(plan, &s, &a.out);
+    let mut job = Job::new(&a, &s, plan.iter().filter(|p| p.1.runs()).count());
     steps::run_all(&mut job, &a, &s, &plan);
     if let Err(e) = job.finish() {
         eprintln!("error: {e}");

@@ -114,14 +114,11 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::schedule_on_pins(&a.mix) {
+    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
     if let Err(code) = super::junit::check_writable(a.junit.as_deref()) {
-        return code;
-    }
-    if let Err(code) = super::link_fits(&s, &a.mix) {
         return code;
     }
     let started = std::time::Instant::now();

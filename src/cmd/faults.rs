@@ -9,6 +9,7 @@
 //! proved equivalent) and no false alarm; 1: anything undetected or a false
 //! alarm; 2: bad input.
 
+use std::fmt::Write as _;
 use std::path::PathBuf;
 
 use campaign::faults::{campaign_with, deep_faults, Campaign, Plan, Target};
@@ -49,13 +50,10 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::schedule_on_pins(&a.mix) {
+    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::link_fits(&s, &a.mix) {
-        return code;
-    }
     // One back-end name everywhere (engines::Backend); the campaign injects
     // into the designs it can build in process.
     let target = match a.backend {
@@ -129,8 +127,30 @@ pub fn run(a: Args) -> u8 {
 
 /// The campaign as text: the matrix, then what was missed and why.
 fn text(c: &Campaign) -> String {
-    use std::fmt::Write as _;
     let mut o = String::new();
+    header(&mut o, c);
+    matrix(&mut o, c);
+    columns(&mut o, c);
+    missed(&mut o, c);
+    let _ = writeln!(
+        o,
+        "{} injections: {} detected, {} undetected, {} proved equivalent; false alarms: {} of {} clean runs over {} random mixes",
+        c.injected,
+        c.detected,
+        c.undetected,
+        c.proved_equivalent,
+        c.false_alarms.rejected,
+        c.false_alarms.runs,
+        c.false_alarms.mixes
+    );
+    for e in &c.false_alarms.examples {
+        let _ = writeln!(o, "  false alarm: {e}");
+    }
+    o
+}
+
+/// The target, the sites and the AXI4-Stream slave of every run.
+fn header(o: &mut String, c: &Campaign) {
     let sites: Vec<String> = c
         .sites
         .iter()
@@ -149,6 +169,10 @@ fn text(c: &Campaign) -> String {
             "  every run's AXI4-Stream slave: tready {p} (every beat waits the longest the mix's guarantee allows)"
         );
     }
+}
+
+/// Fault class x detector, and why a detector cannot see a class.
+fn matrix(o: &mut String, c: &Campaign) {
     let _ = write!(o, "  {:<20} {:<8}", "class", "level");
     for d in &c.detectors {
         let _ = write!(o, " {:>12}", d.name());
@@ -182,6 +206,10 @@ fn text(c: &Campaign) -> String {
     for (d, why) in blind {
         let _ = writeln!(o, "  cannot see: {d}: {why}");
     }
+}
+
+/// Per detector and per engine: what it caught, or why it did not run.
+fn columns(o: &mut String, c: &Campaign) {
     for col in &c.columns {
         match &col.not_run {
             Some(why) => {
@@ -205,6 +233,10 @@ fn text(c: &Campaign) -> String {
             e.engine, e.detected, e.injected, e.cycles, e.seconds
         );
     }
+}
+
+/// The injections no detector caught: undetected, or proved equivalent.
+fn missed(o: &mut String, c: &Campaign) {
     for k in &c.classes {
         for m in &k.undetected {
             let _ = writeln!(
@@ -234,21 +266,6 @@ fn text(c: &Campaign) -> String {
             );
         }
     }
-    let _ = writeln!(
-        o,
-        "{} injections: {} detected, {} undetected, {} proved equivalent; false alarms: {} of {} clean runs over {} random mixes",
-        c.injected,
-        c.detected,
-        c.undetected,
-        c.proved_equivalent,
-        c.false_alarms.rejected,
-        c.false_alarms.runs,
-        c.false_alarms.mixes
-    );
-    for e in &c.false_alarms.examples {
-        let _ = writeln!(o, "  false alarm: {e}");
-    }
-    o
 }
 
 /// The equivalence check's answer in words (not the enum's Debug form).

@@ -283,36 +283,9 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         }
     };
     let events_path = dir.join(EVENTS);
-    let golden = if events_path.exists() {
-        let text = match std::fs::read_to_string(&events_path) {
-            Ok(t) => t,
-            Err(e) => {
-                let why = lut_gen::io_words(&e);
-                errln!(o, "error: {}: cannot read: {why}", events_path.display());
-                return 2;
-            }
-        };
-        match EventLog::parse(&text) {
-            Ok(l) => Some(l),
-            Err(e) if a.update => {
-                errln!(o, "note: {}: {e}; replacing it", events_path.display());
-                None
-            }
-            Err(e) => {
-                errln!(o, "error: {}: {e}", events_path.display());
-                return 2;
-            }
-        }
-    } else if a.update {
-        None
-    } else {
-        errln!(o,
-            "error: no golden for mix `{}`: {} does not exist (record one with `slotforge golden {} --update`)",
-            s.mix.name,
-            events_path.display(),
-            mix.display()
-        );
-        return 2;
+    let golden = match load_events(a, &s, mix, &events_path, o) {
+        Ok(g) => g,
+        Err(code) => return code,
     };
 
     // One run covers the event log and every window.
@@ -374,7 +347,71 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         );
     }
     let golden = golden.expect("loaded above");
-    let cmp = compare(&golden, &log, SHOWN + 1);
+    let mut differ = compare_events(o, &who, &s, &golden, &log, &events_path);
+    match compare_windows(o, &who, &s, &dir, &trace, &windows) {
+        Ok(d) => differ |= d,
+        Err(code) => return code,
+    }
+    if differ || !report.ok {
+        1
+    } else {
+        0
+    }
+}
+
+/// The golden event log at `events_path`: `None` when `--update` records
+/// a new one; a missing or unreadable one is an error (printed: exit 2).
+fn load_events(
+    a: &Args,
+    s: &Schedule,
+    mix: &Path,
+    events_path: &Path,
+    o: &mut Output,
+) -> Result<Option<EventLog>, u8> {
+    if !events_path.exists() {
+        if a.update {
+            return Ok(None);
+        }
+        errln!(o,
+            "error: no golden for mix `{}`: {} does not exist (record one with `slotforge golden {} --update`)",
+            s.mix.name,
+            events_path.display(),
+            mix.display()
+        );
+        return Err(2);
+    }
+    let text = match std::fs::read_to_string(events_path) {
+        Ok(t) => t,
+        Err(e) => {
+            let why = lut_gen::io_words(&e);
+            errln!(o, "error: {}: cannot read: {why}", events_path.display());
+            return Err(2);
+        }
+    };
+    match EventLog::parse(&text) {
+        Ok(l) => Ok(Some(l)),
+        Err(e) if a.update => {
+            errln!(o, "note: {}: {e}; replacing it", events_path.display());
+            Ok(None)
+        }
+        Err(e) => {
+            errln!(o, "error: {}: {e}", events_path.display());
+            Err(2)
+        }
+    }
+}
+
+/// This run's event log against the golden's, the first differences
+/// listed: whether they differ.
+fn compare_events(
+    o: &mut Output,
+    who: &str,
+    s: &Schedule,
+    golden: &EventLog,
+    log: &EventLog,
+    events_path: &Path,
+) -> bool {
+    let cmp = compare(golden, log, SHOWN + 1);
     let mut differ = false;
     if cmp.same() {
         outln!(
@@ -402,36 +439,50 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         }
         for (i, d) in cmp.first.iter().enumerate().take(SHOWN) {
             let what = if i == 0 { "first" } else { "then " };
-            outln!(o, "  {what}: {}", d.describe(&s));
+            outln!(o, "  {what}: {}", d.describe(s));
         }
     }
+    differ
+}
+
+/// This run's waveform windows against the golden's, cycle by cycle:
+/// whether any differs, or the exit code of an error (printed).
+fn compare_windows(
+    o: &mut Output,
+    who: &str,
+    s: &Schedule,
+    dir: &Path,
+    trace: &Trace,
+    windows: &[(&Window, (u64, u64))],
+) -> Result<bool, u8> {
     let tmp = match tempfile::tempdir() {
         Ok(t) => t,
         Err(e) => {
             errln!(o, "error: temporary directory: {e}");
-            return 2;
+            return Err(2);
         }
     };
-    for (w, (k0, k1)) in &windows {
+    let mut differ = false;
+    for (w, (k0, k1)) in windows {
         let gold = dir.join(&w.file);
         // This run's window as VCD: the reader compares cycles, whatever the golden's format.
         let new = tmp.path().join(&w.file).with_extension("vcd");
-        if let Err(e) = write_window(&s, &trace, *k0, *k1, &new, false) {
+        if let Err(e) = write_window(s, trace, *k0, *k1, &new, false) {
             errln!(o, "error: {}: {e}", new.display());
-            return 2;
+            return Err(2);
         }
-        let expected = match read_window(&s, &gold) {
+        let expected = match read_window(s, &gold) {
             Ok(t) => t,
             Err(e) => {
                 errln!(o, "error: golden window {e} (re-record with --update)");
-                return 2;
+                return Err(2);
             }
         };
-        let actual = match read_window(&s, &new) {
+        let actual = match read_window(s, &new) {
             Ok(t) => t,
             Err(e) => {
                 errln!(o, "error: this run's window {}: {e}", w.file);
-                return 2;
+                return Err(2);
             }
         };
         match first_window_difference(&expected, &actual) {
@@ -442,11 +493,7 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
             }
         }
     }
-    if differ || !report.ok {
-        1
-    } else {
-        0
-    }
+    Ok(differ)
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -130,8 +130,30 @@ impl Bound {
     }
 }
 
-/// [`schedule`], then the contract's limits checked ([`fits_pins`]): what
-/// every command that simulates, checks or proves starts with.
+/// Whose limits refuse a mix too large for the gateware.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Limits {
+    /// The pin contract's, before anything runs ([`fits_pins`], exit 2):
+    /// the checker and the engines size their pins from them.
+    Contract,
+    /// The emitter's, as it emits (`verilog`: exit 1, the file named).
+    Emitter,
+}
+
+/// The mix loaded and scheduled, its limits checked, and its link to the
+/// host checked ([`link_fits`]): what every command that emits, simulates,
+/// checks or proves starts with.  On failure the message is printed and
+/// the exit code returned.
+pub fn load_checked(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
+    let s = match limits {
+        Limits::Contract => schedule_on_pins(path)?,
+        Limits::Emitter => schedule(path)?,
+    };
+    link_fits(&s, path)?;
+    Ok(s)
+}
+
+/// [`schedule`], then the contract's limits checked ([`fits_pins`]).
 pub fn schedule_on_pins(path: &Path) -> Result<lut_gen::Schedule, u8> {
     let s = schedule(path)?;
     fits_pins(&s)?;

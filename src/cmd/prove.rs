@@ -41,15 +41,10 @@ fn solver(s: &str) -> Result<Solver, String> {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::schedule_on_pins(&a.mix) {
+    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    // a link too slow for the mix: refused as sim, check, faults, build and
-    // verilog refuse it (file:line:col: link.<key>: ..., exit 1)
-    if let Err(code) = super::link_fits(&s, &a.mix) {
-        return code;
-    }
     let (design, own) = match &a.rtl {
         Some(path) => match engines::rtl::load_rtl(&s, path) {
             Ok(text) => (text, false),

@@ -129,70 +129,22 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: --frames must be at least 1");
         return 2;
     }
-    let s = match super::schedule_on_pins(&a.mix) {
+    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::link_fits(&s, &a.mix) {
-        return code;
-    }
-    let from = a.from.cycles(&s);
-    let to = match a.to {
-        Some(b) => b.cycles(&s),
-        None => from + s.grid.frame_cycles,
-    };
-    if a.vcd.is_some() && to <= from {
-        eprintln!("error: --to ({to} cycles) must be after --from ({from} cycles)");
-        return 2;
-    }
-    // A window beyond the run would come out short, after the whole run.
-    let run_cycles = a.frames.saturating_mul(s.grid.frame_cycles);
-    if a.vcd.is_some() && to > run_cycles {
-        eprintln!(
-            "error: --to ({to} cycles) is beyond the run: {} frame(s) of {} cycles end at cycle {run_cycles}; use --frames {}",
-            a.frames,
-            s.grid.frame_cycles,
-            to.div_ceil(s.grid.frame_cycles)
-        );
-        return 2;
-    }
-    // The VCD's folder is created now, not found missing after the run; its
-    // path is made absolute so the .gtkw beside it finds it from anywhere.
-    let vcd = match a.vcd.as_deref().map(absolute_in_new_folder).transpose() {
-        Ok(v) => v,
-        Err(e) => {
-            eprintln!("error: --vcd {e}");
-            return 2;
-        }
-    };
-    // FST: the run writes a VCD beside it, converted at the end (in
-    // process, through fst-writer).
-    let fst = vcd.as_ref().and_then(|v| {
-        let named = v.extension().is_some_and(|x| x == "fst");
-        (a.fst || named).then(|| v.with_extension("fst"))
+    let prepared = window(&a, &s).and_then(|(from, to)| {
+        let (vcd, fst) = waveform_paths(&a)?;
+        samples_path_free(&a)?;
+        Ok((from, to, vcd, fst))
     });
-    let vcd = match &fst {
-        Some(f) => Some(f.with_extension("fst.vcd")),
-        None => vcd,
+    let (from, to, vcd, fst) = match prepared {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
     };
-    if let Some(p) = &a.samples {
-        let same = |q: &std::path::Path| {
-            p == q || matches!((p.canonicalize(), q.canonicalize()), (Ok(x), Ok(y)) if x == y)
-        };
-        let vcd = a.vcd.as_deref();
-        let gtkw = vcd.map(|v| v.with_extension("gtkw"));
-        if same(&a.mix) || vcd.is_some_and(same) || gtkw.as_deref().is_some_and(same) {
-            eprintln!(
-                "error: --samples {}: is the mix or the waveform of this run; name another file",
-                p.display()
-            );
-            return 2;
-        }
-        if p.is_dir() {
-            eprintln!("error: --samples {}: is a directory", p.display());
-            return 2;
-        }
-    }
     let opts = SimOptions {
         stimulus,
         vcd: vcd.clone().map(|path| VcdOut {
@@ -201,31 +153,12 @@ pub fn run(a: Args) -> u8 {
             to,
             gtkw: true,
         }),
-        rtl: a.rtl,
+        rtl: a.rtl.clone(),
         tready: a.tready,
         ..SimOptions::default()
     };
     let mut log = judge::samples::SampleLog::new();
-    // The slot-level model runs hours per second: no progress to show, and
-    // an observer would make it run the cycle model instead.
-    let result = if backend == Backend::Model && a.samples.is_none() {
-        engines::run(&s, backend, a.frames, &opts)
-    } else {
-        let inner = a
-            .samples
-            .is_some()
-            .then_some(&mut log as &mut dyn engines::Tracer);
-        let mut p = super::progress::CycleProgress::new(
-            a.frames,
-            s.grid.frame_cycles,
-            a.quiet || a.json,
-            inner,
-        );
-        let r = engines::run_observed(&s, backend, a.frames, &opts, Some(&mut p));
-        p.finish();
-        r
-    };
-    let report = match result {
+    let report = match simulate(&a, &s, backend, &opts, &mut log) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");
@@ -258,4 +191,104 @@ pub fn run(a: Args) -> u8 {
     } else {
         1
     }
+}
+
+/// The VCD window's cycles `[from, to)`, refused when empty or beyond the run.
+fn window(a: &Args, s: &lut_gen::Schedule) -> Result<(u64, u64), String> {
+    let from = a.from.cycles(s);
+    let to = match a.to {
+        Some(b) => b.cycles(s),
+        None => from + s.grid.frame_cycles,
+    };
+    if a.vcd.is_some() && to <= from {
+        return Err(format!(
+            "--to ({to} cycles) must be after --from ({from} cycles)"
+        ));
+    }
+    // A window beyond the run would come out short, after the whole run.
+    let run_cycles = a.frames.saturating_mul(s.grid.frame_cycles);
+    if a.vcd.is_some() && to > run_cycles {
+        return Err(format!(
+            "--to ({to} cycles) is beyond the run: {} frame(s) of {} cycles end at cycle {run_cycles}; use --frames {}",
+            a.frames,
+            s.grid.frame_cycles,
+            to.div_ceil(s.grid.frame_cycles)
+        ));
+    }
+    Ok((from, to))
+}
+
+/// The VCD the run writes and the FST it becomes (with `--fst` or a
+/// `.fst` name): (vcd, fst).
+fn waveform_paths(a: &Args) -> Result<(Option<PathBuf>, Option<PathBuf>), String> {
+    // The VCD's folder is created now, not found missing after the run; its
+    // path is made absolute so the .gtkw beside it finds it from anywhere.
+    let vcd = a
+        .vcd
+        .as_deref()
+        .map(absolute_in_new_folder)
+        .transpose()
+        .map_err(|e| format!("--vcd {e}"))?;
+    // FST: the run writes a VCD beside it, converted at the end (in
+    // process, through fst-writer).
+    let fst = vcd.as_ref().and_then(|v| {
+        let named = v.extension().is_some_and(|x| x == "fst");
+        (a.fst || named).then(|| v.with_extension("fst"))
+    });
+    let vcd = match &fst {
+        Some(f) => Some(f.with_extension("fst.vcd")),
+        None => vcd,
+    };
+    Ok((vcd, fst))
+}
+
+/// `--samples` names a file of its own: not the mix, the waveform or a directory.
+fn samples_path_free(a: &Args) -> Result<(), String> {
+    let Some(p) = &a.samples else {
+        return Ok(());
+    };
+    let same = |q: &std::path::Path| {
+        p == q || matches!((p.canonicalize(), q.canonicalize()), (Ok(x), Ok(y)) if x == y)
+    };
+    let vcd = a.vcd.as_deref();
+    let gtkw = vcd.map(|v| v.with_extension("gtkw"));
+    if same(&a.mix) || vcd.is_some_and(same) || gtkw.as_deref().is_some_and(same) {
+        return Err(format!(
+            "--samples {}: is the mix or the waveform of this run; name another file",
+            p.display()
+        ));
+    }
+    if p.is_dir() {
+        return Err(format!("--samples {}: is a directory", p.display()));
+    }
+    Ok(())
+}
+
+/// The run, with progress shown and every sample logged into `log` when
+/// `--samples` asks for them.
+fn simulate(
+    a: &Args,
+    s: &lut_gen::Schedule,
+    backend: Backend,
+    opts: &SimOptions,
+    log: &mut judge::samples::SampleLog,
+) -> Result<judge::Report, engines::error::SimError> {
+    // The slot-level model runs hours per second: no progress to show, and
+    // an observer would make it run the cycle model instead.
+    if backend == Backend::Model && a.samples.is_none() {
+        return engines::run(s, backend, a.frames, opts);
+    }
+    let inner = a
+        .samples
+        .is_some()
+        .then_some(log as &mut dyn engines::Tracer);
+    let mut p = super::progress::CycleProgress::new(
+        a.frames,
+        s.grid.frame_cycles,
+        a.quiet || a.json,
+        inner,
+    );
+    let r = engines::run_observed(s, backend, a.frames, opts, Some(&mut p));
+    p.finish();
+    r
 }

@@ -16,13 +16,11 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> u8 {
-    let s = match super::schedule(&args.mix) {
+    // the gateware's limits are the emitter's to refuse (exit 1)
+    let s = match super::load_checked(&args.mix, super::Limits::Emitter) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::link_fits(&s, &args.mix) {
-        return code;
-    }
     let emitted = match hdl::emit(&s, args.board.as_deref()) {
         Ok(e) => e,
         Err(e @ hdl::HdlError::Unsupported(_)) => {

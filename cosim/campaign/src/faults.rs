@@ -34,7 +34,9 @@ use engines::error::SimError;
 use engines::options::Backend;
 use engines::rusthdl::RustHdlDut;
 
+mod class;
 mod verilog;
+pub use class::{FaultClass, Level};
 pub use verilog::{deep_faults, prove, prove_unavailable, ProveVerdict, VerilogFault};
 
 /// A detector of the judge, measured apart from the others.
@@ -71,14 +73,11 @@ impl Detector {
     }
 
     /// Why this detector has no view of a fault class (at `level`), by design.
-    pub fn blind_to(&self, class: &str, level: &str) -> Option<&'static str> {
-        match (self, class) {
-            (
-                Detector::Sigrok,
-                "mux-late" | "two-mux-en" | "wrong-mux" | "select-swap",
-            ) => Some("the SPI decode reads CS, SCLK and MISO only: mux pins are outside its view, and the design emits whatever code MISO carried"),
-            (Detector::Prove, _) if level == "pins" || level == "reset" => Some("the fault is injected into a simulation's pins, not built into a design: prove reads a design, so it has nothing to prove it against"),
-            (Detector::Sigrok, c) if c.starts_with("link-") || c.starts_with("axis-") => Some("the SPI decode reads CS, SCLK and MISO only: the link's pins are outside its view"),
+    pub fn blind_to(&self, class: &FaultClass, level: Level) -> Option<&'static str> {
+        match (self, level) {
+            (Detector::Sigrok, _) if class.on_mux_pins() => Some("the SPI decode reads CS, SCLK and MISO only: mux pins are outside its view, and the design emits whatever code MISO carried"),
+            (Detector::Prove, Level::Pins | Level::Reset) => Some("the fault is injected into a simulation's pins, not built into a design: prove reads a design, so it has nothing to prove it against"),
+            (Detector::Sigrok, _) if class.on_link() => Some("the SPI decode reads CS, SCLK and MISO only: the link's pins are outside its view"),
             _ => None,
         }
     }
@@ -181,9 +180,8 @@ pub struct Injection {
 /// A class of fault over all its sites.
 #[derive(Debug, Clone, Serialize)]
 pub struct ClassOutcome {
-    pub name: String,
-    /// `pins`, `reset`, `gateware` or `verilog`.
-    pub level: &'static str,
+    pub name: FaultClass,
+    pub level: Level,
     /// Injections (proved-equivalent ones included).
     pub injected: u64,
     /// Injections some detector caught.
@@ -401,7 +399,6 @@ fn outcome(fault: String, site: &Site, j: &Judged, engine: &'static str) -> Inje
 struct DesignCase {
     fault: hdl::GatewareFault,
     site: Site,
-    class: &'static str,
 }
 
 /// The ROM faults of branch `b` at `site`: the branch's first conversion
@@ -432,7 +429,6 @@ fn rom_cases(s: &Schedule, b: usize, site: Site) -> Vec<DesignCase> {
                 from: other,
             },
             site,
-            class: "rom-word",
         },
         DesignCase {
             fault: hdl::GatewareFault::RomSwap {
@@ -441,7 +437,6 @@ fn rom_cases(s: &Schedule, b: usize, site: Site) -> Vec<DesignCase> {
                 b: other,
             },
             site,
-            class: "rom-swap",
         },
     ]
 }
@@ -449,7 +444,7 @@ fn rom_cases(s: &Schedule, b: usize, site: Site) -> Vec<DesignCase> {
 /// One design-level fault of each class, at the middle of frame 0 on the
 /// first branch that has two channels (ROM faults): what the analyser
 /// captures of faulty gateware are tested with.
-pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(&'static str, hdl::GatewareFault)> {
+pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(FaultClass, hdl::GatewareFault)> {
     let f = s.grid.frame_cycles;
     let mid = f / 2 + 7;
     let site = Site {
@@ -457,30 +452,27 @@ pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(&'static str, hdl::Gat
         cycle: mid,
         slot: (mid % f) / s.grid.slot_cycles,
     };
-    let mut v: Vec<(&'static str, hdl::GatewareFault)> = (0..s.branches.len())
+    let mut v: Vec<hdl::GatewareFault> = (0..s.branches.len())
         .map(|b| rom_cases(s, b, site))
         .find(|c| !c.is_empty())
         .unwrap_or_default()
         .into_iter()
-        .map(|c| (c.class, c.fault))
+        .map(|c| c.fault)
         .collect();
-    v.push((
-        "slot-wrap-early",
-        hdl::GatewareFault::SlotWrap { delta: -1 },
-    ));
-    v.push(("slot-wrap-late", hdl::GatewareFault::SlotWrap { delta: 1 }));
+    v.push(hdl::GatewareFault::SlotWrap { delta: -1 });
+    v.push(hdl::GatewareFault::SlotWrap { delta: 1 });
     if s.grid.slices_per_frame > 1 {
-        v.push((
-            "slice-count-short",
-            hdl::GatewareFault::SliceWrap { delta: -1 },
-        ));
-        v.push((
-            "slice-count-long",
-            hdl::GatewareFault::SliceWrap { delta: 1 },
-        ));
+        v.push(hdl::GatewareFault::SliceWrap { delta: -1 });
+        v.push(hdl::GatewareFault::SliceWrap { delta: 1 });
     }
-    v.extend(hdl::GatewareFault::link_faults(s));
-    v
+    v.extend(
+        hdl::GatewareFault::link_faults(s)
+            .into_iter()
+            .map(|(_, f)| f),
+    );
+    v.into_iter()
+        .map(|f| (FaultClass::of_gateware(f), f))
+        .collect()
 }
 
 /// `hdl::RtlSim` with a design-level fault built in, as a [`Dut`] (behind
@@ -611,7 +603,7 @@ fn not_run(d: Detector, plan: &Plan) -> Option<String> {
 
 /// One judged injection: its class, level and outcome, and the work of the
 /// detectors besides the checker.
-type Judgement = (String, &'static str, Injection, Cost);
+type Judgement = (FaultClass, Level, Injection, Cost);
 
 /// The AXI4-Stream slave of every in-process run of the campaign: the worst
 /// case the mix's guarantee allows (every beat accepted in its
@@ -665,14 +657,14 @@ fn pin_injections(
             let mut dut = FaultyDut::new(s, inner, f, site.cycle);
             let j = judge_run(s, &mut dut, frames, sigrok)?;
             let level = if f == Fault::ResetGlitch {
-                "reset"
+                Level::Reset
             } else {
-                "pins"
+                Level::Pins
             };
             // a fault that found nothing to change was not injected
             Ok(dut.injected().then(|| {
                 (
-                    f.class().to_string(),
+                    FaultClass::of_pins(f),
                     level,
                     outcome(f.name(), &site, &j, engine_name(target)),
                     j.cost,
@@ -696,28 +688,25 @@ fn design_cases(s: &Schedule, sites: &[Site]) -> Vec<DesignCase> {
             design.extend(rom_cases(s, b, *site));
         }
     }
-    for (delta, class) in [(-1, "slot-wrap-early"), (1, "slot-wrap-late")] {
+    for delta in [-1, 1] {
         design.push(DesignCase {
             fault: hdl::GatewareFault::SlotWrap { delta },
             site: sites[0],
-            class,
         });
     }
     if s.grid.slices_per_frame > 1 {
-        for (delta, class) in [(-1, "slice-count-short"), (1, "slice-count-long")] {
+        for delta in [-1, 1] {
             design.push(DesignCase {
                 fault: hdl::GatewareFault::SliceWrap { delta },
                 site: sites[0],
-                class,
             });
         }
     }
     // the link stage's faults (a mix with a [link])
-    for (class, fault) in hdl::GatewareFault::link_faults(s) {
+    for (_, fault) in hdl::GatewareFault::link_faults(s) {
         design.push(DesignCase {
             fault,
             site: sites[0],
-            class,
         });
     }
     design
@@ -737,7 +726,8 @@ fn gateware_injections(
         design_cases(s, sites),
         count,
         |c| -> Result<Option<Judgement>, String> {
-            let name = format!("{}: {}", c.class, c.fault);
+            let class = FaultClass::of_gateware(c.fault);
+            let name = format!("{class}: {}", c.fault);
             // a fault the mix's gateware cannot hold (e.g. a frame too long for the full LUT)
             let Ok(sim) = hdl::RtlSim::with_fault(s, c.fault) else {
                 return Ok(None);
@@ -762,7 +752,7 @@ fn gateware_injections(
                     why: format!("no Verilog for the fault: {e}"),
                 },
             });
-            Ok(Some((c.class.to_string(), "gateware", inj, j.cost)))
+            Ok(Some((class, Level::Gateware, inj, j.cost)))
         },
     );
     Ok(runs

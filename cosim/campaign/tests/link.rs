@@ -234,7 +234,7 @@ fn is_link_port(name: &str) -> bool {
 /// rules only).  The same run without the fault passes.
 #[test]
 fn every_link_pin_fault_is_caught_by_its_detector() {
-    use campaign::faults::{Detector, TREADY};
+    use campaign::faults::{Detector, FaultClass, Level, TREADY};
     use judge::faults::{Fault, FaultyDut};
     for s in [tiny_uart(), tiny_axis()] {
         let opts = RunOptions::default();
@@ -265,7 +265,8 @@ fn every_link_pin_fault_is_caught_by_its_detector() {
                 assert!(is_link_port(&d.signal), "{class}: {} diverged", d.signal);
             }
             let rules: Vec<&str> = r.violations.iter().map(|v| v.rule.as_str()).collect();
-            let sees = Detector::Invariants.blind_to(class, "pins").is_none();
+            let kind = FaultClass::of_pins(f);
+            let sees = Detector::Invariants.blind_to(&kind, Level::Pins).is_none();
             let rule = match f {
                 Fault::LinkOverflow => Some("link-overflow"),
                 Fault::AxisTvalidDrop | Fault::AxisTdataChange => Some("axis-stable"),
@@ -289,7 +290,7 @@ fn every_link_pin_fault_is_caught_by_its_detector() {
                     );
                 }
             }
-            assert!(Detector::Sigrok.blind_to(class, "pins").is_some());
+            assert!(Detector::Sigrok.blind_to(&kind, Level::Pins).is_some());
         }
     }
 }
@@ -341,7 +342,7 @@ fn the_presets_campaigns_report_every_link_class_caught() {
             let k = c
                 .classes
                 .iter()
-                .find(|k| k.name == class)
+                .find(|k| k.name.name() == class)
                 .unwrap_or_else(|| panic!("{}: {class} not in the matrix", s.mix.name));
             assert!(k.injected > 0 && k.detected == k.injected, "{class}");
             assert_eq!(k.detected_by[&Detector::Model], k.injected, "{class}");

@@ -17,7 +17,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use campaign::faults::{campaign_with, Campaign, Detector, Plan, Target, VerilogFault};
+use campaign::faults::{
+    campaign_with, Campaign, Detector, FaultClass, Level, Plan, Target, VerilogFault,
+};
 
 use mutate::Operator;
 use testkit::mutate;
@@ -291,7 +293,7 @@ fn mutant_plan(
     plan.verilog_faults = mutate::mutants(&original, per_op)
         .into_iter()
         .map(|m| VerilogFault {
-            class: format!("mutant:{}", m.site.op.name()),
+            class: FaultClass::Mutant(m.site.op.name().into()),
             name: m.describe(),
             verilog: m.text,
         })
@@ -304,7 +306,7 @@ fn mutant_plan(
 /// check's answer (never a proof).
 fn assert_every_mutant_is_counted(c: &Campaign, plan: &Plan) {
     let mut runs = 0;
-    for k in c.classes.iter().filter(|k| k.level == "verilog") {
+    for k in c.classes.iter().filter(|k| k.level == Level::Verilog) {
         assert_eq!(
             k.detected + k.undetected.len() as u64 + k.proved_equivalent.len() as u64,
             k.injected,
@@ -353,7 +355,7 @@ fn a_few_mutants_run_through_the_campaign_on_icarus() {
     let stuck = c
         .classes
         .iter()
-        .find(|k| k.name == "mutant:stuck")
+        .find(|k| k.name == FaultClass::Mutant("stuck".into()))
         .expect("the stuck output's class");
     // measured: #0 changes a pin, #1 (a constant already all ones) is
     // proved equivalent by the miter, not dropped

@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use lut_gen::Schedule;
-use report::{Document, Section, Status, Step};
+use report::{Document, Section, Status};
+
+use super::plan::Step;
 
 /// How one step ended, with a one-line summary and optional detail.
 pub enum Outcome {
@@ -122,10 +124,10 @@ impl Job {
     }
 
     /// Records a step that was not asked for.
-    pub fn not_run(&mut self, id: &str, name: &str, why: &str) {
-        self.doc.steps.push(Step {
-            id: id.into(),
-            name: name.into(),
+    pub fn not_run(&mut self, step: Step, why: &str) {
+        self.doc.steps.push(report::Step {
+            id: step.name().into(),
+            name: step.title().into(),
             status: Status::Skipped,
             seconds: 0.0,
             summary: why.into(),
@@ -136,7 +138,8 @@ impl Job {
 
     /// Runs one step, timed; the report on disk says which step was running
     /// until it ends.
-    pub fn step(&mut self, id: &str, name: &str, f: impl FnOnce(&mut Job) -> Done) -> Status {
+    pub fn step(&mut self, step: Step, f: impl FnOnce(&mut Job) -> Done) -> Status {
+        let name = step.title();
         self.started += 1;
         self.doc.note = format!(
             "This report was written while step {} of {} ({name}) was running: the build was interrupted or is still running; the steps above are complete.",
@@ -169,8 +172,8 @@ impl Job {
             None => {}
         }
         self.doc.sections.extend(d.sections);
-        self.doc.steps.push(Step {
-            id: id.into(),
+        self.doc.steps.push(report::Step {
+            id: step.name().into(),
             name: name.into(),
             status,
             seconds,

@@ -1,4 +1,4 @@
-//! The steps of `build`, by the names `--only` and `--skip` take, each a
+//! The runners of `build`'s steps ([`Step`]), each a
 //! call into a library (`lut-gen`, `hdl`, `engines`, `campaign`, `measure`) and the
 //! writing of its files.
 
@@ -8,101 +8,8 @@ use measure::tables;
 use report::Section;
 
 use super::job::{Done, Job};
+use super::plan::{only_names, Run, Step};
 use super::{Args, Charts};
-
-/// Every step: its name on the command line and in the report.
-pub const STEPS: [(&str, &str); 12] = [
-    ("audit", "audit"),
-    ("lut", "slot LUT"),
-    ("verilog", "Verilog, ports.json, constraints"),
-    ("sim", "co-simulation"),
-    ("golden", "golden comparison"),
-    ("faults", "fault campaign"),
-    ("prove", "formal proof (all time)"),
-    ("synth", "synthesis estimate (iCE40 HX8K)"),
-    ("timing", "chart: timing of a slice"),
-    ("figure7", "chart: Figure 7 for this mix's rates"),
-    ("schedulability", "chart: where scheduling breaks"),
-    ("speed", "chart: speed against accuracy"),
-];
-
-const MIX_CHARTS: [&str; 4] = ["timing", "figure7", "schedulability", "speed"];
-
-/// Why `prove` is left out by default; a remembered proof of the same
-/// Verilog is still shown (`run_all`).
-const PROVE_OPT_IN: &str =
-    "proves for all time (minutes): --charts all or --only prove; a cached proof of the same Verilog is shown";
-
-/// Which steps run: every step with whether it runs, or why a name given
-/// is unknown (checked before anything runs).
-pub fn plan(a: &Args) -> Result<Vec<(&'static str, bool, &'static str)>, String> {
-    let known = |n: &String| STEPS.iter().any(|s| s.0 == n.trim());
-    for (flag, names) in [("--only", &a.only), ("--skip", &a.skip)] {
-        if let Some(bad) = names.iter().find(|n| !known(n)) {
-            return Err(format!(
-                "{flag}: there is no step `{bad}`; the steps are {}",
-                STEPS.iter().map(|s| s.0).collect::<Vec<_>>().join(", ")
-            ));
-        }
-    }
-    let named = |v: &Vec<String>, id: &str| v.iter().any(|n| n.trim() == id);
-    if named(&a.only, "speed") && !named(&a.only, "faults") {
-        return Err(
-            "--only speed: the chart draws this build's fault campaign; ask for both: --only faults,speed"
-                .into(),
-        );
-    }
-    let plan = STEPS
-        .iter()
-        .map(|&(id, _)| {
-            let (run, why) = if !a.only.is_empty() {
-                (named(&a.only, id), "not in --only")
-            } else if named(&a.skip, id) {
-                (false, "--skip")
-            } else if id == "prove" && a.charts != Charts::All {
-                (false, PROVE_OPT_IN)
-            } else if MIX_CHARTS.contains(&id) && a.charts == Charts::None {
-                (false, "--charts none")
-            } else {
-                (true, "")
-            };
-            (id, run, why)
-        })
-        .collect();
-    Ok(speed_needs_faults(plan))
-}
-
-/// The speed chart draws this build's fault campaign: without the faults
-/// step it is left out (said why), not skipped as if something failed.
-fn speed_needs_faults(
-    mut plan: Vec<(&'static str, bool, &'static str)>,
-) -> Vec<(&'static str, bool, &'static str)> {
-    let faults = plan.iter().any(|p| p.0 == "faults" && p.1);
-    for p in plan.iter_mut().filter(|p| p.0 == "speed" && p.1 && !faults) {
-        p.1 = false;
-        p.2 = "draws this build's fault campaign, which is left out";
-    }
-    plan
-}
-
-/// The plan's `why` of a proof left out by default but remembered.
-const REMEMBERED: &str = "remembered";
-
-/// A proof left out by default is still shown when one of the same Verilog
-/// and harness is remembered (`measure::proof::cached`).
-pub fn with_remembered_proof(
-    mut plan: Vec<(&'static str, bool, &'static str)>,
-    s: &Schedule,
-    out: &std::path::Path,
-) -> Vec<(&'static str, bool, &'static str)> {
-    for p in &mut plan {
-        if p.0 == "prove" && !p.1 && p.2 == PROVE_OPT_IN && measure::proof::cached(s, out).is_some()
-        {
-            *p = ("prove", true, REMEMBERED);
-        }
-    }
-    plan
-}
 
 /// The simulator of the co-simulation and the charts: Verilator when it is
 /// installed (the emitted Verilog), else rust-hdl.
@@ -134,42 +41,40 @@ fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
     }))
 }
 
-pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(&'static str, bool, &'static str)]) {
+pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
     let mut sim_report = None;
     let mut campaign = None;
-    let mut background = if plan.iter().any(|p| p.0 == "synth" && p.1) {
+    let mut background = if plan.contains(&(Step::Synth, Run::Yes)) {
         start_synth(&job.out, s)
     } else {
         None
     };
-    for &(id, run, why) in plan {
-        let name = STEPS.iter().find(|x| x.0 == id).map_or(id, |x| x.1);
-        if !run {
-            job.not_run(id, name, &format!("not run ({why})"));
+    for &(step, run) in plan {
+        if let Run::Skip(why) = run {
+            job.not_run(step, &format!("not run ({why})"));
             continue;
         }
-        job.step(id, name, |j| match id {
-            "audit" => audit(j, s),
-            "lut" => lut(j, s),
-            "verilog" => verilog(j, s),
-            "sim" => sim(j, a, s, &mut sim_report),
-            "golden" => golden(j, a, s),
-            "faults" => faults(j, a, s, &mut campaign),
-            "prove" if why == REMEMBERED => proved(
+        job.step(step, |j| match step {
+            Step::Audit => audit(j, s),
+            Step::Lut => lut(j, s),
+            Step::Verilog => verilog(j, s),
+            Step::Sim => sim(j, a, s, &mut sim_report),
+            Step::Golden => golden(j, a, s),
+            Step::Faults => faults(j, a, s, &mut campaign),
+            Step::Prove if run == Run::Remembered => proved(
                 measure::proof::cached(s, &j.out).ok_or("the remembered proof went away".into()),
             ),
-            "prove" => prove(j, s),
-            "synth" => synth(s, background.take()),
-            "timing" => timing(j, s),
-            "figure7" => figure7(s),
-            "schedulability" => {
+            Step::Prove => prove(j, s),
+            Step::Synth => synth(s, background.take()),
+            Step::Timing => timing(j, s),
+            Step::Figure7 => figure7(s),
+            Step::Schedulability => {
                 let (sec, line) = measure::schedulability::schedulability(s);
                 Done::ok(line)
                     .section(sec)
                     .files(&["schedulability.svg", "schedulability.csv"])
             }
-            "speed" => speed(campaign.as_ref()),
-            _ => unreachable!("every step has a runner"),
+            Step::Speed => speed(campaign.as_ref()),
         });
     }
 }
@@ -402,7 +307,7 @@ fn fault_plan(a: &Args, s: &Schedule) -> Result<campaign::faults::Plan, String> 
 
 /// Every site and five clean mixes, rather than the quick default.
 fn full_campaign(a: &Args) -> bool {
-    a.thorough || a.charts == Charts::All || a.only.iter().any(|n| n.trim() == "faults")
+    a.thorough || a.charts == Charts::All || only_names(a, Step::Faults)
 }
 
 fn faults(

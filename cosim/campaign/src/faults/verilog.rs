@@ -15,7 +15,7 @@ use judge::run::reset_cycles;
 use lut_gen::Schedule;
 use serde::Serialize;
 
-use super::{parallel, Cost, Detector, Injection, Judged, Judgement, Runs};
+use super::{parallel, Cost, Detector, FaultClass, Injection, Judged, Judgement, Level, Runs};
 use crate::equiv::Equivalence;
 use crate::sigrok::SpiCapture;
 use engines::options::{Backend, SimOptions};
@@ -24,7 +24,7 @@ use engines::options::{Backend, SimOptions};
 #[derive(Debug, Clone)]
 pub struct VerilogFault {
     /// The class it is counted in (e.g. `mutant:relop`, `rare-collision`).
-    pub class: String,
+    pub class: FaultClass,
     /// What was changed, for the report.
     pub name: String,
     pub verilog: String,
@@ -41,11 +41,9 @@ pub fn deep_faults(s: &Schedule, frames: u64) -> Result<Vec<VerilogFault>, Strin
     ]
     .into_iter()
     .map(|f| {
-        let name = f.name();
-        let class = name.split('@').next().unwrap_or(&name).to_string();
         Ok(VerilogFault {
-            class,
-            name,
+            class: FaultClass::of_deep(f),
+            name: f.name(),
             verilog: f.apply(s, &clean)?,
         })
     })
@@ -165,7 +163,7 @@ pub(super) fn verilog_injections(
             slot: 0,
         };
         let inj = super::outcome(f.name.clone(), &site, &j, e.name());
-        Ok(Some((f.class.clone(), "verilog", inj, j.cost)))
+        Ok(Some((f.class.clone(), Level::Verilog, inj, j.cost)))
     });
     let mut out: Vec<Judgement> = runs
         .into_iter()
