@@ -42,7 +42,7 @@ fn the_reference_design_sample_count_is_the_binarys() {
 /// eskin34's row of the current synthesis table of docs/performance.md.
 fn eskin34_row() -> String {
     let perf = doc("docs/performance.md");
-    let current = perf.split("### Converter parts").nth(1).unwrap();
+    let current = perf.split("## Gateware synthesis").nth(1).unwrap();
     let row = current.lines().find(|l| l.starts_with("| eskin34 |"));
     row.expect("an eskin34 row in docs/performance.md")
         .to_string()
