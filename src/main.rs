@@ -1,6 +1,6 @@
 //! `slotforge`: a thin CLI over the lut-gen, hdl, engines and campaign crates.
 //!
-//! Exit codes follow SPEC: 0 success, 1 infeasible / divergence / difference,
+//! Exit codes: 0 success, 1 infeasible / divergence / difference,
 //! 2 bad input (always with file, line and field where there is one).
 
 use std::process::ExitCode;

@@ -26,7 +26,7 @@ const SMALL: &str =
 [[channel]]\nname = \"x\"\nbranch = \"a\"\nrate_hz = 1_000\n";
 
 #[test]
-fn audit_reference_json_has_the_spec_fields() {
+fn audit_reference_json_has_the_documented_fields() {
     let out = slotforge()
         .args(["audit", "--json"])
         .arg(preset("eskin34.toml"))

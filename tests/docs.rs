@@ -1,6 +1,7 @@
 //! Figures in the docs that the binary computes must be what it prints
 //! (issue 19, item 5): a document that drifts from the tool fails here.
 
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::common_cli::root;
@@ -42,7 +43,7 @@ fn the_reference_design_sample_count_is_the_binarys() {
 /// eskin34's row of the current synthesis table of docs/performance.md.
 fn eskin34_row() -> String {
     let perf = doc("docs/performance.md");
-    let current = perf.split("### Converter parts").nth(1).unwrap();
+    let current = perf.split("## Gateware synthesis").nth(1).unwrap();
     let row = current.lines().find(|l| l.starts_with("| eskin34 |"));
     row.expect("an eskin34 row in docs/performance.md")
         .to_string()
@@ -129,4 +130,141 @@ fn the_reference_design_audit_figures_are_the_binarys() {
         );
     }
     assert!(uart.lines().any(|l| l.starts_with("link: ")), "{uart}");
+}
+
+/// The repository's tracked files (relative paths): `git ls-files`, or,
+/// outside a git checkout, every file but build output and `.git`.
+fn tracked_files() -> Vec<PathBuf> {
+    let git = Command::new("git")
+        .args(["ls-files", "-z"])
+        .current_dir(root())
+        .output();
+    match git {
+        Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout)
+            .split('\0')
+            .filter(|p| !p.is_empty())
+            .map(PathBuf::from)
+            .filter(|p| root().join(p).is_file())
+            .collect(),
+        _ => walk(&root(), Path::new("")),
+    }
+}
+
+/// Files under `dir`, relative to the root, skipping what a build writes.
+fn walk(base: &Path, rel: &Path) -> Vec<PathBuf> {
+    let skip = [".git", "target", "out", "build", "prove-out"];
+    let mut files = Vec::new();
+    for e in std::fs::read_dir(base.join(rel)).unwrap().flatten() {
+        let r = rel.join(e.file_name());
+        if e.path().is_dir() {
+            if !skip.iter().any(|s| Path::new(s) == r) {
+                files.extend(walk(base, &r));
+            }
+        } else {
+            files.push(r);
+        }
+    }
+    files
+}
+
+/// Markdown text with fenced code blocks and inline code spans blanked, so
+/// that code that looks like a link is not taken for one.
+fn prose(md: &str) -> String {
+    let mut out = String::new();
+    let mut fenced = false;
+    for line in md.lines() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced {
+            let mut code = false;
+            for part in line.split('`') {
+                if !code {
+                    out.push_str(part);
+                }
+                out.push(' ');
+                code = !code;
+            }
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The targets of the inline links `[text](target)` (and images) of `md`.
+fn link_targets(md: &str) -> Vec<String> {
+    let text = prose(md);
+    let mut targets = Vec::new();
+    for (i, _) in text.match_indices("](") {
+        let rest = &text[i + 2..];
+        if let Some(end) = rest.find(')') {
+            let t = rest[..end].split_whitespace().next().unwrap_or("");
+            targets.push(t.to_string());
+        }
+    }
+    targets
+}
+
+/// The relative links of one Markdown file that name no existing file.
+fn broken_links(md: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(root().join(md)).unwrap();
+    let dir = md.parent().unwrap_or(Path::new(""));
+    link_targets(&text)
+        .into_iter()
+        .filter(|t| {
+            let external = ["http://", "https://", "mailto:"];
+            !t.is_empty() && !t.starts_with('#') && !external.iter().any(|p| t.starts_with(p))
+        })
+        .filter(|t| {
+            let file = t.split('#').next().unwrap();
+            !root().join(dir).join(file).exists()
+        })
+        .map(|t| format!("{}: ({t})", md.display()))
+        .collect()
+}
+
+/// Every relative link in every tracked Markdown file (README,
+/// ARCHITECTURE, CHANGELOG, docs/, the crates' folders) names a file that
+/// exists; `#anchor` parts are not checked.
+#[test]
+fn every_relative_markdown_link_resolves() {
+    let mds: Vec<PathBuf> = tracked_files()
+        .into_iter()
+        .filter(|p| p.extension().is_some_and(|e| e == "md"))
+        .collect();
+    assert!(mds.iter().any(|p| p == Path::new("README.md")), "{mds:?}");
+    let broken: Vec<String> = mds.iter().flat_map(|m| broken_links(m)).collect();
+    assert!(
+        broken.is_empty(),
+        "{} broken relative links:\n{}",
+        broken.len(),
+        broken.join("\n")
+    );
+}
+
+/// The product names no file its users lack: the project's private notes
+/// and sources live outside the repository.
+#[test]
+fn no_tracked_file_points_outside_the_repository() {
+    // spelt in pieces so that this file does not match itself
+    let banned = [
+        concat!("SPEC", ".md"),
+        concat!("../", "shared"),
+        concat!("shared/", "seeds"),
+    ];
+    let mut hits = Vec::new();
+    for f in tracked_files() {
+        let Ok(text) = std::fs::read_to_string(root().join(&f)) else {
+            continue; // not text
+        };
+        for (n, line) in text.lines().enumerate() {
+            if let Some(b) = banned.iter().find(|b| line.contains(*b)) {
+                hits.push(format!("{}:{}: {b}", f.display(), n + 1));
+            }
+        }
+    }
+    assert!(
+        hits.is_empty(),
+        "references to files users lack:\n{}",
+        hits.join("\n")
+    );
 }

@@ -1,4 +1,4 @@
-//! `slotforge prove`: exit codes and JSON (SPEC: 0 proved, 1 counterexample,
+//! `slotforge prove`: exit codes and JSON (docs/json.md: 0 proved, 1 counterexample,
 //! 2 bad input, 3 bounded only; `result`, `depth`, `properties`, `seconds`,
 //! `counterexample`, `cycle`).  On the tiny mix (a 4,000-cycle frame).
 
@@ -116,7 +116,7 @@ fn rtl_off_the_port_contract_exits_2() {
 }
 
 #[test]
-fn proved_json_has_specs_keys_and_exit_0() {
+fn proved_json_has_its_keys_and_exit_0() {
     if !tools::require_tools(&["yosys", "yosys-abc"]) {
         return;
     }

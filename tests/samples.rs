@@ -1,5 +1,5 @@
-//! `slotforge sim --stimulus sine:HZ --samples F.csv`: the CSV has SPEC's
-//! header and one row per sample of the run, and a tone above a channel's
+//! `slotforge sim --stimulus sine:HZ --samples F.csv`: the CSV has the
+//! documented header and one row per sample of the run, and a tone above a channel's
 //! Nyquist frequency shows in its samples at the aliased frequency; every
 //! back end writes the same samples.
 

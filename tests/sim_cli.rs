@@ -1,5 +1,5 @@
 //! End-to-end tests of `slotforge sim` and `slotforge check`: every back end
-//! passes with SPEC's JSON, a VCD written by `sim --vcd` passes `check` and
+//! passes with the documented JSON, a VCD written by `sim --vcd` passes `check` and
 //! its corrupted copies fail with the divergence named, and bad input of any
 //! kind exits 2 with a message and no panic.
 
@@ -15,7 +15,7 @@ fn eskin34() -> PathBuf {
 use crate::common_cli::{root, sim_window, slotforge, tiny};
 use crate::{progress, tools};
 
-/// Runs `sim --json` and checks SPEC's fields; returns the report.
+/// Runs `sim --json` and checks its documented fields; returns the report.
 fn sim_json(mix: &Path, backend: &str, frames: u64) -> serde_json::Value {
     let out = slotforge()
         .arg("sim")

@@ -54,7 +54,7 @@ pub enum Outcome {
 }
 
 impl Outcome {
-    /// SPEC's exit code: 0 proved, 1 counterexample, 3 bounded only.
+    /// `prove`'s exit code: 0 proved, 1 counterexample, 3 bounded only.
     pub fn exit_code(self) -> u8 {
         match self {
             Outcome::Proved => 0,
@@ -111,7 +111,7 @@ pub struct Proof {
     /// What the result means, in words.
     pub note: String,
     pub counterexample: Option<Counterexample>,
-    /// `counterexample.cycle`, repeated at the top level as SPEC asks.
+    /// `counterexample.cycle`, repeated at the top level (docs/json.md).
     pub cycle: Option<i64>,
 }
 

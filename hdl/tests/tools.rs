@@ -121,7 +121,7 @@ fn gates_branch_count_mixes() {
     }
 }
 
-/// Converter parts (issue 10): the seed-000 AD7685 chain, a user-declared
+/// Converter parts (issue 10): vibrotactile8k's AD7685 chain, a user-declared
 /// 12-bit CS part, and a mix of a chain behind a mux, a lone AD7685 and an
 /// AD7940 on one clock.
 #[test]

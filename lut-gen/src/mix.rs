@@ -67,7 +67,7 @@ pub struct Mix {
     pub link: Option<LinkSpec>,
 }
 
-/// `[link]`: how the samples leave the FPGA (SPEC, "The link to the host").
+/// `[link]`: how the samples leave the FPGA (docs/packet-format.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LinkSpec {
     pub kind: LinkKind,

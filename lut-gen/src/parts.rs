@@ -2,8 +2,8 @@
 //! generator, the ADC model and the checker all read, and the cycle-level SPI
 //! timing derived from them.
 //!
-//! Sources: `shared/notes/datasheets.md` (AD7940, AD7685, TMUX1108).  Numbers
-//! marked "(check)" there stay parameters here rather than constants in logic.
+//! Sources: the AD7940, AD7685 and TMUX1108 datasheets.  Numbers not
+//! confirmed there stay parameters here rather than constants in logic.
 //! A mix may declare its own parts (`[[adc_part]]`, `crate::mix`); they use
 //! the same two conversion styles ([`Start`]).
 

@@ -635,8 +635,8 @@ impl Layout {
 }
 
 /// `ports.json`: every port bit's role, so that any tool finds a branch's
-/// signals without guessing names (SPEC's shape plus `mix`, `clock_hz`, the
-/// port list and each branch's SPI numbers).
+/// signals without guessing names (`mix`, `clock_hz`, the port list and each
+/// branch's SPI numbers; docs/ports.md).
 pub fn manifest(s: &Schedule) -> String {
     use serde_json::json;
     let l = Layout::new(s);

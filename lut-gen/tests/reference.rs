@@ -1,4 +1,4 @@
-//! The reference design (seed 003) must reproduce the paper's Table 1.
+//! The reference design (the paper's e-skin) must reproduce the paper's Table 1.
 
 use std::path::Path;
 

@@ -8,7 +8,7 @@ use lut_gen::AuditReport;
 pub struct Args {
     /// The channel-mix file (TOML).
     pub mix: PathBuf,
-    /// Print the SPEC's JSON report instead of the table.
+    /// Print the report as JSON instead of the table.
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]

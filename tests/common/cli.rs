@@ -32,7 +32,7 @@ pub fn record_golden(dir: &Path) {
 }
 
 /// `dir/name`: `sim --vcd` of 3 frames of the tiny mix on the rusthdl back
-/// end over `[from, to)` (SPEC's bounds).
+/// end over `[from, to)`.
 pub fn sim_window(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
     let wave = dir.join(name);
     slotforge()

@@ -14,7 +14,7 @@
 //! are zero in both copies (`setundef -zero`), as synthesis would pick one
 //! value for both.  Only an answer counts: "undecided" is not a proof.
 //! (`miter -ignore_gold_x` is not used: with it, a slot-ROM word of another
-//! channel was "proved" equivalent; `cosim/tests/equiv.rs` keeps that case.)
+//! channel was "proved" equivalent; `cosim/campaign/tests/equiv.rs` keeps that case.)
 
 use std::path::Path;
 use std::time::Duration;

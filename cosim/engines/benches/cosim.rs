@@ -1,5 +1,5 @@
 //! Side-by-side throughput ratios (not a timed test):
-//!   cargo bench -p cosim --bench cosim [-- FRAMES]
+//!   cargo bench -p engines --bench cosim [-- FRAMES]
 //!
 //! - 1: verilator back end with full checking vs the same verilated model stepped unchecked;
 //! - 2: rusthdl back end with full checking vs hdl::RtlSim stepped unchecked;

@@ -1,5 +1,5 @@
 //! Writes the icarus back end's testbench for a mix into a directory, to run it by hand:
-//! `cargo run -p cosim --example icarus_tb -- MIX DIR [CYCLES [STIMULUS]]`, then
+//! `cargo run -p engines --example icarus_tb -- MIX DIR [CYCLES [STIMULUS]]`, then
 //! `iverilog -g2005 -o sim.vvp tb.v slotforge_top.v && vvp -n sim.vvp` in DIR.
 fn main() {
     let a: Vec<String> = std::env::args().collect();

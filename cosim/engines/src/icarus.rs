@@ -1,5 +1,5 @@
 //! The Icarus back end: the emitted `slotforge_top.v` in Icarus Verilog with
-//! a Verilog AD7940 per branch (`cosim/tb/adc_tb.v.in`), run by `vvp` into a
+//! a Verilog AD7940 per branch (`cosim/engines/tb/adc_tb.v.in`), run by `vvp` into a
 //! temporary VCD that the streaming VCD checker then reads (every invariant
 //! and cycle-exact equality with the reference model), like any waveform
 //! handed to `slotforge check`.

@@ -1,5 +1,5 @@
 //! The `icarus` back end: the emitted Verilog in Icarus with a Verilog
-//! AD7940 model (cosim/tb/adc_tb.v.in); its VCD must pass the checker, and
+//! AD7940 model (cosim/engines/tb/adc_tb.v.in); its VCD must pass the checker, and
 //! its ADCs must give the codes of cosim's own ADC model.
 
 use std::path::{Path, PathBuf};

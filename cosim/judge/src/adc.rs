@@ -9,7 +9,7 @@
 //!   falling edge; after the last word the first part's SDI (tied low)
 //!   follows, so the line reads 0.
 //!
-//! Datasheet edges (shared/notes/datasheets.md): bit 0 is driven after CS
+//! Datasheet edges (the AD7940's): bit 0 is driven after CS
 //! falls, bit `i` after SCLK falling edge `i`, the line is invalid from 10 ns
 //! (t7, hold) to 80..120 ns (t4, access) after each falling edge and high-Z
 //! from 45 ns (t8) after falling edge 16.  [`Adc::drive`] works at cycle level

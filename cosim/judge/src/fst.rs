@@ -8,7 +8,7 @@
 //! lock) then holds for FST without a second copy.  The VCD goes to a
 //! temporary file streamed change by change (wellen streams FST blocks), so
 //! memory stays flat in the file size.  `wellen` may panic on a malformed
-//! file (shared/notes/waveforms.md): that is caught and reported as a bad
+//! file: that is caught and reported as a bad
 //! file.
 
 use std::fmt::Write as _;

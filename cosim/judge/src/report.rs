@@ -1,4 +1,5 @@
-//! The check report, serializable to SPEC's `sim --json` / `check --json`.
+//! The check report, serializable to `sim --json` / `check --json`
+//! (the fields: docs/json.md).
 
 use serde::Serialize;
 use serde_json::Value;

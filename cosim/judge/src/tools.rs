@@ -2,7 +2,7 @@
 //! sigrok-cli): spawn with a time limit, tell "not installed" apart from "ran
 //! and failed", keep the output for the report; and [`present`], the one
 //! test of whether a tool is installed (the build's steps, `prove`'s
-//! engines and the tests' tool policy, `tests/common/tools.rs`, ask it).
+//! engines and the tests' tool policy, `testkit/src/tools.rs`, ask it).
 //! It lives in the judge, the lowest crate that runs a tool (sigrok-cli for
 //! `.sr` captures), so every crate above and every test binary can reach it.
 

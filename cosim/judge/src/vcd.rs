@@ -5,7 +5,7 @@
 //! the file size) rather than the `vcd` or `wellen` crates: `vcd` 0.7 rejects
 //! legal forms (`$var logic`, other scope types, long identifier codes) and
 //! `wellen` panics on some malformed values and silently drops steps where
-//! time goes backwards (shared/notes/waveforms.md); every malformed input here
+//! time goes backwards; every malformed input here
 //! must be a clear error instead.
 //!
 //! Rules:

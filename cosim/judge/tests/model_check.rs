@@ -251,7 +251,7 @@ fn preset(name: &str) -> lut_gen::Schedule {
     lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap()
 }
 
-/// Seed 000: four chained AD7685s (CNV style): the model's pins, the chain's
+/// vibrotactile8k: four chained AD7685s (CNV style): the model's pins, the chain's
 /// ADC model and the checker agree, every member is sampled at the same
 /// instants, and every chained word reaches the sample stream.
 #[test]
