@@ -31,13 +31,13 @@ pub enum Rule {
     AxisStable,
     /// An AXI4-Stream packet's TLAST misplaced.
     AxisTlast,
-    /// The link's overflow flag rose.
+    /// The link's FIFO overflow flag rose.
     LinkOverflow,
-    /// The link's overflow counter moved.
+    /// A packet's trailer reports tokens dropped by the link's FIFO.
     LinkOverflowCount,
     /// More than one mux select line active.
     MuxExclusive,
-    /// The mux selected another channel than scheduled.
+    /// No valid mux selection (device enable and select) at a sampling instant.
     MuxSelect,
     /// The mux had too few cycles to settle before a conversion.
     MuxSettle,
@@ -55,7 +55,7 @@ pub enum Rule {
     SclkCount,
     /// No cycle after a released reset.
     NoCycles,
-    /// The design misbehaved in reset.
+    /// Reset asserted again after it was released (checking stops).
     Reset,
     /// A slice's packet did not arrive in time.
     LinkPacketMissing,
@@ -65,13 +65,13 @@ pub enum Rule {
     LinkFraming,
     /// A packet's CRC did not match.
     LinkCrc,
-    /// The decoder resynchronised on the line.
+    /// A byte where the packet format puts none: the decoder lost its place.
     LinkResync,
     /// A packet's sequence number out of order.
     LinkSequence,
-    /// The design reported packets lost.
+    /// A packet never came: the next good packet on the line is a later one.
     LinkPacketLost,
-    /// A packet's samples differ from the conversions of its slice.
+    /// A packet's records differ from the samples emitted in its slice.
     LinkSamples,
 }
 
