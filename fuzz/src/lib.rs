@@ -230,9 +230,26 @@ pub struct Config {
     pub max_hangs: u64,
 }
 
+/// How an input broke the code under test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CrashKind {
+    Panic,
+    /// No result within the time limit.
+    Hang,
+}
+
+impl fmt::Display for CrashKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            CrashKind::Panic => "panic",
+            CrashKind::Hang => "hang",
+        })
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct Crash {
-    pub kind: &'static str,
+    pub kind: CrashKind,
     pub index: u64,
     pub file: PathBuf,
     pub seed: PathBuf,
@@ -421,7 +438,7 @@ pub fn run(cfg: &Config, seeds: Vec<Seed>) -> Summary {
             }
             Ok(Reply::Panic(m)) => {
                 sum.panics += 1;
-                ("panic", m)
+                (CrashKind::Panic, m)
             }
             Err(_) => {
                 sum.hangs += 1;
@@ -429,7 +446,10 @@ pub fn run(cfg: &Config, seeds: Vec<Seed>) -> Summary {
                 workers += 1;
                 w = spawn_worker(cfg.target, seeds.clone(), workers);
                 scratches.push(w.scratch.clone());
-                ("hang", format!("no result within {:?}", cfg.timeout))
+                (
+                    CrashKind::Hang,
+                    format!("no result within {:?}", cfg.timeout),
+                )
             }
         };
         let file = save(cfg, &bytes);
