@@ -4,7 +4,8 @@
 //! `docs/performance.md` come from the same commands.
 
 use std::path::Path;
-use std::process::Command;
+
+use judge::tools::Tool;
 
 /// What place and route reported.
 #[derive(Debug, Clone, PartialEq)]
@@ -24,7 +25,7 @@ pub struct Synth {
 /// `pcf` the pins are placed as the board file says; without, IO is left
 /// unconstrained (the estimate does not depend on a board).
 pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<Synth, String> {
-    let y = Command::new("yosys")
+    let y = Tool::new("yosys")
         .current_dir(dir)
         .args(["-q", "-l", "yosys.log", "-p"])
         .arg(format!(
@@ -32,17 +33,17 @@ pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<
             hdl::VERILOG_FILE,
             lut_gen::ports::TOP_MODULE,
         ))
-        .output()
+        .run()
         .map_err(|e| format!("yosys could not be started: {e}"))?;
-    if !y.status.success() {
+    if !y.success {
         return Err(format!(
             "yosys failed (see {}):\n{}",
             dir.join("yosys.log").display(),
-            String::from_utf8_lossy(&y.stderr)
+            y.stderr
         ));
     }
-    let mut n = Command::new("nextpnr-ice40");
-    n.current_dir(dir)
+    let n = Tool::new("nextpnr-ice40")
+        .current_dir(dir)
         .args(["--hx8k", "--package", "ct256", "--json", "slotforge.json"])
         .args([
             "--seed",
@@ -54,7 +55,7 @@ pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<
         ])
         .arg("--freq")
         .arg(format!("{}", clock_hz as f64 / 1e6));
-    match pcf {
+    let n = match pcf {
         // nextpnr runs in `dir`: a relative path is the caller's, so it
         // goes absolute first (hdl/synth.sh passes target/synth/<mix>/...)
         Some(p) => n
@@ -63,15 +64,11 @@ pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<
         None => n.arg("--pcf-allow-unconstrained"),
     };
     let n = n
-        .output()
+        .run()
         .map_err(|e| format!("nextpnr-ice40 could not be started: {e}"))?;
-    let log = format!(
-        "{}{}",
-        String::from_utf8_lossy(&n.stdout),
-        String::from_utf8_lossy(&n.stderr)
-    );
+    let log = format!("{}{}", n.stdout, n.stderr);
     let _ = std::fs::write(dir.join("nextpnr.log"), &log);
-    if !n.status.success() {
+    if !n.success {
         let tail: Vec<&str> = log.lines().rev().take(20).collect();
         return Err(format!(
             "nextpnr-ice40 failed (see {}):\n{}",

@@ -6,10 +6,10 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use judge::run::{run_dut, Dut, Observer, RunOptions};
 use judge::timed::{check_capture, TimedReport};
+use judge::tools::Tool;
 use judge::vcdout::{id_code, wire_header};
 use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
@@ -171,7 +171,7 @@ pub fn to_sigrok(vcd: &Path, ts_ps: u64) -> (PathBuf, PathBuf) {
     let sr = vcd.with_extension("sr");
     let downsample = format!("vcd:downsample={ts_ps}");
     sigrok_cli(
-        Command::new("sigrok-cli")
+        Tool::new("sigrok-cli")
             .arg("-i")
             .arg(vcd)
             .args(["-I", &downsample, "-o"])
@@ -179,7 +179,7 @@ pub fn to_sigrok(vcd: &Path, ts_ps: u64) -> (PathBuf, PathBuf) {
     );
     let back = vcd.with_extension("sigrok.vcd");
     sigrok_cli(
-        Command::new("sigrok-cli")
+        Tool::new("sigrok-cli")
             .arg("-i")
             .arg(&sr)
             .args(["-O", "vcd", "-o"])
@@ -188,14 +188,11 @@ pub fn to_sigrok(vcd: &Path, ts_ps: u64) -> (PathBuf, PathBuf) {
     (sr, back)
 }
 
-/// Runs a sigrok-cli command to completion; a failure shows its stderr.
-fn sigrok_cli(cmd: &mut Command) {
-    let out = cmd.output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+/// Runs sigrok-cli (through the tool runner) to completion; a failure
+/// shows its stderr.
+fn sigrok_cli(tool: Tool) {
+    let out = tool.run().unwrap();
+    assert!(out.success, "{}", out.stderr);
 }
 
 pub fn check(s: &Schedule, map: &str, file: &Path) -> TimedReport {

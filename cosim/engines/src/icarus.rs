@@ -16,11 +16,11 @@ use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{BufRead, BufReader, BufWriter, Write};
 use std::path::Path;
-use std::process::Command;
 
 use lut_gen::Schedule;
 
 use judge::adc::{Analog, Stimulus};
+use judge::tools::{Tool, ToolError};
 use judge::vcd::CycleSink;
 use judge::vcdout::edge_ps;
 use judge::Report;
@@ -407,25 +407,25 @@ fn tool_missing(tool: &str) -> BackendError {
     }
 }
 
-fn spawn(cmd: &mut Command, tool: &str, step: &str) -> Result<(), BackendError> {
-    let out = cmd.output().map_err(|e| {
-        if e.kind() == std::io::ErrorKind::NotFound {
-            tool_missing(tool)
-        } else {
-            BackendError::Io(format!("{tool}: {e}"))
-        }
-    })?;
-    if out.status.success() {
+/// Runs `tool` through the tool runner: missing, it is named with how to
+/// install it; failing, its output is the log of `step`.
+fn spawn(tool: Tool, step: &str) -> Result<(), BackendError> {
+    let out = tool.run().map_err(not_run)?;
+    if out.success {
         Ok(())
     } else {
         Err(BackendError::Build {
             step: step.into(),
-            log: format!(
-                "{}{}",
-                String::from_utf8_lossy(&out.stdout),
-                String::from_utf8_lossy(&out.stderr)
-            ),
+            log: out.stdout + &out.stderr,
         })
+    }
+}
+
+/// Why a tool gave no answer, as the back end says it.
+fn not_run(e: ToolError) -> BackendError {
+    match e {
+        ToolError::Missing(tool) => tool_missing(&tool),
+        e => BackendError::Io(e.to_string()),
     }
 }
 
@@ -443,13 +443,7 @@ pub fn run(
     let io = |e: std::io::Error| SimError::Io(format!("icarus back end: {e}"));
     // Name the missing tool before doing any work.
     for tool in ["iverilog", "vvp"] {
-        if let Err(e) = Command::new(tool).arg("-V").output() {
-            return Err(if e.kind() == std::io::ErrorKind::NotFound {
-                tool_missing(tool).into()
-            } else {
-                BackendError::Io(format!("{tool}: {e}")).into()
-            });
-        }
+        Tool::new(tool).arg("-V").run().map_err(not_run)?;
     }
     let dir = tempfile::Builder::new()
         .prefix("slotforge-icarus-")
@@ -473,7 +467,7 @@ pub fn run(
         std::fs::write(d.join(name), text).map_err(io)?;
     }
     spawn(
-        Command::new("iverilog")
+        Tool::new("iverilog")
             .args([
                 "-g2005",
                 "-s",
@@ -484,12 +478,10 @@ pub fn run(
                 hdl::VERILOG_FILE,
             ])
             .current_dir(d),
-        "iverilog",
         "iverilog (compiling the emitted Verilog and the testbench)",
     )?;
     spawn(
-        Command::new("vvp").args(["-n", "sim.vvp"]).current_dir(d),
-        "vvp",
+        Tool::new("vvp").args(["-n", "sim.vvp"]).current_dir(d),
         "vvp (running the simulation)",
     )?;
     let wave = d.join("wave.vcd");

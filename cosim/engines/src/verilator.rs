@@ -7,12 +7,11 @@
 //! the Verilog, the shim and the `verilator --version` / `g++ --version`
 //! banners, so a second run does not rebuild.
 
+use judge::run::Dut;
+use judge::tools::Tool;
+use lut_gen::ports::{LinkPort, Pins, Role, AXIS_PORTS, LINK_PORTS, TOP_MODULE};
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-use judge::run::Dut;
-use lut_gen::ports::{LinkPort, Pins, Role, AXIS_PORTS, LINK_PORTS, TOP_MODULE};
 
 use crate::error::BackendError;
 
@@ -172,15 +171,11 @@ pub fn fnv64(parts: &[&[u8]]) -> u64 {
 }
 
 fn tool_version(tool: &str, hint: &str) -> Result<String, BackendError> {
-    match Command::new(tool).arg("--version").output() {
-        Ok(o) if o.status.success() => Ok(String::from_utf8_lossy(&o.stdout)
-            .lines()
-            .next()
-            .unwrap_or("")
-            .to_string()),
+    match Tool::new(tool).arg("--version").run() {
+        Ok(o) if o.success => Ok(o.stdout.lines().next().unwrap_or("").to_string()),
         Ok(o) => Err(BackendError::Build {
             step: format!("{tool} --version"),
-            log: String::from_utf8_lossy(&o.stderr).into(),
+            log: o.stderr,
         }),
         Err(_) => Err(BackendError::MissingTool {
             tool: tool.into(),
@@ -203,16 +198,15 @@ pub fn cache_root() -> PathBuf {
     std::env::temp_dir().join("slotforge-cache")
 }
 
-fn run(cmd: &mut Command, step: &str) -> Result<(), BackendError> {
-    let o = cmd
-        .output()
+/// Runs one build step through the tool runner; a failure carries its output.
+fn run(tool: Tool, step: &str) -> Result<(), BackendError> {
+    let o = tool
+        .run()
         .map_err(|e| BackendError::Io(format!("{step}: {e}")))?;
-    if !o.status.success() {
-        let mut log = String::from_utf8_lossy(&o.stdout).into_owned();
-        log.push_str(&String::from_utf8_lossy(&o.stderr));
+    if !o.success {
         return Err(BackendError::Build {
             step: step.into(),
-            log,
+            log: o.stdout + &o.stderr,
         });
     }
     Ok(())
@@ -226,10 +220,9 @@ fn compile_all(
     includes: &[PathBuf],
 ) -> Result<(), BackendError> {
     let compile = |src: &Path, out: &Path| {
-        let mut cmd = Command::new("g++");
-        cmd.args(["-c", "-fPIC", "-O2", "-std=gnu++17", "-w"]);
+        let mut cmd = Tool::new("g++").args(["-c", "-fPIC", "-O2", "-std=gnu++17", "-w"]);
         for i in includes {
-            cmd.arg("-I").arg(i);
+            cmd = cmd.arg("-I").arg(i);
         }
         run(
             cmd.arg(src).arg("-o").arg(out),
@@ -364,7 +357,7 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
     // Verilator's own runtime is the same for every model: compiled once.
     let runtime = runtime_objects(&inc, &format!("{vv}{gv}"))?;
     run(
-        Command::new("g++")
+        Tool::new("g++")
             .args(["-shared", "-o"])
             .arg(tmp.join(format!("lib{TOP_MODULE}.so")))
             .args(&objects)
@@ -394,7 +387,7 @@ fn build_dir(key: &str) -> PathBuf {
 /// Verilator's C++ model of `tmp`'s top, into `obj`.
 fn verilate(tmp: &Path, obj: &Path) -> Result<(), BackendError> {
     run(
-        Command::new("verilator")
+        Tool::new("verilator")
             .args([
                 "--cc",
                 "-O3",
@@ -417,11 +410,11 @@ fn verilate(tmp: &Path, obj: &Path) -> Result<(), BackendError> {
 
 /// Verilator's `include` directory.
 fn verilator_include() -> Result<PathBuf, BackendError> {
-    let root = Command::new("verilator")
+    let root = Tool::new("verilator")
         .args(["--getenv", "VERILATOR_ROOT"])
-        .output()
+        .run()
         .map_err(|e| BackendError::Io(e.to_string()))?;
-    let root = PathBuf::from(String::from_utf8_lossy(&root.stdout).trim());
+    let root = PathBuf::from(root.stdout.trim());
     Ok(root.join("include"))
 }
 

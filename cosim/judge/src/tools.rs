@@ -1,12 +1,16 @@
-//! The one runner of the external checking tools (yosys, yosys-abc,
-//! sigrok-cli): spawn with a time limit, tell "not installed" apart from "ran
-//! and failed", keep the output for the report; and [`present`], the one
-//! test of whether a tool is installed (the build's steps, `prove`'s
-//! engines and the tests' tool policy, `testkit/src/tools.rs`, ask it).
-//! It lives in the judge, the lowest crate that runs a tool (sigrok-cli for
-//! `.sr` captures), so every crate above and every test binary can reach it.
+//! The one runner of the external tools (verilator, g++, iverilog, vvp,
+//! yosys, yosys-abc, nextpnr-ice40, sigrok-cli, cvc5): spawn, in a working
+//! directory and with a time limit when asked, tell "not installed" apart
+//! from "ran and failed", keep the output for the report; and [`present`],
+//! the one test of whether a tool is installed (the build's steps, `prove`'s
+//! engines and the tests' tool policy, `testkit::tools`, ask it).  It lives
+//! in the judge, the lowest crate that runs a tool (sigrok-cli for `.sr`
+//! captures), so every crate above and every test binary can reach it.
 
-use std::path::Path;
+use std::ffi::{OsStr, OsString};
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -52,46 +56,188 @@ pub fn present(tool: &str) -> bool {
 }
 
 /// Runs `tool args` in `dir`, stopped after `limit`.  Output goes to files
-/// in `dir` (not pipes), so a chatty tool cannot block on a full pipe.
+/// in `dir` (`<tool>.stdout`, `<tool>.stderr`), kept beside the work.
 pub fn run(
     tool: &str,
     args: &[&str],
     dir: &Path,
     limit: Duration,
 ) -> Result<ToolOutput, ToolError> {
-    let io = |e: std::io::Error| ToolError::Io(format!("{tool}: {e}"));
-    let out_path = dir.join(format!("{tool}.stdout"));
-    let err_path = dir.join(format!("{tool}.stderr"));
-    let t0 = Instant::now();
-    let mut child = match Command::new(tool)
+    Tool::new(tool)
         .args(args)
         .current_dir(dir)
-        .stdin(Stdio::null())
-        .stdout(std::fs::File::create(&out_path).map_err(io)?)
-        .stderr(std::fs::File::create(&err_path).map_err(io)?)
-        .spawn()
-    {
-        Ok(c) => c,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(ToolError::Missing(tool.into()))
+        .timeout(limit)
+        .output_in(dir)
+        .run()
+}
+
+/// One run of a tool: its arguments, where it runs, how long it may take
+/// and where its output goes.  Output goes to files, never pipes, so a
+/// chatty tool cannot block on a full pipe: anonymous temporary files
+/// unless [`Tool::output_in`] names a folder to keep them in.
+#[derive(Debug, Clone)]
+pub struct Tool {
+    program: String,
+    args: Vec<OsString>,
+    dir: Option<PathBuf>,
+    limit: Option<Duration>,
+    output_in: Option<PathBuf>,
+}
+
+impl Tool {
+    pub fn new(program: &str) -> Tool {
+        Tool {
+            program: program.into(),
+            args: Vec::new(),
+            dir: None,
+            limit: None,
+            output_in: None,
         }
-        Err(e) => return Err(io(e)),
-    };
-    let status = loop {
-        if let Some(st) = child.try_wait().map_err(io)? {
-            break st;
+    }
+
+    pub fn arg(mut self, a: impl AsRef<OsStr>) -> Tool {
+        self.args.push(a.as_ref().to_owned());
+        self
+    }
+
+    pub fn args<I: IntoIterator<Item = S>, S: AsRef<OsStr>>(mut self, args: I) -> Tool {
+        self.args
+            .extend(args.into_iter().map(|a| a.as_ref().to_owned()));
+        self
+    }
+
+    /// Runs it in `dir` (default: this process's working directory).
+    pub fn current_dir(mut self, dir: impl Into<PathBuf>) -> Tool {
+        self.dir = Some(dir.into());
+        self
+    }
+
+    /// Stops it after `limit` ([`ToolError::Timeout`]); default: no limit.
+    pub fn timeout(mut self, limit: Duration) -> Tool {
+        self.limit = Some(limit);
+        self
+    }
+
+    /// Keeps its output as `<dir>/<program>.stdout` and `.stderr`.
+    pub fn output_in(mut self, dir: impl Into<PathBuf>) -> Tool {
+        self.output_in = Some(dir.into());
+        self
+    }
+
+    /// Runs it to the end (or its time limit): a missing program is
+    /// [`ToolError::Missing`]; a failing one is `success: false`.
+    pub fn run(&self) -> Result<ToolOutput, ToolError> {
+        let tool = self.program.as_str();
+        let io = |e: std::io::Error| ToolError::Io(format!("{tool}: {e}"));
+        let (mut out, mut err) = match &self.output_in {
+            Some(d) => (
+                kept(&d.join(format!("{tool}.stdout"))).map_err(io)?,
+                kept(&d.join(format!("{tool}.stderr"))).map_err(io)?,
+            ),
+            None => (
+                tempfile::tempfile().map_err(io)?,
+                tempfile::tempfile().map_err(io)?,
+            ),
+        };
+        let mut cmd = Command::new(tool);
+        cmd.args(&self.args)
+            .stdin(Stdio::null())
+            .stdout(out.try_clone().map_err(io)?)
+            .stderr(err.try_clone().map_err(io)?);
+        if let Some(d) = &self.dir {
+            cmd.current_dir(d);
         }
-        if t0.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            return Err(ToolError::Timeout(tool.into(), limit.as_secs()));
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    Ok(ToolOutput {
-        success: status.success(),
-        stdout: std::fs::read_to_string(&out_path).unwrap_or_default(),
-        stderr: std::fs::read_to_string(&err_path).unwrap_or_default(),
-        seconds: t0.elapsed().as_secs_f64(),
-    })
+        let t0 = Instant::now();
+        let mut child = match cmd.spawn() {
+            Ok(c) => c,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(ToolError::Missing(tool.into()))
+            }
+            Err(e) => return Err(io(e)),
+        };
+        let status = match self.limit {
+            None => child.wait().map_err(io)?,
+            Some(limit) => loop {
+                if let Some(st) = child.try_wait().map_err(io)? {
+                    break st;
+                }
+                if t0.elapsed() > limit {
+                    let _ = child.kill();
+                    let _ = child.wait();
+                    return Err(ToolError::Timeout(tool.into(), limit.as_secs()));
+                }
+                std::thread::sleep(Duration::from_millis(5));
+            },
+        };
+        Ok(ToolOutput {
+            success: status.success(),
+            stdout: read_back(&mut out),
+            stderr: read_back(&mut err),
+            seconds: t0.elapsed().as_secs_f64(),
+        })
+    }
+}
+
+/// A file for a tool's output that is kept, opened to be read back too.
+fn kept(path: &Path) -> std::io::Result<File> {
+    std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(true)
+        .open(path)
+}
+
+/// What a tool wrote to `f`, from the start (not UTF-8: replaced, not lost).
+fn read_back(f: &mut File) -> String {
+    let mut bytes = Vec::new();
+    let _ = f
+        .seek(SeekFrom::Start(0))
+        .and_then(|_| f.read_to_end(&mut bytes));
+    String::from_utf8_lossy(&bytes).into_owned()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_run_in_a_folder_with_its_output_and_exit() {
+        let d = tempfile::tempdir().unwrap();
+        let out = Tool::new("sh")
+            .args(["-c", "pwd; echo oops >&2; exit 3"])
+            .current_dir(d.path())
+            .run()
+            .unwrap();
+        assert!(!out.success);
+        let here = d.path().canonicalize().unwrap();
+        assert_eq!(Path::new(out.stdout.trim()), here);
+        assert_eq!(out.stderr, "oops\n");
+        // no output files left in the folder unless asked for
+        assert_eq!(std::fs::read_dir(d.path()).unwrap().count(), 0);
+        let kept = run(
+            "sh",
+            &["-c", "echo kept"],
+            d.path(),
+            Duration::from_secs(60),
+        )
+        .unwrap();
+        assert_eq!(kept.stdout, "kept\n");
+        let file = std::fs::read_to_string(d.path().join("sh.stdout")).unwrap();
+        assert_eq!(file, "kept\n");
+    }
+
+    #[test]
+    fn missing_and_too_slow_tools_are_told_apart() {
+        let missing = Tool::new("slotforge-no-such-tool-7f3a").run();
+        assert_eq!(
+            missing.unwrap_err(),
+            ToolError::Missing("slotforge-no-such-tool-7f3a".into())
+        );
+        let slow = Tool::new("sleep")
+            .arg("5")
+            .timeout(Duration::from_millis(100))
+            .run();
+        assert_eq!(slow.unwrap_err(), ToolError::Timeout("sleep".into(), 0));
+    }
 }

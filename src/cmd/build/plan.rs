@@ -218,3 +218,18 @@ pub fn with_remembered_proof(
     }
     plan
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_step_is_found_by_its_name_and_no_other() {
+        for step in Step::ALL {
+            assert_eq!(format!(" {} ", step.name()).parse(), Ok(step));
+        }
+        assert_eq!("proof".parse::<Step>(), Err(()));
+        assert_eq!(SkipReason::NotInOnly.to_string(), "not in --only");
+        assert!(Run::Remembered.runs() && !Run::Skip(SkipReason::Skipped).runs());
+    }
+}
