@@ -1,0 +1,136 @@
+//! A declared `[[adc_part]]`, checked like every other field.
+
+use super::raw::*;
+use super::*;
+use crate::parts::{AdcPart, Start};
+
+impl Cx<'_> {
+    /// A `[[adc_part]]` table, checked like every other field.
+    pub(super) fn adc_part(&self, i: usize, p: &RawAdcPart) -> Result<AdcPart, MixError> {
+        let f = |k: &str| format!("adc_part[{i}].{k}");
+        let name = self.adc_part_name(i, p)?;
+        let bits = self.positive(&p.bits, &f("bits"))?;
+        if bits > 16 {
+            return Err(self.at(
+                p.bits.span(),
+                f("bits"),
+                format!("{bits} data bits: the sample stream carries at most 16"),
+            ));
+        }
+        let start = match p.start.get_ref().as_str() {
+            "cs" => Start::Cs,
+            "cnv" => Start::Cnv,
+            other => return Err(self.unknown_start(i, p, other)),
+        };
+        let leading_bits = self.nonneg(&p.leading_bits, &f("leading_bits"), 0)?;
+        let trailing_bits = self.nonneg(&p.trailing_bits, &f("trailing_bits"), 0)?;
+        if leading_bits + bits + trailing_bits > 32 {
+            return Err(self.at(
+                p.bits.span(),
+                f("bits"),
+                "leading + data + trailing bits exceed 32 serial clocks per word",
+            ));
+        }
+        if start == Start::Cs && leading_bits == 0 {
+            return Err(self.at(
+                p.start.span(),
+                f("leading_bits"),
+                "a \"cs\" part drives its first bit at CS falling, before any clock: it needs at least one leading bit (the MSB cannot be the first bit)",
+            ));
+        }
+        let sclk_max_hz = self.positive(&p.sclk_max_hz, &f("sclk_max_hz"))?;
+        let sclk_min_hz = self.nonneg(&p.sclk_min_hz, &f("sclk_min_hz"), 1)?.max(1);
+        if sclk_min_hz > sclk_max_hz {
+            return Err(self.at(
+                p.sclk_min_hz
+                    .as_ref()
+                    .map(|s| s.span())
+                    .unwrap_or(p.sclk_max_hz.span()),
+                f("sclk_min_hz"),
+                format!("{sclk_min_hz} Hz is above sclk_max_hz {sclk_max_hz} Hz"),
+            ));
+        }
+        let duty_min_pct = self.nonneg(&p.duty_min_pct, &f("duty_min_pct"), 40)?;
+        if duty_min_pct > 50 {
+            return Err(self.at(
+                p.duty_min_pct.as_ref().unwrap().span(),
+                f("duty_min_pct"),
+                format!("{duty_min_pct} %: no clock has both phases above half the period"),
+            ));
+        }
+        let conversion_ns = self.nonneg(&p.conversion_ns, &f("conversion_ns"), 0)?;
+        if start == Start::Cs && conversion_ns != 0 {
+            return Err(self.at(
+                p.conversion_ns.as_ref().unwrap().span(),
+                f("conversion_ns"),
+                "a \"cs\" part converts while it is read: conversion_ns applies to \"cnv\" parts only",
+            ));
+        }
+        let max_sps = self.positive(&p.max_sps, &f("max_sps"))?;
+        let chain_max = self.adc_part_chain(i, p, start)?;
+        Ok(AdcPart {
+            name,
+            bits: bits as u32,
+            start,
+            leading_bits: leading_bits as u32,
+            trailing_bits: trailing_bits as u32,
+            sclk_min_hz,
+            sclk_max_hz,
+            duty_min_pct: duty_min_pct as u32,
+            max_sps,
+            setup_ns: self.nonneg(&p.setup_ns, &f("setup_ns"), 10)?,
+            quiet_ns: self.nonneg(&p.quiet_ns, &f("quiet_ns"), 0)?,
+            conversion_ns,
+            data_access_ns: self.nonneg(&p.data_access_ns, &f("data_access_ns"), 0)?,
+            data_hold_ns: 0,
+            chain_max: chain_max as u32,
+        })
+    }
+
+    /// `adc_part.name`: lower case, not blank, not a built-in part's.
+    pub(super) fn adc_part_name(&self, i: usize, p: &RawAdcPart) -> Result<String, MixError> {
+        let name = p.name.get_ref().trim().to_ascii_lowercase();
+        if name.is_empty() {
+            return Err(self.at(
+                p.name.span(),
+                format!("adc_part[{i}].name"),
+                "must not be empty",
+            ));
+        }
+        if AdcPart::by_name(&name).is_some() {
+            return Err(self.at(
+                p.name.span(),
+                format!("adc_part[{i}].name"),
+                format!("`{name}` is a built-in part; give the declared part its own name"),
+            ));
+        }
+        Ok(name)
+    }
+
+    pub(super) fn unknown_start(&self, i: usize, p: &RawAdcPart, other: &str) -> MixError {
+        self.at(
+            p.start.span(),
+            format!("adc_part[{i}].start"),
+            format!("unknown start `{other}` (\"cs\": CS falling starts the conversion, \"cnv\": CNV rising)"),
+        )
+    }
+
+    /// `adc_part.chain_max`: 1 unless given; only "cnv" parts chain.
+    pub(super) fn adc_part_chain(
+        &self,
+        i: usize,
+        p: &RawAdcPart,
+        start: Start,
+    ) -> Result<u64, MixError> {
+        let Some(c) = &p.chain_max else { return Ok(1) };
+        let v = self.positive(c, &format!("adc_part[{i}].chain_max"))?;
+        if v > 1 && start == Start::Cs {
+            return Err(self.at(
+                c.span(),
+                format!("adc_part[{i}].chain_max"),
+                "chains are read in one CNV-high window: only \"cnv\" parts chain here",
+            ));
+        }
+        Ok(v)
+    }
+}

@@ -1,0 +1,183 @@
+//! The `[[branch]]` tables.
+
+use std::collections::BTreeMap;
+
+use super::check::Timing;
+use super::raw::*;
+use super::*;
+use crate::parts::{AdcPart, MuxPart};
+
+impl Cx<'_> {
+    /// Every `[[branch]]`, names unique.
+    pub(super) fn branches(
+        &self,
+        raw: &RawMix,
+        parts: &[AdcPart],
+        t: &Timing,
+    ) -> Result<Vec<Branch>, MixError> {
+        let mut known_parts: Vec<String> = AdcPart::known().iter().map(|s| s.to_string()).collect();
+        known_parts.extend(parts.iter().map(|p| p.name.clone()));
+        let mut branches = Vec::new();
+        let mut branch_names: BTreeMap<String, usize> = BTreeMap::new();
+        for (i, b) in raw.branch.iter().enumerate() {
+            let b = b.get_ref();
+            let f = |k: &str| format!("branch[{i}].{k}");
+            let bname = b.name.get_ref().clone();
+            if bname.trim().is_empty() {
+                return Err(self.at(b.name.span(), f("name"), "must not be empty"));
+            }
+            if branch_names.insert(bname.clone(), i).is_some() {
+                return Err(self.at(
+                    b.name.span(),
+                    f("name"),
+                    format!("duplicate branch name `{bname}`"),
+                ));
+            }
+            branches.push(self.branch(i, b, bname, parts, &known_parts, t)?);
+        }
+        Ok(branches)
+    }
+
+    /// One `[[branch]]` past its name: ADC, chain, mux, SCLK, settling.
+    pub(super) fn branch(
+        &self,
+        i: usize,
+        b: &RawBranch,
+        name: String,
+        parts: &[AdcPart],
+        known_parts: &[String],
+        t: &Timing,
+    ) -> Result<Branch, MixError> {
+        let f = |k: &str| format!("branch[{i}].{k}");
+        let wanted = b.adc.get_ref().to_ascii_lowercase();
+        let adc = AdcPart::by_name(&wanted)
+            .or_else(|| parts.iter().find(|p| p.name == wanted).cloned())
+            .ok_or_else(|| {
+                self.at(
+                    b.adc.span(),
+                    f("adc"),
+                    format!(
+                        "unknown ADC `{}` (known: {})",
+                        b.adc.get_ref(),
+                        known_parts.join(", ")
+                    ),
+                )
+            })?;
+        let chain = self.branch_chain(i, b, &adc)?;
+        let mux = MuxPart::by_name(b.mux.get_ref()).ok_or_else(|| {
+            self.at(
+                b.mux.span(),
+                f("mux"),
+                format!(
+                    "unknown mux `{}` (known: {})",
+                    b.mux.get_ref(),
+                    MuxPart::known().join(", ")
+                ),
+            )
+        })?;
+        let sclk_hz = self.branch_sclk(i, b, &adc)?;
+        if t.clock_hz < 2 * adc.sclk_min_hz {
+            return Err(self.at(
+                t.clock_span.clone(),
+                "clock.hz",
+                format!(
+                    "{} Hz is too slow to generate the {} minimum SCLK",
+                    t.clock_hz, adc.name
+                ),
+            ));
+        }
+        let mux_devices = self.branch_mux_devices(i, b, &mux)?;
+        let settle_ns = match &b.settle_ns {
+            None => 0,
+            Some(s) if *s.get_ref() < 0 => {
+                return Err(self.at(s.span(), f("settle_ns"), "must not be negative"));
+            }
+            Some(s) => *s.get_ref() as u64,
+        };
+        Ok(Branch {
+            name,
+            adc,
+            sclk_hz,
+            sclk_explicit: b.sclk_hz.is_some(),
+            mux,
+            mux_devices,
+            settle_ns,
+            chain,
+        })
+    }
+
+    /// `branch.chain`: how many parts, within the part's limit.
+    pub(super) fn branch_chain(
+        &self,
+        i: usize,
+        b: &RawBranch,
+        adc: &AdcPart,
+    ) -> Result<u32, MixError> {
+        let Some(c) = &b.chain else { return Ok(1) };
+        let v = self.positive(c, &format!("branch[{i}].chain"))?;
+        if v > adc.chain_max as u64 {
+            return Err(self.at(
+                c.span(),
+                format!("branch[{i}].chain"),
+                format!(
+                    "{v} parts in a chain: `{}` allows at most {}",
+                    adc.name, adc.chain_max
+                ),
+            ));
+        }
+        Ok(v as u32)
+    }
+
+    /// `branch.sclk_hz`: the part's maximum unless given, and within its range.
+    pub(super) fn branch_sclk(
+        &self,
+        i: usize,
+        b: &RawBranch,
+        adc: &AdcPart,
+    ) -> Result<u64, MixError> {
+        let Some(s) = &b.sclk_hz else {
+            return Ok(adc.sclk_max_hz);
+        };
+        let v = self.positive(s, &format!("branch[{i}].sclk_hz"))?;
+        if v > adc.sclk_max_hz || v < adc.sclk_min_hz {
+            return Err(self.at(
+                s.span(),
+                format!("branch[{i}].sclk_hz"),
+                format!(
+                    "{v} Hz is outside the {} SCLK range {}..={} Hz",
+                    adc.name, adc.sclk_min_hz, adc.sclk_max_hz
+                ),
+            ));
+        }
+        Ok(v)
+    }
+
+    /// `branch.mux_devices`: 1 to 32, and only with a mux.
+    pub(super) fn branch_mux_devices(
+        &self,
+        i: usize,
+        b: &RawBranch,
+        mux: &MuxPart,
+    ) -> Result<u32, MixError> {
+        let f = |k: &str| format!("branch[{i}].{k}");
+        match &b.mux_devices {
+            None => Ok(1),
+            Some(m) if *mux == MuxPart::NONE => Err(self.at(
+                m.span(),
+                f("mux_devices"),
+                "a branch with mux = \"none\" has no mux devices",
+            )),
+            Some(m) => {
+                let v = self.positive(m, &f("mux_devices"))?;
+                if v > 32 {
+                    return Err(self.at(
+                        m.span(),
+                        f("mux_devices"),
+                        "at most 32 mux devices per branch",
+                    ));
+                }
+                Ok(v as u32)
+            }
+        }
+    }
+}

@@ -1,0 +1,401 @@
+//! The `[[channel]]` tables, their mux inputs, and the checks across
+//! channels (chained conversions, sync groups).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::ops::Range;
+
+use toml::Spanned;
+
+use super::check::Timing;
+use super::raw::*;
+use super::words::*;
+use super::*;
+
+/// The channels as read, before automatic inputs are assigned.
+pub(super) struct ChannelDraft {
+    pub(super) channels: Vec<Channel>,
+    /// Per branch: (input, chain member) -> the channel that has it, to name
+    /// it in a clash.
+    pub(super) used_inputs: Vec<BTreeMap<(u32, u32), String>>,
+    /// Channels without an explicit input, in file order.
+    pub(super) pending_auto: Vec<usize>,
+    /// Sync tag -> (channel, where its `sync` is written).
+    pub(super) sync_groups: BTreeMap<String, Vec<(usize, Range<usize>)>>,
+}
+
+impl Cx<'_> {
+    /// Every `[[channel]]`; explicit inputs are taken here, automatic ones
+    /// later so that they fill the gaps deterministically.
+    pub(super) fn channels(
+        &self,
+        raw: &RawMix,
+        branches: &[Branch],
+        t: &Timing,
+    ) -> Result<ChannelDraft, MixError> {
+        let mut draft = ChannelDraft {
+            channels: Vec::new(),
+            used_inputs: vec![BTreeMap::new(); branches.len()],
+            pending_auto: Vec::new(),
+            sync_groups: BTreeMap::new(),
+        };
+        let mut channel_names = BTreeSet::new();
+        for (i, c) in raw.channel.iter().enumerate() {
+            let c = c.get_ref();
+            let f = |k: &str| format!("channel[{i}].{k}");
+            let cname = c.name.get_ref().clone();
+            if cname.trim().is_empty() {
+                return Err(self.at(c.name.span(), f("name"), "must not be empty"));
+            }
+            if !channel_names.insert(cname.clone()) {
+                return Err(self.at(
+                    c.name.span(),
+                    f("name"),
+                    format!("duplicate channel name `{cname}`"),
+                ));
+            }
+            let channel = self.channel(i, c, cname, branches, t, &mut draft)?;
+            draft.channels.push(channel);
+        }
+        Ok(draft)
+    }
+
+    /// One `[[channel]]` past its name.
+    pub(super) fn channel(
+        &self,
+        i: usize,
+        c: &RawChannel,
+        name: String,
+        branches: &[Branch],
+        t: &Timing,
+        draft: &mut ChannelDraft,
+    ) -> Result<Channel, MixError> {
+        let f = |k: &str| format!("channel[{i}].{k}");
+        let branch = self.channel_branch(i, c, branches)?;
+        let rate_hz = self.positive(&c.rate_hz, &f("rate_hz"))?;
+        let frame_us = t.frame_us;
+        if !(rate_hz as u128 * frame_us as u128).is_multiple_of(1_000_000) {
+            return Err(self.at(
+                c.rate_hz.span(),
+                f("rate_hz"),
+                format!(
+                    "{rate_hz} Hz gives {:.3} samples per {frame_us} us frame, not a whole number \
+                     (rates must be multiples of {} Hz){}",
+                    rate_hz as f64 * frame_us as f64 / 1e6,
+                    hz_text(1e6 / frame_us as f64),
+                    frames_that_fit(rate_hz, t.slice_us)
+                ),
+            ));
+        }
+        let member = self.channel_member(i, c, &branches[branch])?;
+        let input = match &c.input {
+            None => {
+                draft.pending_auto.push(i);
+                u32::MAX
+            }
+            Some(v) => {
+                let b = &branches[branch];
+                let used = &mut draft.used_inputs[branch];
+                self.channel_input(i, v, &name, member, b, used)?
+            }
+        };
+        let bandwidth_hz = self.channel_bandwidth(i, c)?;
+        let sync = match &c.sync {
+            None => None,
+            Some(s) => {
+                if s.get_ref().trim().is_empty() {
+                    return Err(self.at(s.span(), f("sync"), "must not be empty"));
+                }
+                draft
+                    .sync_groups
+                    .entry(s.get_ref().clone())
+                    .or_default()
+                    .push((i, s.span()));
+                Some(s.get_ref().clone())
+            }
+        };
+        Ok(Channel {
+            name,
+            branch,
+            rate_hz,
+            input,
+            kind: c.kind.clone(),
+            bandwidth_hz,
+            sync,
+            member,
+        })
+    }
+
+    /// `channel.branch`: a declared branch, by name.
+    pub(super) fn channel_branch(
+        &self,
+        i: usize,
+        c: &RawChannel,
+        branches: &[Branch],
+    ) -> Result<usize, MixError> {
+        // Branch names are unique by now, so the first match is the one.
+        branches
+            .iter()
+            .position(|b| b.name == *c.branch.get_ref())
+            .ok_or_else(|| {
+                self.at(
+                    c.branch.span(),
+                    format!("channel[{i}].branch"),
+                    format!(
+                        "unknown branch `{}` (declared: {})",
+                        c.branch.get_ref(),
+                        branches
+                            .iter()
+                            .map(|b| b.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                )
+            })
+    }
+
+    /// `channel.member`: which part of the branch's chain, 0 unless given.
+    pub(super) fn channel_member(
+        &self,
+        i: usize,
+        c: &RawChannel,
+        b: &Branch,
+    ) -> Result<u32, MixError> {
+        let Some(m) = &c.member else { return Ok(0) };
+        let chain = b.chain;
+        if *m.get_ref() < 0 || *m.get_ref() >= chain as i64 {
+            return Err(self.at(
+                m.span(),
+                format!("channel[{i}].member"),
+                format!(
+                    "member {} is beyond branch `{}`: its chain of {chain} part(s) has members 0..={}",
+                    m.get_ref(),
+                    b.name,
+                    chain - 1
+                ),
+            ));
+        }
+        Ok(*m.get_ref() as u32)
+    }
+
+    /// An explicit `channel.input`: on the branch's muxes and not taken by
+    /// another channel of the same chain member.
+    pub(super) fn channel_input(
+        &self,
+        i: usize,
+        v: &Spanned<i64>,
+        name: &str,
+        member: u32,
+        b: &Branch,
+        used: &mut BTreeMap<(u32, u32), String>,
+    ) -> Result<u32, MixError> {
+        let capacity = b.mux.inputs * b.mux_devices;
+        if *v.get_ref() < 0 || *v.get_ref() >= capacity as i64 {
+            return Err(self.at(
+                v.span(),
+                format!("channel[{i}].input"),
+                format!(
+                    "input {} is beyond branch `{}`: {} mux device(s) give inputs 0..={}",
+                    v.get_ref(),
+                    b.name,
+                    b.mux_devices,
+                    capacity - 1
+                ),
+            ));
+        }
+        let inp = *v.get_ref() as u32;
+        if let Some(other) = used.insert((inp, member), name.to_string()) {
+            let which = if b.chain > 1 {
+                format!(" (chain member {member})")
+            } else {
+                String::new()
+            };
+            return Err(self.at(
+                v.span(),
+                format!("channel[{i}].input"),
+                format!(
+                    "input {inp}{which} of branch `{}` is already taken by channel `{other}`",
+                    b.name
+                ),
+            ));
+        }
+        Ok(inp)
+    }
+
+    /// `channel.bandwidth_hz`: an integer or a float, positive and finite.
+    pub(super) fn channel_bandwidth(
+        &self,
+        i: usize,
+        c: &RawChannel,
+    ) -> Result<Option<f64>, MixError> {
+        let Some(b) = &c.bandwidth_hz else {
+            return Ok(None);
+        };
+        let v = match b.get_ref() {
+            toml::Value::Integer(i) => *i as f64,
+            toml::Value::Float(x) => *x,
+            other => {
+                return Err(self.at(
+                    b.span(),
+                    format!("channel[{i}].bandwidth_hz"),
+                    format!("got {}, expected a number of Hz", value_words(other)),
+                ))
+            }
+        };
+        if !(v > 0.0 && v.is_finite()) {
+            return Err(self.at(
+                b.span(),
+                format!("channel[{i}].bandwidth_hz"),
+                format!("must be positive, got {v}"),
+            ));
+        }
+        Ok(Some(v))
+    }
+
+    /// Channels without an input take the lowest free one of their chain
+    /// member, in file order.
+    pub(super) fn assign_auto_inputs(
+        &self,
+        raw: &RawMix,
+        branches: &[Branch],
+        draft: &mut ChannelDraft,
+    ) -> Result<(), MixError> {
+        let channels = &mut draft.channels;
+        for &i in &draft.pending_auto {
+            let b = channels[i].branch;
+            let capacity = branches[b].mux.inputs * branches[b].mux_devices;
+            let m = channels[i].member;
+            let used_inputs = &mut draft.used_inputs;
+            let free = (0..capacity).find(|k| !used_inputs[b].contains_key(&(*k, m))).ok_or_else(|| {
+                self.at(
+                    raw.channel[i].get_ref().name.span(),
+                    format!("channel[{i}].input"),
+                    format!(
+                        "branch `{}` has no free mux input left ({} device(s), {} inputs); add mux_devices",
+                        branches[b].name, branches[b].mux_devices, capacity
+                    ),
+                )
+            })?;
+            used_inputs[b].insert((free, m), channels[i].name.clone());
+            channels[i].input = free;
+        }
+        Ok(())
+    }
+
+    /// Channels of one branch on one mux input are read in one conversion
+    /// (one per chain member): they share every sampling instant.
+    pub(super) fn check_chain_rates(
+        &self,
+        raw: &RawMix,
+        branches: &[Branch],
+        channels: &[Channel],
+    ) -> Result<(), MixError> {
+        for i in 0..channels.len() {
+            for j in 0..i {
+                let (a, c) = (&channels[j], &channels[i]);
+                if a.branch == c.branch && a.input == c.input && a.rate_hz != c.rate_hz {
+                    return Err(self.at(
+                        raw.channel[i].get_ref().rate_hz.span(),
+                        format!("channel[{i}].rate_hz"),
+                        format!(
+                            "`{}` ({} Hz) and `{}` ({} Hz) are chain members {} and {} of one conversion on branch `{}` (mux input {}): chained parts are sampled together, so they need one rate",
+                            c.name, c.rate_hz, a.name, a.rate_hz, c.member, a.member,
+                            branches[c.branch].name, c.input
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A sync group has one rate and at most one conversion per branch.
+    pub(super) fn check_sync_groups(
+        &self,
+        branches: &[Branch],
+        channels: &[Channel],
+        sync_groups: &BTreeMap<String, Vec<(usize, Range<usize>)>>,
+    ) -> Result<(), MixError> {
+        for (tag, members) in sync_groups {
+            let mut seen = BTreeMap::new();
+            let rate = channels[members[0].0].rate_hz;
+            for (i, span) in members {
+                let c = &channels[*i];
+                if c.rate_hz != rate {
+                    return Err(self.at(
+                        span.clone(),
+                        format!("channel[{i}].sync"),
+                        format!(
+                            "sync group `{tag}` mixes rates ({} Hz and {} Hz): synchronized channels share every sampling instant, so they need one rate",
+                            rate, c.rate_hz
+                        ),
+                    ));
+                }
+                if let Some(other) = seen.insert(c.branch, *i) {
+                    if channels[other].input == c.input {
+                        // Members of one chained conversion: one instant anyway.
+                        continue;
+                    }
+                    return Err(self.at(
+                        span.clone(),
+                        format!("channel[{i}].sync"),
+                        format!(
+                            "sync group `{tag}` has `{}` and `{}` on the same branch `{}`: one ADC cannot sample both at one instant",
+                            channels[other].name, c.name, branches[c.branch].name
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Members of one chained conversion are in one sync group or none.
+    pub(super) fn check_chain_sync(
+        &self,
+        raw: &RawMix,
+        channels: &[Channel],
+    ) -> Result<(), MixError> {
+        for i in 0..channels.len() {
+            for j in 0..i {
+                let (a, c) = (&channels[j], &channels[i]);
+                if a.branch == c.branch && a.input == c.input && a.sync != c.sync {
+                    let span = raw.channel[i]
+                        .get_ref()
+                        .sync
+                        .as_ref()
+                        .map(|s| s.span())
+                        .unwrap_or(raw.channel[i].get_ref().name.span());
+                    return Err(self.at(
+                        span,
+                        format!("channel[{i}].sync"),
+                        format!(
+                            "`{}` and `{}` are read in one chained conversion, so they are in the same sync group or none: give them the same `sync`",
+                            c.name, a.name
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Every branch samples at least one channel.
+    pub(super) fn check_branches_used(
+        &self,
+        raw: &RawMix,
+        branches: &[Branch],
+        channels: &[Channel],
+    ) -> Result<(), MixError> {
+        for (bi, b) in branches.iter().enumerate() {
+            if !channels.iter().any(|c| c.branch == bi) {
+                let span = raw.branch[bi].get_ref().name.span();
+                return Err(self.at(
+                    span,
+                    format!("branch[{bi}].name"),
+                    format!("branch `{}` has no channels", b.name),
+                ));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,223 @@
+use super::*;
+
+const GOOD: &str = r#"
+name = "t"
+[clock]
+hz = 48_000_000
+[frame]
+period_us = 10_000
+slice_us = 1_000
+[[branch]]
+name = "a"
+adc = "ad7940"
+mux = "tmux1108"
+[[channel]]
+name = "c0"
+branch = "a"
+rate_hz = 1_000
+bandwidth_hz = 400
+"#;
+
+fn err(text: &str) -> MixError {
+    parse(Path::new("m.toml"), text).unwrap_err()
+}
+
+#[test]
+fn messages_use_the_mix_format_words_not_rust_types() {
+    let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 1000.5"));
+    assert_eq!(e.field, "channel[0].rate_hz", "{e}");
+    assert!(e.message.contains("expected a whole number of Hz"), "{e}");
+    let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = \"fast\""));
+    assert!(
+        !e.message.contains("i64") && e.message.contains("got the text"),
+        "{e}"
+    );
+    let e = err(&GOOD.replace("slice_us = 1_000", "slice_us = 1.5"));
+    assert!(e.message.contains("whole number of microseconds"), "{e}");
+    // a fractional count per frame: frame periods that fit the rate
+    let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 1_050"));
+    assert!(
+        e.message.contains(
+            "frame periods that fit 1050 Hz with 1000 us slices: 20000 us, 40000 us, 60000 us"
+        ),
+        "{e}"
+    );
+    // the step between rates in the units people write, not 100.000
+    assert!(
+        e.message.contains("(rates must be multiples of 100 Hz)"),
+        "{e}"
+    );
+    let e = err(&GOOD
+        .replace("period_us = 10_000", "period_us = 30_000")
+        .replace("rate_hz = 1_000", "rate_hz = 50"));
+    assert!(e.message.contains("multiples of 33.333 Hz)"), "{e}");
+    // a taken mux input names the channel that has it
+    let two = GOOD.replace("bandwidth_hz = 400", "bandwidth_hz = 400\ninput = 2")
+        + "[[channel]]\nname = \"c1\"\nbranch = \"a\"\nrate_hz = 1_000\ninput = 2\n";
+    let e = err(&two);
+    assert!(e.message.contains("already taken by channel `c0`"), "{e}");
+}
+
+#[test]
+fn good_mix_parses() {
+    let m = parse(Path::new("m.toml"), GOOD).unwrap();
+    assert_eq!(m.clock_hz, 48_000_000);
+    assert_eq!(m.frame_cycles(), 480_000);
+    assert_eq!(m.slice_cycles(), 48_000);
+    assert_eq!(m.channels[0].input, 0);
+    assert_eq!(m.channels[0].bandwidth_hz, Some(400.0));
+    assert_eq!(m.branches[0].sclk_hz, 2_500_000);
+}
+
+#[test]
+fn unknown_key_names_line_and_field() {
+    let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 1_000\nrat_hz = 3"));
+    assert_eq!(e.line, 16, "{e}");
+    assert_eq!(e.field, "channel[0].rat_hz", "{e}");
+    assert!(e.message.contains("unknown field"), "{e}");
+}
+
+#[test]
+fn fractional_samples_per_frame() {
+    let e = err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 1_050"));
+    assert_eq!(e.field, "channel[0].rate_hz");
+    assert_eq!(e.line, 15);
+    assert!(e.message.contains("10.500 samples"), "{e}");
+}
+
+#[test]
+fn fractional_cycles_per_slice() {
+    let e = err(&GOOD.replace("48_000_000", "48_000_500"));
+    assert_eq!(e.field, "clock.hz");
+    assert_eq!(e.line, 4);
+}
+
+#[test]
+fn zero_and_negative_values() {
+    assert_eq!(
+        err(&GOOD.replace("rate_hz = 1_000", "rate_hz = 0")).field,
+        "channel[0].rate_hz"
+    );
+    assert_eq!(
+        err(&GOOD.replace("slice_us = 1_000", "slice_us = -1")).field,
+        "frame.slice_us"
+    );
+}
+
+#[test]
+fn unknown_branch_adc_mux() {
+    assert_eq!(
+        err(&GOOD.replace("branch = \"a\"", "branch = \"b\"")).field,
+        "channel[0].branch"
+    );
+    assert_eq!(
+        err(&GOOD.replace("ad7940", "ad9999")).field,
+        "branch[0].adc"
+    );
+    assert_eq!(
+        err(&GOOD.replace("tmux1108", "cd4051")).field,
+        "branch[0].mux"
+    );
+}
+
+#[test]
+fn duplicate_names_and_inputs() {
+    let dup = format!("{GOOD}\n[[channel]]\nname = \"c0\"\nbranch = \"a\"\nrate_hz = 100\n");
+    let e = err(&dup);
+    assert_eq!(e.field, "channel[1].name");
+    assert_eq!(e.line, 19);
+    let twice = format!(
+        "{}\n[[channel]]\nname = \"c1\"\nbranch = \"a\"\nrate_hz = 100\ninput = 0\n",
+        GOOD.replace("bandwidth_hz = 400", "input = 0")
+    );
+    assert_eq!(err(&twice).field, "channel[1].input");
+    let beyond = GOOD.replace("bandwidth_hz = 400", "input = 8");
+    assert!(err(&beyond).message.contains("beyond"));
+}
+
+#[test]
+fn empty_mix() {
+    let e =
+        err("name = \"x\"\n[clock]\nhz = 1000000\n[frame]\nperiod_us = 1000\nslice_us = 1000\n");
+    assert_eq!(e.field, "branch");
+}
+
+#[test]
+fn syntax_error_has_line() {
+    let e = err("name = \"x\"\n[clock\n");
+    assert_eq!(e.line, 2);
+    // A line with no key still names something (found by proptest).
+    let e = err("name = \"x\"\n=description = \"y\"\n");
+    assert_eq!((e.line, e.field.as_str()), (2, "(syntax)"), "{e}");
+}
+
+const CHAIN: &str = r#"
+name = "t"
+[clock]
+hz = 48_000_000
+[frame]
+period_us = 10_000
+slice_us = 1_000
+[[branch]]
+name = "a"
+adc = "ad7685"
+chain = 2
+mux = "none"
+[[channel]]
+name = "x"
+branch = "a"
+member = 0
+rate_hz = 8_000
+[[channel]]
+name = "y"
+branch = "a"
+member = 1
+rate_hz = 8_000
+"#;
+
+#[test]
+fn chain_members_share_one_conversion() {
+    let m = parse(Path::new("m.toml"), CHAIN).unwrap();
+    assert_eq!(m.branches[0].chain, 2);
+    assert_eq!(m.conversion_group(1), vec![Some(0), Some(1)]);
+    assert_eq!(m.lead_of(1), 0);
+}
+
+#[test]
+fn chain_members_with_different_rates_are_rejected() {
+    let e = err(&CHAIN.replacen("rate_hz = 8_000", "rate_hz = 4_000", 1));
+    assert_eq!(e.field, "channel[1].rate_hz", "{e}");
+    assert_eq!(e.line, 22, "{e}");
+    assert!(
+        e.message.contains("chained parts are sampled together"),
+        "{e}"
+    );
+}
+
+#[test]
+fn chain_limits_and_members() {
+    let e = err(&CHAIN.replace("chain = 2", "chain = 9"));
+    assert_eq!(e.field, "branch[0].chain", "{e}");
+    assert!(e.message.contains("at most 8"), "{e}");
+    let e = err(&CHAIN.replace("member = 1", "member = 2"));
+    assert_eq!(e.field, "channel[1].member", "{e}");
+    let e = err(&CHAIN.replace("member = 1", "member = 0"));
+    assert_eq!(e.field, "channel[1].input", "{e}");
+}
+
+#[test]
+fn declared_parts_are_validated() {
+    let part = "[[adc_part]]\nname = \"p\"\nbits = 12\nstart = \"cs\"\nleading_bits = 4\nsclk_max_hz = 20_000_000\nmax_sps = 1_000_000\n";
+    let good = format!("{}{part}", GOOD.replace("ad7940", "p"));
+    let m = parse(Path::new("m.toml"), &good).unwrap();
+    assert_eq!(m.branches[0].adc.bits, 12);
+    assert_eq!(m.parts.len(), 1);
+    let e = err(&good.replace("start = \"cs\"", "start = \"cnvst\""));
+    assert_eq!((e.field.as_str(), e.line), ("adc_part[0].start", 20), "{e}");
+    let e = err(&good.replace("bits = 12", "bits = 20"));
+    assert_eq!(e.field, "adc_part[0].bits", "{e}");
+    let e = err(&good.replace("max_sps = 1_000_000", "max_sps = 1_000_000\nchain_max = 2"));
+    assert_eq!(e.field, "adc_part[0].chain_max", "{e}");
+    let e = err(&good.replace("sclk_max_hz = 20_000_000\n", ""));
+    assert_eq!(e.field, "adc_part[0].sclk_max_hz", "{e}");
+}
