@@ -43,6 +43,9 @@ mod sim_cli;
 #[path = "tool_policy.rs"]
 mod tool_policy;
 
+#[path = "tree.rs"]
+mod tree;
+
 // Shared by several test files (one copy in this binary).
 use testkit::tools;
 
