@@ -133,7 +133,7 @@ fn check_map_errors_name_the_entry_and_exit_2() {
     let cap = d.path().join("cap.vcd");
     std::fs::write(
         &cap,
-        judge::vcdout::wire_header("1 ns", "libsigrok", &["D0"]) + "#0\n0!\n",
+        judge::wire_header("1 ns", "libsigrok", &["D0"]) + "#0\n0!\n",
     )
     .unwrap();
     slotforge()
@@ -184,7 +184,7 @@ fn check_map_shows_its_progress_in_plain_lines_off_a_terminal() {
     let d = tempfile::tempdir().unwrap();
     let cap = d.path().join("big.vcd");
     let mut text = "$comment Acquisition with 1/8 channels at 24 MHz $end\n".to_string()
-        + &judge::vcdout::wire_header("1 ns", "libsigrok", &["D0"])
+        + &judge::wire_header("1 ns", "libsigrok", &["D0"])
         + "#0\n1!\n";
     // CS toggling every 10 us: a long capture the checker can lock onto or not
     let mut t = 0u64;

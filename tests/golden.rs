@@ -327,7 +327,7 @@ fn rusthdl_verilator_and_icarus_give_identical_event_logs_on_every_preset() {
 }
 
 fn identical_event_logs(mixes: &[PathBuf]) {
-    use judge::events::{compare, EventLog, Trace};
+    use judge::{compare_events as compare, EventLog, Trace};
     let mut backends = vec![engines::Backend::RustHdl];
     if tools::require_tool("verilator") && tools::require_tool("g++") {
         backends.push(engines::Backend::Verilator);

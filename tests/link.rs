@@ -26,7 +26,7 @@ fn link_vcd(src: &str) -> String {
         .expect("link_tx in the VCD")
         .to_string();
     assert!(src.contains("$timescale 1ps $end"));
-    let mut out = judge::vcdout::wire_header("10ns", "top", &["tx"]);
+    let mut out = judge::wire_header("10ns", "top", &["tx"]);
     let mut t = 0u64;
     let mut last = None;
     for l in src

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command as Process;
 
 use assert_cmd::Command;
-use judge::vcd::{read_cycles, CycleSink};
+use judge::{read_cycles, CycleSink};
 use lut_gen::ports::Pins;
 use lut_gen::Schedule;
 

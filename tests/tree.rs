@@ -262,7 +262,7 @@ fn functions_fit_on_a_screen() {
     for f in &files {
         units_of(f, &mut units);
     }
-    units.sort_by(|a, b| b.lines.cmp(&a.lines));
+    units.sort_by_key(|u| std::cmp::Reverse(u.lines));
     let long: Vec<String> = units
         .iter()
         .filter(|u| u.lines > 100)

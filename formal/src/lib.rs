@@ -256,7 +256,7 @@ fn counterexample(
             Outcome::Bounded
         };
     }
-    let (report, _) = judge::vcd::check_vcd_with(
+    let (report, _) = judge::check_vcd_with(
         x.s,
         &r.vcd,
         Some(replay::DUT_SCOPE),
@@ -387,7 +387,7 @@ fn latch_names(prep: &engine::Prepared, latches: &[usize]) -> String {
 /// the cycle-exact model, else its first invariant violation (a violation
 /// can be dated before the cycle that revealed it, e.g. a missing sample at
 /// its conversion's completion).
-pub fn first_rejected(r: &judge::Report) -> Option<u64> {
+pub fn first_rejected(r: &judge::Verdict) -> Option<u64> {
     r.divergences
         .iter()
         .map(|d| d.cycle)

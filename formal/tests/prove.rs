@@ -57,8 +57,7 @@ fn assert_counterexample(s: &lut_gen::Schedule, p: &Proof) {
         "the replay names the failing property: {}",
         p.summary()
     );
-    let report =
-        judge::vcd::check_vcd(s, &c.vcd, Some(formal::replay::DUT_SCOPE)).expect("VCD reads");
+    let report = judge::check_vcd(s, &c.vcd, Some(formal::replay::DUT_SCOPE)).expect("VCD reads");
     assert!(
         !report.ok,
         "check accepts the counterexample:\n{}",
@@ -151,7 +150,7 @@ fn a_fault_after_five_frames_fails_and_is_never_called_proved() {
 /// and a 1 ms frame (4,000 cycles) so each proof takes seconds: one to
 /// three branches, one or two mux devices, SCLK, settling and rates drawn.
 fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
-    let shape = campaign::mixgen::Shape {
+    let shape = campaign::Shape {
         clock_hz: 4_000_000,
         frame_us: 1_000,
         slice_us: 500,
@@ -164,7 +163,7 @@ fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
     };
     let mut found = Vec::new();
     for seed in 1..200u64 {
-        let text = campaign::mixgen::random_mix(seed, &shape);
+        let text = campaign::random_mix(seed, &shape);
         let path = Path::new("random.toml");
         let Ok(mix) = lut_gen::parse(path, &text) else {
             continue;
@@ -298,7 +297,7 @@ fn axis_harness_models_the_slave_and_names_the_link_properties() {
 }
 
 /// The harness's slave when it is never early (`tready_any` low) is the
-/// simulations' worst-case slave: `judge::run::AxisSlave` with
+/// simulations' worst-case slave: `judge::AxisSlave` with
 /// `link::ReadyPattern::WorstCase`, fed the same `tvalid`, raises `tready`
 /// in exactly the same cycles (each beat taken in its `ready_within`-th
 /// cycle), so the harness's slaves are the guarantee's, to the cycle.
@@ -351,7 +350,7 @@ fn the_harness_slave_never_early_is_the_worst_case_slave() {
     }
     let tvalid: Vec<bool> = trace.iter().map(|&(v, _)| v).collect();
     let within = s.mix.link.unwrap().ready_within;
-    let mut slave = judge::run::AxisSlave::new(
+    let mut slave = judge::AxisSlave::new(
         Trace(tvalid.into_iter()),
         link::ReadyPattern::WorstCase,
         within,

@@ -5,8 +5,8 @@
 //! slowest rate a slow tone whose samples keep its shape, compared with the
 //! same channel's own signal.
 
-use judge::adc::Analog;
-use judge::model::SlotModel;
+use judge::Analog;
+use judge::SlotModel;
 use judge::Stimulus;
 use lut_gen::Schedule;
 use report::{draw, Axes, Figure, Marker, Section, Series, Table};

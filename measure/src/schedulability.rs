@@ -9,7 +9,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use campaign::mixgen::{random_mix, Shape};
+use campaign::{random_mix, Shape};
 use lut_gen::{Schedule, Verdict};
 use report::{draw, Axes, Figure, Marker, Section, Series, Table};
 

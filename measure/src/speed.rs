@@ -1,10 +1,10 @@
 //! Speed against accuracy of the verification methods, drawn from one
-//! fault campaign (`campaign::faults::Campaign`) and nothing else: its
+//! fault campaign (`campaign::Campaign`) and nothing else: its
 //! detector columns and its engines, each with the detections the matrix
 //! counts and the seconds the same campaign measured.  The chart draws
 //! counts (n of N), a real-time line, and keeps every point inside its axes.
 
-use campaign::faults::Campaign;
+use campaign::Campaign;
 use report::{draw, Axes, Figure, Marker, Section, Series, Table};
 
 /// One method: what one judged run cost it, and how many of the faults
@@ -39,10 +39,10 @@ pub fn scores(c: &Campaign) -> Vec<MethodScore> {
     let mut out = Vec::new();
     for col in c.columns.iter().filter(|col| col.not_run.is_none()) {
         let how = match col.detector {
-            campaign::faults::Detector::Model => "a clean run checked against the model",
-            campaign::faults::Detector::Invariants => "a clean run checked without the model",
-            campaign::faults::Detector::Sigrok => "every sigrok-cli decode of the campaign",
-            campaign::faults::Detector::Prove => "every proof of the campaign (for all time)",
+            campaign::Detector::Model => "a clean run checked against the model",
+            campaign::Detector::Invariants => "a clean run checked without the model",
+            campaign::Detector::Sigrok => "every sigrok-cli decode of the campaign",
+            campaign::Detector::Prove => "every proof of the campaign (for all time)",
         };
         out.push(MethodScore {
             method: col.detector.name().into(),

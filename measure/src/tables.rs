@@ -206,7 +206,7 @@ fn rotation_table(s: &Schedule, lut: &CompactLut) -> Table {
 }
 
 /// Per-channel sample counts and intervals a run measured.
-pub fn intervals(s: &Schedule, r: &judge::Report) -> Table {
+pub fn intervals(s: &Schedule, r: &judge::Verdict) -> Table {
     let mut t = Table::new(&[
         "channel",
         "branch",
@@ -242,7 +242,7 @@ pub fn intervals(s: &Schedule, r: &judge::Report) -> Table {
 
 /// The fault campaign by class: each detector's count apart ("n of N", or
 /// "cannot see"), then what no detector caught.
-pub fn faults(c: &campaign::faults::Campaign) -> Table {
+pub fn faults(c: &campaign::Campaign) -> Table {
     let mut head: Vec<String> = vec!["class".into(), "level".into(), "injected".into()];
     head.extend(c.detectors.iter().map(|d| d.name().to_string()));
     head.extend(["undetected".into(), "proved equivalent".into()]);

@@ -6,8 +6,8 @@
 //! `sample_valid` strobe.
 
 use engines::{Backend, SimOptions};
-use judge::run::Observer;
-use judge::vcd::CycleSink;
+use judge::CycleSink;
+use judge::Observer;
 use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
 use report::{draw, Axes, Figure, Section, Series, Table};

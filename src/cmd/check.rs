@@ -65,7 +65,7 @@ fn parse_skew(v: &str) -> Result<u64, String> {
 /// `check --map`: a logic-analyser capture at time level.
 fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
     let prepared = parse_skew(&a.skew).and_then(|skew| {
-        let lanes = judge::capture::parse_map(map, s)?;
+        let lanes = judge::parse_map(map, s)?;
         // plain lines off a terminal only for a capture of several chunks
         let progress = super::progress::Counter::new(
             &format!("reading {}", a.wave.display()),
@@ -74,10 +74,10 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
             a.quiet,
         );
         let cap =
-            judge::capture::read_progress(&a.wave, lanes, &|done, total| progress.set(done, total));
+            judge::read_capture_progress(&a.wave, lanes, &|done, total| progress.set(done, total));
         progress.finish();
         let cap = cap?;
-        judge::timed::check_capture(s, &cap, skew).map_err(|e| format!("{}: {e}", a.wave.display()))
+        judge::check_capture(s, &cap, skew).map_err(|e| format!("{}: {e}", a.wave.display()))
     });
     let r = match prepared {
         Ok(r) => r,
@@ -137,7 +137,7 @@ pub fn run(a: Args) -> u8 {
         a.quiet,
     );
     let checked =
-        judge::vcd::check_vcd_progress(&s, &a.wave, a.scope.as_deref(), opts, &|done, total| {
+        judge::check_vcd_progress(&s, &a.wave, a.scope.as_deref(), opts, &|done, total| {
             progress.set(done, total)
         });
     progress.finish();

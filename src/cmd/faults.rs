@@ -12,7 +12,7 @@
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use campaign::faults::{campaign_with, deep_faults, Campaign, Plan, Target};
+use campaign::{campaign_with, deep_faults, Campaign, Plan, Target};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -99,9 +99,9 @@ pub fn run(a: Args) -> u8 {
         a.quiet,
     ));
     let shown = std::sync::Arc::clone(&progress);
-    plan.on_run = Some(campaign::faults::OnRun(std::sync::Arc::new(
-        move |done, total| shown.set(done, total),
-    )));
+    plan.on_run = Some(campaign::OnRun(std::sync::Arc::new(move |done, total| {
+        shown.set(done, total)
+    })));
     let c = campaign_with(&s, &plan);
     progress.finish();
     let c = match c {
@@ -171,7 +171,7 @@ fn header(o: &mut String, c: &Campaign) {
     }
 }
 
-/// Fault class x detector, and why a detector cannot see a class.
+/// PinFault class x detector, and why a detector cannot see a class.
 fn matrix(o: &mut String, c: &Campaign) {
     let _ = write!(o, "  {:<20} {:<8}", "class", "level");
     for d in &c.detectors {
@@ -254,7 +254,7 @@ fn missed(o: &mut String, c: &Campaign) {
         }
         for m in &k.proved_equivalent {
             let why = match m.equivalence {
-                Some(campaign::equiv::Equivalence::ContractProved) => {
+                Some(campaign::Equivalence::ContractProved) => {
                     "the faulty design proves the full pin contract for all time (prove)"
                 }
                 _ => "every output equals the clean gateware's for every input, for all time",
@@ -269,8 +269,8 @@ fn missed(o: &mut String, c: &Campaign) {
 }
 
 /// The equivalence check's answer in words (not the enum's Debug form).
-fn equivalence(e: &campaign::equiv::Equivalence) -> String {
-    use campaign::equiv::Equivalence as E;
+fn equivalence(e: &campaign::Equivalence) -> String {
+    use campaign::Equivalence as E;
     match e {
         E::Proved { seconds } => format!("proved ({seconds:.1} s)"),
         E::Differs { frame: Some(f) } => format!("differs (counterexample at frame {f})"),
@@ -283,7 +283,7 @@ fn equivalence(e: &campaign::equiv::Equivalence) -> String {
 #[cfg(test)]
 mod tests {
     use super::equivalence;
-    use campaign::equiv::Equivalence;
+    use campaign::Equivalence;
 
     #[test]
     fn the_equivalence_verdict_is_words_not_the_enum() {

@@ -16,8 +16,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use engines::{Backend, SimOptions};
-use judge::events::{compare, EventLog, Trace};
-use judge::vcdout::{write_gtkw, VcdWriter};
+use judge::{compare_events as compare, EventLog, Trace};
+use judge::{write_gtkw, VcdWriter};
 use lut_gen::Schedule;
 use serde::Deserialize;
 
@@ -158,7 +158,7 @@ fn write_window(
     path: &Path,
     fst: bool,
 ) -> std::io::Result<()> {
-    use judge::run::Observer;
+    use judge::Observer;
     let vcd = if fst {
         path.with_extension("fst.vcd")
     } else {
@@ -180,7 +180,7 @@ fn write_window(
 /// The cycles of a VCD window as read back by the judge's reader.
 fn read_window(s: &Schedule, path: &Path) -> Result<Trace, String> {
     let mut t = Trace::default();
-    judge::vcd::read_cycles(s, path, None, &mut t).map_err(|e| e.to_string())?;
+    judge::read_cycles(s, path, None, &mut t).map_err(|e| e.to_string())?;
     Ok(t)
 }
 
@@ -294,7 +294,7 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         rtl: a.rtl.clone(),
         ..SimOptions::default()
     };
-    let reset = judge::run::reset_cycles(&s, opts.reset_cycles);
+    let reset = judge::reset_cycles(&s, opts.reset_cycles);
     let mut windows = Vec::new();
     for w in &manifest.window {
         match window_cycles(&s, w, reset, &manifest_path) {

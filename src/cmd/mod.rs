@@ -230,7 +230,7 @@ pub fn write_files(dir: &Path, files: &[(&str, String)]) -> Result<(), u8> {
 /// leaves no partial FST.
 pub fn vcd_to_fst(vcd: &Path, fst: &Path) -> std::io::Result<()> {
     let tmp = fst.with_extension("fst.part");
-    let r = judge::fst::from_vcd(vcd, &tmp);
+    let r = judge::fst_from_vcd(vcd, &tmp);
     if let Err(e) = r {
         let _ = std::fs::remove_file(&tmp);
         return Err(std::io::Error::other(e));

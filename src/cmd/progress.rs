@@ -139,7 +139,7 @@ impl<'a> CycleProgress<'a> {
     }
 }
 
-impl judge::run::Observer for CycleProgress<'_> {
+impl judge::Observer for CycleProgress<'_> {
     fn cycle(&mut self, cycle: u64, rst: bool, pins: &lut_gen::ports::Pins, miso: u64) {
         if let Some(t) = self.inner.as_deref_mut() {
             t.as_observer().cycle(cycle, rst, pins, miso);
@@ -148,7 +148,7 @@ impl judge::run::Observer for CycleProgress<'_> {
     }
 }
 
-impl judge::vcd::CycleSink for CycleProgress<'_> {
+impl judge::CycleSink for CycleProgress<'_> {
     fn cycle(
         &mut self,
         rst: Option<bool>,

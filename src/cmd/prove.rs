@@ -46,7 +46,7 @@ pub fn run(a: Args) -> u8 {
         Err(code) => return code,
     };
     let (design, own) = match &a.rtl {
-        Some(path) => match engines::rtl::load_rtl(&s, path) {
+        Some(path) => match engines::load_rtl(&s, path) {
             Ok(text) => (text, false),
             Err(e) => {
                 eprintln!("error: {e}");

@@ -108,12 +108,12 @@ fn to_fst(
     for f in [
         vcd.to_path_buf(),
         vcd.with_extension("gtkw"),
-        judge::vcdout::channels_path(vcd),
+        judge::channels_path(vcd),
     ] {
         let _ = std::fs::remove_file(f);
     }
     r?;
-    judge::vcdout::write_gtkw(&fst.with_extension("gtkw"), fst, s)
+    judge::write_gtkw(&fst.with_extension("gtkw"), fst, s)
 }
 
 pub fn run(a: Args) -> u8 {
@@ -157,7 +157,7 @@ pub fn run(a: Args) -> u8 {
         tready: a.tready,
         ..SimOptions::default()
     };
-    let mut log = judge::samples::SampleLog::new();
+    let mut log = judge::SampleLog::new();
     let report = match simulate(&a, &s, backend, &opts, &mut log) {
         Ok(r) => r,
         Err(e) => {
@@ -271,8 +271,8 @@ fn simulate(
     s: &lut_gen::Schedule,
     backend: Backend,
     opts: &SimOptions,
-    log: &mut judge::samples::SampleLog,
-) -> Result<judge::Report, engines::error::SimError> {
+    log: &mut judge::SampleLog,
+) -> Result<judge::Verdict, engines::SimError> {
     // The slot-level model runs hours per second: no progress to show, and
     // an observer would make it run the cycle model instead.
     if backend == Backend::Model && a.samples.is_none() {

@@ -7,10 +7,10 @@
 
 use std::path::{Path, PathBuf};
 
-use judge::run::{run_dut, Dut, Observer, RunOptions};
-use judge::timed::{check_capture, TimedReport};
 use judge::tools::Tool;
-use judge::vcdout::{id_code, wire_header};
+use judge::{check_capture, TimedReport};
+use judge::{id_code, wire_header};
+use judge::{run_dut, Dut, Observer, RunOptions};
 use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
 
@@ -196,8 +196,8 @@ fn sigrok_cli(tool: Tool) {
 }
 
 pub fn check(s: &Schedule, map: &str, file: &Path) -> TimedReport {
-    let lanes = judge::capture::parse_map(map, s).unwrap();
-    let cap = judge::capture::read(file, lanes).unwrap();
+    let lanes = judge::parse_map(map, s).unwrap();
+    let cap = judge::read_capture(file, lanes).unwrap();
     check_capture(s, &cap, 0).unwrap()
 }
 

@@ -3,7 +3,7 @@
 //! boundaries; mid-frame), each run checked in full, plus clean runs over
 //! random feasible mixes that must not be rejected (false alarms).
 //!
-//! Classes come at three levels: pin faults (`judge::faults::Fault`: a
+//! Classes come at three levels: pin faults (`judge::PinFault`: a
 //! wrong sample, a CS window late, an extra SCLK edge, a mux late or wrong,
 //! two mux devices on), a reset glitch the design suffers while its `rst`
 //! port stays low, and design-level faults built into the gateware itself
@@ -22,17 +22,17 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use judge::faults::{Fault, FaultyDut};
-use judge::run::{run_dut, Dut, ModelDut, RunOptions};
-use judge::Report;
+use judge::Verdict;
+use judge::{run_dut, Dut, ModelDut, RunOptions};
+use judge::{FaultyDut, PinFault};
 use lut_gen::Schedule;
 use serde::Serialize;
 
 use crate::equiv::Equivalence;
 use crate::sigrok::SpiCapture;
-use engines::error::SimError;
-use engines::options::Backend;
-use engines::rusthdl::RustHdlDut;
+use engines::Backend;
+use engines::RustHdlDut;
+use engines::SimError;
 
 mod class;
 mod verilog;
@@ -303,7 +303,7 @@ impl Cost {
 
 /// A run judged by every detector that runs.
 struct Judged {
-    report: Report,
+    report: Verdict,
     /// sigrok's verdict (`None`: not run).
     sigrok: Option<Result<(), String>>,
     cost: Cost,
@@ -359,7 +359,7 @@ fn judge_run(s: &Schedule, dut: &mut dyn Dut, frames: u64, sigrok: bool) -> Resu
             cost: Cost::default(),
         });
     }
-    let mut cap = SpiCapture::new(s, judge::run::reset_cycles(s, opts.reset_cycles));
+    let mut cap = SpiCapture::new(s, judge::reset_cycles(s, opts.reset_cycles));
     let report = run_dut(s, dut, frames, &opts, "faults", Some(&mut cap));
     let mut j = Judged {
         report,
@@ -614,7 +614,7 @@ pub const TREADY: link::ReadyPattern = link::ReadyPattern::WorstCase;
 
 /// `dut` behind the campaign's slave when `s`'s link is AXI4-Stream.
 fn slave(s: &Schedule, dut: Box<dyn Dut>) -> Box<dyn Dut> {
-    judge::run::with_slave(s, dut, TREADY)
+    judge::with_slave(s, dut, TREADY)
 }
 
 /// The design the faults go into, built for `s`, behind the campaign's slave.
@@ -645,7 +645,7 @@ fn pin_injections(
 ) -> Result<Vec<Judgement>, String> {
     let mut jobs = Vec::new();
     for site in sites {
-        for f in Fault::all(s) {
+        for f in PinFault::all(s) {
             jobs.push((f, *site));
         }
     }
@@ -656,7 +656,7 @@ fn pin_injections(
             let inner = target_dut(s, target).map_err(|e| e.to_string())?;
             let mut dut = FaultyDut::new(s, inner, f, site.cycle);
             let j = judge_run(s, &mut dut, frames, sigrok)?;
-            let level = if f == Fault::ResetGlitch {
+            let level = if f == PinFault::ResetGlitch {
                 Level::Reset
             } else {
                 Level::Pins
@@ -878,17 +878,6 @@ fn engine_columns(judged: &[Judgement], costs: &[(&'static str, u64, f64)]) -> V
         .collect()
 }
 
-/// The campaign on `s` with `frames` frames per run and
-/// `false_alarm_mixes` random feasible mixes run clean.
-pub fn campaign(
-    s: &Schedule,
-    target: Target,
-    frames: u64,
-    false_alarm_mixes: u64,
-) -> Result<Campaign, SimError> {
-    campaign_with(s, &Plan::new(target, frames, false_alarm_mixes))
-}
-
 /// The campaign of `plan` on `s`.
 pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
     let frames = plan.frames.max(3);
@@ -985,7 +974,7 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
 fn planned_runs(s: &Schedule, plan: &Plan, sites: &[Site]) -> u64 {
     let mut n = 1 + plan.false_alarm_mixes;
     if plan.builtin {
-        n += (sites.len() * Fault::all(s).len()) as u64;
+        n += (sites.len() * PinFault::all(s).len()) as u64;
         if plan.target == Target::Rusthdl {
             n += design_cases(s, sites).len() as u64;
         }
@@ -1010,18 +999,8 @@ impl Dut for GatewareDut {
 }
 
 /// Clean runs of `target` over the first `n` feasible mixes of
-/// [`random_mix`], judged by every detector (sigrok with `sigrok`); every
-/// rejection is a false alarm.
-pub fn false_alarms(target: Target, n: u64, sigrok: bool) -> FalseAlarms {
-    let none = Runs {
-        hook: None,
-        done: 0.into(),
-        total: n,
-    };
-    counted_false_alarms(target, n, sigrok, &none)
-}
-
-/// [`false_alarms`], each mix run counted in `count`.
+/// [`random_mix`], judged by every detector (sigrok with `sigrok`), each
+/// counted in `count`; every rejection is a false alarm.
 fn counted_false_alarms(target: Target, n: u64, sigrok: bool, count: &Runs) -> FalseAlarms {
     let mut fa = FalseAlarms {
         mixes: 0,
@@ -1071,6 +1050,6 @@ fn counted_false_alarms(target: Target, n: u64, sigrok: bool, count: &Runs) -> F
 /// A random mix (TOML text) of 1-3 AD7940 branches with 2 ms frames, 1-3
 /// mux devices each, random SCLK and settling, and 2-9 channels at rates
 /// from 500 Hz to 8 kHz; some are infeasible on purpose.
-pub fn random_mix(seed: u64) -> String {
+fn random_mix(seed: u64) -> String {
     crate::mixgen::random_mix(seed, &crate::mixgen::Shape::default())
 }

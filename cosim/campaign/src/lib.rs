@@ -2,16 +2,25 @@
 //! engines. It sits above the engines (`engines`) and the formal flow
 //! (`formal`, the `prove` detector), so no engine depends on `formal`.
 //!
-//! - [`faults`]: the campaign (pin faults, reset glitches and faults built
+//! - `faults`: the campaign (pin faults, reset glitches and faults built
 //!   into the gateware or its Verilog, at many sites; false alarms over
 //!   random mixes), judged by each detector apart: a matrix of fault class x
 //!   detector;
-//! - [`sigrok`]: sigrok-cli's SPI decode of the pins as a detector;
-//! - [`equiv`]: a faulty gateware proved equivalent to the clean one at the
+//! - `sigrok`: sigrok-cli's SPI decode of the pins as a detector;
+//! - `equiv`: a faulty gateware proved equivalent to the clean one at the
 //!   ports (yosys miter, ABC), or not;
-//! - [`mixgen`]: random feasible mixes for false-alarm runs and charts.
+//! - `mixgen`: random feasible mixes for false-alarm runs and charts.
 
-pub mod equiv;
-pub mod faults;
-pub mod mixgen;
-pub mod sigrok;
+// The modules are private: what other crates use is the list below.
+mod equiv;
+mod faults;
+mod mixgen;
+mod sigrok;
+
+pub use equiv::{check as check_equivalence, verdict as equivalence_verdict, Equivalence};
+pub use faults::{
+    campaign_with, deep_faults, gateware_dut, one_gateware_fault_per_class, prove,
+    prove_unavailable, sites, Campaign, Detector, FaultClass, Level, OnRun, Plan, ProveVerdict,
+    Target, VerilogFault, TREADY,
+};
+pub use mixgen::{random_mix, Shape};

@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Duration;
 
-use judge::run::Observer;
+use judge::Observer;
 use lut_gen::parts::{AdcPart, Start};
 use lut_gen::ports::Pins;
 use lut_gen::Schedule;
@@ -73,7 +73,7 @@ impl Observer for SpiCapture {
 
 /// Icarus's VCD, read back cycle by cycle from its first (reset) cycle, as
 /// the in-process engines' observers see it; x/z bits read as 0.
-impl judge::vcd::CycleSink for SpiCapture {
+impl judge::CycleSink for SpiCapture {
     fn cycle(&mut self, rst: Option<bool>, pins: &Pins, _: &Pins, miso: u64, _: u64) {
         let c = self.seen;
         self.seen += 1;
@@ -112,7 +112,7 @@ impl PartDecoder {
 
 /// The branch's lanes as a VCD sigrok reads (1-bit signals `cs`, `sclk`, `miso`).
 fn vcd(changes: &[(u64, u8)], end: u64) -> String {
-    let mut out = judge::vcdout::wire_header("1 ns", "top", &["cs", "sclk", "miso"]);
+    let mut out = judge::wire_header("1 ns", "top", &["cs", "sclk", "miso"]);
     let mut prev: Option<u8> = None;
     for &(t, v) in changes {
         let _ = writeln!(out, "#{t}");

@@ -8,7 +8,7 @@
 
 use std::path::Path;
 
-use judge::timed::check_capture;
+use judge::check_capture;
 
 use crate::tools;
 use testkit::analyser;
@@ -22,7 +22,7 @@ fn mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
     let mut k = seed;
     while v.len() < n {
         k += 1;
-        let text = campaign::faults::random_mix(k);
+        let text = campaign::random_mix(k, &campaign::Shape::default());
         let Ok(mix) = lut_gen::parse(Path::new("random.toml"), &text) else {
             continue;
         };
@@ -50,7 +50,7 @@ fn captures_of_random_mixes(seed: u64, n: usize, classes: usize) {
         // Over two frame boundaries: a branch may start converting late in
         // the window, and a fault of the frame's length shows at a boundary.
         let window = (f * 37 / 100 + k % 97, f * 293 / 100);
-        let mut dut = engines::rusthdl::RustHdlDut::new(&s).unwrap();
+        let mut dut = engines::RustHdlDut::new(&s).unwrap();
         let clean = run(&s, &mut dut, 3);
         let (_, map) = lanes(&s);
         // 100 MHz and 24 MHz analysers, their phases drawn from the seed.
@@ -74,10 +74,10 @@ fn captures_of_random_mixes(seed: u64, n: usize, classes: usize) {
         // Mutated gateware: one design-level fault of every class.
         let reference = d.path().join(format!("ref{k}.vcd"));
         resample(&s, &clean, window.0, window.1, 10_000, 3_333, &reference);
-        let faults = campaign::faults::one_gateware_fault_per_class(&s);
+        let faults = campaign::one_gateware_fault_per_class(&s);
         assert!(!faults.is_empty(), "mix {k}: no gateware fault");
         for (class, fault) in faults.into_iter().take(classes) {
-            let Ok(mut bad) = campaign::faults::gateware_dut(&s, fault) else {
+            let Ok(mut bad) = campaign::gateware_dut(&s, fault) else {
                 continue;
             };
             let pins = run(&s, &mut bad, 3);
@@ -91,8 +91,8 @@ fn captures_of_random_mixes(seed: u64, n: usize, classes: usize) {
                 continue;
             }
             let (sr, _) = to_sigrok(&v, 10_000);
-            let lanes = judge::capture::parse_map(&map, &s).unwrap();
-            let cap = judge::capture::read(&sr, lanes).unwrap();
+            let lanes = judge::parse_map(&map, &s).unwrap();
+            let cap = judge::read_capture(&sr, lanes).unwrap();
             // A design fault may break the phase everywhere (an input
             // problem only if nothing fits at all), never pass.
             match check_capture(&s, &cap, 0) {

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use campaign::equiv::{check, Equivalence};
+use campaign::{check_equivalence as check, Equivalence};
 use hdl::GatewareFault;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
@@ -64,7 +64,7 @@ fn a_wrong_rom_word_is_not_equivalent() {
 /// ABC's answers as the campaign reads them.
 #[test]
 fn abc_output_is_read_as_proved_differs_or_undecided() {
-    use campaign::equiv::verdict;
+    use campaign::equivalence_verdict as verdict;
     assert!(matches!(
         verdict("Property proved.  Time = 0.02 sec\n", 0.1),
         Equivalence::Proved { .. }

@@ -4,7 +4,7 @@
 //! the check on the link's pins, with the wrong bit's byte and packet named,
 //! and the model-free decode of the line sees it too.
 
-use judge::run::{run_dut, Dut, RunOptions};
+use judge::{run_dut, Dut, RunOptions};
 use lut_gen::ports::Pins;
 use lut_gen::Schedule;
 
@@ -105,7 +105,7 @@ struct Beats {
     stalls: u64,
 }
 
-impl judge::run::Observer for Beats {
+impl judge::Observer for Beats {
     fn cycle(&mut self, _c: u64, rst: bool, p: &Pins, _miso: u64) {
         if rst {
             return;
@@ -122,9 +122,9 @@ impl judge::run::Observer for Beats {
 
 /// The beats of a Verilog engine, read back from its pins (Verilator's
 /// cycles, or Icarus's VCD).
-impl judge::vcd::CycleSink for Beats {
+impl judge::CycleSink for Beats {
     fn cycle(&mut self, rst: Option<bool>, p: &Pins, _xz: &Pins, miso: u64, _mx: u64) {
-        judge::run::Observer::cycle(self, 0, rst.unwrap_or(false), p, miso);
+        judge::Observer::cycle(self, 0, rst.unwrap_or(false), p, miso);
     }
 }
 
@@ -177,14 +177,14 @@ fn axis_runs_clean_on_verilator_and_icarus_under_back_pressure() {
 /// model on the pin it touched.
 #[test]
 fn axis_pin_faults_under_back_pressure_break_the_stability_rule() {
-    use judge::faults::{Fault, FaultyDut};
+    use judge::{FaultyDut, PinFault};
     let s = axis_preset();
     for (f, signal) in [
-        (Fault::AxisTdataChange, "m_axis_tdata"),
-        (Fault::AxisTvalidDrop, "m_axis_tvalid"),
+        (PinFault::AxisTdataChange, "m_axis_tdata"),
+        (PinFault::AxisTvalidDrop, "m_axis_tvalid"),
     ] {
         let sim = Sim(hdl::RtlSim::new(&s).unwrap());
-        let slave = judge::run::with_slave(&s, sim, link::ReadyPattern::Random { seed: 5 });
+        let slave = judge::with_slave(&s, sim, link::ReadyPattern::Random { seed: 5 });
         let mut dut = FaultyDut::new(&s, slave, f, 0);
         let r = run_dut(&s, &mut dut, 1, &RunOptions::default(), "test", None);
         let class = f.class();
@@ -234,25 +234,25 @@ fn is_link_port(name: &str) -> bool {
 /// rules only).  The same run without the fault passes.
 #[test]
 fn every_link_pin_fault_is_caught_by_its_detector() {
-    use campaign::faults::{Detector, FaultClass, Level, TREADY};
-    use judge::faults::{Fault, FaultyDut};
+    use campaign::{Detector, FaultClass, Level, TREADY};
+    use judge::{FaultyDut, PinFault};
     for s in [tiny_uart(), tiny_axis()] {
         let opts = RunOptions::default();
         let at = s.grid.frame_cycles + s.grid.frame_cycles / 2 + 7;
         let clean = run_dut(
             &s,
-            &mut *judge::run::with_slave(&s, judge::run::ModelDut::new(&s), TREADY),
+            &mut *judge::with_slave(&s, judge::ModelDut::new(&s), TREADY),
             3,
             &opts,
             "test",
             None,
         );
         assert!(clean.ok, "clean: {}", clean.summary());
-        let faults = Fault::link(&s);
+        let faults = PinFault::link(&s);
         let axis = s.mix.link.unwrap().kind == lut_gen::mix::LinkKind::Axis;
         assert_eq!(faults.len(), if axis { 3 } else { 5 });
         for f in faults {
-            let inner = judge::run::with_slave(&s, judge::run::ModelDut::new(&s), TREADY);
+            let inner = judge::with_slave(&s, judge::ModelDut::new(&s), TREADY);
             let mut dut = FaultyDut::new(&s, inner, f, at);
             let r = run_dut(&s, &mut dut, 3, &opts, "test", None);
             let class = f.class();
@@ -268,8 +268,8 @@ fn every_link_pin_fault_is_caught_by_its_detector() {
             let kind = FaultClass::of_pins(f);
             let sees = Detector::Invariants.blind_to(&kind, Level::Pins).is_none();
             let rule = match f {
-                Fault::LinkOverflow => Some("link-overflow"),
-                Fault::AxisTvalidDrop | Fault::AxisTdataChange => Some("axis-stable"),
+                PinFault::LinkOverflow => Some("link-overflow"),
+                PinFault::AxisTvalidDrop | PinFault::AxisTdataChange => Some("axis-stable"),
                 _ => None,
             };
             match rule {
@@ -304,11 +304,11 @@ fn a_short_axis_fifo_overflows_under_the_campaigns_slave() {
     let s = tiny_axis();
     let opts = RunOptions::default();
     for (pattern, caught) in [
-        (campaign::faults::TREADY, true),
+        (campaign::TREADY, true),
         (link::ReadyPattern::Always, false),
     ] {
         let sim = Sim(hdl::RtlSim::with_fault(&s, hdl::GatewareFault::LinkFifoShort).unwrap());
-        let mut dut = judge::run::with_slave(&s, sim, pattern);
+        let mut dut = judge::with_slave(&s, sim, pattern);
         let r = run_dut(&s, &mut *dut, 3, &opts, "test", None);
         let overflow = r.violations.iter().any(|v| v.rule == "link-overflow");
         assert_eq!(overflow, caught, "{}: {}", pattern.name(), r.summary());
@@ -323,7 +323,7 @@ fn a_short_axis_fifo_overflows_under_the_campaigns_slave() {
 #[test]
 #[ignore = "long: make test-long"]
 fn the_presets_campaigns_report_every_link_class_caught() {
-    use campaign::faults::{campaign_with, sites, Detector, Plan, Target};
+    use campaign::{campaign_with, sites, Detector, Plan, Target};
     for s in [preset(), axis_preset()] {
         let mut plan = Plan::new(Target::Model, 3, 0);
         plan.sites = Some(
@@ -334,7 +334,7 @@ fn the_presets_campaigns_report_every_link_class_caught() {
         );
         let c = campaign_with(&s, &plan).unwrap();
         assert!(c.ok(), "{}: {} undetected", s.mix.name, c.undetected);
-        let want: Vec<&str> = judge::faults::Fault::link(&s)
+        let want: Vec<&str> = judge::PinFault::link(&s)
             .iter()
             .map(|f| f.class())
             .collect();

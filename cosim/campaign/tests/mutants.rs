@@ -17,9 +17,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use campaign::faults::{
-    campaign_with, Campaign, Detector, FaultClass, Level, Plan, Target, VerilogFault,
-};
+use campaign::{campaign_with, Campaign, Detector, FaultClass, Level, Plan, Target, VerilogFault};
 
 use mutate::Operator;
 use testkit::mutate;
@@ -285,7 +283,7 @@ fn mutant_plan(
     engines: &[engines::Backend],
     prove: bool,
 ) -> Plan {
-    let original = engines::rusthdl::verilog(s).unwrap();
+    let original = engines::verilog(s).unwrap();
     let mut plan = Plan::new(Target::Model, 3, 0);
     plan.builtin = false;
     plan.prove = prove;
@@ -364,7 +362,7 @@ fn a_few_mutants_run_through_the_campaign_on_icarus() {
     assert_eq!(stuck.proved_equivalent.len(), 1, "{stuck:?}");
     assert!(matches!(
         stuck.proved_equivalent[0].equivalence,
-        Some(campaign::equiv::Equivalence::Proved { .. })
+        Some(campaign::Equivalence::Proved { .. })
     ));
     assert!(c.column(Detector::Prove).unwrap().not_run.is_some());
 }

@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use judge::faults::{Fault, FaultyDut};
-use judge::run::{run_dut, ModelDut, RunOptions};
+use judge::{run_dut, ModelDut, RunOptions};
+use judge::{FaultyDut, PinFault};
 
 /// Twelve seeds in the default suite, 40 in `make test-long`.
 #[test]
@@ -22,7 +22,7 @@ fn random_feasible_mixes_from(seeds: std::ops::Range<u64>) {
     let drawn = (seeds.end - seeds.start) as usize;
     let mut tested = 0;
     for seed in seeds {
-        let text = campaign::faults::random_mix(seed);
+        let text = campaign::random_mix(seed, &campaign::Shape::default());
         let Ok(mix) = lut_gen::parse(Path::new("rand.toml"), &text) else {
             continue;
         };
@@ -51,7 +51,7 @@ fn random_feasible_mixes_from(seeds: std::ops::Range<u64>) {
             assert!(r.ok, "seed {seed} rusthdl:\n{text}\n{}", r.summary());
         }
         let at = s.grid.frame_cycles / 3 + 11;
-        for f in Fault::all(&s) {
+        for f in PinFault::all(&s) {
             let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
             let r = run_dut(&s, &mut dut, 2, &opts, "faulty", None);
             // a fault that found nothing to change (e.g. no idle slot to move
@@ -61,7 +61,7 @@ fn random_feasible_mixes_from(seeds: std::ops::Range<u64>) {
             }
             // A mux switching two cycles early is only an invariant violation when settling takes longer.
             let invariant_visible = match f {
-                Fault::MuxLate { branch } => s.branches[branch].settle_cycles > 2,
+                PinFault::MuxLate { branch } => s.branches[branch].settle_cycles > 2,
                 _ => true,
             };
             assert!(

@@ -13,11 +13,11 @@
 use std::path::Path;
 use std::time::Instant;
 
-use engines::rusthdl::{verilog, RustHdlDut};
-use engines::verilator::VerilatedDut;
 use engines::Stimulus;
-use judge::run::{run_dut, run_model, run_unchecked, ModelDut, RunOptions};
-use judge::vcdout::write_run;
+use engines::VerilatedDut;
+use engines::{verilog, RustHdlDut};
+use judge::write_run;
+use judge::{run_dut, run_model, run_unchecked, ModelDut, RunOptions};
 
 fn secs<T>(f: impl FnOnce() -> T) -> (f64, T) {
     let t = Instant::now();
@@ -111,7 +111,7 @@ fn main() {
     let vf = (frames / 2).max(1);
     write_run(&vcd, &s, &mut ModelDut::new(&s), vf, &opts, (0, u64::MAX)).unwrap();
     let size = std::fs::metadata(&vcd).unwrap().len() as f64;
-    let (tp, n) = secs(|| judge::vcd::parse_only(&s, &vcd, None).unwrap());
+    let (tp, n) = secs(|| judge::parse_vcd(&s, &vcd, None).unwrap());
     let (tk, r) = secs(|| judge::check_vcd(&s, &vcd, None).unwrap());
     assert!(r.ok, "{}", r.summary());
     println!(

@@ -10,14 +10,10 @@ fn main() {
         .map(|c| c.parse().unwrap())
         .unwrap_or(s.grid.frame_cycles);
     let stimulus = a.get(4).map(|x| x.parse().unwrap()).unwrap_or_default();
-    let tb = engines::icarus::testbench(&s, stimulus, judge::run::reset_cycles(&s, 4), cycles);
+    let tb = engines::icarus_testbench(&s, stimulus, judge::reset_cycles(&s, 4), cycles);
     std::fs::write(d.join("tb.v"), tb.tb).unwrap();
     for (name, text) in tb.tables {
         std::fs::write(d.join(name), text).unwrap();
     }
-    std::fs::write(
-        d.join("slotforge_top.v"),
-        engines::rusthdl::verilog(&s).unwrap(),
-    )
-    .unwrap();
+    std::fs::write(d.join("slotforge_top.v"), engines::verilog(&s).unwrap()).unwrap();
 }

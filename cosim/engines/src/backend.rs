@@ -1,10 +1,10 @@
 //! The back ends behind one call: [`run`] dispatches to each engine.
 
-use judge::events::Trace;
-use judge::run::{reset_cycles, run_dut, run_model, Dut, ModelDut, Observer, RunOptions};
-use judge::vcd::CycleSink;
-use judge::vcdout::{write_gtkw, VcdWriter};
-use judge::Report;
+use judge::CycleSink;
+use judge::Trace;
+use judge::Verdict;
+use judge::{reset_cycles, run_dut, run_model, Dut, ModelDut, Observer, RunOptions};
+use judge::{write_gtkw, VcdWriter};
 use lut_gen::ports::Pins;
 use lut_gen::Schedule;
 
@@ -19,7 +19,7 @@ pub fn run(
     backend: Backend,
     frames: u64,
     opts: &SimOptions,
-) -> Result<Report, SimError> {
+) -> Result<Verdict, SimError> {
     no_rtl_in_process(backend, opts)?;
     match backend {
         Backend::Model => {
@@ -60,7 +60,7 @@ pub fn run_traced(
     frames: u64,
     opts: &SimOptions,
     trace: Option<&mut Trace>,
-) -> Result<Report, SimError> {
+) -> Result<Verdict, SimError> {
     run_observed(
         s,
         backend,
@@ -72,7 +72,7 @@ pub fn run_traced(
 
 /// What can watch every cycle of any back end: the in-process ones call it
 /// as an [`Observer`], Icarus (through its VCD) as a [`CycleSink`].  Every
-/// type that is both is one ([`Trace`], [`judge::samples::SampleLog`]).
+/// type that is both is one ([`Trace`], [`judge::SampleLog`]).
 pub trait Tracer: Observer + CycleSink {
     fn as_observer(&mut self) -> &mut dyn Observer;
     fn as_sink(&mut self) -> &mut dyn CycleSink;
@@ -95,7 +95,7 @@ pub fn run_observed(
     frames: u64,
     opts: &SimOptions,
     trace: Option<&mut dyn Tracer>,
-) -> Result<Report, SimError> {
+) -> Result<Verdict, SimError> {
     no_rtl_in_process(backend, opts)?;
     match backend {
         Backend::Model => in_process(s, &mut ModelDut::new(s), frames, opts, "model", obs(trace)),
@@ -142,7 +142,7 @@ fn in_process(
     opts: &SimOptions,
     source: &str,
     trace: Option<&mut dyn Observer>,
-) -> Result<Report, SimError> {
+) -> Result<Verdict, SimError> {
     let reset = reset_cycles(s, opts.reset_cycles);
     let ro = RunOptions {
         stimulus: opts.stimulus,
@@ -168,7 +168,7 @@ fn in_process(
         trace.map(|t| &mut *t as &mut dyn Observer),
     );
     let obs = (tee.0.is_some() || tee.1.is_some()).then_some(&mut tee as &mut dyn Observer);
-    let mut dut = judge::run::with_slave(s, dut, opts.tready);
+    let mut dut = judge::with_slave(s, dut, opts.tready);
     let report = run_dut(s, &mut *dut, frames, &ro, source, obs);
     if let Some(w) = writer {
         w.finish().map_err(|e| SimError::Io(e.to_string()))?;

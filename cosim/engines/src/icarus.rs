@@ -5,11 +5,11 @@
 //! handed to `slotforge check`.
 //!
 //! The testbench's ADCs give the same codes as cosim's cycle-level ADC model
-//! ([`judge::adc::Adc`]) for the chosen stimulus: `pattern` by the same
+//! ([`judge::Adc`]) for the chosen stimulus: `pattern` by the same
 //! formula, the others from a table of the schedule's conversions (a
 //! conversion the schedule does not expect falls back to the pattern
 //! formula; the checker decodes every value from MISO in any case).  Reset
-//! lasts [`judge::run::reset_cycles`] cycles (the run's `reset_cycles`, one
+//! lasts [`judge::reset_cycles`] cycles (the run's `reset_cycles`, one
 //! at the least), as in the in-process back ends.
 
 use std::fmt::Write as _;
@@ -19,11 +19,11 @@ use std::path::Path;
 
 use lut_gen::Schedule;
 
-use judge::adc::{Analog, Stimulus};
+use judge::edge_ps;
 use judge::tools::{Tool, ToolError};
-use judge::vcd::CycleSink;
-use judge::vcdout::edge_ps;
-use judge::Report;
+use judge::CycleSink;
+use judge::Verdict;
+use judge::{Analog, Stimulus};
 use lut_gen::parts::Start;
 use lut_gen::ports::{Dir, Layout, Pins, Role, AXIS_PORTS, PORTS, TOP_MODULE};
 
@@ -235,7 +235,7 @@ impl Adcs<'_> {
     }
 
     /// Branch `b`'s parts in CNV chain mode (AD7685 style, no busy indicator),
-    /// as `judge::adc::Adc` models them: at the CNV rising edge every part of
+    /// as `judge::Adc` models them: at the CNV rising edge every part of
     /// the chain samples its own input (the chain member's channel); while CNV
     /// is high the stream of all words leaves MSB first, member 0's first, one
     /// bit per SCK falling edge, zeros after the last (the first part's SDI is
@@ -297,7 +297,7 @@ impl Adcs<'_> {
         let trailing = ws - part.leading_bits as usize - part.bits as usize;
         let mask = (1u32 << part.bits) - 1;
         let mut members = String::new();
-        // judge::adc::Adc: the member's channel, or an unconnected input
+        // judge::Adc: the member's channel, or an unconnected input
         let _ = writeln!(members, "    case (id{b})");
         for lead in (0..s.groups.len()).filter(|&c| s.mix.channels[c].branch == b) {
             let mid = match s.groups[lead].get(m) {
@@ -439,7 +439,7 @@ pub fn run(
     frames: u64,
     opts: &SimOptions,
     trace: Option<&mut dyn CycleSink>,
-) -> Result<Report, SimError> {
+) -> Result<Verdict, SimError> {
     let io = |e: std::io::Error| SimError::Io(format!("icarus back end: {e}"));
     // Name the missing tool before doing any work.
     for tool in ["iverilog", "vvp"] {
@@ -450,7 +450,7 @@ pub fn run(
         .tempdir()
         .map_err(io)?;
     let d = dir.path();
-    let reset = judge::run::reset_cycles(s, opts.reset_cycles);
+    let reset = judge::reset_cycles(s, opts.reset_cycles);
     let cycles = frames * s.grid.frame_cycles;
     let tb = testbench_with(s, opts.stimulus, reset, cycles, opts.tready);
     match &opts.rtl {
@@ -485,11 +485,11 @@ pub fn run(
         "vvp (running the simulation)",
     )?;
     let wave = d.join("wave.vcd");
-    let (mut report, _) = judge::vcd::check_vcd_with(s, &wave, Some("tb"), opts.check)
+    let (mut report, _) = judge::check_vcd_with(s, &wave, Some("tb"), opts.check)
         .map_err(|e| SimError::Io(format!("icarus back end: reading its VCD: {e}")))?;
     report.source = "icarus".into();
     if let Some(sink) = trace {
-        judge::vcd::read_cycles(s, &wave, Some("tb"), sink)
+        judge::read_cycles(s, &wave, Some("tb"), sink)
             .map_err(|e| SimError::Io(format!("icarus back end: reading its VCD: {e}")))?;
     }
     if let Some(v) = &opts.vcd {

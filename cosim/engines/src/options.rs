@@ -81,7 +81,7 @@ pub struct SimOptions {
     pub stimulus: Stimulus,
     pub check: CheckOptions,
     pub vcd: Option<VcdOut>,
-    /// Reset cycles before cycle 0 (one at the least: [`judge::run::reset_cycles`]).
+    /// Reset cycles before cycle 0 (one at the least: [`judge::reset_cycles`]).
     pub reset_cycles: u64,
     /// Simulate this Verilog file instead of the emitted one (verilator and
     /// icarus only); its `slotforge_top` must honour the pin contract

@@ -7,8 +7,8 @@
 //! the Verilog, the shim and the `verilator --version` / `g++ --version`
 //! banners, so a second run does not rebuild.
 
-use judge::run::Dut;
 use judge::tools::Tool;
+use judge::Dut;
 use lut_gen::ports::{LinkPort, Pins, Role, AXIS_PORTS, LINK_PORTS, TOP_MODULE};
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};

@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use engines::{Backend, SimOptions, Stimulus, VcdOut};
-use judge::run::{run_dut, Observer, RunOptions};
-use judge::vcd::{read_cycles, CycleSink};
 use judge::Pins;
+use judge::{read_cycles, CycleSink};
+use judge::{run_dut, Observer, RunOptions};
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
 use crate::tools;
@@ -114,8 +114,8 @@ fn icarus_backend_vcd_windows() {
         };
         let r = engines::run(&s, Backend::Icarus, 3, &opts).unwrap();
         assert!(r.ok, "{}", r.summary());
-        let cycles = judge::vcd::parse_only(&s, &wave, None).unwrap();
-        let reset = judge::run::reset_cycles(&s, opts.reset_cycles);
+        let cycles = judge::parse_vcd(&s, &wave, None).unwrap();
+        let reset = judge::reset_cycles(&s, opts.reset_cycles);
         if checks {
             // a window from frame 0 has the reset and checks on its own
             assert_eq!(cycles, reset + (to - from) * f);

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use engines::verilator::VerilatedDut;
-use judge::run::{run_dut, RunOptions};
+use engines::VerilatedDut;
+use judge::{run_dut, RunOptions};
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
 use crate::tools;

@@ -9,8 +9,8 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Instant;
 
-use judge::run::{ModelDut, RunOptions};
-use judge::vcdout::write_run;
+use judge::write_run;
+use judge::{ModelDut, RunOptions};
 
 fn schedule() -> lut_gen::Schedule {
     let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../mixes/eskin34.toml");

@@ -14,8 +14,7 @@
 //! (t7, hold) to 80..120 ns (t4, access) after each falling edge and high-Z
 //! from 45 ns (t8) after falling edge 16.  [`Adc::drive`] works at cycle level
 //! (a bit is valid for the whole cycle after the edge; high-Z reads as 1, a
-//! weak pull-up); [`miso_events`] gives the same waveform at event level with
-//! the invalid windows, for waveform output.
+//! weak pull-up).
 
 use std::f64::consts::PI;
 
@@ -305,55 +304,4 @@ impl Adc {
         self.miso = miso;
         miso
     }
-}
-
-/// One MISO level change at event level, in nanoseconds from the CS falling edge.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MisoEvent {
-    pub ns: f64,
-    /// `Some(bit)` driven, `None` invalid (x) or high-Z after the last bit.
-    pub level: Option<u8>,
-    pub high_z: bool,
-}
-
-/// The MISO waveform of one conversion of `word` with SCLK falling edges at
-/// `falls_ns` (relative to the CS fall): bit 0 from t3 after CS falls, then
-/// for each falling edge an invalid window from t7 (10 ns) to t4 (80 ns at 5 V)
-/// and the next bit, high-Z t8 (45 ns) after edge 16.
-pub fn miso_events(word: u16, falls_ns: &[f64]) -> Vec<MisoEvent> {
-    let bit = |i: usize| Some(((word >> (15 - i)) & 1) as u8);
-    let mut v = vec![
-        MisoEvent {
-            ns: 0.0,
-            level: None,
-            high_z: false,
-        },
-        MisoEvent {
-            ns: 35.0,
-            level: bit(0),
-            high_z: false,
-        },
-    ];
-    for (k, &f) in falls_ns.iter().enumerate() {
-        let i = k + 1;
-        if i >= 16 {
-            v.push(MisoEvent {
-                ns: f + 45.0,
-                level: None,
-                high_z: true,
-            });
-            break;
-        }
-        v.push(MisoEvent {
-            ns: f + 10.0,
-            level: None,
-            high_z: false,
-        });
-        v.push(MisoEvent {
-            ns: f + 80.0,
-            level: bit(i),
-            high_z: false,
-        });
-    }
-    v
 }

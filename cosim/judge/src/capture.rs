@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use lut_gen::ports::{Layout, Role, LINK_PORTS, PORT_NAMES};
+use lut_gen::ports::{Layout, LINK_PORTS, PORT_NAMES};
 use lut_gen::Schedule;
 
 use crate::timed::{Capture, Lane};
@@ -369,19 +369,4 @@ fn read_body<'t>(
     }
     steps.push(((t as f64 * head.scale_ps) as u64, cur));
     Ok(steps)
-}
-
-/// Roles the lanes do not cover at all (for the report).
-pub fn unmapped(lanes: &[Lane]) -> Vec<&'static str> {
-    [
-        Role::CsN,
-        Role::Sclk,
-        Role::MuxSel,
-        Role::MuxEn,
-        Role::SampleValid,
-    ]
-    .into_iter()
-    .filter(|r| !lanes.iter().any(|l| l.role == Some(*r)))
-    .map(|r| r.name())
-    .collect()
 }

@@ -16,8 +16,8 @@ use lut_gen::ports::{Layout, Pins, Role, Signal};
 use crate::invariants::Invariants;
 use crate::linkline::LinkLine;
 use crate::model::CycleModel;
-use crate::report::{Divergence, Report, Violation};
 use crate::rule::Rule;
+use crate::verdict::{Divergence, Verdict, Violation};
 
 /// How much the checker records (it always counts everything).
 #[derive(Debug, Clone, Copy)]
@@ -949,7 +949,7 @@ impl Checker {
     }
 
     /// Ends the check and builds the report.
-    pub fn finish(mut self, source: &str) -> Report {
+    pub fn finish(mut self, source: &str) -> Verdict {
         let cycles = self.c - self.origin;
         if self.phase == Phase::PreReset || (self.phase == Phase::Reset && cycles == 0) {
             self.inv.record(

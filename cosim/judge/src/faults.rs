@@ -1,4 +1,4 @@
-//! Fault injection: a [`Dut`] wrapper that corrupts a design's pins in one
+//! PinFault injection: a [`Dut`] wrapper that corrupts a design's pins in one
 //! precise way, to prove the checker catches each kind of fault.
 
 use std::collections::VecDeque;
@@ -10,7 +10,7 @@ use lut_gen::ports::{Layout, Pins};
 
 /// A kind of fault, injected around the first conversion of `branch` at or after a cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Fault {
+pub enum PinFault {
     /// `sample_channel` of one emitted sample has bit 0 flipped.
     WrongChannel,
     /// `sample_value` of one emitted sample has one bit flipped.
@@ -72,60 +72,60 @@ pub enum Fault {
     AxisTdataChange,
 }
 
-/// Cycles a [`Fault::ResetGlitch`] holds the design in reset.
+/// Cycles a [`PinFault::ResetGlitch`] holds the design in reset.
 pub const GLITCH_CYCLES: u64 = 3;
 
-impl Fault {
+impl PinFault {
     /// The fault's class: its name without the branch.
     pub fn class(&self) -> &'static str {
         match self {
-            Fault::WrongChannel => "wrong-channel",
-            Fault::WrongSampleBit => "wrong-sample-bit",
-            Fault::DropSample => "drop-sample",
-            Fault::CsLate { .. } => "cs-late",
-            Fault::SclkExtraEdge { .. } => "sclk-extra-edge",
-            Fault::MuxLate { .. } => "mux-late",
-            Fault::TwoMuxEn { .. } => "two-mux-en",
-            Fault::WrongMux { .. } => "wrong-mux",
-            Fault::ResetGlitch => "reset-glitch",
-            Fault::ConversionMoved { .. } => "conversion-moved",
-            Fault::PhaseShift { .. } => "phase-shift",
-            Fault::SelectSwap { .. } => "select-swap",
-            Fault::SclkSlow { .. } => "sclk-slow",
-            Fault::NeighbourCode => "neighbour-code",
-            Fault::LinkBitFlip => "link-bit-flip",
-            Fault::LinkDropByte => "link-drop-byte",
-            Fault::LinkStuck { high: true } => "link-stuck-high",
-            Fault::LinkStuck { high: false } => "link-stuck-low",
-            Fault::LinkOverflow => "link-fifo-overflow",
-            Fault::AxisTvalidDrop => "axis-tvalid-drop",
-            Fault::AxisTdataChange => "axis-tdata-change",
+            PinFault::WrongChannel => "wrong-channel",
+            PinFault::WrongSampleBit => "wrong-sample-bit",
+            PinFault::DropSample => "drop-sample",
+            PinFault::CsLate { .. } => "cs-late",
+            PinFault::SclkExtraEdge { .. } => "sclk-extra-edge",
+            PinFault::MuxLate { .. } => "mux-late",
+            PinFault::TwoMuxEn { .. } => "two-mux-en",
+            PinFault::WrongMux { .. } => "wrong-mux",
+            PinFault::ResetGlitch => "reset-glitch",
+            PinFault::ConversionMoved { .. } => "conversion-moved",
+            PinFault::PhaseShift { .. } => "phase-shift",
+            PinFault::SelectSwap { .. } => "select-swap",
+            PinFault::SclkSlow { .. } => "sclk-slow",
+            PinFault::NeighbourCode => "neighbour-code",
+            PinFault::LinkBitFlip => "link-bit-flip",
+            PinFault::LinkDropByte => "link-drop-byte",
+            PinFault::LinkStuck { high: true } => "link-stuck-high",
+            PinFault::LinkStuck { high: false } => "link-stuck-low",
+            PinFault::LinkOverflow => "link-fifo-overflow",
+            PinFault::AxisTvalidDrop => "axis-tvalid-drop",
+            PinFault::AxisTdataChange => "axis-tdata-change",
         }
     }
 
     /// The branch a fault is injected on (stream faults: none).
     pub fn branch(&self) -> Option<usize> {
         match *self {
-            Fault::CsLate { branch }
-            | Fault::SclkExtraEdge { branch }
-            | Fault::MuxLate { branch }
-            | Fault::TwoMuxEn { branch }
-            | Fault::WrongMux { branch }
-            | Fault::ConversionMoved { branch }
-            | Fault::PhaseShift { branch }
-            | Fault::SelectSwap { branch }
-            | Fault::SclkSlow { branch } => Some(branch),
-            Fault::WrongChannel
-            | Fault::WrongSampleBit
-            | Fault::DropSample
-            | Fault::ResetGlitch
-            | Fault::NeighbourCode
-            | Fault::LinkBitFlip
-            | Fault::LinkDropByte
-            | Fault::LinkStuck { .. }
-            | Fault::LinkOverflow
-            | Fault::AxisTvalidDrop
-            | Fault::AxisTdataChange => None,
+            PinFault::CsLate { branch }
+            | PinFault::SclkExtraEdge { branch }
+            | PinFault::MuxLate { branch }
+            | PinFault::TwoMuxEn { branch }
+            | PinFault::WrongMux { branch }
+            | PinFault::ConversionMoved { branch }
+            | PinFault::PhaseShift { branch }
+            | PinFault::SelectSwap { branch }
+            | PinFault::SclkSlow { branch } => Some(branch),
+            PinFault::WrongChannel
+            | PinFault::WrongSampleBit
+            | PinFault::DropSample
+            | PinFault::ResetGlitch
+            | PinFault::NeighbourCode
+            | PinFault::LinkBitFlip
+            | PinFault::LinkDropByte
+            | PinFault::LinkStuck { .. }
+            | PinFault::LinkOverflow
+            | PinFault::AxisTvalidDrop
+            | PinFault::AxisTdataChange => None,
         }
     }
 
@@ -137,55 +137,55 @@ impl Fault {
     }
 
     /// Every fault that applies to the schedule.
-    pub fn all(s: &Schedule) -> Vec<Fault> {
+    pub fn all(s: &Schedule) -> Vec<PinFault> {
         let mut v = vec![
-            Fault::WrongChannel,
-            Fault::WrongSampleBit,
-            Fault::DropSample,
-            Fault::ResetGlitch,
+            PinFault::WrongChannel,
+            PinFault::WrongSampleBit,
+            PinFault::DropSample,
+            PinFault::ResetGlitch,
         ];
         for b in 0..s.branches.len() {
             if s.branch_instants_in_frame(b).is_empty() {
                 continue;
             }
-            v.push(Fault::CsLate { branch: b });
-            v.push(Fault::SclkExtraEdge { branch: b });
-            v.push(Fault::MuxLate { branch: b });
-            v.push(Fault::WrongMux { branch: b });
+            v.push(PinFault::CsLate { branch: b });
+            v.push(PinFault::SclkExtraEdge { branch: b });
+            v.push(PinFault::MuxLate { branch: b });
+            v.push(PinFault::WrongMux { branch: b });
             if s.branches[b].mux_devices >= 2 {
-                v.push(Fault::TwoMuxEn { branch: b });
+                v.push(PinFault::TwoMuxEn { branch: b });
             }
-            v.push(Fault::ConversionMoved { branch: b });
-            v.push(Fault::PhaseShift { branch: b });
+            v.push(PinFault::ConversionMoved { branch: b });
+            v.push(PinFault::PhaseShift { branch: b });
             if same_rate_pair(s, b).is_some() {
-                v.push(Fault::SelectSwap { branch: b });
+                v.push(PinFault::SelectSwap { branch: b });
             }
             if slow_sclk_div(s, b).is_some() {
-                v.push(Fault::SclkSlow { branch: b });
+                v.push(PinFault::SclkSlow { branch: b });
             }
         }
-        v.push(Fault::NeighbourCode);
-        v.extend(Fault::link(s));
+        v.push(PinFault::NeighbourCode);
+        v.extend(PinFault::link(s));
         v
     }
 
     /// The link's pin faults of the schedule's link (none without one):
     /// the UART's line faults, or AXI4-Stream's faults under back-pressure,
     /// and the overflow flag of either.
-    pub fn link(s: &Schedule) -> Vec<Fault> {
+    pub fn link(s: &Schedule) -> Vec<PinFault> {
         match s.mix.link.map(|l| l.kind) {
             None => vec![],
             Some(lut_gen::mix::LinkKind::Uart) => vec![
-                Fault::LinkBitFlip,
-                Fault::LinkDropByte,
-                Fault::LinkStuck { high: true },
-                Fault::LinkStuck { high: false },
-                Fault::LinkOverflow,
+                PinFault::LinkBitFlip,
+                PinFault::LinkDropByte,
+                PinFault::LinkStuck { high: true },
+                PinFault::LinkStuck { high: false },
+                PinFault::LinkOverflow,
             ],
             Some(lut_gen::mix::LinkKind::Axis) => vec![
-                Fault::AxisTvalidDrop,
-                Fault::AxisTdataChange,
-                Fault::LinkOverflow,
+                PinFault::AxisTvalidDrop,
+                PinFault::AxisTdataChange,
+                PinFault::LinkOverflow,
             ],
         }
     }
@@ -194,12 +194,12 @@ impl Fault {
     pub fn is_link(&self) -> bool {
         matches!(
             self,
-            Fault::LinkBitFlip
-                | Fault::LinkDropByte
-                | Fault::LinkStuck { .. }
-                | Fault::LinkOverflow
-                | Fault::AxisTvalidDrop
-                | Fault::AxisTdataChange
+            PinFault::LinkBitFlip
+                | PinFault::LinkDropByte
+                | PinFault::LinkStuck { .. }
+                | PinFault::LinkOverflow
+                | PinFault::AxisTvalidDrop
+                | PinFault::AxisTdataChange
         )
     }
 }
@@ -218,7 +218,7 @@ pub fn same_rate_pair(s: &Schedule, b: usize) -> Option<(usize, usize)> {
     })
 }
 
-/// The SCLK divider of [`Fault::SclkSlow`] on branch `b`: twice the
+/// The SCLK divider of [`PinFault::SclkSlow`] on branch `b`: twice the
 /// branch's, if the part still allows that frequency.
 pub fn slow_sclk_div(s: &Schedule, b: usize) -> Option<u64> {
     let d = s.branches[b].spi.sclk_div * 2;
@@ -229,7 +229,7 @@ pub fn slow_sclk_div(s: &Schedule, b: usize) -> Option<u64> {
 /// Wraps a design and injects one fault at or after cycle `at`.
 pub struct FaultyDut<D> {
     inner: D,
-    fault: Fault,
+    fault: PinFault,
     layout: Layout,
     at: u64,
     /// (previous instant, target instant) of the fault's branch.
@@ -270,7 +270,7 @@ pub struct FaultyDut<D> {
 }
 
 impl<D: Dut> FaultyDut<D> {
-    pub fn new(s: &Schedule, inner: D, fault: Fault, at: u64) -> FaultyDut<D> {
+    pub fn new(s: &Schedule, inner: D, fault: PinFault, at: u64) -> FaultyDut<D> {
         let b = fault.branch().unwrap_or(0);
         let spi = s.branches[b].spi;
         let slot = s.grid.slot_cycles;
@@ -279,21 +279,21 @@ impl<D: Dut> FaultyDut<D> {
         let r_slow = spi.read_cycles + n * (d_slow - spi.sclk_div);
         // the span a fault's conversion needs before the branch's next one
         let need = match fault {
-            Fault::ConversionMoved { .. } => slot + spi.read_cycles + spi.quiet_cycles + 1,
-            Fault::SclkSlow { .. } => r_slow + spi.quiet_cycles + 1,
+            PinFault::ConversionMoved { .. } => slot + spi.read_cycles + spi.quiet_cycles + 1,
+            PinFault::SclkSlow { .. } => r_slow + spi.quiet_cycles + 1,
             _ => 0,
         };
         let (prev, t) = target_instant(s, b, at, need);
         let (hist_len, shift) = match fault {
-            Fault::ConversionMoved { .. } => ((slot + spi.read_cycles + 2) as usize, slot),
-            Fault::SclkSlow { .. } => ((r_slow + 2) as usize, r_slow),
+            PinFault::ConversionMoved { .. } => ((slot + spi.read_cycles + 2) as usize, slot),
+            PinFault::SclkSlow { .. } => ((r_slow + 2) as usize, r_slow),
             _ => (0, 0),
         };
         let channels = match fault {
-            Fault::SelectSwap { branch } => same_rate_pair(s, branch)
+            PinFault::SelectSwap { branch } => same_rate_pair(s, branch)
                 .map(|(x, y)| (x as u16, y as u16))
                 .unwrap_or((0, 0)),
-            Fault::PhaseShift { branch } => {
+            PinFault::PhaseShift { branch } => {
                 let c = s.at((t % s.grid.frame_cycles) / slot, branch).unwrap_or(0) as u16;
                 (c, c)
             }
@@ -364,7 +364,7 @@ impl<D: Dut> Dut for FaultyDut<D> {
     fn step(&mut self, rst: bool, miso: u64) -> Pins {
         let next = self.cycle.map_or(0, |c| c + 1);
         let glitch = !rst
-            && self.fault == Fault::ResetGlitch
+            && self.fault == PinFault::ResetGlitch
             && next >= self.at
             && next < self.at + GLITCH_CYCLES;
         let mut p = self.inner.step(rst || glitch, miso);
@@ -385,27 +385,27 @@ impl<D: Dut> Dut for FaultyDut<D> {
             self.hist.push_back(orig);
         }
         match self.fault {
-            Fault::ResetGlitch => {}
-            Fault::WrongChannel
-            | Fault::WrongSampleBit
-            | Fault::DropSample
-            | Fault::NeighbourCode => self.sample_fault(c, &mut p, &orig),
-            Fault::CsLate { .. } | Fault::SclkExtraEdge { .. } | Fault::PhaseShift { .. } => {
-                self.serial_fault(c, &mut p)
-            }
-            Fault::MuxLate { .. }
-            | Fault::TwoMuxEn { .. }
-            | Fault::WrongMux { .. }
-            | Fault::SelectSwap { .. } => self.mux_fault(c, &mut p),
-            Fault::ConversionMoved { branch } => self.move_conversion(c, &mut p, branch),
-            Fault::SclkSlow { branch } => self.slow_sclk(c, &mut p, branch),
-            Fault::LinkBitFlip | Fault::LinkDropByte => self.uart_char(c, &mut p),
-            Fault::LinkStuck { .. }
-            | Fault::LinkOverflow
-            | Fault::AxisTvalidDrop
-            | Fault::AxisTdataChange => self.link_fault(c, &mut p, &orig),
+            PinFault::ResetGlitch => {}
+            PinFault::WrongChannel
+            | PinFault::WrongSampleBit
+            | PinFault::DropSample
+            | PinFault::NeighbourCode => self.sample_fault(c, &mut p, &orig),
+            PinFault::CsLate { .. }
+            | PinFault::SclkExtraEdge { .. }
+            | PinFault::PhaseShift { .. } => self.serial_fault(c, &mut p),
+            PinFault::MuxLate { .. }
+            | PinFault::TwoMuxEn { .. }
+            | PinFault::WrongMux { .. }
+            | PinFault::SelectSwap { .. } => self.mux_fault(c, &mut p),
+            PinFault::ConversionMoved { branch } => self.move_conversion(c, &mut p, branch),
+            PinFault::SclkSlow { branch } => self.slow_sclk(c, &mut p, branch),
+            PinFault::LinkBitFlip | PinFault::LinkDropByte => self.uart_char(c, &mut p),
+            PinFault::LinkStuck { .. }
+            | PinFault::LinkOverflow
+            | PinFault::AxisTvalidDrop
+            | PinFault::AxisTdataChange => self.link_fault(c, &mut p, &orig),
         }
-        let frozen = matches!(self.fault, Fault::PhaseShift { .. })
+        let frozen = matches!(self.fault, PinFault::PhaseShift { .. })
             && c >= self.t
             && c <= self.t.saturating_add(self.r);
         if !frozen {
@@ -422,17 +422,17 @@ impl<D> FaultyDut<D> {
     #[inline]
     fn sample_fault(&mut self, c: u64, p: &mut Pins, orig: &Pins) {
         match self.fault {
-            Fault::WrongChannel | Fault::WrongSampleBit | Fault::DropSample
+            PinFault::WrongChannel | PinFault::WrongSampleBit | PinFault::DropSample
                 if !self.done && c >= self.at && p.sample_valid =>
             {
                 self.done = true;
                 match self.fault {
-                    Fault::WrongChannel => p.sample_channel ^= 1,
-                    Fault::WrongSampleBit => p.sample_value ^= 1 << 5,
+                    PinFault::WrongChannel => p.sample_channel ^= 1,
+                    PinFault::WrongSampleBit => p.sample_value ^= 1 << 5,
                     _ => p.sample_valid = false,
                 }
             }
-            Fault::NeighbourCode if p.sample_valid => {
+            PinFault::NeighbourCode if p.sample_valid => {
                 if let (false, true, Some(v)) = (self.done, c >= self.at, self.last_value) {
                     p.sample_value = v;
                     self.done = true;
@@ -447,11 +447,11 @@ impl<D> FaultyDut<D> {
     #[inline]
     fn serial_fault(&mut self, c: u64, p: &mut Pins) {
         match self.fault {
-            Fault::CsLate { branch } if c >= self.t && c <= self.t.saturating_add(self.r) => {
+            PinFault::CsLate { branch } if c >= self.t && c <= self.t.saturating_add(self.r) => {
                 let bit = 1u16 << branch;
                 p.cs_n = (p.cs_n & !bit) | (self.prev_cs & bit);
             }
-            Fault::SclkExtraEdge { branch } => {
+            PinFault::SclkExtraEdge { branch } => {
                 // a one-cycle low pulse in a high phase of SCLK, two periods
                 // into the read (one more falling edge than the part expects)
                 // (in the middle of the high phase when it is 3 cycles or
@@ -467,7 +467,7 @@ impl<D> FaultyDut<D> {
                     self.done = true;
                 }
             }
-            Fault::PhaseShift { branch } => {
+            PinFault::PhaseShift { branch } => {
                 let bit = 1u16 << branch;
                 if c >= self.t && c <= self.t.saturating_add(self.r) {
                     // the branch's lanes stay as they were before the instant
@@ -491,7 +491,7 @@ impl<D> FaultyDut<D> {
     #[inline]
     fn mux_fault(&mut self, c: u64, p: &mut Pins) {
         match self.fault {
-            Fault::MuxLate { branch } => {
+            PinFault::MuxLate { branch } => {
                 if c == self.t_prev.saturating_add(1) {
                     self.held = Some(pins_before(&self.layout, p, branch, self.t_prev));
                 }
@@ -501,14 +501,14 @@ impl<D> FaultyDut<D> {
                     }
                 }
             }
-            Fault::TwoMuxEn { branch } if c >= self.t && c < self.t.saturating_add(5) => {
+            PinFault::TwoMuxEn { branch } if c >= self.t && c < self.t.saturating_add(5) => {
                 let n = self.layout.en_n[branch];
                 p.mux_en |= ((1u128 << n) - 1) << self.layout.en_lo[branch];
             }
-            Fault::WrongMux { branch } if c > self.t_prev && c <= self.t => {
+            PinFault::WrongMux { branch } if c > self.t_prev && c <= self.t => {
                 p.mux_sel ^= 1 << (3 * branch);
             }
-            Fault::SelectSwap { branch } if c >= self.at && c < self.at + self.frame => {
+            PinFault::SelectSwap { branch } if c >= self.at && c < self.at + self.frame => {
                 self.swap_selects(p, branch);
             }
             _ => {}
@@ -519,16 +519,16 @@ impl<D> FaultyDut<D> {
     #[inline]
     fn link_fault(&mut self, c: u64, p: &mut Pins, orig: &Pins) {
         match self.fault {
-            Fault::LinkStuck { high } if c >= self.at => {
+            PinFault::LinkStuck { high } if c >= self.at => {
                 p.link_tx = high;
             }
-            Fault::LinkOverflow if c >= self.at => {
+            PinFault::LinkOverflow if c >= self.at => {
                 p.link_overflow = true;
             }
-            Fault::AxisTvalidDrop | Fault::AxisTdataChange => {
+            PinFault::AxisTvalidDrop | PinFault::AxisTdataChange => {
                 if self.stalled && !self.done && c >= self.at {
                     self.done = true;
-                    if self.fault == Fault::AxisTdataChange {
+                    if self.fault == PinFault::AxisTdataChange {
                         p.axis_tdata ^= 0x01;
                     } else {
                         p.axis_tvalid = false;
@@ -546,7 +546,7 @@ impl<D> FaultyDut<D> {
         (k < n).then(|| &self.hist[(n - 1 - k) as usize])
     }
 
-    /// [`Fault::ConversionMoved`]: the branch's CS, SCLK and mux lanes
+    /// [`PinFault::ConversionMoved`]: the branch's CS, SCLK and mux lanes
     /// delayed by one slot from the instant until the moved window closes.
     fn move_conversion(&self, c: u64, p: &mut Pins, b: usize) {
         let end = self.t.saturating_add(self.shift + self.r + 1);
@@ -561,7 +561,7 @@ impl<D> FaultyDut<D> {
         }
     }
 
-    /// [`Fault::SclkSlow`]: the conversion's serial clocks stretched to the
+    /// [`PinFault::SclkSlow`]: the conversion's serial clocks stretched to the
     /// slow period (setup as it was, the tail after the last clock kept).
     fn slow_sclk(&self, c: u64, p: &mut Pins, b: usize) {
         let (t, su, d, d2, n) = (self.t, self.su, self.d, self.d_slow, self.words);
@@ -582,7 +582,7 @@ impl<D> FaultyDut<D> {
         }
     }
 
-    /// [`Fault::LinkBitFlip`], [`Fault::LinkDropByte`]: the UART's
+    /// [`PinFault::LinkBitFlip`], [`PinFault::LinkDropByte`]: the UART's
     /// characters followed on the design's own line from cycle 0 (a start
     /// bit is a falling edge once the previous character has ended), and
     /// the first one starting at or after the site corrupted.
@@ -598,13 +598,13 @@ impl<D> FaultyDut<D> {
         let d = u.div as u64;
         match self.fault {
             // the line's bit 4 is data bit 3 (bit 0 is the start bit)
-            Fault::LinkBitFlip if c >= t + 4 * d && c < t + 5 * d => p.link_tx = !p.link_tx,
-            Fault::LinkDropByte if c < t + u.char_cycles() => p.link_tx = true,
+            PinFault::LinkBitFlip if c >= t + 4 * d && c < t + 5 * d => p.link_tx = !p.link_tx,
+            PinFault::LinkDropByte if c < t + u.char_cycles() => p.link_tx = true,
             _ => {}
         }
     }
 
-    /// [`Fault::SelectSwap`]: branch `b` addressing one of the pair shows
+    /// [`PinFault::SelectSwap`]: branch `b` addressing one of the pair shows
     /// the other's mux address.
     fn swap_selects(&self, p: &mut Pins, b: usize) {
         let (x, y) = self.channels;

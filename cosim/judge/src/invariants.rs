@@ -9,8 +9,8 @@ use lut_gen::ports::Role;
 use lut_gen::{FrameGrid, Schedule};
 use serde_json::json;
 
-use crate::report::{ChannelStats, Report, Violation};
 use crate::rule::Rule;
+use crate::verdict::{ChannelStats, Verdict, Violation};
 
 /// Collects violations; shared by both layers.
 #[derive(Debug, Clone)]
@@ -420,8 +420,8 @@ impl Invariants {
         frames: u64,
         channels: Vec<ChannelStats>,
         samples: u64,
-    ) -> Report {
-        Report {
+    ) -> Verdict {
+        Verdict {
             ok: self.rec.violation_count == 0 && cycles > 0,
             mix: mix.into(),
             source: source.into(),

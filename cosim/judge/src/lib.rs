@@ -4,60 +4,86 @@
 //! This crate depends on neither `hdl` nor rust-hdl, so the independence of
 //! the reference model from the gateware is enforced by the crate graph: a
 //! gateware bug cannot hide behind the same bug in the model.  The
-//! simulation engines that produce waveforms live beside it, in `cosim`.
+//! simulation engines that produce waveforms live beside it, in `engines`.
 //!
-//! - [`model`]: the reference model ([`SlotModel`] for conversions over
+//! - `model`: the reference model ([`SlotModel`] for conversions over
 //!   hours, [`CycleModel`] for every pin at every cycle);
-//! - [`adc`]: the AD7940 model and stimuli;
-//! - [`checker`] / [`invariants`]: the streaming cycle-exact comparison and
+//! - `adc`: the AD7940 model and stimuli;
+//! - `checker` / `invariants`: the streaming cycle-exact comparison and
 //!   the mix's invariants, whose [`Rule`]s a violation names;
-//! - [`run`]: a [`Dut`] driven with the ADC model into the checker, and the
+//! - `run`: a [`Dut`] driven with the ADC model into the checker, and the
 //!   slot-level model run;
-//! - [`faults`]: faults injected into any [`Dut`]'s pins;
-//! - [`vcd`] / [`vcdout`]: reading a VCD from any simulator, writing one;
-//! - [`timed`] / [`capture`]: logic-analyser captures (no clock, any
+//! - `faults`: faults injected into any [`Dut`]'s pins;
+//! - `vcd` / `vcdout`: reading a VCD from any simulator, writing one;
+//! - `timed` / `capture`: logic-analyser captures (no clock, any
 //!   sample rate) checked at time level, the channel map, sigrok input;
-//! - [`fst`]: FST input, through the `wellen` crate;
+//! - `fst`: FST input, through the `wellen` crate;
 //! - `linkline`: the link (UART line or AXI4-Stream beats) decoded and judged without the model;
-//! - [`lock`]: finding the frame phase of a capture that did not start at
+//! - `lock`: finding the frame phase of a capture that did not start at
 //!   reset, and checking it from there;
-//! - [`events`]: a run's pins as a reviewable event log, and the
+//! - `events`: a run's pins as a reviewable event log, and the
 //!   comparison of two logs by signal role (golden tests);
-//! - [`samples`]: a run's samples as CSV (`cycle,time_s,channel,value`);
+//! - `samples`: a run's samples as CSV (`cycle,time_s,channel,value`);
 //! - [`switch`]: the test-only switch that turns a detector off.
 //!
 //! The pins themselves ([`Pins`], [`Layout`], [`Signal`]) are the pin
 //! contract's, `lut_gen::ports`.
 
-pub mod adc;
-pub mod capture;
-pub mod checker;
-pub mod events;
-pub mod faults;
-pub mod fst;
-pub mod invariants;
+// The modules are private: what other crates use is the list below, so the
+// judge's internals can move without touching its users.
+mod adc;
+mod capture;
+mod checker;
+mod events;
+mod faults;
+mod fst;
+mod invariants;
 mod linkline;
-pub mod lock;
-pub mod model;
-pub mod report;
-pub mod rule;
-pub mod run;
-pub mod samples;
+mod lock;
+mod model;
+mod rule;
+mod run;
+mod samples;
 pub mod switch;
-pub mod timed;
-pub mod timedlink;
+mod timed;
+mod timedlink;
 pub mod tools;
-pub mod vcd;
+mod vcd;
 mod vcdlex;
-pub mod vcdout;
+mod vcdout;
+mod verdict;
 
-pub use adc::{Adc, Stimulus};
+pub use lut_gen::ports::{Layout, Pins, Signal};
+
+// The reference model, its ADC and the checker.
+pub use adc::{Adc, Analog, Stimulus};
 pub use checker::{CheckOptions, Checker};
 pub use invariants::Invariants;
-pub use lock::{LockError, LockInfo};
-pub use lut_gen::ports::{Layout, Pins, Signal};
 pub use model::{CycleModel, SlotModel};
-pub use report::Report;
 pub use rule::Rule;
-pub use run::{Dut, ModelDut, Observer};
-pub use vcd::{check_vcd, VcdError};
+pub use verdict::{ChannelStats, Divergence, Verdict, Violation};
+
+// Running a design (any `Dut`) against the model, with faults on its pins.
+pub use faults::{FaultyDut, PinFault};
+pub use run::{
+    reset_cycles, run_dut, run_model, run_unchecked, with_slave, AxisSlave, Dut, ModelDut,
+    Observer, RunOptions,
+};
+
+// Waveforms: VCD and FST in, VCD and GTKWave save files out, windows locked
+// on their frame phase.
+pub use fst::from_vcd as fst_from_vcd;
+pub use lock::{LockError, LockInfo};
+pub use vcd::{
+    check_vcd, check_vcd_progress, check_vcd_with, parse_only as parse_vcd, read_cycles, CycleSink,
+    VcdError, VcdInfo,
+};
+pub use vcdout::{channels_path, edge_ps, id_code, wire_header, write_gtkw, write_run, VcdWriter};
+
+// Logic-analyser captures, judged at time level.
+pub use capture::{parse_map, read as read_capture, read_progress as read_capture_progress};
+pub use timed::{check_capture, TimedReport};
+
+// Logs: a run's pins as events (golden tests), its samples as CSV.
+pub use events::{compare as compare_events, EventLog, Trace};
+pub use samples::SampleLog;

@@ -37,8 +37,8 @@ use lut_gen::Schedule;
 use serde_json::json;
 
 use crate::invariants::Invariants;
-use crate::report::Violation;
 use crate::rule::Rule;
+use crate::verdict::Violation;
 
 const UART_LINE: &str = "link_tx";
 const AXIS_BEATS: &str = "m_axis_tdata";

@@ -25,8 +25,8 @@ use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker, Join};
 use crate::model::CycleModel;
-use crate::report::Report;
 use crate::vcd::CycleSink;
+use crate::verdict::Verdict;
 
 /// The pins that fix the frame phase: CS (or CNV) and the mux lanes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -317,7 +317,7 @@ enum Mode {
 
 /// A [`CycleSink`] that checks a capture from reset when it shows one, and
 /// otherwise locks on its frame phase first.
-pub struct Judge<'a> {
+pub struct WindowCheck<'a> {
     s: &'a Schedule,
     opts: CheckOptions,
     layout: Layout,
@@ -328,8 +328,8 @@ pub struct Judge<'a> {
     mode: Mode,
 }
 
-impl<'a> Judge<'a> {
-    pub fn new(s: &'a Schedule, opts: CheckOptions) -> Judge<'a> {
+impl<'a> WindowCheck<'a> {
+    pub fn new(s: &'a Schedule, opts: CheckOptions) -> WindowCheck<'a> {
         let flip = s
             .mix
             .branches
@@ -337,7 +337,7 @@ impl<'a> Judge<'a> {
             .enumerate()
             .filter(|(_, b)| b.adc.start == Start::Cnv)
             .fold(0u16, |a, (b, _)| a | 1 << b);
-        Judge {
+        WindowCheck {
             s,
             opts,
             layout: Layout::new(s),
@@ -348,7 +348,7 @@ impl<'a> Judge<'a> {
     }
 
     /// The report, and how the phase was found when the capture did not start at reset.
-    pub fn finish(mut self, source: &str) -> Result<(Report, Option<LockInfo>), LockError> {
+    pub fn finish(mut self, source: &str) -> Result<(Verdict, Option<LockInfo>), LockError> {
         if let Mode::Search(search) = &mut self.mode {
             if let Some(c) = search.cands.take() {
                 let n = c.len();
@@ -568,7 +568,7 @@ fn fmt_ctl(c: &Ctl) -> String {
     )
 }
 
-impl CycleSink for Judge<'_> {
+impl CycleSink for WindowCheck<'_> {
     fn cycle(&mut self, rst: Option<bool>, pins: &Pins, xz: &Pins, miso: u64, miso_xz: u64) {
         // Built only where the search keeps it: once joined, a cycle is
         // the checker's alone.

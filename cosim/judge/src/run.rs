@@ -8,9 +8,9 @@ use crate::adc::{Adc, Analog, Stimulus};
 use crate::checker::{CheckOptions, Checker};
 use crate::invariants::Invariants;
 use crate::model::{CycleModel, SlotModel};
-use crate::report::Report;
-use crate::report::Violation;
 use crate::rule::Rule;
+use crate::verdict::Verdict;
+use crate::verdict::Violation;
 use lut_gen::ports::Pins;
 
 /// Anything that behaves like `slotforge_top`: one call per rising clock
@@ -184,7 +184,7 @@ pub fn run_dut<D: Dut + ?Sized>(
     opts: &RunOptions,
     source: &str,
     mut obs: Option<&mut dyn Observer>,
-) -> Report {
+) -> Verdict {
     let mut adc = Adc::new(s, opts.stimulus);
     let mut chk = Checker::new(s, opts.check);
     let ones = (1u64 << s.branches.len()) - 1;
@@ -247,7 +247,7 @@ pub fn run_unchecked<D: Dut + ?Sized>(
 /// conversion-level invariants (counts, intervals, sample stream), plus the
 /// per-branch timing checks that do not need cycles (SPI numbers against
 /// the ADC's limits, CS spacing against the quiet time, mux settling).
-pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usize) -> Report {
+pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usize) -> Verdict {
     let sm = SlotModel::new(s);
     let analog = Analog::new(s, stimulus);
     let mut inv = Invariants::new(s, max_records);

@@ -33,9 +33,9 @@ use lut_gen::ports::{LinkPort, Role, AXIS_PORTS, PORT_NAMES, TOP_MODULE};
 use lut_gen::Schedule;
 
 use crate::checker::{CheckOptions, Checker};
-use crate::lock::{Judge, LockError, LockInfo};
-use crate::report::Report;
+use crate::lock::{LockError, LockInfo, WindowCheck};
 use crate::vcdlex::{self, At, BodyStart, Ev, Lexed};
+use crate::verdict::Verdict;
 use lut_gen::ports::{Layout, Pins};
 
 /// Why a VCD could not be checked (exit 2).
@@ -1301,7 +1301,7 @@ pub fn check_vcd_with(
     path: &Path,
     scope: Option<&str>,
     opts: CheckOptions,
-) -> Result<(Report, VcdInfo), VcdError> {
+) -> Result<(Verdict, VcdInfo), VcdError> {
     check_vcd_progress(s, path, scope, opts, &|_, _| {})
 }
 
@@ -1312,10 +1312,10 @@ pub fn check_vcd_progress(
     scope: Option<&str>,
     opts: CheckOptions,
     on_bytes: OnBytes,
-) -> Result<(Report, VcdInfo), VcdError> {
-    let mut judge = Judge::new(s, opts);
-    let mut info = read_cycles_with(s, path, scope, &mut judge, on_bytes)?;
-    let (report, lock) = judge.finish("vcd").map_err(|error| VcdError::Phase {
+) -> Result<(Verdict, VcdInfo), VcdError> {
+    let mut check = WindowCheck::new(s, opts);
+    let mut info = read_cycles_with(s, path, scope, &mut check, on_bytes)?;
+    let (report, lock) = check.finish("vcd").map_err(|error| VcdError::Phase {
         file: path.to_path_buf(),
         error,
     })?;
@@ -1328,7 +1328,7 @@ pub fn check_vcd(
     s: &Schedule,
     path: impl AsRef<Path>,
     scope: Option<&str>,
-) -> Result<Report, VcdError> {
+) -> Result<Verdict, VcdError> {
     check_vcd_with(s, path.as_ref(), scope, CheckOptions::default()).map(|r| r.0)
 }
 

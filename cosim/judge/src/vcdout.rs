@@ -7,8 +7,8 @@ use std::path::Path;
 
 use lut_gen::Schedule;
 
-use crate::report::Report;
 use crate::run::{run_dut, Dut, Observer, RunOptions};
+use crate::verdict::Verdict;
 use lut_gen::ports::{Layout, Pins, Role, PORTS, TOP_MODULE};
 
 /// The time in picoseconds of clock edge `n` of a run (edge `2k + 1` falls
@@ -232,7 +232,7 @@ pub fn write_run<D: Dut + ?Sized>(
     frames: u64,
     opts: &RunOptions,
     (from, to): (u64, u64),
-) -> std::io::Result<Report> {
+) -> std::io::Result<Verdict> {
     let mut w = VcdWriter::create(path, s, from, to)?;
     let r = run_dut(s, dut, frames, opts, "gen", Some(&mut w));
     w.finish()?;

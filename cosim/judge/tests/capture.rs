@@ -7,8 +7,8 @@
 
 use std::path::Path;
 
-use judge::run::ModelDut;
-use judge::timed::check_capture;
+use judge::check_capture;
+use judge::ModelDut;
 use lut_gen::ports::{Pins, Role};
 use lut_gen::Schedule;
 
@@ -109,14 +109,14 @@ fn a_subset_of_pins_names_what_it_cannot_check() {
         "{text}"
     );
     // An unknown port or bit is an input error naming the entry.
-    let e = judge::capture::parse_map("D0=adc_cs_n[7]", &s).unwrap_err();
+    let e = judge::parse_map("D0=adc_cs_n[7]", &s).unwrap_err();
     assert!(
         e.contains("D0=adc_cs_n[7]") && e.contains("no bit 7"),
         "{e}"
     );
     let f = d.path().join("map.txt");
     std::fs::write(&f, "# probes\nD0 = adc_cs_n[0]\nD1 = adc_clk[0]\n").unwrap();
-    let e = judge::capture::parse_map(f.to_str().unwrap(), &s).unwrap_err();
+    let e = judge::parse_map(f.to_str().unwrap(), &s).unwrap_err();
     assert!(e.contains("map.txt:3") && e.contains("adc_clk"), "{e}");
 }
 
@@ -158,8 +158,8 @@ fn every_fault_class_is_reported_and_a_fault_before_lock_fails_the_design() {
     mutate(&s, &mut early, Mutation::SclkEdgeMissing, from + 1);
     let v = d.path().join("early.vcd");
     let (sr, _) = capture(&s, &early, (from, to), (ts, 3_717), &v);
-    let lanes = judge::capture::parse_map("D0=adc_cs_n[0],D2=adc_sclk[0]", &s).unwrap();
-    let cap = judge::capture::read(&sr, lanes).unwrap();
+    let lanes = judge::parse_map("D0=adc_cs_n[0],D2=adc_sclk[0]", &s).unwrap();
+    let cap = judge::read_capture(&sr, lanes).unwrap();
     let r = check_capture(&s, &cap, 0).expect("a design failure, not an input problem");
     let text = r.summary();
     assert!(!r.ok, "{text}");

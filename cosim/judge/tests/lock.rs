@@ -3,10 +3,10 @@
 
 use std::path::Path;
 
-use judge::faults::{Fault, FaultyDut};
-use judge::run::{Dut, ModelDut, RunOptions};
-use judge::vcdout::write_run;
+use judge::write_run;
 use judge::{CheckOptions, LockError, VcdError};
+use judge::{Dut, ModelDut, RunOptions};
+use judge::{FaultyDut, PinFault};
 
 fn tiny() -> lut_gen::Schedule {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/tiny.toml");
@@ -19,11 +19,8 @@ fn window<D: Dut>(s: &lut_gen::Schedule, dut: &mut D, from: u64, to: u64, path: 
     write_run(path, s, dut, frames, &RunOptions::default(), (from, to)).unwrap();
 }
 
-fn check(
-    s: &lut_gen::Schedule,
-    p: &Path,
-) -> Result<(judge::Report, judge::vcd::VcdInfo), VcdError> {
-    judge::vcd::check_vcd_with(s, p, None, CheckOptions::default())
+fn check(s: &lut_gen::Schedule, p: &Path) -> Result<(judge::Verdict, judge::VcdInfo), VcdError> {
+    judge::check_vcd_with(s, p, None, CheckOptions::default())
 }
 
 #[test]
@@ -46,7 +43,7 @@ fn window_from_mid_frame_locks_and_passes() {
     assert!(r.samples > 10);
     // The frame cycle it names is the truth: capture cycle c is run cycle 5317 + c
     // (after 1 reset cycle... the window counts from the first reset cycle).
-    let reset = judge::run::reset_cycles(&s, RunOptions::default().reset_cycles);
+    let reset = judge::reset_cycles(&s, RunOptions::default().reset_cycles);
     let run_cycle = 5_317 + lock.locked_at - reset;
     assert_eq!(lock.frame_cycle, run_cycle % s.grid.frame_cycles, "{lock}");
 }
@@ -56,7 +53,12 @@ fn fault_inside_the_window_fails_at_its_cycle() {
     let s = tiny();
     let d = tempfile::tempdir().unwrap();
     let p = d.path().join("bad.vcd");
-    let mut dut = FaultyDut::new(&s, ModelDut::new(&s), Fault::MuxLate { branch: 0 }, 9_000);
+    let mut dut = FaultyDut::new(
+        &s,
+        ModelDut::new(&s),
+        PinFault::MuxLate { branch: 0 },
+        9_000,
+    );
     window(&s, &mut dut, 5_317, 13_000, &p);
     let (r, info) = check(&s, &p).unwrap();
     assert!(!r.ok);
@@ -194,20 +196,20 @@ fn uart_line_in_a_window_is_judged_without_the_model() {
     for start in (0..6).map(|k| from + 653 * k) {
         let p = d.path().join("clean.vcd");
         window(&s, &mut ModelDut::new(&s), start, to, &p);
-        let (r, info) = judge::vcd::check_vcd_with(&s, &p, None, opts).unwrap();
+        let (r, info) = judge::check_vcd_with(&s, &p, None, opts).unwrap();
         assert!(info.lock.is_some());
         assert!(r.ok && !r.model_compared, "from {start}: {}", r.summary());
     }
     for f in [
-        Fault::LinkBitFlip,
-        Fault::LinkDropByte,
-        Fault::LinkStuck { high: true },
-        Fault::LinkStuck { high: false },
+        PinFault::LinkBitFlip,
+        PinFault::LinkDropByte,
+        PinFault::LinkStuck { high: true },
+        PinFault::LinkStuck { high: false },
     ] {
         let p = d.path().join(format!("{}.vcd", f.class()));
         let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
         window(&s, &mut dut, from, to, &p);
-        let (r, _) = judge::vcd::check_vcd_with(&s, &p, None, opts).unwrap();
+        let (r, _) = judge::check_vcd_with(&s, &p, None, opts).unwrap();
         let class = f.class();
         eprintln!("{class}: {}", r.summary());
         assert!(!r.ok, "{class}: not caught");

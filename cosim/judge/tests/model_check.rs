@@ -1,4 +1,4 @@
-use judge::run::{run_dut, run_model, ModelDut, RunOptions};
+use judge::{run_dut, run_model, ModelDut, RunOptions};
 use std::path::Path;
 
 /// Every fault of `s` injected into the model at cycle `at` for two
@@ -8,11 +8,11 @@ use std::path::Path;
 fn each_injected_fault(
     s: &lut_gen::Schedule,
     at: u64,
-    judge: impl Fn(&judge::faults::Fault, &judge::Report),
+    judge: impl Fn(&judge::PinFault, &judge::Verdict),
 ) -> usize {
-    use judge::faults::{Fault, FaultyDut};
+    use judge::{FaultyDut, PinFault};
     let mut injected = 0;
-    for f in Fault::all(s) {
+    for f in PinFault::all(s) {
         let mut dut = FaultyDut::new(s, ModelDut::new(s), f, at);
         let r = run_dut(s, &mut dut, 2, &RunOptions::default(), "faulty", None);
         if dut.injected() {
@@ -83,12 +83,12 @@ fn every_fault_is_caught() {
         );
     });
     // every class but the slot-moving ones lands on every branch
-    let all = judge::faults::Fault::all(&s).len();
+    let all = judge::PinFault::all(&s).len();
     assert!(injected + 3 >= all, "{injected} of {all}");
 }
 
 /// Drives the checker by hand: `reset` reset cycles, then `cycles` cycles of the model's pins.
-fn check_by_hand(s: &lut_gen::Schedule, reset: u64, cycles: u64) -> judge::Report {
+fn check_by_hand(s: &lut_gen::Schedule, reset: u64, cycles: u64) -> judge::Verdict {
     check_by_hand_with(s, reset, cycles, 0)
 }
 
@@ -99,8 +99,8 @@ fn check_by_hand_with(
     reset: u64,
     cycles: u64,
     wrong_mux: u64,
-) -> judge::Report {
-    use judge::run::Dut;
+) -> judge::Verdict {
+    use judge::Dut;
     let mut dut = ModelDut::new(s);
     let mut adc = judge::Adc::new(s, judge::Stimulus::Pattern);
     let mut chk = judge::Checker::new(s, judge::CheckOptions::default());
@@ -130,7 +130,7 @@ struct EagerStart {
     m: Option<judge::CycleModel>,
 }
 
-impl judge::run::Dut for EagerStart {
+impl judge::Dut for EagerStart {
     fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
         if rst {
             self.m = None;
@@ -160,11 +160,7 @@ fn no_reset_is_too_short_and_a_short_one_excuses_nothing() {
     let f = s.grid.frame_cycles;
     let settle = s.branches[0].settle_cycles;
     assert_eq!(settle, 96, "2 us at 48 MHz");
-    assert_eq!(
-        judge::run::reset_cycles(&s, 1),
-        1,
-        "runs keep a short reset"
-    );
+    assert_eq!(judge::reset_cycles(&s, 1), 1, "runs keep a short reset");
     // The model skips the three instants of cycle 0 (docs/timing.md,
     // "Start-up"): any reset of one cycle or more passes, however the mux
     // moved during it.
@@ -326,7 +322,7 @@ struct Glitch {
     fall: Option<u64>,
 }
 
-impl judge::run::Dut for Glitch {
+impl judge::Dut for Glitch {
     fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
         let mut p = self.inner.step(rst, miso);
         if rst {
@@ -350,7 +346,7 @@ impl judge::run::Dut for Glitch {
 /// on the sample pins alone breaks `link-samples`.
 #[test]
 fn the_uart_line_is_judged_without_the_model() {
-    use judge::faults::{Fault, FaultyDut};
+    use judge::{FaultyDut, PinFault};
     let s = tiny_uart();
     let opts = RunOptions {
         check: judge::CheckOptions {
@@ -375,10 +371,10 @@ fn the_uart_line_is_judged_without_the_model() {
     }
     let at = s.grid.frame_cycles + s.grid.frame_cycles / 2 + 7;
     for (f, rule) in [
-        (Fault::LinkBitFlip, "link-crc"),
-        (Fault::LinkDropByte, "link-crc"),
-        (Fault::LinkStuck { high: true }, "link-packet-missing"),
-        (Fault::LinkStuck { high: false }, "link-framing"),
+        (PinFault::LinkBitFlip, "link-crc"),
+        (PinFault::LinkDropByte, "link-crc"),
+        (PinFault::LinkStuck { high: true }, "link-packet-missing"),
+        (PinFault::LinkStuck { high: false }, "link-framing"),
     ] {
         let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
         let r = run_dut(&s, &mut dut, 3, &opts, "faulty", None);
@@ -406,7 +402,7 @@ fn the_uart_line_is_judged_without_the_model() {
     assert_eq!(r.violations[0].rule, "link-bit-timing", "{}", r.summary());
     // the stream and the line disagree: a sample changed or dropped on the
     // sample pins only (the line carries what the gateware sent)
-    for f in [Fault::NeighbourCode, Fault::DropSample] {
+    for f in [PinFault::NeighbourCode, PinFault::DropSample] {
         let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
         let r = run_dut(&s, &mut dut, 3, &opts, "faulty", None);
         assert!(
@@ -426,8 +422,8 @@ fn the_uart_line_is_judged_without_the_model() {
 /// only are caught by the beats' decode (`link-*`, `axis-tlast`).
 #[test]
 fn the_axis_beats_are_judged_without_the_model() {
-    use judge::faults::{Fault, FaultyDut};
-    use judge::run::with_slave;
+    use judge::with_slave;
+    use judge::{FaultyDut, PinFault};
     use link::ReadyPattern::{Random, WorstCase};
     let opts = RunOptions {
         check: judge::CheckOptions {
@@ -448,7 +444,7 @@ fn the_axis_beats_are_judged_without_the_model() {
         assert!(r.ok && !r.model_compared, "{}", r.summary());
     }
     let at = s.grid.frame_cycles + s.grid.frame_cycles / 2 + 7;
-    let rules = |mut dut: Box<dyn judge::run::Dut + '_>, what: &str| {
+    let rules = |mut dut: Box<dyn judge::Dut + '_>, what: &str| {
         let r = run_dut(&s, &mut dut, 3, &opts, "faulty", None);
         eprintln!("{what}: {}", r.summary());
         assert!(!r.ok && r.divergence_count == 0, "{what}: {}", r.summary());
@@ -465,7 +461,7 @@ fn the_axis_beats_are_judged_without_the_model() {
         let slave = with_slave(&s, ModelDut::new(&s), WorstCase);
         Box::new(FaultyDut::new(&s, slave, f, at))
     };
-    for f in [Fault::AxisTvalidDrop, Fault::AxisTdataChange] {
+    for f in [PinFault::AxisTvalidDrop, PinFault::AxisTdataChange] {
         let r = rules(faulty(f), f.class());
         assert!(r.contains(&"axis-stable".to_string()), "{r:?}");
     }
@@ -488,7 +484,7 @@ fn the_axis_beats_are_judged_without_the_model() {
             "{what}: {r:?}"
         );
     }
-    for f in [Fault::NeighbourCode, Fault::DropSample] {
+    for f in [PinFault::NeighbourCode, PinFault::DropSample] {
         let r = rules(faulty(f), f.class());
         assert!(r.contains(&"link-samples".to_string()), "{r:?}");
     }
@@ -498,14 +494,14 @@ fn the_axis_beats_are_judged_without_the_model() {
 /// altered: its byte changed, the beat lost (tvalid low), or its `tlast`
 /// inverted.
 struct Beat<'a> {
-    inner: Box<dyn judge::run::Dut + 'a>,
+    inner: Box<dyn judge::Dut + 'a>,
     at: u64,
     c: u64,
     what: &'static str,
     done: bool,
 }
 
-impl judge::run::Dut for Beat<'_> {
+impl judge::Dut for Beat<'_> {
     fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
         let mut p = self.inner.step(rst, miso);
         if rst {
@@ -529,7 +525,7 @@ impl judge::run::Dut for Beat<'_> {
 /// slice a frame later (same length: the schedule repeats every frame), so
 /// framing, CRC and `tlast` stay good and only the sequence is wrong.
 struct Repeat<'a> {
-    inner: Box<dyn judge::run::Dut + 'a>,
+    inner: Box<dyn judge::Dut + 'a>,
     at: u64,
     c: u64,
     slices: usize,
@@ -539,7 +535,7 @@ struct Repeat<'a> {
     sent: usize,
 }
 
-impl judge::run::Dut for Repeat<'_> {
+impl judge::Dut for Repeat<'_> {
     fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
         let mut p = self.inner.step(rst, miso);
         if rst {
@@ -578,7 +574,7 @@ fn a_packet_sent_twice_breaks_the_sequence() {
         ..Default::default()
     };
     let mut dut = Repeat {
-        inner: judge::run::with_slave(&s, ModelDut::new(&s), WorstCase),
+        inner: judge::with_slave(&s, ModelDut::new(&s), WorstCase),
         at: s.grid.frame_cycles + 7,
         c: 0,
         slices: s.grid.slices_per_frame as usize,

@@ -2,10 +2,10 @@
 
 use std::path::{Path, PathBuf};
 
-use judge::faults::{Fault, FaultyDut};
-use judge::run::{Dut, ModelDut, RunOptions};
-use judge::vcdout::write_run;
+use judge::write_run;
 use judge::VcdError;
+use judge::{Dut, ModelDut, RunOptions};
+use judge::{FaultyDut, PinFault};
 
 fn tiny() -> lut_gen::Schedule {
     let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/tiny.toml");
@@ -44,7 +44,7 @@ fn faulty_vcd_fails_with_first_divergence() {
     let d = tempfile::tempdir().unwrap();
     let s = tiny();
     let p = d.path().join("bad.vcd");
-    let mut dut = FaultyDut::new(&s, ModelDut::new(&s), Fault::WrongSampleBit, 4100);
+    let mut dut = FaultyDut::new(&s, ModelDut::new(&s), PinFault::WrongSampleBit, 4100);
     write_vcd(&s, &mut dut, 3, &p);
     let r = judge::check_vcd(&s, &p, None).unwrap();
     assert!(!r.ok);

@@ -115,12 +115,12 @@ impl Job {
 
     /// A hook that shows a step's runs done of N (the fault campaign's) in
     /// the bar, on a terminal; off one the step's own line says when it ends.
-    pub fn runs_hook(&self, what: &str) -> Option<campaign::faults::OnRun> {
+    pub fn runs_hook(&self, what: &str) -> Option<campaign::OnRun> {
         let b = self.bar.clone()?;
         let what = what.to_string();
-        Some(campaign::faults::OnRun(std::sync::Arc::new(
-            move |done, n| b.set_message(format!("{what}: {done} of {n} runs")),
-        )))
+        Some(campaign::OnRun(std::sync::Arc::new(move |done, n| {
+            b.set_message(format!("{what}: {done} of {n} runs"))
+        })))
     }
 
     /// Records a step that was not asked for.

@@ -177,7 +177,7 @@ fn verilog(j: &mut Job, s: &Schedule) -> Done {
     )
 }
 
-fn sim(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<judge::Report>) -> Done {
+fn sim(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<judge::Verdict>) -> Done {
     let g = &s.grid;
     let backend = sim_backend();
     let frames = a.frames.max(1);
@@ -271,19 +271,19 @@ fn golden(j: &mut Job, a: &Args, s: &Schedule) -> Done {
 /// The campaign's plan: the model's pins (the gateware with `--thorough`);
 /// with `--charts all`, also the deep Verilog faults on every installed
 /// Verilog engine and `prove`, so the speed chart compares every method.
-fn fault_plan(a: &Args, s: &Schedule) -> Result<campaign::faults::Plan, String> {
+fn fault_plan(a: &Args, s: &Schedule) -> Result<campaign::Plan, String> {
     let target = if a.thorough {
-        campaign::faults::Target::Rusthdl
+        campaign::Target::Rusthdl
     } else {
-        campaign::faults::Target::Model
+        campaign::Target::Model
     };
     // A fresh mix gets every class at one site (mid-frame) and one clean
     // random mix, judged by the model and the invariants, in seconds; the
     // full campaign (every site, five clean mixes, sigrok's decode) when it
     // is asked for: --only faults, --charts all, --thorough.
-    let mut plan = campaign::faults::Plan::new(target, 3, 5);
+    let mut plan = campaign::Plan::new(target, 3, 5);
     if !full_campaign(a) {
-        let mid = campaign::faults::sites(s)
+        let mid = campaign::sites(s)
             .into_iter()
             .filter(|x| x.name == "mid-frame");
         plan.sites = Some(mid.collect());
@@ -299,7 +299,7 @@ fn fault_plan(a: &Args, s: &Schedule) -> Result<campaign::faults::Plan, String> 
         .filter(|(tool, _)| judge::tools::present(tool))
         .map(|(_, b)| b)
         .collect();
-        plan.verilog_faults = campaign::faults::deep_faults(s, plan.frames)?;
+        plan.verilog_faults = campaign::deep_faults(s, plan.frames)?;
         plan.prove = true;
     }
     Ok(plan)
@@ -310,17 +310,12 @@ fn full_campaign(a: &Args) -> bool {
     a.thorough || a.charts == Charts::All || only_names(a, Step::Faults)
 }
 
-fn faults(
-    j: &mut Job,
-    a: &Args,
-    s: &Schedule,
-    keep: &mut Option<campaign::faults::Campaign>,
-) -> Done {
+fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campaign>) -> Done {
     let full = full_campaign(a);
     let hook = j.runs_hook("fault campaign");
     let c = match fault_plan(a, s).and_then(|mut p| {
         p.on_run = hook;
-        campaign::faults::campaign_with(s, &p).map_err(|e| e.to_string())
+        campaign::campaign_with(s, &p).map_err(|e| e.to_string())
     }) {
         Ok(c) => c,
         Err(e) => return Done::failed(e, ""),
@@ -455,7 +450,7 @@ fn figure7(s: &Schedule) -> Done {
 }
 
 /// Drawn from the fault step's campaign of this build, nothing else.
-fn speed(c: Option<&campaign::faults::Campaign>) -> Done {
+fn speed(c: Option<&campaign::Campaign>) -> Done {
     let Some(c) = c else {
         return Done::skipped(
             "draws the fault campaign of this build, and the faults step did not run",

@@ -5,14 +5,14 @@ use std::borrow::Cow;
 
 use formal::faults::DeepFault;
 use hdl::GatewareFault;
-use judge::faults::Fault;
+use judge::PinFault;
 use serde::{Serialize, Serializer};
 
 /// Where a fault is injected.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Level {
-    /// Into a simulation's pins (`judge::faults::Fault`).
+    /// Into a simulation's pins (`judge::PinFault`).
     Pins,
     /// A reset glitch the design suffers while its `rst` port stays low.
     Reset,
@@ -43,7 +43,7 @@ impl std::fmt::Display for Level {
 /// or engine.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum FaultClass {
-    // pin faults and the reset glitch (`judge::faults::Fault`)
+    // pin faults and the reset glitch (`judge::PinFault`)
     WrongChannel,
     WrongSampleBit,
     DropSample,
@@ -85,30 +85,30 @@ pub enum FaultClass {
 
 impl FaultClass {
     /// The class of a pin fault or the reset glitch.
-    pub fn of_pins(f: Fault) -> FaultClass {
+    pub fn of_pins(f: PinFault) -> FaultClass {
         use FaultClass as C;
         match f {
-            Fault::WrongChannel => C::WrongChannel,
-            Fault::WrongSampleBit => C::WrongSampleBit,
-            Fault::DropSample => C::DropSample,
-            Fault::CsLate { .. } => C::CsLate,
-            Fault::SclkExtraEdge { .. } => C::SclkExtraEdge,
-            Fault::MuxLate { .. } => C::MuxLate,
-            Fault::TwoMuxEn { .. } => C::TwoMuxEn,
-            Fault::WrongMux { .. } => C::WrongMux,
-            Fault::ResetGlitch => C::ResetGlitch,
-            Fault::ConversionMoved { .. } => C::ConversionMoved,
-            Fault::PhaseShift { .. } => C::PhaseShift,
-            Fault::SelectSwap { .. } => C::SelectSwap,
-            Fault::SclkSlow { .. } => C::SclkSlow,
-            Fault::NeighbourCode => C::NeighbourCode,
-            Fault::LinkBitFlip => C::LinkBitFlip,
-            Fault::LinkDropByte => C::LinkDropByte,
-            Fault::LinkStuck { high: true } => C::LinkStuckHigh,
-            Fault::LinkStuck { high: false } => C::LinkStuckLow,
-            Fault::LinkOverflow => C::LinkFifoOverflow,
-            Fault::AxisTvalidDrop => C::AxisTvalidDrop,
-            Fault::AxisTdataChange => C::AxisTdataChange,
+            PinFault::WrongChannel => C::WrongChannel,
+            PinFault::WrongSampleBit => C::WrongSampleBit,
+            PinFault::DropSample => C::DropSample,
+            PinFault::CsLate { .. } => C::CsLate,
+            PinFault::SclkExtraEdge { .. } => C::SclkExtraEdge,
+            PinFault::MuxLate { .. } => C::MuxLate,
+            PinFault::TwoMuxEn { .. } => C::TwoMuxEn,
+            PinFault::WrongMux { .. } => C::WrongMux,
+            PinFault::ResetGlitch => C::ResetGlitch,
+            PinFault::ConversionMoved { .. } => C::ConversionMoved,
+            PinFault::PhaseShift { .. } => C::PhaseShift,
+            PinFault::SelectSwap { .. } => C::SelectSwap,
+            PinFault::SclkSlow { .. } => C::SclkSlow,
+            PinFault::NeighbourCode => C::NeighbourCode,
+            PinFault::LinkBitFlip => C::LinkBitFlip,
+            PinFault::LinkDropByte => C::LinkDropByte,
+            PinFault::LinkStuck { high: true } => C::LinkStuckHigh,
+            PinFault::LinkStuck { high: false } => C::LinkStuckLow,
+            PinFault::LinkOverflow => C::LinkFifoOverflow,
+            PinFault::AxisTvalidDrop => C::AxisTvalidDrop,
+            PinFault::AxisTdataChange => C::AxisTdataChange,
         }
     }
 
@@ -230,7 +230,7 @@ mod tests {
         for name in ["eskin34-uart", "eskin34-axis"] {
             let mix = testkit::root().join(format!("mixes/{name}.toml"));
             let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
-            let pins = Fault::all(&s);
+            let pins = PinFault::all(&s);
             assert!(pins.iter().any(|f| FaultClass::of_pins(*f).on_link()));
             for f in pins {
                 assert_eq!(FaultClass::of_pins(f).name(), f.class(), "{f:?}");

@@ -11,14 +11,14 @@
 
 use std::time::Instant;
 
-use judge::run::reset_cycles;
+use judge::reset_cycles;
 use lut_gen::Schedule;
 use serde::Serialize;
 
 use super::{parallel, Cost, Detector, FaultClass, Injection, Judged, Judgement, Level, Runs};
 use crate::equiv::Equivalence;
 use crate::sigrok::SpiCapture;
-use engines::options::{Backend, SimOptions};
+use engines::{Backend, SimOptions};
 
 /// A faulty design as Verilog text (a `slotforge_top` on the pin contract).
 #[derive(Debug, Clone)]
@@ -34,7 +34,7 @@ pub struct VerilogFault {
 /// frame `frames` (just past a run of `frames` frames), `rare-collision`
 /// needs two equal codes back to back, which the stimuli never give.
 pub fn deep_faults(s: &Schedule, frames: u64) -> Result<Vec<VerilogFault>, String> {
-    let clean = engines::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+    let clean = engines::verilog(s).map_err(|e| e.to_string())?;
     [
         formal::faults::DeepFault::LateCounter { frames },
         formal::faults::DeepFault::RareCollision,
@@ -146,7 +146,7 @@ pub(super) fn verilog_injections(
     prove: bool,
     count: &Runs,
 ) -> Result<Vec<Judgement>, String> {
-    let clean = engines::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+    let clean = engines::verilog(s).map_err(|e| e.to_string())?;
     let mut jobs = Vec::new();
     for f in faults {
         for &e in engines {
@@ -240,7 +240,7 @@ pub(super) fn clean_engine_run(
     frames: u64,
     sigrok: bool,
 ) -> Result<(u64, f64, Option<String>), String> {
-    let clean = engines::rusthdl::verilog(s).map_err(|e| e.to_string())?;
+    let clean = engines::verilog(s).map_err(|e| e.to_string())?;
     let j = judge_verilog(s, engine, &clean, frames, sigrok)?;
     let why = if !j.report.ok {
         Some(j.report.summary())

@@ -90,7 +90,7 @@ impl Violation {
 }
 
 #[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct Report {
+pub struct Verdict {
     pub ok: bool,
     pub mix: String,
     /// `model`, `rusthdl`, `verilator` or `vcd`.
@@ -115,7 +115,7 @@ pub struct Report {
     pub model_compared: bool,
 }
 
-impl Report {
+impl Verdict {
     /// A short human summary, with the first divergence and violations.
     pub fn summary(&self) -> String {
         use std::fmt::Write;
