@@ -227,8 +227,8 @@ pub(crate) const PROVED: &str = "proved for all time";
 fn scoped_note(result: Outcome, note: String, uncovered: usize) -> String {
     match (result, note.strip_prefix(PROVED)) {
         (Outcome::Proved, Some(how)) if uncovered > 0 => format!(
-            "the asserted properties are {PROVED}, not the whole contract: {uncovered} part{} of \
-             it {} not asserted (listed as not covered){how}",
+            "the asserted properties are {PROVED}{how}; not the whole contract: {uncovered} \
+             part{} of it {} not asserted (listed as not covered)",
             if uncovered == 1 { "" } else { "s" },
             if uncovered == 1 { "is" } else { "are" },
         ),
