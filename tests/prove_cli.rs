@@ -126,6 +126,12 @@ fn proved_json_has_its_keys_and_exit_0() {
     assert_eq!(v["depth"], 2 * 4000 + 2);
     assert!(v["seconds"].as_f64().unwrap() > 0.0);
     assert!(v["counterexample"].is_null() && v["cycle"].is_null());
+    // no link: the harness asserts every clause of the contract
+    assert_eq!(v["not_covered"], serde_json::json!([]));
+    assert!(v["note"]
+        .as_str()
+        .unwrap()
+        .starts_with("proved for all time"));
     let props = v["properties"].as_array().unwrap();
     assert_eq!(props.len(), 2 * 3 + 3, "{props:?}");
     assert!(props
@@ -174,4 +180,77 @@ fn build_shows_the_proof_and_a_default_build_shows_it_remembered() {
     let md = build(&fresh, &quick);
     assert!(!md.contains("Formal proof"), "{md}");
     assert!(md.contains("--only prove"), "{md}");
+}
+
+/// A UART mix: `prove --json` names what its harness does not assert (the
+/// line, with the audit's bit time), the text says so and never claims
+/// the whole contract, and a build shows the same list, proved and then
+/// remembered.
+#[test]
+fn a_uart_mix_says_what_it_does_not_prove() {
+    if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mix = dir.path().join("tiny-uart.toml");
+    let text =
+        std::fs::read_to_string(tiny()).unwrap() + "\n[link]\nkind = \"uart\"\nbaud = 1_000_000\n";
+    std::fs::write(&mix, text).unwrap();
+    let v = prove_json(&[mix.to_str().unwrap()], &[], dir.path(), 0);
+    assert_eq!(v["result"], "proved");
+    let nc: Vec<&str> = v["not_covered"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    assert_eq!(nc.len(), 2, "{nc:?}");
+    // 4 MHz / 1 Mbaud: the audit's divider
+    assert!(
+        nc[0].contains("link_tx") && nc[0].contains("each bit 4 cycles"),
+        "{nc:?}"
+    );
+    assert!(nc[1].contains("CRC"), "{nc:?}");
+    let note = v["note"].as_str().unwrap();
+    assert!(
+        note.starts_with("the asserted properties are proved for all time")
+            && note.contains("; not the whole contract: 2 parts of it are not asserted"),
+        "{note}"
+    );
+    let o = slotforge()
+        .args(["prove", mix.to_str().unwrap(), "-o"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("PROVED, EXCEPT"), "{out}");
+    assert!(!out.contains("whole contract)"), "{out}");
+    for n in &nc {
+        assert!(out.contains(n), "{n} not in {out}");
+    }
+    let build = |steps: &[&str]| {
+        let b = dir.path().join("b");
+        let mut c = slotforge();
+        c.env_remove("SLOTFORGE_CACHE")
+            .args(["build", "--quiet", "-o"])
+            .arg(&b)
+            .args(steps)
+            .arg(&mix);
+        c.assert().success();
+        std::fs::read_to_string(b.join("report.md")).unwrap()
+    };
+    let quick = [
+        "--skip",
+        "audit,lut,sim,golden,faults,synth,timing,figure7,schedulability",
+    ];
+    for (md, remembered) in [(build(&["--only", "prove"]), false), (build(&quick), true)] {
+        assert_eq!(md.contains("remembered"), remembered, "{md}");
+        assert!(md.contains("Not covered"), "{md}");
+        assert!(md.contains("proved for all time, except 2 parts"), "{md}");
+        assert!(!md.contains("the whole contract)"), "{md}");
+        for n in &nc {
+            assert!(md.contains(n), "{n} not in {md}");
+        }
+    }
 }

@@ -85,4 +85,39 @@ mod tests {
         assert_ne!(key("ab", "c", Solver::Abc), key("a", "bc", Solver::Abc));
         assert_eq!(k.len(), 32);
     }
+
+    fn proof(not_covered: &[&str]) -> Proof {
+        Proof {
+            mix: "m".into(),
+            solver: Solver::Symbolic,
+            result: Outcome::Proved,
+            depth: 10,
+            properties: Vec::new(),
+            seconds: 1.0,
+            solver_seconds: 0.5,
+            own_design: true,
+            note: "n".into(),
+            not_covered: not_covered.iter().map(|s| s.to_string()).collect(),
+            counterexample: None,
+            cycle: None,
+        }
+    }
+
+    /// A remembered proof carries what it did not cover; one stored before
+    /// the list existed (no `not_covered` key) is not taken for a proof of
+    /// the whole contract: it is not loaded at all.
+    #[test]
+    fn a_remembered_proof_keeps_its_not_covered_list() {
+        let dir = tempfile::tempdir().unwrap();
+        let dirs = [dir.path().to_path_buf()];
+        store(dir.path(), "k1", &proof(&["the line"])).unwrap();
+        let back = load(&dirs, "k1").expect("loads");
+        assert_eq!(back.not_covered, vec!["the line".to_string()]);
+        let mut old: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(file(dir.path(), "k1")).unwrap())
+                .unwrap();
+        old.as_object_mut().unwrap().remove("not_covered");
+        std::fs::write(file(dir.path(), "k2"), old.to_string()).unwrap();
+        assert!(load(&dirs, "k2").is_none());
+    }
 }

@@ -20,7 +20,9 @@ use lut_gen::ports::{Layout, Role, TOP_MODULE};
 use lut_gen::Schedule;
 
 mod compact;
+mod contract;
 mod link;
+pub use contract::{contract, not_covered, Clause};
 pub use link::TREADY_ANY;
 
 /// The module name of the harness.
@@ -35,6 +37,8 @@ pub struct PropertyDef {
     pub wire: String,
     /// What it asserts, in the contract's words.
     pub what: String,
+    /// The contract's clauses it asserts (what `prove` reports as covered).
+    pub covers: Vec<Clause>,
 }
 
 /// A free input of the harness module (besides `clk`): what the engine
@@ -55,6 +59,9 @@ pub struct Harness {
     pub inputs: Vec<FreeInput>,
     /// Cycles of one frame (the period of the control path).
     pub frame_cycles: u64,
+    /// The clauses of the mix's contract no property asserts
+    /// ([`not_covered`]): a proof of this harness says nothing of them.
+    pub not_covered: Vec<Clause>,
 }
 
 /// Why a schedule has no harness.
@@ -232,6 +239,7 @@ pub fn generate_with(s: &Schedule, form: TableForm) -> Result<Harness, HarnessEr
     v.push_str("`ifdef FORMAL\n  always @* if (st != 2'd0) assert (ok);\n`endif\nendmodule\n");
     Ok(Harness {
         verilog: v,
+        not_covered: not_covered(s, &props),
         properties: props,
         inputs: free_inputs(s),
         frame_cycles: g.frame_cycles,
@@ -523,6 +531,7 @@ fn branch_properties(props: &mut Vec<PropertyDef>, b: usize, name: &str) {
     props.push(PropertyDef {
         name: format!("conversion[{name}]"),
         wire: format!("ok_cs{b}"),
+        covers: vec![Clause::Conversion(b)],
         what: "the conversion pin is active exactly in each scheduled conversion window \
                (every channel every interval at its phase, nothing else)"
             .into(),
@@ -530,12 +539,14 @@ fn branch_properties(props: &mut Vec<PropertyDef>, b: usize, name: &str) {
     props.push(PropertyDef {
         name: format!("sclk[{name}]"),
         wire: format!("ok_sclk{b}"),
+        covers: vec![Clause::Sclk(b)],
         what: "SCLK count, period, phase and idle level of every conversion as the part needs"
             .into(),
     });
     props.push(PropertyDef {
         name: format!("mux[{name}]"),
         wire: format!("ok_mux{b}"),
+        covers: vec![Clause::Mux(b)],
         what: "mux select and device enable address the next instant's channel, switching only \
                right after a conversion starts (settled before it, steady through its capture)"
             .into(),
@@ -656,20 +667,23 @@ fn merger_output(v: &mut String, nb: usize, layout: &Layout) {
 }
 
 fn merger_properties(props: &mut Vec<PropertyDef>) {
-    for (name, wire, what) in [
+    for (name, wire, clause, what) in [
         (
             "stream.valid",
             "ok_valid",
+            Clause::StreamValid,
             "one word leaves per finished conversion word, in the model's order: no drop, no duplicate, no overflow",
         ),
         (
             "stream.channel",
             "ok_channel",
+            Clause::StreamChannel,
             "each word carries the channel index of its conversion (chain member)",
         ),
         (
             "stream.value",
             "ok_value",
+            Clause::StreamValue,
             "each word carries the data bits MISO carried at the capture edges, for any input",
         ),
     ] {
@@ -677,6 +691,7 @@ fn merger_properties(props: &mut Vec<PropertyDef>) {
             name: name.into(),
             wire: wire.into(),
             what: what.into(),
+            covers: vec![clause],
         });
     }
 }

@@ -110,6 +110,11 @@ pub struct Proof {
     pub own_design: bool,
     /// What the result means, in words.
     pub note: String,
+    /// The parts of the pin contract the harness does not assert, in plain
+    /// sentences (`harness::not_covered`): a proof says nothing of them.
+    /// Empty when the properties cover the whole contract.  Required in a
+    /// remembered proof too (`cache`): one stored without it is not loaded.
+    pub not_covered: Vec<String>,
     pub counterexample: Option<Counterexample>,
     /// `counterexample.cycle`, repeated at the top level (docs/json.md).
     pub cycle: Option<i64>,
@@ -172,6 +177,8 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         Solver::Abc => strategy::abc(&prep, f, opts)?,
         Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work.path(), f, opts)?,
     };
+    let not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
+    let note = scoped_note(result, note, not_covered.len());
     let solver_seconds = t1.elapsed().as_secs_f64();
     let mut properties: Vec<PropertyResult> = h
         .properties
@@ -206,9 +213,27 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         solver_seconds,
         own_design: opts.own_design,
         note,
+        not_covered,
         counterexample,
         cycle,
     })
+}
+
+/// How every engine's note for a proof begins.
+pub(crate) const PROVED: &str = "proved for all time";
+
+/// A proof's note, claiming "for all time" of the whole contract only when
+/// the harness asserts all of it (`uncovered` parts it does not).
+fn scoped_note(result: Outcome, note: String, uncovered: usize) -> String {
+    match (result, note.strip_prefix(PROVED)) {
+        (Outcome::Proved, Some(how)) if uncovered > 0 => format!(
+            "the asserted properties are {PROVED}{how}; not the whole contract: {uncovered} \
+             part{} of it {} not asserted (listed as not covered)",
+            if uncovered == 1 { "" } else { "s" },
+            if uncovered == 1 { "is" } else { "are" },
+        ),
+        _ => note,
+    }
 }
 
 /// The engines' temporary directory; kept, and named on stderr, when
@@ -306,7 +331,7 @@ fn symbolic(
             Outcome::Proved,
             steps,
             format!(
-                "proved for all time: {}every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} latches, {} gates; {} assertion checks went to a SAT solver), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
+                "{PROVED}: {}every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} latches, {} gates; {} assertion checks went to a SAT solver), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
                 parts_note(&st.parts),
                 g.latches.len(),
                 g.ands.len(),
@@ -405,10 +430,12 @@ impl Proof {
             "{} [{}]: {} ({} properties, depth {}, {:.1} s, solver {:.1} s)",
             self.mix,
             self.solver.name(),
-            match self.result {
-                Outcome::Proved => "PROVED",
-                Outcome::Bounded => "BOUNDED ONLY",
-                Outcome::Failed => "FAILED",
+            match (self.result, self.not_covered.is_empty()) {
+                (Outcome::Proved, true) => "PROVED (the whole contract)",
+                (Outcome::Proved, false) =>
+                    "PROVED, EXCEPT the parts of the contract not covered (below)",
+                (Outcome::Bounded, _) => "BOUNDED ONLY",
+                (Outcome::Failed, _) => "FAILED",
             },
             self.properties.len(),
             self.depth,
@@ -418,7 +445,7 @@ impl Proof {
         let _ = writeln!(s, "  {}", self.note);
         let _ = writeln!(
             s,
-            "  design: {}; properties at the ports only, no internal names",
+            "  design: {}; properties at the ports only, no internal names; any MISO input, one reset cycle",
             if self.own_design {
                 "slotforge's emitted Verilog"
             } else {
@@ -436,6 +463,12 @@ impl Proof {
                 },
                 p.name
             );
+        }
+        if !self.not_covered.is_empty() {
+            let _ = writeln!(s, "  not covered (the harness does not assert it, so neither a proof nor a bound says anything of it):");
+            for n in &self.not_covered {
+                let _ = writeln!(s, "    - {n}");
+            }
         }
         if let Some(c) = &self.counterexample {
             if !c.reproduced {

@@ -2,7 +2,7 @@
 //! and what a run that cannot tell falls back to.
 
 use crate::engine::{self, Combined, Prepared, Solver, Verdict};
-use crate::{Outcome, ProveError, ProveOptions, DEEP_FRAMES};
+use crate::{Outcome, ProveError, ProveOptions, DEEP_FRAMES, PROVED};
 use std::path::Path;
 
 /// What a strategy found: the outcome, its depth (see `Proof::depth`) and
@@ -49,7 +49,7 @@ fn proved_by_recurrence(f: u64) -> Finding {
         Outcome::Proved,
         base,
         format!(
-            "proved for all time: no violation from reset within {base} steps, and for every input the state at step {base} recurs at step {} of a copy started a frame later, so those steps reach every reachable state (state recurrence, ABC bmc3)",
+            "{PROVED}: no violation from reset within {base} steps, and for every input the state at step {base} recurs at step {} of a copy started a frame later, so those steps reach every reachable state (state recurrence, ABC bmc3)",
             base - f
         ),
     )
@@ -148,7 +148,7 @@ pub(crate) fn closing(
         Some(Verdict::Proved) => (
             Outcome::Proved,
             0,
-            format!("proved for all time by {}", opts.solver.name()),
+            format!("{PROVED} by {}", opts.solver.name()),
         ),
         Some(Verdict::Violated { step }) => failed(step),
         _ => {

@@ -737,3 +737,57 @@ fn axis_link_holds_for_every_slave_and_its_faults_fail() {
     eprintln!("eskin34-axis: {v:?} in {:.1} s", t.elapsed().as_secs_f64());
     assert_eq!(v, formal::engine::Verdict::Bounded { steps: 300 }, "{v:?}");
 }
+
+/// `tiny` with a 1 Mbaud UART link (4 cycles a bit).
+fn tiny_uart() -> lut_gen::Schedule {
+    let path = root().join("testkit/mixes/tiny.toml");
+    let text =
+        std::fs::read_to_string(&path).unwrap() + "\n[link]\nkind = \"uart\"\nbaud = 1_000_000\n";
+    let mix = lut_gen::parse(Path::new("tiny-uart.toml"), &text).expect("parses");
+    lut_gen::synthesize(&mix).expect("feasible")
+}
+
+/// A UART mix proves what its harness asserts and says what it does not:
+/// the line.  A gateware whose `link_tx` is stuck high proves the same
+/// (nothing reads the line), so neither claims the whole contract, and the
+/// fault campaign does not take such a proof as the excuse "contract
+/// proved" for a fault no simulation caught.
+#[test]
+fn a_uart_proof_names_the_line_it_does_not_cover_and_excuses_no_line_fault() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = tiny_uart();
+    let clean = emitted(&s);
+    let stuck = edit(&clean, "      tx = tx_r;", "      tx = 1'b1;");
+    for design in [&clean, &stuck] {
+        let dir = tempfile::tempdir().unwrap();
+        let p = prove(&s, design, dir.path());
+        assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+        assert_eq!(p.not_covered.len(), 2, "{:?}", p.not_covered);
+        assert!(p.not_covered.iter().all(|n| n.contains("link_tx")));
+        assert!(!p.note.starts_with("proved for all time"), "{}", p.note);
+        let text = p.summary();
+        assert!(!text.contains("whole contract)"), "{text}");
+        assert!(text.contains("not covered"), "{text}");
+        assert!(text.contains(&p.not_covered[0]), "{text}");
+    }
+    let (v, _) = campaign::faults::prove(&s, &stuck);
+    match v {
+        campaign::faults::ProveVerdict::NoVerdict { why } => {
+            assert!(why.contains("link_tx"), "{why}")
+        }
+        other => panic!("a stuck line is excused: {other:?}"),
+    }
+    // without a link the same proof is the whole contract, and excuses
+    let s = schedule("testkit/mixes/tiny.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    assert!(p.note.starts_with("proved for all time"), "{}", p.note);
+    assert!(p.summary().contains("PROVED (the whole contract)"));
+    assert!(matches!(
+        campaign::faults::prove(&s, &emitted(&s)).0,
+        campaign::faults::ProveVerdict::Proved
+    ));
+}

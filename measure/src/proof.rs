@@ -23,15 +23,25 @@ pub struct Shown {
     pub line: String,
 }
 
-/// The emitted Verilog and the cache key of proving it against `s`'s harness.
-fn keyed(s: &Schedule) -> Result<(String, String), String> {
+/// The emitted Verilog, the cache key of proving it against `s`'s harness,
+/// and what that harness does not assert (a remembered proof is shown with
+/// the list of the harness it was proved against, read afresh).
+fn keyed(s: &Schedule) -> Result<(String, String, Vec<String>), String> {
     let design = hdl::emit(s, None)
         .map_err(|e| e.to_string())?
         .verilog()
         .to_string();
     let h = formal::generate(s).map_err(|e| e.to_string())?;
     let key = formal::cache::key(&h.verilog, &design, ProveOptions::new("").solver);
-    Ok((design, key))
+    let uncovered = h.not_covered.iter().map(|c| c.sentence(s)).collect();
+    Ok((design, key, uncovered))
+}
+
+/// The remembered proof under `key`, with `uncovered` as its list.
+fn remembered(dirs: &[PathBuf], key: &str, uncovered: Vec<String>) -> Option<Proof> {
+    let mut p = formal::cache::load(dirs, key)?;
+    p.not_covered = uncovered;
+    Some(p)
 }
 
 fn cache_dirs(out: &Path) -> Vec<PathBuf> {
@@ -42,8 +52,8 @@ fn cache_dirs(out: &Path) -> Vec<PathBuf> {
 
 /// The remembered proof of `s`'s emitted gateware, if one exists.
 pub fn cached(s: &Schedule, out: &Path) -> Option<Shown> {
-    let (_, key) = keyed(s).ok()?;
-    let p = formal::cache::load(&cache_dirs(out), &key)?;
+    let (_, key, uncovered) = keyed(s).ok()?;
+    let p = remembered(&cache_dirs(out), &key, uncovered)?;
     Some(shown(p, true))
 }
 
@@ -51,9 +61,9 @@ pub fn cached(s: &Schedule, out: &Path) -> Option<Shown> {
 /// a proof in the caches.  `Err`: the proof could not run (a tool missing
 /// or failing, a mix beyond the harness).
 pub fn prove(s: &Schedule, out: &Path) -> Result<Shown, String> {
-    let (design, key) = keyed(s)?;
+    let (design, key, uncovered) = keyed(s)?;
     let dirs = cache_dirs(out);
-    if let Some(p) = formal::cache::load(&dirs, &key) {
+    if let Some(p) = remembered(&dirs, &key, uncovered) {
         return Ok(shown(p, true));
     }
     let p =
@@ -62,6 +72,22 @@ pub fn prove(s: &Schedule, out: &Path) -> Result<Shown, String> {
         formal::cache::store(d, &key, &p)?;
     }
     Ok(shown(p, false))
+}
+
+/// "proved for all time" of the whole contract only when nothing is left
+/// out; else what is left out, named.
+fn claim(uncovered: &[String]) -> String {
+    match uncovered {
+        [] => "proved for all time (the whole contract)".into(),
+        [one] => {
+            format!("proved for all time, except one part of the contract not asserted: {one}")
+        }
+        many => format!(
+            "proved for all time, except {} parts of the contract not asserted (the section's \
+             table \"Not covered\")",
+            many.len()
+        ),
+    }
 }
 
 fn word(o: Outcome) -> &'static str {
@@ -76,7 +102,8 @@ fn word(o: Outcome) -> &'static str {
 pub fn shown(p: Proof, cached: bool) -> Shown {
     let line = match p.result {
         Outcome::Proved => format!(
-            "proved for all time: {} properties, depth {} steps, solver {:.1} s{}",
+            "{}: {} properties, depth {} steps, solver {:.1} s{}",
+            claim(&p.not_covered),
             p.properties.len(),
             p.depth,
             p.solver_seconds,
@@ -105,7 +132,13 @@ pub fn shown(p: Proof, cached: bool) -> Shown {
              the emitted `slotforge_top` for any MISO input, one reset cycle assumed. Result: {}, \
              depth {} steps, {:.1} s in all, solver {:.1} s.",
             p.solver.name(),
-            word(p.result),
+            match (p.result, p.not_covered.len()) {
+                (Outcome::Proved, n) if n > 0 => format!(
+                    "proved, except the {n} part{} of the contract not asserted (table \"Not covered\")",
+                    if n == 1 { "" } else { "s" }
+                ),
+                (o, _) => word(o).into(),
+            },
             p.depth,
             p.seconds,
             p.solver_seconds
@@ -137,10 +170,18 @@ pub fn shown(p: Proof, cached: bool) -> Shown {
         links.push((name(&c.vcd), "the counterexample (VCD)".into()));
         links.push((name(&c.gtkw), "its GTKWave save file".into()));
     }
+    let mut tables = vec![("Properties".into(), t)];
+    if !p.not_covered.is_empty() {
+        let mut n = Table::new(&["part of the contract not asserted (not proved)"]);
+        for q in &p.not_covered {
+            n.push(vec![q.clone()]);
+        }
+        tables.push(("Not covered".into(), n));
+    }
     let section = Section {
         title: "Formal proof".into(),
         paragraphs,
-        tables: vec![("Properties".into(), t)],
+        tables,
         links,
         ..Section::default()
     };

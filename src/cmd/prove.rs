@@ -1,6 +1,7 @@
 //! `slotforge prove MIX [--rtl FILE.v] [--solver symbolic|abc|pdr|cvc5] [--json]`
 //!
-//! Exit 0: proved for all time; 1: a counterexample (its VCD, `.gtkw` and
+//! Exit 0: every asserted property proved for all time (what the harness
+//! does not assert is listed, `not_covered`); 1: a counterexample (its VCD, `.gtkw` and
 //! the checker's diagnosis), or a link too slow for the mix; 2: bad input
 //! or a tool that cannot run;
 //! 3: bounded only (no violation within the depth, not a proof).

@@ -18,7 +18,7 @@ use std::fmt::Write;
 use lut_gen::ports::{Dir, Layout};
 use lut_gen::Schedule;
 
-use super::{width, FreeInput, PropertyDef};
+use super::{width, Clause, FreeInput, PropertyDef};
 
 /// The harness input that lets the slave take a beat early (any cycle).
 pub const TREADY_ANY: &str = "tready_any";
@@ -101,6 +101,7 @@ pub(super) fn properties(
     props.push(PropertyDef {
         name: "link.overflow".into(),
         wire: "ok_link_overflow".into(),
+        covers: vec![Clause::LinkOverflow],
         what: match within {
             Some(n) => format!(
                 "the link's FIFO never overflows: link_overflow stays low for any input and \
@@ -125,6 +126,7 @@ pub(super) fn properties(
     props.push(PropertyDef {
         name: "axis.tvalid".into(),
         wire: "ok_axis_tvalid".into(),
+        covers: vec![Clause::AxisValidHeld],
         what: "a beat offered on m_axis_tvalid stays offered until the slave takes it \
                (AXI4-Stream: tvalid never falls while tready is low)"
             .into(),
@@ -132,6 +134,7 @@ pub(super) fn properties(
     props.push(PropertyDef {
         name: "axis.payload".into(),
         wire: "ok_axis_payload".into(),
+        covers: vec![Clause::AxisPayloadHeld],
         what: "m_axis_tdata and m_axis_tlast do not change while a beat waits for tready".into(),
     });
 }

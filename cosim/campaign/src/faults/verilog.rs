@@ -56,7 +56,8 @@ pub fn deep_faults(s: &Schedule, frames: u64) -> Result<Vec<VerilogFault>, Strin
 pub enum ProveVerdict {
     /// The design violates the contract: a counterexample from reset.
     Failed { cycle: Option<i64> },
-    /// The design proves the full contract for all time.
+    /// The design proves the full contract for all time (nothing of it
+    /// left unasserted: `Proof::not_covered` empty).
     Proved,
     /// Neither within the time limits, or a tool failed: no verdict.
     NoVerdict { why: String },
@@ -80,7 +81,13 @@ pub fn prove(s: &Schedule, design: &str) -> (ProveVerdict, f64) {
                 Err(e) => no(e.to_string()),
                 Ok(p) => match p.result {
                     formal::Outcome::Failed => ProveVerdict::Failed { cycle: p.cycle },
-                    formal::Outcome::Proved => ProveVerdict::Proved,
+                    // a proof that leaves part of the contract unasserted (a
+                    // link's line) cannot excuse a fault there
+                    formal::Outcome::Proved if p.not_covered.is_empty() => ProveVerdict::Proved,
+                    formal::Outcome::Proved => no(format!(
+                        "the asserted properties hold for all time, but prove does not assert: {}",
+                        p.not_covered.join("; ")
+                    )),
                     formal::Outcome::Bounded => no(p.note),
                 },
             }

@@ -1,0 +1,139 @@
+//! The pin contract as clauses, so `prove` can say what it did not assert.
+//!
+//! [`contract`] lists the clauses a mix's `slotforge_top` owes at its
+//! outputs (docs/timing.md; with a link, docs/packet-format.md), from the
+//! ports the mix has.  (How long the reset is, is the proof's assumption,
+//! not a clause: the harness holds `rst` high in one cycle, the shortest
+//! reset and the hardest for start-up, and every summary says so.)  Each harness property names the clauses it asserts
+//! ([`super::PropertyDef::covers`]); [`not_covered`] is the difference.  So
+//! the list a user reads follows what the generated harness asserts: a
+//! property added for a clause takes that clause off the list, and none is
+//! listed by preset.
+
+use lut_gen::ports::Layout;
+use lut_gen::Schedule;
+
+use super::PropertyDef;
+
+/// One clause of the pin contract at the design's outputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Clause {
+    /// Branch `b`'s conversion pin (CS or CNV) in every conversion window.
+    Conversion(usize),
+    /// Branch `b`'s SCLK: count, period, phase and idle level.
+    Sclk(usize),
+    /// Branch `b`'s mux select and device enables.
+    Mux(usize),
+    /// `sample_valid`: one strobe per word, in the merged stream's order.
+    StreamValid,
+    /// `sample_channel` of each word.
+    StreamChannel,
+    /// `sample_value` of each word.
+    StreamValue,
+    /// `link_overflow` stays low: the FIFO never drops a token.
+    LinkOverflow,
+    /// The UART's characters on `link_tx`: start bit, data bits, parity,
+    /// stop bits at the baud divider, idle high.
+    UartCharacters,
+    /// When the AXI4-Stream offers each beat, and which beat has `tlast`.
+    AxisBeats,
+    /// A beat offered and not taken stays offered (`tvalid`).
+    AxisValidHeld,
+    /// A beat offered and not taken keeps its `tdata` and `tlast`.
+    AxisPayloadHeld,
+    /// The bytes the link carries: packets, records, frame counter, CRC.
+    LinkPackets,
+}
+
+/// The clauses `s`'s design owes at its outputs, in report order.
+pub fn contract(s: &Schedule, layout: &Layout) -> Vec<Clause> {
+    let mut c: Vec<Clause> = (0..s.branches.len())
+        .flat_map(|b| [Clause::Conversion(b), Clause::Sclk(b), Clause::Mux(b)])
+        .collect();
+    c.extend([
+        Clause::StreamValid,
+        Clause::StreamChannel,
+        Clause::StreamValue,
+    ]);
+    if layout.link {
+        c.push(Clause::LinkOverflow);
+        if layout.axis {
+            c.extend([
+                Clause::AxisValidHeld,
+                Clause::AxisPayloadHeld,
+                Clause::AxisBeats,
+            ]);
+        } else {
+            c.push(Clause::UartCharacters);
+        }
+        c.push(Clause::LinkPackets);
+    }
+    c
+}
+
+/// The clauses of `s`'s contract that none of `props` asserts.
+pub fn not_covered(s: &Schedule, props: &[PropertyDef]) -> Vec<Clause> {
+    contract(s, &Layout::new(s))
+        .into_iter()
+        .filter(|c| !props.iter().any(|p| p.covers.contains(c)))
+        .collect()
+}
+
+impl Clause {
+    /// The clause in a user's words, with `s`'s names and figures.
+    pub fn sentence(&self, s: &Schedule) -> String {
+        let name = |b: usize| s.branches[b].name.as_str();
+        match *self {
+            Clause::Conversion(b) => format!(
+                "branch {}'s conversion pin (adc_cs_n[{b}]) in every conversion window",
+                name(b)
+            ),
+            Clause::Sclk(b) => format!("branch {}'s SCLK (adc_sclk[{b}])", name(b)),
+            Clause::Mux(b) => format!("branch {}'s mux select and enable lines", name(b)),
+            Clause::StreamValid => "sample_valid: one strobe per converted word".into(),
+            Clause::StreamChannel => "sample_channel of every word".into(),
+            Clause::StreamValue => "sample_value of every word".into(),
+            Clause::LinkOverflow => {
+                "link_overflow stays low (the link's FIFO never drops a token)".into()
+            }
+            Clause::UartCharacters => uart_characters(s),
+            Clause::AxisBeats => "when the AXI4-Stream offers each beat (m_axis_tvalid) and \
+                 which beat carries m_axis_tlast"
+                .into(),
+            Clause::AxisValidHeld => {
+                "a beat offered and not taken stays offered (m_axis_tvalid)".into()
+            }
+            Clause::AxisPayloadHeld => {
+                "a beat offered and not taken keeps m_axis_tdata and m_axis_tlast".into()
+            }
+            Clause::LinkPackets => format!(
+                "the packets the link carries on {} (each slice's header with the frame \
+                 counter and slice, one record per sample with its channel and code, the \
+                 trailer with the overflow count and CRC-16/MODBUS; docs/packet-format.md)",
+                if Layout::new(s).axis {
+                    "m_axis_tdata"
+                } else {
+                    "link_tx"
+                }
+            ),
+        }
+    }
+}
+
+/// The UART clause with the character the audit reports (its divider and
+/// real baud, `lut_gen::hostlink`).
+fn uart_characters(s: &Schedule) -> String {
+    let frame = match lut_gen::hostlink::plan(s) {
+        Some(Ok(p)) => format!(
+            ": start bit, 8 data bits LSB first, parity {}, {} stop bit{}, each bit {} cycles \
+             ({:.0} baud)",
+            p.parity,
+            p.stop_bits,
+            if p.stop_bits == 1 { "" } else { "s" },
+            p.baud_divider,
+            p.baud
+        ),
+        _ => String::new(),
+    };
+    format!("the UART's bit stream on link_tx, character by character{frame}; the line idles high")
+}

@@ -1,0 +1,167 @@
+//! What `prove` covers of the pin contract, and what it says it does not
+//! (`Harness::not_covered`, `Proof::not_covered`): derived from the
+//! harness's properties, on every preset, the test mixes and random mixes
+//! with and without a link.  No external tool: the harness only.
+
+use std::path::{Path, PathBuf};
+
+use formal::harness::{contract, not_covered, Clause};
+use lut_gen::ports::Layout;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// `text` with `link` appended as its `[link]` table; `None` when the mix
+/// has no schedule (an overloaded random draw, a link too slow for it).
+fn schedule(name: &str, text: &str, link: Option<&str>) -> Option<lut_gen::Schedule> {
+    let text = match link {
+        Some(l) if !text.contains("\n[link]") => format!("{text}\n[link]\n{l}\n"),
+        Some(_) => return None,
+        None => text.to_string(),
+    };
+    let mix = lut_gen::parse(Path::new(name), &text).ok()?;
+    let s = lut_gen::synthesize(&mix).ok()?;
+    if let Some(Err(_)) = lut_gen::hostlink::plan(&s) {
+        return None;
+    }
+    formal::generate(&s).is_ok().then_some(s)
+}
+
+const UART: &str = "kind = \"uart\"\nbaud = 1_000_000";
+const AXIS: &str = "kind = \"axis\"\ntlast = \"slice\"\nready_within = 8";
+
+/// Every preset and test mix as it is, and each without a link given a
+/// UART and an AXI4-Stream link; random mixes the same way.
+fn mixes() -> Vec<(String, lut_gen::Schedule)> {
+    let mut texts = Vec::new();
+    for dir in ["mixes", "testkit/mixes"] {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(root().join(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect();
+        files.sort();
+        for f in files {
+            texts.push((
+                f.display().to_string(),
+                std::fs::read_to_string(&f).unwrap(),
+            ));
+        }
+    }
+    let shape = campaign::mixgen::Shape {
+        clock_hz: 4_000_000,
+        frame_us: 1_000,
+        slice_us: 500,
+        branches: (1, 3),
+        mux_devices: (1, 2),
+        sclk_hz: vec![1_000_000, 2_000_000],
+        settle_ns: vec![0, 1_000, 2_000],
+        channels: (2, 8),
+        rates_hz: vec![1_000, 2_000, 4_000],
+    };
+    for seed in 1..12u64 {
+        texts.push((
+            format!("random mix {seed}"),
+            campaign::mixgen::random_mix(seed, &shape),
+        ));
+    }
+    let mut out = Vec::new();
+    for (name, text) in &texts {
+        for link in [None, Some(UART), Some(AXIS)] {
+            if let Some(s) = schedule(name, text, link) {
+                out.push((format!("{name} + {link:?}"), s));
+            }
+        }
+    }
+    out
+}
+
+/// What the harness must leave out, read from the mix's ports: nothing
+/// without a link; a UART's line; an AXI4-Stream's beats and bytes.
+fn expected(s: &lut_gen::Schedule) -> Vec<Clause> {
+    let l = Layout::new(s);
+    match (l.link, l.axis) {
+        (false, _) => vec![],
+        (true, false) => vec![Clause::UartCharacters, Clause::LinkPackets],
+        (true, true) => vec![Clause::AxisBeats, Clause::LinkPackets],
+    }
+}
+
+#[test]
+fn not_covered_is_what_the_harness_leaves_out_for_every_kind_of_mix() {
+    let all = mixes();
+    let kinds = |axis: Option<bool>| {
+        all.iter()
+            .filter(|(_, s)| {
+                let l = Layout::new(s);
+                match axis {
+                    None => !l.link,
+                    Some(a) => l.link && l.axis == a,
+                }
+            })
+            .count()
+    };
+    // enough of each kind that the test says something
+    assert!(kinds(None) >= 8 && kinds(Some(false)) >= 8 && kinds(Some(true)) >= 8);
+    for (name, s) in &all {
+        let h = formal::generate(s).unwrap();
+        assert_eq!(h.not_covered, expected(s), "{name}");
+        // every clause of the contract is asserted by a property or listed
+        for c in contract(s, &Layout::new(s)) {
+            let asserted = h.properties.iter().any(|p| p.covers.contains(&c));
+            assert_ne!(asserted, h.not_covered.contains(&c), "{name}: {c:?}");
+        }
+    }
+}
+
+/// The list is derived from the properties: dropping any one property from
+/// the harness lists exactly the clauses it asserted, on every mix.
+#[test]
+fn dropping_a_property_lists_what_it_asserted() {
+    for (name, s) in mixes().iter().step_by(3) {
+        let h = formal::generate(s).unwrap();
+        for (i, p) in h.properties.iter().enumerate() {
+            let mut rest = h.properties.clone();
+            rest.remove(i);
+            let mut want: Vec<Clause> = h.not_covered.clone();
+            want.extend(&p.covers);
+            want.sort();
+            let mut got = not_covered(s, &rest);
+            got.sort();
+            assert_eq!(got, want, "{name} without {}", p.name);
+        }
+    }
+}
+
+/// The sentences name the pins and the figures the audit reports: the UART
+/// clause carries the divider and baud of `lut_gen::hostlink`.
+#[test]
+fn the_sentences_name_the_pins_and_the_audits_baud() {
+    for (name, s) in mixes() {
+        let h = formal::generate(&s).unwrap();
+        let said: Vec<String> = h.not_covered.iter().map(|c| c.sentence(&s)).collect();
+        let Some(Ok(plan)) = lut_gen::hostlink::plan(&s) else {
+            assert!(said.is_empty(), "{name}: {said:?}");
+            continue;
+        };
+        match plan.uart() {
+            Some(_) => {
+                assert!(
+                    said.iter().all(|t| t.contains("link_tx")),
+                    "{name}: {said:?}"
+                );
+                let want = format!(
+                    "each bit {} cycles ({:.0} baud)",
+                    plan.baud_divider, plan.baud
+                );
+                assert!(said[0].contains(&want), "{name}: {want} not in {said:?}");
+                assert!(said[1].contains("CRC"), "{name}: {said:?}");
+            }
+            None => {
+                assert!(said[0].contains("m_axis_tvalid"), "{name}: {said:?}");
+                assert!(said[1].contains("m_axis_tdata"), "{name}: {said:?}");
+            }
+        }
+    }
+}
