@@ -396,10 +396,10 @@ fn channels(r: &AuditReport) -> Table {
         "mux device, input",
         "rate",
         "`sample_channel`",
-        "interval (cycles), jitter",
+        "interval (cycles)",
         "first sample (cycle)",
-        "settling time, needed (us)",
-        "signal band, Nyquist",
+        "settling time (us)",
+        "signal band (Nyquist)",
     ]);
     for c in &r.channels {
         t.push(channel_row(c));
@@ -419,8 +419,8 @@ fn channel_row(c: &ChannelAudit) -> Vec<String> {
     };
     let band = match (c.bandwidth_hz, c.alias_hz) {
         (Some(b), Some(a)) => format!("{}, {}: ALIASES to {}", hz(b), hz(c.nyquist_hz), hz(a)),
-        (Some(b), None) => format!("{}, {}", hz(b), hz(c.nyquist_hz)),
-        (None, _) => format!("-, {}", hz(c.nyquist_hz)),
+        (Some(b), None) => format!("{} (Nyquist {})", hz(b), hz(c.nyquist_hz)),
+        (None, _) => format!("not given (Nyquist {})", hz(c.nyquist_hz)),
     };
     vec![
         c.name.clone(),
@@ -428,10 +428,10 @@ fn channel_row(c: &ChannelAudit) -> Vec<String> {
         format!("{}, {}", c.device, c.select),
         rate,
         c.sample_channel.to_string(),
-        format!("{}, {}", c.interval_cycles, c.jitter_cycles),
+        format!("{} (jitter {})", c.interval_cycles, c.jitter_cycles),
         c.first_sample_cycle.to_string(),
         format!(
-            "{:.1}, {:.1}",
+            "{:.1} (needs {:.1})",
             c.settle_available_ns / 1e3,
             c.settle_required_ns as f64 / 1e3
         ),

@@ -185,7 +185,7 @@ pub fn chart(c: &Campaign, clean: &[CleanRun]) -> Figure {
         .chain([real.max(1e-6)]);
     let (lo, hi) = xs.fold((f64::MAX, f64::MIN), |a, v| (a.0.min(v), a.1.max(v)));
     let mut axes = Axes::new(
-        "Speed against accuracy of the verification methods (one fault campaign)",
+        "Speed against accuracy of the verification methods (this build)",
         "wall seconds per judged run (log; left of the line: faster than real time)",
         "faults detected (% of those reaching the method; labels: n of N; below 0: cost only)",
     );

@@ -304,9 +304,9 @@ pub fn html(d: &Document) -> String {
     let _ = write!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n<style>\n{}</style>\n</head>\n<body>\n<h1>{}</h1>\n<p>{}</p>\n",
-        esc(&d.title),
+        esc(&d.title.replace('`', "")),
         CSS,
-        esc(&d.title),
+        inline(&d.title),
         inline(&d.subtitle)
     );
     if !d.note.is_empty() {
@@ -395,7 +395,7 @@ pub fn html(d: &Document) -> String {
 /// names break anywhere rather than run out of their cell; headers and the
 /// first column, names of things, break only between words).
 const CSS: &str = "body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}\n\
-table{border-collapse:collapse;margin:1em 0;max-width:100%}td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top;overflow-wrap:anywhere}\n\
+table{border-collapse:collapse;margin:1em 0;max-width:100%}td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top;overflow-wrap:break-word}\n\
 th{background:#eee}td.num{text-align:right;white-space:nowrap}th,td:first-child{overflow-wrap:normal}td.ok,td.FAILED,td.skipped{white-space:nowrap}pre{background:#f6f6f6;padding:.6em;white-space:pre-wrap;overflow-wrap:anywhere;font-size:85%}\n\
 .ok{color:#176917}.FAILED{color:#b00;font-weight:bold}.skipped{color:#777}figure{margin:1.5em 0}\n\
 figcaption{font-size:90%;color:#444;max-width:900px}svg{max-width:100%;height:auto}code{overflow-wrap:anywhere}\n\

@@ -121,7 +121,7 @@ impl Job {
         Job {
             out: a.out.clone(),
             doc: Document {
-                title: format!("slotforge build: {}", s.mix.name),
+                title: format!("slotforge build: `{}`", s.mix.name),
                 subtitle: format!(
                     "{} ({}): {} channels on {} branches, clock {} Hz, frame {} cycles = {} slices x {} slots x {} cycles; {} samples per frame. Machine: {} core(s).",
                     s.mix.description,
