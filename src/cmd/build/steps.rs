@@ -55,7 +55,10 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
         if let Run::Skip(why) = run {
             job.not_run(step, &format!("not run ({why})"));
             if step == Step::Prove {
-                job.answer(Glance::Proved, format!("not in this build: {why}"));
+                job.answer(Glance::Proved, match why {
+                    super::plan::SkipReason::ProveOptIn => "not in this build, and no proof of this same Verilog is remembered: a proof takes minutes (`--charts all` or `--only prove` runs it)".to_string(),
+                    _ => format!("not in this build ({why})"),
+                });
             }
             continue;
         }
