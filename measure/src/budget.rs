@@ -256,7 +256,7 @@ fn branches(r: &AuditReport) -> Table {
 fn headroom(r: &AuditReport) -> Table {
     let mut t = Table::new(&[
         "branch",
-        "rate",
+        "rate (Hz)",
         "more channels",
         "what binds",
         "free mux inputs allow",
@@ -268,7 +268,7 @@ fn headroom(r: &AuditReport) -> Table {
         for h in &b.headroom {
             t.push(vec![
                 b.name.clone(),
-                hz(h.rate_hz as f64),
+                h.rate_hz.to_string(),
                 h.more_channels.to_string(),
                 h.binding.describe().into(),
                 h.by_mux_inputs.to_string(),
@@ -394,12 +394,12 @@ fn channels(r: &AuditReport) -> Table {
         "channel",
         "branch",
         "mux device, input",
-        "rate",
+        "rate (Hz)",
         "`sample_channel`",
         "interval (cycles)",
         "first sample (cycle)",
         "settling time (us)",
-        "signal band (Nyquist)",
+        "signal band, Nyquist (Hz)",
     ]);
     for c in &r.channels {
         t.push(channel_row(c));
@@ -408,19 +408,19 @@ fn channels(r: &AuditReport) -> Table {
 }
 
 fn channel_row(c: &ChannelAudit) -> Vec<String> {
+    let num = |x: f64| {
+        let s = format!("{x:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    };
     let rate = if (c.achieved_hz - c.requested_hz as f64).abs() < 1e-9 {
-        hz(c.achieved_hz)
+        num(c.achieved_hz)
     } else {
-        format!(
-            "{} ({} asked)",
-            hz(c.achieved_hz),
-            hz(c.requested_hz as f64)
-        )
+        format!("{} ({} asked)", num(c.achieved_hz), c.requested_hz)
     };
     let band = match (c.bandwidth_hz, c.alias_hz) {
-        (Some(b), Some(a)) => format!("{}, {}: ALIASES to {}", hz(b), hz(c.nyquist_hz), hz(a)),
-        (Some(b), None) => format!("{} (Nyquist {})", hz(b), hz(c.nyquist_hz)),
-        (None, _) => format!("not given (Nyquist {})", hz(c.nyquist_hz)),
+        (Some(b), Some(a)) => format!("{} ({}): ALIASES to {}", num(b), num(c.nyquist_hz), num(a)),
+        (Some(b), None) => format!("{} ({})", num(b), num(c.nyquist_hz)),
+        (None, _) => format!("not given ({})", num(c.nyquist_hz)),
     };
     vec![
         c.name.clone(),
@@ -437,4 +437,65 @@ fn channel_row(c: &ChannelAudit) -> Vec<String> {
         ),
         band,
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Text outside backticks has no `_` (no field name shown as a word).
+    fn plain_has_underscore(t: &str) -> bool {
+        t.split('`').step_by(2).any(|p| p.contains('_'))
+    }
+
+    /// Every preset and a few random mixes: headers and row labels in
+    /// words, every table whole (each row as wide as its header), each
+    /// channel one row, and the tightest limit is the most used figure
+    /// of the branch table.
+    #[test]
+    fn the_audit_tables_are_words_whole_and_once() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        let mut mixes = Vec::new();
+        for e in std::fs::read_dir(root.join("mixes")).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().is_some_and(|x| x == "toml") {
+                mixes.push(lut_gen::parse(&p, &std::fs::read_to_string(&p).unwrap()).unwrap());
+            }
+        }
+        for seed in 1..6 {
+            let text = campaign::random_mix(seed, &campaign::Shape::default());
+            mixes.push(lut_gen::parse(std::path::Path::new("r.toml"), &text).unwrap());
+        }
+        for mix in &mixes {
+            let s = lut_gen::synthesize(mix).unwrap();
+            let r = AuditReport::of_schedule(&s);
+            let tables = audit(&r);
+            for (cap, t) in &tables {
+                assert!(!plain_has_underscore(cap), "{cap}");
+                for h in &t.columns {
+                    assert!(!plain_has_underscore(h), "{}: {cap}: {h}", mix.name);
+                }
+                assert!(t.rows.iter().all(|row| row.len() == t.columns.len()));
+                if t.columns.len() == 2 {
+                    // label and value: the labels are words
+                    for row in &t.rows {
+                        assert!(!plain_has_underscore(&row[0]), "{}: {}", mix.name, row[0]);
+                    }
+                }
+            }
+            let ch = &tables.iter().find(|t| t.0 == "Channels").unwrap().1;
+            let names: Vec<&String> = ch.rows.iter().map(|r| &r[0]).collect();
+            assert_eq!(names.len(), mix.channels.len(), "{}", mix.name);
+            assert_eq!(tables.iter().filter(|t| t.0 == "Channels").count(), 1);
+            assert_eq!(r.link.is_some(), tables.iter().any(|t| t.0.starts_with("Link budget")));
+            let tight = Tightest::of(&r).unwrap();
+            let most = r
+                .branches
+                .iter()
+                .flat_map(|b| [b.utilization, b.adc_utilization])
+                .chain(r.link.iter().map(|l| l.utilization))
+                .fold(0.0, f64::max);
+            assert_eq!(tight.used, most, "{}", mix.name);
+        }
+    }
 }

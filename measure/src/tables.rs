@@ -131,7 +131,7 @@ fn span(lo: u64, hi: u64) -> String {
 pub fn intervals(s: &Schedule, r: &judge::Verdict) -> Table {
     let mut t = Table::new(&[
         "branch",
-        "rate",
+        "rate (Hz)",
         "channels",
         "samples each",
         "interval promised (cycles)",
@@ -167,7 +167,7 @@ pub fn intervals(s: &Schedule, r: &judge::Verdict) -> Table {
         let mm = |v: &[u64]| span(*v.iter().min().unwrap_or(&0), *v.iter().max().unwrap_or(&0));
         t.push(vec![
             branch,
-            format!("{rate} Hz"),
+            rate.to_string(),
             names(&list),
             mm(&samples),
             mm(&promised),

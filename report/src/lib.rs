@@ -398,7 +398,7 @@ const CSS: &str = "body{font-family:system-ui,sans-serif;max-width:1100px;margin
 table{border-collapse:collapse;margin:1em 0;max-width:100%}td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top;overflow-wrap:break-word}\n\
 th{background:#eee}td.num{text-align:right;white-space:nowrap}th,td:first-child{overflow-wrap:normal}td.ok,td.FAILED,td.skipped{white-space:nowrap}pre{background:#f6f6f6;padding:.6em;white-space:pre-wrap;overflow-wrap:anywhere;font-size:85%}\n\
 .ok{color:#176917}.FAILED{color:#b00;font-weight:bold}.skipped{color:#777}figure{margin:1.5em 0}\n\
-figcaption{font-size:90%;color:#444;max-width:900px}svg{max-width:100%;height:auto}code{overflow-wrap:anywhere}\n\
+figcaption{font-size:90%;color:#444;max-width:900px}svg{max-width:100%;height:auto}code{overflow-wrap:anywhere}th code{overflow-wrap:normal}\n\
 nav ol{columns:2}table.glance{font-size:110%}table.glance th{text-align:left;white-space:nowrap}\n";
 
 fn link(href: &str, text: &str) -> String {
