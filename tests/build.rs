@@ -59,7 +59,14 @@ fn assert_chart_is_the_matrix(out: &Path) {
             )
         })
         .collect();
-    assert_eq!(got.len(), want.len(), "{got:?} vs {want:?}");
+    // the matrix's rows first, then the engines the build ran clean beside
+    // the campaign (cost only: no fault went through them)
+    assert!(got.len() >= want.len(), "{got:?} vs {want:?}");
+    for g in &got[want.len()..] {
+        assert!(g.0.starts_with("engine: ") || g.0 == "prove", "{g:?}");
+        assert_eq!((g.1, g.3, g.4), (1, 0, 0), "{g:?}");
+        assert!(g.2 > 0.0, "{g:?}");
+    }
     for (g, w) in got.iter().zip(&want) {
         assert_eq!((&g.0, g.1, g.3, g.4), (&w.0, w.1, w.3, w.4));
         assert!((g.2 - w.2).abs() < 1e-5, "{g:?} vs {w:?}");
@@ -196,6 +203,21 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
     assert_eq!(col(&quick, "model")["detected"], quick["injected"]);
     // the speed-against-accuracy chart is the fault matrix of this run
     assert_chart_is_the_matrix(&out);
+    // and names every engine the default build ran, with its cost; the
+    // report says what --charts all adds
+    let sa = csv(&out.join("speed-accuracy.csv"));
+    for m in [
+        "engine: cycle model",
+        "engine: verilator",
+        "engine: rusthdl",
+    ] {
+        assert!(sa.iter().any(|r| r[0] == m), "{m}: {sa:?}");
+        assert!(html.contains(m), "{m} not in the report");
+    }
+    let svg = std::fs::read_to_string(out.join("speed-accuracy.svg")).unwrap();
+    assert!(svg.contains("engine: rusthdl (cost only)"), "{svg}");
+    assert!(html.contains("adds") && html.contains("Icarus") && html.contains("sigrok"));
+    assert_reads_like_a_datasheet(&tiny(), &out);
     // the timing diagram's table has every branch's CS edges
     let timing = std::fs::read_to_string(out.join("timing-slice.csv")).unwrap();
     assert!(timing.contains("fast cs_n") && timing.contains("slow cs_n"));
@@ -492,4 +514,168 @@ fn a_skipped_step_fails_strict_and_ci() {
         xml.contains("<skipped") && xml.contains("not installed"),
         "{xml}"
     );
+}
+
+/// Lower-case words joined by underscores (`adc_limit_hz`, `slot_rom.hex`)
+/// in `text` outside code spans and link targets: what a reader should
+/// never see as prose, a header or a row label.
+fn snake_outside_code(md: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    for line in md.lines() {
+        // link targets are addresses, not text
+        let mut plain = String::new();
+        let mut rest = line;
+        while let Some(i) = rest.find("](") {
+            plain.push_str(&rest[..i]);
+            rest = rest[i..].split_once(')').map_or("", |x| x.1);
+        }
+        plain.push_str(rest);
+        for (k, part) in plain.split('`').enumerate() {
+            if k % 2 == 1 {
+                continue; // a code span
+            }
+            for w in part.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')) {
+                let snake = w.contains('_')
+                    && w.starts_with(|c: char| c.is_ascii_lowercase())
+                    && !w.ends_with('_')
+                    && w.chars()
+                        .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+                if snake {
+                    found.push(format!("{w} in: {line}"));
+                }
+            }
+        }
+    }
+    found
+}
+
+/// The Markdown tables of `md`: (caption, header cells, rows).
+fn md_tables(md: &str) -> Vec<(String, Vec<String>, Vec<Vec<String>>)> {
+    let cells = |l: &str| -> Vec<String> {
+        l.trim()
+            .trim_matches('|')
+            .split(" | ")
+            .map(|c| c.trim().to_string())
+            .collect()
+    };
+    let lines: Vec<&str> = md.lines().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i + 1 < lines.len() {
+        if lines[i].starts_with('|') && lines[i + 1].starts_with("|---") {
+            let caption = lines[..i]
+                .iter()
+                .rev()
+                .find(|l| !l.trim().is_empty())
+                .map_or(String::new(), |l| l.to_string());
+            let head = cells(lines[i]);
+            let mut rows = Vec::new();
+            i += 2;
+            while i < lines.len() && lines[i].starts_with('|') {
+                rows.push(cells(lines[i]));
+                i += 1;
+            }
+            out.push((caption, head, rows));
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
+/// The report of a mix no one wrote it for reads like a datasheet: no
+/// snake_case outside code, every table once and whole (no "(1 of 2)"
+/// parts, no row without its key, no channel listed twice, no table wider
+/// than the page), and every file it links exists.
+fn assert_reads_like_a_datasheet(mix: &Path, out: &Path) {
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let what = mix.display();
+    assert_eq!(snake_outside_code(&md), Vec::<String>::new(), "{what}");
+    let tables = md_tables(&md);
+    assert!(tables.len() >= 6, "{what}: {} tables", tables.len());
+    let text = std::fs::read_to_string(mix).unwrap();
+    let parsed = slotforge_mix(mix, &text);
+    for (cap, head, rows) in &tables {
+        assert!(
+            !cap.contains(" of 2)") && !cap.contains(" of 3)"),
+            "{what}: split table {cap}"
+        );
+        assert!(head.len() <= 10, "{what}: {cap}: {} columns", head.len());
+        assert!(rows.iter().all(|r| r.len() == head.len()), "{what}: {cap}");
+        assert!(
+            rows.iter().all(|r| !r[0].is_empty()),
+            "{what}: {cap}: a row without its key"
+        );
+    }
+    // each channel is a row once (the audit's channel table)
+    for name in &parsed {
+        let n = tables
+            .iter()
+            .flat_map(|t| &t.2)
+            .filter(|r| r[0] == *name)
+            .count();
+        assert_eq!(n, 1, "{what}: channel {name} is a row {n} times");
+    }
+    // the first screen answers first: fit, binds, checked, proved, size
+    let first = &tables[0];
+    assert_eq!(first.1, ["question", "answer"], "{what}");
+    for q in [
+        "Does it fit?",
+        "What binds",
+        "Is the gateware checked?",
+        "Is it proved?",
+        "How big",
+    ] {
+        assert!(first.2.iter().any(|r| r[0].starts_with(q)), "{what}: {q}");
+    }
+    // every file the report links is there
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    for href in html
+        .split("href=\"")
+        .skip(1)
+        .filter_map(|x| x.split('"').next())
+    {
+        if !href.starts_with('#') {
+            assert!(
+                out.join(href).is_file(),
+                "{what}: links {href}, which is missing"
+            );
+        }
+    }
+}
+
+/// The channel names of a mix (upper or lower case: the report lists them
+/// as data).
+fn slotforge_mix(path: &Path, text: &str) -> Vec<String> {
+    let m = lut_gen::parse(path, text).unwrap();
+    m.channels.iter().map(|c| c.name.clone()).collect()
+}
+
+#[test]
+fn reports_of_unseen_mixes_read_like_datasheets() {
+    let d = tempfile::tempdir().unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut mixes: Vec<PathBuf> = std::fs::read_dir(root.join("testkit/mixes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    mixes.sort();
+    mixes.push(root.join("mixes/eskin34-uart.toml"));
+    mixes.push(skin28());
+    for seed in [3, 11] {
+        let p = d.path().join(format!("random{seed}.toml"));
+        std::fs::write(&p, campaign::random_mix(seed, &campaign::Shape::default())).unwrap();
+        mixes.push(p);
+    }
+    for (i, mix) in mixes.iter().enumerate() {
+        let out = d.path().join(format!("b{i}"));
+        slotforge()
+            .args(["build", "--quiet", "--only", "audit,lut,verilog", "-o"])
+            .arg(&out)
+            .arg(mix)
+            .assert()
+            .success();
+        assert_reads_like_a_datasheet(mix, &out);
+    }
 }

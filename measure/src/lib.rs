@@ -8,9 +8,12 @@
 //! - [`speed`]: speed against accuracy ([`speed::MethodScore`]);
 //! - [`schedulability`]: where scheduling breaks around the mix;
 //! - [`proof`]: the formal proof of the gateware (or its cached result);
-//! - [`tables`]: the audit, the slot table (Table 1), per-channel intervals
+//! - [`budget`]: the audit as a datasheet (what binds, the margin, each
+//!   budget its own table);
+//! - [`tables`]: the slot table (Table 1), per-channel intervals
 //!   and the fault campaign as report tables.
 
+pub mod budget;
 pub mod dft;
 pub mod figure7;
 pub mod proof;

@@ -34,6 +34,19 @@ impl MethodScore {
     }
 }
 
+/// An engine this build ran clean under the full check outside the fault
+/// campaign (the co-simulation on Verilator, a rust-hdl run, the
+/// remembered proof): its cost is measured, but no fault went through it
+/// in the quick campaign, so it sits on the chart's cost-only row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CleanRun {
+    /// `engine: verilator`, `engine: rusthdl`, `prove`.
+    pub method: String,
+    pub wall_seconds: f64,
+    /// What was timed.
+    pub how: String,
+}
+
 /// The methods of campaign `c`: every detector that ran, then every engine.
 pub fn scores(c: &Campaign) -> Vec<MethodScore> {
     let mut out = Vec::new();
@@ -78,8 +91,40 @@ pub fn run_seconds(c: &Campaign) -> f64 {
     c.engines.first().map_or(0.0, |e| e.cycles as f64) / c.clock_hz.max(1) as f64
 }
 
-/// The chart and its table for `c`'s methods.
-pub fn chart(c: &Campaign) -> Figure {
+/// The clean runs' rows and their points on the cost-only row (y -4),
+/// labels stepped so none hides another.
+fn clean_points(
+    clean: &[CleanRun],
+    table: &mut Table,
+    series: &mut Vec<Series>,
+    placed: &mut Vec<(f64, f64)>,
+) {
+    for (i, m) in clean.iter().enumerate() {
+        table.push(vec![
+            m.method.clone(),
+            "1".into(),
+            format!("{:.6}", m.wall_seconds),
+            format!("{:.6}", m.wall_seconds),
+            "0".into(),
+            "0".into(),
+            m.how.clone(),
+        ]);
+        let x = m.wall_seconds.max(1e-6);
+        let label = format!("{} (cost only)", m.method);
+        let mut sr =
+            Series::scatter(&label, vec![(x, -4.0)]).with_marker(MARKERS[(i + 2) % MARKERS.len()]);
+        let near = placed
+            .iter()
+            .filter(|&&(px, py)| (px / x).log10().abs() < 0.6 && (py + 4.0).abs() < 6.0)
+            .count();
+        placed.push((x, -4.0));
+        sr.labels = vec![(x, -4.0 + 5.0 * near as f64, label)];
+        series.push(sr);
+    }
+}
+
+/// The chart and its table for `c`'s methods and the clean runs beside it.
+pub fn chart(c: &Campaign, clean: &[CleanRun]) -> Figure {
     let scores = scores(c);
     let mut table = Table::new(&[
         "method",
@@ -118,6 +163,7 @@ pub fn chart(c: &Campaign) -> Figure {
     }
     let mut series = Vec::new();
     let mut placed: Vec<(f64, f64)> = Vec::new();
+    clean_points(clean, &mut table, &mut series, &mut placed);
     for (i, (x, detected, of, names)) in points.into_iter().enumerate() {
         let pct = 100.0 * detected as f64 / of as f64;
         let label = format!("{} ({detected} of {of})", names.join(" and "));
@@ -139,9 +185,9 @@ pub fn chart(c: &Campaign) -> Figure {
         .chain([real.max(1e-6)]);
     let (lo, hi) = xs.fold((f64::MAX, f64::MIN), |a, v| (a.0.min(v), a.1.max(v)));
     let mut axes = Axes::new(
-        "Speed against accuracy of the verification methods (one fault campaign)",
+        "Speed against accuracy of the verification methods (this build)",
         "wall seconds per judged run (log; left of the line: faster than real time)",
-        "faults detected (% of those reaching the method; labels: n of N)",
+        "faults detected (% of those reaching the method; labels: n of N; below 0: cost only)",
     );
     axes.log_x = true;
     // a decade of room on each side, so markers and labels stay inside
@@ -149,7 +195,7 @@ pub fn chart(c: &Campaign) -> Figure {
     // room above 100 % for the legend (upper right, about 17 px a row of
     // the plot's ~380 px), so it hides no point or label
     let frac = ((series.len() * 17 + 20) as f64 / 380.0).min(0.6);
-    axes.y_range = Some((-10.0, ((110.0 + 10.0 * frac) / (1.0 - frac)).max(115.0)));
+    axes.y_range = Some((-12.0, ((110.0 + 10.0 * frac) / (1.0 - frac)).max(115.0)));
     axes.vlines = vec![(real.max(1e-6), "real time".into())];
     Figure {
         stem: "speed-accuracy".into(),
@@ -163,8 +209,9 @@ pub fn chart(c: &Campaign) -> Figure {
     }
 }
 
-/// The section for campaign `c`, and its one-line summary.
-pub fn section(c: &Campaign) -> (Section, String) {
+/// The section for campaign `c` and the clean runs beside it, and its
+/// one-line summary. `charts_all`: whether this build ran every method.
+pub fn section(c: &Campaign, clean: &[CleanRun], charts_all: bool) -> (Section, String) {
     let scores = scores(c);
     let line = scores
         .iter()
@@ -177,6 +224,11 @@ pub fn section(c: &Campaign) -> (Section, String) {
                 m.of
             )
         })
+        .chain(
+            clean
+                .iter()
+                .map(|m| format!("{} {:.4} s per run, cost only", m.method, m.wall_seconds)),
+        )
         .collect::<Vec<_>>()
         .join("; ");
     let not_run: Vec<String> = c
@@ -194,14 +246,27 @@ pub fn section(c: &Campaign) -> (Section, String) {
         "Every point is a column of the fault table above, from the same campaign: a detector (its name as in the table) with the injections it can see, or an engine the faults ran through (`engine: NAME`) with the injections that ran through it and were detected by any detector. The cost is what the campaign measured: a clean run of its frames under the checker with and without the model, each sigrok-cli decode, each proof.".into(),
         format!("{line}."),
     ];
+    if !clean.is_empty() {
+        paragraphs.push(format!(
+            "On the row below 0 %, the engines this build also ran clean under the full check, outside the campaign, so no fault went through them here: {}. Their cost is measured; what they catch is measured by `--charts all`.",
+            clean
+                .iter()
+                .map(|m| format!("{} ({})", m.method, m.how))
+                .collect::<Vec<_>>()
+                .join("; ")
+        ));
+    }
     if !not_run.is_empty() {
         paragraphs.push(format!("Not on the chart: {}.", not_run.join("; ")));
+    }
+    if !charts_all {
+        paragraphs.push("`--charts all` adds: every class at every site with five clean random mixes, sigrok-cli's SPI decode as a detector, the deep Verilog faults (a counter that misbehaves after the run's last frame, a merger collision no stimulus drives) run through Verilator and Icarus, each engine with the faults through it and what caught them, and `prove` as a detector of every fault that is a design (minutes on a 48 MHz mix).".into());
     }
     (
         Section {
             title: "Speed against accuracy".into(),
             paragraphs,
-            figures: vec![chart(c)],
+            figures: vec![chart(c, clean)],
             ..Section::default()
         },
         line,

@@ -1,136 +1,10 @@
-//! The report's tables: the audit (from its JSON, so every audited field is
-//! shown, as HTML tables instead of clipped text), the slot table in the
-//! paper's Table 1 form, the co-simulation's per-channel interval
-//! statistics, and the fault campaign.
+//! The report's tables: the slot table in the paper's Table 1 form, the
+//! co-simulation's intervals by branch and rate, and the fault campaign
+//! (the audit's are in [`crate::budget`]).
 
 use lut_gen::lut::{CompactLut, SliceCell};
-use lut_gen::{AuditReport, Schedule};
+use lut_gen::Schedule;
 use report::Table;
-use serde_json::Value;
-
-/// A JSON scalar as a cell.
-fn cell(v: &Value) -> String {
-    match v {
-        Value::Null => "-".into(),
-        Value::String(s) => s.clone(),
-        Value::Number(n) => match n.as_f64() {
-            Some(f) if n.is_f64() => format!("{}", (f * 1e4).round() / 1e4),
-            _ => n.to_string(),
-        },
-        Value::Bool(b) => b.to_string(),
-        Value::Array(a) if a.iter().all(|x| !x.is_object()) => {
-            a.iter().map(cell).collect::<Vec<_>>().join("; ")
-        }
-        other => compact(other),
-    }
-}
-
-/// An object or an array of objects, on one line (`key=value, ...`).
-fn compact(v: &Value) -> String {
-    match v {
-        Value::Object(o) => o
-            .iter()
-            .map(|(k, x)| format!("{k}={}", cell(x)))
-            .collect::<Vec<_>>()
-            .join(", "),
-        Value::Array(a) => a.iter().map(compact).collect::<Vec<_>>().join(" | "),
-        other => cell(other),
-    }
-}
-
-/// Columns per table: wider record lists are split (the first column, the
-/// record's name, repeated), so no table is wider than the page.
-const COLUMNS: usize = 7;
-
-/// The audit as tables: the mix's figures (key, value), then each list of
-/// records (branches, parts, channels) a row per record, and each list
-/// inside a record (a branch's headroom per rate) its own table.
-pub fn audit(r: &AuditReport) -> Vec<(String, Table)> {
-    let v = serde_json::to_value(r).expect("the audit serializes");
-    let Value::Object(o) = v else {
-        return Vec::new();
-    };
-    let mut facts = Table::new(&["figure", "value"]);
-    let mut lists = Vec::new();
-    for (k, x) in &o {
-        match x {
-            Value::Array(a) if a.first().is_some_and(Value::is_object) => {
-                records(&format!("Audit: {k}"), a, &mut lists)
-            }
-            Value::Array(a) if a.is_empty() => facts.push(vec![k.clone(), "none".into()]),
-            _ => facts.push(vec![k.clone(), cell(x)]),
-        }
-    }
-    let mut out = vec![("Audit: the mix".to_string(), facts)];
-    out.extend(lists);
-    out
-}
-
-/// Records as tables of at most [`COLUMNS`] columns, `name` first; nested
-/// record lists become tables of their own, keyed by the parent's name.
-fn records(title: &str, a: &[Value], out: &mut Vec<(String, Table)>) {
-    let keys: Vec<String> = a[0]
-        .as_object()
-        .map(|m| m.keys().cloned().collect())
-        .unwrap_or_default();
-    let key = if keys.iter().any(|k| k == "name") {
-        "name"
-    } else {
-        keys[0].as_str()
-    }
-    .to_string();
-    let nested = |k: &String| {
-        a.iter().any(|r| {
-            r[k.as_str()]
-                .as_array()
-                .is_some_and(|v| v.first().is_some_and(Value::is_object))
-        })
-    };
-    let plain: Vec<&String> = keys.iter().filter(|k| **k != key && !nested(k)).collect();
-    let chunks: Vec<&[&String]> = plain.chunks(COLUMNS - 1).collect();
-    for (n, cols) in chunks.iter().enumerate() {
-        let mut names = vec![key.as_str()];
-        names.extend(cols.iter().map(|c| c.as_str()));
-        let mut t = Table::new(&names);
-        for row in a {
-            let mut r = vec![cell(&row[key.as_str()])];
-            r.extend(cols.iter().map(|c| cell(&row[c.as_str()])));
-            t.push(r);
-        }
-        let part = if chunks.len() > 1 {
-            format!(" ({} of {})", n + 1, chunks.len())
-        } else {
-            String::new()
-        };
-        out.push((format!("{title}{part}"), t));
-    }
-    for k in keys.iter().filter(|k| nested(k)) {
-        let inner: Vec<Value> = a
-            .iter()
-            .flat_map(|row| {
-                let parent = row[key.as_str()].clone();
-                let key = key.clone();
-                row[k.as_str()]
-                    .as_array()
-                    .cloned()
-                    .unwrap_or_default()
-                    .into_iter()
-                    .map(move |mut x| {
-                        if let Value::Object(m) = &mut x {
-                            let mut with = serde_json::Map::new();
-                            with.insert(key.clone(), parent.clone());
-                            with.extend(std::mem::take(m));
-                            *m = with;
-                        }
-                        x
-                    })
-            })
-            .collect();
-        if !inner.is_empty() {
-            records(&format!("{title}: {k}"), &inner, out);
-        }
-    }
-}
 
 /// The slot table in the paper's Table 1 form: a row per slot of the slice,
 /// a column per branch, each cell the channel converted there in every
@@ -139,19 +13,33 @@ fn records(title: &str, a: &[Value], out: &mut Vec<(String, Table)>) {
 pub fn slot_table(s: &Schedule) -> Vec<(String, Table)> {
     let lut = CompactLut::from_schedule(s);
     let name = |c: u16| s.mix.channels[c as usize].name.clone();
-    let mut cols = vec!["slot".to_string()];
-    cols.extend(s.branches.iter().map(|b| b.name.clone()));
-    let refs: Vec<&str> = cols.iter().map(String::as_str).collect();
-    let mut t = Table::new(&refs);
-    for (slot, row) in lut.slice_table.iter().enumerate() {
-        let mut r = vec![slot.to_string()];
-        r.extend(row.iter().map(|c| match c {
-            SliceCell::Idle => "-".to_string(),
-            SliceCell::Fixed(c) => name(*c),
-            SliceCell::Rotate(g) => format!("R{g}"),
-        }));
-        t.push(r);
-    }
+    let cell = |c: &SliceCell| match c {
+        SliceCell::Idle => "-".to_string(),
+        SliceCell::Fixed(c) => name(*c),
+        SliceCell::Rotate(g) => format!("R{g}"),
+    };
+    let t = if 1 + s.branches.len() > MAX_COLUMNS {
+        // a column per branch would be wider than the page: a row per
+        // branch listing its slots, which wraps
+        let mut t = Table::new(&["branch", "channel in slot 0, 1, 2, ... of the slice"]);
+        for (b, br) in s.branches.iter().enumerate() {
+            let list: Vec<String> = lut.slice_table.iter().map(|row| cell(&row[b])).collect();
+            t.push(vec![br.name.clone(), list.join(", ")]);
+        }
+        t
+    } else {
+        let mut cols = vec!["slot".to_string()];
+        // branch names are the user's identifiers: shown as code
+        cols.extend(s.branches.iter().map(|b| format!("`{}`", b.name)));
+        let refs: Vec<&str> = cols.iter().map(String::as_str).collect();
+        let mut t = Table::new(&refs);
+        for (slot, row) in lut.slice_table.iter().enumerate() {
+            let mut r = vec![slot.to_string()];
+            r.extend(row.iter().map(cell));
+            t.push(r);
+        }
+        t
+    };
     let mut out = vec![(
         format!(
             "Table 1: slots of a {} us slice ({} cycles each), same in every slice",
@@ -168,15 +56,28 @@ pub fn slot_table(s: &Schedule) -> Vec<(String, Table)> {
     out
 }
 
+/// Columns a table may have and still fit the report's page.
+pub const MAX_COLUMNS: usize = 10;
+
 /// The rotation groups: a row per group and a column per slice, or, with
 /// more slices than groups (a 20 ms frame of 1 ms slices has 20), a row
-/// per slice and a column per group, so the table fits the page's width.
+/// per slice and a column per group; when either is wider than the page
+/// ([`MAX_COLUMNS`]), a row per group listing its channel slice by slice,
+/// which wraps.
 fn rotation_table(s: &Schedule, lut: &CompactLut) -> Table {
     let name = |c: u16| s.mix.channels[c as usize].name.clone();
     let cell = |e: &Option<u16>| e.map_or("-".into(), name);
     let slices = s.grid.slices_per_frame as usize;
     let groups = &lut.rotations;
     let by_slice = slices > groups.len();
+    if 1 + slices.min(groups.len()) > MAX_COLUMNS {
+        let mut t = Table::new(&["group", "channel in slice 0, 1, 2, ..."]);
+        for (g, group) in groups.iter().enumerate() {
+            let list: Vec<String> = group.iter().map(cell).collect();
+            t.push(vec![format!("R{g}"), list.join(", ")]);
+        }
+        return t;
+    }
     let (corner, heads): (&str, Vec<String>) = if by_slice {
         (
             "slice",
@@ -205,36 +106,76 @@ fn rotation_table(s: &Schedule, lut: &CompactLut) -> Table {
     t
 }
 
-/// Per-channel sample counts and intervals a run measured.
+/// "CH1", "CH1, CH2", or "CH1 to HUM (30)" for a run of names.
+fn names(v: &[&str]) -> String {
+    match v {
+        [] => "-".into(),
+        [a] => a.to_string(),
+        [a, b] => format!("{a}, {b}"),
+        [a, .., z] => format!("{a} to {z} ({})", v.len()),
+    }
+}
+
+/// "a" or "a to b".
+fn span(lo: u64, hi: u64) -> String {
+    if lo == hi {
+        lo.to_string()
+    } else {
+        format!("{lo} to {hi}")
+    }
+}
+
+/// The intervals a run measured, a row per branch and rate (the channels
+/// themselves are listed once, in the audit): channels, samples each,
+/// the interval the schedule promises and the least and most measured.
 pub fn intervals(s: &Schedule, r: &judge::Verdict) -> Table {
     let mut t = Table::new(&[
-        "channel",
         "branch",
-        "rate_hz",
-        "samples",
-        "interval_cycles",
-        "min",
-        "max",
-        "jitter_cycles",
+        "rate (Hz)",
+        "channels",
+        "samples each",
+        "interval promised (cycles)",
+        "interval measured (cycles)",
+        "jitter (cycles)",
     ]);
+    let mut keys: Vec<(String, u64)> = Vec::new();
     for (i, c) in r.channels.iter().enumerate() {
-        let opt = |v: Option<u64>| v.map_or("-".into(), |x| x.to_string());
-        let jitter = match (c.interval_cycles_min, c.interval_cycles_max) {
-            (Some(a), Some(b)) => (b - a).to_string(),
-            _ => "-".into(),
-        };
+        let rate = s.mix.channels.get(i).map_or(0, |m| m.rate_hz);
+        if !keys.contains(&(c.branch.clone(), rate)) {
+            keys.push((c.branch.clone(), rate));
+        }
+    }
+    for (branch, rate) in keys {
+        let group: Vec<&judge::ChannelStats> = r
+            .channels
+            .iter()
+            .enumerate()
+            .filter(|(i, c)| {
+                c.branch == branch && s.mix.channels.get(*i).map_or(0, |m| m.rate_hz) == rate
+            })
+            .map(|x| x.1)
+            .collect();
+        let list: Vec<&str> = group.iter().map(|c| c.name.as_str()).collect();
+        let samples: Vec<u64> = group.iter().map(|c| c.samples).collect();
+        let promised: Vec<u64> = group.iter().map(|c| c.interval_cycles).collect();
+        let lo = group.iter().filter_map(|c| c.interval_cycles_min).min();
+        let hi = group.iter().filter_map(|c| c.interval_cycles_max).max();
+        let jitter = group
+            .iter()
+            .filter_map(|c| Some(c.interval_cycles_max? - c.interval_cycles_min?))
+            .max();
+        let mm = |v: &[u64]| span(*v.iter().min().unwrap_or(&0), *v.iter().max().unwrap_or(&0));
         t.push(vec![
-            c.name.clone(),
-            c.branch.clone(),
-            s.mix
-                .channels
-                .get(i)
-                .map_or("-".into(), |m| m.rate_hz.to_string()),
-            c.samples.to_string(),
-            c.interval_cycles.to_string(),
-            opt(c.interval_cycles_min),
-            opt(c.interval_cycles_max),
-            jitter,
+            branch,
+            rate.to_string(),
+            names(&list),
+            mm(&samples),
+            mm(&promised),
+            match (lo, hi) {
+                (Some(a), Some(b)) => span(a, b),
+                _ => "-".into(),
+            },
+            jitter.map_or("-".into(), |j| j.to_string()),
         ]);
     }
     t
@@ -291,38 +232,33 @@ mod tests {
         assert_eq!(csv.lines().count(), 1 + s.grid.slices_per_frame as usize);
     }
 
+    /// A frame of many slices and many rotation groups: neither layout
+    /// fits the page, so each group is one row listing its channels.
     #[test]
-    fn the_audit_becomes_tables_with_every_channel() {
-        let mix = lut_gen::parse(
-            std::path::Path::new("t.toml"),
-            "name = \"t\"\n[clock]\nhz = 4_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 500\n[[branch]]\nname = \"b\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 1\n[[channel]]\nname = \"X\"\nbranch = \"b\"\nrate_hz = 2_000\n[[channel]]\nname = \"Y\"\nbranch = \"b\"\nrate_hz = 1_000\n",
-        )
-        .unwrap();
+    fn rotation_groups_wider_than_the_page_become_lists() {
+        let mut text = String::from("name = \"t\"\n[clock]\nhz = 4_000_000\n[frame]\nperiod_us = 20_000\nslice_us = 1_000\n");
+        for b in 0..12 {
+            text += &format!("[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 3\n");
+        }
+        for b in 0..12 {
+            for k in 0..20 {
+                text +=
+                    &format!("[[channel]]\nname = \"C{b}_{k}\"\nbranch = \"b{b}\"\nrate_hz = 50\n");
+            }
+        }
+        let mix = lut_gen::parse(std::path::Path::new("t.toml"), &text).unwrap();
         let s = lut_gen::synthesize(&mix).unwrap();
-        let t = audit(&AuditReport::of_schedule(&s));
-        // channels split into tables of at most 7 columns, name first
-        let ch: Vec<&Table> = t
-            .iter()
-            .filter(|x| x.0.starts_with("Audit: channels ("))
-            .map(|x| &x.1)
-            .collect();
-        assert!(ch.len() > 1);
-        assert!(ch
-            .iter()
-            .all(|t| t.columns.len() <= COLUMNS && t.columns[0] == "name" && t.rows.len() == 2));
-        assert!(ch
-            .iter()
-            .any(|t| t.columns.contains(&"alias_hz".to_string())));
-        // a branch's headroom per rate is a table of its own
-        let hr = &t
-            .iter()
-            .find(|x| x.0.starts_with("Audit: branches: headroom"))
-            .unwrap()
-            .1;
-        assert_eq!(hr.columns[0], "name");
-        assert_eq!(hr.rows.len(), 2, "{hr:?}");
-        let st = slot_table(&s);
-        let cells: Vec<&String> = st[0].1.rows.iter().flat_map(|r| &r[1..]).collect();
-        assert!(cells.iter().any(|c| *c == "X"), "{cells:?}");
+        let lut = CompactLut::from_schedule(&s);
+        assert!(
+            lut.rotations.len() >= MAX_COLUMNS && s.grid.slices_per_frame as usize >= MAX_COLUMNS
+        );
+        let tables = slot_table(&s);
+        let (_, rot) = tables.last().unwrap();
+        assert_eq!(rot.columns.len(), 2, "{:?}", rot.columns);
+        assert_eq!(rot.rows.len(), lut.rotations.len());
+        // every rotating channel is named once, in its group's row
+        let all: String = rot.rows.iter().map(|r| r[1].clone() + ", ").collect();
+        assert!(all.contains("C0_0,") && all.contains("C11_19,"), "{all}");
+        assert!(tables.iter().all(|t| t.1.columns.len() <= MAX_COLUMNS));
     }
 }

@@ -96,6 +96,9 @@ pub struct Document {
     pub subtitle: String,
     /// A warning shown at the top (e.g. the job had not finished), may be empty.
     pub note: String,
+    /// The first screen: a question a reader asks first (does it fit,
+    /// what binds, is it checked, proved, how big) and its answer.
+    pub glance: Vec<(String, String)>,
     pub steps: Vec<Step>,
     pub sections: Vec<Section>,
 }
@@ -111,6 +114,83 @@ fn esc(s: &str) -> String {
         .replace('<', "&lt;")
         .replace('>', "&gt;")
         .replace('"', "&quot;")
+}
+
+/// Is `w` a code identifier (`sample_valid`, `synth_ice40`): lower case
+/// words joined by underscores. Upper-case names (`ACC_X`) are the user's.
+pub fn is_snake(w: &str) -> bool {
+    let w = w.trim_matches(|c: char| !c.is_ascii_alphanumeric() && c != '_');
+    let b = w.as_bytes();
+    let joined = (1..b.len().saturating_sub(1)).any(|i| {
+        b[i] == b'_' && b[i - 1].is_ascii_alphanumeric() && b[i + 1].is_ascii_alphanumeric()
+    });
+    joined
+        && w.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+        && w.chars().all(|c| {
+            c.is_ascii_lowercase() || c.is_ascii_digit() || matches!(c, '_' | '.' | '/' | '-')
+        })
+}
+
+/// Splits text into (is code, piece): spans between backticks are code,
+/// and so is any identifier written in snake case outside them (a port or
+/// a file name in a summary), so prose never shows code as words.
+fn spans(t: &str) -> Vec<(bool, String)> {
+    let mut out = Vec::new();
+    for (i, part) in t.split('`').enumerate() {
+        if i % 2 == 1 {
+            out.push((true, part.to_string()));
+            continue;
+        }
+        let mut word = String::new();
+        let flush = |word: &mut String, out: &mut Vec<(bool, String)>| {
+            if !word.is_empty() {
+                out.push((is_snake(word), std::mem::take(word)));
+            }
+        };
+        for c in part.chars() {
+            // a word: letters, digits, `_`, `.` and `/` inside (file names)
+            if c.is_ascii_alphanumeric() || c == '_' || ((c == '.' || c == '/') && !word.is_empty())
+            {
+                word.push(c);
+            } else {
+                flush(&mut word, &mut out);
+                out.push((false, c.to_string()));
+            }
+        }
+        flush(&mut word, &mut out);
+    }
+    out
+}
+
+/// Text as HTML, code spans in `<code>` (a trailing `.` of a sentence
+/// stays outside).
+fn inline(t: &str) -> String {
+    spans(t)
+        .into_iter()
+        .map(|(code, p)| {
+            if code {
+                let body = p.trim_end_matches('.');
+                format!("<code>{}</code>{}", esc(body), &p[body.len()..])
+            } else {
+                esc(&p)
+            }
+        })
+        .collect()
+}
+
+/// Text as Markdown, code spans in backticks.
+fn md_inline(t: &str) -> String {
+    spans(t)
+        .into_iter()
+        .map(|(code, p)| {
+            if code {
+                let body = p.trim_end_matches('.');
+                format!("`{body}`{}", &p[body.len()..])
+            } else {
+                p
+            }
+        })
+        .collect()
 }
 
 /// The SVG made embeddable: no XML prolog, a title for screen readers.
@@ -130,13 +210,13 @@ fn html_table(t: &Table) -> String {
     let mut h = String::from("<table>\n<tr>");
     for c in &t.columns {
         // long snake_case headers may break after an underscore
-        let _ = write!(h, "<th>{}</th>", esc(c).replace('_', "_<wbr>"));
+        let _ = write!(h, "<th>{}</th>", inline(c));
     }
     h.push_str("</tr>\n");
     for r in &t.rows {
         h.push_str("<tr>");
         for c in r {
-            let _ = write!(h, "<td>{}</td>", esc(c));
+            let _ = write!(h, "<td>{}</td>", inline(c));
         }
         h.push_str("</tr>\n");
     }
@@ -145,7 +225,7 @@ fn html_table(t: &Table) -> String {
 }
 
 fn md_table(t: &Table) -> String {
-    let cell = |s: &str| s.replace('|', "\\|");
+    let cell = |s: &str| md_inline(s).replace('|', "\\|");
     let mut m = format!(
         "| {} |\n|{}|\n",
         t.columns
@@ -179,12 +259,42 @@ fn steps_table(d: &Document) -> Table {
             s.summary.clone(),
             s.files
                 .iter()
-                .map(|f| format!("[{f}]({f})"))
+                .map(|f| format!("[`{f}`]({f})"))
                 .collect::<Vec<_>>()
                 .join(" "),
         ]);
     }
     t
+}
+
+/// The first screen's questions and answers (nothing when there are none).
+fn html_glance(d: &Document) -> String {
+    if d.glance.is_empty() {
+        return String::new();
+    }
+    let mut h = String::from("<table class=\"glance\">\n");
+    for (q, a) in &d.glance {
+        let _ = writeln!(h, "<tr><th>{}</th><td>{}</td></tr>", inline(q), inline(a));
+    }
+    h.push_str("</table>\n");
+    h
+}
+
+/// A section's linked files as a list (a file with no description: just its link).
+fn html_links(links: &[(String, String)]) -> String {
+    let mut h = String::new();
+    if !links.is_empty() {
+        h.push_str("<ul>\n");
+        for (f, what) in links {
+            if what.is_empty() {
+                let _ = writeln!(h, "<li>{}</li>", link(f, f));
+            } else {
+                let _ = writeln!(h, "<li>{}: {}</li>", link(f, f), inline(what));
+            }
+        }
+        h.push_str("</ul>\n");
+    }
+    h
 }
 
 /// `report.html`: one self-contained file (charts inline), with a table
@@ -194,14 +304,15 @@ pub fn html(d: &Document) -> String {
     let _ = write!(
         h,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n<style>\n{}</style>\n</head>\n<body>\n<h1>{}</h1>\n<p>{}</p>\n",
-        esc(&d.title),
+        esc(&d.title.replace('`', "")),
         CSS,
-        esc(&d.title),
-        esc(&d.subtitle)
+        inline(&d.title),
+        inline(&d.subtitle)
     );
     if !d.note.is_empty() {
         let _ = writeln!(h, "<p class=\"FAILED\">{}</p>", esc(&d.note));
     }
+    h.push_str(&html_glance(d));
     let verdict = if d.ok() { "ok" } else { "FAILED" };
     h.push_str("<nav><h2>Contents</h2>\n<ol>\n<li><a href=\"#steps\">Steps</a></li>\n");
     for sec in &d.sections {
@@ -225,7 +336,7 @@ pub fn html(d: &Document) -> String {
             esc(&s.name),
             esc(&s.id),
             s.seconds,
-            esc(&s.summary),
+            inline(&s.summary),
             s.files.iter().map(|f| link(f, f)).collect::<Vec<_>>().join(" ")
         );
     }
@@ -251,18 +362,12 @@ pub fn html(d: &Document) -> String {
             esc(&sec.title)
         );
         for p in &sec.paragraphs {
-            let _ = writeln!(h, "<p>{}</p>", esc(p));
+            let _ = writeln!(h, "<p>{}</p>", inline(p));
         }
-        if !sec.links.is_empty() {
-            h.push_str("<ul>\n");
-            for (f, what) in &sec.links {
-                let _ = writeln!(h, "<li>{}: {}</li>", link(f, f), esc(what));
-            }
-            h.push_str("</ul>\n");
-        }
+        h.push_str(&html_links(&sec.links));
         for (cap, t) in &sec.tables {
             if !cap.is_empty() {
-                let _ = writeln!(h, "<p><b>{}</b></p>", esc(cap));
+                let _ = writeln!(h, "<p><b>{}</b></p>", inline(cap));
             }
             h.push_str(&html_table(t));
         }
@@ -274,8 +379,8 @@ pub fn html(d: &Document) -> String {
                 h,
                 "<figure>\n{}\n<figcaption><b>{}</b>. {} (data: {}, picture: {})</figcaption>\n</figure>",
                 inline_svg(&f.svg, &f.title),
-                esc(&f.title),
-                esc(&f.caption),
+                inline(&f.title),
+                inline(&f.caption),
                 link(&format!("{}.csv", f.stem), &format!("{}.csv", f.stem)),
                 link(&format!("{}.svg", f.stem), &format!("{}.svg", f.stem)),
             );
@@ -290,11 +395,11 @@ pub fn html(d: &Document) -> String {
 /// names break anywhere rather than run out of their cell; headers and the
 /// first column, names of things, break only between words).
 const CSS: &str = "body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}\n\
-table{border-collapse:collapse;margin:1em 0;max-width:100%}td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top;overflow-wrap:anywhere}\n\
+table{border-collapse:collapse;margin:1em 0;max-width:100%}td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top;overflow-wrap:break-word}\n\
 th{background:#eee}td.num{text-align:right;white-space:nowrap}th,td:first-child{overflow-wrap:normal}td.ok,td.FAILED,td.skipped{white-space:nowrap}pre{background:#f6f6f6;padding:.6em;white-space:pre-wrap;overflow-wrap:anywhere;font-size:85%}\n\
 .ok{color:#176917}.FAILED{color:#b00;font-weight:bold}.skipped{color:#777}figure{margin:1.5em 0}\n\
-figcaption{font-size:90%;color:#444;max-width:900px}svg{max-width:100%;height:auto}code{overflow-wrap:anywhere}\n\
-nav ol{columns:2}\n";
+figcaption{font-size:90%;color:#444;max-width:900px}svg{max-width:100%;height:auto}code{overflow-wrap:anywhere}th code{overflow-wrap:normal}\n\
+nav ol{columns:2}table.glance{font-size:110%}table.glance th{text-align:left;white-space:nowrap}\n";
 
 fn link(href: &str, text: &str) -> String {
     format!("<a href=\"{}\"><code>{}</code></a>", esc(href), esc(text))
@@ -302,9 +407,16 @@ fn link(href: &str, text: &str) -> String {
 
 /// `report.md`: the same, figures as `<stem>.svg` files beside it.
 pub fn markdown(d: &Document) -> String {
-    let mut m = format!("# {}\n\n{}\n\n", d.title, d.subtitle);
+    let mut m = format!("# {}\n\n{}\n\n", d.title, md_inline(&d.subtitle));
     if !d.note.is_empty() {
         let _ = writeln!(m, "**{}**\n", d.note);
+    }
+    if !d.glance.is_empty() {
+        let mut t = Table::new(&["question", "answer"]);
+        for (q, a) in &d.glance {
+            t.push(vec![q.clone(), a.clone()]);
+        }
+        let _ = writeln!(m, "{}", md_table(&t));
     }
     let _ = writeln!(
         m,
@@ -327,17 +439,21 @@ pub fn markdown(d: &Document) -> String {
     for sec in &d.sections {
         let _ = writeln!(m, "## {}\n", sec.title);
         for p in &sec.paragraphs {
-            let _ = writeln!(m, "{p}\n");
+            let _ = writeln!(m, "{}\n", md_inline(p));
         }
         for (f, what) in &sec.links {
-            let _ = writeln!(m, "- [{f}]({f}): {what}");
+            if what.is_empty() {
+                let _ = writeln!(m, "- [`{f}`]({f})");
+            } else {
+                let _ = writeln!(m, "- [`{f}`]({f}): {}", md_inline(what));
+            }
         }
         if !sec.links.is_empty() {
             m.push('\n');
         }
         for (cap, t) in &sec.tables {
             if !cap.is_empty() {
-                let _ = writeln!(m, "**{cap}**\n");
+                let _ = writeln!(m, "**{}**\n", md_inline(cap));
             }
             let _ = writeln!(m, "{}", md_table(t));
         }
@@ -347,8 +463,13 @@ pub fn markdown(d: &Document) -> String {
         for f in &sec.figures {
             let _ = writeln!(
                 m,
-                "![{}]({}.svg)\n\n*{}.* {} (data: [{}.csv]({}.csv))\n",
-                f.title, f.stem, f.title, f.caption, f.stem, f.stem
+                "![{}]({}.svg)\n\n*{}.* {} (data: [`{}.csv`]({}.csv))\n",
+                f.title,
+                f.stem,
+                f.title,
+                md_inline(&f.caption),
+                f.stem,
+                f.stem
             );
         }
     }
@@ -387,6 +508,7 @@ mod tests {
             title: "r <1>".into(),
             subtitle: "s".into(),
             note: String::new(),
+            glance: vec![("Does it fit?".into(), "yes, `mux_en` ok".into())],
             steps: vec![
                 Step {
                     id: "a".into(),
@@ -431,9 +553,28 @@ mod tests {
         assert!(
             m.contains("![C](c.svg)")
                 && m.contains("| b | FAILED |")
-                && m.contains("[a.txt](a.txt)")
+                && m.contains("[`a.txt`](a.txt)")
         );
+        assert!(h.contains("<code>mux_en</code>") && m.contains("`mux_en` ok"));
         let names: Vec<String> = files(&d).into_iter().map(|f| f.0).collect();
         assert_eq!(names, ["report.html", "report.md", "c.svg", "c.csv"]);
+    }
+
+    #[test]
+    fn code_in_prose_is_marked_as_code() {
+        assert!(
+            is_snake("sample_valid")
+                && is_snake("verilog/slot_rom.hex")
+                && is_snake("synth_ice40.")
+        );
+        assert!(
+            !is_snake("ACC_X") && !is_snake("_x") && !is_snake("frame0.vcd") && !is_snake("a_")
+        );
+        assert_eq!(
+            inline("a sample_valid strobe, `CH_1 x` and slot_rom.hex."),
+            "a <code>sample_valid</code> strobe, <code>CH_1 x</code> and <code>slot_rom.hex</code>."
+        );
+        assert_eq!(md_inline("see mux_sel."), "see `mux_sel`.");
+        assert_eq!(md_inline("1.5 MHz, ACC_X"), "1.5 MHz, ACC_X");
     }
 }

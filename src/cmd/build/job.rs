@@ -59,6 +59,39 @@ impl Done {
     }
 }
 
+/// The questions of the report's first screen, in the order shown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Glance {
+    Fits,
+    Binds,
+    Checked,
+    Faults,
+    Proved,
+    Size,
+}
+
+impl Glance {
+    const ALL: [Glance; 6] = [
+        Glance::Fits,
+        Glance::Binds,
+        Glance::Checked,
+        Glance::Faults,
+        Glance::Proved,
+        Glance::Size,
+    ];
+
+    fn question(self) -> &'static str {
+        match self {
+            Glance::Fits => "Does it fit?",
+            Glance::Binds => "What binds, with what margin?",
+            Glance::Checked => "Is the gateware checked?",
+            Glance::Faults => "Does the check catch faults?",
+            Glance::Proved => "Is it proved?",
+            Glance::Size => "How big and fast is it?",
+        }
+    }
+}
+
 pub struct Job {
     pub out: PathBuf,
     pub doc: Document,
@@ -88,7 +121,7 @@ impl Job {
         Job {
             out: a.out.clone(),
             doc: Document {
-                title: format!("slotforge build: {}", s.mix.name),
+                title: format!("slotforge build: `{}`", s.mix.name),
                 subtitle: format!(
                     "{} ({}): {} channels on {} branches, clock {} Hz, frame {} cycles = {} slices x {} slots x {} cycles; {} samples per frame. Machine: {} core(s).",
                     s.mix.description,
@@ -103,6 +136,10 @@ impl Job {
                     s.samples_per_frame(),
                     std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
                 ),
+                glance: Glance::ALL
+                    .iter()
+                    .map(|g| (g.question().to_string(), "not run in this build".to_string()))
+                    .collect(),
                 ..Document::default()
             },
             quiet: a.quiet,
@@ -121,6 +158,15 @@ impl Job {
         Some(campaign::OnRun(std::sync::Arc::new(move |done, n| {
             b.set_message(format!("{what}: {done} of {n} runs"))
         })))
+    }
+
+    /// Answers one question of the first screen.
+    pub fn answer(&mut self, g: Glance, text: impl Into<String>) {
+        let i = Glance::ALL
+            .iter()
+            .position(|x| *x == g)
+            .expect("every question is shown");
+        self.doc.glance[i].1 = text.into();
     }
 
     /// Records a step that was not asked for.

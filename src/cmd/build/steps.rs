@@ -7,7 +7,7 @@ use lut_gen::{AuditReport, Schedule};
 use measure::tables;
 use report::Section;
 
-use super::job::{Done, Job};
+use super::job::{Done, Glance, Job};
 use super::plan::{only_names, Run, Step};
 use super::{Args, Charts};
 
@@ -43,6 +43,8 @@ fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
 
 pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
     let mut sim_report = None;
+    // engines run clean outside the campaign, for the speed chart
+    let mut clean: Vec<measure::speed::CleanRun> = Vec::new();
     let mut campaign = None;
     let mut background = if plan.contains(&(Step::Synth, Run::Yes)) {
         start_synth(&job.out, s)
@@ -52,20 +54,28 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
     for &(step, run) in plan {
         if let Run::Skip(why) = run {
             job.not_run(step, &format!("not run ({why})"));
+            if step == Step::Prove {
+                job.answer(Glance::Proved, match why {
+                    super::plan::SkipReason::ProveOptIn => "not in this build, and no proof of this same Verilog is remembered: a proof takes minutes (`--charts all` or `--only prove` runs it)".to_string(),
+                    _ => format!("not in this build ({why})"),
+                });
+            }
             continue;
         }
         job.step(step, |j| match step {
             Step::Audit => audit(j, s),
             Step::Lut => lut(j, s),
             Step::Verilog => verilog(j, s),
-            Step::Sim => sim(j, a, s, &mut sim_report),
+            Step::Sim => sim(j, a, s, &mut sim_report, &mut clean),
             Step::Golden => golden(j, a, s),
             Step::Faults => faults(j, a, s, &mut campaign),
             Step::Prove if run == Run::Remembered => proved(
+                j,
                 measure::proof::cached(s, &j.out).ok_or("the remembered proof went away".into()),
+                &mut clean,
             ),
-            Step::Prove => prove(j, s),
-            Step::Synth => synth(s, background.take()),
+            Step::Prove => prove(j, s, &mut clean),
+            Step::Synth => synth(j, s, background.take()),
             Step::Timing => timing(j, s),
             Step::Figure7 => figure7(s),
             Step::Schedulability => {
@@ -74,7 +84,7 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
                     .section(sec)
                     .files(&["schedulability.svg", "schedulability.csv"])
             }
-            Step::Speed => speed(campaign.as_ref()),
+            Step::Speed => speed(s, a, campaign.as_ref(), &mut clean),
         });
     }
 }
@@ -114,13 +124,37 @@ fn audit(j: &mut Job, s: &Schedule) -> Done {
         ],
         ..Section::default()
     };
-    sec.tables = tables::audit(&r);
+    sec.tables = measure::budget::audit(&r);
+    answer_audit(j, &r);
     written(
         w,
         Done::ok(line)
             .files(&["audit.txt", "audit.json"])
             .section(sec),
     )
+}
+
+/// The first screen's answers from the audit: whether it fits, and the
+/// limit that binds with its margin (and the link's budget).
+fn answer_audit(j: &mut Job, r: &AuditReport) {
+    j.answer(
+        Glance::Fits,
+        format!(
+            "yes: {} channels, each at its rate with zero jitter; the converters {:.1} % used",
+            r.channels.len(),
+            r.adc_utilization * 100.0
+        ),
+    );
+    let mut binds = measure::budget::Tightest::of(r).map_or("-".into(), |t| t.words());
+    if let Some(l) = &r.link {
+        binds += &format!(
+            "; link: {:.1} % of the line, FIFO {} tokens deep, latency {:.1} us",
+            l.utilization * 100.0,
+            l.fifo_depth,
+            l.latency_us
+        );
+    }
+    j.answer(Glance::Binds, binds);
 }
 
 fn lut(j: &mut Job, s: &Schedule) -> Done {
@@ -177,7 +211,13 @@ fn verilog(j: &mut Job, s: &Schedule) -> Done {
     )
 }
 
-fn sim(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<judge::Verdict>) -> Done {
+fn sim(
+    j: &mut Job,
+    a: &Args,
+    s: &Schedule,
+    keep: &mut Option<judge::Verdict>,
+    clean: &mut Vec<measure::speed::CleanRun>,
+) -> Done {
     let g = &s.grid;
     let backend = sim_backend();
     let frames = a.frames.max(1);
@@ -190,21 +230,29 @@ fn sim(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<judge::Verdict>) -
         }),
         ..SimOptions::default()
     };
+    let t = std::time::Instant::now();
     let r = match engines::run(s, backend, frames, &opts) {
         Ok(r) => r,
         Err(e) => return Done::failed(format!("{e}"), ""),
     };
+    clean.push(measure::speed::CleanRun {
+        method: format!("engine: {}", backend.name()),
+        wall_seconds: t.elapsed().as_secs_f64(),
+        how: format!(
+            "the co-simulation step: {frames} frames of the emitted design under the checker, with a waveform written"
+        ),
+    });
     let json = serde_json::to_string_pretty(&r).expect("report");
     let w = j.write("", &[("sim.json", json)]);
     let sec = Section {
         title: "Co-simulation".into(),
         paragraphs: vec![format!(
-            "{} frames of the emitted design in {}, every cycle compared with the reference model and every invariant checked: {}. Sample counts and intervals per channel as the run measured them (jitter = largest minus smallest interval).",
+            "{} frames of the emitted design in {}, every cycle compared with the reference model and every invariant checked: {}. Sample counts and intervals as the run measured them, by branch and rate (jitter = largest minus smallest interval; the channels themselves are listed once, in the audit).",
             r.frames,
             backend.name(),
             if r.ok { "no divergence, no violation".to_string() } else { format!("{} divergences, {} violations", r.divergence_count, r.violation_count) }
         )],
-        tables: vec![("Per-channel intervals (cycles)".into(), tables::intervals(s, &r))],
+        tables: vec![("Intervals measured, by branch and rate".into(), tables::intervals(s, &r))],
         links: vec![
             ("frame0.vcd".into(), "frame 0 with its reset cycles (VCD)".into()),
             ("frame0.gtkw".into(), "GTKWave save file for it".into()),
@@ -238,6 +286,24 @@ fn sim(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<judge::Verdict>) -
             r.summary(),
         )
     };
+    j.answer(
+        Glance::Checked,
+        if r.ok {
+            format!(
+                "yes: {} frames of the emitted Verilog on {}, every pin every cycle equal to the reference model, no violation",
+                r.frames,
+                backend.name()
+            )
+        } else {
+            format!(
+                "NO: {} divergences, {} violations in {} frames on {}",
+                r.divergence_count,
+                r.violation_count,
+                r.frames,
+                backend.name()
+            )
+        },
+    );
     *keep = Some(r);
     written(w, d.files(&files).section(sec))
 }
@@ -363,26 +429,67 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campa
     } else {
         Done::failed(line, "see faults.json")
     };
+    j.answer(
+        Glance::Faults,
+        format!(
+            "{} of {} injected faults detected, {} false alarms in {} clean runs ({})",
+            c.detected,
+            c.injected,
+            c.false_alarms.rejected,
+            c.false_alarms.runs,
+            if full {
+                "the full campaign"
+            } else {
+                "the quick campaign"
+            }
+        ),
+    );
     *keep = Some(c);
     written(w, d.files(&["faults.json"]).section(sec))
 }
 
-fn prove(j: &mut Job, s: &Schedule) -> Done {
+fn prove(j: &mut Job, s: &Schedule, clean: &mut Vec<measure::speed::CleanRun>) -> Done {
     if let Some(t) = ["yosys", "yosys-abc", "iverilog"]
         .into_iter()
         .find(|t| !judge::tools::present(t))
     {
         return Done::skipped(format!("{t} not installed (make tools)"));
     }
-    proved(measure::proof::prove(s, &j.out))
+    let r = measure::proof::prove(s, &j.out);
+    proved(j, r, clean)
 }
 
 /// A proof's step: proved is ok; bounded (not a proof) and failed fail.
-fn proved(r: Result<measure::proof::Shown, String>) -> Done {
+fn proved(
+    j: &mut Job,
+    r: Result<measure::proof::Shown, String>,
+    clean: &mut Vec<measure::speed::CleanRun>,
+) -> Done {
     let shown = match r {
         Ok(x) => x,
-        Err(e) => return Done::failed("the proof could not run", e),
+        Err(e) => {
+            j.answer(Glance::Proved, "no: the proof could not run");
+            return Done::failed("the proof could not run", e);
+        }
     };
+    let whose = if shown.cached {
+        "remembered for this same Verilog"
+    } else {
+        "proved in this build"
+    };
+    clean.push(measure::speed::CleanRun {
+        method: "prove".into(),
+        wall_seconds: shown.proof.seconds,
+        how: format!("the clean design proved for all time ({whose}; the seconds it took then)"),
+    });
+    j.answer(
+        Glance::Proved,
+        if shown.proof.result == formal::Outcome::Proved {
+            format!("yes ({whose}): {}", shown.line)
+        } else {
+            format!("NO ({whose}): {}", shown.line)
+        },
+    );
     let files: Vec<String> = shown.section.links.iter().map(|(f, _)| f.clone()).collect();
     let files: Vec<&str> = files.iter().map(String::as_str).collect();
     let d = if shown.proof.result == formal::Outcome::Proved {
@@ -393,8 +500,12 @@ fn proved(r: Result<measure::proof::Shown, String>) -> Done {
     d.files(&files).section(shown.section)
 }
 
-fn synth(s: &Schedule, background: Option<Background>) -> Done {
+fn synth(j: &mut Job, s: &Schedule, background: Option<Background>) -> Done {
     let Some(h) = background else {
+        j.answer(
+            Glance::Size,
+            "not measured: yosys or nextpnr-ice40 not installed",
+        );
         return Done::skipped("yosys or nextpnr-ice40 not installed (make tools)");
     };
     let Ok((r, secs)) = h.join() else {
@@ -410,6 +521,17 @@ fn synth(s: &Schedule, background: Option<Background>) -> Done {
                 r.fmax_mhz,
                 r.fmax_mhz * 1e6 / g.clock_hz as f64,
                 g.clock_hz as f64 / 1e6
+            );
+            j.answer(
+                Glance::Size,
+                format!(
+                    "{} logic cells and {} block RAMs of an iCE40 HX8K; Fmax {:.1} MHz, {:.2}x the {:.1} MHz clock (yosys and nextpnr-ice40)",
+                    r.lcs,
+                    r.brams,
+                    r.fmax_mhz,
+                    r.fmax_mhz * 1e6 / g.clock_hz as f64,
+                    g.clock_hz as f64 / 1e6
+                ),
             );
             let sec = Section {
                 title: "Synthesis estimate".into(),
@@ -449,14 +571,41 @@ fn figure7(s: &Schedule) -> Done {
     }
 }
 
-/// Drawn from the fault step's campaign of this build, nothing else.
-fn speed(c: Option<&campaign::Campaign>) -> Done {
+/// Drawn from the fault step's campaign of this build, with the engines
+/// the build ran clean beside it; rust-hdl, when the co-simulation ran on
+/// Verilator, is run clean here (a few seconds) so every engine is named.
+fn speed(
+    s: &Schedule,
+    a: &Args,
+    c: Option<&campaign::Campaign>,
+    clean: &mut Vec<measure::speed::CleanRun>,
+) -> Done {
     let Some(c) = c else {
         return Done::skipped(
             "draws the fault campaign of this build, and the faults step did not run",
         );
     };
-    let (sec, line) = measure::speed::section(c);
+    let named = |e: &str| {
+        c.engines.iter().any(|x| x.engine == e)
+            || clean.iter().any(|m| m.method == format!("engine: {e}"))
+    };
+    if !named("rusthdl") {
+        let t = std::time::Instant::now();
+        if let Ok(r) = engines::run(s, Backend::RustHdl, c.frames, &SimOptions::default()) {
+            if !r.ok {
+                return Done::failed("rust-hdl's clean run failed the check", r.summary());
+            }
+            clean.push(measure::speed::CleanRun {
+                method: "engine: rusthdl".into(),
+                wall_seconds: t.elapsed().as_secs_f64(),
+                how: format!(
+                    "a clean run of the campaign's {} frames of the gateware in rust-hdl under the checker",
+                    c.frames
+                ),
+            });
+        }
+    }
+    let (sec, line) = measure::speed::section(c, clean, a.charts == Charts::All);
     Done::ok(line)
         .section(sec)
         .files(&["speed-accuracy.svg", "speed-accuracy.csv"])
