@@ -25,6 +25,9 @@ mod icarus;
 #[path = "link.rs"]
 mod link;
 
+#[path = "link_bytes.rs"]
+mod link_bytes;
+
 #[path = "prove_cli.rs"]
 mod prove_cli;
 

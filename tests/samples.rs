@@ -32,7 +32,7 @@ fn sim_samples(
     (v, std::fs::read_to_string(&csv).unwrap())
 }
 
-/// Per channel: (cycle, time_s, value) in row order.
+/// Per channel: (cycle, sampled_s, value) in row order.
 fn by_channel(csv: &str) -> BTreeMap<String, Vec<(u64, f64, f64)>> {
     let mut m: BTreeMap<String, Vec<(u64, f64, f64)>> = BTreeMap::new();
     for line in csv.lines().skip(1) {
@@ -78,7 +78,7 @@ fn a_600_hz_sine_aliases_in_the_samples() {
     );
     assert_eq!(v["ok"], true);
     let lines: Vec<&str> = csv.lines().collect();
-    assert_eq!(lines[0], "cycle,time_s,channel,value");
+    assert_eq!(lines[0], "cycle,sampled_s,channel,value");
     // one row per sample of the run: 349 per frame, less the three instants
     // at cycle 0 (CH1, CH26, CH35: slot 0 of each branch) that the gateware
     // skips at start-up because their mux has not settled
@@ -95,15 +95,23 @@ fn a_600_hz_sine_aliases_in_the_samples() {
         // The row's cycle is the sample_valid strobe: a fixed latency after
         // the sampling instant plus 0..=2 cycles of waiting behind lower
         // branches' samples (one sample leaves per cycle), so strobes are
-        // the exact interval apart within 2 cycles; time_s = cycle / 48 MHz.
+        // the exact interval apart within 2 cycles; sampled_s is the
+        // instant itself, the exact interval apart, before the strobe by the
+        // AD7940's read (321 cycles at 48 MHz), one cycle and the wait.
         for w in x.windows(2) {
             assert!(
                 (w[1].0 - w[0].0).abs_diff(48_000_000 / rate) <= 2,
                 "{name}: {w:?}"
             );
+            let dt = (w[1].1 - w[0].1) * rate as f64;
+            assert!((dt - 1.0).abs() < 1e-9, "{name}: {w:?}");
         }
         for s in x {
-            assert!((s.1 - s.0 as f64 / 48e6).abs() < 1e-12);
+            let lag = s.0 as f64 - s.1 * 48e6;
+            assert!(
+                (322.0 - 1e-3..=324.0 + 1e-3).contains(&lag),
+                "{name}: {s:?}"
+            );
         }
     }
     // 600 Hz sampled at 1 kHz shows as 400 Hz; at 2 kHz it is below Nyquist.

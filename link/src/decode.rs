@@ -52,8 +52,12 @@ pub struct Stats {
     /// The largest overflow count a trailer reported (the FIFO dropped
     /// that many tokens since reset).
     pub overflows: u8,
-    /// A packet was still open when the stream ended.
-    pub cut: bool,
+    /// Bytes of the packet still open when the stream ended: a capture or
+    /// a run stops while the line carries a packet (its trailer leaves
+    /// after the slice it closes), so a whole, valid beginning of a packet
+    /// at the end is in flight, not lost.  A cut packet that was already
+    /// wrong shows as a CRC error, a resync or skipped bytes instead.
+    pub in_flight: u64,
 }
 
 impl Stats {
@@ -64,7 +68,6 @@ impl Stats {
             && self.resyncs == 0
             && self.skipped_bytes == 0
             && self.overflows == 0
-            && !self.cut
     }
 }
 
@@ -129,13 +132,12 @@ impl Decoder {
         }
     }
 
-    /// The stream ended: a packet still open is counted as cut.
+    /// The stream ended: the bytes of a packet still open are counted as
+    /// in flight.  Only a packet whose every word so far is well formed is
+    /// still open (anything else lost sync on its own byte).
     pub fn finish(&mut self) -> Stats {
-        if !self.buf.is_empty() {
-            self.stats.cut = true;
-            self.stats.skipped_bytes += self.buf.len() as u64;
-            self.buf.clear();
-        }
+        self.stats.in_flight = self.buf.len() as u64;
+        self.buf.clear();
         self.stats
     }
 
@@ -293,7 +295,28 @@ mod tests {
         assert_eq!(out[1].frame, 256, "frame counter unwrapped");
         assert_eq!(st.crc_errors, 1);
         assert_eq!(st.lost_packets, 2);
-        assert!(st.cut && st.resyncs >= 1 && st.skipped_bytes >= 4);
+        assert_eq!(st.in_flight, 7);
+        assert!(st.resyncs >= 1 && st.skipped_bytes >= 4);
+    }
+
+    #[test]
+    fn a_stream_ending_inside_a_packet_is_clean_with_its_bytes_in_flight() {
+        let mut s = packet(0, 0, &[(1, 1), (2, 2)]);
+        s.extend(packet(0, 1, &[(3, 3)]));
+        let whole = s.len();
+        s.extend(packet(0, 2, &[(4, 4), (5, 5)]));
+        for end in whole..s.len() {
+            let (out, st) = decode(&s[..end]);
+            assert_eq!(out.len(), 3, "{end}");
+            assert!(st.clean(), "{end}: {st:?}");
+            assert_eq!(st.in_flight as usize, end - whole, "{end}");
+        }
+        // a flipped byte in the middle is a loss, the end still in flight
+        let mut bad = s[..s.len() - 1].to_vec();
+        bad[9] ^= 0x01;
+        let (_, st) = decode(&bad);
+        assert!(!st.clean() && st.crc_errors == 1, "{st:?}");
+        assert_eq!(st.in_flight as usize, s.len() - 1 - whole);
     }
 
     #[test]

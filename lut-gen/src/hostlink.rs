@@ -367,12 +367,13 @@ impl PacketInstants {
         }
     }
 
-    /// The sampling time in seconds of each record of the packet of
-    /// `(frame, slice)` carrying `channels` in order.  A channel with `m`
-    /// records in the packet gets the last `m` of its instants in the slice,
-    /// so a sample skipped at start-up (docs/timing.md) shifts none of the
-    /// others; `None` where the schedule has no instant left for a record.
-    pub fn times(&self, frame: u64, slice: u16, channels: &[u16]) -> Vec<Option<f64>> {
+    /// The sampling instant, in cycles after cycle 0, of each record of the
+    /// packet of `(frame, slice)` carrying `channels` in order.  A channel
+    /// with `m` records in the packet gets the last `m` of its instants in
+    /// the slice, so a sample skipped at start-up (docs/timing.md) shifts
+    /// none of the others; `None` where the schedule has no instant left
+    /// for a record (or it would fall before cycle 0).
+    pub fn cycles(&self, frame: u64, slice: u16, channels: &[u16]) -> Vec<Option<u64>> {
         let Some(list) = self.per_slice.get(slice as usize) else {
             return vec![None; channels.len()];
         };
@@ -387,9 +388,14 @@ impl PacketInstants {
                 let k = (have.len() + *i).checked_sub(m);
                 *i += 1;
                 k.and_then(|k| have.get(k))
-                    .map(|&t| (base + t) as f64 / self.clock_hz as f64)
+                    .and_then(|&t| u64::try_from(base + t).ok())
             })
             .collect()
+    }
+
+    /// The clock the instants count.
+    pub fn clock_hz(&self) -> u64 {
+        self.clock_hz
     }
 }
 
@@ -468,13 +474,36 @@ mod tests {
         let pi = PacketInstants::new(&s);
         // slice 0 of frame 1 carries CH35 (channel 34) sampled at cycle 0 of the slice
         let ch35 = s.mix.channel_index("CH35").unwrap() as u16;
-        let t = pi.times(1, 0, &[ch35, ch35]);
+        let t = pi.cycles(1, 0, &[ch35, ch35]);
         let first = s.first_sample_cycle(ch35 as usize) + s.grid.frame_cycles;
-        assert_eq!(t[0], Some(first as f64 / 48e6));
+        assert_eq!(t[0], Some(first));
         // one record only (the first skipped at start-up): the later instant
-        let t1 = pi.times(1, 0, &[ch35]);
+        let t1 = pi.cycles(1, 0, &[ch35]);
         assert_eq!(t1[0], t[1]);
-        assert!(pi.times(1, 0, &[ch35, ch35, ch35])[0].is_none());
+        assert!(pi.cycles(1, 0, &[ch35, ch35, ch35])[0].is_none());
+    }
+
+    /// The strobe-to-instant rule of `Schedule::sampled_at`, against the
+    /// merged stream computed here from the completions: every strobe of
+    /// a steady frame maps back to its own instant.
+    #[test]
+    fn every_strobe_maps_back_to_its_instant() {
+        for text in [
+            include_str!("../../mixes/eskin34.toml"),
+            include_str!("../../mixes/eskin34-axis.toml"),
+            include_str!("../../mixes/vibrotactile8k.toml"),
+            include_str!("../../mixes/induction5k-adc12.toml"),
+            include_str!("../../mixes/softslip1k.toml"),
+        ] {
+            let m = crate::mix::parse(std::path::Path::new("t.toml"), text).unwrap();
+            let s = crate::synthesize(&m).unwrap();
+            let f = s.grid.frame_cycles;
+            let stream = merged_frame(&s);
+            assert!(!stream.is_empty());
+            for (v, i, ch) in stream {
+                assert_eq!(s.sampled_at(ch as usize, v + f), Some(i + f), "{}", m.name);
+            }
+        }
     }
 
     #[test]

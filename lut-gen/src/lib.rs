@@ -21,7 +21,7 @@ pub mod validate;
 
 pub use mix::{load, parse, Mix, MixError};
 pub use oswords::{io_words, write_words};
-pub use schedule::{FrameGrid, SamplingInstant, Schedule};
+pub use schedule::{seconds, FrameGrid, SamplingInstant, Schedule};
 pub use synth::{synthesize, synthesize_within, Infeasible, Verdict};
 pub mod audit;
 pub mod lut;

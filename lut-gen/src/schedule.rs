@@ -192,6 +192,22 @@ impl Schedule {
         self.channels[channel].offset_slot * self.grid.slot_cycles
     }
 
+    /// The sampling instant of the sample of `channel` that leaves on
+    /// `sample_valid` in cycle `strobe` (docs/timing.md, "Merged sample
+    /// stream"): the channel's last instant `t` with `t + R + 1 <= strobe`,
+    /// `R` its branch's read.  A word waits behind other branches' words for
+    /// fewer cycles than the channel's interval, so no later instant can have
+    /// completed first; `None` when no instant of the channel has completed
+    /// by `strobe` (or the channel does not exist).
+    pub fn sampled_at(&self, channel: usize, strobe: u64) -> Option<u64> {
+        let ch = self.channels.get(channel)?;
+        let branch = self.mix.channels[channel].branch;
+        let first = ch.offset_slot * self.grid.slot_cycles;
+        let last = strobe.checked_sub(self.branches[branch].spi.read_cycles + 1)?;
+        let n = last.checked_sub(first)? / ch.interval_cycles.max(1);
+        Some(first + n * ch.interval_cycles)
+    }
+
     /// Samples converted per frame by all branches.
     pub fn samples_per_frame(&self) -> u64 {
         self.channels.iter().map(|c| c.samples_per_frame).sum()
@@ -203,11 +219,36 @@ impl Schedule {
     }
 }
 
+/// `cycle / clock_hz` seconds as text, rounded once to 1 ps (12 decimals):
+/// the one formatting of a time in cycles that every CSV uses, so the same
+/// instant reads the same in each (no float in between, no drift).
+pub fn seconds(cycle: u64, clock_hz: u64) -> String {
+    let hz = clock_hz.max(1) as u128;
+    let ps = (cycle as u128 * 2_000_000_000_000 + hz) / (2 * hz);
+    format!("{}.{:012}", ps / 1_000_000_000_000, ps % 1_000_000_000_000)
+}
+
 /// Bits to hold values `0..n` (at least 1).
 pub fn bits_for(n: u64) -> u32 {
     if n <= 2 {
         1
     } else {
         64 - (n - 1).leading_zeros()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seconds_are_rounded_once_to_a_picosecond() {
+        assert_eq!(seconds(0, 48_000_000), "0.000000000000");
+        // 1 / 48 MHz = 20.8333.. ns
+        assert_eq!(seconds(1, 48_000_000), "0.000000020833");
+        assert_eq!(seconds(2, 48_000_000), "0.000000041667");
+        assert_eq!(seconds(48_000_000, 48_000_000), "1.000000000000");
+        assert_eq!(seconds(480_000 * 1000 + 24, 48_000_000), "10.000000500000");
+        assert_eq!(seconds(u64::MAX, 1), format!("{}.000000000000", u64::MAX));
     }
 }

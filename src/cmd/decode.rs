@@ -1,13 +1,17 @@
 //! `slotforge decode MIX CAPTURE -o OUT.csv [--json]`: the bytes a host
-//! received from the link, as samples (`frame,slice,channel,value,time_s`).
+//! received from the link, as samples (`frame,slice,channel,value,sampled_s`).
 //!
 //! The decoding is `link::Decoder` (the packet format's one home); the
-//! sampling times come from the schedule (`lut_gen::hostlink::PacketInstants`).
+//! sampling instants come from the schedule (`lut_gen::hostlink::PacketInstants`),
+//! written as `sim --samples` writes them (`lut_gen::seconds`), so the two
+//! CSVs agree on `sampled_s` for the same sample.
 //! `CAPTURE` may be `-`: stdin is decoded as it arrives and each packet's
 //! rows are written when its trailer arrives (with `-o -`, to stdout at once).
 //!
-//! Exit 0: a clean stream; 1: losses, CRC errors, resyncs, an overflow the
-//! gateware reported or a cut stream (counted, never fatal); 2: bad input.
+//! Exit 0: a clean stream (a packet still in flight when the capture ends
+//! included: its bytes are counted, not lost); 1: losses, CRC errors,
+//! resyncs, skipped bytes or an overflow the gateware reported (counted,
+//! never fatal); 2: bad input.
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
@@ -19,7 +23,8 @@ use lut_gen::hostlink::PacketInstants;
 pub struct Args {
     /// The channel-mix file (TOML) with a `[link]`.
     pub mix: PathBuf,
-    /// The raw bytes the host received (a serial-port dump), or `-` for stdin.
+    /// The raw bytes the host received (a serial-port dump, a logic
+    /// analyser's decoded bytes, or `sim --link-bytes`), or `-` for stdin.
     pub capture: PathBuf,
     /// The CSV to write, or `-` for stdout.
     #[arg(short, long)]
@@ -30,7 +35,7 @@ pub struct Args {
 }
 
 /// The CSV's first line.
-pub const HEADER: &str = "frame,slice,channel,value,time_s";
+pub const HEADER: &str = "frame,slice,channel,value,sampled_s";
 
 /// Rows of decoded packets, with names and sampling times from the mix.
 struct Rows {
@@ -45,14 +50,15 @@ impl Rows {
         use std::fmt::Write as _;
         for packet in d.chunk_by(|a, b| (a.frame, a.slice) == (b.frame, b.slice)) {
             let chans: Vec<u16> = packet.iter().map(|x| x.channel).collect();
-            let times = self.times.times(packet[0].frame, packet[0].slice, &chans);
+            let times = self.times.cycles(packet[0].frame, packet[0].slice, &chans);
+            let hz = self.times.clock_hz();
             for (x, t) in packet.iter().zip(times) {
                 let name = self
                     .names
                     .get(x.channel as usize)
                     .cloned()
                     .unwrap_or_else(|| format!("#{}", x.channel));
-                let t = t.map(|t| format!("{t:.12}")).unwrap_or_default();
+                let t = t.map(|t| lut_gen::seconds(t, hz)).unwrap_or_default();
                 let _ = writeln!(out, "{},{},{name},{},{t}", x.frame, x.slice, x.value);
                 self.rows += 1;
             }
@@ -203,7 +209,7 @@ fn report(a: &Args, st: &Stats, rows: u64) {
         "resyncs": st.resyncs,
         "skipped_bytes": st.skipped_bytes,
         "overflows": st.overflows,
-        "cut": st.cut,
+        "in_flight_bytes": st.in_flight,
     });
     if a.json {
         let text = serde_json::to_string_pretty(&json).expect("json") + "\n";
@@ -224,7 +230,7 @@ fn report(a: &Args, st: &Stats, rows: u64) {
         msg.push_str(": clean");
     } else {
         msg.push_str(&format!(
-            "; {} CRC error(s), {} lost packet(s), {} resync(s), {} byte(s) skipped{}{}",
+            "; {} CRC error(s), {} lost packet(s), {} resync(s), {} byte(s) skipped{}",
             st.crc_errors,
             st.lost_packets,
             st.resyncs,
@@ -234,11 +240,12 @@ fn report(a: &Args, st: &Stats, rows: u64) {
             } else {
                 String::new()
             },
-            if st.cut {
-                ", the stream ends inside a packet"
-            } else {
-                ""
-            }
+        ));
+    }
+    if st.in_flight > 0 {
+        msg.push_str(&format!(
+            "; {} byte(s) of a packet still in flight when the capture ends (not a loss)",
+            st.in_flight
         ));
     }
     eprintln!("{msg}");

@@ -1,4 +1,4 @@
-//! `slotforge sim MIX --backend B --frames N [--vcd F --from A --to B] [--json] [--stimulus S] [--samples F.csv] [--rtl FILE.v]`
+//! `slotforge sim MIX --backend B --frames N [--vcd F --from A --to B] [--json] [--stimulus S] [--samples F.csv] [--link-bytes F.bin] [--rtl FILE.v]`
 //!
 //! Back ends: model, rusthdl, verilator, icarus (see `engines::Backend`);
 //! `--rtl` (verilator, icarus) simulates outside Verilog whose top honours
@@ -43,12 +43,21 @@ pub struct Args {
     /// step or chirp.
     #[arg(long, default_value = "pattern")]
     pub stimulus: String,
-    /// Write every sample as CSV: `cycle,time_s,channel,value` (cycle from
-    /// cycle 0, the first after reset; time_s = cycle / clock, rounded once
-    /// to 1 ps; channel = its name; value = the ADC code), one row per
-    /// sample_valid strobe.  With --backend model the cycle-level model runs.
+    /// Write every sample as CSV: `cycle,sampled_s,channel,value` (cycle:
+    /// the sample_valid strobe's, from cycle 0, the first after reset;
+    /// sampled_s: the conversion's sampling instant in seconds after cycle
+    /// 0, rounded once to 1 ps, as `decode` writes it; channel: its name;
+    /// value: the ADC code), one row per strobe.  With --backend model the
+    /// cycle-level model runs.
     #[arg(long)]
     pub samples: Option<PathBuf>,
+    /// Write the bytes the link carried, raw, as a host would have received
+    /// them (UART: each character's data byte read off link_tx at the
+    /// planned divider; AXI4-Stream: the tdata of each accepted beat), for
+    /// `slotforge decode MIX FILE`.  A mix with a [link] only.  With
+    /// --backend model the cycle-level model runs.
+    #[arg(long, value_name = "FILE")]
+    pub link_bytes: Option<PathBuf>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -136,6 +145,7 @@ pub fn run(a: Args) -> u8 {
     let prepared = window(&a, &s).and_then(|(from, to)| {
         let (vcd, fst) = waveform_paths(&a)?;
         samples_path_free(&a)?;
+        link_bytes_path_free(&a, &s)?;
         Ok((from, to, vcd, fst))
     });
     let (from, to, vcd, fst) = match prepared {
@@ -157,8 +167,14 @@ pub fn run(a: Args) -> u8 {
         tready: a.tready,
         ..SimOptions::default()
     };
-    let mut log = judge::SampleLog::new();
-    let report = match simulate(&a, &s, backend, &opts, &mut log) {
+    let mut logs = Logs {
+        samples: a.samples.is_some().then(judge::SampleLog::new),
+        bytes: a
+            .link_bytes
+            .as_ref()
+            .and_then(|_| judge::LinkBytes::new(&s)),
+    };
+    let report = match simulate(&a, &s, backend, &opts, &mut logs) {
         Ok(r) => r,
         Err(e) => {
             eprintln!("error: {e}");
@@ -171,12 +187,9 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     }
-    if let Some(p) = &a.samples {
-        if let Err(e) = log.write_csv(&s, p) {
-            let why = lut_gen::write_words(&e);
-            eprintln!("error: --samples {}: {why}", p.display());
-            return 2;
-        }
+    if let Err(e) = logs.write(&a, &s) {
+        eprintln!("error: {e}");
+        return 2;
     }
     if a.json {
         println!(
@@ -264,24 +277,110 @@ fn samples_path_free(a: &Args) -> Result<(), String> {
     Ok(())
 }
 
-/// The run, with progress shown and every sample logged into `log` when
-/// `--samples` asks for them.
+/// `--link-bytes` needs a mix with a link and names a file of its own.
+fn link_bytes_path_free(a: &Args, s: &lut_gen::Schedule) -> Result<(), String> {
+    let Some(p) = &a.link_bytes else {
+        return Ok(());
+    };
+    if s.mix.link.is_none() {
+        return Err(format!(
+            "--link-bytes {}: {} has no [link]: its samples leave on the parallel sample port, no line carries bytes (see docs/mix-format.md for a [link] table)",
+            p.display(),
+            a.mix.display()
+        ));
+    }
+    let same = |q: &std::path::Path| {
+        p == q || matches!((p.canonicalize(), q.canonicalize()), (Ok(x), Ok(y)) if x == y)
+    };
+    let vcd = a.vcd.as_deref();
+    let gtkw = vcd.map(|v| v.with_extension("gtkw"));
+    let taken = same(&a.mix)
+        || vcd.is_some_and(same)
+        || gtkw.as_deref().is_some_and(same)
+        || a.samples.as_deref().is_some_and(same);
+    if taken {
+        return Err(format!(
+            "--link-bytes {}: is the mix, the waveform or the samples of this run; name another file",
+            p.display()
+        ));
+    }
+    if p.is_dir() {
+        return Err(format!("--link-bytes {}: is a directory", p.display()));
+    }
+    Ok(())
+}
+
+/// What a run logs beside its verdict: its samples (`--samples`) and its
+/// link's bytes (`--link-bytes`).
+struct Logs {
+    samples: Option<judge::SampleLog>,
+    bytes: Option<judge::LinkBytes>,
+}
+
+impl Logs {
+    fn any(&self) -> bool {
+        self.samples.is_some() || self.bytes.is_some()
+    }
+
+    /// The files asked for, each written whole or not at all.
+    fn write(&self, a: &Args, s: &lut_gen::Schedule) -> Result<(), String> {
+        if let (Some(p), Some(log)) = (&a.samples, &self.samples) {
+            log.write_csv(s, p)
+                .map_err(|e| format!("--samples {}: {}", p.display(), lut_gen::write_words(&e)))?;
+        }
+        if let (Some(p), Some(b)) = (&a.link_bytes, &self.bytes) {
+            b.write(p).map_err(|e| {
+                format!("--link-bytes {}: {}", p.display(), lut_gen::write_words(&e))
+            })?;
+        }
+        Ok(())
+    }
+}
+
+impl judge::Observer for Logs {
+    fn cycle(&mut self, cycle: u64, rst: bool, pins: &lut_gen::ports::Pins, miso: u64) {
+        if let Some(l) = &mut self.samples {
+            judge::Observer::cycle(l, cycle, rst, pins, miso);
+        }
+        if let Some(b) = &mut self.bytes {
+            judge::Observer::cycle(b, cycle, rst, pins, miso);
+        }
+    }
+}
+
+impl judge::CycleSink for Logs {
+    fn cycle(
+        &mut self,
+        rst: Option<bool>,
+        pins: &lut_gen::ports::Pins,
+        xz: &lut_gen::ports::Pins,
+        miso: u64,
+        miso_xz: u64,
+    ) {
+        if let Some(l) = &mut self.samples {
+            judge::CycleSink::cycle(l, rst, pins, xz, miso, miso_xz);
+        }
+        if let Some(b) = &mut self.bytes {
+            judge::CycleSink::cycle(b, rst, pins, xz, miso, miso_xz);
+        }
+    }
+}
+
+/// The run, with progress shown and every sample and link byte logged into
+/// `logs` when `--samples` or `--link-bytes` asks for them.
 fn simulate(
     a: &Args,
     s: &lut_gen::Schedule,
     backend: Backend,
     opts: &SimOptions,
-    log: &mut judge::SampleLog,
+    logs: &mut Logs,
 ) -> Result<judge::Verdict, engines::SimError> {
     // The slot-level model runs hours per second: no progress to show, and
     // an observer would make it run the cycle model instead.
-    if backend == Backend::Model && a.samples.is_none() {
+    if backend == Backend::Model && !logs.any() {
         return engines::run(s, backend, a.frames, opts);
     }
-    let inner = a
-        .samples
-        .is_some()
-        .then_some(log as &mut dyn engines::Tracer);
+    let inner = logs.any().then_some(logs as &mut dyn engines::Tracer);
     let mut p = super::progress::CycleProgress::new(
         a.frames,
         s.grid.frame_cycles,

@@ -23,7 +23,7 @@
 //!   reset, and checking it from there;
 //! - `events`: a run's pins as a reviewable event log, and the
 //!   comparison of two logs by signal role (golden tests);
-//! - `samples`: a run's samples as CSV (`cycle,time_s,channel,value`);
+//! - `samples`: a run's samples as CSV (`cycle,sampled_s,channel,value`) and the bytes a link carried;
 //! - [`switch`]: the test-only switch that turns a detector off.
 //!
 //! The pins themselves ([`Pins`], [`Layout`], [`Signal`]) are the pin
@@ -38,6 +38,7 @@ mod events;
 mod faults;
 mod fst;
 mod invariants;
+mod linkbytes;
 mod linkline;
 mod lock;
 mod model;
@@ -84,6 +85,8 @@ pub use vcdout::{channels_path, edge_ps, id_code, wire_header, write_gtkw, write
 pub use capture::{parse_map, read as read_capture, read_progress as read_capture_progress};
 pub use timed::{check_capture, TimedReport};
 
-// Logs: a run's pins as events (golden tests), its samples as CSV.
+// Logs: a run's pins as events (golden tests), its samples as CSV, the
+// bytes its link carried.
 pub use events::{compare as compare_events, EventLog, Trace};
+pub use linkbytes::LinkBytes;
 pub use samples::SampleLog;

@@ -1,8 +1,8 @@
 //! Samples out of a run: one CSV row per `sample_valid` strobe,
 //!
 //! ```text
-//! cycle,time_s,channel,value
-//! 320,0.000006666667,CH1,8192
+//! cycle,sampled_s,channel,value
+//! 322,0.000000000000,CH1,8192
 //! ```
 //!
 //! `cycle` counts from cycle 0, the first cycle after reset is released
@@ -10,10 +10,14 @@
 //! the conversion's sampling instant (its CS fall) plus the read and, when
 //! branches finish together, the cycles it waited behind lower branches
 //! (one sample leaves per cycle), so strobes of one channel are its exact
-//! interval apart within `branches - 1` cycles;
-//! `time_s = cycle / clock_hz`, rounded once to 1 ps (12 decimals; no
-//! accumulated drift); `channel` is the channel's name (the mix's name for
-//! the index on `sample_channel`); `value` is the ADC code on `sample_value`.
+//! interval apart within `branches - 1` cycles.  `sampled_s` is the
+//! sampling instant itself (`Schedule::sampled_at`), in seconds after
+//! cycle 0, rounded once to 1 ps (12 decimals; no accumulated drift): the
+//! same number `slotforge decode` writes for the same sample, so the two
+//! CSVs join on it; empty for a strobe no instant of its channel precedes
+//! (a faulty design's).  `channel` is the channel's name (the mix's name
+//! for the index on `sample_channel`); `value` is the ADC code on
+//! `sample_value`.
 //!
 //! [`SampleLog`] collects the samples while a run goes (it is an
 //! [`Observer`] and a [`CycleSink`], so any back end can feed it) and keeps
@@ -32,7 +36,7 @@ use crate::run::Observer;
 use crate::vcd::CycleSink;
 
 /// The CSV's first line.
-pub const HEADER: &str = "cycle,time_s,channel,value";
+pub const HEADER: &str = "cycle,sampled_s,channel,value";
 
 /// One `sample_valid` strobe.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -99,14 +103,11 @@ impl SampleLog {
                 .channels
                 .get(x.channel as usize)
                 .map_or_else(|| format!("channel{}", x.channel), |c| csv_field(&c.name));
-            let _ = writeln!(
-                o,
-                "{},{},{},{}",
-                x.cycle,
-                time_s(x.cycle, s.grid.clock_hz),
-                name,
-                x.value
-            );
+            let sampled = s
+                .sampled_at(x.channel as usize, x.cycle)
+                .map(|t| lut_gen::seconds(t, s.grid.clock_hz))
+                .unwrap_or_default();
+            let _ = writeln!(o, "{},{sampled},{name},{}", x.cycle, x.value);
         }
         o
     }
@@ -129,12 +130,6 @@ impl CycleSink for SampleLog {
         // an unknown reset level counts as reset, as in `Trace`
         self.push(rst.unwrap_or(true), pins);
     }
-}
-
-/// `cycle / clock_hz` seconds, rounded once to 1 ps, with 12 decimals.
-pub fn time_s(cycle: u64, clock_hz: u64) -> String {
-    let ps = (cycle as u128 * 2_000_000_000_000 + clock_hz as u128) / (2 * clock_hz as u128);
-    format!("{}.{:012}", ps / 1_000_000_000_000, ps % 1_000_000_000_000)
 }
 
 fn csv_field(x: &str) -> String {
@@ -188,17 +183,6 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn times_are_rounded_once_to_a_picosecond() {
-        assert_eq!(time_s(0, 48_000_000), "0.000000000000");
-        // 1 / 48 MHz = 20.8333.. ns
-        assert_eq!(time_s(1, 48_000_000), "0.000000020833");
-        assert_eq!(time_s(2, 48_000_000), "0.000000041667");
-        assert_eq!(time_s(48_000_000, 48_000_000), "1.000000000000");
-        assert_eq!(time_s(480_000 * 1000 + 24, 48_000_000), "10.000000500000");
-        assert_eq!(time_s(u64::MAX, 1), format!("{}.000000000000", u64::MAX));
-    }
 
     #[test]
     fn cycle_zero_follows_the_last_reset_cycle() {
