@@ -4,6 +4,9 @@
 #[path = "build.rs"]
 mod build;
 
+#[path = "bulk.rs"]
+mod bulk;
+
 #[path = "capture.rs"]
 mod capture;
 
