@@ -54,7 +54,10 @@ fn outputs(mix: &Path, out: &Path) -> Vec<(String, String)> {
 /// Both mixes' outputs, compared one by one so a failure names the output.
 fn assert_same(bulk_text: &str, long_text: &str, what: &str) {
     let dir = tempfile::tempdir().unwrap();
-    let (bulk, long) = (dir.path().join("bulkform.toml"), dir.path().join("writtenout.toml"));
+    let (bulk, long) = (
+        dir.path().join("bulkform.toml"),
+        dir.path().join("writtenout.toml"),
+    );
     std::fs::write(&bulk, bulk_text).unwrap();
     std::fs::write(&long, long_text).unwrap();
     let b = outputs(&bulk, &dir.path().join("vb"));

@@ -22,6 +22,9 @@ mod golden;
 #[path = "golden_rtl.rs"]
 mod golden_rtl;
 
+#[path = "hints.rs"]
+mod hints;
+
 #[path = "icarus.rs"]
 mod icarus;
 
