@@ -453,6 +453,9 @@ fn compare_events(
     differ
 }
 
+/// A golden's window and the run's cycles `[from, to)` it covers.
+type WindowAt<'a> = (&'a Window, (u64, u64));
+
 /// This run's waveform windows against the golden's, cycle by cycle:
 /// whether any differs, or the exit code of an error (printed).
 fn compare_windows(
@@ -461,7 +464,7 @@ fn compare_windows(
     s: &Schedule,
     dir: &Path,
     trace: &Trace,
-    (windows, redo): (&[(&Window, (u64, u64))], &str),
+    (windows, redo): (&[WindowAt], &str),
 ) -> Result<bool, u8> {
     let tmp = match tempfile::tempdir() {
         Ok(t) => t,
