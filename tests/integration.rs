@@ -4,6 +4,9 @@
 #[path = "build.rs"]
 mod build;
 
+#[path = "bulk.rs"]
+mod bulk;
+
 #[path = "capture.rs"]
 mod capture;
 
@@ -18,6 +21,9 @@ mod golden;
 
 #[path = "golden_rtl.rs"]
 mod golden_rtl;
+
+#[path = "hints.rs"]
+mod hints;
 
 #[path = "icarus.rs"]
 mod icarus;

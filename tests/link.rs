@@ -213,6 +213,23 @@ fn a_slow_line_is_refused_with_the_minimum_baud_and_bad_links_are_bad_input() {
         "{}:326:8: link.baud: 1476 bytes per frame need 708480 cycles of a 1000000-baud line",
         slow.display()
     );
+    // the report names the file with the line, text and JSON alike
+    assert!(t.contains(&refusal), "{t}");
+    let j = slotforge()
+        .arg("audit")
+        .arg(&slow)
+        .arg("--json")
+        .output()
+        .unwrap();
+    let j: serde_json::Value = serde_json::from_slice(&j.stdout).unwrap();
+    assert!(
+        j["errors"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|x| x.as_str().unwrap().starts_with(&refusal)),
+        "{j}"
+    );
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(
         e.contains(&refusal) && e.contains("the minimum baud that carries this mix is 1500000"),

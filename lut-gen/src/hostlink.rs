@@ -62,7 +62,7 @@ pub struct LinkPlan {
 /// Why the link cannot carry the mix.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinkInfeasible {
-    /// `line N: link.<key>: words` (the audit's form).
+    /// `line N: link.<key>: words` (`audit` names the file too, with [`LinkInfeasible::at`]).
     pub message: String,
     /// Where the refused key is in the mix file, and what is wrong with
     /// it (`link.<key>: words`).

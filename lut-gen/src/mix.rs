@@ -13,6 +13,9 @@ use crate::parts::{AdcPart, MuxPart};
 
 mod adc_part;
 mod branches;
+mod bulk;
+#[cfg(test)]
+mod bulk_tests;
 mod channels;
 mod check;
 mod link_table;

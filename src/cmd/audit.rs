@@ -27,10 +27,15 @@ pub fn run(args: Args) -> u8 {
         Ok(s) => {
             // a line too slow for the mix: named on stderr as the parser
             // names a bad key (the report says it too, and exits 1)
+            let mut report = AuditReport::of_schedule(&s);
             if let Some(Err(e)) = lut_gen::hostlink::plan(&s) {
                 eprintln!("error: {}", e.at(&args.mix));
+                // the report names the file as well as the line
+                for x in report.errors.iter_mut().filter(|x| **x == e.message) {
+                    *x = e.at(&args.mix);
+                }
             }
-            (AuditReport::of_schedule(&s), None)
+            (report, None)
         }
         Err(why) => (AuditReport::of_infeasible(&mix, &why), Some(why)),
     };

@@ -348,7 +348,14 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
     }
     let golden = golden.expect("loaded above");
     let mut differ = compare_events(o, &who, &s, &golden, &log, &events_path);
-    match compare_windows(o, &who, &s, &dir, &trace, &windows) {
+    match compare_windows(
+        o,
+        &who,
+        &s,
+        &dir,
+        &trace,
+        (&windows, &update_command(a, mix)),
+    ) {
         Ok(d) => differ |= d,
         Err(code) => return code,
     }
@@ -372,11 +379,12 @@ fn load_events(
         if a.update {
             return Ok(None);
         }
-        errln!(o,
-            "error: no golden for mix `{}`: {} does not exist (record one with `slotforge golden {} --update`)",
+        errln!(
+            o,
+            "error: no golden for mix `{}`: {} does not exist (record one with `{}`)",
             s.mix.name,
             events_path.display(),
-            mix.display()
+            update_command(a, mix)
         );
         return Err(2);
     }
@@ -445,6 +453,9 @@ fn compare_events(
     differ
 }
 
+/// A golden's window and the run's cycles `[from, to)` it covers.
+type WindowAt<'a> = (&'a Window, (u64, u64));
+
 /// This run's waveform windows against the golden's, cycle by cycle:
 /// whether any differs, or the exit code of an error (printed).
 fn compare_windows(
@@ -453,7 +464,7 @@ fn compare_windows(
     s: &Schedule,
     dir: &Path,
     trace: &Trace,
-    windows: &[(&Window, (u64, u64))],
+    (windows, redo): (&[WindowAt], &str),
 ) -> Result<bool, u8> {
     let tmp = match tempfile::tempdir() {
         Ok(t) => t,
@@ -474,7 +485,7 @@ fn compare_windows(
         let expected = match read_window(s, &gold) {
             Ok(t) => t,
             Err(e) => {
-                errln!(o, "error: golden window {e} (re-record with --update)");
+                errln!(o, "error: golden window {e} (re-record with `{redo}`)");
                 return Err(2);
             }
         };
@@ -561,4 +572,29 @@ fn update(
         outln!(o, "{who}: window {} written ({} cycles)", w.file, k1 - k0);
     }
     0
+}
+
+/// The command that records `mix`'s golden with the options the user gave
+/// (back end, Verilog, folder), so the hint works as printed.
+fn update_command(a: &Args, mix: &Path) -> String {
+    let quote = |p: &Path| {
+        let t = p.display().to_string();
+        if t.contains(|c: char| c.is_whitespace() || "'\"$`\\".contains(c)) {
+            format!("'{}'", t.replace('\'', "'\\''"))
+        } else {
+            t
+        }
+    };
+    let mut cmd = format!(
+        "slotforge golden {} --backend {}",
+        quote(mix),
+        a.backend.name()
+    );
+    if let Some(rtl) = &a.rtl {
+        cmd += &format!(" --rtl {}", quote(rtl));
+    }
+    if a.dir != Path::new("golden") {
+        cmd += &format!(" --dir {}", quote(&a.dir));
+    }
+    cmd + " --update"
 }

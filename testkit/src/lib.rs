@@ -8,9 +8,11 @@
 //! - [`tb_judge`]: the verdict of the independent Icarus testbench
 //!   (`tests/tb/adc_tb.v`) on its log;
 //! - [`mutate`]: the Verilog mutator (mutation testing of the checkers);
-//! - [`analyser`]: logic-analyser captures made from a run's pins.
+//! - [`analyser`]: logic-analyser captures made from a run's pins;
+//! - [`bulk`]: mixes rewritten with bulk channels (`T{0..47}`) and back.
 
 pub mod analyser;
+pub mod bulk;
 pub mod mutate;
 pub mod presets;
 pub mod tb_judge;

@@ -326,6 +326,9 @@ pub struct WindowCheck<'a> {
     /// Capture cycle of the next cycle.
     i: u64,
     mode: Mode,
+    /// Whether `rst` has had a value: one that never has (a VCD without
+    /// `$dumpvars` whose `rst` does not change) is taken as released.
+    rst_seen: bool,
 }
 
 impl<'a> WindowCheck<'a> {
@@ -344,6 +347,7 @@ impl<'a> WindowCheck<'a> {
             flip,
             i: 0,
             mode: Mode::Waiting,
+            rst_seen: false,
         }
     }
 
@@ -570,6 +574,8 @@ fn fmt_ctl(c: &Ctl) -> String {
 
 impl CycleSink for WindowCheck<'_> {
     fn cycle(&mut self, rst: Option<bool>, pins: &Pins, xz: &Pins, miso: u64, miso_xz: u64) {
+        self.rst_seen |= rst.is_some();
+        let rst = if self.rst_seen { rst } else { Some(false) };
         // Built only where the search keeps it: once joined, a cycle is
         // the checker's alone.
         let r = || Rec {
@@ -589,7 +595,14 @@ impl CycleSink for WindowCheck<'_> {
                 self.mode = Mode::Reset(Box::new(c));
             }
             Mode::Waiting => {
-                if rst == Some(false) {
+                // A VCD without `$dumpvars` gives a port no value before its
+                // first change: the capture is read from where every pin
+                // the search reads has one, as a window, and an `rst` that
+                // never had a value is taken as released (a reset that
+                // shows up later still wins, above).  Capture cycles are
+                // counted from there.
+                let unknown = xz.cs_n != 0 || xz.sclk != 0 || xz.mux_sel != 0 || xz.mux_en != 0;
+                if rst != Some(true) && !unknown {
                     self.mode = Mode::Search(Box::new(Search {
                         tpl: Template::new(self.s),
                         cands: None,
@@ -600,6 +613,10 @@ impl CycleSink for WindowCheck<'_> {
                         buf: Buffer::default(),
                     }));
                     self.search_step(r());
+                } else {
+                    // Not read yet: capture cycles count from the first
+                    // one read.
+                    return;
                 }
             }
             Mode::Search(_) => self.search_step(r()),

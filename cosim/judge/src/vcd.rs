@@ -1422,4 +1422,56 @@ mod tests {
             }
         }
     }
+
+    /// A VCD without `$dumpvars` (every port unknown until its first
+    /// change, `rst` never given a value) is read from its first change, as
+    /// a window: a clean one passes, whether cut at reset or later, and a
+    /// fault inside it still fails.
+    #[test]
+    fn a_vcd_without_dumpvars_is_read_from_its_first_change() {
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testkit/mixes/tiny.toml");
+        let s = lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap();
+        let d = tempfile::tempdir().unwrap();
+        let f = s.grid.frame_cycles;
+        for (from, to) in [(0, 2 * f), (f, 4 * f), (f + 777, 3 * f + 5)] {
+            let vcd = d.path().join("w.vcd");
+            let opts = RunOptions::default();
+            write_run(&vcd, &s, &mut ModelDut::new(&s), 4, &opts, (from, to)).unwrap();
+            let text = std::fs::read_to_string(&vcd).unwrap();
+            let a = text.find("$dumpvars").unwrap();
+            let b = a + text[a..].find("$end").unwrap() + "$end\n".len();
+            let bare = format!("{}{}", &text[..a], &text[b..]);
+            assert!(!bare.contains("$dumpvars"));
+            let nd = d.path().join("nd.vcd");
+            std::fs::write(&nd, &bare).unwrap();
+            let (v, _) = check_vcd_with(&s, &nd, None, CheckOptions::default()).unwrap();
+            assert!(v.ok && v.cycles > f, "window {from}..{to}: {v:?}");
+            // a CS edge a cycle late inside it: a fault the check still finds
+            let code_of = |name: &str| {
+                let l = bare
+                    .lines()
+                    .find(|l| l.contains(&format!(" {name} ")))
+                    .unwrap();
+                l.split_whitespace().nth(3).unwrap().to_string()
+            };
+            let cs = code_of("adc_cs_n");
+            let lines: Vec<&str> = bare.lines().collect();
+            let k = lines
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| l.starts_with('b') && l.ends_with(&format!(" {cs}")))
+                .map(|(k, _)| k)
+                .nth(20)
+                .unwrap();
+            let mut bad = lines.clone();
+            bad.remove(k);
+            let bad = bad.join("\n") + "\n";
+            std::fs::write(&nd, bad).unwrap();
+            let r = check_vcd_with(&s, &nd, None, CheckOptions::default());
+            assert!(
+                !matches!(r, Ok((ref v, _)) if v.ok),
+                "window {from}..{to}: a missing CS change passed"
+            );
+        }
+    }
 }

@@ -6,6 +6,7 @@ use std::ops::Range;
 
 use toml::Spanned;
 
+use super::bulk::Declared;
 use super::check::Timing;
 use super::raw::*;
 use super::words::*;
@@ -28,7 +29,7 @@ impl Cx<'_> {
     /// later so that they fill the gaps deterministically.
     pub(super) fn channels(
         &self,
-        raw: &RawMix,
+        decl: &[Declared],
         branches: &[Branch],
         t: &Timing,
     ) -> Result<ChannelDraft, MixError> {
@@ -39,21 +40,20 @@ impl Cx<'_> {
             sync_groups: BTreeMap::new(),
         };
         let mut channel_names = BTreeSet::new();
-        for (i, c) in raw.channel.iter().enumerate() {
-            let c = c.get_ref();
-            let f = |k: &str| format!("channel[{i}].{k}");
+        for (i, d) in decl.iter().enumerate() {
+            let c = &d.raw;
             let cname = c.name.get_ref().clone();
             if cname.trim().is_empty() {
-                return Err(self.at(c.name.span(), f("name"), "must not be empty"));
+                return Err(self.at(c.name.span(), d.field("name"), "must not be empty"));
             }
             if !channel_names.insert(cname.clone()) {
                 return Err(self.at(
                     c.name.span(),
-                    f("name"),
-                    format!("duplicate channel name `{cname}`"),
+                    d.field("name"),
+                    d.say(format!("duplicate channel name `{cname}`")),
                 ));
             }
-            let channel = self.channel(i, c, cname, branches, t, &mut draft)?;
+            let channel = self.channel(i, d, branches, t, &mut draft)?;
             draft.channels.push(channel);
         }
         Ok(draft)
@@ -63,30 +63,35 @@ impl Cx<'_> {
     pub(super) fn channel(
         &self,
         i: usize,
-        c: &RawChannel,
-        name: String,
+        d: &Declared,
         branches: &[Branch],
         t: &Timing,
         draft: &mut ChannelDraft,
     ) -> Result<Channel, MixError> {
-        let f = |k: &str| format!("channel[{i}].{k}");
-        let branch = self.channel_branch(i, c, branches)?;
-        let rate_hz = self.positive(&c.rate_hz, &f("rate_hz"))?;
+        let (c, name) = (&d.raw, d.raw.name.get_ref().clone());
+        let f = |k: &str| d.field(k);
+        let branch = self.channel_branch(d, branches)?;
+        let rate_hz = self
+            .positive(&c.rate_hz, &f("rate_hz"))
+            .map_err(|e| MixError {
+                message: d.say(e.message),
+                ..e
+            })?;
         let frame_us = t.frame_us;
         if !(rate_hz as u128 * frame_us as u128).is_multiple_of(1_000_000) {
             return Err(self.at(
                 c.rate_hz.span(),
                 f("rate_hz"),
-                format!(
+                d.say(format!(
                     "{rate_hz} Hz gives {:.3} samples per {frame_us} us frame, not a whole number \
                      (rates must be multiples of {} Hz){}",
                     rate_hz as f64 * frame_us as f64 / 1e6,
                     hz_text(1e6 / frame_us as f64),
                     frames_that_fit(rate_hz, t.slice_us)
-                ),
+                )),
             ));
         }
-        let member = self.channel_member(i, c, &branches[branch])?;
+        let member = self.channel_member(d, &branches[branch])?;
         let input = match &c.input {
             None => {
                 draft.pending_auto.push(i);
@@ -95,15 +100,15 @@ impl Cx<'_> {
             Some(v) => {
                 let b = &branches[branch];
                 let used = &mut draft.used_inputs[branch];
-                self.channel_input(i, v, &name, member, b, used)?
+                self.channel_input(d, v, member, b, used)?
             }
         };
-        let bandwidth_hz = self.channel_bandwidth(i, c)?;
+        let bandwidth_hz = self.channel_bandwidth(d)?;
         let sync = match &c.sync {
             None => None,
             Some(s) => {
                 if s.get_ref().trim().is_empty() {
-                    return Err(self.at(s.span(), f("sync"), "must not be empty"));
+                    return Err(self.at(s.span(), f("sync"), d.say("must not be empty")));
                 }
                 draft
                     .sync_groups
@@ -128,10 +133,10 @@ impl Cx<'_> {
     /// `channel.branch`: a declared branch, by name.
     pub(super) fn channel_branch(
         &self,
-        i: usize,
-        c: &RawChannel,
+        d: &Declared,
         branches: &[Branch],
     ) -> Result<usize, MixError> {
+        let c = &d.raw;
         // Branch names are unique by now, so the first match is the one.
         branches
             .iter()
@@ -139,8 +144,8 @@ impl Cx<'_> {
             .ok_or_else(|| {
                 self.at(
                     c.branch.span(),
-                    format!("channel[{i}].branch"),
-                    format!(
+                    d.field("branch"),
+                    d.say(format!(
                         "unknown branch `{}` (declared: {})",
                         c.branch.get_ref(),
                         branches
@@ -148,30 +153,28 @@ impl Cx<'_> {
                             .map(|b| b.name.as_str())
                             .collect::<Vec<_>>()
                             .join(", ")
-                    ),
+                    )),
                 )
             })
     }
 
     /// `channel.member`: which part of the branch's chain, 0 unless given.
-    pub(super) fn channel_member(
-        &self,
-        i: usize,
-        c: &RawChannel,
-        b: &Branch,
-    ) -> Result<u32, MixError> {
-        let Some(m) = &c.member else { return Ok(0) };
+    pub(super) fn channel_member(&self, d: &Declared, b: &Branch) -> Result<u32, MixError> {
+        let Some(m) = &d.raw.member else {
+            return Ok(0);
+        };
         let chain = b.chain;
         if *m.get_ref() < 0 || *m.get_ref() >= chain as i64 {
             return Err(self.at(
                 m.span(),
-                format!("channel[{i}].member"),
-                format!(
-                    "member {} is beyond branch `{}`: its chain of {chain} part(s) has members 0..={}",
+                d.field("member"),
+                d.say(format!(
+                    "member {}{} is beyond branch `{}`: its chain of {chain} part(s) has members 0..={}",
                     m.get_ref(),
+                    counted_from(*m.get_ref(), d.step),
                     b.name,
                     chain - 1
-                ),
+                )),
             ));
         }
         Ok(*m.get_ref() as u32)
@@ -181,9 +184,8 @@ impl Cx<'_> {
     /// another channel of the same chain member.
     pub(super) fn channel_input(
         &self,
-        i: usize,
+        d: &Declared,
         v: &Spanned<i64>,
-        name: &str,
         member: u32,
         b: &Branch,
         used: &mut BTreeMap<(u32, u32), String>,
@@ -192,18 +194,19 @@ impl Cx<'_> {
         if *v.get_ref() < 0 || *v.get_ref() >= capacity as i64 {
             return Err(self.at(
                 v.span(),
-                format!("channel[{i}].input"),
-                format!(
-                    "input {} is beyond branch `{}`: {} mux device(s) give inputs 0..={}",
+                d.field("input"),
+                d.say(format!(
+                    "input {}{} is beyond branch `{}`: {} mux device(s) give inputs 0..={}",
                     v.get_ref(),
+                    counted_from(*v.get_ref(), d.step),
                     b.name,
                     b.mux_devices,
                     capacity - 1
-                ),
+                )),
             ));
         }
         let inp = *v.get_ref() as u32;
-        if let Some(other) = used.insert((inp, member), name.to_string()) {
+        if let Some(other) = used.insert((inp, member), d.raw.name.get_ref().clone()) {
             let which = if b.chain > 1 {
                 format!(" (chain member {member})")
             } else {
@@ -211,23 +214,19 @@ impl Cx<'_> {
             };
             return Err(self.at(
                 v.span(),
-                format!("channel[{i}].input"),
-                format!(
+                d.field("input"),
+                d.say(format!(
                     "input {inp}{which} of branch `{}` is already taken by channel `{other}`",
                     b.name
-                ),
+                )),
             ));
         }
         Ok(inp)
     }
 
     /// `channel.bandwidth_hz`: an integer or a float, positive and finite.
-    pub(super) fn channel_bandwidth(
-        &self,
-        i: usize,
-        c: &RawChannel,
-    ) -> Result<Option<f64>, MixError> {
-        let Some(b) = &c.bandwidth_hz else {
+    pub(super) fn channel_bandwidth(&self, d: &Declared) -> Result<Option<f64>, MixError> {
+        let Some(b) = &d.raw.bandwidth_hz else {
             return Ok(None);
         };
         let v = match b.get_ref() {
@@ -236,16 +235,19 @@ impl Cx<'_> {
             other => {
                 return Err(self.at(
                     b.span(),
-                    format!("channel[{i}].bandwidth_hz"),
-                    format!("got {}, expected a number of Hz", value_words(other)),
+                    d.field("bandwidth_hz"),
+                    d.say(format!(
+                        "got {}, expected a number of Hz",
+                        value_words(other)
+                    )),
                 ))
             }
         };
         if !(v > 0.0 && v.is_finite()) {
             return Err(self.at(
                 b.span(),
-                format!("channel[{i}].bandwidth_hz"),
-                format!("must be positive, got {v}"),
+                d.field("bandwidth_hz"),
+                d.say(format!("must be positive, got {v}")),
             ));
         }
         Ok(Some(v))
@@ -255,7 +257,7 @@ impl Cx<'_> {
     /// member, in file order.
     pub(super) fn assign_auto_inputs(
         &self,
-        raw: &RawMix,
+        decl: &[Declared],
         branches: &[Branch],
         draft: &mut ChannelDraft,
     ) -> Result<(), MixError> {
@@ -267,12 +269,12 @@ impl Cx<'_> {
             let used_inputs = &mut draft.used_inputs;
             let free = (0..capacity).find(|k| !used_inputs[b].contains_key(&(*k, m))).ok_or_else(|| {
                 self.at(
-                    raw.channel[i].get_ref().name.span(),
-                    format!("channel[{i}].input"),
-                    format!(
+                    decl[i].raw.name.span(),
+                    decl[i].field("input"),
+                    decl[i].say(format!(
                         "branch `{}` has no free mux input left ({} device(s), {} inputs); add mux_devices",
                         branches[b].name, branches[b].mux_devices, capacity
-                    ),
+                    )),
                 )
             })?;
             used_inputs[b].insert((free, m), channels[i].name.clone());
@@ -285,7 +287,7 @@ impl Cx<'_> {
     /// (one per chain member): they share every sampling instant.
     pub(super) fn check_chain_rates(
         &self,
-        raw: &RawMix,
+        decl: &[Declared],
         branches: &[Branch],
         channels: &[Channel],
     ) -> Result<(), MixError> {
@@ -294,13 +296,13 @@ impl Cx<'_> {
                 let (a, c) = (&channels[j], &channels[i]);
                 if a.branch == c.branch && a.input == c.input && a.rate_hz != c.rate_hz {
                     return Err(self.at(
-                        raw.channel[i].get_ref().rate_hz.span(),
-                        format!("channel[{i}].rate_hz"),
-                        format!(
+                        decl[i].raw.rate_hz.span(),
+                        decl[i].field("rate_hz"),
+                        decl[i].say(format!(
                             "`{}` ({} Hz) and `{}` ({} Hz) are chain members {} and {} of one conversion on branch `{}` (mux input {}): chained parts are sampled together, so they need one rate",
                             c.name, c.rate_hz, a.name, a.rate_hz, c.member, a.member,
                             branches[c.branch].name, c.input
-                        ),
+                        )),
                     ));
                 }
             }
@@ -311,6 +313,7 @@ impl Cx<'_> {
     /// A sync group has one rate and at most one conversion per branch.
     pub(super) fn check_sync_groups(
         &self,
+        decl: &[Declared],
         branches: &[Branch],
         channels: &[Channel],
         sync_groups: &BTreeMap<String, Vec<(usize, Range<usize>)>>,
@@ -323,11 +326,11 @@ impl Cx<'_> {
                 if c.rate_hz != rate {
                     return Err(self.at(
                         span.clone(),
-                        format!("channel[{i}].sync"),
-                        format!(
+                        decl[*i].field("sync"),
+                        decl[*i].say(format!(
                             "sync group `{tag}` mixes rates ({} Hz and {} Hz): synchronized channels share every sampling instant, so they need one rate",
                             rate, c.rate_hz
-                        ),
+                        )),
                     ));
                 }
                 if let Some(other) = seen.insert(c.branch, *i) {
@@ -337,11 +340,11 @@ impl Cx<'_> {
                     }
                     return Err(self.at(
                         span.clone(),
-                        format!("channel[{i}].sync"),
-                        format!(
+                        decl[*i].field("sync"),
+                        decl[*i].say(format!(
                             "sync group `{tag}` has `{}` and `{}` on the same branch `{}`: one ADC cannot sample both at one instant",
                             channels[other].name, c.name, branches[c.branch].name
-                        ),
+                        )),
                     ));
                 }
             }
@@ -352,26 +355,27 @@ impl Cx<'_> {
     /// Members of one chained conversion are in one sync group or none.
     pub(super) fn check_chain_sync(
         &self,
-        raw: &RawMix,
+        decl: &[Declared],
         channels: &[Channel],
     ) -> Result<(), MixError> {
         for i in 0..channels.len() {
             for j in 0..i {
                 let (a, c) = (&channels[j], &channels[i]);
                 if a.branch == c.branch && a.input == c.input && a.sync != c.sync {
-                    let span = raw.channel[i]
-                        .get_ref()
+                    let d = &decl[i];
+                    let span = d
+                        .raw
                         .sync
                         .as_ref()
                         .map(|s| s.span())
-                        .unwrap_or(raw.channel[i].get_ref().name.span());
+                        .unwrap_or(d.raw.name.span());
                     return Err(self.at(
                         span,
-                        format!("channel[{i}].sync"),
-                        format!(
+                        d.field("sync"),
+                        d.say(format!(
                             "`{}` and `{}` are read in one chained conversion, so they are in the same sync group or none: give them the same `sync`",
                             c.name, a.name
-                        ),
+                        )),
                     ));
                 }
             }
@@ -397,5 +401,18 @@ impl Cx<'_> {
             }
         }
         Ok(())
+    }
+}
+
+/// For a channel of a bulk table: how its counted value came about
+/// (`(40 + 7)`), since the user wrote only the first.
+fn counted_from(value: i64, step: u32) -> String {
+    if step == 0 {
+        String::new()
+    } else {
+        format!(
+            " ({} + {step}, counted up from the first channel's)",
+            value - step as i64
+        )
     }
 }

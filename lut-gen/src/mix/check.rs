@@ -112,12 +112,13 @@ impl Cx<'_> {
         }
         let parts = self.declared_parts(&raw)?;
         let branches = self.branches(&raw, &parts, &t)?;
-        let mut draft = self.channels(&raw, &branches, &t)?;
-        self.assign_auto_inputs(&raw, &branches, &mut draft)?;
+        let decl = self.declare_channels(&raw)?;
+        let mut draft = self.channels(&decl, &branches, &t)?;
+        self.assign_auto_inputs(&decl, &branches, &mut draft)?;
         let channels = draft.channels;
-        self.check_chain_rates(&raw, &branches, &channels)?;
-        self.check_sync_groups(&branches, &channels, &draft.sync_groups)?;
-        self.check_chain_sync(&raw, &channels)?;
+        self.check_chain_rates(&decl, &branches, &channels)?;
+        self.check_sync_groups(&decl, &branches, &channels, &draft.sync_groups)?;
+        self.check_chain_sync(&decl, &channels)?;
         self.check_branches_used(&raw, &branches, &channels)?;
         if channels.len() > u16::MAX as usize {
             return Err(self.at(0..0, "channel", "more than 65535 channels"));

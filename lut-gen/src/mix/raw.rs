@@ -75,7 +75,7 @@ pub(super) struct RawAdcPart {
     pub(super) chain_max: Option<Spanned<i64>>,
 }
 
-#[derive(Deserialize)]
+#[derive(Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawChannel {
     pub(super) name: Spanned<String>,
