@@ -13,6 +13,9 @@ mod cli;
 #[path = "docs.rs"]
 mod docs;
 
+#[path = "figures.rs"]
+mod figures;
+
 #[path = "golden.rs"]
 mod golden;
 
