@@ -12,7 +12,7 @@ use serde_json::Value;
 
 use crate::common_cli::slotforge;
 
-const STEPS: &str = "audit,lut,verilog,sim,timing,schedulability";
+const STEPS: &str = "audit,lut,verilog,sim,timing,figure7,schedulability";
 
 /// An AD7685 chain of three (CNV, branch 0, so the timing figure is a CNV
 /// part's) beside an AD7940 branch, at 2 kHz and 250 Hz.
@@ -166,6 +166,28 @@ fn audit_figures(a: &Value, md: &str, out: &Path) {
     assert_eq!(sum, limit);
 }
 
+/// Figure 7's summary: the slowest and the fastest rate of the mix in
+/// audit.json, and their ratio.
+fn figure7_figures(a: &Value, md: &str) {
+    // Figure 7: the slowest and the fastest rate of the mix, and their ratio
+    let s = summary(md, "chart: Figure 7 for this mix's rates");
+    let rates: Vec<f64> = a["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| num(&c["requested_hz"]))
+        .collect();
+    let (slow, fast) = (
+        rates.iter().copied().fold(f64::MAX, f64::min),
+        rates.iter().copied().fold(0.0, f64::max),
+    );
+    assert_eq!(before(s, " Hz keeps its shape"), slow, "{s}");
+    assert_eq!(before(s, " Hz rate"), fast, "{s}");
+    let share = format!("{:.1}", slow / fast * 100.0);
+    let share = share.trim_end_matches(".0");
+    assert!(s.contains(&format!("with {share} % of the data")), "{s}");
+}
+
 /// Builds `text` and holds every figure it prints against its source.
 fn figures_of(text: &str) {
     let d = tempfile::tempdir().unwrap();
@@ -225,6 +247,8 @@ fn figures_of(text: &str) {
     );
     let b0 = branches[0]["name"].as_str().unwrap();
     assert!(s.contains(&format!("of branch {b0} ")), "{s}");
+
+    figure7_figures(&a, &md);
 
     // schedulability: this mix's utilization is the audit's; its parts named
     let s = summary(&md, "chart: where scheduling breaks");
