@@ -16,6 +16,9 @@ mod cli;
 #[path = "docs.rs"]
 mod docs;
 
+#[path = "figures.rs"]
+mod figures;
+
 #[path = "golden.rs"]
 mod golden;
 

@@ -30,8 +30,8 @@ pub struct AuditReport {
     pub samples_per_frame: u64,
     /// Sum of all channels' rates.
     pub aggregate_hz: u64,
-    /// The ADCs' physical limit: sum of their maximum throughputs.
-    pub adc_limit_hz: u64,
+    /// The ADCs' physical limit: the sum of the branches' `adc_max_sps`.
+    pub adc_limit_hz: f64,
     pub adc_utilization: f64,
     pub placement: String,
     pub lut_entries_compact: usize,
@@ -67,8 +67,10 @@ pub struct PartAudit {
     pub conversion_ns: u64,
     /// Cycles one conversion holds the port (conversion + every word read).
     pub read_cycles: u64,
-    /// Conversions per second the branch allows (the shortest legal slot),
-    /// and samples per second (times the chain).
+    /// Conversions per second the converter allows on this port (its
+    /// conversion, every word read at the SCLK used, the quiet time, the
+    /// datasheet's rate), and samples per second (times the chain): the
+    /// branch's `adc_max_sps`, the same value.
     pub max_conversions_hz: f64,
     pub max_samples_hz: f64,
 }
@@ -81,18 +83,8 @@ impl PartAudit {
     ) -> PartAudit {
         let br = &mix.branches[b];
         let a = &br.adc;
-        let spi = plan.map(|p| p.spi).or_else(|| {
-            crate::parts::SpiTiming::derive(a, mix.clock_hz, br.sclk_hz, br.chain).ok()
-        });
-        let min_slot = plan
-            .map(|p| p.min_slot_cycles)
-            .or(spi.map(|t| t.min_period_cycles))
-            .unwrap_or(0);
-        let conv_hz = if min_slot > 0 {
-            mix.clock_hz as f64 / min_slot as f64
-        } else {
-            0.0
-        };
+        let spi = plan.map(|p| p.spi).or_else(|| br.timing(mix.clock_hz).ok());
+        let samples_hz = br.max_samples_hz(mix.clock_hz);
         PartAudit {
             branch: br.name.clone(),
             adc: a.name.clone(),
@@ -104,8 +96,8 @@ impl PartAudit {
             sclk_max_hz: a.sclk_max_hz,
             conversion_ns: a.conversion_ns,
             read_cycles: spi.map(|t| t.read_cycles).unwrap_or(0),
-            max_conversions_hz: conv_hz,
-            max_samples_hz: conv_hz * br.chain as f64,
+            max_conversions_hz: samples_hz / br.chain as f64,
+            max_samples_hz: samples_hz,
         }
     }
 }
@@ -119,8 +111,10 @@ pub struct BranchAudit {
     pub slots_per_frame: u64,
     /// Samples per second the branch's channels demand (sum of their rates).
     pub demand_sps: u64,
-    /// The ADC's maximum throughput (datasheet).
-    pub adc_max_sps: u64,
+    /// The most samples per second the branch's converter delivers at this
+    /// clock and SCLK (`lut_gen::Branch::max_samples_hz`): the datasheet's
+    /// rate, or less when a conversion and its read take longer.
+    pub adc_max_sps: f64,
     /// Of the ADC: `demand_sps / adc_max_sps`.
     pub adc_utilization: f64,
     /// SCLK asked for (`sclk_hz` in the mix, or the ADC's maximum by default).
@@ -246,11 +240,7 @@ impl AuditReport {
         let notes = sclk_notes(&branches, g.clock_hz);
 
         let aggregate_hz: u64 = mix.channels.iter().map(|c| c.rate_hz).sum();
-        let adc_limit_hz: u64 = mix
-            .branches
-            .iter()
-            .map(|b| b.adc.max_sps * b.chain as u64)
-            .sum();
+        let adc_limit_hz = adc_limit_hz(mix);
         let lut = CompactLut::from_schedule(s);
         let link = match crate::hostlink::plan(s) {
             None => None,
@@ -273,7 +263,7 @@ impl AuditReport {
             samples_per_frame: s.samples_per_frame(),
             aggregate_hz,
             adc_limit_hz,
-            adc_utilization: aggregate_hz as f64 / adc_limit_hz as f64,
+            adc_utilization: aggregate_hz as f64 / adc_limit_hz,
             placement: match s.placement {
                 Placement::Constructive => "constructive (first-fit)".into(),
                 Placement::Search { nodes } => format!("exact search ({nodes} nodes)"),
@@ -309,11 +299,11 @@ impl AuditReport {
         }
         errors.extend(why.suggestions.iter().map(|s| format!("suggestion: {s}")));
         let aggregate_hz: u64 = mix.channels.iter().map(|c| c.rate_hz).sum();
-        let adc_limit_hz: u64 = mix
-            .branches
-            .iter()
-            .map(|b| b.adc.max_sps * b.chain as u64)
-            .sum();
+        let adc_limit_hz = adc_limit_hz(mix);
+        let max_sps = |name: &str| {
+            mix.branch_index(name)
+                .map_or(0.0, |i| mix.branches[i].max_samples_hz(mix.clock_hz))
+        };
         let sps = why.slots_per_slice.unwrap_or(0);
         let slice_cycles = mix.slice_cycles();
         AuditReport {
@@ -332,7 +322,7 @@ impl AuditReport {
                 .sum(),
             aggregate_hz,
             adc_limit_hz,
-            adc_utilization: aggregate_hz as f64 / adc_limit_hz as f64,
+            adc_utilization: aggregate_hz as f64 / adc_limit_hz,
             placement: "none".into(),
             parts: (0..mix.branches.len())
                 .map(|b| PartAudit::of(mix, b, None))
@@ -352,13 +342,8 @@ impl AuditReport {
                     conversions_per_frame: b.demand_slots_per_frame,
                     slots_per_frame: b.capacity_slots_per_frame,
                     demand_sps: b.demand_hz,
-                    adc_max_sps: mix.branch_index(&b.name).map_or(0, |i| {
-                        mix.branches[i].adc.max_sps * mix.branches[i].chain as u64
-                    }),
-                    adc_utilization: mix.branch_index(&b.name).map_or(0.0, |i| {
-                        b.demand_hz as f64
-                            / (mix.branches[i].adc.max_sps * mix.branches[i].chain as u64) as f64
-                    }),
+                    adc_max_sps: max_sps(&b.name),
+                    adc_utilization: b.demand_hz as f64 / max_sps(&b.name),
                     sclk_requested_hz: mix
                         .branch_index(&b.name)
                         .map_or(0, |i| mix.branches[i].sclk_hz),
@@ -459,6 +444,14 @@ impl ChannelAudit {
     }
 }
 
+/// The ADCs' summed limit: every branch's [`crate::Branch::max_samples_hz`].
+fn adc_limit_hz(mix: &crate::Mix) -> f64 {
+    mix.branches
+        .iter()
+        .map(|b| b.max_samples_hz(mix.clock_hz))
+        .sum()
+}
+
 /// The shortest settling before any of `slots`: the mux switches one cycle
 /// after the previous CS fall on the branch (`bs`, its conversions).
 fn settle_cycles(s: &Schedule, slots: &[u64], bs: &[u64]) -> u64 {
@@ -530,7 +523,7 @@ impl BranchAudit {
             .collect::<std::collections::BTreeSet<_>>()
             .len() as u32;
         // A chain of N parts gives N samples per conversion.
-        let adc_max_sps = br.adc.max_sps * br.chain as u64;
+        let adc_max_sps = br.max_samples_hz(mix.clock_hz);
         let free_inputs = inputs.saturating_sub(taken);
         let demand_sps: u64 = mix
             .channels
@@ -540,7 +533,7 @@ impl BranchAudit {
             .sum();
         let room = Room {
             free_inputs: free_inputs as u64,
-            adc_spare_sps: adc_max_sps.saturating_sub(demand_sps),
+            adc_spare_sps: (adc_max_sps - demand_sps as f64).max(0.0),
         };
         let headroom = rates
             .iter()
@@ -554,7 +547,7 @@ impl BranchAudit {
             slots_per_frame: g.frame_slots,
             demand_sps,
             adc_max_sps,
-            adc_utilization: demand_sps as f64 / adc_max_sps as f64,
+            adc_utilization: demand_sps as f64 / adc_max_sps,
             sclk_requested_hz: br.sclk_hz,
             sclk_explicit: br.sclk_explicit,
             sclk_hz: spi.sclk_hz,
@@ -569,7 +562,7 @@ impl BranchAudit {
 /// What a branch has left besides table slots.
 struct Room {
     free_inputs: u64,
-    adc_spare_sps: u64,
+    adc_spare_sps: f64,
 }
 
 /// How many more channels at `rate_hz` branch `b` takes, and what binds.
@@ -578,7 +571,7 @@ fn headroom(s: &Schedule, b: usize, rate_hz: u64, room: &Room, finer: &FinerGrid
     let mix = &s.mix;
     let mut free: Vec<bool> = (0..g.frame_slots).map(|t| s.at(t, b).is_none()).collect();
     let by_grid = more_that_fit(&mut free, g.frame_slots, mix.samples_per_frame(rate_hz));
-    let by_adc = room.adc_spare_sps / rate_hz;
+    let by_adc = (room.adc_spare_sps / rate_hz as f64).floor() as u64;
     let (more, binding) = least(room.free_inputs, by_adc, by_grid);
     let finer_grid = finer
         .best(
@@ -831,7 +824,7 @@ mod tests {
         // Recount from the rates: 30 x 1000 S/s on an ADC of 100 kSPS.
         let fast = &a.branches[0];
         assert_eq!(fast.demand_sps, 30 * 1000);
-        assert_eq!(fast.adc_max_sps, 100_000);
+        assert_eq!(fast.adc_max_sps, 100_000.0);
         assert!((fast.adc_utilization - 0.30).abs() < 1e-12);
         // 30 conversions per 1 ms slice fill a 30-slot grid.
         assert_eq!(a.slots_per_slice, 30);
@@ -970,5 +963,35 @@ mod tests {
             assert_eq!(c.sample_channel, i);
         }
         assert!(a.to_text().contains("its index in the mix file, 0-based"));
+    }
+
+    /// A chain's maximum is what its timing allows (50 MHz: 12.5 MHz SCK, a
+    /// 3.2 us conversion and 64 bits read take 418 cycles, so 4 x 50 MHz /
+    /// 418 = 478469 S/s, not 4 x 200 kSPS), and the branch table, the parts
+    /// table and the total print that one value.
+    #[test]
+    fn a_chains_maximum_is_one_figure() {
+        let t = "name = \"v\"\n[clock]\nhz = 50_000_000\n[frame]\nperiod_us = 10_000\nslice_us = 1_000\n\
+                 [[branch]]\nname = \"a\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n\
+                 [[branch]]\nname = \"v\"\nadc = \"ad7685\"\nchain = 4\nmux = \"none\"\n\
+                 [[channel]]\nname = \"A\"\nbranch = \"a\"\nrate_hz = 1_000\n";
+        let mut t = t.to_string();
+        for m in 0..4 {
+            t += &format!(
+                "[[channel]]\nname = \"V{m}\"\nbranch = \"v\"\nmember = {m}\nrate_hz = 4_000\n"
+            );
+        }
+        let a = audit(&crate::parse(Path::new("v.toml"), &t).unwrap());
+        let (b, p) = (&a.branches[1], &a.parts[1]);
+        assert_eq!(b.adc_max_sps.round(), 478_469.0);
+        assert_eq!(b.adc_max_sps, p.max_samples_hz);
+        assert_eq!(p.max_conversions_hz * 4.0, p.max_samples_hz);
+        assert_eq!(a.adc_limit_hz, a.branches[0].adc_max_sps + b.adc_max_sps);
+        let text = a.to_text();
+        assert!(text.contains(" 478469 "), "{text}");
+        assert!(!text.contains("800000"), "{text}");
+        // the ADC's headroom counts against the same figure
+        let h = b.headroom.iter().find(|h| h.rate_hz == 4_000).unwrap();
+        assert_eq!(h.by_adc_throughput, (478_469 - 16_000) / 4_000);
     }
 }

@@ -141,6 +141,26 @@ pub struct Branch {
     pub chain: u32,
 }
 
+impl Branch {
+    /// The SPI timing of this branch's port at `clock_hz`.
+    pub fn timing(
+        &self,
+        clock_hz: u64,
+    ) -> Result<crate::parts::SpiTiming, crate::parts::TimingError> {
+        crate::parts::SpiTiming::derive(&self.adc, clock_hz, self.sclk_hz, self.chain)
+    }
+
+    /// The most samples per second this branch's converter (its whole
+    /// chain) delivers: [`crate::parts::SpiTiming::max_samples_hz`]; when
+    /// the clock cannot drive the part, the datasheet's rate times the chain.
+    pub fn max_samples_hz(&self, clock_hz: u64) -> f64 {
+        self.timing(clock_hz)
+            .map_or(self.adc.max_sps as f64 * self.chain as f64, |t| {
+                t.max_samples_hz(clock_hz)
+            })
+    }
+}
+
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Channel {
     pub name: String,

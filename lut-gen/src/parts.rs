@@ -292,6 +292,21 @@ impl SpiTiming {
         })
     }
 
+    /// Conversions per second the part allows on this port: one every
+    /// `min_period_cycles` (the conversion, every word of the chain read at
+    /// the SCLK used, the quiet time, and the datasheet's throughput limit).
+    pub fn max_conversions_hz(&self, clock_hz: u64) -> f64 {
+        clock_hz as f64 / self.min_period_cycles.max(1) as f64
+    }
+
+    /// Samples per second the port allows: [`Self::max_conversions_hz`]
+    /// times the words of the chain.  The one figure of a branch's converter
+    /// maximum: the audit's branch table, its parts table, its total and the
+    /// utilizations are all this value.
+    pub fn max_samples_hz(&self, clock_hz: u64) -> f64 {
+        self.max_conversions_hz(clock_hz) * self.words as f64
+    }
+
     /// Serial clock periods per conversion (every word of the chain).
     pub fn sclks(&self) -> u64 {
         self.word_sclks as u64 * self.words as u64
@@ -360,6 +375,8 @@ mod tests {
         assert_eq!(t.read_cycles, 155 + 64 * 4);
         assert_eq!(t.captures().count(), 64);
         assert_eq!(t.min_period_cycles, 412); // read + quiet: longer than 200 kSPS
+                                              // so the chain gives 4 x 48 MHz / 412 samples/s, not 4 x 200 kSPS
+        assert_eq!(t.max_samples_hz(48_000_000).floor(), 466_019.0);
     }
 
     #[test]

@@ -293,9 +293,10 @@ fn slow(s: &Schedule) -> Result<(Figure, String), String> {
     }
     let share = rate / fastest as f64;
     let line = format!(
-        "a {f} Hz signal on {name} at {rate} Hz keeps its shape (samples interpolated differ from its input by {:.1} % rms of the amplitude) with {:.0} % of the data of the {fastest} Hz rate",
+        "a {f} Hz signal on {name} at {rate} Hz keeps its shape (samples interpolated differ from its input by {:.1} % rms of the amplitude) with {} % of the data of the {fastest} Hz rate",
         rms * 100.0,
-        share * 100.0
+        // 100 Hz of 4000 Hz is 2.5 %, not "2 %"
+        format!("{:.1}", share * 100.0).trim_end_matches(".0")
     );
     let fig = Figure {
         stem: "figure7-slow".into(),

@@ -16,15 +16,37 @@ use report::{draw, Axes, Figure, Marker, Section, Series, Table};
 /// Random mixes drawn.
 pub const MIXES: u64 = 60;
 
-/// ADC utilization of a mix: demand over the converters' throughput.
+/// ADC utilization of a mix: demand over the converters' throughput, the
+/// audit's `adc_utilization` (the same per-branch maximum,
+/// `lut_gen::Branch::max_samples_hz`, summed in the same order).
 fn utilization(m: &lut_gen::Mix) -> f64 {
     let demand: u64 = m.channels.iter().map(|c| c.rate_hz).sum();
-    let cap: u64 = m
+    let cap: f64 = m
         .branches
         .iter()
-        .map(|b| b.adc.max_sps * b.chain as u64)
+        .map(|b| b.max_samples_hz(m.clock_hz))
         .sum();
-    demand as f64 / cap.max(1) as f64
+    demand as f64 / cap
+}
+
+/// The parts of a mix's branches, counted: `2 x AD7940, 1 x AD7685 (chain
+/// of 4)`, in the order they first appear.
+pub fn parts(m: &lut_gen::Mix) -> String {
+    let mut seen: Vec<(String, usize)> = Vec::new();
+    for b in &m.branches {
+        let name = match b.chain {
+            1 => b.adc.name.to_uppercase(),
+            n => format!("{} (chain of {n})", b.adc.name.to_uppercase()),
+        };
+        match seen.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, k)) => *k += 1,
+            None => seen.push((name, 1)),
+        }
+    }
+    seen.iter()
+        .map(|(n, k)| format!("{k} x {n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The random mixes by outcome, each as (utilization %, synthesis ms).
@@ -50,7 +72,7 @@ pub fn schedulability(s: &Schedule) -> (Section, String) {
     let max = ((n0 * (2.0f64).max(1.2 / u0.max(1e-3))).ceil() as u64).clamp(4, 512);
     let shape = Shape::around(mix, max);
     let mut table = Table::new(&["seed", "channels", "utilization", "verdict", "synthesis_ms"]);
-    let outcomes = sample(&shape, &mut table);
+    let (outcomes, drawn) = sample(&shape, &mut table);
     let t = Instant::now();
     let _ = lut_gen::synthesize(mix);
     let own = (t.elapsed().as_secs_f64() * 1e3).max(1e-3);
@@ -68,7 +90,7 @@ pub fn schedulability(s: &Schedule) -> (Section, String) {
         Section {
             title: "Where scheduling breaks".into(),
             paragraphs: vec![
-                format!("{MIXES} random mixes around this one: its clock ({} Hz), frame ({} us) and slice ({} us), its {} branches (AD7940) and its rates ({}), with 1 to {max} channels. Dots: an exact schedule exists; crosses: none does (synthesis proves it); triangles, if any: undecided (the exact search hit its bound); the square is this mix.", mix.clock_hz, mix.frame_us, mix.slice_us, mix.branches.len(), rates.join(", ")),
+                format!("{MIXES} random mixes around this one: its clock ({} Hz), frame ({} us) and slice ({} us), its number of branches ({}; this mix: {}; the random mixes: {drawn}) and its rates ({}), with 1 to {max} channels. Dots: an exact schedule exists; crosses: none does (synthesis proves it); triangles, if any: undecided (the exact search hit its bound); the square is this mix.", mix.clock_hz, mix.frame_us, mix.slice_us, mix.branches.len(), parts(mix), rates.join(", ")),
                 format!("{line}."),
             ],
             figures: vec![Figure {
@@ -84,14 +106,21 @@ pub fn schedulability(s: &Schedule) -> (Section, String) {
     )
 }
 
-/// Synthesizes the random mixes of `shape`, one table row each.
-fn sample(shape: &Shape, table: &mut Table) -> Outcomes {
+/// Synthesizes the random mixes of `shape`, one table row each; with the
+/// parts the random mixes were drawn with (each mix's [`parts`], the
+/// different ones joined by "or").
+fn sample(shape: &Shape, table: &mut Table) -> (Outcomes, String) {
     let mut o = Outcomes::default();
+    let mut drawn: Vec<String> = Vec::new();
     for seed in 1..=MIXES {
         let text = random_mix(seed, shape);
         let Ok(m) = lut_gen::parse(Path::new("random.toml"), &text) else {
             continue;
         };
+        let p = parts(&m);
+        if !drawn.contains(&p) {
+            drawn.push(p);
+        }
         let u = utilization(&m);
         let t = Instant::now();
         // `None`: scheduled
@@ -111,7 +140,7 @@ fn sample(shape: &Shape, table: &mut Table) -> Outcomes {
         }
         .push((u * 100.0, ms));
     }
-    o
+    (o, drawn.join(" or "))
 }
 
 fn summary(o: &Outcomes, u0: f64) -> String {
@@ -130,7 +159,7 @@ fn summary(o: &Outcomes, u0: f64) -> String {
         )
     };
     format!(
-        "{} of {} random mixes around this one have an exact schedule, up to {best:.0} % ADC utilization{}{undecided}; this mix: {:.0} %",
+        "{} of {} random mixes around this one have an exact schedule, up to {best:.0} % ADC utilization{}{undecided}; this mix: {:.1} % (the audit's ADC utilization)",
         o.scheduled.len(),
         o.total(),
         if worst.is_finite() { format!(", the least loaded proved without one at {worst:.0} %") } else { String::new() },

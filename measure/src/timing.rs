@@ -410,16 +410,20 @@ fn wavedrom(s: &Schedule, l: &Layout, w: &Window, _nb: usize) -> Result<(String,
     let spi = s.branches[0].spi;
     let cyc = &w.cycles;
     let cs = |p: &Pins| lane(l, p, Role::CsN, 0);
-    let idle = cs(&cyc[0].0);
-    let t0 = cyc
-        .iter()
-        .position(|(p, _)| cs(p) != idle)
+    // The window starts on a slot boundary, where a conversion may start:
+    // the first cycle with the pin active that follows an idle one (or the
+    // window's first cycle) is a conversion's start.
+    let active = u64::from(spi.style.active_level());
+    let t0 = (0..cyc.len())
+        .find(|&k| cs(&cyc[k].0) == active && (k == 0 || cs(&cyc[k - 1].0) != active))
         .ok_or("the first branch does not convert in the slice")?;
     let step = spi.sclk_half.max(1) as usize;
     let end = t0 + spi.read_cycles as usize;
+    // Its word's strobe: the first of branch 0 after the read (another
+    // branch's strobe may come first on the merged stream).
     let strobe = cyc[end.min(cyc.len())..]
         .iter()
-        .position(|(p, _)| p.sample_valid)
+        .position(|(p, _)| p.sample_valid && s.mix.channels[p.sample_channel as usize].branch == 0)
         .map(|k| end + k);
     let from = t0.saturating_sub(2 * step);
     let to = (strobe.unwrap_or(end) + 3 * step).min(cyc.len());
@@ -487,8 +491,13 @@ fn wavedrom(s: &Schedule, l: &Layout, w: &Window, _nb: usize) -> Result<(String,
     text.push('\n');
     let line = match strobe {
         Some(k) => format!(
-            "WaveDrom: a conversion and its sample_valid strobe {} cycles after CS",
-            k - t0
+            "WaveDrom: a conversion of branch {} and its sample_valid strobe {} cycles after {}",
+            s.branches[0].name,
+            k - t0,
+            match spi.style {
+                lut_gen::parts::Start::Cs => "CS falls",
+                lut_gen::parts::Start::Cnv => "CNV rises",
+            }
         ),
         None => "WaveDrom: a conversion (its strobe falls outside the window)".into(),
     };

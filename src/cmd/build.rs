@@ -132,10 +132,17 @@ pub fn run(a: Args) -> u8 {
         .filter(|s| s.status == report::Status::Failed)
         .count();
     if !a.quiet {
+        // the count the progress's `[n/N]` counted, and the steps not run
+        let not_run = job.doc.steps.len() - job.total;
         println!(
-            "{}: {} steps, {} failed; report in {}",
+            "{}: {} steps run{}, {} failed; report in {}",
             s.mix.name,
-            job.doc.steps.len(),
+            job.total,
+            if not_run > 0 {
+                format!(" ({not_run} not asked for)")
+            } else {
+                String::new()
+            },
             failed,
             a.out.join("report.html").display()
         );

@@ -44,7 +44,7 @@ impl AuditReport {
         }
         let _ = writeln!(
             o,
-            "{} samples/frame; aggregate {} samples/s of {} the ADCs can do ({:.1} %)",
+            "{} samples/frame; aggregate {} samples/s of {:.0} the ADCs can do ({:.1} %)",
             self.samples_per_frame,
             self.aggregate_hz,
             self.adc_limit_hz,
@@ -77,7 +77,7 @@ impl AuditReport {
             for b in &self.branches {
                 let _ = writeln!(
                     o,
-                    "{:<16} {:>11} {:>11} {:>8.1} {:>11} {:>8.1} {:>10} {:>11}",
+                    "{:<16} {:>11} {:>11.0} {:>8.1} {:>11} {:>8.1} {:>10} {:>11}",
                     b.name,
                     b.demand_sps,
                     b.adc_max_sps,

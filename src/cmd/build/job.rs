@@ -20,11 +20,13 @@ pub enum Outcome {
 }
 
 /// What a step hands back: its outcome, the files it wrote (relative to
-/// the output directory) and its report sections.
+/// the output directory), its report sections, and the time its work took
+/// when that is not the time the step waited (work done in the background).
 pub struct Done {
     pub outcome: Outcome,
     pub files: Vec<String>,
     pub sections: Vec<Section>,
+    pub seconds: Option<f64>,
 }
 
 impl Done {
@@ -33,6 +35,7 @@ impl Done {
             outcome: Outcome::Ok(line.into()),
             files: Vec::new(),
             sections: Vec::new(),
+            seconds: None,
         }
     }
     pub fn failed(line: impl Into<String>, detail: impl Into<String>) -> Done {
@@ -40,6 +43,7 @@ impl Done {
             outcome: Outcome::Failed(line.into(), detail.into()),
             files: Vec::new(),
             sections: Vec::new(),
+            seconds: None,
         }
     }
     pub fn skipped(why: impl Into<String>) -> Done {
@@ -47,10 +51,16 @@ impl Done {
             outcome: Outcome::Skipped(why.into()),
             files: Vec::new(),
             sections: Vec::new(),
+            seconds: None,
         }
     }
     pub fn files(mut self, f: &[&str]) -> Done {
         self.files.extend(f.iter().map(|x| x.to_string()));
+        self
+    }
+    /// The step's work took `seconds` (not the time the step waited for it).
+    pub fn took(mut self, seconds: f64) -> Done {
+        self.seconds = Some(seconds);
         self
     }
     pub fn section(mut self, s: Section) -> Done {
@@ -97,7 +107,8 @@ pub struct Job {
     pub doc: Document,
     quiet: bool,
     bar: Option<indicatif::ProgressBar>,
-    total: usize,
+    /// Steps that run (the progress's `[n/total]`; the final line's count).
+    pub total: usize,
     started: usize,
     /// Steps that were asked for but could not run (a tool missing, a
     /// measurement not possible): `--strict` and CI fail on them.
@@ -199,7 +210,7 @@ impl Job {
         }
         let t = Instant::now();
         let d = f(self);
-        let seconds = t.elapsed().as_secs_f64();
+        let seconds = d.seconds.unwrap_or_else(|| t.elapsed().as_secs_f64());
         let (status, summary, detail) = match d.outcome {
             Outcome::Ok(s) => (Status::Ok, s, String::new()),
             Outcome::Failed(s, d) => (Status::Failed, s, d),
