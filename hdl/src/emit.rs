@@ -310,7 +310,11 @@ fn header(v: &mut String, s: &Schedule) {
     for (b, bp) in s.branches.iter().enumerate() {
         let mux = if l.muxed[b] {
             let (hi, lo) = l.lane_bits(Role::MuxEn, b);
-            format!("{} mux device(s) at {}[{hi}:{lo}]", l.en_n[b], Role::MuxEn.name())
+            format!(
+                "{} mux device(s) at {}[{hi}:{lo}]",
+                l.en_n[b],
+                Role::MuxEn.name()
+            )
         } else {
             "no mux (no mux pins)".to_string()
         };
@@ -349,11 +353,7 @@ fn port_list(v: &mut String, l: &Layout) {
         let _ = writeln!(v, "    {dir} wire {range}{}{sep}", port.name);
     }
     for (i, port) in link_ports.iter().enumerate() {
-        let sep = if core_ports + i + 1 < nports {
-            ","
-        } else {
-            ""
-        };
+        let sep = if core_ports + i + 1 < nports { "," } else { "" };
         let range = if port.width > 1 {
             format!("[{}:0] ", port.width - 1)
         } else {

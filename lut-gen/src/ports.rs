@@ -438,7 +438,12 @@ impl Layout {
             panic!("{m}");
         }
         let nb = s.branches.len();
-        let muxed: Vec<bool> = s.mix.branches.iter().map(|b| b.mux.select_bits > 0).collect();
+        let muxed: Vec<bool> = s
+            .mix
+            .branches
+            .iter()
+            .map(|b| b.mux.select_bits > 0)
+            .collect();
         let (mut sel_lo, mut en_lo, mut en_n) = (vec![], vec![], vec![]);
         let (mut sel, mut acc) = (0, 0);
         for (b, bp) in s.branches.iter().enumerate() {
@@ -564,7 +569,9 @@ impl Layout {
 
     /// The lanes of branch `b`, in the order of [`Role::LANES`].
     pub fn lanes(&self, b: usize) -> impl Iterator<Item = Role> + '_ {
-        Role::LANES.into_iter().filter(move |&r| self.has_lane(r, b))
+        Role::LANES
+            .into_iter()
+            .filter(move |&r| self.has_lane(r, b))
     }
 
     /// The name of branch `b`'s lane of port `r` in `ports.json` and in a
@@ -583,11 +590,7 @@ impl Layout {
     /// # Panics
     /// When branch `b` has no such lane ([`Layout::has_lane`]).
     pub fn lane_bits(&self, r: Role, b: usize) -> (u32, u32) {
-        assert!(
-            self.has_lane(r, b),
-            "branch {b} has no {} lane",
-            r.name()
-        );
+        assert!(self.has_lane(r, b), "branch {b} has no {} lane", r.name());
         let b32 = b as u32;
         match r {
             Role::Miso | Role::CsN | Role::Sclk => (b32, b32),
@@ -841,5 +844,44 @@ mod tests {
         let (hi, lo) = l.lane_bits(Role::MuxEn, l.branches - 1);
         assert_eq!(hi + 1, l.mux_devices);
         assert!(lo <= hi);
+    }
+
+    /// cnvmix: branch 1 (`lone`, `mux = "none"`) between two branches with a
+    /// mux has no mux lanes; branch 2's lanes follow branch 0's directly.
+    #[test]
+    fn a_branch_without_a_mux_has_no_mux_lanes() {
+        let m = crate::mix::parse(
+            std::path::Path::new("cnvmix.toml"),
+            include_str!("../../hdl/tests/data/cnvmix.toml"),
+        )
+        .unwrap();
+        let s = crate::synthesize(&m).unwrap();
+        let l = Layout::new(&s);
+        assert_eq!(l.muxed, vec![true, false, true]);
+        assert_eq!(l.width(Role::MuxSel), 6);
+        assert_eq!(l.lane(Role::MuxSel, 2), "mux_sel[5:3]");
+        assert_eq!(l.lane(Role::MuxEn, 2), "mux_en[1]");
+        assert!(!l.lanes(1).any(|r| matches!(r, Role::MuxSel | Role::MuxEn)));
+        assert!(!l.signals().contains(&Signal::MuxEn(1)));
+        let total: u32 = l.port_widths().iter().sum();
+        assert_eq!(l.bits().len() as u32, total);
+        // the lone branch always converts its one channel; setting its
+        // (absent) mux changes no pin
+        let mut p = Pins::default();
+        l.set_mux(&mut p, 2, 0, 5);
+        let before = p;
+        l.set_mux(&mut p, 1, 0, 7);
+        assert_eq!(p, before);
+        assert_eq!(l.sel(&p, 2), 5);
+        assert_eq!(
+            l.selected(&p, 1)
+                .map(|c| m.channels[c as usize].name.clone()),
+            Ok("LONE".into())
+        );
+        let j: serde_json::Value = serde_json::from_str(&manifest(&s)).unwrap();
+        let lone = &j["branches"][1];
+        assert!(lone.get("mux_sel").is_none() && lone.get("mux_en").is_none());
+        assert_eq!(lone["cnv"], "adc_cs_n[1]");
+        assert_eq!(j["branches"][2]["mux_sel"], "mux_sel[5:3]");
     }
 }

@@ -254,7 +254,11 @@ fn signal_rows(s: &Schedule, l: &Layout, w: &Window, from: u64) -> Vec<Row> {
     for (b, br) in s.branches.iter().enumerate().rev() {
         let mut lanes = vec![
             (format!("{} sclk", br.name), Role::Sclk, 1.0),
-            (format!("{} {}", br.name, l.lane_key(Role::CsN, b)), Role::CsN, 1.0),
+            (
+                format!("{} {}", br.name, l.lane_key(Role::CsN, b)),
+                Role::CsN,
+                1.0,
+            ),
         ];
         if l.muxed[b] {
             // one-hot: the highest device's bit is the tallest step
