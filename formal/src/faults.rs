@@ -37,10 +37,11 @@ impl DeepFault {
         }
         match self {
             DeepFault::LateCounter { frames } => {
-                let sel = "    assign mux_sel = core_mux_sel[";
+                // a concatenation when some branch has no mux; no port when none has one
+                let sel = "    assign mux_sel = ";
                 let at = verilog
                     .find(sel)
-                    .ok_or("no `assign mux_sel` in the wrapper")?;
+                    .ok_or("no `assign mux_sel` in the wrapper (no branch has a mux)")?;
                 let end = at + verilog[at..].find(';').ok_or("unterminated assign")?;
                 // During cycle c the age is c + 1; flip in cycle frames * F + 1.
                 let hit = frames * s.grid.frame_cycles + 2;
@@ -50,7 +51,7 @@ impl DeepFault {
                      always @(posedge clk) fault_age <= rst ? 40'd0 : fault_age + 40'd1;\n    \
                      wire fault_hit = fault_age == 40'd{hit};\n"
                 );
-                let width = 3 * s.branches.len();
+                let width = lut_gen::ports::Layout::new(s).width(lut_gen::ports::Role::MuxSel);
                 let mut v = String::with_capacity(verilog.len() + logic.len() + 32);
                 v.push_str(&verilog[..end]);
                 v.push_str(&format!(" ^ {{{{{}{{1'b0}}}}, fault_hit}}", width - 1));

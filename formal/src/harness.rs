@@ -246,6 +246,26 @@ pub fn generate_with(s: &Schedule, form: TableForm) -> Result<Harness, HarnessEr
     })
 }
 
+/// The declarations of the top's mux ports; none when no branch has a mux
+/// (the top then has neither port).
+fn mux_wires(layout: &Layout) -> String {
+    if !layout.has(Role::MuxSel) {
+        return String::new();
+    }
+    format!(
+        "\n  wire [{}:0] mux_sel;\n  wire [{}:0] mux_en;",
+        layout.width(Role::MuxSel) - 1,
+        layout.width(Role::MuxEn) - 1
+    )
+}
+
+/// The `en` fields of branch `b`'s slot-table rows: its devices, and one
+/// constant device for a branch without a mux (whose rows are never
+/// compared with any pin: it has none).
+fn row_en(layout: &Layout, b: usize) -> u32 {
+    layout.en_n[b].max(1)
+}
+
 fn header(v: &mut String, s: &Schedule, layout: &Layout, form: TableForm) {
     let g = &s.grid;
     let nb = s.branches.len();
@@ -267,11 +287,10 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout, form: TableForm) {
         v,
         "  // st: 0 before the reset edge, 1 the reset cycle, 2 cycle 0 on.\n  \
          reg [1:0] st = 2'd0;\n  wire rst = st == 2'd0;\n  \
-         wire [{}:0] adc_cs_n, adc_sclk;\n  wire [{}:0] mux_sel;\n  wire [{}:0] mux_en;\n  \
+         wire [{}:0] adc_cs_n, adc_sclk;{}\n  \
          wire sample_valid;\n  wire [{}:0] sample_channel;\n  wire [{}:0] sample_value;",
         nb - 1,
-        w(Role::MuxSel) - 1,
-        w(Role::MuxEn) - 1,
+        mux_wires(layout),
         w(Role::SampleChannel) - 1,
         w(Role::SampleValue) - 1
     );
@@ -281,8 +300,13 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout, form: TableForm) {
     let _ = writeln!(
         v,
         "  {TOP_MODULE} dut (.clk(clk), .rst(rst), .adc_miso(adc_miso), .adc_cs_n(adc_cs_n),\n    \
-         .adc_sclk(adc_sclk), .mux_sel(mux_sel), .mux_en(mux_en), .sample_valid(sample_valid),\n    \
-         .sample_channel(sample_channel), .sample_value(sample_value){link_ports});"
+         .adc_sclk(adc_sclk),{} .sample_valid(sample_valid),\n    \
+         .sample_channel(sample_channel), .sample_value(sample_value){link_ports});",
+        if layout.has(Role::MuxSel) {
+            " .mux_sel(mux_sel), .mux_en(mux_en),"
+        } else {
+            ""
+        }
     );
     let (cb, sb) = (width(g.slot_cycles), width(g.frame_slots));
     let _ = writeln!(
@@ -325,7 +349,7 @@ fn slot_table(
     form: TableForm,
 ) -> Result<String, HarnessError> {
     let rows = branch_rows(s, b);
-    let (chb, en_n) = (layout.channel_bits, layout.en_n[b]);
+    let (chb, en_n) = (layout.channel_bits, row_en(layout, b));
     let word = |r: &Row| r.verilog(chb, en_n);
     match form {
         TableForm::Full => Ok(full_table(s, b, &rows, &word)),
@@ -414,19 +438,19 @@ fn branch(
     let _ = writeln!(
         v,
         "  reg [{}:0] tab{b};",
-        row_bits(layout.channel_bits, layout.en_n[b]) - 1
+        row_bits(layout.channel_bits, row_en(layout, b)) - 1
     );
     v.push_str(table);
     branch_conversion(v, s, layout, b);
     branch_expectations(v, s, layout, b);
-    branch_properties(props, b, &p.name);
+    branch_properties(props, b, &p.name, layout.muxed[b]);
 }
 
 /// The row's `act` and `lead` fields, and when branch `b` converts.
 fn branch_conversion(v: &mut String, s: &Schedule, layout: &Layout, b: usize) {
     let (cb, sb) = (width(s.grid.slot_cycles), width(s.grid.frame_slots));
     let chb = layout.channel_bits;
-    let row = RowFields::new(chb, layout.en_n[b]);
+    let row = RowFields::new(chb, row_en(layout, b));
     let r = s.branches[b].spi.read_cycles;
     let skip = s.skipped_at_startup(b, 0);
     let _ = writeln!(
@@ -484,7 +508,7 @@ fn sclk_phases(spi: &SpiTiming, cb: u32) -> SclkPhases {
 fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) {
     let spi = &s.branches[b].spi;
     let cb = width(s.grid.slot_cycles);
-    let en_n = layout.en_n[b];
+    let en_n = row_en(layout, b);
     let row = RowFields::new(layout.channel_bits, en_n);
     let (r, n) = (spi.read_cycles, spi.sclks());
     let SclkPhases {
@@ -503,8 +527,13 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
             format!("!(conv{b} && ({}))", ranges(cb, &low)),
         )
     };
-    let (sel_hi, sel_lo) = layout.lane_bits(Role::MuxSel, b);
-    let (en_hi, en_lo) = layout.lane_bits(Role::MuxEn, b);
+    let ok_mux = if layout.muxed[b] {
+        let (sel_hi, sel_lo) = layout.lane_bits(Role::MuxSel, b);
+        let (en_hi, en_lo) = layout.lane_bits(Role::MuxEn, b);
+        format!("mux_sel[{sel_hi}:{sel_lo}] == exp_sel{b} && mux_en[{en_hi}:{en_lo}] == exp_en{b}")
+    } else {
+        "1'b1".to_string() // no mux pins; its property is not listed
+    };
     let (lo1, lo_e1, lo0, lo_e0) = (row.sel1, row.en1, row.sel0, row.en0);
     let _ = writeln!(
         v,
@@ -514,7 +543,7 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
          wire cap{b} = conv{b} && ({});\n  wire done{b} = conv{b} && cyc == {cb}'d{r};\n  \
          reg [{}:0] w{b} = 0;\n  always @(posedge clk) if (cap{b}) w{b} <= {{w{b}[{}:0], adc_miso[{b}]}};\n  \
          wire ok_cs{b} = adc_cs_n[{b}] == exp_cs{b};\n  wire ok_sclk{b} = adc_sclk[{b}] == exp_sclk{b};\n  \
-         wire ok_mux{b} = mux_sel[{sel_hi}:{sel_lo}] == exp_sel{b} && mux_en[{en_hi}:{en_lo}] == exp_en{b};",
+         wire ok_mux{b} = {ok_mux};",
         en_n - 1,
         lo_e0 + en_n - 1,
         lo_e1 + en_n - 1,
@@ -527,7 +556,7 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
 }
 
 /// The properties of branch `b`, called `name`.
-fn branch_properties(props: &mut Vec<PropertyDef>, b: usize, name: &str) {
+fn branch_properties(props: &mut Vec<PropertyDef>, b: usize, name: &str, muxed: bool) {
     props.push(PropertyDef {
         name: format!("conversion[{name}]"),
         wire: format!("ok_cs{b}"),
@@ -543,6 +572,9 @@ fn branch_properties(props: &mut Vec<PropertyDef>, b: usize, name: &str) {
         what: "SCLK count, period, phase and idle level of every conversion as the part needs"
             .into(),
     });
+    if !muxed {
+        return; // a branch without a mux has no mux pins to assert
+    }
     props.push(PropertyDef {
         name: format!("mux[{name}]"),
         wire: format!("ok_mux{b}"),

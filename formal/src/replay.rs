@@ -96,7 +96,10 @@ fn gtkw(s: &Schedule, h: &Harness, vcd: &Path) -> String {
         let _ = writeln!(g, "{DUT_SCOPE}.{}[{}:0]", r.name(), layout.width(r) - 1);
     }
     let _ = writeln!(g, "@22");
-    for r in [Role::MuxSel, Role::MuxEn] {
+    for r in [Role::MuxSel, Role::MuxEn]
+        .into_iter()
+        .filter(|&r| layout.has(r))
+    {
         let _ = writeln!(g, "{DUT_SCOPE}.{}[{}:0]", r.name(), layout.width(r) - 1);
     }
     let _ = writeln!(g, "@28\n{DUT_SCOPE}.sample_valid\n@24");

@@ -150,6 +150,16 @@ fn a_fault_after_five_frames_fails_and_is_never_called_proved() {
 /// and a 1 ms frame (4,000 cycles) so each proof takes seconds: one to
 /// three branches, one or two mux devices, SCLK, settling and rates drawn.
 fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
+    unseen_mixes_with(count, 0, &|_| true)
+}
+
+/// [`unseen_mixes`] with branches drawn without a mux 1 in `muxless`, kept
+/// when `keep` says so.
+fn unseen_mixes_with(
+    count: usize,
+    muxless: u64,
+    keep: &dyn Fn(&lut_gen::Schedule) -> bool,
+) -> Vec<(u64, lut_gen::Schedule)> {
     let shape = campaign::Shape {
         clock_hz: 4_000_000,
         frame_us: 1_000,
@@ -160,6 +170,7 @@ fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
         settle_ns: vec![0, 1_000, 2_000],
         channels: (2, 8),
         rates_hz: vec![1_000, 2_000, 4_000],
+        muxless,
     };
     let mut found = Vec::new();
     for seed in 1..200u64 {
@@ -173,7 +184,7 @@ fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
         let Ok(s) = lut_gen::synthesize(&mix) else {
             continue;
         };
-        if formal::generate(&s).is_err() {
+        if formal::generate(&s).is_err() || !keep(&s) {
             continue;
         }
         found.push((seed, s));
@@ -202,6 +213,41 @@ fn an_unseen_random_mix_proves() {
     }
     let (seed, s) = unseen_mixes(1).remove(0);
     assert_unseen_mix_proves(seed, &s);
+}
+
+/// A random mix with a branch that has no mux (`mux = "none"`) beside one
+/// that has: the top has no mux lanes for it, the harness asserts none for
+/// it (no `mux[...]` property), and the rest of the contract proves.
+#[test]
+fn an_unseen_mix_with_a_muxless_branch_proves() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let mixed = |s: &lut_gen::Schedule| {
+        let l = lut_gen::ports::Layout::new(s);
+        l.muxed.contains(&true) && l.muxed.contains(&false)
+    };
+    let (seed, s) = unseen_mixes_with(1, 2, &mixed).remove(0);
+    let l = lut_gen::ports::Layout::new(&s);
+    let h = formal::generate(&s).unwrap();
+    for (b, br) in s.branches.iter().enumerate() {
+        let named = h
+            .properties
+            .iter()
+            .any(|p| p.name == format!("mux[{}]", br.name));
+        assert_eq!(named, l.muxed[b], "seed {seed}: branch {}", br.name);
+    }
+    assert_unseen_mix_proves(seed, &s);
+}
+
+/// vibrotactile8k has no mux at all: its top has no `mux_sel`/`mux_en`, and
+/// the harness neither declares nor connects them.
+#[test]
+fn a_mix_without_muxes_has_a_harness_without_mux_pins() {
+    let s = schedule("mixes/vibrotactile8k.toml");
+    let h = formal::generate(&s).unwrap();
+    assert!(!h.verilog.contains("mux_sel") && !h.verilog.contains("mux_en"));
+    assert!(!h.properties.iter().any(|p| p.name.starts_with("mux[")));
 }
 
 #[test]

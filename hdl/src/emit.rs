@@ -267,7 +267,7 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
         .replace("endmodule // top\n", &format!("endmodule // {CORE}\n"));
     let l = Layout::new(s);
     let mut v = String::new();
-    header(&mut v, s, p);
+    header(&mut v, s);
     port_list(&mut v, &l);
     let wired = core_wires(&mut v, p, &l);
     core_instance(&mut v, &wired);
@@ -290,7 +290,7 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
 
 /// The wrapper's header comment: the mix, the grid, each branch's SPI timing
 /// and mux enables.
-fn header(v: &mut String, s: &Schedule, p: &Plan) {
+fn header(v: &mut String, s: &Schedule) {
     let g = &s.grid;
     let _ = writeln!(
         v,
@@ -306,18 +306,22 @@ fn header(v: &mut String, s: &Schedule, p: &Plan) {
         "// clock {} Hz, frame {} cycles = {} slices x {} slots x {} cycles",
         g.clock_hz, g.frame_cycles, g.slices_per_frame, g.slots_per_slice, g.slot_cycles
     );
+    let l = Layout::new(s);
     for (b, bp) in s.branches.iter().enumerate() {
+        let mux = if l.muxed[b] {
+            let (hi, lo) = l.lane_bits(Role::MuxEn, b);
+            format!(
+                "{} mux device(s) at {}[{hi}:{lo}]",
+                l.en_n[b],
+                Role::MuxEn.name()
+            )
+        } else {
+            "no mux (no mux pins)".to_string()
+        };
         let _ = writeln!(
             v,
-            "// branch {b} \"{}\": sclk_div {} setup {} read {} cycles, {} mux device(s) at {}[{}:{}]",
-            bp.name,
-            bp.spi.sclk_div,
-            bp.spi.setup_cycles,
-            bp.spi.read_cycles,
-            p.branches[b].devices,
-            Role::MuxEn.name(),
-            p.branches[b].en_offset + p.branches[b].devices - 1,
-            p.branches[b].en_offset
+            "// branch {b} \"{}\": sclk_div {} setup {} read {} cycles, {mux}",
+            bp.name, bp.spi.sclk_div, bp.spi.setup_cycles, bp.spi.read_cycles,
         );
     }
     let _ = writeln!(
@@ -333,8 +337,9 @@ fn header(v: &mut String, s: &Schedule, p: &Plan) {
 fn port_list(v: &mut String, l: &Layout) {
     let _ = writeln!(v, "module {TOP_MODULE} (");
     let link_ports = l.link_ports();
-    let nports = PORTS.len() + link_ports.len();
-    for (i, port) in PORTS.iter().enumerate() {
+    let core_ports = l.ports().count();
+    let nports = core_ports + link_ports.len();
+    for (i, port) in l.ports().enumerate() {
         let dir = match port.dir {
             Dir::In => "input ",
             Dir::Out => "output",
@@ -348,11 +353,7 @@ fn port_list(v: &mut String, l: &Layout) {
         let _ = writeln!(v, "    {dir} wire {range}{}{sep}", port.name);
     }
     for (i, port) in link_ports.iter().enumerate() {
-        let sep = if PORTS.len() + i + 1 < nports {
-            ","
-        } else {
-            ""
-        };
+        let sep = if core_ports + i + 1 < nports { "," } else { "" };
         let range = if port.width > 1 {
             format!("[{}:0] ", port.width - 1)
         } else {
@@ -401,10 +402,19 @@ fn core_wires(v: &mut String, p: &Plan, l: &Layout) -> Vec<(Role, &'static str, 
                 let _ = writeln!(v, "    assign {wire} = {name};");
             }
             Dir::Out => {
-                let _ = writeln!(v, "    assign {name} = {wire}[{}:0];", w - 1);
-                if w < cw {
-                    unused.push(format!("{wire}[{}:{w}]", cw - 1));
+                let used = core_bits(r, p, l);
+                let part = |(hi, lo): (usize, usize)| format!("{wire}[{hi}:{lo}]");
+                match used.as_slice() {
+                    [] => {}
+                    [one] => {
+                        let _ = writeln!(v, "    assign {name} = {};", part(*one));
+                    }
+                    many => {
+                        let cat: Vec<String> = many.iter().rev().map(|&x| part(x)).collect();
+                        let _ = writeln!(v, "    assign {name} = {{{}}};", cat.join(", "));
+                    }
                 }
+                unused.extend(gaps(&used, cw).into_iter().map(part));
             }
         }
     }
@@ -416,6 +426,56 @@ fn core_wires(v: &mut String, p: &Plan, l: &Layout) -> Vec<(Role, &'static str, 
         );
     }
     wired
+}
+
+/// The core's bits that carry output port `r`'s bits, as `(msb, lsb)` runs
+/// from the port's bit 0 up: the core keeps every branch's mux lanes at
+/// fixed places (`3b` for a select, the plan's `en_offset` for enables, one
+/// constant device for a branch without a mux), the port has only the lanes
+/// of branches that have a mux.
+fn core_bits(r: Role, p: &Plan, l: &Layout) -> Vec<(usize, usize)> {
+    let runs: Vec<(usize, usize)> = match r {
+        Role::MuxSel => (0..l.branches)
+            .filter(|&b| l.muxed[b])
+            .map(|b| {
+                let k = ports::MUX_SELECT_BITS as usize;
+                (k * b + k - 1, k * b)
+            })
+            .collect(),
+        Role::MuxEn => (0..l.branches)
+            .filter(|&b| l.muxed[b])
+            .map(|b| {
+                let (o, n) = (p.branches[b].en_offset, p.branches[b].devices);
+                (o + n - 1, o)
+            })
+            .collect(),
+        r if l.width(r) > 0 => vec![(l.width(r) as usize - 1, 0)],
+        _ => vec![],
+    };
+    let mut merged: Vec<(usize, usize)> = vec![];
+    for (hi, lo) in runs {
+        match merged.last_mut() {
+            Some(last) if last.0 + 1 == lo => last.0 = hi,
+            _ => merged.push((hi, lo)),
+        }
+    }
+    merged
+}
+
+/// The runs of a `width`-bit core wire that `used` (ascending runs) leaves out.
+fn gaps(used: &[(usize, usize)], width: usize) -> Vec<(usize, usize)> {
+    let mut v = vec![];
+    let mut next = 0;
+    for &(hi, lo) in used {
+        if lo > next {
+            v.push((lo - 1, next));
+        }
+        next = hi + 1;
+    }
+    if next < width {
+        v.push((width - 1, next));
+    }
+    v
 }
 
 /// The core instance, its ports on the wires or straight on the wrapper's.
@@ -606,8 +666,8 @@ fn xdc(s: &Schedule) -> String {
     let _ = writeln!(
         t,
         "set_property IOSTANDARD LVCMOS33 [get_ports {{{}}}]",
-        PORTS
-            .iter()
+        Layout::new(s)
+            .ports()
             .map(|p| if p.vector {
                 format!("{}[*]", p.name)
             } else {

@@ -79,7 +79,12 @@ pub struct BranchRom {
     /// (docs/timing.md, "Start-up").
     pub conv0: bool,
     pub devices: usize,
-    /// First device bit of this branch in the `mux_en` port.
+    /// The branch has a multiplexer.  Without one (`mux = "none"`) the core
+    /// still drives a constant device 0 at `en_offset`, but the wrapper and
+    /// [`crate::RtlSim`] leave its mux lanes out of `slotforge_top`'s ports.
+    pub muxed: bool,
+    /// First device bit of this branch in the core's `mux_en` (the port's
+    /// when every branch has a multiplexer).
     pub en_offset: usize,
     /// The conversion pin is a CNV (active high, SCK idles low), not a CS.
     pub cnv: bool,
@@ -360,6 +365,7 @@ fn branch_rom(
         // an instant at cycle 0 it cannot have settled for is skipped.
         conv0: slots[0].is_some() && bp.settle_cycles <= 1,
         devices,
+        muxed: s.mix.branches[b].mux.select_bits > 0,
         en_offset,
         cnv,
         bits: adc.bits,

@@ -68,32 +68,60 @@ pub struct RtlSim {
 }
 
 /// What is needed to turn the core's fixed-maximum ports into [`Pins`].
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(crate) struct PinReader {
     nb: usize,
     lanes: u16,
     ch_mask: u16,
+    /// Some branch has no multiplexer: the port's mux lanes are the core's
+    /// without that branch's, moved down (`(core_sel_lo, core_en_lo,
+    /// devices)` of each branch that has one, in branch order).
+    pack: Option<Vec<(u32, u32, u32)>>,
 }
 
 impl PinReader {
     pub(crate) fn new(p: &plan::Plan) -> PinReader {
         let nb = p.branches.len();
+        let pack = p.branches.iter().any(|b| !b.muxed).then(|| {
+            (p.branches.iter().enumerate())
+                .filter(|(_, r)| r.muxed)
+                .map(|(b, r)| (3 * b as u32, r.en_offset as u32, r.devices as u32))
+                .collect()
+        });
         PinReader {
             nb,
             lanes: ((1u32 << nb) - 1) as u16,
             ch_mask: ((1u32 << p.channel_bits) - 1) as u16,
+            pack,
         }
+    }
+
+    /// The ports' `mux_sel` and `mux_en` from the core's.
+    #[inline]
+    fn mux(&self, sel: u64, en: u128) -> (u64, u128) {
+        let Some(pack) = &self.pack else {
+            return (sel, en);
+        };
+        let (mut s, mut e, mut at_s, mut at_e) = (0u64, 0u128, 0, 0);
+        for &(sl, el, n) in pack {
+            s |= ((sel >> sl) & 7) << at_s;
+            e |= ((en >> el) & ((1u128 << n) - 1)) << at_e;
+            at_s += 3;
+            at_e += n;
+        }
+        (s, e)
     }
 }
 
 /// The `slotforge_top` outputs of the core as they are now.
 #[inline]
 pub(crate) fn read_pins(c: &Core, r: &PinReader) -> Pins {
+    let (mux_sel, mux_en) = r.mux(c.mux_sel_u64(), c.mux_en_u128());
     Pins {
         cs_n: c.adc_cs_n.val().to_u64() as u16 & r.lanes,
         sclk: c.adc_sclk.val().to_u64() as u16 & r.lanes,
-        mux_sel: c.mux_sel_u64(),
-        mux_en: c.mux_en_u128(),
+        mux_sel,
+        mux_en,
         sample_valid: c.sample_valid.val(),
         sample_channel: c.sample_channel.val().to_u64() as u16 & r.ch_mask,
         sample_value: c.sample_value.val().to_u64() as u16,

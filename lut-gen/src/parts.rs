@@ -158,8 +158,8 @@ impl MuxPart {
     };
 
     /// No multiplexer: the converter is wired straight to its sensor (one
-    /// input).  The branch's mux lanes stay in the pin contract and hold a
-    /// constant address (select 0, device 0 enabled); they connect to nothing.
+    /// input).  The branch has no mux lanes in the pin contract (no
+    /// `mux_sel`, no `mux_en` bits: `lut_gen::ports::Layout::muxed`).
     pub const NONE: MuxPart = MuxPart {
         name: "none",
         inputs: 1,

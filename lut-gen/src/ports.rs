@@ -193,9 +193,10 @@ impl Pins {
 
 /// The value of every output port of `slotforge_top` in one cycle.
 ///
-/// Bit `b` of `cs_n`/`sclk` is branch `b`, `mux_sel[3b+2:3b]` is branch
-/// `b`'s select, `mux_en` holds the branches' devices in branch order (see
-/// [`Layout`]).  Sized for [`limits`].
+/// Bit `b` of `cs_n`/`sclk` is branch `b`; `mux_sel` holds the selects and
+/// `mux_en` the devices of the branches that have a multiplexer, in branch
+/// order (`mux_sel[3b+2:3b]` is branch `b`'s select when every branch has
+/// one; see [`Layout`]).  Sized for [`limits`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, Serialize)]
 pub struct Pins {
     pub cs_n: u16,
@@ -398,9 +399,16 @@ impl Signal {
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Layout {
     pub branches: usize,
+    /// Whether each branch has a multiplexer.  A branch with `mux = "none"`
+    /// has no mux lanes at all: no `mux_sel` bits, no `mux_en` bits, so a
+    /// board never routes pins that connect to nothing.
+    pub muxed: Vec<bool>,
+    /// First `mux_sel` bit of each branch ([`MUX_SELECT_BITS`] wide when
+    /// the branch has a mux, none otherwise).
+    pub sel_lo: Vec<u32>,
     /// First `mux_en` bit of each branch.
     pub en_lo: Vec<u32>,
-    /// `mux_en` bits of each branch (at least one).
+    /// `mux_en` bits of each branch (at least one with a mux, 0 without).
     pub en_n: Vec<u32>,
     /// Total mux devices (width of `mux_en`).
     pub mux_devices: u32,
@@ -430,16 +438,24 @@ impl Layout {
             panic!("{m}");
         }
         let nb = s.branches.len();
-        let mut en_lo = Vec::with_capacity(nb);
-        let mut en_n = Vec::with_capacity(nb);
-        let mut acc = 0;
-        for b in &s.branches {
+        let muxed: Vec<bool> = s
+            .mix
+            .branches
+            .iter()
+            .map(|b| b.mux.select_bits > 0)
+            .collect();
+        let (mut sel_lo, mut en_lo, mut en_n) = (vec![], vec![], vec![]);
+        let (mut sel, mut acc) = (0, 0);
+        for (b, bp) in s.branches.iter().enumerate() {
+            let n = if muxed[b] { bp.mux_devices.max(1) } else { 0 };
+            sel_lo.push(sel);
             en_lo.push(acc);
-            en_n.push(b.mux_devices.max(1));
-            acc += b.mux_devices.max(1);
+            en_n.push(n);
+            sel += if muxed[b] { MUX_SELECT_BITS } else { 0 };
+            acc += n;
         }
         let mut lookup: Vec<Vec<Option<u16>>> = (0..nb)
-            .map(|b| vec![None; (en_n[b] * INPUTS_PER_DEVICE) as usize])
+            .map(|b| vec![None; (en_n[b].max(1) * INPUTS_PER_DEVICE) as usize])
             .collect();
         for (c, ch) in s.channels.iter().enumerate() {
             let b = s.mix.channels[c].branch;
@@ -451,6 +467,8 @@ impl Layout {
         }
         Layout {
             branches: nb,
+            muxed,
+            sel_lo,
             en_lo,
             en_n,
             mux_devices: acc,
@@ -515,29 +533,70 @@ impl Layout {
         match r {
             Role::Clock | Role::Reset | Role::SampleValid => 1,
             Role::Miso | Role::CsN | Role::Sclk => nb,
-            Role::MuxSel => MUX_SELECT_BITS * nb,
+            Role::MuxSel => MUX_SELECT_BITS * self.muxed.iter().filter(|&&m| m).count() as u32,
             Role::MuxEn => self.mux_devices,
             Role::SampleChannel => self.channel_bits,
             Role::SampleValue => self.value_bits,
         }
     }
 
-    /// Width of each port of [`PORTS`], in the same order.
+    /// Width of each port of [`PORTS`], in the same order (0: a port the
+    /// top does not have, see [`Layout::has`]).
     pub fn port_widths(&self) -> [u32; 10] {
         Role::ALL.map(|r| self.width(r))
     }
 
+    /// Whether the top has port `r`: `mux_sel` and `mux_en` exist only when
+    /// some branch has a multiplexer.
+    pub fn has(&self, r: Role) -> bool {
+        self.width(r) > 0
+    }
+
+    /// The ports of [`PORTS`] the top has, in port order.
+    pub fn ports(&self) -> impl Iterator<Item = &'static Port> + '_ {
+        PORTS.iter().filter(|p| self.has(p.role))
+    }
+
+    /// Whether branch `b` has a lane of port `r`: every branch has its SPI
+    /// lanes, only a branch with a multiplexer has mux lanes.
+    pub fn has_lane(&self, r: Role, b: usize) -> bool {
+        match r {
+            Role::Miso | Role::CsN | Role::Sclk => true,
+            Role::MuxSel | Role::MuxEn => self.muxed[b],
+            _ => false,
+        }
+    }
+
+    /// The lanes of branch `b`, in the order of [`Role::LANES`].
+    pub fn lanes(&self, b: usize) -> impl Iterator<Item = Role> + '_ {
+        Role::LANES
+            .into_iter()
+            .filter(move |&r| self.has_lane(r, b))
+    }
+
+    /// The name of branch `b`'s lane of port `r` in `ports.json` and in a
+    /// waveform's per-branch view: the role's key, except that the
+    /// `adc_cs_n` lane of a CNV-started part (AD7685) is its `cnv`, active
+    /// high, not a chip select.
+    pub fn lane_key(&self, r: Role, b: usize) -> &'static str {
+        match r {
+            Role::CsN if self.starts[b] == Start::Cnv => "cnv",
+            r => r.key(),
+        }
+    }
+
     /// The bits of port `r` that belong to branch `b`, as `(msb, lsb)`.
+    ///
+    /// # Panics
+    /// When branch `b` has no such lane ([`Layout::has_lane`]).
     pub fn lane_bits(&self, r: Role, b: usize) -> (u32, u32) {
+        assert!(self.has_lane(r, b), "branch {b} has no {} lane", r.name());
         let b32 = b as u32;
         match r {
             Role::Miso | Role::CsN | Role::Sclk => (b32, b32),
-            Role::MuxSel => (
-                MUX_SELECT_BITS * b32 + MUX_SELECT_BITS - 1,
-                MUX_SELECT_BITS * b32,
-            ),
+            Role::MuxSel => (self.sel_lo[b] + MUX_SELECT_BITS - 1, self.sel_lo[b]),
             Role::MuxEn => (self.en_lo[b] + self.en_n[b] - 1, self.en_lo[b]),
-            _ => panic!("{} has no branch lanes", r.name()),
+            _ => unreachable!(),
         }
     }
 
@@ -556,7 +615,7 @@ impl Layout {
     /// `adc_miso[0]`, ...): the rows of a PCF or XDC.
     pub fn bits(&self) -> Vec<(String, Dir)> {
         let mut v = Vec::new();
-        for p in &PORTS {
+        for p in self.ports() {
             if p.vector {
                 for i in 0..self.width(p.role) {
                     v.push((format!("{}[{i}]", p.name), p.dir));
@@ -575,19 +634,31 @@ impl Layout {
         v
     }
 
+    /// Branch `b`'s select (0 for a branch without a mux).
     #[inline]
     pub fn sel(&self, p: &Pins, b: usize) -> u32 {
-        ((p.mux_sel >> (MUX_SELECT_BITS as usize * b)) & (INPUTS_PER_DEVICE as u64 - 1)) as u32
+        if !self.muxed[b] {
+            return 0;
+        }
+        ((p.mux_sel >> self.sel_lo[b]) & (INPUTS_PER_DEVICE as u64 - 1)) as u32
     }
 
+    /// Branch `b`'s device enables (0 for a branch without a mux).
     #[inline]
     pub fn en(&self, p: &Pins, b: usize) -> u64 {
+        if !self.muxed[b] {
+            return 0;
+        }
         ((p.mux_en >> self.en_lo[b]) as u64) & ((1u64 << self.en_n[b]) - 1)
     }
 
-    /// Branch `b`'s mux pins addressing `(device, select)`.
+    /// Branch `b`'s mux pins addressing `(device, select)`; a branch without
+    /// a mux has no pins to set.
     pub fn set_mux(&self, p: &mut Pins, b: usize, device: u32, select: u32) {
-        let sh = MUX_SELECT_BITS as usize * b;
+        if !self.muxed[b] {
+            return;
+        }
+        let sh = self.sel_lo[b] as usize;
         let m = INPUTS_PER_DEVICE as u64 - 1;
         p.mux_sel = (p.mux_sel & !(m << sh)) | ((select as u64 & m) << sh);
         let mask = ((1u128 << self.en_n[b]) - 1) << self.en_lo[b];
@@ -596,6 +667,10 @@ impl Layout {
 
     /// The channel branch `b`'s mux pins select, or why none is.
     pub fn selected(&self, p: &Pins, b: usize) -> Result<u16, String> {
+        if !self.muxed[b] {
+            // wired straight to its sensor: the one input is always selected
+            return self.lookup[b][0].ok_or_else(|| format!("no channel on branch {b}"));
+        }
         let en = self.en(p, b);
         if en.count_ones() != 1 {
             return Err(format!(
@@ -615,8 +690,10 @@ impl Layout {
         for b in 0..self.branches {
             v.push(Signal::CsN(b));
             v.push(Signal::Sclk(b));
-            v.push(Signal::MuxSel(b));
-            v.push(Signal::MuxEn(b));
+            if self.muxed[b] {
+                v.push(Signal::MuxSel(b));
+                v.push(Signal::MuxEn(b));
+            }
         }
         v.extend([
             Signal::SampleValid,
@@ -646,23 +723,20 @@ pub fn manifest(s: &Schedule) -> String {
         .iter()
         .enumerate()
         .map(|(b, bp)| {
-            let (_, en_lo) = l.lane_bits(Role::MuxEn, b);
             let mut o = serde_json::Map::new();
             o.insert("name".into(), json!(bp.name));
-            for r in Role::LANES {
+            for r in l.lanes(b) {
                 let v = match r {
-                    Role::MuxEn => json!((0..s.branches[b].mux_devices.max(1))
-                        .map(|d| bit(Role::MuxEn, en_lo + d))
+                    Role::MuxEn => json!((0..l.en_n[b])
+                        .map(|d| bit(Role::MuxEn, l.en_lo[b] + d))
                         .collect::<Vec<_>>()),
                     r => json!(l.lane(r, b)),
                 };
+                o.insert(l.lane_key(r, b).into(), v);
                 if r == Role::CsN && l.starts[b] == Start::Cnv {
                     // The same lane, driven as the AD7685's CNV (active high).
-                    o.insert("cnv".into(), v);
                     o.insert("active_high".into(), json!(true));
-                    continue;
                 }
-                o.insert(r.key().into(), v);
             }
             if s.mix.branches[b].adc.start == Start::Cnv || s.mix.branches[b].chain > 1 {
                 o.insert("adc".into(), json!(s.mix.branches[b].adc.name));
@@ -690,8 +764,8 @@ pub fn manifest(s: &Schedule) -> String {
             })
         })
         .collect();
-    let mut ports: Vec<_> = PORTS
-        .iter()
+    let mut ports: Vec<_> = l
+        .ports()
         .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": l.width(p.role)}))
         .collect();
     ports.extend(
@@ -770,5 +844,44 @@ mod tests {
         let (hi, lo) = l.lane_bits(Role::MuxEn, l.branches - 1);
         assert_eq!(hi + 1, l.mux_devices);
         assert!(lo <= hi);
+    }
+
+    /// cnvmix: branch 1 (`lone`, `mux = "none"`) between two branches with a
+    /// mux has no mux lanes; branch 2's lanes follow branch 0's directly.
+    #[test]
+    fn a_branch_without_a_mux_has_no_mux_lanes() {
+        let m = crate::mix::parse(
+            std::path::Path::new("cnvmix.toml"),
+            include_str!("../../hdl/tests/data/cnvmix.toml"),
+        )
+        .unwrap();
+        let s = crate::synthesize(&m).unwrap();
+        let l = Layout::new(&s);
+        assert_eq!(l.muxed, vec![true, false, true]);
+        assert_eq!(l.width(Role::MuxSel), 6);
+        assert_eq!(l.lane(Role::MuxSel, 2), "mux_sel[5:3]");
+        assert_eq!(l.lane(Role::MuxEn, 2), "mux_en[1]");
+        assert!(!l.lanes(1).any(|r| matches!(r, Role::MuxSel | Role::MuxEn)));
+        assert!(!l.signals().contains(&Signal::MuxEn(1)));
+        let total: u32 = l.port_widths().iter().sum();
+        assert_eq!(l.bits().len() as u32, total);
+        // the lone branch always converts its one channel; setting its
+        // (absent) mux changes no pin
+        let mut p = Pins::default();
+        l.set_mux(&mut p, 2, 0, 5);
+        let before = p;
+        l.set_mux(&mut p, 1, 0, 7);
+        assert_eq!(p, before);
+        assert_eq!(l.sel(&p, 2), 5);
+        assert_eq!(
+            l.selected(&p, 1)
+                .map(|c| m.channels[c as usize].name.clone()),
+            Ok("LONE".into())
+        );
+        let j: serde_json::Value = serde_json::from_str(&manifest(&s)).unwrap();
+        let lone = &j["branches"][1];
+        assert!(lone.get("mux_sel").is_none() && lone.get("mux_en").is_none());
+        assert_eq!(lone["cnv"], "adc_cs_n[1]");
+        assert_eq!(j["branches"][2]["mux_sel"], "mux_sel[5:3]");
     }
 }

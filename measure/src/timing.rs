@@ -252,15 +252,21 @@ fn signal_rows(s: &Schedule, l: &Layout, w: &Window, from: u64) -> Vec<Row> {
         1.0,
     )];
     for (b, br) in s.branches.iter().enumerate().rev() {
-        // one-hot: the highest device's bit is the tallest step
-        let (hi, lo) = l.lane_bits(Role::MuxEn, b);
-        let en_max = (1u64 << (hi - lo)) as f64;
-        let lanes = [
+        let mut lanes = vec![
             (format!("{} sclk", br.name), Role::Sclk, 1.0),
-            (format!("{} {}", br.name, Role::CsN.key()), Role::CsN, 1.0),
-            (format!("{} mux_sel", br.name), Role::MuxSel, 7.0),
-            (format!("{} mux_en", br.name), Role::MuxEn, en_max),
+            (
+                format!("{} {}", br.name, l.lane_key(Role::CsN, b)),
+                Role::CsN,
+                1.0,
+            ),
         ];
+        if l.muxed[b] {
+            // one-hot: the highest device's bit is the tallest step
+            let (hi, lo) = l.lane_bits(Role::MuxEn, b);
+            let en_max = (1u64 << (hi - lo)) as f64;
+            lanes.push((format!("{} mux_sel", br.name), Role::MuxSel, 7.0));
+            lanes.push((format!("{} mux_en", br.name), Role::MuxEn, en_max));
+        }
         for (name, role, scale) in lanes {
             rows.push((name, changes(&|p| lane(l, p, role, b)), scale));
         }
@@ -308,7 +314,11 @@ fn select_labels(view: &View, names: &[String], labels: &mut Series) {
             .map_or(0.0, |i| i as f64)
     };
     let (x0, span) = view.span();
+    let l = Layout::new(s);
     for (b, br) in s.branches.iter().enumerate() {
+        if !l.muxed[b] {
+            continue; // no select row to label
+        }
         let r = row_of(&format!("{} mux_sel", br.name));
         let texts: Vec<(f64, String)> = s
             .instants(3)
@@ -475,15 +485,20 @@ fn wavedrom(s: &Schedule, l: &Layout, w: &Window, _nb: usize) -> Result<(String,
             "-".into()
         }
     });
+    let mut signal = vec![
+        serde_json::json!({"name": l.lane_key(Role::CsN, 0), "wave": wave(&|p, _| cs(p), false)}),
+        serde_json::json!({"name": Role::Sclk.key(), "wave": wave(&|p, _| lane(l, p, Role::Sclk, 0), false)}),
+        serde_json::json!({"name": Role::Miso.key(), "wave": wave(&|_, m| m & 1, false)}),
+    ];
+    if l.muxed[0] {
+        signal.push(serde_json::json!({"name": Role::MuxSel.key(), "wave": sel_w, "data": sel_d}));
+    }
+    signal.extend([
+        serde_json::json!({"name": Role::SampleValid.name(), "wave": wave(&|p, _| p.sample_valid as u64, true)}),
+        serde_json::json!({"name": Role::SampleChannel.name(), "wave": ch_w, "data": ch_d}),
+    ]);
     let wd = serde_json::json!({
-        "signal": [
-            {"name": Role::CsN.key(), "wave": wave(&|p, _| cs(p), false)},
-            {"name": Role::Sclk.key(), "wave": wave(&|p, _| lane(l, p, Role::Sclk, 0), false)},
-            {"name": Role::Miso.key(), "wave": wave(&|_, m| m & 1, false)},
-            {"name": Role::MuxSel.key(), "wave": sel_w, "data": sel_d},
-            {"name": Role::SampleValid.name(), "wave": wave(&|p, _| p.sample_valid as u64, true)},
-            {"name": Role::SampleChannel.name(), "wave": ch_w, "data": ch_d},
-        ],
+        "signal": signal,
         "head": {"text": format!("{}: a conversion of branch {} in steady state (one step = {} clock cycles)", s.mix.name, s.branches[0].name, step)},
         "config": {"hscale": 1},
     });

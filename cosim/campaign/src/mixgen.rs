@@ -22,6 +22,10 @@ pub struct Shape {
     /// taken already is left out).
     pub channels: (u64, u64),
     pub rates_hz: Vec<u64>,
+    /// Each branch is drawn without a multiplexer (`mux = "none"`, one
+    /// channel) with probability 1 in `muxless`; 0: every branch has one
+    /// (and the draw is the same as before the option existed).
+    pub muxless: u64,
 }
 
 impl Default for Shape {
@@ -38,6 +42,7 @@ impl Default for Shape {
             settle_ns: vec![0, 1_000, 2_000, 5_000],
             channels: (2, 9),
             rates_hz: vec![500, 1_000, 2_000, 4_000, 8_000],
+            muxless: 0,
         }
     }
 }
@@ -67,6 +72,7 @@ impl Shape {
             settle_ns: vec![1_000],
             channels: (1, max_channels.max(1)),
             rates_hz: rates,
+            muxless: 0,
         }
     }
 }
@@ -86,12 +92,21 @@ pub fn random_mix(seed: u64, shape: &Shape) -> String {
         "name = \"random\"\n[clock]\nhz = {}\n[frame]\nperiod_us = {}\nslice_us = {}\n",
         shape.clock_hz, shape.frame_us, shape.slice_us
     );
+    // inputs per branch: 8 per mux device, one without a mux
     let mut devs = Vec::new();
     for b in 0..nb {
         let d = pick(next(), shape.mux_devices);
-        devs.push(d);
         let sclk = shape.sclk_hz[(next() % shape.sclk_hz.len() as u64) as usize];
         let settle = shape.settle_ns[(next() % shape.settle_ns.len() as u64) as usize];
+        if shape.muxless > 0 && next() % shape.muxless == 0 {
+            devs.push(1);
+            let _ = write!(
+                t,
+                "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nsclk_hz = {sclk}\nmux = \"none\"\n"
+            );
+            continue;
+        }
+        devs.push(d * 8);
         let _ = write!(
             t,
             "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nsclk_hz = {sclk}\nmux = \"tmux1108\"\nmux_devices = {d}\nsettle_ns = {settle}\n"
@@ -101,7 +116,7 @@ pub fn random_mix(seed: u64, shape: &Shape) -> String {
     let mut used = std::collections::BTreeSet::new();
     for i in 0..n {
         let b = next() % nb;
-        let input = next() % (devs[b as usize] * 8);
+        let input = next() % devs[b as usize];
         if !used.insert((b, input)) {
             continue;
         }

@@ -13,6 +13,9 @@ mod link;
 #[path = "mutants.rs"]
 mod mutants;
 
+#[path = "pins.rs"]
+mod pins;
+
 #[path = "random_mixes.rs"]
 mod random_mixes;
 

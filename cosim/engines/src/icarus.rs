@@ -25,7 +25,7 @@ use judge::CycleSink;
 use judge::Verdict;
 use judge::{Analog, Stimulus};
 use lut_gen::parts::Start;
-use lut_gen::ports::{Dir, Layout, Pins, Role, AXIS_PORTS, PORTS, TOP_MODULE};
+use lut_gen::ports::{Dir, Layout, Pins, Role, AXIS_PORTS, TOP_MODULE};
 
 use crate::error::{BackendError, SimError};
 use crate::options::{SimOptions, VcdOut};
@@ -84,8 +84,7 @@ pub fn testbench_with(
     {
         g.text.push_str(&axis_slave(tready, a.ready_within));
     }
-    let connect = PORTS
-        .iter()
+    let connect = (g.l.ports())
         .map(|p| p.name)
         .chain(g.l.link_ports().iter().map(|p| p.name))
         .map(|n| format!(".{n}({n})"))
@@ -117,7 +116,7 @@ pub fn testbench_with(
 /// as the ADC model's idle line), outputs as wires.
 fn port_decls(l: &Layout) -> String {
     let mut decls = String::new();
-    for p in &PORTS {
+    for p in l.ports() {
         let w = l.width(p.role);
         let range = if p.vector {
             format!("[{}:0] ", w - 1)
@@ -362,10 +361,15 @@ fn axis_slave(pattern: link::ReadyPattern, within: u32) -> String {
 /// (enable, select) of branch `b`'s mux pins (every enable pattern for up to
 /// six devices, else the one-hot ones; others as `(0, 0)`).
 fn id_case(l: &Layout, analog: &Analog, b: usize) -> String {
+    if !l.muxed[b] {
+        // no mux: the converter always sees its one input
+        let id = analog.input_id(l, &Pins::default(), b);
+        return format!("    id{b} = 64'd{id};\n");
+    }
     let (lo, n) = (l.en_lo[b], l.en_n[b]);
     let id_of = |en: u64, sel: u32| {
         let p = Pins {
-            mux_sel: (sel as u64) << (3 * b),
+            mux_sel: (sel as u64) << l.sel_lo[b],
             mux_en: (en as u128) << lo,
             ..Pins::default()
         };
@@ -379,8 +383,8 @@ fn id_case(l: &Layout, analog: &Analog, b: usize) -> String {
     let mut s = format!(
         "    case ({{{en}[{}:{lo}], {sel}[{}:{}]}})\n",
         lo + n - 1,
-        3 * b + 2,
-        3 * b,
+        l.sel_lo[b] + 2,
+        l.sel_lo[b],
         en = Role::MuxEn.name(),
         sel = Role::MuxSel.name(),
     );

@@ -140,7 +140,8 @@ pub fn check_ports(s: &Schedule, file: &Path, text: &str) -> Result<(), RtlError
     let layout = Layout::new(s);
     let ports = scan_ports(text, TOP_MODULE).map_err(|m| err(file, None, m))?;
     let find = |n: &str| ports.iter().find(|p| p.name == n);
-    for p in &PORTS {
+    // `mux_sel`/`mux_en` only when some branch has a mux
+    for p in layout.ports() {
         let want_w = layout.width(p.role);
         let want_dir = PortDir::of(p.dir);
         let want = if p.vector || want_w > 1 {

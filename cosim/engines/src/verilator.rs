@@ -84,8 +84,7 @@ extern "C" void sf_step(void* p, uint8_t rst, uint64_t miso, SfPins* o) {
     t->eval();
     o->cs_n = t->@cs_n@;
     o->sclk = t->@sclk@;
-    o->mux_sel = t->@mux_sel@;
-    sf_wide(o->mux_en, t->@mux_en@);
+@MUX@
     o->sample_valid = t->@valid@;
     o->sample_channel = t->@channel@;
     o->sample_value = t->@value@;@LINK@
@@ -103,8 +102,10 @@ extern "C" void sf_free(void* p) {
 "#;
 
 /// The shim's C++ text with the contract's module and port names; `link`:
-/// the top's link ports ([`LINK_PORTS`], [`AXIS_PORTS`] or none).
-fn shim(link: &[LinkPort]) -> String {
+/// the top's link ports ([`LINK_PORTS`], [`AXIS_PORTS`] or none); `mux`:
+/// whether the top has `mux_sel` and `mux_en` (a mix in which no branch has
+/// a multiplexer has neither; the shim then reports them 0).
+fn shim(link: &[LinkPort], mux: bool) -> String {
     let (link_in, link_pins) = if link == AXIS_PORTS {
         let [td, tv, tl, tr, ovf] = AXIS_PORTS.map(|p| p.name);
         (
@@ -120,7 +121,13 @@ fn shim(link: &[LinkPort]) -> String {
     } else {
         (String::new(), String::new())
     };
+    let mux = if mux {
+        "    o->mux_sel = t->@mux_sel@;\n    sf_wide(o->mux_en, t->@mux_en@);"
+    } else {
+        "    o->mux_sel = 0;\n    o->mux_en[0] = 0;\n    o->mux_en[1] = 0;"
+    };
     let mut t = SHIM_TEMPLATE
+        .replace("@MUX@", mux)
         .replace("@TOP@", TOP_MODULE)
         .replace("@LINKIN@", &link_in)
         .replace("@LINK@", &link_pins);
@@ -128,6 +135,21 @@ fn shim(link: &[LinkPort]) -> String {
         t = t.replace(&format!("@{}@", r.key()), r.name());
     }
     t
+}
+
+/// Whether the header of `slotforge_top` in `verilog` (from `module` to the
+/// first `;`, ANSI or not) names port `name`: the core's own modules have
+/// the contract's names too, so the whole text does not tell.
+fn top_declares(verilog: &str, name: &str) -> bool {
+    let head = format!("module {TOP_MODULE}");
+    let Some(at) = verilog.find(&head) else {
+        return true;
+    };
+    let rest = &verilog[at + head.len()..];
+    let header = &rest[..rest.find(';').unwrap_or(rest.len())];
+    header
+        .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '$'))
+        .any(|w| w == name)
 }
 
 /// The outputs as the shim writes them: the C++ `SfPins` above, field for
@@ -310,13 +332,16 @@ pub struct Built {
 pub fn build(verilog: &str) -> Result<Built, BackendError> {
     // A top with the link declares its line (emitted Verilog without a
     // link never names it).
-    let shim = shim(if verilog.contains(AXIS_PORTS[0].name) {
-        &AXIS_PORTS
-    } else if verilog.contains(LINK_PORTS[0].name) {
-        &LINK_PORTS
-    } else {
-        &[]
-    });
+    let shim = shim(
+        if verilog.contains(AXIS_PORTS[0].name) {
+            &AXIS_PORTS
+        } else if verilog.contains(LINK_PORTS[0].name) {
+            &LINK_PORTS
+        } else {
+            &[]
+        },
+        top_declares(verilog, Role::MuxSel.name()),
+    );
     let vv = tool_version("verilator", "apt-get install -y verilator")?;
     let gv = tool_version("g++", "apt-get install -y g++")?;
     let key = format!(

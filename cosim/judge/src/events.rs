@@ -12,13 +12,15 @@
 //!
 //! Cycle 0 is the first cycle after reset is released (`docs/timing.md`);
 //! at cycle 0 every branch lane is listed, after that only changes.  Per
-//! branch (in mix order): `mux_sel`, `mux_en` (binary, one digit per device),
-//! `cs_n`, `sclk`; then each `sample_valid` strobe as `sample <channel>
+//! branch (in mix order): `mux_sel`, `mux_en` (binary, one digit per device;
+//! neither for a branch without a mux), `cs_n` (`cnv` for a CNV-started
+//! part such as the AD7685), `sclk`; then each `sample_valid` strobe as `sample <channel>
 //! <code>`.  The time column (exact, rounded once to 1 ps) and the `#` notes
 //! are for the reader; the comparison ignores them.
 
 use std::fmt::Write as _;
 
+use lut_gen::parts::Start;
 use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
 
@@ -188,7 +190,8 @@ impl EventLog {
                 link_events(&mut events, rx.as_mut(), c, p, prev.as_ref());
             }
             for (b, bname) in branches.iter().enumerate() {
-                for r in LANES {
+                // a branch without a mux has no mux lanes to log
+                for r in LANES.into_iter().filter(|&r| l.has_lane(r, b)) {
                     let v = lane_value(&l, p, r, b);
                     if prev.is_some_and(|q| lane_value(&l, &q, r, b) == v) {
                         continue;
@@ -203,7 +206,8 @@ impl EventLog {
                     };
                     let note = match r {
                         Role::MuxSel | Role::MuxEn => format!("-> {}", ch()),
-                        Role::CsN if v == 0 => {
+                        // the conversion starts: CS falls, or a CNV rises
+                        Role::CsN if v == u64::from(l.starts[b] == Start::Cnv) => {
                             let (frame, slot, _) = s.grid.locate(c);
                             format!("slot {frame}:{slot}, {}", ch())
                         }
@@ -212,7 +216,7 @@ impl EventLog {
                     events.push(Event {
                         cycle: c,
                         scope: bname.clone(),
-                        signal: r.key().to_string(),
+                        signal: l.lane_key(r, b).to_string(),
                         value,
                         note,
                     });

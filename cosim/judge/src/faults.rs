@@ -150,14 +150,18 @@ impl PinFault {
             }
             v.push(PinFault::CsLate { branch: b });
             v.push(PinFault::SclkExtraEdge { branch: b });
-            v.push(PinFault::MuxLate { branch: b });
-            v.push(PinFault::WrongMux { branch: b });
-            if s.branches[b].mux_devices >= 2 {
+            // a branch without a mux has no mux pins to fault
+            let muxed = s.mix.branches[b].mux.select_bits > 0;
+            if muxed {
+                v.push(PinFault::MuxLate { branch: b });
+                v.push(PinFault::WrongMux { branch: b });
+            }
+            if muxed && s.branches[b].mux_devices >= 2 {
                 v.push(PinFault::TwoMuxEn { branch: b });
             }
             v.push(PinFault::ConversionMoved { branch: b });
             v.push(PinFault::PhaseShift { branch: b });
-            if same_rate_pair(s, b).is_some() {
+            if muxed && same_rate_pair(s, b).is_some() {
                 v.push(PinFault::SelectSwap { branch: b });
             }
             if slow_sclk_div(s, b).is_some() {
@@ -506,7 +510,7 @@ impl<D> FaultyDut<D> {
                 p.mux_en |= ((1u128 << n) - 1) << self.layout.en_lo[branch];
             }
             PinFault::WrongMux { branch } if c > self.t_prev && c <= self.t => {
-                p.mux_sel ^= 1 << (3 * branch);
+                p.mux_sel ^= 1 << self.layout.sel_lo[branch];
             }
             PinFault::SelectSwap { branch } if c >= self.at && c < self.at + self.frame => {
                 self.swap_selects(p, branch);
@@ -631,13 +635,15 @@ impl<D> FaultyDut<D> {
 /// channel: the previous one is not recorded; use select ^ 1 as "old").
 fn pins_before(layout: &Layout, p: &Pins, branch: usize, _t_prev: u64) -> Pins {
     let mut h = *p;
-    h.mux_sel ^= 1 << (3 * branch);
-    let _ = layout;
+    h.mux_sel ^= 1 << layout.sel_lo[branch];
     h
 }
 
 fn copy_mux(layout: &Layout, p: &mut Pins, from: &Pins, b: usize) {
-    let selm = 7u64 << (3 * b);
+    if !layout.muxed[b] {
+        return; // no mux lanes
+    }
+    let selm = 7u64 << layout.sel_lo[b];
     p.mux_sel = (p.mux_sel & !selm) | (from.mux_sel & selm);
     let enm = ((1u128 << layout.en_n[b]) - 1) << layout.en_lo[b];
     p.mux_en = (p.mux_en & !enm) | (from.mux_en & enm);

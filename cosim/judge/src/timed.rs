@@ -967,6 +967,9 @@ fn what_was_proved(
                 br.name
             ));
         }
+        if !layout.muxed[b] {
+            continue; // no mux, no mux lanes: nothing to settle
+        }
         let settle_ns = br.settle_ns as f64;
         let mux = has(Role::MuxSel, b) && has(Role::MuxEn, b);
         match (mux, tpl.settle_margin[b]) {

@@ -387,10 +387,11 @@ impl<'a> PortSearch<'a> {
         self.vars(sc, p).map(|v| v.width).sum()
     }
 
-    /// Whether port `p` has width `w` in scope `c` (an absent `rst` fits any mix).
+    /// Whether port `p` has width `w` in scope `c` (an absent `rst` fits any
+    /// mix; a port the mix does not have, `w == 0`, is not read).
     fn fits(&self, c: &str, p: &str, w: u32) -> bool {
         let got = self.width_of(c, p);
-        got == w || (p == PORT_NAMES[RST] && got == 0)
+        got == w || w == 0 || (p == PORT_NAMES[RST] && got == 0)
     }
 
     /// The scope holding the design's ports: the one named `want`, or the
@@ -401,10 +402,11 @@ impl<'a> PortSearch<'a> {
         scopes.dedup();
         // `clk` and `rst` may be absent (a capture without them: cycles are then
         // inferred, and the frame phase found from the pins, `lock.rs`).
+        // A mix without multiplexers has no `mux_sel`/`mux_en` (width 0).
         let required: Vec<&str> = PORT_NAMES
             .iter()
             .enumerate()
-            .filter(|(i, _)| *i != CLK && *i != RST)
+            .filter(|(i, _)| *i != CLK && *i != RST && widths[*i] > 0)
             .map(|(_, p)| *p)
             .collect();
         let candidates: Vec<&str> = match want {
@@ -530,6 +532,9 @@ impl<'a> PortSearch<'a> {
         let mut has_clk = false;
         let mut has_rst = true;
         for (p, name) in PORT_NAMES.iter().enumerate() {
+            if widths[p] == 0 {
+                continue; // a port this mix does not have
+            }
             let vs: Vec<&Var> = self.vars(scope, name).collect();
             if vs.is_empty() {
                 if p == CLK {

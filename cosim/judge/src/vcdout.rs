@@ -21,8 +21,14 @@ pub fn edge_ps(clock_hz: u64, n: u64) -> u64 {
     ((n as u128 * 1_000_000_000_000 + f) / (2 * f)) as u64
 }
 
-/// The lanes of a branch that its view in the waveform shows, in order.
+/// The lanes of a branch that its view in the waveform shows, in order (a
+/// branch without a mux has no mux lanes: [`Layout::has_lane`]).
 const BRANCH_VIEW: [Role; 5] = [Role::CsN, Role::Sclk, Role::Miso, Role::MuxSel, Role::MuxEn];
+
+/// Branch `b`'s lanes in its view, in [`BRANCH_VIEW`] order.
+fn view(l: &Layout, b: usize) -> impl Iterator<Item = Role> + '_ {
+    BRANCH_VIEW.into_iter().filter(move |&r| l.has_lane(r, b))
+}
 
 /// Writes the ports of every cycle in `[from, to)` (cycles counted from the
 /// first reset cycle of the run) to a VCD with a 1 ps timescale, at the
@@ -79,6 +85,9 @@ impl VcdWriter {
         writeln!(w, "$scope module {TOP_MODULE} $end")?;
         for (i, port) in PORTS.iter().enumerate() {
             let n = port.name;
+            if widths[i] == 0 {
+                continue; // a port the mix does not have (`mux_sel` without muxes)
+            }
             if !port.vector {
                 writeln!(w, "$var wire 1 {} {n} $end", id_code(i))?;
             } else {
@@ -92,7 +101,8 @@ impl VcdWriter {
             }
         }
         // The link's ports follow the branch views in the value list.
-        let link_at = PORTS.len() + BRANCH_VIEW.len() * s.branches.len();
+        let views: usize = (0..s.branches.len()).map(|b| view(&l, b).count()).sum();
+        let link_at = PORTS.len() + views;
         for (k, lp) in l.link_ports().iter().enumerate() {
             if lp.width == 1 {
                 writeln!(w, "$var wire 1 {} {} $end", id_code(link_at + k), lp.name)?;
@@ -109,7 +119,7 @@ impl VcdWriter {
         }
         for (b, br) in s.branches.iter().enumerate() {
             writeln!(w, "$scope module branch_{} $end", br.name)?;
-            for r in BRANCH_VIEW {
+            for r in view(&l, b) {
                 let (hi, lo) = l.lane_bits(r, b);
                 let n = hi - lo + 1;
                 let i = widths.len();
@@ -123,7 +133,7 @@ impl VcdWriter {
                         n - 1
                     )?;
                 } else {
-                    writeln!(w, "$var wire 1 {} {} $end", id_code(i), r.key())?;
+                    writeln!(w, "$var wire 1 {} {} $end", id_code(i), l.lane_key(r, b))?;
                 }
             }
             writeln!(w, "$upscope $end")?;
@@ -159,7 +169,7 @@ impl VcdWriter {
             r => p.value(r),
         }));
         for b in 0..self.layout.branches {
-            for r in BRANCH_VIEW {
+            for r in view(&self.layout, b) {
                 let (hi, lo) = self.layout.lane_bits(r, b);
                 let v = if r == Role::Miso {
                     miso as u128
@@ -181,6 +191,9 @@ impl VcdWriter {
         }
         writeln!(self.w, "0{}", self.ids[0])?;
         for i in 1..self.cur.len() {
+            if self.widths[i] == 0 {
+                continue;
+            }
             if first || (i == 1 && self.prev[1] != self.cur[1]) {
                 self.put(i)?;
             }
@@ -268,10 +281,12 @@ pub fn channels_text(s: &Schedule) -> String {
 }
 
 /// A GTKWave save file for a VCD written by [`VcdWriter`]: clock and reset,
-/// then one group per branch (cs_n, sclk, miso, mux bits), then the sample
+/// then one group per branch (cs_n, or cnv for a CNV-started part; sclk,
+/// miso, and the mux bits of a branch that has a mux), then the sample
 /// stream with `sample_channel` shown as channel names through the
 /// translate file written beside the save file ([`channels_path`]; named
-/// in the save file the way `vcd` is, so it is found wherever the VCD is).
+/// in the save file the way `vcd` is, so it is found wherever the VCD is),
+/// then the link's ports when the mix has a link: every port the VCD has.
 pub fn write_gtkw(path: &Path, vcd: &Path, s: &Schedule) -> std::io::Result<()> {
     let l = Layout::new(s);
     let names = channels_path(vcd);
@@ -290,12 +305,14 @@ pub fn write_gtkw(path: &Path, vcd: &Path, s: &Schedule) -> std::io::Result<()> 
         writeln!(w, "-branch {b} {}", br.name)?;
         writeln!(w, "@28")?;
         for r in [Role::CsN, Role::Sclk, Role::Miso] {
-            writeln!(w, "{sc}.{}", r.key())?;
+            writeln!(w, "{sc}.{}", l.lane_key(r, b))?;
         }
-        writeln!(w, "@22")?;
-        for r in [Role::MuxSel, Role::MuxEn] {
-            let (hi, lo) = l.lane_bits(r, b);
-            writeln!(w, "{sc}.{}[{}:0]", r.key(), hi - lo)?;
+        if l.muxed[b] {
+            writeln!(w, "@22")?;
+            for r in [Role::MuxSel, Role::MuxEn] {
+                let (hi, lo) = l.lane_bits(r, b);
+                writeln!(w, "{sc}.{}[{}:0]", r.key(), hi - lo)?;
+            }
         }
         writeln!(w, "@1000200")?;
         writeln!(w, "-branch {b} {}", br.name)?;
@@ -314,5 +331,28 @@ pub fn write_gtkw(path: &Path, vcd: &Path, s: &Schedule) -> std::io::Result<()> 
     writeln!(w, "{top}.{}[{}:0]", v.name(), l.width(v) - 1)?;
     writeln!(w, "@1000200")?;
     writeln!(w, "-samples")?;
+    gtkw_link(&mut w, &l)?;
     w.flush()
+}
+
+/// The link's group of a save file: its ports as [`VcdWriter`] dumps them
+/// (`tdata` in hex, the rest as bits); nothing without a link.
+fn gtkw_link(w: &mut impl Write, l: &Layout) -> std::io::Result<()> {
+    if l.link_ports().is_empty() {
+        return Ok(());
+    }
+    let top = TOP_MODULE;
+    writeln!(w, "@800200")?;
+    writeln!(w, "-link")?;
+    for lp in l.link_ports() {
+        if lp.width == 1 {
+            writeln!(w, "@28")?;
+            writeln!(w, "{top}.{}", lp.name)?;
+        } else {
+            writeln!(w, "@22")?;
+            writeln!(w, "{top}.{}[{}:0]", lp.name, lp.width - 1)?;
+        }
+    }
+    writeln!(w, "@1000200")?;
+    writeln!(w, "-link")
 }

@@ -55,6 +55,7 @@ fn rom() -> BranchRom {
         reset_en: 0b10,
         conv0: true,
         devices: 2,
+        muxed: true,
         en_offset: 0,
         cnv: false,
         bits: 14,
