@@ -161,6 +161,7 @@ fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
         settle_ns: vec![0, 1_000, 2_000],
         channels: (2, 8),
         rates_hz: vec![1_000, 2_000, 4_000],
+        link: None,
     };
     let mut found = Vec::new();
     for seed in 1..200u64 {

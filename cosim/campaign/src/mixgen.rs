@@ -22,6 +22,22 @@ pub struct Shape {
     /// taken already is left out).
     pub channels: (u64, u64),
     pub rates_hz: Vec<u64>,
+    /// A `[link]` drawn for every mix (none: no link).  Drawn after
+    /// everything else, so a seed's branches and channels are the same
+    /// with or without it.
+    pub link: Option<LinkShape>,
+}
+
+/// Which links a random mix may get.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinkShape {
+    /// A UART at one of a few bauds (1 in 3 too slow for a busy mix: audit
+    /// refuses it, as it would a user's), any parity and stop bits.
+    Uart,
+    /// AXI4-Stream with a drawn `tlast` and `ready_within`.
+    Axis,
+    /// Either, drawn per mix.
+    Either,
 }
 
 impl Default for Shape {
@@ -38,6 +54,7 @@ impl Default for Shape {
             settle_ns: vec![0, 1_000, 2_000, 5_000],
             channels: (2, 9),
             rates_hz: vec![500, 1_000, 2_000, 4_000, 8_000],
+            link: None,
         }
     }
 }
@@ -67,6 +84,7 @@ impl Shape {
             settle_ns: vec![1_000],
             channels: (1, max_channels.max(1)),
             rates_hz: rates,
+            link: None,
         }
     }
 }
@@ -111,7 +129,31 @@ pub fn random_mix(seed: u64, shape: &Shape) -> String {
             "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {rate}\ninput = {input}\n"
         );
     }
+    if let Some(l) = shape.link {
+        t.push_str(&link_table(l, &mut next));
+    }
     t
+}
+
+/// A `[link]` table of shape `l`, drawn with `next`.
+fn link_table(l: LinkShape, next: &mut impl FnMut() -> u64) -> String {
+    let axis = match l {
+        LinkShape::Uart => false,
+        LinkShape::Axis => true,
+        LinkShape::Either => next() % 2 == 1,
+    };
+    if axis {
+        let tlast = ["slice", "frame"][(next() % 2) as usize];
+        let within = [1, 2, 4, 16, 64][(next() % 5) as usize];
+        format!("[link]\nkind = \"axis\"\ntlast = \"{tlast}\"\nready_within = {within}\n")
+    } else {
+        let baud = [3_000_000, 6_000_000, 12_000_000][(next() % 3) as usize];
+        let parity = ["none", "even", "odd"][(next() % 3) as usize];
+        let stop = 1 + next() % 2;
+        format!(
+            "[link]\nkind = \"uart\"\nbaud = {baud}\nparity = \"{parity}\"\nstop_bits = {stop}\n"
+        )
+    }
 }
 
 #[cfg(test)]
