@@ -25,6 +25,9 @@ mod icarus;
 #[path = "link.rs"]
 mod link;
 
+#[path = "link_windows.rs"]
+mod link_windows;
+
 #[path = "prove_cli.rs"]
 mod prove_cli;
 

@@ -89,6 +89,51 @@ impl Violation {
     }
 }
 
+/// How a check that joined a run mid-stream (a window, a capture from the
+/// middle of a run) joined the link: the bytes in flight when it began are
+/// skipped, and the line is checked from its first whole packet on.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct LinkJoin {
+    /// What joined the line: `"model"` (every link pin compared with the
+    /// model from `compared_from_cycle`) or `"decoder"` (`--no-model`: the
+    /// packets decoded and judged from `header_cycle`).
+    pub by: String,
+    /// The capture cycle from which the model compared the link's pins;
+    /// null when the window showed no whole packet to join at (the
+    /// link's pins were then not compared with the model at all).
+    pub compared_from_cycle: Option<u64>,
+    /// The first whole packet joined at: the capture cycle its header
+    /// began in, its frame counter and slice (null: none).
+    pub header_cycle: Option<u64>,
+    pub frame_counter: Option<u8>,
+    pub slice: Option<u16>,
+    /// Bytes the line carried before that header (in flight when the
+    /// window began, or the first packets'): skipped.
+    pub skipped_bytes: u64,
+}
+
+impl LinkJoin {
+    /// The line the text report gives it.
+    pub fn text(&self) -> String {
+        match (self.header_cycle, self.frame_counter, self.slice) {
+            (Some(h), Some(f), Some(s)) => {
+                let compared = match (self.by.as_str(), self.compared_from_cycle) {
+                    ("model", Some(c)) => format!("; every link pin compared with the model from capture cycle {c}"),
+                    _ => String::new(),
+                };
+                format!(
+                    "link: joined the line at its first whole packet (frame counter {f}, slice {s}; header at capture cycle {h}){compared}; the {} byte(s) before it, in flight when the capture began, were skipped",
+                    self.skipped_bytes
+                )
+            }
+            _ => format!(
+                "link: the capture shows no whole packet to join the line at ({} byte(s) read): the link's pins were not compared with the model",
+                self.skipped_bytes
+            ),
+        }
+    }
+}
+
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Report {
     pub ok: bool,
@@ -113,6 +158,10 @@ pub struct Report {
     pub violations: Vec<Violation>,
     /// Whether the pins were compared against the cycle-level model.
     pub model_compared: bool,
+    /// A check that joined a link design's run mid-stream: where it
+    /// joined the line (absent from reset, or without a link).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link_join: Option<LinkJoin>,
 }
 
 impl Report {
@@ -137,6 +186,9 @@ impl Report {
             self.violation_count,
             if self.ok { "PASS" } else { "FAIL" }
         );
+        if let Some(j) = &self.link_join {
+            let _ = writeln!(s, "{}", j.text());
+        }
         if let Some(d) = self.divergences.first() {
             let _ = writeln!(
                 s,
