@@ -102,3 +102,66 @@ fn explore_presets() {
         }
     }
 }
+
+/// Random link mixes (the one generator, with a `[link]` drawn) whose
+/// link the audit finds feasible: `n` of them from seed `seed` on.
+fn random_link_mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
+    let shape = campaign::mixgen::Shape {
+        link: Some(campaign::mixgen::LinkShape::Either),
+        ..Default::default()
+    };
+    (seed..)
+        .filter_map(|k| {
+            let text = campaign::mixgen::random_mix(k, &shape);
+            let mix = lut_gen::parse(Path::new("random.toml"), &text).ok()?;
+            let s = lut_gen::synthesize(&mix).ok()?;
+            matches!(lut_gen::hostlink::plan(&s), Some(Ok(_))).then_some((k, s))
+        })
+        .take(n)
+        .collect()
+}
+
+#[test]
+fn explore_random() {
+    for (k, s) in random_link_mixes(1, 12) {
+        let f = s.grid.frame_cycles;
+        let mut next = rng(k);
+        for _ in 0..3 {
+            let from = f / 2 + next() % (2 * f);
+            let to = from + f + next() % (2 * f);
+            for model in [true, false] {
+                let (r, _lock) = judge_window(&s, judge::run::ModelDut::new(&s), (from, to), model);
+                if !r.ok {
+                    eprintln!("seed {k} {from}..{to} model={model}: {}", r.summary());
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn explore_seed3() {
+    let (k, s) = random_link_mixes(3, 1).remove(0);
+    let text = campaign::mixgen::random_mix(
+        k,
+        &campaign::mixgen::Shape {
+            link: Some(campaign::mixgen::LinkShape::Either),
+            ..Default::default()
+        },
+    );
+    eprintln!("{text}");
+    let plan = lut_gen::hostlink::plan(&s).unwrap().unwrap();
+    eprintln!(
+        "latency {} slice {} spf {}",
+        plan.latency_cycles, s.grid.slice_cycles, s.grid.slices_per_frame
+    );
+    let r = judge::run::run_dut(
+        &s,
+        &mut judge::run::ModelDut::new(&s),
+        6,
+        &RunOptions::default(),
+        "run",
+        None,
+    );
+    eprintln!("from reset: {}", r.summary());
+}

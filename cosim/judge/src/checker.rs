@@ -303,7 +303,7 @@ impl Checker {
         if opts.model {
             chk.link_join = model
                 .tx_config()
-                .map(|cfg| LinkJoin::new(cfg, s.grid.slices_per_frame, c));
+                .map(|cfg| LinkJoin::new(cfg, s.grid.slices_per_frame, s.grid.slot_cycles, c));
         }
         chk.model = opts.model.then_some(model);
         chk.phase = Phase::Run;
@@ -1003,10 +1003,22 @@ impl Checker {
     /// Where a check that joined mid-stream joined the link, in capture cycles.
     fn link_join_report(&self) -> Option<crate::report::LinkJoin> {
         let place = |c: u64| self.inv.place(c).0;
+        if self.model.is_none() && self.origin > 0 {
+            let line = self.line.as_ref()?;
+            let j = line.joined;
+            return Some(crate::report::LinkJoin {
+                by: "decoder".into(),
+                checked_from_cycle: j.map(|j| place(j.0)),
+                header_cycle: None,
+                frame_counter: j.map(|j| j.1),
+                slice: j.map(|j| j.2),
+                skipped_bytes: j.map_or(line.bytes_read(), |j| j.3),
+            });
+        }
         if let Some(j) = &self.link_join {
             return Some(crate::report::LinkJoin {
                 by: "model".into(),
-                compared_from_cycle: None,
+                checked_from_cycle: None,
                 header_cycle: None,
                 frame_counter: None,
                 slice: None,
@@ -1016,7 +1028,7 @@ impl Checker {
         let j = self.link_joined?;
         Some(crate::report::LinkJoin {
             by: "model".into(),
-            compared_from_cycle: Some(place(j.cycle)),
+            checked_from_cycle: Some(place(j.cycle)),
             header_cycle: Some(place(j.header_cycle)),
             frame_counter: Some(j.frame),
             slice: Some(j.slice),

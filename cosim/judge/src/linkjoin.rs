@@ -45,6 +45,10 @@ enum Wire {
 pub(crate) struct LinkJoin {
     cfg: TxConfig,
     slices: u64,
+    /// Slice boundaries fall on multiples of this in model cycles (the
+    /// slot: the lock knows the frame phase only modulo the CS/mux pins'
+    /// repeat, a whole number of slots).
+    step: u64,
     /// The model cycle the check joined at, or the earliest whose samples
     /// are still kept: a packet's slice must begin at or after it.
     from: u64,
@@ -76,7 +80,7 @@ pub(crate) struct Joined {
 
 impl LinkJoin {
     /// Joining at model cycle `from` a transmitter built as `cfg`.
-    pub(crate) fn new(cfg: TxConfig, slices: u64, from: u64) -> LinkJoin {
+    pub(crate) fn new(cfg: TxConfig, slices: u64, step: u64, from: u64) -> LinkJoin {
         let wire = match cfg.line {
             Line::Uart(u) => Wire::Uart(UartRx::new(u), from),
             Line::Axis(_) => Wire::Axis { offer: None },
@@ -84,6 +88,7 @@ impl LinkJoin {
         LinkJoin {
             cfg,
             slices,
+            step,
             from,
             wire,
             dec: Decoder::new(slices),
@@ -134,13 +139,13 @@ impl LinkJoin {
         self.dec.push_packets(&[byte.0], &mut self.packets);
         let packets = std::mem::take(&mut self.packets);
         let joined = packets.iter().find_map(|pk| self.header(pk));
-        let (h, skipped) = joined?;
-        let tx = self.replay(&h, c);
+        let (h, first, skipped) = joined?;
+        let tx = self.replay(&h, first, c);
         Some((
             tx,
             Joined {
                 cycle: c,
-                header_cycle: h.first,
+                header_cycle: first,
                 frame: h.frame,
                 slice: h.slice,
                 skipped_bytes: skipped,
@@ -151,7 +156,7 @@ impl LinkJoin {
     /// The header of good packet `pk` (it ended with the last byte read),
     /// if the model can join there: its slice began after the join, and
     /// the bytes read are that packet.  With the bytes before it.
-    fn header(&self, pk: &Packet) -> Option<(HeaderOnLine, u64)> {
+    fn header(&self, pk: &Packet) -> Option<(HeaderOnLine, u64, u64)> {
         let n = 4 * (2 + pk.records.len());
         let hi = self.bytes.len().checked_sub(n)?;
         let at = |i: usize| self.bytes[i].0;
@@ -161,28 +166,25 @@ impl LinkJoin {
             && [at(hi + 2), at(hi + 3)] == slice
             && at(self.bytes.len() - 4) == END;
         let first = self.bytes[hi].1.filter(|_| framed)?;
-        // The boundary whose token the header went out with: the latest
-        // start of a slice numbered `slice` before the edge that loaded it.
+        // The boundary whose token the header went out with: where the
+        // model's sample stream has the packet's records in a slice.
         let s = self.cfg.slice_cycles;
-        let k = (first - 1) / s;
-        let back = (k + self.slices - pk.slice as u64 % self.slices) % self.slices;
-        let b = k.checked_sub(back)? * s;
-        if b < self.from {
-            return None;
-        }
+        let b = find_boundary(&self.samples, &pk.records, (self.from, first), self.step, s)?;
+        // the run's slices begin `delta` cycles before the model's
+        let delta = (s - b % s) % s;
         let overflows = match hi.checked_sub(4) {
             Some(t) if at(t) == END => at(t + 1),
             _ => pk.overflows,
         };
         let queued = (b + 1..first)
             .map(|c| Token {
-                boundary: c % s == 0,
+                boundary: (c + delta) % s == 0,
                 sample: self.sample_at(c),
             })
             .filter(|t| t.boundary || t.sample.is_some())
             .collect();
         let h = HeaderOnLine {
-            first,
+            first: first + delta,
             frame: pk.frame as u8,
             slice: pk.slice,
             overflows,
@@ -190,7 +192,7 @@ impl LinkJoin {
             boundary_sample: self.sample_at(b),
             queued,
         };
-        Some((h, self.dropped + hi as u64))
+        Some((h, first, self.dropped + hi as u64))
     }
 
     /// Bytes read from the line so far.
@@ -227,15 +229,55 @@ impl LinkJoin {
         i > 0 && self.tready[i - 1].1
     }
 
-    /// The transmitter rebuilt at header `h`, stepped to cycle `c` with the
-    /// model's sample stream and the slave's `tready`.
-    fn replay(&self, h: &HeaderOnLine, c: u64) -> TxModel {
+    /// The transmitter rebuilt at header `h` (in model cycle `first`),
+    /// stepped to cycle `c` with the model's sample stream and the slave's
+    /// `tready`.
+    fn replay(&self, h: &HeaderOnLine, first: u64, c: u64) -> TxModel {
         let mut tx = TxModel::at_header(self.cfg, h);
-        for t in h.first..c {
+        for t in first..c {
             tx.set_tready(self.tready_at(t));
             tx.clock(false, self.sample_at(t));
         }
         tx.set_tready(self.tready_at(c));
         tx
+    }
+}
+
+/// The start, in `[lo, hi)` and a multiple of `step`, of the slice whose
+/// samples (of `samples`: (cycle, channel, code) in cycle order) are
+/// exactly `records` in order; `s` cycles a slice.  The lock finds the
+/// frame phase from the CS/mux pins, which may repeat within a frame
+/// (every channel at twice the frame rate): then the packets' slices are
+/// what tells the phases apart.  Several fits (equal codes): the one on
+/// the model's own slice grid if it fits, else none.
+pub(crate) fn find_boundary(
+    samples: &[(u64, u16, u16)],
+    records: &[(u16, u16)],
+    (lo, hi): (u64, u64),
+    step: u64,
+    s: u64,
+) -> Option<u64> {
+    if records.is_empty() {
+        return None;
+    }
+    let step = step.max(1);
+    let mut fits = Vec::new();
+    let mut b = lo.div_ceil(step) * step;
+    while b < hi {
+        let i = samples.partition_point(|x| x.0 < b);
+        let j = samples.partition_point(|x| x.0 < b + s);
+        if j - i == records.len()
+            && samples[i..j]
+                .iter()
+                .zip(records)
+                .all(|(x, r)| (x.1, x.2) == *r)
+        {
+            fits.push(b);
+        }
+        b += step;
+    }
+    match fits.as_slice() {
+        [b] => Some(*b),
+        _ => fits.into_iter().find(|b| b % s == 0),
     }
 }

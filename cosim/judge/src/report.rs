@@ -94,43 +94,43 @@ impl Violation {
 /// skipped, and the line is checked from its first whole packet on.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct LinkJoin {
-    /// What joined the line: `"model"` (every link pin compared with the
-    /// model from `compared_from_cycle`) or `"decoder"` (`--no-model`: the
-    /// packets decoded and judged from `header_cycle`).
+    /// What joined the line: `"model"` (the model's transmitter rebuilt
+    /// from the packet, every link pin compared from `checked_from_cycle`)
+    /// or `"decoder"` (`--no-model`: every packet judged from the one that
+    /// ended in `checked_from_cycle`).
     pub by: String,
-    /// The capture cycle from which the model compared the link's pins;
-    /// null when the window showed no whole packet to join at (the
-    /// link's pins were then not compared with the model at all).
-    pub compared_from_cycle: Option<u64>,
+    /// The capture cycle from which the line is checked; null when the
+    /// capture showed no whole packet to join at (the line was then not
+    /// checked).
+    pub checked_from_cycle: Option<u64>,
     /// The first whole packet joined at: the capture cycle its header
-    /// began in, its frame counter and slice (null: none).
+    /// began in (the model only), its frame counter and slice.
     pub header_cycle: Option<u64>,
     pub frame_counter: Option<u8>,
     pub slice: Option<u16>,
-    /// Bytes the line carried before that header (in flight when the
-    /// window began, or the first packets'): skipped.
+    /// Bytes the line carried before that packet, in flight when the
+    /// capture began: skipped.
     pub skipped_bytes: u64,
 }
 
 impl LinkJoin {
     /// The line the text report gives it.
     pub fn text(&self) -> String {
-        match (self.header_cycle, self.frame_counter, self.slice) {
-            (Some(h), Some(f), Some(s)) => {
-                let compared = match (self.by.as_str(), self.compared_from_cycle) {
-                    ("model", Some(c)) => format!("; every link pin compared with the model from capture cycle {c}"),
-                    _ => String::new(),
-                };
-                format!(
-                    "link: joined the line at its first whole packet (frame counter {f}, slice {s}; header at capture cycle {h}){compared}; the {} byte(s) before it, in flight when the capture began, were skipped",
-                    self.skipped_bytes
-                )
-            }
-            _ => format!(
-                "link: the capture shows no whole packet to join the line at ({} byte(s) read): the link's pins were not compared with the model",
+        let (Some(c), Some(f), Some(s)) = (self.checked_from_cycle, self.frame_counter, self.slice)
+        else {
+            return format!(
+                "link: the capture shows no whole packet to join the line at ({} byte(s) read): the line was not checked",
                 self.skipped_bytes
-            ),
-        }
+            );
+        };
+        let what = match self.header_cycle {
+            Some(h) => format!("its header at capture cycle {h}; every link pin compared with the model from capture cycle {c}"),
+            None => format!("read by capture cycle {c}; every packet judged from it on"),
+        };
+        format!(
+            "link: joined the line at its first whole packet (frame counter {f}, slice {s}; {what}); the {} byte(s) before it, in flight when the capture began, were skipped",
+            self.skipped_bytes
+        )
     }
 }
 
