@@ -13,9 +13,10 @@ use judge::vcd::CycleSink;
 use judge::{CheckOptions, LockInfo, Pins, Report};
 
 /// Feeds the cycles `[from, to)` of a run (counted from its first reset
-/// cycle) to the judge, as a VCD of that window would.
+/// cycle) to two judges, with and without the model, as a VCD of that
+/// window would.
 struct Window<'a> {
-    judge: Judge<'a>,
+    judges: [Judge<'a>; 2],
     from: u64,
     to: u64,
 }
@@ -23,25 +24,22 @@ struct Window<'a> {
 impl Observer for Window<'_> {
     fn cycle(&mut self, cycle: u64, rst: bool, pins: &Pins, miso: u64) {
         if (self.from..self.to).contains(&cycle) {
-            self.judge.cycle(Some(rst), pins, &Pins::default(), miso, 0);
+            for j in &mut self.judges {
+                j.cycle(Some(rst), pins, &Pins::default(), miso, 0);
+            }
         }
     }
 }
 
 /// The window `[from, to)` of a run of `dut` (behind the AXIS slave a back
-/// end puts in front of it), judged with or without the model.
-fn judge_window(
-    s: &lut_gen::Schedule,
-    dut: impl Dut,
-    (from, to): (u64, u64),
-    model: bool,
-) -> (Report, LockInfo) {
-    let opts = CheckOptions {
+/// end puts in front of it), judged with the model and without it.
+fn judge_window(s: &lut_gen::Schedule, dut: impl Dut, (from, to): (u64, u64)) -> [Report; 2] {
+    let opts = |model| CheckOptions {
         model,
         ..Default::default()
     };
     let mut w = Window {
-        judge: Judge::new(s, opts),
+        judges: [Judge::new(s, opts(true)), Judge::new(s, opts(false))],
         from,
         to,
     };
@@ -55,8 +53,12 @@ fn judge_window(
         "run",
         Some(&mut w),
     );
-    let (r, lock) = w.judge.finish("window").expect("the window locks");
-    (r, lock.expect("a window from the middle of a run"))
+    w.judges.map(|j| {
+        let (r, lock) = j.finish("window").expect("the window locks");
+        let lock: LockInfo = lock.expect("a window from the middle of a run");
+        assert!(lock.checked_from < 2 * s.grid.slot_cycles, "{lock}");
+        r
+    })
 }
 
 fn load(path: &Path) -> lut_gen::Schedule {
@@ -86,23 +88,6 @@ fn rng(seed: u64) -> impl FnMut() -> u64 {
     }
 }
 
-#[test]
-fn explore_presets() {
-    for name in ["eskin34-uart.toml", "eskin34-axis.toml"] {
-        let s = preset(name);
-        let f = s.grid.frame_cycles;
-        let mut next = rng(1);
-        for _ in 0..2 {
-            let from = f / 2 + next() % f;
-            let to = from + f;
-            for model in [true, false] {
-                let (r, lock) = judge_window(&s, judge::run::ModelDut::new(&s), (from, to), model);
-                eprintln!("{name} {from} model={model}: {}\n  {lock}", r.summary());
-            }
-        }
-    }
-}
-
 /// Random link mixes (the one generator, with a `[link]` drawn) whose
 /// link the audit finds feasible: `n` of them from seed `seed` on.
 fn random_link_mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
@@ -121,47 +106,121 @@ fn random_link_mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
         .collect()
 }
 
-#[test]
-fn explore_random() {
-    for (k, s) in random_link_mixes(1, 12) {
-        let f = s.grid.frame_cycles;
-        let mut next = rng(k);
-        for _ in 0..3 {
-            let from = f / 2 + next() % (2 * f);
-            let to = from + f + next() % (2 * f);
-            for model in [true, false] {
-                let (r, _lock) = judge_window(&s, judge::run::ModelDut::new(&s), (from, to), model);
-                if !r.ok {
-                    eprintln!("seed {k} {from}..{to} model={model}: {}", r.summary());
-                }
-            }
+/// A window of `s` from a random offset: it opens anywhere after the
+/// first half frame and lasts one to three frames.
+fn random_window(s: &lut_gen::Schedule, next: &mut impl FnMut() -> u64) -> (u64, u64) {
+    let f = s.grid.frame_cycles;
+    let from = f / 2 + next() % (2 * f);
+    (from, from + f + next() % (2 * f))
+}
+
+/// Both reports pass, and say where they joined the line: at a whole
+/// packet, after skipping what was in flight.
+fn assert_clean(what: &str, [m, d]: &[Report; 2]) {
+    for (r, by) in [(m, "model"), (d, "decoder")] {
+        assert!(r.ok, "{what}, {by}: {}", r.summary());
+        let j = r
+            .link_join
+            .as_ref()
+            .unwrap_or_else(|| panic!("{what}, {by}: no link join"));
+        assert_eq!(j.by, by, "{what}");
+        let from = j
+            .checked_from_cycle
+            .unwrap_or_else(|| panic!("{what}, {by}: {}", j.text()));
+        assert!(from < r.cycles, "{what}, {by}: {}", j.text());
+        assert!(r.summary().contains(&j.text()), "{what}: the text says it");
+    }
+    assert!(m.model_compared && !d.model_compared);
+    let (jm, jd) = (m.link_join.as_ref().unwrap(), d.link_join.as_ref().unwrap());
+    // the model joins at the header of the packet the decoder judges first
+    assert_eq!(
+        (jm.frame_counter, jm.slice),
+        (jd.frame_counter, jd.slice),
+        "{what}"
+    );
+    assert!(jm.header_cycle.unwrap() < jm.checked_from_cycle.unwrap());
+}
+
+/// The design a window is cut from: rust-hdl's model of the gateware, or
+/// (where a run of many frames must stay quick) the judge's cycle model.
+#[derive(Clone, Copy)]
+enum Engine {
+    RustHdl,
+    Model,
+}
+
+fn design(s: &lut_gen::Schedule, e: Engine) -> Box<dyn Dut> {
+    match e {
+        Engine::RustHdl => Box::new(rusthdl(s)),
+        Engine::Model => Box::new(judge::run::ModelDut::new(s)),
+    }
+}
+
+fn presets(windows: usize, e: Engine) {
+    for name in ["eskin34-uart.toml", "eskin34-axis.toml"] {
+        let s = preset(name);
+        let mut next = rng(27);
+        for _ in 0..windows {
+            let w = random_window(&s, &mut next);
+            assert_clean(
+                &format!("{name} {w:?}"),
+                &judge_window(&s, design(&s, e), w),
+            );
         }
     }
 }
 
 #[test]
-fn explore_seed3() {
-    let (k, s) = random_link_mixes(3, 1).remove(0);
-    let text = campaign::mixgen::random_mix(
-        k,
-        &campaign::mixgen::Shape {
-            link: Some(campaign::mixgen::LinkShape::Either),
-            ..Default::default()
-        },
+fn windows_of_the_link_presets_pass_with_and_without_the_model() {
+    presets(1, Engine::Model);
+}
+
+#[test]
+#[ignore = "long: make test-long"]
+fn windows_of_the_link_presets_on_rust_hdl_pass() {
+    presets(4, Engine::RustHdl);
+}
+
+fn random_mixes(seed: u64, mixes: usize, windows: usize, e: Engine) {
+    let found = random_link_mixes(seed, mixes);
+    assert_eq!(found.len(), mixes);
+    let axis = found
+        .iter()
+        .filter(|(_, s)| {
+            s.mix
+                .link
+                .as_ref()
+                .is_some_and(|l| l.kind == lut_gen::mix::LinkKind::Axis)
+        })
+        .count();
+    assert!(
+        axis > 0 && axis < mixes,
+        "both kinds of link drawn: {axis} AXIS of {mixes}"
     );
-    eprintln!("{text}");
-    let plan = lut_gen::hostlink::plan(&s).unwrap().unwrap();
-    eprintln!(
-        "latency {} slice {} spf {}",
-        plan.latency_cycles, s.grid.slice_cycles, s.grid.slices_per_frame
-    );
-    let r = judge::run::run_dut(
-        &s,
-        &mut judge::run::ModelDut::new(&s),
-        6,
-        &RunOptions::default(),
-        "run",
-        None,
-    );
-    eprintln!("from reset: {}", r.summary());
+    for (k, s) in &found {
+        let mut next = rng(*k);
+        for _ in 0..windows {
+            let w = random_window(s, &mut next);
+            assert_clean(
+                &format!("random mix {k} {w:?}"),
+                &judge_window(s, design(s, e), w),
+            );
+        }
+    }
+}
+
+#[test]
+fn windows_of_random_link_mixes_pass_with_and_without_the_model() {
+    random_mixes(1, 2, 1, Engine::RustHdl);
+}
+
+#[test]
+fn windows_of_more_random_link_mixes_pass_on_the_model() {
+    random_mixes(20, 6, 2, Engine::Model);
+}
+
+#[test]
+#[ignore = "long: make test-long"]
+fn windows_of_forty_random_link_mixes_pass() {
+    random_mixes(100, 40, 4, Engine::RustHdl);
 }

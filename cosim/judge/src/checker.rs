@@ -203,6 +203,9 @@ pub struct Join {
     pub mux_since: Vec<Option<u64>>,
     /// Per branch: the cycle its CS last rose, if the capture showed it.
     pub cs_rise: Vec<Option<u64>>,
+    /// The CS/mux pins repeat every this many cycles (the frame when they
+    /// do not): the model's phase is the run's only modulo it.
+    pub repeat: u64,
 }
 
 const NO_XZ: Pins = Pins {
@@ -300,10 +303,12 @@ impl Checker {
         // the model's.
         model.hold_sample(j.prev.sample_channel, j.prev.sample_value);
         let c = model.cycle();
+        // the run's slices begin a multiple of this off the model's
+        let step = gcd(s.grid.slice_cycles, j.repeat.max(1));
         if opts.model {
             chk.link_join = model
                 .tx_config()
-                .map(|cfg| LinkJoin::new(cfg, s.grid.slices_per_frame, s.grid.slot_cycles, c));
+                .map(|cfg| LinkJoin::new(cfg, s.grid.slices_per_frame, step, c));
         }
         chk.model = opts.model.then_some(model);
         chk.phase = Phase::Run;
@@ -311,7 +316,7 @@ impl Checker {
         chk.origin = c;
         chk.inv.join_at(c, j.capture_cycle);
         if let Some(l) = &mut chk.line {
-            l.join_at(c, j.prev.link_tx);
+            l.join_at(c, j.prev.link_tx, step);
         }
         chk.next_frame_at = (c / s.grid.frame_cycles + 1) * s.grid.frame_cycles;
         chk.prev = j.prev;
@@ -1034,6 +1039,14 @@ impl Checker {
             slice: Some(j.slice),
             skipped_bytes: j.skipped_bytes,
         })
+    }
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
     }
 }
 

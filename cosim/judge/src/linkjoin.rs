@@ -45,9 +45,10 @@ enum Wire {
 pub(crate) struct LinkJoin {
     cfg: TxConfig,
     slices: u64,
-    /// Slice boundaries fall on multiples of this in model cycles (the
-    /// slot: the lock knows the frame phase only modulo the CS/mux pins'
-    /// repeat, a whole number of slots).
+    /// Slice boundaries fall on multiples of this in model cycles: the
+    /// lock knows the frame phase only modulo the CS/mux pins' repeat, so
+    /// the run's slices begin a multiple of it off the model's (the
+    /// greatest common divisor of the slice and the repeat).
     step: u64,
     /// The model cycle the check joined at, or the earliest whose samples
     /// are still kept: a packet's slice must begin at or after it.
@@ -178,7 +179,7 @@ impl LinkJoin {
         };
         let queued = (b + 1..first)
             .map(|c| Token {
-                boundary: (c + delta) % s == 0,
+                boundary: (c + delta).is_multiple_of(s),
                 sample: self.sample_at(c),
             })
             .filter(|t| t.boundary || t.sample.is_some())

@@ -71,6 +71,11 @@ enum Wire {
     Axis(AxisFormat),
 }
 
+/// A joined check learning the run's slice phase: the samples since the
+/// join (cycle, channel, code), the join's cycle, the packets that fitted
+/// no slice.
+type Learning = (Vec<(u64, u16, u16)>, u64, u32);
+
 /// The link's checks (a mix with a `[link]`).
 #[derive(Debug, Clone)]
 pub(crate) struct LinkLine {
@@ -108,8 +113,9 @@ pub(crate) struct LinkLine {
     /// Joined mid-stream and still learning `delta`: every sample since
     /// the join, (cycle, channel, code), the cycle it joined at, and the
     /// good packets that fitted no slice.
-    learning: Option<(Vec<(u64, u16, u16)>, u64, u32)>,
-    slot_cycles: u64,
+    learning: Option<Learning>,
+    /// The run's slices begin a multiple of this off the model's.
+    step: u64,
     /// Where a check that joined mid-stream joined the line: (the cycle
     /// the first packet judged ended in, its frame counter and slice, the
     /// bytes before it).
@@ -155,7 +161,7 @@ impl LinkLine {
             synced: true,
             delta: 0,
             learning: None,
-            slot_cycles: s.grid.slot_cycles,
+            step: s.grid.slice_cycles,
             joined: None,
         })
     }
@@ -163,7 +169,8 @@ impl LinkLine {
     /// The check joins a run at cycle `origin` with the line at `level`:
     /// slices from the first that starts at or after it are checked, and
     /// the line from the first good packet on.
-    pub(crate) fn join_at(&mut self, origin: u64, level: bool) {
+    pub(crate) fn join_at(&mut self, origin: u64, level: bool, step: u64) {
+        self.step = step;
         if let Wire::Uart(u) = &mut self.wire {
             u.rx_origin = origin;
             u.level = level;
@@ -195,7 +202,7 @@ impl LinkLine {
             return true;
         };
         let s = self.slice_cycles;
-        let b = crate::linkjoin::find_boundary(log, &p.records, (*origin, c), self.slot_cycles, s);
+        let b = crate::linkjoin::find_boundary(log, &p.records, (*origin, c), self.step, s);
         let delta = match b {
             Some(b) => (s - b % s) % s,
             None if *misses >= 1 => 0,
