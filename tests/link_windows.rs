@@ -31,9 +31,15 @@ impl Observer for Window<'_> {
     }
 }
 
-/// The window `[from, to)` of a run of `dut` (behind the AXIS slave a back
-/// end puts in front of it), judged with the model and without it.
-fn judge_window(s: &lut_gen::Schedule, dut: impl Dut, (from, to): (u64, u64)) -> [Report; 2] {
+/// `dut` behind the AXIS slave a back end puts in front of it (a design
+/// with an AXIS link; the design itself otherwise).
+fn slaved<'a>(s: &lut_gen::Schedule, dut: impl Dut + 'a) -> Box<dyn Dut + 'a> {
+    judge::run::with_slave(s, dut, ::link::ReadyPattern::Random { seed: 11 })
+}
+
+/// The window `[from, to)` of a run of `dut`, judged with the model and
+/// without it.
+fn judge_window(s: &lut_gen::Schedule, mut dut: impl Dut, (from, to): (u64, u64)) -> [Report; 2] {
     let opts = |model| CheckOptions {
         model,
         ..Default::default()
@@ -43,7 +49,6 @@ fn judge_window(s: &lut_gen::Schedule, dut: impl Dut, (from, to): (u64, u64)) ->
         from,
         to,
     };
-    let mut dut = judge::run::with_slave(s, dut, ::link::ReadyPattern::Random { seed: 11 });
     let frames = to / s.grid.frame_cycles + 1;
     run_dut(
         s,
@@ -151,8 +156,8 @@ enum Engine {
 
 fn design(s: &lut_gen::Schedule, e: Engine) -> Box<dyn Dut> {
     match e {
-        Engine::RustHdl => Box::new(rusthdl(s)),
-        Engine::Model => Box::new(judge::run::ModelDut::new(s)),
+        Engine::RustHdl => slaved(s, rusthdl(s)),
+        Engine::Model => slaved(s, judge::run::ModelDut::new(s)),
     }
 }
 
@@ -223,4 +228,56 @@ fn windows_of_more_random_link_mixes_pass_on_the_model() {
 #[ignore = "long: make test-long"]
 fn windows_of_forty_random_link_mixes_pass() {
     random_mixes(100, 40, 4, Engine::RustHdl);
+}
+
+/// A fault inside a window of a link design fails it, with the model at
+/// the fault's cycle and without it after the fault: a flipped UART bit,
+/// an AXIS beat whose `tdata` changes while it waits, a wrong sample.
+#[test]
+fn a_fault_inside_a_window_fails_it_at_its_cycle() {
+    let mixes = random_link_mixes(1, 4);
+    let kind = |s: &lut_gen::Schedule| s.mix.link.as_ref().map(|l| l.kind);
+    let uart = mixes
+        .iter()
+        .find(|(_, s)| kind(s) == Some(lut_gen::mix::LinkKind::Uart));
+    let axis = mixes
+        .iter()
+        .find(|(_, s)| kind(s) == Some(lut_gen::mix::LinkKind::Axis));
+    let (uart, axis) = (&uart.expect("a UART mix").1, &axis.expect("an AXIS mix").1);
+    let reset = RunOptions::default().reset_cycles;
+    for (s, fault, signal) in [
+        (uart, Fault::LinkBitFlip, "link_tx"),
+        (axis, Fault::AxisTdataChange, "m_axis_tdata"),
+        (uart, Fault::WrongSampleBit, "sample_value"),
+    ] {
+        let f = s.grid.frame_cycles;
+        let (from, to) = (f / 2 + 1_234, f / 2 + 1_234 + 2 * f);
+        // the site, in cycles after reset: a frame into the window, well
+        // after the line was joined
+        let at = from + f;
+        let site = at + reset - from;
+        // outside the slave, as the fault campaign puts it: on the pins
+        let dut = FaultyDut::new(s, slaved(s, rusthdl(s)), fault, at);
+        let [m, d] = judge_window(s, dut, (from, to));
+        let name = fault.class();
+        for r in [&m, &d] {
+            assert!(!r.ok, "{name}: not caught\n{}", r.summary());
+            let j = r.link_join.as_ref().expect("joined the line");
+            let joined = j.checked_from_cycle;
+            assert!(joined.is_some_and(|c| c < site), "{name}: {}", r.summary());
+        }
+        let dv = &m.divergences[0];
+        assert_eq!(dv.signal, signal, "{name}: {}", m.summary());
+        // the first character, beat or sample at or after the site
+        let near = s.grid.slot_cycles * 4;
+        assert!(
+            (site..site + near).contains(&dv.cycle),
+            "{name}: the model's first divergence at capture cycle {}, the fault at {site}",
+            dv.cycle
+        );
+        assert!(!d.violations.is_empty(), "{name}: {}", d.summary());
+        for v in &d.violations {
+            assert!(v.cycle >= site, "{name}: {v:?} before the fault");
+        }
+    }
 }
