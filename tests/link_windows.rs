@@ -281,3 +281,64 @@ fn a_fault_inside_a_window_fails_it_at_its_cycle() {
         }
     }
 }
+
+/// The issue's own steps, on the emitted Verilog: a Verilator window of the
+/// UART preset from frame 1 to 3 passes `check` with and without the
+/// model, and the report says where the line was joined (text and JSON).
+#[test]
+fn a_verilator_window_of_the_uart_preset_passes_check() {
+    if !crate::tools::require_tools(&["verilator", "g++"]) {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let wave = d.path().join("w.vcd");
+    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("mixes/eskin34-uart.toml");
+    crate::common_cli::slotforge()
+        .arg("sim")
+        .arg(&mix)
+        .args([
+            "--backend",
+            "verilator",
+            "--frames",
+            "3",
+            "--from",
+            "1",
+            "--to",
+            "3",
+            "--vcd",
+        ])
+        .arg(&wave)
+        .assert()
+        .code(0);
+    for (flags, by) in [(vec![], "model"), (vec!["--no-model"], "decoder")] {
+        let out = crate::common_cli::slotforge()
+            .arg("check")
+            .args(&flags)
+            .arg(&mix)
+            .arg(&wave)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(out.status.code(), Some(0), "{flags:?}: {text}");
+        assert!(
+            text.contains("link: joined the line at its first whole packet"),
+            "{text}"
+        );
+        let out = crate::common_cli::slotforge()
+            .arg("check")
+            .args(&flags)
+            .arg("--json")
+            .arg(&mix)
+            .arg(&wave)
+            .output()
+            .unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["ok"], true);
+        let j = &v["link_join"];
+        assert_eq!(j["by"], by, "{j}");
+        assert!(j["checked_from_cycle"].as_u64().unwrap() < v["cycles"].as_u64().unwrap());
+        assert!(j["skipped_bytes"].is_u64() && j["slice"].is_u64(), "{j}");
+        // from frame 1: the first whole packet is of frame 1 (counter 1)
+        assert_eq!(j["frame_counter"], 1, "{j}");
+    }
+}
