@@ -36,6 +36,8 @@ mod link;
 
 #[path = "link_bytes.rs"]
 mod link_bytes;
+#[path = "link_windows.rs"]
+mod link_windows;
 
 #[path = "prove_cli.rs"]
 mod prove_cli;

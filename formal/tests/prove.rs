@@ -171,6 +171,7 @@ fn unseen_mixes_with(
         channels: (2, 8),
         rates_hz: vec![1_000, 2_000, 4_000],
         muxless,
+        link: None,
     };
     let mut found = Vec::new();
     for seed in 1..200u64 {

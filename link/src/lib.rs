@@ -26,5 +26,5 @@ pub mod uart;
 pub use axis::{AxisFormat, ReadyDriver, ReadyPattern, Tlast};
 pub use decode::{Decoded, Decoder, Packet, Stats};
 pub use format::Token;
-pub use tx::{Line, TxConfig, TxModel};
+pub use tx::{HeaderOnLine, Line, TxConfig, TxModel};
 pub use uart::{Parity, UartFormat};

@@ -54,6 +54,29 @@ pub struct ByteOnLine {
     pub loaded_at: u64,
 }
 
+/// A header's first byte as a line seen from the middle of a run showed
+/// it: enough to give a transmitter the state the design's had then (see
+/// [`TxModel::at_header`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct HeaderOnLine {
+    /// The cycle its SYNC byte was first on the line (the start bit, or
+    /// the first cycle of the beat's offer), counted as a run from reset
+    /// counts them: slice boundaries at multiples of `slice_cycles`.
+    pub first: u64,
+    /// Its frame counter and slice.
+    pub frame: u8,
+    pub slice: u16,
+    /// The overflow count the trailer before it carried, and the sticky flag.
+    pub overflows: u8,
+    pub overflow_flag: bool,
+    /// The sample written with the slice boundary's token, whose record
+    /// follows the header.
+    pub boundary_sample: Option<(u16, u16)>,
+    /// The tokens written after the boundary's, up to and including the
+    /// edge that loaded the SYNC byte: the FIFO's contents then.
+    pub queued: Vec<Token>,
+}
+
 /// The transmitter in one cycle (the state its registers hold).
 #[derive(Debug, Clone)]
 pub struct TxModel {
@@ -116,6 +139,47 @@ impl TxModel {
             trailer_ends: None,
         };
         t.reset();
+        t
+    }
+
+    /// The transmitter in cycle `h.first` of a run it did not see from
+    /// reset, rebuilt from a header on the line: the boundary's token is
+    /// being sent (its trailer went before, the SYNC byte is on the line)
+    /// and the tokens written since wait behind it, so its registers are
+    /// the design's, counters included.  (A run's state cannot be had from
+    /// the schedule alone: the frame counter, the backlog left by frame 0
+    /// and the samples in flight are the run's own.)
+    pub fn at_header(cfg: TxConfig, h: &HeaderOnLine) -> TxModel {
+        let mut t = TxModel::new(cfg);
+        let tok = Token {
+            boundary: true,
+            sample: h.boundary_sample,
+        };
+        // In cycle x of a run the transmitter has seen x + 1 edges.
+        t.cycle = h.first + 1;
+        t.pos = h.first % cfg.slice_cycles;
+        t.fifo = h.queued.iter().copied().collect();
+        t.tok = tok;
+        t.started = true;
+        // slots 0..=4 (the trailer and the SYNC byte) have been loaded
+        t.mask = Self::slots(&tok, true) & !0x1F;
+        t.have = t.mask != 0;
+        t.hframe = h.frame;
+        t.hslice = h.slice;
+        t.crc = format::crc_update(CRC_INIT, SYNC);
+        t.ovf = h.overflows;
+        t.ovf_flag = h.overflow_flag;
+        t.busy = true;
+        t.byte = SYNC;
+        t.tx = !matches!(cfg.line, Line::Uart(_));
+        t.cur = Some(ByteOnLine {
+            byte: SYNC,
+            kind: WordKind::Header,
+            index: 0,
+            packet: (h.frame, h.slice),
+            sample: None,
+            loaded_at: h.first,
+        });
         t
     }
 
@@ -573,6 +637,68 @@ mod tests {
             bytes[trailer + 1] > 0,
             "the trailer carries the overflow count"
         );
+    }
+
+    /// A transmitter rebuilt from each header on the line (what a check
+    /// joining mid-run sees) drives the same pins as the one that ran from
+    /// reset, from that cycle on, on a UART and on AXIS under back-pressure.
+    #[test]
+    fn a_transmitter_rebuilt_at_a_header_drives_the_same_pins() {
+        let axis = Line::Axis(AxisFormat {
+            tlast: Tlast::Frame,
+            ready_within: 4,
+        });
+        for line in [cfg(4, Some(64)).line, axis] {
+            let cfg = TxConfig {
+                line,
+                ..cfg(4, Some(64))
+            };
+            let sample =
+                |c: u64| (c % 1000 < 300 && c % 97 == 5).then_some((c as u16 % 7, c as u16));
+            let mut t = TxModel::new(cfg);
+            t.clock(false, None);
+            let mut slave = ReadyDriver::new(ReadyPattern::Random { seed: 9 }, 4);
+            let mut rebuilt: Vec<TxModel> = Vec::new();
+            let mut tokens: Vec<(u64, Token)> = Vec::new();
+            for c in 0..7000u64 {
+                if let Some((b, 0)) = t.on_line() {
+                    if b.kind == WordKind::Header && b.index == 0 && b.loaded_at == c {
+                        let at = (b.packet.0 as u64 * 2 + b.packet.1 as u64) * 1000;
+                        let h = HeaderOnLine {
+                            first: c,
+                            frame: b.packet.0,
+                            slice: b.packet.1,
+                            overflows: t.ovf,
+                            overflow_flag: t.ovf_flag,
+                            boundary_sample: sample(at),
+                            queued: tokens.iter().filter(|k| k.0 > at).map(|k| k.1).collect(),
+                        };
+                        rebuilt.push(TxModel::at_header(cfg, &h));
+                    }
+                }
+                let r = slave.ready(t.tvalid());
+                for m in std::iter::once(&mut t).chain(rebuilt.iter_mut()) {
+                    m.set_tready(r);
+                }
+                for (i, m) in rebuilt.iter().enumerate() {
+                    let pins =
+                        |m: &TxModel| (m.line(), m.tvalid(), m.tdata(), m.tlast(), m.overflow());
+                    assert_eq!(pins(m), pins(&t), "cycle {c}: header {i}");
+                    assert_eq!(m.on_line(), t.on_line(), "cycle {c}: header {i}");
+                }
+                let tok = Token {
+                    boundary: c % 1000 == 0,
+                    sample: sample(c),
+                };
+                if tok.boundary || tok.sample.is_some() {
+                    tokens.push((c, tok));
+                }
+                for m in std::iter::once(&mut t).chain(rebuilt.iter_mut()) {
+                    m.clock(false, sample(c));
+                }
+            }
+            assert!(rebuilt.len() >= 6, "{line:?}: {} headers", rebuilt.len());
+        }
     }
 
     #[test]

@@ -26,6 +26,22 @@ pub struct Shape {
     /// channel) with probability 1 in `muxless`; 0: every branch has one
     /// (and the draw is the same as before the option existed).
     pub muxless: u64,
+    /// A `[link]` drawn for every mix (none: no link).  Drawn after
+    /// everything else, so a seed's branches and channels are the same
+    /// with or without it.
+    pub link: Option<LinkShape>,
+}
+
+/// Which links a random mix may get.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinkShape {
+    /// A UART at one of a few bauds (1 in 3 too slow for a busy mix: audit
+    /// refuses it, as it would a user's), any parity and stop bits.
+    Uart,
+    /// AXI4-Stream with a drawn `tlast` and `ready_within`.
+    Axis,
+    /// Either, drawn per mix.
+    Either,
 }
 
 impl Default for Shape {
@@ -43,6 +59,7 @@ impl Default for Shape {
             channels: (2, 9),
             rates_hz: vec![500, 1_000, 2_000, 4_000, 8_000],
             muxless: 0,
+            link: None,
         }
     }
 }
@@ -73,6 +90,7 @@ impl Shape {
             channels: (1, max_channels.max(1)),
             rates_hz: rates,
             muxless: 0,
+            link: None,
         }
     }
 }
@@ -126,7 +144,31 @@ pub fn random_mix(seed: u64, shape: &Shape) -> String {
             "[[channel]]\nname = \"c{i}\"\nbranch = \"b{b}\"\nrate_hz = {rate}\ninput = {input}\n"
         );
     }
+    if let Some(l) = shape.link {
+        t.push_str(&link_table(l, &mut next));
+    }
     t
+}
+
+/// A `[link]` table of shape `l`, drawn with `next`.
+fn link_table(l: LinkShape, next: &mut impl FnMut() -> u64) -> String {
+    let axis = match l {
+        LinkShape::Uart => false,
+        LinkShape::Axis => true,
+        LinkShape::Either => next() % 2 == 1,
+    };
+    if axis {
+        let tlast = ["slice", "frame"][(next() % 2) as usize];
+        let within = [1, 2, 4, 16, 64][(next() % 5) as usize];
+        format!("[link]\nkind = \"axis\"\ntlast = \"{tlast}\"\nready_within = {within}\n")
+    } else {
+        let baud = [3_000_000, 6_000_000, 12_000_000][(next() % 3) as usize];
+        let parity = ["none", "even", "odd"][(next() % 3) as usize];
+        let stop = 1 + next() % 2;
+        format!(
+            "[link]\nkind = \"uart\"\nbaud = {baud}\nparity = \"{parity}\"\nstop_bits = {stop}\n"
+        )
+    }
 }
 
 #[cfg(test)]

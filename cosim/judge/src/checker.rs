@@ -14,6 +14,7 @@ use serde_json::{json, Value};
 use lut_gen::ports::{Layout, Pins, Role, Signal};
 
 use crate::invariants::Invariants;
+use crate::linkjoin::{Joined, LinkJoin};
 use crate::linkline::LinkLine;
 use crate::model::CycleModel;
 use crate::rule::Rule;
@@ -181,6 +182,11 @@ pub struct Checker {
     rst_x_seen: bool,
     /// The model cycle checking began at (0: at reset; later: joined mid-stream).
     origin: u64,
+    /// Joined mid-stream with the model: its link joins from the line
+    /// (until then the link's pins are not compared) ...
+    link_join: Option<LinkJoin>,
+    /// ... and where it did.
+    link_joined: Option<Joined>,
 }
 
 /// Where a check joins a run that it did not see start (a capture from the
@@ -197,6 +203,9 @@ pub struct Join {
     pub mux_since: Vec<Option<u64>>,
     /// Per branch: the cycle its CS last rose, if the capture showed it.
     pub cs_rise: Vec<Option<u64>>,
+    /// The CS/mux pins repeat every this many cycles (the frame when they
+    /// do not): the model's phase is the run's only modulo it.
+    pub repeat: u64,
 }
 
 const NO_XZ: Pins = Pins {
@@ -278,6 +287,8 @@ impl Checker {
             xz_seen: false,
             rst_x_seen: false,
             origin: 0,
+            link_join: None,
+            link_joined: None,
         }
     }
 
@@ -292,13 +303,20 @@ impl Checker {
         // the model's.
         model.hold_sample(j.prev.sample_channel, j.prev.sample_value);
         let c = model.cycle();
+        // the run's slices begin a multiple of this off the model's
+        let step = gcd(s.grid.slice_cycles, j.repeat.max(1));
+        if opts.model {
+            chk.link_join = model
+                .tx_config()
+                .map(|cfg| LinkJoin::new(cfg, s.grid.slices_per_frame, step, c));
+        }
         chk.model = opts.model.then_some(model);
         chk.phase = Phase::Run;
         chk.c = c;
         chk.origin = c;
         chk.inv.join_at(c, j.capture_cycle);
         if let Some(l) = &mut chk.line {
-            l.join_at(c, j.prev.link_tx);
+            l.join_at(c, j.prev.link_tx, step);
         }
         chk.next_frame_at = (c / s.grid.frame_cycles + 1) * s.grid.frame_cycles;
         chk.prev = j.prev;
@@ -446,6 +464,13 @@ impl Checker {
         if let Some(m) = &mut self.model {
             // tready is the slave's: the model takes it from the pins
             m.set_tready(p.axis_tready);
+            if let Some(j) = &mut self.link_join {
+                if let Some((tx, joined)) = j.cycle(c, p, m.pins()) {
+                    m.set_tx(tx);
+                    self.link_join = None;
+                    self.link_joined = Some(joined);
+                }
+            }
             let e = *m.pins();
             if !same(&e, p) || !same(xz, &NO_XZ) || self.div_active {
                 self.compare(c, &e, p, xz);
@@ -523,6 +548,8 @@ impl Checker {
             return;
         }
         let mut any = false;
+        // the link's pins wait for the line to show where the run is
+        let joining = self.link_join.is_some();
         for i in 0..self.signals.len() {
             let s = self.signals[i];
             let (ev, av, ax) = (
@@ -530,7 +557,7 @@ impl Checker {
                 s.get(&self.layout, p),
                 s.get(&self.layout, xz),
             );
-            let bad = ev != av || ax != 0;
+            let bad = (ev != av || ax != 0) && !(joining && s.role().is_none());
             if bad {
                 any = true;
                 if !self.diverging[i] && self.divergences.len() < self.opts.max_records {
@@ -961,6 +988,7 @@ impl Checker {
         if let Some(l) = &mut self.line {
             l.finish(self.c, &mut self.inv);
         }
+        let link_join = self.link_join_report();
         let (frames, channels) = self.inv.finish(self.c);
         let samples = self.inv.emitted_count();
         let model = self.model.is_some();
@@ -970,8 +998,55 @@ impl Checker {
         r.divergence_count = self.divergence_count;
         r.divergences = self.divergences;
         r.model_compared = model;
+        r.link_join = link_join;
         r.ok = r.ok && r.divergence_count == 0;
         r
+    }
+}
+
+impl Checker {
+    /// Where a check that joined mid-stream joined the link, in capture cycles.
+    fn link_join_report(&self) -> Option<crate::report::LinkJoin> {
+        let place = |c: u64| self.inv.place(c).0;
+        if self.model.is_none() && self.origin > 0 {
+            let line = self.line.as_ref()?;
+            let j = line.joined;
+            return Some(crate::report::LinkJoin {
+                by: "decoder".into(),
+                checked_from_cycle: j.map(|j| place(j.0)),
+                header_cycle: None,
+                frame_counter: j.map(|j| j.1),
+                slice: j.map(|j| j.2),
+                skipped_bytes: j.map_or(line.bytes_read(), |j| j.3),
+            });
+        }
+        if let Some(j) = &self.link_join {
+            return Some(crate::report::LinkJoin {
+                by: "model".into(),
+                checked_from_cycle: None,
+                header_cycle: None,
+                frame_counter: None,
+                slice: None,
+                skipped_bytes: j.bytes_read(),
+            });
+        }
+        let j = self.link_joined?;
+        Some(crate::report::LinkJoin {
+            by: "model".into(),
+            checked_from_cycle: Some(place(j.cycle)),
+            header_cycle: Some(place(j.header_cycle)),
+            frame_counter: Some(j.frame),
+            slice: Some(j.slice),
+            skipped_bytes: j.skipped_bytes,
+        })
+    }
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
     }
 }
 

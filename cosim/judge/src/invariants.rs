@@ -435,6 +435,7 @@ impl Invariants {
             violation_count: self.rec.violation_count,
             violations: self.rec.violations,
             model_compared: false,
+            link_join: None,
         }
     }
 

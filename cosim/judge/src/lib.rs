@@ -18,6 +18,8 @@
 //! - `timed` / `capture`: logic-analyser captures (no clock, any
 //!   sample rate) checked at time level, the channel map, sigrok input;
 //! - `fst`: FST input, through the `wellen` crate;
+//! - `linkjoin`: the model's link joined from the line, for a check that
+//!   joins a run mid-stream;
 //! - `linkline`: the link (UART line or AXI4-Stream beats) decoded and judged without the model;
 //! - `lock`: finding the frame phase of a capture that did not start at
 //!   reset, and checking it from there;
@@ -39,6 +41,7 @@ mod faults;
 mod fst;
 mod invariants;
 mod linkbytes;
+mod linkjoin;
 mod linkline;
 mod lock;
 mod model;

@@ -71,6 +71,11 @@ enum Wire {
     Axis(AxisFormat),
 }
 
+/// A joined check learning the run's slice phase: the samples since the
+/// join (cycle, channel, code), the join's cycle, the packets that fitted
+/// no slice.
+type Learning = (Vec<(u64, u16, u16)>, u64, u32);
+
 /// The link's checks (a mix with a `[link]`).
 #[derive(Debug, Clone)]
 pub(crate) struct LinkLine {
@@ -100,6 +105,21 @@ pub(crate) struct LinkLine {
     /// after joining a run mid-stream (what came before is a partial
     /// character or packet, not a fault).
     synced: bool,
+    /// The run's slices begin this many cycles before the model's: the
+    /// lock knows the frame phase only modulo the CS/mux pins' repeat, so
+    /// a check that joined learns it from the first packet whose records
+    /// it finds in its sample stream (`linkjoin::find_boundary`).
+    delta: u64,
+    /// Joined mid-stream and still learning `delta`: every sample since
+    /// the join, (cycle, channel, code), the cycle it joined at, and the
+    /// good packets that fitted no slice.
+    learning: Option<Learning>,
+    /// The run's slices begin a multiple of this off the model's.
+    step: u64,
+    /// Where a check that joined mid-stream joined the line: (the cycle
+    /// the first packet judged ended in, its frame counter and slice, the
+    /// bytes before it).
+    pub(crate) joined: Option<(u64, u8, u16, u64)>,
 }
 
 impl LinkLine {
@@ -139,13 +159,18 @@ impl LinkLine {
             next_boundary: 0,
             offset: Some(0),
             synced: true,
+            delta: 0,
+            learning: None,
+            step: s.grid.slice_cycles,
+            joined: None,
         })
     }
 
     /// The check joins a run at cycle `origin` with the line at `level`:
     /// slices from the first that starts at or after it are checked, and
     /// the line from the first good packet on.
-    pub(crate) fn join_at(&mut self, origin: u64, level: bool) {
+    pub(crate) fn join_at(&mut self, origin: u64, level: bool, step: u64) {
+        self.step = step;
         if let Wire::Uart(u) = &mut self.wire {
             u.rx_origin = origin;
             u.level = level;
@@ -155,6 +180,58 @@ impl LinkLine {
         self.next_boundary = self.first * self.slice_cycles;
         self.offset = None;
         self.synced = false;
+        self.learning = Some((Vec::new(), origin, 0));
+    }
+
+    /// Bytes read from the line so far.
+    pub(crate) fn bytes_read(&self) -> u64 {
+        self.dec.stats().bytes
+    }
+
+    /// The model cycle slice `w` begins in.
+    fn start_of(&self, w: u64) -> u64 {
+        (w * self.slice_cycles).saturating_sub(self.delta)
+    }
+
+    /// Good packet `p` arrived in cycle `c` while learning the run's slice
+    /// phase: whether it is known now (the slices rebuilt on it).  Two
+    /// packets that fit no slice: the lock's phase is taken, so that a
+    /// link whose records are all wrong still fails.
+    fn learn(&mut self, c: u64, p: &Packet) -> bool {
+        let Some((log, origin, misses)) = &mut self.learning else {
+            return true;
+        };
+        let s = self.slice_cycles;
+        let b = crate::linkjoin::find_boundary(log, &p.records, (*origin, c), self.step, s);
+        let delta = match b {
+            Some(b) => (s - b % s) % s,
+            None if *misses >= 1 => 0,
+            None => {
+                *misses += 1;
+                return false;
+            }
+        };
+        let (log, origin, _) = self.learning.take().unwrap_or_default();
+        self.delta = delta;
+        if let Some(b) = b {
+            // the packet's slice is known: its counters give every other's
+            let seq = (p.frame % 256) as i64 * self.slices as i64 + p.slice as i64;
+            self.offset = Some(((b + delta) / s) as i64 - seq);
+        }
+        self.first = (origin + delta).div_ceil(s);
+        self.base = self.first;
+        let now = (c + delta) / s;
+        self.windows = (self.first..=now).map(|_| Window::default()).collect();
+        self.next_boundary = self.start_of(now + 1);
+        for (at, ch, v) in log {
+            let w = (at + delta) / s;
+            if w >= self.first {
+                self.windows[(w - self.first) as usize]
+                    .samples
+                    .push((ch, v, at));
+            }
+        }
+        true
     }
 
     /// The link's pins in cycle `c` (every cycle, in order).
@@ -186,7 +263,10 @@ impl LinkLine {
 
     /// `sample_valid` in cycle `c` with this channel and value.
     pub(crate) fn sample(&mut self, c: u64, channel: u16, value: u16) {
-        if c >= self.first * self.slice_cycles {
+        if let Some((log, _, _)) = &mut self.learning {
+            log.push((c, channel, value));
+        }
+        if c >= self.start_of(self.first) {
             if let Some(w) = self.windows.back_mut() {
                 w.samples.push((channel, value, c));
             }
@@ -211,7 +291,7 @@ impl LinkLine {
 
     /// The last cycle in which slice `w`'s packet may arrive.
     fn due(&self, w: u64) -> u64 {
-        (w + 2) * self.slice_cycles + self.latency
+        self.start_of(w + 2) + self.latency
     }
 
     /// Reports the packets due before cycle `now` (the cycles before it
@@ -245,7 +325,7 @@ impl LinkLine {
 
     /// (slice, frame as reports count them) of window `w`.
     fn slice_frame(&self, w: u64, inv: &Invariants) -> (u64, u64) {
-        (w % self.slices, inv.place(w * self.slice_cycles).1)
+        (w % self.slices, inv.place(self.start_of(w)).1)
     }
 
     /// The line changed in cycle `c`: on a bit boundary of the character
@@ -383,9 +463,17 @@ impl LinkLine {
     /// A good packet arrived in cycle `c`.
     fn packet(&mut self, c: u64, p: Packet, inv: &mut Invariants) {
         self.lost_place = false;
+        if !self.learn(c, &p) {
+            return; // its slice is not known yet: in flight at the join
+        }
         // A packet closes when the next slice's header is sent: its slice
         // ended before this cycle's.
-        let closed = (c / self.slice_cycles) as i64 - 1;
+        let closed = ((c + self.delta) / self.slice_cycles) as i64 - 1;
+        if self.joined.is_none() && self.first > 0 {
+            let bytes = 4 * (2 + p.records.len() as u64);
+            let before = self.dec.stats().bytes.saturating_sub(bytes);
+            self.joined = Some((c, p.frame as u8, p.slice, before));
+        }
         let w = self.window_of(closed, &p);
         self.overflow(c, &p, inv);
         if w < self.first as i64 {

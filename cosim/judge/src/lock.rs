@@ -539,6 +539,7 @@ impl<'a> WindowCheck<'a> {
             prev_xz: prev.xz,
             mux_since,
             cs_rise,
+            repeat: search.tpl.repeat,
         };
         let mut chk = Checker::join(self.s, self.opts, *model, &join);
         for c in from..=self.i {

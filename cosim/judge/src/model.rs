@@ -344,6 +344,29 @@ impl CycleModel {
     fn step_link(&mut self, valid: bool, ch: u16, v: u16) {
         if let Some(t) = &mut self.tx {
             t.clock(false, valid.then_some((ch, v)));
+            self.link_pins();
+        }
+    }
+
+    /// The link's transmitter configuration (a mix with a `[link]`).
+    pub fn tx_config(&self) -> Option<link::TxConfig> {
+        self.tx.as_ref().map(|t| *t.config())
+    }
+
+    /// Replaces the link's transmitter with `tx` (in the current cycle): a
+    /// check that joined mid-run takes the run's own transmitter state from
+    /// the line (`linkjoin`).
+    pub fn set_tx(&mut self, tx: link::TxModel) {
+        if self.tx.is_some() {
+            self.tx = Some(tx);
+            self.link_pins();
+        }
+    }
+
+    /// The link's pins from the transmitter's state.
+    #[inline]
+    fn link_pins(&mut self) {
+        if let Some(t) = &self.tx {
             self.pins.link_overflow = t.overflow();
             if self.axis {
                 self.pins.axis_tdata = t.tdata();

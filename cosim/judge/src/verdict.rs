@@ -89,6 +89,51 @@ impl Violation {
     }
 }
 
+/// How a check that joined a run mid-stream (a window, a capture from the
+/// middle of a run) joined the link: the bytes in flight when it began are
+/// skipped, and the line is checked from its first whole packet on.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct LinkJoin {
+    /// What joined the line: `"model"` (the model's transmitter rebuilt
+    /// from the packet, every link pin compared from `checked_from_cycle`)
+    /// or `"decoder"` (`--no-model`: every packet judged from the one that
+    /// ended in `checked_from_cycle`).
+    pub by: String,
+    /// The capture cycle from which the line is checked; null when the
+    /// capture showed no whole packet to join at (the line was then not
+    /// checked).
+    pub checked_from_cycle: Option<u64>,
+    /// The first whole packet joined at: the capture cycle its header
+    /// began in (the model only), its frame counter and slice.
+    pub header_cycle: Option<u64>,
+    pub frame_counter: Option<u8>,
+    pub slice: Option<u16>,
+    /// Bytes the line carried before that packet, in flight when the
+    /// capture began: skipped.
+    pub skipped_bytes: u64,
+}
+
+impl LinkJoin {
+    /// The line the text report gives it.
+    pub fn text(&self) -> String {
+        let (Some(c), Some(f), Some(s)) = (self.checked_from_cycle, self.frame_counter, self.slice)
+        else {
+            return format!(
+                "link: the capture shows no whole packet to join the line at ({} byte(s) read): the line was not checked",
+                self.skipped_bytes
+            );
+        };
+        let what = match self.header_cycle {
+            Some(h) => format!("its header at capture cycle {h}; every link pin compared with the model from capture cycle {c}"),
+            None => format!("read by capture cycle {c}; every packet judged from it on"),
+        };
+        format!(
+            "link: joined the line at its first whole packet (frame counter {f}, slice {s}; {what}); the {} byte(s) before it, in flight when the capture began, were skipped",
+            self.skipped_bytes
+        )
+    }
+}
+
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Verdict {
     pub ok: bool,
@@ -113,6 +158,10 @@ pub struct Verdict {
     pub violations: Vec<Violation>,
     /// Whether the pins were compared against the cycle-level model.
     pub model_compared: bool,
+    /// A check that joined a link design's run mid-stream: where it
+    /// joined the line (absent from reset, or without a link).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link_join: Option<LinkJoin>,
 }
 
 impl Verdict {
@@ -137,6 +186,9 @@ impl Verdict {
             self.violation_count,
             if self.ok { "PASS" } else { "FAIL" }
         );
+        if let Some(j) = &self.link_join {
+            let _ = writeln!(s, "{}", j.text());
+        }
         if let Some(d) = self.divergences.first() {
             let _ = writeln!(
                 s,
