@@ -6,11 +6,11 @@
 
 use std::path::Path;
 
-use judge::faults::{Fault, FaultyDut};
-use judge::lock::Judge;
-use judge::run::{run_dut, Dut, Observer, RunOptions};
-use judge::vcd::CycleSink;
-use judge::{CheckOptions, LockInfo, Pins, Report};
+use judge::CycleSink;
+use judge::WindowCheck as Judge;
+use judge::{run_dut, Dut, Observer, RunOptions};
+use judge::{CheckOptions, LockInfo, Pins, Verdict};
+use judge::{FaultyDut, PinFault as Fault};
 
 /// Feeds the cycles `[from, to)` of a run (counted from its first reset
 /// cycle) to two judges, with and without the model, as a VCD of that
@@ -34,12 +34,12 @@ impl Observer for Window<'_> {
 /// `dut` behind the AXIS slave a back end puts in front of it (a design
 /// with an AXIS link; the design itself otherwise).
 fn slaved<'a>(s: &lut_gen::Schedule, dut: impl Dut + 'a) -> Box<dyn Dut + 'a> {
-    judge::run::with_slave(s, dut, ::link::ReadyPattern::Random { seed: 11 })
+    judge::with_slave(s, dut, ::link::ReadyPattern::Random { seed: 11 })
 }
 
 /// The window `[from, to)` of a run of `dut`, judged with the model and
 /// without it.
-fn judge_window(s: &lut_gen::Schedule, mut dut: impl Dut, (from, to): (u64, u64)) -> [Report; 2] {
+fn judge_window(s: &lut_gen::Schedule, mut dut: impl Dut, (from, to): (u64, u64)) -> [Verdict; 2] {
     let opts = |model| CheckOptions {
         model,
         ..Default::default()
@@ -96,13 +96,13 @@ fn rng(seed: u64) -> impl FnMut() -> u64 {
 /// Random link mixes (the one generator, with a `[link]` drawn) whose
 /// link the audit finds feasible: `n` of them from seed `seed` on.
 fn random_link_mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
-    let shape = campaign::mixgen::Shape {
-        link: Some(campaign::mixgen::LinkShape::Either),
+    let shape = campaign::Shape {
+        link: Some(campaign::LinkShape::Either),
         ..Default::default()
     };
     (seed..)
         .filter_map(|k| {
-            let text = campaign::mixgen::random_mix(k, &shape);
+            let text = campaign::random_mix(k, &shape);
             let mix = lut_gen::parse(Path::new("random.toml"), &text).ok()?;
             let s = lut_gen::synthesize(&mix).ok()?;
             matches!(lut_gen::hostlink::plan(&s), Some(Ok(_))).then_some((k, s))
@@ -121,7 +121,7 @@ fn random_window(s: &lut_gen::Schedule, next: &mut impl FnMut() -> u64) -> (u64,
 
 /// Both reports pass, and say where they joined the line: at a whole
 /// packet, after skipping what was in flight.
-fn assert_clean(what: &str, [m, d]: &[Report; 2]) {
+fn assert_clean(what: &str, [m, d]: &[Verdict; 2]) {
     for (r, by) in [(m, "model"), (d, "decoder")] {
         assert!(r.ok, "{what}, {by}: {}", r.summary());
         let j = r
@@ -157,7 +157,7 @@ enum Engine {
 fn design(s: &lut_gen::Schedule, e: Engine) -> Box<dyn Dut> {
     match e {
         Engine::RustHdl => slaved(s, rusthdl(s)),
-        Engine::Model => slaved(s, judge::run::ModelDut::new(s)),
+        Engine::Model => slaved(s, judge::ModelDut::new(s)),
     }
 }
 

@@ -49,7 +49,7 @@ fn mixes() -> Vec<(String, lut_gen::Schedule)> {
             ));
         }
     }
-    let shape = campaign::mixgen::Shape {
+    let shape = campaign::Shape {
         clock_hz: 4_000_000,
         frame_us: 1_000,
         slice_us: 500,
@@ -59,11 +59,13 @@ fn mixes() -> Vec<(String, lut_gen::Schedule)> {
         settle_ns: vec![0, 1_000, 2_000],
         channels: (2, 8),
         rates_hz: vec![1_000, 2_000, 4_000],
+        muxless: 0,
+        link: None,
     };
     for seed in 1..12u64 {
         texts.push((
             format!("random mix {seed}"),
-            campaign::mixgen::random_mix(seed, &shape),
+            campaign::random_mix(seed, &shape),
         ));
     }
     let mut out = Vec::new();

@@ -819,9 +819,9 @@ fn a_uart_proof_names_the_line_it_does_not_cover_and_excuses_no_line_fault() {
         assert!(text.contains("not covered"), "{text}");
         assert!(text.contains(&p.not_covered[0]), "{text}");
     }
-    let (v, _) = campaign::faults::prove(&s, &stuck);
+    let (v, _) = campaign::prove(&s, &stuck);
     match v {
-        campaign::faults::ProveVerdict::NoVerdict { why } => {
+        campaign::ProveVerdict::NoVerdict { why } => {
             assert!(why.contains("link_tx"), "{why}")
         }
         other => panic!("a stuck line is excused: {other:?}"),
@@ -834,7 +834,7 @@ fn a_uart_proof_names_the_line_it_does_not_cover_and_excuses_no_line_fault() {
     assert!(p.note.starts_with("proved for all time"), "{}", p.note);
     assert!(p.summary().contains("PROVED (the whole contract)"));
     assert!(matches!(
-        campaign::faults::prove(&s, &emitted(&s)).0,
-        campaign::faults::ProveVerdict::Proved
+        campaign::prove(&s, &emitted(&s)).0,
+        campaign::ProveVerdict::Proved
     ));
 }

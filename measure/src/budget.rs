@@ -487,7 +487,10 @@ mod tests {
             let names: Vec<&String> = ch.rows.iter().map(|r| &r[0]).collect();
             assert_eq!(names.len(), mix.channels.len(), "{}", mix.name);
             assert_eq!(tables.iter().filter(|t| t.0 == "Channels").count(), 1);
-            assert_eq!(r.link.is_some(), tables.iter().any(|t| t.0.starts_with("Link budget")));
+            assert_eq!(
+                r.link.is_some(),
+                tables.iter().any(|t| t.0.starts_with("Link budget"))
+            );
             let tight = Tightest::of(&r).unwrap();
             let most = r
                 .branches

@@ -23,4 +23,4 @@ pub use faults::{
     prove_unavailable, sites, Campaign, Detector, FaultClass, Level, OnRun, Plan, ProveVerdict,
     Target, VerilogFault, TREADY,
 };
-pub use mixgen::{random_mix, Shape};
+pub use mixgen::{random_mix, LinkShape, Shape};

@@ -1006,12 +1006,12 @@ impl Checker {
 
 impl Checker {
     /// Where a check that joined mid-stream joined the link, in capture cycles.
-    fn link_join_report(&self) -> Option<crate::report::LinkJoin> {
+    fn link_join_report(&self) -> Option<crate::verdict::LinkJoin> {
         let place = |c: u64| self.inv.place(c).0;
         if self.model.is_none() && self.origin > 0 {
             let line = self.line.as_ref()?;
             let j = line.joined;
-            return Some(crate::report::LinkJoin {
+            return Some(crate::verdict::LinkJoin {
                 by: "decoder".into(),
                 checked_from_cycle: j.map(|j| place(j.0)),
                 header_cycle: None,
@@ -1021,7 +1021,7 @@ impl Checker {
             });
         }
         if let Some(j) = &self.link_join {
-            return Some(crate::report::LinkJoin {
+            return Some(crate::verdict::LinkJoin {
                 by: "model".into(),
                 checked_from_cycle: None,
                 header_cycle: None,
@@ -1031,7 +1031,7 @@ impl Checker {
             });
         }
         let j = self.link_joined?;
-        Some(crate::report::LinkJoin {
+        Some(crate::verdict::LinkJoin {
             by: "model".into(),
             checked_from_cycle: Some(place(j.cycle)),
             header_cycle: Some(place(j.header_cycle)),

@@ -77,7 +77,7 @@ pub use run::{
 // Waveforms: VCD and FST in, VCD and GTKWave save files out, windows locked
 // on their frame phase.
 pub use fst::from_vcd as fst_from_vcd;
-pub use lock::{LockError, LockInfo};
+pub use lock::{LockError, LockInfo, WindowCheck};
 pub use vcd::{
     check_vcd, check_vcd_progress, check_vcd_with, parse_only as parse_vcd, read_cycles, CycleSink,
     VcdError, VcdInfo,

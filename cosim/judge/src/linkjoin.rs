@@ -15,7 +15,7 @@
 //! cycle and the model compares every link pin from then on.  The bytes
 //! before that header were in flight when the window began: they are
 //! skipped (the decoder-level checks, `linkline`, still read them) and the
-//! report says so ([`crate::report::LinkJoin`]).
+//! report says so ([`crate::verdict::LinkJoin`]).
 
 use std::collections::VecDeque;
 
