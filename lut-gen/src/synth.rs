@@ -466,7 +466,7 @@ fn nearest(rates: impl IntoIterator<Item = u64>, rate: u64) -> String {
 
 /// Exact rates on a grid of `slots` slots per frame, ascending, with their
 /// samples per frame: the period is whole slots and the interval whole cycles.
-fn grid_rates(mix: &Mix, slots: u64) -> impl Iterator<Item = (u64, u64)> + '_ {
+pub(crate) fn grid_rates(mix: &Mix, slots: u64) -> impl Iterator<Item = (u64, u64)> + '_ {
     let frames_per_s = 1e6 / mix.frame_us as f64;
     (1..=slots)
         .filter(move |n| slots.is_multiple_of(*n))
