@@ -76,12 +76,16 @@ pub struct Fix {
     pub change: Change,
     /// The change in words (branch and channel names, rates in Hz).
     pub says: String,
-    /// What it costs: parts added (ADCs and mux devices), then channels
-    /// whose wiring or rate changes; fixes are ordered by this.
+    /// What it costs: parts added (ADCs and mux devices), and channels
+    /// whose wiring or rate changes. Fixes are ordered by [`cost`]: those
+    /// that keep every rate first, then by parts, then by channels.
     pub parts_added: u32,
     pub channels_changed: usize,
     /// The slot grid the fixed mix is scheduled on.
     pub slots_per_slice: u64,
+    /// Where `audit --fixes DIR` wrote it (`DIR/fix-<n>.toml`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
     /// The complete fixed mix file, as it was audited.
     #[serde(skip)]
     pub text: String,
@@ -96,6 +100,15 @@ pub struct FixSearch {
     pub tried: usize,
 }
 
+/// The order fixes are tried and offered in (see [`Candidate::cost`]).
+pub fn cost(change: &Change, parts_added: u32, channels_changed: usize) -> (bool, u32, usize) {
+    (
+        matches!(change, Change::LowerRate { .. }),
+        parts_added,
+        channels_changed,
+    )
+}
+
 /// A candidate before it is tried.
 pub(crate) struct Candidate {
     change: Change,
@@ -105,8 +118,11 @@ pub(crate) struct Candidate {
 }
 
 impl Candidate {
-    fn cost(&self) -> (u32, usize) {
-        (self.parts_added, self.channels_changed)
+    /// A mix's rates are its requirement: a fix that keeps every rate comes
+    /// before one that lowers some; then fewer parts added, then fewer
+    /// channels changed.
+    fn cost(&self) -> (bool, u32, usize) {
+        cost(&self.change, self.parts_added, self.channels_changed)
     }
 }
 
@@ -151,6 +167,7 @@ fn run(path: &Path, text: &str, mut cands: Vec<Candidate>) -> FixSearch {
                 parts_added: c.parts_added,
                 channels_changed: c.channels_changed,
                 slots_per_slice: sps,
+                file: None,
                 text: fixed,
             });
         }

@@ -105,7 +105,7 @@ fn over_full(
         }
         lower(mix, b, r, excess, slots, &have, out);
     }
-    split(mix, b, out);
+    split(mix, b, excess, out);
 }
 
 /// `moved` (all at `rate`) from `b` to each of the roomiest other branches.
@@ -238,19 +238,29 @@ fn lowered(ch: Vec<String>, from: u64, to: u64) -> Candidate {
     }
 }
 
-/// A second branch like `b`, taking every other of `b`'s movable channels.
-fn split(mix: &Mix, b: usize, out: &mut Vec<Candidate>) {
+/// A second branch like `b`, taking the fewest of `b`'s movable channels
+/// (fastest first) that free `excess` conversions per frame.
+fn split(mix: &Mix, b: usize, excess: u64, out: &mut Vec<Candidate>) {
     let like = &mix.branches[b];
     let name = (2..)
         .map(|k| format!("{}_{k}", like.name))
         .find(|n| mix.branch_index(n).is_none())
         .unwrap();
-    let ch: Vec<String> = movable(mix, b, None)
+    let mut by_rate = movable(mix, b, None);
+    let rate = |n: &String| mix.channels[mix.channel_index(n).unwrap()].rate_hz;
+    by_rate.sort_by_key(|n| std::cmp::Reverse(rate(n)));
+    let mut freed = 0;
+    let ch: Vec<String> = by_rate
         .into_iter()
-        .skip(1)
-        .step_by(2)
+        .take_while(|n| {
+            let more = freed < excess;
+            freed += mix.samples_per_frame(rate(n));
+            more
+        })
         .collect();
-    if ch.is_empty() {
+    // (take_while counted the first channel it left behind too)
+    let freed: u64 = ch.iter().map(|n| mix.samples_per_frame(rate(n))).sum();
+    if ch.is_empty() || freed < excess {
         return;
     }
     let mut edits = vec![Edit::BranchLike {

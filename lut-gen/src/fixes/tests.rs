@@ -60,7 +60,7 @@ fn a_move_to_a_branch_without_free_inputs_brings_its_mux_devices() {
     let costs: Vec<_> = found
         .fixes
         .iter()
-        .map(|f| (f.parts_added, f.channels_changed))
+        .map(|f| cost(&f.change, f.parts_added, f.channels_changed))
         .collect();
     let mut sorted = costs.clone();
     sorted.sort();
@@ -121,4 +121,23 @@ fn a_mix_no_fix_helps_offers_none() {
     let found = search(Path::new("t.toml"), &text, &mix, &why);
     assert!(found.fixes.is_empty(), "{found}");
     assert!(found.to_string().contains("no fix found"), "{found}");
+}
+
+/// The wording: the first fix of the over-full branch moves its
+/// channels and says to where, with the devices the move needs.
+#[test]
+fn the_first_fix_keeps_every_rate() {
+    let text = format!(
+        "{HEAD}{}{}{}{}",
+        branch("taxels", 6),
+        branch("slow", 1),
+        channels("T", "taxels", 44, 2_500),
+        channels("S", "slow", 6, 500)
+    );
+    let (mix, why) = infeasible(&text);
+    let found = search(Path::new("t.toml"), &text, &mix, &why);
+    assert_eq!(
+        found.fixes[0].says,
+        "move `T40`, `T41`, `T42`, `T43` (2500 Hz) from branch `taxels` to branch `slow`, and give `slow` 2 mux devices instead of 1 for the inputs"
+    );
 }
