@@ -13,6 +13,9 @@ mod cli;
 #[path = "docs.rs"]
 mod docs;
 
+#[path = "fixes.rs"]
+mod fixes;
+
 #[path = "golden.rs"]
 mod golden;
 

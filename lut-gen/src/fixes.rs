@@ -72,9 +72,9 @@ pub enum Change {
 /// A change that was applied, synthesized and audited feasible.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Fix {
-    #[serde(flatten)]
-    pub change: Change,
-    /// The change in words (branch and channel names, rates in Hz).
+    /// One change, or one per over-full branch when several are.
+    pub changes: Vec<Change>,
+    /// The changes in words (branch and channel names, rates in Hz).
     pub says: String,
     /// What it costs: parts added (ADCs and mux devices), and channels
     /// whose wiring or rate changes. Fixes are ordered by [`cost`]: those
@@ -101,17 +101,20 @@ pub struct FixSearch {
 }
 
 /// The order fixes are tried and offered in (see [`Candidate::cost`]).
-pub fn cost(change: &Change, parts_added: u32, channels_changed: usize) -> (bool, u32, usize) {
+pub fn cost(changes: &[Change], parts_added: u32, channels_changed: usize) -> (bool, u32, usize) {
     (
-        matches!(change, Change::LowerRate { .. }),
+        changes
+            .iter()
+            .any(|c| matches!(c, Change::LowerRate { .. })),
         parts_added,
         channels_changed,
     )
 }
 
 /// A candidate before it is tried.
+#[derive(Clone)]
 pub(crate) struct Candidate {
-    change: Change,
+    changes: Vec<Change>,
     edits: Vec<Edit>,
     parts_added: u32,
     channels_changed: usize,
@@ -122,7 +125,24 @@ impl Candidate {
     /// before one that lowers some; then fewer parts added, then fewer
     /// channels changed.
     fn cost(&self) -> (bool, u32, usize) {
-        cost(&self.change, self.parts_added, self.channels_changed)
+        cost(&self.changes, self.parts_added, self.channels_changed)
+    }
+
+    /// The candidates of several branches as one.
+    fn join(parts: Vec<Candidate>) -> Candidate {
+        let mut all = Candidate {
+            changes: Vec::new(),
+            edits: Vec::new(),
+            parts_added: 0,
+            channels_changed: 0,
+        };
+        for p in parts {
+            all.changes.extend(p.changes);
+            all.edits.extend(p.edits);
+            all.parts_added += p.parts_added;
+            all.channels_changed += p.channels_changed;
+        }
+        all
     }
 }
 
@@ -158,11 +178,16 @@ fn run(path: &Path, text: &str, mut cands: Vec<Candidate>) -> FixSearch {
             continue;
         };
         out.tried += 1;
-        let says = words(&c.change);
+        let says = c
+            .changes
+            .iter()
+            .map(words)
+            .collect::<Vec<_>>()
+            .join("; and ");
         let fixed = format!("# slotforge audit: {says}\n{edited}");
         if let Some(sps) = feasible(path, &fixed, CANDIDATE_BUDGET) {
             out.fixes.push(Fix {
-                change: c.change,
+                changes: c.changes,
                 says,
                 parts_added: c.parts_added,
                 channels_changed: c.channels_changed,

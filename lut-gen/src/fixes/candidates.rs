@@ -15,14 +15,42 @@ pub(super) fn for_schedule(mix: &Mix, why: &Infeasible) -> Vec<Candidate> {
         .slots_per_slice
         .map(|s| s * mix.slices_per_frame())
         .unwrap_or(0);
+    let mut each = Vec::new();
     for (b, d) in why.branches.iter().enumerate().take(16) {
         if d.demand_slots_per_frame > d.capacity_slots_per_frame {
             let excess = d.demand_slots_per_frame - d.capacity_slots_per_frame;
-            over_full(mix, why, b, excess, slots, &mut out);
+            let mut mine = Vec::new();
+            over_full(mix, why, b, excess, slots, &mut mine);
+            each.push(mine);
         }
     }
+    out.extend(together(&each));
+    out.extend(each.into_iter().flatten());
     troubled(mix, why, slots, &mut out);
     out
+}
+
+/// Several over-full branches need a change each: the first candidate
+/// of one kind on every branch, as one fix.
+fn together(each: &[Vec<Candidate>]) -> Vec<Candidate> {
+    if each.len() < 2 {
+        return Vec::new();
+    }
+    let kinds: [fn(&Change) -> bool; 3] = [
+        |c| matches!(c, Change::MoveChannels { .. }),
+        |c| matches!(c, Change::AddBranch { .. }),
+        |c| matches!(c, Change::LowerRate { .. }),
+    ];
+    kinds
+        .iter()
+        .filter_map(|kind| {
+            let firsts: Option<Vec<Candidate>> = each
+                .iter()
+                .map(|mine| mine.iter().find(|c| c.changes.iter().all(kind)).cloned())
+                .collect();
+            firsts.map(Candidate::join)
+        })
+        .collect()
 }
 
 /// Another slice length (the nearest that give whole cycles), and a free grid.
@@ -52,10 +80,10 @@ fn grids(mix: &Mix) -> Vec<Candidate> {
 
 fn grid(slice_us: Option<(u64, u64)>, dropped: Option<u64>, edits: Vec<Edit>) -> Candidate {
     Candidate {
-        change: Change::Grid {
+        changes: vec![Change::Grid {
             slice_us,
             dropped_slots_per_slice: dropped,
-        },
+        }],
         edits,
         parts_added: 0,
         channels_changed: 0,
@@ -157,13 +185,13 @@ fn moves(
             });
         }
         out.push(Candidate {
-            change: Change::MoveChannels {
+            changes: vec![Change::MoveChannels {
                 from: mix.branches[b].name.clone(),
                 to: tb.name.clone(),
                 channels: moved.to_vec(),
                 rate_hz: rate,
                 mux_devices: devices,
-            },
+            }],
             edits,
             parts_added: devices.map(|(a, z)| z - a).unwrap_or(0),
             channels_changed: moved.len(),
@@ -229,11 +257,11 @@ fn lowered(ch: Vec<String>, from: u64, to: u64) -> Candidate {
             })
             .collect(),
         channels_changed: ch.len(),
-        change: Change::LowerRate {
+        changes: vec![Change::LowerRate {
             channels: ch,
             from_hz: from,
             to_hz: to,
-        },
+        }],
         parts_added: 0,
     }
 }
@@ -274,11 +302,11 @@ fn split(mix: &Mix, b: usize, excess: u64, out: &mut Vec<Candidate>) {
     out.push(Candidate {
         parts_added: 1 + like.mux_devices * u32::from(like.mux.inputs > 1),
         channels_changed: ch.len(),
-        change: Change::AddBranch {
+        changes: vec![Change::AddBranch {
             name,
             like: like.name.clone(),
             channels: ch,
-        },
+        }],
         edits,
     });
 }
@@ -357,11 +385,11 @@ pub(super) fn for_mux_inputs(text: &str) -> Vec<Candidate> {
             continue;
         }
         out.push(Candidate {
-            change: Change::AddMuxDevices {
+            changes: vec![Change::AddMuxDevices {
                 branch: name.to_string(),
                 from: devices,
                 to: need,
-            },
+            }],
             edits: vec![Edit::MuxDevices {
                 name: name.to_string(),
                 devices: need,

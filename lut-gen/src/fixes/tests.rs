@@ -46,12 +46,12 @@ fn a_move_to_a_branch_without_free_inputs_brings_its_mux_devices() {
             "{}",
             f.says
         );
-        if let Change::MoveChannels {
+        if let [Change::MoveChannels {
             to,
             mux_devices,
             channels,
             ..
-        } = &f.change
+        }] = &f.changes[..]
         {
             assert_eq!(to, "slow");
             assert!(mux_devices.is_some() || channels.len() <= 2, "{}", f.says);
@@ -60,7 +60,7 @@ fn a_move_to_a_branch_without_free_inputs_brings_its_mux_devices() {
     let costs: Vec<_> = found
         .fixes
         .iter()
-        .map(|f| cost(&f.change, f.parts_added, f.channels_changed))
+        .map(|f| cost(&f.changes, f.parts_added, f.channels_changed))
         .collect();
     let mut sorted = costs.clone();
     sorted.sort();
@@ -77,8 +77,8 @@ fn a_rate_too_high_for_the_adc_is_lowered_to_one_that_fits() {
     let lowered: Vec<u64> = found
         .fixes
         .iter()
-        .filter_map(|f| match f.change {
-            Change::LowerRate { to_hz, .. } => Some(to_hz),
+        .filter_map(|f| match f.changes[..] {
+            [Change::LowerRate { to_hz, .. }] => Some(to_hz),
             _ => None,
         })
         .collect();
@@ -97,12 +97,12 @@ fn too_many_channels_for_the_mux_get_the_devices_they_need() {
     let found = search_unloadable(Path::new("t.toml"), &text);
     assert_eq!(found.fixes.len(), 1, "{found}");
     assert_eq!(
-        found.fixes[0].change,
-        Change::AddMuxDevices {
+        found.fixes[0].changes,
+        vec![Change::AddMuxDevices {
             branch: "a".into(),
             from: 1,
             to: 2
-        }
+        }]
     );
     assert!(found.fixes[0]
         .says
