@@ -235,7 +235,7 @@ pub fn words(c: &Change) -> String {
             }
             if let Some(s) = dropped_slots_per_slice {
                 parts.push(format!(
-                    "let the synthesizer choose the slot grid (remove `slots_per_slice = {s}`)"
+                    "let the synthesizer choose the slot grid (remove `[frame] slots_per_slice = {s}`)"
                 ));
             }
             parts.join(", and ")

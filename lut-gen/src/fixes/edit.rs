@@ -9,7 +9,7 @@ use toml_edit::{value, DocumentMut, Item, Table};
 pub(super) enum Edit {
     /// `[frame].slice_us = us`.
     SliceUs(u64),
-    /// Leave the slot grid to the synthesizer (drop `slots_per_slice`).
+    /// Leave the slot grid to the synthesizer (drop `[frame] slots_per_slice`).
     FreeGrid,
     /// Channel `name` on branch `to`, its mux input chosen by the loader
     /// (the lowest free one) and its chain member the first.
@@ -40,7 +40,9 @@ fn apply_one(doc: &mut DocumentMut, e: &Edit) -> Option<()> {
                 .insert("slice_us", value(*us as i64));
         }
         Edit::FreeGrid => {
-            doc.remove("slots_per_slice");
+            doc.get_mut("frame")?
+                .as_table_like_mut()?
+                .remove("slots_per_slice")?;
         }
         Edit::MoveChannel { name, to } => {
             let t = named(doc, "channel", name)?;
@@ -79,7 +81,7 @@ mod tests {
 
     #[test]
     fn edits_keep_the_users_comments_and_change_only_what_they_name() {
-        let text = "# my mix\nname = \"m\"\nslots_per_slice = 4\n[frame]\nperiod_us = 1000 # one ms\nslice_us = 500\n\
+        let text = "# my mix\nname = \"m\"\n[frame]\nperiod_us = 1000 # one ms\nslice_us = 500\nslots_per_slice = 4\n\
                     [[branch]]\nname = \"a\"\nmux_devices = 1\n[[channel]]\nname = \"x\"\nbranch = \"a\"\ninput = 3\nrate_hz = 1000\n";
         let out = apply(
             text,

@@ -141,3 +141,24 @@ fn the_first_fix_keeps_every_rate() {
         "move `T40`, `T41`, `T42`, `T43` (2500 Hz) from branch `taxels` to branch `slow`, and give `slow` 2 mux devices instead of 1 for the inputs"
     );
 }
+
+/// A forced grid on which the channels collide: the fix frees the grid
+/// (the mix fits at 96 slots per slice, not the 48 forced).
+#[test]
+fn a_forced_grid_that_cannot_hold_the_mix_is_freed() {
+    let text = include_str!("../../tests/data/missed.toml")
+        .replace("slice_us = ", "slots_per_slice = 48\nslice_us = ");
+    let (mix, why) = infeasible(&text);
+    let found = search(Path::new("m.toml"), &text, &mix, &why);
+    assert_eq!(
+        found.fixes[0].changes,
+        vec![Change::Grid {
+            slice_us: None,
+            dropped_slots_per_slice: Some(48)
+        }],
+        "{found}"
+    );
+    assert_eq!(found.fixes[0].slots_per_slice, 96);
+    let keys = found.fixes[0].text.lines().filter(|l| !l.starts_with('#'));
+    assert!(!keys.into_iter().any(|l| l.contains("slots_per_slice")));
+}
