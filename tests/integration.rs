@@ -18,6 +18,8 @@ mod docs;
 
 #[path = "figures.rs"]
 mod figures;
+#[path = "fixes.rs"]
+mod fixes;
 
 #[path = "golden.rs"]
 mod golden;

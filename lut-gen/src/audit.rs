@@ -49,6 +49,13 @@ pub struct AuditReport {
     /// utilisation, FIFO depth, worst latency, minimum baud.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub link: Option<crate::hostlink::LinkPlan>,
+    /// Only without a schedule: the changes that make the mix fit, each
+    /// applied and audited feasible first, cheapest first (empty: none
+    /// found), and how many changes were tried.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fixes: Option<Vec<crate::fixes::Fix>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fixes_tried: Option<usize>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -278,6 +285,8 @@ impl AuditReport {
             notes,
             branches,
             channels,
+            fixes: None,
+            fixes_tried: None,
         }
     }
 
@@ -359,6 +368,8 @@ impl AuditReport {
                 .collect(),
             channels: Vec::new(),
             link: None,
+            fixes: None,
+            fixes_tried: None,
         }
     }
 

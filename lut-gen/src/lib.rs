@@ -8,8 +8,10 @@
 //! - [`ports`]: the pin contract of `slotforge_top` (names, roles, widths, lanes, limits, `ports.json`);
 //! - [`hostlink`]: the link to the host planned from the schedule (divider, bytes per frame, FIFO depth, latency, minimum baud);
 //! - [`oswords`]: what the OS says about a user's file, in words;
+//! - [`fixes`]: changes that make an infeasible mix fit, each tried before it is offered;
 //! - [`audit`]: rates, intervals, headroom, settling and Nyquist, as text or JSON.
 
+pub mod fixes;
 pub mod hostlink;
 pub mod mix;
 pub mod oswords;

@@ -466,7 +466,7 @@ fn nearest(rates: impl IntoIterator<Item = u64>, rate: u64) -> String {
 
 /// Exact rates on a grid of `slots` slots per frame, ascending, with their
 /// samples per frame: the period is whole slots and the interval whole cycles.
-fn grid_rates(mix: &Mix, slots: u64) -> impl Iterator<Item = (u64, u64)> + '_ {
+pub(crate) fn grid_rates(mix: &Mix, slots: u64) -> impl Iterator<Item = (u64, u64)> + '_ {
     let frames_per_s = 1e6 / mix.frame_us as f64;
     (1..=slots)
         .filter(move |n| slots.is_multiple_of(*n))
@@ -553,12 +553,9 @@ fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
                     .push(over_capacity(&mix.branches[b].name, d, sps, k));
             }
         }
+        // What would make an over-full branch fit is not guessed here from
+        // counts: `audit` tries each change on the mix (`crate::fixes`).
         collisions(mix, dg, &demand, bound, &mut f);
-        for b in 0..nb {
-            if demand[b] > slots {
-                rebalance(mix, b, slots, &demand, &mut f.suggestions);
-            }
-        }
     }
 
     let branches = (0..nb)
@@ -661,61 +658,6 @@ fn collisions(mix: &Mix, dg: DiagGrid, demand: &[u64], bound: Option<u64>, f: &m
         } else {
             "rates that are not harmonic collide: two progressions of periods p and q meet unless their offsets differ modulo gcd(p, q), and no choice of offsets separates them all".into()
         });
-    }
-}
-
-/// Over-full branch `b`: move channels to the branch with the most room,
-/// else add a branch; or lower its fastest rate.
-fn rebalance(mix: &Mix, b: usize, slots: u64, demand: &[u64], suggestions: &mut Vec<String>) {
-    let nb = mix.branches.len();
-    let excess = demand[b] - slots;
-    let mut rates: Vec<u64> = mix
-        .channels
-        .iter()
-        .filter(|c| c.branch == b)
-        .map(|c| c.rate_hz)
-        .collect();
-    rates.sort_unstable();
-    rates.dedup();
-    let mut moved = false;
-    for &r in rates.iter().rev() {
-        let n = mix.samples_per_frame(r);
-        let count = excess.div_ceil(n);
-        let have = mix
-            .channels
-            .iter()
-            .filter(|c| c.branch == b && c.rate_hz == r)
-            .count() as u64;
-        if count > have {
-            continue;
-        }
-        if let Some(t) = (0..nb)
-            .filter(|&t| t != b)
-            .max_by_key(|&t| slots.saturating_sub(demand[t]))
-        {
-            let room = slots.saturating_sub(demand[t]) / n;
-            if room >= count {
-                suggestions.push(format!(
-                    "move {count} of the {r} Hz channels from `{}` to `{}` (room there for {room} more at {r} Hz)",
-                    mix.branches[b].name, mix.branches[t].name
-                ));
-                moved = true;
-                break;
-            }
-        }
-    }
-    if !moved {
-        suggestions.push(format!(
-            "add a branch: the other branches cannot absorb {excess} more conversions per frame"
-        ));
-    }
-    if let Some(&fast) = rates.last() {
-        let n = mix.samples_per_frame(fast);
-        let reduce = excess.div_ceil(n);
-        suggestions.push(format!(
-            "or lower the rate of {reduce} of the {fast} Hz channels on `{}`",
-            mix.branches[b].name
-        ));
     }
 }
 

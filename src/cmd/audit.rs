@@ -1,7 +1,9 @@
-//! `slotforge audit MIX [--json]`: does the mix fit, and how well?
+//! `slotforge audit MIX [--json] [--fixes DIR]`: does the mix fit, how
+//! well, and if not, which changes (each tried first) make it fit?
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
+use lut_gen::fixes::FixSearch;
 use lut_gen::AuditReport;
 
 #[derive(clap::Args)]
@@ -11,15 +13,28 @@ pub struct Args {
     /// Print the report as JSON instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// For a mix that does not fit: write each fix offered as a complete
+    /// mix file DIR/fix-<n>.toml (n from 1, in the printed order), each one
+    /// audited feasible. DIR is created if missing; one that holds fix
+    /// files already is refused, nothing written.
+    #[arg(long, value_name = "DIR")]
+    pub fixes: Option<PathBuf>,
     #[command(flatten)]
     pub search: super::SearchLimit,
 }
 
 pub fn run(args: Args) -> u8 {
+    if let Some(dir) = &args.fixes {
+        if let Err(e) = fresh_fix_dir(dir) {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    }
     let mix = match lut_gen::load(&args.mix) {
         Ok(m) => m,
         Err(e) => {
             eprintln!("error: {e}");
+            unloadable(&args);
             return 2;
         }
     };
@@ -35,14 +50,29 @@ pub fn run(args: Args) -> u8 {
                     *x = e.at(&args.mix);
                 }
             }
+            if let Some(dir) = &args.fixes {
+                eprintln!("the mix fits: no fixes written to {}", dir.display());
+            }
             (report, None)
         }
-        Err(why) => (AuditReport::of_infeasible(&mix, &why), Some(why)),
+        Err(mut why) => {
+            // advice from counts alone is not printed: the fixes replace
+            // it, each one tried on the mix first
+            why.suggestions.clear();
+            let mut found = search(&args.mix, &mix, &why);
+            if let Err(code) = write_all(&args, &mut found) {
+                return code;
+            }
+            let mut report = AuditReport::of_infeasible(&mix, &why);
+            report.fixes_tried = Some(found.tried);
+            report.fixes = Some(found.fixes.clone());
+            (report, Some((why, found)))
+        }
     };
     if args.json {
         print!("{}", report.to_json());
-    } else if let Some(why) = &diagnosis {
-        print!("{why}");
+    } else if let Some((why, found)) = &diagnosis {
+        print!("{why}{found}");
     } else {
         print!("{}", report.to_text());
     }
@@ -51,4 +81,88 @@ pub fn run(args: Args) -> u8 {
         (false, Some(v)) => super::verdict_exit(v),
         (false, None) => 1,
     }
+}
+
+/// The fixes of a loaded mix without a schedule (the file's own text is
+/// edited, so it is read again).
+fn search(path: &Path, mix: &lut_gen::Mix, why: &lut_gen::Infeasible) -> FixSearch {
+    match std::fs::read_to_string(path) {
+        Ok(text) => lut_gen::fixes::search(path, &text, mix, why),
+        Err(_) => FixSearch {
+            fixes: Vec::new(),
+            tried: 0,
+        },
+    }
+}
+
+/// A mix the loader refused: if more mux devices make it load and fit,
+/// say which (after the error), and write them when asked.
+fn unloadable(args: &Args) {
+    let Ok(text) = std::fs::read_to_string(&args.mix) else {
+        return;
+    };
+    let mut found = lut_gen::fixes::search_unloadable(&args.mix, &text);
+    if found.fixes.is_empty() {
+        return;
+    }
+    if write_all(args, &mut found).is_err() {
+        return;
+    }
+    eprint!("{found}");
+}
+
+/// `--fixes DIR`: refused before any work if DIR holds fix files already.
+fn fresh_fix_dir(dir: &Path) -> Result<(), String> {
+    if !dir.exists() {
+        return Ok(());
+    }
+    if !dir.is_dir() {
+        return Err(format!("{}: exists and is not a folder", dir.display()));
+    }
+    let entries = std::fs::read_dir(dir)
+        .map_err(|e| format!("{}: cannot read: {}", dir.display(), lut_gen::io_words(&e)))?;
+    let mut taken: Vec<String> = entries
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("fix-") && n.ends_with(".toml"))
+        .collect();
+    taken.sort();
+    if taken.is_empty() {
+        return Ok(());
+    }
+    Err(format!(
+        "{}: holds fix files already ({}): nothing written; give --fixes a new or empty folder",
+        dir.display(),
+        taken.join(", ")
+    ))
+}
+
+/// Writes every fix as `DIR/fix-<n>.toml` and records where.
+fn write_all(args: &Args, found: &mut FixSearch) -> Result<(), u8> {
+    let Some(dir) = &args.fixes else {
+        return Ok(());
+    };
+    if found.fixes.is_empty() {
+        eprintln!("no fix found: nothing written to {}", dir.display());
+        return Ok(());
+    }
+    let names: Vec<String> = (1..=found.fixes.len())
+        .map(|n| format!("fix-{n}.toml"))
+        .collect();
+    let files: Vec<(&str, String)> = names
+        .iter()
+        .zip(&found.fixes)
+        .map(|(n, f)| (n.as_str(), f.text.clone()))
+        .collect();
+    super::write_files(dir, &files)?;
+    for (n, f) in names.iter().zip(&mut found.fixes) {
+        f.file = Some(dir.join(n).display().to_string());
+    }
+    eprintln!(
+        "wrote {} fix file(s) to {}: {}",
+        names.len(),
+        dir.display(),
+        names.join(", ")
+    );
+    Ok(())
 }

@@ -1,0 +1,127 @@
+//! Edits of the user's own mix text: a fix is written as the file the
+//! user would have written (comments, order and layout kept), so that the
+//! file a fix offers is exactly the text that was re-synthesized.
+
+use toml_edit::{value, DocumentMut, Item, Table};
+
+/// One change to a mix file, in the mix format's own terms.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Edit {
+    /// `[frame].slice_us = us`.
+    SliceUs(u64),
+    /// Leave the slot grid to the synthesizer (drop `[frame] slots_per_slice`).
+    FreeGrid,
+    /// Channel `name` on branch `to`, its mux input chosen by the loader
+    /// (the lowest free one) and its chain member the first.
+    MoveChannel { name: String, to: String },
+    /// Channel `name` at `hz`.
+    Rate { name: String, hz: u64 },
+    /// Branch `name` with `devices` mux devices.
+    MuxDevices { name: String, devices: u32 },
+    /// A new branch `name` with every setting of branch `like`.
+    BranchLike { name: String, like: String },
+}
+
+/// `text` with `edits` applied, or `None` when the text is not TOML or a
+/// table an edit names is missing (the candidate is then not offered).
+pub(super) fn apply(text: &str, edits: &[Edit]) -> Option<String> {
+    let mut doc: DocumentMut = text.parse().ok()?;
+    for e in edits {
+        apply_one(&mut doc, e)?;
+    }
+    Some(doc.to_string())
+}
+
+fn apply_one(doc: &mut DocumentMut, e: &Edit) -> Option<()> {
+    match e {
+        Edit::SliceUs(us) => {
+            doc.get_mut("frame")?
+                .as_table_like_mut()?
+                .insert("slice_us", value(*us as i64));
+        }
+        Edit::FreeGrid => {
+            doc.get_mut("frame")?
+                .as_table_like_mut()?
+                .remove("slots_per_slice")?;
+        }
+        Edit::MoveChannel { name, to } => {
+            let t = named(doc, "channel", name)?;
+            t.insert("branch", value(to.as_str()));
+            t.remove("input");
+            t.remove("member");
+        }
+        Edit::Rate { name, hz } => {
+            named(doc, "channel", name)?.insert("rate_hz", value(*hz as i64));
+        }
+        Edit::MuxDevices { name, devices } => {
+            named(doc, "branch", name)?.insert("mux_devices", value(*devices as i64));
+        }
+        Edit::BranchLike { name, like } => {
+            let mut t: Table = named(doc, "branch", like)?.clone();
+            t.insert("name", value(name.as_str()));
+            // a copy keeps its place after the original's siblings
+            t.set_position(usize::MAX);
+            doc.get_mut("branch")?.as_array_of_tables_mut()?.push(t);
+        }
+    }
+    Some(())
+}
+
+/// The `[[array]]` table whose `name` is `name`.
+fn named<'a>(doc: &'a mut DocumentMut, array: &str, name: &str) -> Option<&'a mut Table> {
+    doc.get_mut(array)?
+        .as_array_of_tables_mut()?
+        .iter_mut()
+        .find(|t| t.get("name").and_then(Item::as_str) == Some(name))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edits_keep_the_users_comments_and_change_only_what_they_name() {
+        let text = "# my mix\nname = \"m\"\n[frame]\nperiod_us = 1000 # one ms\nslice_us = 500\nslots_per_slice = 4\n\
+                    [[branch]]\nname = \"a\"\nmux_devices = 1\n[[channel]]\nname = \"x\"\nbranch = \"a\"\ninput = 3\nrate_hz = 1000\n";
+        let out = apply(
+            text,
+            &[
+                Edit::FreeGrid,
+                Edit::SliceUs(250),
+                Edit::MoveChannel {
+                    name: "x".into(),
+                    to: "b".into(),
+                },
+                Edit::Rate {
+                    name: "x".into(),
+                    hz: 500,
+                },
+                Edit::MuxDevices {
+                    name: "a".into(),
+                    devices: 2,
+                },
+                Edit::BranchLike {
+                    name: "b".into(),
+                    like: "a".into(),
+                },
+            ],
+        )
+        .unwrap();
+        assert!(out.starts_with("# my mix\n"), "{out}");
+        assert!(out.contains("period_us = 1000 # one ms"), "{out}");
+        assert!(!out.contains("slots_per_slice"), "{out}");
+        assert!(out.contains("slice_us = 250"), "{out}");
+        assert!(!out.contains("input"), "{out}");
+        assert!(out.contains("rate_hz = 500"), "{out}");
+        assert!(out.contains("mux_devices = 2"), "{out}");
+        assert_eq!(out.matches("[[branch]]").count(), 2, "{out}");
+        assert!(apply(
+            text,
+            &[Edit::Rate {
+                name: "nobody".into(),
+                hz: 1
+            }]
+        )
+        .is_none());
+    }
+}
