@@ -47,8 +47,14 @@ pub enum Clause {
 
 /// The clauses `s`'s design owes at its outputs, in report order.
 pub fn contract(s: &Schedule, layout: &Layout) -> Vec<Clause> {
+    // A branch without a mux has no mux lines to owe.
     let mut c: Vec<Clause> = (0..s.branches.len())
-        .flat_map(|b| [Clause::Conversion(b), Clause::Sclk(b), Clause::Mux(b)])
+        .flat_map(|b| {
+            let mux = layout.muxed.get(b).copied().unwrap_or(true);
+            [Clause::Conversion(b), Clause::Sclk(b)]
+                .into_iter()
+                .chain(mux.then_some(Clause::Mux(b)))
+        })
         .collect();
     c.extend([
         Clause::StreamValid,
