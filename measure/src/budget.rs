@@ -139,7 +139,7 @@ fn facts(r: &AuditReport) -> Table {
     row(
         "Sample rate of all channels",
         format!(
-            "{} samples/s = {} of the converters' {} samples/s",
+            "{} samples/s = {} of the converters' {:.0} samples/s",
             r.aggregate_hz,
             pct(r.adc_utilization),
             r.adc_limit_hz
@@ -230,7 +230,7 @@ fn branches(r: &AuditReport) -> Table {
                 pct(b.utilization)
             ),
             format!(
-                "{} of {} ({})",
+                "{} of {:.0} ({})",
                 b.demand_sps,
                 b.adc_max_sps,
                 pct(b.adc_utilization)
@@ -452,6 +452,18 @@ mod tests {
     /// words, every table whole (each row as wide as its header), each
     /// channel one row, and the tightest limit is the most used figure
     /// of the branch table.
+    /// A number printed with more than three decimals: a float written
+    /// out as it is stored, not as a reader wants it.
+    fn raw_float(cell: &str) -> bool {
+        let b = cell.as_bytes();
+        (1..b.len()).any(|i| {
+            b[i - 1] == b'.'
+                && i >= 2
+                && b[i - 2].is_ascii_digit()
+                && b[i..].iter().take_while(|c| c.is_ascii_digit()).count() > 3
+        })
+    }
+
     #[test]
     fn the_audit_tables_are_words_whole_and_once() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -462,6 +474,9 @@ mod tests {
                 mixes.push(lut_gen::parse(&p, &std::fs::read_to_string(&p).unwrap()).unwrap());
             }
         }
+        // a part whose throughput is not a whole number of samples/s
+        let cnv = root.join("hdl/tests/data/cnvmix.toml");
+        mixes.push(lut_gen::parse(&cnv, &std::fs::read_to_string(&cnv).unwrap()).unwrap());
         for seed in 1..6 {
             let text = campaign::random_mix(seed, &campaign::Shape::default());
             mixes.push(lut_gen::parse(std::path::Path::new("r.toml"), &text).unwrap());
@@ -476,6 +491,13 @@ mod tests {
                     assert!(!plain_has_underscore(h), "{}: {cap}: {h}", mix.name);
                 }
                 assert!(t.rows.iter().all(|row| row.len() == t.columns.len()));
+                for cell in t.rows.iter().flatten() {
+                    assert!(
+                        !raw_float(cell),
+                        "{}: {cap}: an unrounded number: {cell}",
+                        mix.name
+                    );
+                }
                 if t.columns.len() == 2 {
                     // label and value: the labels are words
                     for row in &t.rows {
