@@ -164,7 +164,7 @@ fn random_link_mixes(dir: &Path, link: &str, n: usize) -> Vec<PathBuf> {
             let path = dir.join(format!("random-{seed}.toml"));
             let m = lut_gen::parse(&path, &text).ok()?;
             let s = lut_gen::synthesize(&m).ok()?;
-            lut_gen::hostlink::plan(&s)?.ok()?;
+            lut_gen::plan_link(&s)?.ok()?;
             std::fs::write(&path, text).unwrap();
             Some(path)
         })

@@ -105,7 +105,7 @@ fn random_link_mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
             let text = campaign::random_mix(k, &shape);
             let mix = lut_gen::parse(Path::new("random.toml"), &text).ok()?;
             let s = lut_gen::synthesize(&mix).ok()?;
-            matches!(lut_gen::hostlink::plan(&s), Some(Ok(_))).then_some((k, s))
+            matches!(lut_gen::plan_link(&s), Some(Ok(_))).then_some((k, s))
         })
         .take(n)
         .collect()
@@ -195,7 +195,7 @@ fn random_mixes(seed: u64, mixes: usize, windows: usize, e: Engine) {
             s.mix
                 .link
                 .as_ref()
-                .is_some_and(|l| l.kind == lut_gen::mix::LinkKind::Axis)
+                .is_some_and(|l| l.kind == lut_gen::LinkKind::Axis)
         })
         .count();
     assert!(
@@ -239,10 +239,10 @@ fn a_fault_inside_a_window_fails_it_at_its_cycle() {
     let kind = |s: &lut_gen::Schedule| s.mix.link.as_ref().map(|l| l.kind);
     let uart = mixes
         .iter()
-        .find(|(_, s)| kind(s) == Some(lut_gen::mix::LinkKind::Uart));
+        .find(|(_, s)| kind(s) == Some(lut_gen::LinkKind::Uart));
     let axis = mixes
         .iter()
-        .find(|(_, s)| kind(s) == Some(lut_gen::mix::LinkKind::Axis));
+        .find(|(_, s)| kind(s) == Some(lut_gen::LinkKind::Axis));
     let (uart, axis) = (&uart.expect("a UART mix").1, &axis.expect("an AXIS mix").1);
     let reset = RunOptions::default().reset_cycles;
     for (s, fault, signal) in [

@@ -8,7 +8,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use lut_gen::ports::{Dir, Layout, PORTS, TOP_MODULE};
+use lut_gen::{Dir, Layout, PORTS, TOP_MODULE};
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
@@ -63,7 +63,7 @@ fn wrapper(mutate: bool) -> String {
         let width = l.width(p.role);
         let range = if !p.vector {
             String::new()
-        } else if p.role == lut_gen::ports::Role::MuxSel {
+        } else if p.role == lut_gen::Role::MuxSel {
             "[SEL-1:0] ".into()
         } else if width == l.branches as u32 {
             "[NB-1:0] ".into()
@@ -88,7 +88,7 @@ fn wrapper(mutate: bool) -> String {
         .collect();
     let _ = writeln!(w, "  emitted_top core({});", conns.join(", "));
     for p in PORTS.iter().filter(|p| p.dir == Dir::Out) {
-        let flip = if mutate && p.role == lut_gen::ports::Role::SampleValue {
+        let flip = if mutate && p.role == lut_gen::Role::SampleValue {
             " ^ 1'b1"
         } else {
             ""
@@ -141,7 +141,7 @@ fn tops_off_the_contract_exit_2_naming_the_port() {
     let d = tempfile::tempdir().unwrap();
     let v = emitted();
     let l = Layout::new(&schedule());
-    let en = l.width(lut_gen::ports::Role::MuxEn);
+    let en = l.width(lut_gen::Role::MuxEn);
     let cases: Vec<(&str, String, Vec<String>)> = vec![
         (
             "renamed.v",

@@ -21,7 +21,7 @@ use std::process::Command as Process;
 
 use assert_cmd::Command;
 use judge::{read_cycles, CycleSink};
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 use lut_gen::Schedule;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
@@ -146,9 +146,9 @@ struct PartDecoder {
 }
 
 impl PartDecoder {
-    fn of(part: &lut_gen::parts::AdcPart) -> PartDecoder {
+    fn of(part: &lut_gen::AdcPart) -> PartDecoder {
         let w = part.word_sclks();
-        let cnv = part.start == lut_gen::parts::Start::Cnv;
+        let cnv = part.start == lut_gen::Start::Cnv;
         // Mode 3 reads stream bits 1..=w at the w rising edges (bit 0 comes
         // before the first); mode 0 reads bits 0..w.
         let (options, shift) = if cnv {

@@ -17,7 +17,7 @@ fn main() {
         eprintln!("{path}: {e}");
         std::process::exit(1)
     });
-    let g = formal::aiger::parse(&text).unwrap_or_else(|e| {
+    let g = formal::parse_aiger(&text).unwrap_or_else(|e| {
         eprintln!("{path}: {e}");
         std::process::exit(1)
     });
@@ -38,9 +38,9 @@ fn main() {
     let choices: Vec<usize> = std::env::var("CHOICES")
         .map(|c| c.split(',').map(|x| num(x, "CHOICES") as usize).collect())
         .unwrap_or_default();
-    let (found, st) = formal::symsim::prove(&g, &choices, period, 2, max, Some(deadline));
+    let (found, st) = formal::prove_aig(&g, &choices, period, 2, max, Some(deadline));
     let verdict = match &found {
-        formal::symsim::Found::Violated { step, .. } => format!("violated at step {step}"),
+        formal::Found::Violated { step, .. } => format!("violated at step {step}"),
         other => format!("{other:?}"),
     };
     println!("{verdict}");

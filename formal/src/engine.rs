@@ -56,7 +56,7 @@ impl Solver {
 
 /// What one engine run found.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Verdict {
+pub enum SolverVerdict {
     /// Holds in every reachable state.
     Proved,
     /// Violated at this step from the first step (0 = the step before reset's edge).
@@ -126,7 +126,7 @@ pub fn prepare(dir: &Path, solver: Solver) -> Result<Prepared, ProveError> {
 }
 
 /// ABC's `bmc3` from reset for at most `frames` steps and `secs` seconds.
-pub fn bmc(p: &Prepared, frames: u64, secs: u64) -> Result<Verdict, ProveError> {
+pub fn bmc(p: &Prepared, frames: u64, secs: u64) -> Result<SolverVerdict, ProveError> {
     let cmd = format!(
         "read_aiger design.aig; fold; strash; bmc3 -F {frames} -T {secs}; write_cex -a cex.aiw"
     );
@@ -140,7 +140,7 @@ pub fn bmc(p: &Prepared, frames: u64, secs: u64) -> Result<Verdict, ProveError> 
 }
 
 /// ABC's `pdr` for at most `secs` seconds.
-pub fn pdr(p: &Prepared, secs: u64) -> Result<Option<Verdict>, ProveError> {
+pub fn pdr(p: &Prepared, secs: u64) -> Result<Option<SolverVerdict>, ProveError> {
     let cmd = format!("read_aiger design.aig; fold; strash; pdr -T {secs}; write_cex -a cex.aiw");
     let out = run_tool(
         &p.dir,
@@ -149,17 +149,17 @@ pub fn pdr(p: &Prepared, secs: u64) -> Result<Option<Verdict>, ProveError> {
         Duration::from_secs(secs),
     )?;
     if out.contains("Property proved") {
-        return Ok(Some(Verdict::Proved));
+        return Ok(Some(SolverVerdict::Proved));
     }
     match parse_abc(&out, 0)? {
-        v @ Verdict::Violated { .. } => Ok(Some(v)),
+        v @ SolverVerdict::Violated { .. } => Ok(Some(v)),
         _ => Ok(None),
     }
 }
 
 /// Reads ABC's verdict: "Output 0 of miter ... was asserted in frame N." or
 /// "No output asserted in N frames.".
-pub(crate) fn parse_abc(out: &str, frames: u64) -> Result<Verdict, ProveError> {
+pub(crate) fn parse_abc(out: &str, frames: u64) -> Result<SolverVerdict, ProveError> {
     for line in out.lines() {
         if let Some(i) = line.find("was asserted in frame ") {
             let n: String = line[i + 22..]
@@ -169,7 +169,7 @@ pub(crate) fn parse_abc(out: &str, frames: u64) -> Result<Verdict, ProveError> {
             let step = n
                 .parse()
                 .map_err(|_| ProveError::Tool(format!("ABC: cannot read `{line}`")))?;
-            return Ok(Verdict::Violated { step });
+            return Ok(SolverVerdict::Violated { step });
         }
         if let Some(i) = line.find("No output asserted in ") {
             let n: String = line[i + 22..]
@@ -177,7 +177,7 @@ pub(crate) fn parse_abc(out: &str, frames: u64) -> Result<Verdict, ProveError> {
                 .take_while(|c| c.is_ascii_digit())
                 .collect();
             if let Ok(steps) = n.parse() {
-                return Ok(Verdict::Bounded { steps });
+                return Ok(SolverVerdict::Bounded { steps });
             }
         }
     }
@@ -196,9 +196,9 @@ pub(crate) fn parse_abc(out: &str, frames: u64) -> Result<Verdict, ProveError> {
                 }
             }
         }
-        return Ok(Verdict::Bounded { steps: done });
+        return Ok(SolverVerdict::Bounded { steps: done });
     }
-    Ok(Verdict::Bounded { steps: 0 })
+    Ok(SolverVerdict::Bounded { steps: 0 })
 }
 
 /// The recurrence check (`aiger.rs`): whether, for every input, the state
@@ -211,8 +211,8 @@ pub fn recurrence(p: &Prepared, frame_cycles: u64, secs: u64) -> Result<Option<b
     let build = crate::aiger::recurrence_miter;
     Ok(
         match bmc_on_miter(p, "recur.aig", build, frame_cycles, secs)? {
-            Verdict::Violated { .. } => Some(false),
-            Verdict::Bounded { steps } if steps > check => Some(true),
+            SolverVerdict::Violated { .. } => Some(false),
+            SolverVerdict::Bounded { steps } if steps > check => Some(true),
             _ => None,
         },
     )
@@ -228,7 +228,7 @@ fn bmc_on_miter(
     build: fn(&crate::aiger::Aig, &[usize], u64, u64) -> Vec<u8>,
     frame_cycles: u64,
     secs: u64,
-) -> Result<Verdict, ProveError> {
+) -> Result<SolverVerdict, ProveError> {
     let aag = std::fs::read_to_string(p.dir.join("design.aag"))
         .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
     let g = crate::aiger::parse(&aag).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
@@ -276,9 +276,9 @@ pub fn combined(
     let build = crate::aiger::combined_miter;
     Ok(
         match bmc_on_miter(p, "combined.aig", build, frame_cycles, secs)? {
-            Verdict::Violated { step } if step < check => Some(Combined::Fails { step }),
-            Verdict::Violated { .. } => Some(Combined::AtCheck),
-            Verdict::Bounded { steps } if steps > check => Some(Combined::Holds),
+            SolverVerdict::Violated { step } if step < check => Some(Combined::Fails { step }),
+            SolverVerdict::Violated { .. } => Some(Combined::AtCheck),
+            SolverVerdict::Bounded { steps } if steps > check => Some(Combined::Holds),
             _ => None,
         },
     )
@@ -302,7 +302,7 @@ fn named_inputs(p: &Prepared, name: Option<&str>) -> Result<Vec<(usize, usize)>,
 }
 
 /// cvc5 through yosys-smtbmc: k-induction of depth `k` (base case from reset).
-pub fn smt_induction(p: &Prepared, k: u64, secs: u64) -> Result<Option<Verdict>, ProveError> {
+pub fn smt_induction(p: &Prepared, k: u64, secs: u64) -> Result<Option<SolverVerdict>, ProveError> {
     let k = k.to_string();
     let out = run_tool(
         &p.dir,
@@ -326,7 +326,7 @@ pub fn smt_induction(p: &Prepared, k: u64, secs: u64) -> Result<Option<Verdict>,
         Err(e) => return Err(e),
     };
     if out.contains("PASSED") && !out.contains("FAILED") {
-        return Ok(Some(Verdict::Proved));
+        return Ok(Some(SolverVerdict::Proved));
     }
     Ok(None)
 }
@@ -374,7 +374,7 @@ mod tests {
                 100
             )
             .unwrap(),
-            Verdict::Violated { step: 57 }
+            SolverVerdict::Violated { step: 57 }
         );
         assert_eq!(
             parse_abc(
@@ -382,7 +382,7 @@ mod tests {
                 1000
             )
             .unwrap(),
-            Verdict::Bounded { steps: 1000 }
+            SolverVerdict::Bounded { steps: 1000 }
         );
     }
 

@@ -51,7 +51,7 @@ impl DeepFault {
                      always @(posedge clk) fault_age <= rst ? 40'd0 : fault_age + 40'd1;\n    \
                      wire fault_hit = fault_age == 40'd{hit};\n"
                 );
-                let width = lut_gen::ports::Layout::new(s).width(lut_gen::ports::Role::MuxSel);
+                let width = lut_gen::Layout::new(s).width(lut_gen::Role::MuxSel);
                 let mut v = String::with_capacity(verilog.len() + logic.len() + 32);
                 v.push_str(&verilog[..end]);
                 v.push_str(&format!(" ^ {{{{{}{{1'b0}}}}, fault_hit}}", width - 1));

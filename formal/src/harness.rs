@@ -15,9 +15,9 @@
 
 use std::fmt::Write;
 
-use lut_gen::parts::{SpiTiming, Start};
-use lut_gen::ports::{Layout, Role, TOP_MODULE};
 use lut_gen::Schedule;
+use lut_gen::{Layout, Role, TOP_MODULE};
+use lut_gen::{SpiTiming, Start};
 
 mod compact;
 mod contract;
@@ -77,7 +77,7 @@ pub(crate) fn width(n: u64) -> u32 {
 /// The largest frame the full tables cover (one case arm per slot and
 /// branch); a longer frame gets the compact tables, held to the same
 /// number of case arms per branch (`harness/compact.rs`).
-pub const MAX_FRAME_SLOTS: u64 = 65_536;
+pub const FULL_TABLE_MAX_SLOTS: u64 = 65_536;
 
 /// How the harness writes its per-branch slot tables.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -86,14 +86,14 @@ pub enum TableForm {
     Full,
     /// One row per slot of the slice, fixed or a rotation group indexed by
     /// the slice in the frame: `lut_gen::lut::CompactLut`'s idea applied to
-    /// the harness's rows, for frames beyond [`MAX_FRAME_SLOTS`].
+    /// the harness's rows, for frames beyond [`FULL_TABLE_MAX_SLOTS`].
     Compact,
 }
 
 impl TableForm {
     /// The form [`generate`] uses for `s`: full while the frame fits.
     pub fn for_schedule(s: &Schedule) -> TableForm {
-        if s.grid.frame_slots <= MAX_FRAME_SLOTS {
+        if s.grid.frame_slots <= FULL_TABLE_MAX_SLOTS {
             TableForm::Full
         } else {
             TableForm::Compact
@@ -188,9 +188,9 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
 pub fn generate_with(s: &Schedule, form: TableForm) -> Result<Harness, HarnessError> {
     Layout::fits(s).map_err(HarnessError)?;
     let g = &s.grid;
-    if form == TableForm::Full && g.frame_slots > MAX_FRAME_SLOTS {
+    if form == TableForm::Full && g.frame_slots > FULL_TABLE_MAX_SLOTS {
         return Err(HarnessError(format!(
-            "mix `{}`: a frame of {} slots is beyond the formal harness's full tables ({MAX_FRAME_SLOTS})",
+            "mix `{}`: a frame of {} slots is beyond the formal harness's full tables ({FULL_TABLE_MAX_SLOTS})",
             s.mix.name, g.frame_slots
         )));
     }

@@ -8,14 +8,16 @@
 //!
 //! A bounded result is reported as `bounded` with its depth, never as a proof.
 
-pub mod aiger;
+mod aiger;
+// A public namespace, not an export list: `cache::key`, `cache::load` and
+// `cache::store` read as the proof cache's only with the module's name.
 pub mod cache;
-pub mod engine;
-pub mod faults;
-pub mod harness;
-pub mod replay;
+mod engine;
+mod faults;
+mod harness;
+mod replay;
 mod strategy;
-pub mod symsim;
+mod symsim;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -24,8 +26,22 @@ use serde::{Deserialize, Serialize};
 
 use lut_gen::Schedule;
 
-pub use engine::Solver;
-pub use harness::{generate, Harness, HarnessError, PropertyDef};
+// The harness: the pin contract as assertions on the ports of any design.
+pub use harness::{
+    contract, generate, generate_with, not_covered, Clause, FreeInput, Harness, HarnessError,
+    PropertyDef, TableForm, FULL_TABLE_MAX_SLOTS, TREADY_ANY,
+};
+
+// The solvers, and the steps a test runs one at a time.
+pub use engine::{bmc, prepare, Prepared, Solver, SolverVerdict};
+
+// The default engine on its own (symbolic simulation of an AIGER graph).
+pub use aiger::{parse as parse_aiger, Aig};
+pub use symsim::{prove as prove_aig, Found, SymStats};
+
+// A counterexample's replay, and the faults that only a proof finds.
+pub use faults::DeepFault;
+pub use replay::DUT_SCOPE;
 
 /// Why `prove` could not give a verdict.
 #[derive(Debug, thiserror::Error)]

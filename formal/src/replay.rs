@@ -9,7 +9,7 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use lut_gen::ports::Role;
+use lut_gen::Role;
 use lut_gen::Schedule;
 
 use crate::engine::run_tool;
@@ -91,7 +91,7 @@ fn gtkw(s: &Schedule, h: &Harness, vcd: &Path) -> String {
     for r in [Role::Clock, Role::Reset] {
         let _ = writeln!(g, "{DUT_SCOPE}.{}", r.name());
     }
-    let layout = lut_gen::ports::Layout::new(s);
+    let layout = lut_gen::Layout::new(s);
     for r in [Role::Miso, Role::CsN, Role::Sclk] {
         let _ = writeln!(g, "{DUT_SCOPE}.{}[{}:0]", r.name(), layout.width(r) - 1);
     }

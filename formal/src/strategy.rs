@@ -1,7 +1,7 @@
 //! How each solver's engines are combined into a result: which runs first,
 //! and what a run that cannot tell falls back to.
 
-use crate::engine::{self, Combined, Prepared, Solver, Verdict};
+use crate::engine::{self, Combined, Prepared, Solver, SolverVerdict};
 use crate::{Outcome, ProveError, ProveOptions, DEEP_FRAMES, PROVED};
 use std::path::Path;
 
@@ -56,11 +56,11 @@ fn proved_by_recurrence(f: u64) -> Finding {
 }
 
 /// A bounded search's verdict when it found a violation; `bounded` otherwise.
-fn violation_or(v: Verdict, bounded: impl FnOnce(u64) -> Finding) -> Finding {
+fn violation_or(v: SolverVerdict, bounded: impl FnOnce(u64) -> Finding) -> Finding {
     match v {
-        Verdict::Violated { step } => failed(step),
-        Verdict::Bounded { steps } => bounded(steps),
-        Verdict::Proved => unreachable!("bmc3 proves nothing"),
+        SolverVerdict::Violated { step } => failed(step),
+        SolverVerdict::Bounded { steps } => bounded(steps),
+        SolverVerdict::Proved => unreachable!("bmc3 proves nothing"),
     }
 }
 
@@ -89,7 +89,7 @@ fn abc_separate(prep: &Prepared, f: u64, opts: &ProveOptions) -> Result<Finding,
     let base = recurrence_bound(f);
     Ok(
         match engine::bmc(prep, search_depth(f, opts), opts.bmc_timeout_s)? {
-            Verdict::Bounded { steps } if steps > base => {
+            SolverVerdict::Bounded { steps } if steps > base => {
                 match engine::recurrence(prep, f, opts.timeout_s)? {
                     Some(true) => proved_by_recurrence(f),
                     // No argument for all time: search deeper for a violation.
@@ -145,12 +145,12 @@ pub(crate) fn closing(
         engine::smt_induction(prep, 4, opts.timeout_s)?
     };
     Ok(match closed {
-        Some(Verdict::Proved) => (
+        Some(SolverVerdict::Proved) => (
             Outcome::Proved,
             0,
             format!("{PROVED} by {}", opts.solver.name()),
         ),
-        Some(Verdict::Violated { step }) => failed(step),
+        Some(SolverVerdict::Violated { step }) => failed(step),
         _ => {
             let aig = engine::prepare(work, Solver::Abc)?;
             violation_or(

@@ -5,8 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
-use formal::harness::{contract, not_covered, Clause};
-use lut_gen::ports::Layout;
+use formal::{contract, not_covered, Clause};
+use lut_gen::Layout;
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
@@ -22,7 +22,7 @@ fn schedule(name: &str, text: &str, link: Option<&str>) -> Option<lut_gen::Sched
     };
     let mix = lut_gen::parse(Path::new(name), &text).ok()?;
     let s = lut_gen::synthesize(&mix).ok()?;
-    if let Some(Err(_)) = lut_gen::hostlink::plan(&s) {
+    if let Some(Err(_)) = lut_gen::plan_link(&s) {
         return None;
     }
     formal::generate(&s).is_ok().then_some(s)
@@ -143,7 +143,7 @@ fn the_sentences_name_the_pins_and_the_audits_baud() {
     for (name, s) in mixes() {
         let h = formal::generate(&s).unwrap();
         let said: Vec<String> = h.not_covered.iter().map(|c| c.sentence(&s)).collect();
-        let Some(Ok(plan)) = lut_gen::hostlink::plan(&s) else {
+        let Some(Ok(plan)) = lut_gen::plan_link(&s) else {
             assert!(said.is_empty(), "{name}: {said:?}");
             continue;
         };

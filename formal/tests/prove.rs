@@ -16,7 +16,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use formal::faults::DeepFault;
+use formal::DeepFault;
 use formal::{Outcome, Proof, ProveOptions};
 
 use testkit::mutate;
@@ -57,7 +57,7 @@ fn assert_counterexample(s: &lut_gen::Schedule, p: &Proof) {
         "the replay names the failing property: {}",
         p.summary()
     );
-    let report = judge::check_vcd(s, &c.vcd, Some(formal::replay::DUT_SCOPE)).expect("VCD reads");
+    let report = judge::check_vcd(s, &c.vcd, Some(formal::DUT_SCOPE)).expect("VCD reads");
     assert!(
         !report.ok,
         "check accepts the counterexample:\n{}",
@@ -225,11 +225,11 @@ fn an_unseen_mix_with_a_muxless_branch_proves() {
         return;
     }
     let mixed = |s: &lut_gen::Schedule| {
-        let l = lut_gen::ports::Layout::new(s);
+        let l = lut_gen::Layout::new(s);
         l.muxed.contains(&true) && l.muxed.contains(&false)
     };
     let (seed, s) = unseen_mixes_with(1, 2, &mixed).remove(0);
-    let l = lut_gen::ports::Layout::new(&s);
+    let l = lut_gen::Layout::new(&s);
     let h = formal::generate(&s).unwrap();
     for (b, br) in s.branches.iter().enumerate() {
         let named = h
@@ -286,13 +286,13 @@ fn tiny_axis() -> lut_gen::Schedule {
 }
 
 /// ABC's bounded search from reset of harness + `design`, `steps` deep.
-fn bmc(s: &lut_gen::Schedule, design: &str, steps: u64) -> formal::engine::Verdict {
+fn bmc(s: &lut_gen::Schedule, design: &str, steps: u64) -> formal::SolverVerdict {
     let h = formal::generate(s).expect("a harness");
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("harness.v"), &h.verilog).unwrap();
     std::fs::write(dir.path().join("design.v"), design).unwrap();
-    let prep = formal::engine::prepare(dir.path(), formal::Solver::Abc).expect("yosys");
-    formal::engine::bmc(&prep, steps, 300).expect("bmc3 runs")
+    let prep = formal::prepare(dir.path(), formal::Solver::Abc).expect("yosys");
+    formal::bmc(&prep, steps, 300).expect("bmc3 runs")
 }
 
 /// `design` with `from` replaced by `to` exactly once (the test fails if
@@ -331,7 +331,7 @@ fn axis_harness_models_the_slave_and_names_the_link_properties() {
     );
     // tready is the harness's choice within the guarantee, never assumed.
     let inputs: Vec<&str> = h.inputs.iter().map(|i| i.name.as_str()).collect();
-    assert_eq!(inputs, ["adc_miso", formal::harness::TREADY_ANY]);
+    assert_eq!(inputs, ["adc_miso", formal::TREADY_ANY]);
     assert!(
         h.verilog.contains("waited >= 6'd63"),
         "deadline: 63 cycles waited"
@@ -366,7 +366,7 @@ fn the_harness_slave_never_early_is_the_worst_case_slave() {
          if (h.st == 2'd2) $display(\"C %b %b\", h.m_axis_tvalid, h.m_axis_tready);\n    end\n    \
          $finish;\n  end\nendmodule\n",
         s.branches.len() - 1,
-        formal::harness::TREADY_ANY
+        formal::TREADY_ANY
     );
     std::fs::write(dir.path().join("tb.v"), tb).unwrap();
     let ok = std::process::Command::new("iverilog")
@@ -388,8 +388,8 @@ fn the_harness_slave_never_early_is_the_worst_case_slave() {
     // A design that shows the harness's tvalid, cycle by cycle.
     struct Trace(std::vec::IntoIter<bool>);
     impl judge::Dut for Trace {
-        fn step(&mut self, rst: bool, _miso: u64) -> lut_gen::ports::Pins {
-            lut_gen::ports::Pins {
+        fn step(&mut self, rst: bool, _miso: u64) -> lut_gen::Pins {
+            lut_gen::Pins {
                 axis_tvalid: !rst && self.0.next().unwrap_or(false),
                 ..Default::default()
             }
@@ -429,7 +429,7 @@ fn axis_gateware_has_no_violation_in_a_bounded_search() {
     }
     let s = tiny_axis();
     let v = bmc(&s, &emitted(&s), 300);
-    assert_eq!(v, formal::engine::Verdict::Bounded { steps: 300 }, "{v:?}");
+    assert_eq!(v, formal::SolverVerdict::Bounded { steps: 300 }, "{v:?}");
 }
 
 /// The clean AXI4-Stream gateware proves for all time under every slave
@@ -571,8 +571,8 @@ fn compact_and_full_harness_tables_agree_cycle_by_cycle() {
         return;
     }
     let s = schedule("testkit/mixes/tiny.toml");
-    let full = formal::harness::generate_with(&s, formal::harness::TableForm::Full).unwrap();
-    let compact = formal::harness::generate_with(&s, formal::harness::TableForm::Compact).unwrap();
+    let full = formal::generate_with(&s, formal::TableForm::Full).unwrap();
+    let compact = formal::generate_with(&s, formal::TableForm::Compact).unwrap();
     assert!(compact.verilog.contains("case (sis)") && compact.verilog.contains("rot0_0"));
     assert!(!full.verilog.contains("case (sis)"));
     let mut signals: Vec<String> = (0..s.branches.len()).map(|b| format!("tab{b}")).collect();
@@ -594,10 +594,10 @@ fn compact_and_full_harness_tables_agree_cycle_by_cycle() {
 #[test]
 fn a_frame_beyond_the_full_tables_gets_the_compact_harness() {
     let s = schedule("formal/tests/data/frame80k.toml");
-    assert!(s.grid.frame_slots > formal::harness::MAX_FRAME_SLOTS);
+    assert!(s.grid.frame_slots > formal::FULL_TABLE_MAX_SLOTS);
     let h = formal::generate(&s).expect("a compact harness");
     assert!(h.verilog.contains("case (sis)"), "compact tables");
-    let full = formal::harness::generate_with(&s, formal::harness::TableForm::Full);
+    let full = formal::generate_with(&s, formal::TableForm::Full);
     assert!(full.unwrap_err().to_string().contains("full tables"));
     if !tools::require_tools(&["iverilog", "vvp"]) {
         return;
@@ -776,13 +776,13 @@ fn axis_link_holds_for_every_slave_and_its_faults_fail() {
     let t = Instant::now();
     let v = bmc(&s, &clean, steps);
     eprintln!("clean: {v:?} in {:.1} s", t.elapsed().as_secs_f64());
-    assert_eq!(v, formal::engine::Verdict::Bounded { steps }, "{v:?}");
+    assert_eq!(v, formal::SolverVerdict::Bounded { steps }, "{v:?}");
     // The preset: its first beats wait up to 63 cycles behind any slave.
     let s = schedule("mixes/eskin34-axis.toml");
     let t = Instant::now();
     let v = bmc(&s, &emitted(&s), 300);
     eprintln!("eskin34-axis: {v:?} in {:.1} s", t.elapsed().as_secs_f64());
-    assert_eq!(v, formal::engine::Verdict::Bounded { steps: 300 }, "{v:?}");
+    assert_eq!(v, formal::SolverVerdict::Bounded { steps: 300 }, "{v:?}");
 }
 
 /// `tiny` with a 1 Mbaud UART link (4 cycles a bit).

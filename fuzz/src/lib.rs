@@ -8,7 +8,7 @@
 //! every panic or hang is saved for replay.  Input `i` of a run depends only
 //! on `(--seed, i)`, so runs are reproducible.
 
-pub mod mutate;
+mod mutate;
 
 use std::cell::RefCell;
 use std::fmt;
@@ -44,7 +44,7 @@ impl Target {
             Target::Vcd => "vcd",
         }
     }
-    pub fn ops(self) -> Vec<Op> {
+    pub(crate) fn ops(self) -> Vec<Op> {
         let specific = match self {
             Target::Mix => mutate::TOML_OPS,
             Target::Vcd => mutate::VCD_OPS,
@@ -147,7 +147,7 @@ pub fn load_seeds(target: Target, root: &Path) -> Result<Vec<Seed>, String> {
                         MIX_DIRS.join(", ")
                     ));
                 };
-                let mix = lut_gen::mix::load(&m).map_err(|e| e.to_string())?;
+                let mix = lut_gen::load(&m).map_err(|e| e.to_string())?;
                 let s = lut_gen::synthesize(&mix).map_err(|e| format!("{}: {e}", m.display()))?;
                 (Some(Arc::new(s)), Some(m))
             }
@@ -183,10 +183,10 @@ pub fn exec(target: Target, input: &[u8], seed: &Seed, scratch: &Path) -> Outcom
             // Valid UTF-8 goes through `parse`, anything else through `load`
             // (which must reject it cleanly).
             let r = match std::str::from_utf8(input) {
-                Ok(text) => lut_gen::mix::parse(Path::new("fuzz.toml"), text),
+                Ok(text) => lut_gen::parse(Path::new("fuzz.toml"), text),
                 Err(_) => {
                     std::fs::write(scratch, input).expect("scratch file");
-                    lut_gen::mix::load(scratch)
+                    lut_gen::load(scratch)
                 }
             };
             match r {

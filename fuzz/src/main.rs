@@ -16,7 +16,7 @@ use slotforge_fuzz::{load_seeds, run, workspace_root, Config, Target};
     about = "Structure-aware fuzzing of the mix parser (mix) or the VCD reader (vcd)"
 )]
 struct Args {
-    /// `mix` (lut_gen::mix::parse/load) or `vcd` (judge::check_vcd).
+    /// `mix` (lut_gen::parse/load) or `vcd` (judge::check_vcd).
     target: Target,
     /// Inputs to run.
     #[arg(long, default_value_t = 100_000)]

@@ -7,8 +7,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use lut_gen::ports::{self, Dir, Layout, Role, PORTS, TOP_MODULE};
 use lut_gen::Schedule;
+use lut_gen::{Dir, Layout, Role, PORTS, TOP_MODULE};
 use rust_hdl::prelude::*;
 use serde::Deserialize;
 
@@ -117,7 +117,7 @@ impl Board {
             message: m,
         };
         let text = std::fs::read_to_string(path).map_err(|e| err(lut_gen::io_words(&e)))?;
-        toml::from_str(&text).map_err(|e| err(lut_gen::mix::plain(&e.to_string(), "")))
+        toml::from_str(&text).map_err(|e| err(lut_gen::toml_words(&e.to_string(), "")))
     }
 }
 
@@ -149,7 +149,7 @@ pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Em
     };
     let mut files = vec![
         (VERILOG_FILE.to_string(), verilog(s, &p)),
-        (MANIFEST_FILE.to_string(), ports::manifest(s)),
+        (MANIFEST_FILE.to_string(), lut_gen::manifest(s)),
         // The schedule's LUT in the one layout `slotforge lut` also writes, so
         // the two commands can share an output directory; the ROM image the
         // gateware embeds (per-branch words) is `slot_rom.hex`.
@@ -242,7 +242,7 @@ fn core_lanes(r: Role) -> Option<(&'static str, usize)> {
         Role::Sclk => Some(("core_sclk", MAX_BRANCHES)),
         Role::MuxSel => Some((
             "core_mux_sel",
-            ports::MUX_SELECT_BITS as usize * MAX_BRANCHES,
+            lut_gen::MUX_SELECT_BITS as usize * MAX_BRANCHES,
         )),
         Role::MuxEn => Some(("core_mux_en", EN_TOTAL)),
         Role::SampleChannel => Some(("core_channel", CH_BITS)),
@@ -438,7 +438,7 @@ fn core_bits(r: Role, p: &Plan, l: &Layout) -> Vec<(usize, usize)> {
         Role::MuxSel => (0..l.branches)
             .filter(|&b| l.muxed[b])
             .map(|b| {
-                let k = ports::MUX_SELECT_BITS as usize;
+                let k = lut_gen::MUX_SELECT_BITS as usize;
                 (k * b + k - 1, k * b)
             })
             .collect(),
@@ -496,7 +496,7 @@ fn core_instance(v: &mut String, wired: &[(Role, &'static str, usize)]) {
 /// The link instance (UART or AXI4-Stream), when the mix has a link.
 fn link_instance(v: &mut String, p: &Plan) {
     if p.link.is_some_and(|lp| lp.axis.is_some()) {
-        let [td, tv, tl, tr, ovf] = ports::AXIS_PORTS.map(|p| p.name);
+        let [td, tv, tl, tr, ovf] = lut_gen::AXIS_PORTS.map(|p| p.name);
         let _ = writeln!(v);
         let _ = writeln!(
             v,
@@ -510,7 +510,7 @@ fn link_instance(v: &mut String, p: &Plan) {
             Role::SampleValid.name()
         );
     } else if p.link.is_some() {
-        let [tx, ovf] = ports::LINK_PORTS.map(|p| p.name);
+        let [tx, ovf] = lut_gen::LINK_PORTS.map(|p| p.name);
         let _ = writeln!(v);
         let _ = writeln!(
             v,
@@ -772,10 +772,10 @@ mod tests {
 
     /// The core's ports are rust-hdl field names (`core/top.rs`), which cannot
     /// be generated from the contract's table: this is where a port renamed
-    /// in `lut_gen::ports::PORTS` without renaming the core's field fails.
+    /// in `lut_gen::PORTS` without renaming the core's field fails.
     #[test]
     fn core_ports_are_the_contracts() {
-        let m = lut_gen::mix::parse(
+        let m = lut_gen::parse(
             Path::new("eskin34.toml"),
             include_str!("../../mixes/eskin34.toml"),
         )

@@ -81,7 +81,7 @@ impl GatewareFault {
             ("link-crc-init", GatewareFault::LinkCrcInit),
         ];
         // an AXI4-Stream link has no baud divider to get wrong
-        if link.kind == lut_gen::mix::LinkKind::Uart {
+        if link.kind == lut_gen::LinkKind::Uart {
             v.insert(1, ("link-baud-fast", GatewareFault::LinkBaud { delta: -1 }));
         }
         v

@@ -14,7 +14,7 @@ use rust_hdl::prelude::*;
 
 use crate::widths::{CH_BITS, VALUE_BITS};
 
-/// What the link is built for (from `lut_gen::hostlink::LinkPlan`).
+/// What the link is built for (from `lut_gen::LinkPlan`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LinkParams {
     pub slice_cycles: u64,
@@ -35,7 +35,7 @@ pub struct LinkParams {
 
 impl LinkParams {
     pub(crate) fn of(s: &lut_gen::Schedule) -> Result<Option<LinkParams>, String> {
-        let Some(r) = lut_gen::hostlink::plan(s) else {
+        let Some(r) = lut_gen::plan_link(s) else {
             return Ok(None);
         };
         let p = r.map_err(|e| e.message)?;

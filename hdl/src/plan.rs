@@ -256,7 +256,7 @@ fn check_grid(s: &Schedule, form: LutForm) -> Result<bool, HdlError> {
     let g = &s.grid;
     let nb = s.branches.len();
     // branch, channel and device counts: the pin contract's limits
-    lut_gen::ports::Layout::fits(s).map_err(unsupported)?;
+    lut_gen::Layout::fits(s).map_err(unsupported)?;
     let sps = g.slots_per_slice;
     let k = g.slices_per_frame;
     if g.frame_slots == 0 || sps * k != g.frame_slots {
@@ -318,7 +318,7 @@ fn branch_rom(
     let bp = &s.branches[b];
     let adc = &s.mix.branches[b].adc;
     let chain = s.mix.branches[b].chain;
-    let cnv = adc.start == lut_gen::parts::Start::Cnv;
+    let cnv = adc.start == lut_gen::Start::Cnv;
     let spi = &bp.spi;
     check_spi(s, b, words)?;
     let devices = bp.mux_devices.max(1) as usize;
@@ -388,16 +388,16 @@ fn check_spi(s: &Schedule, b: usize, words: u64) -> Result<(), HdlError> {
     let bp = &s.branches[b];
     let adc = &s.mix.branches[b].adc;
     let chain = s.mix.branches[b].chain;
-    let cnv = adc.start == lut_gen::parts::Start::Cnv;
+    let cnv = adc.start == lut_gen::Start::Cnv;
     let spi = &bp.spi;
     let sclks = adc.word_sclks() as u64 * chain as u64;
-    if adc.bits < 1 || adc.bits > lut_gen::ports::SAMPLE_VALUE_BITS {
+    if adc.bits < 1 || adc.bits > lut_gen::SAMPLE_VALUE_BITS {
         return Err(unsupported(format!(
             "branch {}: ADC {} has {} data bits: the gateware carries 1 to {}",
             bp.name,
             adc.name,
             adc.bits,
-            lut_gen::ports::SAMPLE_VALUE_BITS
+            lut_gen::SAMPLE_VALUE_BITS
         )));
     }
     if adc.word_sclks() > MAX_WORD_SCLKS as u32 {

@@ -3,7 +3,7 @@
 
 use rust_hdl::prelude::*;
 
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 
 use crate::core::Core;
 use crate::link::{AxisLink, UartLink};

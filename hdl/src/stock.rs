@@ -16,7 +16,7 @@ use rust_hdl::prelude::*;
 
 use crate::core::Core;
 use crate::sim::{read_pins, PinReader};
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 
 use crate::{plan, HdlError};
 

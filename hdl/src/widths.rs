@@ -1,9 +1,9 @@
 //! Register widths of the fixed-maximum core, in one place that both the
 //! planner (`plan.rs`, which checks a schedule against them) and the
 //! rust-hdl blocks (`core/`, which are built at them) read.  The lane
-//! counts come from the pin contract's limits (`lut_gen::ports::limits`).
+//! counts come from the pin contract's limits (`lut_gen::limits`).
 
-pub use lut_gen::ports::limits::{MAX_BRANCHES, MAX_CHANNELS, MAX_DEVICES, MAX_DEVICES_PER_BRANCH};
+pub use lut_gen::limits::{MAX_BRANCHES, MAX_CHANNELS, MAX_DEVICES, MAX_DEVICES_PER_BRANCH};
 
 /// Bits to count `0..n` (`n` a power of two).
 const fn log2(n: usize) -> usize {
@@ -26,7 +26,7 @@ pub const WORD_BIT_BITS: usize = 6;
 /// Width of the chain member counter (up to 8 chained parts).
 pub const MEMBER_BITS: usize = 3;
 /// Width of `sample_value` in the core: the widest word the pin contract carries.
-pub const VALUE_BITS: usize = lut_gen::ports::SAMPLE_VALUE_BITS as usize;
+pub const VALUE_BITS: usize = lut_gen::SAMPLE_VALUE_BITS as usize;
 /// Width of a channel index.
 pub const CH_BITS: usize = log2(MAX_CHANNELS);
 /// Width of a device index inside a branch.

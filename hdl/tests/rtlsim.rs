@@ -110,7 +110,7 @@ fn full300_matches_timing_contract() {
 #[test]
 fn b16_matches_timing_contract() {
     let s = data_mix("b16");
-    assert_eq!(s.branches.len(), lut_gen::ports::limits::MAX_BRANCHES);
+    assert_eq!(s.branches.len(), lut_gen::limits::MAX_BRANCHES);
     run_and_compare(&s, 2 * s.grid.frame_cycles);
 }
 
@@ -119,9 +119,9 @@ fn b16_matches_timing_contract() {
 #[test]
 fn ch1024_matches_timing_contract() {
     let s = data_mix("ch1024");
-    assert_eq!(s.channels.len(), lut_gen::ports::limits::MAX_CHANNELS);
+    assert_eq!(s.channels.len(), lut_gen::limits::MAX_CHANNELS);
     let devices: u32 = s.branches.iter().map(|b| b.mux_devices).sum();
-    assert_eq!(devices as usize, lut_gen::ports::limits::MAX_DEVICES);
+    assert_eq!(devices as usize, lut_gen::limits::MAX_DEVICES);
     run_and_compare(&s, s.grid.frame_cycles + s.grid.slice_cycles);
 }
 

@@ -418,7 +418,7 @@ impl TxModel {
 
 /// What the audit needs to know about a link carrying a periodic stream.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Measured {
+pub struct SteadyState {
     /// The FIFO's exact worst-case backlog, in tokens.
     pub backlog: usize,
     /// Worst cycles from a sampling instant to the end of its packet's
@@ -435,7 +435,11 @@ pub struct Measured {
 /// code)`; a sample may leave after its frame ends (a valid cycle beyond the
 /// frame) and its instant is then in the frame it belongs to.  `None` if the
 /// backlog keeps growing for `max_frames` frames (the link cannot drain it).
-pub fn measure(cfg: TxConfig, frame: &[(u64, u64, u16)], max_frames: u64) -> Option<Measured> {
+pub fn steady_state(
+    cfg: TxConfig,
+    frame: &[(u64, u64, u16)],
+    max_frames: u64,
+) -> Option<SteadyState> {
     let frame_cycles = cfg.slice_cycles * cfg.slices_per_frame;
     let cfg = TxConfig { depth: None, ..cfg };
     let mut t = TxModel::new(cfg);
@@ -478,7 +482,7 @@ pub fn measure(cfg: TxConfig, frame: &[(u64, u64, u16)], max_frames: u64) -> Opt
                 .map(|(w, &i)| ends[w] - i)
                 .max()
                 .unwrap_or(0);
-            return Some(Measured {
+            return Some(SteadyState {
                 backlog: t.max_backlog,
                 latency_cycles: latency,
                 frames: f,
@@ -706,7 +710,7 @@ mod tests {
         // Three samples in a row on an idle line: the first is popped the
         // cycle after its push, the other two wait behind it.
         let frame = [(500, 400, 0), (501, 400, 1), (502, 400, 2)];
-        let m = measure(cfg(4, None), &frame, 16).expect("drains");
+        let m = steady_state(cfg(4, None), &frame, 16).expect("drains");
         assert_eq!(m.backlog, 2);
         assert!(m.latency_cycles > 0);
     }

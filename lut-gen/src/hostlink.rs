@@ -10,8 +10,8 @@
 use std::collections::{BTreeMap, VecDeque};
 
 use link::format;
-use link::tx::{self, Line, TxConfig};
 use link::{AxisFormat, UartFormat};
+use link::{Line, SteadyState, TxConfig};
 use serde::Serialize;
 
 use crate::mix::{LinkKind, LinkSpec};
@@ -252,14 +252,14 @@ fn plan_spec(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> 
 }
 
 /// The backlog and latency at one divider, if the FIFO stays within its limit.
-fn measure(s: &Schedule, line: Line, stream: &[(u64, u64, u16)]) -> Option<tx::Measured> {
+fn measure(s: &Schedule, line: Line, stream: &[(u64, u64, u16)]) -> Option<SteadyState> {
     let cfg = TxConfig {
         line,
         slice_cycles: s.grid.slice_cycles,
         slices_per_frame: s.grid.slices_per_frame,
         depth: None,
     };
-    tx::measure(cfg, stream, MAX_FRAMES).filter(|m| m.backlog <= MAX_FIFO_DEPTH)
+    link::steady_state(cfg, stream, MAX_FRAMES).filter(|m| m.backlog <= MAX_FIFO_DEPTH)
 }
 
 /// The largest divider (lowest baud) whose line carries the frame's bytes

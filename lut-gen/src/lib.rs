@@ -1,31 +1,59 @@
 //! lut-gen: everything slotforge knows about a channel mix before any HDL.
 //!
-//! - [`mix`]: the TOML format and its validation (errors name file, line, field);
-//! - [`parts`]: ADC and mux models as data, and the SPI timing they imply;
-//! - [`synth`]: slot-grid choice and jitter-free placement, or a diagnosis;
-//! - [`validate`]: an independent proof of a schedule's promises;
+//! - `mix`: the TOML format and its validation (errors name file, line, field);
+//! - `parts`: ADC and mux models as data, and the SPI timing they imply;
+//! - `synth`: slot-grid choice and jitter-free placement, or a diagnosis;
+//! - `validate`: an independent proof of a schedule's promises;
 //! - [`lut`]: the slot LUT as a full frame table and in compact form;
-//! - [`ports`]: the pin contract of `slotforge_top` (names, roles, widths, lanes, limits, `ports.json`);
-//! - [`hostlink`]: the link to the host planned from the schedule (divider, bytes per frame, FIFO depth, latency, minimum baud);
-//! - [`oswords`]: what the OS says about a user's file, in words;
-//! - [`fixes`]: changes that make an infeasible mix fit, each tried before it is offered;
-//! - [`audit`]: rates, intervals, headroom, settling and Nyquist, as text or JSON.
+//! - `ports`: the pin contract of `slotforge_top` (names, roles, widths, lanes, limits, `ports.json`);
+//! - `hostlink`: the link to the host planned from the schedule (divider, bytes per frame, FIFO depth, latency, minimum baud);
+//! - `oswords`: what the OS says about a user's file, in words;
+//! - `fixes`: changes that make an infeasible mix fit, each tried before it is offered;
+//! - `audit`: rates, intervals, headroom, settling and Nyquist, as text or JSON.
 
-pub mod fixes;
-pub mod hostlink;
-pub mod mix;
-pub mod oswords;
-pub mod parts;
-pub mod ports;
-pub mod schedule;
-pub mod synth;
-pub mod validate;
-
-pub use mix::{load, parse, Mix, MixError};
-pub use oswords::{io_words, write_words};
-pub use schedule::{seconds, FrameGrid, SamplingInstant, Schedule};
-pub use synth::{synthesize, synthesize_within, Infeasible, Verdict};
-pub mod audit;
+mod audit;
+mod fixes;
+mod hostlink;
+// A public namespace, not an export list: the slot table's three file forms
+// (`lut::to_hex`, `lut::to_csv`, `lut::to_markdown`) and its compact form
+// read as what they are only with the module's name.
 pub mod lut;
+mod mix;
+mod oswords;
+mod parts;
+mod ports;
+mod schedule;
+mod synth;
+mod validate;
 
-pub use audit::AuditReport;
+// The mix and its parts.
+pub use mix::{load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError};
+pub use parts::{ns_to_cycles, AdcPart, MuxPart, SpiTiming, Start, TimingError};
+
+// The schedule: synthesis, its independent proof, and what it promises.
+pub use schedule::{
+    seconds, BranchPlan, ChannelSlots, FrameGrid, Placement, SamplingInstant, Schedule,
+};
+pub use synth::{
+    synthesize, synthesize_within, BranchDiagnosis, Infeasible, Verdict, SEARCH_BUDGET,
+};
+pub use validate::validate;
+
+// The audit, and the fixes offered for an infeasible mix.
+pub use audit::{AuditReport, BranchAudit, ChannelAudit, FinerGrid, Headroom, Limit, PartAudit};
+pub use fixes::{
+    search as search_fixes, search_unloadable as search_fixes_unloadable, Change, Fix, FixSearch,
+};
+
+// The pin contract of `slotforge_top`. `limits` stays a namespace: its
+// `MAX_*` are the contract's, apart from the gateware's own (`hdl::MAX_*`).
+pub use ports::{
+    limits, manifest, Dir, Layout, LinkPort, Pins, Port, Role, Signal, AXIS_PORTS, LINK_PORTS,
+    MUX_SELECT_BITS, PORTS, PORT_NAMES, SAMPLE_VALUE_BITS, TOP_MODULE,
+};
+
+// The link to the host, planned from the schedule.
+pub use hostlink::{merged_frame, plan as plan_link, LinkInfeasible, LinkPlan, PacketInstants};
+
+// What the OS says about a user's file, in words.
+pub use oswords::{io_words, write_words};

@@ -26,7 +26,7 @@ mod words;
 
 use check::Cx;
 use raw::RawMix;
-pub use words::plain;
+pub use words::toml_words;
 
 /// A bad mix file: where, which field, and why.  Always exit code 2.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -128,7 +128,7 @@ proptest! {
         let text = to_toml(&spec);
         let mix = lut_gen::parse(Path::new("prop.toml"), &text).expect("generated mix parses");
         let s = lut_gen::synthesize(&mix).map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
-        prop_assert!(lut_gen::validate::validate(&s).is_ok());
+        prop_assert!(lut_gen::validate(&s).is_ok());
         prop_assert_eq!(CompactLut::from_schedule(&s).expand(), s.frame_table.clone());
         let audit = lut_gen::AuditReport::of_schedule(&s);
         prop_assert!(audit.feasible, "{:?}", audit.errors);
@@ -190,7 +190,7 @@ proptest! {
         let mix = lut_gen::parse(Path::new("prop.toml"), &text).expect("generated mix parses");
         let s = lut_gen::synthesize(&mix).map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
         prop_assert!(s.grid.slots_per_slice <= GRIDS[grid]);
-        prop_assert!(lut_gen::validate::validate(&s).is_ok());
+        prop_assert!(lut_gen::validate(&s).is_ok());
     }
 }
 
@@ -239,7 +239,7 @@ fn validator_rejects_a_jittered_table() {
     let a = 16 * nb + acoustic;
     let b = 17 * nb + acoustic;
     s.frame_table.swap(a, b);
-    let problems = lut_gen::validate::validate(&s).unwrap_err();
+    let problems = lut_gen::validate(&s).unwrap_err();
     assert!(
         problems
             .iter()
@@ -287,7 +287,7 @@ fn a_feasible_mix_the_bounded_search_missed() {
     let mix = lut_gen::load(Path::new(path)).expect("parses");
     let s = lut_gen::synthesize(&mix).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(s.grid.slots_per_slice, 96);
-    assert!(matches!(s.placement, lut_gen::schedule::Placement::Search { nodes } if nodes < 100));
+    assert!(matches!(s.placement, lut_gen::Placement::Search { nodes } if nodes < 100));
 }
 
 /// The campaign behind "never infeasible without a proof, rarely unknown":
@@ -335,7 +335,7 @@ fn mixes_near_capacity_are_all_decided() {
             let text = to_toml(&spec);
             let mix = lut_gen::parse(Path::new("near.toml"), &text).expect("generated mix parses");
             match lut_gen::synthesize(&mix) {
-                Ok(s) => assert!(lut_gen::validate::validate(&s).is_ok(), "{text}"),
+                Ok(s) => assert!(lut_gen::validate(&s).is_ok(), "{text}"),
                 Err(e) => assert_eq!(
                     e.verdict,
                     lut_gen::Verdict::Infeasible,

@@ -35,7 +35,7 @@ fn eskin34_reproduces_table_1() {
         assert_eq!(s.at(k * 30, stat), Some(ch));
     }
     assert_eq!(s.at(9 * 30, stat), None);
-    lut_gen::validate::validate(&s).unwrap();
+    lut_gen::validate(&s).unwrap();
 }
 
 /// Snapshots of the reference outputs: a change here is reviewed like code

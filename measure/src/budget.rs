@@ -5,9 +5,9 @@
 //! `audit.json`). Every cell is read from the [`AuditReport`] the audit
 //! step wrote, so the tables and the JSON cannot disagree.
 
-use lut_gen::audit::{BranchAudit, ChannelAudit, Headroom};
-use lut_gen::hostlink::LinkPlan;
 use lut_gen::AuditReport;
+use lut_gen::LinkPlan;
+use lut_gen::{BranchAudit, ChannelAudit, Headroom};
 use report::Table;
 
 /// A frequency in the unit that reads best (`48 MHz`, `2.4 MHz`, `1000 Hz`).
@@ -86,7 +86,7 @@ fn link_kind(l: &LinkPlan) -> &'static str {
 }
 
 /// Every table of the audit, in reading order.
-pub fn audit(r: &AuditReport) -> Vec<(String, Table)> {
+pub fn budget_tables(r: &AuditReport) -> Vec<(String, Table)> {
     let mut out = vec![("The mix".to_string(), facts(r))];
     out.push((branch_caption(r), branches(r)));
     out.push((
@@ -373,8 +373,8 @@ fn parts(r: &AuditReport) -> Table {
             p.branch.clone(),
             p.adc.to_uppercase(),
             match p.start {
-                lut_gen::parts::Start::Cs => "CS falling".into(),
-                lut_gen::parts::Start::Cnv => format!("CNV rising, {} ns", p.conversion_ns),
+                lut_gen::Start::Cs => "CS falling".into(),
+                lut_gen::Start::Cnv => format!("CNV rising, {} ns", p.conversion_ns),
             },
             p.bits.to_string(),
             format!("{} ({})", p.chain, p.chain_max),
@@ -484,7 +484,7 @@ mod tests {
         for mix in &mixes {
             let s = lut_gen::synthesize(mix).unwrap();
             let r = AuditReport::of_schedule(&s);
-            let tables = audit(&r);
+            let tables = budget_tables(&r);
             for (cap, t) in &tables {
                 assert!(!plain_has_underscore(cap), "{cap}");
                 for h in &t.columns {

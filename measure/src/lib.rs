@@ -2,23 +2,38 @@
 //! returned as a `report::Section` (text, tables, charts with their CSV)
 //! and a one-line summary, so the CLI only calls and writes.
 //!
-//! - [`synth`]: the one yosys + nextpnr-ice40 flow (also `hdl/synth.sh`);
-//! - [`figure7`]: the paper's Figure 7 for the mix's own rates ([`dft`]);
-//! - [`timing`]: a steady-state slice's timing diagram and WaveDrom JSON;
-//! - [`speed`]: speed against accuracy ([`speed::MethodScore`]);
-//! - [`schedulability`]: where scheduling breaks around the mix;
-//! - [`proof`]: the formal proof of the gateware (or its cached result);
-//! - [`budget`]: the audit as a datasheet (what binds, the margin, each
+//! - `synth`: the one yosys + nextpnr-ice40 flow (also `hdl/synth.sh`);
+//! - `figure7`: the paper's Figure 7 for the mix's own rates (`dft`);
+//! - `timing`: a steady-state slice's timing diagram and WaveDrom JSON;
+//! - `speed`: speed against accuracy (`MethodScore`);
+//! - `schedulability`: where scheduling breaks around the mix;
+//! - `proof`: the formal proof of the gateware (or its cached result);
+//! - `budget`: the audit as a datasheet (what binds, the margin, each
 //!   budget its own table);
-//! - [`tables`]: the slot table (Table 1), per-channel intervals
+//! - `tables`: the slot table (Table 1), per-channel intervals
 //!   and the fault campaign as report tables.
 
-pub mod budget;
-pub mod dft;
-pub mod figure7;
-pub mod proof;
-pub mod schedulability;
-pub mod speed;
-pub mod synth;
-pub mod tables;
-pub mod timing;
+mod budget;
+mod dft;
+mod figure7;
+mod proof;
+mod schedulability;
+mod speed;
+mod synth;
+mod tables;
+mod timing;
+
+// Each measurement: a report section and its one-line summary.
+pub use figure7::figure7;
+pub use proof::{cached_proof, proof, ShownProof};
+pub use schedulability::schedulability;
+pub use speed::{speed, CleanRun};
+pub use timing::timing;
+
+// The place-and-route flow on its own (also `hdl/synth.sh`).
+pub use synth::{place_and_route, Synth};
+
+// The report's tables: the audit's budgets, the slot table, the intervals
+// measured and the fault campaign.
+pub use budget::{budget_tables, Tightest};
+pub use tables::{fault_table, interval_table, slot_table};

@@ -15,7 +15,7 @@ use report::{Section, Table};
 pub const DIR: &str = "prove";
 
 /// A proof to show: how it came (`cached`) and the report's section.
-pub struct Shown {
+pub struct ShownProof {
     pub proof: Proof,
     pub cached: bool,
     pub section: Section,
@@ -51,7 +51,7 @@ fn cache_dirs(out: &Path) -> Vec<PathBuf> {
 }
 
 /// The remembered proof of `s`'s emitted gateware, if one exists.
-pub fn cached(s: &Schedule, out: &Path) -> Option<Shown> {
+pub fn cached_proof(s: &Schedule, out: &Path) -> Option<ShownProof> {
     let (_, key, uncovered) = keyed(s).ok()?;
     let p = remembered(&cache_dirs(out), &key, uncovered)?;
     Some(shown(p, true))
@@ -60,7 +60,7 @@ pub fn cached(s: &Schedule, out: &Path) -> Option<Shown> {
 /// Proves `s`'s emitted gateware (or shows the remembered proof) and keeps
 /// a proof in the caches.  `Err`: the proof could not run (a tool missing
 /// or failing, a mix beyond the harness).
-pub fn prove(s: &Schedule, out: &Path) -> Result<Shown, String> {
+pub fn proof(s: &Schedule, out: &Path) -> Result<ShownProof, String> {
     let (design, key, uncovered) = keyed(s)?;
     let dirs = cache_dirs(out);
     if let Some(p) = remembered(&dirs, &key, uncovered) {
@@ -99,7 +99,7 @@ fn word(o: Outcome) -> &'static str {
 }
 
 /// The section and line of `p`.
-pub fn shown(p: Proof, cached: bool) -> Shown {
+pub fn shown(p: Proof, cached: bool) -> ShownProof {
     let line = match p.result {
         Outcome::Proved => format!(
             "{}: {} properties, depth {} steps, solver {:.1} s{}",
@@ -185,7 +185,7 @@ pub fn shown(p: Proof, cached: bool) -> Shown {
         links,
         ..Section::default()
     };
-    Shown {
+    ShownProof {
         proof: p,
         cached,
         section,

@@ -211,7 +211,7 @@ pub fn chart(c: &Campaign, clean: &[CleanRun]) -> Figure {
 
 /// The section for campaign `c` and the clean runs beside it, and its
 /// one-line summary. `charts_all`: whether this build ran every method.
-pub fn section(c: &Campaign, clean: &[CleanRun], charts_all: bool) -> (Section, String) {
+pub fn speed(c: &Campaign, clean: &[CleanRun], charts_all: bool) -> (Section, String) {
     let scores = scores(c);
     let line = scores
         .iter()

@@ -31,7 +31,7 @@ pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<
         .arg(format!(
             "read_verilog {}; synth_ice40 -top {} -json slotforge.json; check -assert; tee -q -o stat.txt stat",
             hdl::VERILOG_FILE,
-            lut_gen::ports::TOP_MODULE,
+            lut_gen::TOP_MODULE,
         ))
         .run()
         .map_err(|e| format!("yosys could not be started: {e}"))?;

@@ -128,7 +128,7 @@ fn span(lo: u64, hi: u64) -> String {
 /// The intervals a run measured, a row per branch and rate (the channels
 /// themselves are listed once, in the audit): channels, samples each,
 /// the interval the schedule promises and the least and most measured.
-pub fn intervals(s: &Schedule, r: &judge::Verdict) -> Table {
+pub fn interval_table(s: &Schedule, r: &judge::Verdict) -> Table {
     let mut t = Table::new(&[
         "branch",
         "rate (Hz)",
@@ -183,7 +183,7 @@ pub fn intervals(s: &Schedule, r: &judge::Verdict) -> Table {
 
 /// The fault campaign by class: each detector's count apart ("n of N", or
 /// "cannot see"), then what no detector caught.
-pub fn faults(c: &campaign::Campaign) -> Table {
+pub fn fault_table(c: &campaign::Campaign) -> Table {
     let mut head: Vec<String> = vec!["class".into(), "level".into(), "injected".into()];
     head.extend(c.detectors.iter().map(|d| d.name().to_string()));
     head.extend(["undetected".into(), "proved equivalent".into()]);

@@ -8,8 +8,8 @@
 use engines::{Backend, SimOptions};
 use judge::CycleSink;
 use judge::Observer;
-use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
+use lut_gen::{Layout, Pins, Role};
 use report::{draw, Axes, Figure, Section, Series, Table};
 
 /// Keeps the pins of cycles `[from, to)` after cycle 0 only.
@@ -510,8 +510,8 @@ fn wavedrom(s: &Schedule, l: &Layout, w: &Window, _nb: usize) -> Result<(String,
             s.branches[0].name,
             k - t0,
             match spi.style {
-                lut_gen::parts::Start::Cs => "CS falls",
-                lut_gen::parts::Start::Cnv => "CNV rises",
+                lut_gen::Start::Cs => "CS falls",
+                lut_gen::Start::Cnv => "CNV rises",
             }
         ),
         None => "WaveDrom: a conversion (its strobe falls outside the window)".into(),

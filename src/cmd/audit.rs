@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use lut_gen::fixes::FixSearch;
 use lut_gen::AuditReport;
+use lut_gen::FixSearch;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -43,7 +43,7 @@ pub fn run(args: Args) -> u8 {
             // a line too slow for the mix: named on stderr as the parser
             // names a bad key (the report says it too, and exits 1)
             let mut report = AuditReport::of_schedule(&s);
-            if let Some(Err(e)) = lut_gen::hostlink::plan(&s) {
+            if let Some(Err(e)) = lut_gen::plan_link(&s) {
                 eprintln!("error: {}", e.at(&args.mix));
                 // the report names the file as well as the line
                 for x in report.errors.iter_mut().filter(|x| **x == e.message) {
@@ -87,7 +87,7 @@ pub fn run(args: Args) -> u8 {
 /// edited, so it is read again).
 fn search(path: &Path, mix: &lut_gen::Mix, why: &lut_gen::Infeasible) -> FixSearch {
     match std::fs::read_to_string(path) {
-        Ok(text) => lut_gen::fixes::search(path, &text, mix, why),
+        Ok(text) => lut_gen::search_fixes(path, &text, mix, why),
         Err(_) => FixSearch {
             fixes: Vec::new(),
             tried: 0,
@@ -101,7 +101,7 @@ fn unloadable(args: &Args) {
     let Ok(text) = std::fs::read_to_string(&args.mix) else {
         return;
     };
-    let mut found = lut_gen::fixes::search_unloadable(&args.mix, &text);
+    let mut found = lut_gen::search_fixes_unloadable(&args.mix, &text);
     if found.fixes.is_empty() {
         return;
     }

@@ -2,7 +2,7 @@
 //! received from the link, as samples (`frame,slice,channel,value,sampled_s`).
 //!
 //! The decoding is `link::Decoder` (the packet format's one home); the
-//! sampling instants come from the schedule (`lut_gen::hostlink::PacketInstants`),
+//! sampling instants come from the schedule (`lut_gen::PacketInstants`),
 //! written as `sim --samples` writes them (`lut_gen::seconds`), so the two
 //! CSVs agree on `sampled_s` for the same sample.
 //! `CAPTURE` may be `-`: stdin is decoded as it arrives and each packet's
@@ -17,7 +17,7 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use link::{Decoded, Decoder, Stats};
-use lut_gen::hostlink::PacketInstants;
+use lut_gen::PacketInstants;
 
 #[derive(clap::Args)]
 pub struct Args {

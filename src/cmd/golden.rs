@@ -108,7 +108,7 @@ fn load_manifest(path: &Path) -> Result<Manifest, String> {
         format!(
             "{}:{line}: {}",
             path.display(),
-            lut_gen::mix::plain(e.message(), "")
+            lut_gen::toml_words(e.message(), "")
         )
     })?;
     if m.frames == 0 {
@@ -203,7 +203,7 @@ fn first_window_difference(a: &Trace, b: &Trace) -> Option<String> {
 }
 
 /// A cycle's pins by their port names, as the VCD names them.
-fn pins_text(p: &lut_gen::ports::Pins) -> String {
+fn pins_text(p: &lut_gen::Pins) -> String {
     format!(
         "cs_n={:#b} sclk={:#b} mux_sel={:#x} mux_en={:#b} sample_valid={} sample_channel={} sample_value={}",
         p.cs_n,

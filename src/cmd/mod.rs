@@ -17,7 +17,7 @@ use std::path::Path;
 
 /// Loads and schedules a mix, printing the error and returning the exit code on failure.
 pub fn schedule(path: &Path) -> Result<lut_gen::Schedule, u8> {
-    schedule_within(path, lut_gen::synth::SEARCH_BUDGET)
+    schedule_within(path, lut_gen::SEARCH_BUDGET)
 }
 
 /// [`schedule`] with the exact search capped at `budget` placements per
@@ -41,7 +41,7 @@ pub struct SearchLimit {
     /// it gives up: a mix it stops on is "unknown" (exit 3), not infeasible.
     /// Smaller answers sooner; larger decides more mixes.
     #[arg(long = "search-limit", value_name = "N", value_parser = whole_number,
-          default_value_t = lut_gen::synth::SEARCH_BUDGET)]
+          default_value_t = lut_gen::SEARCH_BUDGET)]
     pub nodes: u64,
 }
 
@@ -163,7 +163,7 @@ pub fn schedule_on_pins(path: &Path) -> Result<lut_gen::Schedule, u8> {
 /// Checks that a schedule fits the pin contract's limits (the checker and
 /// the engines size their pins from them), else prints why: exit 2.
 pub fn fits_pins(s: &lut_gen::Schedule) -> Result<(), u8> {
-    lut_gen::ports::Layout::fits(s).map_err(|m| {
+    lut_gen::Layout::fits(s).map_err(|m| {
         eprintln!("error: mix `{}`: {m}", s.mix.name);
         2u8
     })
@@ -173,7 +173,7 @@ pub fn fits_pins(s: &lut_gen::Schedule) -> Result<(), u8> {
 /// (the audit's "infeasible"): the key named as the parser names a bad
 /// one, `file:line:col: link.<key>: ...`, with the minimum that fits; exit 1.
 pub fn link_fits(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
-    match lut_gen::hostlink::plan(s) {
+    match lut_gen::plan_link(s) {
         Some(Err(e)) => {
             eprintln!("error: {}", e.at(file));
             Err(1)

@@ -140,7 +140,7 @@ impl<'a> CycleProgress<'a> {
 }
 
 impl judge::Observer for CycleProgress<'_> {
-    fn cycle(&mut self, cycle: u64, rst: bool, pins: &lut_gen::ports::Pins, miso: u64) {
+    fn cycle(&mut self, cycle: u64, rst: bool, pins: &lut_gen::Pins, miso: u64) {
         if let Some(t) = self.inner.as_deref_mut() {
             t.as_observer().cycle(cycle, rst, pins, miso);
         }
@@ -152,8 +152,8 @@ impl judge::CycleSink for CycleProgress<'_> {
     fn cycle(
         &mut self,
         rst: Option<bool>,
-        pins: &lut_gen::ports::Pins,
-        xz: &lut_gen::ports::Pins,
+        pins: &lut_gen::Pins,
+        xz: &lut_gen::Pins,
         miso: u64,
         miso_xz: u64,
     ) {

@@ -338,7 +338,7 @@ impl Logs {
 }
 
 impl judge::Observer for Logs {
-    fn cycle(&mut self, cycle: u64, rst: bool, pins: &lut_gen::ports::Pins, miso: u64) {
+    fn cycle(&mut self, cycle: u64, rst: bool, pins: &lut_gen::Pins, miso: u64) {
         if let Some(l) = &mut self.samples {
             judge::Observer::cycle(l, cycle, rst, pins, miso);
         }
@@ -352,8 +352,8 @@ impl judge::CycleSink for Logs {
     fn cycle(
         &mut self,
         rst: Option<bool>,
-        pins: &lut_gen::ports::Pins,
-        xz: &lut_gen::ports::Pins,
+        pins: &lut_gen::Pins,
+        xz: &lut_gen::Pins,
         miso: u64,
         miso_xz: u64,
     ) {

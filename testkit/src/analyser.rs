@@ -11,8 +11,8 @@ use judge::tools::Tool;
 use judge::{check_capture, TimedReport};
 use judge::{id_code, wire_header};
 use judge::{run_dut, Dut, Observer, RunOptions};
-use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
+use lut_gen::{Layout, Pins, Role};
 
 /// Every cycle's pins after reset.
 #[derive(Default)]
@@ -232,7 +232,7 @@ pub fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {
         .unwrap();
     let slot = s.grid.slot_cycles as usize;
     if let Mutation::LinkBitsFlipped = m {
-        let div = lut_gen::hostlink::plan(s).unwrap().unwrap().baud_divider as usize;
+        let div = lut_gen::plan_link(s).unwrap().unwrap().baud_divider as usize;
         // A start bit at or after `at`, then its bits 2-4 inverted.
         let st = (at..pins.len())
             .find(|&c| !pins[c].link_tx && pins[c - 1].link_tx)

@@ -957,7 +957,7 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
         tready: s
             .mix
             .link
-            .filter(|l| l.kind == lut_gen::mix::LinkKind::Axis)
+            .filter(|l| l.kind == lut_gen::LinkKind::Axis)
             .map(|_| TREADY.name()),
         injected: sum(|c| c.injected),
         detected: sum(|c| c.detected),
@@ -990,7 +990,7 @@ fn planned_runs(s: &Schedule, plan: &Plan, sites: &[Site]) -> u64 {
 struct GatewareDut(hdl::RtlSim);
 
 impl Dut for GatewareDut {
-    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::Pins {
         self.0.step(rst, miso)
     }
     fn set_tready(&mut self, ready: bool) {
@@ -1018,7 +1018,7 @@ fn counted_false_alarms(target: Target, n: u64, sigrok: bool, count: &Runs) -> F
         let Ok(s) = lut_gen::synthesize(&mix) else {
             continue;
         };
-        if lut_gen::ports::Layout::fits(&s).is_err() {
+        if lut_gen::Layout::fits(&s).is_err() {
             continue;
         }
         let Ok(mut dut) = target_dut(&s, target) else {

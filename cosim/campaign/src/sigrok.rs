@@ -14,9 +14,9 @@ use std::path::Path;
 use std::time::Duration;
 
 use judge::Observer;
-use lut_gen::parts::{AdcPart, Start};
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 use lut_gen::Schedule;
+use lut_gen::{AdcPart, Start};
 
 use judge::tools::{self, ToolError};
 

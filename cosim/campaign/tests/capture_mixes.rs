@@ -29,7 +29,7 @@ fn mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
         let Ok(s) = lut_gen::synthesize(&mix) else {
             continue;
         };
-        if lut_gen::ports::Layout::fits(&s).is_err()
+        if lut_gen::Layout::fits(&s).is_err()
             || (0..s.branches.len()).any(|b| s.branch_instants_in_frame(b).is_empty())
         {
             continue;

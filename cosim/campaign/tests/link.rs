@@ -5,7 +5,7 @@
 //! and the model-free decode of the line sees it too.
 
 use judge::{run_dut, Dut, RunOptions};
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 use lut_gen::Schedule;
 
 struct Sim(hdl::RtlSim);
@@ -249,7 +249,7 @@ fn every_link_pin_fault_is_caught_by_its_detector() {
         );
         assert!(clean.ok, "clean: {}", clean.summary());
         let faults = PinFault::link(&s);
-        let axis = s.mix.link.unwrap().kind == lut_gen::mix::LinkKind::Axis;
+        let axis = s.mix.link.unwrap().kind == lut_gen::LinkKind::Axis;
         assert_eq!(faults.len(), if axis { 3 } else { 5 });
         for f in faults {
             let inner = judge::with_slave(&s, judge::ModelDut::new(&s), TREADY);

@@ -9,9 +9,9 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use judge::{run_dut, ModelDut, RunOptions};
-use lut_gen::parts::Start;
-use lut_gen::ports::{Layout, Role};
 use lut_gen::Schedule;
+use lut_gen::Start;
+use lut_gen::{Layout, Role};
 
 use crate::tools;
 

@@ -5,7 +5,7 @@ use judge::Trace;
 use judge::Verdict;
 use judge::{reset_cycles, run_dut, run_model, Dut, ModelDut, Observer, RunOptions};
 use judge::{write_gtkw, VcdWriter};
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 use lut_gen::Schedule;
 
 use crate::error::SimError;

@@ -24,8 +24,8 @@ use judge::tools::{Tool, ToolError};
 use judge::CycleSink;
 use judge::Verdict;
 use judge::{Analog, Stimulus};
-use lut_gen::parts::Start;
-use lut_gen::ports::{Dir, Layout, Pins, Role, AXIS_PORTS, TOP_MODULE};
+use lut_gen::Start;
+use lut_gen::{Dir, Layout, Pins, Role, AXIS_PORTS, TOP_MODULE};
 
 use crate::error::{BackendError, SimError};
 use crate::options::{SimOptions, VcdOut};
@@ -78,7 +78,7 @@ pub fn testbench_with(
             g.cs_part(b);
         }
     }
-    if let Some(a) = lut_gen::hostlink::plan(s)
+    if let Some(a) = lut_gen::plan_link(s)
         .and_then(|p| p.ok())
         .and_then(|p| p.axis())
     {

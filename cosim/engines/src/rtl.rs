@@ -3,7 +3,7 @@
 //! simulates it.
 //!
 //! The check is a small scanner of the top module (name
-//! [`lut_gen::ports::TOP_MODULE`]), not a Verilog front end: it finds the
+//! [`lut_gen::TOP_MODULE`]), not a Verilog front end: it finds the
 //! module, reads its port list in ANSI style (`input wire [N:0] name`) or
 //! non-ANSI style (a list of names plus `input [N:0] name;` declarations in
 //! the body), with `wire`/`reg`/`logic` and similar net types, and evaluates
@@ -19,8 +19,8 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use lut_gen::ports::{Dir, Layout, PORTS, TOP_MODULE};
 use lut_gen::Schedule;
+use lut_gen::{Dir, Layout, PORTS, TOP_MODULE};
 
 use crate::error::SimError;
 

@@ -2,7 +2,7 @@
 //! emitted blocks) as a [`Dut`], in process.
 
 use judge::Dut;
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 use lut_gen::Schedule;
 
 use crate::error::SimError;

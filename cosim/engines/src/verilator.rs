@@ -9,7 +9,7 @@
 
 use judge::tools::Tool;
 use judge::Dut;
-use lut_gen::ports::{LinkPort, Pins, Role, AXIS_PORTS, LINK_PORTS, TOP_MODULE};
+use lut_gen::{LinkPort, Pins, Role, AXIS_PORTS, LINK_PORTS, TOP_MODULE};
 use std::marker::PhantomData;
 use std::path::{Path, PathBuf};
 
@@ -176,7 +176,7 @@ struct SfPins {
 }
 
 const _: () = assert!(std::mem::size_of::<SfPins>() == 40);
-const _: () = assert!(lut_gen::ports::limits::MAX_DEVICES <= 128);
+const _: () = assert!(lut_gen::limits::MAX_DEVICES <= 128);
 
 /// FNV-1a, 64 bit: a stable cache key across Rust versions.
 pub fn fnv64(parts: &[&[u8]]) -> u64 {

@@ -20,7 +20,7 @@ use std::f64::consts::PI;
 
 use lut_gen::Schedule;
 
-use lut_gen::ports::{Layout, Pins};
+use lut_gen::{Layout, Pins};
 
 /// What each analog input carries.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -217,7 +217,7 @@ impl Adc {
             .branches
             .iter()
             .map(|b| PartModel {
-                cnv: b.adc.start == lut_gen::parts::Start::Cnv,
+                cnv: b.adc.start == lut_gen::Start::Cnv,
                 bits: b.adc.bits,
                 leading: b.adc.leading_bits,
                 word_sclks: b.adc.word_sclks(),

@@ -6,8 +6,8 @@
 
 use std::path::Path;
 
-use lut_gen::ports::{Layout, LINK_PORTS, PORT_NAMES};
 use lut_gen::Schedule;
+use lut_gen::{Layout, LINK_PORTS, PORT_NAMES};
 
 use crate::timed::{Capture, Lane};
 
@@ -71,7 +71,7 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
                     widths[pi]
                 )));
             }
-            Some(lut_gen::ports::PORTS[pi].role)
+            Some(lut_gen::PORTS[pi].role)
         };
         if role.is_none() && lanes.iter().any(|l| l.role.is_none()) {
             return Err(at(format!("`{link_tx}` is mapped twice")));

@@ -7,11 +7,11 @@
 //!   and exclusivity, and MISO decoding);
 //! - cycle-exact equality with the [`CycleModel`] built from the schedule.
 
-use lut_gen::parts::ns_to_cycles;
+use lut_gen::ns_to_cycles;
 use lut_gen::{FrameGrid, Schedule};
 use serde_json::{json, Value};
 
-use lut_gen::ports::{Layout, Pins, Role, Signal};
+use lut_gen::{Layout, Pins, Role, Signal};
 
 use crate::invariants::Invariants;
 use crate::linkjoin::{Joined, LinkJoin};
@@ -239,7 +239,7 @@ impl Checker {
                     + ns_to_cycles(b.adc.setup_ns, mix.clock_hz).max(1),
                 quiet_min: ns_to_cycles(b.adc.quiet_ns, mix.clock_hz).max(1),
                 settle_min: ns_to_cycles(b.settle_ns, mix.clock_hz),
-                cnv: b.adc.start == lut_gen::parts::Start::Cnv,
+                cnv: b.adc.start == lut_gen::Start::Cnv,
                 sclks: b.adc.word_sclks() * b.chain,
                 word_sclks: b.adc.word_sclks(),
                 bits: b.adc.bits,
@@ -252,7 +252,7 @@ impl Checker {
             .branches
             .iter()
             .enumerate()
-            .filter(|(_, b)| b.adc.start == lut_gen::parts::Start::Cnv)
+            .filter(|(_, b)| b.adc.start == lut_gen::Start::Cnv)
             .fold(0u16, |a, (b, _)| a | 1 << b);
         Checker {
             flip,

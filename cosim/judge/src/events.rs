@@ -20,9 +20,9 @@
 
 use std::fmt::Write as _;
 
-use lut_gen::parts::Start;
-use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
+use lut_gen::Start;
+use lut_gen::{Layout, Pins, Role};
 
 use crate::run::Observer;
 use crate::vcd::CycleSink;
@@ -122,7 +122,7 @@ pub const LINK_SCOPE: &str = "link";
 /// stop bit's middle sample), a change of the overflow flag.
 fn link_events(
     events: &mut Vec<Event>,
-    rx: Option<&mut link::rx::UartRx>,
+    rx: Option<&mut link::UartRx>,
     c: u64,
     p: &Pins,
     prev: Option<&Pins>,
@@ -179,11 +179,11 @@ impl EventLog {
         };
         let n = (trace.len() - z).min(cycles as usize);
         // The link's line read back as a receiver would, one event per byte.
-        let plan = lut_gen::hostlink::plan(s).and_then(|p| p.ok());
+        let plan = lut_gen::plan_link(s).and_then(|p| p.ok());
         let mut rx = plan
             .as_ref()
             .and_then(|lp| lp.uart())
-            .map(link::rx::UartRx::new);
+            .map(link::UartRx::new);
         for (c, (_, p, _)) in trace.cycles[z..z + n].iter().enumerate() {
             let c = c as u64;
             if plan.is_some() {

@@ -6,7 +6,7 @@ use std::collections::VecDeque;
 use lut_gen::Schedule;
 
 use crate::run::Dut;
-use lut_gen::ports::{Layout, Pins};
+use lut_gen::{Layout, Pins};
 
 /// A kind of fault, injected around the first conversion of `branch` at or after a cycle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -179,14 +179,14 @@ impl PinFault {
     pub fn link(s: &Schedule) -> Vec<PinFault> {
         match s.mix.link.map(|l| l.kind) {
             None => vec![],
-            Some(lut_gen::mix::LinkKind::Uart) => vec![
+            Some(lut_gen::LinkKind::Uart) => vec![
                 PinFault::LinkBitFlip,
                 PinFault::LinkDropByte,
                 PinFault::LinkStuck { high: true },
                 PinFault::LinkStuck { high: false },
                 PinFault::LinkOverflow,
             ],
-            Some(lut_gen::mix::LinkKind::Axis) => vec![
+            Some(lut_gen::LinkKind::Axis) => vec![
                 PinFault::AxisTvalidDrop,
                 PinFault::AxisTdataChange,
                 PinFault::LinkOverflow,
@@ -329,7 +329,7 @@ impl<D: Dut> FaultyDut<D> {
             last_value: None,
             frame: s.grid.frame_cycles,
             addresses: s.channels.iter().map(|c| (c.device, c.select)).collect(),
-            uart: lut_gen::hostlink::plan(s)
+            uart: lut_gen::plan_link(s)
                 .and_then(|p| p.ok())
                 .and_then(|p| p.uart()),
             char_end: 0,

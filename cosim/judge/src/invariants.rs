@@ -5,7 +5,7 @@
 
 use std::collections::VecDeque;
 
-use lut_gen::ports::Role;
+use lut_gen::Role;
 use lut_gen::{FrameGrid, Schedule};
 use serde_json::json;
 

@@ -57,7 +57,7 @@ mod vcdlex;
 mod vcdout;
 mod verdict;
 
-pub use lut_gen::ports::{Layout, Pins, Signal};
+pub use lut_gen::{Layout, Pins, Signal};
 
 // The reference model, its ADC and the checker.
 pub use adc::{Adc, Analog, Stimulus};

@@ -3,15 +3,15 @@
 //!
 //! A UART's bytes are read from `link_tx` by a receiver sampling the line
 //! once per cycle at the divider the link was planned with
-//! (`link::rx::UartRx`, the host's serial port); an AXI4-Stream's are the
+//! (`link::UartRx`, the host's serial port); an AXI4-Stream's are the
 //! `tdata` of every beat the slave accepted (`tvalid` and `tready` high in
 //! one cycle).  Only what the line finished carrying counts: a character
 //! whose stop bit had not been sampled when the run ended is not a byte yet.
 //! Like [`crate::SampleLog`], it keeps what follows the last reset cycle.
 
-use link::rx::UartRx;
 use link::UartFormat;
-use lut_gen::ports::Pins;
+use link::UartRx;
+use lut_gen::Pins;
 use lut_gen::Schedule;
 
 use crate::run::Observer;
@@ -40,7 +40,7 @@ impl LinkBytes {
     /// A collector for the mix's planned link; `None` when the mix has no
     /// `[link]` or its link cannot be planned (the audit says why).
     pub fn new(s: &Schedule) -> Option<LinkBytes> {
-        let plan = lut_gen::hostlink::plan(s)?.ok()?;
+        let plan = lut_gen::plan_link(s)?.ok()?;
         let wire = match plan.uart() {
             Some(fmt) => Wire::Uart {
                 fmt,

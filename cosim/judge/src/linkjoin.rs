@@ -20,9 +20,9 @@
 use std::collections::VecDeque;
 
 use link::format::{END, SYNC};
-use link::rx::UartRx;
+use link::UartRx;
 use link::{Decoder, HeaderOnLine, Line, Packet, Token, TxConfig, TxModel};
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 
 /// The bytes kept while searching at most; older ones are forgotten.
 const MAX_BYTES: usize = 1 << 16;

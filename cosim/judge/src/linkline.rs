@@ -30,9 +30,9 @@
 
 use std::collections::VecDeque;
 
-use link::rx::{RxByte, UartRx};
 use link::{AxisFormat, Decoder, Packet, Stats, Tlast, UartFormat};
-use lut_gen::ports::Pins;
+use link::{RxByte, UartRx};
+use lut_gen::Pins;
 use lut_gen::Schedule;
 use serde_json::json;
 
@@ -125,7 +125,7 @@ pub(crate) struct LinkLine {
 impl LinkLine {
     /// The link's checks for a mix with a feasible `[link]`; `None` otherwise.
     pub(crate) fn new(s: &Schedule) -> Option<LinkLine> {
-        let plan = lut_gen::hostlink::plan(s)?.ok()?;
+        let plan = lut_gen::plan_link(s)?.ok()?;
         let (wire, port) = match (plan.uart(), plan.axis()) {
             (Some(fmt), _) => (
                 Wire::Uart(Uart {

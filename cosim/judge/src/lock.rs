@@ -19,9 +19,9 @@
 
 use std::fmt;
 
-use lut_gen::parts::Start;
-use lut_gen::ports::{Layout, Pins};
 use lut_gen::Schedule;
+use lut_gen::Start;
+use lut_gen::{Layout, Pins};
 
 use crate::checker::{CheckOptions, Checker, Join};
 use crate::model::CycleModel;

@@ -10,7 +10,7 @@
 
 use lut_gen::Schedule;
 
-use lut_gen::ports::{Layout, Pins};
+use lut_gen::{Layout, Pins};
 
 /// One conversion's word in the periodic frame template (a chained
 /// conversion gives one per chain member read).
@@ -199,7 +199,7 @@ impl BranchModel {
             spi.sclk_half,
             spi.read_cycles,
         );
-        let cnv = spi.style == lut_gen::parts::Start::Cnv;
+        let cnv = spi.style == lut_gen::Start::Cnv;
         let sclks = spi.sclks();
         let caps = if cnv { sclks } else { sclks - 1 };
         let mut offs = vec![1, r];
@@ -301,7 +301,7 @@ impl CycleModel {
             .filter(|(_, m)| !m.cnv)
             .fold(0u16, |a, (b, _)| a | 1 << b);
         // The transmitter after its reset edge: line idle (high).
-        let (tx, axis) = match lut_gen::hostlink::plan(s) {
+        let (tx, axis) = match lut_gen::plan_link(s) {
             Some(Ok(p)) => (Some(link::TxModel::new(p.tx_config(s))), p.axis().is_some()),
             _ => (None, false),
         };
@@ -390,7 +390,7 @@ impl CycleModel {
 
     /// The byte on the link's line in the current cycle and which of its
     /// bits (0: the start bit): what a capture's line is held against.
-    pub fn link_byte(&self) -> Option<(link::tx::ByteOnLine, u32)> {
+    pub fn link_byte(&self) -> Option<(link::ByteOnLine, u32)> {
         self.tx.as_ref()?.on_line()
     }
 

@@ -1,8 +1,8 @@
 //! Driving a design cycle by cycle with the ADC model, fully checked, and
 //! the slot-level model back end.
 
-use lut_gen::ports::{Layout, Signal};
 use lut_gen::Schedule;
+use lut_gen::{Layout, Signal};
 
 use crate::adc::{Adc, Analog, Stimulus};
 use crate::checker::{CheckOptions, Checker};
@@ -11,7 +11,7 @@ use crate::model::{CycleModel, SlotModel};
 use crate::rule::Rule;
 use crate::verdict::Verdict;
 use crate::verdict::Violation;
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 
 /// Anything that behaves like `slotforge_top`: one call per rising clock
 /// edge, with `rst` and `adc_miso` as sampled at that edge; returns the
@@ -89,7 +89,7 @@ pub fn with_slave<'a, D: Dut + 'a>(
     dut: D,
     pattern: link::ReadyPattern,
 ) -> Box<dyn Dut + 'a> {
-    match lut_gen::hostlink::plan(s)
+    match lut_gen::plan_link(s)
         .and_then(|p| p.ok())
         .and_then(|p| p.axis())
     {
@@ -289,7 +289,7 @@ fn sm_first_member(sm: &SlotModel, c: &crate::model::Conversion) -> u16 {
 }
 
 fn static_checks(s: &Schedule, sm: &SlotModel, inv: &mut Invariants) {
-    use lut_gen::parts::ns_to_cycles;
+    use lut_gen::ns_to_cycles;
     use serde_json::json;
     let mix = &s.mix;
     let clock = mix.clock_hz;

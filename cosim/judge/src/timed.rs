@@ -22,8 +22,8 @@
 
 use std::fmt::Write as _;
 
-use lut_gen::ports::{Layout, Pins, Role};
 use lut_gen::Schedule;
+use lut_gen::{Layout, Pins, Role};
 
 use crate::model::CycleModel;
 
@@ -40,7 +40,7 @@ impl Lane {
     pub fn port_bit(&self) -> String {
         match self.role {
             Some(r) => format!("{}[{}]", r.name(), self.bit),
-            None => lut_gen::ports::LINK_PORTS[0].name.to_string(),
+            None => lut_gen::LINK_PORTS[0].name.to_string(),
         }
     }
 
@@ -284,7 +284,7 @@ pub(crate) fn cnv_mask(s: &Schedule) -> u16 {
         .branches
         .iter()
         .enumerate()
-        .filter(|(_, b)| b.adc.start == lut_gen::parts::Start::Cnv)
+        .filter(|(_, b)| b.adc.start == lut_gen::Start::Cnv)
         .fold(0u16, |a, (b, _)| a | 1 << b)
 }
 

@@ -2,7 +2,7 @@
 //! is decoded from the capture's samples by the `link` crate (its receiver
 //! and its host decoder, the same a host runs), and every packet's samples
 //! must be the schedule's channels in the schedule's order for its slice
-//! (`lut_gen::hostlink::merged_frame`), with good CRCs and no packet lost.
+//! (`lut_gen::merged_frame`), with good CRCs and no packet lost.
 //!
 //! Once the edge check has found the frame phase (`LinkPhase`), the cycle
 //! model runs along the capture and predicts the line: every byte's start
@@ -12,7 +12,7 @@
 //! fed the bits MISO carried, so each record byte of that branch's channels
 //! must be the code MISO carried.
 
-use lut_gen::ports::Role;
+use lut_gen::Role;
 use lut_gen::Schedule;
 
 use crate::model::CycleModel;
@@ -43,7 +43,7 @@ pub struct LinkCheck {
 fn packet_order(s: &Schedule) -> Vec<Vec<u16>> {
     let g = &s.grid;
     let mut per_slice = vec![Vec::new(); g.slices_per_frame as usize];
-    for (cycle, _, ch) in lut_gen::hostlink::merged_frame(s) {
+    for (cycle, _, ch) in lut_gen::merged_frame(s) {
         let k = (cycle / g.slice_cycles % g.slices_per_frame) as usize;
         per_slice[k].push(ch);
     }
@@ -59,7 +59,7 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
         proved: Vec::new(),
         not_proved: Vec::new(),
     };
-    let plan = match lut_gen::hostlink::plan(s) {
+    let plan = match lut_gen::plan_link(s) {
         Some(Ok(p)) => p,
         _ => {
             out.not_proved
@@ -204,7 +204,7 @@ fn read_line(
     let tc = 1e12 / s.mix.clock_hz as f64;
     let t0 = cap.steps.first().map(|x| x.0).unwrap_or(0) as f64;
     let end = cap.steps.last().map(|x| x.0).unwrap_or(0) as f64;
-    let mut rx = link::rx::UartRx::new(fmt);
+    let mut rx = link::UartRx::new(fmt);
     let mut dec = link::Decoder::new(s.grid.slices_per_frame);
     let mut line = LineSampler {
         k: 0,

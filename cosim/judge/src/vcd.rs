@@ -29,14 +29,14 @@ use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
-use lut_gen::ports::{LinkPort, Role, AXIS_PORTS, PORT_NAMES, TOP_MODULE};
 use lut_gen::Schedule;
+use lut_gen::{LinkPort, Role, AXIS_PORTS, PORT_NAMES, TOP_MODULE};
 
 use crate::checker::{CheckOptions, Checker};
 use crate::lock::{LockError, LockInfo, WindowCheck};
 use crate::vcdlex::{self, At, BodyStart, Ev, Lexed};
 use crate::verdict::Verdict;
-use lut_gen::ports::{Layout, Pins};
+use lut_gen::{Layout, Pins};
 
 /// Why a VCD could not be checked (exit 2).
 #[derive(Debug)]

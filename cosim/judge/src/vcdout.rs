@@ -9,7 +9,7 @@ use lut_gen::Schedule;
 
 use crate::run::{run_dut, Dut, Observer, RunOptions};
 use crate::verdict::Verdict;
-use lut_gen::ports::{Layout, Pins, Role, PORTS, TOP_MODULE};
+use lut_gen::{Layout, Pins, Role, PORTS, TOP_MODULE};
 
 /// The time in picoseconds of clock edge `n` of a run (edge `2k + 1` falls
 /// before cycle `k` (counted from the first reset cycle), edge `2k + 2`

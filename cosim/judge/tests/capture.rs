@@ -9,8 +9,8 @@ use std::path::Path;
 
 use judge::check_capture;
 use judge::ModelDut;
-use lut_gen::ports::{Pins, Role};
 use lut_gen::Schedule;
+use lut_gen::{Pins, Role};
 
 use analyser::{capture, check, lanes, mutate, resample_lanes, run_with_miso, Mutation};
 use testkit::analyser;
@@ -274,7 +274,7 @@ fn the_lock_takes_the_first_conversion_start_on_any_lane() {
         r.summary()
     );
     // Branch 0's CS not probed: D0 is adc_cs_n[0] in `lanes`' order.
-    assert_eq!(lanes_v[0], (Some(lut_gen::ports::Role::CsN), 0));
+    assert_eq!(lanes_v[0], (Some(lut_gen::Role::CsN), 0));
     let without_cs0: Vec<&str> = map.split(',').skip(1).collect();
     let r = check(&s, &without_cs0.join(","), &sr);
     assert!(r.ok, "{}", r.summary());
@@ -327,7 +327,7 @@ fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
     let (pins, miso) = run_with_miso(&s, &mut ModelDut::new(&s), 3);
     let (mut lanes_v, mut map) = lanes(&s);
     let link = format!("D{}", lanes_v.len() - 1);
-    let branches = lut_gen::ports::Layout::new(&s).branches;
+    let branches = lut_gen::Layout::new(&s).branches;
     for b in 0..branches as u32 {
         map += &format!(",D{}=adc_miso[{b}]", lanes_v.len());
         lanes_v.push((Some(Role::Miso), b));
@@ -356,7 +356,7 @@ fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
     assert!(text.contains("equal the codes MISO carried"), "{text}");
 
     // The line two bit times late from the first start bit after frame 1.
-    let div = lut_gen::hostlink::plan(&s).unwrap().unwrap().baud_divider as usize;
+    let div = lut_gen::plan_link(&s).unwrap().unwrap().baud_divider as usize;
     let st = (f..pins.len())
         .find(|&c| !pins[c].link_tx && pins[c - 1].link_tx)
         .unwrap();

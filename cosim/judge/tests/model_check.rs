@@ -126,12 +126,12 @@ fn check_by_hand_with(
 /// cycle 0 on the mux value it took in reset.
 struct EagerStart {
     s: lut_gen::Schedule,
-    reset: lut_gen::ports::Pins,
+    reset: lut_gen::Pins,
     m: Option<judge::CycleModel>,
 }
 
 impl judge::Dut for EagerStart {
-    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::Pins {
         if rst {
             self.m = None;
             return self.reset;
@@ -311,7 +311,7 @@ fn tiny_with(kind: &str, keys: &str) -> lut_gen::Schedule {
     let mix = lut_gen::parse(Path::new("tiny-uart.toml"), &text).unwrap();
     let s = lut_gen::synthesize(&mix).unwrap();
     // a line that cannot carry the mix has no link to check
-    assert!(matches!(lut_gen::hostlink::plan(&s), Some(Ok(_))), "{keys}");
+    assert!(matches!(lut_gen::plan_link(&s), Some(Ok(_))), "{keys}");
     s
 }
 
@@ -325,7 +325,7 @@ struct Glitch {
 }
 
 impl judge::Dut for Glitch {
-    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::Pins {
         let mut p = self.inner.step(rst, miso);
         if rst {
             return p;
@@ -504,7 +504,7 @@ struct Beat<'a> {
 }
 
 impl judge::Dut for Beat<'_> {
-    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::Pins {
         let mut p = self.inner.step(rst, miso);
         if rst {
             return p;
@@ -538,7 +538,7 @@ struct Repeat<'a> {
 }
 
 impl judge::Dut for Repeat<'_> {
-    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::ports::Pins {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::Pins {
         let mut p = self.inner.step(rst, miso);
         if rst {
             return p;

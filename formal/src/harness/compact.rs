@@ -1,5 +1,5 @@
 //! The harness's compact slot tables, for frames beyond the full tables'
-//! [`MAX_FRAME_SLOTS`] (a 1 Hz channel's one-second frame).
+//! [`FULL_TABLE_MAX_SLOTS`] (a 1 Hz channel's one-second frame).
 //!
 //! The idea is `lut_gen::lut::CompactLut`'s (hdl/DESIGN.md): a row per slot
 //! of the slice that is either the same in every slice of the frame or a
@@ -14,10 +14,10 @@
 use std::collections::HashMap;
 use std::fmt::Write;
 
-use lut_gen::schedule::FrameGrid;
+use lut_gen::FrameGrid;
 use lut_gen::Schedule;
 
-use super::{most_common, width, HarnessError, Row, MAX_FRAME_SLOTS};
+use super::{most_common, width, HarnessError, Row, FULL_TABLE_MAX_SLOTS};
 
 /// One slot of the slice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -92,7 +92,7 @@ pub(super) fn counters(v: &mut String, g: &FrameGrid) {
 
 /// Branch `b`'s table: the rotation groups (each a case on `slc`), then the
 /// slice table (a case on `sis`) that sets `tab{b}`.  Held to the full
-/// tables' size: at most [`MAX_FRAME_SLOTS`] case arms.
+/// tables' size: at most [`FULL_TABLE_MAX_SLOTS`] case arms.
 pub(super) fn table(
     s: &Schedule,
     b: usize,
@@ -104,11 +104,11 @@ pub(super) fn table(
     let (sps, slices) = (g.slots_per_slice as usize, g.slices_per_frame as usize);
     let c = Compact::new(rows, sps, slices);
     let arms = sps + c.groups.len() * slices;
-    if arms as u64 > MAX_FRAME_SLOTS {
+    if arms as u64 > FULL_TABLE_MAX_SLOTS {
         return Err(HarnessError(format!(
             "mix `{}`: branch {}'s slot table needs {arms} case arms even in compact form \
              ({sps} slots per slice, {} rotation groups of {slices} slices), beyond the formal \
-             harness's {MAX_FRAME_SLOTS}",
+             harness's {FULL_TABLE_MAX_SLOTS}",
             s.mix.name,
             s.branches[b].name,
             c.groups.len()

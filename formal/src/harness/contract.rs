@@ -10,7 +10,7 @@
 //! property added for a clause takes that clause off the list, and none is
 //! listed by preset.
 
-use lut_gen::ports::Layout;
+use lut_gen::Layout;
 use lut_gen::Schedule;
 
 use super::PropertyDef;
@@ -129,7 +129,7 @@ impl Clause {
 /// The UART clause with the character the audit reports (its divider and
 /// real baud, `lut_gen::hostlink`).
 fn uart_characters(s: &Schedule) -> String {
-    let frame = match lut_gen::hostlink::plan(s) {
+    let frame = match lut_gen::plan_link(s) {
         Some(Ok(p)) => format!(
             ": start bit, 8 data bits LSB first, parity {}, {} stop bit{}, each bit {} cycles \
              ({:.0} baud)",

@@ -15,8 +15,8 @@
 
 use std::fmt::Write;
 
-use lut_gen::ports::{Dir, Layout};
 use lut_gen::Schedule;
+use lut_gen::{Dir, Layout};
 
 use super::{width, Clause, FreeInput, PropertyDef};
 

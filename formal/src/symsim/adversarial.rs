@@ -229,7 +229,7 @@ fn judged(g: &Aig, period: u64, offset: u64, max_steps: u64) -> Found {
     judged_with_stats(g, period, offset, max_steps).0
 }
 
-fn judged_with_stats(g: &Aig, period: u64, offset: u64, max_steps: u64) -> (Found, Stats) {
+fn judged_with_stats(g: &Aig, period: u64, offset: u64, max_steps: u64) -> (Found, SymStats) {
     judged_by(g, period, offset, || {
         run(g, period, offset, max_steps, None)
     })
@@ -240,8 +240,8 @@ fn judged_by(
     g: &Aig,
     period: u64,
     offset: u64,
-    engine: impl FnOnce() -> (Found, Stats),
-) -> (Found, Stats) {
+    engine: impl FnOnce() -> (Found, SymStats),
+) -> (Found, SymStats) {
     let (f, st) = engine();
     let c = Concrete::new(g);
     let truth = c.first_bad();

@@ -59,7 +59,7 @@ pub enum Found {
 
 /// Figures of a run, for the report and the benchmark.
 #[derive(Debug, Clone, Default)]
-pub struct Stats {
+pub struct SymStats {
     /// Satisfiability checks of the assertions (a window's disjunction, or
     /// one step of a window that had a violation).
     pub sat_calls: u64,
@@ -90,7 +90,7 @@ pub fn run(
     offset: u64,
     max_steps: u64,
     deadline: Option<Instant>,
-) -> (Found, Stats) {
+) -> (Found, SymStats) {
     let limits = Limits {
         period,
         offset,
@@ -117,7 +117,7 @@ pub fn prove(
     offset: u64,
     max_steps: u64,
     deadline: Option<Instant>,
-) -> (Found, Stats) {
+) -> (Found, SymStats) {
     if choices.is_empty() {
         let (f, mut st) = run(g, period, offset, max_steps, deadline);
         st.parts = [1, 0, 0];
@@ -139,9 +139,9 @@ pub fn prove(
             explicit.push(part);
         }
     }
-    let mut stats = Stats {
+    let mut stats = SymStats {
         parts: [symbolic.len(), inductive.len(), explicit.len()],
-        ..Stats::default()
+        ..SymStats::default()
     };
     let mut results = Vec::new();
     let whole = Limits {
@@ -163,7 +163,7 @@ pub fn prove(
         };
         let (found, st) = match how {
             2 => match explicit::run(&sub, choices, &lim) {
-                Some(f) => (f, Stats::default()),
+                Some(f) => (f, SymStats::default()),
                 None => {
                     // too many inputs to enumerate: simulated symbolically
                     stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
@@ -260,7 +260,7 @@ struct Sim<'a> {
     /// and their disjunction.
     pending: Vec<(u64, u32)>,
     pending_any: u32,
-    stats: Stats,
+    stats: SymStats,
     gc_at: usize,
 }
 
@@ -289,13 +289,13 @@ impl<'a> Sim<'a> {
             prev_state: Vec::new(),
             pending: Vec::new(),
             pending_any: 0,
-            stats: Stats::default(),
+            stats: SymStats::default(),
             gc_at: 1 << 20,
         }
     }
 
     /// Runs to a verdict, `lim.max_steps` or the deadline.
-    fn run(mut self, lim: &Limits) -> (Found, Stats) {
+    fn run(mut self, lim: &Limits) -> (Found, SymStats) {
         // every boundary's state, canonical: a state equal to an earlier
         // boundary's closes the search (a FIFO's pointers may need several
         // periods to come round)

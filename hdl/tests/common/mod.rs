@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use lut_gen::ports::Pins;
+use lut_gen::Pins;
 use lut_gen::Schedule;
 
 pub fn root() -> PathBuf {
@@ -172,9 +172,9 @@ struct Lane {
 
 impl Adc {
     pub fn new(clock_hz: u64, seed: u64) -> Adc {
-        let part = lut_gen::parts::AdcPart::ad7940();
+        let part = lut_gen::AdcPart::ad7940();
         Adc {
-            access: lut_gen::parts::ns_to_cycles(part.data_access_ns, clock_hz),
+            access: lut_gen::ns_to_cycles(part.data_access_ns, clock_hz),
             hold: part.data_hold_ns * clock_hz / 1_000_000_000,
             lane: Lane {
                 prev_cs: true,

@@ -59,7 +59,7 @@ impl Cx<'_> {
         let message = (!named)
             .then(|| header_message(self.text, e.span(), &field))
             .flatten()
-            .unwrap_or_else(|| plain(e.message(), &field));
+            .unwrap_or_else(|| toml_words(e.message(), &field));
         MixError {
             file: self.file.to_path_buf(),
             line,

@@ -159,7 +159,7 @@ pub(super) fn value_words(v: &toml::Value) -> String {
 /// A TOML error message in the words of the mix format, not of Rust's
 /// types: `expected i64` becomes "expected a whole number", of Hz, us or ns
 /// by the unit of `field`.
-pub fn plain(m: &str, field: &str) -> String {
+pub fn toml_words(m: &str, field: &str) -> String {
     let key = field.rsplit('.').next().unwrap_or("");
     let unit = if key.ends_with("_hz") || key == "hz" {
         " of Hz"

@@ -98,7 +98,7 @@ impl std::str::FromStr for Step {
 pub enum Run {
     Yes,
     /// `prove` left out by default, shown from the proof remembered for
-    /// the same Verilog (`measure::proof::cached`) without proving again.
+    /// the same Verilog (`measure::cached_proof`) without proving again.
     Remembered,
     Skip(SkipReason),
 }
@@ -203,7 +203,7 @@ fn speed_needs_faults(mut plan: Vec<(Step, Run)>) -> Vec<(Step, Run)> {
 }
 
 /// A proof left out by default is still shown when one of the same Verilog
-/// and harness is remembered (`measure::proof::cached`).
+/// and harness is remembered (`measure::cached_proof`).
 pub fn with_remembered_proof(
     mut plan: Vec<(Step, Run)>,
     s: &Schedule,
@@ -211,7 +211,7 @@ pub fn with_remembered_proof(
 ) -> Vec<(Step, Run)> {
     for p in &mut plan {
         if *p == (Step::Prove, Run::Skip(SkipReason::ProveOptIn))
-            && measure::proof::cached(s, out).is_some()
+            && measure::cached_proof(s, out).is_some()
         {
             p.1 = Run::Remembered;
         }

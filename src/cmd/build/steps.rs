@@ -4,7 +4,6 @@
 
 use engines::{Backend, SimOptions, VcdOut};
 use lut_gen::{AuditReport, Schedule};
-use measure::tables;
 use report::Section;
 
 use super::job::{Done, Glance, Job};
@@ -23,7 +22,7 @@ fn sim_backend() -> Backend {
 
 /// Place and route started at once in a thread: yosys and nextpnr are
 /// other processes, so on two cores they run beside the simulations.
-type Background = std::thread::JoinHandle<(Result<measure::synth::Synth, String>, f64)>;
+type Background = std::thread::JoinHandle<(Result<measure::Synth, String>, f64)>;
 
 fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
     if !judge::tools::present("yosys") || !judge::tools::present("nextpnr-ice40") {
@@ -36,7 +35,7 @@ fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
     let clock = s.grid.clock_hz;
     Some(std::thread::spawn(move || {
         let t = std::time::Instant::now();
-        let r = measure::synth::place_and_route(&dir, None, clock);
+        let r = measure::place_and_route(&dir, None, clock);
         (r, t.elapsed().as_secs_f64())
     }))
 }
@@ -44,7 +43,7 @@ fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
 pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
     let mut sim_report = None;
     // engines run clean outside the campaign, for the speed chart
-    let mut clean: Vec<measure::speed::CleanRun> = Vec::new();
+    let mut clean: Vec<measure::CleanRun> = Vec::new();
     let mut campaign = None;
     let mut background = if plan.contains(&(Step::Synth, Run::Yes)) {
         start_synth(&job.out, s)
@@ -71,7 +70,7 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
             Step::Faults => faults(j, a, s, &mut campaign),
             Step::Prove if run == Run::Remembered => proved(
                 j,
-                measure::proof::cached(s, &j.out).ok_or("the remembered proof went away".into()),
+                measure::cached_proof(s, &j.out).ok_or("the remembered proof went away".into()),
                 &mut clean,
             ),
             Step::Prove => prove(j, s, &mut clean),
@@ -79,7 +78,7 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
             Step::Timing => timing(j, s),
             Step::Figure7 => figure7(s),
             Step::Schedulability => {
-                let (sec, line) = measure::schedulability::schedulability(s);
+                let (sec, line) = measure::schedulability(s);
                 Done::ok(line)
                     .section(sec)
                     .files(&["schedulability.svg", "schedulability.csv"])
@@ -124,7 +123,7 @@ fn audit(j: &mut Job, s: &Schedule) -> Done {
         ],
         ..Section::default()
     };
-    sec.tables = measure::budget::audit(&r);
+    sec.tables = measure::budget_tables(&r);
     answer_audit(j, &r);
     written(
         w,
@@ -145,7 +144,7 @@ fn answer_audit(j: &mut Job, r: &AuditReport) {
             r.adc_utilization * 100.0
         ),
     );
-    let mut binds = measure::budget::Tightest::of(r).map_or("-".into(), |t| t.words());
+    let mut binds = measure::Tightest::of(r).map_or("-".into(), |t| t.words());
     if let Some(l) = &r.link {
         binds += &format!(
             "; link: {:.1} % of the line, FIFO {} tokens deep, latency {:.1} us",
@@ -169,7 +168,7 @@ fn lut(j: &mut Job, s: &Schedule) -> Done {
             "The schedule as the paper's Table 1: {} slots per slice, {} slices per frame; every slice runs the same slots, and a rotation group's channel changes from slice to slice (the slice counter picks it).",
             s.grid.slots_per_slice, s.grid.slices_per_frame
         )],
-        tables: tables::slot_table(s),
+        tables: measure::slot_table(s),
         links: vec![
             ("lut/slots.hex".into(), "one word per frame slot ($readmemh)".into()),
             ("lut/slots.csv".into(), "the frame table".into()),
@@ -216,7 +215,7 @@ fn sim(
     a: &Args,
     s: &Schedule,
     keep: &mut Option<judge::Verdict>,
-    clean: &mut Vec<measure::speed::CleanRun>,
+    clean: &mut Vec<measure::CleanRun>,
 ) -> Done {
     let g = &s.grid;
     let backend = sim_backend();
@@ -235,7 +234,7 @@ fn sim(
         Ok(r) => r,
         Err(e) => return Done::failed(format!("{e}"), ""),
     };
-    clean.push(measure::speed::CleanRun {
+    clean.push(measure::CleanRun {
         method: format!("engine: {}", backend.name()),
         wall_seconds: t.elapsed().as_secs_f64(),
         how: format!(
@@ -252,7 +251,7 @@ fn sim(
             backend.name(),
             if r.ok { "no divergence, no violation".to_string() } else { format!("{} divergences, {} violations", r.divergence_count, r.violation_count) }
         )],
-        tables: vec![("Intervals measured, by branch and rate".into(), tables::intervals(s, &r))],
+        tables: vec![("Intervals measured, by branch and rate".into(), measure::interval_table(s, &r))],
         links: vec![
             ("frame0.vcd".into(), "frame 0 with its reset cycles (VCD)".into()),
             ("frame0.gtkw".into(), "GTKWave save file for it".into()),
@@ -420,7 +419,7 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campa
                 .collect::<Vec<_>>()
                 .join(", ")
         )],
-        tables: vec![("Faults by class".into(), tables::faults(&c))],
+        tables: vec![("Faults by class".into(), measure::fault_table(&c))],
         links: vec![("faults.json".into(), "every injection".into())],
         ..Section::default()
     };
@@ -448,22 +447,22 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campa
     written(w, d.files(&["faults.json"]).section(sec))
 }
 
-fn prove(j: &mut Job, s: &Schedule, clean: &mut Vec<measure::speed::CleanRun>) -> Done {
+fn prove(j: &mut Job, s: &Schedule, clean: &mut Vec<measure::CleanRun>) -> Done {
     if let Some(t) = ["yosys", "yosys-abc", "iverilog"]
         .into_iter()
         .find(|t| !judge::tools::present(t))
     {
         return Done::skipped(format!("{t} not installed (make tools)"));
     }
-    let r = measure::proof::prove(s, &j.out);
+    let r = measure::proof(s, &j.out);
     proved(j, r, clean)
 }
 
 /// A proof's step: proved is ok; bounded (not a proof) and failed fail.
 fn proved(
     j: &mut Job,
-    r: Result<measure::proof::Shown, String>,
-    clean: &mut Vec<measure::speed::CleanRun>,
+    r: Result<measure::ShownProof, String>,
+    clean: &mut Vec<measure::CleanRun>,
 ) -> Done {
     let shown = match r {
         Ok(x) => x,
@@ -477,7 +476,7 @@ fn proved(
     } else {
         "proved in this build"
     };
-    clean.push(measure::speed::CleanRun {
+    clean.push(measure::CleanRun {
         method: "prove".into(),
         wall_seconds: shown.proof.seconds,
         how: format!("the clean design proved for all time ({whose}; the seconds it took then)"),
@@ -555,7 +554,7 @@ fn synth(j: &mut Job, s: &Schedule, background: Option<Background>) -> Done {
 }
 
 fn timing(j: &mut Job, s: &Schedule) -> Done {
-    match measure::timing::timing(s, sim_backend()) {
+    match measure::timing(s, sim_backend()) {
         Ok((sec, wavedrom, line)) => written(
             j.write("", &[("conversion.wavedrom.json", wavedrom)]),
             Done::ok(line)
@@ -567,7 +566,7 @@ fn timing(j: &mut Job, s: &Schedule) -> Done {
 }
 
 fn figure7(s: &Schedule) -> Done {
-    match measure::figure7::figure7(s) {
+    match measure::figure7(s) {
         Ok((sec, line)) => Done::ok(line).section(sec),
         Err(e) => Done::failed(e, ""),
     }
@@ -580,7 +579,7 @@ fn speed(
     s: &Schedule,
     a: &Args,
     c: Option<&campaign::Campaign>,
-    clean: &mut Vec<measure::speed::CleanRun>,
+    clean: &mut Vec<measure::CleanRun>,
 ) -> Done {
     let Some(c) = c else {
         return Done::skipped(
@@ -597,7 +596,7 @@ fn speed(
             if !r.ok {
                 return Done::failed("rust-hdl's clean run failed the check", r.summary());
             }
-            clean.push(measure::speed::CleanRun {
+            clean.push(measure::CleanRun {
                 method: "engine: rusthdl".into(),
                 wall_seconds: t.elapsed().as_secs_f64(),
                 how: format!(
@@ -607,7 +606,7 @@ fn speed(
             });
         }
     }
-    let (sec, line) = measure::speed::section(c, clean, a.charts == Charts::All);
+    let (sec, line) = measure::speed(c, clean, a.charts == Charts::All);
     Done::ok(line)
         .section(sec)
         .files(&["speed-accuracy.svg", "speed-accuracy.csv"])

@@ -3,7 +3,7 @@
 
 use std::borrow::Cow;
 
-use formal::faults::DeepFault;
+use formal::DeepFault;
 use hdl::GatewareFault;
 use judge::PinFault;
 use serde::{Serialize, Serializer};

@@ -36,13 +36,13 @@ pub struct VerilogFault {
 pub fn deep_faults(s: &Schedule, frames: u64) -> Result<Vec<VerilogFault>, String> {
     let clean = engines::verilog(s).map_err(|e| e.to_string())?;
     // the late counter flips `mux_sel[0]`: a mix without any mux has no such pin
-    let muxed = lut_gen::ports::Layout::new(s).has(lut_gen::ports::Role::MuxSel);
+    let muxed = lut_gen::Layout::new(s).has(lut_gen::Role::MuxSel);
     [
-        formal::faults::DeepFault::LateCounter { frames },
-        formal::faults::DeepFault::RareCollision,
+        formal::DeepFault::LateCounter { frames },
+        formal::DeepFault::RareCollision,
     ]
     .into_iter()
-    .filter(|f| muxed || !matches!(f, formal::faults::DeepFault::LateCounter { .. }))
+    .filter(|f| muxed || !matches!(f, formal::DeepFault::LateCounter { .. }))
     .map(|f| {
         Ok(VerilogFault {
             class: FaultClass::of_deep(f),
