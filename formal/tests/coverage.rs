@@ -137,7 +137,7 @@ fn dropping_a_property_lists_what_it_asserted() {
 }
 
 /// The sentences name the pins and the figures the audit reports: the UART
-/// clause carries the divider and baud of `lut_gen::hostlink`.
+/// clause carries the divider and baud of `lut_gen::plan_link`.
 #[test]
 fn the_sentences_name_the_pins_and_the_audits_baud() {
     for (name, s) in mixes() {

@@ -1,5 +1,5 @@
 //! Long-running, structure-aware fuzzing of slotforge's two readers of
-//! untrusted files: the mix parser (`lut_gen::mix`) and the VCD reader
+//! untrusted files: the mix parser (`lut_gen::parse`) and the VCD reader
 //! (`judge::check_vcd`).  Outside `make test`: `make fuzz` (docs/fuzzing.md).
 //!
 //! Inputs are real files (the preset mixes, test fixtures, VCDs written by

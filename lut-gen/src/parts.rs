@@ -159,7 +159,7 @@ impl MuxPart {
 
     /// No multiplexer: the converter is wired straight to its sensor (one
     /// input).  The branch has no mux lanes in the pin contract (no
-    /// `mux_sel`, no `mux_en` bits: `lut_gen::ports::Layout::muxed`).
+    /// `mux_sel`, no `mux_en` bits: `lut_gen::Layout::muxed`).
     pub const NONE: MuxPart = MuxPart {
         name: "none",
         inputs: 1,

@@ -1,6 +1,6 @@
 //! `cargo run -p measure --example synth -- MIX.toml OUTDIR [BOARD.toml]`:
 //! emits the mix's gateware into OUTDIR and runs the one place-and-route
-//! flow (`measure::synth`, the same as `slotforge build`'s synthesis step);
+//! flow (`measure::place_and_route`, the same as `slotforge build`'s synthesis step);
 //! prints `mix clock_MHz LCs LUT4 DFF BRAM Fmax_MHz Fmax/clock`.
 use std::path::Path;
 

@@ -1,4 +1,4 @@
-//! ADC models from the part data (`lut_gen::parts`):
+//! ADC models from the part data (`lut_gen::AdcPart`):
 //!
 //! - CS parts (AD7940): sample the analog input the branch's mux selects at
 //!   the CS falling edge and shift the word out on MISO (the leading bits as

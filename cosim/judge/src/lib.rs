@@ -29,7 +29,7 @@
 //! - [`switch`]: the test-only switch that turns a detector off.
 //!
 //! The pins themselves ([`Pins`], [`Layout`], [`Signal`]) are the pin
-//! contract's, `lut_gen::ports`.
+//! contract's, `lut_gen::PORTS`.
 
 // The modules are private: what other crates use is the list below, so the
 // judge's internals can move without touching its users.

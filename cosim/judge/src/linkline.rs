@@ -25,7 +25,7 @@
 //!   `sample_valid` strobe fell in its slice's cycles, in order, channel
 //!   and value; a trailer reports no FIFO overflow;
 //! - **delivery**: a slice's packet has arrived at the latest the audit's
-//!   worst-case latency (`lut_gen::hostlink`) plus one slice after the
+//!   worst-case latency (`lut_gen::plan_link`) plus one slice after the
 //!   slice ended, so a line that goes quiet is caught.
 
 use std::collections::VecDeque;

@@ -127,7 +127,7 @@ impl Clause {
 }
 
 /// The UART clause with the character the audit reports (its divider and
-/// real baud, `lut_gen::hostlink`).
+/// real baud, `lut_gen::plan_link`).
 fn uart_characters(s: &Schedule) -> String {
     let frame = match lut_gen::plan_link(s) {
         Some(Ok(p)) => format!(

@@ -9,7 +9,7 @@
 //! `ReadyPattern::WorstCase` is the member that is never early).  So every
 //! engine, including one that ignores `assume`, sees every slave that
 //! honours the guarantee and no other.  The FIFO's depth is the worst-case
-//! backlog under that guarantee (`lut_gen::hostlink`), so `link.overflow`
+//! backlog under that guarantee (`lut_gen::plan_link`), so `link.overflow`
 //! is the claim that the depth is enough for every such slave, not only
 //! for the worst-case pattern a simulation drives.
 
