@@ -174,6 +174,24 @@ impl Role {
 }
 
 impl Pins {
+    /// Every pin low, in a `const` (`Default` is not): as an unknown-bits
+    /// mask (`xz`), no bit of any port is `x` or `z`.
+    pub const LOW: Pins = Pins {
+        cs_n: 0,
+        sclk: 0,
+        mux_sel: 0,
+        mux_en: 0,
+        sample_valid: false,
+        sample_channel: 0,
+        sample_value: 0,
+        link_tx: false,
+        link_overflow: false,
+        axis_tdata: 0,
+        axis_tvalid: false,
+        axis_tlast: false,
+        axis_tready: false,
+    };
+
     /// The value of output port `r` (inputs read as 0); `u128` because
     /// `mux_en` has up to [`limits::MAX_DEVICES`] bits.
     #[inline]

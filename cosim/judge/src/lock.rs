@@ -550,21 +550,8 @@ impl<'a> WindowCheck<'a> {
     }
 }
 
-const NO_XZ: Pins = Pins {
-    cs_n: 0,
-    sclk: 0,
-    mux_sel: 0,
-    mux_en: 0,
-    sample_valid: false,
-    sample_channel: 0,
-    sample_value: 0,
-    link_tx: false,
-    link_overflow: false,
-    axis_tdata: 0,
-    axis_tvalid: false,
-    axis_tlast: false,
-    axis_tready: false,
-};
+/// No bit unknown: an `xz` mask of every pin low.
+const NO_XZ: Pins = Pins::LOW;
 
 fn fmt_ctl(c: &Ctl) -> String {
     format!(
