@@ -130,24 +130,14 @@ pub fn bmc(p: &Prepared, frames: u64, secs: u64) -> Result<SolverVerdict, ProveE
     let cmd = format!(
         "read_aiger design.aig; fold; strash; bmc3 -F {frames} -T {secs}; write_cex -a cex.aiw"
     );
-    let out = run_tool(
-        &p.dir,
-        "yosys-abc",
-        &["-c", &cmd],
-        Duration::from_secs(secs),
-    )?;
+    let out = abc(p, &cmd, secs)?;
     parse_abc(&out, frames)
 }
 
 /// ABC's `pdr` for at most `secs` seconds.
 pub fn pdr(p: &Prepared, secs: u64) -> Result<Option<SolverVerdict>, ProveError> {
     let cmd = format!("read_aiger design.aig; fold; strash; pdr -T {secs}; write_cex -a cex.aiw");
-    let out = run_tool(
-        &p.dir,
-        "yosys-abc",
-        &["-c", &cmd],
-        Duration::from_secs(secs),
-    )?;
+    let out = abc(p, &cmd, secs)?;
     if out.contains("Property proved") {
         return Ok(Some(SolverVerdict::Proved));
     }
@@ -155,6 +145,17 @@ pub fn pdr(p: &Prepared, secs: u64) -> Result<Option<SolverVerdict>, ProveError>
         v @ SolverVerdict::Violated { .. } => Ok(Some(v)),
         _ => Ok(None),
     }
+}
+
+/// Runs one `yosys-abc` script in the work directory for at most `secs`
+/// seconds; its output.
+fn abc(p: &Prepared, script: &str, secs: u64) -> Result<String, ProveError> {
+    run_tool(
+        &p.dir,
+        "yosys-abc",
+        &["-c", script],
+        Duration::from_secs(secs),
+    )
 }
 
 /// Reads ABC's verdict: "Output 0 of miter ... was asserted in frame N." or
@@ -243,12 +244,7 @@ fn bmc_on_miter(
         .map_err(|e| ProveError::Tool(format!("{name}: {e}")))?;
     let frames = check + 2;
     let cmd = format!("read_aiger {name}; strash; bmc3 -F {frames} -T {secs}");
-    let out = run_tool(
-        &p.dir,
-        "yosys-abc",
-        &["-c", &cmd],
-        Duration::from_secs(secs),
-    )?;
+    let out = abc(p, &cmd, secs)?;
     parse_abc(&out, frames)
 }
 

@@ -3,6 +3,8 @@
 //! harness's properties, on every preset, the test mixes and random mixes
 //! with and without a link.  No external tool: the harness only.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use formal::{contract, not_covered, Clause};
@@ -49,19 +51,7 @@ fn mixes() -> Vec<(String, lut_gen::Schedule)> {
             ));
         }
     }
-    let shape = campaign::Shape {
-        clock_hz: 4_000_000,
-        frame_us: 1_000,
-        slice_us: 500,
-        branches: (1, 3),
-        mux_devices: (1, 2),
-        sclk_hz: vec![1_000_000, 2_000_000],
-        settle_ns: vec![0, 1_000, 2_000],
-        channels: (2, 8),
-        rates_hz: vec![1_000, 2_000, 4_000],
-        muxless: 0,
-        link: None,
-    };
+    let shape = common::quick_proof_shape(0);
     for seed in 1..12u64 {
         texts.push((
             format!("random mix {seed}"),

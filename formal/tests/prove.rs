@@ -13,6 +13,8 @@
 //! engines agree; the AXI4-Stream link over a slice and its payload and
 //! FIFO faults.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -146,9 +148,7 @@ fn a_fault_after_five_frames_fails_and_is_never_called_proved() {
     );
 }
 
-/// Random mixes from the one generator (`campaign::mixgen`), on a 4 MHz clock
-/// and a 1 ms frame (4,000 cycles) so each proof takes seconds: one to
-/// three branches, one or two mux devices, SCLK, settling and rates drawn.
+/// Random mixes of `common::quick_proof_shape` (each proof takes seconds).
 fn unseen_mixes(count: usize) -> Vec<(u64, lut_gen::Schedule)> {
     unseen_mixes_with(count, 0, &|_| true)
 }
@@ -160,19 +160,7 @@ fn unseen_mixes_with(
     muxless: u64,
     keep: &dyn Fn(&lut_gen::Schedule) -> bool,
 ) -> Vec<(u64, lut_gen::Schedule)> {
-    let shape = campaign::Shape {
-        clock_hz: 4_000_000,
-        frame_us: 1_000,
-        slice_us: 500,
-        branches: (1, 3),
-        mux_devices: (1, 2),
-        sclk_hz: vec![1_000_000, 2_000_000],
-        settle_ns: vec![0, 1_000, 2_000],
-        channels: (2, 8),
-        rates_hz: vec![1_000, 2_000, 4_000],
-        muxless,
-        link: None,
-    };
+    let shape = common::quick_proof_shape(muxless);
     let mut found = Vec::new();
     for seed in 1..200u64 {
         let text = campaign::random_mix(seed, &shape);
