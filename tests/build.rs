@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::common_cli::{record_golden, slotforge, tiny};
+use crate::common_cli::{column, record_golden, slotforge, tiny};
 use crate::tools;
 
 #[path = "common/browser.rs"]
@@ -183,16 +183,7 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
     );
     // judged by the model and the invariants; sigrok's decodes are the
     // full campaign's, and the page says so
-    let col = |v: &serde_json::Value, d: &str| -> serde_json::Value {
-        v["columns"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|c| c["detector"] == d)
-            .unwrap()
-            .clone()
-    };
-    let sigrok = col(&quick, "sigrok");
+    let sigrok = column(&quick, "sigrok");
     assert!(
         sigrok["not_run"]
             .as_str()
@@ -200,7 +191,7 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
             .contains("quick campaign"),
         "{sigrok}"
     );
-    assert_eq!(col(&quick, "model")["detected"], quick["injected"]);
+    assert_eq!(column(&quick, "model")["detected"], quick["injected"]);
     // the speed-against-accuracy chart is the fault matrix of this run
     assert_chart_is_the_matrix(&out);
     // and names every engine the default build ran, with its cost; the

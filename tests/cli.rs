@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-use crate::common_cli::{slotforge, tiny};
+use crate::common_cli::{column, slotforge, tiny};
 use crate::{progress, tools};
 
 fn preset(name: &str) -> PathBuf {
@@ -401,16 +401,6 @@ fn key(i: &serde_json::Value) -> (String, String) {
         i["fault"].as_str().unwrap().to_string(),
         i["site"].as_str().unwrap().to_string(),
     )
-}
-
-fn column(v: &serde_json::Value, d: &str) -> serde_json::Value {
-    v["columns"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["detector"] == d)
-        .unwrap()
-        .clone()
 }
 
 /// The injections detector `d` catches, measured with every other

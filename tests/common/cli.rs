@@ -45,3 +45,14 @@ pub fn sim_window(dir: &Path, name: &str, from: &str, to: &str) -> PathBuf {
         .code(0);
     wave
 }
+
+/// The column of detector `d` in a fault campaign's JSON (`faults --json`).
+pub fn column(v: &serde_json::Value, d: &str) -> serde_json::Value {
+    v["columns"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["detector"] == d)
+        .unwrap()
+        .clone()
+}
