@@ -48,6 +48,11 @@ fn manifest() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// The mutation campaigns' mix (`testkit/mixes/mutants.toml`), scheduled.
+fn mutants_schedule() -> lut_gen::Schedule {
+    lut_gen::synthesize(&lut_gen::load(&testkit::mix("mutants")).unwrap()).unwrap()
+}
+
 struct Bench {
     mix: lut_gen::Mix,
     s: lut_gen::Schedule,
@@ -156,7 +161,7 @@ fn every_mutant_the_independent_testbench_rejects_is_rejected_by_check() {
         return;
     }
     let t0 = Instant::now();
-    let mix = lut_gen::load(&manifest().join("../../testkit/mixes/mutants.toml")).unwrap();
+    let mix = lut_gen::load(&testkit::mix("mutants")).unwrap();
     let s = lut_gen::synthesize(&mix).unwrap();
     let bench = Bench {
         cycles: s.grid.frame_cycles * 5 / 2 + 50,
@@ -335,10 +340,7 @@ fn a_few_mutants_run_through_the_campaign_on_icarus() {
     if !tools::require_tools(&["iverilog", "yosys", "yosys-abc"]) {
         return;
     }
-    let s = lut_gen::synthesize(
-        &lut_gen::load(&manifest().join("../../testkit/mixes/mutants.toml")).unwrap(),
-    )
-    .unwrap();
+    let s = mutants_schedule();
     // stuck outputs: they change a pin whatever the schedule, so no
     // equivalence check (up to 90 s each) runs in the default suite
     let plan = mutant_plan(
@@ -375,10 +377,7 @@ fn the_mutant_campaign_through_every_detector_and_prove() {
     if !tools::require_tools(&["verilator", "iverilog", "yosys", "yosys-abc", "sigrok-cli"]) {
         return;
     }
-    let s = lut_gen::synthesize(
-        &lut_gen::load(&manifest().join("../../testkit/mixes/mutants.toml")).unwrap(),
-    )
-    .unwrap();
+    let s = mutants_schedule();
     let plan = mutant_plan(
         &s,
         &PER_OP,

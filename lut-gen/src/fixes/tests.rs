@@ -25,18 +25,24 @@ fn channels(prefix: &str, branch: &str, n: usize, rate: u64) -> String {
         .collect()
 }
 
-/// The case: the branch with room in its slots has too few free
-/// mux inputs, so the move that is offered also adds a device, and the
-/// fixed text is feasible.
-#[test]
-fn a_move_to_a_branch_without_free_inputs_brings_its_mux_devices() {
-    let text = format!(
+/// The mix: 44 taxels at 2.5 kHz overfill their branch, and the
+/// slow branch, with room in its slots, has too few free mux inputs.
+fn over_full_taxels() -> String {
+    format!(
         "{HEAD}{}{}{}{}",
         branch("taxels", 6),
         branch("slow", 1),
         channels("T", "taxels", 44, 2_500),
         channels("S", "slow", 6, 500)
-    );
+    )
+}
+
+/// The case: the branch with room in its slots has too few free
+/// mux inputs, so the move that is offered also adds a device, and the
+/// fixed text is feasible.
+#[test]
+fn a_move_to_a_branch_without_free_inputs_brings_its_mux_devices() {
+    let text = over_full_taxels();
     let (mix, why) = infeasible(&text);
     let found = search(Path::new("t.toml"), &text, &mix, &why);
     assert!(!found.fixes.is_empty(), "{found}");
@@ -127,13 +133,7 @@ fn a_mix_no_fix_helps_offers_none() {
 /// channels and says to where, with the devices the move needs.
 #[test]
 fn the_first_fix_keeps_every_rate() {
-    let text = format!(
-        "{HEAD}{}{}{}{}",
-        branch("taxels", 6),
-        branch("slow", 1),
-        channels("T", "taxels", 44, 2_500),
-        channels("S", "slow", 6, 500)
-    );
+    let text = over_full_taxels();
     let (mix, why) = infeasible(&text);
     let found = search(Path::new("t.toml"), &text, &mix, &why);
     assert_eq!(
