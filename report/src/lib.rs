@@ -263,14 +263,14 @@ fn time_row(d: &Document) -> (String, f64, String) {
     };
     // as shown, to two decimals: equal when they print equal
     let why = if (sum * 100.0).round() > (wall * 100.0).round() {
-        "more than the wall time: some steps' work ran at the same time as others, and counts in each"
+        ", more than the wall time: some steps' work ran at the same time as others and counts in each"
     } else {
-        "the rest of the wall time went between the steps (writing the report)"
+        "; the rest of the wall time went between the steps (writing the report)"
     };
     (
         "the whole build, start to end (wall clock)".into(),
         wall,
-        format!("the steps' own times add up to {sum:.2} s: {why}"),
+        format!("the steps' own times add up to {sum:.2} s{why}"),
     )
 }
 
@@ -628,7 +628,7 @@ mod tests {
                 ..Document::default()
             };
             let (h, m) = (html(&d), markdown(&d));
-            let row = format!("| the whole build, start to end (wall clock) |  | {wall:.2} | the steps' own times add up to 3.50 s: ");
+            let row = format!("| the whole build, start to end (wall clock) |  | {wall:.2} | the steps' own times add up to 3.50 s");
             assert!(m.contains(&row), "{m}");
             assert!(
                 h.contains(&format!("<td class=\"num\">{wall:.2}</td><td>the steps")),
