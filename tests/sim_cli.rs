@@ -689,9 +689,9 @@ fn check_says_the_frames_a_window_holds() {
         let frames = match (whole, part) {
             (1, 0) => "1 whole frame,".to_string(),
             (n, 0) => format!("{n} whole frames,"),
-            (0, p) => format!("part of a frame ({p} cycles),"),
-            (1, p) => format!("1 whole frame and part of one more ({p} cycles),"),
-            (n, p) => format!("{n} whole frames and part of one more ({p} cycles),"),
+            (0, p) => format!("a partial frame of {p} cycles,"),
+            (1, p) => format!("1 whole frame and a partial frame of {p} cycles,"),
+            (n, p) => format!("{n} whole frames and a partial frame of {p} cycles,"),
         };
         assert!(
             text.contains(&format!(": {cycles} cycles, {frames}")),
@@ -707,7 +707,7 @@ fn check_says_the_frames_a_window_holds() {
             ("0", "0.5ms") => (0, 2000),
             ("0", "1.5ms") => (1, 2000),
             // a window that opens mid-run is checked from its lock, a few
-            // cycles in: part of its 1000
+            // cycles in: a partial frame of up to its 1000 cycles
             _ => (0, part.clamp(1, 1000)),
         };
         assert_eq!((whole, part), expect, "{from}..{to}: {text}");

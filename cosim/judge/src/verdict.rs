@@ -175,8 +175,8 @@ impl Verdict {
         };
         match (self.frames, self.partial_frame_cycles) {
             (_, 0) => whole,
-            (0, p) => format!("part of a frame ({})", counted(p, "cycle")),
-            (_, p) => format!("{whole} and part of one more ({})", counted(p, "cycle")),
+            (0, p) => format!("a partial frame of {}", counted(p, "cycle")),
+            (_, p) => format!("{whole} and a partial frame of {}", counted(p, "cycle")),
         }
     }
 
