@@ -601,6 +601,39 @@ fn assert_reads_like_a_datasheet(mix: &Path, out: &Path) {
             "{what}: {cap}: a row without its key"
         );
     }
+    // the steps table ends with the build's wall time beside the sum of
+    // the rows above it (steps may overlap: never a "total" of them)
+    let (_, _, steps) = tables
+        .iter()
+        .find(|t| t.1.first().map(String::as_str) == Some("step"))
+        .expect("the steps table");
+    let (last, rows) = steps.split_last().unwrap();
+    assert_eq!(
+        last[0], "the whole build, start to end (wall clock)",
+        "{what}"
+    );
+    let wall: f64 = last[2].parse().unwrap();
+    let sum: f64 = rows.iter().map(|r| r[2].parse::<f64>().unwrap()).sum();
+    let said: f64 = last[3]
+        .strip_prefix("the steps' own times add up to ")
+        .and_then(|r| r.split(" s").next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{what}: {last:?}"));
+    assert!(
+        (said - sum).abs() <= 0.005 * rows.len() as f64 + 0.01,
+        "{what}: {said} vs {sum}"
+    );
+    assert!(
+        wall > 0.0
+            && wall
+                >= rows
+                    .iter()
+                    .map(|r| r[2].parse::<f64>().unwrap())
+                    .fold(0.0, f64::max)
+                    - 0.01,
+        "{what}: {last:?}"
+    );
+    assert!(!rows.iter().any(|r| r[0] == "total"), "{what}");
     // each channel is a row once (the audit's channel table)
     for name in &parsed {
         let n = tables

@@ -178,7 +178,8 @@ fn check_map_errors_name_the_entry_and_exit_2() {
 }
 
 /// `check --map` off a terminal tells how far it read a capture of several
-/// MB (bytes of the file), a line per tenth; `--quiet` tells nothing.
+/// MB (bytes of the file), a line every few seconds; nothing when the
+/// reading ends within a second, nothing with `--quiet`.
 #[test]
 fn check_map_shows_its_progress_in_plain_lines_off_a_terminal() {
     let d = tempfile::tempdir().unwrap();
@@ -194,9 +195,10 @@ fn check_map_shows_its_progress_in_plain_lines_off_a_terminal() {
     }
     std::fs::write(&cap, &text).unwrap();
     let size = text.len() as f64 / 1e6;
-    let run = |quiet: bool| {
+    let run = |quiet: bool, step: &str| {
         let mut c = slotforge();
-        c.arg("check")
+        c.env(progress::STEP_ENV, step)
+            .arg("check")
             .arg(tiny())
             .arg(&cap)
             .args(["--map", "D0=adc_cs_n[0]"]);
@@ -206,9 +208,10 @@ fn check_map_shows_its_progress_in_plain_lines_off_a_terminal() {
         let out = c.output().unwrap();
         String::from_utf8_lossy(&out.stderr).into_owned()
     };
-    let log = run(false);
+    let log = run(false, progress::SLOW);
     let prefix = format!("reading {}: ", cap.display());
-    let total = progress::rises_to_total(&log, &prefix, " MB read");
+    let total = progress::paced(&log, &prefix, " MB read");
     assert!((total - size).abs() < 0.05, "{total} of {size} MB: {log}");
-    assert!(!run(true).contains("MB read"));
+    assert!(!run(false, progress::QUICK).contains("MB read"));
+    assert!(!run(true, progress::SLOW).contains("MB read"));
 }

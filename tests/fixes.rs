@@ -138,6 +138,97 @@ fn random_infeasible_mixes_get_fixes_that_audit_feasible() {
     assert!(infeasible >= 3, "only {infeasible} infeasible random mixes");
 }
 
+/// The standard bauds a host offers (as `lut_gen::fixes` lists them).
+const STANDARD_BAUDS: [u64; 22] = [
+    9_600, 19_200, 38_400, 57_600, 115_200, 230_400, 250_000, 460_800, 500_000, 576_000, 921_600,
+    1_000_000, 1_152_000, 1_500_000, 2_000_000, 2_500_000, 3_000_000, 4_000_000, 6_000_000,
+    8_000_000, 10_000_000, 12_000_000,
+];
+
+/// Random UART mixes made infeasible by a low baud get one fix, "raise the
+/// baud", to a standard baud the clock divides within 2 %: its file audits
+/// feasible, and the mix at every lower such baud (above the low one)
+/// does not, so the baud offered is the lowest that works.
+#[test]
+fn random_link_mixes_too_slow_for_their_line_get_the_lowest_baud_that_works() {
+    let dir = tempfile::tempdir().unwrap();
+    let shape = campaign::Shape {
+        link: Some(campaign::LinkShape::Uart),
+        ..campaign::Shape::default()
+    };
+    let audit_code = |path: &Path| {
+        slotforge()
+            .arg("audit")
+            .arg(path)
+            .output()
+            .unwrap()
+            .status
+            .code()
+    };
+    let mut tested = 0;
+    for seed in 1..=60u64 {
+        let text = campaign::random_mix(seed, &shape);
+        let Ok(mix) = lut_gen::parse(Path::new("r.toml"), &text) else {
+            continue;
+        };
+        let Ok(s) = lut_gen::synthesize(&mix) else {
+            continue;
+        };
+        let low = [9_600, 57_600, 115_200][(seed % 3) as usize];
+        let (head, tail) = text.split_once("baud = ").unwrap();
+        let rest = tail.split_once('\n').unwrap().1;
+        let slow = format!("{head}baud = {low}\n{rest}");
+        let path = write(dir.path(), &format!("r{seed}.toml"), &slow);
+        if audit_code(&path) != Some(1) {
+            continue; // a mix so light that the low baud carries it
+        }
+        let fixes = dir.path().join(format!("r{seed}"));
+        assert_eq!(
+            fixes_written_audit_feasible(&path, &fixes, 1),
+            1,
+            "seed {seed}:\n{slow}"
+        );
+        let fixed = std::fs::read_to_string(fixes.join("fix-1.toml")).unwrap();
+        let to: u64 = fixed
+            .lines()
+            .find_map(|l| l.strip_prefix("baud = "))
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(STANDARD_BAUDS.contains(&to), "seed {seed}: {to}");
+        assert!(
+            fixed.contains(&format!("raise the link's baud from {low} to {to}")),
+            "{fixed}"
+        );
+        let clock = s.grid.clock_hz as f64;
+        let divides = |b: u64| {
+            let div = (clock / b as f64).round();
+            div >= 4.0 && (clock / div - b as f64).abs() / b as f64 <= 0.02
+        };
+        assert!(divides(to), "seed {seed}: {to}");
+        for lower in STANDARD_BAUDS
+            .into_iter()
+            .filter(|&b| b > low && b < to && divides(b))
+        {
+            let p = write(
+                dir.path(),
+                &format!("r{seed}-{lower}.toml"),
+                &slow.replace(&format!("baud = {low}\n"), &format!("baud = {lower}\n")),
+            );
+            assert_eq!(
+                audit_code(&p),
+                Some(1),
+                "seed {seed}: {lower} baud carries the mix, {to} offered"
+            );
+        }
+        tested += 1;
+        if tested >= 4 {
+            break;
+        }
+    }
+    assert!(tested >= 3, "only {tested} random link mixes tested");
+}
+
 /// A mix no change within reach fixes says so, offers none, writes none.
 #[test]
 fn a_mix_no_fix_helps_says_so() {

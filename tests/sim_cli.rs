@@ -163,7 +163,8 @@ fn check_json(wave: &Path, code: i32) -> serde_json::Value {
 }
 
 /// `check` off a terminal tells how far it read a waveform of several
-/// MB, a line per tenth with the counts; `--quiet` tells nothing.
+/// MB, a line every few seconds with the counts; nothing when the reading
+/// ends within a second; `--quiet` tells nothing.
 #[test]
 fn check_shows_its_progress_in_plain_lines_off_a_terminal() {
     let d = tempfile::tempdir().unwrap();
@@ -177,15 +178,20 @@ fn check_shows_its_progress_in_plain_lines_off_a_terminal() {
         .code(0);
     let size = std::fs::metadata(&wave).unwrap().len();
     assert!(size > 2 << 20, "{size} bytes: too small to show progress");
-    let out = slotforge()
-        .arg("check")
-        .arg(tiny())
-        .arg(&wave)
-        .assert()
-        .code(0);
-    let log = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+    let log = |step: &str| {
+        let out = slotforge()
+            .env(progress::STEP_ENV, step)
+            .arg("check")
+            .arg(tiny())
+            .arg(&wave)
+            .assert()
+            .code(0);
+        String::from_utf8_lossy(&out.get_output().stderr).into_owned()
+    };
+    assert!(!log(progress::QUICK).contains("MB read"));
+    let log = log(progress::SLOW);
     let prefix = format!("checking {}: ", wave.display());
-    let total = progress::rises_to_total(&log, &prefix, " MB read");
+    let total = progress::paced(&log, &prefix, " MB read");
     // the whole body, which is the file less its header of a few kB
     let mb = size as f64 / 1e6;
     assert!(
@@ -642,5 +648,68 @@ fn check_locks_on_windows_from_mid_run() {
             .code(0)
             .stdout(predicate::str::contains("PASS"))
             .stderr(predicate::str::contains("locked on the frame phase"));
+    }
+}
+
+/// `check`'s line says how many frames the window holds, from the JSON's
+/// `frames` and `partial_frame_cycles`: whole frames and a partial one said
+/// as such, singular and plural right, on windows of one, two, half and one
+/// and a half frames (tiny: 4000 cycles a frame of 1 ms).
+#[test]
+fn check_says_the_frames_a_window_holds() {
+    let d = tempfile::tempdir().unwrap();
+    for (i, (from, to)) in [
+        ("0", "1"),
+        ("0", "2"),
+        ("0", "0.5ms"),
+        ("0", "1.5ms"),
+        ("1", "1.25ms"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let wave = sim_window(d.path(), &format!("w{i}.vcd"), from, to);
+        let run = |json: bool| {
+            let mut c = slotforge();
+            c.arg("check").arg(tiny()).arg(&wave).arg("--quiet");
+            if json {
+                c.arg("--json");
+            }
+            let out = c.assert().code(0);
+            String::from_utf8_lossy(&out.get_output().stdout).into_owned()
+        };
+        let v: serde_json::Value = serde_json::from_str(&run(true)).unwrap();
+        let (whole, part) = (
+            v["frames"].as_u64().unwrap(),
+            v["partial_frame_cycles"].as_u64().unwrap(),
+        );
+        let cycles = v["cycles"].as_u64().unwrap();
+        assert_eq!(whole * 4000 + part, cycles, "{from}..{to}: {v}");
+        let text = run(false);
+        let frames = match (whole, part) {
+            (1, 0) => "1 whole frame,".to_string(),
+            (n, 0) => format!("{n} whole frames,"),
+            (0, p) => format!("a partial frame of {p} cycles,"),
+            (1, p) => format!("1 whole frame and a partial frame of {p} cycles,"),
+            (n, p) => format!("{n} whole frames and a partial frame of {p} cycles,"),
+        };
+        assert!(
+            text.contains(&format!(": {cycles} cycles, {frames}")),
+            "{from}..{to}: {text}"
+        );
+        assert!(
+            !text.contains(" 1 frames") && !text.contains(" 1 violations"),
+            "{text}"
+        );
+        let expect = match (from, to) {
+            ("0", "1") => (1, 0),
+            ("0", "2") => (2, 0),
+            ("0", "0.5ms") => (0, 2000),
+            ("0", "1.5ms") => (1, 2000),
+            // a window that opens mid-run is checked from its lock, a few
+            // cycles in: a partial frame of up to its 1000 cycles
+            _ => (0, part.clamp(1, 1000)),
+        };
+        assert_eq!((whole, part), expect, "{from}..{to}: {text}");
     }
 }

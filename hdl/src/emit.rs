@@ -642,13 +642,56 @@ fn period_ns(s: &Schedule) -> String {
     t
 }
 
+/// Every port of the top as a constraint names it (`adc_cs_n[*]` for a
+/// vector), with its direction: the contract's ports and the link's, so
+/// that no port is left out of a constraints file.
+fn port_patterns(s: &Schedule) -> Vec<(String, Dir)> {
+    let l = Layout::new(s);
+    let pattern = |name: &str, vector: bool| {
+        if vector {
+            format!("{name}[*]")
+        } else {
+            name.to_string()
+        }
+    };
+    let mut v: Vec<(String, Dir)> = l
+        .ports()
+        .map(|p| (pattern(p.name, p.vector), p.dir))
+        .collect();
+    v.extend(
+        l.link_ports()
+            .iter()
+            .map(|p| (pattern(p.name, p.width > 1), p.dir)),
+    );
+    v
+}
+
+/// The clock, and every other port's timing against it: all of them are
+/// sampled or driven on `clk`'s rising edge.  The delays are 0 ns, for the
+/// board's own to replace.
 fn sdc(s: &Schedule) -> String {
-    format!(
+    let mut t = format!(
         "# slotforge_top timing constraint for mix \"{}\" ({} Hz)\ncreate_clock -name clk -period {} [get_ports clk]\n",
         s.mix.name,
         s.grid.clock_hz,
         period_ns(s)
-    )
+    );
+    let _ = writeln!(
+        t,
+        "# Every other port is synchronous to clk; replace 0 with your board's delays (ns)."
+    );
+    let ports = port_patterns(s);
+    for (cmd, dir) in [("set_input_delay", Dir::In), ("set_output_delay", Dir::Out)] {
+        let names: Vec<&str> = ports
+            .iter()
+            .filter(|(n, d)| *d == dir && n != "clk")
+            .map(|(n, _)| n.as_str())
+            .collect();
+        if !names.is_empty() {
+            let _ = writeln!(t, "{cmd} -clock clk 0 [get_ports {{{}}}]", names.join(" "));
+        }
+    }
+    t
 }
 
 fn xdc(s: &Schedule) -> String {
@@ -666,13 +709,9 @@ fn xdc(s: &Schedule) -> String {
     let _ = writeln!(
         t,
         "set_property IOSTANDARD LVCMOS33 [get_ports {{{}}}]",
-        Layout::new(s)
-            .ports()
-            .map(|p| if p.vector {
-                format!("{}[*]", p.name)
-            } else {
-                p.name.to_string()
-            })
+        port_patterns(s)
+            .into_iter()
+            .map(|p| p.0)
             .collect::<Vec<_>>()
             .join(" ")
     );

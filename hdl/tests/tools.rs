@@ -266,3 +266,86 @@ fn board_file_pcf_covers_every_port_bit() {
         "{pcf}"
     );
 }
+
+/// Every port of `ports.json`, link ports included, has its line in every
+/// constraints file of every preset: the XDC's IOSTANDARD and a pin row,
+/// the PCF's `set_io` (template and board file), the SDC's clock or I/O
+/// delay in its direction.
+#[test]
+fn every_port_is_in_every_constraints_file() {
+    let board = root().join("constraints/ice40-hx8k-breakout.toml");
+    let presets = testkit::presets::presets(&root());
+    assert!(presets.len() >= 7, "{presets:?}");
+    let mut link_ports = 0;
+    for path in presets {
+        let tag = path.display().to_string();
+        let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
+        let e = hdl::emit(&s, None).unwrap();
+        let with_board = hdl::emit(&s, Some(&board)).unwrap();
+        let j: serde_json::Value = serde_json::from_str(e.ports_json()).unwrap();
+        // the names a constraint gives a port: itself, its bits, `[*]`
+        let names = |line: &str| -> Vec<String> {
+            let Some((_, rest)) = line.split_once("get_ports ") else {
+                return Vec::new();
+            };
+            let inner = match rest.strip_prefix('{') {
+                Some(r) => r.split('}').next().unwrap_or(""),
+                None => rest.split(']').next().unwrap_or(""),
+            };
+            inner
+                .split_whitespace()
+                .map(|n| n.split('[').next().unwrap().to_string())
+                .collect()
+        };
+        let xdc = e.file("slotforge.xdc").unwrap();
+        let sdc = e.file("slotforge.sdc").unwrap();
+        let iostd = xdc.lines().find(|l| l.contains("IOSTANDARD")).unwrap();
+        let iostd_names: Vec<&str> = iostd
+            .split_once('{')
+            .unwrap()
+            .1
+            .trim_end_matches("}]")
+            .split(' ')
+            .map(|n| n.trim_end_matches("[*]"))
+            .collect();
+        for p in j["ports"].as_array().unwrap() {
+            let name = p["name"].as_str().unwrap();
+            link_ports += name.starts_with("link_") as usize + name.starts_with("m_axis_") as usize;
+            assert!(iostd_names.contains(&name), "{tag}: {name}: {iostd}");
+            let pin_row = |text: &str, prefix: &str| {
+                text.lines().any(|l| {
+                    l.strip_prefix(prefix).is_some_and(|r| {
+                        let bit = r.split_whitespace().next().unwrap_or("");
+                        bit == name || bit.starts_with(&format!("{name}["))
+                    })
+                })
+            };
+            assert!(
+                pin_row(e.file("slotforge.pcf").unwrap(), "# set_io "),
+                "{tag}: {name} in the PCF template"
+            );
+            assert!(
+                pin_row(with_board.file("slotforge.pcf").unwrap(), "set_io "),
+                "{tag}: {name} in the board's PCF"
+            );
+            assert!(
+                xdc.lines()
+                    .filter(|l| l.contains("PACKAGE_PIN"))
+                    .any(|l| names(l).iter().any(|n| n == name)),
+                "{tag}: {name}: no pin row in the XDC"
+            );
+            let cmd = match (name, p["dir"].as_str().unwrap()) {
+                ("clk", _) => "create_clock",
+                (_, "in") => "set_input_delay",
+                _ => "set_output_delay",
+            };
+            assert!(
+                sdc.lines()
+                    .filter(|l| l.starts_with(cmd))
+                    .any(|l| names(l).iter().any(|n| n == name)),
+                "{tag}: {name}: no {cmd} in the SDC:\n{sdc}"
+            );
+        }
+    }
+    assert!(link_ports >= 6, "link ports tested: {link_ports}");
+}

@@ -67,6 +67,9 @@ pub enum Change {
         like: String,
         channels: Vec<String>,
     },
+    /// A faster UART (`[link].baud`): a standard baud the clock divides
+    /// within the audit's tolerance.
+    RaiseBaud { from: u64, to: u64 },
 }
 
 /// A change that was applied, synthesized and audited feasible.
@@ -150,6 +153,37 @@ impl Candidate {
 /// for the reasons in `why`.
 pub fn search(path: &Path, text: &str, mix: &Mix, why: &Infeasible) -> FixSearch {
     run(path, text, candidates::for_schedule(mix, why))
+}
+
+/// Fixes for a mix that has a schedule but whose UART cannot carry its
+/// samples (`s`, its schedule; `min_baud`, the slowest line that would):
+/// the lowest standard baud that the clock divides within the audit's
+/// tolerance and that audits feasible.
+pub fn search_link(path: &Path, text: &str, s: &crate::Schedule, min_baud: f64) -> FixSearch {
+    let mut out = FixSearch {
+        fixes: Vec::new(),
+        tried: 0,
+    };
+    let Some(link) = s
+        .mix
+        .link
+        .as_ref()
+        .filter(|l| l.kind == crate::mix::LinkKind::Uart)
+    else {
+        return out;
+    };
+    for c in candidates::faster_lines(s.grid.clock_hz, link.baud, min_baud) {
+        if out.tried >= MAX_TRIED {
+            break;
+        }
+        let found = run(path, text, vec![c]);
+        out.tried += found.tried;
+        if !found.fixes.is_empty() {
+            out.fixes = found.fixes;
+            break;
+        }
+    }
+    out
 }
 
 /// Fixes for a mix file the loader refuses because a branch has more
@@ -274,6 +308,9 @@ pub fn words(c: &Change) -> String {
             "add a branch `{name}` built like `{like}` (its own ADC and mux) and move {} to it",
             names(channels)
         ),
+        Change::RaiseBaud { from, to } => {
+            format!("raise the link's baud from {from} to {to} (`[link] baud = {to}`)")
+        }
     }
 }
 

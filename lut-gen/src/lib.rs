@@ -27,7 +27,9 @@ mod synth;
 mod validate;
 
 // The mix and its parts.
-pub use mix::{load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError};
+pub use mix::{
+    load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError, MAX_BAUD_ERROR_PCT,
+};
 pub use parts::{ns_to_cycles, AdcPart, MuxPart, SpiTiming, Start, TimingError};
 
 // The schedule: synthesis, its independent proof, and what it promises.
@@ -42,7 +44,8 @@ pub use validate::validate;
 // The audit, and the fixes offered for an infeasible mix.
 pub use audit::{AuditReport, BranchAudit, ChannelAudit, FinerGrid, Headroom, Limit, PartAudit};
 pub use fixes::{
-    search as search_fixes, search_unloadable as search_fixes_unloadable, Change, Fix, FixSearch,
+    search as search_fixes, search_link as search_fixes_link,
+    search_unloadable as search_fixes_unloadable, Change, Fix, FixSearch,
 };
 
 // The pin contract of `slotforge_top`. `limits` stays a namespace: its

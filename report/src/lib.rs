@@ -101,6 +101,9 @@ pub struct Document {
     pub glance: Vec<(String, String)>,
     pub steps: Vec<Step>,
     pub sections: Vec<Section>,
+    /// The whole job from start to end, by the wall clock (the steps'
+    /// own times can overlap: a step's work may run beside the others).
+    pub wall_seconds: Option<f64>,
 }
 
 impl Document {
@@ -249,6 +252,28 @@ fn md_table(t: &Table) -> String {
     m
 }
 
+/// The steps table's last row, for what it is: the job's wall time beside
+/// the sum of the steps' own times (which overlap when a step's work ran
+/// beside the others, so they never make a "total"), or, without a wall
+/// time, that sum named as a sum.
+fn time_row(d: &Document) -> (String, f64, String) {
+    let sum: f64 = d.steps.iter().map(|s| s.seconds).sum();
+    let Some(wall) = d.wall_seconds else {
+        return ("the steps' times added up".into(), sum, String::new());
+    };
+    // as shown, to two decimals: equal when they print equal
+    let why = if (sum * 100.0).round() > (wall * 100.0).round() {
+        ", more than the wall time: some steps' work ran at the same time as others and counts in each"
+    } else {
+        "; the rest of the wall time went between the steps (writing the report)"
+    };
+    (
+        "the whole build, start to end (wall clock)".into(),
+        wall,
+        format!("the steps' own times add up to {sum:.2} s{why}"),
+    )
+}
+
 fn steps_table(d: &Document) -> Table {
     let mut t = Table::new(&["step", "status", "seconds", "result", "files"]);
     for s in &d.steps {
@@ -264,6 +289,14 @@ fn steps_table(d: &Document) -> Table {
                 .join(" "),
         ]);
     }
+    let (what, seconds, note) = time_row(d);
+    t.push(vec![
+        what,
+        String::new(),
+        format!("{seconds:.2}"),
+        note,
+        String::new(),
+    ]);
     t
 }
 
@@ -340,8 +373,13 @@ pub fn html(d: &Document) -> String {
             s.files.iter().map(|f| link(f, f)).collect::<Vec<_>>().join(" ")
         );
     }
-    let total: f64 = d.steps.iter().map(|s| s.seconds).sum();
-    let _ = writeln!(h, "<tr><td>total</td><td></td><td class=\"num\">{total:.2}</td><td></td><td></td></tr>\n</table>");
+    let (what, seconds, note) = time_row(d);
+    let _ = writeln!(
+        h,
+        "<tr><td>{}</td><td></td><td class=\"num\">{seconds:.2}</td><td>{}</td><td></td></tr>\n</table>",
+        esc(&what),
+        inline(&note)
+    );
     for s in d
         .steps
         .iter()
@@ -540,6 +578,7 @@ mod tests {
                 }],
                 ..Section::default()
             }],
+            wall_seconds: None,
         };
         assert!(!d.ok());
         let h = html(&d);
@@ -556,8 +595,48 @@ mod tests {
                 && m.contains("[`a.txt`](a.txt)")
         );
         assert!(h.contains("<code>mux_en</code>") && m.contains("`mux_en` ok"));
+        // no wall time: the last row is the sum, named as one
+        assert!(
+            h.contains(
+                "<tr><td>the steps' times added up</td><td></td><td class=\"num\">1.50</td>"
+            ),
+            "{h}"
+        );
+        assert!(m.contains("| the steps' times added up |  | 1.50 |"), "{m}");
         let names: Vec<String> = files(&d).into_iter().map(|f| f.0).collect();
         assert_eq!(names, ["report.html", "report.md", "c.svg", "c.csv"]);
+    }
+
+    /// The last row of the steps table is the wall time when the job gives
+    /// one, beside the steps' sum, said to be more than it when steps
+    /// overlapped and less when time went between them.
+    #[test]
+    fn the_steps_last_row_is_the_wall_time_beside_their_sum() {
+        let step = |id: &str, seconds: f64| Step {
+            id: id.into(),
+            name: id.into(),
+            status: Status::Ok,
+            seconds,
+            summary: String::new(),
+            detail: String::new(),
+            files: vec![],
+        };
+        for (wall, more) in [(2.0, true), (5.0, false)] {
+            let d = Document {
+                steps: vec![step("a", 1.0), step("b", 2.5)],
+                wall_seconds: Some(wall),
+                ..Document::default()
+            };
+            let (h, m) = (html(&d), markdown(&d));
+            let row = format!("| the whole build, start to end (wall clock) |  | {wall:.2} | the steps' own times add up to 3.50 s");
+            assert!(m.contains(&row), "{m}");
+            assert!(
+                h.contains(&format!("<td class=\"num\">{wall:.2}</td><td>the steps")),
+                "{h}"
+            );
+            assert_eq!(m.contains("more than the wall time"), more, "{m}");
+            assert!(!m.contains("| total |") && !h.contains("<td>total</td>"));
+        }
     }
 
     #[test]

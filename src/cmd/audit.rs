@@ -43,17 +43,36 @@ pub fn run(args: Args) -> u8 {
             // a line too slow for the mix: named on stderr as the parser
             // names a bad key (the report says it too, and exits 1)
             let mut report = AuditReport::of_schedule(&s);
+            let mut found = None;
             if let Some(Err(e)) = lut_gen::plan_link(&s) {
                 eprintln!("error: {}", e.at(&args.mix));
                 // the report names the file as well as the line
                 for x in report.errors.iter_mut().filter(|x| **x == e.message) {
                     *x = e.at(&args.mix);
                 }
-            }
-            if let Some(dir) = &args.fixes {
+                // a faster line, tried on the mix before it is offered
+                let mut f = match std::fs::read_to_string(&args.mix) {
+                    Ok(text) => lut_gen::search_fixes_link(
+                        &args.mix,
+                        &text,
+                        &s,
+                        e.min_baud.unwrap_or(f64::NAN),
+                    ),
+                    Err(_) => FixSearch {
+                        fixes: Vec::new(),
+                        tried: 0,
+                    },
+                };
+                if let Err(code) = write_all(&args, &mut f) {
+                    return code;
+                }
+                report.fixes_tried = Some(f.tried);
+                report.fixes = Some(f.fixes.clone());
+                found = Some(f);
+            } else if let Some(dir) = &args.fixes {
                 eprintln!("the mix fits: no fixes written to {}", dir.display());
             }
-            (report, None)
+            (report, found.map(Diagnosis::Link))
         }
         Err(mut why) => {
             // advice from counts alone is not printed: the fixes replace
@@ -66,21 +85,37 @@ pub fn run(args: Args) -> u8 {
             let mut report = AuditReport::of_infeasible(&mix, &why);
             report.fixes_tried = Some(found.tried);
             report.fixes = Some(found.fixes.clone());
-            (report, Some((why, found)))
+            (report, Some(Diagnosis::Schedule(why, found)))
         }
     };
     if args.json {
         print!("{}", report.to_json());
-    } else if let Some((why, found)) = &diagnosis {
-        print!("{why}{found}");
     } else {
-        print!("{}", report.to_text());
+        match &diagnosis {
+            Some(Diagnosis::Schedule(why, found)) => print!("{why}{found}"),
+            Some(Diagnosis::Link(found)) if found.fixes.is_empty() => println!(
+                "{}  no fix found: no standard baud that this clock divides within {} % carries the mix ({} tried)",
+                report.to_text(),
+                lut_gen::MAX_BAUD_ERROR_PCT,
+                found.tried
+            ),
+            Some(Diagnosis::Link(found)) => print!("{}{found}", report.to_text()),
+            None => print!("{}", report.to_text()),
+        }
     }
     match (report.feasible, report.verdict) {
         (true, _) => 0,
         (false, Some(v)) => super::verdict_exit(v),
         (false, None) => 1,
     }
+}
+
+/// Why a mix does not fit, with the fixes tried for it.
+enum Diagnosis {
+    /// No schedule.
+    Schedule(lut_gen::Infeasible, FixSearch),
+    /// A schedule, and a UART too slow for it.
+    Link(FixSearch),
 }
 
 /// The fixes of a loaded mix without a schedule (the file's own text is

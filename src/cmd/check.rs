@@ -33,8 +33,9 @@ pub struct Args {
     /// With --map: the analyser's channel-to-channel skew allowed (`5ns`).
     #[arg(long, default_value = "0ns")]
     pub skew: String,
-    /// No progress display (on stderr: a bar on a terminal; otherwise a
-    /// line per tenth of a waveform of 2 MiB or more).
+    /// No progress display (on stderr: a bar on a terminal; otherwise, for
+    /// a waveform of 2 MiB or more, nothing in the first second, then a
+    /// line every few seconds).
     #[arg(long)]
     pub quiet: bool,
     /// Also write JUnit XML: one test case for the waveform, a failure

@@ -43,8 +43,8 @@ pub struct Args {
     /// Print the campaign as JSON.
     #[arg(long)]
     pub json: bool,
-    /// No progress display (on stderr: a bar on a terminal, a line per
-    /// tenth of the runs otherwise).
+    /// No progress display (on stderr: a bar on a terminal; otherwise
+    /// nothing in the first second, then a line every few seconds).
     #[arg(long)]
     pub quiet: bool,
 }

@@ -1,15 +1,101 @@
 //! Progress of a command that works through several items (steps, mixes,
-//! frames): an indicatif bar with counts and ETA on a terminal, a plain
-//! line per item when stderr is not a terminal (CI logs), nothing with
+//! frames): an indicatif bar with counts and ETA on a terminal; off one
+//! (CI logs, pipes) plain lines at the [`Pace`]: nothing for work that ends
+//! within a second, then at most one line every few seconds; nothing with
 //! `--quiet`.
 
 use std::io::IsTerminal;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// No plain line before this: work that ends within it says nothing.
+pub const QUIET: Duration = Duration::from_secs(1);
+/// At most one plain line per this.
+pub const EVERY: Duration = Duration::from_secs(3);
+
+/// Tests set this to a number of milliseconds: the clock then advances by
+/// that much at each reading instead of following the wall (a controllable
+/// clock for the progress tests of the CLI).
+const STEP_ENV: &str = "SLOTFORGE_TEST_PROGRESS_STEP_MS";
+
+/// Where the time since the work began comes from.
+enum Clock {
+    Wall(Instant),
+    /// Advances by `step` at each reading (`readings` so far).
+    Stepped {
+        step: Duration,
+        readings: AtomicU64,
+    },
+}
+
+impl Clock {
+    fn now(&self) -> Duration {
+        match self {
+            Clock::Wall(t) => t.elapsed(),
+            Clock::Stepped { step, readings } => {
+                *step * (readings.fetch_add(1, Ordering::Relaxed) as u32 + 1)
+            }
+        }
+    }
+}
+
+/// When a plain line may be printed: not in the first [`QUIET`], then not
+/// within [`EVERY`] of the last one.  Shared by threads (the fault
+/// campaign's runs).
+pub struct Pace {
+    clock: Clock,
+    last: Mutex<Option<Duration>>,
+}
+
+impl Pace {
+    /// The wall clock, or the stepped one a test asked for.
+    pub fn start() -> Pace {
+        let step = std::env::var(STEP_ENV)
+            .ok()
+            .and_then(|v| v.parse::<u64>().ok());
+        match step {
+            Some(ms) => Pace::stepped(Duration::from_millis(ms)),
+            None => Pace::with(Clock::Wall(Instant::now())),
+        }
+    }
+
+    fn stepped(step: Duration) -> Pace {
+        Pace::with(Clock::Stepped {
+            step,
+            readings: 0.into(),
+        })
+    }
+
+    fn with(clock: Clock) -> Pace {
+        Pace {
+            clock,
+            last: Mutex::new(None),
+        }
+    }
+
+    /// The time since the start when a line is due now (and counts it as
+    /// printed), `None` when it is not.
+    pub fn due(&self) -> Option<Duration> {
+        let now = self.clock.now();
+        if now < QUIET {
+            return None;
+        }
+        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        if last.is_some_and(|t| now < t + EVERY) {
+            return None;
+        }
+        *last = Some(now);
+        Some(now)
+    }
+}
 
 pub struct Progress {
     bar: Option<indicatif::ProgressBar>,
     plain: bool,
     len: u64,
     done: std::cell::Cell<u64>,
+    pace: Pace,
 }
 
 impl Progress {
@@ -31,6 +117,7 @@ impl Progress {
             plain: !quiet && !tty && len > 1,
             len,
             done: 0.into(),
+            pace: Pace::start(),
         }
     }
 
@@ -38,7 +125,9 @@ impl Progress {
     pub fn message(&self, m: &str) {
         match &self.bar {
             Some(b) => b.set_message(m.to_string()),
-            None if self.plain => eprintln!("[{}/{}] {m}", self.done.get() + 1, self.len),
+            None if self.plain && self.pace.due().is_some() => {
+                eprintln!("[{}/{}] {m}", self.done.get() + 1, self.len)
+            }
             None => {}
         }
     }
@@ -74,7 +163,7 @@ impl Progress {
 
 /// Counts a simulation's cycles into a bar (frames done, ETA), passing
 /// every cycle on to `inner` when there is one.  Off a terminal it prints a
-/// line per tenth of the run.
+/// line at the [`Pace`].
 pub struct CycleProgress<'a> {
     bar: Option<indicatif::ProgressBar>,
     plain: bool,
@@ -82,6 +171,7 @@ pub struct CycleProgress<'a> {
     total: u64,
     seen: u64,
     inner: Option<&'a mut dyn engines::Tracer>,
+    pace: Pace,
 }
 
 impl<'a> CycleProgress<'a> {
@@ -110,6 +200,7 @@ impl<'a> CycleProgress<'a> {
             total: frames * frame_cycles,
             seen: 0,
             inner,
+            pace: Pace::start(),
         }
     }
 
@@ -120,15 +211,12 @@ impl<'a> CycleProgress<'a> {
         }
         if let Some(b) = &self.bar {
             b.set_position(self.seen / self.frame_cycles.max(1));
-        } else if self.plain && self.total / self.frame_cycles.max(1) >= 10 {
-            let tenth = self.total / 10;
-            if self.seen % tenth < 65_536 {
-                eprintln!(
-                    "simulated {} of {} frames",
-                    self.seen / self.frame_cycles.max(1),
-                    self.total / self.frame_cycles.max(1)
-                );
-            }
+        } else if self.plain && self.pace.due().is_some() {
+            eprintln!(
+                "simulated {} of {} frames",
+                self.seen / self.frame_cycles.max(1),
+                self.total / self.frame_cycles.max(1)
+            );
         }
     }
 
@@ -175,7 +263,7 @@ pub enum Unit {
 
 /// Work that reports "done of N" from any thread (the fault campaign's
 /// runs, the bytes of a waveform read): an indicatif bar with the counts
-/// and ETA on a terminal; off one, a plain line at every tenth (only when
+/// and ETA on a terminal; off one, a plain line at the [`Pace`] (only when
 /// the work is more than a few pieces: `min_total`); nothing with
 /// `--quiet`.
 pub struct Counter {
@@ -184,9 +272,7 @@ pub struct Counter {
     bar: Option<indicatif::ProgressBar>,
     plain: bool,
     min_total: u64,
-    started: std::time::Instant,
-    /// The last tenth printed off a terminal.
-    tenth: std::sync::atomic::AtomicU64,
+    pace: Pace,
 }
 
 impl Counter {
@@ -214,8 +300,7 @@ impl Counter {
             bar,
             plain: !quiet && !tty,
             min_total,
-            started: std::time::Instant::now(),
-            tenth: 0.into(),
+            pace: Pace::start(),
         }
     }
 
@@ -226,21 +311,23 @@ impl Counter {
             b.set_position(done);
             return;
         }
-        if !self.plain || total < self.min_total || total == 0 {
-            return;
-        }
-        let tenth = done * 10 / total;
-        let last = self
-            .tenth
-            .fetch_max(tenth, std::sync::atomic::Ordering::Relaxed);
-        if tenth > last {
-            eprintln!("{}", self.line(done, total));
+        if let Some(line) = self.plain_line(done, total) {
+            eprintln!("{line}");
         }
     }
 
-    /// The plain line: counts, elapsed time and the time left at this pace.
-    fn line(&self, done: u64, total: u64) -> String {
-        let secs = self.started.elapsed().as_secs_f64();
+    /// The plain line to print now off a terminal, if one is due.
+    fn plain_line(&self, done: u64, total: u64) -> Option<String> {
+        if !self.plain || total < self.min_total || total == 0 {
+            return None;
+        }
+        let at = self.pace.due()?;
+        Some(self.line(done, total, at.as_secs_f64()))
+    }
+
+    /// The plain line: counts, the time since the start (`secs`) and the
+    /// time left at this pace.
+    fn line(&self, done: u64, total: u64, secs: f64) -> String {
         let left = secs * (total - done.min(total)) as f64 / done.max(1) as f64;
         let counts = match self.unit {
             Unit::Runs => format!("{done} of {total} runs"),
@@ -266,16 +353,70 @@ impl Counter {
 
 #[cfg(test)]
 mod tests {
-    use super::{Counter, Unit};
+    use super::{Counter, Pace, Unit, EVERY, QUIET};
+    use std::time::Duration;
+
+    /// A counter that prints plain lines (as off a terminal) on a clock
+    /// that advances by `step` at each reading.
+    fn plain(what: &str, unit: Unit, step: Duration) -> Counter {
+        let mut c = Counter::new(what, unit, 1, true);
+        c.plain = true;
+        c.pace = Pace::stepped(step);
+        c
+    }
 
     #[test]
     fn a_plain_line_names_the_counts_and_the_time_left() {
         let c = Counter::new("fault campaign", Unit::Runs, 1, true);
-        let l = c.line(3, 12);
-        assert!(l.starts_with("fault campaign: 3 of 12 runs (25%, "), "{l}");
-        assert!(l.ends_with(" s left)"), "{l}");
+        let l = c.line(3, 12, 6.0);
+        assert_eq!(
+            l,
+            "fault campaign: 3 of 12 runs (25%, 6 s, about 18 s left)"
+        );
         let c = Counter::new("checking w.vcd", Unit::Bytes, 1, true);
-        let l = c.line(2_500_000, 10_000_000);
+        let l = c.line(2_500_000, 10_000_000, 1.0);
         assert!(l.contains("2.5 of 10.0 MB read (25%"), "{l}");
+    }
+
+    /// Nothing in the first second, then a line at most every few seconds,
+    /// however often the work asks.
+    #[test]
+    fn the_pace_is_silent_for_a_second_then_one_line_per_few_seconds() {
+        let pace = Pace::stepped(Duration::from_millis(100));
+        let due: Vec<Duration> = (0..200).filter_map(|_| pace.due()).collect();
+        assert_eq!(due.first(), Some(&QUIET), "{due:?}");
+        assert!(due.windows(2).all(|w| w[1] - w[0] >= EVERY), "{due:?}");
+        // 20 s of readings: at 1, 4, 7, ..., 19 s
+        assert_eq!(due.len(), 7, "{due:?}");
+        let quick = Pace::stepped(Duration::from_millis(99));
+        assert!((0..10).all(|_| quick.due().is_none()));
+    }
+
+    /// Work that ends within a second prints nothing, however many pieces
+    /// it reports; long work prints lines that rise, a few seconds apart.
+    #[test]
+    fn a_counter_is_silent_for_quick_work_and_paced_for_long_work() {
+        let c = plain("fault campaign", Unit::Runs, Duration::from_millis(10));
+        let quick: Vec<String> = (1..=90).filter_map(|i| c.plain_line(i, 90)).collect();
+        assert!(quick.is_empty(), "{quick:?}");
+        let c = plain("checking w.vcd", Unit::Bytes, Duration::from_millis(250));
+        let total = 100_000_000;
+        let lines: Vec<String> = (1..=100)
+            .filter_map(|i| c.plain_line(i * 1_000_000, total))
+            .collect();
+        // 25 s of work: at 1, 4, ..., 25 s
+        assert_eq!(lines.len(), 9, "{lines:?}");
+        let secs: Vec<u64> = lines
+            .iter()
+            .map(|l| {
+                let (_, t) = l.split_once("%, ").unwrap();
+                t.split(' ').next().unwrap().parse().unwrap()
+            })
+            .collect();
+        assert_eq!(secs, [1, 4, 7, 10, 13, 16, 19, 22, 25], "{lines:?}");
+        assert!(
+            lines[0].starts_with("checking w.vcd: 4.0 of 100.0 MB read (4%"),
+            "{lines:?}"
+        );
     }
 }

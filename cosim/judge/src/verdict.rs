@@ -165,25 +165,35 @@ pub struct Verdict {
 }
 
 impl Verdict {
+    /// The frames the window holds, in words, from `frames` and
+    /// `partial_frame_cycles` (the JSON's fields): whole frames, and a
+    /// partial one said as such.
+    pub fn frames_held(&self) -> String {
+        let whole = match self.frames {
+            1 => "1 whole frame".to_string(),
+            n => format!("{n} whole frames"),
+        };
+        match (self.frames, self.partial_frame_cycles) {
+            (_, 0) => whole,
+            (0, p) => format!("a partial frame of {}", counted(p, "cycle")),
+            (_, p) => format!("{whole} and a partial frame of {}", counted(p, "cycle")),
+        }
+    }
+
     /// A short human summary, with the first divergence and violations.
     pub fn summary(&self) -> String {
         use std::fmt::Write;
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "{} [{}]: {} cycles, {} frames{}, {} samples, {} divergent cycles, {} violations: {}",
+            "{} [{}]: {}, {}, {}, {}, {}: {}",
             self.mix,
             self.source,
-            self.cycles,
-            self.frames,
-            if self.partial_frame_cycles > 0 {
-                format!(" + {} cycles of a partial frame", self.partial_frame_cycles)
-            } else {
-                String::new()
-            },
-            self.samples,
-            self.divergence_count,
-            self.violation_count,
+            counted(self.cycles, "cycle"),
+            self.frames_held(),
+            counted(self.samples, "sample"),
+            counted(self.divergence_count, "divergent cycle"),
+            counted(self.violation_count, "violation"),
             if self.ok { "PASS" } else { "FAIL" }
         );
         if let Some(j) = &self.link_join {
@@ -231,5 +241,14 @@ impl Verdict {
             let _ = writeln!(s, "... {} more violations", self.violation_count - 10);
         }
         s
+    }
+}
+
+/// `n` and the noun, plural unless `n` is 1: "1 frame", "2 frames".
+fn counted(n: u64, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
     }
 }

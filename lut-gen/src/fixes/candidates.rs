@@ -400,3 +400,34 @@ pub(super) fn for_mux_inputs(text: &str) -> Vec<Candidate> {
     }
     out
 }
+
+/// The standard UART bauds a host's serial port offers, lowest first.
+const STANDARD_BAUDS: [u64; 22] = [
+    9_600, 19_200, 38_400, 57_600, 115_200, 230_400, 250_000, 460_800, 500_000, 576_000, 921_600,
+    1_000_000, 1_152_000, 1_500_000, 2_000_000, 2_500_000, 3_000_000, 4_000_000, 6_000_000,
+    8_000_000, 10_000_000, 12_000_000,
+];
+
+/// A faster line for a UART too slow for its mix: every standard baud
+/// above `baud` and at or above `min_baud` (the slowest divider that
+/// carries the mix) that the clock divides within the loader's tolerance,
+/// lowest first.
+pub(super) fn faster_lines(clock_hz: u64, baud: u64, min_baud: f64) -> Vec<Candidate> {
+    use crate::mix::{MAX_BAUD_ERROR_PCT, MIN_BAUD_DIVIDER};
+    STANDARD_BAUDS
+        .into_iter()
+        .filter(|&b| b > baud && (min_baud.is_nan() || b as f64 >= min_baud * 0.98))
+        .filter(|&b| {
+            let div = link::UartFormat::divider(clock_hz, b);
+            let real = link::UartFormat::real_baud(clock_hz, div);
+            div >= MIN_BAUD_DIVIDER
+                && (real - b as f64).abs() / b as f64 * 100.0 <= MAX_BAUD_ERROR_PCT
+        })
+        .map(|to| Candidate {
+            changes: vec![Change::RaiseBaud { from: baud, to }],
+            edits: vec![Edit::Baud(to)],
+            parts_added: 0,
+            channels_changed: 0,
+        })
+        .collect()
+}

@@ -20,6 +20,8 @@ pub(super) enum Edit {
     MuxDevices { name: String, devices: u32 },
     /// A new branch `name` with every setting of branch `like`.
     BranchLike { name: String, like: String },
+    /// `[link].baud`.
+    Baud(u64),
 }
 
 /// `text` with `edits` applied, or `None` when the text is not TOML or a
@@ -62,6 +64,11 @@ fn apply_one(doc: &mut DocumentMut, e: &Edit) -> Option<()> {
             // a copy keeps its place after the original's siblings
             t.set_position(usize::MAX);
             doc.get_mut("branch")?.as_array_of_tables_mut()?.push(t);
+        }
+        Edit::Baud(baud) => {
+            doc.get_mut("link")?
+                .as_table_like_mut()?
+                .insert("baud", value(*baud as i64));
         }
     }
     Some(())

@@ -107,6 +107,8 @@ pub struct Job {
     pub doc: Document,
     quiet: bool,
     bar: Option<indicatif::ProgressBar>,
+    /// When the first step began: the report's wall time.
+    begun: Instant,
     /// Steps that run (the progress's `[n/total]`; the final line's count).
     pub total: usize,
     started: usize,
@@ -155,6 +157,7 @@ impl Job {
             },
             quiet: a.quiet,
             bar,
+            begun: Instant::now(),
             total,
             started: 0,
             degraded: Vec::new(),
@@ -268,6 +271,7 @@ impl Job {
             b.finish_and_clear();
         }
         self.doc.note.clear();
+        self.doc.wall_seconds = Some(self.begun.elapsed().as_secs_f64());
         // report files are listed too: written first so the list has them
         self.write_report()?;
         let mut links = Vec::new();
