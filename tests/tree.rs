@@ -344,12 +344,6 @@ const PUBLIC_MODULES: &[(&str, &str, &str)] = &[
         "switch",
         "the test-only detector switch, behind the `test-switch` feature",
     ),
-    (
-        "report",
-        "chart",
-        "not yet private: report/src was being rewritten in the same session; \
-         `chart`'s items are already exported (`report::draw`, `report::Table`)",
-    ),
 ];
 
 /// `testkit` is exempt: a dev-only toolbox whose modules are the helpers'

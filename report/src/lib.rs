@@ -1,11 +1,11 @@
 //! report: the main job's report, `report.html` (self-contained: SVG
 //! inline, no scripts, no external files) and `report.md` (figures as files
-//! beside it), and the charts in it ([`chart`]).
+//! beside it), and the charts in it ([`draw`]).
 //!
 //! It knows nothing of simulation: the `build` command measures, and hands
 //! this crate steps, sections, tables and charts to lay out.
 
-pub mod chart;
+mod chart;
 
 use std::fmt::Write as _;
 
