@@ -38,6 +38,8 @@ mod link;
 
 #[path = "link_bytes.rs"]
 mod link_bytes;
+#[path = "link_captures.rs"]
+mod link_captures;
 #[path = "link_windows.rs"]
 mod link_windows;
 

@@ -83,7 +83,7 @@ fn rusthdl(s: &lut_gen::Schedule) -> engines::RustHdlDut {
 }
 
 /// A seeded xorshift for the windows' offsets.
-fn rng(seed: u64) -> impl FnMut() -> u64 {
+pub(crate) fn rng(seed: u64) -> impl FnMut() -> u64 {
     let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
     move || {
         x ^= x << 13;
@@ -95,7 +95,7 @@ fn rng(seed: u64) -> impl FnMut() -> u64 {
 
 /// Random link mixes (the one generator, with a `[link]` drawn) whose
 /// link the audit finds feasible: `n` of them from seed `seed` on.
-fn random_link_mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
+pub(crate) fn random_link_mixes(seed: u64, n: usize) -> Vec<(u64, lut_gen::Schedule)> {
     let shape = campaign::Shape {
         link: Some(campaign::LinkShape::Either),
         ..Default::default()
@@ -340,5 +340,68 @@ fn a_verilator_window_of_the_uart_preset_passes_check() {
         assert!(j["skipped_bytes"].is_u64() && j["slice"].is_u64(), "{j}");
         // from frame 1: the first whole packet is of frame 1 (counter 1)
         assert_eq!(j["frame_counter"], 1, "{j}");
+    }
+}
+
+/// The line before the first whole packet is not judged, and the report
+/// says how much of it: a flipped UART bit there passes unseen, inside the
+/// cycles the join reports as not judged (text and JSON fields); a window
+/// too short to hold a whole packet says the link was not judged at all.
+#[test]
+fn the_line_before_the_join_is_reported_as_not_judged() {
+    let mixes = random_link_mixes(1, 4);
+    let kind = |s: &lut_gen::Schedule| s.mix.link.as_ref().map(|l| l.kind);
+    let (_, s) = mixes
+        .iter()
+        .find(|(_, s)| kind(s) == Some(lut_gen::LinkKind::Uart))
+        .expect("a UART mix");
+    let reset = RunOptions::default().reset_cycles;
+    let f = s.grid.frame_cycles;
+    let (from, to) = (f / 2 + 777, f / 2 + 777 + f);
+    // the first character that starts in the window: in flight, before
+    // the first whole packet
+    let dut = FaultyDut::new(s, slaved(s, rusthdl(s)), Fault::LinkBitFlip, from);
+    let site = reset; // capture cycles: the window's first cycle
+    for r in judge_window(s, dut, (from, to)) {
+        let j = r.link_join.as_ref().expect("joined");
+        assert!(r.ok, "{}", r.summary());
+        assert!(j.judged, "{}", r.summary());
+        assert!(
+            j.unjudged_cycles > site,
+            "the fault at capture cycle {site} lies in the unjudged part: {}",
+            r.summary()
+        );
+        assert_eq!(Some(j.unjudged_cycles), j.header_cycle, "{}", r.summary());
+        assert!(j.header_cycle < j.checked_from_cycle, "{}", r.summary());
+        let text = r.summary();
+        assert!(
+            text.contains(&format!(
+                "its first {} cycle(s) and {} byte(s)",
+                j.unjudged_cycles, j.skipped_bytes
+            )) && text.contains("not judged"),
+            "{text}"
+        );
+    }
+    // A window of a third of a slice: no whole packet in it.
+    let (from, to) = (f / 2 + 777, f / 2 + 777 + s.grid.slice_cycles / 3);
+    let dut = slaved(s, judge::ModelDut::new(s));
+    for r in judge_window(s, dut, (from, to)) {
+        let j = r.link_join.as_ref().expect("a link join report");
+        assert!(
+            !j.judged && j.checked_from_cycle.is_none(),
+            "{}",
+            r.summary()
+        );
+        // every cycle of the window the lock checked, and at most the window
+        assert!(
+            (r.cycles..=to - from).contains(&j.unjudged_cycles),
+            "{} of {} cycles: {}",
+            j.unjudged_cycles,
+            to - from,
+            r.summary()
+        );
+        let text = r.summary();
+        assert!(text.contains("PASS (the link not judged)"), "{text}");
+        assert!(text.contains("link: NOT JUDGED"), "{text}");
     }
 }

@@ -157,3 +157,56 @@ fn the_sentences_name_the_pins_and_the_audits_baud() {
         }
     }
 }
+
+/// Random mixes drawn with their own link (the generator's `LinkShape`,
+/// both kinds, baud and AXI4-Stream options drawn with the mix): the list
+/// names the UART's bit stream on `link_tx` for a UART mix and nothing of
+/// an AXI4-Stream, the AXI4-Stream's beats on `m_axis_*` for an AXI4-Stream
+/// mix and nothing of `link_tx`.
+#[test]
+fn not_covered_names_each_link_kinds_own_stream() {
+    let shape = campaign::Shape {
+        link: Some(campaign::LinkShape::Either),
+        ..Default::default()
+    };
+    let (mut uart, mut axis) = (0, 0);
+    for seed in 1..60u64 {
+        let text = campaign::random_mix(seed, &shape);
+        let Some(s) = schedule(&format!("link mix {seed}"), &text, None) else {
+            continue;
+        };
+        let l = Layout::new(&s);
+        if !l.link {
+            continue;
+        }
+        let h = formal::generate(&s).unwrap();
+        assert_eq!(h.not_covered, expected(&s), "mix {seed}");
+        let said: Vec<String> = h.not_covered.iter().map(|c| c.sentence(&s)).collect();
+        let all = said.join("\n");
+        if l.axis {
+            axis += 1;
+            assert!(
+                all.contains("m_axis_tvalid") && all.contains("m_axis_tdata"),
+                "mix {seed}: {all}"
+            );
+            assert!(
+                !all.contains("link_tx") && !all.contains("UART"),
+                "mix {seed}: {all}"
+            );
+        } else {
+            uart += 1;
+            assert!(
+                all.contains("the UART's bit stream on link_tx"),
+                "mix {seed}: {all}"
+            );
+            assert!(
+                !all.contains("m_axis") && !all.contains("AXI4-Stream"),
+                "mix {seed}: {all}"
+            );
+        }
+    }
+    assert!(
+        uart >= 5 && axis >= 5,
+        "both kinds drawn: {uart} UART, {axis} AXIS"
+    );
+}

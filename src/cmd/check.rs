@@ -18,7 +18,8 @@ pub struct Args {
     /// Scope of slotforge_top's ports (e.g. `tb.dut`); found automatically when unambiguous.
     #[arg(long)]
     pub scope: Option<String>,
-    /// Check the invariants only, not the cycle-exact model.
+    /// Check the invariants only, not the cycle-exact model (with --map:
+    /// the link's line decoded and judged, not timed against the model).
     #[arg(long)]
     pub no_model: bool,
     /// Print the report as JSON.
@@ -78,7 +79,8 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
             judge::read_capture_progress(&a.wave, lanes, &|done, total| progress.set(done, total));
         progress.finish();
         let cap = cap?;
-        judge::check_capture(s, &cap, skew).map_err(|e| format!("{}: {e}", a.wave.display()))
+        judge::check_capture_with(s, &cap, skew, !a.no_model)
+            .map_err(|e| format!("{}: {e}", a.wave.display()))
     });
     let r = match prepared {
         Ok(r) => r,
@@ -102,6 +104,17 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
                 "rule": v.rule, "detail": v.detail})).collect::<Vec<_>>(),
             "proved": r.proved,
             "not_proved": r.not_proved,
+            "link_join": r.link_join.as_ref().map(|j| serde_json::json!({
+                "by": j.by,
+                "judged": j.judged,
+                "why_not": j.why_not,
+                "header_ps": j.header_ps,
+                "frame_counter": j.frame_counter,
+                "slice": j.slice,
+                "skipped_bytes": j.skipped_bytes,
+                "unjudged_ps": j.unjudged_ps,
+                "text": j.text(),
+            })),
         });
         println!("{}", serde_json::to_string_pretty(&v).expect("json"));
     } else {

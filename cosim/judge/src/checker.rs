@@ -994,37 +994,48 @@ impl Checker {
 impl Checker {
     /// Where a check that joined mid-stream joined the link, in capture cycles.
     fn link_join_report(&self) -> Option<crate::verdict::LinkJoin> {
+        use crate::verdict::LinkJoin as Report;
         let place = |c: u64| self.inv.place(c).0;
+        // not joined: the line was not judged in any of the capture's cycles
+        let unjudged = |by: &str, bytes: u64| Report {
+            by: by.into(),
+            judged: false,
+            checked_from_cycle: None,
+            header_cycle: None,
+            frame_counter: None,
+            slice: None,
+            skipped_bytes: bytes,
+            unjudged_cycles: place(self.c),
+        };
         if self.model.is_none() && self.origin > 0 {
             let line = self.line.as_ref()?;
-            let j = line.joined;
-            return Some(crate::verdict::LinkJoin {
+            let Some((c, frame, slice, bytes, header)) = line.joined else {
+                return Some(unjudged("decoder", line.bytes_read()));
+            };
+            return Some(Report {
                 by: "decoder".into(),
-                checked_from_cycle: j.map(|j| place(j.0)),
-                header_cycle: None,
-                frame_counter: j.map(|j| j.1),
-                slice: j.map(|j| j.2),
-                skipped_bytes: j.map_or(line.bytes_read(), |j| j.3),
+                judged: true,
+                checked_from_cycle: Some(place(c)),
+                header_cycle: header.map(place),
+                frame_counter: Some(frame),
+                slice: Some(slice),
+                skipped_bytes: bytes,
+                unjudged_cycles: place(header.unwrap_or(c)),
             });
         }
         if let Some(j) = &self.link_join {
-            return Some(crate::verdict::LinkJoin {
-                by: "model".into(),
-                checked_from_cycle: None,
-                header_cycle: None,
-                frame_counter: None,
-                slice: None,
-                skipped_bytes: j.bytes_read(),
-            });
+            return Some(unjudged("model", j.bytes_read()));
         }
         let j = self.link_joined?;
-        Some(crate::verdict::LinkJoin {
+        Some(Report {
             by: "model".into(),
+            judged: true,
             checked_from_cycle: Some(place(j.cycle)),
             header_cycle: Some(place(j.header_cycle)),
             frame_counter: Some(j.frame),
             slice: Some(j.slice),
             skipped_bytes: j.skipped_bytes,
+            unjudged_cycles: place(j.header_cycle),
         })
     }
 }

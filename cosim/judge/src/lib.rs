@@ -86,7 +86,7 @@ pub use vcdout::{channels_path, edge_ps, id_code, wire_header, write_gtkw, write
 
 // Logic-analyser captures, judged at time level.
 pub use capture::{parse_map, read as read_capture, read_progress as read_capture_progress};
-pub use timed::{check_capture, TimedReport};
+pub use timed::{check_capture, check_capture_with, LineJoin, TimedReport};
 
 // Logs: a run's pins as events (golden tests), its samples as CSV, the
 // bytes its link carried.

@@ -118,9 +118,15 @@ pub(crate) struct LinkLine {
     step: u64,
     /// Where a check that joined mid-stream joined the line: (the cycle
     /// the first packet judged ended in, its frame counter and slice, the
-    /// bytes before it).
-    pub(crate) joined: Option<(u64, u8, u16, u64)>,
+    /// bytes before it, the cycle its header began in if still known).
+    pub(crate) joined: Option<(u64, u8, u16, u64, Option<u64>)>,
+    /// Joined mid-stream and not yet at a packet: the first cycle of each
+    /// byte read (the last [`MAX_STARTS`]), for the joined packet's header.
+    starts: VecDeque<u64>,
 }
+
+/// Byte start cycles kept while joining: more than any packet's bytes.
+const MAX_STARTS: usize = 1 << 14;
 
 impl LinkLine {
     /// The link's checks for a mix with a feasible `[link]`; `None` otherwise.
@@ -163,6 +169,7 @@ impl LinkLine {
             learning: None,
             step: s.grid.slice_cycles,
             joined: None,
+            starts: VecDeque::new(),
         })
     }
 
@@ -393,7 +400,20 @@ impl LinkLine {
             }
             return;
         }
+        let start = b.start + u.rx_origin;
+        self.started(start);
         self.byte(c, b.byte, inv);
+    }
+
+    /// A byte began on the line in cycle `c`: kept while joining.
+    fn started(&mut self, c: u64) {
+        if self.joined.is_some() || self.first == 0 {
+            return;
+        }
+        if self.starts.len() == MAX_STARTS {
+            self.starts.pop_front();
+        }
+        self.starts.push_back(c);
     }
 
     /// An AXI4-Stream beat in cycle `c`: its byte, and `tlast` where the
@@ -401,6 +421,7 @@ impl LinkLine {
     fn beat(&mut self, c: u64, byte: u8, tlast: bool, inv: &mut Invariants) {
         let Wire::Axis(fmt) = self.wire else { return };
         let before = self.seen;
+        self.started(c);
         let ends = self.byte(c, byte, inv);
         let clean = self.seen.crc_errors == before.crc_errors
             && self.seen.skipped_bytes == before.skipped_bytes;
@@ -472,7 +493,11 @@ impl LinkLine {
         if self.joined.is_none() && self.first > 0 {
             let bytes = 4 * (2 + p.records.len() as u64);
             let before = self.dec.stats().bytes.saturating_sub(bytes);
-            self.joined = Some((c, p.frame as u8, p.slice, before));
+            let header = (self.starts.len() as u64)
+                .checked_sub(bytes)
+                .map(|i| self.starts[i as usize]);
+            self.joined = Some((c, p.frame as u8, p.slice, before, header));
+            self.starts = VecDeque::new();
         }
         let w = self.window_of(closed, &p);
         self.overflow(c, &p, inv);

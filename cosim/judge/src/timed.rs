@@ -26,6 +26,7 @@ use lut_gen::Schedule;
 use lut_gen::{Layout, Pins, Role};
 
 use crate::model::CycleModel;
+pub use crate::timedlink::LineJoin;
 
 /// One analyser channel mapped to one port bit (`adc_cs_n[0]`), or to the
 /// link's line (`link_tx`, `role` None: decoded, not timed edge by edge).
@@ -118,6 +119,8 @@ pub struct TimedReport {
     /// What the resolution and the mapped pins allowed to be proved, and not.
     pub proved: Vec<String>,
     pub not_proved: Vec<String>,
+    /// A UART line decoded from the capture: where it was joined.
+    pub link_join: Option<LineJoin>,
 }
 
 impl TimedReport {
@@ -136,8 +139,15 @@ impl TimedReport {
             self.edges_checked,
             self.conversions,
             self.violations_total,
-            if self.ok { "PASS" } else { "FAIL" }
+            match (self.ok, &self.link_join) {
+                (false, _) => "FAIL",
+                (true, Some(j)) if !j.judged => "PASS (the link not judged)",
+                (true, _) => "PASS",
+            }
         );
+        if let Some(j) = &self.link_join {
+            let _ = writeln!(s, "{}", j.text());
+        }
         for v in &self.violations {
             let _ = writeln!(
                 s,
@@ -433,8 +443,20 @@ impl Ctx<'_> {
     }
 }
 
-/// Checks a capture at time level against the schedule.
+/// Checks a capture at time level against the schedule (the link's line
+/// held to the model).
 pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedReport, TimedError> {
+    check_capture_with(s, cap, skew_ps, true)
+}
+
+/// [`check_capture`]; without the `model` the link's line is decoded and
+/// judged but not held to the model's timing and codes (`--no-model`).
+pub fn check_capture_with(
+    s: &Schedule,
+    cap: &Capture,
+    skew_ps: u64,
+    model: bool,
+) -> Result<TimedReport, TimedError> {
     let clock = s.mix.clock_hz as i128;
     let tc_ps = 1e12 / s.mix.clock_hz as f64;
     let mut not_proved = Vec::new();
@@ -482,11 +504,12 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
         (span_ps as f64 / (tpl.frame as f64 * tc_ps) * tpl.conversions_per_frame as f64) as u64;
     let (mut proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
     not_proved.extend(np);
-    check_link_lane(
+    let link_join = check_link_lane(
         s,
         cap,
         &ctx,
         &cands,
+        model,
         &mut found,
         &mut proved,
         &mut not_proved,
@@ -505,6 +528,7 @@ pub fn check_capture(s: &Schedule, cap: &Capture, skew_ps: u64) -> Result<TimedR
         violations_total: found.total,
         proved,
         not_proved,
+        link_join,
     })
 }
 
@@ -818,34 +842,41 @@ fn missing_edges(ctx: &Ctx, lanes: &[Lane], c: &Cand, end: i128, found: &mut Fou
 
 /// The link's line, decoded when a lane carries it (timed by the unique
 /// phase, if one).
+#[allow(clippy::too_many_arguments)]
 fn check_link_lane(
     s: &Schedule,
     cap: &Capture,
     ctx: &Ctx,
     cands: &[Cand],
+    model: bool,
     found: &mut Found,
     proved: &mut Vec<String>,
     not_proved: &mut Vec<String>,
-) {
+) -> Option<LineJoin> {
     match cap.lanes.iter().position(|l| l.role.is_none()) {
         Some(li) => {
-            let phase = (cands.len() == 1).then(|| crate::timedlink::LinkPhase {
-                lo: cands[0].lo,
-                hi: cands[0].hi,
-                t: ctx.t,
-                skew: ctx.skew,
-            });
-            let lk = crate::timedlink::check_link(s, cap, li, phase);
+            let phases: Vec<_> = cands
+                .iter()
+                .map(|c| crate::timedlink::LinkPhase {
+                    lo: c.lo,
+                    hi: c.hi,
+                    t: ctx.t,
+                    skew: ctx.skew,
+                })
+                .collect();
+            let lk = crate::timedlink::check_link(s, cap, li, &phases, model);
             for v in lk.violations {
                 found.push(v);
             }
             proved.extend(lk.proved);
             not_proved.extend(lk.not_proved);
+            return lk.join;
         }
         None if Layout::new(s).link => not_proved
             .push("the link's samples (map link_tx to an analyser channel to decode them)".into()),
         None => {}
     }
+    None
 }
 
 /// Conversion starts a stretch of the capture must fit at their times (after

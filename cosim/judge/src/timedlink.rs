@@ -37,6 +37,55 @@ pub struct LinkCheck {
     pub violations: Vec<TimedViolation>,
     pub proved: Vec<String>,
     pub not_proved: Vec<String>,
+    /// Where the line was joined (a UART line decoded from the capture).
+    pub join: Option<LineJoin>,
+}
+
+/// Where a capture's line was joined: at its first whole packet.  What
+/// came before (bytes in flight when the capture began) was not judged.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LineJoin {
+    /// `"model"`: the packets decoded and every character from the joined
+    /// packet's header on timed against the model (and its records held
+    /// to the codes MISO carried); `"decoder"` (`--no-model`): the packets
+    /// decoded and judged, not timed.
+    pub by: &'static str,
+    /// False: the line was not judged (`why_not` says why).
+    pub judged: bool,
+    pub why_not: Option<String>,
+    /// The capture's time of the joined packet's header (its SYNC byte's
+    /// start bit), its frame counter and slice.
+    pub header_ps: Option<u64>,
+    pub frame_counter: Option<u8>,
+    pub slice: Option<u16>,
+    /// Characters read before it: skipped.
+    pub skipped_bytes: u64,
+    /// The capture's time before the header (the whole capture when not
+    /// joined): the line there was not judged, a fault there is not seen.
+    pub unjudged_ps: u64,
+}
+
+impl LineJoin {
+    /// The line the text report gives it.
+    pub fn text(&self) -> String {
+        let (Some(h), Some(f), Some(s)) = (self.header_ps, self.frame_counter, self.slice) else {
+            return format!(
+                "link: NOT JUDGED: {}: nothing of the link in the capture's {:.3} us was checked",
+                self.why_not.as_deref().unwrap_or("no whole packet"),
+                self.unjudged_ps as f64 / 1e6,
+            );
+        };
+        let what = match self.by {
+            "model" => "every character from its header on timed against the model",
+            _ => "every packet from it on decoded and judged; not timed (--no-model)",
+        };
+        format!(
+            "link: joined the line at its first whole packet (frame counter {f}, slice {s}; its header at {:.3} us; {what}); the line before it was not judged: its first {:.3} us and {} character(s), in flight when the capture began, were skipped (a fault there is not seen)",
+            h as f64 / 1e6,
+            self.unjudged_ps as f64 / 1e6,
+            self.skipped_bytes
+        )
+    }
 }
 
 /// The channels of each slice's packet in steady state, in order.
@@ -51,13 +100,22 @@ fn packet_order(s: &Schedule) -> Vec<Vec<u16>> {
 }
 
 /// Decodes lane `li` of `cap` (the line) and checks it against `s`; with
-/// the frame phase, also every byte's timing and the sample codes.
-pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhase>) -> LinkCheck {
+/// the model and the frame phase (the one of `phases`, the candidates the
+/// pins fit, that the line's characters fit), also every byte's timing
+/// and the sample codes.
+pub fn check_link(
+    s: &Schedule,
+    cap: &Capture,
+    li: usize,
+    phases: &[LinkPhase],
+    model: bool,
+) -> LinkCheck {
     let lane = &cap.lanes[li];
     let mut out = LinkCheck {
         violations: Vec::new(),
         proved: Vec::new(),
         not_proved: Vec::new(),
+        join: None,
     };
     let plan = match lut_gen::plan_link(s) {
         Some(Ok(p)) => p,
@@ -68,6 +126,17 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
         }
     };
     let Some(fmt) = plan.uart() else {
+        let (t0, end) = (cap.steps.first(), cap.steps.last());
+        out.join = Some(LineJoin {
+            by: if model { "model" } else { "decoder" },
+            judged: false,
+            why_not: Some("an AXI4-Stream link's beats are not read from an analyser's capture (check a VCD of the design's ports)".into()),
+            header_ps: None,
+            frame_counter: None,
+            slice: None,
+            skipped_bytes: 0,
+            unjudged_ps: end.zip(t0).map_or(0, |(e, b)| e.0 - b.0),
+        });
         out.not_proved.push(format!(
             "{} (link_tx): the mix's link is AXI4-Stream, which has no serial line; its beats are checked cycle by cycle in a VCD of the design's ports",
             lane.channel
@@ -86,11 +155,13 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
         return out;
     }
     let line = read_line(s, cap, li, fmt, &mut out);
-    let end = cap.steps.last().map(|x| x.0).unwrap_or(0) as f64;
+    let end = cap.steps.last().map(|x| x.0).unwrap_or(0);
+    let t0 = cap.steps.first().map_or(0, |x| x.0);
+    out.join = Some(line.joined(model, (t0, end)));
     if line.stats.overflows > 0 {
         out.violations.push(order_violation(
             lane,
-            end,
+            end as f64,
             format!(
                 "a trailer reports {} token(s) dropped by the FIFO",
                 line.stats.overflows
@@ -100,14 +171,24 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
     check_order(s, lane, &line.packets, &mut out);
     let packets = &line.packets;
     if packets.is_empty() {
-        out.violations.push(order_violation(
-            lane,
-            end,
-            format!(
-                "no good packet decoded from the line ({} bytes read at {:.0} baud)",
-                line.stats.bytes, plan.baud
-            ),
-        ));
+        // A capture long enough that some packet must have begun and ended
+        // in it: the line is broken.  A shorter one: not judged, and said so.
+        let due =
+            (2 * s.grid.slice_cycles + plan.latency_cycles) as f64 * 1e12 / s.mix.clock_hz as f64;
+        let what = format!(
+            "no good packet decoded from the line ({} bytes read at {:.0} baud)",
+            line.stats.bytes, plan.baud
+        );
+        if (end - t0) as f64 > due {
+            out.violations.push(order_violation(lane, end as f64, what));
+        } else {
+            out.not_proved.push(format!(
+                "{} (link_tx): the line: {what} in a capture shorter than two slices and the link's latency ({:.3} us)",
+                lane.channel,
+                due / 1e6
+            ));
+        }
+        return out;
     }
     let samples: usize = packets.iter().map(|p| p.3.len()).sum();
     out.proved.push(format!(
@@ -116,12 +197,17 @@ pub fn check_link(s: &Schedule, cap: &Capture, li: usize, phase: Option<LinkPhas
         packets.len(),
         plan.baud
     ));
-    match phase {
-        Some(ph) => hold_bytes(s, cap, li, ph, &line.chars, &mut out),
-        None => out.not_proved.push(format!(
-            "{} (link_tx): the bytes' timing and the sample codes (no unique frame phase to time them against)",
+    let from = line.join.map_or(0, |j| j.0);
+    match (model, phases) {
+        (false, _) => out.not_proved.push(format!(
+            "{} (link_tx): the bytes' timing and the sample codes (--no-model: the line is decoded, not held to the model)",
             lane.channel
         )),
+        (true, []) => out.not_proved.push(format!(
+            "{} (link_tx): the bytes' timing and the sample codes (no frame phase to time them against)",
+            lane.channel
+        )),
+        (true, _) => hold_bytes(s, cap, li, phases, (&line.chars, from), &mut out),
     }
     out
 }
@@ -146,6 +232,33 @@ struct LineRead {
     /// Every character read: (the capture's time of its start bit's edge, byte).
     chars: Vec<(u64, u8)>,
     stats: link::Stats,
+    /// The first good packet: the index in `chars` of its header, its
+    /// frame counter and slice.
+    join: Option<(usize, u8, u16)>,
+}
+
+impl LineRead {
+    /// Where the line was joined, in a capture of times `[t0, end]` (ps).
+    fn joined(&self, model: bool, (t0, end): (u64, u64)) -> LineJoin {
+        let header = self
+            .join
+            .map(|(i, _, _)| self.chars.get(i).map_or(end, |c| c.0));
+        LineJoin {
+            by: if model { "model" } else { "decoder" },
+            judged: self.join.is_some(),
+            why_not: self.join.is_none().then(|| {
+                format!(
+                    "the capture shows no whole packet to join the line at ({} character(s) read)",
+                    self.chars.len()
+                )
+            }),
+            header_ps: header,
+            frame_counter: self.join.map(|j| j.1),
+            slice: self.join.map(|j| j.2),
+            skipped_bytes: self.join.map_or(self.chars.len(), |j| j.0) as u64,
+            unjudged_ps: header.unwrap_or(end) - t0,
+        }
+    }
 }
 
 /// Lane `li` of the capture as the receiver samples it, once per clock
@@ -218,6 +331,7 @@ fn read_line(
     let mut framing = 0u64;
     let (mut crc, mut lost) = (0u64, 0u64);
     let mut chars: Vec<(u64, u8)> = Vec::new();
+    let mut join = None;
     loop {
         let t = t0 + n as f64 * tc;
         if t > end {
@@ -249,12 +363,16 @@ fn read_line(
             continue;
         }
         decoded.clear();
-        dec.push(&[b.byte], &mut decoded);
-        for d in &decoded {
-            match packets.last_mut() {
-                Some(p) if p.1 == d.frame && p.2 == d.slice => p.3.push(d.channel),
-                _ => packets.push((t, d.frame, d.slice, vec![d.channel])),
+        dec.push_packets(&[b.byte], &mut decoded);
+        for d in decoded.drain(..) {
+            if join.is_none() {
+                // the packet's header, if its start bit was seen with the rest
+                let i = chars.len().saturating_sub(4 * (2 + d.records.len()));
+                let sync = chars.get(i).is_some_and(|c| c.1 == link::format::SYNC);
+                join = Some((if sync { i } else { chars.len() }, d.frame as u8, d.slice));
             }
+            let chans = d.records.iter().map(|r| r.0).collect();
+            packets.push((t, d.frame, d.slice, chans));
         }
         let st = dec.stats();
         if st.crc_errors > crc {
@@ -278,6 +396,7 @@ fn read_line(
         packets,
         chars,
         stats: dec.finish(),
+        join,
     }
 }
 
@@ -461,39 +580,62 @@ fn predict(s: &Schedule, cap: &Capture, ph: LinkPhase, clock: i128) -> Predictio
     Prediction { bytes: out }
 }
 
-/// Holds every character read from the line against the model's bytes:
-/// its start bit within the resolution of the model's start bit, and, for a
-/// record of a branch whose MISO is captured, the same byte.
+/// Holds every character read from the line from index `from` (the first
+/// whole packet's header) on against the model's bytes: its start bit
+/// within the resolution of the model's start bit, and, for a record of a
+/// branch whose MISO is captured, the same byte.  Of several frame phases
+/// the pins fit alike, the line's characters pick the one they fit best
+/// (its slices are where the packets say).
 fn hold_bytes(
     s: &Schedule,
     cap: &Capture,
     li: usize,
-    ph: LinkPhase,
-    chars: &[(u64, u8)],
+    phases: &[LinkPhase],
+    (chars, from): (&[(u64, u8)], usize),
     out: &mut LinkCheck,
 ) {
     let lane = &cap.lanes[li];
     let clock = s.mix.clock_hz as i128;
-    let Prediction { bytes: pred } = predict(s, cap, ph, clock);
     let misos = miso_lanes(cap);
-    let held = Holding {
-        s,
-        lane,
-        ph,
-        clock,
-        pred: &pred,
-        misos: &misos,
+    let mut best: Option<(LinkPhase, Held, LinkCheck)> = None;
+    for &ph in phases.iter().take(MAX_PHASES) {
+        let Prediction { bytes: pred } = predict(s, cap, ph, clock);
+        let mut scratch = LinkCheck {
+            violations: Vec::new(),
+            proved: Vec::new(),
+            not_proved: Vec::new(),
+            join: None,
+        };
+        let held = Holding {
+            s,
+            lane,
+            ph,
+            clock,
+            pred: &pred,
+            misos: &misos,
+        }
+        .hold(&chars[from.min(chars.len())..], &mut scratch);
+        let better = best.as_ref().is_none_or(|(_, b, _)| {
+            (held.late + held.wrong, std::cmp::Reverse(held.held))
+                < (b.late + b.wrong, std::cmp::Reverse(b.held))
+        });
+        if better {
+            best = Some((ph, held, scratch));
+        }
     }
-    .hold(chars, out);
+    let Some((ph, held, scratch)) = best else {
+        return;
+    };
+    out.violations.extend(scratch.violations);
     let unc = ph.hi - ph.lo + ph.t + 2 * ph.skew;
     if held.late == 0 && held.held > 0 {
         out.proved.push(format!(
-            "{} (link_tx): every one of {} characters' start bits within {:.1} ns of the schedule's time (sample period, skew and the phase's spread){}",
+            "{} (link_tx): every one of {} characters' start bits within {:.1} ns of the schedule's time (sample period, skew and the phase's spread), from the first whole packet's header on{}",
             lane.channel,
             held.held,
             (unc / clock) as f64 / 1e3,
-            if held.skipped > 0 {
-                format!(", from the first in step with the line ({} read out of step before it)", held.skipped)
+            if phases.len() > 1 {
+                format!(", at the frame phase the line fits of the {} the pins fit alike", phases.len())
             } else {
                 String::new()
             }
@@ -527,6 +669,9 @@ fn hold_bytes(
     }
 }
 
+/// Frame phases the line's characters are tried at, at most.
+const MAX_PHASES: usize = 16;
+
 /// The characters read, held against the model's bytes.
 struct Holding<'a> {
     s: &'a Schedule,
@@ -547,8 +692,6 @@ struct Held {
     wrong: u64,
     /// Characters whose start bit is the schedule's.
     held: u64,
-    /// Characters read out of step before the first that was in step.
-    skipped: u64,
     /// Record bytes compared with the model's.
     compared: u64,
     /// Record bytes whose code the capture did not resolve.
@@ -591,11 +734,8 @@ impl Holding<'_> {
         let mid = (ph.lo + ph.hi) / 2;
         let mut n = Held::default();
         let mut used = 0usize;
-        // A capture that opens inside a character reads the line out of step
-        // until a fall that is a start bit: like a host's receiver, the check
-        // is in step from the first character that starts at one of the
-        // schedule's start bits.
-        let mut synced = false;
+        // From the first whole packet's header on, the line is in step:
+        // every character must start at one of the schedule's start bits.
         for &(edge_ps, byte) in chars {
             let x = edge_ps as i128 * clock;
             let near = self.nearest(x, used);
@@ -604,10 +744,6 @@ impl Holding<'_> {
                 ph.lo + ct <= x + ph.skew && ph.hi + ct >= x - ph.t - ph.skew
             });
             let Some(j) = fits else {
-                if !synced {
-                    n.skipped += 1;
-                    continue;
-                }
                 n.late += 1;
                 if n.late <= 3 {
                     let want = near.map_or("none near".to_string(), |j| {
@@ -628,7 +764,6 @@ impl Holding<'_> {
                 }
                 continue;
             };
-            synced = true;
             used = j + 1;
             n.held += 1;
             self.hold_record(&pred[j], edge_ps, byte, &mut n, out);

@@ -99,18 +99,26 @@ pub struct LinkJoin {
     /// or `"decoder"` (`--no-model`: every packet judged from the one that
     /// ended in `checked_from_cycle`).
     pub by: String,
+    /// Whether the line was judged at all: false when the capture showed
+    /// no whole packet to join at.
+    pub judged: bool,
     /// The capture cycle from which the line is checked; null when the
     /// capture showed no whole packet to join at (the line was then not
     /// checked).
     pub checked_from_cycle: Option<u64>,
     /// The first whole packet joined at: the capture cycle its header
-    /// began in (the model only), its frame counter and slice.
+    /// began in, its frame counter and slice.
     pub header_cycle: Option<u64>,
     pub frame_counter: Option<u8>,
     pub slice: Option<u16>,
     /// Bytes the line carried before that packet, in flight when the
     /// capture began: skipped.
     pub skipped_bytes: u64,
+    /// The capture cycles of the line not judged: from the capture's
+    /// first cycle to the joined packet's header (to its end where the
+    /// header's cycle is not known), or the whole capture when no packet
+    /// was joined.  A fault on the line there is not seen.
+    pub unjudged_cycles: u64,
 }
 
 impl LinkJoin {
@@ -119,17 +127,18 @@ impl LinkJoin {
         let (Some(c), Some(f), Some(s)) = (self.checked_from_cycle, self.frame_counter, self.slice)
         else {
             return format!(
-                "link: the capture shows no whole packet to join the line at ({} byte(s) read): the line was not checked",
-                self.skipped_bytes
+                "link: NOT JUDGED: the capture's {} cycles show no whole packet to join the line at ({} byte(s) read): nothing on the line was checked",
+                self.unjudged_cycles, self.skipped_bytes
             );
         };
-        let what = match self.header_cycle {
-            Some(h) => format!("its header at capture cycle {h}; every link pin compared with the model from capture cycle {c}"),
-            None => format!("read by capture cycle {c}; every packet judged from it on"),
+        let what = match (self.header_cycle, self.by.as_str()) {
+            (Some(h), "model") => format!("its header at capture cycle {h}; every link pin compared with the model from capture cycle {c}"),
+            (Some(h), _) => format!("its header at capture cycle {h}, read by capture cycle {c}; every packet judged from it on"),
+            (None, _) => format!("read by capture cycle {c}; every packet judged from it on"),
         };
         format!(
-            "link: joined the line at its first whole packet (frame counter {f}, slice {s}; {what}); the {} byte(s) before it, in flight when the capture began, were skipped",
-            self.skipped_bytes
+            "link: joined the line at its first whole packet (frame counter {f}, slice {s}; {what}); the line before it was not judged: its first {} cycle(s) and {} byte(s), in flight when the capture began, were skipped (a fault there is not seen)",
+            self.unjudged_cycles, self.skipped_bytes
         )
     }
 }
@@ -194,7 +203,11 @@ impl Verdict {
             counted(self.samples, "sample"),
             counted(self.divergence_count, "divergent cycle"),
             counted(self.violation_count, "violation"),
-            if self.ok { "PASS" } else { "FAIL" }
+            match (self.ok, &self.link_join) {
+                (false, _) => "FAIL",
+                (true, Some(j)) if !j.judged => "PASS (the link not judged)",
+                (true, _) => "PASS",
+            }
         );
         if let Some(j) = &self.link_join {
             let _ = writeln!(s, "{}", j.text());

@@ -1,0 +1,332 @@
+//! Logic-analyser captures of link designs taken mid-run (`check --map`):
+//! the UART line is joined at its first whole packet, with the model (every
+//! character from that packet's header on timed against it, at the frame
+//! phase the line fits) and without it (decoded and judged); what came
+//! before is skipped and said to be unjudged.  Every link preset and random
+//! link mixes at random offsets pass; a fault after the join fails at its
+//! time; a fault before it passes inside the time reported as not judged;
+//! a capture with no whole packet says the link was not judged.
+
+use std::path::Path;
+
+use lut_gen::LinkKind;
+use lut_gen::Pins;
+use lut_gen::Schedule;
+use testkit::analyser;
+
+use crate::link_windows::{random_link_mixes, rng};
+
+/// Every cycle's pins after reset of `frames` frames of rust-hdl's model of
+/// the gateware behind the AXIS slave a back end puts in front of it.
+fn pins(s: &Schedule, frames: u64) -> Vec<Pins> {
+    let dut = engines::RustHdlDut::new(s).expect("rust-hdl builds");
+    let mut dut = judge::with_slave(s, dut, ::link::ReadyPattern::Random { seed: 11 });
+    analyser::run(s, &mut dut, frames)
+}
+
+/// What a 100 MHz analyser (first sample `phase` ps into cycle `w.0`)
+/// records of cycles `w`, as sigrok-cli's VCD says it, judged with the
+/// model and without it.
+fn judged(
+    s: &Schedule,
+    pins: &[Pins],
+    w: (u64, u64),
+    phase: u64,
+    out: &Path,
+) -> [judge::TimedReport; 2] {
+    let (_, map) = analyser::lanes(s);
+    analyser::resample(s, pins, w.0, w.1, 10_000, phase, out);
+    let text = std::fs::read_to_string(out).unwrap().replace(
+        "$enddefinitions $end\n",
+        "$comment\n  Acquisition at 100 MHz\n$end\n$enddefinitions $end\n",
+    );
+    std::fs::write(out, text).unwrap();
+    let lanes = judge::parse_map(&map, s).unwrap();
+    let cap = judge::read_capture(out, lanes).unwrap();
+    [true, false].map(|model| judge::check_capture_with(s, &cap, 0, model).unwrap())
+}
+
+fn kind(s: &Schedule) -> Option<LinkKind> {
+    s.mix.link.as_ref().map(|l| l.kind)
+}
+
+/// The time of cycle `c` of a capture of cycles from `from` (first sample
+/// `phase` ps in), in ps.
+fn at_ps(s: &Schedule, c: u64, from: u64, phase: u64) -> u64 {
+    ((c - from) as f64 * 1e12 / s.mix.clock_hz as f64) as u64 - phase
+}
+
+/// Both reports pass; a UART line is joined at a whole packet, by the
+/// model or the decoder, the model timing every character from it on.
+fn assert_clean(what: &str, s: &Schedule, [m, d]: &[judge::TimedReport; 2]) {
+    for (r, by) in [(m, "model"), (d, "decoder")] {
+        let text = r.summary();
+        assert!(r.ok, "{what}, {by}: {text}");
+        if kind(s) != Some(LinkKind::Uart) {
+            // an AXI4-Stream link's beats are not read from a capture:
+            // said so, on the first line too
+            assert!(
+                text.contains("AXI4-Stream, which has no serial line"),
+                "{what}: {text}"
+            );
+            assert!(
+                text.contains("PASS (the link not judged)"),
+                "{what}: {text}"
+            );
+            assert!(
+                text.contains("link: NOT JUDGED: an AXI4-Stream"),
+                "{what}: {text}"
+            );
+            let j = r.link_join.as_ref().unwrap();
+            assert!(!j.judged && j.unjudged_ps > 0, "{what}: {text}");
+            continue;
+        }
+        let j = r
+            .link_join
+            .as_ref()
+            .unwrap_or_else(|| panic!("{what}: {text}"));
+        assert!(j.judged && j.by == by, "{what}: {text}");
+        assert_eq!(Some(j.unjudged_ps), j.header_ps, "{what}: {text}");
+        assert!(text.contains(&j.text()), "{what}: {text}");
+    }
+    if kind(s) == Some(LinkKind::Uart) {
+        let text = m.summary();
+        assert!(
+            text.contains("from the first whole packet's header on"),
+            "{what}: the model timed the line: {text}"
+        );
+        assert!(
+            d.summary().contains("--no-model: the line is decoded"),
+            "{what}"
+        );
+        let (jm, jd) = (m.link_join.as_ref().unwrap(), d.link_join.as_ref().unwrap());
+        assert_eq!(
+            jm,
+            &judge::LineJoin {
+                by: "model",
+                ..jd.clone()
+            },
+            "{what}"
+        );
+    }
+}
+
+fn random_captures(seed: u64, mixes: usize, captures: usize) {
+    let d = tempfile::tempdir().unwrap();
+    let found = random_link_mixes(seed, mixes);
+    let uart = found
+        .iter()
+        .filter(|(_, s)| kind(s) == Some(LinkKind::Uart))
+        .count();
+    assert!(
+        uart > 0 && uart < mixes,
+        "both kinds drawn: {uart} UART of {mixes}"
+    );
+    for (k, s) in &found {
+        let f = s.grid.frame_cycles;
+        let p = pins(s, 6);
+        let mut next = rng(*k);
+        for i in 0..captures {
+            let from = f / 2 + next() % (3 * f);
+            let w = (from, from + f + next() % f);
+            let phase = next() % 9_000;
+            let r = judged(s, &p, w, phase, &d.path().join(format!("{k}-{i}.vcd")));
+            assert_clean(&format!("random mix {k} {w:?}"), s, &r);
+        }
+    }
+}
+
+#[test]
+fn captures_of_random_link_mixes_at_random_offsets_pass() {
+    random_captures(1, 6, 2);
+}
+
+#[test]
+#[ignore = "long: make test-long"]
+fn captures_of_thirty_random_link_mixes_pass() {
+    random_captures(200, 30, 4);
+}
+
+#[test]
+fn captures_of_the_link_presets_at_random_offsets_pass() {
+    let d = tempfile::tempdir().unwrap();
+    for name in ["eskin34-uart.toml", "eskin34-axis.toml"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("mixes")
+            .join(name);
+        let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
+        let f = s.grid.frame_cycles;
+        let p = pins(&s, 3);
+        let mut next = rng(27);
+        for i in 0..2 {
+            let from = f / 2 + next() % f;
+            let w = (from, from + f / 2 + next() % (f / 2));
+            let r = judged(
+                &s,
+                &p,
+                w,
+                next() % 9_000,
+                &d.path().join(format!("{i}.vcd")),
+            );
+            assert_clean(&format!("{name} {w:?}"), &s, &r);
+        }
+    }
+}
+
+/// The UART mixes of the random link mixes from seed 1.
+fn uart_mix() -> Schedule {
+    random_link_mixes(1, 4)
+        .into_iter()
+        .map(|(_, s)| s)
+        .find(|s| kind(s) == Some(LinkKind::Uart))
+        .expect("a UART mix")
+}
+
+/// Faults inside a capture, after the join: three bits of a character
+/// inverted (a bad CRC) fail it with and without the model, within the
+/// packet; the line two bit times late from a start bit on (every byte
+/// intact) fails with the model at that character's start bit.
+#[test]
+fn a_fault_after_the_join_fails_the_capture_at_its_time() {
+    let s = uart_mix();
+    let d = tempfile::tempdir().unwrap();
+    let f = s.grid.frame_cycles;
+    let clean = pins(&s, 4);
+    let (w, phase) = ((f / 2 + 1_234, f / 2 + 1_234 + 2 * f), 4_321);
+    let at = w.0 + f;
+    let start = |p: &[Pins]| {
+        (at as usize..p.len())
+            .find(|&c| !p[c].link_tx && p[c - 1].link_tx)
+            .unwrap()
+    };
+    let st = start(&clean);
+    let t = at_ps(&s, st as u64, w.0, phase);
+    // the packet's end at the latest: a slice and the link's latency on
+    let plan = lut_gen::plan_link(&s).unwrap().unwrap();
+    let within = at_ps(
+        &s,
+        w.0 + 2 * s.grid.slice_cycles + plan.latency_cycles,
+        w.0,
+        phase,
+    );
+    let mut flipped = clean.clone();
+    analyser::mutate(&s, &mut flipped, analyser::Mutation::LinkBitsFlipped, at);
+    for r in judged(&s, &flipped, w, phase, &d.path().join("flip.vcd")) {
+        let text = r.summary();
+        assert!(!r.ok, "{text}");
+        let j = r.link_join.as_ref().unwrap();
+        assert!(j.header_ps.unwrap() < t, "joined before the fault: {text}");
+        let v = &r.violations[0];
+        assert!(v.rule.contains("link"), "{text}");
+        assert!(
+            (t..t + within).contains(&v.time_ps),
+            "fault at {t} ps: {text}"
+        );
+    }
+    let div = plan.baud_divider as usize;
+    let mut late = clean.clone();
+    for c in st..late.len() {
+        late[c].link_tx = if c < st + 2 * div {
+            true
+        } else {
+            clean[c - 2 * div].link_tx
+        };
+    }
+    let [m, dec] = judged(&s, &late, w, phase, &d.path().join("late.vcd"));
+    let text = m.summary();
+    assert!(!m.ok, "{text}");
+    let v = &m.violations[0];
+    assert!(v.rule.contains("link timing"), "{text}");
+    let (lo, hi) = (t, t + at_ps(&s, w.0 + 3 * div as u64, w.0, 0));
+    assert!(
+        (lo..hi).contains(&v.time_ps),
+        "the late start bit at {lo} ps: {text}"
+    );
+    // intact bytes: the decoder alone does not see a timing fault
+    assert!(dec.ok, "{}", dec.summary());
+}
+
+/// The line before the first whole packet is not judged and the report
+/// says how long: three bits flipped in the capture's first character
+/// pass, inside the time reported unjudged.  A capture shorter than a
+/// packet says the link was not judged at all.
+#[test]
+fn the_line_before_the_join_is_reported_as_not_judged() {
+    let s = uart_mix();
+    let d = tempfile::tempdir().unwrap();
+    let f = s.grid.frame_cycles;
+    let clean = pins(&s, 3);
+    let phase = 2_345;
+    // a window opening inside a packet: a character starts just after it
+    let from = (f / 2..f)
+        .find(|&c| !clean[c as usize + 5].link_tx && clean[c as usize + 4].link_tx)
+        .unwrap();
+    let w = (from, from + f);
+    let mut bad = clean.clone();
+    analyser::mutate(&s, &mut bad, analyser::Mutation::LinkBitsFlipped, from);
+    let t = at_ps(&s, from + 5, from, phase);
+    for r in judged(&s, &bad, w, phase, &d.path().join("before.vcd")) {
+        let text = r.summary();
+        let j = r.link_join.as_ref().unwrap();
+        if j.header_ps.is_some_and(|h| h <= t) {
+            panic!("the capture's first character is a header: {text}");
+        }
+        assert!(r.ok, "unseen before the join: {text}");
+        assert!(j.judged && j.unjudged_ps > t, "{text}");
+        assert!(j.skipped_bytes > 0, "{text}");
+        assert!(text.contains("the line before it was not judged"), "{text}");
+    }
+    // a third of a slice: no whole packet
+    let w = (from, from + s.grid.slice_cycles / 3);
+    for r in judged(&s, &clean, w, phase, &d.path().join("short.vcd")) {
+        let text = r.summary();
+        let j = r.link_join.as_ref().unwrap();
+        assert!(r.ok && !j.judged && j.header_ps.is_none(), "{text}");
+        assert!(text.contains("PASS (the link not judged)"), "{text}");
+        assert!(text.contains("link: NOT JUDGED"), "{text}");
+        assert!(j.unjudged_ps > 0, "{text}");
+    }
+}
+
+/// `check --map` of a capture of the UART preset from its middle: exit 0
+/// with and without `--no-model`, the `link:` line in the text, and
+/// `link_join` in the JSON with what joined the line and what was skipped.
+#[test]
+fn check_map_reports_where_it_joined_the_line() {
+    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("mixes/eskin34-uart.toml");
+    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    let f = s.grid.frame_cycles;
+    let p = pins(&s, 2);
+    let d = tempfile::tempdir().unwrap();
+    let wave = d.path().join("capture.vcd");
+    let [m, _] = judged(&s, &p, (f / 3 + 999, f + f / 2), 1_234, &wave);
+    let (_, map) = analyser::lanes(&s);
+    for (flags, by) in [(vec![], "model"), (vec!["--no-model"], "decoder")] {
+        let run = |json: bool| {
+            let mut cmd = crate::common_cli::slotforge();
+            cmd.arg("check").args(&flags).args(["--map", &map]);
+            if json {
+                cmd.arg("--json");
+            }
+            cmd.arg(&mix).arg(&wave).output().unwrap()
+        };
+        let out = run(false);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(out.status.code(), Some(0), "{flags:?}: {text}");
+        assert!(
+            text.contains("link: joined the line at its first whole packet"),
+            "{text}"
+        );
+        let out = run(true);
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let j = &v["link_join"];
+        assert_eq!(j["by"], by, "{j}");
+        assert_eq!(j["judged"], true, "{j}");
+        let mj = m.link_join.as_ref().unwrap();
+        assert_eq!(j["header_ps"], mj.header_ps.unwrap(), "{j}");
+        assert_eq!(j["unjudged_ps"], mj.unjudged_ps, "{j}");
+        assert_eq!(j["skipped_bytes"], mj.skipped_bytes, "{j}");
+        assert_eq!(j["frame_counter"], mj.frame_counter.unwrap(), "{j}");
+        assert!(text.contains(j["text"].as_str().unwrap()), "{j}");
+    }
+}
