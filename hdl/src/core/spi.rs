@@ -3,6 +3,7 @@
 use rust_hdl::prelude::*;
 
 use super::c;
+use super::timing::mask;
 use crate::plan::SeqTiming;
 use crate::widths::*;
 
@@ -19,6 +20,11 @@ use crate::widths::*;
 /// time too) and the SCLK periods: it starts at `sclk_div - setup` modulo
 /// `2^PH_BITS`, so it reaches the end of a period exactly `setup` cycles
 /// after the start, however long the setup.
+///
+/// Each counter's increment is masked to the mix's own width (`k_*_mask`,
+/// the phase counter's wide enough for both the period and the setup), so
+/// yosys removes the bits above it (issue 28: the core's maximum widths
+/// cost flip-flops, carry cells and compare LUTs in every design).
 #[derive(LogicBlock)]
 pub struct SpiSeq {
     pub clock: Signal<In, Clock>,
@@ -57,11 +63,17 @@ pub struct SpiSeq {
     /// The last rising edge reads a bit (CNV parts; a CS part's last edge
     /// comes after its last bit).
     k_cap_last: Constant<Bit>,
+    k_ph_mask: Constant<Bits<PH_BITS>>,
+    k_nf_mask: Constant<Bits<NFALL_BITS>>,
+    k_wb_mask: Constant<Bits<WORD_BIT_BITS>>,
 }
 
 impl SpiSeq {
     pub(super) fn new(t: &SeqTiming) -> SpiSeq {
-        let ph_mod = 1u64 << PH_BITS;
+        // the phase counts modulo 2^w: from sclk_div - setup through the
+        // wrap to sclk_div - 1, so 2^w must exceed both
+        let ph_mask = mask(t.sclk_div.max(t.setup_cycles));
+        let ph_mod = ph_mask + 1;
         SpiSeq {
             clock: Default::default(),
             rst: Default::default(),
@@ -95,6 +107,9 @@ impl SpiSeq {
             k_data_n: c(t.bits),
             k_sclk_idle: Constant::new(!t.cnv),
             k_cap_last: Constant::new(t.cnv),
+            k_ph_mask: c(ph_mask),
+            k_nf_mask: c(mask(t.sclks)),
+            k_wb_mask: c(mask(t.word_sclks - 1)),
         }
     }
 }
@@ -119,7 +134,7 @@ impl Logic for SpiSeq {
             if self.wrap.val() {
                 self.ph.d.next = self.k_ph_zero.val();
             } else {
-                self.ph.d.next = self.ph.q.val() + self.k_ph_one.val();
+                self.ph.d.next = (self.ph.q.val() + self.k_ph_one.val()) & self.k_ph_mask.val();
             }
             if self.wrap.val() {
                 if self.nfall.q.val() == self.k_nf_end.val() {
@@ -129,7 +144,8 @@ impl Logic for SpiSeq {
                     self.r_sclk.d.next = self.k_sclk_idle.val();
                     self.r_done.d.next = true;
                 } else {
-                    self.nfall.d.next = self.nfall.q.val() + self.k_nf_one.val();
+                    self.nfall.d.next =
+                        (self.nfall.q.val() + self.k_nf_one.val()) & self.k_nf_mask.val();
                     self.r_sclk.d.next = false;
                 }
             }
@@ -141,7 +157,8 @@ impl Logic for SpiSeq {
                 if self.wbit.q.val() == self.k_wb_last.val() {
                     self.wbit.d.next = self.k_wb_zero.val();
                 } else {
-                    self.wbit.d.next = self.wbit.q.val() + self.k_wb_one.val();
+                    self.wbit.d.next =
+                        (self.wbit.q.val() + self.k_wb_one.val()) & self.k_wb_mask.val();
                 }
                 // (wbit - leading) wraps to >= 32 below the window.
                 if ((self.wbit.q.val() - self.k_data_lo.val()) < self.k_data_n.val())

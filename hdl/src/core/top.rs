@@ -97,6 +97,7 @@ impl Core {
         drive(&mut t.st0.clock, k);
         drive(&mut t.slot.clock, k);
         drive(&mut t.sl.clock, k);
+        drive(&mut t.succ.clock, k);
         for q in self.seqs.iter_mut() {
             drive(&mut q.clock, k);
             drive(&mut q.r_cs_n.clock, k);
