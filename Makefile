@@ -20,7 +20,7 @@ endif
 # `PROPTEST_RNG_SEED=random make test` explores new cases.
 export PROPTEST_RNG_SEED ?= 1
 
-.PHONY: test-long run test tools lut audit verilog cosim golden golden-update synth bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
+.PHONY: test-long run test tools lut audit verilog cosim golden golden-update synth synth-bench bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 # The main job on the reference mix: audit, LUT, Verilog, co-simulation, golden,
 # faults, synthesis estimate, and build/eskin34/report.html with its charts.
@@ -97,6 +97,12 @@ cosim: tools
 # Place and route on an iCE40 HX8K; prints LCs and Fmax (figures: docs/performance.md).
 synth: tools
 	bash hdl/synth.sh $(MIX)
+
+# every preset (or MIXES) placed at nextpnr seeds 1-3: LCs, median Fmax, ratios to the hand-written anchors
+MIXES ?= mixes/*.toml
+synth-bench: tools
+	$(CARGO) build -q -p measure --example synth_bench
+	target/debug/examples/synth_bench target/synth-bench constraints/ice40-hx8k-breakout.toml $(MIXES)
 
 bench:
 	$(CARGO) bench -p judge --bench check_vs_wellen

@@ -5,7 +5,7 @@
 #   hdl/synth.sh [MIX.toml ...]      (default: mixes/*.toml hdl/tests/data/*.toml)
 #
 # The flow itself (yosys synth_ice40, nextpnr-ice40 with the board's pins) is
-# measure::synth::place_and_route, the same one `slotforge build` runs; this
+# measure::place_and_route, the same one `slotforge build` runs; this
 # script only loops over mixes.  Work files go to target/synth/<mix>/.
 set -euo pipefail
 # mixes named on the command line are the caller's paths: made absolute

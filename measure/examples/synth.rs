@@ -29,7 +29,7 @@ fn main() {
         std::process::exit(1)
     });
     let pcf = board.map(|_| out.join("slotforge.pcf"));
-    match measure::place_and_route(out, pcf.as_deref(), s.grid.clock_hz) {
+    match measure::place_and_route(out, pcf.as_deref(), s.grid.clock_hz, 1) {
         Ok(r) => {
             let mhz = s.grid.clock_hz as f64 / 1e6;
             println!(

@@ -31,7 +31,9 @@ pub use speed::{speed, CleanRun};
 pub use timing::timing;
 
 // The place-and-route flow on its own (also `hdl/synth.sh`).
-pub use synth::{place_and_route, Synth};
+pub use synth::{
+    anchor, median_fmax, place_and_route, place_and_route_seeds, Anchor, Synth, HAND_ANCHORS,
+};
 
 // The report's tables: the audit's budgets, the slot table, the intervals
 // measured and the fault campaign.

@@ -20,11 +20,92 @@ pub struct Synth {
     pub fmax_mhz: f64,
 }
 
-/// yosys `synth_ice40` then nextpnr-ice40 on `dir/slotforge_top.v`, work
-/// files and logs (`yosys.log`, `stat.txt`, `nextpnr.log`) in `dir`.  With
-/// `pcf` the pins are placed as the board file says; without, IO is left
-/// unconstrained (the estimate does not depend on a board).
-pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<Synth, String> {
+/// yosys `synth_ice40` then nextpnr-ice40 (placement seed `seed`) on
+/// `dir/slotforge_top.v`, work files and logs (`yosys.log`, `stat.txt`,
+/// `nextpnr.log`) in `dir`.  With `pcf` the pins are placed as the board
+/// file says; without, IO is left unconstrained (the estimate does not
+/// depend on a board).
+pub fn place_and_route(
+    dir: &Path,
+    pcf: Option<&Path>,
+    clock_hz: u64,
+    seed: u64,
+) -> Result<Synth, String> {
+    synthesize(dir)?;
+    place(dir, pcf, clock_hz, seed, "")
+}
+
+/// The same flow with yosys once and nextpnr once per seed (logs
+/// `nextpnr-<seed>.log`): one figure per seed, in `seeds`' order.
+pub fn place_and_route_seeds(
+    dir: &Path,
+    pcf: Option<&Path>,
+    clock_hz: u64,
+    seeds: &[u64],
+) -> Result<Vec<Synth>, String> {
+    synthesize(dir)?;
+    seeds
+        .iter()
+        .map(|&s| place(dir, pcf, clock_hz, s, &format!("-{s}")))
+        .collect()
+}
+
+/// The median of the seeds' Fmax (the mean of the middle two for an even
+/// count); `None` for no runs.
+pub fn median_fmax(runs: &[Synth]) -> Option<f64> {
+    let mut f: Vec<f64> = runs.iter().map(|r| r.fmax_mhz).collect();
+    f.sort_by(|a, b| a.total_cmp(b));
+    let n = f.len();
+    match n {
+        0 => None,
+        _ if n % 2 == 1 => Some(f[n / 2]),
+        _ => Some((f[n / 2 - 1] + f[n / 2]) / 2.0),
+    }
+}
+
+/// A hand-written design of the same contract, measured on this flow
+/// (issue 28: Verilog-2001 written from docs/timing.md and
+/// docs/packet-format.md alone, accepted by `sim --rtl`, `golden --rtl`
+/// and `prove --rtl`; median Fmax of seeds 1-3).  The anchor that the
+/// emitted design's ratios are printed against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Anchor {
+    pub mix: &'static str,
+    pub lcs: u64,
+    pub lut4: u64,
+    pub dff: u64,
+    pub brams: u64,
+    pub fmax_mhz: f64,
+}
+
+/// The hand-written anchors (issue 28's table).
+pub const HAND_ANCHORS: [Anchor; 2] = [
+    Anchor {
+        mix: "eskin34",
+        lcs: 166,
+        lut4: 112,
+        dff: 114,
+        brams: 0,
+        fmax_mhz: 210.0,
+    },
+    Anchor {
+        mix: "eskin34-uart",
+        lcs: 326,
+        lut4: 246,
+        dff: 186,
+        brams: 2,
+        fmax_mhz: 165.0,
+    },
+];
+
+/// The hand-written anchor of mix `name`, if there is one.
+pub fn anchor(name: &str) -> Option<&'static Anchor> {
+    HAND_ANCHORS.iter().find(|a| a.mix == name)
+}
+
+/// yosys `synth_ice40` on `dir/slotforge_top.v` (`yosys.log`, `stat.txt`,
+/// `slotforge.json` in `dir`).
+fn synthesize(dir: &Path) -> Result<(), String> {
     let y = Tool::new("yosys")
         .current_dir(dir)
         .args(["-q", "-l", "yosys.log", "-p"])
@@ -42,17 +123,27 @@ pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<
             y.stderr
         ));
     }
+    Ok(())
+}
+
+/// nextpnr-ice40 at `seed` on `dir/slotforge.json`; its log is
+/// `nextpnr<tag>.log`.
+fn place(
+    dir: &Path,
+    pcf: Option<&Path>,
+    clock_hz: u64,
+    seed: u64,
+    tag: &str,
+) -> Result<Synth, String> {
     let n = Tool::new("nextpnr-ice40")
         .current_dir(dir)
         .args(["--hx8k", "--package", "ct256", "--json", "slotforge.json"])
-        .args([
-            "--seed",
-            "1",
-            "--asc",
-            "slotforge.asc",
-            "--report",
-            "report.json",
-        ])
+        .arg("--seed")
+        .arg(seed.to_string())
+        .arg("--asc")
+        .arg(format!("slotforge{tag}.asc"))
+        .arg("--report")
+        .arg(format!("report{tag}.json"))
         .arg("--freq")
         .arg(format!("{}", clock_hz as f64 / 1e6));
     let n = match pcf {
@@ -67,17 +158,18 @@ pub fn place_and_route(dir: &Path, pcf: Option<&Path>, clock_hz: u64) -> Result<
         .run()
         .map_err(|e| format!("nextpnr-ice40 could not be started: {e}"))?;
     let log = format!("{}{}", n.stdout, n.stderr);
-    let _ = std::fs::write(dir.join("nextpnr.log"), &log);
+    let log_file = dir.join(format!("nextpnr{tag}.log"));
+    let _ = std::fs::write(&log_file, &log);
     if !n.success {
         let tail: Vec<&str> = log.lines().rev().take(20).collect();
         return Err(format!(
             "nextpnr-ice40 failed (see {}):\n{}",
-            dir.join("nextpnr.log").display(),
+            log_file.display(),
             tail.into_iter().rev().collect::<Vec<_>>().join("\n")
         ));
     }
     let stat = std::fs::read_to_string(dir.join("stat.txt")).unwrap_or_default();
-    parse(&log, &stat).map_err(|e| format!("{}: {e}", dir.join("nextpnr.log").display()))
+    parse(&log, &stat).map_err(|e| format!("{}: {e}", log_file.display()))
 }
 
 /// The figures of nextpnr's log and yosys's `stat`.  A log without the
@@ -143,6 +235,25 @@ mod tests {
         let stat = "   Number of cells: 9\n     SB_CARRY  4\n     SB_DFF 10\n     SB_DFFER 7\n     SB_LUT4 120\n";
         assert_eq!(cells(stat, |c| c == "SB_LUT4"), 120);
         assert_eq!(cells(stat, |c| c.starts_with("SB_DFF")), 17);
+    }
+
+    #[test]
+    fn median_of_seeds_is_the_middle_run() {
+        let run = |f| Synth {
+            lcs: 1,
+            lut4: 1,
+            dff: 1,
+            brams: 0,
+            fmax_mhz: f,
+        };
+        assert_eq!(
+            median_fmax(&[run(150.0), run(120.0), run(170.0)]),
+            Some(150.0)
+        );
+        assert_eq!(median_fmax(&[run(100.0), run(120.0)]), Some(110.0));
+        assert_eq!(median_fmax(&[]), None);
+        assert_eq!(anchor("eskin34").map(|a| a.lcs), Some(166));
+        assert!(anchor("softslip1k").is_none());
     }
 
     #[test]

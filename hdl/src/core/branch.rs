@@ -28,6 +28,9 @@ pub struct BranchUnit {
     pub mux_sel: Signal<Out, Bits<3>>,
     pub mux_en: Signal<Out, Bits<EN_BITS>>,
     pub done: Signal<Out, Bit>,
+    /// `done` of the next cycle (the D input of its flip-flop), for the
+    /// merger's registered "anything to take" flag.
+    pub done_next: Signal<Out, Bit>,
     pub res_ch: Signal<Out, Bits<CH_BITS>>,
     pub res_val: Signal<Out, Bits<VALUE_BITS>>,
     /// More words of this conversion follow the one on `res_*`.
@@ -78,6 +81,7 @@ impl BranchUnit {
             mux_sel: Default::default(),
             mux_en: Default::default(),
             done: Default::default(),
+            done_next: Default::default(),
             res_ch: Default::default(),
             res_val: Default::default(),
             more: Default::default(),
@@ -163,6 +167,7 @@ impl Logic for BranchUnit {
         self.mux_sel.next = self.r_sel.q.val();
         self.mux_en.next = self.r_en.q.val();
         self.done.next = self.r_done.q.val();
+        self.done_next.next = self.seq_done.val() & self.act.q.val() & !self.rst.val();
         self.res_ch.next = self.reader.ch.val();
         self.res_val.next = self.reader.val.val();
         self.more.next = self.reader.more.val();

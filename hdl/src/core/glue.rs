@@ -91,6 +91,10 @@ fn lanes(s: &mut String, nb: usize, devices: &[usize]) {
         cat(&|b| format!("branches${b}$done"), pad_lanes("1'b0"))
     ));
     s.push_str(&format!(
+        "  merge$done_next = {};\n",
+        cat(&|b| format!("branches${b}$done_next"), pad_lanes("1'b0"))
+    ));
+    s.push_str(&format!(
         "  merge$more = {};\n",
         cat(&|b| format!("branches${b}$more"), pad_lanes("1'b0"))
     ));

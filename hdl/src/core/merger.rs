@@ -9,6 +9,11 @@ use crate::widths::*;
 /// Fixed-maximum lanes (`MAX_BRANCHES`); the update is a loop and the
 /// Verilog a priority chain over the mix's branches only, generated per mix,
 /// so the lanes a mix does not have cost nothing.
+///
+/// The output registers load when P(c) is not empty; that enable is a
+/// flip-flop (`r_any`, computed a cycle early from the next pending set and
+/// the branches' `done_next`) rather than an OR over the pending set and
+/// the completions, which was the core's critical path (issue 28).
 #[derive(LogicBlock)]
 pub struct Merger {
     pub clock: Signal<In, Clock>,
@@ -16,6 +21,8 @@ pub struct Merger {
     pub done: Signal<In, Bits<MAX_BRANCHES>>,
     /// Lane `b` has more words of the same conversion after the one offered.
     pub more: Signal<In, Bits<MAX_BRANCHES>>,
+    /// `done` of the next cycle.
+    pub done_next: Signal<In, Bits<MAX_BRANCHES>>,
     pub ch: [Signal<In, Bits<CH_BITS>>; MAX_BRANCHES],
     pub v: [Signal<In, Bits<VALUE_BITS>>; MAX_BRANCHES],
     /// The lane whose word is taken at the end of this cycle (one-hot).
@@ -27,6 +34,8 @@ pub struct Merger {
     pub(super) r_ch: DFF<Bits<CH_BITS>>,
     pub(super) r_val: DFF<Bits<VALUE_BITS>>,
     pub(super) pend: DFF<Bits<MAX_BRANCHES>>,
+    /// P(c) is not empty (kept equal to `(pend | done) != 0`).
+    pub(super) r_any: DFF<Bit>,
     /// Branches of the mix (lanes `0..nb` are used).
     _nb: usize,
 }
@@ -38,6 +47,7 @@ impl Merger {
             rst: Default::default(),
             done: Default::default(),
             more: Default::default(),
+            done_next: Default::default(),
             ch: std::array::from_fn(|_| Default::default()),
             v: std::array::from_fn(|_| Default::default()),
             grant: Default::default(),
@@ -48,6 +58,7 @@ impl Merger {
             r_ch: Default::default(),
             r_val: Default::default(),
             pend: Default::default(),
+            r_any: Default::default(),
             _nb: nb,
         }
     }
@@ -55,26 +66,37 @@ impl Merger {
 
 impl Logic for Merger {
     fn update(&mut self) {
-        dff_setup!(self, clock, r_valid, r_ch, r_val, pend);
+        dff_setup!(self, clock, r_valid, r_ch, r_val, pend, r_any);
         let p = self.pend.q.val().to_u64() | self.done.val().to_u64();
         self.r_valid.d.next = p != 0;
-        self.pend.d.next = 0u64.into();
+        let mut pend = 0u64;
         self.grant.next = 0u64.into();
         if p != 0 {
             let b = p.trailing_zeros() as usize;
             let more = self.more.val().to_u64() & (1 << b);
+            // A chained conversion stays pending until its last word leaves.
+            pend = (p & (p - 1)) | more;
+            self.grant.next = (1u64 << b).into();
+        }
+        if self.r_any.q.val() {
+            // the Verilog's last lane is its `else`: the same lane when
+            // `r_any` holds its invariant
+            let b = if p != 0 {
+                p.trailing_zeros() as usize
+            } else {
+                self._nb - 1
+            };
             self.r_ch.d.next = self.ch[b].val();
             self.r_val.d.next = self.v[b].val();
-            // A chained conversion stays pending until its last word leaves.
-            self.pend.d.next = ((p & (p - 1)) | more).into();
-            self.grant.next = (1u64 << b).into();
         }
         if self.rst.val() {
             self.r_valid.d.next = false;
             self.r_ch.d.next = 0u64.into();
             self.r_val.d.next = 0u64.into();
-            self.pend.d.next = 0u64.into();
+            pend = 0;
         }
+        self.pend.d.next = pend.into();
+        self.r_any.d.next = !self.rst.val() & ((pend | self.done_next.val().to_u64()) != 0);
         self.valid.next = self.r_valid.q.val();
         self.channel.next = self.r_ch.q.val();
         self.value.next = self.r_val.q.val();
@@ -89,6 +111,8 @@ impl Logic for Merger {
         self.r_val.d.connect();
         self.pend.clock.connect();
         self.pend.d.connect();
+        self.r_any.clock.connect();
+        self.r_any.d.connect();
         self.grant.connect();
         self.valid.connect();
         self.channel.connect();
@@ -103,12 +127,13 @@ impl Logic for Merger {
             nb - 1
         );
         s.push_str("always @(*) begin\n");
-        for f in ["r_valid", "r_ch", "r_val", "pend"] {
+        for f in ["r_valid", "r_ch", "r_val", "pend", "r_any"] {
             s.push_str(&format!("  {f}$clock = clock;\n"));
         }
         s.push_str(&format!(
             "  r_valid$d = |p;\n  r_ch$d = r_ch$q;\n  r_val$d = r_val$q;\n  pend$d = {w}'h0;\n  grant = {w}'h0;\n"
         ));
+        // grant and the next pending set: the priority chain over P(c)
         for b in 0..nb {
             let kw = if b == 0 { "if" } else { "else if" };
             let mut rest = String::new();
@@ -123,18 +148,38 @@ impl Logic for Merger {
                 rest
             };
             s.push_str(&format!(
-                "  {kw} (p[{b}]) begin\n    r_ch$d = ch${b};\n    r_val$d = v${b};\n    pend$d = {pend};\n    pend$d[{b}] = more[{b}];\n    grant = {w}'h{:x};\n  end\n",
+                "  {kw} (p[{b}]) begin\n    pend$d = {pend};\n    pend$d[{b}] = more[{b}];\n    grant = {w}'h{:x};\n  end\n",
                 1u64 << b
             ));
         }
+        // the output registers: enabled by the registered r_any (= P(c) not
+        // empty), the last lane as the chain's `else`
+        s.push_str("  if (r_any$q) begin\n");
+        for b in 0..nb {
+            let kw = match b {
+                0 if nb == 1 => "  begin".to_string(),
+                0 => format!("  if (p[{b}]) begin"),
+                _ if b + 1 == nb => "  else begin".to_string(),
+                _ => format!("  else if (p[{b}]) begin"),
+            };
+            s.push_str(&format!(
+                "  {kw}\n      r_ch$d = ch${b};\n      r_val$d = v${b};\n    end\n"
+            ));
+        }
+        s.push_str("  end\n");
         s.push_str(&format!(
             "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = {VALUE_BITS}'h0;\n    pend$d = {w}'h0;\n  end\n"
+        ));
+        s.push_str(&format!(
+            "  r_any$d = !rst & |{{pend$d[{0}:0], done_next[{0}:0]}};\n",
+            nb - 1
         ));
         s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
         let mut unused: Vec<String> = Vec::new();
         if nb < w {
             unused.push(format!("done[{}:{nb}]", w - 1));
             unused.push(format!("more[{}:{nb}]", w - 1));
+            unused.push(format!("done_next[{}:{nb}]", w - 1));
             unused.push(format!("pend$q[{}:{nb}]", w - 1));
             for b in nb..w {
                 unused.push(format!("ch${b}"));

@@ -3,6 +3,7 @@
 use rust_hdl::prelude::*;
 
 use super::c;
+use super::timing::mask;
 use crate::plan::SeqTiming;
 use crate::widths::*;
 
@@ -19,6 +20,11 @@ use crate::widths::*;
 /// time too) and the SCLK periods: it starts at `sclk_div - setup` modulo
 /// `2^PH_BITS`, so it reaches the end of a period exactly `setup` cycles
 /// after the start, however long the setup.
+///
+/// Each counter's increment is masked to the mix's own width (`k_*_mask`,
+/// the phase counter's wide enough for both the period and the setup), so
+/// yosys removes the bits above it (issue 28: the core's maximum widths
+/// cost flip-flops, carry cells and compare LUTs in every design).
 #[derive(LogicBlock)]
 pub struct SpiSeq {
     pub clock: Signal<In, Clock>,
@@ -34,6 +40,11 @@ pub struct SpiSeq {
     pub(super) nfall: DFF<Bits<NFALL_BITS>>,
     /// Index within its word of the serial bit the next rising edge reads.
     pub(super) wbit: DFF<Bits<WORD_BIT_BITS>>,
+    /// `wbit` is a data bit (in `leading_bits .. leading_bits + bits`),
+    /// kept in step with it: two equality compares on the current bit
+    /// instead of a subtract-and-compare carry chain (the core's critical
+    /// path once the counters were trimmed).
+    pub(super) indata: DFF<Bit>,
     pub(super) r_cap: DFF<Bit>,
     pub(super) r_done: DFF<Bit>,
     wrap: Signal<Local, Bit>,
@@ -50,18 +61,29 @@ pub struct SpiSeq {
     k_wb_last: Constant<Bits<WORD_BIT_BITS>>,
     k_wb_zero: Constant<Bits<WORD_BIT_BITS>>,
     k_wb_one: Constant<Bits<WORD_BIT_BITS>>,
-    k_data_lo: Constant<Bits<WORD_BIT_BITS>>,
-    k_data_n: Constant<Bits<WORD_BIT_BITS>>,
+    /// The bit whose successor enters (leaves) the data window, and
+    /// whether the first bit of a word is in it.
+    k_wb_enter: Constant<Bits<WORD_BIT_BITS>>,
+    k_wb_leave: Constant<Bits<WORD_BIT_BITS>>,
+    k_in_first: Constant<Bit>,
     /// SCLK level between conversions (CS parts high, CNV parts low).
     k_sclk_idle: Constant<Bit>,
     /// The last rising edge reads a bit (CNV parts; a CS part's last edge
     /// comes after its last bit).
     k_cap_last: Constant<Bit>,
+    k_ph_mask: Constant<Bits<PH_BITS>>,
+    k_nf_mask: Constant<Bits<NFALL_BITS>>,
+    k_wb_mask: Constant<Bits<WORD_BIT_BITS>>,
 }
 
 impl SpiSeq {
     pub(super) fn new(t: &SeqTiming) -> SpiSeq {
-        let ph_mod = 1u64 << PH_BITS;
+        // the phase counts modulo 2^w: from sclk_div - setup through the
+        // wrap to sclk_div - 1, so 2^w must exceed both
+        let ph_mask = mask(t.sclk_div.max(t.setup_cycles));
+        let ph_mod = ph_mask + 1;
+        let w = t.word_sclks;
+        let in_data = |b: u64| b >= t.leading_bits && b < t.leading_bits + t.bits;
         SpiSeq {
             clock: Default::default(),
             rst: Default::default(),
@@ -75,6 +97,7 @@ impl SpiSeq {
             ph: Default::default(),
             nfall: Default::default(),
             wbit: Default::default(),
+            indata: Default::default(),
             r_cap: Default::default(),
             r_done: Default::default(),
             wrap: Default::default(),
@@ -91,10 +114,14 @@ impl SpiSeq {
             k_wb_last: c(t.word_sclks - 1),
             k_wb_zero: c(0),
             k_wb_one: c(1),
-            k_data_lo: c(t.leading_bits),
-            k_data_n: c(t.bits),
+            k_wb_enter: c((t.leading_bits + w - 1) % w),
+            k_wb_leave: c((t.leading_bits + t.bits + w - 1) % w),
+            k_in_first: Constant::new(in_data(t.first_bit())),
             k_sclk_idle: Constant::new(!t.cnv),
             k_cap_last: Constant::new(t.cnv),
+            k_ph_mask: c(ph_mask),
+            k_nf_mask: c(mask(t.sclks)),
+            k_wb_mask: c(mask(t.word_sclks - 1)),
         }
     }
 }
@@ -102,7 +129,7 @@ impl SpiSeq {
 impl Logic for SpiSeq {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, r_cs_n, r_sclk, ph, nfall, wbit, r_cap, r_done);
+        dff_setup!(self, clock, r_cs_n, r_sclk, ph, nfall, wbit, indata, r_cap, r_done);
         self.wrap.next = self.ph.q.val() == self.k_ph_last.val();
         self.half.next = self.ph.q.val() == self.k_ph_half.val();
         self.r_cap.d.next = false;
@@ -115,11 +142,12 @@ impl Logic for SpiSeq {
             self.ph.d.next = self.k_ph_start.val();
             self.nfall.d.next = self.k_nf_zero.val();
             self.wbit.d.next = self.k_wb_first.val();
+            self.indata.d.next = self.k_in_first.val();
         } else if !self.r_cs_n.q.val() {
             if self.wrap.val() {
                 self.ph.d.next = self.k_ph_zero.val();
             } else {
-                self.ph.d.next = self.ph.q.val() + self.k_ph_one.val();
+                self.ph.d.next = (self.ph.q.val() + self.k_ph_one.val()) & self.k_ph_mask.val();
             }
             if self.wrap.val() {
                 if self.nfall.q.val() == self.k_nf_end.val() {
@@ -129,7 +157,8 @@ impl Logic for SpiSeq {
                     self.r_sclk.d.next = self.k_sclk_idle.val();
                     self.r_done.d.next = true;
                 } else {
-                    self.nfall.d.next = self.nfall.q.val() + self.k_nf_one.val();
+                    self.nfall.d.next =
+                        (self.nfall.q.val() + self.k_nf_one.val()) & self.k_nf_mask.val();
                     self.r_sclk.d.next = false;
                 }
             }
@@ -141,10 +170,15 @@ impl Logic for SpiSeq {
                 if self.wbit.q.val() == self.k_wb_last.val() {
                     self.wbit.d.next = self.k_wb_zero.val();
                 } else {
-                    self.wbit.d.next = self.wbit.q.val() + self.k_wb_one.val();
+                    self.wbit.d.next =
+                        (self.wbit.q.val() + self.k_wb_one.val()) & self.k_wb_mask.val();
                 }
-                // (wbit - leading) wraps to >= 32 below the window.
-                if ((self.wbit.q.val() - self.k_data_lo.val()) < self.k_data_n.val())
+                if self.wbit.q.val() == self.k_wb_enter.val() {
+                    self.indata.d.next = true;
+                } else if self.wbit.q.val() == self.k_wb_leave.val() {
+                    self.indata.d.next = false;
+                }
+                if self.indata.q.val()
                     & ((self.nfall.q.val() != self.k_nf_end.val()) | self.k_cap_last.val())
                 {
                     self.r_cap.d.next = true;
@@ -158,6 +192,7 @@ impl Logic for SpiSeq {
             self.ph.d.next = self.k_ph_start.val();
             self.nfall.d.next = self.k_nf_zero.val();
             self.wbit.d.next = self.k_wb_first.val();
+            self.indata.d.next = self.k_in_first.val();
             self.r_cap.d.next = false;
             self.r_done.d.next = false;
         }

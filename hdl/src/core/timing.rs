@@ -11,6 +11,15 @@ use crate::widths::*;
 /// is the (combinational) next value of the slot pointer, so the ROMs'
 /// registered data describe slot `u` from the second cycle of slot `u - 1`
 /// through its last, and slot `u + 1` in the first cycle of slot `u`.
+///
+/// Lean in synthesis (issue 28): the counters are declared at the core's
+/// maximum widths (rust-hdl fixes widths when the crate compiles), but every
+/// increment is masked to the mix's own width (`k_*_mask`), so the bits
+/// above it have a constant-zero D input and yosys removes them with their
+/// carry and compare logic. The ROM address is a one-LUT multiplexer of two
+/// registers (`slot`, `succ` = the slot after it) rather than the slot's
+/// compare-and-increment, which was the core's critical path into the
+/// block RAMs' address pins.
 #[derive(LogicBlock)]
 pub struct TimingGen {
     pub clock: Signal<In, Clock>,
@@ -29,6 +38,8 @@ pub struct TimingGen {
     /// slice (compact LUT), with its slice in `sl`.
     pub(super) slot: DFF<Bits<SLOT_BITS>>,
     pub(super) sl: DFF<Bits<SLICE_BITS>>,
+    /// The slot after `slot` (wrapping at the last), kept in step with it.
+    pub(super) succ: DFF<Bits<SLOT_BITS>>,
     nxt: Signal<Local, Bits<SLOT_BITS>>,
     nxt_sl: Signal<Local, Bits<SLICE_BITS>>,
     k_compact: Constant<Bit>,
@@ -42,10 +53,18 @@ pub struct TimingGen {
     k_slot_last: Constant<Bits<SLOT_BITS>>,
     k_slot_zero: Constant<Bits<SLOT_BITS>>,
     k_slot_one: Constant<Bits<SLOT_BITS>>,
+    /// The mix's own counter widths, as masks.
+    k_cnt_mask: Constant<Bits<CNT_BITS>>,
+    k_slot_mask: Constant<Bits<SLOT_BITS>>,
 }
 
 impl TimingGen {
     pub(super) fn new(plan: &Plan) -> TimingGen {
+        let slot_last = if plan.compact {
+            plan.slots_per_slice - 1
+        } else {
+            plan.frame_slots - 1
+        };
         TimingGen {
             clock: Default::default(),
             rst: Default::default(),
@@ -60,6 +79,7 @@ impl TimingGen {
             st0: Default::default(),
             slot: Default::default(),
             sl: Default::default(),
+            succ: Default::default(),
             nxt: Default::default(),
             nxt_sl: Default::default(),
             k_compact: Constant::new(plan.compact),
@@ -74,25 +94,29 @@ impl TimingGen {
             k_cnt_rst: c(1 % plan.slot_cycles),
             k_cnt_zero: c(0),
             k_cnt_one: c(1),
-            k_slot_last: c(if plan.compact {
-                plan.slots_per_slice - 1
-            } else {
-                plan.frame_slots - 1
-            }),
+            k_slot_last: c(slot_last),
             k_slot_zero: c(0),
             k_slot_one: c(1),
+            k_cnt_mask: c(mask(plan.slot_cycles - 1)),
+            k_slot_mask: c(mask(slot_last)),
         }
     }
+}
+
+/// All ones over the bits that count `0..=last` (at least one bit).
+pub(super) fn mask(last: u64) -> u64 {
+    let bits = 64 - last.leading_zeros();
+    (1u64 << bits.max(1)) - 1
 }
 
 impl Logic for TimingGen {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, cnt, st, st2, st0, slot, sl);
+        dff_setup!(self, clock, cnt, st, st2, st0, slot, sl, succ);
         if self.cnt.q.val() == self.k_cnt_last.val() {
             self.cnt.d.next = self.k_cnt_zero.val();
         } else {
-            self.cnt.d.next = self.cnt.q.val() + self.k_cnt_one.val();
+            self.cnt.d.next = (self.cnt.q.val() + self.k_cnt_one.val()) & self.k_cnt_mask.val();
         }
         self.st2.d.next = self.cnt.q.val() == self.k_cnt_last.val();
         self.st.d.next = self.st2.q.val();
@@ -100,17 +124,13 @@ impl Logic for TimingGen {
         self.nxt.next = self.slot.q.val();
         self.nxt_sl.next = self.sl.q.val();
         if self.st.q.val() {
-            if self.slot.q.val() == self.k_slot_last.val() {
-                self.nxt.next = self.k_slot_zero.val();
-                if self.k_compact.val() {
-                    if self.sl.q.val() == self.k_sl_last.val() {
-                        self.nxt_sl.next = self.k_sl_zero.val();
-                    } else {
-                        self.nxt_sl.next = self.sl.q.val() + self.k_sl_one.val();
-                    }
+            self.nxt.next = self.succ.q.val();
+            if (self.slot.q.val() == self.k_slot_last.val()) & self.k_compact.val() {
+                if self.sl.q.val() == self.k_sl_last.val() {
+                    self.nxt_sl.next = self.k_sl_zero.val();
+                } else {
+                    self.nxt_sl.next = self.sl.q.val() + self.k_sl_one.val();
                 }
-            } else {
-                self.nxt.next = self.slot.q.val() + self.k_slot_one.val();
             }
         }
         if self.rst.val() {
@@ -121,7 +141,12 @@ impl Logic for TimingGen {
             self.nxt.next = self.k_slot_zero.val();
             self.nxt_sl.next = self.k_sl_zero.val();
         }
-        self.slot.d.next = self.nxt.val();
+        self.slot.d.next = self.nxt.val() & self.k_slot_mask.val();
+        if self.nxt.val() == self.k_slot_last.val() {
+            self.succ.d.next = self.k_slot_zero.val();
+        } else {
+            self.succ.d.next = (self.nxt.val() + self.k_slot_one.val()) & self.k_slot_mask.val();
+        }
         self.sl.d.next = self.nxt_sl.val();
         self.addr.next = self.nxt.val();
         self.slice.next = self.nxt_sl.val();

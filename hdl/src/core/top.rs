@@ -97,6 +97,7 @@ impl Core {
         drive(&mut t.st0.clock, k);
         drive(&mut t.slot.clock, k);
         drive(&mut t.sl.clock, k);
+        drive(&mut t.succ.clock, k);
         for q in self.seqs.iter_mut() {
             drive(&mut q.clock, k);
             drive(&mut q.r_cs_n.clock, k);
@@ -104,6 +105,7 @@ impl Core {
             drive(&mut q.ph.clock, k);
             drive(&mut q.nfall.clock, k);
             drive(&mut q.wbit.clock, k);
+            drive(&mut q.indata.clock, k);
             drive(&mut q.r_cap.clock, k);
             drive(&mut q.r_done.clock, k);
         }
@@ -127,6 +129,7 @@ impl Core {
         drive(&mut m.r_ch.clock, k);
         drive(&mut m.r_val.clock, k);
         drive(&mut m.pend.clock, k);
+        drive(&mut m.r_any.clock, k);
     }
 }
 
@@ -154,6 +157,7 @@ impl Logic for Core {
         let grant = self.merge.grant.val().to_u64();
         let (mut cs, mut sclk, mut sel, mut en, mut done) = (0u64, 0u64, 0u64, 0u128, 0u64);
         let mut more = 0u64;
+        let mut done_next = 0u64;
         let mut en_off = 0usize;
         let mut chs = [0u64; MAX_BRANCHES];
         let mut vals = [0u64; MAX_BRANCHES];
@@ -181,6 +185,7 @@ impl Logic for Core {
             en |= ((u.mux_en.val().to_u64() & mask) as u128) << en_off;
             en_off += d;
             done |= (u.done.val() as u64) << b;
+            done_next |= (u.done_next.val() as u64) << b;
             chs[b] = u.res_ch.val().to_u64();
             vals[b] = u.res_val.val().to_u64();
         }
@@ -204,6 +209,7 @@ impl Logic for Core {
         }
         self.merge.done.next = done.into();
         self.merge.more.next = more.into();
+        self.merge.done_next.next = done_next.into();
         // Lanes >= nb keep their default 0 (the glue ties them to zero).
         let m = &mut self.merge;
         for b in 0..nb {
@@ -242,6 +248,7 @@ impl Logic for Core {
         }
         self.merge.done.connect();
         self.merge.more.connect();
+        self.merge.done_next.connect();
         for b in 0..MAX_BRANCHES {
             self.merge.ch[b].connect();
             self.merge.v[b].connect();

@@ -35,7 +35,7 @@ fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
     let clock = s.grid.clock_hz;
     Some(std::thread::spawn(move || {
         let t = std::time::Instant::now();
-        let r = measure::place_and_route(&dir, None, clock);
+        let r = measure::place_and_route(&dir, None, clock, 1);
         (r, t.elapsed().as_secs_f64())
     }))
 }
