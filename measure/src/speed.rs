@@ -148,7 +148,7 @@ pub fn sample_scores(methods: &[MethodRun]) -> Vec<MethodScore> {
 /// figures the chart's points are drawn from.
 pub fn methods_table(methods: &[MethodRun]) -> Table {
     let mut t = Table::new(&[
-        "Method",
+        "Engine",
         "Faults run",
         "Caught",
         "Missed",
@@ -328,7 +328,7 @@ pub fn section(
         })
         .collect();
     let mut paragraphs = vec![
-        "Every point is a column of the fault table above, from the same campaign: a detector (its name as in the table) with the injections it can see, or an engine the faults ran through (`engine: NAME`) with the injections that ran through it and were detected by any detector. The cost is what the campaign measured: a clean run of its frames under the checker with and without the model, each sigrok-cli decode, each proof.".into(),
+        "The campaign's points are the columns of the fault table above: a detector (its name as in the table) with the injections it can see, or an engine the faults ran through (`engine: NAME`) with the injections that ran through it and were detected by any detector. The cost is what the campaign measured: a clean run of its frames under the checker with and without the model, each sigrok-cli decode, each proof.".into(),
         format!("{line}."),
     ];
     paragraphs.extend(methods_paragraph(c, methods));
