@@ -18,6 +18,30 @@ fn csv(path: &Path) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// The engines of `methods.json` that ran faults, as (method, faults run,
+/// seconds, caught); the report's methods table holds the same figures.
+fn methods_rows(out: &Path) -> Vec<(String, u64, f64, u64, u64)> {
+    let text = std::fs::read_to_string(out.join("methods.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let mut rows = Vec::new();
+    for m in v.as_array().unwrap() {
+        let (runs, caught) = (
+            m["faults_run"].as_u64().unwrap(),
+            m["caught"].as_u64().unwrap(),
+        );
+        let name = m["engine"].as_str().unwrap();
+        let secs = m["seconds"].as_f64().unwrap();
+        let row = format!("| {name} | {runs} | {caught} |");
+        assert!(md.contains(&row), "{row} not in report.md's methods table");
+        assert!(md.contains(&format!("| {secs:.3} | {:.3} |", secs / runs.max(1) as f64)));
+        if m["not_run"].is_null() && runs > 0 {
+            rows.push((format!("engine: {name}"), runs, secs, caught, runs));
+        }
+    }
+    rows
+}
+
 /// The rows of `speed-accuracy.csv` are the columns (detectors that ran)
 /// and the engines of `faults.json` of the same build: the same names,
 /// counts and timings, in that order.
@@ -59,14 +83,24 @@ fn assert_chart_is_the_matrix(out: &Path) {
             )
         })
         .collect();
-    // the matrix's rows first, then the engines the build ran clean beside
-    // the campaign (cost only: no fault went through them)
-    assert!(got.len() >= want.len(), "{got:?} vs {want:?}");
-    for g in &got[want.len()..] {
+    // the matrix's rows first, then the engines that ran the sample of the
+    // quick campaign (methods.json: the same figures), then what the build
+    // ran clean beside the campaign (cost only: no fault went through it)
+    let sample = methods_rows(out);
+    let at = want.len() + sample.len();
+    assert!(got.len() >= at, "{got:?} vs {want:?} and {sample:?}");
+    for (g, m) in got[want.len()..at].iter().zip(&sample) {
+        assert_eq!((&g.0, g.1, g.3, g.4), (&m.0, m.1, m.3, m.1), "{g:?}");
+        assert!(g.1 > 0, "{g:?}");
+        assert!((g.2 - m.2).abs() < 1e-5, "{g:?} vs {m:?}");
+    }
+    for g in &got[at..] {
         assert!(g.0.starts_with("engine: ") || g.0 == "prove", "{g:?}");
+        assert!(!sample.iter().any(|m| m.0 == g.0), "{g:?} twice");
         assert_eq!((g.1, g.3, g.4), (1, 0, 0), "{g:?}");
         assert!(g.2 > 0.0, "{g:?}");
     }
+    want.extend(sample);
     for (g, w) in got.iter().zip(&want) {
         assert_eq!((&g.0, g.1, g.3, g.4), (&w.0, w.1, w.3, w.4));
         assert!((g.2 - w.2).abs() < 1e-5, "{g:?} vs {w:?}");
@@ -205,8 +239,12 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         assert!(sa.iter().any(|r| r[0] == m), "{m}: {sa:?}");
         assert!(html.contains(m), "{m} not in the report");
     }
-    let svg = std::fs::read_to_string(out.join("speed-accuracy.svg")).unwrap();
-    assert!(svg.contains("engine: rusthdl (cost only)"), "{svg}");
+    // the gateware's engines ran faults, each with its catch on the chart
+    for (name, runs, ..) in methods_rows(&out) {
+        assert!(runs > 0, "{name}");
+        assert!(html.contains(&format!("<code>{name}</code> ran {runs} of them")));
+    }
+    assert_eq!(methods_rows(&out).len(), 2, "rusthdl and verilator");
     assert!(html.contains("adds") && html.contains("Icarus") && html.contains("sigrok"));
     assert_reads_like_a_datasheet(&tiny(), &out);
     // the timing diagram's table has every branch's CS edges
@@ -376,6 +414,35 @@ fn a_failing_step_fails_the_build_and_the_others_still_run() {
     );
 }
 
+/// An engine of the speed chart's sample that misses faults is data: its
+/// points and the methods table show the misses, and the chart's step stays
+/// ok (the fault campaign is what gates the build; here it fails, as it
+/// must with the checker switched off).
+#[test]
+fn an_engine_that_misses_leaves_the_chart_green() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("b");
+    slotforge()
+        .env("SLOTFORGE_TEST_DISABLE_DETECTOR", "model,invariants,sigrok")
+        .args(["build", "--quiet", "--only", "faults,speed", "-o"])
+        .arg(&out)
+        .arg(tiny())
+        .assert()
+        .code(1);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("| fault campaign | FAILED |"), "{md}");
+    assert!(
+        md.contains("| chart: speed against accuracy | ok |"),
+        "{md}"
+    );
+    let rows = methods_rows(&out);
+    assert!(!rows.is_empty());
+    for (name, runs, _, caught, _) in &rows {
+        assert!(*runs > 0 && *caught == 0, "{name}: {rows:?}");
+    }
+    assert_chart_is_the_matrix(&out);
+}
+
 fn skin28() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/skin28.toml")
 }
@@ -414,6 +481,10 @@ fn a_new_users_mix_builds_by_default_and_its_report_renders() {
             "{rate} Hz: peak at {f}, want {alias}"
         );
     }
+    // the chart's points are the campaign's and the sample's figures, and
+    // every gateware engine ran faults
+    assert_chart_is_the_matrix(&out);
+    assert!(methods_rows(&out).iter().any(|m| m.0 == "engine: rusthdl"));
     let r = browser::render(&out);
     assert_eq!(browser::problems(&out, &r), Vec::<String>::new());
 }

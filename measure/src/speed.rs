@@ -4,7 +4,7 @@
 //! counts and the seconds the same campaign measured.  The chart draws
 //! counts (n of N), a real-time line, and keeps every point inside its axes.
 
-use campaign::Campaign;
+use campaign::{Campaign, MethodRun};
 use report::{draw, Axes, Figure, Marker, Section, Series, Table};
 
 /// One method: what one judged run cost it, and how many of the faults
@@ -123,9 +123,88 @@ fn clean_points(
     }
 }
 
-/// The chart and its table for `c`'s methods and the clean runs beside it.
-pub fn chart(c: &Campaign, clean: &[CleanRun]) -> Figure {
-    let scores = scores(c);
+/// The scores of the engines that ran the sample of the quick campaign
+/// (`campaign::methods`), rows of the methods table: each engine's faults
+/// run, caught, and its wall seconds.
+pub fn sample_scores(methods: &[MethodRun]) -> Vec<MethodScore> {
+    methods
+        .iter()
+        .filter(|m| m.not_run.is_none() && m.faults_run > 0)
+        .map(|m| MethodScore {
+            method: format!("engine: {}", m.engine.name()),
+            runs: m.faults_run,
+            wall_seconds: m.seconds,
+            detected: m.caught,
+            of: m.faults_run,
+            how: format!(
+                "the sample of the quick campaign: {} fault(s) at its site; {} frames each; judged by the checker",
+                m.faults_run, m.frames
+            ),
+        })
+        .collect()
+}
+
+/// The methods table of the report: one row per engine of the sample, the
+/// figures the chart's points are drawn from.
+pub fn methods_table(methods: &[MethodRun]) -> Table {
+    let mut t = Table::new(&[
+        "Engine",
+        "Faults run",
+        "Caught",
+        "Missed",
+        "Frames per run",
+        "Time (s)",
+        "Time per run (s)",
+    ]);
+    for m in methods {
+        let missed = match &m.not_run {
+            Some(why) => format!("not run: {why}"),
+            None if m.missed.is_empty() => "none".into(),
+            None => m.missed.join(", "),
+        };
+        t.push(vec![
+            m.engine.name().into(),
+            m.faults_run.to_string(),
+            m.caught.to_string(),
+            missed,
+            m.frames.to_string(),
+            format!("{:.3}", m.seconds),
+            format!("{:.3}", m.seconds_per_run()),
+        ]);
+    }
+    t
+}
+
+/// What the engines of the sample ran, in words: how many faults each
+/// point ran, and those an engine could not run.
+fn methods_paragraph(c: &Campaign, methods: &[MethodRun]) -> Option<String> {
+    if methods.is_empty() {
+        return None;
+    }
+    let each: Vec<String> = methods
+        .iter()
+        .map(|m| match &m.not_run {
+            Some(why) => format!("{}: not run ({why})", m.engine.name()),
+            None => format!(
+                "`engine: {}` ran {} of them and caught {}",
+                m.engine.name(),
+                m.faults_run,
+                m.caught
+            ),
+        })
+        .collect();
+    Some(format!(
+        "The gateware's engines ran a sample of the quick campaign (its pin faults, one of each class, in an order fixed by the mix's name, at the same site, {} frames per run, judged by the same checker): {}. Their points and the table below are the same figures; a fault an engine misses is shown, and does not fail the build (the campaign above gates it).",
+        methods.first().map_or(c.frames, |m| m.frames),
+        each.join("; ")
+    ))
+}
+
+/// The chart and its table for `c`'s methods, the engines of the sample
+/// (`methods`) and the clean runs beside them.
+pub fn chart(c: &Campaign, methods: &[MethodRun], clean: &[CleanRun]) -> Figure {
+    let mut scores = scores(c);
+    scores.extend(sample_scores(methods));
     let mut table = Table::new(&[
         "method",
         "runs_timed",
@@ -211,8 +290,14 @@ pub fn chart(c: &Campaign, clean: &[CleanRun]) -> Figure {
 
 /// The section for campaign `c` and the clean runs beside it, and its
 /// one-line summary. `charts_all`: whether this build ran every method.
-pub fn speed(c: &Campaign, clean: &[CleanRun], charts_all: bool) -> (Section, String) {
-    let scores = scores(c);
+pub fn speed(
+    c: &Campaign,
+    methods: &[MethodRun],
+    clean: &[CleanRun],
+    charts_all: bool,
+) -> (Section, String) {
+    let mut scores = scores(c);
+    scores.extend(sample_scores(methods));
     let line = scores
         .iter()
         .map(|m| {
@@ -243,12 +328,13 @@ pub fn speed(c: &Campaign, clean: &[CleanRun], charts_all: bool) -> (Section, St
         })
         .collect();
     let mut paragraphs = vec![
-        "Every point is a column of the fault table above, from the same campaign: a detector (its name as in the table) with the injections it can see, or an engine the faults ran through (`engine: NAME`) with the injections that ran through it and were detected by any detector. The cost is what the campaign measured: a clean run of its frames under the checker with and without the model, each sigrok-cli decode, each proof.".into(),
+        "The campaign's points are the columns of the fault table above: a detector (its name as in the table) with the injections it can see, or an engine the faults ran through (`engine: NAME`) with the injections that ran through it and were detected by any detector. The cost is what the campaign measured: a clean run of its frames under the checker with and without the model, each sigrok-cli decode, each proof.".into(),
         format!("{line}."),
     ];
+    paragraphs.extend(methods_paragraph(c, methods));
     if !clean.is_empty() {
         paragraphs.push(format!(
-            "On the row below 0 %, the engines this build also ran clean under the full check, outside the campaign, so no fault went through them here: {}. Their cost is measured; what they catch is measured by `--charts all`.",
+            "On the row below 0 %, what this build also ran clean, outside the campaign, so no fault went through it here: {}. Its cost is measured; what it catches is measured by `--charts all`.",
             clean
                 .iter()
                 .map(|m| format!("{} ({})", m.method, m.how))
@@ -260,13 +346,21 @@ pub fn speed(c: &Campaign, clean: &[CleanRun], charts_all: bool) -> (Section, St
         paragraphs.push(format!("Not on the chart: {}.", not_run.join("; ")));
     }
     if !charts_all {
-        paragraphs.push("`--charts all` adds: every class at every site with five clean random mixes, sigrok-cli's SPI decode as a detector, the deep Verilog faults (a counter that misbehaves after the run's last frame, a merger collision no stimulus drives) run through Verilator and Icarus, each engine with the faults through it and what caught them, and `prove` as a detector of every fault that is a design (minutes on a 48 MHz mix).".into());
+        paragraphs.push("`--charts all` adds: every class at every site with five clean random mixes, sigrok-cli's SPI decode as a detector, the deep Verilog faults (a counter that misbehaves after the run's last frame, a merger collision no stimulus drives) run through Verilator and Icarus, each engine with the faults through it and what caught them (a simulation misses the deep faults by design: that is what they show), and `prove` as a detector of every fault that is a design (minutes on a 48 MHz mix).".into());
     }
     (
         Section {
             title: "Speed against accuracy".into(),
             paragraphs,
-            figures: vec![chart(c, clean)],
+            tables: if methods.is_empty() {
+                vec![]
+            } else {
+                vec![(
+                    "Engines on a sample of the quick campaign".into(),
+                    methods_table(methods),
+                )]
+            },
+            figures: vec![chart(c, methods, clean)],
             ..Section::default()
         },
         line,

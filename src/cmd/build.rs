@@ -6,8 +6,8 @@
 //! `measure` crate; this module parses, calls and writes.
 //!
 //! Fast by default: every default step is about the mix itself; the speed
-//! chart is drawn from the fault step's campaign, which with `--charts all`
-//! also runs the deep Verilog faults on every Verilog engine and `prove`.
+//! chart is drawn from the fault step's campaign and a sample of its faults
+//! on rust-hdl and Verilator; with `--charts all` the campaign also runs the deep Verilog faults on every Verilog engine and `prove`.
 //! The report is rewritten after every step, so an interrupted build
 //! leaves a report of the steps that finished.
 //!
@@ -41,7 +41,8 @@ pub struct Args {
     #[arg(long, default_value = "golden")]
     pub golden: PathBuf,
     /// Which charts: `mix` (timing, figure7, schedulability, and speed
-    /// against accuracy drawn from the fault campaign), `all` (the campaign
+    /// against accuracy drawn from the fault campaign, with a sample of its
+    /// faults run on rust-hdl and Verilator), `all` (the campaign
     /// at every site instead of the quick one, also running the deep Verilog
     /// faults on Verilator and Icarus and `prove`: minutes), or `none`.
     #[arg(long, value_enum, default_value_t = Charts::Mix)]

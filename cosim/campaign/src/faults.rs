@@ -35,8 +35,10 @@ use engines::RustHdlDut;
 use engines::SimError;
 
 mod class;
+mod methods;
 mod verilog;
 pub use class::{FaultClass, Level};
+pub use methods::{methods, sample as methods_sample, Engine, MethodRun};
 pub use verilog::{deep_faults, prove, prove_unavailable, ProveVerdict, VerilogFault};
 
 /// A detector of the judge, measured apart from the others.

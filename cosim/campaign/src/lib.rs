@@ -19,8 +19,8 @@ mod sigrok;
 
 pub use equiv::{check as check_equivalence, verdict as equivalence_verdict, Equivalence};
 pub use faults::{
-    campaign_with, deep_faults, gateware_dut, one_gateware_fault_per_class, prove,
-    prove_unavailable, sites, Campaign, Detector, FaultClass, Level, OnRun, Plan, ProveVerdict,
-    Target, VerilogFault, TREADY,
+    campaign_with, deep_faults, gateware_dut, methods, methods_sample,
+    one_gateware_fault_per_class, prove, prove_unavailable, sites, Campaign, Detector, Engine,
+    FaultClass, Level, MethodRun, OnRun, Plan, ProveVerdict, Target, VerilogFault, TREADY,
 };
 pub use mixgen::{random_mix, LinkShape, Shape};

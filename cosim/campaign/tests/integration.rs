@@ -10,6 +10,9 @@ mod equiv;
 #[path = "link.rs"]
 mod link;
 
+#[path = "methods.rs"]
+mod methods;
+
 #[path = "mutants.rs"]
 mod mutants;
 
