@@ -99,6 +99,9 @@ struct Regs {
     hframe: u8,
     hslice: u16,
     crc: u16,
+    /// UART: the character in transit is one the CRC covers (not its own
+    /// two bytes); its data bits go into `crc` as they reach the line.
+    in_crc: bool,
     ovfc: u8,
     ovf: bool,
     busy: bool,
@@ -208,16 +211,19 @@ fn reset_regs(p: &LinkParams, r: &mut Regs) {
     };
 }
 
-fn crc8(mut c: u16, d: u8) -> u16 {
-    c ^= d as u16;
-    for _ in 0..8 {
-        c = if c & 1 == 1 {
-            (c >> 1) ^ 0xA001
-        } else {
-            c >> 1
-        };
+/// CRC-16/MODBUS after one more bit (the line's order: LSB first).
+fn crc1(c: u16, bit: bool) -> u16 {
+    if (c & 1 == 1) != bit {
+        (c >> 1) ^ 0xA001
+    } else {
+        c >> 1
     }
-    c
+}
+
+/// CRC-16/MODBUS after one more byte (the AXI4-Stream link's, a beat a
+/// cycle).
+fn crc8(c: u16, d: u8) -> u16 {
+    (0..8).fold(c, |c, i| crc1(c, d >> i & 1 == 1))
 }
 
 impl UartLink {
@@ -308,6 +314,11 @@ fn shift(p: &LinkParams, r: &Regs, nx: &mut Regs, tready: bool, last_tick: bool)
                 nx.bitn = r.bitn + 1;
                 nx.tx = r.chr >> 1 & 1 == 1;
                 nx.chr = r.chr >> 1;
+                // the data bit that goes out next (bits 1..=8 of the
+                // character) enters the CRC
+                if r.in_crc && r.bitn < 8 {
+                    nx.crc = crc1(r.crc, nx.tx);
+                }
             }
         } else {
             nx.dv = r.dv + 1;
@@ -345,11 +356,16 @@ fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
     nx.tlast = slot == 3 && (p.axis == Some(link::Tlast::Slice) || r.hslice == 0);
     nx.mask = rest;
     nx.have = rest != 0;
-    match slot {
-        2 | 3 => {}
-        4 => nx.crc = crc8(p.crc_init, byte),
-        _ => nx.crc = crc8(r.crc, byte),
+    match (p.axis, slot) {
+        (_, 2 | 3) => {}
+        // UART: the CRC follows the line bit by bit (`shift`); a header
+        // restarts it
+        (None, 4) => nx.crc = p.crc_init,
+        (None, _) => {}
+        (Some(_), 4) => nx.crc = crc8(p.crc_init, byte),
+        (Some(_), _) => nx.crc = crc8(r.crc, byte),
     }
+    nx.in_crc = !matches!(slot, 2 | 3);
     if slot == 7 {
         nx.started = true;
         if r.hslice as u64 + 1 == p.slices_per_frame {
@@ -507,7 +523,7 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
         );
         let _ = writeln!(
             s,
-            "reg [{}:0] chr;\ninitial chr = {cb}'d0;\nreg tx_r;\ninitial tx_r = 1'b1;\n",
+            "reg [{}:0] chr;\ninitial chr = {cb}'d0;\nreg tx_r;\ninitial tx_r = 1'b1;\n// the character in transit is covered by the CRC (not one of its bytes)\nreg in_crc;\ninitial in_crc = 1'b0;\n",
             cb - 1
         );
     }
@@ -586,15 +602,25 @@ fn byte_out(s: &mut String) {
 /// The CRC after the outgoing byte, and (UART) its character with start,
 /// parity and stop bits.
 fn crc_and_character(s: &mut String, p: &LinkParams, w: Widths) {
-    // CRC-16/MODBUS of one byte
+    if p.axis.is_some() {
+        // CRC-16/MODBUS of one byte: a beat may leave every cycle
+        let _ = writeln!(
+            s,
+            "function [15:0] crc8;\n  input [15:0] c;\n  input [7:0] d;\n  integer i;\n  reg [15:0] x;\n  begin\n    x = c ^ {{8'h00, d}};\n    for (i = 0; i < 8; i = i + 1)\n      x = x[0] ? ((x >> 1) ^ 16'ha001) : (x >> 1);\n    crc8 = x;\n  end\nendfunction\n"
+        );
+        let _ = writeln!(
+            s,
+            "wire [15:0] crc_next = crc8((slot == 4'd4) ? 16'h{:04x} : crc, byte_out);\n",
+            p.crc_init
+        );
+        return;
+    }
+    // UART: CRC-16/MODBUS one bit at a time, the data bit that goes out
+    // next (`chr[1]`) in line order: 16 flip-flops and a few LUTs instead
+    // of a byte-wide XOR tree behind the byte multiplexer
     let _ = writeln!(
         s,
-        "function [15:0] crc8;\n  input [15:0] c;\n  input [7:0] d;\n  integer i;\n  reg [15:0] x;\n  begin\n    x = c ^ {{8'h00, d}};\n    for (i = 0; i < 8; i = i + 1)\n      x = x[0] ? ((x >> 1) ^ 16'ha001) : (x >> 1);\n    crc8 = x;\n  end\nendfunction\n"
-    );
-    let _ = writeln!(
-        s,
-        "wire [15:0] crc_next = crc8((slot == 4'd4) ? 16'h{:04x} : crc, byte_out);",
-        p.crc_init
+        "wire [15:0] crc_bit = {{1'b0, crc[15:1]}} ^ ({{16{{crc[0] ^ chr[1]}}}} & 16'ha001);"
     );
     let stops = "1'b1, ".repeat(p.stop_bits as usize);
     let parity = match p.parity {
@@ -602,13 +628,11 @@ fn crc_and_character(s: &mut String, p: &LinkParams, w: Widths) {
         2 => "~^byte_out, ",
         _ => "",
     };
-    if p.axis.is_none() {
-        let _ = writeln!(
-            s,
-            "wire [{}:0] chr_load = {{{stops}{parity}byte_out, 1'b0}};\n",
-            w.cb - 1
-        );
-    }
+    let _ = writeln!(
+        s,
+        "wire [{}:0] chr_load = {{{stops}{parity}byte_out, 1'b0}};\n",
+        w.cb - 1
+    );
 }
 
 /// The reset branch of the register update.
@@ -620,7 +644,7 @@ fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
     let out_reset = if p.axis.is_some() {
         "    tdata_r <= 8'd0;\n    tlast_r <= 1'b0;".to_string()
     } else {
-        format!("    bitn <= {bw}'d0;\n    dv <= {dw}'d0;\n    tx_r <= 1'b1;")
+        format!("    bitn <= {bw}'d0;\n    dv <= {dw}'d0;\n    tx_r <= 1'b1;\n    in_crc <= 1'b0;")
     };
     let _ = writeln!(
         s,
@@ -680,8 +704,9 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
     } else {
         let _ = writeln!(
         s,
-        "    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (bitn == {}) begin\n          busy <= 1'b0;\n          tx_r <= 1'b1;\n        end else begin\n          bitn <= bitn + {bw}'d1;\n          tx_r <= chr[1];\n          chr <= chr >> 1;\n        end\n      end else dv <= dv + {dw}'d1;\n    end",
-        lit(bw, cb as u64 - 1)
+        "    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (bitn == {}) begin\n          busy <= 1'b0;\n          tx_r <= 1'b1;\n        end else begin\n          bitn <= bitn + {bw}'d1;\n          tx_r <= chr[1];\n          chr <= chr >> 1;\n          if (in_crc & (bitn < {})) crc <= crc_bit;\n        end\n      end else dv <= dv + {dw}'d1;\n    end",
+        lit(bw, cb as u64 - 1),
+        lit(bw, 8)
     );
     }
     let load_out = match p.axis {
@@ -695,9 +720,16 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
         ),
         None => format!("      chr <= chr_load;\n      bitn <= {bw}'d0;\n      dv <= {dw}'d0;\n      tx_r <= 1'b0;"),
     };
+    let crc_load = match p.axis {
+        Some(_) => "      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;".to_string(),
+        None => format!(
+            "      if (slot == 4'd4) crc <= 16'h{:04x};\n      in_crc <= (slot != 4'd2) && (slot != 4'd3);",
+            p.crc_init
+        ),
+    };
     let _ = writeln!(
         s,
-        "    if (load) begin\n{load_out}\n      busy <= 1'b1;\n      mask <= rest;\n      have <= rest != 12'd0;\n      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == 16'd{}) begin\n          hslice <= 16'd0;\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + 16'd1;\n      end\n    end",
+        "    if (load) begin\n{load_out}\n      busy <= 1'b1;\n      mask <= rest;\n      have <= rest != 12'd0;\n{crc_load}\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == 16'd{}) begin\n          hslice <= 16'd0;\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + 16'd1;\n      end\n    end",
         p.slices_per_frame - 1
     );
 }
