@@ -94,7 +94,9 @@ struct Regs {
     n: usize,
     have: bool,
     tok: u32,
-    mask: u16,
+    /// The next byte slot of the token (0-3 trailer, 4-7 header, 8-11
+    /// record) before skipping what the token does not carry.
+    bcnt: u8,
     started: bool,
     hframe: u8,
     hslice: u16,
@@ -277,11 +279,9 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
         nx.tok = t;
         nx.rd = (r.rd + 1) % p.depth;
         nx.have = true;
-        let b = t >> 27 & 1 == 1;
-        let s = t >> 26 & 1 == 1;
-        nx.mask = (if s { 0xF00 } else { 0 })
-            | (if b { 0x0F0 } else { 0 })
-            | (if b && r.started { 0x00F } else { 0 });
+        // a trailer only once a header went out; a token without a
+        // boundary skips to its record (`slot`)
+        nx.bcnt = if r.started { 0 } else { 4 };
     }
     if push {
         if room {
@@ -326,11 +326,22 @@ fn shift(p: &LinkParams, r: &Regs, nx: &mut Regs, tready: bool, last_tick: bool)
     }
 }
 
-/// The next byte of the packet (the lowest slot left in `r.mask`) starts
+/// The byte slot the serializer sends next: `bcnt`, or the record when
+/// the token is no boundary.
+fn slot(r: &Regs) -> u8 {
+    if r.bcnt < 8 && r.tok >> 27 & 1 == 0 {
+        8
+    } else {
+        r.bcnt
+    }
+}
+
+/// The next byte of the packet (slot [`slot`]) starts
 /// out; the CRC and the header's frame/slice counters follow it.
 fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
-    let slot = r.mask.trailing_zeros();
-    let rest = r.mask & r.mask.wrapping_sub(1);
+    let slot = slot(r);
+    // a token ends with its record, or its header when it has none
+    let last = slot == 11 || (slot == 7 && r.tok >> 26 & 1 == 0);
     let byte = match slot {
         0 => 0x5A,
         1 => r.ovfc,
@@ -354,8 +365,8 @@ fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
     // the trailer of a frame's last slice goes out when the next
     // header's slice has wrapped to 0
     nx.tlast = slot == 3 && (p.axis == Some(link::Tlast::Slice) || r.hslice == 0);
-    nx.mask = rest;
-    nx.have = rest != 0;
+    nx.bcnt = slot + 1;
+    nx.have = !last;
     match (p.axis, slot) {
         (_, 2 | 3) => {}
         // UART: the CRC follows the line bit by bit (`shift`); a header
@@ -427,6 +438,8 @@ struct Widths {
     dw: usize,
     cb: usize,
     bw: usize,
+    /// Header slice counter.
+    hw: usize,
 }
 
 /// A `w`-bit decimal literal.
@@ -444,10 +457,11 @@ fn link_verilog(p: &LinkParams) -> String {
         dw: width(p.div as u64 - 1),
         cb,
         bw: width(cb as u64 - 1),
+        hw: width(p.slices_per_frame - 1),
     };
     declarations(&mut s, p, w);
     wires(&mut s, p, w);
-    byte_out(&mut s);
+    byte_out(&mut s, w.hw);
     crc_and_character(&mut s, p, w);
     let _ = writeln!(s, "always @(posedge clock) begin\n  if (rst) begin");
     register_reset(&mut s, p, w);
@@ -474,6 +488,7 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
         dw,
         cb,
         bw,
+        ..
     } = w;
     let tb = TOKEN_BITS;
     let axis = p.axis.is_some();
@@ -497,13 +512,14 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     }
     let _ = writeln!(
         s,
-        "reg have;\ninitial have = 1'b0;\n// the popped token without its two flags (they become the mask)\nreg [{}:0] tok;\ninitial tok = {}'d0;\nreg [11:0] mask;\ninitial mask = 12'd0;",
-        tb - 3,
-        tb - 2
+        "reg have;\ninitial have = 1'b0;\n// the token being sent\nreg [{}:0] tok;\ninitial tok = {tb}'d0;\n// its next byte slot (0-3 trailer, 4-7 header, 8-11 record)\nreg [3:0] bcnt;\ninitial bcnt = 4'd0;",
+        tb - 1,
     );
     let _ = writeln!(
         s,
-        "reg started;\ninitial started = 1'b0;\nreg [7:0] hframe;\ninitial hframe = 8'd0;\nreg [15:0] hslice;\ninitial hslice = 16'd0;"
+        "reg started;\ninitial started = 1'b0;\nreg [7:0] hframe;\ninitial hframe = 8'd0;\nreg [{}:0] hslice;\ninitial hslice = {};",
+        w.hw - 1,
+        lit(w.hw, 0)
     );
     let _ = writeln!(
         s,
@@ -551,26 +567,34 @@ fn wires(s: &mut String, p: &LinkParams, w: Widths) {
     let _ = writeln!(s, "wire load = ready & have;");
     let _ = writeln!(s, "wire pop = !have & (n != {nw}'d0);");
     let _ = writeln!(s, "wire room = (n < {}) | pop;", lit(nw, p.depth as u64));
-    let _ = writeln!(s, "wire [11:0] rest = mask & (mask - 12'd1);");
+    // a token without a boundary skips to its record; it ends with its
+    // record, or its header when it has none
+    let _ = writeln!(
+        s,
+        "wire [3:0] slot = (!bcnt[3] & !tok[{}]) ? 4'd8 : bcnt;",
+        tb - 1
+    );
+    let _ = writeln!(
+        s,
+        "wire last = (slot == 4'd11) | ((slot == 4'd7) & !tok[{}]);",
+        tb - 2
+    );
     let _ = writeln!(s, "wire [{}:0] head = mem[rd];", tb - 1);
     let _ = writeln!(s, "wire [{}:0] token = {{bnd, valid, ch, val}};", tb - 1);
 }
 
-/// The lowest byte slot still to send, and that byte.
-fn byte_out(s: &mut String) {
-    let _ = writeln!(s, "reg [3:0] slot;\nalways @(*) begin\n  casez (mask)");
-    for i in 0..12 {
-        let pat: String = (0..12)
-            .rev()
-            .map(|b| match b.cmp(&i) {
-                std::cmp::Ordering::Greater => '?',
-                std::cmp::Ordering::Equal => '1',
-                std::cmp::Ordering::Less => '0',
-            })
-            .collect();
-        let _ = writeln!(s, "    12'b{pat}: slot = 4'd{i};");
+/// Bits `lo..lo + 8` of the `w`-bit register `r` as a byte (zeros above
+/// its top).
+fn byte_of(r: &str, w: usize, lo: usize) -> String {
+    match w {
+        _ if w <= lo => "8'd0".into(),
+        _ if w >= lo + 8 => format!("{r}[{}:{lo}]", lo + 7),
+        _ => format!("{{{}'d0, {r}[{}:{lo}]}}", lo + 8 - w, w - 1),
     }
-    let _ = writeln!(s, "    default: slot = 4'd0;\n  endcase\nend\n");
+}
+
+/// The byte of the slot being sent.
+fn byte_out(s: &mut String, hw: usize) {
     let _ = writeln!(s, "reg [7:0] byte_out;\nalways @(*) begin\n  case (slot)");
     for (i, e) in [
         "8'h5a",
@@ -579,8 +603,8 @@ fn byte_out(s: &mut String) {
         "crc[15:8]",
         "8'ha5",
         "hframe",
-        "hslice[15:8]",
-        "hslice[7:0]",
+        &byte_of("hslice", hw, 8),
+        &byte_of("hslice", hw, 0),
     ]
     .iter()
     .enumerate()
@@ -648,14 +672,14 @@ fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
     };
     let _ = writeln!(
         s,
-        "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    mask <= 12'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= 16'd0;\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n{out_reset}\n  end else begin"
+        "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    bcnt <= 4'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= {};\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n{out_reset}\n  end else begin",
+        lit(w.hw, 0)
     );
 }
 
 /// The slice position and the token FIFO: push, pop, overflow, count.
 fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths { pw, aw, nw, .. } = w;
-    let tb = TOKEN_BITS;
     let _ = writeln!(
         s,
         "    pos <= (pos == {}) ? {} : pos + {};",
@@ -671,12 +695,8 @@ fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
     };
     let _ = writeln!(
         s,
-        "    if (pop) begin\n      tok <= head[{}:0];\n      rd <= {};\n      have <= 1'b1;\n      mask <= {{{{4{{head[{}]}}}}, {{4{{head[{}]}}}}, {{4{{head[{}] & started}}}}}};\n    end",
-        tb - 3,
+        "    if (pop) begin\n      tok <= head;\n      rd <= {};\n      have <= 1'b1;\n      // a trailer only once a header went out\n      bcnt <= started ? 4'd0 : 4'd4;\n    end",
         wrap("rd"),
-        tb - 2,
-        tb - 1,
-        tb - 1
     );
     let _ = writeln!(
         s,
@@ -709,13 +729,14 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
         lit(bw, 8)
     );
     }
+    let tlast_frame = format!("(slot == 4'd3) & (hslice == {})", lit(w.hw, 0));
     let load_out = match p.axis {
         Some(t) => format!(
             "      tdata_r <= byte_out;\n      tlast_r <= {};",
             if t == link::Tlast::Slice {
                 "slot == 4'd3"
             } else {
-                "(slot == 4'd3) & (hslice == 16'd0)"
+                &tlast_frame
             }
         ),
         None => format!("      chr <= chr_load;\n      bitn <= {bw}'d0;\n      dv <= {dw}'d0;\n      tx_r <= 1'b0;"),
@@ -729,7 +750,9 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
     };
     let _ = writeln!(
         s,
-        "    if (load) begin\n{load_out}\n      busy <= 1'b1;\n      mask <= rest;\n      have <= rest != 12'd0;\n{crc_load}\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == 16'd{}) begin\n          hslice <= 16'd0;\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + 16'd1;\n      end\n    end",
-        p.slices_per_frame - 1
+        "    if (load) begin\n{load_out}\n      busy <= 1'b1;\n      bcnt <= slot + 4'd1;\n      have <= !last;\n{crc_load}\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == {}) begin\n          hslice <= {};\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + {};\n      end\n    end",
+        lit(w.hw, p.slices_per_frame - 1),
+        lit(w.hw, 0),
+        lit(w.hw, 1)
     );
 }
