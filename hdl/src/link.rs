@@ -201,12 +201,14 @@ impl Logic for AxisLink {
     }
 }
 
-/// The registers' values after reset (the FIFO's memory keeps its contents).
+/// The registers' values after reset (the FIFO's memory and its read
+/// register `tok` keep their contents).
 fn reset_regs(p: &LinkParams, r: &mut Regs) {
     let mem = std::mem::take(&mut r.mem);
     *r = Regs {
         pos: p.slice_cycles - 1,
         mem,
+        tok: r.tok,
         crc: 0xFFFF,
         tx: true,
         ..Default::default()
@@ -463,6 +465,10 @@ fn link_verilog(p: &LinkParams) -> String {
     wires(&mut s, p, w);
     byte_out(&mut s, w.hw);
     crc_and_character(&mut s, p, w);
+    let _ = writeln!(
+        s,
+        "// the FIFO's memory: written with a token accepted, read into `tok`\n// when the serializer takes the oldest (the value before this edge's write)\nalways @(posedge clock) begin\n  if (!rst & push & room) mem[wr] <= token;\n  if (!rst & pop) tok <= mem[rd];\nend\n"
+    );
     let _ = writeln!(s, "always @(posedge clock) begin\n  if (rst) begin");
     register_reset(&mut s, p, w);
     fifo_update(&mut s, p, w);
@@ -506,13 +512,21 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
         );
     }
     let _ = writeln!(s, "reg [{}:0] pos;\ninitial pos = {};", pw - 1, lit(pw, 0));
-    let _ = writeln!(s, "reg [{}:0] mem [0:{}];", tb - 1, p.depth - 1);
+    // the FIFO's tokens in block RAM where the family has it; `tok`, the
+    // token being sent, is its read register (no initial value: a block
+    // RAM's output has none; it is read only once a token was taken)
+    let _ = writeln!(
+        s,
+        "(* ram_style = \"block\" *)\nreg [{}:0] mem [0:{}];",
+        tb - 1,
+        p.depth - 1
+    );
     for (n, w) in [("wr", aw), ("rd", aw), ("n", nw)] {
         let _ = writeln!(s, "reg [{}:0] {n};\ninitial {n} = {w}'d0;", w - 1);
     }
     let _ = writeln!(
         s,
-        "reg have;\ninitial have = 1'b0;\n// the token being sent\nreg [{}:0] tok;\ninitial tok = {tb}'d0;\n// its next byte slot (0-3 trailer, 4-7 header, 8-11 record)\nreg [3:0] bcnt;\ninitial bcnt = 4'd0;",
+        "reg have;\ninitial have = 1'b0;\nreg [{}:0] tok;\n// its next byte slot (0-3 trailer, 4-7 header, 8-11 record)\nreg [3:0] bcnt;\ninitial bcnt = 4'd0;",
         tb - 1,
     );
     let _ = writeln!(
@@ -579,7 +593,6 @@ fn wires(s: &mut String, p: &LinkParams, w: Widths) {
         "wire last = (slot == 4'd11) | ((slot == 4'd7) & !tok[{}]);",
         tb - 2
     );
-    let _ = writeln!(s, "wire [{}:0] head = mem[rd];", tb - 1);
     let _ = writeln!(s, "wire [{}:0] token = {{bnd, valid, ch, val}};", tb - 1);
 }
 
@@ -695,12 +708,12 @@ fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
     };
     let _ = writeln!(
         s,
-        "    if (pop) begin\n      tok <= head;\n      rd <= {};\n      have <= 1'b1;\n      // a trailer only once a header went out\n      bcnt <= started ? 4'd0 : 4'd4;\n    end",
+        "    if (pop) begin\n      rd <= {};\n      have <= 1'b1;\n      // a trailer only once a header went out\n      bcnt <= started ? 4'd0 : 4'd4;\n    end",
         wrap("rd"),
     );
     let _ = writeln!(
         s,
-        "    if (push) begin\n      if (room) begin\n        mem[wr] <= token;\n        wr <= {};\n      end else begin\n        if (ovfc != 8'hff) ovfc <= ovfc + 8'd1;\n        ovf_r <= 1'b1;\n      end\n    end",
+        "    if (push) begin\n      if (room) begin\n        wr <= {};\n      end else begin\n        if (ovfc != 8'hff) ovfc <= ovfc + 8'd1;\n        ovf_r <= 1'b1;\n      end\n    end",
         wrap("wr")
     );
     // A one-bit count (a FIFO of one token) has no padding bits: `{0'd0, x}`
