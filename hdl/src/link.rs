@@ -87,7 +87,10 @@ const TOKEN_BITS: usize = 2 + CH_BITS + VALUE_BITS;
 /// The registers of the link (the Rust twin's state).
 #[derive(Debug, Clone, Default)]
 struct Regs {
-    pos: u64,
+    /// Cycles to the next slice's first cycle (a down-counter), and
+    /// `left == 0` registered (a boundary: this cycle starts a slice).
+    left: u64,
+    bnd: bool,
     mem: Vec<u32>,
     wr: usize,
     rd: usize,
@@ -206,7 +209,8 @@ impl Logic for AxisLink {
 fn reset_regs(p: &LinkParams, r: &mut Regs) {
     let mem = std::mem::take(&mut r.mem);
     *r = Regs {
-        pos: p.slice_cycles - 1,
+        left: 1 % p.slice_cycles,
+        bnd: p.slice_cycles == 1,
         mem,
         tok: r.tok,
         crc: 0xFFFF,
@@ -244,6 +248,7 @@ impl UartLink {
             _r: Regs {
                 mem: vec![0; p.depth],
                 tx: true,
+                bnd: true,
                 crc: 0xFFFF,
                 ..Default::default()
             },
@@ -259,7 +264,7 @@ impl UartLink {
 /// AXIS master's, whose slave drives `tready` in the cycle the edge ends).
 fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bool) {
     let p = *p;
-    let bnd = r.pos == 0;
+    let bnd = r.bnd;
     let push = bnd || valid;
     let last_tick = r.dv + 1 == p.div;
     let ready = match p.axis {
@@ -271,10 +276,11 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
     let room = r.n < p.depth || pop;
     // next state, from the values before the edge
     let mut nx = r.clone();
-    nx.pos = if r.pos + 1 == p.slice_cycles {
-        0
+    nx.left = if bnd { p.slice_cycles - 1 } else { r.left - 1 };
+    nx.bnd = if bnd {
+        p.slice_cycles == 1
     } else {
-        r.pos + 1
+        r.left == 1
     };
     if pop {
         let t = r.mem[r.rd];
@@ -511,7 +517,14 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
             p.div, p.depth
         );
     }
-    let _ = writeln!(s, "reg [{}:0] pos;\ninitial pos = {};", pw - 1, lit(pw, 0));
+    // the slice position as a down-counter with its end registered: the
+    // boundary is a flip-flop, not a compare behind the carry chain
+    let _ = writeln!(
+        s,
+        "reg [{}:0] left;\ninitial left = {};\nreg bnd;\ninitial bnd = 1'b1;",
+        pw - 1,
+        lit(pw, 0)
+    );
     // the FIFO's tokens in block RAM where the family has it; `tok`, the
     // token being sent, is its read register (no initial value: a block
     // RAM's output has none; it is read only once a token was taken)
@@ -561,11 +574,8 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
 
 /// The handshake and FIFO wires of one cycle.
 fn wires(s: &mut String, p: &LinkParams, w: Widths) {
-    let Widths {
-        pw, nw, dw, cb, bw, ..
-    } = w;
+    let Widths { nw, dw, cb, bw, .. } = w;
     let tb = TOKEN_BITS;
-    let _ = writeln!(s, "wire bnd = pos == {};", lit(pw, 0));
     let _ = writeln!(s, "wire push = bnd | valid;");
     if p.axis.is_some() {
         // a beat is taken at an edge where tvalid and tready are high
@@ -677,7 +687,12 @@ fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths {
         pw, aw, nw, dw, bw, ..
     } = w;
-    let _ = writeln!(s, "    pos <= {};", lit(pw, p.slice_cycles - 1));
+    let _ = writeln!(
+        s,
+        "    left <= {};\n    bnd <= 1'b{};",
+        lit(pw, 1 % p.slice_cycles),
+        (p.slice_cycles == 1) as u8
+    );
     let out_reset = if p.axis.is_some() {
         "    tdata_r <= 8'd0;\n    tlast_r <= 1'b0;".to_string()
     } else {
@@ -695,9 +710,10 @@ fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths { pw, aw, nw, .. } = w;
     let _ = writeln!(
         s,
-        "    pos <= (pos == {}) ? {} : pos + {};",
+        "    left <= bnd ? {} : left - {};\n    bnd <= bnd ? 1'b{} : (left == {});",
         lit(pw, p.slice_cycles - 1),
-        lit(pw, 0),
+        lit(pw, 1),
+        (p.slice_cycles == 1) as u8,
         lit(pw, 1)
     );
     let wrap = |r: &str| {
