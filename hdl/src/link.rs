@@ -87,10 +87,12 @@ const TOKEN_BITS: usize = 2 + CH_BITS + VALUE_BITS;
 /// The registers of the link (the Rust twin's state).
 #[derive(Debug, Clone, Default)]
 struct Regs {
-    /// Cycles to the next slice's first cycle (a down-counter), and
-    /// `left == 0` registered (a boundary: this cycle starts a slice).
-    left: u64,
+    /// The next cycle's position in the slice (0 after reset), and two
+    /// of its values registered: `npos == 1` (a boundary: this cycle
+    /// starts a slice) and `npos == slice_cycles - 1` (wrap to 0).
+    npos: u64,
     bnd: bool,
+    wrap: bool,
     mem: Vec<u32>,
     wr: usize,
     rd: usize,
@@ -110,10 +112,11 @@ struct Regs {
     ovfc: u8,
     ovf: bool,
     busy: bool,
-    bitn: u32,
     dv: u32,
+    /// UART: the character still to send, shifted right with zeros: its
+    /// bit 0 is the line (`link_tx`); 1 alone, the last stop bit (and
+    /// idle, where it stays).
     chr: u16,
-    tx: bool,
     /// AXIS: the byte offered and its `tlast` (`busy` is `tvalid`).
     tdata: u8,
     tlast: bool,
@@ -209,12 +212,13 @@ impl Logic for AxisLink {
 fn reset_regs(p: &LinkParams, r: &mut Regs) {
     let mem = std::mem::take(&mut r.mem);
     *r = Regs {
-        left: 1 % p.slice_cycles,
+        npos: 0,
         bnd: p.slice_cycles == 1,
+        wrap: p.slice_cycles == 1,
         mem,
         tok: r.tok,
         crc: 0xFFFF,
-        tx: true,
+        chr: 1,
         ..Default::default()
     };
 }
@@ -236,7 +240,7 @@ fn crc8(c: u16, d: u8) -> u16 {
 
 impl UartLink {
     pub fn new(p: LinkParams) -> UartLink {
-        UartLink {
+        let mut l = UartLink {
             clock: Default::default(),
             rst: Default::default(),
             valid: Default::default(),
@@ -247,12 +251,12 @@ impl UartLink {
             _p: p,
             _r: Regs {
                 mem: vec![0; p.depth],
-                tx: true,
-                bnd: true,
-                crc: 0xFFFF,
                 ..Default::default()
             },
-        }
+        };
+        // the Verilog's initial values are its reset values
+        reset_regs(&p, &mut l._r);
+        l
     }
 
     fn edge(&mut self, valid: bool, ch: u32, val: u32) {
@@ -268,7 +272,7 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
     let push = bnd || valid;
     let last_tick = r.dv + 1 == p.div;
     let ready = match p.axis {
-        None => !r.busy || (last_tick && r.bitn + 1 == p.char_bits()),
+        None => !r.busy || (last_tick && r.chr == 1),
         Some(_) => !r.busy || tready,
     };
     let load = ready && r.have;
@@ -276,11 +280,13 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
     let room = r.n < p.depth || pop;
     // next state, from the values before the edge
     let mut nx = r.clone();
-    nx.left = if bnd { p.slice_cycles - 1 } else { r.left - 1 };
-    nx.bnd = if bnd {
-        p.slice_cycles == 1
+    let one = p.slice_cycles == 1;
+    nx.npos = if r.wrap { 0 } else { r.npos + 1 };
+    nx.bnd = if r.wrap { one } else { r.npos == 0 };
+    nx.wrap = if r.wrap {
+        one
     } else {
-        r.left == 1
+        r.npos + 2 == p.slice_cycles
     };
     if pop {
         let t = r.mem[r.rd];
@@ -315,17 +321,15 @@ fn shift(p: &LinkParams, r: &Regs, nx: &mut Regs, tready: bool, last_tick: bool)
     } else if r.busy {
         if last_tick {
             nx.dv = 0;
-            if r.bitn + 1 == p.char_bits() {
+            if r.chr == 1 {
                 nx.busy = false;
-                nx.tx = true;
             } else {
-                nx.bitn = r.bitn + 1;
-                nx.tx = r.chr >> 1 & 1 == 1;
                 nx.chr = r.chr >> 1;
                 // the data bit that goes out next (bits 1..=8 of the
-                // character) enters the CRC
-                if r.in_crc && r.bitn < 8 {
-                    nx.crc = crc1(r.crc, nx.tx);
+                // character) enters the CRC: the top stop bit has not yet
+                // left the top 8 places
+                if r.in_crc && r.chr >> (p.char_bits() - 8) != 0 {
+                    nx.crc = crc1(r.crc, r.chr >> 1 & 1 == 1);
                 }
             }
         } else {
@@ -366,9 +370,7 @@ fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
     };
     nx.chr = p.frame(byte);
     nx.busy = true;
-    nx.bitn = 0;
     nx.dv = 0;
-    nx.tx = p.axis.is_some();
     nx.tdata = byte;
     // the trailer of a frame's last slice goes out when the next
     // header's slice has wrapped to 0
@@ -416,7 +418,7 @@ impl Logic for UartLink {
                 self.edge(v, c, x);
             }
         }
-        self.tx.next = self._r.tx;
+        self.tx.next = self._r.chr & 1 == 1;
         self.ovf.next = self._r.ovf;
     }
 
@@ -442,10 +444,9 @@ struct Widths {
     pw: usize,
     aw: usize,
     nw: usize,
-    /// UART only: bit-period divider, bits per character, bit counter.
+    /// UART only: bit-period divider, bits per character.
     dw: usize,
     cb: usize,
-    bw: usize,
     /// Header slice counter.
     hw: usize,
 }
@@ -464,7 +465,6 @@ fn link_verilog(p: &LinkParams) -> String {
         nw: width(p.depth as u64),
         dw: width(p.div as u64 - 1),
         cb,
-        bw: width(cb as u64 - 1),
         hw: width(p.slices_per_frame - 1),
     };
     declarations(&mut s, p, w);
@@ -486,7 +486,7 @@ fn link_verilog(p: &LinkParams) -> String {
             "always @(*) begin\n  tdata = tdata_r;\n  tvalid = busy;\n  tlast = tlast_r;\n  ovf = ovf_r;\nend"
         );
     } else {
-        let _ = writeln!(s, "always @(*) begin\n  tx = tx_r;\n  ovf = ovf_r;\nend");
+        let _ = writeln!(s, "always @(*) begin\n  tx = chr[0];\n  ovf = ovf_r;\nend");
     }
     s
 }
@@ -494,13 +494,7 @@ fn link_verilog(p: &LinkParams) -> String {
 /// What the link is, then its registers with their initial values.
 fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths {
-        pw,
-        aw,
-        nw,
-        dw,
-        cb,
-        bw,
-        ..
+        pw, aw, nw, dw, cb, ..
     } = w;
     let tb = TOKEN_BITS;
     let axis = p.axis.is_some();
@@ -517,11 +511,13 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
             p.div, p.depth
         );
     }
-    // the slice position as a down-counter with its end registered: the
-    // boundary is a flip-flop, not a compare behind the carry chain
+    // the next cycle's position in the slice, counting up from 0 (no
+    // flip-flop set: an unbroken carry chain), with the boundary and the
+    // wrap registered, not compares behind the chain
+    let one = (p.slice_cycles == 1) as u8;
     let _ = writeln!(
         s,
-        "reg [{}:0] left;\ninitial left = {};\nreg bnd;\ninitial bnd = 1'b1;",
+        "reg [{}:0] npos;\ninitial npos = {};\nreg bnd;\ninitial bnd = 1'b{one};\nreg wrap;\ninitial wrap = 1'b{one};",
         pw - 1,
         lit(pw, 0)
     );
@@ -560,13 +556,12 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     } else {
         let _ = writeln!(
             s,
-            "reg busy;\ninitial busy = 1'b0;\nreg [{}:0] bitn;\ninitial bitn = {bw}'d0;\nreg [{}:0] dv;\ninitial dv = {dw}'d0;",
-            bw - 1,
+            "reg busy;\ninitial busy = 1'b0;\nreg [{}:0] dv;\ninitial dv = {dw}'d0;",
             dw - 1
         );
         let _ = writeln!(
             s,
-            "reg [{}:0] chr;\ninitial chr = {cb}'d0;\nreg tx_r;\ninitial tx_r = 1'b1;\n// the character in transit is covered by the CRC (not one of its bytes)\nreg in_crc;\ninitial in_crc = 1'b0;\n",
+            "// the character still to send, shifted right with zeros: chr[0] is the\n// line; 1 alone is the last stop bit (and idle, where it stays)\nreg [{}:0] chr;\ninitial chr = {cb}'d1;\n// the character in transit is covered by the CRC (not one of its bytes)\nreg in_crc;\ninitial in_crc = 1'b0;\n",
             cb - 1
         );
     }
@@ -574,7 +569,7 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
 
 /// The handshake and FIFO wires of one cycle.
 fn wires(s: &mut String, p: &LinkParams, w: Widths) {
-    let Widths { nw, dw, cb, bw, .. } = w;
+    let Widths { nw, dw, cb, .. } = w;
     let tb = TOKEN_BITS;
     let _ = writeln!(s, "wire push = bnd | valid;");
     if p.axis.is_some() {
@@ -584,8 +579,11 @@ fn wires(s: &mut String, p: &LinkParams, w: Widths) {
         let _ = writeln!(s, "wire last_tick = dv == {};", lit(dw, p.div as u64 - 1));
         let _ = writeln!(
             s,
-            "wire ready = !busy | (last_tick & (bitn == {}));",
-            lit(bw, cb as u64 - 1)
+            "wire chr_end = chr[{}:1] == {};\n// the next bit is a data bit: the top stop bit is still in the top 8 places\nwire data_next = chr[{}:{}] != 8'd0;\nwire ready = !busy | (last_tick & chr_end);",
+            cb - 1,
+            lit(cb - 1, 0),
+            cb - 1,
+            cb - 8
         );
     }
     let _ = writeln!(s, "wire load = ready & have;");
@@ -685,18 +683,18 @@ fn crc_and_character(s: &mut String, p: &LinkParams, w: Widths) {
 /// The reset branch of the register update.
 fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths {
-        pw, aw, nw, dw, bw, ..
+        pw, aw, nw, dw, cb, ..
     } = w;
+    let one = (p.slice_cycles == 1) as u8;
     let _ = writeln!(
         s,
-        "    left <= {};\n    bnd <= 1'b{};",
-        lit(pw, 1 % p.slice_cycles),
-        (p.slice_cycles == 1) as u8
+        "    npos <= {};\n    bnd <= 1'b{one};\n    wrap <= 1'b{one};",
+        lit(pw, 0),
     );
     let out_reset = if p.axis.is_some() {
         "    tdata_r <= 8'd0;\n    tlast_r <= 1'b0;".to_string()
     } else {
-        format!("    bitn <= {bw}'d0;\n    dv <= {dw}'d0;\n    tx_r <= 1'b1;\n    in_crc <= 1'b0;")
+        format!("    dv <= {dw}'d0;\n    chr <= {cb}'d1;\n    in_crc <= 1'b0;")
     };
     let _ = writeln!(
         s,
@@ -708,13 +706,14 @@ fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
 /// The slice position and the token FIFO: push, pop, overflow, count.
 fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths { pw, aw, nw, .. } = w;
+    let one = (p.slice_cycles == 1) as u8;
     let _ = writeln!(
         s,
-        "    left <= bnd ? {} : left - {};\n    bnd <= bnd ? 1'b{} : (left == {});",
-        lit(pw, p.slice_cycles - 1),
+        "    npos <= wrap ? {} : npos + {};\n    bnd <= wrap ? 1'b{one} : (npos == {});\n    wrap <= wrap ? 1'b{one} : (npos == {});",
+        lit(pw, 0),
         lit(pw, 1),
-        (p.slice_cycles == 1) as u8,
-        lit(pw, 1)
+        lit(pw, 0),
+        lit(pw, p.slice_cycles.saturating_sub(2))
     );
     let wrap = |r: &str| {
         format!(
@@ -747,15 +746,13 @@ fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
 /// The byte in transit (bit periods or the beat taken), and the next byte's
 /// load with the CRC and header counters.
 fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
-    let Widths { dw, cb, bw, .. } = w;
+    let Widths { dw, .. } = w;
     if p.axis.is_some() {
         let _ = writeln!(s, "    if (busy & tready) busy <= 1'b0;");
     } else {
         let _ = writeln!(
         s,
-        "    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (bitn == {}) begin\n          busy <= 1'b0;\n          tx_r <= 1'b1;\n        end else begin\n          bitn <= bitn + {bw}'d1;\n          tx_r <= chr[1];\n          chr <= chr >> 1;\n          if (in_crc & (bitn < {})) crc <= crc_bit;\n        end\n      end else dv <= dv + {dw}'d1;\n    end",
-        lit(bw, cb as u64 - 1),
-        lit(bw, 8)
+"    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (chr_end) busy <= 1'b0;\n        else begin\n          chr <= chr >> 1;\n          if (in_crc & data_next) crc <= crc_bit;\n        end\n      end else dv <= dv + {dw}'d1;\n    end"
     );
     }
     let tlast_frame = format!("(slot == 4'd3) & (hslice == {})", lit(w.hw, 0));
@@ -768,7 +765,7 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
                 &tlast_frame
             }
         ),
-        None => format!("      chr <= chr_load;\n      bitn <= {bw}'d0;\n      dv <= {dw}'d0;\n      tx_r <= 1'b0;"),
+        None => format!("      chr <= chr_load;\n      dv <= {dw}'d0;"),
     };
     let crc_load = match p.axis {
         Some(_) => "      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;".to_string(),
