@@ -169,7 +169,7 @@ impl AxisLink {
             _p: p,
             _r: Regs::default(),
         };
-        l._r.mem = vec![0; p.depth];
+        l._r.mem = vec![0; p.depth + 1];
         reset_regs(&p, &mut l._r);
         l
     }
@@ -250,7 +250,7 @@ impl UartLink {
             ovf: Default::default(),
             _p: p,
             _r: Regs {
-                mem: vec![0; p.depth],
+                mem: vec![0; p.depth + 1],
                 ..Default::default()
             },
         };
@@ -291,7 +291,7 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
     if pop {
         let t = r.mem[r.rd];
         nx.tok = t;
-        nx.rd = (r.rd + 1) % p.depth;
+        nx.rd = (r.rd + 1) % (p.depth + 1);
         nx.have = true;
         // a trailer only once a header went out; a token without a
         // boundary skips to its record (`slot`)
@@ -300,7 +300,7 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
     if push {
         if room {
             nx.mem[r.wr] = (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
-            nx.wr = (r.wr + 1) % p.depth;
+            nx.wr = (r.wr + 1) % (p.depth + 1);
         } else {
             nx.ovfc = r.ovfc.saturating_add(1);
             nx.ovf = true;
@@ -440,7 +440,7 @@ fn width(n: u64) -> usize {
 /// The link's register and counter widths.
 #[derive(Clone, Copy)]
 struct Widths {
-    /// Slice position, FIFO address, FIFO count.
+    /// Slice position, FIFO address (`depth + 1` entries), FIFO count.
     pw: usize,
     aw: usize,
     nw: usize,
@@ -461,7 +461,7 @@ fn link_verilog(p: &LinkParams) -> String {
     let cb = p.char_bits() as usize;
     let w = Widths {
         pw: width(p.slice_cycles - 1),
-        aw: width(p.depth as u64 - 1),
+        aw: width(p.depth as u64),
         nw: width(p.depth as u64),
         dw: width(p.div as u64 - 1),
         cb,
@@ -523,12 +523,15 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     );
     // the FIFO's tokens in block RAM where the family has it; `tok`, the
     // token being sent, is its read register (no initial value: a block
-    // RAM's output has none; it is read only once a token was taken)
+    // RAM's output has none; it is read only once a token was taken).
+    // One entry more than the depth: a pop never reads the entry written
+    // at the same edge, so the RAM needs no read-first emulation (a write
+    // register, a bypass; `no_rw_check`)
     let _ = writeln!(
         s,
-        "(* ram_style = \"block\" *)\nreg [{}:0] mem [0:{}];",
+        "(* ram_style = \"block\", no_rw_check *)\nreg [{}:0] mem [0:{}];",
         tb - 1,
-        p.depth - 1
+        p.depth
     );
     for (n, w) in [("wr", aw), ("rd", aw), ("n", nw)] {
         let _ = writeln!(s, "reg [{}:0] {n};\ninitial {n} = {w}'d0;", w - 1);
@@ -718,7 +721,7 @@ fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
     let wrap = |r: &str| {
         format!(
             "({r} == {}) ? {aw}'d0 : {r} + {aw}'d1",
-            lit(aw, p.depth as u64 - 1)
+            lit(aw, p.depth as u64)
         )
     };
     let _ = writeln!(
