@@ -112,6 +112,11 @@ struct Regs {
     ovfc: u8,
     ovf: bool,
     busy: bool,
+    /// UART: the bit on the line (0 the start bit). Not read off `chr`:
+    /// the FIFO's handshake would then depend on the bytes' values, which
+    /// `prove` would have to carry (the frame counter does not come round
+    /// after a frame).
+    bitn: u32,
     dv: u32,
     /// UART: the character still to send, shifted right with zeros: its
     /// bit 0 is the line (`link_tx`); 1 alone, the last stop bit (and
@@ -272,7 +277,7 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
     let push = bnd || valid;
     let last_tick = r.dv + 1 == p.div;
     let ready = match p.axis {
-        None => !r.busy || (last_tick && r.chr == 1),
+        None => !r.busy || (last_tick && r.bitn + 1 == p.char_bits()),
         Some(_) => !r.busy || tready,
     };
     let load = ready && r.have;
@@ -321,14 +326,14 @@ fn shift(p: &LinkParams, r: &Regs, nx: &mut Regs, tready: bool, last_tick: bool)
     } else if r.busy {
         if last_tick {
             nx.dv = 0;
-            if r.chr == 1 {
+            if r.bitn + 1 == p.char_bits() {
                 nx.busy = false;
             } else {
+                nx.bitn = r.bitn + 1;
                 nx.chr = r.chr >> 1;
                 // the data bit that goes out next (bits 1..=8 of the
-                // character) enters the CRC: the top stop bit has not yet
-                // left the top 8 places
-                if r.in_crc && r.chr >> (p.char_bits() - 8) != 0 {
+                // character) enters the CRC
+                if r.in_crc && r.bitn < 8 {
                     nx.crc = crc1(r.crc, r.chr >> 1 & 1 == 1);
                 }
             }
@@ -370,6 +375,7 @@ fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
     };
     nx.chr = p.frame(byte);
     nx.busy = true;
+    nx.bitn = 0;
     nx.dv = 0;
     nx.tdata = byte;
     // the trailer of a frame's last slice goes out when the next
@@ -444,9 +450,10 @@ struct Widths {
     pw: usize,
     aw: usize,
     nw: usize,
-    /// UART only: bit-period divider, bits per character.
+    /// UART only: bit-period divider, bits per character, bit counter.
     dw: usize,
     cb: usize,
+    bw: usize,
     /// Header slice counter.
     hw: usize,
 }
@@ -465,6 +472,7 @@ fn link_verilog(p: &LinkParams) -> String {
         nw: width(p.depth as u64),
         dw: width(p.div as u64 - 1),
         cb,
+        bw: width(cb as u64 - 1),
         hw: width(p.slices_per_frame - 1),
     };
     declarations(&mut s, p, w);
@@ -559,7 +567,9 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     } else {
         let _ = writeln!(
             s,
-            "reg busy;\ninitial busy = 1'b0;\nreg [{}:0] dv;\ninitial dv = {dw}'d0;",
+            "reg busy;\ninitial busy = 1'b0;\nreg [{}:0] bitn;\ninitial bitn = {}'d0;\nreg [{}:0] dv;\ninitial dv = {dw}'d0;",
+            w.bw - 1,
+            w.bw,
             dw - 1
         );
         let _ = writeln!(
@@ -582,11 +592,9 @@ fn wires(s: &mut String, p: &LinkParams, w: Widths) {
         let _ = writeln!(s, "wire last_tick = dv == {};", lit(dw, p.div as u64 - 1));
         let _ = writeln!(
             s,
-            "wire chr_end = chr[{}:1] == {};\n// the next bit is a data bit: the top stop bit is still in the top 8 places\nwire data_next = chr[{}:{}] != 8'd0;\nwire ready = !busy | (last_tick & chr_end);",
-            cb - 1,
-            lit(cb - 1, 0),
-            cb - 1,
-            cb - 8
+            "// the bit counter, not `chr`'s contents, ends a character: the FIFO's\n// handshake stays independent of the bytes' values (and `prove` of them)\nwire chr_end = bitn == {};\n// the next bit is a data bit\nwire data_next = bitn < {};\nwire ready = !busy | (last_tick & chr_end);",
+            lit(w.bw, cb as u64 - 1),
+            lit(w.bw, 8)
         );
     }
     let _ = writeln!(s, "wire load = ready & have;");
@@ -697,7 +705,10 @@ fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
     let out_reset = if p.axis.is_some() {
         "    tdata_r <= 8'd0;\n    tlast_r <= 1'b0;".to_string()
     } else {
-        format!("    dv <= {dw}'d0;\n    chr <= {cb}'d1;\n    in_crc <= 1'b0;")
+        format!(
+            "    bitn <= {}'d0;\n    dv <= {dw}'d0;\n    chr <= {cb}'d1;\n    in_crc <= 1'b0;",
+            w.bw
+        )
     };
     let _ = writeln!(
         s,
@@ -755,7 +766,8 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
     } else {
         let _ = writeln!(
         s,
-"    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (chr_end) busy <= 1'b0;\n        else begin\n          chr <= chr >> 1;\n          if (in_crc & data_next) crc <= crc_bit;\n        end\n      end else dv <= dv + {dw}'d1;\n    end"
+"    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (chr_end) busy <= 1'b0;\n        else begin\n          bitn <= bitn + {}'d1;\n          chr <= chr >> 1;\n          if (in_crc & data_next) crc <= crc_bit;\n        end\n      end else dv <= dv + {dw}'d1;\n    end",
+        w.bw
     );
     }
     let tlast_frame = format!("(slot == 4'd3) & (hslice == {})", lit(w.hw, 0));
@@ -768,7 +780,10 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
                 &tlast_frame
             }
         ),
-        None => format!("      chr <= chr_load;\n      dv <= {dw}'d0;"),
+        None => format!(
+            "      chr <= chr_load;\n      bitn <= {}'d0;\n      dv <= {dw}'d0;",
+            w.bw
+        ),
     };
     let crc_load = match p.axis {
         Some(_) => "      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;".to_string(),
