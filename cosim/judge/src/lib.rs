@@ -50,6 +50,7 @@ mod run;
 mod samples;
 pub mod switch;
 mod timed;
+mod timedaxis;
 mod timedlink;
 pub mod tools;
 mod vcd;

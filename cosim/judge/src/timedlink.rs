@@ -89,7 +89,7 @@ impl LineJoin {
 }
 
 /// The channels of each slice's packet in steady state, in order.
-fn packet_order(s: &Schedule) -> Vec<Vec<u16>> {
+pub(crate) fn packet_order(s: &Schedule) -> Vec<Vec<u16>> {
     let g = &s.grid;
     let mut per_slice = vec![Vec::new(); g.slices_per_frame as usize];
     for (cycle, _, ch) in lut_gen::hostlink::merged_frame(s) {
@@ -213,7 +213,7 @@ pub fn check_link(
 }
 
 /// A violation of the packets' order on the line, at `t` ps.
-fn order_violation(lane: &Lane, t: f64, detail: String) -> TimedViolation {
+pub(crate) fn order_violation(lane: &Lane, t: f64, detail: String) -> TimedViolation {
     TimedViolation {
         time_ps: t as u64,
         channel: lane.channel.clone(),
@@ -224,22 +224,22 @@ fn order_violation(lane: &Lane, t: f64, detail: String) -> TimedViolation {
 }
 
 /// A decoded packet: (time, frame, slice, channels).
-type LinePacket = (f64, u64, u16, Vec<u16>);
+pub(crate) type LinePacket = (f64, u64, u16, Vec<u16>);
 
 /// What the host's receiver and decoder read from the line.
-struct LineRead {
-    packets: Vec<LinePacket>,
+pub(crate) struct LineRead {
+    pub(crate) packets: Vec<LinePacket>,
     /// Every character read: (the capture's time of its start bit's edge, byte).
-    chars: Vec<(u64, u8)>,
-    stats: link::Stats,
+    pub(crate) chars: Vec<(u64, u8)>,
+    pub(crate) stats: link::Stats,
     /// The first good packet: the index in `chars` of its header, its
     /// frame counter and slice.
-    join: Option<(usize, u8, u16)>,
+    pub(crate) join: Option<(usize, u8, u16)>,
 }
 
 impl LineRead {
     /// Where the line was joined, in a capture of times `[t0, end]` (ps).
-    fn joined(&self, model: bool, (t0, end): (u64, u64)) -> LineJoin {
+    pub(crate) fn joined(&self, model: bool, (t0, end): (u64, u64)) -> LineJoin {
         let header = self
             .join
             .map(|(i, _, _)| self.chars.get(i).map_or(end, |c| c.0));
@@ -402,7 +402,7 @@ fn read_line(
 
 /// Every packet's channels must be the schedule's for its slice (the first
 /// three that are not are listed).
-fn check_order(s: &Schedule, lane: &Lane, packets: &[LinePacket], out: &mut LinkCheck) {
+pub(crate) fn check_order(s: &Schedule, lane: &Lane, packets: &[LinePacket], out: &mut LinkCheck) {
     let order = packet_order(s);
     let mut wrong = 0;
     for (t, frame, slice, chans) in packets {
