@@ -93,7 +93,7 @@ pub(crate) fn check_axis(
         _ => None,
     };
     let unjudged = |why: String| LineJoin {
-        by: if model { "model" } else { "decoder" },
+        by: "decoder",
         judged: false,
         why_not: Some(why),
         header_ps: None,
@@ -132,7 +132,9 @@ pub(crate) fn check_axis(
     let (beats, overflow) = read_beats(cap, &ports, tc);
     let lane = &cap.lanes[ports.tdata[0]];
     let read = decode(s, lane, &beats, fmt, &mut out);
-    out.join = Some(read.joined(model, (t0, end)));
+    // the beats are decoded and judged, not held to the model: the join is
+    // the decoder's with and without the model
+    out.join = Some(read.joined(false, (t0, end)));
     judge_read(s, cap, &ports, (&read, overflow), model, &mut out);
     let _ = phases;
     out
@@ -203,6 +205,7 @@ fn decode(
     let mut dec = link::Decoder::new(slices);
     let (mut packets, mut decoded) = (Vec::new(), Vec::new());
     let (mut join, mut crc, mut lost, mut tlast_wrong) = (None, 0u64, 0u64, 0u64);
+    let mut lost_place = false;
     let mut chars = Vec::with_capacity(beats.len());
     for (i, &(t, byte, tlast)) in beats.iter().enumerate() {
         chars.push((t, byte));
@@ -210,6 +213,7 @@ fn decode(
         decoded.clear();
         dec.push_packets(&[byte], &mut decoded);
         let mut ends = None;
+        let decoded_any = !decoded.is_empty();
         for d in decoded.drain(..) {
             if join.is_none() {
                 let h = (i + 1).saturating_sub(4 * (2 + d.records.len()));
@@ -240,6 +244,18 @@ fn decode(
             ));
         }
         lost = st.lost_packets;
+        if join.is_some() && st.skipped_bytes > before.skipped_bytes && !lost_place {
+            // once per loss of place: the decoder searches for a header again
+            out.violations.push(order_violation(
+                lane,
+                t as f64,
+                format!("byte 0x{byte:02x} is not where the packet format puts a word: the decoder lost its place and searches for a header"),
+            ));
+        }
+        lost_place = match decoded_any {
+            true => false,
+            false => lost_place || st.skipped_bytes > before.skipped_bytes,
+        };
         let clean = st.crc_errors == before.crc_errors && st.skipped_bytes == before.skipped_bytes;
         let want = ends.is_some_and(|sl| fmt.tlast == Tlast::Slice || sl as u64 + 1 == slices);
         if join.is_some() && clean && tlast != want {

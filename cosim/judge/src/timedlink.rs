@@ -77,10 +77,10 @@ impl LineJoin {
         };
         let what = match self.by {
             "model" => "every character from its header on timed against the model",
-            _ => "every packet from it on decoded and judged; not timed (--no-model)",
+            _ => "every packet from it on decoded and judged, not timed against the model",
         };
         format!(
-            "link: joined the line at its first whole packet (frame counter {f}, slice {s}; its header at {:.3} us; {what}); the line before it was not judged: its first {:.3} us and {} character(s), in flight when the capture began, were skipped (a fault there is not seen)",
+            "link: joined the line at its first whole packet (frame counter {f}, slice {s}; its header at {:.3} us; {what}); the line before it was not judged: its first {:.3} us and {} byte(s), in flight when the capture began, were skipped (a fault there is not seen)",
             h as f64 / 1e6,
             self.unjudged_ps as f64 / 1e6,
             self.skipped_bytes
@@ -126,21 +126,7 @@ pub fn check_link(
         }
     };
     let Some(fmt) = plan.uart() else {
-        let (t0, end) = (cap.steps.first(), cap.steps.last());
-        out.join = Some(LineJoin {
-            by: if model { "model" } else { "decoder" },
-            judged: false,
-            why_not: Some("an AXI4-Stream link's beats are not read from an analyser's capture (check a VCD of the design's ports)".into()),
-            header_ps: None,
-            frame_counter: None,
-            slice: None,
-            skipped_bytes: 0,
-            unjudged_ps: end.zip(t0).map_or(0, |(e, b)| e.0 - b.0),
-        });
-        out.not_proved.push(format!(
-            "{} (link_tx): the mix's link is AXI4-Stream, which has no serial line; its beats are checked cycle by cycle in a VCD of the design's ports",
-            lane.channel
-        ));
+        // an AXI4-Stream link's beats: `timedaxis`
         return out;
     };
     // A bit must span at least two analyser samples to be read.
