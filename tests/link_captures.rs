@@ -73,21 +73,19 @@ fn assert_clean(what: &str, s: &Schedule, [m, d]: &[judge::TimedReport; 2]) {
             .link_join
             .as_ref()
             .unwrap_or_else(|| panic!("{what}: {text}"));
-        let by = if kind(s) == Some(LinkKind::Axis) {
-            "decoder"
-        } else {
-            by
-        };
         assert!(j.judged && j.by == by, "{what}: {text}");
         assert_eq!(Some(j.unjudged_ps), j.header_ps, "{what}: {text}");
         assert!(text.contains(&j.text()), "{what}: {text}");
     }
     if kind(s) == Some(LinkKind::Axis) {
-        // not held to the model: both joins are the decoder's, and said so
-        assert_eq!(m.link_join, d.link_join, "{what}");
+        // held to the model with tready from the capture
+        let text = m.summary();
         assert!(
-            m.summary()
-                .contains("not yet done for an analyser's capture of an AXI4-Stream link"),
+            text.contains("held to the model (tready from the capture)"),
+            "{what}: {text}"
+        );
+        assert!(
+            d.summary().contains("--no-model: the beats are decoded"),
             "{what}"
         );
     }
@@ -325,6 +323,7 @@ fn check_map_reports_where_it_joined_the_line() {
         assert_eq!(j["by"], by, "{j}");
         assert_eq!(j["judged"], true, "{j}");
         let mj = m.link_join.as_ref().unwrap();
+        assert_eq!(j["by"], mj.by, "{j}");
         assert_eq!(j["header_ps"], mj.header_ps.unwrap(), "{j}");
         assert_eq!(j["unjudged_ps"], mj.unjudged_ps, "{j}");
         assert_eq!(j["skipped_bytes"], mj.skipped_bytes, "{j}");
@@ -454,10 +453,10 @@ fn check_map_reads_an_axis_links_beats() {
     let p = pins(&s, 2);
     let d = tempfile::tempdir().unwrap();
     let wave = d.path().join("capture.vcd");
-    let [m, _] = judged(&s, &p, (f / 3 + 555, f + f / 2), 4_321, &wave);
+    let reports = judged(&s, &p, (f / 3 + 555, f + f / 2), 4_321, &wave);
     let (_, map) = analyser::lanes(&s);
     assert!(map.contains("m_axis_tdata[7]") && map.contains("link_overflow"));
-    for flags in [vec![], vec!["--no-model"]] {
+    for (flags, m) in [(vec![], &reports[0]), (vec!["--no-model"], &reports[1])] {
         let mut cmd = crate::common_cli::slotforge();
         cmd.arg("check")
             .args(&flags)
@@ -468,6 +467,7 @@ fn check_map_reads_an_axis_links_beats() {
         let j = &v["link_join"];
         assert_eq!(j["judged"], true, "{j}");
         let mj = m.link_join.as_ref().unwrap();
+        assert_eq!(j["by"], mj.by, "{j}");
         assert_eq!(j["header_ps"], mj.header_ps.unwrap(), "{j}");
         assert_eq!(j["skipped_bytes"], mj.skipped_bytes, "{j}");
     }

@@ -30,7 +30,7 @@ pub struct LinkPhase {
 }
 
 /// One cycle in units.
-const TC: i128 = 1_000_000_000_000;
+pub(crate) const TC: i128 = 1_000_000_000_000;
 
 /// What the line showed.
 pub struct LinkCheck {
