@@ -412,6 +412,37 @@ fn an_axis_fault_after_the_join_fails_the_capture_at_its_time() {
     }
 }
 
+/// With the model, the beats' cycles are held to it (tready from the
+/// capture): the stream one cycle late from a beat on (tvalid low in that
+/// cycle) fails the model's report at that beat.
+#[test]
+fn an_axis_beat_a_cycle_late_fails_against_the_model() {
+    let s = axis_mix();
+    let d = tempfile::tempdir().unwrap();
+    let f = s.grid.frame_cycles;
+    let clean = pins(&s, 4);
+    let (w, phase) = ((f / 2 + 321, f / 2 + 321 + 2 * f), 6_543);
+    let c = beats(&clean, w.0 + f).next().unwrap();
+    let mut late = clean.clone();
+    for k in c..late.len() {
+        let o = if k == c { None } else { Some(&clean[k - 1]) };
+        late[k].axis_tvalid = o.is_some_and(|o| o.axis_tvalid);
+        late[k].axis_tdata = o.map_or(0, |o| o.axis_tdata);
+        late[k].axis_tlast = o.is_some_and(|o| o.axis_tlast);
+    }
+    let t = at_ps(&s, c as u64, w.0, phase);
+    let tc = at_ps(&s, w.0 + 1, w.0, 0);
+    let [m, _] = judged(&s, &late, w, phase, &d.path().join("late.vcd"));
+    let text = m.summary();
+    assert!(!m.ok, "{text}");
+    let v = m
+        .violations
+        .iter()
+        .find(|v| v.rule == "link timing (beats)")
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(v.time_ps.abs_diff(t) <= 2 * tc, "late from {t} ps: {text}");
+}
+
 /// On an AXI4-Stream link the beats before the first whole packet are not
 /// judged: a flipped `tdata` bit in the capture's first beat passes, inside
 /// the time reported unjudged.
