@@ -62,24 +62,12 @@ fn assert_clean(what: &str, s: &Schedule, [m, d]: &[judge::TimedReport; 2]) {
     for (r, by) in [(m, "model"), (d, "decoder")] {
         let text = r.summary();
         assert!(r.ok, "{what}, {by}: {text}");
-        if kind(s) != Some(LinkKind::Uart) {
-            // an AXI4-Stream link's beats are not read from a capture:
-            // said so, on the first line too
+        if kind(s) == Some(LinkKind::Axis) {
+            // the beats read and judged from the first whole packet on
             assert!(
-                text.contains("AXI4-Stream, which has no serial line"),
+                text.contains("m_axis_tdata: ") && text.contains("tlast on exactly the beats"),
                 "{what}: {text}"
             );
-            assert!(
-                text.contains("PASS (the link not judged)"),
-                "{what}: {text}"
-            );
-            assert!(
-                text.contains("link: NOT JUDGED: an AXI4-Stream"),
-                "{what}: {text}"
-            );
-            let j = r.link_join.as_ref().unwrap();
-            assert!(!j.judged && j.unjudged_ps > 0, "{what}: {text}");
-            continue;
         }
         let j = r
             .link_join
@@ -88,6 +76,18 @@ fn assert_clean(what: &str, s: &Schedule, [m, d]: &[judge::TimedReport; 2]) {
         assert!(j.judged && j.by == by, "{what}: {text}");
         assert_eq!(Some(j.unjudged_ps), j.header_ps, "{what}: {text}");
         assert!(text.contains(&j.text()), "{what}: {text}");
+    }
+    if kind(s) == Some(LinkKind::Axis) {
+        // held to the model with tready from the capture
+        let text = m.summary();
+        assert!(
+            text.contains("held to the model (tready from the capture)"),
+            "{what}: {text}"
+        );
+        assert!(
+            d.summary().contains("--no-model: the beats are decoded"),
+            "{what}"
+        );
     }
     if kind(s) == Some(LinkKind::Uart) {
         let text = m.summary();
@@ -329,4 +329,182 @@ fn check_map_reports_where_it_joined_the_line() {
         assert_eq!(j["frame_counter"], mj.frame_counter.unwrap(), "{j}");
         assert!(text.contains(j["text"].as_str().unwrap()), "{j}");
     }
+}
+
+/// The AXI4-Stream mixes of the random link mixes from seed 1.
+fn axis_mix() -> Schedule {
+    random_link_mixes(1, 6)
+        .into_iter()
+        .map(|(_, s)| s)
+        .find(|s| kind(s) == Some(LinkKind::Axis))
+        .expect("an AXI4-Stream mix")
+}
+
+/// The cycles of `p` from `at` on with a beat (tvalid and tready high).
+fn beats(p: &[Pins], at: u64) -> impl Iterator<Item = usize> + '_ {
+    (at as usize..p.len()).filter(|&c| p[c].axis_tvalid && p[c].axis_tready)
+}
+
+/// Faults on an AXI4-Stream link inside a capture, after the join: a
+/// flipped `tdata` bit (a bad CRC) and a dropped `tlast` fail it, with
+/// and without the model, at the beat's time (within a packet for the
+/// CRC, which shows at the trailer).
+#[test]
+fn an_axis_fault_after_the_join_fails_the_capture_at_its_time() {
+    let s = axis_mix();
+    let d = tempfile::tempdir().unwrap();
+    let f = s.grid.frame_cycles;
+    let clean = pins(&s, 4);
+    let (w, phase) = ((f / 2 + 777, f / 2 + 777 + 2 * f), 3_210);
+    let at = w.0 + f;
+    let plan = lut_gen::plan_link(&s).unwrap().unwrap();
+    let within = at_ps(
+        &s,
+        w.0 + 2 * s.grid.slice_cycles + plan.latency_cycles,
+        w.0,
+        0,
+    );
+    // tdata bit 2 flipped: in a packet's seventh beat (a record's, or the
+    // trailer's CRC), a bad CRC; in its header's SYNC, the decoder loses
+    // its place
+    let sync = beats(&clean, at)
+        .find(|&c| clean[c].axis_tdata == link::format::SYNC)
+        .unwrap();
+    for (k, what) in [(6, "bad CRC"), (0, "lost its place")] {
+        let c = beats(&clean, sync as u64).nth(k).unwrap();
+        let mut flipped = clean.clone();
+        flipped[c].axis_tdata ^= 4;
+        let t = at_ps(&s, c as u64, w.0, phase);
+        for r in judged(&s, &flipped, w, phase, &d.path().join("flip.vcd")) {
+            let text = r.summary();
+            assert!(!r.ok, "{text}");
+            let j = r.link_join.as_ref().unwrap();
+            assert!(
+                j.judged && j.header_ps.unwrap() < t,
+                "joined before: {text}"
+            );
+            let v = &r.violations[0];
+            assert!(v.rule.contains("link"), "{text}");
+            assert!(
+                (t..t + within).contains(&v.time_ps),
+                "fault at {t} ps: {text}"
+            );
+            assert!(v.detail.contains(what), "{what}: {text}");
+        }
+    }
+    // a packet's last beat without tlast
+    let c = beats(&clean, at).find(|&c| clean[c].axis_tlast).unwrap();
+    let mut dropped = clean.clone();
+    dropped[c].axis_tlast = false;
+    let t = at_ps(&s, c as u64, w.0, phase);
+    let tc = at_ps(&s, w.0 + 1, w.0, 0);
+    for r in judged(&s, &dropped, w, phase, &d.path().join("tlast.vcd")) {
+        let text = r.summary();
+        assert!(!r.ok, "{text}");
+        let v = &r.violations[0];
+        assert_eq!(v.rule, "link tlast", "{text}");
+        assert_eq!(v.port_bit, "m_axis_tlast", "{text}");
+        assert!(
+            v.time_ps.abs_diff(t) <= tc,
+            "tlast dropped at {t} ps: {text}"
+        );
+    }
+}
+
+/// With the model, the beats' cycles are held to it (tready from the
+/// capture): the stream one cycle late from a beat on (tvalid low in that
+/// cycle) fails the model's report at that beat.
+#[test]
+fn an_axis_beat_a_cycle_late_fails_against_the_model() {
+    let s = axis_mix();
+    let d = tempfile::tempdir().unwrap();
+    let f = s.grid.frame_cycles;
+    let clean = pins(&s, 4);
+    let (w, phase) = ((f / 2 + 321, f / 2 + 321 + 2 * f), 6_543);
+    let c = beats(&clean, w.0 + f).next().unwrap();
+    let mut late = clean.clone();
+    for k in c..late.len() {
+        let o = if k == c { None } else { Some(&clean[k - 1]) };
+        late[k].axis_tvalid = o.is_some_and(|o| o.axis_tvalid);
+        late[k].axis_tdata = o.map_or(0, |o| o.axis_tdata);
+        late[k].axis_tlast = o.is_some_and(|o| o.axis_tlast);
+    }
+    let t = at_ps(&s, c as u64, w.0, phase);
+    let tc = at_ps(&s, w.0 + 1, w.0, 0);
+    let [m, _] = judged(&s, &late, w, phase, &d.path().join("late.vcd"));
+    let text = m.summary();
+    assert!(!m.ok, "{text}");
+    let v = m
+        .violations
+        .iter()
+        .find(|v| v.rule == "link timing (beats)")
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(v.time_ps.abs_diff(t) <= 2 * tc, "late from {t} ps: {text}");
+}
+
+/// On an AXI4-Stream link the beats before the first whole packet are not
+/// judged: a flipped `tdata` bit in the capture's first beat passes, inside
+/// the time reported unjudged.
+#[test]
+fn axis_beats_before_the_join_are_reported_as_not_judged() {
+    let s = axis_mix();
+    let d = tempfile::tempdir().unwrap();
+    let f = s.grid.frame_cycles;
+    let clean = pins(&s, 3);
+    let phase = 1_234;
+    // a window opening inside a packet: its first beat is not a header
+    let from = (f / 2..f)
+        .find(|&c| {
+            let p = &clean[c as usize + 3];
+            p.axis_tvalid && p.axis_tready && p.axis_tdata != link::format::SYNC
+        })
+        .unwrap();
+    let w = (from, from + f);
+    let mut bad = clean.clone();
+    bad[from as usize + 3].axis_tdata ^= 0x10;
+    let t = at_ps(&s, from + 3, from, phase);
+    for r in judged(&s, &bad, w, phase, &d.path().join("before.vcd")) {
+        let text = r.summary();
+        let j = r.link_join.as_ref().unwrap();
+        assert!(r.ok, "unseen before the join: {text}");
+        assert!(j.judged && j.unjudged_ps > t, "{text}");
+        assert!(j.skipped_bytes > 0, "{text}");
+        assert!(text.contains("the line before it was not judged"), "{text}");
+    }
+}
+
+/// `check --map` of a capture of the AXI4-Stream preset: the map names the
+/// `m_axis_*` ports and `link_overflow`; exit 0, `link_join` in the JSON.
+#[test]
+fn check_map_reads_an_axis_links_beats() {
+    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("mixes/eskin34-axis.toml");
+    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    let f = s.grid.frame_cycles;
+    let p = pins(&s, 2);
+    let d = tempfile::tempdir().unwrap();
+    let wave = d.path().join("capture.vcd");
+    let reports = judged(&s, &p, (f / 3 + 555, f + f / 2), 4_321, &wave);
+    let (_, map) = analyser::lanes(&s);
+    assert!(map.contains("m_axis_tdata[7]") && map.contains("link_overflow"));
+    for (flags, m) in [(vec![], &reports[0]), (vec!["--no-model"], &reports[1])] {
+        let mut cmd = crate::common_cli::slotforge();
+        cmd.arg("check")
+            .args(&flags)
+            .args(["--map", &map, "--json"]);
+        let out = cmd.arg(&mix).arg(&wave).output().unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(out.status.code(), Some(0), "{flags:?}: {v}");
+        let j = &v["link_join"];
+        assert_eq!(j["judged"], true, "{j}");
+        let mj = m.link_join.as_ref().unwrap();
+        assert_eq!(j["by"], mj.by, "{j}");
+        assert_eq!(j["header_ps"], mj.header_ps.unwrap(), "{j}");
+        assert_eq!(j["skipped_bytes"], mj.skipped_bytes, "{j}");
+    }
+    // link_tx is not a port of an AXI4-Stream mix: the message says which are
+    let e = judge::parse_map("D0=link_tx", &s).unwrap_err();
+    assert!(
+        e.contains("AXI4-Stream") && e.contains("m_axis_tdata[7:0]"),
+        "{e}"
+    );
 }

@@ -67,18 +67,42 @@ pub fn lanes(s: &Schedule) -> (Vec<(Option<Role>, u32)>, String) {
             v.push((Some(r), b));
         }
     }
-    // The link's line, for a mix with a link.
-    if l.link {
-        v.push((None, 0));
+    // The link's line, for a mix with a UART; an AXI4-Stream link's beat
+    // ports and overflow flag ([`AXIS_LANE`] on).
+    match (l.link, l.axis) {
+        (true, false) => v.push((None, 0)),
+        (true, true) => v.extend((0..AXIS_LANES.len() as u32).map(|k| (None, AXIS_LANE + k))),
+        _ => {}
     }
     let map = v
         .iter()
         .enumerate()
-        .map(|(i, (r, b))| format!("D{i}={}[{b}]", r.map_or("link_tx", |r| r.name())))
+        .map(|(i, (r, b))| match (r, b.checked_sub(AXIS_LANE)) {
+            (None, Some(k)) => format!("D{i}={}", AXIS_LANES[k as usize]),
+            _ => format!("D{i}={}[{b}]", r.map_or("link_tx", |r| r.name())),
+        })
         .collect::<Vec<_>>()
         .join(",");
     (v, map)
 }
+
+/// A lane `(None, AXIS_LANE + k)` of [`lanes`] is the AXI4-Stream port bit
+/// `AXIS_LANES[k]`.
+pub const AXIS_LANE: u32 = 100;
+pub const AXIS_LANES: [&str; 12] = [
+    "m_axis_tdata[0]",
+    "m_axis_tdata[1]",
+    "m_axis_tdata[2]",
+    "m_axis_tdata[3]",
+    "m_axis_tdata[4]",
+    "m_axis_tdata[5]",
+    "m_axis_tdata[6]",
+    "m_axis_tdata[7]",
+    "m_axis_tvalid",
+    "m_axis_tready",
+    "m_axis_tlast",
+    "link_overflow",
+];
 
 pub fn bit(p: &Pins, r: Option<Role>, b: u32) -> bool {
     let v: u128 = match r {
@@ -87,7 +111,14 @@ pub fn bit(p: &Pins, r: Option<Role>, b: u32) -> bool {
         Some(Role::MuxSel) => p.mux_sel as u128,
         Some(Role::MuxEn) => p.mux_en,
         Some(_) => p.sample_valid as u128,
-        None => p.link_tx as u128,
+        None => match b.checked_sub(AXIS_LANE) {
+            Some(k @ 0..8) => return p.axis_tdata >> k & 1 == 1,
+            Some(8) => return p.axis_tvalid,
+            Some(9) => return p.axis_tready,
+            Some(10) => return p.axis_tlast,
+            Some(_) => return p.link_overflow,
+            None => p.link_tx as u128,
+        },
     };
     v >> b & 1 == 1
 }

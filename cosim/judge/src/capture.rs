@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use lut_gen::Schedule;
-use lut_gen::{Layout, LINK_PORTS, PORT_NAMES};
+use lut_gen::{Layout, Role, Signal, AXIS_PORTS, LINK_PORTS, PORT_NAMES};
 
 use crate::timed::{Capture, Lane};
 
@@ -23,7 +23,6 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
         (t, Some(spec))
     };
     let layout = Layout::new(s);
-    let widths = layout.port_widths();
     let mut lanes: Vec<Lane> = Vec::new();
     for (n, raw) in text.lines().enumerate() {
         let line = raw.split('#').next().unwrap_or("").trim();
@@ -48,33 +47,9 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
             }
             None => (port, 0),
         };
-        let link_tx = LINK_PORTS[0].name;
-        let role = if name == link_tx {
-            if !layout.link {
-                return Err(at(format!("`{link_tx}`: this mix has no [link]")));
-            }
-            if bit != 0 {
-                return Err(at(format!("`{link_tx}` has 1 bit, no bit {bit}")));
-            }
-            None
-        } else {
-            let Some(pi) = PORT_NAMES.iter().position(|p| *p == name) else {
-                return Err(at(format!(
-                    "`{name}` is not a port of slotforge_top ({}{})",
-                    PORT_NAMES.join(", "),
-                    if layout.link { ", link_tx" } else { "" }
-                )));
-            };
-            if bit >= widths[pi] {
-                return Err(at(format!(
-                    "`{name}` has {} bit(s) in this mix, no bit {bit}",
-                    widths[pi]
-                )));
-            }
-            Some(lut_gen::PORTS[pi].role)
-        };
-        if role.is_none() && lanes.iter().any(|l| l.role.is_none()) {
-            return Err(at(format!("`{link_tx}` is mapped twice")));
+        let (role, link) = lane_port(&layout, name, bit).map_err(at)?;
+        if let Some(l) = link.filter(|_| lanes.iter().any(|x| x.link == link && x.bit == bit)) {
+            return Err(at(format!("`{}` is mapped twice", l.name(&layout))));
         }
         if lanes.iter().any(|l| l.channel == ch) {
             return Err(at(format!("channel `{ch}` is mapped twice")));
@@ -83,6 +58,7 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
             channel: ch.to_string(),
             role,
             bit,
+            link,
         });
     }
     if lanes.is_empty() {
@@ -95,6 +71,57 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
         ));
     }
     Ok(lanes)
+}
+
+/// The port bit `name[bit]` names: a core port's role, or the link's port
+/// (`link_tx`, `link_overflow`, `m_axis_*`, the ones this mix's link has).
+fn lane_port(
+    layout: &Layout,
+    name: &str,
+    bit: u32,
+) -> Result<(Option<Role>, Option<Signal>), String> {
+    let widths = layout.port_widths();
+    let link_names = || {
+        layout
+            .link_ports()
+            .iter()
+            .map(|p| match p.width {
+                1 => p.name.to_string(),
+                w => format!("{}[{}:0]", p.name, w - 1),
+            })
+            .collect::<Vec<_>>()
+    };
+    if LINK_PORTS.iter().chain(&AXIS_PORTS).any(|p| p.name == name) {
+        let Some(p) = layout.link_ports().iter().find(|q| q.name == name) else {
+            return Err(match (layout.link, layout.axis) {
+                (false, _) => format!("`{name}`: this mix has no [link]"),
+                (true, axis) => format!(
+                    "`{name}`: this mix's link is {}, whose ports are {}",
+                    if axis { "AXI4-Stream" } else { "a UART" },
+                    link_names().join(", ")
+                ),
+            });
+        };
+        if bit >= p.width {
+            return Err(format!("`{name}` has {} bit(s), no bit {bit}", p.width));
+        }
+        return Ok((None, Some(p.signal)));
+    }
+    let Some(pi) = PORT_NAMES.iter().position(|p| *p == name) else {
+        let mut names: Vec<String> = PORT_NAMES.iter().map(|p| p.to_string()).collect();
+        names.extend(link_names());
+        return Err(format!(
+            "`{name}` is not a port of slotforge_top ({})",
+            names.join(", ")
+        ));
+    };
+    if bit >= widths[pi] {
+        return Err(format!(
+            "`{name}` has {} bit(s) in this mix, no bit {bit}",
+            widths[pi]
+        ));
+    }
+    Ok((Some(lut_gen::PORTS[pi].role), None))
 }
 
 /// Reads a capture: sigrok-cli's VCD, or a `.sr` session through sigrok-cli.

@@ -34,6 +34,7 @@
 // The modules are private: what other crates use is the list below, so the
 // judge's internals can move without touching its users.
 mod adc;
+mod axishold;
 mod capture;
 mod checker;
 mod events;
@@ -50,6 +51,7 @@ mod run;
 mod samples;
 pub mod switch;
 mod timed;
+mod timedaxis;
 mod timedlink;
 pub mod tools;
 mod vcd;

@@ -64,6 +64,10 @@ pub(crate) struct LinkJoin {
     samples: Vec<(u64, u16, u16)>,
     /// `tready` since the join, run-length coded: (first cycle, level).
     tready: Vec<(u64, bool)>,
+    /// The model's sample codes are not the run's (an analyser's capture
+    /// without MISO): a packet's slice is placed by its number and its
+    /// records' channels, on the model's own slice grid.
+    blind: bool,
 }
 
 /// Where the model's link joined the line.
@@ -98,7 +102,16 @@ impl LinkJoin {
             dropped: 0,
             samples: Vec::new(),
             tready: Vec::new(),
+            blind: false,
         }
+    }
+
+    /// [`LinkJoin::new`] for a model whose sample codes are not the run's:
+    /// the codes are left out (a record's bytes and the CRC are then not
+    /// the line's; the beats' timing, which does not depend on them, is).
+    pub(crate) fn blind(mut self) -> LinkJoin {
+        self.blind = true;
+        self
     }
 
     /// Model cycle `c`: the design's pins `p` and the model's `e` (its
@@ -106,7 +119,8 @@ impl LinkJoin {
     /// as it is in cycle `c`, and where it joined.
     pub(crate) fn cycle(&mut self, c: u64, p: &Pins, e: &Pins) -> Option<(TxModel, Joined)> {
         if e.sample_valid {
-            self.samples.push((c, e.sample_channel, e.sample_value));
+            let code = if self.blind { 0 } else { e.sample_value };
+            self.samples.push((c, e.sample_channel, code));
         }
         if self.tready.last().map(|t| t.1) != Some(p.axis_tready) {
             self.tready.push((c, p.axis_tready));
@@ -170,7 +184,11 @@ impl LinkJoin {
         // The boundary whose token the header went out with: where the
         // model's sample stream has the packet's records in a slice.
         let s = self.cfg.slice_cycles;
-        let b = find_boundary(&self.samples, &pk.records, (self.from, first), self.step, s)?;
+        let b = if self.blind {
+            self.blind_boundary(pk, first)?
+        } else {
+            find_boundary(&self.samples, &pk.records, (self.from, first), self.step, s)?
+        };
         // the run's slices begin `delta` cycles before the model's
         let delta = (s - b % s) % s;
         let overflows = match hi.checked_sub(4) {
@@ -194,6 +212,22 @@ impl LinkJoin {
             queued,
         };
         Some((h, first, self.dropped + hi as u64))
+    }
+
+    /// The start of packet `pk`'s slice on the model's own grid: the last
+    /// before `first` (its header's cycle) with its number, if its samples'
+    /// channels are the packet's records' and it began after the join.
+    fn blind_boundary(&self, pk: &Packet, first: u64) -> Option<u64> {
+        let s = self.cfg.slice_cycles;
+        let mut k = first.checked_sub(1)? / s;
+        while k % self.slices != pk.slice as u64 {
+            k = k.checked_sub(1)?;
+        }
+        let b = k * s;
+        let i = self.samples.partition_point(|x| x.0 < b);
+        let j = self.samples.partition_point(|x| x.0 < b + s);
+        let chans = self.samples[i..j].iter().map(|x| x.1);
+        (b >= self.from && chans.eq(pk.records.iter().map(|r| r.0))).then_some(b)
     }
 
     /// Bytes read from the line so far.

@@ -23,26 +23,40 @@
 use std::fmt::Write as _;
 
 use lut_gen::Schedule;
-use lut_gen::{Layout, Pins, Role};
+use lut_gen::{Layout, Pins, Role, Signal};
 
 use crate::model::CycleModel;
 pub use crate::timedlink::LineJoin;
 
-/// One analyser channel mapped to one port bit (`adc_cs_n[0]`), or to the
-/// link's line (`link_tx`, `role` None: decoded, not timed edge by edge).
+/// One analyser channel mapped to one port bit (`adc_cs_n[0]`), or to a
+/// link port's bit (`link_tx`, `m_axis_tdata[3]`: `role` None, `link` the
+/// port; decoded, not timed edge by edge).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Lane {
     pub channel: String,
     pub role: Option<Role>,
     pub bit: u32,
+    /// The link's port, when `role` is None.
+    pub link: Option<Signal>,
 }
 
 impl Lane {
     pub fn port_bit(&self) -> String {
-        match self.role {
-            Some(r) => format!("{}[{}]", r.name(), self.bit),
-            None => lut_gen::LINK_PORTS[0].name.to_string(),
+        match (self.role, self.link) {
+            (Some(r), _) => format!("{}[{}]", r.name(), self.bit),
+            (None, Some(Signal::AxisTdata)) => format!("m_axis_tdata[{}]", self.bit),
+            (None, l) => lut_gen::LINK_PORTS
+                .iter()
+                .chain(&lut_gen::AXIS_PORTS)
+                .find(|p| Some(p.signal) == l)
+                .map_or(lut_gen::LINK_PORTS[0].name, |p| p.name)
+                .to_string(),
         }
+    }
+
+    /// Whether this lane carries the UART's line.
+    pub(crate) fn is_line(&self) -> bool {
+        self.role.is_none() && self.link.is_none_or(|l| l == Signal::LinkTx)
     }
 
     fn is(&self, r: Role) -> bool {
@@ -56,7 +70,14 @@ impl Lane {
             Some(Role::MuxSel) => p.mux_sel as u128,
             Some(Role::MuxEn) => p.mux_en,
             Some(Role::SampleValid) => p.sample_valid as u128,
-            None => p.link_tx as u128,
+            None => match self.link {
+                Some(Signal::AxisTdata) => p.axis_tdata as u128,
+                Some(Signal::AxisTvalid) => p.axis_tvalid as u128,
+                Some(Signal::AxisTready) => p.axis_tready as u128,
+                Some(Signal::AxisTlast) => p.axis_tlast as u128,
+                Some(Signal::LinkOverflow) => p.link_overflow as u128,
+                _ => p.link_tx as u128,
+            },
             _ => 0,
         };
         v >> self.bit & 1 == 1
@@ -552,7 +573,7 @@ fn checked_lanes(
                 return false;
             }
             if !lane.predictable() {
-                let linked = lane.is(Role::Miso) && all.iter().any(|l| l.role.is_none());
+                let linked = lane.is(Role::Miso) && all.iter().any(|l| l.is_line());
                 not_proved.push(format!(
                     "{} ({}): its values come from the ADC, not the schedule; not checked at time level{}",
                     lane.channel,
@@ -853,30 +874,39 @@ fn check_link_lane(
     proved: &mut Vec<String>,
     not_proved: &mut Vec<String>,
 ) -> Option<LineJoin> {
-    match cap.lanes.iter().position(|l| l.role.is_none()) {
-        Some(li) => {
-            let phases: Vec<_> = cands
-                .iter()
-                .map(|c| crate::timedlink::LinkPhase {
-                    lo: c.lo,
-                    hi: c.hi,
-                    t: ctx.t,
-                    skew: ctx.skew,
-                })
-                .collect();
-            let lk = crate::timedlink::check_link(s, cap, li, &phases, model);
-            for v in lk.violations {
-                found.push(v);
-            }
-            proved.extend(lk.proved);
-            not_proved.extend(lk.not_proved);
-            return lk.join;
+    let layout = Layout::new(s);
+    let phases: Vec<_> = cands
+        .iter()
+        .map(|c| crate::timedlink::LinkPhase {
+            lo: c.lo,
+            hi: c.hi,
+            t: ctx.t,
+            skew: ctx.skew,
+        })
+        .collect();
+    let line = cap.lanes.iter().position(|l| l.is_line());
+    let axis = cap.lanes.iter().any(|l| l.role.is_none()) && layout.axis;
+    let lk = match line {
+        _ if axis => crate::timedaxis::check_axis(s, cap, &phases, model),
+        Some(li) if !layout.axis => crate::timedlink::check_link(s, cap, li, &phases, model),
+        _ if layout.axis => {
+            not_proved.push("the link's samples (map m_axis_tdata[7:0], m_axis_tvalid, m_axis_tready and m_axis_tlast to analyser channels to read its beats)".into());
+            return None;
         }
-        None if Layout::new(s).link => not_proved
-            .push("the link's samples (map link_tx to an analyser channel to decode them)".into()),
-        None => {}
+        _ if layout.link => {
+            not_proved.push(
+                "the link's samples (map link_tx to an analyser channel to decode them)".into(),
+            );
+            return None;
+        }
+        _ => return None,
+    };
+    for v in lk.violations {
+        found.push(v);
     }
-    None
+    proved.extend(lk.proved);
+    not_proved.extend(lk.not_proved);
+    lk.join
 }
 
 /// Conversion starts a stretch of the capture must fit at their times (after
