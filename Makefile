@@ -98,7 +98,7 @@ cosim: tools
 synth: tools
 	bash hdl/synth.sh $(MIX)
 
-# every preset (or MIXES) placed at nextpnr seeds 1-3: LCs, median Fmax, ratios to the hand-written anchors
+# every preset (or MIXES) placed at nextpnr seeds 1-3: LCs, median Fmax, ratios to the hand-written reference designs (not in the repository)
 MIXES ?= mixes/*.toml
 synth-bench: tools
 	$(CARGO) build -q -p measure --example synth_bench

@@ -18,7 +18,9 @@
 mod core;
 mod emit;
 mod fault;
+mod header;
 mod link;
+mod names;
 mod plan;
 mod sim;
 #[cfg(feature = "stock")]

@@ -3,7 +3,8 @@
 //! synthesizes it once and places it at nextpnr seeds 1, 2 and 3 in the
 //! same run (`measure::synth::place_and_route_seeds`), then prints LCs,
 //! LUT4, DFF, BRAM, each seed's Fmax and their median; for a mix with a
-//! hand-written anchor (issue 28, `measure::synth::HAND_ANCHORS`) also the
+//! hand-written reference design (not in the repository,
+//! `measure::synth::HAND_ANCHORS`) also the
 //! ratios to it: LCs over the hand design's and median Fmax over its median.
 use std::path::{Path, PathBuf};
 
@@ -17,7 +18,7 @@ fn main() {
     }
     let (out, board) = (Path::new(&args[1]), Path::new(&args[2]));
     println!(
-        "{:<18} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>8} {:>8} {:>6}  vs hand-written anchor",
+        "{:<18} {:>6} {:>6} {:>6} {:>5} {:>8} {:>8} {:>8} {:>8} {:>6}  vs hand-written reference design",
         "mix", "LCs", "LUT4", "DFF", "BRAM", "seed1", "seed2", "seed3", "median", "/clock"
     );
     let mut failed = false;

@@ -63,11 +63,11 @@ pub fn median_fmax(runs: &[Synth]) -> Option<f64> {
     }
 }
 
-/// A hand-written design of the same contract, measured on this flow
-/// (issue 28: Verilog-2001 written from docs/timing.md and
+/// A hand-written reference design of the same contract (not in the
+/// repository: Verilog-2001 written from docs/timing.md and
 /// docs/packet-format.md alone, accepted by `sim --rtl`, `golden --rtl`
-/// and `prove --rtl`; median Fmax of seeds 1-3).  The anchor that the
-/// emitted design's ratios are printed against.
+/// and `prove --rtl`), measured on this flow (median Fmax of seeds 1-3).
+/// The anchor that the emitted design's ratios are printed against.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Anchor {
     pub mix: &'static str,
@@ -78,7 +78,7 @@ pub struct Anchor {
     pub fmax_mhz: f64,
 }
 
-/// The hand-written anchors (issue 28's table).
+/// The hand-written reference designs' figures (not in the repository).
 pub const HAND_ANCHORS: [Anchor; 2] = [
     Anchor {
         mix: "eskin34",

@@ -19,6 +19,9 @@ mod mutants;
 #[path = "pins.rs"]
 mod pins;
 
+#[path = "readable.rs"]
+mod readable;
+
 #[path = "random_mixes.rs"]
 mod random_mixes;
 

@@ -13,7 +13,7 @@ use crate::widths::*;
 /// The output registers load when P(c) is not empty; that enable is a
 /// flip-flop (`r_any`, computed a cycle early from the next pending set and
 /// the branches' `done_next`) rather than an OR over the pending set and
-/// the completions, which was the core's critical path (issue 28).
+/// the completions, which was the core's critical path (docs/performance.md, "Lean gateware").
 #[derive(LogicBlock)]
 pub struct Merger {
     pub clock: Signal<In, Clock>,

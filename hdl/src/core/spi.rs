@@ -23,7 +23,7 @@ use crate::widths::*;
 ///
 /// Each counter's increment is masked to the mix's own width (`k_*_mask`,
 /// the phase counter's wide enough for both the period and the setup), so
-/// yosys removes the bits above it (issue 28: the core's maximum widths
+/// yosys removes the bits above it (the core's maximum widths
 /// cost flip-flops, carry cells and compare LUTs in every design).
 #[derive(LogicBlock)]
 pub struct SpiSeq {

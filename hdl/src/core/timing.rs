@@ -12,7 +12,7 @@ use crate::widths::*;
 /// registered data describe slot `u` from the second cycle of slot `u - 1`
 /// through its last, and slot `u + 1` in the first cycle of slot `u`.
 ///
-/// Lean in synthesis (issue 28): the counters are declared at the core's
+/// Lean in synthesis: the counters are declared at the core's
 /// maximum widths (rust-hdl fixes widths when the crate compiles), but every
 /// increment is masked to the mix's own width (`k_*_mask`), so the bits
 /// above it have a constant-zero D input and yosys removes them with their

@@ -1,0 +1,330 @@
+//! Readable names for rust-hdl's Verilog: a deterministic post-pass over
+//! its text.
+//!
+//! rust-hdl names a child by its path with `$` between the parts: modules
+//! `top$branches$0$act`, instances `branches$0`, the wires to a child
+//! `branches$0$clock`, array ports `ch$0`.  `$` is legal in a Verilog
+//! identifier but reads as a system task, and no engineer searches for it.
+//! Here every such name becomes plain: the parts joined by `_`, a `Vec` child
+//! `branches$b` read as `branch<b>`, `seqs$i` as `spi_seq<i>`, `merge` (the
+//! module) as `merger`, and a module under `slotforge_core` is named
+//! `slotforge_<path>`.  rust-hdl also emits one module per flip-flop (a
+//! `DFF` child is a module of its own, named after its path); the modules of
+//! equal text (every `W`-bit register) become one, `slotforge_dff<W>`.
+//!
+//! A new name never equals a name the text already has or another new one:
+//! on a clash the separator becomes `__`, then a number is appended.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+/// The prefix rust-hdl's core modules get (emit renames `top` to it).
+const CORE_PREFIX: &str = "slotforge_core$";
+
+fn is_ident(c: u8) -> bool {
+    c.is_ascii_alphanumeric() || c == b'_' || c == b'$'
+}
+
+/// Every identifier of `text` as `(start, end)`: a run of identifier
+/// characters that starts with a letter or `_` (so `$display` and the
+/// digits of `10'h3f` are not one).
+fn idents(text: &str) -> Vec<(usize, usize)> {
+    let b = text.as_bytes();
+    let mut out = vec![];
+    let mut i = 0;
+    while i < b.len() {
+        if !is_ident(b[i]) {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < b.len() && is_ident(b[i]) {
+            i += 1;
+        }
+        if b[start].is_ascii_alphabetic() || b[start] == b'_' {
+            out.push((start, i));
+        }
+    }
+    out
+}
+
+/// The readable parts of a `$` path: `branches`, `b` -> `branch<b>`;
+/// `seqs`, `i` -> `spi_seq<i>`.
+fn parts(path: &str) -> Vec<String> {
+    let raw: Vec<&str> = path.split('$').collect();
+    let mut out = vec![];
+    let mut k = 0;
+    while k < raw.len() {
+        let index = raw
+            .get(k + 1)
+            .filter(|x| x.bytes().all(|c| c.is_ascii_digit()));
+        match (raw[k], index) {
+            ("branches", Some(b)) => {
+                out.push(format!("branch{b}"));
+                k += 2;
+            }
+            ("seqs", Some(i)) => {
+                out.push(format!("spi_seq{i}"));
+                k += 2;
+            }
+            (p, _) => {
+                out.push(p.to_string());
+                k += 1;
+            }
+        }
+    }
+    out
+}
+
+/// The readable name of a `$` identifier, its parts joined by `sep`.
+fn candidate(old: &str, is_module: bool, sep: &str) -> String {
+    match old.strip_prefix(CORE_PREFIX).filter(|_| is_module) {
+        Some(path) => {
+            let mut p = parts(path);
+            if p == ["merge"] {
+                p[0] = "merger".into();
+            }
+            format!("slotforge{sep}{}", p.join(sep))
+        }
+        None => parts(old).join(sep),
+    }
+}
+
+/// A name not in `taken`, from `want(sep)`: `_`, then `__`, then numbered.
+fn fresh(taken: &BTreeSet<String>, want: impl Fn(&str) -> String) -> String {
+    for sep in ["_", "__"] {
+        let n = want(sep);
+        if !taken.contains(&n) {
+            return n;
+        }
+    }
+    let base = want("__");
+    (2..)
+        .map(|k| format!("{base}_{k}"))
+        .find(|n| !taken.contains(n))
+        .expect("some number is free")
+}
+
+/// Replace every identifier of `text` that `map` has.
+fn replace(text: &str, map: &BTreeMap<String, String>) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut last = 0;
+    for (s, e) in idents(text) {
+        if let Some(new) = map.get(&text[s..e]) {
+            out.push_str(&text[last..s]);
+            out.push_str(new);
+            last = e;
+        }
+    }
+    out.push_str(&text[last..]);
+    out
+}
+
+/// The names of the modules `text` declares, in order.
+fn module_names(text: &str) -> Vec<String> {
+    text.lines()
+        .filter_map(|l| l.strip_prefix("module "))
+        .map(|rest| {
+            rest.split(|c: char| !c.is_ascii() || !is_ident(c as u8))
+                .next()
+                .unwrap_or("")
+                .to_string()
+        })
+        .collect()
+}
+
+/// `text` with every `$` identifier renamed (see the module doc).
+fn rename(text: &str) -> String {
+    let modules: BTreeSet<String> = module_names(text).into_iter().collect();
+    let mut taken: BTreeSet<String> = idents(text)
+        .into_iter()
+        .map(|(s, e)| &text[s..e])
+        .filter(|n| !n.contains('$'))
+        .map(str::to_string)
+        .collect();
+    let mut map = BTreeMap::new();
+    for (s, e) in idents(text) {
+        let old = &text[s..e];
+        if !old.contains('$') || map.contains_key(old) {
+            continue;
+        }
+        let m = modules.contains(old);
+        let new = fresh(&taken, |sep| candidate(old, m, sep));
+        taken.insert(new.clone());
+        map.insert(old.to_string(), new);
+    }
+    replace(text, &map)
+}
+
+/// One module's text (from `module` to its `endmodule` line) and its name.
+struct Chunk<'a> {
+    name: String,
+    text: &'a str,
+}
+
+/// `text` cut into module chunks and the text between them.
+fn chunks(text: &str) -> Vec<Result<Chunk<'_>, &str>> {
+    let mut out = vec![];
+    let mut rest = text;
+    while let Some(at) = find_line(rest, "module ") {
+        out.push(Err(&rest[..at]));
+        let name = module_names(&rest[at..]).remove(0);
+        let end_line = format!("endmodule // {name}\n");
+        let end = match rest[at..].find(&end_line) {
+            Some(k) => at + k + end_line.len(),
+            // a module ended by a bare `endmodule` (the wrapper): leave it be
+            None => {
+                let k = rest[at..]
+                    .find("endmodule\n")
+                    .map_or(rest.len() - at, |k| k + 10);
+                at + k
+            }
+        };
+        out.push(Ok(Chunk {
+            name,
+            text: &rest[at..end],
+        }));
+        rest = &rest[end..];
+    }
+    out.push(Err(rest));
+    out
+}
+
+/// Where the first line of `text` that starts with `prefix` begins.
+fn find_line(text: &str, prefix: &str) -> Option<usize> {
+    let mut at = 0;
+    for l in text.split_inclusive('\n') {
+        if l.starts_with(prefix) {
+            return Some(at);
+        }
+        at += l.len();
+    }
+    None
+}
+
+/// A flip-flop module's width (rust-hdl's `DFF`: ports `d`, `q`, `clock`).
+fn dff_width(c: &Chunk) -> Option<u32> {
+    if !c
+        .text
+        .starts_with(&format!("module {}(d,q,clock);", c.name))
+    {
+        return None;
+    }
+    let decl = c
+        .text
+        .lines()
+        .find(|l| l.trim_start().starts_with("output reg"))?;
+    match decl.split('[').nth(1) {
+        None => Some(1),
+        Some(r) => r
+            .split(':')
+            .next()?
+            .trim()
+            .parse::<u32>()
+            .ok()
+            .map(|h| h + 1),
+    }
+}
+
+/// The flip-flop modules of equal text merged into one, `slotforge_dff<W>`.
+fn merge_dffs(text: &str) -> String {
+    let cs = chunks(text);
+    let mut taken: BTreeSet<String> = idents(text)
+        .into_iter()
+        .map(|(s, e)| text[s..e].to_string())
+        .collect();
+    // body with the module's own name blanked -> the shared name
+    let mut shared: BTreeMap<String, String> = BTreeMap::new();
+    let mut map: BTreeMap<String, String> = BTreeMap::new();
+    let mut keep = vec![];
+    for c in cs.iter() {
+        let Ok(c) = c else {
+            keep.push(true);
+            continue;
+        };
+        let Some(w) = dff_width(c) else {
+            keep.push(true);
+            continue;
+        };
+        let body = c.text.replace(&c.name, "");
+        let first = !shared.contains_key(&body);
+        let name = shared
+            .entry(body)
+            .or_insert_with(|| {
+                let n = fresh(&taken, |sep| format!("slotforge{sep}dff{w}"));
+                taken.insert(n.clone());
+                n
+            })
+            .clone();
+        map.insert(c.name.clone(), name);
+        keep.push(first);
+    }
+    let mut out = String::with_capacity(text.len());
+    for (c, k) in cs.iter().zip(keep) {
+        match (c, k) {
+            (Err(t), _) => out.push_str(t),
+            (Ok(c), true) => out.push_str(c.text),
+            // the separating blank line of a dropped module goes with it
+            (Ok(_), false) => {
+                if out.ends_with("\n\n") {
+                    out.pop();
+                }
+            }
+        }
+    }
+    replace(&out, &map)
+}
+
+/// rust-hdl's text with readable names: no `$` in any identifier, one
+/// module per register width.
+pub(crate) fn readable(text: &str) -> String {
+    merge_dffs(&rename(text))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paths_read_as_blocks() {
+        assert_eq!(
+            candidate("slotforge_core$branches$12$rom", true, "_"),
+            "slotforge_branch12_rom"
+        );
+        assert_eq!(
+            candidate("slotforge_core$seqs$0", true, "_"),
+            "slotforge_spi_seq0"
+        );
+        assert_eq!(
+            candidate("slotforge_core$merge", true, "_"),
+            "slotforge_merger"
+        );
+        assert_eq!(candidate("merge$ch$3", false, "_"), "merge_ch_3");
+        assert_eq!(candidate("seqs$1$cs_n", false, "__"), "spi_seq1__cs_n");
+    }
+
+    #[test]
+    fn a_clash_takes_another_name() {
+        let t = "module m(a$b, a_b);\nendmodule // m\n";
+        let r = rename(t);
+        assert_eq!(r, "module m(a__b, a_b);\nendmodule // m\n");
+    }
+
+    #[test]
+    fn registers_of_equal_text_share_a_module() {
+        let dff = |n: &str, w: &str| {
+            format!("module {n}(d,q,clock);\n    output reg  {w}q;\nendmodule // {n}\n")
+        };
+        let t = format!(
+            "module top(x);\n    a$r a(.d(x));\n    b$r b(.d(x));\n    c$r c(.d(x));\nendmodule // top\n\n{}\n{}\n{}",
+            dff("a$r", "[3:0] "),
+            dff("b$r", ""),
+            dff("c$r", "[3:0] ")
+        );
+        let r = readable(&t);
+        assert!(!r.contains('$'), "{r}");
+        assert_eq!(r.matches("module slotforge_dff4(").count(), 1, "{r}");
+        assert_eq!(r.matches("module slotforge_dff1(").count(), 1, "{r}");
+        assert_eq!(r.matches("slotforge_dff4 ").count(), 2, "{r}");
+        assert_eq!(r.matches("endmodule").count(), 3, "{r}");
+    }
+}
