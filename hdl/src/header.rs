@@ -9,8 +9,8 @@
 
 use std::fmt::Write as _;
 
-use lut_gen::ports::{Layout, Role};
 use lut_gen::Schedule;
+use lut_gen::{Layout, Role};
 
 use crate::plan::Plan;
 

@@ -1,10 +1,10 @@
 //! `cargo run -p measure --example synth_bench -- OUTDIR BOARD.toml MIX.toml...`
 //! (`make synth-bench`): emits each mix's gateware into `OUTDIR/<mix>/`,
 //! synthesizes it once and places it at nextpnr seeds 1, 2 and 3 in the
-//! same run (`measure::synth::place_and_route_seeds`), then prints LCs,
+//! same run (`measure::place_and_route_seeds`), then prints LCs,
 //! LUT4, DFF, BRAM, each seed's Fmax and their median; for a mix with a
 //! hand-written reference design (not in the repository,
-//! `measure::synth::HAND_ANCHORS`) also the
+//! `measure::HAND_ANCHORS`) also the
 //! ratios to it: LCs over the hand design's and median Fmax over its median.
 use std::path::{Path, PathBuf};
 
