@@ -268,3 +268,14 @@ fn no_tracked_file_points_outside_the_repository() {
         hits.join("\n")
     );
 }
+
+/// docs/performance.md holds the current figures only (their history is
+/// CHANGELOG.md's), so it stays a page a reader takes in: at most 300 lines.
+#[test]
+fn the_performance_page_holds_current_figures_only() {
+    let lines = doc("docs/performance.md").lines().count();
+    assert!(
+        lines <= 300,
+        "docs/performance.md has {lines} lines (at most 300): move history to CHANGELOG.md"
+    );
+}
