@@ -134,14 +134,14 @@ fn text(c: &Campaign) -> String {
     missed(&mut o, c);
     let _ = writeln!(
         o,
-        "{} injections: {} detected, {} undetected, {} proved equivalent; false alarms: {} of {} clean runs over {} random mixes",
+        "{} injections: {} detected, {} undetected, {} proved equivalent; false alarms: {} of {} over {}",
         c.injected,
         c.detected,
         c.undetected,
         c.proved_equivalent,
         c.false_alarms.rejected,
-        c.false_alarms.runs,
-        c.false_alarms.mixes
+        super::counted(c.false_alarms.runs, "clean run"),
+        super::counted(c.false_alarms.mixes, "random mix")
     );
     for e in &c.false_alarms.examples {
         let _ = writeln!(o, "  false alarm: {e}");

@@ -248,3 +248,27 @@ pub fn whole_number(v: &str) -> Result<u64, String> {
     t.parse()
         .map_err(|_| format!("too large: at most {}", u64::MAX))
 }
+
+/// `n` of a countable noun, singular or plural as `n` needs ("1 clean run",
+/// "2 clean runs", "3 random mixes").
+pub(crate) fn counted(n: u64, noun: &str) -> String {
+    match n {
+        1 => format!("1 {noun}"),
+        _ if noun.ends_with('x') || noun.ends_with('s') => format!("{n} {noun}es"),
+        _ => format!("{n} {noun}s"),
+    }
+}
+
+#[cfg(test)]
+mod counted_tests {
+    use super::counted;
+
+    #[test]
+    fn one_is_singular_and_every_other_count_plural() {
+        assert_eq!(counted(1, "clean run"), "1 clean run");
+        assert_eq!(counted(0, "clean run"), "0 clean runs");
+        assert_eq!(counted(2, "site"), "2 sites");
+        assert_eq!(counted(3, "random mix"), "3 random mixes");
+        assert_eq!(counted(1, "random mix"), "1 random mix");
+    }
+}

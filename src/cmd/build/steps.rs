@@ -9,6 +9,7 @@ use report::Section;
 use super::job::{Done, Glance, Job};
 use super::plan::{only_names, Run, Step};
 use super::{Args, Charts};
+use crate::cmd::counted;
 
 /// The simulator of the co-simulation and the charts: Verilator when it is
 /// installed (the emitted Verilog), else rust-hdl.
@@ -398,16 +399,16 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campa
         "cycle model (the reference model's pins)"
     };
     let line = format!(
-        "{} of {} injections detected ({} undetected, {} proved equivalent) over {} classes and {} site(s) ({target_name}{}); {} false alarms in {} clean runs",
+        "{} of {} injections detected ({} undetected, {} proved equivalent) over {} classes and {} ({target_name}{}); {} false alarms in {}",
         c.detected,
         c.injected,
         c.undetected,
         c.proved_equivalent,
         c.classes.len(),
-        c.sites.len(),
+        counted(c.sites.len() as u64, "site"),
         if full { "" } else { "; quick" },
         c.false_alarms.rejected,
-        c.false_alarms.runs
+        counted(c.false_alarms.runs, "clean run")
     );
     let sec = Section {
         title: "Fault campaign".into(),
@@ -431,11 +432,11 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campa
     j.answer(
         Glance::Faults,
         format!(
-            "{} of {} injected faults detected, {} false alarms in {} clean runs ({})",
+            "{} of {} injected faults detected, {} false alarms in {} ({})",
             c.detected,
             c.injected,
             c.false_alarms.rejected,
-            c.false_alarms.runs,
+            counted(c.false_alarms.runs, "clean run"),
             if full {
                 "the full campaign"
             } else {
