@@ -160,11 +160,7 @@ impl TimedReport {
             self.edges_checked,
             self.conversions,
             self.violations_total,
-            match (self.ok, &self.link_join) {
-                (false, _) => "FAIL",
-                (true, Some(j)) if !j.judged => "PASS (the link not judged)",
-                (true, _) => "PASS",
-            }
+            crate::verdict::verdict_word(self.ok, self.link_join.as_ref().map(|j| j.judged))
         );
         if let Some(j) = &self.link_join {
             let _ = writeln!(s, "{}", j.text());

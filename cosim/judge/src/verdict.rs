@@ -203,11 +203,7 @@ impl Verdict {
             counted(self.samples, "sample"),
             counted(self.divergence_count, "divergent cycle"),
             counted(self.violation_count, "violation"),
-            match (self.ok, &self.link_join) {
-                (false, _) => "FAIL",
-                (true, Some(j)) if !j.judged => "PASS (the link not judged)",
-                (true, _) => "PASS",
-            }
+            verdict_word(self.ok, self.link_join.as_ref().map(|j| j.judged))
         );
         if let Some(j) = &self.link_join {
             let _ = writeln!(s, "{}", j.text());
@@ -258,6 +254,16 @@ impl Verdict {
 }
 
 /// `n` and the noun, plural unless `n` is 1: "1 frame", "2 frames".
+/// The first line's verdict, for a window and for a capture alike: a pass
+/// whose link was never joined says so rather than reading as a whole pass.
+pub(crate) fn verdict_word(ok: bool, link_judged: Option<bool>) -> &'static str {
+    match (ok, link_judged) {
+        (false, _) => "FAIL",
+        (true, Some(false)) => "PASS (the link not judged)",
+        (true, _) => "PASS",
+    }
+}
+
 fn counted(n: u64, noun: &str) -> String {
     if n == 1 {
         format!("1 {noun}")
