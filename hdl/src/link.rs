@@ -541,6 +541,15 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
         tb - 1,
         p.depth
     );
+    // zeros at power-on, as the Rust twin's: a block RAM's initial
+    // contents cost nothing, and no stale entry holds a power-on value
+    // that `prove` would have to enumerate (an AXI4-Stream link's FIFO is
+    // searched state by state, every power-on value a state of its own)
+    let _ = writeln!(
+        s,
+        "integer mem_i;\ninitial for (mem_i = 0; mem_i <= {}; mem_i = mem_i + 1) mem[mem_i] = {}'d0;",
+        p.depth, tb
+    );
     for (n, w) in [("wr", aw), ("rd", aw), ("n", nw)] {
         let _ = writeln!(s, "reg [{}:0] {n};\ninitial {n} = {w}'d0;", w - 1);
     }
