@@ -81,8 +81,11 @@ impl LinkParams {
     }
 }
 
-/// Token layout in the FIFO: `{boundary, sample, channel[9:0], code[15:0]}`.
+/// Token layout in the twin's FIFO: `{boundary, sample, channel[9:0],
+/// code[15:0]}`; the Verilog keeps the boundary flag beside the block RAM
+/// (`fbnd`), which holds the rest (`RAM_BITS`).
 const TOKEN_BITS: usize = 2 + CH_BITS + VALUE_BITS;
+const RAM_BITS: usize = TOKEN_BITS - 1;
 
 /// The registers of the link (the Rust twin's state).
 #[derive(Debug, Clone, Default)]
@@ -100,7 +103,7 @@ struct Regs {
     have: bool,
     tok: u32,
     /// The next byte slot of the token (0-3 trailer, 4-7 header, 8-11
-    /// record) before skipping what the token does not carry.
+    /// record); a token without a boundary starts at 8.
     bcnt: u8,
     started: bool,
     hframe: u8,
@@ -298,9 +301,14 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
         nx.tok = t;
         nx.rd = (r.rd + 1) % (p.depth + 1);
         nx.have = true;
-        // a trailer only once a header went out; a token without a
-        // boundary skips to its record (`slot`)
-        nx.bcnt = if r.started { 0 } else { 4 };
+        // a token without a boundary skips to its record; a trailer only
+        // once a header went out (its flag is `fbnd`, in flip-flops: the
+        // slot is decided here, not behind the block RAM's output)
+        nx.bcnt = match (t >> 27 & 1 == 1, r.started) {
+            (false, _) => 8,
+            (true, true) => 0,
+            (true, false) => 4,
+        };
     }
     if push {
         if room {
@@ -343,14 +351,10 @@ fn shift(p: &LinkParams, r: &Regs, nx: &mut Regs, tready: bool, last_tick: bool)
     }
 }
 
-/// The byte slot the serializer sends next: `bcnt`, or the record when
-/// the token is no boundary.
+/// The byte slot the serializer sends next (a token without a boundary
+/// starts at its record: the pop set `bcnt` so).
 fn slot(r: &Regs) -> u8 {
-    if r.bcnt < 8 && r.tok >> 27 & 1 == 0 {
-        8
-    } else {
-        r.bcnt
-    }
+    r.bcnt
 }
 
 /// The next byte of the packet (slot [`slot`]) starts
@@ -481,7 +485,7 @@ fn link_verilog(p: &LinkParams) -> String {
     crc_and_character(&mut s, p, w);
     let _ = writeln!(
         s,
-        "// the FIFO's memory: written with a token accepted, read into `tok`\n// when the serializer takes the oldest (the value before this edge's write)\nalways @(posedge clock) begin\n  if (!rst & push & room) mem[wr] <= token;\n  if (!rst & pop) tok <= mem[rd];\nend\n"
+        "// the FIFO's memory: written with a token accepted, read into `tok`\n// when the serializer takes the oldest (the value before this edge's write)\nalways @(posedge clock) begin\n  if (!rst & push & room) begin\n    mem[wr] <= token;\n    fbnd[wr] <= bnd;\n  end\n  if (!rst & pop) tok <= mem[rd];\nend\n"
     );
     let _ = writeln!(s, "always @(posedge clock) begin\n  if (rst) begin");
     register_reset(&mut s, p, w);
@@ -504,7 +508,7 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths {
         pw, aw, nw, dw, cb, ..
     } = w;
-    let tb = TOKEN_BITS;
+    let rb = RAM_BITS;
     let axis = p.axis.is_some();
     if axis {
         let _ = writeln!(
@@ -535,20 +539,25 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     // One entry more than the depth: a pop never reads the entry written
     // at the same edge, so the RAM needs no read-first emulation (a write
     // register, a bypass; `no_rw_check`)
-    let _ = writeln!(
-        s,
-        "(* ram_style = \"block\", no_rw_check *)\nreg [{}:0] mem [0:{}];",
-        tb - 1,
-        p.depth
-    );
-    // zeros at power-on, as the Rust twin's: a block RAM's initial
+    // Zeros at power-on, as the Rust twin's: a block RAM's initial
     // contents cost nothing, and no stale entry holds a power-on value
     // that `prove` would have to enumerate (an AXI4-Stream link's FIFO is
-    // searched state by state, every power-on value a state of its own)
+    // searched state by state, every power-on value a state of its own).
     let _ = writeln!(
         s,
-        "integer mem_i;\ninitial for (mem_i = 0; mem_i <= {}; mem_i = mem_i + 1) mem[mem_i] = {}'d0;",
-        p.depth, tb
+        "(* ram_style = \"block\", no_rw_check *)\nreg [{}:0] mem [0:{}];\ninteger mem_i;\ninitial for (mem_i = 0; mem_i <= {}; mem_i = mem_i + 1) mem[mem_i] = {rb}'d0;",
+        rb - 1,
+        p.depth,
+        p.depth
+    );
+    // each entry's boundary flag in flip-flops: a popped token's first
+    // byte slot is set at the pop, so the byte multiplexer's select is a
+    // register, not a compare behind the block RAM's slow output
+    let _ = writeln!(
+        s,
+        "reg [{}:0] fbnd;\ninitial fbnd = {}'d0;",
+        p.depth,
+        p.depth + 1
     );
     for (n, w) in [("wr", aw), ("rd", aw), ("n", nw)] {
         let _ = writeln!(s, "reg [{}:0] {n};\ninitial {n} = {w}'d0;", w - 1);
@@ -556,7 +565,7 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     let _ = writeln!(
         s,
         "reg have;\ninitial have = 1'b0;\nreg [{}:0] tok;\n// its next byte slot (0-3 trailer, 4-7 header, 8-11 record)\nreg [3:0] bcnt;\ninitial bcnt = 4'd0;",
-        tb - 1,
+        rb - 1,
     );
     let _ = writeln!(
         s,
@@ -592,7 +601,6 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
 /// The handshake and FIFO wires of one cycle.
 fn wires(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths { nw, dw, cb, .. } = w;
-    let tb = TOKEN_BITS;
     let _ = writeln!(s, "wire push = bnd | valid;");
     if p.axis.is_some() {
         // a beat is taken at an edge where tvalid and tready are high
@@ -609,19 +617,14 @@ fn wires(s: &mut String, p: &LinkParams, w: Widths) {
     let _ = writeln!(s, "wire load = ready & have;");
     let _ = writeln!(s, "wire pop = !have & (n != {nw}'d0);");
     let _ = writeln!(s, "wire room = (n < {}) | pop;", lit(nw, p.depth as u64));
-    // a token without a boundary skips to its record; it ends with its
-    // record, or its header when it has none
-    let _ = writeln!(
-        s,
-        "wire [3:0] slot = (!bcnt[3] & !tok[{}]) ? 4'd8 : bcnt;",
-        tb - 1
-    );
+    // a token ends with its record, or its header when it has none
+    let _ = writeln!(s, "wire [3:0] slot = bcnt;");
     let _ = writeln!(
         s,
         "wire last = (slot == 4'd11) | ((slot == 4'd7) & !tok[{}]);",
-        tb - 2
+        RAM_BITS - 1
     );
-    let _ = writeln!(s, "wire [{}:0] token = {{bnd, valid, ch, val}};", tb - 1);
+    let _ = writeln!(s, "wire [{}:0] token = {{valid, ch, val}};", RAM_BITS - 1);
 }
 
 /// Bits `lo..lo + 8` of the `w`-bit register `r` as a byte (zeros above
@@ -746,7 +749,7 @@ fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
     };
     let _ = writeln!(
         s,
-        "    if (pop) begin\n      rd <= {};\n      have <= 1'b1;\n      // a trailer only once a header went out\n      bcnt <= started ? 4'd0 : 4'd4;\n    end",
+        "    if (pop) begin\n      rd <= {};\n      have <= 1'b1;\n      // a token without a boundary skips to its record; a trailer only\n      // once a header went out\n      bcnt <= !fbnd[rd] ? 4'd8 : started ? 4'd0 : 4'd4;\n    end",
         wrap("rd"),
     );
     let _ = writeln!(
