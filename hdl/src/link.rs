@@ -310,9 +310,12 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
             (true, false) => 4,
         };
     }
+    // the free entry `wr` (never a queued token: at most `depth` of the
+    // `depth + 1` entries are) takes every cycle's token; it is kept when
+    // `wr` advances
+    nx.mem[r.wr] = (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
     if push {
         if room {
-            nx.mem[r.wr] = (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
             nx.wr = (r.wr + 1) % (p.depth + 1);
         } else {
             nx.ovfc = r.ovfc.saturating_add(1);
@@ -485,7 +488,7 @@ fn link_verilog(p: &LinkParams) -> String {
     crc_and_character(&mut s, p, w);
     let _ = writeln!(
         s,
-        "// the FIFO's memory: written with a token accepted, read into `tok`\n// when the serializer takes the oldest (the value before this edge's write)\nalways @(posedge clock) begin\n  if (!rst & push & room) begin\n    mem[wr] <= token;\n    fbnd[wr] <= bnd;\n  end\n  if (!rst & pop) tok <= mem[rd];\nend\n"
+        "// the FIFO's memory: its free entry `wr` takes this cycle's token in\n// every cycle (kept only when `wr` advances: no write enable behind the\n// core's `valid`), read into `tok` when the serializer takes the oldest\nalways @(posedge clock) begin\n  if (!rst) begin\n    mem[wr] <= token;\n    fbnd[wr] <= bnd;\n  end\n  if (!rst & pop) tok <= mem[rd];\nend\n"
     );
     let _ = writeln!(s, "always @(posedge clock) begin\n  if (rst) begin");
     register_reset(&mut s, p, w);
