@@ -365,7 +365,12 @@ fn core_wires(v: &mut String, p: &Plan, l: &Layout) -> Vec<(Role, &'static str, 
     for &(_, wire, cw) in &wired {
         let _ = writeln!(v, "    wire [{}:0] {wire};", cw - 1);
     }
+    // the core's slot starts, which the link counts for its slice boundary
+    let _ = writeln!(v, "    wire core_slot_tick;");
     let mut unused = vec![];
+    if p.link.is_none() {
+        unused.push("core_slot_tick".to_string());
+    }
     for &(r, wire, cw) in &wired {
         if p.link.is_some() && matches!(r, Role::SampleChannel | Role::SampleValue) {
             // the link reads the core's full-width channel and code
@@ -462,15 +467,14 @@ fn gaps(used: &[(usize, usize)], width: usize) -> Vec<(usize, usize)> {
 fn core_instance(v: &mut String, wired: &[(Role, &'static str, usize)]) {
     let _ = writeln!(v);
     let _ = writeln!(v, "    {CORE} core (");
-    for (i, port) in PORTS.iter().enumerate() {
+    for port in PORTS.iter() {
         let to = wired
             .iter()
             .find(|(r, ..)| *r == port.role)
             .map_or(port.name, |(_, wire, _)| *wire);
-        let sep = if i + 1 < PORTS.len() { "," } else { "" };
-        let _ = writeln!(v, "        .{}({to}){sep}", core_port_name(port.role));
+        let _ = writeln!(v, "        .{}({to}),", core_port_name(port.role));
     }
-    let _ = writeln!(v, "    );");
+    let _ = writeln!(v, "        .slot_tick(core_slot_tick)\n    );");
 }
 
 /// The link instance (UART or AXI4-Stream), when the mix has a link.
@@ -484,7 +488,7 @@ fn link_instance(v: &mut String, p: &Plan) {
         );
         let _ = writeln!(
             v,
-            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .tready({tr}),\n        .tdata({td}),\n        .tvalid({tv}),\n        .tlast({tl}),\n        .ovf({ovf})\n    );",
+            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .slot_tick(core_slot_tick),\n        .tready({tr}),\n        .tdata({td}),\n        .tvalid({tv}),\n        .tlast({tl}),\n        .ovf({ovf})\n    );",
             Role::Clock.name(),
             Role::Reset.name(),
             Role::SampleValid.name()
@@ -498,7 +502,7 @@ fn link_instance(v: &mut String, p: &Plan) {
         );
         let _ = writeln!(
             v,
-            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .tx({tx}),\n        .ovf({ovf})\n    );",
+            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .slot_tick(core_slot_tick),\n        .tx({tx}),\n        .ovf({ovf})\n    );",
             Role::Clock.name(),
             Role::Reset.name(),
             Role::SampleValid.name()

@@ -9,7 +9,7 @@ pub(super) fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: us
     child_inputs(&mut s, nb, seq_of, nseq);
     lanes(&mut s, nb, devices);
     s.push_str(
-        "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\nend\n",
+        "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
     );
     unused_wires(&mut s, nb, devices);
     s
