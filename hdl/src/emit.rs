@@ -815,7 +815,13 @@ mod tests {
             .trim_end_matches(");")
             .split(',')
             .collect();
-        let want: Vec<&str> = PORTS.iter().map(|p| core_port_name(p.role)).collect();
+        // and one beyond the contract: the timebase's slot starts, which the
+        // link counts (wired inside the wrapper, never a pin)
+        let want: Vec<&str> = PORTS
+            .iter()
+            .map(|p| core_port_name(p.role))
+            .chain(["slot_tick"])
+            .collect();
         assert_eq!(ports, want);
         // and the wrapper exposes exactly the contract's ports, in order
         let top = format!("module {TOP_MODULE} (");
