@@ -6,6 +6,7 @@
 //! - `validate`: an independent proof of a schedule's promises;
 //! - [`lut`]: the slot LUT as a full frame table and in compact form;
 //! - `ports`: the pin contract of `slotforge_top` (names, roles, widths, lanes, limits, `ports.json`);
+//! - `fpga`: the FPGA parts of the open families (tool and cell-model names);
 //! - `hostlink`: the link to the host planned from the schedule (divider, bytes per frame, FIFO depth, latency, minimum baud);
 //! - `oswords`: what the OS says about a user's file, in words;
 //! - `fixes`: changes that make an infeasible mix fit, each tried before it is offered;
@@ -13,6 +14,7 @@
 
 mod audit;
 mod fixes;
+mod fpga;
 mod hostlink;
 // A public namespace, not an export list: the slot table's three file forms
 // (`lut::to_hex`, `lut::to_csv`, `lut::to_markdown`) and its compact form
@@ -54,6 +56,9 @@ pub use ports::{
     limits, manifest, Dir, Layout, LinkPort, Pins, Port, Role, Signal, AXIS_PORTS, LINK_PORTS,
     MUX_SELECT_BITS, PORTS, PORT_NAMES, SAMPLE_VALUE_BITS, TOP_MODULE,
 };
+
+// The FPGA parts slotforge synthesizes for.
+pub use fpga::{Family, Fpga};
 
 // The link to the host, planned from the schedule.
 pub use hostlink::{merged_frame, plan as plan_link, LinkInfeasible, LinkPlan, PacketInstants};
