@@ -240,6 +240,8 @@ impl AuditReport {
         let mut rates: Vec<u64> = mix.channels.iter().map(|c| c.rate_hz).collect();
         rates.sort_unstable();
         rates.dedup();
+        // (0: a channel the mode does not sample, no headroom to give)
+        rates.retain(|&r| r > 0);
         let finer = FinerGrids::of(s);
         let branches: Vec<BranchAudit> = (0..nb)
             .map(|b| BranchAudit::of(s, b, &branch_slots[b], &rates, &finer))
@@ -416,14 +418,19 @@ impl ChannelAudit {
         let settle_cycles = settle_cycles(s, &slots, &branch_slots[ch.branch]);
         let settle_available_ns = cycles_to_ns(settle_cycles, g.clock_hz);
         let required = mix.branches[ch.branch].settle_ns;
-        if settle_available_ns < required as f64 {
+        // A channel its mode does not sample (rate 0) has no instant to settle for.
+        if n > 0 && settle_available_ns < required as f64 {
             errors.push(format!(
                 "`{}`: mux settles for {:.0} ns before a sampling instant, {} ns required",
                 ch.name, settle_available_ns, required
             ));
         }
         let nyquist = ch.rate_hz as f64 / 2.0;
-        let alias = nyquist_check(ch, nyquist, warnings);
+        let alias = if ch.rate_hz > 0 {
+            nyquist_check(ch, nyquist, warnings)
+        } else {
+            None
+        };
         if hi != lo || lo != s.channels[c].interval_cycles {
             errors.push(format!(
                 "`{}`: intervals {lo}..{hi} cycles, {} promised",
@@ -710,7 +717,7 @@ impl FinerGrids {
             .map(|b| {
                 mix.channels
                     .iter()
-                    .filter(|c| c.branch == b)
+                    .filter(|c| c.branch == b && c.rate_hz > 0)
                     .map(|c| mix.samples_per_frame(c.rate_hz))
                     .collect()
             })

@@ -10,6 +10,7 @@
 //! - `hostlink`: the link to the host planned from the schedule (divider, bytes per frame, FIFO depth, latency, minimum baud);
 //! - `oswords`: what the OS says about a user's file, in words;
 //! - `fixes`: changes that make an infeasible mix fit, each tried before it is offered;
+//! - `switching`: when a mode switch takes effect, and the worst reaction to a trigger or the pin;
 //! - `audit`: rates, intervals, headroom, settling and Nyquist, as text or JSON.
 
 mod audit;
@@ -25,6 +26,7 @@ mod oswords;
 mod parts;
 mod ports;
 mod schedule;
+mod switching;
 mod synth;
 mod validate;
 
@@ -44,6 +46,9 @@ pub use synth::{
 };
 pub use validate::validate;
 
+// Modes: when a switch takes effect, and how long a reaction takes.
+pub use switching::{first_instant, pin_latency, trigger_latency, TriggerLatency};
+
 // The audit, and the fixes offered for an infeasible mix.
 pub use audit::{AuditReport, BranchAudit, ChannelAudit, FinerGrid, Headroom, Limit, PartAudit};
 pub use fixes::{
@@ -62,7 +67,10 @@ pub use ports::{
 pub use fpga::{Family, Fpga};
 
 // The link to the host, planned from the schedule.
-pub use hostlink::{merged_frame, plan as plan_link, LinkInfeasible, LinkPlan, PacketInstants};
+pub use hostlink::{
+    merged_frame, merged_run, plan as plan_link, switch_backlog, LinkInfeasible, LinkPlan,
+    PacketInstants, SwitchFifo,
+};
 
 // What the OS says about a user's file, in words.
 pub use oswords::{io_words, write_words};

@@ -162,6 +162,7 @@ impl Cx<'_> {
             return Ok(None);
         };
         self.check_mode_rates(decl, channels, &names)?;
+        self.check_modes_sample(raw, &names, channels)?;
         let triggers = self.triggers(raw, &names, select, branches, channels)?;
         Ok(Some(Modes {
             names,

@@ -264,6 +264,27 @@ impl Cx<'_> {
         Ok(())
     }
 
+    /// Every mode samples something (a switch takes effect at its first
+    /// sample, and a mode of silence is no schedule).
+    pub(super) fn check_modes_sample(
+        &self,
+        raw: &RawMix,
+        names: &[String],
+        channels: &[Channel],
+    ) -> Result<(), MixError> {
+        match (0..names.len()).find(|&m| channels.iter().all(|c| c.rates[m] == 0)) {
+            None => Ok(()),
+            Some(m) => Err(self.at(
+                raw.mode[m].get_ref().name.span(),
+                format!("mode[{m}].name"),
+                format!(
+                    "mode `{}` samples no channel (every rate is 0 in it)",
+                    names[m]
+                ),
+            )),
+        }
+    }
+
     /// Every `[[trigger]]`, resolved and checked against the modes' rates.
     pub(super) fn triggers(
         &self,
