@@ -12,7 +12,10 @@ use crate::parts::cycles_to_ns;
 use crate::schedule::{Placement, Schedule};
 use crate::synth::Infeasible;
 
+mod modes;
 mod text;
+
+pub use modes::{ModeAudit, ModeBranch, ModeChannel, ModeLink, TriggerAudit};
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AuditReport {
@@ -56,6 +59,15 @@ pub struct AuditReport {
     pub fixes: Option<Vec<crate::fixes::Fix>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fixes_tried: Option<usize>,
+    /// A mix with modes (the figures above are the reset mode's): how the
+    /// mode is selected, every mode's table, and each trigger's worst
+    /// reaction. Absent for a mix without modes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mode_select: Option<crate::mix::ModeSelect>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub modes: Vec<ModeAudit>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub triggers: Vec<TriggerAudit>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -259,7 +271,7 @@ impl AuditReport {
                 None
             }
         };
-        AuditReport {
+        let mut report = AuditReport {
             mix: mix.name.clone(),
             feasible: errors.is_empty(),
             verdict: None,
@@ -289,7 +301,12 @@ impl AuditReport {
             channels,
             fixes: None,
             fixes_tried: None,
-        }
+            mode_select: None,
+            modes: Vec::new(),
+            triggers: Vec::new(),
+        };
+        report.add_modes(s);
+        report
     }
 
     /// The report of a mix with no schedule: the diagnosis becomes `errors`.
@@ -372,6 +389,9 @@ impl AuditReport {
             link: None,
             fixes: None,
             fixes_tried: None,
+            mode_select: None,
+            modes: Vec::new(),
+            triggers: Vec::new(),
         }
     }
 

@@ -188,6 +188,7 @@ fn check_schedule(s: &Schedule) -> Result<(), TestCaseError> {
             .unwrap();
         prop_assert_eq!(got.cycles, walked, "trigger {}", k);
     }
+    text_and_json_agree(s);
     Ok(())
 }
 
@@ -272,4 +273,111 @@ fn the_merged_run_agrees_with_the_steady_frame() {
     let across = lut_gen::merged_run(&[&s.modes[0], &s.modes[1]]);
     let count = |m: &Schedule| m.samples_per_frame() as usize;
     assert_eq!(across.len(), count(&s.modes[0]) + count(&s.modes[1]));
+}
+
+/// Every figure of the text's mode table, trigger lines and switch line
+/// equals the JSON's (one value behind both).
+fn text_and_json_agree(s: &Schedule) {
+    let r = lut_gen::AuditReport::of_schedule(s);
+    let text = r.to_text();
+    let json: serde_json::Value = serde_json::from_str(&r.to_json()).unwrap();
+    let modes = json["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), s.modes.len());
+    let table: Vec<Vec<&str>> = text
+        .lines()
+        .skip_while(|l| !l.starts_with("#   mode"))
+        .skip(1)
+        .take(modes.len())
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    for (m, row) in modes.iter().zip(&table) {
+        assert_eq!(row[0], m["number"].to_string());
+        assert_eq!(row[1], m["name"].as_str().unwrap());
+        assert_eq!(row[2], m["samples_per_frame"].to_string());
+        assert_eq!(row[3], m["aggregate_hz"].to_string());
+        assert_eq!(
+            row[4],
+            format!("{:.1}", m["adc_utilization"].as_f64().unwrap() * 100.0)
+        );
+        let binds = format!("`{}`:", m["binding_branch"].as_str().unwrap());
+        assert_eq!(row[6], binds);
+    }
+    // the rates table: one row per channel, one column per mode
+    for (c, ch) in s.mix.channels.iter().enumerate() {
+        let line = text
+            .lines()
+            .skip_while(|l| !l.starts_with("rate Hz"))
+            .nth(1 + c)
+            .unwrap();
+        let cols: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(cols[0], ch.name);
+        for (m, mode) in modes.iter().enumerate() {
+            assert_eq!(cols[1 + m], mode["channels"][c]["rate_hz"].to_string());
+            assert_eq!(mode["channels"][c]["rate_hz"], ch.rates[m]);
+        }
+    }
+    let triggers = json["triggers"]
+        .as_array()
+        .map_or(&[][..], |v| v.as_slice());
+    for (k, t) in triggers.iter().enumerate() {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with(&format!("trigger {k}:")))
+            .unwrap();
+        let want = format!("worst latency {} cycles", t["latency_cycles"]);
+        assert!(line.contains(&want), "{line} / {want}");
+        assert_eq!(
+            t["latency_cycles"],
+            lut_gen::trigger_latency(s, k).unwrap().cycles
+        );
+    }
+    if let Some(sw) = json["link"]["switches"].as_array() {
+        let line = text
+            .lines()
+            .find(|l| l.starts_with("link across switches"))
+            .unwrap();
+        for x in sw {
+            let want = format!(
+                "{}->{} {}",
+                x["from"].as_str().unwrap(),
+                x["to"].as_str().unwrap(),
+                x["backlog"]
+            );
+            assert!(line.contains(&want), "{line} / {want}");
+            assert!(x["backlog"].as_u64().unwrap() <= json["link"]["fifo_depth"].as_u64().unwrap());
+        }
+    }
+}
+
+#[test]
+fn the_audits_text_and_json_agree_on_modes() {
+    for name in ["modes-pin", "modes-auto", "eskin34-adaptive"] {
+        text_and_json_agree(&lut_gen::synthesize(&testkit(name)).unwrap());
+    }
+}
+
+/// The FIFO across a switch is at least each side's own steady backlog,
+/// and a "switch" to the same mode is its steady state.
+#[test]
+fn a_switch_needs_at_least_either_modes_fifo() {
+    for name in ["modes-auto", "eskin34-adaptive"] {
+        let s = lut_gen::synthesize(&testkit(name)).unwrap();
+        let plan = lut_gen::plan_link(&s).unwrap().unwrap();
+        let own: Vec<usize> = s
+            .modes
+            .iter()
+            .map(|m| lut_gen::plan_link(m).unwrap().unwrap().fifo_depth)
+            .collect();
+        for (a, ma) in s.modes.iter().enumerate() {
+            let same = lut_gen::switch_backlog(ma, ma, plan.line);
+            assert_eq!(same.max(1), own[a], "{name} mode {a}");
+            for (b, mb) in s.modes.iter().enumerate() {
+                let x = lut_gen::switch_backlog(ma, mb, plan.line);
+                // the run starts with `a` frames to its steady state
+                assert!(x.max(1) >= own[a], "{name} {a}->{b}");
+                assert!(x <= plan.fifo_depth, "{name} {a}->{b}");
+            }
+        }
+        assert_eq!(plan.switches.len(), s.modes.len() * (s.modes.len() - 1));
+    }
 }

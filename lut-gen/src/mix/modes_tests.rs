@@ -156,6 +156,11 @@ fn bad_modes_are_named_by_line_and_field() {
         "level = -1",
         "outside the code range",
     );
+}
+
+#[test]
+fn bad_trigger_fields_are_named_by_line_and_field() {
+    let auto = "modes-auto";
     refused(
         auto,
         "to = \"touch\"",
@@ -212,6 +217,11 @@ fn bad_modes_are_named_by_line_and_field() {
         "for_frames = 0",
         "must be 1 to",
     );
+}
+
+#[test]
+fn bad_triggers_are_named_by_line_and_field() {
+    let auto = "modes-auto";
     // a watched channel not sampled in a mode its trigger leaves
     // (V is sampled in `touch`, the one mode trigger[1] leaves: accepted)
     assert!(parse(
@@ -245,6 +255,10 @@ fn bad_modes_are_named_by_line_and_field() {
             && e.message.contains("every mode but `to`"),
         "{e}"
     );
+}
+
+#[test]
+fn bad_pin_modes_are_named_by_line_and_field() {
     let pin = "modes-pin";
     refused(
         pin,
