@@ -62,8 +62,8 @@ pub use fixes::{
 // The pin contract of `slotforge_top`. `limits` stays a namespace: its
 // `MAX_*` are the contract's, apart from the gateware's own (`hdl::MAX_*`).
 pub use ports::{
-    limits, manifest, Dir, Layout, LinkPort, Pins, Port, Role, Signal, AXIS_PORTS, LINK_PORTS,
-    MUX_SELECT_BITS, PORTS, PORT_NAMES, SAMPLE_VALUE_BITS, TOP_MODULE,
+    limits, manifest, Dir, Layout, LinkPort, ModePort, Pins, Port, Role, Signal, AXIS_PORTS,
+    LINK_PORTS, MODE_PORTS, MUX_SELECT_BITS, PORTS, PORT_NAMES, SAMPLE_VALUE_BITS, TOP_MODULE,
 };
 
 // The FPGA parts slotforge synthesizes for.

@@ -14,6 +14,9 @@
 
 use serde::Serialize;
 
+mod mode;
+pub use mode::{ModePort, MODE_PORTS};
+
 use crate::parts::Start;
 use crate::schedule::Schedule;
 
@@ -443,6 +446,10 @@ pub struct Layout {
     pub link: bool,
     /// The link is AXI4-Stream ([`AXIS_PORTS`]), not a UART ([`LINK_PORTS`]).
     pub axis: bool,
+    /// Bits of the mode ports ([`Layout::mode_ports`]); 0: no modes.
+    pub mode_bits: u32,
+    /// Modes chosen by the `mode_sel` pin (`select = "pin"`).
+    pub mode_pin: bool,
 }
 
 impl Layout {
@@ -499,6 +506,12 @@ impl Layout {
                 .mix
                 .link
                 .is_some_and(|l| l.kind == crate::mix::LinkKind::Axis),
+            mode_bits: s.mix.modes.as_ref().map_or(0, |m| m.select_bits()),
+            mode_pin: s
+                .mix
+                .modes
+                .as_ref()
+                .is_some_and(|m| m.select == crate::mix::ModeSelect::Pin),
         }
     }
 
@@ -791,6 +804,11 @@ pub fn manifest(s: &Schedule) -> String {
             .iter()
             .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": p.width})),
     );
+    ports.extend(
+        l.mode_ports()
+            .iter()
+            .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": l.mode_bits})),
+    );
     let mut doc = json!({
         "top": TOP_MODULE,
         "mix": s.mix.name,
@@ -824,6 +842,9 @@ pub fn manifest(s: &Schedule) -> String {
         o.insert("fifo_depth".into(), json!(p.fifo_depth));
         o.insert("packet_format".into(), json!("docs/packet-format.md"));
         doc["link"] = serde_json::Value::Object(o);
+    }
+    if let Some(m) = mode::manifest_mode(s, &l) {
+        doc["mode"] = m;
     }
     let mut t = serde_json::to_string_pretty(&doc).expect("json");
     t.push('\n');
