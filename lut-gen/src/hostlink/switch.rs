@@ -24,7 +24,11 @@ pub(super) fn plan_modes(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, Link
     let mut plans = Vec::new();
     for (m, ms) in s.modes.iter().enumerate() {
         let p = plan_one(ms, spec).map_err(|e| {
-            let detail = format!("in mode `{}`: {}", names[m], e.detail);
+            // `link.<key>: words` stays the field first, as every refusal
+            let detail = match e.detail.split_once(": ") {
+                Some((key, words)) => format!("{key}: in mode `{}`, {words}", names[m]),
+                None => format!("in mode `{}`: {}", names[m], e.detail),
+            };
             LinkInfeasible::new(spec, detail, e.min_baud)
         })?;
         plans.push(p);

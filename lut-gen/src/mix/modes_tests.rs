@@ -27,22 +27,22 @@ fn line_of(text: &str, needle: &str) -> usize {
 fn rates_override_rate_hz_per_mode() {
     let m = testkit("modes-pin");
     let modes = m.modes.as_ref().unwrap();
-    assert_eq!(modes.names, ["slow", "fast"]);
+    assert_eq!(modes.names, ["fast", "slow"]);
     assert_eq!(modes.select, ModeSelect::Pin);
     assert!(modes.triggers.is_empty());
     let rates: Vec<_> = m.channels.iter().map(|c| c.rates.clone()).collect();
     assert_eq!(
         rates,
         [
-            vec![1_000, 4_000],
+            vec![4_000, 1_000],
             vec![2_000, 2_000],
-            vec![0, 1_000],
+            vec![1_000, 0],
             vec![2_000, 2_000],
-            vec![0, 1_000]
+            vec![1_000, 0]
         ]
     );
     // `in_mode` is the mix at one mode's rates
-    let slow = m.in_mode(0);
+    let slow = m.in_mode(1);
     assert_eq!(
         slow.channels.iter().map(|c| c.rate_hz).collect::<Vec<_>>(),
         [1_000, 2_000, 0, 2_000, 0]
@@ -118,10 +118,10 @@ fn bad_modes_are_named_by_line_and_field() {
     );
     refused(
         auto,
-        "rates = { rest = 0 }",
-        "rates = { rest = -5 }",
-        "channel[1].rates.rest",
-        "rest = -5",
+        "rates = { hold = 0 }",
+        "rates = { hold = -5 }",
+        "channel[1].rates.hold",
+        "hold = -5",
         "must not be negative",
     );
     refused(
@@ -229,31 +229,34 @@ fn bad_triggers_are_named_by_line_and_field() {
         &text(auto).replacen("channels = [\"T0\"]", "channels = [\"V\"]", 1)
     )
     .is_ok());
-    refused(
-        auto,
+    let t = text(auto).replacen("rates = { hold = 0 }", "rates = { rest = 0 }", 1);
+    let t = t.replacen(
         "channels = [\"T{0..3}\"]",
         "channels = [\"TEMP\", \"V\"]",
-        "trigger[0].channels",
-        "channels = [\"TEMP\", \"V\"]",
-        "`V` is not sampled in mode `rest` (rate 0), which this trigger leaves",
-    );
-    // without `from` a trigger leaves every mode but `to`
-    let t = text(auto).replacen("rates = { rest = 0 }", "rates = { hold = 0 }", 1);
-    let t = t.replacen(
-        "channels = [\"T{0..3}\"]\nfor_frames = 2",
-        "channels = [\"V\"]\nfor_frames = 2",
         1,
     );
     let e = err(&t);
     assert_eq!(
         (e.field.as_str(), e.line),
-        ("trigger[2].channels", line_of(&t, "channels = [\"V\"]")),
+        (
+            "trigger[0].channels",
+            line_of(&t, "channels = [\"TEMP\", \"V\"]")
+        ),
         "{e}"
     );
     assert!(
-        e.message.contains("`V` is not sampled in mode `hold`")
-            && e.message.contains("every mode but `to`"),
+        e.message
+            .contains("`V` is not sampled in mode `rest` (rate 0), which this trigger leaves"),
         "{e}"
+    );
+    // without `from` a trigger leaves every mode but `to`
+    refused(
+        auto,
+        "channels = [\"T{0..3}\"]\nfor_frames = 2",
+        "channels = [\"V\"]\nfor_frames = 2",
+        "trigger[2].channels",
+        "channels = [\"V\"]\nfor_frames = 2",
+        "`V` is not sampled in mode `hold` (rate 0), which this trigger leaves",
     );
 }
 
@@ -262,19 +265,19 @@ fn bad_pin_modes_are_named_by_line_and_field() {
     let pin = "modes-pin";
     refused(
         pin,
-        "[[mode]]\nname = \"fast\"\n",
+        "[[mode]]\nname = \"slow\"\n",
         "",
         "mode[0].name",
-        "name = \"slow\"",
+        "name = \"fast\"",
         "a single mode never switches",
     );
     refused(
         pin,
+        "name = \"slow\"\n\n[modes]",
         "name = \"fast\"\n\n[modes]",
-        "name = \"slow\"\n\n[modes]",
         "mode[1].name",
-        "name = \"slow\"\n\n[modes]",
-        "duplicate mode name `slow`",
+        "name = \"fast\"\n\n[modes]",
+        "duplicate mode name `fast`",
     );
     refused(
         pin,
@@ -313,7 +316,7 @@ fn bad_pin_modes_are_named_by_line_and_field() {
 fn modes_keys_without_modes_are_refused() {
     let pin = text("modes-pin");
     let none = pin.replace(
-        "[[mode]]\nname = \"slow\"\n\n[[mode]]\nname = \"fast\"\n\n",
+        "[[mode]]\nname = \"fast\"\n\n[[mode]]\nname = \"slow\"\n\n",
         "",
     );
     let e = err(&none);

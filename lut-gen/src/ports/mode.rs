@@ -93,7 +93,7 @@ mod tests {
         assert_eq!(d["mode"]["sel"], "mode_sel");
         assert_eq!(d["mode"]["mode"], "mode");
         assert_eq!(d["mode"]["bits"], 1);
-        assert_eq!(d["mode"]["names"], serde_json::json!(["slow", "fast"]));
+        assert_eq!(d["mode"]["names"], serde_json::json!(["fast", "slow"]));
         let ports = d["ports"].as_array().unwrap();
         let last: Vec<_> = ports[ports.len() - 2..]
             .iter()

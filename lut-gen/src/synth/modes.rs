@@ -150,7 +150,7 @@ mod tests {
         let why = synthesize(&forced).unwrap_err();
         assert!(
             why.to_string()
-                .contains("mode `slow` has no jitter-free schedule"),
+                .contains("mode `fast` has no jitter-free schedule"),
             "{why}"
         );
     }
