@@ -96,14 +96,18 @@ pub fn switch_backlog(a: &Schedule, b: &Schedule, line: Line) -> usize {
         Line::Axis(x) => Some(ReadyDriver::new(ReadyPattern::WorstCase, x.ready_within)),
         Line::Uart(_) => None,
     };
-    let valid: BTreeMap<u64, u16> = stream.iter().map(|&(v, _, ch)| (v, ch)).collect();
     let end = (frames.len() as u64 + 1) * g.frame_cycles;
-    for c in 0..end {
+    // by cycle: the sample on `sample_valid`, if any
+    let mut valid: Vec<Option<u16>> = vec![None; end as usize];
+    for &(v, _, ch) in stream.iter().filter(|&&(v, _, _)| v < end) {
+        valid[v as usize] = Some(ch);
+    }
+    for v in valid {
         if let Some(d) = slave.as_mut() {
             let r = d.ready(t.tvalid());
             t.set_tready(r);
         }
-        t.clock(false, valid.get(&c).map(|&ch| (ch, 0)));
+        t.clock(false, v.map(|ch| (ch, 0)));
         if t.max_backlog > MAX_FIFO_DEPTH {
             break;
         }

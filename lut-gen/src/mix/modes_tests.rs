@@ -358,3 +358,21 @@ fn auto_without_triggers_and_chains_across_modes_are_refused() {
     );
     assert!(e.message.contains("at least one [[trigger]]"), "{e}");
 }
+
+#[test]
+fn a_mode_that_samples_nothing_is_named() {
+    // modes-pin's `slow` without A0, A1 and B0: nothing left to sample
+    let t = text("modes-pin")
+        .replace("rates = { slow = 1_000 }", "rates = { slow = 0 }")
+        .replace(
+            "rate_hz = 2_000\n",
+            "rate_hz = 2_000\nrates = { slow = 0 }\n",
+        );
+    let e = err(&t);
+    assert_eq!(
+        (e.field.as_str(), e.line),
+        ("mode[1].name", line_of(&t, "name = \"slow\"")),
+        "{e}"
+    );
+    assert!(e.message.contains("mode `slow` samples no channel"), "{e}");
+}
