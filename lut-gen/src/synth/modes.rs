@@ -84,10 +84,9 @@ fn alone(mix: &Mix, reasons: Vec<String>) -> Infeasible {
 /// `why` one mode has no schedule, said of that mode.
 fn in_mode(mix: &Mix, name: &str, mut why: Infeasible) -> Infeasible {
     why.mix = mix.name.clone();
-    why.reasons.insert(
-        0,
-        format!("mode `{name}` has no jitter-free schedule at its rates, on any grid"),
-    );
+    for r in &mut why.reasons {
+        *r = format!("in mode `{name}`: {r}");
+    }
     why
 }
 
@@ -148,11 +147,7 @@ mod tests {
         let mut forced = mix.clone();
         forced.slots_per_slice = Some(1);
         let why = synthesize(&forced).unwrap_err();
-        assert!(
-            why.to_string()
-                .contains("mode `fast` has no jitter-free schedule"),
-            "{why}"
-        );
+        assert!(why.to_string().contains("in mode `fast`: "), "{why}");
     }
 
     #[test]
