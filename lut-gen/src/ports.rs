@@ -824,24 +824,8 @@ pub fn manifest(s: &Schedule) -> String {
         "channels": channels,
         "ports": ports,
     });
-    if let Some(Ok(p)) = crate::hostlink::plan(s) {
-        let mut o = serde_json::Map::new();
-        o.insert("kind".into(), json!(p.kind));
-        for lp in l.link_ports() {
-            o.insert(lp.key.into(), json!(lp.name));
-        }
-        if let Some(a) = p.axis() {
-            o.insert("tlast_at".into(), json!(a.tlast.name()));
-            o.insert("ready_within".into(), json!(a.ready_within));
-        } else {
-            o.insert("baud".into(), json!(p.baud));
-            o.insert("baud_divider".into(), json!(p.baud_divider));
-            o.insert("parity".into(), json!(p.parity));
-            o.insert("stop_bits".into(), json!(p.stop_bits));
-        }
-        o.insert("fifo_depth".into(), json!(p.fifo_depth));
-        o.insert("packet_format".into(), json!("docs/packet-format.md"));
-        doc["link"] = serde_json::Value::Object(o);
+    if let Some(link) = manifest_link(s, &l) {
+        doc["link"] = link;
     }
     if let Some(m) = mode::manifest_mode(s, &l) {
         doc["mode"] = m;
@@ -849,6 +833,32 @@ pub fn manifest(s: &Schedule) -> String {
     let mut t = serde_json::to_string_pretty(&doc).expect("json");
     t.push('\n');
     t
+}
+
+/// `ports.json`'s `"link"`: the link's ports by key and its line; `None`
+/// without a link (or with one the mix cannot use).
+fn manifest_link(s: &Schedule, l: &Layout) -> Option<serde_json::Value> {
+    use serde_json::json;
+    let Some(Ok(p)) = crate::hostlink::plan(s) else {
+        return None;
+    };
+    let mut o = serde_json::Map::new();
+    o.insert("kind".into(), json!(p.kind));
+    for lp in l.link_ports() {
+        o.insert(lp.key.into(), json!(lp.name));
+    }
+    if let Some(a) = p.axis() {
+        o.insert("tlast_at".into(), json!(a.tlast.name()));
+        o.insert("ready_within".into(), json!(a.ready_within));
+    } else {
+        o.insert("baud".into(), json!(p.baud));
+        o.insert("baud_divider".into(), json!(p.baud_divider));
+        o.insert("parity".into(), json!(p.parity));
+        o.insert("stop_bits".into(), json!(p.stop_bits));
+    }
+    o.insert("fifo_depth".into(), json!(p.fifo_depth));
+    o.insert("packet_format".into(), json!("docs/packet-format.md"));
+    Some(serde_json::Value::Object(o))
 }
 
 #[cfg(test)]
