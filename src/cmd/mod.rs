@@ -150,7 +150,31 @@ pub fn load_checked(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8
         Limits::Emitter => schedule(path)?,
     };
     link_fits(&s, path)?;
+    one_mode(&s, path)?;
     Ok(s)
+}
+
+/// Refuses a mix with modes in every command past the plan (`audit` and
+/// `lut` plan every mode): the gateware, its simulation, proof and the
+/// host's decoder follow the reset mode only, so running them would show a
+/// design that never switches as if it were the mix.  Exit 2.
+pub fn one_mode(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
+    match &s.mix.modes {
+        Some(m) if m.names.len() > 1 => {
+            eprintln!(
+                "error: {}: the mix declares {} modes ({}): `audit` and `lut` plan every \
+                 mode, but the gateware does not switch modes yet, so this command would \
+                 show the reset mode `{}` alone; audit it, or remove the [[mode]] tables \
+                 to build one mode",
+                file.display(),
+                m.names.len(),
+                m.names.join(", "),
+                m.names[0]
+            );
+            Err(2)
+        }
+        _ => Ok(()),
+    }
 }
 
 /// [`schedule`], then the contract's limits checked ([`fits_pins`]).
