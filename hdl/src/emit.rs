@@ -165,6 +165,9 @@ pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Em
             },
         ),
     ];
+    let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+    let core = crate::fusesoc::core_file(s, &names);
+    files.push((crate::fusesoc::CORE_FILE.to_string(), core));
     files.sort();
     Ok(Emitted { files })
 }

@@ -2,6 +2,7 @@
 //! returned as a `report::Section` (text, tables, charts with their CSV)
 //! and a one-line summary, so the CLI only calls and writes.
 //!
+//! - `netlist`: a family's gate-level netlist with its cell models;
 //! - `synth`: the one yosys + nextpnr-ice40 flow (also `hdl/synth.sh`);
 //! - `figure7`: the paper's Figure 7 for the mix's own rates (`dft`);
 //! - `timing`: a steady-state slice's timing diagram and WaveDrom JSON;
@@ -16,6 +17,7 @@
 mod budget;
 mod dft;
 mod figure7;
+mod netlist;
 mod proof;
 mod schedulability;
 mod speed;
@@ -29,6 +31,10 @@ pub use proof::{cached_proof, proof, ShownProof};
 pub use schedulability::schedulability;
 pub use speed::{speed, CleanRun};
 pub use timing::timing;
+
+// The netlist yosys writes for a family, with its cell models (`sim
+// --netlist`, `prove --netlist`).
+pub use netlist::{netlist, Netlist, NETLIST_FILE, NETLIST_SIM_FILE};
 
 // The place-and-route flow on its own (also `hdl/synth.sh`).
 pub use synth::{

@@ -54,6 +54,12 @@ pub fn verdict_exit(v: lut_gen::Verdict) -> u8 {
     }
 }
 
+/// The `--netlist`/`--fpga` value parser: a part or its family
+/// (`lut_gen::Fpga`); anything else names the known ones.
+pub fn fpga(s: &str) -> Result<lut_gen::Fpga, String> {
+    lut_gen::Fpga::parse(s)
+}
+
 /// The `--backend` value parser: the names `engines::Backend` knows.
 pub fn backend(s: &str) -> Result<engines::Backend, String> {
     s.parse()

@@ -1,0 +1,183 @@
+//! The netlist that goes to the chip: yosys' `synth_<family>` of the emitted
+//! gateware, written back as gate-level Verilog (`write_verilog -noattr`)
+//! and joined with the family's cell models (yosys' `<family>/cells_sim.v`)
+//! into one self-contained file, so `sim --netlist` and `prove --netlist`
+//! hand it to the same `--rtl` path the outside Verilog takes: the same ADC
+//! model, the same judge, the same harness.
+
+use std::path::{Path, PathBuf};
+
+use judge::tools::Tool;
+use lut_gen::{Fpga, Schedule};
+
+/// The gate-level netlist (alone) as yosys writes it, in the work folder.
+pub const NETLIST_FILE: &str = "netlist.v";
+/// The netlist with the cell models, the file the simulators read.
+pub const NETLIST_SIM_FILE: &str = "netlist_sim.v";
+
+/// A family's netlist of one schedule's gateware.
+#[derive(Debug, Clone)]
+pub struct Netlist {
+    pub fpga: Fpga,
+    /// The netlist followed by the cell models (includes inlined).
+    pub text: String,
+    /// Cell instances in the netlist (the family's primitives).
+    pub cells: usize,
+    /// Where the cell models were read from.
+    pub models: PathBuf,
+}
+
+impl Netlist {
+    /// What a proof or a simulation of this netlist says nothing of, one
+    /// plain sentence each (`prove --netlist`'s `not_covered`).
+    pub fn not_covered(&self) -> Vec<String> {
+        vec![
+            format!(
+                "the {} silicon itself: its cells are yosys' simulation models ({}), taken as the chip's behaviour",
+                self.fpga,
+                self.models.display()
+            ),
+            format!(
+                "what place and route does after yosys (nextpnr's packing and routing for the {}) and any timing: setup, hold and clock-to-out are `synth --fpga`'s Fmax, not this check's",
+                self.fpga
+            ),
+        ]
+    }
+}
+
+/// Where yosys keeps its share folder (`<family>/cells_sim.v`): beside the
+/// `yosys` found on PATH (`bin/../share/yosys`), else the Debian place.
+fn share_dir() -> Result<PathBuf, String> {
+    let mut places = vec![];
+    if let Some(path) = std::env::var_os("PATH") {
+        for d in std::env::split_paths(&path) {
+            if d.join("yosys").is_file() {
+                if let Some(prefix) = d.parent() {
+                    places.push(prefix.join("share").join("yosys"));
+                }
+            }
+        }
+    }
+    places.push(PathBuf::from("/usr/share/yosys"));
+    places
+        .iter()
+        .find(|p| p.join("ice40").join("cells_sim.v").is_file())
+        .cloned()
+        .ok_or_else(|| {
+            format!(
+                "yosys' cell models (<share>/ice40/cells_sim.v) were not found in {}: install yosys (`make tools`)",
+                places
+                    .iter()
+                    .map(|p| p.display().to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })
+}
+
+/// The family's cell models with their `` `include``s inlined (ECP5 keeps
+/// its flip-flops and IO in `.vh` files), as one text.
+fn cell_models(fpga: Fpga) -> Result<(PathBuf, String), String> {
+    let dir = share_dir()?.join(fpga.family().name());
+    let path = dir.join("cells_sim.v");
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut out = String::with_capacity(text.len() * 2);
+    for line in text.lines() {
+        let inc = line
+            .trim()
+            .strip_prefix("`include \"")
+            .and_then(|r| r.strip_suffix('"'));
+        match inc {
+            Some(name) => {
+                let p = dir.join(name);
+                let t = std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+                out.push_str(&t);
+            }
+            None => out.push_str(line),
+        }
+        out.push('\n');
+    }
+    Ok((path, out))
+}
+
+/// What a family's models need to be read as Verilog-2005 by Icarus as
+/// well as by Verilator: the iCE40 models give some ports default values
+/// (`input CE = 1'b1`, SystemVerilog) unless told not to; the netlist
+/// connects every port of every cell yosys makes, so nothing relies on them.
+fn prologue(fpga: Fpga) -> &'static str {
+    match fpga.family() {
+        lut_gen::Family::Ice40 => "`define NO_ICE40_DEFAULT_ASSIGNMENTS\n",
+        lut_gen::Family::Ecp5 | lut_gen::Family::Gowin => "",
+    }
+}
+
+/// Emits the gateware of `s` into `dir`, synthesizes it for `fpga` with
+/// yosys (log `netlist.log`) and returns the netlist with the cell models;
+/// `dir` also gets [`NETLIST_FILE`] and [`NETLIST_SIM_FILE`].
+pub fn netlist(s: &Schedule, fpga: Fpga, dir: &Path) -> Result<Netlist, String> {
+    let e = hdl::emit(s, None).map_err(|e| format!("mix `{}`: {e}", s.mix.name))?;
+    e.write_to(dir).map_err(|e| e.to_string())?;
+    let y = Tool::new("yosys")
+        .current_dir(dir)
+        .args(["-q", "-l", "netlist.log", "-p"])
+        .arg(format!(
+            "read_verilog {}; synth_{} -top {}; write_verilog -noattr {NETLIST_FILE}",
+            hdl::VERILOG_FILE,
+            fpga.family().name(),
+            lut_gen::TOP_MODULE,
+        ))
+        .run()
+        .map_err(|e| format!("yosys could not be started: {e}"))?;
+    if !y.success {
+        return Err(format!(
+            "yosys synth_{} failed (see {}):\n{}",
+            fpga.family().name(),
+            dir.join("netlist.log").display(),
+            y.stderr
+        ));
+    }
+    let nl_path = dir.join(NETLIST_FILE);
+    let nl =
+        std::fs::read_to_string(&nl_path).map_err(|e| format!("{}: {e}", nl_path.display()))?;
+    let (models, cells_text) = cell_models(fpga)?;
+    let text = format!(
+        "// {} netlist of slotforge_top (yosys synth_{}) and the family's cell models ({})\n{}{nl}\n{cells_text}",
+        fpga,
+        fpga.family().name(),
+        models.display(),
+        prologue(fpga)
+    );
+    std::fs::write(dir.join(NETLIST_SIM_FILE), &text).map_err(|e| e.to_string())?;
+    Ok(Netlist {
+        fpga,
+        cells: count_cells(&nl),
+        text,
+        models,
+    })
+}
+
+/// Cell instances in a `write_verilog -noattr` netlist: its lines that
+/// open an instance (`  SB_LUT4 #(`, `  SB_DFF \q_reg  (`): a module name
+/// (the families' primitives are upper case, Verilog's keywords lower case)
+/// at the body's indent.
+fn count_cells(nl: &str) -> usize {
+    nl.lines()
+        .filter(|l| {
+            let t = l.trim_start();
+            l.len() - t.len() == 2
+                && t.chars().next().is_some_and(|c| c.is_ascii_uppercase())
+                && t.trim_end().ends_with('(')
+        })
+        .count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_instances_not_declarations() {
+        let nl = "module m(a);\n  input a;\n  wire [3:0] b;\n  SB_LUT4 #(\n    .LUT_INIT(16'h1)\n  ) _1_ (\n  );\n  SB_DFF \\q_reg  (\n  );\n  assign b = 0;\nendmodule\n";
+        assert_eq!(count_cells(nl), 2);
+    }
+}
