@@ -121,3 +121,46 @@ fn unknown_families_and_in_process_back_ends_are_refused() {
         "{err}"
     );
 }
+
+#[test]
+fn prove_netlist_proves_the_ice40_netlist_and_an_edit_fails_at_a_cycle() {
+    if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
+        return;
+    }
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("netlist-prove");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let prove = |args: &[&str], code: i32| {
+        let out = slotforge()
+            .arg("prove")
+            .arg(tiny())
+            .args(args)
+            .arg("--json")
+            .arg("-o")
+            .arg(dir.join("out"))
+            .assert()
+            .code(code);
+        serde_json::from_slice::<serde_json::Value>(&out.get_output().stdout).unwrap()
+    };
+    let v = prove(&["--netlist", "ice40"], 0);
+    assert_eq!(v["result"], "proved", "{v}");
+    assert_eq!(v["netlist"], "ice40-hx8k");
+    assert_eq!(v["own_design"], false);
+    // what a netlist proof leaves out is said, so the note does not claim it all
+    let nc: Vec<&str> = v["not_covered"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap())
+        .collect();
+    assert!(nc.iter().any(|x| x.contains("cells_sim.v")), "{nc:?}");
+    assert!(nc.iter().any(|x| x.contains("timing")), "{nc:?}");
+    assert!(v["note"]
+        .as_str()
+        .unwrap()
+        .starts_with("the asserted properties are proved for all time"));
+    let bad = inverted_lut(&dir);
+    let f = prove(&["--rtl", bad.to_str().unwrap()], 1);
+    assert_eq!(f["result"], "failed", "{f}");
+    assert!(f["cycle"].as_i64().is_some(), "{f}");
+}

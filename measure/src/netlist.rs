@@ -111,12 +111,14 @@ fn prologue(fpga: Fpga) -> &'static str {
     }
 }
 
-/// Emits the gateware of `s` into `dir`, synthesizes it for `fpga` with
+/// Writes the gateware's Verilog of `s` into `dir`, synthesizes it for `fpga` with
 /// yosys (log `netlist.log`) and returns the netlist with the cell models;
 /// `dir` also gets [`NETLIST_FILE`] and [`NETLIST_SIM_FILE`].
 pub fn netlist(s: &Schedule, fpga: Fpga, dir: &Path) -> Result<Netlist, String> {
     let e = hdl::emit(s, None).map_err(|e| format!("mix `{}`: {e}", s.mix.name))?;
-    e.write_to(dir).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let v = dir.join(hdl::VERILOG_FILE);
+    std::fs::write(&v, e.verilog()).map_err(|e| format!("{}: {e}", v.display()))?;
     let y = Tool::new("yosys")
         .current_dir(dir)
         .args(["-q", "-l", "netlist.log", "-p"])
