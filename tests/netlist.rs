@@ -3,7 +3,9 @@
 //! judge as the RTL. An unseen random mix passes on Verilator and Icarus
 //! for iCE40; a netlist with one LUT's function inverted fails, both
 //! engines naming the same first cycle; an unknown family or an in-process
-//! back end is refused (exit 2) naming what would do.
+//! back end is refused (exit 2) naming what would do, and so is a netlist
+//! with a cell whose model is a blackbox. `prove --netlist` proves the
+//! iCE40 netlist and says what it leaves out.
 
 use std::path::{Path, PathBuf};
 
@@ -163,4 +165,37 @@ fn prove_netlist_proves_the_ice40_netlist_and_an_edit_fails_at_a_cycle() {
     let f = prove(&["--rtl", bad.to_str().unwrap()], 1);
     assert_eq!(f["result"], "failed", "{f}");
     assert!(f["cycle"].as_i64().is_some(), "{f}");
+}
+
+/// A netlist whose block RAM the family's models leave as a blackbox
+/// (ECP5's DP16KD in yosys' cells_sim.v) is refused, naming the cell and
+/// the models, rather than judged as if the ROM read zeros; an AXI4-Stream
+/// mix's netlist (its `m_axis_tready` input is the link's contract) passes.
+#[test]
+fn blackbox_cells_are_refused_and_a_linked_mixs_netlist_passes() {
+    if !tools::require_tools(&["yosys", "verilator"]) {
+        return;
+    }
+    let eskin = crate::common_cli::root().join("mixes/eskin34.toml");
+    let out = slotforge()
+        .arg("sim")
+        .arg(&eskin)
+        .args([
+            "--backend",
+            "verilator",
+            "--frames",
+            "1",
+            "--netlist",
+            "ecp5",
+        ])
+        .assert()
+        .code(2);
+    let err = String::from_utf8_lossy(&out.get_output().stderr).into_owned();
+    assert!(
+        err.contains("DP16KD") && err.contains("cells_sim.v") && err.contains("blackbox"),
+        "{err}"
+    );
+    let axis = crate::common_cli::root().join("mixes/eskin34-axis.toml");
+    let v = sim_json(&axis, &["--backend", "verilator", "--netlist", "ice40"], 0);
+    assert_eq!(v["ok"], true, "{v}");
 }

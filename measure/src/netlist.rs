@@ -142,6 +142,14 @@ pub fn netlist(s: &Schedule, fpga: Fpga, dir: &Path) -> Result<Netlist, String> 
     let nl =
         std::fs::read_to_string(&nl_path).map_err(|e| format!("{}: {e}", nl_path.display()))?;
     let (models, cells_text) = cell_models(fpga)?;
+    let hollow = hollow_cells(&nl, &cells_text);
+    if !hollow.is_empty() {
+        return Err(format!(
+            "the {fpga} netlist uses {}, which yosys' cell models ({}) declare as a blackbox, without behaviour: a simulation or proof of the netlist would read nothing from it. On this family a mix whose slot ROM stays in logic can be checked; the iCE40's models cover every cell",
+            hollow.join(", "),
+            models.display()
+        ));
+    }
     let text = format!(
         "// {} netlist of slotforge_top (yosys synth_{}) and the family's cell models ({})\n{}{nl}\n{cells_text}",
         fpga,
@@ -163,14 +171,55 @@ pub fn netlist(s: &Schedule, fpga: Fpga, dir: &Path) -> Result<Netlist, String> 
 /// (the families' primitives are upper case, Verilog's keywords lower case)
 /// at the body's indent.
 fn count_cells(nl: &str) -> usize {
+    nl.lines().filter(|l| is_instance(l)).count()
+}
+
+/// Whether a netlist line opens a cell instance ([`count_cells`]).
+fn is_instance(l: &str) -> bool {
+    let t = l.trim_start();
+    l.len() - t.len() == 2
+        && t.chars().next().is_some_and(|c| c.is_ascii_uppercase())
+        && t.trim_end().ends_with('(')
+}
+
+/// The cell types `nl` instantiates (`  SB_LUT4 #(`, `  DP16KD \\x  (`).
+fn cell_types(nl: &str) -> std::collections::BTreeSet<&str> {
     nl.lines()
-        .filter(|l| {
-            let t = l.trim_start();
-            l.len() - t.len() == 2
-                && t.chars().next().is_some_and(|c| c.is_ascii_uppercase())
-                && t.trim_end().ends_with('(')
+        .filter(|l| is_instance(l))
+        .filter_map(|l| l.split_whitespace().next())
+        .collect()
+}
+
+/// The cells of `nl` that the models in `models` leave without behaviour:
+/// a module with no `always`, `assign`, `initial` or instance of another
+/// cell (yosys ships ECP5's DP16KD and Gowin's SPX9 so), or no module.
+fn hollow_cells(nl: &str, models: &str) -> Vec<String> {
+    let acts = |body: &str| {
+        ["always", "assign", "initial", "generate"]
+            .iter()
+            .any(|k| body.contains(k))
+            || body.lines().any(|l| {
+                let t = l.trim_start();
+                let word: String = t
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                    .collect();
+                word.starts_with(|c: char| c.is_ascii_uppercase()) && t.contains('(')
+            })
+    };
+    cell_types(nl)
+        .into_iter()
+        .filter(|cell| {
+            let head = format!("module {cell}");
+            let body = models.split("endmodule").find_map(|m| {
+                let at = m.find(&head)?;
+                let rest = &m[at + head.len()..];
+                rest.starts_with(['(', ' ', '#', '\n']).then_some(rest)
+            });
+            !body.is_some_and(acts)
         })
-        .count()
+        .map(str::to_string)
+        .collect()
 }
 
 #[cfg(test)]
@@ -181,5 +230,14 @@ mod tests {
     fn counts_instances_not_declarations() {
         let nl = "module m(a);\n  input a;\n  wire [3:0] b;\n  SB_LUT4 #(\n    .LUT_INIT(16'h1)\n  ) _1_ (\n  );\n  SB_DFF \\q_reg  (\n  );\n  assign b = 0;\nendmodule\n";
         assert_eq!(count_cells(nl), 2);
+    }
+
+    #[test]
+    fn cells_without_behaviour_are_found() {
+        let nl = "  SB_LUT4 #(\n  ) _1_ (\n  );\n  DP16KD \\r  (\n  );\n  WRAP _2_ (\n  );\n  GONE _3_ (\n  );\n";
+        let models = "module SB_LUT4 (output O, input I0);\n  assign O = I0;\nendmodule\n\
+                      module DP16KD(\n  input A, output B\n);\n  parameter X = 1;\nendmodule\n\
+                      module WRAP (input A, output B);\n  SB_LUT4 l (.O(B), .I0(A));\nendmodule\n";
+        assert_eq!(hollow_cells(nl, models), ["DP16KD", "GONE"]);
     }
 }
