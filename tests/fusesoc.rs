@@ -107,6 +107,37 @@ fn fusesoc_lints_the_core_of_an_unseen_mix_and_of_presets() {
     }
 }
 
+/// A board of another family writes its constraint file (LPF for the
+/// ULX3S, CST for the Tang Nano 9K), and the core hands it to that family's
+/// target: FuseSoC copies it into the flow's work folder.
+#[test]
+fn a_boards_constraints_join_its_familys_target() {
+    if !tools::require_tools(&["fusesoc"]) {
+        return;
+    }
+    let tmp = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    for (board, file, target) in [
+        ("ulx3s-25f", "slotforge.lpf", "ecp5"),
+        ("tang-nano-9k", "slotforge.cst", "gowin"),
+    ] {
+        let dir = tmp.join(format!("fusesoc-{board}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        slotforge()
+            .arg("verilog")
+            .arg(root().join("testkit/mixes/tiny.toml"))
+            .arg("-o")
+            .arg(&dir)
+            .arg("--board")
+            .arg(root().join(format!("constraints/{board}.toml")))
+            .assert()
+            .success();
+        assert!(dir.join(file).is_file(), "{board} writes {file}");
+        let (ok, text, build) = fusesoc(&dir, target, true);
+        assert!(ok, "fusesoc --setup --target {target} ({board}):\n{text}");
+        assert!(names_under(&build).contains(&file.to_string()), "{board}");
+    }
+}
+
 #[test]
 fn fusesoc_lint_fails_on_a_warning_and_the_core_is_deterministic() {
     if !tools::require_tools(&["fusesoc", "verilator"]) {

@@ -28,20 +28,16 @@ fn constraint_kind(name: &str) -> Option<(&'static str, Option<Fpga>)> {
 }
 
 /// The Edalize tool (the flow of the open tools) for a part, and its
-/// options: the part the rest of slotforge names (`lut_gen::Fpga`).
+/// options: the part as the rest of slotforge names it (`Fpga::nextpnr`).
 fn flow(f: Fpga) -> (&'static str, Vec<(&'static str, String)>) {
+    let part = format!("[{}]", f.nextpnr().1.join(", "));
     match f {
         Fpga::Ice40Hx8k => (
             "icestorm",
-            vec![
-                ("pnr", "next".into()),
-                ("nextpnr_options", "[--hx8k, --package, ct256]".into()),
-            ],
+            vec![("pnr", "next".into()), ("nextpnr_options", part)],
         ),
-        Fpga::Ecp5_25k => (
-            "trellis",
-            vec![("nextpnr_options", "[--25k, --package, CABGA256]".into())],
-        ),
+        Fpga::Ecp5_25k => ("trellis", vec![("nextpnr_options", part)]),
+        // Edalize's apicula flow names the device itself
         Fpga::Gw1n9 => ("apicula", vec![("device", "GW1NR-LV9QN88PC6/I5".into())]),
     }
 }

@@ -5,7 +5,8 @@
 //! rust-hdl stays behind this API: nothing public here names a rust-hdl type.
 //!
 //! - [`emit`] / [`Emitted`]: `slotforge_top.v`, `ports.json`, `slots.hex` (the LUT), `slot_rom.hex` (the ROM image),
-//!   `slotforge.pcf`, `slotforge.sdc`, `slotforge.xdc`, and `slotforge_top.core` (FuseSoC CAPI2, `fusesoc`);
+//!   `slotforge.pcf` (or a board's `.lpf` / `.cst`), `slotforge.sdc`, `slotforge.xdc`, and `slotforge_top.core` (FuseSoC CAPI2);
+//! - [`Board`] / [`stock_board`]: board files (`constraints/*.toml`), one per FPGA part;
 //! - [`RtlSim`] / [`Pins`]: cycle-accurate simulation of the same blocks;
 //! - [`stock_simulation_cycles`] / [`StockRun`]: the same blocks under
 //!   rust-hdl's stock threaded `Simulation` engine (the reference that
@@ -15,6 +16,7 @@
 //! The cycle-level behaviour is `docs/timing.md`; the design choices are in
 //! `hdl/DESIGN.md`.
 
+mod board;
 mod core;
 mod emit;
 mod fault;
@@ -28,7 +30,8 @@ mod sim;
 mod stock;
 mod widths;
 
-pub use emit::{emit, emit_with, verilog_pair, Board, Emitted, MANIFEST_FILE, VERILOG_FILE};
+pub use board::{stock_board, Board};
+pub use emit::{emit, emit_with, verilog_pair, Emitted, MANIFEST_FILE, VERILOG_FILE};
 pub use fault::GatewareFault;
 pub use fusesoc::{vlnv, CORE_FILE};
 pub use plan::{

@@ -1,5 +1,6 @@
 //! The netlist that goes to the chip: yosys' `synth_<family>` of the emitted
-//! gateware, written back as gate-level Verilog (`write_verilog -noattr`)
+//! gateware (`crate::synthesize_for`, the run whose cells `synth --fpga`
+//! counts), written back as gate-level Verilog (`write_verilog -noattr`)
 //! and joined with the family's cell models (yosys' `<family>/cells_sim.v`)
 //! into one self-contained file, so `sim --netlist` and `prove --netlist`
 //! hand it to the same `--rtl` path the outside Verilog takes: the same ADC
@@ -7,11 +8,8 @@
 
 use std::path::{Path, PathBuf};
 
-use judge::tools::Tool;
 use lut_gen::{Fpga, Schedule};
 
-/// The gate-level netlist (alone) as yosys writes it, in the work folder.
-pub const NETLIST_FILE: &str = "netlist.v";
 /// The netlist with the cell models, the file the simulators read.
 pub const NETLIST_SIM_FILE: &str = "netlist_sim.v";
 
@@ -45,59 +43,47 @@ impl Netlist {
     }
 }
 
-/// Where yosys keeps its share folder (`<family>/cells_sim.v`): beside the
-/// `yosys` found on PATH (`bin/../share/yosys`), else the Debian place.
-fn share_dir() -> Result<PathBuf, String> {
-    let mut places = vec![];
-    if let Some(path) = std::env::var_os("PATH") {
-        for d in std::env::split_paths(&path) {
-            if d.join("yosys").is_file() {
-                if let Some(prefix) = d.parent() {
-                    places.push(prefix.join("share").join("yosys"));
-                }
-            }
-        }
-    }
-    places.push(PathBuf::from("/usr/share/yosys"));
-    places
-        .iter()
-        .find(|p| p.join("ice40").join("cells_sim.v").is_file())
-        .cloned()
-        .ok_or_else(|| {
-            format!(
-                "yosys' cell models (<share>/ice40/cells_sim.v) were not found in {}: install yosys (`make tools`)",
-                places
-                    .iter()
-                    .map(|p| p.display().to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )
-        })
+/// The family's cell models with their `` `include``s inlined (ECP5 keeps
+/// its flip-flops and IO in `.vh` files, which a newer yosys includes from
+/// two places), each file once, as one text.
+fn cell_models(path: &Path) -> Result<String, String> {
+    let mut out = String::new();
+    let mut seen = std::collections::BTreeSet::new();
+    inline(path, &mut seen, &mut out)?;
+    Ok(out)
 }
 
-/// The family's cell models with their `` `include``s inlined (ECP5 keeps
-/// its flip-flops and IO in `.vh` files), as one text.
-fn cell_models(fpga: Fpga) -> Result<(PathBuf, String), String> {
-    let dir = share_dir()?.join(fpga.family().name());
-    let path = dir.join("cells_sim.v");
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut out = String::with_capacity(text.len() * 2);
+/// `path`'s text into `out` with its includes inlined, a file already
+/// inlined (`seen`) left out.
+fn inline(
+    path: &Path,
+    seen: &mut std::collections::BTreeSet<PathBuf>,
+    out: &mut String,
+) -> Result<(), String> {
+    if !seen.insert(path.to_path_buf()) {
+        return Ok(());
+    }
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     for line in text.lines() {
         let inc = line
             .trim()
             .strip_prefix("`include \"")
             .and_then(|r| r.strip_suffix('"'));
         match inc {
-            Some(name) => {
-                let p = dir.join(name);
-                let t = std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))?;
-                out.push_str(&t);
+            Some(name) => inline(&dir.join(name), seen, out)?,
+            // an elaboration check (SystemVerilog's `$error` as a generate
+            // item, in a newer ECP5 model): Icarus cannot read it, and the
+            // netlist yosys wrote already has the parameters it allows
+            None if line.trim_start().starts_with("$error(") => {
+                out.push_str("// ");
+                out.push_str(line.trim_start());
             }
             None => out.push_str(line),
         }
         out.push('\n');
     }
-    Ok((path, out))
+    Ok(())
 }
 
 /// What a family's models need to be read as Verilog-2005 by Icarus as
@@ -111,38 +97,28 @@ fn prologue(fpga: Fpga) -> &'static str {
     }
 }
 
-/// Writes the gateware's Verilog of `s` into `dir`, synthesizes it for `fpga` with
-/// yosys (log `netlist.log`) and returns the netlist with the cell models;
-/// `dir` also gets [`NETLIST_FILE`] and [`NETLIST_SIM_FILE`].
+/// Writes the gateware's Verilog of `s` into `dir`, synthesizes it for
+/// `fpga` (`crate::synthesize_for`: its files and `yosys.log` in `dir`) and
+/// returns the netlist with the cell models, also written as
+/// [`NETLIST_SIM_FILE`]. A cell the models leave without behaviour is an
+/// error naming it.
 pub fn netlist(s: &Schedule, fpga: Fpga, dir: &Path) -> Result<Netlist, String> {
     let e = hdl::emit(s, None).map_err(|e| format!("mix `{}`: {e}", s.mix.name))?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let v = dir.join(hdl::VERILOG_FILE);
     std::fs::write(&v, e.verilog()).map_err(|e| format!("{}: {e}", v.display()))?;
-    let y = Tool::new("yosys")
-        .current_dir(dir)
-        .args(["-q", "-l", "netlist.log", "-p"])
-        .arg(format!(
-            "read_verilog {}; synth_{} -top {}; write_verilog -noattr {NETLIST_FILE}",
-            hdl::VERILOG_FILE,
-            fpga.family().name(),
-            lut_gen::TOP_MODULE,
-        ))
-        .run()
-        .map_err(|e| format!("yosys could not be started: {e}"))?;
-    if !y.success {
-        return Err(format!(
-            "yosys synth_{} failed (see {}):\n{}",
-            fpga.family().name(),
-            dir.join("netlist.log").display(),
-            y.stderr
-        ));
-    }
-    let nl_path = dir.join(NETLIST_FILE);
+    let y = crate::synthesize_for(fpga, dir)?;
     let nl =
-        std::fs::read_to_string(&nl_path).map_err(|e| format!("{}: {e}", nl_path.display()))?;
-    let (models, cells_text) = cell_models(fpga)?;
-    let hollow = hollow_cells(&nl, &cells_text);
+        std::fs::read_to_string(&y.netlist).map_err(|e| format!("{}: {e}", y.netlist.display()))?;
+    let models = y.cell_models.clone();
+    let cells_text = cell_models(&models)?;
+    let used: Vec<&str> = y
+        .cells
+        .iter()
+        .filter(|(c, n)| *n > 0 && !c.starts_with('$'))
+        .map(|(c, _)| c.as_str())
+        .collect();
+    let hollow = hollow_cells(&used, &cells_text);
     if !hollow.is_empty() {
         return Err(format!(
             "the {fpga} netlist uses {}, which yosys' cell models ({}) declare as a blackbox, without behaviour: a simulation or proof of the netlist would read nothing from it. On this family a mix whose slot ROM stays in logic can be checked; the iCE40's models cover every cell",
@@ -160,40 +136,21 @@ pub fn netlist(s: &Schedule, fpga: Fpga, dir: &Path) -> Result<Netlist, String> 
     std::fs::write(dir.join(NETLIST_SIM_FILE), &text).map_err(|e| e.to_string())?;
     Ok(Netlist {
         fpga,
-        cells: count_cells(&nl),
+        cells: y
+            .cells
+            .iter()
+            .filter(|(c, _)| !c.starts_with('$'))
+            .map(|(_, n)| *n as usize)
+            .sum(),
         text,
         models,
     })
 }
 
-/// Cell instances in a `write_verilog -noattr` netlist: its lines that
-/// open an instance (`  SB_LUT4 #(`, `  SB_DFF \q_reg  (`): a module name
-/// (the families' primitives are upper case, Verilog's keywords lower case)
-/// at the body's indent.
-fn count_cells(nl: &str) -> usize {
-    nl.lines().filter(|l| is_instance(l)).count()
-}
-
-/// Whether a netlist line opens a cell instance ([`count_cells`]).
-fn is_instance(l: &str) -> bool {
-    let t = l.trim_start();
-    l.len() - t.len() == 2
-        && t.chars().next().is_some_and(|c| c.is_ascii_uppercase())
-        && t.trim_end().ends_with('(')
-}
-
-/// The cell types `nl` instantiates (`  SB_LUT4 #(`, `  DP16KD \\x  (`).
-fn cell_types(nl: &str) -> std::collections::BTreeSet<&str> {
-    nl.lines()
-        .filter(|l| is_instance(l))
-        .filter_map(|l| l.split_whitespace().next())
-        .collect()
-}
-
-/// The cells of `nl` that the models in `models` leave without behaviour:
+/// The cells of `used` that the models in `models` leave without behaviour:
 /// a module with no `always`, `assign`, `initial` or instance of another
 /// cell (yosys ships ECP5's DP16KD and Gowin's SPX9 so), or no module.
-fn hollow_cells(nl: &str, models: &str) -> Vec<String> {
+fn hollow_cells(used: &[&str], models: &str) -> Vec<String> {
     let acts = |body: &str| {
         ["always", "assign", "initial", "generate"]
             .iter()
@@ -207,8 +164,7 @@ fn hollow_cells(nl: &str, models: &str) -> Vec<String> {
                 word.starts_with(|c: char| c.is_ascii_uppercase()) && t.contains('(')
             })
     };
-    cell_types(nl)
-        .into_iter()
+    used.iter()
         .filter(|cell| {
             let head = format!("module {cell}");
             let body = models.split("endmodule").find_map(|m| {
@@ -218,7 +174,7 @@ fn hollow_cells(nl: &str, models: &str) -> Vec<String> {
             });
             !body.is_some_and(acts)
         })
-        .map(str::to_string)
+        .map(|c| c.to_string())
         .collect()
 }
 
@@ -227,17 +183,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn counts_instances_not_declarations() {
-        let nl = "module m(a);\n  input a;\n  wire [3:0] b;\n  SB_LUT4 #(\n    .LUT_INIT(16'h1)\n  ) _1_ (\n  );\n  SB_DFF \\q_reg  (\n  );\n  assign b = 0;\nendmodule\n";
-        assert_eq!(count_cells(nl), 2);
-    }
-
-    #[test]
     fn cells_without_behaviour_are_found() {
-        let nl = "  SB_LUT4 #(\n  ) _1_ (\n  );\n  DP16KD \\r  (\n  );\n  WRAP _2_ (\n  );\n  GONE _3_ (\n  );\n";
+        let used = ["SB_LUT4", "DP16KD", "WRAP", "GONE"];
         let models = "module SB_LUT4 (output O, input I0);\n  assign O = I0;\nendmodule\n\
                       module DP16KD(\n  input A, output B\n);\n  parameter X = 1;\nendmodule\n\
                       module WRAP (input A, output B);\n  SB_LUT4 l (.O(B), .I0(A));\nendmodule\n";
-        assert_eq!(hollow_cells(nl, models), ["DP16KD", "GONE"]);
+        assert_eq!(hollow_cells(&used, models), ["DP16KD", "GONE"]);
     }
 }

@@ -11,6 +11,7 @@ pub mod lut;
 pub mod progress;
 pub mod prove;
 pub mod sim;
+pub mod synth;
 pub mod verilog;
 
 use std::path::Path;
