@@ -21,6 +21,9 @@ mod figures;
 #[path = "fixes.rs"]
 mod fixes;
 
+#[path = "fusesoc.rs"]
+mod fusesoc;
+
 #[path = "golden.rs"]
 mod golden;
 
@@ -42,6 +45,9 @@ mod link_bytes;
 mod link_captures;
 #[path = "link_windows.rs"]
 mod link_windows;
+
+#[path = "netlist.rs"]
+mod netlist;
 
 #[path = "prove_cli.rs"]
 mod prove_cli;

@@ -67,7 +67,7 @@ pub use ports::{
 };
 
 // The FPGA parts slotforge synthesizes for.
-pub use fpga::{Family, Fpga};
+pub use fpga::{Constraints, Family, Fpga};
 
 // The link to the host, planned from the schedule.
 pub use hostlink::{

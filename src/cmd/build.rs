@@ -51,7 +51,8 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', value_name = "STEP,...")]
     pub only: Vec<String>,
     /// Leave out these steps (comma-separated): audit, lut, verilog, sim,
-    /// golden, faults, prove, synth, timing, figure7, schedulability, speed.
+    /// golden, faults, prove, synth, netlist, timing, figure7, schedulability,
+    /// speed.
     #[arg(long, value_delimiter = ',', value_name = "STEP,...")]
     pub skip: Vec<String>,
     /// Also write the steps as JUnit XML (one test case per step).

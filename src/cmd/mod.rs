@@ -11,6 +11,7 @@ pub mod lut;
 pub mod progress;
 pub mod prove;
 pub mod sim;
+pub mod synth;
 pub mod verilog;
 
 use std::path::Path;
@@ -52,6 +53,12 @@ pub fn verdict_exit(v: lut_gen::Verdict) -> u8 {
         lut_gen::Verdict::Infeasible => 1,
         lut_gen::Verdict::Unknown => 3,
     }
+}
+
+/// The `--netlist`/`--fpga` value parser: a part or its family
+/// (`lut_gen::Fpga`); anything else names the known ones.
+pub fn fpga(s: &str) -> Result<lut_gen::Fpga, String> {
+    lut_gen::Fpga::parse(s)
 }
 
 /// The `--backend` value parser: the names `engines::Backend` knows.

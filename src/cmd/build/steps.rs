@@ -76,6 +76,7 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
             ),
             Step::Prove => prove(j, s, &mut clean),
             Step::Synth => synth(j, s, background.take()),
+            Step::Netlist => netlist(j, s),
             Step::Timing => timing(j, s),
             Step::Figure7 => figure7(s),
             Step::Schedulability => {
@@ -552,6 +553,68 @@ fn synth(j: &mut Job, s: &Schedule, background: Option<Background>) -> Done {
         }
         Err(e) => Done::failed("place and route failed", e),
     }
+}
+
+/// The netlist that goes to the chip: yosys' iCE40 netlist of the emitted
+/// Verilog with the cell models, one frame under the same ADC model and
+/// judge as the co-simulation (`sim --netlist ice40`); its report is
+/// `netlist.json` (as `sim --json`), the summary and section read from it.
+fn netlist(j: &mut Job, s: &Schedule) -> Done {
+    let backend = if judge::tools::present("verilator") {
+        Backend::Verilator
+    } else {
+        Backend::Icarus
+    };
+    if !judge::tools::present("yosys") || !judge::tools::present(backend.name()) {
+        return Done::skipped("yosys or a Verilog simulator not installed (make tools)");
+    }
+    let fpga = lut_gen::Fpga::Ice40Hx8k;
+    let dir = j.out.join("netlist");
+    if let Err(e) = measure::netlist(s, fpga, &dir) {
+        return Done::failed("yosys could not write the netlist", e);
+    }
+    let opts = SimOptions {
+        rtl: Some(dir.join(measure::NETLIST_SIM_FILE)),
+        ..SimOptions::default()
+    };
+    let mut r = match engines::run(s, backend, 1, &opts) {
+        Ok(r) => r,
+        Err(e) => return Done::failed(format!("{e}"), ""),
+    };
+    r.source = format!("{}, {fpga} netlist", r.source);
+    let json = serde_json::to_string_pretty(&r).expect("report");
+    let w = j.write("", &[("netlist.json", json)]);
+    let line = if r.ok {
+        format!(
+            "{}: {} frame, {} samples, every cycle equal to the model, no violation",
+            r.source, r.frames, r.samples
+        )
+    } else {
+        format!(
+            "{}: {} divergences, {} violations",
+            r.source, r.divergence_count, r.violation_count
+        )
+    };
+    let sec = Section {
+        title: "The netlist on the chip".into(),
+        paragraphs: vec![format!(
+            "yosys synth_ice40 of the emitted Verilog, written back as gate-level Verilog and simulated with yosys' iCE40 cell models under the same ADC model and checker as the co-simulation ({line}). Place and route and timing are not part of this check (the synthesis estimate's Fmax is)."
+        )],
+        links: vec![
+            (
+                format!("netlist/{}", measure::NETLIST_FILE),
+                "the netlist".into(),
+            ),
+            ("netlist.json".into(), "the check report".into()),
+        ],
+        ..Section::default()
+    };
+    let d = if r.ok {
+        Done::ok(line)
+    } else {
+        Done::failed(line, r.summary())
+    };
+    written(w, d.files(&["netlist.json"]).section(sec))
 }
 
 fn timing(j: &mut Job, s: &Schedule) -> Done {
