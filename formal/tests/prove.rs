@@ -794,7 +794,7 @@ fn a_uart_proof_names_the_line_it_does_not_cover_and_excuses_no_line_fault() {
     }
     let s = tiny_uart();
     let clean = emitted(&s);
-    let stuck = edit(&clean, "      tx = tx_r;", "      tx = 1'b1;");
+    let stuck = edit(&clean, "      tx = chr[0];", "      tx = 1'b1;");
     for design in [&clean, &stuck] {
         let dir = tempfile::tempdir().unwrap();
         let p = prove(&s, design, dir.path());

@@ -81,31 +81,50 @@ impl LinkParams {
     }
 }
 
-/// Token layout in the FIFO: `{boundary, sample, channel[9:0], code[15:0]}`.
+/// Token layout in the twin's FIFO: `{boundary, sample, channel[9:0],
+/// code[15:0]}`; the Verilog keeps the boundary flag beside the block RAM
+/// (`fbnd`), which holds the rest (`RAM_BITS`).
 const TOKEN_BITS: usize = 2 + CH_BITS + VALUE_BITS;
+const RAM_BITS: usize = TOKEN_BITS - 1;
 
 /// The registers of the link (the Rust twin's state).
 #[derive(Debug, Clone, Default)]
 struct Regs {
-    pos: u64,
+    /// The next cycle's position in the slice (0 after reset), and two
+    /// of its values registered: `npos == 1` (a boundary: this cycle
+    /// starts a slice) and `npos == slice_cycles - 1` (wrap to 0).
+    npos: u64,
+    bnd: bool,
+    wrap: bool,
     mem: Vec<u32>,
     wr: usize,
     rd: usize,
     n: usize,
     have: bool,
     tok: u32,
-    mask: u16,
+    /// The next byte slot of the token (0-3 trailer, 4-7 header, 8-11
+    /// record); a token without a boundary starts at 8.
+    bcnt: u8,
     started: bool,
     hframe: u8,
     hslice: u16,
     crc: u16,
+    /// UART: the character in transit is one the CRC covers (not its own
+    /// two bytes); its data bits go into `crc` as they reach the line.
+    in_crc: bool,
     ovfc: u8,
     ovf: bool,
     busy: bool,
+    /// UART: the bit on the line (0 the start bit). Not read off `chr`:
+    /// the FIFO's handshake would then depend on the bytes' values, which
+    /// `prove` would have to carry (the frame counter does not come round
+    /// after a frame).
     bitn: u32,
     dv: u32,
+    /// UART: the character still to send, shifted right with zeros: its
+    /// bit 0 is the line (`link_tx`); 1 alone, the last stop bit (and
+    /// idle, where it stays).
     chr: u16,
-    tx: bool,
     /// AXIS: the byte offered and its `tlast` (`busy` is `tvalid`).
     tdata: u8,
     tlast: bool,
@@ -158,7 +177,7 @@ impl AxisLink {
             _p: p,
             _r: Regs::default(),
         };
-        l._r.mem = vec![0; p.depth];
+        l._r.mem = vec![0; p.depth + 1];
         reset_regs(&p, &mut l._r);
         l
     }
@@ -196,33 +215,40 @@ impl Logic for AxisLink {
     }
 }
 
-/// The registers' values after reset (the FIFO's memory keeps its contents).
+/// The registers' values after reset (the FIFO's memory and its read
+/// register `tok` keep their contents).
 fn reset_regs(p: &LinkParams, r: &mut Regs) {
     let mem = std::mem::take(&mut r.mem);
     *r = Regs {
-        pos: p.slice_cycles - 1,
+        npos: 0,
+        bnd: p.slice_cycles == 1,
+        wrap: p.slice_cycles == 1,
         mem,
+        tok: r.tok,
         crc: 0xFFFF,
-        tx: true,
+        chr: 1,
         ..Default::default()
     };
 }
 
-fn crc8(mut c: u16, d: u8) -> u16 {
-    c ^= d as u16;
-    for _ in 0..8 {
-        c = if c & 1 == 1 {
-            (c >> 1) ^ 0xA001
-        } else {
-            c >> 1
-        };
+/// CRC-16/MODBUS after one more bit (the line's order: LSB first).
+fn crc1(c: u16, bit: bool) -> u16 {
+    if (c & 1 == 1) != bit {
+        (c >> 1) ^ 0xA001
+    } else {
+        c >> 1
     }
-    c
+}
+
+/// CRC-16/MODBUS after one more byte (the AXI4-Stream link's, a beat a
+/// cycle).
+fn crc8(c: u16, d: u8) -> u16 {
+    (0..8).fold(c, |c, i| crc1(c, d >> i & 1 == 1))
 }
 
 impl UartLink {
     pub fn new(p: LinkParams) -> UartLink {
-        UartLink {
+        let mut l = UartLink {
             clock: Default::default(),
             rst: Default::default(),
             valid: Default::default(),
@@ -232,12 +258,13 @@ impl UartLink {
             ovf: Default::default(),
             _p: p,
             _r: Regs {
-                mem: vec![0; p.depth],
-                tx: true,
-                crc: 0xFFFF,
+                mem: vec![0; p.depth + 1],
                 ..Default::default()
             },
-        }
+        };
+        // the Verilog's initial values are its reset values
+        reset_regs(&p, &mut l._r);
+        l
     }
 
     fn edge(&mut self, valid: bool, ch: u32, val: u32) {
@@ -249,7 +276,7 @@ impl UartLink {
 /// AXIS master's, whose slave drives `tready` in the cycle the edge ends).
 fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bool) {
     let p = *p;
-    let bnd = r.pos == 0;
+    let bnd = r.bnd;
     let push = bnd || valid;
     let last_tick = r.dv + 1 == p.div;
     let ready = match p.axis {
@@ -261,26 +288,35 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
     let room = r.n < p.depth || pop;
     // next state, from the values before the edge
     let mut nx = r.clone();
-    nx.pos = if r.pos + 1 == p.slice_cycles {
-        0
+    let one = p.slice_cycles == 1;
+    nx.npos = if r.wrap { 0 } else { r.npos + 1 };
+    nx.bnd = if r.wrap { one } else { r.npos == 0 };
+    nx.wrap = if r.wrap {
+        one
     } else {
-        r.pos + 1
+        r.npos + 2 == p.slice_cycles
     };
     if pop {
         let t = r.mem[r.rd];
         nx.tok = t;
-        nx.rd = (r.rd + 1) % p.depth;
+        nx.rd = (r.rd + 1) % (p.depth + 1);
         nx.have = true;
-        let b = t >> 27 & 1 == 1;
-        let s = t >> 26 & 1 == 1;
-        nx.mask = (if s { 0xF00 } else { 0 })
-            | (if b { 0x0F0 } else { 0 })
-            | (if b && r.started { 0x00F } else { 0 });
+        // a token without a boundary skips to its record; a trailer only
+        // once a header went out (its flag is `fbnd`, in flip-flops: the
+        // slot is decided here, not behind the block RAM's output)
+        nx.bcnt = match (t >> 27 & 1 == 1, r.started) {
+            (false, _) => 8,
+            (true, true) => 0,
+            (true, false) => 4,
+        };
     }
+    // the free entry `wr` (never a queued token: at most `depth` of the
+    // `depth + 1` entries are) takes every cycle's token; it is kept when
+    // `wr` advances
+    nx.mem[r.wr] = (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
     if push {
         if room {
-            nx.mem[r.wr] = (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
-            nx.wr = (r.wr + 1) % p.depth;
+            nx.wr = (r.wr + 1) % (p.depth + 1);
         } else {
             nx.ovfc = r.ovfc.saturating_add(1);
             nx.ovf = true;
@@ -303,11 +339,14 @@ fn shift(p: &LinkParams, r: &Regs, nx: &mut Regs, tready: bool, last_tick: bool)
             nx.dv = 0;
             if r.bitn + 1 == p.char_bits() {
                 nx.busy = false;
-                nx.tx = true;
             } else {
                 nx.bitn = r.bitn + 1;
-                nx.tx = r.chr >> 1 & 1 == 1;
                 nx.chr = r.chr >> 1;
+                // the data bit that goes out next (bits 1..=8 of the
+                // character) enters the CRC
+                if r.in_crc && r.bitn < 8 {
+                    nx.crc = crc1(r.crc, r.chr >> 1 & 1 == 1);
+                }
             }
         } else {
             nx.dv = r.dv + 1;
@@ -315,11 +354,18 @@ fn shift(p: &LinkParams, r: &Regs, nx: &mut Regs, tready: bool, last_tick: bool)
     }
 }
 
-/// The next byte of the packet (the lowest slot left in `r.mask`) starts
+/// The byte slot the serializer sends next (a token without a boundary
+/// starts at its record: the pop set `bcnt` so).
+fn slot(r: &Regs) -> u8 {
+    r.bcnt
+}
+
+/// The next byte of the packet (slot [`slot`]) starts
 /// out; the CRC and the header's frame/slice counters follow it.
 fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
-    let slot = r.mask.trailing_zeros();
-    let rest = r.mask & r.mask.wrapping_sub(1);
+    let slot = slot(r);
+    // a token ends with its record, or its header when it has none
+    let last = slot == 11 || (slot == 7 && r.tok >> 26 & 1 == 0);
     let byte = match slot {
         0 => 0x5A,
         1 => r.ovfc,
@@ -338,18 +384,22 @@ fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
     nx.busy = true;
     nx.bitn = 0;
     nx.dv = 0;
-    nx.tx = p.axis.is_some();
     nx.tdata = byte;
     // the trailer of a frame's last slice goes out when the next
     // header's slice has wrapped to 0
     nx.tlast = slot == 3 && (p.axis == Some(link::Tlast::Slice) || r.hslice == 0);
-    nx.mask = rest;
-    nx.have = rest != 0;
-    match slot {
-        2 | 3 => {}
-        4 => nx.crc = crc8(p.crc_init, byte),
-        _ => nx.crc = crc8(r.crc, byte),
+    nx.bcnt = slot + 1;
+    nx.have = !last;
+    match (p.axis, slot) {
+        (_, 2 | 3) => {}
+        // UART: the CRC follows the line bit by bit (`shift`); a header
+        // restarts it
+        (None, 4) => nx.crc = p.crc_init,
+        (None, _) => {}
+        (Some(_), 4) => nx.crc = crc8(p.crc_init, byte),
+        (Some(_), _) => nx.crc = crc8(r.crc, byte),
     }
+    nx.in_crc = !matches!(slot, 2 | 3);
     if slot == 7 {
         nx.started = true;
         if r.hslice as u64 + 1 == p.slices_per_frame {
@@ -381,7 +431,7 @@ impl Logic for UartLink {
                 self.edge(v, c, x);
             }
         }
-        self.tx.next = self._r.tx;
+        self.tx.next = self._r.chr & 1 == 1;
         self.ovf.next = self._r.ovf;
     }
 
@@ -403,7 +453,7 @@ fn width(n: u64) -> usize {
 /// The link's register and counter widths.
 #[derive(Clone, Copy)]
 struct Widths {
-    /// Slice position, FIFO address, FIFO count.
+    /// Slice position, FIFO address (`depth + 1` entries), FIFO count.
     pw: usize,
     aw: usize,
     nw: usize,
@@ -411,6 +461,8 @@ struct Widths {
     dw: usize,
     cb: usize,
     bw: usize,
+    /// Header slice counter.
+    hw: usize,
 }
 
 /// A `w`-bit decimal literal.
@@ -423,16 +475,21 @@ fn link_verilog(p: &LinkParams) -> String {
     let cb = p.char_bits() as usize;
     let w = Widths {
         pw: width(p.slice_cycles - 1),
-        aw: width(p.depth as u64 - 1),
+        aw: width(p.depth as u64),
         nw: width(p.depth as u64),
         dw: width(p.div as u64 - 1),
         cb,
         bw: width(cb as u64 - 1),
+        hw: width(p.slices_per_frame - 1),
     };
     declarations(&mut s, p, w);
     wires(&mut s, p, w);
-    byte_out(&mut s);
+    byte_out(&mut s, w.hw);
     crc_and_character(&mut s, p, w);
+    let _ = writeln!(
+        s,
+        "// the FIFO's memory: its free entry `wr` takes this cycle's token in\n// every cycle (kept only when `wr` advances: no write enable behind the\n// core's `valid`), read into `tok` when the serializer takes the oldest\nalways @(posedge clock) begin\n  if (!rst) begin\n    mem[wr] <= token;\n    fbnd[wr] <= bnd;\n  end\n  if (!rst & pop) tok <= mem[rd];\nend\n"
+    );
     let _ = writeln!(s, "always @(posedge clock) begin\n  if (rst) begin");
     register_reset(&mut s, p, w);
     fifo_update(&mut s, p, w);
@@ -444,7 +501,7 @@ fn link_verilog(p: &LinkParams) -> String {
             "always @(*) begin\n  tdata = tdata_r;\n  tvalid = busy;\n  tlast = tlast_r;\n  ovf = ovf_r;\nend"
         );
     } else {
-        let _ = writeln!(s, "always @(*) begin\n  tx = tx_r;\n  ovf = ovf_r;\nend");
+        let _ = writeln!(s, "always @(*) begin\n  tx = chr[0];\n  ovf = ovf_r;\nend");
     }
     s
 }
@@ -452,14 +509,9 @@ fn link_verilog(p: &LinkParams) -> String {
 /// What the link is, then its registers with their initial values.
 fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths {
-        pw,
-        aw,
-        nw,
-        dw,
-        cb,
-        bw,
+        pw, aw, nw, dw, cb, ..
     } = w;
-    let tb = TOKEN_BITS;
+    let rb = RAM_BITS;
     let axis = p.axis.is_some();
     if axis {
         let _ = writeln!(
@@ -474,20 +526,55 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
             p.div, p.depth
         );
     }
-    let _ = writeln!(s, "reg [{}:0] pos;\ninitial pos = {};", pw - 1, lit(pw, 0));
-    let _ = writeln!(s, "reg [{}:0] mem [0:{}];", tb - 1, p.depth - 1);
+    // the next cycle's position in the slice, counting up from 0 (no
+    // flip-flop set: an unbroken carry chain), with the boundary and the
+    // wrap registered, not compares behind the chain
+    let one = (p.slice_cycles == 1) as u8;
+    let _ = writeln!(
+        s,
+        "reg [{}:0] npos;\ninitial npos = {};\nreg bnd;\ninitial bnd = 1'b{one};\nreg wrap;\ninitial wrap = 1'b{one};",
+        pw - 1,
+        lit(pw, 0)
+    );
+    // the FIFO's tokens in block RAM where the family has it; `tok`, the
+    // token being sent, is its read register (no initial value: a block
+    // RAM's output has none; it is read only once a token was taken).
+    // One entry more than the depth: a pop never reads the entry written
+    // at the same edge, so the RAM needs no read-first emulation (a write
+    // register, a bypass; `no_rw_check`)
+    // Zeros at power-on, as the Rust twin's: a block RAM's initial
+    // contents cost nothing, and no stale entry holds a power-on value
+    // that `prove` would have to enumerate (an AXI4-Stream link's FIFO is
+    // searched state by state, every power-on value a state of its own).
+    let _ = writeln!(
+        s,
+        "(* ram_style = \"block\", no_rw_check *)\nreg [{}:0] mem [0:{}];\ninteger mem_i;\ninitial for (mem_i = 0; mem_i <= {}; mem_i = mem_i + 1) mem[mem_i] = {rb}'d0;",
+        rb - 1,
+        p.depth,
+        p.depth
+    );
+    // each entry's boundary flag in flip-flops: a popped token's first
+    // byte slot is set at the pop, so the byte multiplexer's select is a
+    // register, not a compare behind the block RAM's slow output
+    let _ = writeln!(
+        s,
+        "reg [{}:0] fbnd;\ninitial fbnd = {}'d0;",
+        p.depth,
+        p.depth + 1
+    );
     for (n, w) in [("wr", aw), ("rd", aw), ("n", nw)] {
         let _ = writeln!(s, "reg [{}:0] {n};\ninitial {n} = {w}'d0;", w - 1);
     }
     let _ = writeln!(
         s,
-        "reg have;\ninitial have = 1'b0;\n// the popped token without its two flags (they become the mask)\nreg [{}:0] tok;\ninitial tok = {}'d0;\nreg [11:0] mask;\ninitial mask = 12'd0;",
-        tb - 3,
-        tb - 2
+        "reg have;\ninitial have = 1'b0;\nreg [{}:0] tok;\n// its next byte slot (0-3 trailer, 4-7 header, 8-11 record)\nreg [3:0] bcnt;\ninitial bcnt = 4'd0;",
+        rb - 1,
     );
     let _ = writeln!(
         s,
-        "reg started;\ninitial started = 1'b0;\nreg [7:0] hframe;\ninitial hframe = 8'd0;\nreg [15:0] hslice;\ninitial hslice = 16'd0;"
+        "reg started;\ninitial started = 1'b0;\nreg [7:0] hframe;\ninitial hframe = 8'd0;\nreg [{}:0] hslice;\ninitial hslice = {};",
+        w.hw - 1,
+        lit(w.hw, 0)
     );
     let _ = writeln!(
         s,
@@ -501,13 +588,14 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     } else {
         let _ = writeln!(
             s,
-            "reg busy;\ninitial busy = 1'b0;\nreg [{}:0] bitn;\ninitial bitn = {bw}'d0;\nreg [{}:0] dv;\ninitial dv = {dw}'d0;",
-            bw - 1,
+            "reg busy;\ninitial busy = 1'b0;\nreg [{}:0] bitn;\ninitial bitn = {}'d0;\nreg [{}:0] dv;\ninitial dv = {dw}'d0;",
+            w.bw - 1,
+            w.bw,
             dw - 1
         );
         let _ = writeln!(
             s,
-            "reg [{}:0] chr;\ninitial chr = {cb}'d0;\nreg tx_r;\ninitial tx_r = 1'b1;\n",
+            "// the character still to send, shifted right with zeros: chr[0] is the\n// line; 1 alone is the last stop bit (and idle, where it stays)\nreg [{}:0] chr;\ninitial chr = {cb}'d1;\n// the character in transit is covered by the CRC (not one of its bytes)\nreg in_crc;\ninitial in_crc = 1'b0;\n",
             cb - 1
         );
     }
@@ -515,11 +603,7 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
 
 /// The handshake and FIFO wires of one cycle.
 fn wires(s: &mut String, p: &LinkParams, w: Widths) {
-    let Widths {
-        pw, nw, dw, cb, bw, ..
-    } = w;
-    let tb = TOKEN_BITS;
-    let _ = writeln!(s, "wire bnd = pos == {};", lit(pw, 0));
+    let Widths { nw, dw, cb, .. } = w;
     let _ = writeln!(s, "wire push = bnd | valid;");
     if p.axis.is_some() {
         // a beat is taken at an edge where tvalid and tready are high
@@ -528,33 +612,36 @@ fn wires(s: &mut String, p: &LinkParams, w: Widths) {
         let _ = writeln!(s, "wire last_tick = dv == {};", lit(dw, p.div as u64 - 1));
         let _ = writeln!(
             s,
-            "wire ready = !busy | (last_tick & (bitn == {}));",
-            lit(bw, cb as u64 - 1)
+            "// the bit counter, not `chr`'s contents, ends a character: the FIFO's\n// handshake stays independent of the bytes' values (and `prove` of them)\nwire chr_end = bitn == {};\n// the next bit is a data bit\nwire data_next = bitn < {};\nwire ready = !busy | (last_tick & chr_end);",
+            lit(w.bw, cb as u64 - 1),
+            lit(w.bw, 8)
         );
     }
     let _ = writeln!(s, "wire load = ready & have;");
     let _ = writeln!(s, "wire pop = !have & (n != {nw}'d0);");
     let _ = writeln!(s, "wire room = (n < {}) | pop;", lit(nw, p.depth as u64));
-    let _ = writeln!(s, "wire [11:0] rest = mask & (mask - 12'd1);");
-    let _ = writeln!(s, "wire [{}:0] head = mem[rd];", tb - 1);
-    let _ = writeln!(s, "wire [{}:0] token = {{bnd, valid, ch, val}};", tb - 1);
+    // a token ends with its record, or its header when it has none
+    let _ = writeln!(s, "wire [3:0] slot = bcnt;");
+    let _ = writeln!(
+        s,
+        "wire last = (slot == 4'd11) | ((slot == 4'd7) & !tok[{}]);",
+        RAM_BITS - 1
+    );
+    let _ = writeln!(s, "wire [{}:0] token = {{valid, ch, val}};", RAM_BITS - 1);
 }
 
-/// The lowest byte slot still to send, and that byte.
-fn byte_out(s: &mut String) {
-    let _ = writeln!(s, "reg [3:0] slot;\nalways @(*) begin\n  casez (mask)");
-    for i in 0..12 {
-        let pat: String = (0..12)
-            .rev()
-            .map(|b| match b.cmp(&i) {
-                std::cmp::Ordering::Greater => '?',
-                std::cmp::Ordering::Equal => '1',
-                std::cmp::Ordering::Less => '0',
-            })
-            .collect();
-        let _ = writeln!(s, "    12'b{pat}: slot = 4'd{i};");
+/// Bits `lo..lo + 8` of the `w`-bit register `r` as a byte (zeros above
+/// its top).
+fn byte_of(r: &str, w: usize, lo: usize) -> String {
+    match w {
+        _ if w <= lo => "8'd0".into(),
+        _ if w >= lo + 8 => format!("{r}[{}:{lo}]", lo + 7),
+        _ => format!("{{{}'d0, {r}[{}:{lo}]}}", lo + 8 - w, w - 1),
     }
-    let _ = writeln!(s, "    default: slot = 4'd0;\n  endcase\nend\n");
+}
+
+/// The byte of the slot being sent.
+fn byte_out(s: &mut String, hw: usize) {
     let _ = writeln!(s, "reg [7:0] byte_out;\nalways @(*) begin\n  case (slot)");
     for (i, e) in [
         "8'h5a",
@@ -563,8 +650,8 @@ fn byte_out(s: &mut String) {
         "crc[15:8]",
         "8'ha5",
         "hframe",
-        "hslice[15:8]",
-        "hslice[7:0]",
+        &byte_of("hslice", hw, 8),
+        &byte_of("hslice", hw, 0),
     ]
     .iter()
     .enumerate()
@@ -586,15 +673,25 @@ fn byte_out(s: &mut String) {
 /// The CRC after the outgoing byte, and (UART) its character with start,
 /// parity and stop bits.
 fn crc_and_character(s: &mut String, p: &LinkParams, w: Widths) {
-    // CRC-16/MODBUS of one byte
+    if p.axis.is_some() {
+        // CRC-16/MODBUS of one byte: a beat may leave every cycle
+        let _ = writeln!(
+            s,
+            "function [15:0] crc8;\n  input [15:0] c;\n  input [7:0] d;\n  integer i;\n  reg [15:0] x;\n  begin\n    x = c ^ {{8'h00, d}};\n    for (i = 0; i < 8; i = i + 1)\n      x = x[0] ? ((x >> 1) ^ 16'ha001) : (x >> 1);\n    crc8 = x;\n  end\nendfunction\n"
+        );
+        let _ = writeln!(
+            s,
+            "wire [15:0] crc_next = crc8((slot == 4'd4) ? 16'h{:04x} : crc, byte_out);\n",
+            p.crc_init
+        );
+        return;
+    }
+    // UART: CRC-16/MODBUS one bit at a time, the data bit that goes out
+    // next (`chr[1]`) in line order: 16 flip-flops and a few LUTs instead
+    // of a byte-wide XOR tree behind the byte multiplexer
     let _ = writeln!(
         s,
-        "function [15:0] crc8;\n  input [15:0] c;\n  input [7:0] d;\n  integer i;\n  reg [15:0] x;\n  begin\n    x = c ^ {{8'h00, d}};\n    for (i = 0; i < 8; i = i + 1)\n      x = x[0] ? ((x >> 1) ^ 16'ha001) : (x >> 1);\n    crc8 = x;\n  end\nendfunction\n"
-    );
-    let _ = writeln!(
-        s,
-        "wire [15:0] crc_next = crc8((slot == 4'd4) ? 16'h{:04x} : crc, byte_out);",
-        p.crc_init
+        "wire [15:0] crc_bit = {{1'b0, crc[15:1]}} ^ ({{16{{crc[0] ^ chr[1]}}}} & 16'ha001);"
     );
     let stops = "1'b1, ".repeat(p.stop_bits as usize);
     let parity = match p.parity {
@@ -602,61 +699,65 @@ fn crc_and_character(s: &mut String, p: &LinkParams, w: Widths) {
         2 => "~^byte_out, ",
         _ => "",
     };
-    if p.axis.is_none() {
-        let _ = writeln!(
-            s,
-            "wire [{}:0] chr_load = {{{stops}{parity}byte_out, 1'b0}};\n",
-            w.cb - 1
-        );
-    }
+    let _ = writeln!(
+        s,
+        "wire [{}:0] chr_load = {{{stops}{parity}byte_out, 1'b0}};\n",
+        w.cb - 1
+    );
 }
 
 /// The reset branch of the register update.
 fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths {
-        pw, aw, nw, dw, bw, ..
+        pw, aw, nw, dw, cb, ..
     } = w;
-    let _ = writeln!(s, "    pos <= {};", lit(pw, p.slice_cycles - 1));
+    let one = (p.slice_cycles == 1) as u8;
+    let _ = writeln!(
+        s,
+        "    npos <= {};\n    bnd <= 1'b{one};\n    wrap <= 1'b{one};",
+        lit(pw, 0),
+    );
     let out_reset = if p.axis.is_some() {
         "    tdata_r <= 8'd0;\n    tlast_r <= 1'b0;".to_string()
     } else {
-        format!("    bitn <= {bw}'d0;\n    dv <= {dw}'d0;\n    tx_r <= 1'b1;")
+        format!(
+            "    bitn <= {}'d0;\n    dv <= {dw}'d0;\n    chr <= {cb}'d1;\n    in_crc <= 1'b0;",
+            w.bw
+        )
     };
     let _ = writeln!(
         s,
-        "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    mask <= 12'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= 16'd0;\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n{out_reset}\n  end else begin"
+        "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    bcnt <= 4'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= {};\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n{out_reset}\n  end else begin",
+        lit(w.hw, 0)
     );
 }
 
 /// The slice position and the token FIFO: push, pop, overflow, count.
 fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths { pw, aw, nw, .. } = w;
-    let tb = TOKEN_BITS;
+    let one = (p.slice_cycles == 1) as u8;
     let _ = writeln!(
         s,
-        "    pos <= (pos == {}) ? {} : pos + {};",
-        lit(pw, p.slice_cycles - 1),
+        "    npos <= wrap ? {} : npos + {};\n    bnd <= wrap ? 1'b{one} : (npos == {});\n    wrap <= wrap ? 1'b{one} : (npos == {});",
         lit(pw, 0),
-        lit(pw, 1)
+        lit(pw, 1),
+        lit(pw, 0),
+        lit(pw, p.slice_cycles.saturating_sub(2))
     );
     let wrap = |r: &str| {
         format!(
             "({r} == {}) ? {aw}'d0 : {r} + {aw}'d1",
-            lit(aw, p.depth as u64 - 1)
+            lit(aw, p.depth as u64)
         )
     };
     let _ = writeln!(
         s,
-        "    if (pop) begin\n      tok <= head[{}:0];\n      rd <= {};\n      have <= 1'b1;\n      mask <= {{{{4{{head[{}]}}}}, {{4{{head[{}]}}}}, {{4{{head[{}] & started}}}}}};\n    end",
-        tb - 3,
+        "    if (pop) begin\n      rd <= {};\n      have <= 1'b1;\n      // a token without a boundary skips to its record; a trailer only\n      // once a header went out\n      bcnt <= !fbnd[rd] ? 4'd8 : started ? 4'd0 : 4'd4;\n    end",
         wrap("rd"),
-        tb - 2,
-        tb - 1,
-        tb - 1
     );
     let _ = writeln!(
         s,
-        "    if (push) begin\n      if (room) begin\n        mem[wr] <= token;\n        wr <= {};\n      end else begin\n        if (ovfc != 8'hff) ovfc <= ovfc + 8'd1;\n        ovf_r <= 1'b1;\n      end\n    end",
+        "    if (push) begin\n      if (room) begin\n        wr <= {};\n      end else begin\n        if (ovfc != 8'hff) ovfc <= ovfc + 8'd1;\n        ovf_r <= 1'b1;\n      end\n    end",
         wrap("wr")
     );
     // A one-bit count (a FIFO of one token) has no padding bits: `{0'd0, x}`
@@ -674,30 +775,43 @@ fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
 /// The byte in transit (bit periods or the beat taken), and the next byte's
 /// load with the CRC and header counters.
 fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
-    let Widths { dw, cb, bw, .. } = w;
+    let Widths { dw, .. } = w;
     if p.axis.is_some() {
         let _ = writeln!(s, "    if (busy & tready) busy <= 1'b0;");
     } else {
         let _ = writeln!(
         s,
-        "    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (bitn == {}) begin\n          busy <= 1'b0;\n          tx_r <= 1'b1;\n        end else begin\n          bitn <= bitn + {bw}'d1;\n          tx_r <= chr[1];\n          chr <= chr >> 1;\n        end\n      end else dv <= dv + {dw}'d1;\n    end",
-        lit(bw, cb as u64 - 1)
+"    if (busy) begin\n      if (last_tick) begin\n        dv <= {dw}'d0;\n        if (chr_end) busy <= 1'b0;\n        else begin\n          bitn <= bitn + {}'d1;\n          chr <= chr >> 1;\n          if (in_crc & data_next) crc <= crc_bit;\n        end\n      end else dv <= dv + {dw}'d1;\n    end",
+        w.bw
     );
     }
+    let tlast_frame = format!("(slot == 4'd3) & (hslice == {})", lit(w.hw, 0));
     let load_out = match p.axis {
         Some(t) => format!(
             "      tdata_r <= byte_out;\n      tlast_r <= {};",
             if t == link::Tlast::Slice {
                 "slot == 4'd3"
             } else {
-                "(slot == 4'd3) & (hslice == 16'd0)"
+                &tlast_frame
             }
         ),
-        None => format!("      chr <= chr_load;\n      bitn <= {bw}'d0;\n      dv <= {dw}'d0;\n      tx_r <= 1'b0;"),
+        None => format!(
+            "      chr <= chr_load;\n      bitn <= {}'d0;\n      dv <= {dw}'d0;",
+            w.bw
+        ),
+    };
+    let crc_load = match p.axis {
+        Some(_) => "      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;".to_string(),
+        None => format!(
+            "      if (slot == 4'd4) crc <= 16'h{:04x};\n      in_crc <= (slot != 4'd2) && (slot != 4'd3);",
+            p.crc_init
+        ),
     };
     let _ = writeln!(
         s,
-        "    if (load) begin\n{load_out}\n      busy <= 1'b1;\n      mask <= rest;\n      have <= rest != 12'd0;\n      if (slot != 4'd2 && slot != 4'd3) crc <= crc_next;\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == 16'd{}) begin\n          hslice <= 16'd0;\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + 16'd1;\n      end\n    end",
-        p.slices_per_frame - 1
+        "    if (load) begin\n{load_out}\n      busy <= 1'b1;\n      bcnt <= slot + 4'd1;\n      have <= !last;\n{crc_load}\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == {}) begin\n          hslice <= {};\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + {};\n      end\n    end",
+        lit(w.hw, p.slices_per_frame - 1),
+        lit(w.hw, 0),
+        lit(w.hw, 1)
     );
 }

@@ -350,3 +350,55 @@ fn every_port_is_in_every_constraints_file() {
     }
     assert!(link_ports >= 6, "link ports tested: {link_ports}");
 }
+
+/// The lean link on iCE40, on both presets and a small mix of
+/// another line shape: the FIFO's tokens and their read register are a
+/// block RAM (no token flip-flops), and a UART's CRC is bit-serial (no
+/// byte-wide CRC function).
+#[test]
+fn the_links_fifo_is_block_ram() {
+    if !policy::require_tool("yosys") {
+        return;
+    }
+    let tiny = std::fs::read_to_string(common::root().join("testkit/mixes/tiny.toml")).unwrap()
+        + "\n[link]\nkind = \"uart\"\nbaud = 1_000_000\nparity = \"odd\"\nstop_bits = 2\n";
+    let tiny =
+        lut_gen::synthesize(&lut_gen::parse(Path::new("tiny-uart.toml"), &tiny).unwrap()).unwrap();
+    let uart = common::root().join("mixes/eskin34-uart.toml");
+    let uart = lut_gen::synthesize(&lut_gen::load(&uart).unwrap()).unwrap();
+    for (s, tag, axis) in [
+        (uart, "lean-uart", false),
+        (eskin34_axis(), "lean-axis", true),
+        (tiny, "lean-tiny", false),
+    ] {
+        let dir = emit_to(&s, tag);
+        let v = std::fs::read_to_string(dir.join("slotforge_top.v")).unwrap();
+        assert_eq!(v.contains("function [15:0] crc8"), axis, "{tag}");
+        let (ok, text) = run(
+            &dir,
+            Command::new("yosys").args([
+                "-p",
+                "read_verilog slotforge_top.v; synth_ice40 -top slotforge_link; stat",
+            ]),
+        );
+        assert!(ok, "{tag}: {}", &text[text.len().saturating_sub(3000)..]);
+        let count = |cell: &str| -> usize {
+            text.lines()
+                .filter(|l| l.split_whitespace().next() == Some(cell))
+                .filter_map(|l| l.split_whitespace().nth(1)?.parse().ok())
+                .next_back()
+                .unwrap_or(0)
+        };
+        // 28-bit tokens: two 16-bit-wide block RAMs
+        assert_eq!(count("SB_RAM40_4K"), 2, "{tag}: {text}");
+        // the last `stat` (synth_ice40 prints one of its own)
+        let last = &text[text.rfind("Number of cells").unwrap_or(0)..];
+        let dffs: usize = last
+            .lines()
+            .filter(|l| l.trim_start().starts_with("SB_DFF"))
+            .filter_map(|l| l.split_whitespace().nth(1)?.parse::<usize>().ok())
+            .sum();
+        // a read-first emulation (a write register and bypass) would add 28+
+        assert!(dffs > 0 && dffs < 100, "{tag}: {dffs} flip-flops");
+    }
+}
