@@ -62,6 +62,9 @@ fn stat_sum(stat: &Value, pick: impl Fn(&str) -> bool) -> u64 {
         .sum()
 }
 
+/// A family's logic cell and block RAM (nextpnr), LUT and flip-flop (yosys).
+type Names = (&'static str, &'static str, fn(&str) -> bool, fn(&str) -> bool);
+
 /// The family's names in the tools' own reports: nextpnr's logic cell and
 /// block RAM, yosys' LUT and flip-flop types (the test's own table).
 fn names(
