@@ -63,18 +63,16 @@ fn stat_sum(stat: &Value, pick: impl Fn(&str) -> bool) -> u64 {
 }
 
 /// A family's logic cell and block RAM (nextpnr), LUT and flip-flop (yosys).
-type Names = (&'static str, &'static str, fn(&str) -> bool, fn(&str) -> bool);
+type Names = (
+    &'static str,
+    &'static str,
+    fn(&str) -> bool,
+    fn(&str) -> bool,
+);
 
 /// The family's names in the tools' own reports: nextpnr's logic cell and
 /// block RAM, yosys' LUT and flip-flop types (the test's own table).
-fn names(
-    f: Fpga,
-) -> (
-    &'static str,
-    &'static str,
-    fn(&str) -> bool,
-    fn(&str) -> bool,
-) {
+fn names(f: Fpga) -> Names {
     match f {
         Fpga::Ice40Hx8k => (
             "ICESTORM_LC",
