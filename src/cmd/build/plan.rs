@@ -66,7 +66,7 @@ impl Step {
             Step::Golden => "golden comparison",
             Step::Faults => "fault campaign",
             Step::Prove => "formal proof (all time)",
-            Step::Synth => "synthesis estimate (iCE40 HX8K)",
+            Step::Synth => "synthesis estimate (--fpga part)",
             Step::Timing => "chart: timing of a slice",
             Step::Figure7 => "chart: Figure 7 for this mix's rates",
             Step::Schedulability => "chart: where scheduling breaks",
