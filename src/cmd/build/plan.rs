@@ -66,7 +66,7 @@ impl Step {
             Step::Golden => "golden comparison",
             Step::Faults => "fault campaign",
             Step::Prove => "formal proof (all time)",
-            Step::Synth => "synthesis estimate (--fpga part)",
+            Step::Synth => "synthesis estimate (yosys, nextpnr)",
             Step::Timing => "chart: timing of a slice",
             Step::Figure7 => "chart: Figure 7 for this mix's rates",
             Step::Schedulability => "chart: where scheduling breaks",
