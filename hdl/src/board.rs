@@ -258,7 +258,7 @@ mod tests {
             let bits = Layout::new(s).bits();
             for f in Fpga::ALL {
                 let b: Board = toml::from_str(stock_board(f)).unwrap();
-                assert_eq!(b.fpga, f);
+                assert_eq!((b.fpga, b.name.as_str()), (f, f.board().0));
                 let format = f.family().constraints();
                 let (file, text) = b.constraints(s, Path::new("board.toml")).unwrap();
                 assert_eq!(file, format.file());
