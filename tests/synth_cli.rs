@@ -150,6 +150,9 @@ fn check_part(mix: &Path, f: Fpga, dir: &Path) {
         let name = c["cell"].as_str().unwrap();
         assert_eq!(c["used"].as_u64(), Some(used(name)), "{f} {name}");
     }
+    // the gate-level netlist the netlist simulation reads is beside them
+    let netlist = std::fs::read_to_string(out.join(measure::NETLIST_FILE)).unwrap();
+    assert!(netlist.contains("module slotforge_top"), "{f}");
     // the pins were the board's: the constraint file is in the work folder
     let file = out.join(f.family().constraints().file());
     assert!(file.is_file(), "{}", file.display());
