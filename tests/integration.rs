@@ -64,6 +64,9 @@ mod sigrok;
 #[path = "sim_cli.rs"]
 mod sim_cli;
 
+#[path = "synth_cli.rs"]
+mod synth_cli;
+
 #[path = "tool_policy.rs"]
 mod tool_policy;
 

@@ -52,8 +52,8 @@ impl Fpga {
     pub fn board(self) -> (&'static str, &'static str) {
         match self {
             Fpga::Ice40Hx8k => ("iCE40-HX8K Breakout Board", "ice40-hx8k-breakout.toml"),
-            Fpga::Ecp5_25k => ("Radiona ULX3S (LFE5U-25F)", "ulx3s-25f.toml"),
-            Fpga::Gw1n9 => ("Sipeed Tang Nano 9K", "tang-nano-9k.toml"),
+            Fpga::Ecp5_25k => ("ULX3S", "ulx3s-25f.toml"),
+            Fpga::Gw1n9 => ("Tang Nano 9K", "tang-nano-9k.toml"),
         }
     }
 

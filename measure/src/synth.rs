@@ -15,16 +15,18 @@ use crate::yosys::{find_program, synthesize_for, Synthesized, SYNTH_JSON};
 pub struct Synth {
     pub fpga: Fpga,
     /// Logic cells placed: nextpnr's `ICESTORM_LC` (iCE40), `TRELLIS_COMB`
-    /// (ECP5; half a slice), `LUT4` (Gowin: a LUT and its flip-flop).
+    /// (ECP5; half a slice), `LUT4` (Gowin: the LUTs placed, the router's
+    /// pass-through ones included), all from nextpnr's `--report`.
     pub lcs: u64,
     /// LUTs (`SB_LUT4`, `LUT4`, Gowin's `LUT1`-`LUT4`) and flip-flops
     /// (`SB_DFF*`, `TRELLIS_FF`, Gowin's `DFF*`) from yosys' `stat`.
     pub lut4: u64,
     pub dff: u64,
     /// Block RAMs placed (`ICESTORM_RAM`, `DP16KD`, Gowin's `BSRAM`).
+    /// `fmax_mhz`: the report's achieved Fmax of `clk`.
     pub brams: u64,
     pub fmax_mhz: f64,
-    /// nextpnr's utilisation table, the cells used: the family's own
+    /// nextpnr's utilization (its report), the cells used: the family's own
     /// names, `(cell, used, available)`.
     pub cells: Vec<(String, u64, u64)>,
 }
@@ -194,7 +196,12 @@ fn place(
             tail.into_iter().rev().collect::<Vec<_>>().join("\n")
         ));
     }
-    parse(fpga, &log, &y.cells).map_err(|e| format!("{}: {e}", log_file.display()))
+    // the report is the placed and routed design's (the log's utilisation
+    // table is printed before routing adds Gowin's route-through LUTs)
+    let report = dir.join(format!("report{tag}.json"));
+    let text =
+        std::fs::read_to_string(&report).map_err(|e| format!("{}: {e}", report.display()))?;
+    parse(fpga, &text, &y.cells).map_err(|e| format!("{}: {e}", report.display()))
 }
 
 /// The family's names for what the report counts: nextpnr's logic cell
@@ -229,58 +236,59 @@ fn names(fpga: Fpga) -> Names {
     }
 }
 
-/// The figures of nextpnr's log and yosys's `stat`.  A log without the
-/// utilisation table or an Fmax is an error, never "0 logic cells".
-fn parse(fpga: Fpga, log: &str, stat: &[(String, u64)]) -> Result<Synth, String> {
+/// The figures of nextpnr's `--report` JSON and yosys's `stat`.  A report
+/// without the family's cells or an Fmax is an error, never "0 logic
+/// cells".
+fn parse(fpga: Fpga, report: &str, stat: &[(String, u64)]) -> Result<Synth, String> {
     let n = names(fpga);
     let (program, _) = fpga.nextpnr();
-    let table = utilisation(log);
+    let v: serde_json::Value =
+        serde_json::from_str(report).map_err(|e| format!("{program}'s report: {e}"))?;
+    let table: Vec<(String, u64, u64)> = v
+        .get("utilization")
+        .and_then(|u| u.as_object())
+        .map(|u| {
+            u.iter()
+                .filter_map(|(c, x)| {
+                    Some((
+                        c.clone(),
+                        x.get("used")?.as_u64()?,
+                        x.get("available")?.as_u64()?,
+                    ))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
     let need = |cell: &str| {
         table
             .iter()
             .find(|(c, ..)| c == cell)
             .map(|&(_, used, _)| used)
             .ok_or(format!(
-                "no `{cell}: used/available` line in {program}'s log: it could not be parsed"
+                "no `{cell}` in the utilization of {program}'s report: it could not be parsed"
             ))
     };
     let count = |pick: fn(&str) -> bool| -> u64 {
         stat.iter().filter(|(c, _)| pick(c)).map(|(_, k)| k).sum()
     };
+    // the slowest clock's (the gateware has one, `clk`)
+    let fmax = v
+        .get("fmax")
+        .and_then(|f| f.as_object())
+        .into_iter()
+        .flatten()
+        .filter_map(|(_, c)| c.get("achieved")?.as_f64())
+        .reduce(f64::min)
+        .ok_or(format!("{program} reported no Fmax"))?;
     Ok(Synth {
         fpga,
         lcs: need(n.logic_cell)?,
         brams: need(n.bram)?,
         lut4: count(n.lut),
         dff: count(n.ff),
-        fmax_mhz: fmax(log).ok_or(format!("{program} reported no Fmax"))?,
+        fmax_mhz: fmax,
         cells: table.into_iter().filter(|&(_, used, _)| used > 0).collect(),
     })
-}
-
-/// nextpnr's utilisation table (the last one): `(cell, used, available)`.
-fn utilisation(log: &str) -> Vec<(String, u64, u64)> {
-    let start = log.rfind("Device utilisation:").map_or(log.len(), |i| i);
-    log[start..]
-        .lines()
-        .skip(1)
-        .map_while(|l| {
-            let l = l.strip_prefix("Info:")?.trim();
-            let (cell, rest) = l.split_once(':')?;
-            let mut nums = rest.split('/');
-            let used = nums.next()?.trim().parse().ok()?;
-            let avail = nums.next()?.split_whitespace().next()?.parse().ok()?;
-            Some((cell.trim().to_string(), used, avail))
-        })
-        .collect()
-}
-
-/// The last `Max frequency for clock '...': F MHz` of nextpnr's log.
-fn fmax(log: &str) -> Option<f64> {
-    log.lines()
-        .filter(|l| l.contains("Max frequency for clock"))
-        .filter_map(|l| l.rsplit("': ").next()?.split(' ').next()?.parse().ok())
-        .next_back()
 }
 
 #[cfg(test)]
@@ -289,10 +297,9 @@ mod tests {
 
     #[test]
     fn reads_nextpnr_and_yosys_figures() {
-        let log = "Info: Device utilisation:\nInfo:     ICESTORM_LC:   263/ 7680     3%\nInfo:    ICESTORM_RAM:     3/   32     9%\n\
-                   Info:           SB_GB:     0/    8     0%\n\n\
-                   Info: Max frequency for clock 'clk$SB_IO_IN_$glb_clk': 98.50 MHz (PASS at 48.00 MHz)\n\
-                   Info: Max frequency for clock 'clk$SB_IO_IN_$glb_clk': 117.00 MHz (PASS at 48.00 MHz)\n";
+        let report = r#"{"fmax": {"clk$SB_IO_IN_$glb_clk": {"achieved": 117.25, "constraint": 48}},
+            "utilization": {"ICESTORM_LC": {"available": 7680, "used": 263},
+              "ICESTORM_RAM": {"available": 32, "used": 3}, "SB_GB": {"available": 8, "used": 0}}}"#;
         let stat: Vec<(String, u64)> = [
             ("SB_CARRY", 4),
             ("SB_DFF", 10),
@@ -301,9 +308,9 @@ mod tests {
         ]
         .map(|(c, n)| (c.to_string(), n))
         .to_vec();
-        let r = parse(Fpga::Ice40Hx8k, log, &stat).unwrap();
+        let r = parse(Fpga::Ice40Hx8k, report, &stat).unwrap();
         assert_eq!((r.lcs, r.brams, r.lut4, r.dff), (263, 3, 120, 17));
-        assert_eq!(r.fmax_mhz, 117.0);
+        assert_eq!(r.fmax_mhz, 117.25);
         assert_eq!(
             r.cells,
             vec![
@@ -311,16 +318,20 @@ mod tests {
                 ("ICESTORM_RAM".into(), 3, 32)
             ]
         );
-        // ECP5's tab-indented table and cell names
-        let log = "Info: Device utilisation:\nInfo: \t          TRELLIS_IO:      48/    197    24%\nInfo: \t              DP16KD:       3/     56     5%\n\
-                   Info: \t        TRELLIS_COMB:     167/  24288     0%\n\
-                   Info: Max frequency for clock '$glbnet$clk$TRELLIS_IO_IN': 134.23 MHz (PASS at 48.00 MHz)\n";
-        let stat: Vec<(String, u64)> = [("LUT4", 115), ("TRELLIS_FF", 159), ("CCU2C", 17)]
-            .map(|(c, n)| (c.to_string(), n))
-            .to_vec();
-        let r = parse(Fpga::Ecp5_25k, log, &stat).unwrap();
-        assert_eq!((r.lcs, r.brams, r.lut4, r.dff), (167, 3, 115, 159));
-        assert_eq!(r.cells[0], ("TRELLIS_IO".to_string(), 48, 197));
+        // Gowin's names: LUT1-LUT4 are LUTs, every DFF* a flip-flop
+        let report = r#"{"fmax": {"clk": {"achieved": 133.5}},
+            "utilization": {"LUT4": {"available": 8640, "used": 220}, "BSRAM": {"available": 26, "used": 3}}}"#;
+        let stat: Vec<(String, u64)> = [
+            ("LUT1", 9),
+            ("LUT3", 50),
+            ("DFFRE", 45),
+            ("DFF", 28),
+            ("ALU", 34),
+        ]
+        .map(|(c, n)| (c.to_string(), n))
+        .to_vec();
+        let r = parse(Fpga::Gw1n9, report, &stat).unwrap();
+        assert_eq!((r.lcs, r.brams, r.lut4, r.dff), (220, 3, 59, 73));
     }
 
     #[test]
@@ -345,18 +356,20 @@ mod tests {
     }
 
     #[test]
-    fn a_log_that_cannot_be_parsed_is_an_error_not_zero_cells() {
-        // a nextpnr whose table changed its words: no utilisation line
-        let log = "Info: Device utilisation:\nInfo:     LOGIC_CELLS:   263/ 7680     3%\n\
-                   Info: Max frequency for clock 'clk': 98.50 MHz (PASS at 48.00 MHz)\n";
-        let e = parse(Fpga::Ice40Hx8k, log, &[]).unwrap_err();
+    fn a_report_that_cannot_be_parsed_is_an_error_not_zero_cells() {
+        // a nextpnr whose report changed its words: no ICESTORM_LC
+        let report = r#"{"fmax": {"clk": {"achieved": 98.5}},
+            "utilization": {"LOGIC_CELLS": {"available": 7680, "used": 263}}}"#;
+        let e = parse(Fpga::Ice40Hx8k, report, &[]).unwrap_err();
         assert!(
             e.contains("ICESTORM_LC") && e.contains("could not be parsed"),
             "{e}"
         );
-        let no_fmax = "Info: Device utilisation:\nInfo:     ICESTORM_LC:   263/ 7680     3%\nInfo:    ICESTORM_RAM:     3/   32     9%\n";
+        let no_fmax = r#"{"fmax": {}, "utilization": {"ICESTORM_LC": {"available": 7680, "used": 263},
+            "ICESTORM_RAM": {"available": 32, "used": 3}}}"#;
         assert!(parse(Fpga::Ice40Hx8k, no_fmax, &[])
             .unwrap_err()
             .contains("Fmax"));
+        assert!(parse(Fpga::Ecp5_25k, "Info: not JSON", &[]).is_err());
     }
 }

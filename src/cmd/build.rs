@@ -55,6 +55,11 @@ pub struct Args {
     /// speed.
     #[arg(long, value_delimiter = ',', value_name = "STEP,...")]
     pub skip: Vec<String>,
+    /// The FPGA part of the synthesis step: ice40-hx8k (IO left
+    /// unconstrained), ecp5-25k or gw1n-9 (on their board's pins, as
+    /// `slotforge synth --fpga` places them).
+    #[arg(long, value_parser = lut_gen::Fpga::parse, default_value = "ice40-hx8k")]
+    pub fpga: lut_gen::Fpga,
     /// Also write the steps as JUnit XML (one test case per step).
     #[arg(long, value_name = "FILE")]
     pub junit: Option<PathBuf>,

@@ -69,7 +69,7 @@ impl Step {
             Step::Golden => "golden comparison",
             Step::Faults => "fault campaign",
             Step::Prove => "formal proof (all time)",
-            Step::Synth => "synthesis estimate (iCE40 HX8K)",
+            Step::Synth => "synthesis estimate (yosys, nextpnr)",
             Step::Netlist => "netlist simulated (iCE40, a frame)",
             Step::Timing => "chart: timing of a slice",
             Step::Figure7 => "chart: Figure 7 for this mix's rates",
