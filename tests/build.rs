@@ -162,7 +162,7 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         .descendants()
         .filter(|n| n.has_tag_name("testcase"))
         .collect();
-    assert_eq!(cases.len(), 12, "{xml}");
+    assert_eq!(cases.len(), 13, "{xml}");
     // the proof is opt-in (tests/prove_cli.rs builds with it); every other
     // step runs
     let prove = cases
@@ -180,6 +180,8 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         "verilog/ports.json",
         "verilog/slotforge.pcf",
         "sim.json",
+        "netlist.json",
+        "verilog/slotforge_top.core",
         "frame0.vcd",
         "frame0.gtkw",
         "frame0.channels.txt",
@@ -757,6 +759,8 @@ fn reports_of_unseen_mixes_read_like_datasheets() {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        // A mix with modes is audited only (tests/cli.rs: the refusal).
+        .filter(|p| lut_gen::load(p).unwrap().modes.is_none())
         .collect();
     mixes.sort();
     mixes.push(root.join("mixes/eskin34-uart.toml"));

@@ -761,3 +761,39 @@ fn deep_faults_escape_every_simulation_column_and_prove_catches_them() {
         .unwrap()
         .contains("simulation"));
 }
+
+/// A mix with modes is planned by `audit` and `lut`; every command that
+/// would show the gateware refuses it, naming its modes, rather than show
+/// the reset mode alone as if it were the mix.
+#[test]
+fn a_mix_with_modes_is_audited_and_refused_where_the_gateware_would_show_one_mode() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let d = tempfile::tempdir().unwrap();
+    for name in ["modes-pin", "modes-auto"] {
+        let mix = root.join("testkit/mixes").join(format!("{name}.toml"));
+        let modes = lut_gen::load(&mix).unwrap().modes.unwrap().names;
+        slotforge().arg("audit").arg(&mix).assert().success();
+        let out = d.path().join(name);
+        let refused: [&[&str]; 5] = [
+            &["verilog", "-o"],
+            &["sim", "--backend", "model", "--frames", "1", "--vcd"],
+            &["build", "--quiet", "-o"],
+            &["golden", "--dir"],
+            &["prove", "-o"],
+        ];
+        for args in refused {
+            let a = slotforge()
+                .args(args)
+                .arg(&out)
+                .arg(&mix)
+                .assert()
+                .code(2)
+                .stderr(predicate::str::contains("does not switch modes"));
+            let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+            for m in &modes {
+                assert!(err.contains(m.as_str()), "{args:?}: {err}");
+            }
+        }
+        assert!(!out.join("slotforge_top.v").exists());
+    }
+}

@@ -12,7 +12,7 @@ use serde_json::Value;
 
 use crate::common_cli::slotforge;
 
-const STEPS: &str = "audit,lut,verilog,sim,timing,figure7,schedulability";
+const STEPS: &str = "audit,lut,verilog,sim,netlist,timing,figure7,schedulability";
 
 /// An AD7685 chain of three (CNV, branch 0, so the timing figure is a CNV
 /// part's) beside an AD7940 branch, at 2 kHz and 250 Hz.
@@ -237,6 +237,13 @@ fn figures_of(text: &str) {
     let s = summary(&md, "co-simulation");
     assert_eq!(before(s, " frames"), num(&sim["frames"]), "{s}");
     assert_eq!(before(s, " samples"), num(&sim["samples"]), "{s}");
+
+    // the netlist: netlist.json's source, frames and samples
+    let nl = json(&out.join("netlist.json"));
+    let s = summary(&md, "netlist simulated (iCE40, a frame)");
+    assert!(s.starts_with(nl["source"].as_str().unwrap()), "{s}");
+    assert_eq!(before(s, " frame,"), num(&nl["frames"]), "{s}");
+    assert_eq!(before(s, " samples"), num(&nl["samples"]), "{s}");
 
     // timing: the grid, and branch 0's strobe at read_cycles + 1 (docs/timing.md)
     let s = summary(&md, "chart: timing of a slice");

@@ -21,6 +21,9 @@ mod figures;
 #[path = "fixes.rs"]
 mod fixes;
 
+#[path = "fusesoc.rs"]
+mod fusesoc;
+
 #[path = "golden.rs"]
 mod golden;
 
@@ -43,6 +46,9 @@ mod link_captures;
 #[path = "link_windows.rs"]
 mod link_windows;
 
+#[path = "netlist.rs"]
+mod netlist;
+
 #[path = "prove_cli.rs"]
 mod prove_cli;
 
@@ -57,6 +63,9 @@ mod sigrok;
 
 #[path = "sim_cli.rs"]
 mod sim_cli;
+
+#[path = "synth_cli.rs"]
+mod synth_cli;
 
 #[path = "tool_policy.rs"]
 mod tool_policy;

@@ -61,6 +61,7 @@ fn every_tool_is_installed() {
         "nextpnr-ice40",
         "sigrok-cli",
         "cvc5",
+        "fusesoc",
     ];
     for tool in every {
         let ci = std::env::var("CI").ok();

@@ -124,6 +124,10 @@ pub struct Proof {
     pub solver_seconds: f64,
     /// Whether the design is slotforge's own emitted Verilog.
     pub own_design: bool,
+    /// `prove --netlist`: the part whose gate-level netlist (with yosys'
+    /// cell models, flattened) was proved, e.g. `ice40-hx8k`; null for RTL.
+    #[serde(default)]
+    pub netlist: Option<String>,
     /// What the result means, in words.
     pub note: String,
     /// The parts of the pin contract the harness does not assert, in plain
@@ -150,6 +154,10 @@ pub struct ProveOptions {
     pub out_dir: PathBuf,
     /// The design is slotforge's own Verilog (reported; the harness is the same).
     pub own_design: bool,
+    /// The design is this part's gate-level netlist with the cell models
+    /// (reported as [`Proof::netlist`]), and what proving it leaves out
+    /// (the models stand for the silicon, no timing): added to `not_covered`.
+    pub netlist: Option<(String, Vec<String>)>,
 }
 
 impl ProveOptions {
@@ -161,6 +169,7 @@ impl ProveOptions {
             bmc_timeout_s: 1800,
             out_dir: out_dir.into(),
             own_design: true,
+            netlist: None,
         }
     }
 }
@@ -193,7 +202,10 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         Solver::Abc => strategy::abc(&prep, f, opts)?,
         Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work.path(), f, opts)?,
     };
-    let not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
+    let mut not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
+    if let Some((_, also)) = &opts.netlist {
+        not_covered.extend(also.iter().cloned());
+    }
     let note = scoped_note(result, note, not_covered.len());
     let solver_seconds = t1.elapsed().as_secs_f64();
     let mut properties: Vec<PropertyResult> = h
@@ -228,6 +240,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         seconds: t0.elapsed().as_secs_f64(),
         solver_seconds,
         own_design: opts.own_design,
+        netlist: opts.netlist.as_ref().map(|(part, _)| part.clone()),
         note,
         not_covered,
         counterexample,
@@ -462,10 +475,12 @@ impl Proof {
         let _ = writeln!(
             s,
             "  design: {}; properties at the ports only, no internal names; any MISO input, one reset cycle",
-            if self.own_design {
-                "slotforge's emitted Verilog"
-            } else {
-                "outside Verilog (--rtl)"
+            match (&self.netlist, self.own_design) {
+                (Some(part), _) => format!(
+                    "the {part} netlist of slotforge's emitted Verilog (yosys, with the cell models flattened in)"
+                ),
+                (None, true) => "slotforge's emitted Verilog".to_string(),
+                (None, false) => "outside Verilog (--rtl)".to_string(),
             }
         );
         for p in &self.properties {

@@ -10,8 +10,8 @@ use std::path::Path;
 use lut_gen::Schedule;
 use lut_gen::{Dir, Layout, Role, PORTS, TOP_MODULE};
 use rust_hdl::prelude::*;
-use serde::Deserialize;
 
+use crate::board::{pcf_template, pnr_name, Board};
 use crate::core::Core;
 use crate::link::{AxisLink, UartLink};
 use crate::plan::{plan_with, LutForm, Plan};
@@ -78,61 +78,6 @@ impl Emitted {
     }
 }
 
-/// A board file: which package pin each port bit goes to.
-///
-/// ```toml
-/// name = "..."
-/// device = "hx8k"        # nextpnr-ice40 --hx8k
-/// package = "ct256"
-/// [pins]                 # explicit bits, e.g. clk = "J3", "adc_cs_n[0]" = "B6"
-/// clk = "J3"
-/// [pool]                 # remaining bits take these pins, in port-table order
-/// pins = ["A5", "A6"]
-/// ```
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Board {
-    pub name: String,
-    #[serde(default)]
-    pub description: String,
-    pub device: String,
-    pub package: String,
-    #[serde(default)]
-    pub pins: std::collections::BTreeMap<String, String>,
-    #[serde(default)]
-    pub pool: Pool,
-}
-
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Pool {
-    #[serde(default)]
-    pub pins: Vec<String>,
-}
-
-impl Board {
-    pub fn load(path: &Path) -> Result<Board, HdlError> {
-        let err = |m: String| HdlError::Board {
-            path: path.display().to_string(),
-            message: m,
-        };
-        let text = std::fs::read_to_string(path).map_err(|e| err(lut_gen::io_words(&e)))?;
-        toml::from_str(&text).map_err(|e| err(lut_gen::toml_words(&e.to_string(), "")))
-    }
-}
-
-/// The name place-and-route tools give a port bit: yosys and nextpnr call
-/// the only bit of a 1-bit vector port by the port's name.
-fn pnr_name(bits: &[(String, Dir)], bit: &str) -> String {
-    if let Some(base) = bit.strip_suffix("[0]") {
-        let wider = format!("{base}[1]");
-        if !bits.iter().any(|(n, _)| *n == wider) {
-            return base.to_string();
-        }
-    }
-    bit.to_string()
-}
-
 /// Generate every file for a schedule.  With `board`, the PCF maps port bits
 /// to that board's pins; without, a template PCF lists every port bit.
 pub fn emit(s: &Schedule, board: Option<&Path>) -> Result<Emitted, HdlError> {
@@ -147,6 +92,12 @@ pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Em
         Some(path) => Some((path, Board::load(path)?)),
         None => None,
     };
+    // a board writes its family's constraint file; without one, the PCF
+    // template lists every port bit
+    let constraints = match &board {
+        Some((path, b)) => b.constraints(s, path)?,
+        None => ("slotforge.pcf".to_string(), pcf_template(s)),
+    };
     let mut files = vec![
         (VERILOG_FILE.to_string(), verilog(s, &p)),
         (MANIFEST_FILE.to_string(), lut_gen::manifest(s)),
@@ -157,14 +108,11 @@ pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Em
         ("slot_rom.hex".to_string(), slots_hex(s, &p)),
         ("slotforge.sdc".to_string(), sdc(s)),
         ("slotforge.xdc".to_string(), xdc(s)),
-        (
-            "slotforge.pcf".to_string(),
-            match &board {
-                Some((path, b)) => pcf_board(s, path, b)?,
-                None => pcf_template(s),
-            },
-        ),
+        constraints,
     ];
+    let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+    let core = crate::fusesoc::core_file(s, &names);
+    files.push((crate::fusesoc::CORE_FILE.to_string(), core));
     files.sort();
     Ok(Emitted { files })
 }
@@ -614,7 +562,7 @@ fn slots_hex(s: &Schedule, p: &Plan) -> String {
 // Constraints
 // ---------------------------------------------------------------------------
 
-fn period_ns(s: &Schedule) -> String {
+pub(crate) fn period_ns(s: &Schedule) -> String {
     let ns = 1e9 / s.grid.clock_hz as f64;
     let mut t = format!("{ns:.3}");
     while t.ends_with('0') {
@@ -709,84 +657,6 @@ fn xdc(s: &Schedule) -> String {
         );
     }
     t
-}
-
-fn pcf_template(s: &Schedule) -> String {
-    let mut t = String::new();
-    let _ = writeln!(
-        t,
-        "# slotforge_top iCE40 pin constraints (template) for mix \"{}\"",
-        s.mix.name
-    );
-    let _ = writeln!(
-        t,
-        "# No board file was given: replace every <pin> and uncomment, or emit with a board file."
-    );
-    let bits = Layout::new(s).bits();
-    for (bit, dir) in &bits {
-        let _ = writeln!(
-            t,
-            "# set_io {} <pin>    # {}",
-            pnr_name(&bits, bit),
-            dir.verilog()
-        );
-    }
-    t
-}
-
-fn pcf_board(s: &Schedule, path: &Path, b: &Board) -> Result<String, HdlError> {
-    let bits = Layout::new(s).bits();
-    let err = |m: String| HdlError::Board {
-        path: path.display().to_string(),
-        message: m,
-    };
-    for k in b.pins.keys() {
-        if !bits.iter().any(|(n, _)| n == k) {
-            // Pins for bits another mix has (e.g. adc_cs_n[7]) are fine; only
-            // names that can never be a port bit are errors.
-            let base = k.split('[').next().unwrap_or("");
-            if !PORTS.iter().any(|p| p.name == base) {
-                return Err(err(format!("[pins] names `{k}`, which is not a port bit")));
-            }
-        }
-    }
-    let mut used: Vec<&str> = vec![];
-    let mut pool = b
-        .pool
-        .pins
-        .iter()
-        .filter(|x| !b.pins.values().any(|v| v == *x));
-    let mut t = String::new();
-    let _ = writeln!(
-        t,
-        "# slotforge_top iCE40 pin constraints for mix \"{}\" on board \"{}\" ({} {})",
-        s.mix.name, b.name, b.device, b.package
-    );
-    for (bit, dir) in &bits {
-        let pin = match b.pins.get(bit) {
-            Some(x) => x.as_str(),
-            None => match pool.next() {
-                Some(x) => x.as_str(),
-                None => {
-                    return Err(err(format!(
-                        "no pin for `{bit}`: [pins] does not name it and the [pool] is exhausted ({} port bits)",
-                        bits.len()
-                    )))
-                }
-            },
-        };
-        if used.contains(&pin) {
-            return Err(err(format!("pin {pin} is assigned twice")));
-        }
-        used.push(pin);
-        let _ = writeln!(
-            t,
-            "set_io {} {pin}    # {}",
-            pnr_name(&bits, bit),
-            dir.verilog()
-        );
-    }
-    Ok(t)
 }
 
 #[cfg(test)]

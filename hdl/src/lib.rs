@@ -5,7 +5,8 @@
 //! rust-hdl stays behind this API: nothing public here names a rust-hdl type.
 //!
 //! - [`emit`] / [`Emitted`]: `slotforge_top.v`, `ports.json`, `slots.hex` (the LUT), `slot_rom.hex` (the ROM image),
-//!   `slotforge.pcf`, `slotforge.sdc`, `slotforge.xdc`;
+//!   `slotforge.pcf` (or a board's `.lpf` / `.cst`), `slotforge.sdc`, `slotforge.xdc`, and `slotforge_top.core` (FuseSoC CAPI2);
+//! - [`Board`] / [`stock_board`]: board files (`constraints/*.toml`), one per FPGA part;
 //! - [`RtlSim`] / [`Pins`]: cycle-accurate simulation of the same blocks;
 //! - [`stock_simulation_cycles`] / [`StockRun`]: the same blocks under
 //!   rust-hdl's stock threaded `Simulation` engine (the reference that
@@ -15,9 +16,11 @@
 //! The cycle-level behaviour is `docs/timing.md`; the design choices are in
 //! `hdl/DESIGN.md`.
 
+mod board;
 mod core;
 mod emit;
 mod fault;
+mod fusesoc;
 mod header;
 mod link;
 mod names;
@@ -27,8 +30,10 @@ mod sim;
 mod stock;
 mod widths;
 
-pub use emit::{emit, emit_with, verilog_pair, Board, Emitted, MANIFEST_FILE, VERILOG_FILE};
+pub use board::{stock_board, Board};
+pub use emit::{emit, emit_with, verilog_pair, Emitted, MANIFEST_FILE, VERILOG_FILE};
 pub use fault::GatewareFault;
+pub use fusesoc::{vlnv, CORE_FILE};
 pub use plan::{
     LutForm, FULL_LUT_MAX_BITS, MAX_FRAME_SLOTS, MAX_SCLK_DIV, MAX_SLICES_PER_FRAME,
     MAX_SLOTS_PER_SLICE, MAX_SLOT_CYCLES,

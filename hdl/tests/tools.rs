@@ -206,6 +206,7 @@ fn emission_is_deterministic() {
             "slotforge.pcf",
             "slotforge.sdc",
             "slotforge.xdc",
+            "slotforge_top.core",
             "slotforge_top.v",
             "slots.hex"
         ]

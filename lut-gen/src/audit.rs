@@ -12,7 +12,10 @@ use crate::parts::cycles_to_ns;
 use crate::schedule::{Placement, Schedule};
 use crate::synth::Infeasible;
 
+mod modes;
 mod text;
+
+pub use modes::{ModeAudit, ModeBranch, ModeChannel, ModeLink, TriggerAudit};
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AuditReport {
@@ -56,6 +59,15 @@ pub struct AuditReport {
     pub fixes: Option<Vec<crate::fixes::Fix>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fixes_tried: Option<usize>,
+    /// A mix with modes (the figures above are the reset mode's): how the
+    /// mode is selected, every mode's table, and each trigger's worst
+    /// reaction. Absent for a mix without modes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mode_select: Option<crate::mix::ModeSelect>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub modes: Vec<ModeAudit>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub triggers: Vec<TriggerAudit>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -240,6 +252,8 @@ impl AuditReport {
         let mut rates: Vec<u64> = mix.channels.iter().map(|c| c.rate_hz).collect();
         rates.sort_unstable();
         rates.dedup();
+        // (0: a channel the mode does not sample, no headroom to give)
+        rates.retain(|&r| r > 0);
         let finer = FinerGrids::of(s);
         let branches: Vec<BranchAudit> = (0..nb)
             .map(|b| BranchAudit::of(s, b, &branch_slots[b], &rates, &finer))
@@ -257,7 +271,7 @@ impl AuditReport {
                 None
             }
         };
-        AuditReport {
+        let mut report = AuditReport {
             mix: mix.name.clone(),
             feasible: errors.is_empty(),
             verdict: None,
@@ -287,7 +301,12 @@ impl AuditReport {
             channels,
             fixes: None,
             fixes_tried: None,
-        }
+            mode_select: None,
+            modes: Vec::new(),
+            triggers: Vec::new(),
+        };
+        report.add_modes(s);
+        report
     }
 
     /// The report of a mix with no schedule: the diagnosis becomes `errors`.
@@ -370,6 +389,9 @@ impl AuditReport {
             link: None,
             fixes: None,
             fixes_tried: None,
+            mode_select: None,
+            modes: Vec::new(),
+            triggers: Vec::new(),
         }
     }
 
@@ -416,14 +438,19 @@ impl ChannelAudit {
         let settle_cycles = settle_cycles(s, &slots, &branch_slots[ch.branch]);
         let settle_available_ns = cycles_to_ns(settle_cycles, g.clock_hz);
         let required = mix.branches[ch.branch].settle_ns;
-        if settle_available_ns < required as f64 {
+        // A channel its mode does not sample (rate 0) has no instant to settle for.
+        if n > 0 && settle_available_ns < required as f64 {
             errors.push(format!(
                 "`{}`: mux settles for {:.0} ns before a sampling instant, {} ns required",
                 ch.name, settle_available_ns, required
             ));
         }
         let nyquist = ch.rate_hz as f64 / 2.0;
-        let alias = nyquist_check(ch, nyquist, warnings);
+        let alias = if ch.rate_hz > 0 {
+            nyquist_check(ch, nyquist, warnings)
+        } else {
+            None
+        };
         if hi != lo || lo != s.channels[c].interval_cycles {
             errors.push(format!(
                 "`{}`: intervals {lo}..{hi} cycles, {} promised",
@@ -710,7 +737,7 @@ impl FinerGrids {
             .map(|b| {
                 mix.channels
                     .iter()
-                    .filter(|c| c.branch == b)
+                    .filter(|c| c.branch == b && c.rate_hz > 0)
                     .map(|c| mix.samples_per_frame(c.rate_hz))
                     .collect()
             })

@@ -17,6 +17,9 @@ use serde::Serialize;
 use crate::mix::{LinkKind, LinkSpec};
 use crate::schedule::Schedule;
 
+mod switch;
+pub use switch::{merged_run, switch_backlog, SwitchFifo};
+
 /// The most tokens the gateware's FIFO holds.
 pub const MAX_FIFO_DEPTH: usize = 1024;
 /// Frames the backlog measurement may run before it calls the stream
@@ -57,6 +60,14 @@ pub struct LinkPlan {
     /// The line the transmitter drives (UART or AXIS).
     #[serde(skip)]
     pub line: Line,
+    /// A mix with modes: the mode whose frame carries the most bytes (the
+    /// figures above are its, but `fifo_depth`, `latency_*` and `min_baud`
+    /// are the worst of every mode and switch), and the FIFO across each
+    /// switch between two modes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub worst_mode: Option<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub switches: Vec<SwitchFifo>,
 }
 
 /// Why the link cannot carry the mix.
@@ -127,10 +138,18 @@ impl LinkPlan {
 /// The mix's link plan; `None` without `[link]`.
 pub fn plan(s: &Schedule) -> Option<Result<LinkPlan, LinkInfeasible>> {
     let spec = s.mix.link?;
-    Some(match spec.kind {
-        LinkKind::Uart => plan_spec(s, &spec),
-        LinkKind::Axis => plan_axis(s, &spec),
+    Some(match s.modes.is_empty() {
+        true => plan_one(s, &spec),
+        false => switch::plan_modes(s, &spec),
     })
+}
+
+/// One schedule's link (a mix without modes, or one mode).
+fn plan_one(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> {
+    match spec.kind {
+        LinkKind::Uart => plan_spec(s, spec),
+        LinkKind::Axis => plan_axis(s, spec),
+    }
 }
 
 fn axis_of(spec: &LinkSpec, ready_within: u32) -> Line {
@@ -188,6 +207,8 @@ fn plan_axis(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> 
         ready_within: Some(n),
         max_ready_within: max_n,
         line: axis_of(spec, n),
+        worst_mode: None,
+        switches: Vec::new(),
     })
 }
 
@@ -248,6 +269,8 @@ fn plan_spec(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> 
         ready_within: None,
         max_ready_within: None,
         line: Line::Uart(uart),
+        worst_mode: None,
+        switches: Vec::new(),
     })
 }
 

@@ -6,13 +6,16 @@
 //! - `validate`: an independent proof of a schedule's promises;
 //! - [`lut`]: the slot LUT as a full frame table and in compact form;
 //! - `ports`: the pin contract of `slotforge_top` (names, roles, widths, lanes, limits, `ports.json`);
+//! - `fpga`: the FPGA parts of the open families (tool and cell-model names);
 //! - `hostlink`: the link to the host planned from the schedule (divider, bytes per frame, FIFO depth, latency, minimum baud);
 //! - `oswords`: what the OS says about a user's file, in words;
 //! - `fixes`: changes that make an infeasible mix fit, each tried before it is offered;
+//! - `switching`: when a mode switch takes effect, and the worst reaction to a trigger or the pin;
 //! - `audit`: rates, intervals, headroom, settling and Nyquist, as text or JSON.
 
 mod audit;
 mod fixes;
+mod fpga;
 mod hostlink;
 // A public namespace, not an export list: the slot table's three file forms
 // (`lut::to_hex`, `lut::to_csv`, `lut::to_markdown`) and its compact form
@@ -23,12 +26,14 @@ mod oswords;
 mod parts;
 mod ports;
 mod schedule;
+mod switching;
 mod synth;
 mod validate;
 
 // The mix and its parts.
 pub use mix::{
-    load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError, MAX_BAUD_ERROR_PCT,
+    load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError, ModeSelect, Modes,
+    Trigger, When, MAX_BAUD_ERROR_PCT,
 };
 pub use parts::{ns_to_cycles, AdcPart, MuxPart, SpiTiming, Start, TimingError};
 
@@ -41,8 +46,14 @@ pub use synth::{
 };
 pub use validate::validate;
 
+// Modes: when a switch takes effect, and how long a reaction takes.
+pub use switching::{first_instant, pin_latency, trigger_latency, TriggerLatency};
+
 // The audit, and the fixes offered for an infeasible mix.
-pub use audit::{AuditReport, BranchAudit, ChannelAudit, FinerGrid, Headroom, Limit, PartAudit};
+pub use audit::{
+    AuditReport, BranchAudit, ChannelAudit, FinerGrid, Headroom, Limit, ModeAudit, ModeBranch,
+    ModeChannel, ModeLink, PartAudit, TriggerAudit,
+};
 pub use fixes::{
     search as search_fixes, search_link as search_fixes_link,
     search_unloadable as search_fixes_unloadable, Change, Fix, FixSearch,
@@ -51,12 +62,18 @@ pub use fixes::{
 // The pin contract of `slotforge_top`. `limits` stays a namespace: its
 // `MAX_*` are the contract's, apart from the gateware's own (`hdl::MAX_*`).
 pub use ports::{
-    limits, manifest, Dir, Layout, LinkPort, Pins, Port, Role, Signal, AXIS_PORTS, LINK_PORTS,
-    MUX_SELECT_BITS, PORTS, PORT_NAMES, SAMPLE_VALUE_BITS, TOP_MODULE,
+    limits, manifest, Dir, Layout, LinkPort, ModePort, Pins, Port, Role, Signal, AXIS_PORTS,
+    LINK_PORTS, MODE_PORTS, MUX_SELECT_BITS, PORTS, PORT_NAMES, SAMPLE_VALUE_BITS, TOP_MODULE,
 };
 
+// The FPGA parts slotforge synthesizes for.
+pub use fpga::{Constraints, Family, Fpga};
+
 // The link to the host, planned from the schedule.
-pub use hostlink::{merged_frame, plan as plan_link, LinkInfeasible, LinkPlan, PacketInstants};
+pub use hostlink::{
+    merged_frame, merged_run, plan as plan_link, switch_backlog, LinkInfeasible, LinkPlan,
+    PacketInstants, SwitchFifo,
+};
 
 // What the OS says about a user's file, in words.
 pub use oswords::{io_words, write_words};

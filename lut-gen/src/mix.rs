@@ -19,12 +19,16 @@ mod bulk_tests;
 mod channels;
 mod check;
 mod link_table;
+mod modes;
+#[cfg(test)]
+mod modes_tests;
 mod raw;
 #[cfg(test)]
 mod tests;
 mod words;
 
 use check::Cx;
+pub use modes::{ModeSelect, Modes, Trigger, When};
 use raw::RawMix;
 pub use words::toml_words;
 
@@ -79,6 +83,10 @@ pub struct Mix {
     /// is the output.  Reported by the audit's own `link` section.
     #[serde(skip)]
     pub link: Option<LinkSpec>,
+    /// `[[mode]]`, `[modes]` and `[[trigger]]`; `None`: one mode, as every
+    /// mix before modes (docs/mix-format.md, "Modes").
+    #[serde(skip)]
+    pub modes: Option<Modes>,
 }
 
 /// `[link]`: how the samples leave the FPGA (docs/packet-format.md).
@@ -175,6 +183,10 @@ pub struct Channel {
     /// Position of its part in the branch's chain: 0 is the part whose
     /// output drives the FPGA's MISO, whose word comes out first.
     pub member: u32,
+    /// The rate in each mode (`Modes::names` order; 0: not sampled in
+    /// it); empty for a mix without modes.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rates: Vec<u64>,
 }
 
 impl Mix {
@@ -191,6 +203,23 @@ impl Mix {
     pub fn samples_per_frame(&self, rate_hz: u64) -> u64 {
         rate_hz * self.frame_us / 1_000_000
     }
+    /// Modes in the mix (1 for a mix without modes).
+    pub fn mode_count(&self) -> usize {
+        self.modes.as_ref().map_or(1, |m| m.names.len())
+    }
+
+    /// The mix as it runs in mode `m`: every channel's `rate_hz` is its
+    /// rate in that mode (0: not sampled). A mix without modes is itself.
+    pub fn in_mode(&self, m: usize) -> Mix {
+        let mut mix = self.clone();
+        for c in &mut mix.channels {
+            if let Some(&r) = c.rates.get(m) {
+                c.rate_hz = r;
+            }
+        }
+        mix
+    }
+
     pub fn branch_index(&self, name: &str) -> Option<usize> {
         self.branches.iter().position(|b| b.name == name)
     }

@@ -14,6 +14,9 @@
 
 use serde::Serialize;
 
+mod mode;
+pub use mode::{ModePort, MODE_PORTS};
+
 use crate::parts::Start;
 use crate::schedule::Schedule;
 
@@ -443,6 +446,10 @@ pub struct Layout {
     pub link: bool,
     /// The link is AXI4-Stream ([`AXIS_PORTS`]), not a UART ([`LINK_PORTS`]).
     pub axis: bool,
+    /// Bits of the mode ports ([`Layout::mode_ports`]); 0: no modes.
+    pub mode_bits: u32,
+    /// Modes chosen by the `mode_sel` pin (`select = "pin"`).
+    pub mode_pin: bool,
 }
 
 impl Layout {
@@ -499,6 +506,12 @@ impl Layout {
                 .mix
                 .link
                 .is_some_and(|l| l.kind == crate::mix::LinkKind::Axis),
+            mode_bits: s.mix.modes.as_ref().map_or(0, |m| m.select_bits()),
+            mode_pin: s
+                .mix
+                .modes
+                .as_ref()
+                .is_some_and(|m| m.select == crate::mix::ModeSelect::Pin),
         }
     }
 
@@ -791,6 +804,11 @@ pub fn manifest(s: &Schedule) -> String {
             .iter()
             .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": p.width})),
     );
+    ports.extend(
+        l.mode_ports()
+            .iter()
+            .map(|p| json!({"name": p.name, "dir": p.dir.short(), "width": l.mode_bits})),
+    );
     let mut doc = json!({
         "top": TOP_MODULE,
         "mix": s.mix.name,
@@ -806,28 +824,41 @@ pub fn manifest(s: &Schedule) -> String {
         "channels": channels,
         "ports": ports,
     });
-    if let Some(Ok(p)) = crate::hostlink::plan(s) {
-        let mut o = serde_json::Map::new();
-        o.insert("kind".into(), json!(p.kind));
-        for lp in l.link_ports() {
-            o.insert(lp.key.into(), json!(lp.name));
-        }
-        if let Some(a) = p.axis() {
-            o.insert("tlast_at".into(), json!(a.tlast.name()));
-            o.insert("ready_within".into(), json!(a.ready_within));
-        } else {
-            o.insert("baud".into(), json!(p.baud));
-            o.insert("baud_divider".into(), json!(p.baud_divider));
-            o.insert("parity".into(), json!(p.parity));
-            o.insert("stop_bits".into(), json!(p.stop_bits));
-        }
-        o.insert("fifo_depth".into(), json!(p.fifo_depth));
-        o.insert("packet_format".into(), json!("docs/packet-format.md"));
-        doc["link"] = serde_json::Value::Object(o);
+    if let Some(link) = manifest_link(s, &l) {
+        doc["link"] = link;
+    }
+    if let Some(m) = mode::manifest_mode(s, &l) {
+        doc["mode"] = m;
     }
     let mut t = serde_json::to_string_pretty(&doc).expect("json");
     t.push('\n');
     t
+}
+
+/// `ports.json`'s `"link"`: the link's ports by key and its line; `None`
+/// without a link (or with one the mix cannot use).
+fn manifest_link(s: &Schedule, l: &Layout) -> Option<serde_json::Value> {
+    use serde_json::json;
+    let Some(Ok(p)) = crate::hostlink::plan(s) else {
+        return None;
+    };
+    let mut o = serde_json::Map::new();
+    o.insert("kind".into(), json!(p.kind));
+    for lp in l.link_ports() {
+        o.insert(lp.key.into(), json!(lp.name));
+    }
+    if let Some(a) = p.axis() {
+        o.insert("tlast_at".into(), json!(a.tlast.name()));
+        o.insert("ready_within".into(), json!(a.ready_within));
+    } else {
+        o.insert("baud".into(), json!(p.baud));
+        o.insert("baud_divider".into(), json!(p.baud_divider));
+        o.insert("parity".into(), json!(p.parity));
+        o.insert("stop_bits".into(), json!(p.stop_bits));
+    }
+    o.insert("fifo_depth".into(), json!(p.fifo_depth));
+    o.insert("packet_format".into(), json!("docs/packet-format.md"));
+    Some(serde_json::Value::Object(o))
 }
 
 #[cfg(test)]

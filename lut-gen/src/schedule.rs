@@ -105,6 +105,16 @@ pub struct Schedule {
     /// (`Mix::conversion_group`); `[Some(c)]` for an unchained channel.
     #[serde(skip)]
     pub groups: Vec<Vec<Option<usize>>>,
+    /// A mix with modes: every mode's schedule by mode number (the mix's
+    /// `[[mode]]` order; `modes[0]`, the mode after reset, has this
+    /// schedule's own table), all on this schedule's `grid`; each one's `mix`
+    /// is `Mix::in_mode` without `modes` (rates of that mode, 0 for a
+    /// channel it does not sample, whose `ChannelSlots` have no samples and
+    /// no slot) and its own `modes` is empty. Empty for a mix without
+    /// modes. This schedule's `mix` is `Mix::in_mode(0)` with `modes`: the
+    /// select kind and the triggers (channels by index, levels as codes).
+    #[serde(skip)]
+    pub modes: Vec<Schedule>,
 }
 
 impl Schedule {
@@ -201,11 +211,19 @@ impl Schedule {
     /// by `strobe` (or the channel does not exist).
     pub fn sampled_at(&self, channel: usize, strobe: u64) -> Option<u64> {
         let ch = self.channels.get(channel)?;
+        if ch.samples_per_frame == 0 {
+            return None;
+        }
         let branch = self.mix.channels[channel].branch;
         let first = ch.offset_slot * self.grid.slot_cycles;
         let last = strobe.checked_sub(self.branches[branch].spi.read_cycles + 1)?;
         let n = last.checked_sub(first)? / ch.interval_cycles.max(1);
         Some(first + n * ch.interval_cycles)
+    }
+
+    /// The mix's modes (select kind, names, triggers), if it has any.
+    pub fn mode_plan(&self) -> Option<&crate::mix::Modes> {
+        self.mix.modes.as_ref()
     }
 
     /// Samples converted per frame by all branches.

@@ -19,7 +19,18 @@ use crate::mix::Mix;
 use crate::parts::{ns_to_cycles, SpiTiming};
 use crate::schedule::{BranchPlan, ChannelSlots, FrameGrid, Placement, Schedule};
 
+mod modes;
 mod search;
+
+/// The summary of a channel a mode does not sample: no slot, no interval.
+const UNSAMPLED: ChannelSlots = ChannelSlots {
+    samples_per_frame: 0,
+    period_slots: 0,
+    offset_slot: 0,
+    interval_cycles: 0,
+    device: 0,
+    select: 0,
+};
 
 /// Placements the exact search may try per slot-grid candidate.
 pub const SEARCH_BUDGET: u64 = 400_000;
@@ -191,8 +202,9 @@ fn units_of(mix: &Mix, frame_slots: u64) -> Vec<Unit> {
     let mut units: Vec<Unit> = Vec::new();
     let mut by_tag: std::collections::BTreeMap<&str, usize> = Default::default();
     for (i, c) in mix.channels.iter().enumerate() {
-        if mix.lead_of(i) != i {
-            // Read in its lead's conversion (a chain member): placed with it.
+        if mix.lead_of(i) != i || c.rate_hz == 0 {
+            // Read in its lead's conversion (a chain member): placed with
+            // it; or not sampled (in this mode).
             continue;
         }
         let period = frame_slots / mix.samples_per_frame(c.rate_hz);
@@ -302,7 +314,19 @@ pub fn synthesize(mix: &Mix) -> Result<Schedule, Infeasible> {
 /// [`synthesize`] with `budget` placements per slot grid for the exact
 /// search (`--search-limit`): a smaller budget answers sooner, and a mix
 /// whose search it cuts short is [`Verdict::Unknown`], never infeasible.
+///
+/// A mix with modes gets one grid every mode fits (the fewest slots that
+/// place them all) and a schedule per mode on it ([`Schedule::modes`]); a
+/// mode that fits no grid is diagnosed by name.
 pub fn synthesize_within(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible> {
+    match &mix.modes {
+        None => synthesize_one(mix, budget),
+        Some(_) => modes::synthesize_modes(mix, budget),
+    }
+}
+
+/// One mode (or a mix without modes): the grid and the placement.
+fn synthesize_one(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible> {
     let fail = |reasons: Vec<String>, suggestions: Vec<String>| Infeasible {
         mix: mix.name.clone(),
         verdict: Verdict::Infeasible,
@@ -318,7 +342,7 @@ pub fn synthesize_within(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible>
     let inexact: Vec<String> = mix
         .channels
         .iter()
-        .filter(|c| !mix.clock_hz.is_multiple_of(c.rate_hz))
+        .filter(|c| c.rate_hz > 0 && !mix.clock_hz.is_multiple_of(c.rate_hz))
         .map(|c| {
             format!(
                 "channel `{}`: {} Hz gives {:.3} clock cycles between samples at {} Hz; no grid makes that exact (nearest exact rates: {})",
@@ -371,7 +395,7 @@ pub fn synthesize_within(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible>
         if mix
             .channels
             .iter()
-            .any(|c| !slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
+            .any(|c| c.rate_hz > 0 && !slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
         {
             continue;
         }
@@ -417,6 +441,7 @@ fn build(
         for &c in &u.channels {
             let ch = &mix.channels[c];
             for m in mix.conversion_group(c).into_iter().flatten() {
+                // (rate 0: no unit; its zero summary is filled in below)
                 channels[m] = Some(ChannelSlots {
                     samples_per_frame: mix.samples_per_frame(ch.rate_hz),
                     period_slots: u.period,
@@ -435,10 +460,21 @@ fn build(
         mix: mix.clone(),
         grid,
         branches: plans,
-        channels: channels.into_iter().map(Option::unwrap).collect(),
+        channels: channels
+            .into_iter()
+            .zip(&mix.channels)
+            .map(|(c, ch)| {
+                c.unwrap_or(ChannelSlots {
+                    device: ch.input / 8,
+                    select: ch.input % 8,
+                    ..UNSAMPLED
+                })
+            })
+            .collect(),
         frame_table: table,
         placement,
         groups: Schedule::groups_of(mix),
+        modes: Vec::new(),
     }
 }
 
@@ -514,7 +550,7 @@ fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
     let whole = |sps: u64| {
         mix.channels
             .iter()
-            .all(|c| (k * sps).is_multiple_of(mix.samples_per_frame(c.rate_hz)))
+            .all(|c| c.rate_hz == 0 || (k * sps).is_multiple_of(mix.samples_per_frame(c.rate_hz)))
     };
     let sps = candidates
         .iter()
@@ -536,7 +572,7 @@ fn diagnose(mix: &Mix, candidates: &[u64], bound: Option<u64>) -> Infeasible {
     let not_whole: Vec<&str> = mix
         .channels
         .iter()
-        .filter(|c| !slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
+        .filter(|c| c.rate_hz > 0 && !slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
         .map(|c| c.name.as_str())
         .collect();
     if !not_whole.is_empty() {
@@ -592,7 +628,7 @@ fn periods_not_whole(mix: &Mix, dg: DiagGrid, f: &mut Findings) {
     for c in mix
         .channels
         .iter()
-        .filter(|c| !dg.slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
+        .filter(|c| c.rate_hz > 0 && !dg.slots.is_multiple_of(mix.samples_per_frame(c.rate_hz)))
     {
         f.unplaced[c.branch].push(c.name.clone());
         f.suggestions.push(format!(

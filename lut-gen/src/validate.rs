@@ -22,6 +22,7 @@ pub fn validate(s: &Schedule) -> Result<(), Vec<String>> {
         check_channel(s, c, got, &mut bad);
     }
     check_sync(s, &slots_of, &mut bad);
+    check_modes(s, &mut bad);
     if bad.is_empty() {
         Ok(())
     } else {
@@ -204,6 +205,13 @@ fn check_channel(s: &Schedule, c: usize, got: &[u64], bad: &mut Vec<String>) {
         ));
         return;
     }
+    if want == 0 {
+        // Not sampled (in this mode): no slot, and a summary that says so.
+        if s.channels.get(c).is_none_or(|cs| cs.samples_per_frame != 0) {
+            bad.push(format!("`{}`: summary of an unsampled channel", ch.name));
+        }
+        return;
+    }
     if !mix.clock_hz.is_multiple_of(ch.rate_hz) {
         bad.push(format!("`{}`: clock/rate is not whole", ch.name));
         return;
@@ -262,6 +270,46 @@ fn check_sync(s: &Schedule, slots_of: &[Vec<u64>], bad: &mut Vec<String>) {
                     mix.channels[w[0]].name, mix.channels[w[1]].name
                 ));
             }
+        }
+    }
+}
+
+/// A mix with modes: one schedule per mode, each valid on its own, all on
+/// this schedule's grid (a switch changes tables at a frame start, never
+/// the grid), the first being this schedule's own table.
+fn check_modes(s: &Schedule, bad: &mut Vec<String>) {
+    let want = s.mix.modes.as_ref().map_or(0, |m| m.names.len());
+    if s.modes.len() != want {
+        bad.push(format!("{} mode schedules for {want} modes", s.modes.len()));
+        return;
+    }
+    for (m, ms) in s.modes.iter().enumerate() {
+        let name = &s.mix.modes.as_ref().unwrap().names[m];
+        if ms.grid != s.grid {
+            bad.push(format!(
+                "mode `{name}`: its slot grid differs from the reset mode's"
+            ));
+        }
+        for ch in &ms.mix.channels {
+            if ch.rates.get(m) != Some(&ch.rate_hz) {
+                bad.push(format!(
+                    "mode `{name}`: `{}` is not at its rate in the mode",
+                    ch.name
+                ));
+            }
+        }
+        if !ms.modes.is_empty() {
+            bad.push(format!(
+                "mode `{name}`: a mode's schedule has modes of its own"
+            ));
+        }
+        if let Err(more) = validate(ms) {
+            bad.extend(more.into_iter().map(|p| format!("mode `{name}`: {p}")));
+        }
+    }
+    if let Some(first) = s.modes.first() {
+        if first.frame_table != s.frame_table || first.channels != s.channels {
+            bad.push("the reset mode's schedule is not the schedule's own table".into());
         }
     }
 }

@@ -2,7 +2,11 @@
 //! returned as a `report::Section` (text, tables, charts with their CSV)
 //! and a one-line summary, so the CLI only calls and writes.
 //!
-//! - `synth`: the one yosys + nextpnr-ice40 flow (also `hdl/synth.sh`);
+//! - `netlist`: a family's gate-level netlist with its cell models, one
+//!   file for `sim --netlist` and `prove --netlist`;
+//! - `synth`: the yosys + nextpnr flow of each FPGA part (also `hdl/synth.sh`);
+//! - `yosys`: yosys for a part (JSON, gate-level netlist, cell models) and
+//!   where the flows' programs are (PATH or `.venv/`);
 //! - `figure7`: the paper's Figure 7 for the mix's own rates (`dft`);
 //! - `timing`: a steady-state slice's timing diagram and WaveDrom JSON;
 //! - `speed`: speed against accuracy (`MethodScore`);
@@ -16,12 +20,14 @@
 mod budget;
 mod dft;
 mod figure7;
+mod netlist;
 mod proof;
 mod schedulability;
 mod speed;
 mod synth;
 mod tables;
 mod timing;
+mod yosys;
 
 // Each measurement: a report section and its one-line summary.
 pub use figure7::figure7;
@@ -30,10 +36,18 @@ pub use schedulability::schedulability;
 pub use speed::{speed, CleanRun};
 pub use timing::timing;
 
-// The place-and-route flow on its own (also `hdl/synth.sh`).
+// The netlist yosys writes for a family, with its cell models (`sim
+// --netlist`, `prove --netlist`).
+pub use netlist::{netlist, Netlist, NETLIST_SIM_FILE};
+
+// The place-and-route flow on its own (also `hdl/synth.sh`), for each
+// FPGA part; yosys for a part (the synthesized JSON, the gate-level netlist
+// and the family's cell models, for `sim --netlist`).
 pub use synth::{
-    anchor, median_fmax, place_and_route, place_and_route_seeds, Anchor, Synth, HAND_ANCHORS,
+    anchor, median_fmax, place_and_route, place_and_route_for, place_and_route_seeds, Anchor,
+    Synth, HAND_ANCHORS,
 };
+pub use yosys::{find_program, synthesize_for, Synthesized, NETLIST_FILE, SYNTH_JSON};
 
 // The report's tables: the audit's budgets, the slot table, the intervals
 // measured and the fault campaign.

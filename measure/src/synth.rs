@@ -6,18 +6,29 @@
 use std::path::Path;
 
 use judge::tools::Tool;
+use lut_gen::{Family, Fpga};
 
-/// What place and route reported.
+use crate::yosys::{find_program, synthesize_for, Synthesized, SYNTH_JSON};
+
+/// What synthesis and place and route reported for one part.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Synth {
-    /// Logic cells placed (`ICESTORM_LC`).
+    pub fpga: Fpga,
+    /// Logic cells placed: nextpnr's `ICESTORM_LC` (iCE40), `TRELLIS_COMB`
+    /// (ECP5; half a slice), `LUT4` (Gowin: the LUTs placed, the router's
+    /// pass-through ones included), all from nextpnr's `--report`.
     pub lcs: u64,
-    /// `SB_LUT4` and flip-flops (`SB_DFF*`) from yosys' `stat`.
+    /// LUTs (`SB_LUT4`, `LUT4`, Gowin's `LUT1`-`LUT4`) and flip-flops
+    /// (`SB_DFF*`, `TRELLIS_FF`, Gowin's `DFF*`) from yosys' `stat`.
     pub lut4: u64,
     pub dff: u64,
-    /// Block RAMs (`ICESTORM_RAM`).
+    /// Block RAMs placed (`ICESTORM_RAM`, `DP16KD`, Gowin's `BSRAM`).
+    /// `fmax_mhz`: the report's achieved Fmax of `clk`.
     pub brams: u64,
     pub fmax_mhz: f64,
+    /// nextpnr's utilization (its report), the cells used: the family's own
+    /// names, `(cell, used, available)`.
+    pub cells: Vec<(String, u64, u64)>,
 }
 
 /// yosys `synth_ice40` then nextpnr-ice40 (placement seed `seed`) on
@@ -31,8 +42,21 @@ pub fn place_and_route(
     clock_hz: u64,
     seed: u64,
 ) -> Result<Synth, String> {
-    synthesize(dir)?;
-    place(dir, pcf, clock_hz, seed, "")
+    place_and_route_for(Fpga::Ice40Hx8k, dir, pcf, clock_hz, seed)
+}
+
+/// [`place_and_route`] for any part: its yosys (`crate::synthesize_for`)
+/// and its nextpnr with the constraint file `constraints` of its family.
+/// Gowin's nextpnr places no port without a pin: it needs the file.
+pub fn place_and_route_for(
+    fpga: Fpga,
+    dir: &Path,
+    constraints: Option<&Path>,
+    clock_hz: u64,
+    seed: u64,
+) -> Result<Synth, String> {
+    let y = synthesize_for(fpga, dir)?;
+    place(&y, dir, constraints, clock_hz, seed, "")
 }
 
 /// The same flow with yosys once and nextpnr once per seed (logs
@@ -43,10 +67,10 @@ pub fn place_and_route_seeds(
     clock_hz: u64,
     seeds: &[u64],
 ) -> Result<Vec<Synth>, String> {
-    synthesize(dir)?;
+    let y = synthesize_for(Fpga::Ice40Hx8k, dir)?;
     seeds
         .iter()
-        .map(|&s| place(dir, pcf, clock_hz, s, &format!("-{s}")))
+        .map(|&s| place(&y, dir, pcf, clock_hz, s, &format!("-{s}")))
         .collect()
 }
 
@@ -103,120 +127,168 @@ pub fn anchor(name: &str) -> Option<&'static Anchor> {
     HAND_ANCHORS.iter().find(|a| a.mix == name)
 }
 
-/// yosys `synth_ice40` on `dir/slotforge_top.v` (`yosys.log`, `stat.txt`,
-/// `slotforge.json` in `dir`).
-fn synthesize(dir: &Path) -> Result<(), String> {
-    let y = Tool::new("yosys")
-        .current_dir(dir)
-        .args(["-q", "-l", "yosys.log", "-p"])
-        .arg(format!(
-            "read_verilog {}; synth_ice40 -top {} -json slotforge.json; check -assert; tee -q -o stat.txt stat",
-            hdl::VERILOG_FILE,
-            lut_gen::TOP_MODULE,
-        ))
-        .run()
-        .map_err(|e| format!("yosys could not be started: {e}"))?;
-    if !y.success {
-        return Err(format!(
-            "yosys failed (see {}):\n{}",
-            dir.join("yosys.log").display(),
-            y.stderr
-        ));
+/// The constraint file as nextpnr is given it: a YoWASP nextpnr sees only
+/// its working folder, so the file is copied in and named relative to it;
+/// a native one takes it where it is (hdl/synth.sh passes a path of its own).
+fn constraint_arg(fpga: Fpga, dir: &Path, file: &Path) -> Result<String, String> {
+    let (program, _) = fpga.nextpnr();
+    if !program.starts_with("yowasp") {
+        let abs = std::path::absolute(file).map_err(|e| format!("{}: {e}", file.display()))?;
+        return Ok(abs.to_string_lossy().into_owned());
     }
-    Ok(())
+    let name = file
+        .file_name()
+        .ok_or(format!("{}: not a file", file.display()))?;
+    let inside = dir.join(name);
+    if std::path::absolute(&inside).ok() != std::path::absolute(file).ok() {
+        std::fs::copy(file, &inside).map_err(|e| format!("{}: {e}", file.display()))?;
+    }
+    Ok(name.to_string_lossy().into_owned())
 }
 
-/// nextpnr-ice40 at `seed` on `dir/slotforge.json`; its log is
-/// `nextpnr<tag>.log`.
+/// nextpnr of `y`'s part at `seed` on `dir/slotforge.json`; its log is
+/// `nextpnr<tag>.log`, its report `report<tag>.json`.
 fn place(
+    y: &Synthesized,
     dir: &Path,
-    pcf: Option<&Path>,
+    constraints: Option<&Path>,
     clock_hz: u64,
     seed: u64,
     tag: &str,
 ) -> Result<Synth, String> {
-    let n = Tool::new("nextpnr-ice40")
+    let fpga = y.fpga;
+    let (program, part) = fpga.nextpnr();
+    let mut args: Vec<String> = part.iter().map(|a| a.to_string()).collect();
+    args.extend([
+        "--json".into(),
+        SYNTH_JSON.into(),
+        "--seed".into(),
+        seed.to_string(),
+    ]);
+    args.extend(["--report".into(), format!("report{tag}.json")]);
+    args.extend(["--freq".into(), format!("{}", clock_hz as f64 / 1e6)]);
+    if fpga == Fpga::Ice40Hx8k {
+        // the placed design, for icepack (hdl/synth.sh's bitstream)
+        args.extend(["--asc".into(), format!("slotforge{tag}.asc")]);
+    }
+    match constraints {
+        Some(p) => args.extend(
+            fpga.family()
+                .constraints()
+                .nextpnr_args(&constraint_arg(fpga, dir, p)?),
+        ),
+        None if fpga == Fpga::Ice40Hx8k => args.push("--pcf-allow-unconstrained".into()),
+        None => {}
+    }
+    let n = Tool::new(&find_program(program)?.to_string_lossy())
         .current_dir(dir)
-        .args(["--hx8k", "--package", "ct256", "--json", "slotforge.json"])
-        .arg("--seed")
-        .arg(seed.to_string())
-        .arg("--asc")
-        .arg(format!("slotforge{tag}.asc"))
-        .arg("--report")
-        .arg(format!("report{tag}.json"))
-        .arg("--freq")
-        .arg(format!("{}", clock_hz as f64 / 1e6));
-    let n = match pcf {
-        // nextpnr runs in `dir`: a relative path is the caller's, so it
-        // goes absolute first (hdl/synth.sh passes target/synth/<mix>/...)
-        Some(p) => n
-            .arg("--pcf")
-            .arg(std::path::absolute(p).map_err(|e| format!("{}: {e}", p.display()))?),
-        None => n.arg("--pcf-allow-unconstrained"),
-    };
-    let n = n
+        .args(&args)
         .run()
-        .map_err(|e| format!("nextpnr-ice40 could not be started: {e}"))?;
+        .map_err(|e| format!("{program} could not be started: {e}"))?;
     let log = format!("{}{}", n.stdout, n.stderr);
     let log_file = dir.join(format!("nextpnr{tag}.log"));
     let _ = std::fs::write(&log_file, &log);
     if !n.success {
         let tail: Vec<&str> = log.lines().rev().take(20).collect();
         return Err(format!(
-            "nextpnr-ice40 failed (see {}):\n{}",
+            "{program} failed (see {}):\n{}",
             log_file.display(),
             tail.into_iter().rev().collect::<Vec<_>>().join("\n")
         ));
     }
-    let stat = std::fs::read_to_string(dir.join("stat.txt")).unwrap_or_default();
-    parse(&log, &stat).map_err(|e| format!("{}: {e}", log_file.display()))
+    // the report is the placed and routed design's (the log's utilisation
+    // table is printed before routing adds Gowin's route-through LUTs)
+    let report = dir.join(format!("report{tag}.json"));
+    let text =
+        std::fs::read_to_string(&report).map_err(|e| format!("{}: {e}", report.display()))?;
+    parse(fpga, &text, &y.cells).map_err(|e| format!("{}: {e}", report.display()))
 }
 
-/// The figures of nextpnr's log and yosys's `stat`.  A log without the
-/// utilisation table or an Fmax is an error, never "0 logic cells".
-fn parse(log: &str, stat: &str) -> Result<Synth, String> {
-    let need = |cell: &str| {
-        used(log, cell).ok_or(format!(
-            "no `{cell}: used/available` line in nextpnr-ice40's log: it could not be parsed"
-        ))
-    };
-    Ok(Synth {
-        lcs: need("ICESTORM_LC")?,
-        brams: need("ICESTORM_RAM")?,
-        lut4: cells(stat, |c| c == "SB_LUT4"),
-        dff: cells(stat, |c| c.starts_with("SB_DFF")),
-        fmax_mhz: fmax(log).ok_or("nextpnr-ice40 reported no Fmax")?,
-    })
+/// The family's names for what the report counts: nextpnr's logic cell
+/// and block RAM, and yosys' LUT and flip-flop cells.
+struct Names {
+    logic_cell: &'static str,
+    bram: &'static str,
+    lut: fn(&str) -> bool,
+    ff: fn(&str) -> bool,
 }
 
-/// `CELL: used/available` from nextpnr's utilisation table (the last one).
-fn used(log: &str, cell: &str) -> Option<u64> {
-    let key = format!("{cell}:");
-    log.lines()
-        .filter_map(|l| Some(&l[l.find(&key)? + key.len()..]))
-        .filter_map(|r| r.trim().split('/').next()?.trim().parse().ok())
-        .next_back()
+fn names(fpga: Fpga) -> Names {
+    match fpga.family() {
+        Family::Ice40 => Names {
+            logic_cell: "ICESTORM_LC",
+            bram: "ICESTORM_RAM",
+            lut: |c| c == "SB_LUT4",
+            ff: |c| c.starts_with("SB_DFF"),
+        },
+        Family::Ecp5 => Names {
+            logic_cell: "TRELLIS_COMB",
+            bram: "DP16KD",
+            lut: |c| c == "LUT4",
+            ff: |c| c == "TRELLIS_FF",
+        },
+        Family::Gowin => Names {
+            logic_cell: "LUT4",
+            bram: "BSRAM",
+            lut: |c| matches!(c, "LUT1" | "LUT2" | "LUT3" | "LUT4"),
+            ff: |c| c.starts_with("DFF"),
+        },
+    }
 }
 
-/// The sum of yosys `stat` counts of the cells `pick` accepts (the last
-/// `stat` block only: the top module after synthesis).
-fn cells(stat: &str, pick: impl Fn(&str) -> bool) -> u64 {
-    let last = stat.rfind("Number of cells").map_or(stat, |i| &stat[i..]);
-    last.lines()
-        .filter_map(|l| {
-            let mut w = l.split_whitespace();
-            let (c, n) = (w.next()?, w.next()?);
-            pick(c).then(|| n.parse::<u64>().ok()).flatten()
+/// The figures of nextpnr's `--report` JSON and yosys's `stat`.  A report
+/// without the family's cells or an Fmax is an error, never "0 logic
+/// cells".
+fn parse(fpga: Fpga, report: &str, stat: &[(String, u64)]) -> Result<Synth, String> {
+    let n = names(fpga);
+    let (program, _) = fpga.nextpnr();
+    let v: serde_json::Value =
+        serde_json::from_str(report).map_err(|e| format!("{program}'s report: {e}"))?;
+    let table: Vec<(String, u64, u64)> = v
+        .get("utilization")
+        .and_then(|u| u.as_object())
+        .map(|u| {
+            u.iter()
+                .filter_map(|(c, x)| {
+                    Some((
+                        c.clone(),
+                        x.get("used")?.as_u64()?,
+                        x.get("available")?.as_u64()?,
+                    ))
+                })
+                .collect()
         })
-        .sum()
-}
-
-/// The last `Max frequency for clock '...': F MHz` of nextpnr's log.
-fn fmax(log: &str) -> Option<f64> {
-    log.lines()
-        .filter(|l| l.contains("Max frequency for clock"))
-        .filter_map(|l| l.rsplit("': ").next()?.split(' ').next()?.parse().ok())
-        .next_back()
+        .unwrap_or_default();
+    let need = |cell: &str| {
+        table
+            .iter()
+            .find(|(c, ..)| c == cell)
+            .map(|&(_, used, _)| used)
+            .ok_or(format!(
+                "no `{cell}` in the utilization of {program}'s report: it could not be parsed"
+            ))
+    };
+    let count = |pick: fn(&str) -> bool| -> u64 {
+        stat.iter().filter(|(c, _)| pick(c)).map(|(_, k)| k).sum()
+    };
+    // the slowest clock's (the gateware has one, `clk`)
+    let fmax = v
+        .get("fmax")
+        .and_then(|f| f.as_object())
+        .into_iter()
+        .flatten()
+        .filter_map(|(_, c)| c.get("achieved")?.as_f64())
+        .reduce(f64::min)
+        .ok_or(format!("{program} reported no Fmax"))?;
+    Ok(Synth {
+        fpga,
+        lcs: need(n.logic_cell)?,
+        brams: need(n.bram)?,
+        lut4: count(n.lut),
+        dff: count(n.ff),
+        fmax_mhz: fmax,
+        cells: table.into_iter().filter(|&(_, used, _)| used > 0).collect(),
+    })
 }
 
 #[cfg(test)]
@@ -225,21 +297,48 @@ mod tests {
 
     #[test]
     fn reads_nextpnr_and_yosys_figures() {
-        let log = "Info: Device utilisation:\nInfo:     ICESTORM_LC:   263/ 7680     3%\nInfo:    ICESTORM_RAM:     3/   32     9%\n\
-                   Info: Max frequency for clock 'clk$SB_IO_IN_$glb_clk': 98.50 MHz (PASS at 48.00 MHz)\n\
-                   Info: Max frequency for clock 'clk$SB_IO_IN_$glb_clk': 117.00 MHz (PASS at 48.00 MHz)\n";
-        assert_eq!(used(log, "ICESTORM_LC"), Some(263));
-        assert_eq!(used(log, "ICESTORM_RAM"), Some(3));
-        assert_eq!(parse(log, "").unwrap().lcs, 263);
-        assert_eq!(fmax(log), Some(117.0));
-        let stat = "   Number of cells: 9\n     SB_CARRY  4\n     SB_DFF 10\n     SB_DFFER 7\n     SB_LUT4 120\n";
-        assert_eq!(cells(stat, |c| c == "SB_LUT4"), 120);
-        assert_eq!(cells(stat, |c| c.starts_with("SB_DFF")), 17);
+        let report = r#"{"fmax": {"clk$SB_IO_IN_$glb_clk": {"achieved": 117.25, "constraint": 48}},
+            "utilization": {"ICESTORM_LC": {"available": 7680, "used": 263},
+              "ICESTORM_RAM": {"available": 32, "used": 3}, "SB_GB": {"available": 8, "used": 0}}}"#;
+        let stat: Vec<(String, u64)> = [
+            ("SB_CARRY", 4),
+            ("SB_DFF", 10),
+            ("SB_DFFER", 7),
+            ("SB_LUT4", 120),
+        ]
+        .map(|(c, n)| (c.to_string(), n))
+        .to_vec();
+        let r = parse(Fpga::Ice40Hx8k, report, &stat).unwrap();
+        assert_eq!((r.lcs, r.brams, r.lut4, r.dff), (263, 3, 120, 17));
+        assert_eq!(r.fmax_mhz, 117.25);
+        assert_eq!(
+            r.cells,
+            vec![
+                ("ICESTORM_LC".to_string(), 263, 7680),
+                ("ICESTORM_RAM".into(), 3, 32)
+            ]
+        );
+        // Gowin's names: LUT1-LUT4 are LUTs, every DFF* a flip-flop
+        let report = r#"{"fmax": {"clk": {"achieved": 133.5}},
+            "utilization": {"LUT4": {"available": 8640, "used": 220}, "BSRAM": {"available": 26, "used": 3}}}"#;
+        let stat: Vec<(String, u64)> = [
+            ("LUT1", 9),
+            ("LUT3", 50),
+            ("DFFRE", 45),
+            ("DFF", 28),
+            ("ALU", 34),
+        ]
+        .map(|(c, n)| (c.to_string(), n))
+        .to_vec();
+        let r = parse(Fpga::Gw1n9, report, &stat).unwrap();
+        assert_eq!((r.lcs, r.brams, r.lut4, r.dff), (220, 3, 59, 73));
     }
 
     #[test]
     fn median_of_seeds_is_the_middle_run() {
         let run = |f| Synth {
+            fpga: Fpga::Ice40Hx8k,
+            cells: vec![],
             lcs: 1,
             lut4: 1,
             dff: 1,
@@ -257,16 +356,20 @@ mod tests {
     }
 
     #[test]
-    fn a_log_that_cannot_be_parsed_is_an_error_not_zero_cells() {
-        // a nextpnr whose table changed its words: no utilisation line
-        let log = "Info: Device utilisation:\nInfo:     LOGIC_CELLS:   263/ 7680     3%\n\
-                   Info: Max frequency for clock 'clk': 98.50 MHz (PASS at 48.00 MHz)\n";
-        let e = parse(log, "").unwrap_err();
+    fn a_report_that_cannot_be_parsed_is_an_error_not_zero_cells() {
+        // a nextpnr whose report changed its words: no ICESTORM_LC
+        let report = r#"{"fmax": {"clk": {"achieved": 98.5}},
+            "utilization": {"LOGIC_CELLS": {"available": 7680, "used": 263}}}"#;
+        let e = parse(Fpga::Ice40Hx8k, report, &[]).unwrap_err();
         assert!(
             e.contains("ICESTORM_LC") && e.contains("could not be parsed"),
             "{e}"
         );
-        let no_fmax = "Info:     ICESTORM_LC:   263/ 7680     3%\nInfo:    ICESTORM_RAM:     3/   32     9%\n";
-        assert!(parse(no_fmax, "").unwrap_err().contains("Fmax"));
+        let no_fmax = r#"{"fmax": {}, "utilization": {"ICESTORM_LC": {"available": 7680, "used": 263},
+            "ICESTORM_RAM": {"available": 32, "used": 3}}}"#;
+        assert!(parse(Fpga::Ice40Hx8k, no_fmax, &[])
+            .unwrap_err()
+            .contains("Fmax"));
+        assert!(parse(Fpga::Ecp5_25k, "Info: not JSON", &[]).is_err());
     }
 }

@@ -51,9 +51,15 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', value_name = "STEP,...")]
     pub only: Vec<String>,
     /// Leave out these steps (comma-separated): audit, lut, verilog, sim,
-    /// golden, faults, prove, synth, timing, figure7, schedulability, speed.
+    /// golden, faults, prove, synth, netlist, timing, figure7, schedulability,
+    /// speed.
     #[arg(long, value_delimiter = ',', value_name = "STEP,...")]
     pub skip: Vec<String>,
+    /// The FPGA part of the synthesis step: ice40-hx8k (IO left
+    /// unconstrained), ecp5-25k or gw1n-9 (on their board's pins, as
+    /// `slotforge synth --fpga` places them).
+    #[arg(long, value_parser = lut_gen::Fpga::parse, default_value = "ice40-hx8k")]
+    pub fpga: lut_gen::Fpga,
     /// Also write the steps as JUnit XML (one test case per step).
     #[arg(long, value_name = "FILE")]
     pub junit: Option<PathBuf>,

@@ -124,6 +124,9 @@ pub fn run(a: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
+    if let Err(code) = super::one_mode(&s, &a.mix) {
+        return code;
+    }
     if s.mix.link.is_none() {
         eprintln!(
             "error: {}: the mix has no [link]: its samples leave on the parallel sample port, there is nothing to decode",

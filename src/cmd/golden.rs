@@ -273,6 +273,9 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
+    if let Err(code) = super::one_mode(&s, mix) {
+        return code;
+    }
     let dir = a.dir.join(&s.mix.name);
     let manifest_path = dir.join(MANIFEST);
     let manifest = match load_manifest(&manifest_path) {

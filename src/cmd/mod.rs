@@ -11,6 +11,7 @@ pub mod lut;
 pub mod progress;
 pub mod prove;
 pub mod sim;
+pub mod synth;
 pub mod verilog;
 
 use std::path::Path;
@@ -52,6 +53,12 @@ pub fn verdict_exit(v: lut_gen::Verdict) -> u8 {
         lut_gen::Verdict::Infeasible => 1,
         lut_gen::Verdict::Unknown => 3,
     }
+}
+
+/// The `--netlist`/`--fpga` value parser: a part or its family
+/// (`lut_gen::Fpga`); anything else names the known ones.
+pub fn fpga(s: &str) -> Result<lut_gen::Fpga, String> {
+    lut_gen::Fpga::parse(s)
 }
 
 /// The `--backend` value parser: the names `engines::Backend` knows.
@@ -150,7 +157,31 @@ pub fn load_checked(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8
         Limits::Emitter => schedule(path)?,
     };
     link_fits(&s, path)?;
+    one_mode(&s, path)?;
     Ok(s)
+}
+
+/// Refuses a mix with modes in every command past the plan (`audit` and
+/// `lut` plan every mode): the gateware, its simulation, proof and the
+/// host's decoder follow the reset mode only, so running them would show a
+/// design that never switches as if it were the mix.  Exit 2.
+pub fn one_mode(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
+    match &s.mix.modes {
+        Some(m) if m.names.len() > 1 => {
+            eprintln!(
+                "error: {}: the mix declares {} modes ({}): `audit` and `lut` plan every \
+                 mode, but the gateware does not switch modes yet, so this command would \
+                 show the reset mode `{}` alone; audit it, or remove the [[mode]] tables \
+                 to build one mode",
+                file.display(),
+                m.names.len(),
+                m.names.join(", "),
+                m.names[0]
+            );
+            Err(2)
+        }
+        _ => Ok(()),
+    }
 }
 
 /// [`schedule`], then the contract's limits checked ([`fits_pins`]).

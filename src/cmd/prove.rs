@@ -1,4 +1,4 @@
-//! `slotforge prove MIX [--rtl FILE.v] [--solver symbolic|abc|pdr|cvc5] [--json]`
+//! `slotforge prove MIX [--rtl FILE.v | --netlist FAMILY] [--solver symbolic|abc|pdr|cvc5] [--json]`
 //!
 //! Exit 0: every asserted property proved for all time (what the harness
 //! does not assert is listed, `not_covered`); 1: a counterexample (its VCD, `.gtkw` and
@@ -17,6 +17,11 @@ pub struct Args {
     /// Prove this Verilog (a `slotforge_top` on the port contract) instead of the emitted gateware.
     #[arg(long)]
     pub rtl: Option<PathBuf>,
+    /// Prove the gate-level netlist yosys writes for this FPGA family
+    /// (ice40, ecp5, gowin, or a part name), with the family's cell models
+    /// flattened in, under the same harness.
+    #[arg(long, value_name = "FAMILY", value_parser = super::fpga, conflicts_with = "rtl")]
+    pub netlist: Option<lut_gen::Fpga>,
     /// The engine: `symbolic` (exact symbolic simulation from reset until the state recurs a frame later, default), `abc` (ABC's bounded search to the recurrence bound + the two-copy recurrence miter), `pdr` (ABC IC3) or `cvc5` (k-induction through yosys-smtbmc).
     #[arg(long, default_value = "symbolic", value_parser = solver)]
     pub solver: Solver,
@@ -37,6 +42,30 @@ pub struct Args {
     pub json: bool,
 }
 
+/// The design to prove: `--rtl`'s file, `--netlist`'s netlist with its
+/// cell models, or the emitted Verilog; and whether it is slotforge's own.
+fn design(
+    a: &Args,
+    s: &lut_gen::Schedule,
+) -> Result<(String, bool, Option<measure::Netlist>), String> {
+    if let Some(path) = &a.rtl {
+        return engines::load_rtl(s, path)
+            .map(|t| (t, false, None))
+            .map_err(|e| e.to_string());
+    }
+    if let Some(fpga) = a.netlist {
+        let dir = tempfile::Builder::new()
+            .prefix("slotforge-netlist-")
+            .tempdir()
+            .map_err(|e| format!("--netlist: a work folder: {e}"))?;
+        let n = measure::netlist(s, fpga, dir.path())?;
+        return Ok((n.text.clone(), false, Some(n)));
+    }
+    hdl::emit(s, None)
+        .map(|e| (e.verilog().to_string(), true, None))
+        .map_err(|e| format!("{}: {e}", a.mix.display()))
+}
+
 fn solver(s: &str) -> Result<Solver, String> {
     s.parse()
 }
@@ -46,21 +75,12 @@ pub fn run(a: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let (design, own) = match &a.rtl {
-        Some(path) => match engines::load_rtl(&s, path) {
-            Ok(text) => (text, false),
-            Err(e) => {
-                eprintln!("error: {e}");
-                return 2;
-            }
-        },
-        None => match hdl::emit(&s, None) {
-            Ok(e) => (e.verilog().to_string(), true),
-            Err(e) => {
-                eprintln!("error: {}: {e}", a.mix.display());
-                return 2;
-            }
-        },
+    let (design, own, netlist) = match design(&a, &s) {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
     };
     if let Some(path) = &a.harness {
         match formal::generate(&s) {
@@ -88,6 +108,7 @@ pub fn run(a: Args) -> u8 {
     opts.bmc_timeout_s = a.timeout;
     opts.depth = a.depth;
     opts.own_design = own;
+    opts.netlist = netlist.map(|n| (n.fpga.name().to_string(), n.not_covered()));
     let proof = match formal::prove(&s, &design, &opts) {
         Ok(p) => p,
         Err(e) => {

@@ -2,7 +2,9 @@
 //!
 //! Back ends: model, rusthdl, verilator, icarus (see `engines::Backend`);
 //! `--rtl` (verilator, icarus) simulates outside Verilog whose top honours
-//! the pin contract (`engines::rtl`).
+//! the pin contract (`engines::rtl`); `--netlist FAMILY` the netlist yosys
+//! writes for an FPGA family, with its cell models, on the same path
+//! (`measure::netlist`).
 //!
 //! Exit 0: every cycle passed; 1: a divergence or violation; 2: bad input or
 //! a missing tool.
@@ -68,6 +70,12 @@ pub struct Args {
     /// its top module must honour the pin contract for the mix.
     #[arg(long, value_name = "FILE.v")]
     pub rtl: Option<PathBuf>,
+    /// Simulate the gate-level netlist yosys writes for this FPGA family
+    /// (ice40, ecp5, gowin, or a part: ice40-hx8k, ecp5-25k, gw1n-9) with the
+    /// family's cell models (verilator, icarus), under the same ADC model
+    /// and judge.
+    #[arg(long, value_name = "FAMILY", value_parser = super::fpga, conflicts_with = "rtl")]
+    pub netlist: Option<lut_gen::Fpga>,
     /// An AXI4-Stream link's slave: `always` (ready in every cycle),
     /// `random` or `random:SEED` (seeded, within the mix's
     /// `link.ready_within`), `worst` (every beat taken in its
@@ -155,6 +163,13 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
+    let netlist = match netlist_rtl(&a, &s) {
+        Ok(n) => n,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
     let opts = SimOptions {
         stimulus,
         vcd: vcd.clone().map(|path| VcdOut {
@@ -163,7 +178,10 @@ pub fn run(a: Args) -> u8 {
             to,
             gtkw: true,
         }),
-        rtl: a.rtl.clone(),
+        rtl: netlist
+            .as_ref()
+            .map(|(d, _)| d.path().join(measure::NETLIST_SIM_FILE))
+            .or_else(|| a.rtl.clone()),
         tready: a.tready,
         ..SimOptions::default()
     };
@@ -175,7 +193,12 @@ pub fn run(a: Args) -> u8 {
             .and_then(|_| judge::LinkBytes::new(&s)),
     };
     let report = match simulate(&a, &s, backend, &opts, &mut logs) {
-        Ok(r) => r,
+        Ok(mut r) => {
+            if let Some((_, f)) = &netlist {
+                r.source = format!("{}, {f} netlist", r.source);
+            }
+            r
+        }
         Err(e) => {
             eprintln!("error: {e}");
             return 2;
@@ -204,6 +227,29 @@ pub fn run(a: Args) -> u8 {
     } else {
         1
     }
+}
+
+/// `--netlist FAMILY`: yosys' netlist of the emitted gateware with the
+/// family's cell models, in a work folder that lives as long as the run.
+fn netlist_rtl(
+    a: &Args,
+    s: &lut_gen::Schedule,
+) -> Result<Option<(tempfile::TempDir, lut_gen::Fpga)>, String> {
+    let Some(fpga) = a.netlist else {
+        return Ok(None);
+    };
+    if !matches!(a.backend, Backend::Verilator | Backend::Icarus) {
+        return Err(format!(
+            "--netlist {fpga}: the netlist runs on a Verilog simulator: --backend verilator or icarus, not {}",
+            a.backend.name()
+        ));
+    }
+    let dir = tempfile::Builder::new()
+        .prefix("slotforge-netlist-")
+        .tempdir()
+        .map_err(|e| format!("--netlist: a work folder: {e}"))?;
+    measure::netlist(s, fpga, dir.path())?;
+    Ok(Some((dir, fpga)))
 }
 
 /// The VCD window's cycles `[from, to)`, refused when empty or beyond the run.

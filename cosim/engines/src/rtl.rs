@@ -217,23 +217,37 @@ pub fn check_ports(s: &Schedule, file: &Path, text: &str) -> Result<(), RtlError
             }
         }
     }
-    if let Some(x) = ports
+    no_extra_input(file, &layout, &ports)
+}
+
+/// An input or inout outside the contract would be driven by nothing; the
+/// mix's link ports (a UART's or AXI4-Stream's, `m_axis_tready` an input the
+/// testbench drives) are the contract's too. Extra outputs are ignored.
+fn no_extra_input(file: &Path, layout: &Layout, ports: &[PortDecl]) -> Result<(), RtlError> {
+    let link = layout.link_ports();
+    let contract = |n: &str| PORTS.iter().any(|p| p.name == n) || link.iter().any(|p| p.name == n);
+    let Some(x) = ports
         .iter()
-        .find(|d| !PORTS.iter().any(|p| p.name == d.name) && d.dir != Some(PortDir::Output))
-    {
-        return Err(err(
-            file,
-            Some(&x.name),
-            format!(
-                "module {TOP_MODULE}, line {}: port `{}` ({}) is not in the pin contract, and nothing would drive it (only extra outputs are allowed); contract ports: {}",
-                x.line,
-                x.name,
-                x.dir.map_or("no direction", |d| d.verilog()),
-                PORTS.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
-            ),
-        ));
-    }
-    Ok(())
+        .find(|d| !contract(&d.name) && d.dir != Some(PortDir::Output))
+    else {
+        return Ok(());
+    };
+    Err(err(
+        file,
+        Some(&x.name),
+        format!(
+            "module {TOP_MODULE}, line {}: port `{}` ({}) is not in the pin contract, and nothing would drive it (only extra outputs are allowed); contract ports: {}",
+            x.line,
+            x.name,
+            x.dir.map_or("no direction", |d| d.verilog()),
+            PORTS
+                .iter()
+                .map(|p| p.name)
+                .chain(link.iter().map(|p| p.name))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    ))
 }
 
 fn plural(n: u32) -> &'static str {

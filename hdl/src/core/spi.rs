@@ -47,16 +47,33 @@ pub struct SpiSeq {
     pub(super) indata: DFF<Bit>,
     pub(super) r_cap: DFF<Bit>,
     pub(super) r_done: DFF<Bit>,
-    wrap: Signal<Local, Bit>,
-    half: Signal<Local, Bit>,
-    k_ph_last: Constant<Bits<PH_BITS>>,
-    k_ph_half: Constant<Bits<PH_BITS>>,
+    /// Registered compares, kept in step with their counters: `ph` is at
+    /// the period's end (`f_wrap`) or its middle (`f_half`), `nfall` is not
+    /// zero (`f_nz`) or at the last period (`f_end`). The strobes' D inputs
+    /// (and the synchronous resets yosys makes of them) read these flags
+    /// instead of comparing the counters, so each is two LUT levels at most.
+    pub(super) f_wrap: DFF<Bit>,
+    pub(super) f_half: DFF<Bit>,
+    pub(super) f_nz: DFF<Bit>,
+    pub(super) f_end: DFF<Bit>,
+    init: Signal<Local, Bit>,
+    step: Signal<Local, Bit>,
+    rise: Signal<Local, Bit>,
     k_ph_start: Constant<Bits<PH_BITS>>,
     k_ph_zero: Constant<Bits<PH_BITS>>,
+    /// The phase before the period's end (its middle), modulo the
+    /// counter's width: the flag is set when the counter leaves it.
+    k_ph_pre_last: Constant<Bits<PH_BITS>>,
+    k_ph_pre_half: Constant<Bits<PH_BITS>>,
+    /// The flags' values at the start phase and at phase zero.
+    k_wrap_start: Constant<Bit>,
+    k_half_start: Constant<Bit>,
+    k_half_zero: Constant<Bit>,
+    k_nf_pre_end: Constant<Bits<NFALL_BITS>>,
     k_ph_one: Constant<Bits<PH_BITS>>,
     k_nf_zero: Constant<Bits<NFALL_BITS>>,
     k_nf_one: Constant<Bits<NFALL_BITS>>,
-    k_nf_end: Constant<Bits<NFALL_BITS>>,
+    k_end_start: Constant<Bit>,
     k_wb_first: Constant<Bits<WORD_BIT_BITS>>,
     k_wb_last: Constant<Bits<WORD_BIT_BITS>>,
     k_wb_zero: Constant<Bits<WORD_BIT_BITS>>,
@@ -82,6 +99,7 @@ impl SpiSeq {
         // wrap to sclk_div - 1, so 2^w must exceed both
         let ph_mask = mask(t.sclk_div.max(t.setup_cycles));
         let ph_mod = ph_mask + 1;
+        let ph_start = (t.sclk_div + ph_mod - t.setup_cycles) % ph_mod;
         let w = t.word_sclks;
         let in_data = |b: u64| b >= t.leading_bits && b < t.leading_bits + t.bits;
         SpiSeq {
@@ -100,16 +118,25 @@ impl SpiSeq {
             indata: Default::default(),
             r_cap: Default::default(),
             r_done: Default::default(),
-            wrap: Default::default(),
-            half: Default::default(),
-            k_ph_last: c(t.sclk_div - 1),
-            k_ph_half: c(t.sclk_half - 1),
-            k_ph_start: c((t.sclk_div + ph_mod - t.setup_cycles) % ph_mod),
+            f_wrap: Default::default(),
+            f_half: Default::default(),
+            f_nz: Default::default(),
+            f_end: Default::default(),
+            init: Default::default(),
+            step: Default::default(),
+            rise: Default::default(),
+            k_ph_start: c(ph_start),
             k_ph_zero: c(0),
+            k_ph_pre_last: c((t.sclk_div - 2) % ph_mod),
+            k_ph_pre_half: c((t.sclk_half + ph_mod - 2) % ph_mod),
+            k_wrap_start: Constant::new(ph_start == t.sclk_div - 1),
+            k_half_start: Constant::new(ph_start == t.sclk_half - 1),
+            k_half_zero: Constant::new(t.sclk_half == 1),
+            k_nf_pre_end: c(t.sclks.saturating_sub(1)),
             k_ph_one: c(1),
             k_nf_zero: c(0),
             k_nf_one: c(1),
-            k_nf_end: c(t.sclks),
+            k_end_start: Constant::new(t.sclks == 0),
             k_wb_first: c(t.first_bit()),
             k_wb_last: c(t.word_sclks - 1),
             k_wb_zero: c(0),
@@ -129,28 +156,34 @@ impl SpiSeq {
 impl Logic for SpiSeq {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, r_cs_n, r_sclk, ph, nfall, wbit, indata, r_cap, r_done);
-        self.wrap.next = self.ph.q.val() == self.k_ph_last.val();
-        self.half.next = self.ph.q.val() == self.k_ph_half.val();
+        dff_setup!(
+            self, clock, r_cs_n, r_sclk, ph, nfall, wbit, indata, r_cap, r_done, f_wrap, f_half,
+            f_nz, f_end
+        );
+        // Cycle t - 2 (`start2`), or reset (the state of cycle t - 1 for
+        // an instant t at cycle 0): a converting branch's conversion pin
+        // becomes active at the edge that begins t.
+        self.init.next = self.start2.val() | self.rst.val();
+        // The conversion runs: the phase counts. `init` overrides all of
+        // it below (a set or reset of each flip-flop, one LUT from `rst`
+        // and `start2`), so it is not in here.
+        self.step.next = !self.r_cs_n.q.val();
+        // SCLK rising edge `nfall` begins the next cycle + 1.
+        self.rise.next = self.step.val() & self.f_half.q.val() & self.f_nz.q.val();
         self.r_cap.d.next = false;
         self.r_done.d.next = false;
-        if self.start2.val() {
-            // Cycle t - 2: a converting branch's conversion pin becomes
-            // active at the edge that begins t.
-            self.r_cs_n.d.next = false;
-            self.r_sclk.d.next = self.k_sclk_idle.val();
-            self.ph.d.next = self.k_ph_start.val();
-            self.nfall.d.next = self.k_nf_zero.val();
-            self.wbit.d.next = self.k_wb_first.val();
-            self.indata.d.next = self.k_in_first.val();
-        } else if !self.r_cs_n.q.val() {
-            if self.wrap.val() {
+        if self.step.val() {
+            if self.f_wrap.q.val() {
                 self.ph.d.next = self.k_ph_zero.val();
+                self.f_wrap.d.next = false;
+                self.f_half.d.next = self.k_half_zero.val();
             } else {
                 self.ph.d.next = (self.ph.q.val() + self.k_ph_one.val()) & self.k_ph_mask.val();
+                self.f_wrap.d.next = self.ph.q.val() == self.k_ph_pre_last.val();
+                self.f_half.d.next = self.ph.q.val() == self.k_ph_pre_half.val();
             }
-            if self.wrap.val() {
-                if self.nfall.q.val() == self.k_nf_end.val() {
+            if self.f_wrap.q.val() {
+                if self.f_end.q.val() {
                     // Cycle t + R - 2: the pin is released (and SCLK back at
                     // idle) at the edge that begins t + R.
                     self.r_cs_n.d.next = true;
@@ -159,38 +192,39 @@ impl Logic for SpiSeq {
                 } else {
                     self.nfall.d.next =
                         (self.nfall.q.val() + self.k_nf_one.val()) & self.k_nf_mask.val();
+                    self.f_nz.d.next = true;
+                    self.f_end.d.next = self.nfall.q.val() == self.k_nf_pre_end.val();
                     self.r_sclk.d.next = false;
                 }
             }
-            if self.half.val() & (self.nfall.q.val() != self.k_nf_zero.val()) {
-                // SCLK rising edge `nfall` begins the next cycle + 1: capture
-                // the serial bit it reads at the end of the next cycle, if
-                // that bit is a data bit.
-                self.r_sclk.d.next = true;
-                if self.wbit.q.val() == self.k_wb_last.val() {
-                    self.wbit.d.next = self.k_wb_zero.val();
-                } else {
-                    self.wbit.d.next =
-                        (self.wbit.q.val() + self.k_wb_one.val()) & self.k_wb_mask.val();
-                }
-                if self.wbit.q.val() == self.k_wb_enter.val() {
-                    self.indata.d.next = true;
-                } else if self.wbit.q.val() == self.k_wb_leave.val() {
-                    self.indata.d.next = false;
-                }
-                if self.indata.q.val()
-                    & ((self.nfall.q.val() != self.k_nf_end.val()) | self.k_cap_last.val())
-                {
-                    self.r_cap.d.next = true;
-                }
+        }
+        if self.rise.val() {
+            // Capture the serial bit this edge reads at the end of the next
+            // cycle, if that bit is a data bit.
+            self.r_sclk.d.next = true;
+            if self.wbit.q.val() == self.k_wb_last.val() {
+                self.wbit.d.next = self.k_wb_zero.val();
+            } else {
+                self.wbit.d.next = (self.wbit.q.val() + self.k_wb_one.val()) & self.k_wb_mask.val();
+            }
+            if self.wbit.q.val() == self.k_wb_enter.val() {
+                self.indata.d.next = true;
+            } else if self.wbit.q.val() == self.k_wb_leave.val() {
+                self.indata.d.next = false;
+            }
+            if self.indata.q.val() & (!self.f_end.q.val() | self.k_cap_last.val()) {
+                self.r_cap.d.next = true;
             }
         }
-        if self.rst.val() {
-            // The state of cycle t - 1 for an instant t at cycle 0.
+        if self.init.val() {
             self.r_cs_n.d.next = false;
             self.r_sclk.d.next = self.k_sclk_idle.val();
             self.ph.d.next = self.k_ph_start.val();
+            self.f_wrap.d.next = self.k_wrap_start.val();
+            self.f_half.d.next = self.k_half_start.val();
             self.nfall.d.next = self.k_nf_zero.val();
+            self.f_nz.d.next = false;
+            self.f_end.d.next = self.k_end_start.val();
             self.wbit.d.next = self.k_wb_first.val();
             self.indata.d.next = self.k_in_first.val();
             self.r_cap.d.next = false;

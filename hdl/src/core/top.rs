@@ -111,6 +111,10 @@ impl Core {
             drive(&mut q.indata.clock, k);
             drive(&mut q.r_cap.clock, k);
             drive(&mut q.r_done.clock, k);
+            drive(&mut q.f_wrap.clock, k);
+            drive(&mut q.f_half.clock, k);
+            drive(&mut q.f_nz.clock, k);
+            drive(&mut q.f_end.clock, k);
         }
         for u in self.branches.iter_mut() {
             drive(&mut u.clock, k);

@@ -13,6 +13,7 @@ impl AuditReport {
         self.part_table(&mut o);
         self.channel_table(&mut o);
         self.link_lines(&mut o);
+        self.mode_lines(&mut o);
         self.messages(&mut o);
         o
     }
@@ -234,7 +235,8 @@ impl AuditReport {
             );
             let _ = writeln!(
                 o,
-                "link: {} words ({} bytes) per frame, stream {:.1} % busy at worst; FIFO depth {} tokens (worst-case backlog); worst latency instant -> last beat of its packet {} cycles ({:.1} us)",
+                "link{}: {} words ({} bytes) per frame, stream {:.1} % busy at worst; FIFO depth {} tokens (worst-case backlog); worst latency instant -> last beat of its packet {} cycles ({:.1} us)",
+                worst_mode(l),
                 l.words_per_frame,
                 l.bytes_per_frame,
                 l.utilization * 100.0,
@@ -256,7 +258,8 @@ impl AuditReport {
             );
             let _ = writeln!(
                 o,
-                "link: {} words ({} bytes) per frame, line {:.1} % used; FIFO depth {} tokens (worst-case backlog); worst latency instant -> last bit of its packet {} cycles ({:.1} us); minimum baud {:.0}",
+                "link{}: {} words ({} bytes) per frame, line {:.1} % used; FIFO depth {} tokens (worst-case backlog); worst latency instant -> last bit of its packet {} cycles ({:.1} us); minimum baud {:.0}",
+                worst_mode(l),
                 l.words_per_frame,
                 l.bytes_per_frame,
                 l.utilization * 100.0,
@@ -279,5 +282,13 @@ impl AuditReport {
         for e in &self.errors {
             let _ = writeln!(o, "error: {e}");
         }
+    }
+}
+
+/// With modes, the link's words and bytes are its worst mode's: say whose.
+fn worst_mode(l: &crate::hostlink::LinkPlan) -> String {
+    match &l.worst_mode {
+        Some(m) => format!(" in mode `{m}` (the most bytes per frame; FIFO, latency and minimum baud the worst of every mode and switch)"),
+        None => String::new(),
     }
 }

@@ -127,6 +127,7 @@ impl Cx<'_> {
             bandwidth_hz,
             sync,
             member,
+            rates: Vec::new(),
         })
     }
 

@@ -115,7 +115,7 @@ impl Cx<'_> {
         let decl = self.declare_channels(&raw)?;
         let mut draft = self.channels(&decl, &branches, &t)?;
         self.assign_auto_inputs(&decl, &branches, &mut draft)?;
-        let channels = draft.channels;
+        let mut channels = draft.channels;
         self.check_chain_rates(&decl, &branches, &channels)?;
         self.check_sync_groups(&decl, &branches, &channels, &draft.sync_groups)?;
         self.check_chain_sync(&decl, &channels)?;
@@ -124,6 +124,7 @@ impl Cx<'_> {
             return Err(self.at(0..0, "channel", "more than 65535 channels"));
         }
 
+        let modes = self.modes(&raw, &decl, &branches, &mut channels, &t)?;
         let link = match &raw.link {
             None => None,
             Some(l) => Some(self.link(l, t.clock_hz)?),
@@ -139,7 +140,35 @@ impl Cx<'_> {
             branches,
             channels,
             link,
+            modes,
         })
+    }
+
+    /// `[[mode]]`, `[modes]`, each channel's `rates` and the `[[trigger]]`s.
+    fn modes(
+        &self,
+        raw: &RawMix,
+        decl: &[super::bulk::Declared],
+        branches: &[Branch],
+        channels: &mut [Channel],
+        t: &Timing,
+    ) -> Result<Option<Modes>, MixError> {
+        let named = self.mode_names(raw)?;
+        let names = named.as_ref().map(|(n, _)| n.as_slice());
+        for (c, d) in channels.iter_mut().zip(decl) {
+            c.rates = self.channel_rates(d, c.rate_hz, names, t)?;
+        }
+        let Some((names, select)) = named else {
+            return Ok(None);
+        };
+        self.check_mode_rates(decl, channels, &names)?;
+        self.check_modes_sample(raw, &names, channels)?;
+        let triggers = self.triggers(raw, &names, select, branches, channels)?;
+        Ok(Some(Modes {
+            names,
+            select,
+            triggers,
+        }))
     }
 
     /// `name`: present and not blank.

@@ -17,6 +17,34 @@ pub(super) struct RawMix {
     #[serde(default)]
     pub(super) channel: Vec<Spanned<RawChannel>>,
     pub(super) link: Option<Spanned<RawLink>>,
+    #[serde(default)]
+    pub(super) mode: Vec<Spanned<RawMode>>,
+    pub(super) modes: Option<Spanned<RawModes>>,
+    #[serde(default)]
+    pub(super) trigger: Vec<Spanned<RawTrigger>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMode {
+    pub(super) name: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawModes {
+    pub(super) select: Spanned<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawTrigger {
+    pub(super) to: Spanned<String>,
+    pub(super) from: Option<Spanned<String>>,
+    pub(super) when: Spanned<String>,
+    pub(super) level: Spanned<i64>,
+    pub(super) channels: Spanned<Vec<Spanned<String>>>,
+    pub(super) for_frames: Option<Spanned<i64>>,
 }
 
 #[derive(Deserialize)]
@@ -87,4 +115,6 @@ pub(super) struct RawChannel {
     pub(super) bandwidth_hz: Option<Spanned<toml::Value>>,
     pub(super) sync: Option<Spanned<String>>,
     pub(super) member: Option<Spanned<i64>>,
+    /// `rates = { <mode> = <hz> }`: the rate in a mode, overriding `rate_hz`.
+    pub(super) rates: Option<Spanned<std::collections::BTreeMap<String, Spanned<i64>>>>,
 }

@@ -16,6 +16,7 @@ pub enum Step {
     Faults,
     Prove,
     Synth,
+    Netlist,
     Timing,
     Figure7,
     Schedulability,
@@ -23,7 +24,7 @@ pub enum Step {
 }
 
 impl Step {
-    pub const ALL: [Step; 12] = [
+    pub const ALL: [Step; 13] = [
         Step::Audit,
         Step::Lut,
         Step::Verilog,
@@ -32,6 +33,7 @@ impl Step {
         Step::Faults,
         Step::Prove,
         Step::Synth,
+        Step::Netlist,
         Step::Timing,
         Step::Figure7,
         Step::Schedulability,
@@ -49,6 +51,7 @@ impl Step {
             Step::Faults => "faults",
             Step::Prove => "prove",
             Step::Synth => "synth",
+            Step::Netlist => "netlist",
             Step::Timing => "timing",
             Step::Figure7 => "figure7",
             Step::Schedulability => "schedulability",
@@ -66,7 +69,8 @@ impl Step {
             Step::Golden => "golden comparison",
             Step::Faults => "fault campaign",
             Step::Prove => "formal proof (all time)",
-            Step::Synth => "synthesis estimate (iCE40 HX8K)",
+            Step::Synth => "synthesis estimate (yosys, nextpnr)",
+            Step::Netlist => "netlist simulated (iCE40, a frame)",
             Step::Timing => "chart: timing of a slice",
             Step::Figure7 => "chart: Figure 7 for this mix's rates",
             Step::Schedulability => "chart: where scheduling breaks",

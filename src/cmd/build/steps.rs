@@ -25,18 +25,35 @@ fn sim_backend() -> Backend {
 /// other processes, so on two cores they run beside the simulations.
 type Background = std::thread::JoinHandle<(Result<measure::Synth, String>, f64)>;
 
-fn start_synth(out: &std::path::Path, s: &Schedule) -> Option<Background> {
-    if !judge::tools::present("yosys") || !judge::tools::present("nextpnr-ice40") {
+fn start_synth(out: &std::path::Path, s: &Schedule, fpga: lut_gen::Fpga) -> Option<Background> {
+    let (pnr, _) = fpga.nextpnr();
+    if measure::find_program(fpga.yosys()).is_err() || measure::find_program(pnr).is_err() {
         return None;
     }
     let dir = out.join("synth");
-    let e = hdl::emit(s, None).ok()?;
+    // iCE40: IO left unconstrained, as the estimate always was; the other
+    // parts on their board (Gowin's nextpnr places no unconstrained port)
+    let board = (fpga != lut_gen::Fpga::Ice40Hx8k).then(|| dir.join(fpga.board().1));
     std::fs::create_dir_all(&dir).ok()?;
-    super::super::write_atomic(&dir, hdl::VERILOG_FILE, e.verilog()).ok()?;
+    if let Some(b) = &board {
+        std::fs::write(b, hdl::stock_board(fpga)).ok()?;
+    }
     let clock = s.grid.clock_hz;
+    let e = hdl::emit(s, board.as_deref());
+    if let Ok(e) = &e {
+        super::super::write_atomic(&dir, hdl::VERILOG_FILE, e.verilog()).ok()?;
+        if board.is_some() {
+            let c = fpga.family().constraints().file();
+            super::super::write_atomic(&dir, c, e.file(c)?).ok()?;
+        }
+    }
+    let constraints = board.map(|_| dir.join(fpga.family().constraints().file()));
     Some(std::thread::spawn(move || {
         let t = std::time::Instant::now();
-        let r = measure::place_and_route(&dir, None, clock, 1);
+        let r = match e {
+            Ok(_) => measure::place_and_route_for(fpga, &dir, constraints.as_deref(), clock, 1),
+            Err(e) => Err(e.to_string()),
+        };
         (r, t.elapsed().as_secs_f64())
     }))
 }
@@ -47,7 +64,7 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
     let mut clean: Vec<measure::CleanRun> = Vec::new();
     let mut campaign = None;
     let mut background = if plan.contains(&(Step::Synth, Run::Yes)) {
-        start_synth(&job.out, s)
+        start_synth(&job.out, s, a.fpga)
     } else {
         None
     };
@@ -75,7 +92,8 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
                 &mut clean,
             ),
             Step::Prove => prove(j, s, &mut clean),
-            Step::Synth => synth(j, s, background.take()),
+            Step::Synth => synth(j, s, a.fpga, background.take()),
+            Step::Netlist => netlist(j, s),
             Step::Timing => timing(j, s),
             Step::Figure7 => figure7(s),
             Step::Schedulability => {
@@ -500,13 +518,17 @@ fn proved(
     d.files(&files).section(shown.section)
 }
 
-fn synth(j: &mut Job, s: &Schedule, background: Option<Background>) -> Done {
+fn synth(j: &mut Job, s: &Schedule, fpga: lut_gen::Fpga, background: Option<Background>) -> Done {
+    let (pnr, _) = fpga.nextpnr();
     let Some(h) = background else {
         j.answer(
             Glance::Size,
-            "not measured: yosys or nextpnr-ice40 not installed",
+            format!("not measured: {} or {pnr} not installed", fpga.yosys()),
         );
-        return Done::skipped("yosys or nextpnr-ice40 not installed (make tools)");
+        return Done::skipped(format!(
+            "{} or {pnr} not installed (make tools)",
+            fpga.yosys()
+        ));
     };
     let Ok((r, secs)) = h.join() else {
         return Done::failed("place and route stopped unexpectedly", "");
@@ -525,19 +547,31 @@ fn synth(j: &mut Job, s: &Schedule, background: Option<Background>) -> Done {
             j.answer(
                 Glance::Size,
                 format!(
-                    "{} logic cells and {} block RAMs of an iCE40 HX8K; Fmax {:.1} MHz, {:.2}x the {:.1} MHz clock (yosys and nextpnr-ice40)",
+                    "{} logic cells and {} block RAMs of {}; Fmax {:.1} MHz, {:.2}x the {:.1} MHz clock ({} and {pnr})",
                     r.lcs,
                     r.brams,
+                    part_words(fpga),
                     r.fmax_mhz,
                     r.fmax_mhz * 1e6 / g.clock_hz as f64,
-                    g.clock_hz as f64 / 1e6
+                    g.clock_hz as f64 / 1e6,
+                    fpga.yosys()
                 ),
             );
+            let how = match fpga {
+                lut_gen::Fpga::Ice40Hx8k => "yosys synth_ice40 and nextpnr-ice40 --hx8k (IO left unconstrained, seed 1), the flow of hdl/synth.sh".to_string(),
+                f => format!("{} synth_{} and {pnr} (the pins of the {}, seed 1), the flow of `slotforge synth --fpga {f}`", f.yosys(), f.family(), f.board().0),
+            };
             let sec = Section {
                 title: "Synthesis estimate".into(),
-                paragraphs: vec![format!("yosys synth_ice40 and nextpnr-ice40 --hx8k (IO left unconstrained, seed 1), the flow of hdl/synth.sh: {line}; {} LUT4s and {} flip-flops.", r.lut4, r.dff)],
+                paragraphs: vec![format!(
+                    "{how}: {line}; {} LUT4s and {} flip-flops.",
+                    r.lut4, r.dff
+                )],
                 links: vec![
-                    ("synth/slotforge_top.v".into(), "the Verilog synthesized".into()),
+                    (
+                        "synth/slotforge_top.v".into(),
+                        "the Verilog synthesized".into(),
+                    ),
                     ("synth/yosys.log".into(), "yosys log".into()),
                     ("synth/stat.txt".into(), "cell counts".into()),
                     ("synth/nextpnr.log".into(), "place and route log".into()),
@@ -551,6 +585,77 @@ fn synth(j: &mut Job, s: &Schedule, background: Option<Background>) -> Done {
                 .section(sec)
         }
         Err(e) => Done::failed("place and route failed", e),
+    }
+}
+
+/// The netlist that goes to the chip: yosys' iCE40 netlist of the emitted
+/// Verilog with the cell models, one frame under the same ADC model and
+/// judge as the co-simulation (`sim --netlist ice40`); its report is
+/// `netlist.json` (as `sim --json`), the summary and section read from it.
+fn netlist(j: &mut Job, s: &Schedule) -> Done {
+    let backend = if judge::tools::present("verilator") {
+        Backend::Verilator
+    } else {
+        Backend::Icarus
+    };
+    if !judge::tools::present("yosys") || !judge::tools::present(backend.name()) {
+        return Done::skipped("yosys or a Verilog simulator not installed (make tools)");
+    }
+    let fpga = lut_gen::Fpga::Ice40Hx8k;
+    let dir = j.out.join("netlist");
+    if let Err(e) = measure::netlist(s, fpga, &dir) {
+        return Done::failed("yosys could not write the netlist", e);
+    }
+    let opts = SimOptions {
+        rtl: Some(dir.join(measure::NETLIST_SIM_FILE)),
+        ..SimOptions::default()
+    };
+    let mut r = match engines::run(s, backend, 1, &opts) {
+        Ok(r) => r,
+        Err(e) => return Done::failed(format!("{e}"), ""),
+    };
+    r.source = format!("{}, {fpga} netlist", r.source);
+    let json = serde_json::to_string_pretty(&r).expect("report");
+    let w = j.write("", &[("netlist.json", json)]);
+    let line = if r.ok {
+        format!(
+            "{}: {} frame, {} samples, every cycle equal to the model, no violation",
+            r.source, r.frames, r.samples
+        )
+    } else {
+        format!(
+            "{}: {} divergences, {} violations",
+            r.source, r.divergence_count, r.violation_count
+        )
+    };
+    let sec = Section {
+        title: "The netlist on the chip".into(),
+        paragraphs: vec![format!(
+            "yosys synth_ice40 of the emitted Verilog, written back as gate-level Verilog and simulated with yosys' iCE40 cell models under the same ADC model and checker as the co-simulation ({line}). Place and route and timing are not part of this check (the synthesis estimate's Fmax is)."
+        )],
+        links: vec![
+            (
+                format!("netlist/{}", measure::NETLIST_FILE),
+                "the netlist".into(),
+            ),
+            ("netlist.json".into(), "the check report".into()),
+        ],
+        ..Section::default()
+    };
+    let d = if r.ok {
+        Done::ok(line)
+    } else {
+        Done::failed(line, r.summary())
+    };
+    written(w, d.files(&["netlist.json"]).section(sec))
+}
+
+/// The part as the report's glance names it.
+fn part_words(fpga: lut_gen::Fpga) -> &'static str {
+    match fpga {
+        lut_gen::Fpga::Ice40Hx8k => "an iCE40 HX8K",
+        lut_gen::Fpga::Ecp5_25k => "an ECP5 LFE5U-25F",
+        lut_gen::Fpga::Gw1n9 => "a Gowin GW1NR-9",
     }
 }
 

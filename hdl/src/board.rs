@@ -1,0 +1,317 @@
+//! Board files (`constraints/*.toml`): which package pin each port bit goes
+//! to on a board, and the constraint file of the board's FPGA family that
+//! says so (iCE40 PCF, ECP5 LPF, Gowin CST).
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use lut_gen::{Constraints, Dir, Fpga, Layout, Schedule, PORTS};
+use serde::Deserialize;
+
+use crate::HdlError;
+
+/// A board file: which package pin each port bit goes to.
+///
+/// ```toml
+/// name = "..."
+/// fpga = "ice40-hx8k"    # the part: ice40-hx8k, ecp5-25k or gw1n-9 (default ice40-hx8k)
+/// device = "hx8k"        # as the vendor names it (for the reader)
+/// package = "ct256"
+/// io_type = "LVCMOS33"   # LPF/CST I/O standard (default LVCMOS33)
+/// [io_types]             # pins in a bank at another voltage
+/// "10" = "LVCMOS18"
+/// [pins]                 # explicit bits, e.g. clk = "J3", "adc_cs_n[0]" = "B6"
+/// clk = "J3"
+/// [pool]                 # remaining bits take these pins, in port-table order
+/// pins = ["A5", "A6"]
+/// ```
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Board {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    #[serde(default = "ice40", deserialize_with = "fpga")]
+    pub fpga: Fpga,
+    pub device: String,
+    pub package: String,
+    #[serde(default = "lvcmos33")]
+    pub io_type: String,
+    #[serde(default)]
+    pub io_types: BTreeMap<String, String>,
+    #[serde(default)]
+    pub pins: BTreeMap<String, String>,
+    #[serde(default)]
+    pub pool: Pool,
+}
+
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Pool {
+    #[serde(default)]
+    pub pins: Vec<String>,
+}
+
+// board files written before there were other families are iCE40 boards
+fn ice40() -> Fpga {
+    Fpga::Ice40Hx8k
+}
+
+fn lvcmos33() -> String {
+    "LVCMOS33".into()
+}
+
+fn fpga<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Fpga, D::Error> {
+    let t = String::deserialize(d)?;
+    Fpga::parse(&t).map_err(serde::de::Error::custom)
+}
+
+/// The board file slotforge ships for a part (`constraints/`), as text:
+/// `synth --fpga` places on it.
+pub fn stock_board(fpga: Fpga) -> &'static str {
+    match fpga {
+        Fpga::Ice40Hx8k => include_str!("../../constraints/ice40-hx8k-breakout.toml"),
+        Fpga::Ecp5_25k => include_str!("../../constraints/ulx3s-25f.toml"),
+        Fpga::Gw1n9 => include_str!("../../constraints/tang-nano-9k.toml"),
+    }
+}
+
+impl Board {
+    pub fn load(path: &Path) -> Result<Board, HdlError> {
+        let err = |m: String| HdlError::Board {
+            path: path.display().to_string(),
+            message: m,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| err(lut_gen::io_words(&e)))?;
+        toml::from_str(&text).map_err(|e| err(lut_gen::toml_words(&e.to_string(), "")))
+    }
+
+    /// The constraint file for this board's family: its name and text.
+    pub(crate) fn constraints(
+        &self,
+        s: &Schedule,
+        path: &Path,
+    ) -> Result<(String, String), HdlError> {
+        let placed = self.place(s, path)?;
+        let format = self.fpga.family().constraints();
+        let mut t = String::new();
+        let (c, family) = match format {
+            Constraints::Pcf => ("#", "iCE40"),
+            Constraints::Lpf => ("#", "ECP5"),
+            Constraints::Cst => ("//", "Gowin"),
+        };
+        let _ = writeln!(
+            t,
+            "{c} slotforge_top {family} pin constraints for mix \"{}\" on board \"{}\" ({} {})",
+            s.mix.name, self.name, self.device, self.package
+        );
+        let mhz = s.grid.clock_hz as f64 / 1e6;
+        for (name, pin, dir) in &placed {
+            let io = self.io_types.get(pin).unwrap_or(&self.io_type);
+            let d = dir.verilog();
+            let _ = match format {
+                Constraints::Pcf => writeln!(t, "set_io {name} {pin}    # {d}"),
+                Constraints::Lpf => writeln!(
+                    t,
+                    "LOCATE COMP \"{name}\" SITE \"{pin}\";    # {d}\nIOBUF PORT \"{name}\" IO_TYPE={io};"
+                ),
+                Constraints::Cst => writeln!(
+                    t,
+                    "IO_LOC \"{name}\" {pin};    // {d}\nIO_PORT \"{name}\" IO_TYPE={io};"
+                ),
+            };
+        }
+        if format == Constraints::Lpf {
+            let _ = writeln!(t, "FREQUENCY PORT \"clk\" {mhz} MHZ;");
+        }
+        Ok((format.file().to_string(), t))
+    }
+
+    /// Every port bit's pin: named in [pins], else the pool's next, as
+    /// `(name as place and route calls it, pin, direction)`.
+    fn place(&self, s: &Schedule, path: &Path) -> Result<Vec<(String, String, Dir)>, HdlError> {
+        let bits = Layout::new(s).bits();
+        let err = |m: String| HdlError::Board {
+            path: path.display().to_string(),
+            message: m,
+        };
+        for k in self.pins.keys() {
+            if !bits.iter().any(|(n, _)| n == k) {
+                // Pins for bits another mix has (e.g. adc_cs_n[7]) are fine; only
+                // names that can never be a port bit are errors.
+                let base = k.split('[').next().unwrap_or("");
+                if !PORTS.iter().any(|p| p.name == base) {
+                    return Err(err(format!("[pins] names `{k}`, which is not a port bit")));
+                }
+            }
+        }
+        let mut pool = self
+            .pool
+            .pins
+            .iter()
+            .filter(|x| !self.pins.values().any(|v| v == *x));
+        let have = bits
+            .iter()
+            .filter(|(b, _)| self.pins.contains_key(b))
+            .count()
+            + pool.clone().count();
+        if have < bits.len() {
+            return Err(err(format!(
+                "mix \"{}\" has {} port bits, but board \"{}\" ({}) offers {have} pins ([pins] and [pool]): \
+                 a mix with fewer branches or mux devices, a link instead of the parallel sample port, or a larger package fits",
+                s.mix.name,
+                bits.len(),
+                self.name,
+                self.fpga.part_number()
+            )));
+        }
+        let mut used: Vec<&str> = vec![];
+        let mut placed = vec![];
+        for (bit, dir) in &bits {
+            let pin = match self.pins.get(bit) {
+                Some(x) => x.as_str(),
+                None => pool.next().map(String::as_str).unwrap_or_default(),
+            };
+            if used.contains(&pin) {
+                return Err(err(format!("pin {pin} is assigned twice")));
+            }
+            used.push(pin);
+            placed.push((pnr_name(&bits, bit), pin.to_string(), *dir));
+        }
+        Ok(placed)
+    }
+}
+
+/// The name place-and-route tools give a port bit: yosys and nextpnr call
+/// the only bit of a 1-bit vector port by the port's name.
+pub(crate) fn pnr_name(bits: &[(String, Dir)], bit: &str) -> String {
+    if let Some(base) = bit.strip_suffix("[0]") {
+        let wider = format!("{base}[1]");
+        if !bits.iter().any(|(n, _)| *n == wider) {
+            return base.to_string();
+        }
+    }
+    bit.to_string()
+}
+
+/// The iCE40 PCF without a board: every port bit, pins to fill in.
+pub(crate) fn pcf_template(s: &Schedule) -> String {
+    let mut t = String::new();
+    let _ = writeln!(
+        t,
+        "# slotforge_top iCE40 pin constraints (template) for mix \"{}\"",
+        s.mix.name
+    );
+    let _ = writeln!(
+        t,
+        "# No board file was given: replace every <pin> and uncomment, or emit with a board file."
+    );
+    let bits = Layout::new(s).bits();
+    for (bit, dir) in &bits {
+        let _ = writeln!(
+            t,
+            "# set_io {} <pin>    # {}",
+            pnr_name(&bits, bit),
+            dir.verilog()
+        );
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn schedule(name: &str, text: &str) -> Schedule {
+        lut_gen::synthesize(&lut_gen::parse(Path::new(name), text).unwrap()).unwrap()
+    }
+
+    /// `(port name, pin)` of each line that places one, in the format's words.
+    fn placed(format: Constraints, text: &str) -> Vec<(String, String)> {
+        let unquote = |w: &str| w.trim_matches(|c| c == '"' || c == ';').to_string();
+        text.lines()
+            .filter_map(|l| {
+                let w: Vec<&str> = l.split_whitespace().collect();
+                match (format, w.as_slice()) {
+                    (Constraints::Pcf, ["set_io", n, p, ..]) => Some((unquote(n), unquote(p))),
+                    (Constraints::Lpf, ["LOCATE", "COMP", n, "SITE", p, ..]) => {
+                        Some((unquote(n), unquote(p)))
+                    }
+                    (Constraints::Cst, ["IO_LOC", n, p, ..]) => Some((unquote(n), unquote(p))),
+                    _ => None,
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn each_parts_board_places_every_port_bit_once_in_its_format() {
+        let mixes = [
+            schedule("eskin34.toml", include_str!("../../mixes/eskin34.toml")),
+            schedule(
+                "cnvmix2ms.toml",
+                include_str!("../../testkit/mixes/cnvmix2ms.toml"),
+            ),
+        ];
+        for s in &mixes {
+            let bits = Layout::new(s).bits();
+            for f in Fpga::ALL {
+                let b: Board = toml::from_str(stock_board(f)).unwrap();
+                assert_eq!((b.fpga, b.name.as_str()), (f, f.board().0));
+                let format = f.family().constraints();
+                let (file, text) = b.constraints(s, Path::new("board.toml")).unwrap();
+                assert_eq!(file, format.file());
+                let p = placed(format, &text);
+                assert_eq!(p.len(), bits.len(), "{f}: {text}");
+                let mut names: Vec<&str> = p.iter().map(|(n, _)| n.as_str()).collect();
+                let mut pins: Vec<&str> = p.iter().map(|(_, x)| x.as_str()).collect();
+                names.sort();
+                names.dedup();
+                pins.sort();
+                pins.dedup();
+                assert_eq!((names.len(), pins.len()), (bits.len(), bits.len()), "{f}");
+                for (n, pin) in &p {
+                    assert!(b.pins.values().chain(&b.pool.pins).any(|x| x == pin));
+                    if format != Constraints::Pcf {
+                        // each port its I/O standard, the pin's bank's
+                        let io = b.io_types.get(pin).unwrap_or(&b.io_type);
+                        assert!(text.contains(&format!("\"{n}\" IO_TYPE={io};")), "{n}");
+                    }
+                }
+                let clk = p.iter().find(|(n, _)| n == "clk").unwrap();
+                assert_eq!(Some(&clk.1), b.pins.get("clk"), "{f}");
+                if format == Constraints::Lpf {
+                    let mhz = s.grid.clock_hz as f64 / 1e6;
+                    assert!(text.contains(&format!("FREQUENCY PORT \"clk\" {mhz} MHZ;")));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_board_without_a_part_is_an_ice40_one_and_a_bad_part_is_named() {
+        let old = "name = \"b\"\ndevice = \"hx8k\"\npackage = \"ct256\"\n";
+        let b: Board = toml::from_str(old).unwrap();
+        assert_eq!(b.fpga, Fpga::Ice40Hx8k);
+        let e = toml::from_str::<Board>(&format!("{old}fpga = \"xc7a35t\"\n")).unwrap_err();
+        assert!(e.to_string().contains("xc7a35t"), "{e}");
+    }
+
+    #[test]
+    fn emit_with_a_board_writes_its_familys_file_only() {
+        let s = schedule("eskin34.toml", include_str!("../../mixes/eskin34.toml"));
+        let d = std::env::temp_dir().join(format!("slotforge-board-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        for f in Fpga::ALL {
+            let path = d.join(f.board().1);
+            std::fs::write(&path, stock_board(f)).unwrap();
+            let e = crate::emit(&s, Some(&path)).unwrap();
+            for c in [Constraints::Pcf, Constraints::Lpf, Constraints::Cst] {
+                let want = c == f.family().constraints();
+                assert_eq!(e.file(c.file()).is_some(), want, "{f} {}", c.file());
+            }
+        }
+        let _ = std::fs::remove_dir_all(&d);
+    }
+}

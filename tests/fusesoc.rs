@@ -1,0 +1,161 @@
+//! `slotforge verilog` writes a FuseSoC core (`slotforge_top.core`) beside
+//! the Verilog: FuseSoC itself reads it and runs its `lint` target
+//! (Verilator, -Wall) on an unseen random mix and on presets, copies the
+//! ROM images into its work directory, sets up every family's synthesis
+//! target, and fails the lint when the Verilog has a warning.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::common_cli::{root, slotforge};
+use crate::tools;
+
+fn emit(mix: &Path, out: &Path) {
+    let _ = std::fs::remove_dir_all(out);
+    slotforge()
+        .arg("verilog")
+        .arg(mix)
+        .arg("-o")
+        .arg(out)
+        .assert()
+        .success();
+}
+
+/// The core's VLNV, as its `name:` line says.
+fn vlnv(dir: &Path) -> String {
+    let core = std::fs::read_to_string(dir.join(hdl::CORE_FILE)).unwrap();
+    core.lines()
+        .find_map(|l| l.strip_prefix("name: "))
+        .expect("a name line")
+        .to_string()
+}
+
+/// `fusesoc run --target T` on the core in `dir` (build root beside it);
+/// `setup`: only the flow's files are written, no tool runs.
+fn fusesoc(dir: &Path, target: &str, setup: bool) -> (bool, String, PathBuf) {
+    let build = dir.with_extension("fusesoc-build");
+    let _ = std::fs::remove_dir_all(&build);
+    let mut c = Command::new("fusesoc");
+    c.arg("--cores-root").arg(dir).arg("run");
+    if setup {
+        c.arg("--setup");
+    }
+    c.arg("--build-root")
+        .arg(&build)
+        .args(["--target", target])
+        .arg(vlnv(dir));
+    let out = c.output().expect("fusesoc runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.success() && !text.contains("ERROR"), text, build)
+}
+
+/// Every file a work directory under `build` holds, by name.
+fn names_under(build: &Path) -> Vec<String> {
+    let mut v = vec![];
+    let mut stack = vec![build.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if let Some(n) = p.file_name() {
+                v.push(n.to_string_lossy().into_owned());
+            }
+        }
+    }
+    v
+}
+
+fn lint_passes(mix: &Path, tag: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("fusesoc-{tag}"));
+    emit(mix, &dir);
+    let (ok, text, build) = fusesoc(&dir, "lint", false);
+    assert!(ok, "fusesoc lint of {tag}:\n{text}");
+    // the ROM images reach the tool's work directory beside the Verilog
+    let copied = names_under(&build);
+    for rom in ["slot_rom.hex", "slots.hex"] {
+        assert!(
+            copied.iter().filter(|n| *n == rom).count() >= 2,
+            "{rom} not copied for the tool ({tag}): {copied:?}"
+        );
+    }
+    dir
+}
+
+#[test]
+fn fusesoc_lints_the_core_of_an_unseen_mix_and_of_presets() {
+    if !tools::require_tools(&["fusesoc", "verilator"]) {
+        return;
+    }
+    let tmp = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let text = campaign::random_mix(3030, &campaign::Shape::default());
+    let mix = tmp.join("fusesoc-random.toml");
+    std::fs::write(&mix, text).unwrap();
+    lint_passes(&mix, "random");
+    let dir = lint_passes(&root().join("mixes/eskin34-uart.toml"), "eskin34-uart");
+    // every family's flow accepts its target (tool options, file types)
+    for target in ["ice40", "ecp5", "gowin"] {
+        let (ok, text, build) = fusesoc(&dir, target, true);
+        assert!(ok, "fusesoc --setup --target {target}:\n{text}");
+        if target == "ice40" {
+            assert!(names_under(&build).contains(&"slotforge.pcf".to_string()));
+        }
+    }
+}
+
+/// A board of another family writes its constraint file (LPF for the
+/// ULX3S, CST for the Tang Nano 9K), and the core hands it to that family's
+/// target: FuseSoC copies it into the flow's work folder.
+#[test]
+fn a_boards_constraints_join_its_familys_target() {
+    if !tools::require_tools(&["fusesoc"]) {
+        return;
+    }
+    let tmp = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    for (board, file, target) in [
+        ("ulx3s-25f", "slotforge.lpf", "ecp5"),
+        ("tang-nano-9k", "slotforge.cst", "gowin"),
+    ] {
+        let dir = tmp.join(format!("fusesoc-{board}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        slotforge()
+            .arg("verilog")
+            .arg(root().join("testkit/mixes/tiny.toml"))
+            .arg("-o")
+            .arg(&dir)
+            .arg("--board")
+            .arg(root().join(format!("constraints/{board}.toml")))
+            .assert()
+            .success();
+        assert!(dir.join(file).is_file(), "{board} writes {file}");
+        let (ok, text, build) = fusesoc(&dir, target, true);
+        assert!(ok, "fusesoc --setup --target {target} ({board}):\n{text}");
+        assert!(names_under(&build).contains(&file.to_string()), "{board}");
+    }
+}
+
+#[test]
+fn fusesoc_lint_fails_on_a_warning_and_the_core_is_deterministic() {
+    if !tools::require_tools(&["fusesoc", "verilator"]) {
+        return;
+    }
+    let mix = root().join("testkit/mixes/tiny.toml");
+    let tmp = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let (a, b) = (tmp.join("fusesoc-tiny-a"), tmp.join("fusesoc-tiny-b"));
+    emit(&mix, &a);
+    emit(&mix, &b);
+    let core = |d: &Path| std::fs::read(d.join(hdl::CORE_FILE)).unwrap();
+    assert_eq!(core(&a), core(&b));
+    // a net nothing reads: Verilator's -Wall warns, so FuseSoC's lint fails
+    let v = a.join("slotforge_top.v");
+    let text = std::fs::read_to_string(&v).unwrap();
+    let bad = text.replacen("endmodule\n", "wire dangling_net;\nendmodule\n", 1);
+    assert_ne!(bad, text);
+    std::fs::write(&v, bad).unwrap();
+    let (ok, out, _) = fusesoc(&a, "lint", false);
+    assert!(!ok && out.contains("dangling_net"), "{out}");
+}
