@@ -549,6 +549,12 @@ impl Layout {
                 b.name, b.mux_devices
             ));
         }
+        if let Some(b) = (0..nb).find(|&b| s.has_command(b)) {
+            return Err(format!(
+                "branch {}: converter `{}` takes a command word on adc_mosi, which the gateware does not drive yet",
+                s.branches[b].name, s.mix.branches[b].adc.name
+            ));
+        }
         let total: usize = s.branches.iter().map(|b| b.mux_devices as usize).sum();
         if total > MAX_DEVICES {
             return Err(format!(
