@@ -984,8 +984,10 @@ mod tests {
         assert_eq!(l.muxed, vec![false, true, false]);
         let total: u32 = l.port_widths().iter().sum();
         assert_eq!(l.bits().len() as u32, total);
-        let mut p = Pins::default();
-        p.mosi = 0b10;
+        let p = Pins {
+            mosi: 0b10,
+            ..Pins::default()
+        };
         assert!(!l.mosi(&p, 0) && !l.mosi(&p, 1) && l.mosi(&p, 2));
         assert_eq!(Signal::Mosi(2).get(&l, &p), 1);
         assert!(!l.signals().contains(&Signal::Mosi(1)));
