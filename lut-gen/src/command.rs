@@ -121,6 +121,35 @@ mod tests {
         }
     }
 
+    /// The audit reports each commanded branch's word and pipeline from the
+    /// same part the schedule sends, in text and JSON.
+    #[test]
+    fn the_audit_names_the_word_and_the_prepared_conversions() {
+        for adc in ["mcp3208", "ad7689"] {
+            let m = parse(Path::new("cmd.toml"), &mix(adc, &[1000, 2000])).unwrap();
+            let s = synthesize(&m).unwrap();
+            let a = crate::AuditReport::of_schedule(&s);
+            let c = a.branches[0].command.as_ref().unwrap();
+            assert_eq!(c.prepared_conversions, s.prepared_conversions(0));
+            let t = a.to_text();
+            assert!(t.contains(&format!("sends {} on adc_mosi", c.template)), "{t}");
+            assert_eq!(
+                t.contains("the first 2 conversion(s) after reset are prepared"),
+                adc == "ad7689",
+                "{t}"
+            );
+            let j: serde_json::Value = serde_json::from_str(&a.to_json()).unwrap();
+            assert_eq!(j["branches"][0]["command"]["ahead"], c.ahead);
+        }
+        let plain = crate::load(Path::new(&format!(
+            "{}/../testkit/mixes/tiny.toml",
+            env!("CARGO_MANIFEST_DIR")
+        )))
+        .unwrap();
+        let j = crate::AuditReport::of_schedule(&synthesize(&plain).unwrap()).to_json();
+        assert!(!j.contains("\"command\""));
+    }
+
     #[test]
     fn listening_parts_send_nothing() {
         for name in ["tiny", "cnvmix2ms"] {

@@ -54,8 +54,8 @@ pub use switching::{first_instant, pin_latency, trigger_latency, TriggerLatency}
 
 // The audit, and the fixes offered for an infeasible mix.
 pub use audit::{
-    AuditReport, BranchAudit, ChannelAudit, FinerGrid, Headroom, Limit, ModeAudit, ModeBranch,
-    ModeChannel, ModeLink, PartAudit, TriggerAudit,
+    AuditReport, BranchAudit, ChannelAudit, CommandAudit, FinerGrid, Headroom, Limit, ModeAudit,
+    ModeBranch, ModeChannel, ModeLink, PartAudit, TriggerAudit,
 };
 pub use fixes::{
     search as search_fixes, search_link as search_fixes_link,
