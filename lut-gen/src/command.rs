@@ -132,7 +132,10 @@ mod tests {
             let c = a.branches[0].command.as_ref().unwrap();
             assert_eq!(c.prepared_conversions, s.prepared_conversions(0));
             let t = a.to_text();
-            assert!(t.contains(&format!("sends {} on adc_mosi", c.template)), "{t}");
+            assert!(
+                t.contains(&format!("sends {} on adc_mosi", c.template)),
+                "{t}"
+            );
             assert_eq!(
                 t.contains("the first 2 conversion(s) after reset are prepared"),
                 adc == "ad7689",

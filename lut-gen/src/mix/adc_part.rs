@@ -84,7 +84,7 @@ impl Cx<'_> {
             data_access_ns: self.nonneg(&p.data_access_ns, &f("data_access_ns"), 0)?,
             data_hold_ns: 0,
             chain_max: chain_max as u32,
-            command: self.adc_part_command(i, p, chain_max)?,
+            command: self.adc_part_command(i, p, chain_max, leading_bits + bits + trailing_bits)?,
         })
     }
 
@@ -95,6 +95,7 @@ impl Cx<'_> {
         i: usize,
         p: &RawAdcPart,
         chain_max: u64,
+        word_sclks: u64,
     ) -> Result<Option<Command>, MixError> {
         let f = |k: &str| format!("adc_part[{i}].{k}");
         let Some(t) = &p.command else {
@@ -124,6 +125,27 @@ impl Cx<'_> {
         }
         let c = Command::parse(t.get_ref(), ahead as u32)
             .map_err(|m| self.at(t.span(), f("command"), m))?;
+        let lead = self.nonneg(&p.leading_bits, &f("leading_bits"), 0)?;
+        if c.bits.len() as u64 > word_sclks {
+            return Err(self.at(
+                t.span(),
+                f("command"),
+                format!(
+                    "{} bits: longer than the part's {word_sclks} serial clocks per word",
+                    c.bits.len()
+                ),
+            ));
+        }
+        if ahead == 0 && c.bits.len() as u64 > lead {
+            return Err(self.at(
+                t.span(),
+                f("command"),
+                format!(
+                    "{} bits select the conversion they are sent in: the part must have at least as many leading_bits ({lead}) before its first data bit",
+                    c.bits.len()
+                ),
+            ));
+        }
         Ok(Some(c))
     }
 
