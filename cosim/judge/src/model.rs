@@ -184,6 +184,12 @@ struct BranchModel {
     leading: u64,
     /// (device, select) of each channel (indexed by channel).
     addr: Vec<(u32, u32)>,
+    /// A converter with a command word: the word each instant of `inst`
+    /// sends on `adc_mosi` (`Schedule::commands_in_frame`), the current
+    /// one, and the conversions after reset still prepared, not data.
+    words: Vec<Vec<bool>>,
+    wi: usize,
+    prepared: u32,
 }
 
 impl BranchModel {
@@ -242,6 +248,9 @@ impl BranchModel {
             bits: spi.bits,
             leading: spi.leading_bits as u64,
             addr: addr.to_vec(),
+            words: s.commands_in_frame(b).into_iter().map(|c| c.word).collect(),
+            wi: 0,
+            prepared: s.prepared_conversions(b),
         };
         m.advance_next_instant(g.frame_cycles);
         m
@@ -542,6 +551,7 @@ impl CycleModel {
                     m.t = Some(m.tn);
                     m.tch = m.tnch;
                     m.conv = settled_at_startup(m.tn, m.settle);
+                    m.wi = m.ni.checked_sub(1).unwrap_or(m.inst.len() - 1);
                     m.advance_next_instant(self.frame_cycles);
                     m.oi = 0;
                     m.word = 0;
@@ -568,7 +578,10 @@ impl CycleModel {
                             self.capture |= bit;
                         }
                     }
-                    if k == m.r && m.conv {
+                    if k == m.r && m.conv && m.prepared > 0 {
+                        // A prepared conversion: its word was never ours.
+                        m.prepared -= 1;
+                    } else if k == m.r && m.conv {
                         // Bit j of the serial stream sits at sclks-1-j of `word`.
                         self.pending |= bit;
                         let mask = (1u128 << m.bits) - 1;
@@ -597,6 +610,11 @@ impl CycleModel {
                 }
                 self.pins.cs_n = (self.pins.cs_n & !bit) | if cs { bit } else { 0 };
                 self.pins.sclk = (self.pins.sclk & !bit) | if sclk { bit } else { 0 };
+                if let Some(i) = self.layout.mosi_lo[b] {
+                    let v = Self::mosi_at(&self.br[b], c);
+                    self.pins.mosi = (self.pins.mosi & !(1 << i)) | (v as u16) << i;
+                }
+                let m = &mut self.br[b];
                 if m.tn != u64::MAX || m.t.is_some() {
                     let (dev, sel) = m.addr[ch as usize];
                     self.layout.set_mux(&mut self.pins, b, dev, sel);
@@ -605,5 +623,22 @@ impl CycleModel {
             next = next.min(self.br[b].next);
         }
         self.next_event = next;
+    }
+
+    /// `adc_mosi` of a commanded branch in cycle `c`: bit `k` of the
+    /// conversion's word through SCLK period `k + 1` (docs/timing.md,
+    /// "Command words"), else 0.
+    fn mosi_at(m: &BranchModel, c: u64) -> bool {
+        let Some(t) = m.t else { return false };
+        let k = c - t;
+        if !m.conv || k < m.su || k >= m.r {
+            return false;
+        }
+        let i = ((k - m.su) / m.d) as usize;
+        m.words
+            .get(m.wi)
+            .and_then(|w| w.get(i))
+            .copied()
+            .unwrap_or(false)
     }
 }

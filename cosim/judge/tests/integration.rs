@@ -4,6 +4,9 @@
 #[path = "capture.rs"]
 mod capture;
 
+#[path = "command.rs"]
+mod command;
+
 #[path = "fuzz_regressions.rs"]
 mod fuzz_regressions;
 
