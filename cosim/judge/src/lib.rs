@@ -46,6 +46,7 @@ mod linkjoin;
 mod linkline;
 mod lock;
 mod model;
+mod modes;
 mod rule;
 mod run;
 mod samples;
@@ -66,6 +67,7 @@ pub use adc::{Adc, Analog, Stimulus};
 pub use checker::{CheckOptions, Checker};
 pub use invariants::Invariants;
 pub use model::{CycleModel, SlotModel};
+pub use modes::ModeTrack;
 pub use rule::Rule;
 pub use verdict::{ChannelStats, Divergence, Verdict, Violation};
 
