@@ -82,6 +82,53 @@ pub struct Args {
     /// `ready_within`-th cycle, the case the FIFO depth is computed for).
     #[arg(long, default_value = "always", value_parser = parse_tready)]
     pub tready: link::ReadyPattern,
+    /// A mix with pin-selected modes: drive `mode_sel` with FRAME=MODE
+    /// requests, comma-separated (MODE a name or a number; e.g.
+    /// `--modes 3=touch,9=rest`): from the first cycle of frame FRAME on the
+    /// pin shows MODE, which by the contract runs from frame FRAME + 2.
+    /// Before the first request the pin shows 0.  --backend model only (the
+    /// gateware does not switch modes yet).
+    #[arg(long, value_name = "FRAME=MODE,...")]
+    pub modes: Option<String>,
+}
+
+/// `--modes FRAME=MODE,...` against the mix's modes.
+fn parse_modes(text: &str, s: &lut_gen::Schedule) -> Result<Vec<(u64, u8)>, String> {
+    let plan = match s.mode_plan() {
+        Some(p) if p.select == lut_gen::ModeSelect::Pin => p,
+        Some(_) => {
+            return Err(format!(
+                "--modes {text}: mix `{}` chooses its modes by triggers (select = \"auto\"), not by the mode_sel pin",
+                s.mix.name
+            ))
+        }
+        None => return Err(format!("--modes {text}: mix `{}` has no [[mode]] tables", s.mix.name)),
+    };
+    text.split(',')
+        .map(|item| {
+            let (f, m) = item.trim().split_once('=').ok_or_else(|| {
+                format!(
+                    "--modes: `{item}` is not FRAME=MODE (e.g. 3={})",
+                    plan.names[plan.names.len() - 1]
+                )
+            })?;
+            let frame: u64 = f
+                .trim()
+                .parse()
+                .map_err(|_| format!("--modes: `{item}`: `{f}` is not a frame number"))?;
+            let m = m.trim();
+            let mode = plan
+                .index(m)
+                .or_else(|| m.parse::<usize>().ok().filter(|&n| n < plan.names.len()))
+                .ok_or_else(|| {
+                    format!(
+                        "--modes: `{item}`: no mode `{m}` (the mix's modes: {})",
+                        plan.names.join(", ")
+                    )
+                })?;
+            Ok((frame, mode as u8))
+        })
+        .collect()
 }
 
 fn parse_tready(s: &str) -> Result<link::ReadyPattern, String> {
@@ -146,9 +193,21 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: --frames must be at least 1");
         return 2;
     }
-    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
+    // The model follows mode switches; the gateware does not yet.
+    let load = match backend {
+        Backend::Model => super::load_any_modes,
+        _ => super::load_checked,
+    };
+    let s = match load(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
+    };
+    let modes = match a.modes.as_deref().map(|t| parse_modes(t, &s)).transpose() {
+        Ok(m) => m.unwrap_or_default(),
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
     };
     let prepared = window(&a, &s).and_then(|(from, to)| {
         let (vcd, fst) = waveform_paths(&a)?;
@@ -183,6 +242,7 @@ pub fn run(a: Args) -> u8 {
             .map(|(d, _)| d.path().join(measure::NETLIST_SIM_FILE))
             .or_else(|| a.rtl.clone()),
         tready: a.tready,
+        modes,
         ..SimOptions::default()
     };
     let mut logs = Logs {

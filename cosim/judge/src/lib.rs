@@ -45,6 +45,7 @@ mod linkbytes;
 mod linkjoin;
 mod linkline;
 mod lock;
+mod modecheck;
 mod model;
 mod modes;
 mod rule;
@@ -74,8 +75,8 @@ pub use verdict::{ChannelStats, Divergence, Verdict, Violation};
 // Running a design (any `Dut`) against the model, with faults on its pins.
 pub use faults::{FaultyDut, PinFault};
 pub use run::{
-    reset_cycles, run_dut, run_model, run_unchecked, with_slave, AxisSlave, Dut, ModelDut,
-    Observer, RunOptions,
+    reset_cycles, run_dut, run_model, run_unchecked, with_slave, AxisSlave, Dut, ModeRequests,
+    ModelDut, Observer, RunOptions,
 };
 
 // Waveforms: VCD and FST in, VCD and GTKWave save files out, windows locked
