@@ -145,3 +145,144 @@ fn random_request_sequences_on_pin_mode_mixes() {
         }
     }
 }
+
+/// One cycle of a recorded run: `rst`, the pins, `adc_miso`.
+type Cycle = (bool, lut_gen::Pins, u64);
+
+/// A run of the model under `requests`, every cycle recorded (4 reset cycles).
+fn record(s: &Schedule, frames: u64, requests: &[(u64, u8)]) -> Vec<Cycle> {
+    use judge::Dut;
+    let mut dut = judge::ModeRequests::new(s, judge::ModelDut::new(s), requests);
+    let mut adc = Adc::new(s, Stimulus::Pattern);
+    let mut out = Vec::new();
+    let mut miso = (1u64 << s.branches.len()) - 1;
+    for _ in 0..4 {
+        let p = dut.step(true, miso);
+        miso = adc.drive(0, &p);
+        out.push((true, p, miso));
+    }
+    for c in 0..frames * s.grid.frame_cycles {
+        let p = dut.step(false, miso);
+        miso = adc.drive(c, &p);
+        out.push((false, p, miso));
+    }
+    out
+}
+
+fn judge_trace(s: &Schedule, trace: &[Cycle], model: bool) -> judge::Verdict {
+    let mut chk = judge::Checker::new(
+        s,
+        judge::CheckOptions {
+            model,
+            ..Default::default()
+        },
+    );
+    for (rst, p, miso) in trace {
+        chk.cycle(*rst, p, *miso);
+    }
+    chk.finish("trace")
+}
+
+fn first_violation(v: &judge::Verdict, rule: &str) -> Option<u64> {
+    v.violations
+        .iter()
+        .filter(|x| x.rule == rule)
+        .map(|x| x.cycle)
+        .min()
+}
+
+fn pin_schedule() -> Schedule {
+    schedule(&testkit::mix("modes-pin"))
+}
+
+#[test]
+fn a_clean_switching_run_passes_with_and_without_the_model() {
+    let s = pin_schedule();
+    let trace = record(&s, 10, &[(2, 1), (5, 0)]);
+    for model in [true, false] {
+        let v = judge_trace(&s, &trace, model);
+        assert!(v.ok, "model {model}: {}", v.summary());
+    }
+}
+
+#[test]
+fn mode_sel_altered_at_a_frame_boundary_fails_two_frames_later() {
+    let s = pin_schedule();
+    let f = s.grid.frame_cycles;
+    let trace = record(&s, 10, &[(2, 1), (5, 0)]);
+    // The request for `slow` shown from frame 2 on: withdraw it in the last
+    // cycle of frame 3, so frame 5 must run `fast` again, which the design
+    // (deciding on what it saw) does not.
+    let mut bad = trace.clone();
+    bad[4 + (4 * f - 1) as usize].1.mode_sel = 0;
+    let v = judge_trace(&s, &bad, false);
+    assert!(!v.ok);
+    assert_eq!(
+        first_violation(&v, "mode-decision"),
+        Some(5 * f),
+        "{}",
+        v.summary()
+    );
+    let v = judge_trace(&s, &bad, true);
+    assert!(!v.ok);
+    let d = v
+        .divergences
+        .iter()
+        .find(|d| d.signal == "mode")
+        .expect("mode diverges");
+    assert_eq!(d.cycle, 5 * f, "{}", v.summary());
+}
+
+#[test]
+fn a_switch_inside_a_frame_or_without_a_request_fails_at_its_cycle() {
+    let s = pin_schedule();
+    let f = s.grid.frame_cycles;
+    let trace = record(&s, 10, &[(2, 1), (5, 0)]);
+    // `mode` already shows `slow` 3 cycles before frame 4 begins
+    let mut early = trace.clone();
+    for c in 4 * f - 3..4 * f {
+        early[4 + c as usize].1.mode = 1;
+    }
+    for model in [false, true] {
+        let v = judge_trace(&s, &early, model);
+        assert_eq!(
+            first_violation(&v, "mode-switch"),
+            Some(4 * f - 3),
+            "{}",
+            v.summary()
+        );
+    }
+    // a design that ignores the request: `mode` stays `fast` (its samples
+    // then follow `fast` too, so the counts are `fast`'s)
+    let ignored = record(&s, 10, &[]);
+    let mut claimed = ignored.clone();
+    for (k, (_, p, _)) in claimed.iter_mut().enumerate().skip(4) {
+        p.mode_sel = trace[k].1.mode_sel;
+    }
+    let v = judge_trace(&s, &claimed, false);
+    assert_eq!(
+        first_violation(&v, "mode-decision"),
+        Some(4 * f),
+        "{}",
+        v.summary()
+    );
+    // and one that switches with no request: the counts of its frames are
+    // the mode it shows, but the mode is not the one decided
+    let mut unasked = record(&s, 10, &[(2, 1)]);
+    for (_, p, _) in unasked.iter_mut() {
+        p.mode_sel = 0;
+    }
+    let v = judge_trace(&s, &unasked, false);
+    assert_eq!(
+        first_violation(&v, "mode-decision"),
+        Some(4 * f),
+        "{}",
+        v.summary()
+    );
+    assert_eq!(
+        first_violation(&v, "samples-per-frame"),
+        None,
+        "{}",
+        v.summary()
+    );
+}
