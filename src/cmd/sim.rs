@@ -42,7 +42,11 @@ pub struct Args {
     /// ADC input: pattern (unique code per channel and slot), sine (a
     /// channel-specific frequency below its Nyquist limit), sine:HZ (every
     /// channel at HZ, e.g. sine:600 or sine:1.5e3; above Nyquist it aliases),
-    /// step or chirp.
+    /// step or chirp; or a scene of contact: touch:NAMES@FROM-TO presses the
+    /// named channels (names or bulk patterns, comma-separated; codes 1/32
+    /// below full scale) in frames FROM to TO (exclusive), low (1/64 of full
+    /// scale) elsewhere; stroke:NAMES@FROM-TO presses them one after the
+    /// other, each for an equal share of the interval.
     #[arg(long, default_value = "pattern")]
     pub stimulus: String,
     /// Write every sample as CSV: `cycle,sampled_s,channel,value` (cycle:
@@ -182,13 +186,14 @@ fn to_fst(
 
 pub fn run(a: Args) -> u8 {
     let backend = a.backend;
-    let stimulus: Stimulus = match a.stimulus.parse() {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
-    };
+    // a scene names channels: it is read once the mix is loaded
+    let scene = ["touch:", "stroke:"]
+        .iter()
+        .any(|p| a.stimulus.starts_with(p));
+    if let (false, Err(e)) = (scene, a.stimulus.parse::<Stimulus>()) {
+        eprintln!("error: {e}");
+        return 2;
+    }
     if a.frames == 0 {
         eprintln!("error: --frames must be at least 1");
         return 2;
@@ -201,6 +206,13 @@ pub fn run(a: Args) -> u8 {
     let s = match load(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
+    };
+    let stimulus = match Stimulus::parse_for(&a.stimulus, &s) {
+        Ok(k) => k,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
     };
     let modes = match a.modes.as_deref().map(|t| parse_modes(t, &s)).transpose() {
         Ok(m) => m.unwrap_or_default(),

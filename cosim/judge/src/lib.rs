@@ -64,7 +64,7 @@ mod verdict;
 pub use lut_gen::{Layout, Pins, Signal};
 
 // The reference model, its ADC and the checker.
-pub use adc::{Adc, Analog, Stimulus};
+pub use adc::{Adc, Analog, Scene, Stimulus};
 pub use checker::{CheckOptions, Checker};
 pub use invariants::Invariants;
 pub use model::{CycleModel, SlotModel};

@@ -24,9 +24,18 @@ fn sel_at(requests: &[(u64, u8)], f: u64) -> u8 {
 /// returns, per frame, the `mode` pin at its first cycle and the CS falls
 /// per channel.
 fn run(s: &Schedule, frames: u64, requests: &[(u64, u8)]) -> Vec<(u8, Vec<u64>)> {
+    run_with(s, frames, requests, Stimulus::Pattern)
+}
+
+fn run_with(
+    s: &Schedule,
+    frames: u64,
+    requests: &[(u64, u8)],
+    stimulus: Stimulus,
+) -> Vec<(u8, Vec<u64>)> {
     let f = s.grid.frame_cycles;
     let layout = Layout::new(s);
-    let mut adc = Adc::new(s, Stimulus::Pattern);
+    let mut adc = Adc::new(s, stimulus);
     let mut m = CycleModel::new(s);
     let mut out: Vec<(u8, Vec<u64>)> = Vec::new();
     let mut prev_cs = m.pins().cs_n;
@@ -151,9 +160,18 @@ type Cycle = (bool, lut_gen::Pins, u64);
 
 /// A run of the model under `requests`, every cycle recorded (4 reset cycles).
 fn record(s: &Schedule, frames: u64, requests: &[(u64, u8)]) -> Vec<Cycle> {
+    record_with(s, frames, requests, Stimulus::Pattern)
+}
+
+fn record_with(
+    s: &Schedule,
+    frames: u64,
+    requests: &[(u64, u8)],
+    stimulus: Stimulus,
+) -> Vec<Cycle> {
     use judge::Dut;
     let mut dut = judge::ModeRequests::new(s, judge::ModelDut::new(s), requests);
-    let mut adc = Adc::new(s, Stimulus::Pattern);
+    let mut adc = Adc::new(s, stimulus);
     let mut out = Vec::new();
     let mut miso = (1u64 << s.branches.len()) - 1;
     for _ in 0..4 {
@@ -285,4 +303,88 @@ fn a_switch_inside_a_frame_or_without_a_request_fails_at_its_cycle() {
         "{}",
         v.summary()
     );
+}
+
+/// Auto select under a touch: the model leaves the reset mode two frames
+/// after the touch begins (a one-frame `above` trigger on a channel sampled
+/// in every frame), every frame's counts are its mode's, the run is clean
+/// with and without the model, and the same pins with the mode claimed
+/// before any touch fail at that frame.
+#[test]
+fn a_touch_switches_auto_mixes_and_back_with_each_modes_counts() {
+    for (name, touched, from, to, frames) in [
+        ("modes-auto", "T0,T2", 4u64, 14u64, 24u64),
+        ("eskin34-adaptive", "CH7,CH11", 2, 5, 10),
+    ] {
+        let s = schedule(&testkit::mix(name));
+        let f = s.grid.frame_cycles;
+        let text = format!("touch:{touched}@{from}-{to}");
+        let k = Stimulus::parse_for(&text, &s).unwrap();
+        let got = run_with(&s, frames, &[], k);
+        let modes: Vec<u8> = got.iter().map(|g| g.0).collect();
+        assert!(
+            modes[..(from + 2) as usize].iter().all(|&m| m == 0),
+            "{name}: {modes:?}"
+        );
+        assert_ne!(modes[(from + 2) as usize], 0, "{name}: {modes:?}");
+        for (g, (mode, counts)) in got.iter().enumerate().skip(1) {
+            let ms = &s.modes[*mode as usize];
+            for (c, &n) in counts.iter().enumerate() {
+                assert_eq!(n, ms.channels[c].samples_per_frame, "{name} frame {g}");
+            }
+        }
+        let trace = record_with(&s, frames, &[], k);
+        for model in [true, false] {
+            let v = judge_trace(&s, &trace, model);
+            assert!(v.ok, "{name}, model {model}: {}", v.summary());
+        }
+        // the design claims the contact mode before any contact
+        let mut unasked = trace.clone();
+        let want = modes[(from + 2) as usize];
+        for (_, p, _) in unasked.iter_mut().skip(4 + 2 * f as usize).take(f as usize) {
+            p.mode = want;
+        }
+        let v = judge_trace(&s, &unasked, false);
+        assert_eq!(
+            first_violation(&v, "mode-decision"),
+            Some(2 * f),
+            "{name}: {}",
+            v.summary()
+        );
+    }
+}
+
+#[test]
+fn modes_auto_returns_to_rest_after_the_release() {
+    let s = schedule(&testkit::mix("modes-auto"));
+    let k = Stimulus::parse_for("stroke:T{0..3}@3-15", &s).unwrap();
+    let got = run_with(&s, 30, &[], k);
+    let modes: Vec<u8> = got.iter().map(|g| g.0).collect();
+    let names = &s.mode_plan().unwrap().names;
+    let seen: Vec<&str> = modes
+        .iter()
+        .enumerate()
+        .filter(|&(g, m)| g == 0 || modes[g - 1] != *m)
+        .map(|(_, &m)| names[m as usize].as_str())
+        .collect();
+    // rest, touched, T0 held for 3 frames (hold), the others (touch again
+    // is not armed from hold), released: rest
+    assert_eq!(seen.first(), Some(&"rest"), "{modes:?}");
+    assert!(seen.contains(&"touch"), "{seen:?}");
+    assert_eq!(seen.last(), Some(&"rest"), "{seen:?}");
+    assert_eq!(*modes.last().unwrap(), 0);
+}
+
+#[test]
+fn scenes_name_the_mixs_channels() {
+    let s = schedule(&testkit::mix("modes-auto"));
+    for bad in [
+        "touch:T9@1-2",
+        "touch:T0@2-1",
+        "stroke:T0",
+        "touch:T{0..}@1-3",
+    ] {
+        assert!(Stimulus::parse_for(bad, &s).is_err(), "{bad}");
+    }
+    assert!(Stimulus::parse_for("sine:600", &s).is_ok());
 }
