@@ -96,6 +96,29 @@ pub struct Args {
     pub modes: Option<String>,
 }
 
+/// What is refused before the mix is read: a stimulus that names no
+/// channel and is not one, no frames.
+fn early_checks(a: &Args) -> Result<(), String> {
+    // a scene names channels: it is read once the mix is loaded
+    let scene = ["touch:", "stroke:"]
+        .iter()
+        .any(|p| a.stimulus.starts_with(p));
+    if !scene {
+        a.stimulus.parse::<Stimulus>()?;
+    }
+    if a.frames == 0 {
+        return Err("--frames must be at least 1".into());
+    }
+    Ok(())
+}
+
+/// `--stimulus` (a scene names the mix's channels) and `--modes`.
+fn scene_and_modes(a: &Args, s: &lut_gen::Schedule) -> Result<(Stimulus, Vec<(u64, u8)>), String> {
+    let stimulus = Stimulus::parse_for(&a.stimulus, s)?;
+    let modes = a.modes.as_deref().map(|t| parse_modes(t, s)).transpose()?;
+    Ok((stimulus, modes.unwrap_or_default()))
+}
+
 /// `--modes FRAME=MODE,...` against the mix's modes.
 fn parse_modes(text: &str, s: &lut_gen::Schedule) -> Result<Vec<(u64, u8)>, String> {
     let plan = match s.mode_plan() {
@@ -186,16 +209,8 @@ fn to_fst(
 
 pub fn run(a: Args) -> u8 {
     let backend = a.backend;
-    // a scene names channels: it is read once the mix is loaded
-    let scene = ["touch:", "stroke:"]
-        .iter()
-        .any(|p| a.stimulus.starts_with(p));
-    if let (false, Err(e)) = (scene, a.stimulus.parse::<Stimulus>()) {
+    if let Err(e) = early_checks(&a) {
         eprintln!("error: {e}");
-        return 2;
-    }
-    if a.frames == 0 {
-        eprintln!("error: --frames must be at least 1");
         return 2;
     }
     // The model follows mode switches; the gateware does not yet.
@@ -207,27 +222,14 @@ pub fn run(a: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let stimulus = match Stimulus::parse_for(&a.stimulus, &s) {
-        Ok(k) => k,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
-    };
-    let modes = match a.modes.as_deref().map(|t| parse_modes(t, &s)).transpose() {
-        Ok(m) => m.unwrap_or_default(),
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
-    };
-    let prepared = window(&a, &s).and_then(|(from, to)| {
+    let prepared = scene_and_modes(&a, &s).and_then(|(k, modes)| {
+        let (from, to) = window(&a, &s)?;
         let (vcd, fst) = waveform_paths(&a)?;
         samples_path_free(&a)?;
         link_bytes_path_free(&a, &s)?;
-        Ok((from, to, vcd, fst))
+        Ok((k, modes, from, to, vcd, fst))
     });
-    let (from, to, vcd, fst) = match prepared {
+    let (stimulus, modes, from, to, vcd, fst) = match prepared {
         Ok(p) => p,
         Err(e) => {
             eprintln!("error: {e}");

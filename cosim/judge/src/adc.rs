@@ -163,7 +163,7 @@ impl std::str::FromStr for Stimulus {
             "step" => Ok(Stimulus::Step),
             "chirp" => Ok(Stimulus::Chirp),
             _ => Err(format!(
-                "unknown stimulus `{s}` (pattern, sine, sine:HZ, step, chirp)"
+                "unknown stimulus `{s}` (pattern, sine, sine:HZ, step, chirp, touch:NAMES@FROM-TO, stroke:NAMES@FROM-TO)"
             )),
         }
     }
