@@ -34,8 +34,8 @@ mod validate;
 
 // The mix and its parts.
 pub use mix::{
-    load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError, ModeSelect, Modes,
-    Trigger, When, MAX_BAUD_ERROR_PCT,
+    expand_names, load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError,
+    ModeSelect, Modes, Trigger, When, MAX_BAUD_ERROR_PCT,
 };
 pub use parts::{ns_to_cycles, AdcPart, CmdBit, Command, MuxPart, SpiTiming, Start, TimingError};
 

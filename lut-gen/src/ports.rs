@@ -206,6 +206,8 @@ impl Pins {
         axis_tvalid: false,
         axis_tlast: false,
         axis_tready: false,
+        mode_sel: 0,
+        mode: 0,
     };
 
     /// The value of output port `r` (inputs read as 0); `u128` because
@@ -254,6 +256,11 @@ pub struct Pins {
     pub axis_tvalid: bool,
     pub axis_tlast: bool,
     pub axis_tready: bool,
+    /// A mix with modes: `mode_sel` (an input, pin select only, recorded so
+    /// the judge sees the request of every cycle) and `mode`, the mode in
+    /// force (docs/timing.md, "Mode switches"); 0 without modes.
+    pub mode_sel: u8,
+    pub mode: u8,
 }
 
 /// A port of the link to the host: present only when the mix has a

@@ -567,6 +567,9 @@ impl Dut for VerilatedDut {
             axis_tvalid: self.out.axis_tvalid != 0,
             axis_tlast: self.out.axis_tlast != 0,
             axis_tready: false,
+            // the emitted gateware has no mode ports yet (one_mode refuses it)
+            mode_sel: 0,
+            mode: 0,
         }
     }
 

@@ -44,6 +44,108 @@ pub enum Stimulus {
     Step,
     /// A linear chirp per channel from 0 to its Nyquist frequency over each frame.
     Chirp,
+    /// Contact on named channels (`touch:` / `stroke:`, [`Scene`]); built
+    /// with [`Stimulus::parse_for`], which needs the mix's channel names.
+    Scene(&'static Scene),
+}
+
+/// A scene of contact: the named channels are pressed (codes near full
+/// scale) inside frames `[from, to)` and low outside; a stroke presses them
+/// one after the other, each for an equal share of the interval (seed 003's
+/// Figure 11: a finger sliding over a row of taxels).  Every other channel
+/// stays low.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Scene {
+    pub stroke: bool,
+    /// Channel indices, in the order given.
+    pub channels: Vec<usize>,
+    pub from: u64,
+    pub to: u64,
+}
+
+impl Scene {
+    /// Whether channel `id` is pressed in `cycle` (frames of `frame_cycles`).
+    fn pressed(&self, id: usize, cycle: u64, frame_cycles: u64) -> bool {
+        let (a, b) = (self.from * frame_cycles, self.to * frame_cycles);
+        if cycle < a || cycle >= b {
+            return false;
+        }
+        let Some(k) = self.channels.iter().position(|&c| c == id) else {
+            return false;
+        };
+        if !self.stroke {
+            return true;
+        }
+        let n = self.channels.len() as u64;
+        let share = (cycle - a) * n / (b - a);
+        share == k as u64
+    }
+
+    /// The `bits`-bit code of channel `id` in `cycle`: pressed, 1/32 below
+    /// full scale; else 1/64 of it (a few codes apart per channel).
+    fn code(&self, id: u64, cycle: u64, frame_cycles: u64, bits: u32) -> u16 {
+        let full = (1u32 << bits) - 1;
+        let v = if self.pressed(id as usize, cycle, frame_cycles) {
+            full - full / 32 - (id % 8) as u32
+        } else {
+            full / 64 + (id % 8) as u32
+        };
+        v as u16
+    }
+}
+
+impl Stimulus {
+    /// A stimulus as the command line writes it, with `touch:NAMES@FROM-TO`
+    /// and `stroke:NAMES@FROM-TO` (NAMES: channel names or bulk patterns,
+    /// comma-separated; FROM-TO: frames, TO exclusive) resolved against the
+    /// mix.  The scene lives as long as the program: a stimulus is `Copy`.
+    pub fn parse_for(text: &str, s: &Schedule) -> Result<Stimulus, String> {
+        let (stroke, rest) = match (text.strip_prefix("touch:"), text.strip_prefix("stroke:")) {
+            (Some(r), _) => (false, r),
+            (_, Some(r)) => (true, r),
+            _ => return text.parse(),
+        };
+        let (names, span) = rest.rsplit_once('@').ok_or_else(|| {
+            format!("stimulus `{text}`: NAMES@FROM-TO expected (e.g. touch:T0,T1@4-12, frames)")
+        })?;
+        let (a, b) = span
+            .split_once('-')
+            .and_then(|(a, b)| Some((a.trim().parse::<u64>().ok()?, b.trim().parse::<u64>().ok()?)))
+            .filter(|(a, b)| a < b)
+            .ok_or_else(|| {
+                format!(
+                    "stimulus `{text}`: `{span}` is not FROM-TO, two frame numbers with FROM < TO"
+                )
+            })?;
+        let mut channels = Vec::new();
+        for written in names.split(',').map(str::trim) {
+            for name in
+                lut_gen::expand_names(written).map_err(|e| format!("stimulus `{text}`: {e}"))?
+            {
+                let c = s
+                    .mix
+                    .channels
+                    .iter()
+                    .position(|c| c.name == name)
+                    .ok_or_else(|| {
+                        format!(
+                            "stimulus `{text}`: mix `{}` has no channel named `{name}`",
+                            s.mix.name
+                        )
+                    })?;
+                if !channels.contains(&c) {
+                    channels.push(c);
+                }
+            }
+        }
+        let scene = Scene {
+            stroke,
+            channels,
+            from: a,
+            to: b,
+        };
+        Ok(Stimulus::Scene(Box::leak(Box::new(scene))))
+    }
 }
 
 impl std::str::FromStr for Stimulus {
@@ -68,7 +170,7 @@ impl std::str::FromStr for Stimulus {
             "step" => Ok(Stimulus::Step),
             "chirp" => Ok(Stimulus::Chirp),
             _ => Err(format!(
-                "unknown stimulus `{s}` (pattern, sine, sine:HZ, step, chirp)"
+                "unknown stimulus `{s}` (pattern, sine, sine:HZ, step, chirp, touch:NAMES@FROM-TO, stroke:NAMES@FROM-TO)"
             )),
         }
     }
@@ -119,11 +221,16 @@ impl Analog {
     /// `cycle` (the 14-bit [`Analog::code`] for 14 bits).
     #[inline]
     pub fn code_bits(&self, id: u64, cycle: u64, bits: u32) -> u16 {
+        if let Stimulus::Scene(sc) = self.kind {
+            if id < self.channels {
+                return sc.code(id, cycle, self.frame_cycles, bits);
+            }
+        }
         if bits == 14 {
             return self.code(id, cycle);
         }
         let mask = ((1u32 << bits) - 1) as u16;
-        if self.kind == Stimulus::Pattern || id >= self.channels {
+        if matches!(self.kind, Stimulus::Pattern | Stimulus::Scene(_)) || id >= self.channels {
             let n = (cycle / self.slot_cycles) * (self.channels + 64) + id;
             return (n.wrapping_mul(0x2F5B).wrapping_add(0x1A5) as u16) & mask;
         }
@@ -140,7 +247,10 @@ impl Analog {
     /// `id < channels` is a channel; larger ids are unconnected inputs.
     #[inline]
     pub fn code(&self, id: u64, cycle: u64) -> u16 {
-        if self.kind == Stimulus::Pattern || id >= self.channels {
+        if let (Stimulus::Scene(sc), true) = (self.kind, id < self.channels) {
+            return sc.code(id, cycle, self.frame_cycles, 14);
+        }
+        if matches!(self.kind, Stimulus::Pattern | Stimulus::Scene(_)) || id >= self.channels {
             let n = (cycle / self.slot_cycles) * (self.channels + 64) + id;
             return ((n.wrapping_mul(0x2F5B) + 0x1A5) & 0x3fff) as u16;
         }
@@ -160,7 +270,7 @@ impl Analog {
                 let span = self.frame_cycles as f64 / self.clock_hz;
                 (PI * self.freq[i] / span * tf * tf).sin()
             }
-            Stimulus::Pattern => unreachable!(),
+            Stimulus::Pattern | Stimulus::Scene(_) => unreachable!(),
         };
         (8192.0 + 8000.0 * x).round().clamp(0.0, 16383.0) as u16
     }

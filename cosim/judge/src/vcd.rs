@@ -808,6 +808,9 @@ impl State {
                 axis_tvalid: self.axis && g(LINK + 1) & 1 == 1,
                 axis_tlast: self.axis && g(LINK + 2) & 1 == 1,
                 axis_tready: self.axis && g(LINK + 3) & 1 == 1,
+                // the mode ports are not read from a VCD yet
+                mode_sel: 0,
+                mode: 0,
             }
         };
         (pick(|p| p.v), pick(|p| p.x))

@@ -18,3 +18,6 @@ mod model_check;
 
 #[path = "vcd.rs"]
 mod vcd;
+
+#[path = "modes.rs"]
+mod modes;
