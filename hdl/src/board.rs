@@ -157,14 +157,17 @@ impl Board {
             .count()
             + pool.clone().count();
         if have < bits.len() {
-            return Err(err(format!(
+            return Err(HdlError::Pins {
+                path: path.display().to_string(),
+                message: format!(
                 "mix \"{}\" has {} port bits, but board \"{}\" ({}) offers {have} pins ([pins] and [pool]): \
-                 a mix with fewer branches or mux devices, a link instead of the parallel sample port, or a larger package fits",
+                 a mix with fewer branches or mux devices, or a board with more pins, fits",
                 s.mix.name,
                 bits.len(),
                 self.name,
                 self.fpga.part_number()
-            )));
+                ),
+            });
         }
         let mut used: Vec<&str> = vec![];
         let mut placed = vec![];
