@@ -1,6 +1,6 @@
-//! The one yosys + nextpnr-ice40 flow (an iCE40-HX8K, ct256): `build`'s
-//! synthesis step and `hdl/synth.sh` (through `examples/synth.rs`) both run
-//! [`place_and_route`], so the figures in the report and in
+//! The yosys + nextpnr flow of each part ([`Fpga`]): `synth`, `build`'s
+//! synthesis step and `hdl/synth.sh` (through `examples/synth.rs`) all run
+//! [`place_and_route_for`], so the figures in the report and in
 //! `docs/performance.md` come from the same commands.
 
 use std::path::Path;

@@ -265,10 +265,10 @@ fn sim(
     let sec = Section {
         title: "Co-simulation".into(),
         paragraphs: vec![format!(
-            "{} frames of the emitted design in {}, every cycle compared with the reference model and every invariant checked: {}. Sample counts and intervals as the run measured them, by branch and rate (jitter = largest minus smallest interval; the channels themselves are listed once, in the audit).",
-            r.frames,
+            "{} of the emitted design in {}, every cycle compared with the reference model and every invariant checked: {}. Sample counts and intervals as the run measured them, by branch and rate (jitter = largest minus smallest interval; the channels themselves are listed once, in the audit).",
+            counted(r.frames, "frame"),
             backend.name(),
-            if r.ok { "no divergence, no violation".to_string() } else { format!("{} divergences, {} violations", r.divergence_count, r.violation_count) }
+            if r.ok { "no divergence, no violation".to_string() } else { format!("{}, {}", counted(r.divergence_count, "divergence"), counted(r.violation_count, "violation")) }
         )],
         tables: vec![("Intervals measured, by branch and rate".into(), measure::interval_table(s, &r))],
         links: vec![
@@ -290,16 +290,17 @@ fn sim(
     ];
     let d = if r.ok {
         Done::ok(format!(
-            "{}: {} frames, {} samples, every cycle equal to the model, no violation",
+            "{}: {}, {}, every cycle equal to the model, no violation",
             backend.name(),
-            r.frames,
-            r.samples
+            counted(r.frames, "frame"),
+            counted(r.samples, "sample")
         ))
     } else {
         Done::failed(
             format!(
-                "{} divergences, {} violations",
-                r.divergence_count, r.violation_count
+                "{}, {}",
+                counted(r.divergence_count, "divergence"),
+                counted(r.violation_count, "violation")
             ),
             r.summary(),
         )
@@ -308,16 +309,16 @@ fn sim(
         Glance::Checked,
         if r.ok {
             format!(
-                "yes: {} frames of the emitted Verilog on {}, every pin every cycle equal to the reference model, no violation",
-                r.frames,
+                "yes: {} of the emitted Verilog on {}, every pin every cycle equal to the reference model, no violation",
+                counted(r.frames, "frame"),
                 backend.name()
             )
         } else {
             format!(
-                "NO: {} divergences, {} violations in {} frames on {}",
-                r.divergence_count,
-                r.violation_count,
-                r.frames,
+                "NO: {}, {} in {} on {}",
+                counted(r.divergence_count, "divergence"),
+                counted(r.violation_count, "violation"),
+                counted(r.frames, "frame"),
                 backend.name()
             )
         },
@@ -619,13 +620,17 @@ fn netlist(j: &mut Job, s: &Schedule) -> Done {
     let w = j.write("", &[("netlist.json", json)]);
     let line = if r.ok {
         format!(
-            "{}: {} frame, {} samples, every cycle equal to the model, no violation",
-            r.source, r.frames, r.samples
+            "{}: {}, {}, every cycle equal to the model, no violation",
+            r.source,
+            counted(r.frames, "frame"),
+            counted(r.samples, "sample")
         )
     } else {
         format!(
-            "{}: {} divergences, {} violations",
-            r.source, r.divergence_count, r.violation_count
+            "{}: {}, {}",
+            r.source,
+            counted(r.divergence_count, "divergence"),
+            counted(r.violation_count, "violation")
         )
     };
     let sec = Section {
