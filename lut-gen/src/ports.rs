@@ -490,7 +490,7 @@ impl Layout {
     /// When `s` exceeds [`limits`]; callers that take user mixes check
     /// [`Layout::fits`] first.
     pub fn new(s: &Schedule) -> Layout {
-        if let Err(m) = Layout::fits_limits(s) {
+        if let Err(m) = Layout::fits(s) {
             panic!("{m}");
         }
         let nb = s.branches.len();
@@ -563,22 +563,8 @@ impl Layout {
         }
     }
 
-    /// Whether the gateware and the judge take `s`: it fits [`limits`], and
-    /// no converter takes a command word (the gateware does not drive
-    /// `adc_mosi` yet, nor does the judge model it: issue 30).
-    pub fn fits(s: &Schedule) -> Result<(), String> {
-        Layout::fits_limits(s)?;
-        if let Some(b) = (0..s.branches.len()).find(|&b| s.has_command(b)) {
-            return Err(format!(
-                "branch {}: converter `{}` takes a command word on adc_mosi, which the gateware does not drive yet",
-                s.branches[b].name, s.mix.branches[b].adc.name
-            ));
-        }
-        Ok(())
-    }
-
     /// Whether `s` fits the gateware's [`limits`], or which limit it exceeds.
-    fn fits_limits(s: &Schedule) -> Result<(), String> {
+    pub fn fits(s: &Schedule) -> Result<(), String> {
         use limits::*;
         let nb = s.branches.len();
         if nb == 0 || nb > MAX_BRANCHES {
