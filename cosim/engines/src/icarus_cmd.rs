@@ -59,14 +59,14 @@ pub(crate) fn part(s: &Schedule, b: usize, mosi_lane: u32, table: &str) -> Strin
     );
     let queue = queue_decls(s, b, cmd);
     t.push_str(&queue);
+    let pad = if ws > adc.bits as usize {
+        format!("{}'h0, ", ws - adc.bits as usize)
+    } else {
+        String::new()
+    };
+    let code = format!("code{b}[{}:0]", adc.bits - 1);
     let fill = format!(
-        "    code{b} = pattern16(t{b}, id{b}) & 16'h{mask:x};\n{table}    n{b} = n{b} + 1;\n    stream{b} = {{{pad}{code}}} << {trailing};\n",
-        pad = if ws > adc.bits as usize {
-            format!("{}'h0, ", ws - adc.bits as usize)
-        } else {
-            String::new()
-        },
-        code = format!("code{b}[{}:0]", adc.bits - 1),
+        "    code{b} = pattern16(t{b}, id{b}) & 16'h{mask:x};\n{table}    n{b} = n{b} + 1;\n    stream{b} = {{{pad}{code}}} << {trailing};\n"
     );
     let pop = if cmd.ahead > 0 {
         let mut p = format!("    id{b} = q{b}_0;\n");

@@ -166,6 +166,26 @@ impl Core {
     }
 }
 
+/// A command unit's inputs: the core's clock, reset and slot start, its
+/// branch's pins and its sequencer's SCLK and done strobe.
+#[inline]
+fn feed_cmd(
+    q: &mut CmdUnit,
+    u: &BranchUnit,
+    (clk, rst, start0): (Clock, bool, bool),
+    (q_sclk, q_done): (bool, bool),
+) {
+    q.clock.next = clk;
+    q.rst.next = rst;
+    q.start0.next = start0;
+    q.pin.next = u.cs_n.val();
+    q.bsclk.next = u.sclk.val();
+    q.qsclk.next = q_sclk;
+    q.qdone.next = q_done;
+    q.sel.next = u.mux_sel.val();
+    q.done.next = u.done.val();
+}
+
 impl Logic for Core {
     fn update(&mut self) {
         let clk = self.clock.val();
@@ -221,15 +241,7 @@ impl Logic for Core {
             let mut live = true;
             if let Some(i) = self._cmd_of[b] {
                 let q = &mut self.cmds[i];
-                q.clock.next = clk;
-                q.rst.next = rst;
-                q.start0.next = start0;
-                q.pin.next = u.cs_n.val();
-                q.bsclk.next = u.sclk.val();
-                q.qsclk.next = q_sclk;
-                q.qdone.next = q_done;
-                q.sel.next = u.mux_sel.val();
-                q.done.next = u.done.val();
+                feed_cmd(q, u, (clk, rst, start0), (q_sclk, q_done));
                 live = q.live.val();
                 mosi |= (q.mosi.val() as u64) << i;
             }
