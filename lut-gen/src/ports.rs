@@ -490,7 +490,7 @@ impl Layout {
     /// When `s` exceeds [`limits`]; callers that take user mixes check
     /// [`Layout::fits`] first.
     pub fn new(s: &Schedule) -> Layout {
-        if let Err(m) = Layout::fits(s) {
+        if let Err(m) = Layout::fits_limits(s) {
             panic!("{m}");
         }
         let nb = s.branches.len();
@@ -563,8 +563,15 @@ impl Layout {
         }
     }
 
-    /// Whether `s` fits the gateware's [`limits`], or which limit it exceeds.
+    /// Whether the gateware and the judge take `s`: it fits [`limits`]
+    /// (converters with a command word included: the gateware drives
+    /// `adc_mosi`).
     pub fn fits(s: &Schedule) -> Result<(), String> {
+        Layout::fits_limits(s)
+    }
+
+    /// Whether `s` fits the gateware's [`limits`], or which limit it exceeds.
+    fn fits_limits(s: &Schedule) -> Result<(), String> {
         use limits::*;
         let nb = s.branches.len();
         if nb == 0 || nb > MAX_BRANCHES {

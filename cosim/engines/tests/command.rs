@@ -77,7 +77,12 @@ fn first_difference<D: Dut>(s: &Schedule, dut: &mut D, frames: u64) -> (Option<S
     let mut miso = (1u64 << s.branches.len()) - 1;
     let (mut samples, mut mosi) = (0, 0);
     let cmp = |c: i64, d: &Pins, m: &Pins| {
-        (d != m).then(|| format!("cycle {c}: gateware {d:?}\nmodel    {m:?}"))
+        (d != m).then(|| {
+            format!(
+                "cycle {c}: differs in {:?}\ngateware {d:?}\nmodel    {m:?}",
+                differing(d, m)
+            )
+        })
     };
     for k in 0..2 {
         let (d, m) = (dut.step(true, miso), model.step(true, miso));
@@ -96,6 +101,25 @@ fn first_difference<D: Dut>(s: &Schedule, dut: &mut D, frames: u64) -> (Option<S
         miso = adc.drive(c, &d);
     }
     (None, samples, mosi)
+}
+
+/// The pins in which `a` and `b` differ.
+fn differing(a: &Pins, b: &Pins) -> Vec<&'static str> {
+    let mut v = vec![];
+    for (name, same) in [
+        ("cs_n", a.cs_n == b.cs_n),
+        ("sclk", a.sclk == b.sclk),
+        ("mosi", a.mosi == b.mosi),
+        ("mux", a.mux_sel == b.mux_sel && a.mux_en == b.mux_en),
+        ("sample_valid", a.sample_valid == b.sample_valid),
+        ("sample_channel", a.sample_channel == b.sample_channel),
+        ("sample_value", a.sample_value == b.sample_value),
+    ] {
+        if !same {
+            v.push(name);
+        }
+    }
+    v
 }
 
 fn assert_same<D: Dut>(what: &str, s: &Schedule, dut: &mut D, frames: u64) {
@@ -226,7 +250,7 @@ fn icarus_testbench_converts_what_the_words_select() {
     }));
     for (what, s, stimulus) in runs {
         let mut beside = BesideModel::new(&s);
-        icarus_beside(&s, stimulus, 2, &mut beside);
+        icarus_beside(&s, None, stimulus, 2, &mut beside);
         if let Some(d) = beside.diff {
             panic!("{what}: {d}");
         }
@@ -237,13 +261,22 @@ fn icarus_testbench_converts_what_the_words_select() {
 
 /// Runs the Icarus testbench (`engines::icarus_testbench`, the back end's
 /// own) on the emitted Verilog and hands every cycle of its VCD to `sink`.
-fn icarus_beside(s: &Schedule, stimulus: Stimulus, frames: u64, sink: &mut BesideModel) {
+fn icarus_beside(
+    s: &Schedule,
+    design: Option<&str>,
+    stimulus: Stimulus,
+    frames: u64,
+    sink: &mut BesideModel,
+) {
     let dir = tempfile::Builder::new()
         .prefix("slotforge-cmd-icarus-")
         .tempdir()
         .unwrap();
     let d = dir.path();
     hdl::emit(s, None).unwrap().write_to(d).unwrap();
+    if let Some(v) = design {
+        std::fs::write(d.join(hdl::VERILOG_FILE), v).unwrap();
+    }
     let tb = engines::icarus_testbench(s, stimulus, 4, frames * s.grid.frame_cycles);
     std::fs::write(d.join("tb.v"), &tb.tb).unwrap();
     for (name, text) in &tb.tables {
@@ -266,4 +299,44 @@ fn icarus_beside(s: &Schedule, stimulus: Stimulus, frames: u64, sink: &mut Besid
     ]));
     run(std::process::Command::new("vvp").args(["-n", "sim.vvp"]));
     judge::read_cycles(s, &d.join("wave.vcd"), Some("tb"), sink).unwrap();
+}
+
+/// The emitted Verilog with channel bit 0 of every command word taken from
+/// channel bit 1: a gateware that sends the wrong channel bits (the mutant
+/// the issue names).
+pub fn wrong_channel_bits(verilog: &str) -> String {
+    let mut n = 0;
+    let out: Vec<String> = verilog
+        .lines()
+        .map(|l| {
+            if l.trim_start().starts_with("wire [") && l.contains(" word = {") {
+                n += 1;
+                l.replacen("sel[0]", "sel[1]", 1)
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    assert!(n > 0, "no command word in the design");
+    out.join("\n") + "\n"
+}
+
+/// The wrong-channel mutant differs from the model on both Verilog engines:
+/// on `adc_mosi` first, and the ADC models then convert the wrong input.
+#[test]
+fn a_gateware_sending_the_wrong_channel_bits_fails_on_both_verilog_engines() {
+    if !tools::require_tools(&["verilator", "g++", "iverilog", "vvp"]) {
+        return;
+    }
+    for name in ["cmd-mcp3208", "cmd-ad7689"] {
+        let s = schedule(name);
+        let bad = wrong_channel_bits(&engines::verilog(&s).unwrap());
+        let (mut dut, _) = VerilatedDut::new(&bad).unwrap();
+        let (diff, _, _) = first_difference(&s, &mut dut, 1);
+        let d = diff.unwrap_or_else(|| panic!("{name}: Verilator ran the mutant clean"));
+        assert!(d.contains("differs in [\"mosi\"]"), "{name}: {d}");
+        let mut beside = BesideModel::new(&s);
+        icarus_beside(&s, Some(&bad), Stimulus::Pattern, 1, &mut beside);
+        assert!(beside.diff.is_some(), "{name}: Icarus ran the mutant clean");
+    }
 }
