@@ -37,6 +37,7 @@ mod adc;
 mod axishold;
 mod capture;
 mod checker;
+mod cmdword;
 mod events;
 mod faults;
 mod fst;

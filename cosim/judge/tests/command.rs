@@ -147,3 +147,122 @@ fn a_wrong_channel_bit_is_a_wrong_sample() {
         }
     }
 }
+
+/// A run of `frames` frames of `dut` judged by the checker (with or
+/// without the model).
+fn judged<D: Dut>(s: &Schedule, dut: &mut D, frames: u64, model: bool) -> judge::Verdict {
+    let opts = judge::RunOptions {
+        check: judge::CheckOptions {
+            model,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    judge::run_dut(s, dut, frames, &opts, "test", None)
+}
+
+fn rules(v: &judge::Verdict) -> Vec<String> {
+    v.violations.iter().map(|v| v.rule.to_string()).collect()
+}
+
+#[test]
+fn the_model_passes_its_own_checker_with_and_without_itself() {
+    for seed in 0..8 {
+        let s = random_mix(seed);
+        for model in [true, false] {
+            let v = judged(&s, &mut ModelDut::new(&s), 3, model);
+            assert!(v.ok, "seed {seed} model {model}: {}", v.summary());
+            assert!(v.samples > 0);
+        }
+    }
+}
+
+/// The cycles (after reset) in which branch `b` sends bit `k` of the word
+/// of its conversion number `n` (0: the first), as the model drives them.
+fn bit_cycles(s: &Schedule, b: usize, n: usize, k: usize) -> Vec<u64> {
+    let mut m = CycleModel::new(s);
+    let mut starts = Vec::new();
+    let mut out = Vec::new();
+    for c in 0..3 * s.grid.frame_cycles {
+        if let Some((_, bit, t)) = m.command_bit(b) {
+            if starts.last() != Some(&t) {
+                starts.push(t);
+            }
+            if starts.len() == n + 1 && bit == k {
+                out.push(c);
+            }
+        }
+        m.step(0);
+    }
+    out
+}
+
+/// Flips `adc_mosi` bit `lane` in the cycles `at` (counted after reset).
+struct FlipAt<D> {
+    dut: D,
+    lane: u32,
+    at: Vec<u64>,
+    c: u64,
+}
+impl<D: Dut> Dut for FlipAt<D> {
+    fn step(&mut self, rst: bool, miso: u64) -> Pins {
+        let mut p = self.dut.step(rst, miso);
+        if rst {
+            self.c = 0;
+            return p;
+        }
+        if self.at.contains(&self.c) {
+            p.mosi ^= 1 << self.lane;
+        }
+        self.c += 1;
+        p
+    }
+}
+
+/// The first channel bit of branch `b`'s word (its MSB).
+fn channel_bit(s: &Schedule, b: usize) -> usize {
+    let cmd = s.mix.branches[b].adc.command.as_ref().unwrap();
+    cmd.bits
+        .iter()
+        .position(|x| matches!(x, lut_gen::CmdBit::Channel(_)))
+        .unwrap()
+}
+
+#[test]
+fn a_wrong_command_bit_is_named_at_its_cycle_and_breaks_the_attribution() {
+    for seed in 0..6 {
+        let s = random_mix(seed);
+        for (lane, b) in [(0u32, 0usize), (1, 2)] {
+            let n = 1 + seed as usize % 3;
+            let k = channel_bit(&s, b) + seed as usize % 3;
+            let at = bit_cycles(&s, b, n, k);
+            assert!(!at.is_empty(), "seed {seed} branch {b}");
+            let mut dut = FlipAt {
+                dut: ModelDut::new(&s),
+                lane,
+                at: at.clone(),
+                c: 0,
+            };
+            let v = judged(&s, &mut dut, 3, true);
+            let d = &v.divergences[0];
+            assert_eq!(d.cycle, at[0], "seed {seed} branch {b}: {}", v.summary());
+            assert_eq!(d.signal, format!("adc_mosi[{lane}]"));
+            assert!(
+                d.context[0].contains(&format!("bit {k} (0 = the first) of the command word")),
+                "{:?}",
+                d.context
+            );
+            // Without the model: the sample that word selected is held to
+            // the channel it selected (or the word to the branch's inputs).
+            dut.dut = ModelDut::new(&s);
+            let v = judged(&s, &mut dut, 3, false);
+            let r = rules(&v);
+            assert!(
+                r.iter()
+                    .any(|r| r == "command-channel" || r == "command-word"),
+                "seed {seed} branch {b} bit {k}: {r:?} {}",
+                v.summary()
+            );
+        }
+    }
+}
