@@ -223,6 +223,8 @@ fn to_fst(
     judge::write_gtkw(&fst.with_extension("gtkw"), fst, s)
 }
 
+type Load = fn(&std::path::Path, super::Limits) -> Result<lut_gen::Schedule, u8>;
+
 pub fn run(a: Args) -> u8 {
     let backend = a.backend;
     if let Err(e) = early_checks(&a) {
@@ -230,11 +232,11 @@ pub fn run(a: Args) -> u8 {
         return 2;
     }
     // The model follows mode switches; the gateware does not yet.
-    let load = match backend {
-        Backend::Model => super::load_any_modes,
-        _ => super::load_checked,
+    let (load, limits) = match backend {
+        Backend::Model => (super::load_any_modes as Load, super::Limits::Judge),
+        _ => (super::load_checked as Load, super::Limits::Contract),
     };
-    let s = match load(&a.mix, super::Limits::Contract) {
+    let s = match load(&a.mix, limits) {
         Ok(s) => s,
         Err(code) => return code,
     };
