@@ -266,3 +266,46 @@ fn a_wrong_command_bit_is_named_at_its_cycle_and_breaks_the_attribution() {
         }
     }
 }
+
+/// The command-word pin faults apply to every commanded branch of a
+/// random mix and to no other; each is caught with the model (its first
+/// divergence on that branch's `adc_mosi`) and without it (the conversion
+/// held to the channel its word selected, or the word refused).
+#[test]
+fn command_faults_are_caught_with_and_without_the_model() {
+    use judge::{FaultyDut, PinFault};
+    for seed in 0..6 {
+        let s = random_mix(seed);
+        let all = PinFault::all(&s);
+        for b in 0..s.branches.len() {
+            for f in [
+                PinFault::WrongChannelBits { branch: b },
+                PinFault::LateCommand { branch: b },
+            ] {
+                assert_eq!(all.contains(&f), s.has_command(b), "seed {seed} {f:?}");
+                if !s.has_command(b) {
+                    continue;
+                }
+                let at = s.grid.frame_cycles / 3 + seed * 977;
+                let lane = CycleModel::new(&s).layout().mosi_lo[b].unwrap();
+                for model in [true, false] {
+                    let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
+                    let v = judged(&s, &mut dut, 4, model);
+                    assert!(!v.ok, "seed {seed} {f:?} model {model}: missed");
+                    if model {
+                        let d = &v.divergences[0];
+                        assert_eq!(d.signal, format!("adc_mosi[{lane}]"), "{f:?}");
+                        assert!(d.cycle >= at, "{f:?}: {}", d.cycle);
+                    } else {
+                        let r = rules(&v);
+                        assert!(
+                            r.iter()
+                                .any(|r| r == "command-channel" || r == "command-word"),
+                            "seed {seed} {f:?}: {r:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
