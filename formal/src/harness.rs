@@ -19,6 +19,7 @@ use lut_gen::Schedule;
 use lut_gen::{Layout, Role, TOP_MODULE};
 use lut_gen::{SpiTiming, Start};
 
+mod command;
 mod compact;
 mod contract;
 mod link;
@@ -196,6 +197,12 @@ pub fn generate_with(s: &Schedule, form: TableForm) -> Result<Harness, HarnessEr
     }
     let layout = Layout::new(s);
     let nb = s.branches.len();
+    if form == TableForm::Compact && (0..nb).any(|b| s.has_command(b)) {
+        return Err(HarnessError(format!(
+            "mix `{}`: a frame of {} slots with a command word is beyond the formal harness (its words are tabled per slot, at most {FULL_TABLE_MAX_SLOTS})",
+            s.mix.name, g.frame_slots
+        )));
+    }
     let total_words: u64 = (0..nb).map(|b| u64::from(s.branches[b].spi.words)).sum();
     for (b, p) in s.branches.iter().enumerate() {
         let spi = &p.spi;
@@ -287,9 +294,10 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout, form: TableForm) {
         v,
         "  // st: 0 before the reset edge, 1 the reset cycle, 2 cycle 0 on.\n  \
          reg [1:0] st = 2'd0;\n  wire rst = st == 2'd0;\n  \
-         wire [{}:0] adc_cs_n, adc_sclk;{}\n  \
+         wire [{}:0] adc_cs_n, adc_sclk;{}{}\n  \
          wire sample_valid;\n  wire [{}:0] sample_channel;\n  wire [{}:0] sample_value;",
         nb - 1,
+        command::port(layout).0,
         mux_wires(layout),
         w(Role::SampleChannel) - 1,
         w(Role::SampleValue) - 1
@@ -300,8 +308,9 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout, form: TableForm) {
     let _ = writeln!(
         v,
         "  {TOP_MODULE} dut (.clk(clk), .rst(rst), .adc_miso(adc_miso), .adc_cs_n(adc_cs_n),\n    \
-         .adc_sclk(adc_sclk),{} .sample_valid(sample_valid),\n    \
+         .adc_sclk(adc_sclk),{}{} .sample_valid(sample_valid),\n    \
          .sample_channel(sample_channel), .sample_value(sample_value){link_ports});",
+        command::port(layout).1,
         if layout.has(Role::MuxSel) {
             " .mux_sel(mux_sel), .mux_en(mux_en),"
         } else {
@@ -444,6 +453,7 @@ fn branch(
     branch_conversion(v, s, layout, b);
     branch_expectations(v, s, layout, b);
     branch_properties(props, b, &p.name, layout.muxed[b]);
+    command::mosi(v, props, s, layout, b);
 }
 
 /// The row's `act` and `lead` fields, and when branch `b` converts.
@@ -540,7 +550,7 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
         "  wire exp_cs{b} = {cs_exp};\n  wire exp_sclk{b} = {sclk_exp};\n  \
          wire [{}:0] exp_en{b} = cyc == {cb}'d0 ? tab{b}[{}:{lo_e0}] : tab{b}[{}:{lo_e1}];\n  \
          wire [2:0] exp_sel{b} = cyc == {cb}'d0 ? tab{b}[{}:{lo0}] : tab{b}[{}:{lo1}];\n  \
-         wire cap{b} = conv{b} && ({});\n  wire done{b} = conv{b} && cyc == {cb}'d{r};\n  \
+         wire cap{b} = conv{b} && ({});\n  \
          reg [{}:0] w{b} = 0;\n  always @(posedge clk) if (cap{b}) w{b} <= {{w{b}[{}:0], adc_miso[{b}]}};\n  \
          wire ok_cs{b} = adc_cs_n[{b}] == exp_cs{b};\n  wire ok_sclk{b} = adc_sclk[{b}] == exp_sclk{b};\n  \
          wire ok_mux{b} = {ok_mux};",
@@ -553,6 +563,7 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
         n - 1,
         n.saturating_sub(2),
     );
+    command::done(v, s, b, &format!("conv{b} && cyc == {cb}'d{r}"));
 }
 
 /// The properties of branch `b`, called `name`.

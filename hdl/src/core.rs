@@ -12,6 +12,7 @@
 //!  |    |- rom: SlotRom   that branch's column of the frame table (BRAM-friendly)
 //!  |    `- DFFs           "converts this slot" flag, CS/SCLK outputs gated by it,
 //!  |                      MISO shift register, channel, mux control
+//!  |- cmds: Vec<CmdUnit>  one per branch with a command word: adc_mosi, prepared conversions
 //!  `- merge: Merger       pending set + lowest-branch-first sample stream (Verilog over the mix's lanes)
 //! ```
 //!
@@ -19,6 +20,7 @@
 //! emitted Verilog has no 32-bit literals and lints clean.
 
 mod branch;
+mod command;
 mod glue;
 mod merger;
 mod slot_rom;
@@ -32,6 +34,7 @@ mod word_reader;
 use rust_hdl::prelude::*;
 
 use branch::BranchUnit;
+use command::CmdUnit;
 use merger::Merger;
 use slot_rom::SlotRom;
 use spi::SpiSeq;

@@ -195,8 +195,9 @@ fn core_lanes(r: Role) -> Option<(&'static str, usize)> {
         Role::MuxEn => Some(("core_mux_en", EN_TOTAL)),
         Role::SampleChannel => Some(("core_channel", CH_BITS)),
         Role::SampleValue => Some(("core_value", VALUE_BITS)),
-        // no mix the gateware takes has `adc_mosi` yet (`Layout::fits`)
-        Role::Clock | Role::Reset | Role::SampleValid | Role::Mosi => None,
+        // only a mix with a command word has it (`core_ports`)
+        Role::Mosi => Some(("core_mosi", MAX_BRANCHES)),
+        Role::Clock | Role::Reset | Role::SampleValid => None,
     }
 }
 
@@ -222,7 +223,7 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     header(&mut v, s, p);
     port_list(&mut v, &l);
     let wired = core_wires(&mut v, p, &l);
-    core_instance(&mut v, &wired);
+    core_instance(&mut v, &l, &wired);
     link_instance(&mut v, p);
     let _ = writeln!(v, "endmodule");
     let _ = writeln!(v);
@@ -307,8 +308,7 @@ fn core_wires(v: &mut String, p: &Plan, l: &Layout) -> Vec<(Role, &'static str, 
         "    // The core has fixed maximum widths ({MAX_BRANCHES} branches, {EN_TOTAL} mux enables, {CH_BITS}-bit channel);"
     );
     let _ = writeln!(v, "    // this wrapper exposes exactly the mix's bits.");
-    let wired: Vec<(Role, &str, usize)> = PORTS
-        .iter()
+    let wired: Vec<(Role, &str, usize)> = core_ports(l)
         .filter_map(|port| core_lanes(port.role).map(|(wire, cw)| (port.role, wire, cw)))
         .collect();
     for &(_, wire, cw) in &wired {
@@ -412,17 +412,19 @@ fn gaps(used: &[(usize, usize)], width: usize) -> Vec<(usize, usize)> {
     v
 }
 
-/// The contract's ports the core has: all but `adc_mosi`, which no mix the
-/// gateware takes has yet (`Layout::fits`).
-fn core_ports() -> impl Iterator<Item = &'static lut_gen::Port> {
-    PORTS.iter().filter(|p| p.role != Role::Mosi)
+/// The contract's ports the core has: all but `adc_mosi` for a mix without
+/// a command word (the core then has no such port: `Core::adc_mosi`).
+fn core_ports(l: &Layout) -> impl Iterator<Item = &'static lut_gen::Port> + '_ {
+    PORTS
+        .iter()
+        .filter(|p| p.role != Role::Mosi || l.width(Role::Mosi) > 0)
 }
 
 /// The core instance, its ports on the wires or straight on the wrapper's.
-fn core_instance(v: &mut String, wired: &[(Role, &'static str, usize)]) {
+fn core_instance(v: &mut String, l: &Layout, wired: &[(Role, &'static str, usize)]) {
     let _ = writeln!(v);
     let _ = writeln!(v, "    {CORE} core (");
-    for port in core_ports() {
+    for port in core_ports(l) {
         let to = wired
             .iter()
             .find(|(r, ..)| *r == port.role)
@@ -668,6 +670,18 @@ fn xdc(s: &Schedule) -> String {
 
 #[cfg(test)]
 mod tests {
+    /// Two converters with a command word (one on each style) beside a
+    /// listening one.
+    const COMMAND_MIX: &str =
+        "name = \"cmd\"\n[clock]\nhz = 48000000\n[frame]\nperiod_us = 1000\nslice_us = 1000\n\
+        [[branch]]\nname = \"m\"\nadc = \"mcp3208\"\nmux = \"internal\"\n\
+        [[branch]]\nname = \"l\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n\
+        [[branch]]\nname = \"a\"\nadc = \"ad7689\"\nmux = \"internal\"\n\
+        [[channel]]\nname = \"m5\"\nbranch = \"m\"\nrate_hz = 2000\ninput = 5\n\
+        [[channel]]\nname = \"l0\"\nbranch = \"l\"\nrate_hz = 1000\ninput = 0\n\
+        [[channel]]\nname = \"a3\"\nbranch = \"a\"\nrate_hz = 1000\ninput = 3\n\
+        [[channel]]\nname = \"a6\"\nbranch = \"a\"\nrate_hz = 2000\ninput = 6\n";
+
     use super::*;
 
     /// The core's ports are rust-hdl field names (`core/top.rs`), which cannot
@@ -675,47 +689,51 @@ mod tests {
     /// in `lut_gen::PORTS` without renaming the core's field fails.
     #[test]
     fn core_ports_are_the_contracts() {
-        let m = lut_gen::parse(
-            Path::new("eskin34.toml"),
-            include_str!("../../mixes/eskin34.toml"),
-        )
-        .unwrap();
-        let s = lut_gen::synthesize(&m).unwrap();
-        let v = emit(&s, None).unwrap();
-        let head = format!("module {CORE}(");
-        let line = v
-            .verilog()
-            .lines()
-            .find(|l| l.starts_with(&head))
-            .expect("the core module");
-        let ports: Vec<&str> = line[head.len()..]
-            .trim_end_matches(");")
-            .split(',')
-            .collect();
-        // and one beyond the contract: the timebase's slot starts, which the
-        // link counts (wired inside the wrapper, never a pin)
-        let want: Vec<&str> = core_ports()
-            .map(|p| core_port_name(p.role))
-            .chain(["slot_tick"])
-            .collect();
-        assert_eq!(ports, want);
-        // and the wrapper exposes exactly the contract's ports, in order
-        let top = format!("module {TOP_MODULE} (");
-        let decl: Vec<String> = v
-            .verilog()
-            .lines()
-            .skip_while(|l| *l != top)
-            .skip(1)
-            .take_while(|l| *l != ");")
-            .map(|l| {
-                l.trim_end_matches(',')
-                    .rsplit(' ')
-                    .next()
-                    .unwrap()
-                    .to_string()
-            })
-            .collect();
-        let names: Vec<String> = core_ports().map(|p| p.name.to_string()).collect();
-        assert_eq!(decl, names);
+        // a mix with a command word has `adc_mosi` on both, the others not
+        for (name, text) in [
+            ("eskin34.toml", include_str!("../../mixes/eskin34.toml")),
+            ("cmd.toml", COMMAND_MIX),
+        ] {
+            let m = lut_gen::parse(Path::new(name), text).unwrap();
+            let s = lut_gen::synthesize(&m).unwrap();
+            let l = Layout::new(&s);
+            assert_eq!(l.width(Role::Mosi) > 0, name == "cmd.toml");
+            let v = emit(&s, None).unwrap();
+            let head = format!("module {CORE}(");
+            let line = v
+                .verilog()
+                .lines()
+                .find(|l| l.starts_with(&head))
+                .expect("the core module");
+            let ports: Vec<&str> = line[head.len()..]
+                .trim_end_matches(");")
+                .split(',')
+                .collect();
+            // and one beyond the contract: the timebase's slot starts, which the
+            // link counts (wired inside the wrapper, never a pin)
+            let want: Vec<&str> = core_ports(&l)
+                .map(|p| core_port_name(p.role))
+                .chain(["slot_tick"])
+                .collect();
+            assert_eq!(ports, want);
+            // and the wrapper exposes exactly the contract's ports, in order
+            let top = format!("module {TOP_MODULE} (");
+            let decl: Vec<String> = v
+                .verilog()
+                .lines()
+                .skip_while(|l| *l != top)
+                .skip(1)
+                .take_while(|l| *l != ");")
+                .map(|l| {
+                    l.trim_end_matches(',')
+                        .rsplit(' ')
+                        .next()
+                        .unwrap()
+                        .to_string()
+                })
+                .collect();
+            let names: Vec<String> = core_ports(&l).map(|p| p.name.to_string()).collect();
+            assert_eq!(decl, names);
+        }
     }
 }

@@ -84,6 +84,16 @@ pub(crate) fn blocks(s: &Schedule, p: &Plan) -> String {
             "\"Per branch `b`\" (MISO bits)",
         );
     }
+    // a command unit per branch whose converter takes a command word
+    let commanded = (0..p.branches.len()).filter(|&b| p.branches[b].command.is_some());
+    for (i, b) in commanded.enumerate() {
+        row(
+            &mut v,
+            &format!("slotforge_cmd{i}"),
+            &format!("branch {b}'s command word on adc_mosi, its prepared conversions"),
+            "\"Command words\"",
+        );
+    }
     row(
         &mut v,
         "slotforge_merger",

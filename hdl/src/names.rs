@@ -66,6 +66,16 @@ fn parts(path: &str) -> Vec<String> {
                 out.push(format!("spi_seq{i}"));
                 k += 2;
             }
+            ("cmds", Some(i)) => {
+                out.push(format!("cmd{i}"));
+                k += 2;
+            }
+            // the core's `adc_mosi` is a `Vec` of one signal (none in a mix
+            // without a command word): the port reads as the contract's
+            ("adc_mosi", Some(_)) if raw.len() == 2 => {
+                out.push("adc_mosi".into());
+                k += 2;
+            }
             (p, _) => {
                 out.push(p.to_string());
                 k += 1;

@@ -97,6 +97,11 @@ pub struct BranchRom {
     /// The compact form (only in a compact plan; `words` is then empty and
     /// the mux field of slot `u`'s word is the next instant after slot `u`).
     pub compact: Option<CompactRom>,
+    /// The converter takes a command word on `adc_mosi`.  Its branch has no
+    /// external mux, so the ROM's mux field carries instead the input each
+    /// conversion's word selects (`Schedule::commands_in_frame`), under the
+    /// same rule (the branch's first instant at slot `u` or later).
+    pub command: Option<lut_gen::Command>,
 }
 
 impl BranchRom {
@@ -341,7 +346,7 @@ fn branch_rom(
         }
     };
     let slots: Vec<Option<usize>> = (0..g.frame_slots).map(|t| s.at(t, b)).collect();
-    for c in slots.iter().flatten() {
+    for c in slots.iter().flatten().filter(|_| !s.has_command(b)) {
         let ch = &s.channels[*c];
         if ch.select > 7 || ch.device as usize >= devices {
             return Err(unsupported(format!(
@@ -351,7 +356,8 @@ fn branch_rom(
         }
     }
     let members = chain_members(s, b, &slots)?;
-    let next = next_instants(&slots);
+    let fields = mux_fields(s, b, &slots)?;
+    let next = next_instants(&fields);
     let mut rom = BranchRom {
         words: vec![],
         addr_bits: addr_bits(g.frame_slots),
@@ -372,13 +378,38 @@ fn branch_rom(
         chain,
         members,
         compact: None,
+        command: adc.command.clone(),
     };
     fill_rom(s, &mut rom, &slots, &next, compact);
-    if let Some(c) = next[0] {
-        rom.reset_sel = s.channels[c].select;
-        rom.reset_en = 1u64 << s.channels[c].device;
+    if let Some((sel, dev)) = next[0] {
+        rom.reset_sel = sel;
+        rom.reset_en = 1u64 << dev;
     }
     Ok(rom)
+}
+
+/// The mux field of each frame slot where branch `b` converts: the
+/// channel's (select, device), or for a converter with a command word the
+/// input its word selects (in the select bits; the device is 0).
+fn mux_fields(
+    s: &Schedule,
+    b: usize,
+    slots: &[Option<usize>],
+) -> Result<Vec<Option<(u32, u32)>>, HdlError> {
+    let mut f: Vec<Option<(u32, u32)>> = slots
+        .iter()
+        .map(|c| c.map(|c| (s.channels[c].select, s.channels[c].device)))
+        .collect();
+    for w in s.commands_in_frame(b) {
+        if w.input > 7 {
+            return Err(unsupported(format!(
+                "branch {}: its word selects input {}: the gateware sends at most 3 channel bits (inputs 0..=7)",
+                s.branches[b].name, w.input
+            )));
+        }
+        f[w.slot as usize] = Some((w.input, 0));
+    }
+    Ok(f)
 }
 
 /// Branch `b`'s part and SPI timing against what the sequencer's counters,
@@ -494,11 +525,11 @@ fn chain_members(
     Ok(members)
 }
 
-/// `next[u]`: the channel of the first instant at slot `u` or later (cyclic).
-fn next_instants(slots: &[Option<usize>]) -> Vec<Option<usize>> {
+/// `next[u]`: the mux field of the first instant at slot `u` or later (cyclic).
+fn next_instants(slots: &[Option<(u32, u32)>]) -> Vec<Option<(u32, u32)>> {
     let n = slots.len();
-    let mut next: Vec<Option<usize>> = vec![None; n];
-    let mut cur: Option<usize> = None;
+    let mut next: Vec<Option<(u32, u32)>> = vec![None; n];
+    let mut cur: Option<(u32, u32)> = None;
     for u in (0..2 * n).rev() {
         if let Some(c) = slots[u % n] {
             cur = Some(c);
@@ -515,16 +546,13 @@ fn fill_rom(
     s: &Schedule,
     rom: &mut BranchRom,
     slots: &[Option<usize>],
-    next: &[Option<usize>],
+    next: &[Option<(u32, u32)>],
     compact: bool,
 ) {
     let g = &s.grid;
     let (sps, k) = (g.slots_per_slice, g.slices_per_frame);
     let n = slots.len();
-    let mux = |c: Option<usize>| match c {
-        Some(c) => (s.channels[c].select, s.channels[c].device),
-        None => (0, 0),
-    };
+    let mux = |f: Option<(u32, u32)>| f.unwrap_or((0, 0));
     if compact {
         // The word of slot u carries the mux field of the next instant
         // *after* slot u: the branch moves it to the mux one slot later.

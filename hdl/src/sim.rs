@@ -121,6 +121,9 @@ pub(crate) fn read_pins(c: &Core, r: &PinReader) -> Pins {
     Pins {
         cs_n: c.adc_cs_n.val().to_u64() as u16 & r.lanes,
         sclk: c.adc_sclk.val().to_u64() as u16 & r.lanes,
+        // lane `i` = the `i`-th branch with a command word (the core ties
+        // the rest to 0); no signal at all in a mix without one
+        mosi: c.adc_mosi.first().map_or(0, |m| m.val().to_u64() as u16),
         mux_sel,
         mux_en,
         sample_valid: c.sample_valid.val(),

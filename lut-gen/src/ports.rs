@@ -563,18 +563,11 @@ impl Layout {
         }
     }
 
-    /// Whether the gateware and the judge take `s`: it fits [`limits`], and
-    /// no converter takes a command word (the gateware does not drive
-    /// `adc_mosi` yet, nor does the judge model it: issue 30).
+    /// Whether the gateware and the judge take `s`: it fits [`limits`]
+    /// (converters with a command word included: the gateware drives
+    /// `adc_mosi`).
     pub fn fits(s: &Schedule) -> Result<(), String> {
-        Layout::fits_limits(s)?;
-        if let Some(b) = (0..s.branches.len()).find(|&b| s.has_command(b)) {
-            return Err(format!(
-                "branch {}: converter `{}` takes a command word on adc_mosi, which the gateware does not drive yet",
-                s.branches[b].name, s.mix.branches[b].adc.name
-            ));
-        }
-        Ok(())
+        Layout::fits_limits(s)
     }
 
     /// Whether `s` fits the pin contract's [`limits`] alone: what the judge

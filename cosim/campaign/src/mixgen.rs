@@ -26,6 +26,11 @@ pub struct Shape {
     /// channel) with probability 1 in `muxless`; 0: every branch has one
     /// (and the draw is the same as before the option existed).
     pub muxless: u64,
+    /// Each branch (with a mux) is drawn with a converter that takes a
+    /// command word (`mcp3208` or `ad7689`, `mux = "internal"`, its eight
+    /// inputs) with probability 1 in `commanded`; 0: never (and the draw
+    /// is the same as before the option existed).
+    pub commanded: u64,
     /// A `[link]` drawn for every mix (none: no link).  Drawn after
     /// everything else, so a seed's branches and channels are the same
     /// with or without it.
@@ -59,6 +64,7 @@ impl Default for Shape {
             channels: (2, 9),
             rates_hz: vec![500, 1_000, 2_000, 4_000, 8_000],
             muxless: 0,
+            commanded: 0,
             link: None,
         }
     }
@@ -90,6 +96,7 @@ impl Shape {
             channels: (1, max_channels.max(1)),
             rates_hz: rates,
             muxless: 0,
+            commanded: 0,
             link: None,
         }
     }
@@ -121,6 +128,15 @@ pub fn random_mix(seed: u64, shape: &Shape) -> String {
             let _ = write!(
                 t,
                 "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nsclk_hz = {sclk}\nmux = \"none\"\n"
+            );
+            continue;
+        }
+        if shape.commanded > 0 && next() % shape.commanded == 0 {
+            devs.push(8);
+            let adc = ["mcp3208", "ad7689"][(next() % 2) as usize];
+            let _ = write!(
+                t,
+                "[[branch]]\nname = \"b{b}\"\nadc = \"{adc}\"\nmux = \"internal\"\n"
             );
             continue;
         }

@@ -28,5 +28,8 @@ mod readable;
 #[path = "random_mixes.rs"]
 mod random_mixes;
 
+#[path = "gateware_commands.rs"]
+mod gateware_commands;
+
 // Shared by several test files (one copy in this binary).
 use testkit::tools;

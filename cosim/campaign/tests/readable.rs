@@ -180,3 +180,22 @@ fn random_mixes_read_as_blocks() {
     }
     assert!(tested >= 4, "only {tested} of 8 random mixes are feasible");
 }
+
+/// Mixes with converters that take a command word (the test mixes and a
+/// commanded random mix): each command unit is a module the header names,
+/// and the text lints clean.
+#[test]
+fn commanded_mixes_read_as_blocks() {
+    for name in ["cmd-mcp3208", "cmd-ad7689", "cmd-both"] {
+        let s = lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap();
+        let v = hdl::emit(&s, None).unwrap().verilog().to_string();
+        let units = (0..s.branches.len()).filter(|&b| s.has_command(b)).count();
+        for i in 0..units {
+            assert!(
+                named_in_header(&v).contains(&format!("slotforge_cmd{i}")),
+                "{name}"
+            );
+        }
+        check(name, &s, true);
+    }
+}

@@ -72,7 +72,9 @@ pub fn testbench_with(
     };
     for b in 0..g.l.branches {
         let _ = writeln!(g.text, "  // branch {b} ({})", s.branches[b].name);
-        if s.mix.branches[b].adc.start == Start::Cnv {
+        if s.has_command(b) {
+            g.commanded(b);
+        } else if s.mix.branches[b].adc.start == Start::Cnv {
             g.cnv_chain(b);
         } else {
             g.cs_part(b);
@@ -173,6 +175,39 @@ impl Adcs<'_> {
             "  reg [63:0] tab{b} [0:{}];\n  initial $readmemh(\"{name}\", tab{b});",
             lines - 1
         );
+    }
+
+    /// Branch `b`'s part with a command word (`crate::icarus_cmd`), and
+    /// for a stimulus other than the pattern its table of codes: each
+    /// conversion's channel, or the unselected input of a prepared one.
+    fn commanded(&mut self, b: usize) {
+        let s = self.s;
+        let mut table = String::new();
+        if self.stimulus != Stimulus::Pattern {
+            let bits = s.mix.branches[b].adc.bits;
+            let mut hex = String::new();
+            let mut len = 0u64;
+            let conv: Vec<_> = self.conversions(b).collect();
+            for (k, i) in conv.iter().enumerate() {
+                let id = if s.is_prepared(b, k as u64) {
+                    s.channels.len() as u64 + 1 + b as u64
+                } else {
+                    i.channel as u64
+                };
+                let code = self.analog.code_bits(id, i.cycle, bits);
+                let _ = writeln!(hex, "{:04x}{:08x}{:04x}", id as u16, i.cycle as u32, code);
+                len += 1;
+            }
+            if len > 0 {
+                self.add_table(b, hex, len);
+                table = format!(
+                    "    if (n{b} < {len} && tab{b}[n{b}][63:48] == id{b}[15:0] && tab{b}[n{b}][47:16] == t{b}[31:0])\n      code{b} = tab{b}[n{b}][15:0];\n"
+                );
+            }
+        }
+        let lane = self.l.mosi_lo[b].expect("a commanded branch has an adc_mosi bit");
+        let text = crate::icarus_cmd::part(s, b, lane, &table);
+        self.text.push_str(&text);
     }
 
     /// Branch `b`'s part with an active-low CS (AD7940 style).

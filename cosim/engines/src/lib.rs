@@ -22,6 +22,7 @@
 mod backend;
 mod error;
 mod icarus;
+mod icarus_cmd;
 mod options;
 mod rtl;
 mod rusthdl;

@@ -33,6 +33,7 @@ struct SfPins {
     uint16_t sample_value;
     uint16_t cs_n;
     uint16_t sclk;
+    uint16_t mosi;
     uint8_t sample_valid;
     uint8_t link_tx;
     uint8_t link_overflow;
@@ -41,9 +42,9 @@ struct SfPins {
     uint8_t axis_tlast;
     // an input: the AXIS slave's tready, set by the caller before the edge
     uint8_t axis_tready;
-    uint8_t pad[1];
+    uint8_t pad[7];
 };
-static_assert(sizeof(SfPins) == 40, "SfPins must match the Rust layout");
+static_assert(sizeof(SfPins) == 48, "SfPins must match the Rust layout");
 
 // A port of up to 64 bits.
 template <typename T> static inline void sf_wide(uint64_t* o, const T& v) {
@@ -84,6 +85,7 @@ extern "C" void sf_step(void* p, uint8_t rst, uint64_t miso, SfPins* o) {
     t->eval();
     o->cs_n = t->@cs_n@;
     o->sclk = t->@sclk@;
+@MOSI@
 @MUX@
     o->sample_valid = t->@valid@;
     o->sample_channel = t->@channel@;
@@ -104,8 +106,9 @@ extern "C" void sf_free(void* p) {
 /// The shim's C++ text with the contract's module and port names; `link`:
 /// the top's link ports ([`LINK_PORTS`], [`AXIS_PORTS`] or none); `mux`:
 /// whether the top has `mux_sel` and `mux_en` (a mix in which no branch has
-/// a multiplexer has neither; the shim then reports them 0).
-fn shim(link: &[LinkPort], mux: bool) -> String {
+/// a multiplexer has neither; the shim then reports them 0); `mosi`: whether
+/// it has `adc_mosi` (a mix with a command word).
+fn shim(link: &[LinkPort], mux: bool, mosi: bool) -> String {
     let (link_in, link_pins) = if link == AXIS_PORTS {
         let [td, tv, tl, tr, ovf] = AXIS_PORTS.map(|p| p.name);
         (
@@ -126,8 +129,14 @@ fn shim(link: &[LinkPort], mux: bool) -> String {
     } else {
         "    o->mux_sel = 0;\n    o->mux_en[0] = 0;\n    o->mux_en[1] = 0;"
     };
+    let mosi = if mosi {
+        "    o->mosi = t->@mosi@;"
+    } else {
+        "    o->mosi = 0;"
+    };
     let mut t = SHIM_TEMPLATE
         .replace("@MUX@", mux)
+        .replace("@MOSI@", mosi)
         .replace("@TOP@", TOP_MODULE)
         .replace("@LINKIN@", &link_in)
         .replace("@LINK@", &link_pins);
@@ -164,6 +173,7 @@ struct SfPins {
     sample_value: u16,
     cs_n: u16,
     sclk: u16,
+    mosi: u16,
     sample_valid: u8,
     link_tx: u8,
     link_overflow: u8,
@@ -172,10 +182,10 @@ struct SfPins {
     axis_tlast: u8,
     /// An input: set before each step.
     axis_tready: u8,
-    pad: [u8; 1],
+    pad: [u8; 7],
 }
 
-const _: () = assert!(std::mem::size_of::<SfPins>() == 40);
+const _: () = assert!(std::mem::size_of::<SfPins>() == 48);
 const _: () = assert!(lut_gen::limits::MAX_DEVICES <= 128);
 
 /// FNV-1a, 64 bit: a stable cache key across Rust versions.
@@ -341,6 +351,7 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
             &[]
         },
         top_declares(verilog, Role::MuxSel.name()),
+        top_declares(verilog, Role::Mosi.name()),
     );
     let vv = tool_version("verilator", "apt-get install -y verilator")?;
     let gv = tool_version("g++", "apt-get install -y g++")?;
@@ -554,8 +565,7 @@ impl Dut for VerilatedDut {
         Pins {
             cs_n: self.out.cs_n,
             sclk: self.out.sclk,
-            // no mix the gateware takes has `adc_mosi` yet (`Layout::fits`)
-            mosi: 0,
+            mosi: self.out.mosi,
             mux_sel: self.out.mux_sel,
             mux_en: self.out.mux_en[0] as u128 | (self.out.mux_en[1] as u128) << 64,
             sample_valid: self.out.sample_valid != 0,

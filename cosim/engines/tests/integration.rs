@@ -4,6 +4,9 @@
 #[path = "backends.rs"]
 mod backends;
 
+#[path = "command.rs"]
+mod command;
+
 #[path = "icarus.rs"]
 mod icarus;
 

@@ -24,6 +24,12 @@ pub enum Clause {
     Sclk(usize),
     /// Branch `b`'s mux select and device enables.
     Mux(usize),
+    /// Branch `b`'s command word on `adc_mosi` (a converter that takes one).
+    Mosi(usize),
+    /// That branch `b`'s converter converts the input its word selected,
+    /// `ahead` conversions later: the part's own behaviour, which no proof
+    /// with a free `adc_miso` can assert.
+    CommandEffect(usize),
     /// `sample_valid`: one strobe per word, in the merged stream's order.
     StreamValid,
     /// `sample_channel` of each word.
@@ -51,9 +57,12 @@ pub fn contract(s: &Schedule, layout: &Layout) -> Vec<Clause> {
     let mut c: Vec<Clause> = (0..s.branches.len())
         .flat_map(|b| {
             let mux = layout.muxed.get(b).copied().unwrap_or(true);
+            let cmd = s.has_command(b);
             [Clause::Conversion(b), Clause::Sclk(b)]
                 .into_iter()
                 .chain(mux.then_some(Clause::Mux(b)))
+                .chain(cmd.then_some(Clause::Mosi(b)))
+                .chain(cmd.then_some(Clause::CommandEffect(b)))
         })
         .collect();
     c.extend([
@@ -96,6 +105,22 @@ impl Clause {
             ),
             Clause::Sclk(b) => format!("branch {}'s SCLK (adc_sclk[{b}])", name(b)),
             Clause::Mux(b) => format!("branch {}'s mux select and enable lines", name(b)),
+            Clause::Mosi(b) => format!(
+                "branch {}'s command word on adc_mosi[{}]",
+                name(b),
+                Layout::new(s).mosi_lo[b].unwrap_or_default()
+            ),
+            Clause::CommandEffect(b) => format!(
+                "that branch {}'s {} converts the input each word selects ({}): the part's own \
+                 behaviour; adc_miso is free in the proof, so any code it returns is taken as \
+                 the channel the schedule names",
+                name(b),
+                s.mix.branches[b].adc.name,
+                match s.prepared_conversions(b) {
+                    0 => "in the same conversion".to_string(),
+                    n => format!("{n} conversions later"),
+                }
+            ),
             Clause::StreamValid => "sample_valid: one strobe per converted word".into(),
             Clause::StreamChannel => "sample_channel of every word".into(),
             Clause::StreamValue => "sample_value of every word".into(),

@@ -17,6 +17,7 @@ pub fn quick_proof_shape(muxless: u64) -> campaign::Shape {
         channels: (2, 8),
         rates_hz: vec![1_000, 2_000, 4_000],
         muxless,
+        commanded: 0,
         link: None,
     }
 }

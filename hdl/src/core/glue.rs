@@ -3,11 +3,18 @@
 use crate::widths::*;
 
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
-pub(super) fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> String {
+pub(super) fn core_glue(
+    nb: usize,
+    devices: &[usize],
+    seq_of: &[usize],
+    nseq: usize,
+    cmd_of: &[Option<usize>],
+) -> String {
     let mut s = String::new();
     s.push_str("always @(*) begin\n");
     child_inputs(&mut s, nb, seq_of, nseq);
-    lanes(&mut s, nb, devices);
+    command_units(&mut s, seq_of, cmd_of);
+    lanes(&mut s, nb, devices, cmd_of);
     s.push_str(
         "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
     );
@@ -38,9 +45,35 @@ fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize) {
     }
 }
 
+/// Each command unit's inputs (its branch's pins, its sequencer's levels,
+/// the slot start) and the `adc_mosi` lanes (absent without a unit).
+fn command_units(s: &mut String, seq_of: &[usize], cmd_of: &[Option<usize>]) {
+    let mut lanes = vec![];
+    for (b, i) in cmd_of.iter().enumerate() {
+        let Some(i) = i else { continue };
+        let (u, q, c) = (
+            format!("branches${b}"),
+            format!("seqs${}", seq_of[b]),
+            format!("cmds${i}"),
+        );
+        s.push_str(&format!(
+            "  {c}$clock = clock;\n  {c}$rst = rst;\n  {c}$start0 = timing$start0;\n  {c}$pin = {u}$cs_n;\n  {c}$bsclk = {u}$sclk;\n  {c}$qsclk = {q}$sclk;\n  {c}$qdone = {q}$done;\n  {c}$sel = {u}$mux_sel;\n  {c}$done = {u}$done;\n"
+        ));
+        lanes.insert(0, format!("{c}$mosi"));
+    }
+    if !lanes.is_empty() {
+        if lanes.len() < MAX_BRANCHES {
+            lanes.insert(0, format!("{}'h0", MAX_BRANCHES - lanes.len()));
+        }
+        s.push_str(&format!("  adc_mosi$0 = {{{}}};\n", lanes.join(", ")));
+    }
+}
+
 /// The branches' lanes gathered into the fixed-maximum ports and the
-/// merger's inputs; lanes the mix does not have are tied off.
-fn lanes(s: &mut String, nb: usize, devices: &[usize]) {
+/// merger's inputs; lanes the mix does not have are tied off.  A branch
+/// with a command unit hands the merger no completion while its unit says
+/// the conversion was only prepared.
+fn lanes(s: &mut String, nb: usize, devices: &[usize], cmd_of: &[Option<usize>]) {
     let cat = |f: &dyn Fn(usize) -> String, pad: Option<String>| -> String {
         let mut parts: Vec<String> = (0..nb).rev().map(f).collect();
         if let Some(p) = pad {
@@ -86,13 +119,17 @@ fn lanes(s: &mut String, nb: usize, devices: &[usize]) {
             }
         )
     ));
+    let gated = |b: usize, sig: &str| match cmd_of[b] {
+        Some(i) => format!("branches${b}${sig} & cmds${i}$live"),
+        None => format!("branches${b}${sig}"),
+    };
     s.push_str(&format!(
         "  merge$done = {};\n",
-        cat(&|b| format!("branches${b}$done"), pad_lanes("1'b0"))
+        cat(&|b| gated(b, "done"), pad_lanes("1'b0"))
     ));
     s.push_str(&format!(
         "  merge$done_next = {};\n",
-        cat(&|b| format!("branches${b}$done_next"), pad_lanes("1'b0"))
+        cat(&|b| gated(b, "done_next"), pad_lanes("1'b0"))
     ));
     s.push_str(&format!(
         "  merge$more = {};\n",

@@ -62,6 +62,7 @@ fn rom() -> BranchRom {
         chain: 1,
         members: vec![],
         compact: None,
+        command: None,
     };
     // mux fields: the first instant at this slot or later
     r.words = vec![

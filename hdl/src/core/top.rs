@@ -3,7 +3,7 @@
 use rust_hdl::prelude::*;
 
 use super::glue::core_glue;
-use super::{BranchUnit, Merger, SpiSeq, TimingGen};
+use super::{BranchUnit, CmdUnit, Merger, SpiSeq, TimingGen};
 use crate::plan::Plan;
 use crate::widths::*;
 
@@ -14,6 +14,10 @@ pub struct Core {
     pub adc_miso: Signal<In, Bits<MAX_BRANCHES>>,
     pub adc_cs_n: Signal<Out, Bits<MAX_BRANCHES>>,
     pub adc_sclk: Signal<Out, Bits<MAX_BRANCHES>>,
+    /// `adc_mosi`, lane `i` = the `i`-th branch whose converter takes a
+    /// command word: one signal when the mix has such a branch, none
+    /// otherwise (so the core of any other mix has no such port).
+    pub adc_mosi: Vec<Signal<Out, Bits<MAX_BRANCHES>>>,
     pub mux_sel: Signal<Out, Bits<{ 3 * MAX_BRANCHES }>>,
     pub mux_en: Signal<Out, Bits<EN_TOTAL>>,
     pub sample_valid: Signal<Out, Bit>,
@@ -24,7 +28,11 @@ pub struct Core {
     pub timing: TimingGen,
     pub seqs: Vec<SpiSeq>,
     pub branches: Vec<BranchUnit>,
+    /// One command unit per branch with a command word, in branch order.
+    pub cmds: Vec<CmdUnit>,
     pub merge: Merger,
+    /// The command unit of each branch, if it has one.
+    _cmd_of: Vec<Option<usize>>,
     /// Devices per branch (the glue's per-mix parameters besides the count).
     _devices: Vec<usize>,
     /// Sequencer of each branch.
@@ -37,12 +45,25 @@ pub struct Core {
 
 impl Core {
     pub fn new(plan: &Plan) -> Core {
+        let mut cmd_of = vec![None; plan.branches.len()];
+        let mut cmds = vec![];
+        for (b, r) in plan.branches.iter().enumerate() {
+            if let Some(c) = &r.command {
+                cmd_of[b] = Some(cmds.len());
+                let setup = plan.seqs[r.seq].setup_cycles;
+                cmds.push(CmdUnit::new(c, r.cnv, setup, b));
+            }
+        }
         Core {
             clock: Default::default(),
             rst: Default::default(),
             adc_miso: Default::default(),
             adc_cs_n: Default::default(),
             adc_sclk: Default::default(),
+            adc_mosi: match cmds.is_empty() {
+                true => vec![],
+                false => vec![Default::default()],
+            },
             mux_sel: Default::default(),
             mux_en: Default::default(),
             sample_valid: Default::default(),
@@ -52,6 +73,8 @@ impl Core {
             timing: TimingGen::new(plan),
             seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
             branches: plan.branches.iter().map(BranchUnit::new).collect(),
+            cmds,
+            _cmd_of: cmd_of,
             merge: Merger::new(plan.branches.len()),
             _devices: plan.branches.iter().map(|b| b.devices).collect(),
             _seq_of: plan.branches.iter().map(|b| b.seq).collect(),
@@ -130,6 +153,9 @@ impl Core {
             drive(&mut u.p_sel.clock, k);
             drive(&mut u.p_dev.clock, k);
         }
+        for u in self.cmds.iter_mut() {
+            drive(&mut u.clock, k);
+        }
         let m = &mut self.merge;
         drive(&mut m.clock, k);
         drive(&mut m.r_valid.clock, k);
@@ -138,6 +164,26 @@ impl Core {
         drive(&mut m.pend.clock, k);
         drive(&mut m.r_any.clock, k);
     }
+}
+
+/// A command unit's inputs: the core's clock, reset and slot start, its
+/// branch's pins and its sequencer's SCLK and done strobe.
+#[inline]
+fn feed_cmd(
+    q: &mut CmdUnit,
+    u: &BranchUnit,
+    (clk, rst, start0): (Clock, bool, bool),
+    (q_sclk, q_done): (bool, bool),
+) {
+    q.clock.next = clk;
+    q.rst.next = rst;
+    q.start0.next = start0;
+    q.pin.next = u.cs_n.val();
+    q.bsclk.next = u.sclk.val();
+    q.qsclk.next = q_sclk;
+    q.qdone.next = q_done;
+    q.sel.next = u.mux_sel.val();
+    q.done.next = u.done.val();
 }
 
 impl Logic for Core {
@@ -165,6 +211,7 @@ impl Logic for Core {
         let (mut cs, mut sclk, mut sel, mut en, mut done) = (0u64, 0u64, 0u64, 0u128, 0u64);
         let mut more = 0u64;
         let mut done_next = 0u64;
+        let mut mosi = 0u64;
         let mut en_off = 0usize;
         let mut chs = [0u64; MAX_BRANCHES];
         let mut vals = [0u64; MAX_BRANCHES];
@@ -191,8 +238,15 @@ impl Logic for Core {
             let mask = if d >= 64 { u64::MAX } else { (1u64 << d) - 1 };
             en |= ((u.mux_en.val().to_u64() & mask) as u128) << en_off;
             en_off += d;
-            done |= (u.done.val() as u64) << b;
-            done_next |= (u.done_next.val() as u64) << b;
+            let mut live = true;
+            if let Some(i) = self._cmd_of[b] {
+                let q = &mut self.cmds[i];
+                feed_cmd(q, u, (clk, rst, start0), (q_sclk, q_done));
+                live = q.live.val();
+                mosi |= (q.mosi.val() as u64) << i;
+            }
+            done |= ((u.done.val() && live) as u64) << b;
+            done_next |= ((u.done_next.val() && live) as u64) << b;
             chs[b] = u.res_ch.val().to_u64();
             vals[b] = u.res_val.val().to_u64();
         }
@@ -202,6 +256,9 @@ impl Logic for Core {
         let idle: u64 = ((1u64 << MAX_BRANCHES) - 1) & !((1u64 << nb) - 1);
         self.adc_cs_n.next = (cs | idle).into();
         self.adc_sclk.next = (sclk | idle).into();
+        for m in self.adc_mosi.iter_mut() {
+            m.next = mosi.into();
+        }
         // `mux_sel` (48 bits) and `mux_en` (128 bits) are wider than rust-hdl's
         // short bit vectors (32 bits), so it stores them as `[bool; N]`:
         // converting them on every evaluation pass dominated the simulation,
@@ -254,6 +311,20 @@ impl Logic for Core {
             u.miso.connect();
             u.grant.connect();
         }
+        for q in self.cmds.iter_mut() {
+            q.clock.connect();
+            q.rst.connect();
+            q.start0.connect();
+            q.pin.connect();
+            q.bsclk.connect();
+            q.qsclk.connect();
+            q.qdone.connect();
+            q.sel.connect();
+            q.done.connect();
+        }
+        for m in self.adc_mosi.iter_mut() {
+            m.connect();
+        }
         self.merge.done.connect();
         self.merge.more.connect();
         self.merge.done_next.connect();
@@ -277,6 +348,7 @@ impl Logic for Core {
             &self._devices,
             &self._seq_of,
             self.seqs.len(),
+            &self._cmd_of,
         ))
     }
 }

@@ -1,0 +1,288 @@
+//! Command unit: the word a converter with a command word takes on
+//! `adc_mosi`, one bit per SCLK period, and the conversions after reset
+//! that are prepared rather than data (docs/timing.md, "Command words").
+
+use std::fmt::Write as _;
+
+use rust_hdl::prelude::*;
+
+use lut_gen::{CmdBit, Command};
+
+/// One per branch whose converter takes a command word (none in a mix
+/// without one, so the other mixes' Verilog has no trace of it).  Custom
+/// Verilog, like the word reader, so the word register is exactly the
+/// word's width and the template's fixed bits are constants.
+///
+/// It reads only what the branch and its sequencer already drive: the
+/// branch's conversion pin and SCLK (`pin`, `bsclk`: the levels of this
+/// cycle) and the sequencer's SCLK and done strobe (`qsclk`, `qdone`: the
+/// levels a converting branch has in the next cycle).  An SCLK period
+/// begins in the next cycle where SCLK falls from this cycle to the next,
+/// during a conversion; a CNV part's first period has no falling edge (SCK
+/// idles low), so a counter from the slot start (`start0`, cycle `t`)
+/// finds cycle `t + Su - 1`.  `sel` is the branch's mux field (the input
+/// the word of its next instant selects: `Plan`), loaded into the word at
+/// the slot start; bit `k` of the word goes on the lane for period `k + 1`
+/// and the lane returns to 0 when the conversion ends.
+///
+/// `live` is low while conversions after reset are still prepared (the
+/// part's `ahead`: their results were selected by no word of ours): each
+/// completion (`done`) counts one down, and the core does not hand the
+/// merger a completion while `live` is low.
+#[derive(LogicBlock)]
+pub struct CmdUnit {
+    pub clock: Signal<In, Clock>,
+    pub rst: Signal<In, Bit>,
+    pub start0: Signal<In, Bit>,
+    pub pin: Signal<In, Bit>,
+    pub bsclk: Signal<In, Bit>,
+    pub qsclk: Signal<In, Bit>,
+    pub qdone: Signal<In, Bit>,
+    pub sel: Signal<In, Bits<3>>,
+    pub done: Signal<In, Bit>,
+    pub mosi: Signal<Out, Bit>,
+    pub live: Signal<Out, Bit>,
+    _bits: Vec<CmdBit>,
+    _ahead: u64,
+    _cnv: bool,
+    _setup: u64,
+    _branch: usize,
+    /// The twin's registers: the word still to send (bit 0 next), the
+    /// lane, the CNV first-period counter, the prepared conversions left.
+    _sh: u64,
+    _mosi: bool,
+    _cnt: u64,
+    _prep: u64,
+}
+
+impl CmdUnit {
+    pub(super) fn new(cmd: &Command, cnv: bool, setup: u64, branch: usize) -> CmdUnit {
+        CmdUnit {
+            clock: Default::default(),
+            rst: Default::default(),
+            start0: Default::default(),
+            pin: Default::default(),
+            bsclk: Default::default(),
+            qsclk: Default::default(),
+            qdone: Default::default(),
+            sel: Default::default(),
+            done: Default::default(),
+            mosi: Default::default(),
+            live: Default::default(),
+            _bits: cmd.bits.clone(),
+            _ahead: cmd.ahead as u64,
+            _cnv: cnv,
+            _setup: setup,
+            _branch: branch,
+            _sh: 0,
+            _mosi: false,
+            _cnt: 0,
+            _prep: cmd.ahead as u64,
+        }
+    }
+
+    /// The word for input `sel`, bit `k` = the `k`-th bit sent.
+    fn word(&self, sel: u64) -> u64 {
+        self._bits.iter().enumerate().fold(0, |w, (k, b)| {
+            let v = match *b {
+                CmdBit::Zero => 0,
+                CmdBit::One => 1,
+                CmdBit::Channel(j) => sel >> j & 1,
+            };
+            w | v << k
+        })
+    }
+
+    /// Whether the next cycle begins an SCLK period of a conversion.
+    fn period_starts(&self) -> bool {
+        let act = self.pin.val() == self._cnv;
+        let fall = self.bsclk.val() & !self.qsclk.val();
+        let first = self._cnv
+            && if self._setup == 1 {
+                self.start0.val()
+            } else {
+                self._cnt == 1
+            };
+        act && (fall || first)
+    }
+
+    /// Width of the CNV first-period counter (counts `setup - 1` down).
+    fn cnt_bits(&self) -> usize {
+        (64 - (self._setup - 1).leading_zeros()).max(1) as usize
+    }
+
+    fn prep_bits(&self) -> usize {
+        (64 - self._ahead.leading_zeros()).max(1) as usize
+    }
+}
+
+impl Logic for CmdUnit {
+    fn update(&mut self) {
+        if self.clock.pos_edge() {
+            let src = if self.start0.val() {
+                self.word(self.sel.val().to_u64())
+            } else {
+                self._sh
+            };
+            let per = self.period_starts();
+            if self.start0.val() {
+                self._sh = src;
+            }
+            if self.rst.val() || self.qdone.val() {
+                self._mosi = false;
+            } else if per {
+                self._mosi = src & 1 == 1;
+                self._sh = src >> 1;
+            }
+            if self.rst.val() {
+                self._cnt = 0;
+            } else if self.start0.val() {
+                self._cnt = self._setup - 1;
+            } else if self._cnt != 0 {
+                self._cnt -= 1;
+            }
+            if self.rst.val() {
+                self._prep = self._ahead;
+            } else if self.done.val() && self._prep != 0 {
+                self._prep -= 1;
+            }
+        }
+        self.mosi.next = self._mosi;
+        self.live.next = self._prep == 0;
+    }
+
+    fn connect(&mut self) {
+        self.mosi.connect();
+        self.live.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        Verilog::Custom(self.verilog())
+    }
+}
+
+impl CmdUnit {
+    fn verilog(&self) -> String {
+        let l = self._bits.len();
+        let mut s = String::new();
+        let tmpl: String = Command {
+            bits: self._bits.clone(),
+            ahead: self._ahead as u32,
+        }
+        .template();
+        let _ = writeln!(
+            s,
+            "// branch {}: command word {tmpl} (first bit first) on the MOSI lane, selecting the conversion {} later",
+            self._branch, self._ahead
+        );
+        let bits: Vec<String> = (self._bits.iter().rev())
+            .map(|b| match *b {
+                CmdBit::Zero => "1'b0".to_string(),
+                CmdBit::One => "1'b1".to_string(),
+                CmdBit::Channel(j) => format!("sel[{j}]"),
+            })
+            .collect();
+        let _ = writeln!(s, "wire [{}:0] word = {{{}}};", l - 1, bits.join(", "));
+        let unused: Vec<String> = (0..3u8)
+            .filter(|j| !self._bits.contains(&CmdBit::Channel(*j)))
+            .map(|j| format!("sel[{j}]"))
+            .collect();
+        if !unused.is_empty() {
+            let _ = writeln!(
+                s,
+                "// select bits beyond the word's channel bits\nwire unused_sel = |{{{}}};",
+                unused.join(", ")
+            );
+        }
+        let _ = writeln!(s, "reg [{}:0] sh;\ninitial sh = {l}'h0;", l - 1);
+        let _ = writeln!(s, "reg r_mosi;\ninitial r_mosi = 1'b0;");
+        let _ = writeln!(s, "wire [{}:0] src = start0 ? word : sh;", l - 1);
+        let act = if self._cnv { "pin" } else { "~pin" };
+        let first = self.first_strobe(&mut s);
+        let _ = writeln!(
+            s,
+            "// an SCLK period of a conversion begins in the next cycle\nwire per = {act} & ((bsclk & ~qsclk){first});"
+        );
+        let shifted = if l == 1 {
+            "1'b0".to_string()
+        } else {
+            format!("{{1'b0, src[{}:1]}}", l - 1)
+        };
+        let _ = writeln!(s, "\nalways @(posedge clock) begin");
+        let _ = writeln!(s, "  if (start0) sh <= word;");
+        let _ = writeln!(s, "  if (rst | qdone) r_mosi <= 1'b0;");
+        let _ = writeln!(s, "  else if (per) begin");
+        let _ = writeln!(s, "    r_mosi <= src[0];\n    sh <= {shifted};\n  end");
+        let _ = writeln!(s, "end\n");
+        self.prepared(&mut s);
+        let _ = writeln!(
+            s,
+            "\nalways @(*) begin\n  mosi = r_mosi;\n  live = {};\nend",
+            self.live_expr()
+        );
+        s
+    }
+
+    /// The CNV part's first period (no falling edge): ` | first` and its
+    /// counter; a CS part's first period begins with a falling edge.
+    fn first_strobe(&self, s: &mut String) -> &'static str {
+        if !self._cnv {
+            return "";
+        }
+        if self._setup == 1 {
+            let _ = writeln!(
+                s,
+                "// the first period begins right after the slot start\nwire first = start0;"
+            );
+            return " | first";
+        }
+        let w = self.cnt_bits();
+        let _ = writeln!(
+            s,
+            "// cycles to the first period (setup {} cycles from the slot start)",
+            self._setup
+        );
+        let _ = writeln!(s, "reg [{}:0] cnt;\ninitial cnt = {w}'h0;", w - 1);
+        let _ = writeln!(s, "always @(posedge clock) begin");
+        let _ = writeln!(s, "  if (rst) cnt <= {w}'h0;");
+        let _ = writeln!(s, "  else if (start0) cnt <= {w}'d{};", self._setup - 1);
+        let _ = writeln!(s, "  else if (cnt != {w}'h0) cnt <= cnt - {w}'h1;");
+        let _ = writeln!(s, "end");
+        let _ = writeln!(s, "wire first = cnt == {w}'h1;");
+        " | first"
+    }
+
+    /// The prepared-conversion counter (a part with `ahead` > 0).
+    fn prepared(&self, s: &mut String) {
+        if self._ahead == 0 {
+            let _ = writeln!(s, "// the word selects its own conversion: nothing is prepared\nwire unused_cmd = done;");
+            return;
+        }
+        let w = self.prep_bits();
+        let _ = writeln!(
+            s,
+            "// conversions after reset still prepared (selected by no word of ours)"
+        );
+        let _ = writeln!(
+            s,
+            "reg [{}:0] prep;\ninitial prep = {w}'d{};",
+            w - 1,
+            self._ahead
+        );
+        let _ = writeln!(s, "always @(posedge clock) begin");
+        let _ = writeln!(s, "  if (rst) prep <= {w}'d{};", self._ahead);
+        let _ = writeln!(
+            s,
+            "  else if (done && prep != {w}'h0) prep <= prep - {w}'h1;"
+        );
+        let _ = writeln!(s, "end");
+    }
+
+    fn live_expr(&self) -> String {
+        if self._ahead == 0 {
+            "1'b1".into()
+        } else {
+            format!("prep == {}'h0", self.prep_bits())
+        }
+    }
+}
