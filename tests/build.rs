@@ -761,12 +761,6 @@ fn reports_of_unseen_mixes_read_like_datasheets() {
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         // A mix with modes is audited only (tests/cli.rs: the refusal).
         .filter(|p| lut_gen::load(p).unwrap().modes.is_none())
-        // So is one whose converter takes a command word until the gateware
-        // drives adc_mosi (`Layout::fits` then takes it).
-        .filter(|p| {
-            let s = lut_gen::synthesize(&lut_gen::load(p).unwrap()).unwrap();
-            lut_gen::Layout::fits(&s).is_ok()
-        })
         .collect();
     mixes.sort();
     mixes.push(root.join("mixes/eskin34-uart.toml"));

@@ -570,13 +570,6 @@ impl Layout {
         Layout::fits_limits(s)
     }
 
-    /// Whether `s` fits the pin contract's [`limits`] alone: what the judge
-    /// needs (its model and checker drive and read `adc_mosi`), while
-    /// [`Layout::fits`] also refuses what the gateware does not build yet.
-    pub fn fits_judge(s: &Schedule) -> Result<(), String> {
-        Layout::fits_limits(s)
-    }
-
     /// Whether `s` fits the gateware's [`limits`], or which limit it exceeds.
     fn fits_limits(s: &Schedule) -> Result<(), String> {
         use limits::*;

@@ -50,13 +50,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> u8 {
-    // The model's pins take a converter with a command word; the gateware
-    // does not drive adc_mosi yet.
-    let limits = match a.backend {
-        engines::Backend::Model => super::Limits::Judge,
-        _ => super::Limits::Contract,
-    };
-    let s = match super::load_checked(&a.mix, limits) {
+    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };

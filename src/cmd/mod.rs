@@ -145,10 +145,6 @@ pub enum Limits {
     Contract,
     /// The emitter's, as it emits (`verilog`: exit 1, the file named).
     Emitter,
-    /// The judge's (`check`, `sim --backend model`): the contract's, and a
-    /// converter with a command word is taken (the model drives `adc_mosi`,
-    /// the checker reads it) before the gateware drives it.
-    Judge,
 }
 
 /// The mix loaded and scheduled, its limits checked, and its link to the
@@ -167,14 +163,6 @@ pub fn load_any_modes(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, 
     let s = match limits {
         Limits::Contract => schedule_on_pins(path)?,
         Limits::Emitter => schedule(path)?,
-        Limits::Judge => {
-            let s = schedule(path)?;
-            lut_gen::Layout::fits_judge(&s).map_err(|m| {
-                eprintln!("error: mix `{}`: {m}", s.mix.name);
-                2u8
-            })?;
-            s
-        }
     };
     link_fits(&s, path)?;
     Ok(s)

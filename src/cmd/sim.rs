@@ -223,8 +223,6 @@ fn to_fst(
     judge::write_gtkw(&fst.with_extension("gtkw"), fst, s)
 }
 
-type Load = fn(&std::path::Path, super::Limits) -> Result<lut_gen::Schedule, u8>;
-
 pub fn run(a: Args) -> u8 {
     let backend = a.backend;
     if let Err(e) = early_checks(&a) {
@@ -232,11 +230,11 @@ pub fn run(a: Args) -> u8 {
         return 2;
     }
     // The model follows mode switches; the gateware does not yet.
-    let (load, limits) = match backend {
-        Backend::Model => (super::load_any_modes as Load, super::Limits::Judge),
-        _ => (super::load_checked as Load, super::Limits::Contract),
+    let load = match backend {
+        Backend::Model => super::load_any_modes,
+        _ => super::load_checked,
     };
-    let s = match load(&a.mix, limits) {
+    let s = match load(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };

@@ -97,3 +97,77 @@ fn command_faults_join_the_campaign_and_every_detector_sees_them() {
         }
     }
 }
+
+/// The emitted Verilog's word of the `k`-th command unit (`wire [..] word =
+/// {MSB, ..., bit sent first};`), edited by `f` (its elements, MSB first).
+fn edit_word(v: &str, k: usize, f: &dyn Fn(&mut Vec<String>)) -> String {
+    let mut seen = 0;
+    let lines: Vec<String> = v
+        .lines()
+        .map(|l| {
+            let Some((head, rest)) = l.split_once("] word = {") else {
+                return l.to_string();
+            };
+            seen += 1;
+            if seen != k + 1 {
+                return l.to_string();
+            }
+            let body = rest.strip_suffix("};").unwrap();
+            let mut el: Vec<String> = body.split(", ").map(str::to_string).collect();
+            f(&mut el);
+            format!("{head}] word = {{{}}};", el.join(", "))
+        })
+        .collect();
+    assert!(seen > k, "no command unit {k}");
+    lines.join("\n") + "\n"
+}
+
+/// Verilog that sends the wrong channel bits (the channel bit sent last
+/// inverted in every word) or each word one SCLK period late, one command unit at a
+/// time, on Icarus: every detector catches each, and the clean Verilog
+/// passes them all (sigrok's MOSI decode included).
+#[test]
+fn verilog_sending_wrong_or_late_words_fails_on_icarus() {
+    if !tools::require_tools(&["sigrok-cli", "iverilog"]) {
+        return;
+    }
+    let s = load("cmd-pair");
+    let v = engines::verilog(&s).unwrap();
+    let units = (0..s.branches.len()).filter(|&b| s.has_command(b)).count();
+    let mut plan = Plan::new(Target::Model, 3, 0);
+    plan.builtin = false;
+    plan.verilog_engines = vec![engines::Backend::Icarus];
+    for k in 0..units {
+        let wrong = edit_word(&v, k, &|el| {
+            let i = el.iter().position(|e| e.starts_with("sel[")).unwrap();
+            el[i] = format!("~{}", el[i]);
+        });
+        let late = edit_word(&v, k, &|el| {
+            el.remove(0);
+            el.push("1'b0".into());
+        });
+        for (class, verilog) in [
+            (FaultClass::WrongChannelBits, wrong),
+            (FaultClass::LateCommand, late),
+        ] {
+            plan.verilog_faults.push(campaign::VerilogFault {
+                name: format!("{class:?} unit {k}"),
+                class,
+                verilog,
+            });
+        }
+    }
+    let c = campaign_with(&s, &plan).unwrap();
+    assert_eq!(c.false_alarms.rejected, 0, "{:?}", c.false_alarms);
+    for class in [FaultClass::WrongChannelBits, FaultClass::LateCommand] {
+        let k = c.classes.iter().find(|k| k.name == class).unwrap();
+        assert_eq!(k.injected, units as u64, "{class:?}");
+        for d in [Detector::Model, Detector::Invariants, Detector::Sigrok] {
+            assert_eq!(
+                k.detected_by.get(&d),
+                Some(&k.injected),
+                "{class:?} {d:?}: {k:?}"
+            );
+        }
+    }
+}
