@@ -895,3 +895,93 @@ fn the_model_back_end_simulates_mode_switches() {
         .stderr(predicate::str::contains("mode ports"));
     assert!(!vcd.exists());
 }
+
+/// Converters with a command word on the judge's side: `sim --backend
+/// model` of the shared commanded mix writes a VCD with `adc_mosi` that
+/// `check` passes with and without the model; the same VCD with one
+/// `adc_mosi` change inverted fails on that lane, the bit and word named
+/// (and, without the model, as a sample held to another channel than its
+/// word selected, or a word the part would not take).
+#[test]
+fn a_commanded_mix_is_simulated_on_the_model_and_checked() {
+    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("testkit/mixes/cmd-pair.toml");
+    let d = tempfile::tempdir().unwrap();
+    let vcd = d.path().join("w.vcd");
+    slotforge()
+        .args([
+            "sim",
+            "--quiet",
+            "--backend",
+            "model",
+            "--frames",
+            "4",
+            "--to",
+            "4",
+            "--vcd",
+        ])
+        .arg(&vcd)
+        .arg(&mix)
+        .assert()
+        .success();
+    let check = |wave: &Path, extra: &[&str]| {
+        slotforge()
+            .args(["check", "--json"])
+            .args(extra)
+            .arg(&mix)
+            .arg(wave)
+            .assert()
+    };
+    for extra in [&[][..], &["--no-model"]] {
+        let a = check(&vcd, extra).success();
+        let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
+        assert!(v["samples"].as_u64().unwrap() > 50, "{v}");
+    }
+    // Invert the value of the 40th change of adc_mosi (a whole run of cycles).
+    let text = std::fs::read_to_string(&vcd).unwrap();
+    let id = text
+        .lines()
+        .find(|l| l.contains(" adc_mosi [1:0]"))
+        .and_then(|l| l.split_whitespace().nth(3))
+        .unwrap()
+        .to_string();
+    let mut n = 0;
+    let bad: Vec<String> = text
+        .lines()
+        .map(|l| {
+            match l
+                .strip_prefix('b')
+                .and_then(|r| r.strip_suffix(&format!(" {id}")))
+            {
+                Some(bits) if n < 40 => {
+                    n += 1;
+                    if n == 40 {
+                        let v = u8::from_str_radix(bits, 2).unwrap() ^ 0b10;
+                        return format!("b{v:b} {id}");
+                    }
+                    l.to_string()
+                }
+                _ => l.to_string(),
+            }
+        })
+        .collect();
+    assert_eq!(n, 40);
+    let flipped = d.path().join("bad.vcd");
+    std::fs::write(&flipped, bad.join("\n") + "\n").unwrap();
+    let a = check(&flipped, &[]).code(1);
+    let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
+    let dv = &v["divergences"][0];
+    assert_eq!(dv["signal"], "adc_mosi[1]", "{v}");
+    assert!(
+        dv["context"][0].as_str().unwrap().contains("command word"),
+        "{v}"
+    );
+    let a = check(&flipped, &["--no-model"]).code(1);
+    let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
+    let rules: Vec<&str> = v["violations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x["rule"].as_str().unwrap())
+        .collect();
+    assert!(rules.iter().any(|r| r.starts_with("command-")), "{rules:?}");
+}

@@ -865,7 +865,6 @@ fn commanded_mixes_prove_and_name_what_the_part_does_as_not_covered() {
 /// bit 1 (the mix has inputs where they differ) fails `prove` on the
 /// command word, with a counterexample the replay reproduces.
 #[test]
-#[ignore = "the replay's checker takes commanded mixes on branch i30-judge: run once both are merged"]
 fn a_gateware_sending_the_wrong_channel_bits_fails_prove() {
     if !tools::require_tools(&TOOLS) {
         return;

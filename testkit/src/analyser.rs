@@ -51,7 +51,7 @@ pub fn run_with_miso<D: Dut>(s: &Schedule, dut: &mut D, frames: u64) -> (Vec<Pin
     (r.0, r.1)
 }
 
-/// The analyser's channels: every CS, SCLK, mux select and enable bit and
+/// The analyser's channels: every CS, SCLK, MOSI, mux select and enable bit and
 /// sample_valid, as D0..Dn, with the `--map` that names them.
 pub fn lanes(s: &Schedule) -> (Vec<(Option<Role>, u32)>, String) {
     let l = Layout::new(s);
@@ -59,6 +59,7 @@ pub fn lanes(s: &Schedule) -> (Vec<(Option<Role>, u32)>, String) {
     for r in [
         Role::CsN,
         Role::Sclk,
+        Role::Mosi,
         Role::MuxSel,
         Role::MuxEn,
         Role::SampleValid,
@@ -108,6 +109,7 @@ pub fn bit(p: &Pins, r: Option<Role>, b: u32) -> bool {
     let v: u128 = match r {
         Some(Role::CsN) => p.cs_n as u128,
         Some(Role::Sclk) => p.sclk as u128,
+        Some(Role::Mosi) => p.mosi as u128,
         Some(Role::MuxSel) => p.mux_sel as u128,
         Some(Role::MuxEn) => p.mux_en,
         Some(_) => p.sample_valid as u128,

@@ -3,7 +3,11 @@
 //! the part's SPI mode and word size.  A run passes when, per branch, the
 //! words it decodes are the sample values the design emitted for that
 //! branch's channels, in order, and there are as many as the schedule has
-//! conversions in the window.  It has no view of the mux pins.
+//! conversions in the window.  It has no view of the mux pins.  A branch
+//! whose converter takes a command word has its `adc_mosi` lane decoded as
+//! well: each word must be the one the schedule sends in that conversion
+//! (`Schedule::commands_in_frame`), and the prepared conversions after reset
+//! are no samples.
 //!
 //! The window starts at frame 1 (where faults land); one cycle is one
 //! nanosecond of the VCD sigrok reads (its SPI decoder counts edges, not
@@ -25,7 +29,9 @@ pub struct SpiCapture {
     /// Observer cycle of the window's first cycle (the last of frame 0).
     from: u64,
     last: Vec<Option<u8>>,
-    /// Per branch: (time, cs | sclk << 1 | miso << 2) at every change.
+    /// Each branch's `adc_mosi` bit, if it has one.
+    mosi: Vec<Option<u32>>,
+    /// Per branch: (time, cs | sclk << 1 | miso << 2 | mosi << 3) at every change.
     changes: Vec<Vec<(u64, u8)>>,
     samples: Vec<(u16, u16)>,
     end: u64,
@@ -41,6 +47,7 @@ impl SpiCapture {
             // a cycle early, so that a CS falling at frame 1's first cycle is an edge
             from: reset + s.grid.frame_cycles - 1,
             last: vec![None; nb],
+            mosi: lut_gen::Layout::new(s).mosi_lo,
             changes: vec![Vec::new(); nb],
             samples: Vec::new(),
             end: 0,
@@ -57,9 +64,11 @@ impl Observer for SpiCapture {
         let t = cycle - self.from;
         self.end = t + 1;
         for (b, last) in self.last.iter_mut().enumerate() {
+            let mosi = self.mosi[b].map_or(0, |i| (p.mosi >> i & 1) as u8);
             let v = (p.cs_n >> b & 1) as u8
                 | ((p.sclk >> b & 1) as u8) << 1
-                | ((miso >> b & 1) as u8) << 2;
+                | ((miso >> b & 1) as u8) << 2
+                | mosi << 3;
             if *last != Some(v) {
                 *last = Some(v);
                 self.changes[b].push((t, v));
@@ -110,13 +119,14 @@ impl PartDecoder {
     }
 }
 
-/// The branch's lanes as a VCD sigrok reads (1-bit signals `cs`, `sclk`, `miso`).
+/// The branch's lanes as a VCD sigrok reads (1-bit signals `cs`, `sclk`,
+/// `miso`, `mosi`).
 fn vcd(changes: &[(u64, u8)], end: u64) -> String {
-    let mut out = judge::wire_header("1 ns", "top", &["cs", "sclk", "miso"]);
+    let mut out = judge::wire_header("1 ns", "top", &["cs", "sclk", "miso", "mosi"]);
     let mut prev: Option<u8> = None;
     for &(t, v) in changes {
         let _ = writeln!(out, "#{t}");
-        for (k, id) in ['!', '"', '#'].iter().enumerate() {
+        for (k, id) in ['!', '"', '#', '$'].iter().enumerate() {
             let bit = v >> k & 1;
             if prev.map(|p| p >> k & 1) != Some(bit) {
                 let _ = writeln!(out, "{bit}{id}");
@@ -131,10 +141,32 @@ fn vcd(changes: &[(u64, u8)], end: u64) -> String {
 /// The codes sigrok decodes from one branch's VCD.
 fn decode(file: &Path, part: &AdcPart) -> Result<Vec<u16>, String> {
     let d = PartDecoder::of(part);
+    let words = words(file, &d, "miso")?;
+    Ok(words
+        .into_iter()
+        .map(|w| (w >> d.shift) as u16 & d.mask)
+        .collect())
+}
+
+/// The command words sigrok decodes from one branch's `mosi` lane, first
+/// bit first (the word's bits are the top of each SPI word).
+fn decode_commands(file: &Path, part: &AdcPart) -> Result<Vec<Vec<bool>>, String> {
+    let d = PartDecoder::of(part);
+    let n = part.command.as_ref().map_or(0, |c| c.bits.len() as u32);
+    let words = words(file, &d, "mosi")?;
+    Ok(words
+        .into_iter()
+        .map(|w| (0..n).map(|i| w >> (d.wordsize - 1 - i) & 1 == 1).collect())
+        .collect())
+}
+
+/// The words sigrok-cli's SPI decoder reads on `lane` (`miso` or `mosi`).
+fn words(file: &Path, d: &PartDecoder, lane: &str) -> Result<Vec<u32>, String> {
     let dec = format!(
-        "spi:clk=sclk:miso=miso:cs=cs:{}:wordsize={}",
+        "spi:clk=sclk:miso=miso:mosi=mosi:cs=cs:{}:wordsize={}",
         d.options, d.wordsize
     );
+    let ann = format!("spi={lane}-data");
     let name = file
         .file_name()
         .and_then(|n| n.to_str())
@@ -142,7 +174,7 @@ fn decode(file: &Path, part: &AdcPart) -> Result<Vec<u16>, String> {
     let dir = file.parent().unwrap_or(Path::new("."));
     let out = tools::run(
         "sigrok-cli",
-        &["-I", "vcd", "-i", name, "-P", &dec, "-A", "spi=miso-data"],
+        &["-I", "vcd", "-i", name, "-P", &dec, "-A", &ann],
         dir,
         Duration::from_secs(120),
     )
@@ -154,9 +186,7 @@ fn decode(file: &Path, part: &AdcPart) -> Result<Vec<u16>, String> {
         .lines()
         .map(|l| {
             let w = l.rsplit(':').next().unwrap_or("").trim();
-            u32::from_str_radix(w, 16)
-                .map(|w| (w >> d.shift) as u16 & d.mask)
-                .map_err(|_| format!("sigrok-cli printed `{l}`"))
+            u32::from_str_radix(w, 16).map_err(|_| format!("sigrok-cli printed `{l}`"))
         })
         .collect()
 }
@@ -178,48 +208,186 @@ pub fn check(
     frames: u64,
     dir: &Path,
 ) -> Result<Result<(), String>, String> {
-    let f = s.grid.frame_cycles;
-    let total = frames * f;
-    let slack = s.mix.branches.iter().map(|b| b.chain as u64).sum::<u64>() + 2;
-    for (b, br) in s.branches.iter().enumerate() {
-        let part = &s.mix.branches[b].adc;
+    for b in 0..s.branches.len() {
         let file = dir.join(format!("b{b}.vcd"));
         std::fs::write(&file, vcd(&cap.changes[b], cap.end)).map_err(|e| e.to_string())?;
-        let words = decode(&file, part)?;
-        let read = br.spi.read_cycles;
-        let count = |margin: u64| -> usize {
-            s.instants(frames)
-                .filter(|i| i.branch == b && i.cycle >= f && i.cycle + read + margin < total)
-                .map(|i| s.words_of(i.channel).count())
-                .sum()
-        };
-        let values: Vec<u16> = cap
-            .samples
-            .iter()
-            .filter(|(c, _)| s.mix.channels.get(*c as usize).map(|c| c.branch) == Some(b))
-            .map(|&(_, v)| v)
-            .collect();
-        let name = &br.name;
-        if words.len() != count(0) {
-            return Ok(Err(format!(
-                "branch {name}: sigrok decoded {} words, the schedule has {} conversions",
-                words.len(),
-                count(0)
-            )));
-        }
-        if let Some(k) = (0..words.len().min(values.len())).find(|&k| words[k] != values[k]) {
-            return Ok(Err(format!(
-                "branch {name}: word {k}: SPI (sigrok) read {:#06x}, the design emitted {:#06x}",
-                words[k], values[k]
-            )));
-        }
-        if values.len() > words.len() || values.len() < count(slack) {
-            return Ok(Err(format!(
-                "branch {name}: the design emitted {} samples for {} decoded words",
-                values.len(),
-                words.len()
-            )));
+        if let Err(e) = check_branch(s, cap, frames, b, &file)? {
+            return Ok(Err(e));
         }
     }
     Ok(Ok(()))
+}
+
+/// Branch `b`'s conversions in the window (frame 1 on) whose read ends
+/// more than `margin` cycles before the run: (its index among the branch's
+/// conversions in its frame, its channel).
+fn window_conversions(s: &Schedule, b: usize, frames: u64, margin: u64) -> Vec<(usize, usize)> {
+    let f = s.grid.frame_cycles;
+    let read = s.branches[b].spi.read_cycles;
+    let mut out = Vec::new();
+    for frame in 1..frames {
+        let mine = s
+            .instants(frames)
+            .filter(|i| i.branch == b && i.cycle / f == frame);
+        for (k, i) in mine.enumerate() {
+            if i.cycle + read + margin < frames * f {
+                out.push((k, i.channel));
+            }
+        }
+    }
+    out
+}
+
+/// Branch `b`'s decode against the design's samples and, for a converter
+/// with a command word, its `mosi` words against the schedule's.
+fn check_branch(
+    s: &Schedule,
+    cap: &SpiCapture,
+    frames: u64,
+    b: usize,
+    file: &Path,
+) -> Result<Result<(), String>, String> {
+    let part = &s.mix.branches[b].adc;
+    let name = &s.branches[b].name;
+    let slack = s.mix.branches.iter().map(|b| b.chain as u64).sum::<u64>() + 2;
+    let count = |margin: u64| -> usize {
+        window_conversions(s, b, frames, margin)
+            .iter()
+            .map(|&(_, ch)| s.words_of(ch).count())
+            .sum()
+    };
+    let words = decode(file, part)?;
+    if words.len() != count(0) {
+        return Ok(Err(format!(
+            "branch {name}: sigrok decoded {} words, the schedule has {} conversions",
+            words.len(),
+            count(0)
+        )));
+    }
+    if s.has_command(b) {
+        if let Err(e) = check_commands(s, frames, b, file)? {
+            return Ok(Err(e));
+        }
+    }
+    // The prepared conversions after reset that fall in the window are
+    // read on the wire, never emitted.
+    let before = s
+        .instants(1)
+        .filter(|i| i.branch == b && !s.skipped_at_startup(b, i.cycle))
+        .count();
+    let prepared = (s.prepared_conversions(b) as usize).saturating_sub(before);
+    let words = &words[prepared.min(words.len())..];
+    let values: Vec<u16> = cap
+        .samples
+        .iter()
+        .filter(|(c, _)| s.mix.channels.get(*c as usize).map(|c| c.branch) == Some(b))
+        .map(|&(_, v)| v)
+        .collect();
+    if let Some(k) = (0..words.len().min(values.len())).find(|&k| words[k] != values[k]) {
+        return Ok(Err(format!(
+            "branch {name}: word {k}: SPI (sigrok) read {:#06x}, the design emitted {:#06x}",
+            words[k], values[k]
+        )));
+    }
+    if values.len() > words.len() || values.len() + prepared < count(slack) {
+        return Ok(Err(format!(
+            "branch {name}: the design emitted {} samples for {} decoded words",
+            values.len(),
+            words.len()
+        )));
+    }
+    Ok(Ok(()))
+}
+
+/// Branch `b`'s command words as sigrok decodes them from `mosi`, each the
+/// word the schedule sends in that conversion.
+fn check_commands(
+    s: &Schedule,
+    frames: u64,
+    b: usize,
+    file: &Path,
+) -> Result<Result<(), String>, String> {
+    let name = &s.branches[b].name;
+    let sent = s.commands_in_frame(b);
+    let got = decode_commands(file, &s.mix.branches[b].adc)?;
+    let want: Vec<&lut_gen::CommandSent> = window_conversions(s, b, frames, 0)
+        .iter()
+        .map(|&(k, _)| &sent[k])
+        .collect();
+    let bits = |w: &[bool]| -> String { w.iter().map(|&v| if v { '1' } else { '0' }).collect() };
+    if got.len() != want.len() {
+        return Ok(Err(format!(
+            "branch {name}: sigrok decoded {} command words on mosi, the schedule sends {}",
+            got.len(),
+            want.len()
+        )));
+    }
+    if let Some(k) = (0..got.len()).find(|&k| got[k] != want[k].word) {
+        return Ok(Err(format!(
+            "branch {name}: command word {k}: SPI (sigrok) read {} on mosi, the schedule sends {} (selecting {})",
+            bits(&got[k]),
+            bits(&want[k].word),
+            s.mix.channels[want[k].selects].name
+        )));
+    }
+    Ok(Ok(()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use judge::{run_dut, Dut, FaultyDut, ModelDut, PinFault, RunOptions};
+
+    fn capture(s: &Schedule, dut: &mut dyn Dut, frames: u64) -> SpiCapture {
+        let opts = RunOptions::default();
+        let mut cap = SpiCapture::new(s, judge::reset_cycles(s, opts.reset_cycles));
+        run_dut(s, dut, frames, &opts, "sigrok", Some(&mut cap));
+        cap
+    }
+
+    /// sigrok's decoder reads the command words on `mosi`: on a clean run
+    /// of the shared commanded mixes they are the schedule's, every one;
+    /// a word with a wrong channel bit is named.
+    #[test]
+    fn sigrok_reads_the_command_words_on_mosi() {
+        if !testkit::tools::require_tool("sigrok-cli") {
+            return;
+        }
+        for name in ["cmd-pair", "cmd-solo"] {
+            let s = lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap();
+            let frames = 4;
+            let dir = tempfile::tempdir().unwrap();
+            let cap = capture(&s, &mut ModelDut::new(&s), frames);
+            assert_eq!(
+                check(&s, &cap, frames, dir.path()).unwrap(),
+                Ok(()),
+                "{name}"
+            );
+            for b in (0..s.branches.len()).filter(|&b| s.has_command(b)) {
+                let got = decode_commands(
+                    &dir.path().join(format!("b{b}.vcd")),
+                    &s.mix.branches[b].adc,
+                )
+                .unwrap();
+                let sent = s.commands_in_frame(b);
+                let want: Vec<Vec<bool>> = window_conversions(&s, b, frames, 0)
+                    .iter()
+                    .map(|&(k, _)| sent[k].word.clone())
+                    .collect();
+                assert!(!got.is_empty(), "{name} branch {b}");
+                assert_eq!(got, want, "{name} branch {b}");
+            }
+            let b = (0..s.branches.len()).find(|&b| s.has_command(b)).unwrap();
+            let at = s.grid.frame_cycles * 3 / 2;
+            let mut dut = FaultyDut::new(
+                &s,
+                ModelDut::new(&s),
+                PinFault::WrongChannelBits { branch: b },
+                at,
+            );
+            let cap = capture(&s, &mut dut, frames);
+            let e = check(&s, &cap, frames, dir.path()).unwrap().unwrap_err();
+            assert!(e.contains("command word"), "{name}: {e}");
+        }
+    }
 }

@@ -4,6 +4,9 @@
 #[path = "capture_mixes.rs"]
 mod capture_mixes;
 
+#[path = "commands.rs"]
+mod commands;
+
 #[path = "equiv.rs"]
 mod equiv;
 

@@ -13,6 +13,7 @@ use serde_json::{json, Value};
 
 use lut_gen::{Layout, Pins, Role, Signal};
 
+use crate::cmdword::{CommandRead, Selected};
 use crate::invariants::Invariants;
 use crate::linkjoin::{Joined, LinkJoin};
 use crate::linkline::LinkLine;
@@ -85,6 +86,10 @@ struct BranchState {
     /// Joined mid-stream before this branch's mux last moved: the settling of
     /// its first conversion cannot be known.
     mux_unknown: bool,
+    /// A commanded branch: the conversion is prepared (no sample), and the
+    /// cycle of the conversion whose word selected `ch`.
+    prepared: bool,
+    word_at: Option<u64>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -131,7 +136,9 @@ fn same(a: &Pins, b: &Pins) -> bool {
         | (((a.cs_n ^ b.cs_n) as u128) << 64)
         | (((a.sclk ^ b.sclk) as u128) << 80)
         | (((a.sample_channel ^ b.sample_channel) as u128) << 96)
-        | (((a.sample_value ^ b.sample_value) as u128) << 112);
+        | (((a.sample_value ^ b.sample_value) as u128) << 112)
+        // overlapping bits are harmless: only `== 0` is asked
+        | ((a.mosi ^ b.mosi) as u128);
     let modes = (a.mode ^ b.mode) | (a.mode_sel ^ b.mode_sel);
     let flags = (a.sample_valid ^ b.sample_valid)
         | (a.link_tx ^ b.link_tx)
@@ -185,6 +192,15 @@ pub struct Checker {
     rst_x_seen: bool,
     /// The model cycle checking began at (0: at reset; later: joined mid-stream).
     origin: u64,
+    /// Per branch: its command words read from `adc_mosi` (a converter that
+    /// takes one), and the words the schedule sends (for reports).
+    cmds: Vec<Option<CommandRead>>,
+    words: Vec<Vec<lut_gen::CommandSent>>,
+    /// Sampling instants held back, in time order, while a commanded
+    /// branch's word (a part that converts in the same read) is still being
+    /// clocked in: (cycle, branch, channel, still open).  Frames do not close
+    /// while any is held.
+    held: std::collections::VecDeque<(u64, usize, Option<u16>, bool)>,
     /// Joined mid-stream with the model: its link joins from the line
     /// (until then the link's pins are not compared) ...
     link_join: Option<LinkJoin>,
@@ -280,6 +296,13 @@ impl Checker {
             origin: 0,
             link_join: None,
             link_joined: None,
+            cmds: (0..s.branches.len())
+                .map(|b| CommandRead::new(s, b))
+                .collect(),
+            words: (0..s.branches.len())
+                .map(|b| s.commands_in_frame(b))
+                .collect(),
+            held: Default::default(),
         }
     }
 
@@ -319,6 +342,7 @@ impl Checker {
             st.mux_unknown = j.mux_since[b].is_none();
             st.mux_since = j.mux_since[b].unwrap_or(0);
         }
+        chk.cmds.iter_mut().flatten().for_each(CommandRead::join);
         chk
     }
 
@@ -490,9 +514,11 @@ impl Checker {
         if self.layout.link {
             self.link_rules(c, p);
         }
-        if c + 1 == self.next_frame_at {
+        if c + 1 >= self.next_frame_at && self.held.is_empty() {
             self.inv.close_frames(c + 1);
-            self.next_frame_at += self.grid.frame_cycles;
+            while self.next_frame_at <= c + 1 {
+                self.next_frame_at += self.grid.frame_cycles;
+            }
         }
         self.prev = *p;
         self.prev_xz = *xz;
@@ -569,6 +595,9 @@ impl Checker {
                         .map(|(hc, hp, he)| ctx_line(inv.place(*hc).0, hp, he.as_ref()))
                         .collect();
                     context.push(format!("{} <- diverges", ctx_line(cycle, p, Some(e))));
+                    if let Signal::Mosi(b) = s {
+                        context.insert(0, self.command_context(b, m, ev));
+                    }
                     if s == Signal::LinkTx {
                         context.extend(m.link_context());
                     }
@@ -728,6 +757,12 @@ impl Checker {
                     } else {
                         self.sclk_rise(b, c);
                     }
+                    // the part latches DIN at its own clock's rising edge
+                    // (a fall in the CS view for a CNV part)
+                    let real_rise = (p.sclk & bit != 0) != self.limits[b].cnv;
+                    if real_rise && self.cmds[b].is_some() {
+                        self.latch(b, self.layout.mosi(p, b));
+                    }
                 } else {
                     self.inv.record(
                         Violation::new(Rule::SclkIdle, c)
@@ -785,6 +820,10 @@ impl Checker {
                     }),
             );
         }
+        if self.cmds[b].is_some() {
+            self.cs_fall_commanded(b, c);
+            return;
+        }
         let sel_x = self.layout.sel(xz, b) != 0 || self.layout.en(xz, b) != 0;
         let ch = match self.layout.selected(p, b) {
             Ok(ch) if !sel_x => Some(ch),
@@ -816,9 +855,135 @@ impl Checker {
                         self.inv.instant(c, b, m as u16);
                     }
                 }
-                None => self.inv.instant(c, b, ch),
+                None => self.instant(c, b, ch),
             }
         }
+    }
+
+    /// A sampling instant, or held back behind a command word still being
+    /// clocked in (`held`).
+    fn instant(&mut self, t: u64, b: usize, ch: u16) {
+        if self.held.is_empty() {
+            self.inv.instant(t, b, ch);
+        } else {
+            self.held.push_back((t, b, Some(ch), false));
+        }
+    }
+
+    /// A conversion of a commanded branch begins at `c`: its channel is the
+    /// one its command word selected (docs/timing.md, "Command words"), not
+    /// the mux pins' (it has none); a part that converts in the same read
+    /// holds the instant until the word is in.
+    fn cs_fall_commanded(&mut self, b: usize, c: u64) {
+        let sel = self.cmds[b].as_mut().and_then(|r| r.start(c));
+        let st = &mut self.br[b];
+        st.low = true;
+        st.t = c;
+        st.falls = 0;
+        st.rises = 0;
+        st.word = 0;
+        st.word_bad = false;
+        st.ch = None;
+        st.prepared = false;
+        st.word_at = None;
+        match sel {
+            None => self.held.push_back((c, b, None, true)),
+            Some(sel) => self.selected(b, c, sel),
+        }
+    }
+
+    /// Branch `b`'s conversion at `t` converts what `sel` says.
+    fn selected(&mut self, b: usize, t: u64, sel: Selected) {
+        match sel {
+            Selected::Prepared => self.br[b].prepared = true,
+            Selected::Unknown => self.inv.blind(t),
+            Selected::Word { sent_at, channel } => {
+                let st = &mut self.br[b];
+                st.ch = channel;
+                st.word_at = Some(sent_at);
+                if let Some(ch) = channel {
+                    self.instant(t, b, ch);
+                }
+            }
+        }
+    }
+
+    /// DIN bit `v` of branch `b` latched; a whole word of a part that
+    /// converts in the same read settles its held instant.
+    fn latch(&mut self, b: usize, v: bool) {
+        if let Some(sel) = self.cmds[b].as_mut().and_then(|r| r.latch(v)) {
+            self.resolve(b, sel);
+        }
+    }
+
+    /// Branch `b`'s held instant converts what `sel` says: the instants
+    /// held behind it go on in time order.
+    fn resolve(&mut self, b: usize, sel: Selected) {
+        let t = self.br[b].t;
+        if let Some(h) = self.held.iter_mut().find(|h| h.3 && h.1 == b) {
+            h.3 = false;
+            match sel {
+                Selected::Word { sent_at, channel } => {
+                    h.2 = channel;
+                    self.br[b].ch = channel;
+                    self.br[b].word_at = Some(sent_at);
+                }
+                _ => self.inv.blind(t),
+            }
+        }
+        self.flush_held();
+    }
+
+    fn flush_held(&mut self) {
+        while let Some(&(t, b, ch, false)) = self.held.front() {
+            self.held.pop_front();
+            if let Some(ch) = ch {
+                self.inv.instant(t, b, ch);
+            }
+        }
+    }
+
+    /// A commanded branch's read ended at `c`: its word, if malformed, is
+    /// `command-word`; a pipelined part queues what it selects.
+    fn end_word(&mut self, b: usize, c: u64) {
+        let Some(r) = self.cmds[b].as_mut() else {
+            return;
+        };
+        let bad = r.bad_word();
+        let sel = r.end();
+        if let Some(w) = bad {
+            let t = self.inv.place(w.sent_at).0;
+            self.inv.record(
+                Violation::new(Rule::CommandWord, c)
+                    .signal(Signal::Mosi(b).name(&self.layout))
+                    .actual(json!(w.bits))
+                    .detail(format!(
+                        "branch {}: the command word {} of the conversion at cycle {t}: {}",
+                        self.branch_names[b], w.bits, w.why
+                    )),
+            );
+        }
+        if let Some(sel) = sel {
+            self.resolve(b, sel);
+        }
+    }
+
+    /// The command word the model sends on branch `b` now, for the report
+    /// of a wrong `adc_mosi` bit (`want`: the model's bit).
+    fn command_context(&self, b: usize, m: &CycleModel, want: u64) -> String {
+        let name = &self.branch_names[b];
+        let Some((wi, k, t)) = m.command_bit(b) else {
+            return format!("branch {name}: no command word is being sent here (adc_mosi idles low between words), expected {want}");
+        };
+        let w = &self.words[b][wi];
+        let bits: String = w.word.iter().map(|&v| if v { '1' } else { '0' }).collect();
+        let ch = self.names.get(w.selects).map_or("?", String::as_str);
+        format!(
+            "branch {name}: bit {k} (0 = the first) of the command word {bits} of the conversion at cycle {} (slot {}), which selects {ch} (input {}); expected {want}",
+            self.inv.place(t).0,
+            w.slot,
+            w.input
+        )
     }
 
     /// The mux must have settled for `settle_min` cycles at the sampling
@@ -973,6 +1138,15 @@ impl Checker {
                     }),
             );
         }
+        let st = if self.cmds[b].is_some() {
+            self.end_word(b, c);
+            self.br[b].clone()
+        } else {
+            st
+        };
+        if st.prepared {
+            return; // no word of ours selected it: not a sample
+        }
         // Bit j of the serial stream sits at sclks-1-j of `word` (CS parts
         // never read bit 0, a leading zero).
         let mask = (1u128 << lim.bits) - 1;
@@ -985,13 +1159,15 @@ impl Checker {
                 for (m, g) in self.groups[ch as usize].clone().into_iter().enumerate() {
                     if let Some(g) = g {
                         let code = (!st.word_bad).then_some(word(m as u32));
-                        self.inv.completion(c, b, Some(g as u16), code, st.t);
+                        let g = Some(g as u16);
+                        self.inv.completion_by_word(c, b, g, code, st.t, st.word_at);
                     }
                 }
             }
             _ => {
                 let code = (!st.word_bad).then_some(word(0));
-                self.inv.completion(c, b, st.ch, code, st.t);
+                self.inv
+                    .completion_by_word(c, b, st.ch, code, st.t, st.word_at);
             }
         }
     }
@@ -1009,6 +1185,9 @@ impl Checker {
         if let Some(l) = &mut self.line {
             l.finish(self.c, &mut self.inv);
         }
+        // a word never finished: its instant counts for no channel
+        self.held.iter_mut().for_each(|h| h.3 = false);
+        self.flush_held();
         let link_join = self.link_join_report();
         let (frames, channels) = self.inv.finish(self.c);
         let samples = self.inv.emitted_count();

@@ -48,6 +48,16 @@ pub enum PinFault {
     SclkSlow { branch: usize },
     /// One sample leaves with the code of the conversion emitted before it.
     NeighbourCode,
+    // Faults of a converter's command word on `adc_mosi` (a branch whose
+    // part takes one): CS, SCLK and the samples stay as they were, so the
+    // model's `adc_mosi` or the model-free attribution of each conversion
+    // to the channel its word selected must tell.
+    /// The word of one conversion of `branch` with its first channel bit
+    /// (the MSB) inverted: the part converts another input.
+    WrongChannelBits { branch: usize },
+    /// The word of one conversion of `branch` sent one SCLK period late:
+    /// each bit in the period after its own, the lane low in the first.
+    LateCommand { branch: usize },
     // Faults of the link to the host, on its pins (a mix with a `[link]`):
     // what a noisy wire, a lost character, a broken driver or a full FIFO
     // shows at the FPGA's edge.  The gateware's own link faults (a FIFO one
@@ -93,6 +103,8 @@ impl PinFault {
             PinFault::SelectSwap { .. } => "select-swap",
             PinFault::SclkSlow { .. } => "sclk-slow",
             PinFault::NeighbourCode => "neighbour-code",
+            PinFault::WrongChannelBits { .. } => "wrong-channel-bits",
+            PinFault::LateCommand { .. } => "late-command",
             PinFault::LinkBitFlip => "link-bit-flip",
             PinFault::LinkDropByte => "link-drop-byte",
             PinFault::LinkStuck { high: true } => "link-stuck-high",
@@ -114,7 +126,9 @@ impl PinFault {
             | PinFault::ConversionMoved { branch }
             | PinFault::PhaseShift { branch }
             | PinFault::SelectSwap { branch }
-            | PinFault::SclkSlow { branch } => Some(branch),
+            | PinFault::SclkSlow { branch }
+            | PinFault::WrongChannelBits { branch }
+            | PinFault::LateCommand { branch } => Some(branch),
             PinFault::WrongChannel
             | PinFault::WrongSampleBit
             | PinFault::DropSample
@@ -166,6 +180,12 @@ impl PinFault {
             }
             if slow_sclk_div(s, b).is_some() {
                 v.push(PinFault::SclkSlow { branch: b });
+            }
+            if s.has_command(b) {
+                v.push(PinFault::WrongChannelBits { branch: b });
+            }
+            if late_word_differs(s, b) {
+                v.push(PinFault::LateCommand { branch: b });
             }
         }
         v.push(PinFault::NeighbourCode);
@@ -222,6 +242,31 @@ pub fn same_rate_pair(s: &Schedule, b: usize) -> Option<(usize, usize)> {
     })
 }
 
+/// Whether every word branch `b` sends, one SCLK period late, selects
+/// another input than on time or none (so [`PinFault::LateCommand`] shows
+/// without the model too); false for a branch without a command word.
+pub fn late_word_differs(s: &Schedule, b: usize) -> bool {
+    let Some(cmd) = &s.mix.branches[b].adc.command else {
+        return false;
+    };
+    s.commands_in_frame(b).iter().all(|w| {
+        let late: Vec<bool> = std::iter::once(false)
+            .chain(w.word.iter().copied())
+            .collect();
+        cmd.channel_of(&late) != Some(w.input)
+    })
+}
+
+/// The position of the first channel bit of branch `b`'s command word.
+fn first_channel_bit(s: &Schedule, b: usize) -> u64 {
+    s.mix.branches[b].adc.command.as_ref().map_or(0, |c| {
+        c.bits
+            .iter()
+            .position(|x| matches!(x, lut_gen::CmdBit::Channel(_)))
+            .unwrap_or(0) as u64
+    })
+}
+
 /// The SCLK divider of [`PinFault::SclkSlow`] on branch `b`: twice the
 /// branch's, if the part still allows that frequency.
 pub fn slow_sclk_div(s: &Schedule, b: usize) -> Option<u64> {
@@ -271,6 +316,11 @@ pub struct FaultyDut<D> {
     hit: Option<u64>,
     /// AXI4-Stream: a beat waited for `tready` in the previous cycle.
     stalled: bool,
+    /// Command-word faults: the channel bit inverted, and the fault's
+    /// branch's `adc_mosi` lane as the design drove it in the last SCLK
+    /// period (the newest last).
+    cmd_bit: u64,
+    mosi_hist: VecDeque<bool>,
 }
 
 impl<D: Dut> FaultyDut<D> {
@@ -335,6 +385,8 @@ impl<D: Dut> FaultyDut<D> {
             char_end: 0,
             hit: None,
             stalled: false,
+            cmd_bit: first_channel_bit(s, b),
+            mosi_hist: VecDeque::with_capacity(spi.sclk_div as usize + 1),
         }
     }
 }
@@ -403,6 +455,9 @@ impl<D: Dut> Dut for FaultyDut<D> {
             | PinFault::SelectSwap { .. } => self.mux_fault(c, &mut p),
             PinFault::ConversionMoved { branch } => self.move_conversion(c, &mut p, branch),
             PinFault::SclkSlow { branch } => self.slow_sclk(c, &mut p, branch),
+            PinFault::WrongChannelBits { branch } | PinFault::LateCommand { branch } => {
+                self.command_fault(c, &mut p, branch)
+            }
             PinFault::LinkBitFlip | PinFault::LinkDropByte => self.uart_char(c, &mut p),
             PinFault::LinkStuck { .. }
             | PinFault::LinkOverflow
@@ -422,6 +477,33 @@ impl<D: Dut> Dut for FaultyDut<D> {
 }
 
 impl<D> FaultyDut<D> {
+    /// Cycle `c` under the command word's faults, in the target
+    /// conversion's read (bit `i` of the word is on the lane through SCLK
+    /// period `i + 1`: docs/timing.md, "Command words").
+    fn command_fault(&mut self, c: u64, p: &mut Pins, b: usize) {
+        let Some(lane) = self.layout.mosi_lo[b] else {
+            return;
+        };
+        let was = p.mosi >> lane & 1 == 1;
+        let d = self.d as usize;
+        let delayed = (self.mosi_hist.len() == d).then(|| self.mosi_hist[0]);
+        if self.mosi_hist.len() == d {
+            self.mosi_hist.pop_front();
+        }
+        self.mosi_hist.push_back(was);
+        if c < self.t + self.su || c >= self.t.saturating_add(self.r) {
+            return;
+        }
+        let i = (c - self.t - self.su) / self.d;
+        let v = match self.fault {
+            PinFault::WrongChannelBits { .. } if i == self.cmd_bit => !was,
+            PinFault::LateCommand { .. } if i == 0 => false,
+            PinFault::LateCommand { .. } => delayed.unwrap_or(false),
+            _ => was,
+        };
+        p.mosi = (p.mosi & !(1 << lane)) | (v as u16) << lane;
+    }
+
     /// Cycle `c` under the sample stream's faults.
     #[inline]
     fn sample_fault(&mut self, c: u64, p: &mut Pins, orig: &Pins) {

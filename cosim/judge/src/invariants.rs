@@ -53,6 +53,9 @@ struct Pending {
     branch: usize,
     channel: Option<u16>,
     code: Option<u16>,
+    /// A commanded branch: the cycle of the conversion whose word selected
+    /// `channel` (then a sample of another channel is `command-channel`).
+    word_at: Option<u64>,
 }
 
 /// Model-independent checks at conversion level: per-channel counts per
@@ -92,6 +95,12 @@ pub struct Invariants {
     interval_m: Vec<Vec<u64>>,
     mc: Option<Box<ModeCheck>>,
     cur_mode: usize,
+    /// (frame, channel) of each prepared conversion after reset (converters
+    /// with a command word: no word of ours selected it, so it is no
+    /// sample), and the last cycle a conversion's channel could not be
+    /// known (joined mid-stream): counts are not checked in its frame.
+    prepared: Vec<(u64, usize)>,
+    blind_until: Option<u64>,
 }
 
 impl Invariants {
@@ -158,7 +167,16 @@ impl Invariants {
             interval_m,
             mc: ModeCheck::new(s).map(Box::new),
             cur_mode: 0,
+            prepared: prepared_conversions(s),
+            blind_until: None,
         }
+    }
+
+    /// A conversion at cycle `t` whose channel the check cannot know (its
+    /// command word was sent before the check joined): its frame's counts
+    /// are not checked.
+    pub fn blind(&mut self, t: u64) {
+        self.blind_until = Some(t);
     }
 
     /// A mix with switches: cycle `c`'s `mode_sel` and `mode` (before its
@@ -210,8 +228,15 @@ impl Invariants {
                 Some(mc) => &self.spf_m[mc.shown],
                 None => &self.spf,
             };
-            let partial = self.frame * self.frame_cycles < self.origin;
+            let start = self.frame * self.frame_cycles;
+            let partial = start < self.origin || self.blind_until.is_some_and(|b| start <= b);
             for (ch, &want) in spf.iter().enumerate() {
+                let want = want
+                    - self
+                        .prepared
+                        .iter()
+                        .filter(|&&p| p == (self.frame, ch))
+                        .count() as u64;
                 let n = self.in_frame[ch];
                 if (partial && n > want) || (!partial && n != want) {
                     let name = self.names[ch].clone();
@@ -316,6 +341,21 @@ impl Invariants {
         code: Option<u16>,
         instant: u64,
     ) {
+        self.completion_by_word(c, branch, channel, code, instant, None)
+    }
+
+    /// [`Invariants::completion`] of a commanded branch's conversion, whose
+    /// `channel` the word sent in the conversion at `word_at` selected.
+    #[inline]
+    pub fn completion_by_word(
+        &mut self,
+        c: u64,
+        branch: usize,
+        channel: Option<u16>,
+        code: Option<u16>,
+        instant: u64,
+        word_at: Option<u64>,
+    ) {
         self.conversions += 1;
         if let (Some(mc), Some(ch), Some(v)) = (&mut self.mc, channel, code) {
             mc.track.sample(ch as usize, v);
@@ -327,6 +367,7 @@ impl Invariants {
             branch,
             channel,
             code,
+            word_at,
         });
     }
 
@@ -370,7 +411,27 @@ impl Invariants {
                     )),
             );
         }
-        if let Some(ch) = p.channel {
+        if let (Some(ch), Some(at)) = (p.channel, p.word_at) {
+            if ch != channel {
+                let name = self
+                    .names
+                    .get(ch as usize)
+                    .map(String::as_str)
+                    .unwrap_or("?");
+                self.rec.record(
+                    Violation::new(Rule::CommandChannel, c)
+                        .signal(Role::SampleChannel.name().to_string())
+                        .expected(json!(ch))
+                        .actual(json!(channel))
+                        .channel(self.name(Some(ch)))
+                        .detail(format!(
+                            "{} {channel} but the command word sent in the conversion at cycle {at} selected {ch} ({name}) for the conversion sampled at cycle {}",
+                            Role::SampleChannel.name(),
+                            p.instant
+                        )),
+                );
+            }
+        } else if let Some(ch) = p.channel {
             if ch != channel {
                 self.rec.record(
                     Violation::new(Rule::SampleChannel, c)
@@ -488,4 +549,23 @@ impl Invariants {
     pub fn emitted_count(&self) -> u64 {
         self.emitted
     }
+}
+
+/// (frame, channel) of the conversions after reset that are prepared, not
+/// data: each commanded branch's first `ahead` conversions (the gateware
+/// performs them, reads nothing of them; `Schedule::prepared_conversions`).
+fn prepared_conversions(s: &Schedule) -> Vec<(u64, usize)> {
+    let fc = s.grid.frame_cycles;
+    let mut out = Vec::new();
+    for b in 0..s.branches.len() {
+        let n = s.prepared_conversions(b) as usize;
+        if n == 0 {
+            continue;
+        }
+        let performed = s
+            .instants(n as u64 + 1)
+            .filter(|i| i.branch == b && !(i.cycle < fc && s.skipped_at_startup(b, i.cycle)));
+        out.extend(performed.take(n).map(|i| (i.cycle / fc, i.channel)));
+    }
+    out
 }

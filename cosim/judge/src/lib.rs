@@ -10,7 +10,8 @@
 //!   hours, [`CycleModel`] for every pin at every cycle);
 //! - `adc`: the AD7940 model and stimuli;
 //! - `checker` / `invariants`: the streaming cycle-exact comparison and
-//!   the mix's invariants, whose [`Rule`]s a violation names;
+//!   the mix's invariants, whose [`Rule`]s a violation names; `cmdword`:
+//!   the command words on `adc_mosi` read back as the part reads them;
 //! - `run`: a [`Dut`] driven with the ADC model into the checker, and the
 //!   slot-level model run;
 //! - `faults`: faults injected into any [`Dut`]'s pins;
@@ -37,6 +38,7 @@ mod adc;
 mod axishold;
 mod capture;
 mod checker;
+mod cmdword;
 mod events;
 mod faults;
 mod fst;

@@ -518,6 +518,21 @@ impl CycleModel {
         }
     }
 
+    /// The command word branch `b` is sending in the current cycle: (its
+    /// index in `Schedule::commands_in_frame`, the bit on the lane, the
+    /// conversion's instant), or `None` outside a word (the lane idles low).
+    /// For the checker's report of a wrong `adc_mosi` bit.
+    pub fn command_bit(&self, b: usize) -> Option<(usize, usize, u64)> {
+        let m = &self.br[b];
+        let t = m.t?;
+        let k = self.c.checked_sub(t)?;
+        if !m.conv || m.words.is_empty() || k < m.su || k >= m.r {
+            return None;
+        }
+        let i = ((k - m.su) / m.d) as usize;
+        (i < m.words.get(m.wi)?.len()).then_some((m.wi, i, t))
+    }
+
     /// No conversion that began before the current cycle is still running or
     /// waiting to be emitted: a check that joins here (a capture from the
     /// middle of a run) needs none of the MISO bits it did not see.

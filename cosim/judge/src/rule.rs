@@ -79,6 +79,14 @@ pub enum Rule {
     /// A frame's mode is not the one the contract decides: a request
     /// ignored, or a switch without its request or trigger condition.
     ModeDecision,
+    /// A command word on `adc_mosi` that the part would not take as the mix
+    /// meant: a fixed bit differs, the word is short, or it selects an input
+    /// the branch has no channel on.
+    CommandWord,
+    /// A sample whose channel differs from the one its conversion's command
+    /// word selected (for a pipelined part, the word sent `ahead`
+    /// conversions earlier).
+    CommandChannel,
 }
 
 impl Rule {
@@ -120,6 +128,8 @@ impl Rule {
             Rule::LinkSamples => "link-samples",
             Rule::ModeSwitch => "mode-switch",
             Rule::ModeDecision => "mode-decision",
+            Rule::CommandWord => "command-word",
+            Rule::CommandChannel => "command-channel",
         }
     }
 }

@@ -321,14 +321,28 @@ pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usi
     let mut inv = Invariants::new(s, max_records);
     static_checks(s, &sm, &mut inv);
     let f = s.grid.frame_cycles;
+    // A converter with a command word: its first conversions after reset
+    // are prepared, never data (`Schedule::prepared_conversions`).
+    let mut prep: Vec<u32> = (0..s.branches.len())
+        .map(|b| s.prepared_conversions(b))
+        .collect();
+    let mut skipped = Vec::new();
     for frame in 0..frames {
         let base = frame * f;
         let (conversions, emissions) = sm.frame(frame);
         for cv in conversions {
+            if prep[cv.branch] > 0 {
+                prep[cv.branch] -= 1;
+                skipped.push((base + cv.instant, cv.branch));
+                continue;
+            }
             inv.instant(base + cv.instant, cv.branch, cv.channel);
         }
         for cv in emissions {
             let t = base + cv.instant;
+            if skipped.contains(&(t, cv.branch)) {
+                continue;
+            }
             let code = analog.code_bits(cv.channel as u64, t, s.mix.branches[cv.branch].adc.bits);
             inv.completion(
                 base + cv.complete,

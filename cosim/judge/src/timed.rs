@@ -67,6 +67,7 @@ impl Lane {
         let v = match self.role {
             Some(Role::CsN) => p.cs_n as u128,
             Some(Role::Sclk) => p.sclk as u128,
+            Some(Role::Mosi) => p.mosi as u128,
             Some(Role::MuxSel) => p.mux_sel as u128,
             Some(Role::MuxEn) => p.mux_en,
             Some(Role::SampleValid) => p.sample_valid as u128,
@@ -87,7 +88,14 @@ impl Lane {
     fn predictable(&self) -> bool {
         matches!(
             self.role,
-            Some(Role::CsN | Role::Sclk | Role::MuxSel | Role::MuxEn | Role::SampleValid)
+            Some(
+                Role::CsN
+                    | Role::Sclk
+                    | Role::Mosi
+                    | Role::MuxSel
+                    | Role::MuxEn
+                    | Role::SampleValid
+            )
         )
     }
 
@@ -95,6 +103,7 @@ impl Lane {
         match self.role {
             Some(Role::CsN) => "conversion instant (rate, interval, slot order)",
             Some(Role::Sclk) => "serial clock (SCLK count and period per conversion)",
+            Some(Role::Mosi) => "command words (every bit, at its time)",
             Some(Role::MuxSel | Role::MuxEn) => "mux switching (slot order, settling before CS)",
             Some(Role::SampleValid) => "sample stream timing",
             None => "link samples (order on the line)",
@@ -1023,6 +1032,19 @@ fn what_was_proved(
                 "branch {}: SCLK count and period (no SCLK lane checked)",
                 br.name
             ));
+        }
+        if layout.has_lane(Role::Mosi, b) {
+            if has(Role::Mosi, b) {
+                yes.push(format!(
+                    "branch {}: every bit of every command word on adc_mosi, at its time",
+                    br.name
+                ));
+            } else {
+                no.push(format!(
+                    "branch {}: its command words (no adc_mosi lane checked)",
+                    br.name
+                ));
+            }
         }
         if !layout.muxed[b] {
             continue; // no mux, no mux lanes: nothing to settle

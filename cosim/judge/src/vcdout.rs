@@ -23,7 +23,14 @@ pub fn edge_ps(clock_hz: u64, n: u64) -> u64 {
 
 /// The lanes of a branch that its view in the waveform shows, in order (a
 /// branch without a mux has no mux lanes: [`Layout::has_lane`]).
-const BRANCH_VIEW: [Role; 5] = [Role::CsN, Role::Sclk, Role::Miso, Role::MuxSel, Role::MuxEn];
+const BRANCH_VIEW: [Role; 6] = [
+    Role::CsN,
+    Role::Sclk,
+    Role::Mosi,
+    Role::Miso,
+    Role::MuxSel,
+    Role::MuxEn,
+];
 
 /// Branch `b`'s lanes in its view, in [`BRANCH_VIEW`] order.
 fn view(l: &Layout, b: usize) -> impl Iterator<Item = Role> + '_ {
@@ -217,7 +224,11 @@ impl VcdWriter {
     fn put(&mut self, i: usize) -> std::io::Result<()> {
         // a 1-bit value as a scalar change, except the branch-lane ports
         // (`adc_cs_n` of a one-branch mix is still a vector)
-        let lanes = i < PORTS.len() && matches!(Role::ALL[i], Role::Miso | Role::CsN | Role::Sclk);
+        let lanes = i < PORTS.len()
+            && matches!(
+                Role::ALL[i],
+                Role::Miso | Role::CsN | Role::Sclk | Role::Mosi
+            );
         if self.widths[i] == 1 && !lanes {
             writeln!(self.w, "{}{}", self.cur[i], self.ids[i])
         } else {
@@ -304,8 +315,10 @@ pub fn write_gtkw(path: &Path, vcd: &Path, s: &Schedule) -> std::io::Result<()> 
         writeln!(w, "@800200")?;
         writeln!(w, "-branch {b} {}", br.name)?;
         writeln!(w, "@28")?;
-        for r in [Role::CsN, Role::Sclk, Role::Miso] {
-            writeln!(w, "{sc}.{}", l.lane_key(r, b))?;
+        for r in [Role::CsN, Role::Sclk, Role::Mosi, Role::Miso] {
+            if l.has_lane(r, b) {
+                writeln!(w, "{sc}.{}", l.lane_key(r, b))?;
+            }
         }
         if l.muxed[b] {
             writeln!(w, "@22")?;

@@ -1,0 +1,173 @@
+//! Converters with a command word in the fault campaign: the classes
+//! `wrong-channel-bits` and `late-command` are injected into every
+//! commanded branch of the shared test mixes (an MCP3208, an AD7689 and a
+//! listening AD7940; one AD7689 alone) and of random commanded mixes, and
+//! each injection is caught by the model, by the invariants (the sample
+//! held to the channel its word selected) and by sigrok's SPI decode of
+//! `mosi`; clean runs pass every detector, sigrok's included.
+
+use std::path::Path;
+
+use campaign::{campaign_with, sites, Detector, FaultClass, Plan, Target};
+use lut_gen::Schedule;
+
+use crate::tools;
+
+/// A random mix with an `mcp3208` and an `ad7689` branch (and a listening
+/// one), channels on random inputs at random rates, from `seed`.
+fn random_commanded(seed: u64) -> Schedule {
+    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut next = |n: u64| {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x % n
+    };
+    let mut t = String::from(
+        "name = \"rc\"\n[clock]\nhz = 24000000\n[frame]\nperiod_us = 1000\nslice_us = 500\n",
+    );
+    let branches = [
+        ("m", "mcp3208", "internal"),
+        ("l", "ad7940", "tmux1108"),
+        ("a", "ad7689", "internal"),
+    ];
+    for (name, adc, mux) in branches {
+        t += &format!("[[branch]]\nname = \"{name}\"\nadc = \"{adc}\"\nmux = \"{mux}\"\n");
+    }
+    let mut n = 0;
+    for (name, _, _) in branches {
+        let mut inputs: Vec<u64> = (0..8).collect();
+        for _ in 0..2 + next(3) {
+            let input = inputs.remove(next(inputs.len() as u64) as usize);
+            let rate = [2000, 4000][next(2) as usize];
+            t += &format!(
+                "[[channel]]\nname = \"c{n}\"\nbranch = \"{name}\"\nrate_hz = {rate}\ninput = {input}\n"
+            );
+            n += 1;
+        }
+    }
+    let m = lut_gen::parse(Path::new("rc.toml"), &t).unwrap();
+    lut_gen::synthesize(&m).unwrap()
+}
+
+fn load(name: &str) -> Schedule {
+    lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap()
+}
+
+#[test]
+fn command_faults_join_the_campaign_and_every_detector_sees_them() {
+    if !tools::require_tool("sigrok-cli") {
+        return;
+    }
+    let mut mixes = vec![load("cmd-pair"), load("cmd-solo")];
+    mixes.extend([5, 9].map(random_commanded));
+    for s in &mixes {
+        let mut plan = Plan::new(Target::Model, 4, 0);
+        plan.sites = Some(
+            sites(s)
+                .into_iter()
+                .filter(|x| x.name == "mid-frame")
+                .collect(),
+        );
+        let c = campaign_with(s, &plan).unwrap();
+        let name = &s.mix.name;
+        assert!(
+            c.ok(),
+            "{name}: {:#?}",
+            c.classes
+                .iter()
+                .filter(|k| !k.undetected.is_empty())
+                .collect::<Vec<_>>()
+        );
+        let commanded = (0..s.branches.len()).filter(|&b| s.has_command(b)).count() as u64;
+        for class in [FaultClass::WrongChannelBits, FaultClass::LateCommand] {
+            let k = c
+                .classes
+                .iter()
+                .find(|k| k.name == class)
+                .unwrap_or_else(|| panic!("{name}: no {class:?}"));
+            assert_eq!(k.injected, commanded, "{name} {class:?}");
+            for d in [Detector::Model, Detector::Invariants, Detector::Sigrok] {
+                assert_eq!(
+                    k.detected_by.get(&d),
+                    Some(&k.injected),
+                    "{name} {class:?} {d:?}"
+                );
+            }
+        }
+    }
+}
+
+/// The emitted Verilog's word of the `k`-th command unit (`wire [..] word =
+/// {MSB, ..., bit sent first};`), edited by `f` (its elements, MSB first).
+fn edit_word(v: &str, k: usize, f: &dyn Fn(&mut Vec<String>)) -> String {
+    let mut seen = 0;
+    let lines: Vec<String> = v
+        .lines()
+        .map(|l| {
+            let Some((head, rest)) = l.split_once("] word = {") else {
+                return l.to_string();
+            };
+            seen += 1;
+            if seen != k + 1 {
+                return l.to_string();
+            }
+            let body = rest.strip_suffix("};").unwrap();
+            let mut el: Vec<String> = body.split(", ").map(str::to_string).collect();
+            f(&mut el);
+            format!("{head}] word = {{{}}};", el.join(", "))
+        })
+        .collect();
+    assert!(seen > k, "no command unit {k}");
+    lines.join("\n") + "\n"
+}
+
+/// Verilog that sends the wrong channel bits (the channel bit sent last
+/// inverted in every word) or each word one SCLK period late, one command unit at a
+/// time, on Icarus: every detector catches each, and the clean Verilog
+/// passes them all (sigrok's MOSI decode included).
+#[test]
+fn verilog_sending_wrong_or_late_words_fails_on_icarus() {
+    if !tools::require_tools(&["sigrok-cli", "iverilog"]) {
+        return;
+    }
+    let s = load("cmd-pair");
+    let v = engines::verilog(&s).unwrap();
+    let units = (0..s.branches.len()).filter(|&b| s.has_command(b)).count();
+    let mut plan = Plan::new(Target::Model, 3, 0);
+    plan.builtin = false;
+    plan.verilog_engines = vec![engines::Backend::Icarus];
+    for k in 0..units {
+        let wrong = edit_word(&v, k, &|el| {
+            let i = el.iter().position(|e| e.starts_with("sel[")).unwrap();
+            el[i] = format!("~{}", el[i]);
+        });
+        let late = edit_word(&v, k, &|el| {
+            el.remove(0);
+            el.push("1'b0".into());
+        });
+        for (class, verilog) in [
+            (FaultClass::WrongChannelBits, wrong),
+            (FaultClass::LateCommand, late),
+        ] {
+            plan.verilog_faults.push(campaign::VerilogFault {
+                name: format!("{class:?} unit {k}"),
+                class,
+                verilog,
+            });
+        }
+    }
+    let c = campaign_with(&s, &plan).unwrap();
+    assert_eq!(c.false_alarms.rejected, 0, "{:?}", c.false_alarms);
+    for class in [FaultClass::WrongChannelBits, FaultClass::LateCommand] {
+        let k = c.classes.iter().find(|k| k.name == class).unwrap();
+        assert_eq!(k.injected, units as u64, "{class:?}");
+        for d in [Detector::Model, Detector::Invariants, Detector::Sigrok] {
+            assert_eq!(
+                k.detected_by.get(&d),
+                Some(&k.injected),
+                "{class:?} {d:?}: {k:?}"
+            );
+        }
+    }
+}
