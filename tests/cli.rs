@@ -800,8 +800,8 @@ fn a_mix_with_modes_is_audited_and_refused_where_the_gateware_would_show_one_mod
 
 /// `sim --backend model` follows mode switches: `--modes` drives `mode_sel`
 /// of a pin-select mix, `touch:` switches an auto mix; every frame is judged
-/// against its mode.  What needs the mode ports in a file (a VCD, the
-/// link's bytes) or a mode the mix does not have is refused with the reason.
+/// against its mode; its VCD passes `check`.  A mode the mix does not have
+/// is refused with the reason.
 #[test]
 fn the_model_back_end_simulates_mode_switches() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -845,9 +845,21 @@ fn the_model_back_end_simulates_mode_switches() {
             .code(2)
             .stderr(predicate::str::contains(why));
     }
+    // the run's VCD carries mode_sel and mode: `check` judges it with and
+    // without the model
     let vcd = d.path().join("w.vcd");
-    sim(&pin, &["--vcd", vcd.to_str().unwrap()])
-        .code(2)
-        .stderr(predicate::str::contains("mode ports"));
-    assert!(!vcd.exists());
+    sim(
+        &pin,
+        &["--modes", "2=slow,7=fast", "--vcd", vcd.to_str().unwrap()],
+    )
+    .success();
+    for extra in [&[][..], &["--no-model"][..]] {
+        slotforge()
+            .args(["check", "--json"])
+            .args(extra)
+            .arg(&pin)
+            .arg(&vcd)
+            .assert()
+            .success();
+    }
 }

@@ -21,3 +21,6 @@ mod vcd;
 
 #[path = "modes.rs"]
 mod modes;
+
+#[path = "modevcd.rs"]
+mod modevcd;
