@@ -114,16 +114,6 @@ fn early_checks(a: &Args) -> Result<(), String> {
 
 /// `--stimulus` (a scene names the mix's channels) and `--modes`.
 fn scene_and_modes(a: &Args, s: &lut_gen::Schedule) -> Result<(Stimulus, Vec<(u64, u8)>), String> {
-    if s.modes.len() > 1 {
-        // The link's packets do not carry the mode yet.
-        if a.link_bytes.is_some() {
-            return Err(format!(
-                "--link-bytes: mix `{}` switches modes, and the link's packets do not carry \
-                 the mode yet; --samples writes the run's samples",
-                s.mix.name
-            ));
-        }
-    }
     let stimulus = Stimulus::parse_for(&a.stimulus, s)?;
     let modes = a.modes.as_deref().map(|t| parse_modes(t, s)).transpose()?;
     Ok((stimulus, modes.unwrap_or_default()))

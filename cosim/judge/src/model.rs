@@ -567,6 +567,9 @@ impl CycleModel {
         if self.tx.is_some() {
             let p = self.pins;
             self.step_pins(miso);
+            if let Some(t) = &mut self.tx {
+                t.set_mode(p.mode);
+            }
             self.step_link(p.sample_valid, p.sample_channel, p.sample_value);
         } else {
             self.step_pins(miso);

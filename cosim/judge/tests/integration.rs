@@ -24,3 +24,6 @@ mod modes;
 
 #[path = "modevcd.rs"]
 mod modevcd;
+
+#[path = "modelink.rs"]
+mod modelink;
