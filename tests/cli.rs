@@ -863,3 +863,40 @@ fn the_model_back_end_simulates_mode_switches() {
             .success();
     }
 }
+
+/// `faults` on a mix with modes runs its switching scenario on the model
+/// and counts the `mode` output's classes; the gateware back end, which
+/// does not switch yet, is refused.
+#[test]
+fn faults_on_a_mode_mix_run_on_the_model_with_the_mode_classes() {
+    let pin = Path::new(env!("CARGO_MANIFEST_DIR")).join("testkit/mixes/modes-pin.toml");
+    let a = slotforge()
+        .args([
+            "faults",
+            "--quiet",
+            "--json",
+            "--frames",
+            "4",
+            "--false-alarm-mixes",
+            "0",
+        ])
+        .arg(&pin)
+        .assert()
+        .success();
+    let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
+    let names: Vec<&str> = v["classes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    for class in ["mode-early", "mode-stuck", "mode-unasked"] {
+        assert!(names.contains(&class), "{names:?}");
+    }
+    slotforge()
+        .args(["faults", "--quiet", "--backend", "rusthdl"])
+        .arg(&pin)
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("does not switch modes"));
+}

@@ -27,3 +27,6 @@ mod random_mixes;
 
 // Shared by several test files (one copy in this binary).
 use testkit::tools;
+
+#[path = "modes.rs"]
+mod modes;
