@@ -844,8 +844,8 @@ fn a_mix_with_modes_is_audited_and_refused_where_the_gateware_would_show_one_mod
 
 /// `sim --backend model` follows mode switches: `--modes` drives `mode_sel`
 /// of a pin-select mix, `touch:` switches an auto mix; every frame is judged
-/// against its mode.  What needs the mode ports in a file (a VCD, the
-/// link's bytes) or a mode the mix does not have is refused with the reason.
+/// against its mode; its VCD passes `check`.  A mode the mix does not have
+/// is refused with the reason.
 #[test]
 fn the_model_back_end_simulates_mode_switches() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -889,11 +889,60 @@ fn the_model_back_end_simulates_mode_switches() {
             .code(2)
             .stderr(predicate::str::contains(why));
     }
+    // the run's VCD carries mode_sel and mode: `check` judges it with and
+    // without the model
     let vcd = d.path().join("w.vcd");
-    sim(&pin, &["--vcd", vcd.to_str().unwrap()])
+    sim(
+        &pin,
+        &["--modes", "2=slow,7=fast", "--vcd", vcd.to_str().unwrap()],
+    )
+    .success();
+    for extra in [&[][..], &["--no-model"][..]] {
+        slotforge()
+            .args(["check", "--json"])
+            .args(extra)
+            .arg(&pin)
+            .arg(&vcd)
+            .assert()
+            .success();
+    }
+}
+
+/// `faults` on a mix with modes runs its switching scenario on the model
+/// and counts the `mode` output's classes; the gateware back end, which
+/// does not switch yet, is refused.
+#[test]
+fn faults_on_a_mode_mix_run_on_the_model_with_the_mode_classes() {
+    let pin = Path::new(env!("CARGO_MANIFEST_DIR")).join("testkit/mixes/modes-pin.toml");
+    let a = slotforge()
+        .args([
+            "faults",
+            "--quiet",
+            "--json",
+            "--frames",
+            "4",
+            "--false-alarm-mixes",
+            "0",
+        ])
+        .arg(&pin)
+        .assert()
+        .success();
+    let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
+    let names: Vec<&str> = v["classes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    for class in ["mode-early", "mode-stuck", "mode-unasked"] {
+        assert!(names.contains(&class), "{names:?}");
+    }
+    slotforge()
+        .args(["faults", "--quiet", "--backend", "rusthdl"])
+        .arg(&pin)
+        .assert()
         .code(2)
-        .stderr(predicate::str::contains("mode ports"));
-    assert!(!vcd.exists());
+        .stderr(predicate::str::contains("does not switch modes"));
 }
 
 /// Converters with a command word on the judge's side: `sim --backend

@@ -34,11 +34,16 @@ fn sim_rows(csv: &str) -> Rows {
 
 fn decoded_rows(csv: &str) -> Vec<(String, String, String)> {
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("frame,slice,channel,value,sampled_s"));
+    // a mix with modes has a `mode` column after the slice
+    let m = match lines.next() {
+        Some("frame,slice,channel,value,sampled_s") => 0,
+        Some("frame,slice,mode,channel,value,sampled_s") => 1,
+        h => panic!("decode's header: {h:?}"),
+    };
     lines
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();
-            (f[2].into(), f[3].into(), f[4].into())
+            (f[2 + m].into(), f[3 + m].into(), f[4 + m].into())
         })
         .collect()
 }
@@ -46,6 +51,17 @@ fn decoded_rows(csv: &str) -> Vec<(String, String, String)> {
 /// `sim MIX --backend B --frames N --samples --link-bytes`: the bytes and
 /// the samples' CSV text.
 fn sim(mix: &Path, backend: &str, frames: u64, dir: &Path) -> (Vec<u8>, String) {
+    sim_with(mix, backend, frames, dir, &[])
+}
+
+/// [`sim`] with more options (`--modes`, `--stimulus`).
+fn sim_with(
+    mix: &Path,
+    backend: &str,
+    frames: u64,
+    dir: &Path,
+    extra: &[&str],
+) -> (Vec<u8>, String) {
     let (csv, bin) = (
         dir.join(format!("{backend}.csv")),
         dir.join(format!("{backend}.bin")),
@@ -56,6 +72,7 @@ fn sim(mix: &Path, backend: &str, frames: u64, dir: &Path) -> (Vec<u8>, String) 
         .args(["--backend", backend, "--frames", &frames.to_string()])
         .args(["--quiet", "--samples"])
         .arg(&csv)
+        .args(extra)
         .arg("--link-bytes")
         .arg(&bin)
         .assert()
@@ -96,8 +113,14 @@ fn schedule(mix: &Path) -> lut_gen::Schedule {
 /// (exit 0).  A byte flipped in a record is a loss (exit 1).  Returns the
 /// bytes.
 fn bytes_decode_to_the_samples(mix: &Path, backend: &str, frames: u64) -> Vec<u8> {
+    bytes_decode_with(mix, backend, frames, &[]).0
+}
+
+/// [`bytes_decode_to_the_samples`] with more `sim` options; the bytes and
+/// the decoded CSV.
+fn bytes_decode_with(mix: &Path, backend: &str, frames: u64, extra: &[&str]) -> (Vec<u8>, String) {
     let dir = tempfile::tempdir().unwrap();
-    let (bytes, csv) = sim(mix, backend, frames, dir.path());
+    let (bytes, csv) = sim_with(mix, backend, frames, dir.path(), extra);
     let sim = sim_rows(&csv);
     let (code, j, out) = decode(mix, &bytes, dir.path());
     let what = format!("{} on {backend}: {j}", mix.display());
@@ -134,12 +157,64 @@ fn bytes_decode_to_the_samples(mix: &Path, backend: &str, frames: u64) -> Vec<u8
     let at = heads[heads.len() / 2] + 4 + 3;
     let mut bad = bytes.clone();
     bad[at] ^= 0x10;
-    let (code, j, out) = decode(mix, &bad, dir.path());
+    let (code, j, bad_out) = decode(mix, &bad, dir.path());
     assert_eq!(code, 1, "flipped: {what}");
     assert_eq!(j["ok"], false, "{j}");
     assert!(j["crc_errors"].as_u64().unwrap() >= 1, "{j}");
-    assert!(decoded_rows(&out).len() < dec.len(), "{j}");
-    bytes
+    assert!(decoded_rows(&bad_out).len() < dec.len(), "{j}");
+    (bytes, out)
+}
+
+/// The `mode` column of a decoded CSV (a mix with modes), row by row.
+fn mode_column(csv: &str) -> Vec<String> {
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("frame,slice,mode,channel,value,sampled_s")
+    );
+    lines
+        .map(|l| l.split(',').nth(2).unwrap().to_string())
+        .collect()
+}
+
+/// A switching run's link (pin select under `--modes`, auto under a
+/// touch) decodes to the run's samples with their `sampled_s` (each mode's
+/// schedule, and the frame before's for the samples a packet carries
+/// over), and the `mode` column shows every mode the run went through.
+#[test]
+fn mode_mixes_bytes_decode_with_their_modes() {
+    let dir = tempfile::tempdir().unwrap();
+    let pin = dir.path().join("modes-pin-uart.toml");
+    let text = std::fs::read_to_string(root().join("testkit/mixes/modes-pin.toml")).unwrap();
+    std::fs::write(&pin, text + "\n[link]\nkind = \"uart\"\nbaud = 1_000_000\n").unwrap();
+    let auto = root().join("testkit/mixes/modes-auto.toml");
+    for (mix, frames, extra, want) in [
+        (
+            &pin,
+            10,
+            ["--modes", "2=slow,5=fast"],
+            &["fast", "slow"][..],
+        ),
+        (
+            &auto,
+            14,
+            ["--stimulus", "touch:T0,T2@2-6"],
+            &["rest", "touch"][..],
+        ),
+    ] {
+        let (_, csv) = bytes_decode_with(mix, "model", frames, &extra);
+        let mut modes = mode_column(&csv);
+        modes.dedup();
+        assert_eq!(
+            modes.first().map(String::as_str),
+            Some(want[0]),
+            "{modes:?}"
+        );
+        assert!(modes.len() >= 3, "{}: {modes:?}", mix.display());
+        for m in want {
+            assert!(modes.iter().any(|x| x == m), "{m}: {modes:?}");
+        }
+    }
 }
 
 #[test]

@@ -18,6 +18,10 @@ pub struct Decoded {
     /// packet decoded on.
     pub frame: u64,
     pub slice: u16,
+    /// A mix with modes: the mode of the packet's frame and of the frame
+    /// before it (0 without).
+    pub mode: u8,
+    pub prev_mode: u8,
     pub channel: u16,
     pub value: u16,
 }
@@ -29,6 +33,10 @@ pub struct Packet {
     /// The header's frame counter unwrapped as in [`Decoded::frame`].
     pub frame: u64,
     pub slice: u16,
+    /// A mix with modes: the mode of the packet's frame and of the frame
+    /// before it, from the header (0 without modes).
+    pub mode: u8,
+    pub prev_mode: u8,
     /// (channel, value) of every record, in order.
     pub records: Vec<(u16, u16)>,
     /// The trailer's overflow count.
@@ -75,6 +83,8 @@ impl Stats {
 #[derive(Debug, Clone)]
 pub struct Decoder {
     slices: u64,
+    /// Bits of each mode in the header's slice field (0: no modes).
+    mode_bits: u32,
     /// Bytes of the packet being read (from its SYNC on).
     buf: Vec<u8>,
     /// Bytes to (re)read before new input.
@@ -93,8 +103,15 @@ const MAX_PACKET_BYTES: usize = WORD_BYTES * (2 + 16 * 4096);
 impl Decoder {
     /// A decoder for a mix with `slices_per_frame` slices per frame.
     pub fn new(slices_per_frame: u64) -> Decoder {
+        Decoder::with_modes(slices_per_frame, 0)
+    }
+
+    /// A decoder for a mix with modes of `mode_bits` bits (0: none), whose
+    /// headers carry the modes above the slice (`format::slice_field`).
+    pub fn with_modes(slices_per_frame: u64, mode_bits: u32) -> Decoder {
         Decoder {
             slices: slices_per_frame.max(1),
+            mode_bits,
             buf: Vec::new(),
             pending: VecDeque::new(),
             last: None,
@@ -116,6 +133,8 @@ impl Decoder {
             out.extend(p.records.iter().map(|&(channel, value)| Decoded {
                 frame: p.frame,
                 slice: p.slice,
+                mode: p.mode,
+                prev_mode: p.prev_mode,
                 channel,
                 value,
             }));
@@ -171,8 +190,15 @@ impl Decoder {
         }
     }
 
+    /// (slice, mode, mode of the frame before) of the header read.
+    fn header_fields(&self) -> (u64, u8, u8) {
+        let field = u16::from_be_bytes([self.buf[2], self.buf[3]]);
+        let (slice, mode, prev) = format::split_slice_field(field, self.mode_bits);
+        (slice as u64, mode, prev)
+    }
+
     fn header_slice(&self) -> u64 {
-        u16::from_be_bytes([self.buf[2], self.buf[3]]) as u64
+        self.header_fields().0
     }
 
     fn skip(&mut self, n: u64) {
@@ -202,7 +228,7 @@ impl Decoder {
             return;
         }
         let frame8 = self.buf[1] as u64;
-        let slice = self.header_slice();
+        let (slice, mode, prev_mode) = self.header_fields();
         let period = 256 * self.slices;
         let seq8 = frame8 * self.slices + slice;
         let seq = match self.last {
@@ -231,6 +257,8 @@ impl Decoder {
         out.push(Packet {
             frame: seq / self.slices,
             slice: (seq % self.slices) as u16,
+            mode,
+            prev_mode,
             records,
             overflows,
         });
@@ -331,6 +359,47 @@ mod tests {
         assert_eq!(out[0].records, [(1, 0xA5A5)]);
         assert_eq!((out[1].frame, out[1].slice), (4, 0));
         assert!(out[1].records.is_empty());
+    }
+
+    #[test]
+    fn a_mode_mixs_headers_give_the_modes_and_the_slice() {
+        let mut s = Vec::new();
+        for (frame, slice, mode, prev) in [
+            (0u8, 2u16, 0u8, 0u8),
+            (1, 0, 2, 0),
+            (1, 1, 2, 0),
+            (1, 2, 2, 0),
+            (2, 0, 1, 2),
+        ] {
+            let mut p = packet(frame, format::slice_field(slice, mode, prev, 2), &[(1, 9)]);
+            // the CRC covers the header as sent
+            let n = p.len();
+            let c = format::crc(&p[..n - 2]);
+            p[n - 2..].copy_from_slice(&c.to_le_bytes());
+            s.extend(p);
+        }
+        let mut d = Decoder::with_modes(3, 2);
+        let mut out = Vec::new();
+        d.push_packets(&s, &mut out);
+        let got: Vec<(u64, u16, u8, u8)> = out
+            .iter()
+            .map(|p| (p.frame, p.slice, p.mode, p.prev_mode))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                (0, 2, 0, 0),
+                (1, 0, 2, 0),
+                (1, 1, 2, 0),
+                (1, 2, 2, 0),
+                (2, 0, 1, 2)
+            ]
+        );
+        assert!(d.finish().clean());
+        // without the mode bits the same headers name slices out of range
+        let mut plain = Decoder::new(3);
+        plain.push_packets(&s, &mut Vec::new());
+        assert!(!plain.finish().clean());
     }
 
     #[test]

@@ -66,12 +66,47 @@ pub fn trailer(overflows: u8, crc: u16) -> [u8; 4] {
     [END, overflows, crc as u8, (crc >> 8) as u8]
 }
 
+/// A mix with modes (docs/packet-format.md, "Modes"): the header's 16-bit
+/// slice field carries, from its top bit down, the mode of the packet's
+/// frame and the mode of the frame before it (`mode_bits` bits each), then
+/// the slice.  Without modes (`mode_bits` 0) it is the slice alone, so
+/// those mixes' bytes are unchanged.
+pub fn slice_field(slice: u16, mode: u8, prev: u8, mode_bits: u32) -> u16 {
+    if mode_bits == 0 {
+        return slice;
+    }
+    let low = 16 - 2 * mode_bits;
+    ((mode as u16) << (low + mode_bits)) | ((prev as u16) << low) | slice
+}
+
+/// (slice, mode, mode of the frame before) of a header's slice field.
+pub fn split_slice_field(field: u16, mode_bits: u32) -> (u16, u8, u8) {
+    if mode_bits == 0 {
+        return (field, 0, 0);
+    }
+    let low = 16 - 2 * mode_bits;
+    let m = (1u16 << mode_bits) - 1;
+    (
+        field & ((1 << low) - 1),
+        (field >> (low + mode_bits) & m) as u8,
+        (field >> low & m) as u8,
+    )
+}
+
+/// Whether a frame of `slices` slices leaves room in the slice field for
+/// two modes of `mode_bits` bits.
+pub fn modes_fit(slices: u64, mode_bits: u32) -> bool {
+    mode_bits == 0 || (2 * mode_bits < 16 && slices <= 1 << (16 - 2 * mode_bits))
+}
+
 /// What the packetizer writes into the FIFO in one cycle: a slice boundary
-/// (the cycle is the first of a slice), a sample, or both.
+/// (the cycle is the first of a slice), a sample, or both; with the `mode`
+/// input in that cycle (a mix with modes: a boundary's header carries it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct Token {
     pub boundary: bool,
     pub sample: Option<(u16, u16)>,
+    pub mode: u8,
 }
 
 /// Which word of a token a byte belongs to.
@@ -112,6 +147,25 @@ mod tests {
     fn crc_is_modbus() {
         // The standard check value of CRC-16/MODBUS.
         assert_eq!(crc(b"123456789"), 0x4B37);
+    }
+
+    #[test]
+    fn the_slice_field_carries_two_modes_above_the_slice() {
+        assert_eq!(slice_field(9, 3, 1, 0), 9);
+        for bits in 1..=7u32 {
+            let top = (1u64 << (16 - 2 * bits)) - 1;
+            for (slice, mode, prev) in [
+                (0u64, 0u8, 0u8),
+                (top, (1 << bits) - 1, 0),
+                (5, 1, (1 << bits) - 1),
+            ] {
+                let slice = slice.min(top) as u16;
+                let f = slice_field(slice, mode, prev, bits);
+                assert_eq!(split_slice_field(f, bits), (slice, mode, prev), "{bits}");
+            }
+            assert!(modes_fit(top + 1, bits) && !modes_fit(top + 2, bits));
+        }
+        assert!(!modes_fit(1, 8));
     }
 
     #[test]

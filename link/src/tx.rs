@@ -37,6 +37,9 @@ pub struct TxConfig {
     pub slices_per_frame: u64,
     /// FIFO depth in tokens; `None`: unbounded (to measure the backlog).
     pub depth: Option<usize>,
+    /// Bits of the `mode` input (a mix with modes; 0 without): each header
+    /// carries its frame's mode and the one before ([`format::slice_field`]).
+    pub mode_bits: u32,
 }
 
 /// The byte on the line and what it carries, for reports.
@@ -66,6 +69,9 @@ pub struct HeaderOnLine {
     /// Its frame counter and slice.
     pub frame: u8,
     pub slice: u16,
+    /// Its frame's mode and the mode of the frame before (0 without modes).
+    pub mode: u8,
+    pub prev_mode: u8,
     /// The overflow count the trailer before it carried, and the sticky flag.
     pub overflows: u8,
     pub overflow_flag: bool,
@@ -91,6 +97,11 @@ pub struct TxModel {
     started: bool,
     hframe: u8,
     hslice: u16,
+    /// The modes of the last header's frame and of the frame before it,
+    /// and the `mode` input in the current cycle.
+    fmode: u8,
+    pmode: u8,
+    mode_in: u8,
     crc: u16,
     ovf: u8,
     ovf_flag: bool,
@@ -124,6 +135,9 @@ impl TxModel {
             started: false,
             hframe: 0,
             hslice: 0,
+            fmode: 0,
+            pmode: 0,
+            mode_in: 0,
             crc: CRC_INIT,
             ovf: 0,
             ovf_flag: false,
@@ -154,6 +168,7 @@ impl TxModel {
         let tok = Token {
             boundary: true,
             sample: h.boundary_sample,
+            mode: h.mode,
         };
         // In cycle x of a run the transmitter has seen x + 1 edges.
         t.cycle = h.first + 1;
@@ -166,6 +181,8 @@ impl TxModel {
         t.have = t.mask != 0;
         t.hframe = h.frame;
         t.hslice = h.slice;
+        t.fmode = h.mode;
+        t.pmode = h.prev_mode;
         t.crc = format::crc_update(CRC_INIT, SYNC);
         t.ovf = h.overflows;
         t.ovf_flag = h.overflow_flag;
@@ -191,6 +208,8 @@ impl TxModel {
         self.started = false;
         self.hframe = 0;
         self.hslice = 0;
+        self.fmode = 0;
+        self.pmode = 0;
         self.crc = CRC_INIT;
         self.ovf = 0;
         self.ovf_flag = false;
@@ -232,6 +251,12 @@ impl TxModel {
         self.tready = r;
     }
 
+    /// A mix with modes: the `mode` input in the current cycle, before
+    /// [`TxModel::clock`] (a boundary's token takes it to its header).
+    pub fn set_mode(&mut self, mode: u8) {
+        self.mode_in = mode;
+    }
+
     /// The sticky overflow flag (`link_overflow`) in the current cycle.
     pub fn overflow(&self) -> bool {
         self.ovf_flag
@@ -267,6 +292,7 @@ impl TxModel {
         let token = Token {
             boundary: self.pos == 0,
             sample,
+            mode: self.mode_in,
         };
         let ready = match self.cfg.line {
             Line::Uart(u) => !self.busy || (self.div + 1 == u.div && self.bit + 1 == u.bits()),
@@ -345,6 +371,14 @@ impl TxModel {
         self.mask &= self.mask - 1;
         self.have = self.mask != 0;
         let (ch, val) = self.tok.sample.unwrap_or((0, 0));
+        if slot == 4 {
+            // a header: its frame's mode, and the one before at a frame's first
+            if self.hslice == 0 {
+                self.pmode = self.fmode;
+            }
+            self.fmode = self.tok.mode;
+        }
+        let field = format::slice_field(self.hslice, self.fmode, self.pmode, self.cfg.mode_bits);
         let byte = match slot {
             0 => END,
             1 => self.ovf,
@@ -352,8 +386,8 @@ impl TxModel {
             3 => (self.crc >> 8) as u8,
             4 => SYNC,
             5 => self.hframe,
-            6 => (self.hslice >> 8) as u8,
-            7 => self.hslice as u8,
+            6 => (field >> 8) as u8,
+            7 => field as u8,
             8 => (ch >> 8) as u8,
             9 => ch as u8,
             10 => (val >> 8) as u8,
@@ -516,6 +550,7 @@ mod tests {
             slice_cycles: 1000,
             slices_per_frame: 2,
             depth,
+            mode_bits: 0,
         }
     }
 
@@ -645,17 +680,28 @@ mod tests {
 
     /// A transmitter rebuilt from each header on the line (what a check
     /// joining mid-run sees) drives the same pins as the one that ran from
-    /// reset, from that cycle on, on a UART and on AXIS under back-pressure.
+    /// reset, from that cycle on, on a UART and on AXIS under back-pressure,
+    /// with and without modes switching between frames.
     #[test]
     fn a_transmitter_rebuilt_at_a_header_drives_the_same_pins() {
         let axis = Line::Axis(AxisFormat {
             tlast: Tlast::Frame,
             ready_within: 4,
         });
-        for line in [cfg(4, Some(64)).line, axis] {
+        let lines = [cfg(4, Some(64)).line, axis];
+        for (line, mode_bits) in lines.into_iter().flat_map(|l| [(l, 0), (l, 2)]) {
             let cfg = TxConfig {
                 line,
+                mode_bits,
                 ..cfg(4, Some(64))
+            };
+            // frames of 2000 cycles; with modes, a new mode most frames
+            let mode = |c: u64| {
+                if mode_bits == 0 {
+                    0
+                } else {
+                    (c / 2000 * 5 % 3) as u8
+                }
             };
             let sample =
                 |c: u64| (c % 1000 < 300 && c % 97 == 5).then_some((c as u16 % 7, c as u16));
@@ -672,6 +718,8 @@ mod tests {
                             first: c,
                             frame: b.packet.0,
                             slice: b.packet.1,
+                            mode: t.fmode,
+                            prev_mode: t.pmode,
                             overflows: t.ovf,
                             overflow_flag: t.ovf_flag,
                             boundary_sample: sample(at),
@@ -693,11 +741,13 @@ mod tests {
                 let tok = Token {
                     boundary: c % 1000 == 0,
                     sample: sample(c),
+                    mode: mode(c),
                 };
                 if tok.boundary || tok.sample.is_some() {
                     tokens.push((c, tok));
                 }
                 for m in std::iter::once(&mut t).chain(rebuilt.iter_mut()) {
+                    m.set_mode(mode(c));
                     m.clock(false, sample(c));
                 }
             }

@@ -131,6 +131,7 @@ impl LinkPlan {
             slice_cycles: s.grid.slice_cycles,
             slices_per_frame: s.grid.slices_per_frame,
             depth: Some(self.fifo_depth),
+            mode_bits: s.mix.modes.as_ref().map_or(0, |m| m.select_bits()),
         }
     }
 }
@@ -281,6 +282,8 @@ fn measure(s: &Schedule, line: Line, stream: &[(u64, u64, u16)]) -> Option<Stead
         slice_cycles: s.grid.slice_cycles,
         slices_per_frame: s.grid.slices_per_frame,
         depth: None,
+        // the header's size does not depend on the modes it carries
+        mode_bits: 0,
     };
     link::steady_state(cfg, stream, MAX_FRAMES).filter(|m| m.backlog <= MAX_FIFO_DEPTH)
 }
@@ -397,9 +400,31 @@ impl PacketInstants {
     /// none of the others; `None` where the schedule has no instant left
     /// for a record (or it would fall before cycle 0).
     pub fn cycles(&self, frame: u64, slice: u16, channels: &[u16]) -> Vec<Option<u64>> {
-        let Some(list) = self.per_slice.get(slice as usize) else {
+        self.cycles_after(self, frame, slice, channels)
+    }
+
+    /// [`PacketInstants::cycles`] of a mix with modes: the packet's frame
+    /// runs this mode and the frame before ran `prev`'s, whose samples the
+    /// packet carries over (docs/packet-format.md, "Modes").
+    pub fn cycles_after(
+        &self,
+        prev: &PacketInstants,
+        frame: u64,
+        slice: u16,
+        channels: &[u16],
+    ) -> Vec<Option<u64>> {
+        let (Some(own), Some(before)) = (
+            self.per_slice.get(slice as usize),
+            prev.per_slice.get(slice as usize),
+        ) else {
             return vec![None; channels.len()];
         };
+        let list: Vec<(u16, i64)> = before
+            .iter()
+            .filter(|e| e.1 < 0)
+            .chain(own.iter().filter(|e| e.1 >= 0))
+            .copied()
+            .collect();
         let base = (frame * self.frame_cycles) as i64;
         let mut seen: BTreeMap<u16, usize> = BTreeMap::new();
         channels

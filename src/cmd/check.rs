@@ -128,10 +128,16 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
+    // A VCD carries the mode ports; a logic-analyser capture's map does not.
+    let s = match super::load_any_modes(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
+    if a.map.is_some() {
+        if let Err(code) = super::one_mode(&s, &a.mix) {
+            return code;
+        }
+    }
     if let Err(code) = super::junit::check_writable(a.junit.as_deref()) {
         return code;
     }

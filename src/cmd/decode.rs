@@ -1,5 +1,7 @@
 //! `slotforge decode MIX CAPTURE -o OUT.csv [--json]`: the bytes a host
-//! received from the link, as samples (`frame,slice,channel,value,sampled_s`).
+//! received from the link, as samples (`frame,slice,channel,value,sampled_s`;
+//! a mix with modes adds `mode`, the name of the packet's frame's mode, whose
+//! schedule, and the frame before's, give `sampled_s`).
 //!
 //! The decoding is `link::Decoder` (the packet format's one home); the
 //! sampling instants come from the schedule (`lut_gen::PacketInstants`),
@@ -36,11 +38,15 @@ pub struct Args {
 
 /// The CSV's first line.
 pub const HEADER: &str = "frame,slice,channel,value,sampled_s";
+/// The CSV's first line for a mix with modes.
+pub const HEADER_MODES: &str = "frame,slice,mode,channel,value,sampled_s";
 
 /// Rows of decoded packets, with names and sampling times from the mix.
 struct Rows {
     names: Vec<String>,
     times: PacketInstants,
+    /// A mix with modes: each mode's name and packet instants.
+    modes: Vec<(String, PacketInstants)>,
     rows: u64,
 }
 
@@ -50,7 +56,17 @@ impl Rows {
         use std::fmt::Write as _;
         for packet in d.chunk_by(|a, b| (a.frame, a.slice) == (b.frame, b.slice)) {
             let chans: Vec<u16> = packet.iter().map(|x| x.channel).collect();
-            let times = self.times.cycles(packet[0].frame, packet[0].slice, &chans);
+            let (f, k) = (packet[0].frame, packet[0].slice);
+            let (times, mode) = match self.modes.get(packet[0].mode as usize) {
+                Some((name, own)) => {
+                    let prev = self
+                        .modes
+                        .get(packet[0].prev_mode as usize)
+                        .map_or(own, |m| &m.1);
+                    (own.cycles_after(prev, f, k, &chans), format!("{name},"))
+                }
+                None => (self.times.cycles(f, k, &chans), String::new()),
+            };
             let hz = self.times.clock_hz();
             for (x, t) in packet.iter().zip(times) {
                 let name = self
@@ -59,7 +75,7 @@ impl Rows {
                     .cloned()
                     .unwrap_or_else(|| format!("#{}", x.channel));
                 let t = t.map(|t| lut_gen::seconds(t, hz)).unwrap_or_default();
-                let _ = writeln!(out, "{},{},{name},{},{t}", x.frame, x.slice, x.value);
+                let _ = writeln!(out, "{},{},{mode}{name},{},{t}", x.frame, x.slice, x.value);
                 self.rows += 1;
             }
         }
@@ -124,9 +140,6 @@ pub fn run(a: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::one_mode(&s, &a.mix) {
-        return code;
-    }
     if s.mix.link.is_none() {
         eprintln!(
             "error: {}: the mix has no [link]: its samples leave on the parallel sample port, there is nothing to decode",
@@ -156,13 +169,34 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
+    let names = s.mode_plan().map(|m| m.names.clone()).unwrap_or_default();
+    let modes: Vec<(String, PacketInstants)> = if s.modes.len() > 1 {
+        names
+            .into_iter()
+            .zip(s.modes.iter().map(PacketInstants::new))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let mode_bits = match lut_gen::plan_link(&s) {
+        Some(Ok(p)) => p.tx_config(&s).mode_bits,
+        _ => 0,
+    };
+    let mut text = format!(
+        "{}\n",
+        if modes.is_empty() {
+            HEADER
+        } else {
+            HEADER_MODES
+        }
+    );
     let mut rows = Rows {
         names: s.mix.channels.iter().map(|c| c.name.clone()).collect(),
         times: PacketInstants::new(&s),
+        modes,
         rows: 0,
     };
-    let mut dec = Decoder::new(s.grid.slices_per_frame);
-    let mut text = format!("{HEADER}\n");
+    let mut dec = Decoder::with_modes(s.grid.slices_per_frame, mode_bits);
     let mut buf = vec![0u8; 1 << 16];
     let mut got = Vec::new();
     loop {

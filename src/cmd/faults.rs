@@ -50,10 +50,17 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
+    // The model follows mode switches (the campaign runs a switching
+    // scenario); the gateware does not switch yet.
+    let s = match super::load_any_modes(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
+    if a.backend != engines::Backend::Model {
+        if let Err(code) = super::one_mode(&s, &a.mix) {
+            return code;
+        }
+    }
     // One back-end name everywhere (engines::Backend); the campaign injects
     // into the designs it can build in process.
     let target = match a.backend {

@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use judge::Verdict;
-use judge::{run_dut, Dut, ModelDut, RunOptions};
+use judge::{run_dut, Dut, ModelDut};
 use judge::{FaultyDut, PinFault};
 use lut_gen::Schedule;
 use serde::Serialize;
@@ -36,6 +36,7 @@ use engines::SimError;
 
 mod class;
 mod methods;
+mod modes;
 mod verilog;
 pub use class::{FaultClass, Level};
 pub use methods::{methods, sample as methods_sample, Engine, MethodRun};
@@ -80,6 +81,7 @@ impl Detector {
             (Detector::Sigrok, _) if class.on_mux_pins() => Some("the SPI decode reads CS, SCLK and MISO only: mux pins are outside its view, and the design emits whatever code MISO carried"),
             (Detector::Prove, Level::Pins | Level::Reset) => Some("the fault is injected into a simulation's pins, not built into a design: prove reads a design, so it has nothing to prove it against"),
             (Detector::Sigrok, _) if class.on_link() => Some("the SPI decode reads CS, SCLK and MISO only: the link's pins are outside its view"),
+            (Detector::Sigrok, _) if class.on_mode_pin() => Some("the SPI decode reads CS, SCLK and MISO only: the `mode` output is outside its view"),
             _ => None,
         }
     }
@@ -352,7 +354,7 @@ impl Judged {
 /// Runs `dut` for `frames` frames under the checker (model comparison and
 /// invariants, counted apart) and, with `sigrok`, decodes its SPI pins.
 fn judge_run(s: &Schedule, dut: &mut dyn Dut, frames: u64, sigrok: bool) -> Result<Judged, String> {
-    let opts = RunOptions::default();
+    let opts = modes::run_options(s, frames);
     if !sigrok {
         let report = run_dut(s, dut, frames, &opts, "faults", None);
         return Ok(Judged {
@@ -622,7 +624,8 @@ fn slave(s: &Schedule, dut: Box<dyn Dut>) -> Box<dyn Dut> {
 /// The design the faults go into, built for `s`, behind the campaign's slave.
 fn target_dut(s: &Schedule, target: Target) -> Result<Box<dyn Dut>, SimError> {
     let d: Box<dyn Dut> = match target {
-        Target::Model => Box::new(ModelDut::new(s)),
+        // a mix with modes runs its switching scenario
+        Target::Model => modes::with_requests(s, Box::new(ModelDut::new(s))),
         Target::Rusthdl => Box::new(RustHdlDut::new(s)?),
     };
     Ok(slave(s, d))
@@ -647,9 +650,13 @@ fn pin_injections(
 ) -> Result<Vec<Judgement>, String> {
     let mut jobs = Vec::new();
     for site in sites {
-        for f in PinFault::all(s) {
+        for f in PinFault::all(s).into_iter().filter(|f| !f.is_mode()) {
             jobs.push((f, *site));
         }
+    }
+    // the `mode` faults at the scenario's frame starts
+    for f in PinFault::all(s).into_iter().filter(PinFault::is_mode) {
+        jobs.extend(modes::mode_site(s, f, frames).map(|site| (f, site)));
     }
     let runs = parallel(
         jobs,
@@ -853,7 +860,7 @@ fn clean_target_runs(s: &Schedule, target: Target, frames: u64) -> [(u64, f64); 
         let Ok(mut dut) = target_dut(s, target) else {
             return (0, 0.0);
         };
-        let mut opts = RunOptions::default();
+        let mut opts = modes::run_options(s, frames);
         opts.check.model = model;
         let t = Instant::now();
         let r = run_dut(s, &mut dut, frames, &opts, "timing", None);
@@ -976,7 +983,9 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
 fn planned_runs(s: &Schedule, plan: &Plan, sites: &[Site]) -> u64 {
     let mut n = 1 + plan.false_alarm_mixes;
     if plan.builtin {
-        n += (sites.len() * PinFault::all(s).len()) as u64;
+        let all = PinFault::all(s);
+        let mode = all.iter().filter(|f| f.is_mode()).count();
+        n += (sites.len() * (all.len() - mode) + mode) as u64;
         if plan.target == Target::Rusthdl {
             n += design_cases(s, sites).len() as u64;
         }

@@ -33,3 +33,6 @@ mod gateware_commands;
 
 // Shared by several test files (one copy in this binary).
 use testkit::tools;
+
+#[path = "modes.rs"]
+mod modes;

@@ -80,6 +80,19 @@ pub enum PinFault {
     /// AXI4-Stream: the first beat at or after the site that waits for
     /// `tready` has `tdata` bit 0 changed in the next cycle.
     AxisTdataChange,
+    // Faults of the `mode` output (a mix with modes, docs/timing.md "Mode
+    // switches"), sited at a frame start `S` of a switching run: the
+    // campaign puts the first two where the run switches, the third where
+    // it does not.
+    /// `mode` shows another mode (the next by number: the new one of a
+    /// two-mode mix) in the cycle before `S`: a switch a cycle early.
+    ModeEarly,
+    /// `mode` keeps the mode of the frame before `S` through frame `S`:
+    /// a switch shown a frame late.
+    ModeStuck,
+    /// `mode` shows another mode (the next by number) through frame `S`: a
+    /// switch nothing decided.
+    ModeUnasked,
 }
 
 /// Cycles a [`PinFault::ResetGlitch`] holds the design in reset.
@@ -112,6 +125,9 @@ impl PinFault {
             PinFault::LinkOverflow => "link-fifo-overflow",
             PinFault::AxisTvalidDrop => "axis-tvalid-drop",
             PinFault::AxisTdataChange => "axis-tdata-change",
+            PinFault::ModeEarly => "mode-early",
+            PinFault::ModeStuck => "mode-stuck",
+            PinFault::ModeUnasked => "mode-unasked",
         }
     }
 
@@ -139,7 +155,10 @@ impl PinFault {
             | PinFault::LinkStuck { .. }
             | PinFault::LinkOverflow
             | PinFault::AxisTvalidDrop
-            | PinFault::AxisTdataChange => None,
+            | PinFault::AxisTdataChange
+            | PinFault::ModeEarly
+            | PinFault::ModeStuck
+            | PinFault::ModeUnasked => None,
         }
     }
 
@@ -190,7 +209,23 @@ impl PinFault {
         }
         v.push(PinFault::NeighbourCode);
         v.extend(PinFault::link(s));
+        if s.modes.len() > 1 {
+            v.extend([
+                PinFault::ModeEarly,
+                PinFault::ModeStuck,
+                PinFault::ModeUnasked,
+            ]);
+        }
         v
+    }
+
+    /// Whether this is a fault of the `mode` output (sited at frame starts
+    /// of a switching run).
+    pub fn is_mode(&self) -> bool {
+        matches!(
+            self,
+            PinFault::ModeEarly | PinFault::ModeStuck | PinFault::ModeUnasked
+        )
     }
 
     /// The link's pin faults of the schedule's link (none without one):
@@ -321,6 +356,9 @@ pub struct FaultyDut<D> {
     /// period (the newest last).
     cmd_bit: u64,
     mosi_hist: VecDeque<bool>,
+    /// Mode faults: the number of modes, and `mode` in the cycle before.
+    modes: u8,
+    mode_before: u8,
 }
 
 impl<D: Dut> FaultyDut<D> {
@@ -387,6 +425,8 @@ impl<D: Dut> FaultyDut<D> {
             stalled: false,
             cmd_bit: first_channel_bit(s, b),
             mosi_hist: VecDeque::with_capacity(spi.sclk_div as usize + 1),
+            modes: s.modes.len().max(1) as u8,
+            mode_before: 0,
         }
     }
 }
@@ -463,6 +503,9 @@ impl<D: Dut> Dut for FaultyDut<D> {
             | PinFault::LinkOverflow
             | PinFault::AxisTvalidDrop
             | PinFault::AxisTdataChange => self.link_fault(c, &mut p, &orig),
+            PinFault::ModeEarly | PinFault::ModeStuck | PinFault::ModeUnasked => {
+                self.mode_fault(c, &mut p)
+            }
         }
         let frozen = matches!(self.fault, PinFault::PhaseShift { .. })
             && c >= self.t
@@ -705,6 +748,18 @@ impl<D> FaultyDut<D> {
 }
 
 impl<D> FaultyDut<D> {
+    /// The mode faults at frame start `at` (which the campaign chooses).
+    fn mode_fault(&mut self, c: u64, p: &mut Pins) {
+        let other = (p.mode + 1) % self.modes;
+        let frame = c >= self.at && c < self.at + self.frame;
+        match self.fault {
+            PinFault::ModeEarly if c + 1 == self.at => p.mode = other,
+            PinFault::ModeStuck if frame => p.mode = self.mode_before,
+            PinFault::ModeUnasked if frame => p.mode = other,
+            _ => self.mode_before = p.mode,
+        }
+    }
+
     /// Whether the fault has changed anything yet (a fault that found
     /// nothing to change was not injected).
     pub fn injected(&self) -> bool {

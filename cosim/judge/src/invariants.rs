@@ -208,6 +208,9 @@ impl Invariants {
         self.frame = origin / self.frame_cycles;
         self.rec.shift = origin - capture_cycle;
         self.rec.frame_base = self.frame;
+        if let Some(mc) = &mut self.mc {
+            mc.join(self.frame);
+        }
     }
 
     /// (cycle, frame, slot) of model cycle `c` as reports give them.
@@ -475,7 +478,12 @@ impl Invariants {
         let frames = cycles / self.frame_cycles;
         self.close_frames(frames * self.frame_cycles);
         if cycles > frames * self.frame_cycles {
-            let spf = if frames == 0 { &self.spf0 } else { &self.spf };
+            let spf = match &self.mc {
+                _ if frames == 0 => &self.spf0,
+                // the mode the design showed at the partial frame's start
+                Some(mc) => &self.spf_m[mc.shown],
+                None => &self.spf,
+            };
             for (ch, &most) in spf.iter().enumerate() {
                 if self.in_frame[ch] > most {
                     let name = self.names[ch].clone();

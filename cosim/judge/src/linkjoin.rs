@@ -64,6 +64,9 @@ pub(crate) struct LinkJoin {
     samples: Vec<(u64, u16, u16)>,
     /// `tready` since the join, run-length coded: (first cycle, level).
     tready: Vec<(u64, bool)>,
+    /// A mix with modes: the `mode` pin since the join, run-length coded
+    /// (a boundary's token takes it to its header).
+    modes: Vec<(u64, u8)>,
     /// The model's sample codes are not the run's (an analyser's capture
     /// without MISO): a packet's slice is placed by its number and its
     /// records' channels, on the model's own slice grid.
@@ -96,12 +99,13 @@ impl LinkJoin {
             step,
             from,
             wire,
-            dec: Decoder::new(slices),
+            dec: Decoder::with_modes(slices, cfg.mode_bits),
             packets: Vec::new(),
             bytes: VecDeque::new(),
             dropped: 0,
             samples: Vec::new(),
             tready: Vec::new(),
+            modes: Vec::new(),
             blind: false,
         }
     }
@@ -125,7 +129,11 @@ impl LinkJoin {
         if self.tready.last().map(|t| t.1) != Some(p.axis_tready) {
             self.tready.push((c, p.axis_tready));
         }
-        if self.samples.len() > MAX_LOG || self.tready.len() > MAX_LOG {
+        if self.modes.last().map(|t| t.1) != Some(p.mode) {
+            self.modes.push((c, p.mode));
+        }
+        if self.samples.len() > MAX_LOG || self.tready.len() > MAX_LOG || self.modes.len() > MAX_LOG
+        {
             self.forget(c);
         }
         let byte = match &mut self.wire {
@@ -175,7 +183,8 @@ impl LinkJoin {
         let n = 4 * (2 + pk.records.len());
         let hi = self.bytes.len().checked_sub(n)?;
         let at = |i: usize| self.bytes[i].0;
-        let slice = pk.slice.to_be_bytes();
+        let slice = link::format::slice_field(pk.slice, pk.mode, pk.prev_mode, self.cfg.mode_bits)
+            .to_be_bytes();
         let framed = at(hi) == SYNC
             && at(hi + 1) == pk.frame as u8
             && [at(hi + 2), at(hi + 3)] == slice
@@ -199,6 +208,7 @@ impl LinkJoin {
             .map(|c| Token {
                 boundary: (c + delta).is_multiple_of(s),
                 sample: self.sample_at(c),
+                mode: self.mode_at(c),
             })
             .filter(|t| t.boundary || t.sample.is_some())
             .collect();
@@ -206,6 +216,8 @@ impl LinkJoin {
             first: first + delta,
             frame: pk.frame as u8,
             slice: pk.slice,
+            mode: pk.mode,
+            prev_mode: pk.prev_mode,
             overflows,
             overflow_flag: overflows > 0,
             boundary_sample: self.sample_at(b),
@@ -249,6 +261,19 @@ impl LinkJoin {
         let i = self.tready.partition_point(|x| x.0 <= keep);
         self.tready.drain(..i);
         self.tready.insert(0, (keep, level));
+        let mode = self.mode_at(keep);
+        let i = self.modes.partition_point(|x| x.0 <= keep);
+        self.modes.drain(..i);
+        self.modes.insert(0, (keep, mode));
+    }
+
+    fn mode_at(&self, c: u64) -> u8 {
+        let i = self.modes.partition_point(|x| x.0 <= c);
+        if i > 0 {
+            self.modes[i - 1].1
+        } else {
+            0
+        }
     }
 
     fn sample_at(&self, c: u64) -> Option<(u16, u16)> {
@@ -271,6 +296,7 @@ impl LinkJoin {
         let mut tx = TxModel::at_header(self.cfg, h);
         for t in first..c {
             tx.set_tready(self.tready_at(t));
+            tx.set_mode(self.mode_at(t));
             tx.clock(false, self.sample_at(t));
         }
         tx.set_tready(self.tready_at(c));

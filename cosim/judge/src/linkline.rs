@@ -24,6 +24,8 @@
 //! - **content**: each packet carries exactly the samples whose
 //!   `sample_valid` strobe fell in its slice's cycles, in order, channel
 //!   and value; a trailer reports no FIFO overflow;
+//! - **modes** (a mix with modes): each header names the mode `mode`
+//!   showed in its slice and the mode of the frame before;
 //! - **delivery**: a slice's packet has arrived at the latest the audit's
 //!   worst-case latency (`lut_gen::plan_link`) plus one slice after the
 //!   slice ended, so a line that goes quiet is caught.
@@ -123,6 +125,20 @@ pub(crate) struct LinkLine {
     /// Joined mid-stream and not yet at a packet: the first cycle of each
     /// byte read (the last [`MAX_STARTS`]), for the joined packet's header.
     starts: VecDeque<u64>,
+    /// A mix with modes: the `mode` pin's changes (cycle, mode) over the
+    /// last frames, and the first cycle seen (0 from reset).
+    modes: VecDeque<(u64, u8)>,
+    mode_bits: u32,
+    seen_from: u64,
+}
+
+/// The decoder of a mix's packets (its modes' bits in the headers).
+pub(crate) fn decoder(s: &Schedule) -> Decoder {
+    let bits = match lut_gen::plan_link(s) {
+        Some(Ok(p)) => p.tx_config(s).mode_bits,
+        _ => 0,
+    };
+    Decoder::with_modes(s.grid.slices_per_frame, bits)
 }
 
 /// Byte start cycles kept while joining: more than any packet's bytes.
@@ -150,7 +166,7 @@ impl LinkLine {
         Some(LinkLine {
             wire,
             port,
-            dec: Decoder::new(s.grid.slices_per_frame),
+            dec: decoder(s),
             packets: Vec::new(),
             seen: Stats::default(),
             lost_place: false,
@@ -170,6 +186,9 @@ impl LinkLine {
             step: s.grid.slice_cycles,
             joined: None,
             starts: VecDeque::new(),
+            modes: VecDeque::new(),
+            mode_bits: plan.tx_config(s).mode_bits,
+            seen_from: 0,
         })
     }
 
@@ -188,6 +207,7 @@ impl LinkLine {
         self.offset = None;
         self.synced = false;
         self.learning = Some((Vec::new(), origin, 0));
+        self.seen_from = origin;
     }
 
     /// Bytes read from the line so far.
@@ -244,6 +264,13 @@ impl LinkLine {
     /// The link's pins in cycle `c` (every cycle, in order).
     #[inline]
     pub(crate) fn cycle(&mut self, c: u64, p: &Pins, inv: &mut Invariants) {
+        if self.mode_bits > 0 && self.modes.back().map(|m| m.1) != Some(p.mode) {
+            self.modes.push_back((c, p.mode));
+            let keep = c.saturating_sub(4 * self.slices * self.slice_cycles);
+            while self.modes.len() > 2 && self.modes[1].0 <= keep {
+                self.modes.pop_front();
+            }
+        }
         if c >= self.next_boundary {
             self.boundary(c, inv);
         }
@@ -539,6 +566,48 @@ impl LinkLine {
         let win = self.windows.pop_front().unwrap_or_default();
         self.base += 1;
         self.compare(c, w, &win, &p.records, inv);
+        if self.mode_bits > 0 {
+            self.check_modes(c, w, &p, inv);
+        }
+    }
+
+    /// The `mode` pin in cycle `x`, if the check saw it.
+    fn mode_at(&self, x: i64) -> Option<u8> {
+        if x < self.seen_from as i64 {
+            // before cycle 0 of a run from reset: mode 0 (frame 0's "before")
+            return (self.seen_from == 0).then_some(0);
+        }
+        let i = self.modes.partition_point(|m| m.0 as i64 <= x);
+        (i > 0).then(|| self.modes[i - 1].1)
+    }
+
+    /// A mix with modes: the header's mode against `mode` in its slice's
+    /// first cycle, and its mode of the frame before against `mode` a frame
+    /// earlier.
+    fn check_modes(&self, c: u64, w: u64, p: &Packet, inv: &mut Invariants) {
+        let start = self.start_of(w) as i64;
+        let frame = (self.slices * self.slice_cycles) as i64;
+        let (Some(mode), prev) = (self.mode_at(start), self.mode_at(start - frame)) else {
+            return;
+        };
+        if p.mode == mode && prev.is_none_or(|m| m == p.prev_mode) {
+            return;
+        }
+        let (slice, f) = self.slice_frame(w, inv);
+        let shown = match prev {
+            Some(m) => format!("mode {mode} (the frame before: {m})"),
+            None => format!("mode {mode}"),
+        };
+        inv.record(
+            Violation::new(Rule::LinkMode, c)
+                .signal(self.port.to_string())
+                .expected(json!(shown))
+                .actual(json!(format!("mode {} (the frame before: {})", p.mode, p.prev_mode)))
+                .detail(format!(
+                    "the packet of frame {f} slice {slice} names mode {} (the frame before: {}), but `mode` showed {shown}",
+                    p.mode, p.prev_mode
+                )),
+        );
     }
 
     /// The slice (window) a packet is of, when the last slice closed is

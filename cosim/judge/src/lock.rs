@@ -56,16 +56,27 @@ struct Template {
 }
 
 impl Template {
-    fn new(s: &Schedule) -> Template {
+    /// The template of a mix without switches (`mode` None), or of mode
+    /// `m` run steadily (frame 3 of a model held in it from frame 2 on).
+    fn new(s: &Schedule, mode: Option<usize>) -> Template {
         let f = s.grid.frame_cycles;
-        let mut m = CycleModel::at(s, f - 1);
+        let (mut m, k) = match mode {
+            None => (CycleModel::at(s, f - 1), 1),
+            Some(mode) => (
+                CycleModel::with_modes(s, &[(2, mode), (3, mode), (4, mode)]),
+                3,
+            ),
+        };
+        while m.cycle() < k * f - 1 {
+            m.step(0);
+        }
         let mut prev = ctl(m.pins());
         let mut ev = Vec::new();
         m.step(0);
-        while m.cycle() < 2 * f {
+        while m.cycle() < (k + 1) * f {
             let c = ctl(m.pins());
             if c != prev {
-                ev.push((m.cycle() - f, c));
+                ev.push((m.cycle() - k * f, c));
                 prev = c;
             }
             m.step(0);
@@ -112,15 +123,19 @@ impl Template {
         last + self.gap((last + phase) % self.frame, self.ev[k].0)
     }
 
-    /// Candidate (phase, next event) for a first change `prev -> cur` at capture cycle `i`.
-    fn candidates(&self, i: u64, prev: Ctl, cur: Ctl) -> Vec<(u64, usize)> {
+    /// Candidate (phase, next event) for a first change `prev -> cur` at
+    /// capture cycle `i`, the search having seen `unchanged` cycles without one.
+    fn candidates(&self, i: u64, unchanged: u64, prev: Ctl, cur: Ctl) -> Vec<(u64, usize)> {
         let n = self.ev.len();
         let mut seen = std::collections::BTreeSet::new();
         let mut out = Vec::new();
         for k in 0..n {
             // The change before must lie before the capture: it showed none.
             let before = self.ev[(k + n - 1) % n];
-            if self.ev[k].1 == cur && before.1 == prev && self.gap(before.0, self.ev[k].0) >= i {
+            if self.ev[k].1 == cur
+                && before.1 == prev
+                && self.gap(before.0, self.ev[k].0) >= unchanged
+            {
                 let phase = (self.ev[k].0 + self.frame - i % self.frame) % self.frame;
                 if seen.insert(phase % self.repeat) {
                     out.push((phase, (k + 1) % n));
@@ -289,6 +304,14 @@ impl Buffer {
 
 struct Search {
     tpl: Template,
+    /// A mix with switches: the mode the template runs (the one the `mode`
+    /// pin shows), the cycle the search (re)started at, and why the last
+    /// attempt failed (a switch's frame changes fit no one mode's template:
+    /// the search starts over, and a change of `mode`, a frame start, gives
+    /// the phase outright).
+    mode: Option<usize>,
+    since: u64,
+    failed: Option<LockError>,
     cands: Option<Vec<(u64, usize)>>,
     prev: Option<Ctl>,
     changes: u64,
@@ -329,6 +352,8 @@ pub struct WindowCheck<'a> {
     /// Whether `rst` has had a value: one that never has (a VCD without
     /// `$dumpvars` whose `rst` does not change) is taken as released.
     rst_seen: bool,
+    /// The capture has ended: a pending join takes what it has.
+    ending: bool,
 }
 
 impl<'a> WindowCheck<'a> {
@@ -348,11 +373,18 @@ impl<'a> WindowCheck<'a> {
             i: 0,
             mode: Mode::Waiting,
             rst_seen: false,
+            ending: false,
         }
     }
 
     /// The report, and how the phase was found when the capture did not start at reset.
     pub fn finish(mut self, source: &str) -> Result<(Verdict, Option<LockInfo>), LockError> {
+        self.ending = true;
+        if matches!(self.mode, Mode::Pending { .. }) {
+            self.i -= 1;
+            self.try_join();
+            self.i += 1;
+        }
         if let Mode::Search(search) = &mut self.mode {
             if let Some(c) = search.cands.take() {
                 let n = c.len();
@@ -385,7 +417,10 @@ impl<'a> WindowCheck<'a> {
                 locked_at: info.locked_at,
                 cycles: self.i,
             }),
-            Mode::Search(_) => Err(LockError::NoChanges { cycles: self.i }),
+            Mode::Search(mut k) => Err(k
+                .failed
+                .take()
+                .unwrap_or(LockError::NoChanges { cycles: self.i })),
         }
     }
 
@@ -395,6 +430,15 @@ impl<'a> WindowCheck<'a> {
             unreachable!()
         };
         search.buf.push(i, r);
+        let shown = r.pins.mode as usize;
+        if search.mode.is_some_and(|m| m != shown) && shown < self.s.modes.len() {
+            // `mode` changed: cycle i begins a frame, in the mode shown
+            search.tpl = Template::new(self.s, Some(shown));
+            search.mode = Some(shown);
+            let f = search.tpl.frame;
+            self.locked((f - i % f) % f, 1);
+            return;
+        }
         let cur = ctl(&r.pins);
         let known = ctl(&r.xz) == ctl(&NO_XZ);
         let prev = search.prev.replace(cur).filter(|_| known);
@@ -414,7 +458,7 @@ impl<'a> WindowCheck<'a> {
         let fitted_before = search.cands.as_ref().map(Vec::len);
         let cands = match search.cands.take() {
             None => {
-                let c = tpl.candidates(i, prev, cur);
+                let c = tpl.candidates(i, i - search.since, prev, cur);
                 search.first_candidates = c.len();
                 c
             }
@@ -430,7 +474,7 @@ impl<'a> WindowCheck<'a> {
         };
         match cands.len() {
             0 => {
-                self.mode = Mode::Failed(LockError::Impossible {
+                let e = LockError::Impossible {
                     cycle: i,
                     fitted_before: fitted_before.unwrap_or(0),
                     detail: format!(
@@ -438,7 +482,13 @@ impl<'a> WindowCheck<'a> {
                         fmt_ctl(&prev),
                         fmt_ctl(&cur)
                     ),
-                });
+                };
+                if search.mode.is_some() {
+                    search.failed = Some(e);
+                    search.since = i;
+                } else {
+                    self.mode = Mode::Failed(e);
+                }
             }
             1 => self.locked(cands[0].0, 1),
             _ => search.cands = Some(cands),
@@ -457,7 +507,11 @@ impl<'a> WindowCheck<'a> {
         let fc = (i + phase) % f;
         // Join after the first kept cycle: the checker needs the cycle before.
         let mut from = search.buf.first() + 1;
-        let mut model = CycleModel::at(self.s, f + (from + phase) % f);
+        let mut model = match search.mode {
+            None => CycleModel::at(self.s, f + (from + phase) % f),
+            // frame 3 of a model in the modes the capture showed
+            Some(_) => self.model_in_modes(&search.buf, 3 * f + (from + phase) % f, from),
+        };
         while !model.quiet() {
             model.step(0);
             from += 1;
@@ -488,12 +542,58 @@ impl<'a> WindowCheck<'a> {
         self.try_join();
     }
 
+    /// Frames after the join frame whose modes were decided before the
+    /// capture could show why (`ModeTrack::join`): a joined model takes them
+    /// from the `mode` pin, so the check waits until the capture showed the
+    /// last one's first cycle (or ended).
+    fn modes_known(&self) -> bool {
+        let Mode::Pending {
+            search,
+            model,
+            from,
+            ..
+        } = &self.mode
+        else {
+            return true;
+        };
+        if search.mode.is_none() || self.ending {
+            return true;
+        }
+        let f = self.s.grid.frame_cycles;
+        let learn = crate::modes::ModeTrack::new(self.s).join(0);
+        self.i + model.cycle() % f >= from + learn * f
+    }
+
+    /// The model at model cycle `at` (capture cycle `from`) with every
+    /// frame up to the join's in the mode the capture shows at `from`, and
+    /// the next frames' modes as the `mode` pin showed them at their starts.
+    fn model_in_modes(&self, buf: &Buffer, at: u64, from: u64) -> CycleModel {
+        let f = self.s.grid.frame_cycles;
+        // capture cycle `start + k f` begins model frame `mf + k`
+        let (mf, start) = (at / f, from as i64 - (at % f) as i64);
+        let mut forced: Vec<(u64, usize)> = (2..=mf)
+            .map(|g| (g, buf.at(from).pins.mode as usize))
+            .collect();
+        let learn = crate::modes::ModeTrack::new(self.s).join(0);
+        for d in 1..=learn {
+            let c = (start + (d * f) as i64) as u64;
+            if c <= self.i {
+                forced.push((mf + d, buf.at(c).pins.mode as usize));
+            }
+        }
+        let mut model = CycleModel::with_modes(self.s, &forced);
+        while model.cycle() < at {
+            model.step(0);
+        }
+        model
+    }
+
     /// Joins once the capture has reached the cycle checking begins at.
     fn try_join(&mut self) {
         let Mode::Pending { from, .. } = &self.mode else {
             return;
         };
-        if *from > self.i {
+        if *from > self.i || !self.modes_known() {
             return;
         }
         let Mode::Pending {
@@ -504,6 +604,10 @@ impl<'a> WindowCheck<'a> {
         } = std::mem::replace(&mut self.mode, Mode::Waiting)
         else {
             unreachable!()
+        };
+        let model = match search.mode {
+            Some(_) => Box::new(self.model_in_modes(&search.buf, model.cycle(), from)),
+            None => model,
         };
         let at = model.cycle();
         let buf = &search.buf;
@@ -591,8 +695,13 @@ impl CycleSink for WindowCheck<'_> {
                 // counted from there.
                 let unknown = xz.cs_n != 0 || xz.sclk != 0 || xz.mux_sel != 0 || xz.mux_en != 0;
                 if rst != Some(true) && !unknown {
+                    let mode = (self.s.modes.len() > 1)
+                        .then(|| (pins.mode as usize).min(self.s.modes.len() - 1));
                     self.mode = Mode::Search(Box::new(Search {
-                        tpl: Template::new(self.s),
+                        tpl: Template::new(self.s, mode),
+                        mode,
+                        since: 0,
+                        failed: None,
                         cands: None,
                         prev: None,
                         changes: 0,

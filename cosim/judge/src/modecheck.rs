@@ -21,6 +21,11 @@ pub(crate) struct ModeCheck {
     prev: u8,
     /// The mode the design showed at the start of the frame being counted.
     pub(crate) shown: usize,
+    /// A check that joined mid-run: the last frame whose mode is learnt
+    /// from the `mode` pin (decided before the join), and whether a cycle
+    /// was seen yet.
+    learn_until: Option<u64>,
+    seen: bool,
 }
 
 impl ModeCheck {
@@ -34,6 +39,8 @@ impl ModeCheck {
             sel: 0,
             prev: 0,
             shown: 0,
+            learn_until: None,
+            seen: false,
         })
     }
 
@@ -50,6 +57,15 @@ impl ModeCheck {
         self.sel = mode_sel;
         let prev = std::mem::replace(&mut self.prev, mode);
         let f = c / self.frame_cycles;
+        let first = !std::mem::replace(&mut self.seen, true);
+        if self.learn_until.is_some_and(|l| f <= l)
+            && (first || c.is_multiple_of(self.frame_cycles))
+        {
+            // decided before the join: the design says which
+            self.track.learn(mode as usize, first);
+            self.shown = (mode as usize).min(self.names.len() - 1);
+            return None;
+        }
         if c.is_multiple_of(self.frame_cycles) {
             let want = self.track.mode_of(f).unwrap_or(0);
             self.shown = if (mode as usize) < self.names.len() {
@@ -89,6 +105,12 @@ impl ModeCheck {
             );
         }
         None
+    }
+
+    /// The check joins a run in frame `frame` (model cycles).
+    pub(crate) fn join(&mut self, frame: u64) {
+        self.learn_until = Some(self.track.join(frame));
+        self.seen = false;
     }
 
     /// The edge that begins the next frame: decides the mode of the frame

@@ -419,6 +419,17 @@ impl CycleModel {
         &self.track
     }
 
+    /// The model at cycle 0 with the modes of frames 2 and later given
+    /// (`(frame, mode)`), not decided from its inputs: where a check that
+    /// joins a run mid-way starts (docs/timing.md, "Mode switches").
+    pub fn with_modes(s: &Schedule, modes: &[(u64, usize)]) -> CycleModel {
+        let mut m = CycleModel::new(s);
+        for &(f, mode) in modes {
+            m.track.force(f, mode);
+        }
+        m
+    }
+
     /// The link's transmitter configuration (a mix with a `[link]`).
     pub fn tx_config(&self) -> Option<link::TxConfig> {
         self.tx.as_ref().map(|t| *t.config())
@@ -571,6 +582,9 @@ impl CycleModel {
         if self.tx.is_some() {
             let p = self.pins;
             self.step_pins(miso);
+            if let Some(t) = &mut self.tx {
+                t.set_mode(p.mode);
+            }
             self.step_link(p.sample_valid, p.sample_channel, p.sample_value);
         } else {
             self.step_pins(miso);

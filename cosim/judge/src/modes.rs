@@ -65,6 +65,10 @@ pub struct ModeTrack {
     cur: usize,
     next: usize,
     prev: usize,
+    /// Decisions given, not taken from the pins: (frame, mode).  A check
+    /// that joins a run mid-way starts its model with the modes the run's
+    /// `mode` pin showed (`lock`), and the lock's templates run one mode.
+    forced: Vec<(u64, usize)>,
 }
 
 impl ModeTrack {
@@ -104,6 +108,7 @@ impl ModeTrack {
             cur: 0,
             next: 0,
             prev: 0,
+            forced: Vec::new(),
         };
         m.open_windows();
         m
@@ -141,6 +146,48 @@ impl ModeTrack {
     /// The frame in force.
     pub fn frame(&self) -> u64 {
         self.frame
+    }
+
+    /// Frame `frame` (2 or later: frames 0 and 1 run mode 0) runs `mode`,
+    /// whatever the pins or the windows say.
+    pub fn force(&mut self, frame: u64, mode: usize) {
+        if mode < self.count {
+            self.forced.push((frame, mode));
+        }
+    }
+
+    /// A check that joined a run in frame `frame`, whose mode it does not
+    /// know yet: every trigger's run restarts (the windows before the join
+    /// were not seen).  Returns the last frame whose mode was decided from
+    /// what came before the join (the caller takes it from the `mode` pin
+    /// with [`ModeTrack::learn`]): the next frame for pin select, and the
+    /// frames decided from a window the join cut, for auto select.
+    pub fn join(&mut self, frame: u64) -> u64 {
+        self.frame = frame;
+        for t in &mut self.trig {
+            t.run = 0;
+        }
+        self.open_windows();
+        let reach = self
+            .trig
+            .iter()
+            .map(|t| t.for_frames as u64)
+            .max()
+            .unwrap_or(0);
+        frame + 1 + reach
+    }
+
+    /// The mode of the frame in force, taken from the design (a frame whose
+    /// decision the check did not see).  At the join (`joined`) the next
+    /// frame's is not known either: it is learnt at its start too.
+    pub fn learn(&mut self, mode: usize, joined: bool) {
+        if mode < self.count {
+            self.cur = mode;
+            if joined {
+                self.next = mode;
+                self.prev = mode;
+            }
+        }
     }
 
     fn open_windows(&mut self) {
@@ -201,6 +248,11 @@ impl ModeTrack {
                 .find(|t| t.armed_in(m) && self.cur == m && t.run >= t.for_frames)
                 .map_or(m, |t| t.to),
         };
+        let decided = self
+            .forced
+            .iter()
+            .find(|f| f.0 == self.frame + 2)
+            .map_or(decided, |f| f.1);
         self.prev = self.cur;
         self.frame += 1;
         self.cur = m;

@@ -73,6 +73,9 @@ pub enum Rule {
     LinkPacketLost,
     /// A packet's records differ from the samples emitted in its slice.
     LinkSamples,
+    /// A mix with modes: a packet's header names another mode (or mode of
+    /// the frame before) than `mode` showed.
+    LinkMode,
     /// The `mode` output changed inside a frame (a switch takes effect at a
     /// frame start only).
     ModeSwitch,
@@ -126,6 +129,7 @@ impl Rule {
             Rule::LinkSequence => "link-sequence",
             Rule::LinkPacketLost => "link-packet-lost",
             Rule::LinkSamples => "link-samples",
+            Rule::LinkMode => "link-mode",
             Rule::ModeSwitch => "mode-switch",
             Rule::ModeDecision => "mode-decision",
             Rule::CommandWord => "command-word",

@@ -57,6 +57,8 @@ pub struct SampleLog {
     seen: u64,
     /// Run cycle of cycle 0, once reset is low.
     zero: Option<u64>,
+    /// A mix with modes: the `mode` pin's changes (cycle, mode) from cycle 0.
+    modes: Vec<(u64, u8)>,
 }
 
 impl SampleLog {
@@ -80,9 +82,13 @@ impl SampleLog {
             // cycle 0 follows the last reset cycle
             self.zero = None;
             self.samples.clear();
+            self.modes.clear();
             return;
         }
         let zero = *self.zero.get_or_insert(k);
+        if self.modes.last().map_or(p.mode != 0, |m| m.1 != p.mode) {
+            self.modes.push((k - zero, p.mode));
+        }
         if p.sample_valid {
             self.samples.push(Sample {
                 cycle: k - zero,
@@ -103,13 +109,48 @@ impl SampleLog {
                 .channels
                 .get(x.channel as usize)
                 .map_or_else(|| format!("channel{}", x.channel), |c| csv_field(&c.name));
-            let sampled = s
-                .sampled_at(x.channel as usize, x.cycle)
+            let sampled = self
+                .sampled_at(s, x)
                 .map(|t| lut_gen::seconds(t, s.grid.clock_hz))
                 .unwrap_or_default();
             let _ = writeln!(o, "{},{sampled},{name},{}", x.cycle, x.value);
         }
         o
+    }
+
+    /// The `mode` pin in cycle `c` (0 before any change).
+    fn mode_at(&self, c: u64) -> usize {
+        let i = self.modes.partition_point(|m| m.0 <= c);
+        if i == 0 {
+            0
+        } else {
+            self.modes[i - 1].1 as usize
+        }
+    }
+
+    /// The sampling instant of `x`: its mode's schedule, or (a sample that
+    /// left after its frame ended) the frame before's mode's.
+    fn sampled_at(&self, s: &Schedule, x: &Sample) -> Option<u64> {
+        let ch = x.channel as usize;
+        if s.modes.len() < 2 {
+            return s.sampled_at(ch, x.cycle);
+        }
+        let f = s.grid.frame_cycles;
+        let start = x.cycle / f * f;
+        let here = s.modes.get(self.mode_at(x.cycle))?;
+        let own = here.sampled_at(ch, x.cycle).filter(|&t| t >= start);
+        let before = || {
+            let m = if start == 0 {
+                0
+            } else {
+                self.mode_at(start - 1)
+            };
+            s.modes
+                .get(m)?
+                .sampled_at(ch, x.cycle)
+                .filter(|&t| t < start)
+        };
+        own.or_else(before).or_else(|| here.sampled_at(ch, x.cycle))
     }
 
     /// Writes the CSV to `path` atomically: to a new temporary file beside

@@ -268,7 +268,7 @@ fn decode(
     out: &mut LinkCheck,
 ) -> LineRead {
     let slices = s.grid.slices_per_frame;
-    let mut dec = link::Decoder::new(slices);
+    let mut dec = crate::linkline::decoder(s);
     let (mut packets, mut decoded) = (Vec::new(), Vec::new());
     let (mut join, mut crc, mut lost, mut tlast_wrong) = (None, 0u64, 0u64, 0u64);
     let mut lost_place = false;

@@ -304,7 +304,7 @@ fn read_line(
     let t0 = cap.steps.first().map(|x| x.0).unwrap_or(0) as f64;
     let end = cap.steps.last().map(|x| x.0).unwrap_or(0) as f64;
     let mut rx = link::UartRx::new(fmt);
-    let mut dec = link::Decoder::new(s.grid.slices_per_frame);
+    let mut dec = crate::linkline::decoder(s);
     let mut line = LineSampler {
         k: 0,
         level: true,

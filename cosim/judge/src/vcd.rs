@@ -30,7 +30,7 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 
 use lut_gen::Schedule;
-use lut_gen::{LinkPort, Role, AXIS_PORTS, PORT_NAMES, TOP_MODULE};
+use lut_gen::{LinkPort, ModePort, Role, AXIS_PORTS, PORT_NAMES, TOP_MODULE};
 
 use crate::checker::{CheckOptions, Checker};
 use crate::lock::{LockError, LockInfo, WindowCheck};
@@ -303,8 +303,12 @@ const CHAN: usize = Role::SampleChannel as usize;
 const VALUE: usize = Role::SampleValue as usize;
 /// The first of the link's ports in [`State`].
 const LINK: usize = PORT_NAMES.len();
-/// Port slots: [`PORT_NAMES`], then the most link ports a mix has ([`AXIS_PORTS`]).
-const NPORT: usize = LINK + AXIS_PORTS.len();
+/// The mode ports' slots ([`lut_gen::MODE_PORTS`]: `mode_sel`, `mode`),
+/// after the most link ports a mix has ([`AXIS_PORTS`]).
+const MODE_SEL: usize = LINK + AXIS_PORTS.len();
+const MODE: usize = MODE_SEL + 1;
+/// Port slots: [`PORT_NAMES`], the link's, the mode ports.
+const NPORT: usize = MODE + 1;
 
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
 /// (or `lsb - j` when the range is ascending).
@@ -332,6 +336,8 @@ struct Resolved {
     widths: [u32; 11],
     /// The link's ports, read after [`PORT_NAMES`] (none without a link).
     link: &'static [LinkPort],
+    /// The mode ports the mix has and their width (none without modes).
+    modes: (&'static [ModePort], u32),
 }
 
 fn resolve(
@@ -349,6 +355,7 @@ fn resolve(
     }
     let (has_clk, has_rst) = ps.port_sinks(scope, widths, &mut ids)?;
     ps.link_sinks(scope, layout, &mut ids)?;
+    ps.mode_sinks(scope, layout, &mut ids)?;
     Ok(Resolved {
         ids: Ids::new(ids),
         has_clk,
@@ -356,6 +363,7 @@ fn resolve(
         scope: scope.to_string(),
         widths,
         link: layout.link_ports(),
+        modes: (layout.mode_ports(), layout.mode_bits),
     })
 }
 
@@ -701,6 +709,37 @@ impl Ids {
     }
 }
 
+impl PortSearch<'_> {
+    /// The sinks of the mix's mode ports in `scope` (docs/timing.md, "Mode
+    /// switches"): `mode_sel` (pin select) and `mode`, each `mode_bits` wide.
+    fn mode_sinks(
+        &self,
+        scope: &str,
+        layout: &Layout,
+        ids: &mut HashMap<Vec<u8>, Vec<Sink>>,
+    ) -> Result<(), VcdError> {
+        for mp in layout.mode_ports() {
+            let slot = if mp.dir == lut_gen::Dir::In {
+                MODE_SEL
+            } else {
+                MODE
+            };
+            let vs: Vec<&Var> = self.vars(scope, mp.name).collect();
+            if vs.is_empty() {
+                return Err(self.err(format!(
+                    "port `{}` (the mix switches modes) not found in scope `{scope}`",
+                    mp.name
+                )));
+            }
+            for v in vs {
+                let sink = self.sink(scope, mp.name, slot, v, layout.mode_bits)?;
+                ids.get_mut(&v.id).unwrap().push(sink);
+            }
+        }
+        Ok(())
+    }
+}
+
 // ------------------------------------------------------------------ body
 
 /// Parses a vector/scalar value into (value, x/z mask), left-extended to `width`.
@@ -808,9 +847,8 @@ impl State {
                 axis_tvalid: self.axis && g(LINK + 1) & 1 == 1,
                 axis_tlast: self.axis && g(LINK + 2) & 1 == 1,
                 axis_tready: self.axis && g(LINK + 3) & 1 == 1,
-                // the mode ports are not read from a VCD yet
-                mode_sel: 0,
-                mode: 0,
+                mode_sel: g(MODE_SEL) as u8,
+                mode: g(MODE) as u8,
             }
         };
         (pick(|p| p.v), pick(|p| p.x))
@@ -1085,6 +1123,14 @@ fn body(
     };
     for (k, lp) in res.link.iter().enumerate() {
         st.port[LINK + k].x = (1u128 << lp.width) - 1;
+    }
+    for mp in res.modes.0 {
+        let slot = if mp.dir == lut_gen::Dir::In {
+            MODE_SEL
+        } else {
+            MODE
+        };
+        st.port[slot].x = (1u128 << res.modes.1) - 1;
     }
     for (i, w) in res.widths.iter().enumerate() {
         st.port[i].x = if *w >= 128 {

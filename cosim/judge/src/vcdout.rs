@@ -9,7 +9,7 @@ use lut_gen::Schedule;
 
 use crate::run::{run_dut, Dut, Observer, RunOptions};
 use crate::verdict::Verdict;
-use lut_gen::{Layout, Pins, Role, PORTS, TOP_MODULE};
+use lut_gen::{Dir, Layout, Pins, Role, PORTS, TOP_MODULE};
 
 /// The time in picoseconds of clock edge `n` of a run (edge `2k + 1` falls
 /// before cycle `k` (counted from the first reset cycle), edge `2k + 2`
@@ -146,6 +146,23 @@ impl VcdWriter {
             writeln!(w, "$upscope $end")?;
         }
         widths.extend(l.link_ports().iter().map(|lp| lp.width));
+        // The mode ports follow the link's (a mix with modes).
+        for mp in l.mode_ports() {
+            let i = widths.len();
+            widths.push(l.mode_bits);
+            if l.mode_bits == 1 {
+                writeln!(w, "$var wire 1 {} {} $end", id_code(i), mp.name)?;
+            } else {
+                let n = l.mode_bits;
+                writeln!(
+                    w,
+                    "$var wire {n} {} {} [{}:0] $end",
+                    id_code(i),
+                    mp.name,
+                    n - 1
+                )?;
+            }
+        }
         writeln!(w, "$upscope $end")?;
         writeln!(w, "$enddefinitions $end")?;
         let ids = (0..widths.len()).map(id_code).collect();
@@ -189,6 +206,11 @@ impl VcdWriter {
         let l = &self.layout;
         self.cur
             .extend(l.link_ports().iter().map(|lp| lp.signal.get(l, p) as u128));
+        self.cur
+            .extend(l.mode_ports().iter().map(|mp| match mp.dir {
+                Dir::In => p.mode_sel as u128,
+                _ => p.mode as u128,
+            }));
         // rst is sampled at the edge that begins cycle k: it changes half a
         // period before it; the outputs and MISO of cycle k change at the edge.
         let first = self.prev.is_empty();
@@ -345,7 +367,28 @@ pub fn write_gtkw(path: &Path, vcd: &Path, s: &Schedule) -> std::io::Result<()> 
     writeln!(w, "@1000200")?;
     writeln!(w, "-samples")?;
     gtkw_link(&mut w, &l)?;
+    gtkw_modes(&mut w, &l)?;
     w.flush()
+}
+
+/// The mode ports' group (decimal: the mode's number); nothing without modes.
+fn gtkw_modes(w: &mut impl Write, l: &Layout) -> std::io::Result<()> {
+    if l.mode_ports().is_empty() {
+        return Ok(());
+    }
+    writeln!(w, "@800200")?;
+    writeln!(w, "-modes")?;
+    for mp in l.mode_ports() {
+        if l.mode_bits == 1 {
+            writeln!(w, "@28")?;
+            writeln!(w, "{TOP_MODULE}.{}", mp.name)?;
+        } else {
+            writeln!(w, "@24")?;
+            writeln!(w, "{TOP_MODULE}.{}[{}:0]", mp.name, l.mode_bits - 1)?;
+        }
+    }
+    writeln!(w, "@1000200")?;
+    writeln!(w, "-modes")
 }
 
 /// The link's group of a save file: its ports as [`VcdWriter`] dumps them

@@ -21,3 +21,9 @@ mod vcd;
 
 #[path = "modes.rs"]
 mod modes;
+
+#[path = "modevcd.rs"]
+mod modevcd;
+
+#[path = "modelink.rs"]
+mod modelink;

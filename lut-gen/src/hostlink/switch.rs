@@ -20,7 +20,17 @@ pub struct SwitchFifo {
 /// utilisation; the deepest FIFO and the longest latency of any mode or
 /// switch; the highest minimum baud of any mode.
 pub(super) fn plan_modes(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, LinkInfeasible> {
-    let names = &s.mix.modes.as_ref().expect("modes").names;
+    let modes = s.mix.modes.as_ref().expect("modes");
+    let names = &modes.names;
+    if !link::format::modes_fit(s.grid.slices_per_frame, modes.select_bits()) {
+        // docs/packet-format.md, "Modes": two modes and the slice in 16 bits
+        let detail = format!(
+            "link: {} slices per frame leave no room for two {}-bit modes in a packet header's slice field",
+            s.grid.slices_per_frame,
+            modes.select_bits()
+        );
+        return Err(LinkInfeasible::new(spec, detail, None));
+    }
     let mut plans = Vec::new();
     for (m, ms) in s.modes.iter().enumerate() {
         let p = plan_one(ms, spec).map_err(|e| {
@@ -89,6 +99,7 @@ pub fn switch_backlog(a: &Schedule, b: &Schedule, line: Line) -> usize {
         slice_cycles: g.slice_cycles,
         slices_per_frame: g.slices_per_frame,
         depth: None,
+        mode_bits: 0,
     };
     let mut t = TxModel::new(cfg);
     t.clock(true, None);

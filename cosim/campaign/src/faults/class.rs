@@ -67,6 +67,9 @@ pub enum FaultClass {
     LinkFifoOverflow,
     AxisTvalidDrop,
     AxisTdataChange,
+    ModeEarly,
+    ModeStuck,
+    ModeUnasked,
     // built into the gateware (`hdl::GatewareFault`)
     RomWord,
     RomSwap,
@@ -113,6 +116,9 @@ impl FaultClass {
             PinFault::LinkOverflow => C::LinkFifoOverflow,
             PinFault::AxisTvalidDrop => C::AxisTvalidDrop,
             PinFault::AxisTdataChange => C::AxisTdataChange,
+            PinFault::ModeEarly => C::ModeEarly,
+            PinFault::ModeStuck => C::ModeStuck,
+            PinFault::ModeUnasked => C::ModeUnasked,
         }
     }
 
@@ -168,6 +174,9 @@ impl FaultClass {
             C::LinkFifoOverflow => "link-fifo-overflow",
             C::AxisTvalidDrop => "axis-tvalid-drop",
             C::AxisTdataChange => "axis-tdata-change",
+            C::ModeEarly => "mode-early",
+            C::ModeStuck => "mode-stuck",
+            C::ModeUnasked => "mode-unasked",
             C::RomWord => "rom-word",
             C::RomSwap => "rom-swap",
             C::SlotWrapEarly => "slot-wrap-early",
@@ -189,6 +198,12 @@ impl FaultClass {
     pub fn on_mux_pins(&self) -> bool {
         use FaultClass as C;
         matches!(self, C::MuxLate | C::TwoMuxEn | C::WrongMux | C::SelectSwap)
+    }
+
+    /// A fault of the `mode` output (a mix with modes).
+    pub fn on_mode_pin(&self) -> bool {
+        use FaultClass as C;
+        matches!(self, C::ModeEarly | C::ModeStuck | C::ModeUnasked)
     }
 
     /// A fault of the link to the host (UART or AXI4-Stream), at its pins
