@@ -21,6 +21,7 @@
 mod branch;
 mod glue;
 mod merger;
+mod modes;
 mod slot_rom;
 mod spi;
 #[cfg(test)]
@@ -33,6 +34,7 @@ use rust_hdl::prelude::*;
 
 use branch::BranchUnit;
 use merger::Merger;
+use modes::ModeGen;
 use slot_rom::SlotRom;
 use spi::SpiSeq;
 use timing::TimingGen;

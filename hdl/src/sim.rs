@@ -185,6 +185,14 @@ impl RtlSim {
         self.tready = ready;
     }
 
+    /// `mode_sel` during the cycle the last [`RtlSim::step`] returned
+    /// (sampled by the next step, like `miso`; ignored without the pin).
+    pub fn set_mode_sel(&mut self, sel: u8) {
+        if let Some(s) = self.core.mode_sel.first_mut() {
+            s.next = (sel as u64).into();
+        }
+    }
+
     /// Apply one rising clock edge; see the type's documentation.
     pub fn step(&mut self, rst: bool, miso: u64) -> Pins {
         let miso = miso & self.reader.lanes as u64;
@@ -202,7 +210,8 @@ impl RtlSim {
         // passes are needed only when an input changes and its new value
         // has to propagate to the flip-flops' D inputs.
         c.drive_clock(false);
-        if c.rst.val() != rst || c.adc_miso.val().to_u64() != miso {
+        let sel_moved = (c.mode_sel.first()).is_some_and(|s| s.next != s.val());
+        if c.rst.val() != rst || c.adc_miso.val().to_u64() != miso || sel_moved {
             c.rst.next = rst;
             c.adc_miso.next = miso.into();
             let ok = settle(c, &mut self.passes);
@@ -213,6 +222,9 @@ impl RtlSim {
         let ok = settle(c, &mut self.passes);
         debug_assert!(ok, "combinational logic did not settle");
         let mut pins = read_pins(c, &self.reader);
+        if let Some(m) = c.mode.first() {
+            pins.mode = m.val().to_u64() as u8;
+        }
         if let Some(l) = &self.link {
             pins.link_tx = l.tx.val();
             pins.link_overflow = l.ovf.val();

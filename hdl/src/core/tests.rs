@@ -62,6 +62,7 @@ fn rom() -> BranchRom {
         chain: 1,
         members: vec![],
         compact: None,
+        modes: None,
     };
     // mux fields: the first instant at this slot or later
     r.words = vec![
@@ -76,6 +77,7 @@ fn rom() -> BranchRom {
 fn harness(div: u64, setup: u64) -> Harness {
     let plan = Plan {
         link: None,
+        modes: None,
         compact: false,
         slots_per_slice: 4,
         slices_per_frame: 1,
