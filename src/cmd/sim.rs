@@ -231,7 +231,7 @@ pub fn run(a: Args) -> u8 {
     }
     // The model follows mode switches; the gateware does not yet.
     let load = match backend {
-        Backend::Model | Backend::RustHdl => super::load_any_modes,
+        Backend::Model | Backend::RustHdl | Backend::Verilator => super::load_any_modes,
         _ => super::load_checked,
     };
     let s = match load(&a.mix, super::Limits::Contract) {
