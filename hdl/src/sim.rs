@@ -78,6 +78,8 @@ pub(crate) struct PinReader {
     /// without that branch's, moved down (`(core_sel_lo, core_en_lo,
     /// devices)` of each branch that has one, in branch order).
     pack: Option<Vec<(u32, u32, u32)>>,
+    /// Bits of `mode_sel` and `mode` (0 without modes).
+    mode_bits: u32,
 }
 
 impl PinReader {
@@ -94,6 +96,7 @@ impl PinReader {
             lanes: ((1u32 << nb) - 1) as u16,
             ch_mask: ((1u32 << p.channel_bits) - 1) as u16,
             pack,
+            mode_bits: p.modes.as_ref().map_or(0, |m| m.bits),
         }
     }
 
@@ -188,8 +191,10 @@ impl RtlSim {
     /// `mode_sel` during the cycle the last [`RtlSim::step`] returned
     /// (sampled by the next step, like `miso`; ignored without the pin).
     pub fn set_mode_sel(&mut self, sel: u8) {
+        // the wrapper's port is as wide as the modes need
+        let bits = self.reader.mode_bits;
         if let Some(s) = self.core.mode_sel.first_mut() {
-            s.next = (sel as u64).into();
+            s.next = (sel as u64 & ((1 << bits) - 1)).into();
         }
     }
 

@@ -105,7 +105,7 @@ extern "C" void sf_free(void* p) {
 /// the top's link ports ([`LINK_PORTS`], [`AXIS_PORTS`] or none); `mux`:
 /// whether the top has `mux_sel` and `mux_en` (a mix in which no branch has
 /// a multiplexer has neither; the shim then reports them 0).
-fn shim(link: &[LinkPort], mux: bool, modes: (bool, bool)) -> String {
+fn shim(link: &[LinkPort], mux: bool, modes: (Option<u32>, bool)) -> String {
     let (mut link_in, mut link_pins) = if link == AXIS_PORTS {
         let [td, tv, tl, tr, ovf] = AXIS_PORTS.map(|p| p.name);
         (
@@ -125,9 +125,10 @@ fn shim(link: &[LinkPort], mux: bool, modes: (bool, bool)) -> String {
     // argument and `mode` in the pad byte, so the shim of every other top
     // (and its cache key) stays as it was.
     let [sel, mode] = lut_gen::MODE_PORTS.map(|p| p.name);
-    if modes.0 {
+    if let Some(bits) = modes.0 {
         link_in.push_str(&format!(
-            "\n    t->@miso@ = miso & 0x00ffffffffffffffULL;\n    t->{sel} = miso >> 56;"
+            "\n    t->@miso@ = miso & 0x00ffffffffffffffULL;\n    t->{sel} = (miso >> 56) & 0x{:x};",
+            (1u32 << bits) - 1
         ));
     }
     if modes.1 {
@@ -162,6 +163,28 @@ fn top_declares(verilog: &str, name: &str) -> bool {
     header
         .split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '$'))
         .any(|w| w == name)
+}
+
+/// The width of `slotforge_top`'s `mode_sel` (`input wire [N:0] mode_sel`
+/// in the ANSI header the emitter writes), if it has one: the shim keeps a
+/// request within the port, as the pin would.
+fn mode_sel_bits(verilog: &str) -> Option<u32> {
+    let name = lut_gen::MODE_PORTS[0].name;
+    if !top_declares(verilog, name) {
+        return None;
+    }
+    let head = format!("module {TOP_MODULE}");
+    let at = verilog.find(&head)?;
+    let rest = &verilog[at..];
+    let line = rest.lines().find(|l| {
+        l.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .any(|w| w == name)
+    })?;
+    let bits = match (line.find('['), line.find(':')) {
+        (Some(a), Some(b)) if a < b => line[a + 1..b].trim().parse::<u32>().ok()? + 1,
+        _ => 1,
+    };
+    Some(bits.min(8))
 }
 
 /// The outputs as the shim writes them: the C++ `SfPins` above, field for
@@ -355,7 +378,7 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
         },
         top_declares(verilog, Role::MuxSel.name()),
         (
-            top_declares(verilog, lut_gen::MODE_PORTS[0].name),
+            mode_sel_bits(verilog),
             top_declares(verilog, lut_gen::MODE_PORTS[1].name),
         ),
     );

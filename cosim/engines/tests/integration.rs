@@ -7,6 +7,9 @@ mod backends;
 #[path = "icarus.rs"]
 mod icarus;
 
+#[path = "modes.rs"]
+mod modes;
+
 #[path = "verilator_shim.rs"]
 mod verilator_shim;
 
