@@ -178,6 +178,19 @@ impl SlotRom {
             dw,
             pad(format!("q[{}:0]", dw - 1), dw, DEV_BITS),
         ));
+        let mut unused = vec![];
+        if mb + 1 < SLICE_BITS {
+            unused.push(format!("slice[{}:{}]", SLICE_BITS - 1, mb + 1));
+        }
+        if aw < SLOT_BITS {
+            unused.push(format!("address[{}:{}]", SLOT_BITS - 1, aw));
+        }
+        if !unused.is_empty() {
+            s.push_str(&format!(
+                "\n// inputs and bits this LUT form and size do not use\nwire unused_rom = |{{{}}};\n",
+                unused.join(", ")
+            ));
+        }
         s
     }
 }
@@ -273,17 +286,6 @@ impl Logic for SlotRom {
         } else if let Some(m) = &self._modes {
             table(&mut s, "mem", wb + 1, &self._words);
             s.push_str(&self.modes_verilog(m));
-            used_addr = self._addr_bits;
-            if m.mode_bits + 1 < SLICE_BITS {
-                unused.push(format!("slice[{}:{}]", SLICE_BITS - 1, m.mode_bits + 1));
-            }
-            if used_addr < SLOT_BITS {
-                unused.push(format!("address[{}:{}]", SLOT_BITS - 1, used_addr));
-            }
-            s.push_str(&format!(
-                "\n// inputs and bits this LUT form and size do not use\nwire unused_rom = |{{{}}};\n",
-                unused.join(", ")
-            ));
             return Verilog::Custom(s);
         } else {
             let aw = self._addr_bits;

@@ -156,6 +156,26 @@ impl Core {
     }
 }
 
+impl Core {
+    /// The mode block's timebase inputs and `mode`; the ROM address and
+    /// `slice` the branches take: the mode block's with modes, else the
+    /// timing generator's.
+    fn mode_block_inputs(&mut self, clk: Clock, rst: bool) -> (Bits<SLOT_BITS>, Bits<SLICE_BITS>) {
+        let Some(g) = self.modes.first_mut() else {
+            return (self.timing.addr.val(), self.timing.slice.val());
+        };
+        g.clock.next = clk;
+        g.rst.next = rst;
+        g.start1.next = self.timing.start1.val();
+        g.addr.next = self.timing.addr.val();
+        if let Some(sel) = self.mode_sel.first() {
+            g.mode_sel.next = sel.val();
+        }
+        self.mode[0].next = g.mode.val();
+        (g.maddr.val(), g.minfo.val())
+    }
+}
+
 impl Logic for Core {
     fn update(&mut self) {
         let clk = self.clock.val();
@@ -167,20 +187,7 @@ impl Logic for Core {
         let start = self.timing.start2.val();
         let start1 = self.timing.start1.val();
         let start0 = self.timing.start0.val();
-        let mut addr = self.timing.addr.val();
-        let mut slice = self.timing.slice.val();
-        if let Some(g) = self.modes.first_mut() {
-            g.clock.next = clk;
-            g.rst.next = rst;
-            g.start1.next = self.timing.start1.val();
-            g.addr.next = addr;
-            if let Some(sel) = self.mode_sel.first() {
-                g.mode_sel.next = sel.val();
-            }
-            addr = g.maddr.val();
-            slice = g.minfo.val();
-            self.mode[0].next = g.mode.val();
-        }
+        let (addr, slice) = self.mode_block_inputs(clk, rst);
         let mut seq = [(false, false, false, false); MAX_BRANCHES];
         for (i, q) in self.seqs.iter_mut().enumerate() {
             q.clock.next = clk;
