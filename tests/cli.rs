@@ -775,8 +775,7 @@ fn a_mix_with_modes_is_built_and_refused_where_a_command_would_show_one_mode() {
         let modes = lut_gen::load(&mix).unwrap().modes.unwrap().names;
         slotforge().arg("audit").arg(&mix).assert().success();
         let out = d.path().join(name);
-        let refused: [&[&str]; 4] = [
-            &["sim", "--backend", "icarus", "--frames", "1", "--vcd"],
+        let refused: [&[&str]; 3] = [
             &["build", "--quiet", "-o"],
             &["golden", "--dir"],
             &["prove", "-o"],
@@ -829,7 +828,7 @@ fn the_model_back_end_simulates_mode_switches() {
             .assert()
     };
     let a = sim(&pin, &["--modes", "2=slow,7=fast"]).success();
-    for backend in ["rusthdl", "verilator"] {
+    for backend in ["rusthdl", "verilator", "icarus"] {
         let g = sim(&pin, &["--modes", "2=slow,7=fast", "--backend", backend]).success();
         let w: serde_json::Value = serde_json::from_slice(&g.get_output().stdout).unwrap();
         assert_eq!(

@@ -231,8 +231,9 @@ pub fn run(a: Args) -> u8 {
     }
     // The model follows mode switches; the gateware does not yet.
     let load = match backend {
-        Backend::Model | Backend::RustHdl | Backend::Verilator => super::load_any_modes,
-        _ => super::load_checked,
+        Backend::Model | Backend::RustHdl | Backend::Verilator | Backend::Icarus => {
+            super::load_any_modes
+        }
     };
     let s = match load(&a.mix, super::Limits::Contract) {
         Ok(s) => s,

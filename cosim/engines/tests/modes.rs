@@ -292,10 +292,49 @@ fn sim_options_carry_requests_to_every_in_process_back_end() {
         modes: vec![(1, 1), (5, 0)],
         ..SimOptions::default()
     };
-    for b in [Backend::RustHdl, Backend::Verilator] {
+    for b in [Backend::RustHdl, Backend::Verilator, Backend::Icarus] {
         let v = engines::run(&s, b, 9, &opts).unwrap();
         assert!(v.ok, "{b:?}: {}", v.summary());
     }
+}
+
+/// Icarus, through its VCD (the mode pins read back), samples the same as
+/// the in-process back ends: under pin requests, and under a touch that
+/// switches an auto mix (the testbench's codes follow the model's modes).
+#[test]
+fn icarus_follows_requests_and_a_touch_like_the_in_process_back_ends() {
+    let count = |s: &Schedule, b: Backend, opts: &SimOptions, frames: u64| {
+        let mut log = judge::SampleLog::new();
+        let v = engines::run_observed(s, b, frames, opts, Some(&mut log)).unwrap();
+        assert!(v.ok, "{} {b:?}: {}", s.mix.name, v.summary());
+        let rows: Vec<(u64, u16, u16)> = log
+            .samples
+            .iter()
+            .map(|x| (x.cycle, x.channel, x.value))
+            .collect();
+        rows
+    };
+    let pin = schedule("modes-pin");
+    let opts = SimOptions {
+        modes: vec![(1, 1), (4, 0), (5, 1)],
+        ..SimOptions::default()
+    };
+    assert_eq!(
+        count(&pin, Backend::Icarus, &opts, 10),
+        count(&pin, Backend::RustHdl, &opts, 10)
+    );
+    let auto = schedule("modes-auto");
+    let opts = SimOptions {
+        stimulus: Stimulus::parse_for("touch:T1@2-9", &auto).unwrap(),
+        ..SimOptions::default()
+    };
+    let (i, r) = (
+        count(&auto, Backend::Icarus, &opts, 16),
+        count(&auto, Backend::RustHdl, &opts, 16),
+    );
+    assert_eq!(i, r);
+    // more than 16 frames at rest (9 a frame) would give
+    assert!(r.len() > 16 * 9 + 20, "{}", r.len());
 }
 
 /// A new user's mix whose second mode leaves branch `y` out: its mux holds

@@ -303,8 +303,12 @@ const CHAN: usize = Role::SampleChannel as usize;
 const VALUE: usize = Role::SampleValue as usize;
 /// The first of the link's ports in [`State`].
 const LINK: usize = PORT_NAMES.len();
-/// Port slots: [`PORT_NAMES`], then the most link ports a mix has ([`AXIS_PORTS`]).
-const NPORT: usize = LINK + AXIS_PORTS.len();
+/// The mode ports' slots (`mode_sel`, `mode`), after the most link ports a
+/// mix has ([`AXIS_PORTS`]).
+const MSEL: usize = LINK + AXIS_PORTS.len();
+const MODE: usize = MSEL + 1;
+/// Port slots: [`PORT_NAMES`], the link's, the modes'.
+const NPORT: usize = MODE + 1;
 
 /// How one identifier code feeds a port: var bit j -> port bit `lsb + j`
 /// (or `lsb - j` when the range is ascending).
@@ -332,6 +336,9 @@ struct Resolved {
     widths: [u32; 11],
     /// The link's ports, read after [`PORT_NAMES`] (none without a link).
     link: &'static [LinkPort],
+    /// Bits of the mode ports (0 without modes), and whether `mode_sel` is one.
+    mode_bits: u32,
+    mode_pin: bool,
 }
 
 fn resolve(
@@ -349,6 +356,7 @@ fn resolve(
     }
     let (has_clk, has_rst) = ps.port_sinks(scope, widths, &mut ids)?;
     ps.link_sinks(scope, layout, &mut ids)?;
+    ps.mode_sinks(scope, layout, &mut ids)?;
     Ok(Resolved {
         ids: Ids::new(ids),
         has_clk,
@@ -356,6 +364,8 @@ fn resolve(
         scope: scope.to_string(),
         widths,
         link: layout.link_ports(),
+        mode_bits: layout.mode_bits,
+        mode_pin: layout.mode_pin,
     })
 }
 
@@ -628,6 +638,41 @@ impl<'a> PortSearch<'a> {
     }
 }
 
+impl PortSearch<'_> {
+    /// The sinks of the mix's mode ports in `scope` (`mode_sel`: pin
+    /// select only; none without modes).
+    fn mode_sinks(
+        &self,
+        scope: &str,
+        layout: &Layout,
+        ids: &mut HashMap<Vec<u8>, Vec<Sink>>,
+    ) -> Result<(), VcdError> {
+        for p in layout.mode_ports() {
+            let v = self
+                .vars(scope, p.name)
+                .find(|v| v.width == layout.mode_bits)
+                .ok_or_else(|| {
+                    self.err(format!(
+                        "port `{}` ({} bit(s), the mix's modes) not found in scope `{scope}`",
+                        p.name, layout.mode_bits
+                    ))
+                })?;
+            let slot = if p.dir == lut_gen::Dir::In {
+                MSEL
+            } else {
+                MODE
+            };
+            ids.get_mut(&v.id).unwrap().push(Sink {
+                port: slot as u8,
+                width: layout.mode_bits,
+                lsb: 0,
+                down: true,
+            });
+        }
+        Ok(())
+    }
+}
+
 /// Identifier code -> sinks.  Codes of up to three characters (every
 /// simulator's first 830 000 signals) index a table directly: hashing the
 /// code of every value change was a tenth of `check`'s time.
@@ -808,9 +853,9 @@ impl State {
                 axis_tvalid: self.axis && g(LINK + 1) & 1 == 1,
                 axis_tlast: self.axis && g(LINK + 2) & 1 == 1,
                 axis_tready: self.axis && g(LINK + 3) & 1 == 1,
-                // the mode ports are not read from a VCD yet
-                mode_sel: 0,
-                mode: 0,
+                // an input: the value an edge samples is set by `edge`
+                mode_sel: g(MSEL) as u8,
+                mode: g(MODE) as u8,
             }
         };
         (pick(|p| p.v), pick(|p| p.x))
@@ -881,6 +926,7 @@ struct Before {
     rst: (u32, u32),
     miso: (u32, u32),
     tready: (u32, u32),
+    msel: (u32, u32),
 }
 
 impl Before {
@@ -891,6 +937,7 @@ impl Before {
             rst: n(&port[RST]),
             miso: n(&port[MISO]),
             tready: n(&port[LINK + 3]),
+            msel: n(&port[MSEL]),
         }
     }
 }
@@ -923,12 +970,17 @@ struct Applier<'a> {
     pending: Pending,
 }
 
-/// The inputs an edge samples: MISO and, with an AXIS link, tready.
-type Inputs = (Val, Option<Val>);
+/// The inputs an edge samples: MISO, with an AXIS link tready, and
+/// `mode_sel` (0 without the pin).
+type Inputs = (Val, Option<Val>, Val);
 
 impl Applier<'_> {
     fn inputs(&self, b: &Before) -> Inputs {
-        (val(b.miso), self.st.axis.then_some(val(b.tready)))
+        (
+            val(b.miso),
+            self.st.axis.then_some(val(b.tready)),
+            val(b.msel),
+        )
     }
 
     /// The outputs now, and their x/z masks.
@@ -944,12 +996,14 @@ impl Applier<'_> {
     /// Hands on the pending cycle with the inputs the edge ending it
     /// samples: MISO and, for an AXIS link, tready (an input like MISO: the
     /// cycle's value is the one that edge samples).
-    fn edge(&mut self, rst: Option<bool>, pins: Pins, xz: Pins, (miso, tready): Inputs) {
+    fn edge(&mut self, rst: Option<bool>, pins: Pins, xz: Pins, (miso, tready, msel): Inputs) {
         if let Some((r, mut p, mut x)) = self.pending.take() {
             if let Some(t) = tready {
                 p.axis_tready = t.v & 1 == 1;
                 x.axis_tready = t.x & 1 == 1;
             }
+            p.mode_sel = msel.v as u8;
+            x.mode_sel = msel.x as u8;
             self.sink.cycle(r, &p, &x, miso.v as u64, miso.x as u64);
         }
         self.info.cycles += 1;
@@ -1086,6 +1140,10 @@ fn body(
     for (k, lp) in res.link.iter().enumerate() {
         st.port[LINK + k].x = (1u128 << lp.width) - 1;
     }
+    st.port[MODE].x = (1u128 << res.mode_bits) - 1;
+    if res.mode_pin {
+        st.port[MSEL].x = (1u128 << res.mode_bits) - 1;
+    }
     for (i, w) in res.widths.iter().enumerate() {
         st.port[i].x = if *w >= 128 {
             u128::MAX
@@ -1121,11 +1179,13 @@ fn body(
     let time = ap.time;
     ap.close(time, None);
     if let Some((r, mut p, mut x)) = ap.pending.take() {
-        let (miso, tready) = ap.inputs(&Before::of(&ap.st.port));
+        let (miso, tready, msel) = ap.inputs(&Before::of(&ap.st.port));
         if let Some(t) = tready {
             p.axis_tready = t.v & 1 == 1;
             x.axis_tready = t.x & 1 == 1;
         }
+        p.mode_sel = msel.v as u8;
+        x.mode_sel = msel.x as u8;
         ap.sink.cycle(r, &p, &x, miso.v as u64, miso.x as u64);
     }
     ap.info.last_time = time;
