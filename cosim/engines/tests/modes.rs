@@ -75,7 +75,7 @@ impl Observer for Recorder {
             return;
         }
         let k = &mut self.counts;
-        if self.c % k.frame_cycles == 0 {
+        if self.c.is_multiple_of(k.frame_cycles) {
             k.frames.push((pins.mode, vec![0; k.channels]));
         }
         if pins.sample_valid {

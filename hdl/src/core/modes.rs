@@ -301,12 +301,8 @@ fn triggers_verilog(s: &mut String, p: &ModePlan, nb: usize, unused: &mut Vec<St
     for (k, t) in p.triggers.iter().enumerate().rev() {
         d = format!("fire{k} ? {}'d{} : ({d})", p.bits, t.to);
     }
-    for b in 0..nb {
-        if !used[b] {
-            unused.push(format!("done[{b}]"));
-            unused.push(format!("ch${b}"));
-            unused.push(format!("v${b}"));
-        }
+    for (b, _) in used.iter().enumerate().filter(|(_, u)| !**u) {
+        unused.extend([format!("done[{b}]"), format!("ch${b}"), format!("v${b}")]);
     }
     d
 }
