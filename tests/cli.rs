@@ -867,9 +867,67 @@ fn the_model_back_end_simulates_mode_switches() {
             .code(2)
             .stderr(predicate::str::contains(why));
     }
-    let vcd = d.path().join("w.vcd");
-    sim(&pin, &["--vcd", vcd.to_str().unwrap()])
+    let bytes = d.path().join("w.bin");
+    sim(&auto, &["--link-bytes", bytes.to_str().unwrap()])
         .code(2)
-        .stderr(predicate::str::contains("mode ports"));
-    assert!(!vcd.exists());
+        .stderr(predicate::str::contains("do not carry the mode"));
+    assert!(!bytes.exists());
+}
+
+/// A pin-select run's VCD (Verilator, the whole run) carries `mode_sel` and
+/// `mode`: `check` passes it with and without the model, and fails it with
+/// one request taken out of the file (the switch it asked for is then
+/// unasked), at that frame's start.
+#[test]
+fn a_vcd_with_mode_switches_passes_check_and_fails_with_a_request_removed() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let pin = root.join("testkit/mixes/modes-pin.toml");
+    let d = tempfile::tempdir().unwrap();
+    let vcd = d.path().join("w.vcd");
+    slotforge()
+        .args([
+            "sim",
+            "--quiet",
+            "--backend",
+            "verilator",
+            "--frames",
+            "12",
+            "--to",
+            "12",
+        ])
+        .args(["--modes", "2=slow,6=fast,7=slow,8=fast", "--vcd"])
+        .arg(&vcd)
+        .arg(&pin)
+        .assert()
+        .success();
+    let check = |file: &Path, extra: &[&str]| {
+        slotforge()
+            .arg("check")
+            .arg(&pin)
+            .arg(file)
+            .args(extra)
+            .assert()
+    };
+    check(&vcd, &[]).success();
+    check(&vcd, &["--no-model"]).success();
+    // `mode_sel`'s id code: its `$var` line
+    let text = std::fs::read_to_string(&vcd).unwrap();
+    let id = text
+        .lines()
+        .find(|l| l.ends_with(" mode_sel $end"))
+        .and_then(|l| l.split_whitespace().nth(3))
+        .unwrap()
+        .to_string();
+    let rise = format!("1{id}");
+    let mut lines: Vec<&str> = text.lines().collect();
+    let at = lines.iter().position(|l| *l == rise).unwrap();
+    lines.remove(at);
+    let bad = d.path().join("bad.vcd");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    check(&bad, &[])
+        .code(1)
+        .stdout(predicate::str::contains("cycle 16000"));
+    check(&bad, &["--no-model"])
+        .code(1)
+        .stdout(predicate::str::contains("mode-decision"));
 }

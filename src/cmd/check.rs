@@ -128,7 +128,7 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
+    let s = match super::load_any_modes(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };

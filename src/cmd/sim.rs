@@ -114,21 +114,13 @@ fn early_checks(a: &Args) -> Result<(), String> {
 
 /// `--stimulus` (a scene names the mix's channels) and `--modes`.
 fn scene_and_modes(a: &Args, s: &lut_gen::Schedule) -> Result<(Stimulus, Vec<(u64, u8)>), String> {
-    if s.modes.len() > 1 {
-        // The VCD writer and the link's packets do not carry the mode yet.
-        let file = match (&a.vcd, &a.link_bytes) {
-            (Some(_), _) => Some("--vcd"),
-            (_, Some(_)) => Some("--link-bytes"),
-            _ => None,
-        };
-        if let Some(opt) = file {
-            return Err(format!(
-                "{opt}: mix `{}` switches modes, and this file would not carry the mode ports \
-                 (mode_sel, mode) nor the mode in the link's packets yet; --samples writes \
-                 the run's samples",
-                s.mix.name
-            ));
-        }
+    if s.modes.len() > 1 && a.link_bytes.is_some() {
+        // The link's packets do not carry the mode yet.
+        return Err(format!(
+            "--link-bytes: mix `{}` switches modes, and the link's packets do not carry the \
+             mode yet; --samples writes the run's samples",
+            s.mix.name
+        ));
     }
     let stimulus = Stimulus::parse_for(&a.stimulus, s)?;
     let modes = a.modes.as_deref().map(|t| parse_modes(t, s)).transpose()?;

@@ -139,6 +139,21 @@ impl VcdWriter {
             writeln!(w, "$upscope $end")?;
         }
         widths.extend(l.link_ports().iter().map(|lp| lp.width));
+        // A mix with modes: `mode_sel` (an input, like MISO) and `mode`.
+        for p in l.mode_ports() {
+            let i = widths.len();
+            widths.push(l.mode_bits);
+            match l.mode_bits {
+                1 => writeln!(w, "$var wire 1 {} {} $end", id_code(i), p.name)?,
+                n => writeln!(
+                    w,
+                    "$var wire {n} {} {} [{}:0] $end",
+                    id_code(i),
+                    p.name,
+                    n - 1
+                )?,
+            }
+        }
         writeln!(w, "$upscope $end")?;
         writeln!(w, "$enddefinitions $end")?;
         let ids = (0..widths.len()).map(id_code).collect();
@@ -182,6 +197,14 @@ impl VcdWriter {
         let l = &self.layout;
         self.cur
             .extend(l.link_ports().iter().map(|lp| lp.signal.get(l, p) as u128));
+        for mp in l.mode_ports() {
+            let v = if mp.dir == lut_gen::Dir::In {
+                p.mode_sel
+            } else {
+                p.mode
+            };
+            self.cur.push(v as u128);
+        }
         // rst is sampled at the edge that begins cycle k: it changes half a
         // period before it; the outputs and MISO of cycle k change at the edge.
         let first = self.prev.is_empty();
