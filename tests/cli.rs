@@ -806,11 +806,12 @@ fn deep_faults_escape_every_simulation_column_and_prove_catches_them() {
         .contains("simulation"));
 }
 
-/// A mix with modes is planned by `audit` and `lut`; every command that
-/// would show the gateware refuses it, naming its modes, rather than show
-/// the reset mode alone as if it were the mix.
+/// A mix with modes is planned by `audit` and `lut` and built by `verilog`
+/// (with its mode ports); every command that does not follow the switches
+/// yet refuses it, naming its modes, rather than show the reset mode alone
+/// as if it were the mix.
 #[test]
-fn a_mix_with_modes_is_audited_and_refused_where_the_gateware_would_show_one_mode() {
+fn a_mix_with_modes_is_built_and_refused_where_a_command_would_show_one_mode() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let d = tempfile::tempdir().unwrap();
     for name in ["modes-pin", "modes-auto"] {
@@ -818,9 +819,7 @@ fn a_mix_with_modes_is_audited_and_refused_where_the_gateware_would_show_one_mod
         let modes = lut_gen::load(&mix).unwrap().modes.unwrap().names;
         slotforge().arg("audit").arg(&mix).assert().success();
         let out = d.path().join(name);
-        let refused: [&[&str]; 5] = [
-            &["verilog", "-o"],
-            &["sim", "--backend", "verilator", "--frames", "1", "--vcd"],
+        let refused: [&[&str]; 3] = [
             &["build", "--quiet", "-o"],
             &["golden", "--dir"],
             &["prove", "-o"],
@@ -832,13 +831,26 @@ fn a_mix_with_modes_is_audited_and_refused_where_the_gateware_would_show_one_mod
                 .arg(&mix)
                 .assert()
                 .code(2)
-                .stderr(predicate::str::contains("does not switch modes"));
+                .stderr(predicate::str::contains("does not yet"));
             let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
             for m in &modes {
                 assert!(err.contains(m.as_str()), "{args:?}: {err}");
             }
         }
         assert!(!out.join("slotforge_top.v").exists());
+        slotforge()
+            .args(["verilog", "-o"])
+            .arg(&out)
+            .arg(&mix)
+            .assert()
+            .success();
+        let v = std::fs::read_to_string(out.join("slotforge_top.v")).unwrap();
+        assert!(v.contains("output wire") && v.contains(" mode\n"), "{name}");
+        assert_eq!(
+            v.contains("input wire mode_sel"),
+            name == "modes-pin",
+            "{name}"
+        );
     }
 }
 
@@ -860,6 +872,16 @@ fn the_model_back_end_simulates_mode_switches() {
             .assert()
     };
     let a = sim(&pin, &["--modes", "2=slow,7=fast"]).success();
+    for backend in ["rusthdl", "verilator", "icarus"] {
+        let g = sim(&pin, &["--modes", "2=slow,7=fast", "--backend", backend]).success();
+        let w: serde_json::Value = serde_json::from_slice(&g.get_output().stdout).unwrap();
+        assert_eq!(
+            w["channels"],
+            serde_json::from_slice::<serde_json::Value>(&a.get_output().stdout).unwrap()
+                ["channels"],
+            "{backend}"
+        );
+    }
     let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
     // frames 0-3 and 9-13 fast, 4-8 slow: A0 4 a frame in fast, 1 in slow,
     // less its instant at cycle 0 skipped at start-up; A2 only in fast
@@ -1033,4 +1055,62 @@ fn a_commanded_mix_is_simulated_on_the_model_and_checked() {
         .map(|x| x["rule"].as_str().unwrap())
         .collect();
     assert!(rules.iter().any(|r| r.starts_with("command-")), "{rules:?}");
+}
+
+/// A pin-select run's VCD (Verilator, the whole run) carries `mode_sel` and
+/// `mode`: `check` passes it with and without the model, and fails it with
+/// one request taken out of the file (the switch it asked for is then
+/// unasked), at that frame's start.
+#[test]
+fn a_vcd_with_mode_switches_passes_check_and_fails_with_a_request_removed() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let pin = root.join("testkit/mixes/modes-pin.toml");
+    let d = tempfile::tempdir().unwrap();
+    let vcd = d.path().join("w.vcd");
+    slotforge()
+        .args([
+            "sim",
+            "--quiet",
+            "--backend",
+            "verilator",
+            "--frames",
+            "12",
+            "--to",
+            "12",
+        ])
+        .args(["--modes", "2=slow,6=fast,7=slow,8=fast", "--vcd"])
+        .arg(&vcd)
+        .arg(&pin)
+        .assert()
+        .success();
+    let check = |file: &Path, extra: &[&str]| {
+        slotforge()
+            .arg("check")
+            .arg(&pin)
+            .arg(file)
+            .args(extra)
+            .assert()
+    };
+    check(&vcd, &[]).success();
+    check(&vcd, &["--no-model"]).success();
+    // `mode_sel`'s id code: its `$var` line
+    let text = std::fs::read_to_string(&vcd).unwrap();
+    let id = text
+        .lines()
+        .find(|l| l.ends_with(" mode_sel $end"))
+        .and_then(|l| l.split_whitespace().nth(3))
+        .unwrap()
+        .to_string();
+    let rise = format!("1{id}");
+    let mut lines: Vec<&str> = text.lines().collect();
+    let at = lines.iter().position(|l| *l == rise).unwrap();
+    lines.remove(at);
+    let bad = d.path().join("bad.vcd");
+    std::fs::write(&bad, lines.join("\n") + "\n").unwrap();
+    check(&bad, &[])
+        .code(1)
+        .stdout(predicate::str::contains("cycle 16000"));
+    check(&bad, &["--no-model"])
+        .code(1)
+        .stdout(predicate::str::contains("mode-decision"));
 }

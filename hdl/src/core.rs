@@ -23,6 +23,7 @@ mod branch;
 mod command;
 mod glue;
 mod merger;
+mod modes;
 mod slot_rom;
 mod spi;
 #[cfg(test)]
@@ -36,6 +37,7 @@ use rust_hdl::prelude::*;
 use branch::BranchUnit;
 use command::CmdUnit;
 use merger::Merger;
+use modes::ModeGen;
 use slot_rom::SlotRom;
 use spi::SpiSeq;
 use timing::TimingGen;

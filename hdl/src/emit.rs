@@ -223,7 +223,8 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     header(&mut v, s, p);
     port_list(&mut v, &l);
     let wired = core_wires(&mut v, p, &l);
-    core_instance(&mut v, &l, &wired);
+    let modes = mode_wires(&mut v, &l);
+    core_instance(&mut v, &l, &wired, &modes);
     link_instance(&mut v, p);
     let _ = writeln!(v, "endmodule");
     let _ = writeln!(v);
@@ -268,7 +269,7 @@ fn port_list(v: &mut String, l: &Layout) {
     let _ = writeln!(v, "module {TOP_MODULE} (");
     let link_ports = l.link_ports();
     let core_ports = l.ports().count();
-    let nports = core_ports + link_ports.len();
+    let nports = core_ports + link_ports.len() + l.mode_ports().len();
     for (i, port) in l.ports().enumerate() {
         let dir = match port.dir {
             Dir::In => "input ",
@@ -286,6 +287,24 @@ fn port_list(v: &mut String, l: &Layout) {
         let sep = if core_ports + i + 1 < nports { "," } else { "" };
         let range = if port.width > 1 {
             format!("[{}:0] ", port.width - 1)
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            v,
+            "    {} wire {range}{}{sep}",
+            port.dir.verilog(),
+            port.name
+        );
+    }
+    for (i, port) in l.mode_ports().iter().enumerate() {
+        let sep = if i + 1 < l.mode_ports().len() {
+            ","
+        } else {
+            ""
+        };
+        let range = if l.mode_bits > 1 {
+            format!("[{}:0] ", l.mode_bits - 1)
         } else {
             String::new()
         };
@@ -420,8 +439,48 @@ fn core_ports(l: &Layout) -> impl Iterator<Item = &'static lut_gen::Port> + '_ {
         .filter(|p| p.role != Role::Mosi || l.width(Role::Mosi) > 0)
 }
 
+/// A mix with modes: the core's `mode` at the core's width, the wrapper's
+/// port its low bits; returns the core's mode ports' connections.
+fn mode_wires(v: &mut String, l: &Layout) -> Vec<(String, String)> {
+    let mb = l.mode_bits as usize;
+    if mb == 0 {
+        return vec![];
+    }
+    let w = crate::widths::MODE_BITS;
+    let _ = writeln!(
+        v,
+        "    // the mode in force (docs/timing.md, \"Mode switches\")\n    wire [{}:0] core_mode;",
+        w - 1
+    );
+    let low = if mb > 1 {
+        format!("[{}:0]", mb - 1)
+    } else {
+        "[0]".into()
+    };
+    let _ = writeln!(v, "    assign mode = core_mode{low};");
+    if mb < w {
+        let _ = writeln!(v, "    wire unused_core_mode = |core_mode[{}:{mb}];", w - 1);
+    }
+    let mut out = vec![];
+    if l.mode_pin {
+        let sel = if mb < w {
+            format!("{{{}'h0, mode_sel}}", w - mb)
+        } else {
+            "mode_sel".into()
+        };
+        out.push(("mode_sel_0".to_string(), sel));
+    }
+    out.push(("mode_0".to_string(), "core_mode".to_string()));
+    out
+}
+
 /// The core instance, its ports on the wires or straight on the wrapper's.
-fn core_instance(v: &mut String, l: &Layout, wired: &[(Role, &'static str, usize)]) {
+fn core_instance(
+    v: &mut String,
+    l: &Layout,
+    wired: &[(Role, &'static str, usize)],
+    modes: &[(String, String)],
+) {
     let _ = writeln!(v);
     let _ = writeln!(v, "    {CORE} core (");
     for port in core_ports(l) {
@@ -431,7 +490,16 @@ fn core_instance(v: &mut String, l: &Layout, wired: &[(Role, &'static str, usize
             .map_or(port.name, |(_, wire, _)| *wire);
         let _ = writeln!(v, "        .{}({to}),", core_port_name(port.role));
     }
-    let _ = writeln!(v, "        .slot_tick(core_slot_tick)\n    );");
+    if modes.is_empty() {
+        let _ = writeln!(v, "        .slot_tick(core_slot_tick)\n    );");
+        return;
+    }
+    let _ = writeln!(v, "        .slot_tick(core_slot_tick),");
+    let ends: Vec<String> = modes
+        .iter()
+        .map(|(p, w)| format!("        .{p}({w})"))
+        .collect();
+    let _ = writeln!(v, "{}\n    );", ends.join(",\n"));
 }
 
 /// The link instance (UART or AXI4-Stream), when the mix has a link.

@@ -23,6 +23,7 @@ mod fault;
 mod fusesoc;
 mod header;
 mod link;
+mod modeplan;
 mod names;
 mod plan;
 mod sim;

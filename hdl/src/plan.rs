@@ -3,6 +3,7 @@
 
 use lut_gen::Schedule;
 
+use crate::modeplan::{ModePlan, ModeRom};
 use crate::HdlError;
 
 use crate::widths::{
@@ -102,11 +103,14 @@ pub struct BranchRom {
     /// conversion's word selects (`Schedule::commands_in_frame`), under the
     /// same rule (the branch's first instant at slot `u` or later).
     pub command: Option<lut_gen::Command>,
+    /// A mix with modes: every mode's table in `words` (the mode above the
+    /// slot on the address, a `w` bit above each word), see `modeplan`.
+    pub modes: Option<ModeRom>,
 }
 
 impl BranchRom {
     pub fn word_bits(&self) -> usize {
-        1 + self.ch_bits + 3 + self.dev_bits
+        1 + self.ch_bits + 3 + self.dev_bits + self.modes.is_some() as usize
     }
 
     /// Pack one ROM word.
@@ -155,6 +159,8 @@ pub struct Plan {
     pub branches: Vec<BranchRom>,
     /// The link stage, when the mix has a `[link]`.
     pub link: Option<crate::link::LinkParams>,
+    /// The mode block, when the mix has modes.
+    pub modes: Option<ModePlan>,
 }
 
 pub fn addr_bits(frame_slots: u64) -> usize {
@@ -242,7 +248,7 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         en_offset += rom.devices;
         branches.push(rom);
     }
-    Ok(Plan {
+    let mut p = Plan {
         compact,
         slots_per_slice: g.slots_per_slice,
         slices_per_frame: g.slices_per_frame,
@@ -252,7 +258,10 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         seqs,
         branches,
         link: crate::link::LinkParams::of(s).map_err(unsupported)?,
-    })
+        modes: None,
+    };
+    crate::modeplan::apply(s, &mut p)?;
+    Ok(p)
 }
 
 /// The grid against the gateware's counters and ROMs; whether the slot LUT
@@ -379,6 +388,7 @@ fn branch_rom(
         members,
         compact: None,
         command: adc.command.clone(),
+        modes: None,
     };
     fill_rom(s, &mut rom, &slots, &next, compact);
     if let Some((sel, dev)) = next[0] {

@@ -78,6 +78,8 @@ pub(crate) struct PinReader {
     /// without that branch's, moved down (`(core_sel_lo, core_en_lo,
     /// devices)` of each branch that has one, in branch order).
     pack: Option<Vec<(u32, u32, u32)>>,
+    /// Bits of `mode_sel` and `mode` (0 without modes).
+    mode_bits: u32,
 }
 
 impl PinReader {
@@ -94,6 +96,7 @@ impl PinReader {
             lanes: ((1u32 << nb) - 1) as u16,
             ch_mask: ((1u32 << p.channel_bits) - 1) as u16,
             pack,
+            mode_bits: p.modes.as_ref().map_or(0, |m| m.bits),
         }
     }
 
@@ -188,6 +191,16 @@ impl RtlSim {
         self.tready = ready;
     }
 
+    /// `mode_sel` during the cycle the last [`RtlSim::step`] returned
+    /// (sampled by the next step, like `miso`; ignored without the pin).
+    pub fn set_mode_sel(&mut self, sel: u8) {
+        // the wrapper's port is as wide as the modes need
+        let bits = self.reader.mode_bits;
+        if let Some(s) = self.core.mode_sel.first_mut() {
+            s.next = (sel as u64 & ((1 << bits) - 1)).into();
+        }
+    }
+
     /// Apply one rising clock edge; see the type's documentation.
     pub fn step(&mut self, rst: bool, miso: u64) -> Pins {
         let miso = miso & self.reader.lanes as u64;
@@ -205,7 +218,8 @@ impl RtlSim {
         // passes are needed only when an input changes and its new value
         // has to propagate to the flip-flops' D inputs.
         c.drive_clock(false);
-        if c.rst.val() != rst || c.adc_miso.val().to_u64() != miso {
+        let sel_moved = (c.mode_sel.first()).is_some_and(|s| s.next != s.val());
+        if c.rst.val() != rst || c.adc_miso.val().to_u64() != miso || sel_moved {
             c.rst.next = rst;
             c.adc_miso.next = miso.into();
             let ok = settle(c, &mut self.passes);
@@ -216,6 +230,9 @@ impl RtlSim {
         let ok = settle(c, &mut self.passes);
         debug_assert!(ok, "combinational logic did not settle");
         let mut pins = read_pins(c, &self.reader);
+        if let Some(m) = c.mode.first() {
+            pins.mode = m.val().to_u64() as u8;
+        }
         if let Some(l) = &self.link {
             pins.link_tx = l.tx.val();
             pins.link_overflow = l.ovf.val();

@@ -17,6 +17,8 @@ pub const CNT_BITS: usize = 20;
 pub const SLOT_BITS: usize = 12;
 /// Width of the slice counter (compact LUT only).
 pub const SLICE_BITS: usize = 10;
+/// Bits of the mode number in the core (16 modes at most).
+pub const MODE_BITS: usize = 4;
 /// Width of the SCLK phase counter.
 pub const PH_BITS: usize = 10;
 /// Width of the SCLK period counter (periods per conversion, all words).

@@ -157,8 +157,8 @@ pub fn load_checked(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8
     Ok(s)
 }
 
-/// [`load_checked`] for what follows mode switches without gateware (`sim
-/// --backend model`): a mix with modes is not refused.
+/// [`load_checked`] for what follows mode switches (`verilog`, `sim
+/// --backend model`, `rusthdl`, `verilator`): a mix with modes is not refused.
 pub fn load_any_modes(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
     let s = match limits {
         Limits::Contract => schedule_on_pins(path)?,
@@ -176,10 +176,10 @@ pub fn one_mode(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
     match &s.mix.modes {
         Some(m) if m.names.len() > 1 => {
             eprintln!(
-                "error: {}: the mix declares {} modes ({}): `audit` and `lut` plan every \
-                 mode and `sim --backend model` follows the switches, but the gateware does \
-                 not switch modes yet, so this command would show the reset mode `{}` alone; \
-                 audit it, simulate its model, or remove the [[mode]] tables to build one mode",
+                "error: {}: the mix declares {} modes ({}): `audit`, `lut` and `verilog` \
+                 plan every mode and `sim --backend model`, `rusthdl` and `verilator` follow \
+                 the switches, but this command does not yet, so it would show the reset \
+                 mode `{}` alone; simulate it, or remove the [[mode]] tables to build one mode",
                 file.display(),
                 m.names.len(),
                 m.names.join(", "),

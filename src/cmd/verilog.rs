@@ -17,7 +17,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> u8 {
     // the gateware's limits are the emitter's to refuse (exit 1)
-    let s = match super::load_checked(&args.mix, super::Limits::Emitter) {
+    let s = match super::load_any_modes(&args.mix, super::Limits::Emitter) {
         Ok(s) => s,
         Err(code) => return code,
     };

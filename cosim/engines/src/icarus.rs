@@ -49,17 +49,21 @@ pub fn testbench(s: &Schedule, stimulus: Stimulus, reset_cycles: u64, cycles: u6
         reset_cycles,
         cycles,
         link::ReadyPattern::Always,
+        &[],
     )
 }
 
 /// [`testbench`] with the AXI4-Stream slave driving `tready` as `pattern`
-/// (a mix with an `axis` link; ignored otherwise).
+/// (a mix with an `axis` link; ignored otherwise) and `mode_sel` showing
+/// `modes` (`(frame, mode)` requests, as `judge::ModeRequests` drives it; a
+/// mix with pin-selected modes).
 pub fn testbench_with(
     s: &Schedule,
     stimulus: Stimulus,
     reset_cycles: u64,
     cycles: u64,
     tready: link::ReadyPattern,
+    modes: &[(u64, u8)],
 ) -> Testbench {
     let mut g = Adcs {
         s,
@@ -67,6 +71,7 @@ pub fn testbench_with(
         analog: Analog::new(s, stimulus),
         stimulus,
         frames: cycles.div_ceil(s.grid.frame_cycles),
+        switched: (s.modes.len() > 1).then(|| switched_conversions(s, stimulus, modes, cycles)),
         text: String::new(),
         tables: Vec::new(),
     };
@@ -86,9 +91,13 @@ pub fn testbench_with(
     {
         g.text.push_str(&axis_slave(tready, a.ready_within));
     }
+    if g.l.mode_pin {
+        g.text.push_str(&mode_requests(s, &g.l, modes));
+    }
     let connect = (g.l.ports())
         .map(|p| p.name)
         .chain(g.l.link_ports().iter().map(|p| p.name))
+        .chain(g.l.mode_ports().iter().map(|p| p.name))
         .map(|n| format!(".{n}({n})"))
         .collect::<Vec<_>>()
         .join(",\n    ");
@@ -112,6 +121,66 @@ pub fn testbench_with(
         tables: g.tables,
         reset_cycles,
     }
+}
+
+/// A mix with modes: each branch's conversions (cycle of the CS fall, the
+/// input its mux selects) as the cycle model makes them under `modes` and
+/// `stimulus` over `cycles` cycles, so the code tables follow the switches.
+fn switched_conversions(
+    s: &Schedule,
+    stimulus: Stimulus,
+    modes: &[(u64, u8)],
+    cycles: u64,
+) -> Vec<Vec<lut_gen::SamplingInstant>> {
+    struct Falls<'a> {
+        l: Layout,
+        analog: Analog,
+        c: u64,
+        cs: u16,
+        /// CNV branches (their conversion starts at the pin's rise).
+        cnv: u16,
+        out: &'a mut Vec<Vec<lut_gen::SamplingInstant>>,
+    }
+    impl judge::Observer for Falls<'_> {
+        fn cycle(&mut self, _: u64, rst: bool, p: &Pins, _: u64) {
+            if rst {
+                self.cs = p.cs_n;
+                return;
+            }
+            for b in 0..self.l.branches {
+                let (was, now) = ((self.cs ^ self.cnv) >> b & 1, (p.cs_n ^ self.cnv) >> b & 1);
+                if was == 1 && now == 0 {
+                    let channel = self.analog.input_id(&self.l, p, b) as usize;
+                    self.out[b].push(lut_gen::SamplingInstant {
+                        cycle: self.c,
+                        branch: b,
+                        channel,
+                    });
+                }
+            }
+            self.cs = p.cs_n;
+            self.c += 1;
+        }
+    }
+    let mut out = vec![Vec::new(); s.branches.len()];
+    let mut obs = Falls {
+        l: Layout::new(s),
+        analog: Analog::new(s, stimulus),
+        c: 0,
+        cs: u16::MAX,
+        cnv: (0..s.branches.len())
+            .filter(|&b| s.mix.branches[b].adc.start == Start::Cnv)
+            .fold(0, |m, b| m | 1 << b),
+        out: &mut out,
+    };
+    let ro = judge::RunOptions {
+        stimulus,
+        ..Default::default()
+    };
+    let mut dut = judge::ModeRequests::new(s, judge::ModelDut::new(s), modes);
+    let frames = cycles.div_ceil(s.grid.frame_cycles);
+    judge::run_dut(s, &mut dut, frames, &ro, "model", Some(&mut obs));
+    out
 }
 
 /// The DUT's ports as testbench signals: inputs driven (MISO pulled up,
@@ -139,7 +208,42 @@ fn port_decls(l: &Layout) -> String {
             (_, w) => writeln!(decls, "  wire [{}:0] {};", w - 1, p.name),
         };
     }
+    let range = match l.mode_bits {
+        1 => String::new(),
+        w => format!("[{}:0] ", w - 1),
+    };
+    for p in l.mode_ports() {
+        let _ = match p.dir {
+            Dir::In => writeln!(decls, "  reg {range}{} = 0;", p.name),
+            Dir::Out => writeln!(decls, "  wire {range}{};", p.name),
+        };
+    }
     decls
+}
+
+/// `mode_sel` from `(frame, mode)` requests: from the first cycle of the
+/// frame on (0 before the first, and in reset), as `judge::ModeRequests`.
+fn mode_requests(s: &Schedule, l: &Layout, modes: &[(u64, u8)]) -> String {
+    let name = lut_gen::MODE_PORTS[0].name;
+    let mut reqs = modes.to_vec();
+    reqs.sort_by_key(|r| r.0);
+    let mask = (1u32 << l.mode_bits) - 1;
+    let mut t = format!(
+        "  // mode_sel: the requests (frame, mode), each from its frame's first cycle\n  // (set mid-cycle, so the cycle counter is current and the edge that ends\n  // the cycle samples it)\n  always @(negedge {}) if (!{} && started) begin\n    {name} <= 0;\n",
+        Role::Clock.name(),
+        Role::Reset.name()
+    );
+    for (f, m) in reqs {
+        let _ = writeln!(
+            t,
+            "    if (cyc >= 64'd{}) {name} <= {}'d{};",
+            f * s.grid.frame_cycles,
+            l.mode_bits,
+            m as u32 & mask
+        );
+    }
+    t.push_str("  end\n\n");
+    t
 }
 
 /// The testbench's ADC models as they are written: the Verilog text and
@@ -151,6 +255,9 @@ struct Adcs<'a> {
     stimulus: Stimulus,
     /// Frames the run covers (the code tables' extent).
     frames: u64,
+    /// A mix with modes: each branch's conversions as the model makes them
+    /// under the run's requests and stimulus (the modes switch).
+    switched: Option<Vec<Vec<lut_gen::SamplingInstant>>>,
     text: String,
     tables: Vec<(String, String)>,
 }
@@ -158,11 +265,17 @@ struct Adcs<'a> {
 impl Adcs<'_> {
     /// The conversions of branch `b` the gateware makes: less those skipped
     /// at start-up (docs/timing.md, "Start-up").
-    fn conversions(&self, b: usize) -> impl Iterator<Item = lut_gen::SamplingInstant> + '_ {
+    fn conversions(&self, b: usize) -> Box<dyn Iterator<Item = lut_gen::SamplingInstant> + '_> {
+        if let Some(sw) = &self.switched {
+            return Box::new(sw[b].iter().copied());
+        }
         let s = self.s;
         let f = s.grid.frame_cycles;
-        s.instants(self.frames)
-            .filter(move |i| i.branch == b && !(i.cycle < f && s.skipped_at_startup(b, i.cycle)))
+        Box::new(
+            s.instants(self.frames).filter(move |i| {
+                i.branch == b && !(i.cycle < f && s.skipped_at_startup(b, i.cycle))
+            }),
+        )
     }
 
     /// Adds branch `b`'s code table `codes<b>.hex` of `lines` lines, and
@@ -491,7 +604,7 @@ pub fn run(
     let d = dir.path();
     let reset = judge::reset_cycles(s, opts.reset_cycles);
     let cycles = frames * s.grid.frame_cycles;
-    let tb = testbench_with(s, opts.stimulus, reset, cycles, opts.tready);
+    let tb = testbench_with(s, opts.stimulus, reset, cycles, opts.tready, &opts.modes);
     match &opts.rtl {
         // outside Verilog (checked against the contract) in the emitted file's place
         Some(path) => {

@@ -27,6 +27,10 @@ impl Dut for RustHdlDut {
     fn set_tready(&mut self, ready: bool) {
         self.0.set_tready(ready)
     }
+
+    fn set_mode_sel(&mut self, sel: u8) {
+        self.0.set_mode_sel(sel)
+    }
 }
 
 /// The emitted Verilog of a schedule.

@@ -107,9 +107,10 @@ extern "C" void sf_free(void* p) {
 /// the top's link ports ([`LINK_PORTS`], [`AXIS_PORTS`] or none); `mux`:
 /// whether the top has `mux_sel` and `mux_en` (a mix in which no branch has
 /// a multiplexer has neither; the shim then reports them 0); `mosi`: whether
-/// it has `adc_mosi` (a mix with a command word).
-fn shim(link: &[LinkPort], mux: bool, mosi: bool) -> String {
-    let (link_in, link_pins) = if link == AXIS_PORTS {
+/// it has `adc_mosi` (a mix with a command word); `modes`: `mode_sel`'s
+/// width and whether it has `mode`.
+fn shim(link: &[LinkPort], mux: bool, mosi: bool, modes: (Option<u32>, bool)) -> String {
+    let (mut link_in, mut link_pins) = if link == AXIS_PORTS {
         let [td, tv, tl, tr, ovf] = AXIS_PORTS.map(|p| p.name);
         (
             format!("\n    t->{tr} = o->axis_tready;"),
@@ -124,6 +125,19 @@ fn shim(link: &[LinkPort], mux: bool, mosi: bool) -> String {
     } else {
         (String::new(), String::new())
     };
+    // A top with modes: `mode_sel` travels in the top byte of the `miso`
+    // argument and `mode` in the pad byte, so the shim of every other top
+    // (and its cache key) stays as it was.
+    let [sel, mode] = lut_gen::MODE_PORTS.map(|p| p.name);
+    if let Some(bits) = modes.0 {
+        link_in.push_str(&format!(
+            "\n    t->@miso@ = miso & 0x00ffffffffffffffULL;\n    t->{sel} = (miso >> 56) & 0x{:x};",
+            (1u32 << bits) - 1
+        ));
+    }
+    if modes.1 {
+        link_pins.push_str(&format!("\n    o->pad[0] = t->{mode};"));
+    }
     let mux = if mux {
         "    o->mux_sel = t->@mux_sel@;\n    sf_wide(o->mux_en, t->@mux_en@);"
     } else {
@@ -161,6 +175,28 @@ fn top_declares(verilog: &str, name: &str) -> bool {
         .any(|w| w == name)
 }
 
+/// The width of `slotforge_top`'s `mode_sel` (`input wire [N:0] mode_sel`
+/// in the ANSI header the emitter writes), if it has one: the shim keeps a
+/// request within the port, as the pin would.
+fn mode_sel_bits(verilog: &str) -> Option<u32> {
+    let name = lut_gen::MODE_PORTS[0].name;
+    if !top_declares(verilog, name) {
+        return None;
+    }
+    let head = format!("module {TOP_MODULE}");
+    let at = verilog.find(&head)?;
+    let rest = &verilog[at..];
+    let line = rest.lines().find(|l| {
+        l.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .any(|w| w == name)
+    })?;
+    let bits = match (line.find('['), line.find(':')) {
+        (Some(a), Some(b)) if a < b => line[a + 1..b].trim().parse::<u32>().ok()? + 1,
+        _ => 1,
+    };
+    Some(bits.min(8))
+}
+
 /// The outputs as the shim writes them: the C++ `SfPins` above, field for
 /// field, wide enough for the contract's limits (`Pins`).
 #[repr(C)]
@@ -182,7 +218,9 @@ struct SfPins {
     axis_tlast: u8,
     /// An input: set before each step.
     axis_tready: u8,
-    pad: [u8; 7],
+    /// `mode` (the shim's `pad[0]`; 0 for a top without it).
+    mode: u8,
+    pad: [u8; 6],
 }
 
 const _: () = assert!(std::mem::size_of::<SfPins>() == 48);
@@ -352,6 +390,10 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
         },
         top_declares(verilog, Role::MuxSel.name()),
         top_declares(verilog, Role::Mosi.name()),
+        (
+            mode_sel_bits(verilog),
+            top_declares(verilog, lut_gen::MODE_PORTS[1].name),
+        ),
     );
     let vv = tool_version("verilator", "apt-get install -y verilator")?;
     let gv = tool_version("g++", "apt-get install -y g++")?;
@@ -521,6 +563,8 @@ pub struct VerilatedDut {
     free: FreeFn,
     model: *mut std::ffi::c_void,
     out: SfPins,
+    /// `mode_sel` for the next step (the top byte of its `miso`).
+    mode_sel: u8,
     _not_send: PhantomData<*const ()>,
 }
 
@@ -551,6 +595,7 @@ impl VerilatedDut {
                 free,
                 model,
                 out: SfPins::default(),
+                mode_sel: 0,
                 _not_send: PhantomData,
             })
         }
@@ -561,6 +606,7 @@ impl Dut for VerilatedDut {
     #[inline]
     fn step(&mut self, rst: bool, miso: u64) -> Pins {
         // SAFETY: `model` came from sf_new of the same library and is freed only in Drop.
+        let miso = miso | (self.mode_sel as u64) << 56;
         unsafe { (self.step)(self.model, rst as u8, miso, &mut self.out) };
         Pins {
             cs_n: self.out.cs_n,
@@ -577,10 +623,13 @@ impl Dut for VerilatedDut {
             axis_tvalid: self.out.axis_tvalid != 0,
             axis_tlast: self.out.axis_tlast != 0,
             axis_tready: false,
-            // the emitted gateware has no mode ports yet (one_mode refuses it)
-            mode_sel: 0,
-            mode: 0,
+            mode_sel: self.mode_sel,
+            mode: self.out.mode,
         }
+    }
+
+    fn set_mode_sel(&mut self, sel: u8) {
+        self.mode_sel = sel;
     }
 
     fn set_tready(&mut self, ready: bool) {

@@ -10,6 +10,9 @@ mod command;
 #[path = "icarus.rs"]
 mod icarus;
 
+#[path = "modes.rs"]
+mod modes;
+
 #[path = "verilator_shim.rs"]
 mod verilator_shim;
 

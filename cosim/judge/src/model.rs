@@ -742,16 +742,19 @@ impl CycleModel {
     /// At the edge that begins a frame (cycle `c`): the mode of the frame
     /// after it is decided from `mode_sel` of the cycle before or the
     /// windows closed, `mode` shows the new frame's, and a branch that had
-    /// no instant in the frames decided looks again.
+    /// no instant in the frames decided looks again (its mux moves in the
+    /// next cycle).
     fn frame_start(&mut self, c: u64) {
         if c != (self.track.frame() + 1) * self.frame_cycles {
             return;
         }
         self.track.frame_start(self.mode_sel);
         self.pins.mode = self.track.mode() as u8;
+        // Its mux moves in the frame's second cycle, as after an instant
+        // (the gateware loads a mux at a slot start, from the slot's word).
         for m in self.br.iter_mut().filter(|m| m.waiting) {
             m.advance_next_instant(self.frame_cycles, &self.track);
-            m.next = c;
+            m.next = c + 1;
         }
     }
 }

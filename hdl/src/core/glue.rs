@@ -3,27 +3,38 @@
 use crate::widths::*;
 
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
+/// `modes`: a mix with modes (pin select, the branches whose words the
+/// mode block reads).
 pub(super) fn core_glue(
     nb: usize,
     devices: &[usize],
     seq_of: &[usize],
     nseq: usize,
     cmd_of: &[Option<usize>],
+    modes: Option<(bool, usize)>,
 ) -> String {
     let mut s = String::new();
     s.push_str("always @(*) begin\n");
-    child_inputs(&mut s, nb, seq_of, nseq);
+    child_inputs(&mut s, nb, seq_of, nseq, modes.is_none());
+    if let Some((pin, lanes)) = modes {
+        mode_inputs(&mut s, nb, pin, lanes);
+    }
     command_units(&mut s, seq_of, cmd_of);
     lanes(&mut s, nb, devices, cmd_of);
     s.push_str(
         "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
     );
     unused_wires(&mut s, nb, devices);
+    if modes.is_some() {
+        s.push_str("// the mode block gives the branches their ROM address\nwire unused_slice = |timing$slice;\n");
+    }
     s
 }
 
 /// Clock, reset, slot strobes and sequencer levels into every child.
-fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize) {
+/// `timebase`: the branches' ROM address is the timing generator's (else
+/// the mode block's, [`mode_inputs`]).
+fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize, timebase: bool) {
     for (who, _) in [("timing", 0), ("merge", 0)] {
         s.push_str(&format!("  {who}$clock = clock;\n  {who}$rst = rst;\n"));
     }
@@ -37,8 +48,13 @@ fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize) {
         let u = format!("branches${b}");
         let q = format!("seqs${seq}");
         s.push_str(&format!(
-            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = timing$start0;\n  {u}$addr = timing$addr;\n  {u}$slice = timing$slice;\n"
+            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = timing$start0;\n"
         ));
+        if timebase {
+            s.push_str(&format!(
+                "  {u}$addr = timing$addr;\n  {u}$slice = timing$slice;\n"
+            ));
+        }
         s.push_str(&format!(
             "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$miso = adc_miso[{b}];\n  {u}$grant = merge$grant[{b}];\n"
         ));
@@ -67,6 +83,40 @@ fn command_units(s: &mut String, seq_of: &[usize], cmd_of: &[Option<usize>]) {
         }
         s.push_str(&format!("  adc_mosi$0 = {{{}}};\n", lanes.join(", ")));
     }
+
+/// The mode block's inputs, the ROM address and mode information it gives
+/// every branch in place of the timing generator's, and the `mode` port.
+fn mode_inputs(s: &mut String, nb: usize, pin: bool, lanes: usize) {
+    let g = "modes$0";
+    s.push_str(&format!(
+        "  {g}$clock = clock;\n  {g}$rst = rst;\n  {g}$start1 = timing$start1;\n  {g}$addr = timing$addr;\n"
+    ));
+    if pin {
+        s.push_str(&format!("  {g}$mode_sel = mode_sel$0;\n"));
+    } else {
+        s.push_str(&format!("  {g}$mode_sel = {MODE_BITS}'h0;\n"));
+    }
+    let done: Vec<String> = (0..nb)
+        .rev()
+        .map(|b| format!("branches${b}$done"))
+        .collect();
+    let pad = if nb < MAX_BRANCHES {
+        format!("{}'h0, ", MAX_BRANCHES - nb)
+    } else {
+        String::new()
+    };
+    s.push_str(&format!("  {g}$done = {{{pad}{}}};\n", done.join(", ")));
+    for b in 0..lanes {
+        s.push_str(&format!(
+            "  {g}$ch${b} = branches${b}$res_ch;\n  {g}$v${b} = branches${b}$res_val;\n"
+        ));
+    }
+    for b in 0..nb {
+        s.push_str(&format!(
+            "  branches${b}$addr = {g}$maddr;\n  branches${b}$slice = {g}$minfo;\n"
+        ));
+    }
+    s.push_str(&format!("  mode$0 = {g}$mode;\n"));
 }
 
 /// The branches' lanes gathered into the fixed-maximum ports and the

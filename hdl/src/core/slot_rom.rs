@@ -2,6 +2,7 @@
 
 use rust_hdl::prelude::*;
 
+use crate::modeplan::ModeRom;
 use crate::plan::{BranchRom, CompactRom};
 use crate::widths::*;
 
@@ -23,6 +24,16 @@ pub struct SlotRom {
     _ch_bits: usize,
     _dev_bits: usize,
     _compact: Option<CompactRom>,
+    /// A mix with modes: the mode is on the address above the slot, and
+    /// `slice` carries the next frame's mode (low bits) and whether the
+    /// address is in the next frame (the bit above); see `read_modes`.
+    _modes: Option<ModeRom>,
+    /// Modes: the reset mux field, the word read, its frame is the next
+    /// one, and the mux field last output (held).
+    _reset: (u32, u32),
+    _qm: u32,
+    _qn: bool,
+    _held: (u32, u32),
     /// Compact form: slice-table word, its slice, rotation word.
     _q1: u32,
     _jq: usize,
@@ -45,6 +56,11 @@ impl SlotRom {
             _ch_bits: rom.ch_bits,
             _dev_bits: rom.dev_bits,
             _compact: rom.compact.clone(),
+            _modes: rom.modes.clone(),
+            _reset: (rom.reset_sel, rom.reset_en.trailing_zeros() % 64),
+            _qm: 0,
+            _qn: false,
+            _held: (0, 0),
             _q1: 0,
             _jq: 0,
             _q2: 0,
@@ -53,6 +69,41 @@ impl SlotRom {
 
     fn word_bits(&self) -> usize {
         1 + self._ch_bits + 3 + self._dev_bits
+    }
+
+    /// A mix with modes: the word of the address registered as the full
+    /// table's, its `w` bit (no instant left in its mode's frame) replaced
+    /// by the first instant of the next frame's mode, or the mux held when
+    /// that frame is not decided yet (the word's own frame is the next) or
+    /// its mode does not use the branch (docs/timing.md, "Mode switches").
+    fn read_modes(&mut self, m: &ModeRom) {
+        let wb = self.word_bits();
+        let dw = self._dev_bits;
+        if self.clock.pos_edge() {
+            self._held = if self.rst.val() {
+                self._reset
+            } else {
+                self.mode_field(m)
+            };
+            let a = self.address.val().to_u64() as usize;
+            self._qm = self._words.get(a).copied().unwrap_or(0);
+            self._qn = self.slice.val().to_u64() >> m.mode_bits & 1 == 1;
+        }
+        let (sel, dev) = self.mode_field(m);
+        let q = self._qm & ((1 << wb) - 1) & !((1 << (3 + dw)) - 1);
+        self.set_outputs((q | sel << dw | dev) as u64);
+    }
+
+    /// The mux field out of the word read (see [`SlotRom::read_modes`]).
+    fn mode_field(&self, m: &ModeRom) -> (u32, u32) {
+        let nm = self.slice.val().to_u64() as usize & ((1 << m.mode_bits) - 1);
+        let first = m.first.get(nm).copied().flatten();
+        let dw = self._dev_bits;
+        match (self._qm >> self.word_bits() & 1 == 1, self._qn, first) {
+            (false, ..) => (self._qm >> dw & 7, self._qm & ((1 << dw) - 1)),
+            (true, false, Some(f)) => f,
+            _ => self._held,
+        }
     }
 
     /// Compact form: the payload width of a slice-table word and the
@@ -75,12 +126,82 @@ impl SlotRom {
         self.msel.next = ((w >> dw) & 0x7).into();
         self.mdev.next = (w & ((1 << dw) - 1)).into();
     }
+
+    /// The Verilog of [`SlotRom::read_modes`].
+    fn modes_verilog(&self, m: &ModeRom) -> String {
+        let (cw, dw) = (self._ch_bits, self._dev_bits);
+        let wb = self.word_bits();
+        let mb = m.mode_bits;
+        let aw = self._addr_bits;
+        let mut s = format!(
+            "// the word (its mode's table at {{mode, slot}}; bit {wb}: no instant left in that mode's frame),\n// whether its frame is the next one, and the mux field last output\nreg [{wb}:0] q;\nreg qn;\nreg [2:0] hsel;\nreg [{}:0] hdev;\n\n",
+            dw - 1
+        );
+        s.push_str(&format!(
+            "// the first instant of the next frame's mode (slice[{}:0]), if it uses this branch\nreg fuse;\nreg [2:0] fsel;\nreg [{}:0] fdev;\nalways @(*) begin\n  case (slice[{}:0])\n",
+            mb - 1,
+            dw - 1,
+            mb - 1
+        ));
+        for (k, f) in m.first.iter().enumerate() {
+            let (u, sel, dev) = f.map_or((0, 0, 0), |(a, b)| (1, a, b));
+            s.push_str(&format!(
+                "    {mb}'d{k}: begin fuse = 1'b{u}; fsel = 3'd{sel}; fdev = {dw}'d{dev}; end\n"
+            ));
+        }
+        if m.first.len() < 1 << mb {
+            s.push_str(&format!(
+                "    default: begin fuse = 1'b0; fsel = 3'd0; fdev = {dw}'d0; end\n"
+            ));
+        }
+        s.push_str("  endcase\nend\n\n");
+        let (rsel, rdev) = self._reset;
+        s.push_str(&format!(
+            "wire hold = q[{wb}] & (qn | ~fuse);\nalways @(posedge clock) begin\n  q <= mem[address[{}:0]];\n  qn <= slice[{mb}];\n  if (rst) begin\n    hsel <= 3'd{rsel};\n    hdev <= {dw}'d{rdev};\n  end else begin\n    hsel <= msel;\n    hdev <= mdev[{}:0];\n  end\nend\n\n",
+            aw - 1,
+            dw - 1
+        ));
+        let pad = |field: String, bits: usize, full: usize| {
+            if bits < full {
+                format!("{{{}'h0, {field}}}", full - bits)
+            } else {
+                field
+            }
+        };
+        s.push_str(&format!(
+            "always @(*) begin\n  conv = q[{}];\n  ch = {};\n  if (hold) begin\n    msel = hsel;\n    mdev = {};\n  end else if (q[{wb}]) begin\n    msel = fsel;\n    mdev = {};\n  end else begin\n    msel = q[{}:{}];\n    mdev = {};\n  end\nend\n",
+            wb - 1,
+            pad(format!("q[{}:{}]", wb - 2, 3 + dw), cw, CH_BITS),
+            pad("hdev".into(), dw, DEV_BITS),
+            pad("fdev".into(), dw, DEV_BITS),
+            dw + 2,
+            dw,
+            pad(format!("q[{}:0]", dw - 1), dw, DEV_BITS),
+        ));
+        let mut unused = vec![];
+        if mb + 1 < SLICE_BITS {
+            unused.push(format!("slice[{}:{}]", SLICE_BITS - 1, mb + 1));
+        }
+        if aw < SLOT_BITS {
+            unused.push(format!("address[{}:{}]", SLOT_BITS - 1, aw));
+        }
+        if !unused.is_empty() {
+            s.push_str(&format!(
+                "\n// inputs and bits this LUT form and size do not use\nwire unused_rom = |{{{}}};\n",
+                unused.join(", ")
+            ));
+        }
+        s
+    }
 }
 
 impl Logic for SlotRom {
     fn update(&mut self) {
         let wb = self.word_bits();
-        if let Some(c) = &self._compact {
+        if let Some(m) = self._modes.take() {
+            self.read_modes(&m);
+            self._modes = Some(m);
+        } else if let Some(c) = &self._compact {
             let (payload, a0) = Self::compact_numbers(c, wb);
             if self.clock.pos_edge() {
                 let ra = if self.rst.val() {
@@ -162,6 +283,10 @@ impl Logic for SlotRom {
             if sb < SLICE_BITS {
                 unused.push(format!("slice[{}:{}]", SLICE_BITS - 1, sb));
             }
+        } else if let Some(m) = &self._modes {
+            table(&mut s, "mem", wb + 1, &self._words);
+            s.push_str(&self.modes_verilog(m));
+            return Verilog::Custom(s);
         } else {
             let aw = self._addr_bits;
             table(&mut s, "mem", wb, &self._words);

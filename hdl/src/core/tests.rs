@@ -63,6 +63,7 @@ fn rom() -> BranchRom {
         members: vec![],
         compact: None,
         command: None,
+        modes: None,
     };
     // mux fields: the first instant at this slot or later
     r.words = vec![
@@ -77,6 +78,7 @@ fn rom() -> BranchRom {
 fn harness(div: u64, setup: u64) -> Harness {
     let plan = Plan {
         link: None,
+        modes: None,
         compact: false,
         slots_per_slice: 4,
         slices_per_frame: 1,

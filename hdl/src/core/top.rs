@@ -3,7 +3,7 @@
 use rust_hdl::prelude::*;
 
 use super::glue::core_glue;
-use super::{BranchUnit, CmdUnit, Merger, SpiSeq, TimingGen};
+use super::{BranchUnit, CmdUnit, Merger, ModeGen, SpiSeq, TimingGen};
 use crate::plan::Plan;
 use crate::widths::*;
 
@@ -25,6 +25,11 @@ pub struct Core {
     pub sample_value: Signal<Out, Bits<VALUE_BITS>>,
     /// The timebase's `start1` (the next cycle starts a slot), for the link.
     pub slot_tick: Signal<Out, Bit>,
+    /// A mix with modes: `mode_sel` (pin select) and `mode`, one each, and
+    /// the mode block; none otherwise, so a mix without modes has the
+    /// core it always had.
+    pub mode_sel: Vec<Signal<In, Bits<MODE_BITS>>>,
+    pub mode: Vec<Signal<Out, Bits<MODE_BITS>>>,
     pub timing: TimingGen,
     pub seqs: Vec<SpiSeq>,
     pub branches: Vec<BranchUnit>,
@@ -33,6 +38,7 @@ pub struct Core {
     pub merge: Merger,
     /// The command unit of each branch, if it has one.
     _cmd_of: Vec<Option<usize>>,
+    pub modes: Vec<ModeGen>,
     /// Devices per branch (the glue's per-mix parameters besides the count).
     _devices: Vec<usize>,
     /// Sequencer of each branch.
@@ -70,12 +76,19 @@ impl Core {
             sample_channel: Default::default(),
             sample_value: Default::default(),
             slot_tick: Default::default(),
+            mode_sel: (plan.modes.iter().filter(|m| m.pin))
+                .map(|_| Default::default())
+                .collect(),
+            mode: plan.modes.iter().map(|_| Default::default()).collect(),
             timing: TimingGen::new(plan),
             seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
             branches: plan.branches.iter().map(BranchUnit::new).collect(),
             cmds,
             _cmd_of: cmd_of,
             merge: Merger::new(plan.branches.len()),
+            modes: (plan.modes.iter())
+                .map(|m| ModeGen::new(m, plan.branches.len()))
+                .collect(),
             _devices: plan.branches.iter().map(|b| b.devices).collect(),
             _seq_of: plan.branches.iter().map(|b| b.seq).collect(),
             _mux_en: 0,
@@ -163,6 +176,29 @@ impl Core {
         drive(&mut m.r_val.clock, k);
         drive(&mut m.pend.clock, k);
         drive(&mut m.r_any.clock, k);
+        for g in self.modes.iter_mut() {
+            drive(&mut g.clock, k);
+        }
+    }
+}
+
+impl Core {
+    /// The mode block's timebase inputs and `mode`; the ROM address and
+    /// `slice` the branches take: the mode block's with modes, else the
+    /// timing generator's.
+    fn mode_block_inputs(&mut self, clk: Clock, rst: bool) -> (Bits<SLOT_BITS>, Bits<SLICE_BITS>) {
+        let Some(g) = self.modes.first_mut() else {
+            return (self.timing.addr.val(), self.timing.slice.val());
+        };
+        g.clock.next = clk;
+        g.rst.next = rst;
+        g.start1.next = self.timing.start1.val();
+        g.addr.next = self.timing.addr.val();
+        if let Some(sel) = self.mode_sel.first() {
+            g.mode_sel.next = sel.val();
+        }
+        self.mode[0].next = g.mode.val();
+        (g.maddr.val(), g.minfo.val())
     }
 }
 
@@ -197,8 +233,7 @@ impl Logic for Core {
         let start = self.timing.start2.val();
         let start1 = self.timing.start1.val();
         let start0 = self.timing.start0.val();
-        let addr = self.timing.addr.val();
-        let slice = self.timing.slice.val();
+        let (addr, slice) = self.mode_block_inputs(clk, rst);
         let mut seq = [(false, false, false, false); MAX_BRANCHES];
         for (i, q) in self.seqs.iter_mut().enumerate() {
             q.clock.next = clk;
@@ -271,6 +306,13 @@ impl Logic for Core {
             self._mux_en = en;
             self.mux_en.next = en.to_bits();
         }
+        if let Some(g) = self.modes.first_mut() {
+            g.done.next = done.into();
+            for b in 0..g.ch.len() {
+                g.ch[b].next = chs[b].into();
+                g.v[b].next = vals[b].into();
+            }
+        }
         self.merge.done.next = done.into();
         self.merge.more.next = more.into();
         self.merge.done_next.next = done_next.into();
@@ -340,6 +382,17 @@ impl Logic for Core {
         self.sample_channel.connect();
         self.sample_value.connect();
         self.slot_tick.connect();
+        for g in self.modes.iter_mut() {
+            g.clock.connect();
+            g.rst.connect();
+            g.start1.connect();
+            g.addr.connect();
+            g.mode_sel.connect();
+            g.done.connect();
+            g.ch.iter_mut().for_each(|s| s.connect());
+            g.v.iter_mut().for_each(|s| s.connect());
+        }
+        self.mode.iter_mut().for_each(|s| s.connect());
     }
 
     fn hdl(&self) -> Verilog {
@@ -349,6 +402,9 @@ impl Logic for Core {
             &self._seq_of,
             self.seqs.len(),
             &self._cmd_of,
+            self.modes
+                .first()
+                .map(|g| (!self.mode_sel.is_empty(), g.ch.len())),
         ))
     }
 }

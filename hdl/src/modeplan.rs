@@ -1,0 +1,206 @@
+//! The numbers of a mix with modes (docs/timing.md, "Mode switches"), pure
+//! Rust: every mode's slot table in one ROM image per branch (the mode's
+//! number on the address bits above the slot), each branch's first instant
+//! of every mode (where its mux goes when a frame ends without another
+//! instant), and the triggers as the mode block evaluates them.
+
+use lut_gen::{ModeSelect, Schedule, When};
+
+use crate::plan::{addr_bits, BranchRom, Plan};
+use crate::widths::{MODE_BITS, SLOT_BITS};
+use crate::HdlError;
+
+/// The modes of a plan: what the mode block (`core/modes.rs`) is built from.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModePlan {
+    pub count: usize,
+    /// Bits of `mode_sel` and `mode` (`Modes::select_bits`).
+    pub bits: u32,
+    /// `select = "pin"` (else the triggers decide).
+    pub pin: bool,
+    /// Address bits of one mode's table (the slot's); the mode sits above.
+    pub slot_bits: usize,
+    pub triggers: Vec<TrigPlan>,
+}
+
+/// One `[[trigger]]` in the gateware's terms.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TrigPlan {
+    pub to: usize,
+    pub from: Option<usize>,
+    pub above: bool,
+    pub level: u32,
+    pub for_frames: u32,
+    /// Per branch, the watched channels it converts (empty: none).
+    pub watch: Vec<Vec<u32>>,
+}
+
+impl TrigPlan {
+    /// Armed in mode `m` (docs/timing.md: `from = m`, or no `from` and `to != m`).
+    pub fn armed_in(&self, m: usize) -> bool {
+        m != self.to && self.from.is_none_or(|f| f == m)
+    }
+    /// Bits of the run counter (counts to `for_frames`, saturating).
+    pub fn run_bits(&self) -> usize {
+        addr_bits(self.for_frames as u64 + 1)
+    }
+}
+
+/// A branch's mode-specific ROM numbers.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModeRom {
+    /// Per mode: the mux (select, device) of the branch's first instant in
+    /// that mode's frame; `None` when the mode does not use the branch.
+    pub first: Vec<Option<(u32, u32)>>,
+    /// Bits of the mode number on the address and in the `slice` input.
+    pub mode_bits: usize,
+}
+
+fn unsupported(m: String) -> HdlError {
+    HdlError::Unsupported(m)
+}
+
+/// Every mode's table into the plan's ROMs, and the mode block's numbers;
+/// nothing for a mix without modes.
+pub fn apply(s: &Schedule, p: &mut Plan) -> Result<(), HdlError> {
+    let Some(m) = s.mode_plan().filter(|m| m.names.len() > 1) else {
+        return Ok(());
+    };
+    let count = m.names.len();
+    let bits = m.select_bits();
+    let slot_bits = addr_bits(p.frame_slots);
+    if p.compact {
+        return Err(unsupported(format!(
+            "a mix with modes needs the full frame table, but {} slots per frame of {} branches take the compact form",
+            p.frame_slots,
+            p.branches.len()
+        )));
+    }
+    if p.frame_slots < 2 {
+        return Err(unsupported(
+            "a mix with modes needs at least 2 slots per frame (the next frame's table is read in the last slot)".into(),
+        ));
+    }
+    if bits as usize > MODE_BITS || slot_bits + bits as usize > SLOT_BITS {
+        return Err(unsupported(format!(
+            "{count} modes of {} slots: the slot ROM's address has {SLOT_BITS} bits for the slot and the mode together",
+            p.frame_slots
+        )));
+    }
+    for b in 0..p.branches.len() {
+        let used: Vec<bool> = s
+            .modes
+            .iter()
+            .map(|ms| (0..p.frame_slots).any(|u| ms.at(u, b).is_some()))
+            .collect();
+        if !used[0] && used.iter().any(|u| *u) {
+            return Err(unsupported(format!(
+                "branch {}: the reset mode `{}` does not use it but another mode does: its mux would have no reset value to hold (give it a channel in `{}`)",
+                s.branches[b].name, m.names[0], m.names[0]
+            )));
+        }
+        let rom = &mut p.branches[b];
+        rom.members = all_members(s, b, rom)?;
+        fill(s, b, rom, bits as usize, slot_bits);
+    }
+    let triggers = match m.select {
+        ModeSelect::Pin => vec![],
+        ModeSelect::Auto => triggers(s, m)?,
+    };
+    p.modes = Some(ModePlan {
+        count,
+        bits,
+        pin: m.select == ModeSelect::Pin,
+        slot_bits,
+        triggers,
+    });
+    Ok(())
+}
+
+/// The triggers with each watched channel by branch; a watched channel must
+/// be its conversion's only word (the mode block reads the word as the
+/// conversion completes, before the merger steps a chain).
+fn triggers(s: &Schedule, m: &lut_gen::Modes) -> Result<Vec<TrigPlan>, HdlError> {
+    let nb = s.branches.len();
+    let mut out = vec![];
+    for t in &m.triggers {
+        let mut watch = vec![vec![]; nb];
+        for &c in &t.channels {
+            let b = s.mix.channels[c].branch;
+            if s.mix.branches[b].chain > 1 {
+                return Err(unsupported(format!(
+                    "trigger at line {}: channel {} is on the chained branch {}: the gateware watches unchained branches only",
+                    t.line, s.mix.channels[c].name, s.branches[b].name
+                )));
+            }
+            watch[b].push(c as u32);
+        }
+        out.push(TrigPlan {
+            to: t.to,
+            from: t.from,
+            above: t.when == When::Above,
+            level: t.level,
+            for_frames: t.for_frames.max(1),
+            watch,
+        });
+    }
+    Ok(out)
+}
+
+/// The chain members of every lead channel branch `b` converts in any mode.
+fn all_members(s: &Schedule, b: usize, rom: &BranchRom) -> Result<Vec<(u32, Vec<u32>)>, HdlError> {
+    let mut members = rom.members.clone();
+    if rom.chain < 2 {
+        return Ok(members);
+    }
+    for ms in &s.modes {
+        for u in 0..s.grid.frame_slots {
+            let Some(lead) = ms.at(u, b) else { continue };
+            if members.iter().any(|(l, _)| *l as usize == lead) {
+                continue;
+            }
+            let chans: Vec<u32> = ms.groups[lead]
+                .iter()
+                .flatten()
+                .map(|c| *c as u32)
+                .collect();
+            if chans.len() != rom.chain as usize {
+                return Err(unsupported(format!(
+                    "branch {}: the conversion of channel {} reads {} chained words but only {} of them are declared channels",
+                    s.branches[b].name, s.mix.channels[lead].name, rom.chain, chans.len()
+                )));
+            }
+            members.push((lead as u32, chans));
+        }
+    }
+    members.sort();
+    Ok(members)
+}
+
+/// Branch `b`'s ROM: mode `m`'s word of slot `u` at address `m << slot_bits
+/// | u`, `{w, conv, ch, sel, dev}` with `w` set when the mode has no
+/// instant at slot `u` or later (the mux field is then the next frame's,
+/// chosen as the word is read).
+fn fill(s: &Schedule, b: usize, rom: &mut BranchRom, mode_bits: usize, slot_bits: usize) {
+    let n = s.grid.frame_slots as usize;
+    let top = rom.word_bits();
+    let mut words = vec![0u32; 1 << (slot_bits + mode_bits)];
+    let mut first = vec![];
+    for (m, ms) in s.modes.iter().enumerate() {
+        let slots: Vec<Option<usize>> = (0..n as u64).map(|u| ms.at(u, b)).collect();
+        let mux = |c: usize| (s.channels[c].select, s.channels[c].device);
+        let mut next: Option<usize> = None;
+        for u in (0..n).rev() {
+            if let Some(c) = slots[u] {
+                next = Some(c);
+            }
+            let (sel, dev) = next.map_or((0, 0), mux);
+            let w = rom.word(slots[u].is_some(), slots[u].unwrap_or(0) as u32, sel, dev);
+            words[(m << slot_bits) | u] = w | (next.is_none() as u32) << top;
+        }
+        first.push(next.map(mux));
+    }
+    rom.words = words;
+    rom.addr_bits = slot_bits + mode_bits;
+    rom.modes = Some(ModeRom { first, mode_bits });
+}
