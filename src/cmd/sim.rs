@@ -90,8 +90,8 @@ pub struct Args {
     /// requests, comma-separated (MODE a name or a number; e.g.
     /// `--modes 3=touch,9=rest`): from the first cycle of frame FRAME on the
     /// pin shows MODE, which by the contract runs from frame FRAME + 2.
-    /// Before the first request the pin shows 0.  --backend model only (the
-    /// gateware does not switch modes yet).
+    /// Before the first request the pin shows 0.  --backend model,
+    /// rusthdl or verilator.
     #[arg(long, value_name = "FRAME=MODE,...")]
     pub modes: Option<String>,
 }
@@ -215,8 +215,9 @@ pub fn run(a: Args) -> u8 {
     }
     // The model follows mode switches; the gateware does not yet.
     let load = match backend {
-        Backend::Model => super::load_any_modes,
-        _ => super::load_checked,
+        Backend::Model | Backend::RustHdl | Backend::Verilator | Backend::Icarus => {
+            super::load_any_modes
+        }
     };
     let s = match load(&a.mix, super::Limits::Contract) {
         Ok(s) => s,

@@ -83,6 +83,7 @@ fn command_units(s: &mut String, seq_of: &[usize], cmd_of: &[Option<usize>]) {
         }
         s.push_str(&format!("  adc_mosi$0 = {{{}}};\n", lanes.join(", ")));
     }
+}
 
 /// The mode block's inputs, the ROM address and mode information it gives
 /// every branch in place of the timing generator's, and the `mode` port.
