@@ -621,15 +621,7 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
         "reg have;\ninitial have = 1'b0;\nreg [{}:0] tok;\n// its next byte slot (0-3 trailer, 4-7 header, 8-11 record)\nreg [3:0] bcnt;\ninitial bcnt = 4'd0;",
         rb - 1,
     );
-    if p.mode_bits > 0 {
-        let b = p.mode_bits;
-        let _ = writeln!(
-            s,
-            "// the modes of the last header's frame and of the frame before it\nreg [{}:0] fmode;\ninitial fmode = {b}'d0;\nreg [{}:0] pmode;\ninitial pmode = {b}'d0;",
-            b - 1,
-            b - 1
-        );
-    }
+    mode_registers(s, p.mode_bits);
     let _ = writeln!(
         s,
         "reg started;\ninitial started = 1'b0;\nreg [7:0] hframe;\ninitial hframe = 8'd0;\nreg [{}:0] hslice;\ninitial hslice = {};",
@@ -657,6 +649,19 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
             s,
             "// the character still to send, shifted right with zeros: chr[0] is the\n// line; 1 alone is the last stop bit (and idle, where it stays)\nreg [{}:0] chr;\ninitial chr = {cb}'d1;\n// the character in transit is covered by the CRC (not one of its bytes)\nreg in_crc;\ninitial in_crc = 1'b0;\n",
             cb - 1
+        );
+    }
+}
+
+/// A mix with modes: the modes of the last header's frame and of the
+/// frame before it (nothing without modes).
+fn mode_registers(s: &mut String, b: u32) {
+    if b > 0 {
+        let _ = writeln!(
+            s,
+            "// the modes of the last header's frame and of the frame before it\nreg [{}:0] fmode;\ninitial fmode = {b}'d0;\nreg [{}:0] pmode;\ninitial pmode = {b}'d0;",
+            b - 1,
+            b - 1
         );
     }
 }
