@@ -34,7 +34,14 @@ pub struct LinkParams {
     /// An AXI4-Stream master instead of the UART (`div`, `parity` and
     /// `stop_bits` unused): where `tlast` goes.
     pub axis: Option<link::Tlast>,
+    /// A mix with modes: bits of the `mode` input (the core's mode in
+    /// force), which each boundary's token carries to its header
+    /// (docs/packet-format.md, "Modes"); 0: no modes, no input.
+    pub mode_bits: u32,
 }
+
+/// The most mode bits the link's FIFO entry carries (above its 28 bits).
+pub const MAX_LINK_MODE_BITS: u32 = 4;
 
 impl LinkParams {
     pub(crate) fn of(s: &lut_gen::Schedule) -> Result<Option<LinkParams>, String> {
@@ -42,6 +49,13 @@ impl LinkParams {
             return Ok(None);
         };
         let p = r.map_err(|e| e.message)?;
+        let mode_bits = p.tx_config(s).mode_bits;
+        if mode_bits > MAX_LINK_MODE_BITS {
+            return Err(format!(
+                "the link carries at most {} modes in its packets, the mix has more",
+                1 << MAX_LINK_MODE_BITS
+            ));
+        }
         Ok(Some(LinkParams {
             slice_cycles: s.grid.slice_cycles,
             slots_per_slice: s.grid.slots_per_slice,
@@ -56,6 +70,7 @@ impl LinkParams {
             stop_bits: p.stop_bits,
             depth: p.fifo_depth,
             crc_init: link::format::CRC_INIT,
+            mode_bits,
         }))
     }
 
@@ -113,6 +128,10 @@ struct Regs {
     started: bool,
     hframe: u8,
     hslice: u16,
+    /// A mix with modes: the mode of the last header's frame and of the
+    /// frame before it.
+    fmode: u8,
+    pmode: u8,
     crc: u16,
     /// UART: the character in transit is one the CRC covers (not its own
     /// two bytes); its data bits go into `crc` as they reach the line.
@@ -148,6 +167,10 @@ pub struct UartLink {
     pub ovf: Signal<Out, Bit>,
     _p: LinkParams,
     _r: Regs,
+    /// The `mode` input (a mix with modes) during the cycle the next edge
+    /// ends: the core's mode in force, which `RtlSim` sets once the core
+    /// switches (0 until then: the gateware refuses mode mixes).
+    pub(crate) _mode: u8,
 }
 
 /// The AXI4-Stream form of the link: the same packetizer, FIFO and
@@ -168,6 +191,10 @@ pub struct AxisLink {
     pub ovf: Signal<Out, Bit>,
     _p: LinkParams,
     _r: Regs,
+    /// The `mode` input (a mix with modes) during the cycle the next edge
+    /// ends: the core's mode in force, which `RtlSim` sets once the core
+    /// switches (0 until then: the gateware refuses mode mixes).
+    pub(crate) _mode: u8,
 }
 
 impl AxisLink {
@@ -186,6 +213,7 @@ impl AxisLink {
             ovf: Default::default(),
             _p: p,
             _r: Regs::default(),
+            _mode: 0,
         };
         l._r.mem = vec![0; p.depth + 1];
         reset_regs(&p, &mut l._r);
@@ -205,7 +233,8 @@ impl Logic for AxisLink {
                     self.val.val().to_u64() as u32,
                 );
                 let t = self.slot_tick.val();
-                edge(&self._p, &mut self._r, v, c, x, t, self.tready.val());
+                let m = self._mode;
+                edge(&self._p, &mut self._r, (v, c, x, m), t, self.tready.val());
             }
         }
         self.tdata.next = (self._r.tdata as u64).into();
@@ -272,6 +301,7 @@ impl UartLink {
                 mem: vec![0; p.depth + 1],
                 ..Default::default()
             },
+            _mode: 0,
         };
         // the Verilog's initial values are its reset values
         reset_regs(&p, &mut l._r);
@@ -279,13 +309,17 @@ impl UartLink {
     }
 
     fn edge(&mut self, valid: bool, ch: u32, val: u32, tick: bool) {
-        edge(&self._p, &mut self._r, valid, ch, val, tick, false);
+        let m = self._mode;
+        edge(&self._p, &mut self._r, (valid, ch, val, m), tick, false);
     }
 }
 
 /// The registers after one clock edge (the UART's, or with `p.axis` the
 /// AXIS master's, whose slave drives `tready` in the cycle the edge ends).
-fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tick: bool, tready: bool) {
+/// `input`: the sample stream and the `mode` input, (valid, channel,
+/// code, mode).
+fn edge(p: &LinkParams, r: &mut Regs, input: (bool, u32, u32, u8), tick: bool, tready: bool) {
+    let (valid, ch, val, mode) = input;
     let p = *p;
     let bnd = r.bnd;
     let push = bnd || valid;
@@ -320,7 +354,8 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tick: bool
     // the free entry `wr` (never a queued token: at most `depth` of the
     // `depth + 1` entries are) takes every cycle's token; it is kept when
     // `wr` advances
-    nx.mem[r.wr] = (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
+    let mode = (mode as u32) & ((1 << p.mode_bits) - 1);
+    nx.mem[r.wr] = mode << 28 | (bnd as u32) << 27 | (valid as u32) << 26 | ch << 16 | val;
     if push {
         if room {
             nx.wr = (r.wr + 1) % (p.depth + 1);
@@ -373,6 +408,15 @@ fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
     let slot = slot(r);
     // a token ends with its record, or its header when it has none
     let last = slot == 11 || (slot == 7 && r.tok >> 26 & 1 == 0);
+    // a header: its frame's mode (the token's), and the one before at a
+    // frame's first slice (no modes: the slice alone)
+    if slot == 4 {
+        nx.fmode = (r.tok >> 28) as u8;
+        if r.hslice == 0 {
+            nx.pmode = r.fmode;
+        }
+    }
+    let field = link::format::slice_field(r.hslice, r.fmode, r.pmode, p.mode_bits);
     let byte = match slot {
         0 => 0x5A,
         1 => r.ovfc,
@@ -380,8 +424,8 @@ fn load_byte(p: &LinkParams, r: &Regs, nx: &mut Regs) {
         3 => (r.crc >> 8) as u8,
         4 => 0xA5,
         5 => r.hframe,
-        6 => (r.hslice >> 8) as u8,
-        7 => r.hslice as u8,
+        6 => (field >> 8) as u8,
+        7 => field as u8,
         8 => ((r.tok >> 24) & 3) as u8,
         9 => (r.tok >> 16) as u8,
         10 => (r.tok >> 8) as u8,
@@ -491,7 +535,7 @@ fn link_verilog(p: &LinkParams) -> String {
     };
     declarations(&mut s, p, w);
     wires(&mut s, p, w);
-    byte_out(&mut s, w.hw);
+    byte_out(&mut s, w.hw, p.mode_bits);
     crc_and_character(&mut s, p, w);
     let _ = writeln!(
         s,
@@ -518,7 +562,7 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths {
         pw, aw, nw, dw, cb, ..
     } = w;
-    let rb = RAM_BITS;
+    let rb = RAM_BITS + p.mode_bits as usize;
     let axis = p.axis.is_some();
     if axis {
         let _ = writeln!(
@@ -577,6 +621,7 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
         "reg have;\ninitial have = 1'b0;\nreg [{}:0] tok;\n// its next byte slot (0-3 trailer, 4-7 header, 8-11 record)\nreg [3:0] bcnt;\ninitial bcnt = 4'd0;",
         rb - 1,
     );
+    mode_registers(s, p.mode_bits);
     let _ = writeln!(
         s,
         "reg started;\ninitial started = 1'b0;\nreg [7:0] hframe;\ninitial hframe = 8'd0;\nreg [{}:0] hslice;\ninitial hslice = {};",
@@ -608,6 +653,19 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
     }
 }
 
+/// A mix with modes: the modes of the last header's frame and of the
+/// frame before it (nothing without modes).
+fn mode_registers(s: &mut String, b: u32) {
+    if b > 0 {
+        let _ = writeln!(
+            s,
+            "// the modes of the last header's frame and of the frame before it\nreg [{}:0] fmode;\ninitial fmode = {b}'d0;\nreg [{}:0] pmode;\ninitial pmode = {b}'d0;",
+            b - 1,
+            b - 1
+        );
+    }
+}
+
 /// The handshake and FIFO wires of one cycle.
 fn wires(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths { nw, dw, cb, .. } = w;
@@ -634,7 +692,18 @@ fn wires(s: &mut String, p: &LinkParams, w: Widths) {
         "wire last = (slot == 4'd11) | ((slot == 4'd7) & !tok[{}]);",
         RAM_BITS - 1
     );
-    let _ = writeln!(s, "wire [{}:0] token = {{valid, ch, val}};", RAM_BITS - 1);
+    if p.mode_bits > 0 {
+        let top = RAM_BITS + p.mode_bits as usize - 1;
+        let _ = writeln!(s, "wire [{top}:0] token = {{mode, valid, ch, val}};");
+        // the header's slice field: the two modes above the slice
+        let pad = match 16 - 2 * p.mode_bits as usize - w.hw {
+            0 => String::new(),
+            n => format!("{n}'d0, "),
+        };
+        let _ = writeln!(s, "wire [15:0] hfield = {{fmode, pmode, {pad}hslice}};");
+    } else {
+        let _ = writeln!(s, "wire [{}:0] token = {{valid, ch, val}};", RAM_BITS - 1);
+    }
 }
 
 /// Bits `lo..lo + 8` of the `w`-bit register `r` as a byte (zeros above
@@ -648,8 +717,13 @@ fn byte_of(r: &str, w: usize, lo: usize) -> String {
 }
 
 /// The byte of the slot being sent.
-fn byte_out(s: &mut String, hw: usize) {
+fn byte_out(s: &mut String, hw: usize, mode_bits: u32) {
     let _ = writeln!(s, "reg [7:0] byte_out;\nalways @(*) begin\n  case (slot)");
+    let (hi, lo) = if mode_bits > 0 {
+        ("hfield[15:8]".to_string(), "hfield[7:0]".to_string())
+    } else {
+        (byte_of("hslice", hw, 8), byte_of("hslice", hw, 0))
+    };
     for (i, e) in [
         "8'h5a",
         "ovfc",
@@ -657,8 +731,8 @@ fn byte_out(s: &mut String, hw: usize) {
         "crc[15:8]",
         "8'ha5",
         "hframe",
-        &byte_of("hslice", hw, 8),
-        &byte_of("hslice", hw, 0),
+        &hi,
+        &lo,
     ]
     .iter()
     .enumerate()
@@ -730,8 +804,12 @@ fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
     };
     let _ = writeln!(
         s,
-        "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    bcnt <= 4'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= {};\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n{out_reset}\n  end else begin",
-        lit(w.hw, 0)
+        "    wr <= {aw}'d0;\n    rd <= {aw}'d0;\n    n <= {nw}'d0;\n    have <= 1'b0;\n    bcnt <= 4'd0;\n    started <= 1'b0;\n    hframe <= 8'd0;\n    hslice <= {};\n    crc <= 16'hffff;\n    ovfc <= 8'd0;\n    ovf_r <= 1'b0;\n    busy <= 1'b0;\n{out_reset}{}\n  end else begin",
+        lit(w.hw, 0),
+        match p.mode_bits {
+            0 => String::new(),
+            b => format!("\n    fmode <= {b}'d0;\n    pmode <= {b}'d0;"),
+        }
     );
 }
 
@@ -809,6 +887,14 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
             p.crc_init
         ),
     };
+    let crc_load = match p.mode_bits {
+        0 => crc_load,
+        b => format!(
+            "{crc_load}\n      if (slot == 4'd4) begin\n        fmode <= tok[{}:{RAM_BITS}];\n        if (hslice == {}) pmode <= fmode;\n      end",
+            RAM_BITS + b as usize - 1,
+            lit(w.hw, 0)
+        ),
+    };
     let _ = writeln!(
         s,
         "    if (load) begin\n{load_out}\n      busy <= 1'b1;\n      bcnt <= slot + 4'd1;\n      have <= !last;\n{crc_load}\n      if (slot == 4'd7) begin\n        started <= 1'b1;\n        if (hslice == {}) begin\n          hslice <= {};\n          hframe <= hframe + 8'd1;\n        end else hslice <= hslice + {};\n      end\n    end",
@@ -816,4 +902,76 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
         lit(w.hw, 0),
         lit(w.hw, 1)
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The twin of a mode mix's link (2 mode bits, UART), driven with a
+    /// slot tick, sparse samples and a `mode` input that changes at frame
+    /// starts: its line decodes clean with the modes, and every header
+    /// names its frame's mode and the one before (docs/packet-format.md,
+    /// "Modes").
+    #[test]
+    fn headers_carry_the_mode_input() {
+        let p = LinkParams {
+            slice_cycles: 800,
+            slots_per_slice: 4,
+            slices_per_frame: 3,
+            div: 2,
+            parity: 0,
+            stop_bits: 1,
+            depth: 16,
+            crc_init: link::format::CRC_INIT,
+            axis: None,
+            mode_bits: 2,
+        };
+        let modes = [0u8, 2, 2, 1, 3, 0, 0, 1];
+        let mut r = Regs {
+            mem: vec![0; p.depth + 1],
+            ..Default::default()
+        };
+        reset_regs(&p, &mut r);
+        let fmt = link::UartFormat {
+            div: 2,
+            parity: link::Parity::None,
+            stop_bits: 1,
+        };
+        let mut rx = link::UartRx::new(fmt);
+        let mut dec = link::Decoder::with_modes(p.slices_per_frame, p.mode_bits);
+        let mut got = Vec::new();
+        let slot = p.slice_cycles / p.slots_per_slice;
+        let frame = p.slice_cycles * p.slices_per_frame;
+        let mut bounds = 0u64;
+        for c in 0..modes.len() as u64 * frame + 2000 {
+            if let Some(b) = rx.sample(r.chr & 1 == 1) {
+                dec.push_packets(&[b.byte], &mut got);
+            }
+            // the mode of the frame whose slice this cycle may start
+            bounds += r.bnd as u64;
+            let f = (bounds.saturating_sub(1) / p.slices_per_frame) as usize;
+            let mode = modes[f.min(modes.len() - 1)];
+            let valid = bounds > 0 && c % 151 == 5;
+            let input = (valid, (c % 5) as u32, c as u32 & 0xffff, mode);
+            edge(&p, &mut r, input, c % slot == slot - 1, false);
+        }
+        let st = dec.finish();
+        assert!(st.clean(), "{st:?}");
+        let got: Vec<_> = got
+            .into_iter()
+            .filter(|k| (k.frame as usize) < modes.len())
+            .collect();
+        assert!(got.len() >= modes.len() * 3 - 1, "{} packets", got.len());
+        for k in &got {
+            let f = k.frame as usize;
+            let before = if f == 0 { 0 } else { modes[f - 1] };
+            assert_eq!(
+                (k.mode, k.prev_mode),
+                (modes[f], before),
+                "frame {f} slice {}",
+                k.slice
+            );
+        }
+    }
 }
