@@ -964,7 +964,7 @@ fn faults_on_a_mode_mix_run_on_the_model_with_the_mode_classes() {
         .arg(&pin)
         .assert()
         .code(2)
-        .stderr(predicate::str::contains("does not switch modes"));
+        .stderr(predicate::str::contains("this command does not yet"));
 }
 
 /// Converters with a command word on the judge's side: `sim --backend

@@ -504,6 +504,12 @@ fn core_instance(
 
 /// The link instance (UART or AXI4-Stream), when the mix has a link.
 fn link_instance(v: &mut String, p: &Plan) {
+    // a mix with modes: the core's mode in force, at the link's width
+    let mode = match p.link.map_or(0, |lp| lp.mode_bits) {
+        0 => String::new(),
+        mb if mb as usize == crate::widths::MODE_BITS => "\n        .mode(core_mode),".into(),
+        mb => format!("\n        .mode(core_mode[{}:0]),", mb - 1),
+    };
     if p.link.is_some_and(|lp| lp.axis.is_some()) {
         let [td, tv, tl, tr, ovf] = lut_gen::AXIS_PORTS.map(|p| p.name);
         let _ = writeln!(v);
@@ -513,7 +519,7 @@ fn link_instance(v: &mut String, p: &Plan) {
         );
         let _ = writeln!(
             v,
-            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .slot_tick(core_slot_tick),\n        .tready({tr}),\n        .tdata({td}),\n        .tvalid({tv}),\n        .tlast({tl}),\n        .ovf({ovf})\n    );",
+            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .slot_tick(core_slot_tick),{mode}\n        .tready({tr}),\n        .tdata({td}),\n        .tvalid({tv}),\n        .tlast({tl}),\n        .ovf({ovf})\n    );",
             Role::Clock.name(),
             Role::Reset.name(),
             Role::SampleValid.name()
@@ -527,7 +533,7 @@ fn link_instance(v: &mut String, p: &Plan) {
         );
         let _ = writeln!(
             v,
-            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .slot_tick(core_slot_tick),\n        .tx({tx}),\n        .ovf({ovf})\n    );",
+            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .slot_tick(core_slot_tick),{mode}\n        .tx({tx}),\n        .ovf({ovf})\n    );",
             Role::Clock.name(),
             Role::Reset.name(),
             Role::SampleValid.name()

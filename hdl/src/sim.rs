@@ -33,6 +33,8 @@ macro_rules! clock_link {
         l.ch.next = c.sample_channel.val();
         l.val.next = c.sample_value.val();
         l.slot_tick.next = c.slot_tick.val();
+        // a mix with modes: the mode in force, which each header carries
+        l._mode = c.mode.first().map_or(0, |m| m.val().to_u64() as u8);
         settle(l, $passes);
         l.clock.next = Clock::from(true);
         settle(l, $passes);
