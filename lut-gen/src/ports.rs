@@ -976,7 +976,7 @@ mod tests {
                     [[channel]]\nname = \"z\"\nbranch = \"a\"\nrate_hz = 2000\ninput = 5\n";
         let m = crate::mix::parse(std::path::Path::new("cmd.toml"), text).unwrap();
         let s = crate::synthesize(&m).unwrap();
-        assert!(Layout::fits(&s).unwrap_err().contains("adc_mosi"));
+        assert!(Layout::fits(&s).is_ok(), "the gateware takes it");
         let l = Layout::new(&s);
         assert_eq!(l.mosi_lo, vec![Some(0), None, Some(1)]);
         assert_eq!(l.width(Role::Mosi), 2);
