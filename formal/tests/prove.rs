@@ -828,7 +828,8 @@ fn a_uart_proof_names_the_line_it_does_not_cover_and_excuses_no_line_fault() {
 }
 
 /// Converters with a command word (an MCP3208 beside a listening AD7940;
-/// an AD7689 with its two-conversion pipeline beside an AD7685): the
+/// an AD7689 with its two-conversion pipeline beside an AD7685; a
+/// user-declared 16-channel part on inputs above 7): the
 /// harness asserts `adc_mosi` bit for bit and leaves the prepared
 /// conversions out of the stream, the emitted gateware proves, and the
 /// proof says it does not cover what the part does with the word.
@@ -837,7 +838,7 @@ fn commanded_mixes_prove_and_name_what_the_part_does_as_not_covered() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
-    for name in ["cmd-mcp3208", "cmd-ad7689"] {
+    for name in ["cmd-mcp3208", "cmd-ad7689", "cmd-ads7953"] {
         let s = schedule(&format!("testkit/mixes/{name}.toml"));
         let dir = tempfile::tempdir().unwrap();
         let p = prove(&s, &emitted(&s), dir.path());

@@ -400,7 +400,8 @@ fn branch_rom(
 
 /// The mux field of each frame slot where branch `b` converts: the
 /// channel's (select, device), or for a converter with a command word the
-/// input its word selects (in the select bits; the device is 0).
+/// input its word selects (its low 3 bits as the select, bit 3 as the
+/// device).
 fn mux_fields(
     s: &Schedule,
     b: usize,
@@ -410,14 +411,17 @@ fn mux_fields(
         .iter()
         .map(|c| c.map(|c| (s.channels[c].select, s.channels[c].device)))
         .collect();
+    // inputs 0..=15 (`Command::parse` allows at most 4 channel bits): the
+    // low 3 in the select field, the 4th in the device field (one bit for
+    // a branch without mux devices, `BranchRom::dev_bits`)
     for w in s.commands_in_frame(b) {
-        if w.input > 7 {
+        if w.input > 15 {
             return Err(unsupported(format!(
-                "branch {}: its word selects input {}: the gateware sends at most 3 channel bits (inputs 0..=7)",
+                "branch {}: its word selects input {}: the gateware sends at most 4 channel bits",
                 s.branches[b].name, w.input
             )));
         }
-        f[w.slot as usize] = Some((w.input, 0));
+        f[w.slot as usize] = Some((w.input & 7, w.input >> 3));
     }
     Ok(f)
 }

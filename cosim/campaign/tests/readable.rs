@@ -186,7 +186,7 @@ fn random_mixes_read_as_blocks() {
 /// and the text lints clean.
 #[test]
 fn commanded_mixes_read_as_blocks() {
-    for name in ["cmd-mcp3208", "cmd-ad7689", "cmd-both"] {
+    for name in ["cmd-mcp3208", "cmd-ad7689", "cmd-both", "cmd-ads7953"] {
         let s = lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap();
         let v = hdl::emit(&s, None).unwrap().verilog().to_string();
         let units = (0..s.branches.len()).filter(|&b| s.has_command(b)).count();

@@ -141,7 +141,7 @@ fn assert_same<D: Dut>(what: &str, s: &Schedule, dut: &mut D, frames: u64) {
 
 #[test]
 fn rusthdl_drives_the_command_words_of_the_test_mixes() {
-    for name in ["cmd-mcp3208", "cmd-ad7689", "cmd-both"] {
+    for name in ["cmd-mcp3208", "cmd-ad7689", "cmd-both", "cmd-ads7953"] {
         let s = schedule(name);
         assert_same(name, &s, &mut RustHdlDut::new(&s).unwrap(), 3);
     }
@@ -161,10 +161,11 @@ fn verilator_drives_the_command_words() {
     if !tools::require_tools(&["verilator", "g++"]) {
         return;
     }
-    let mut mixes: Vec<(String, Schedule)> = ["cmd-mcp3208", "cmd-ad7689", "cmd-both"]
-        .iter()
-        .map(|n| (n.to_string(), schedule(n)))
-        .collect();
+    let mut mixes: Vec<(String, Schedule)> =
+        ["cmd-mcp3208", "cmd-ad7689", "cmd-both", "cmd-ads7953"]
+            .iter()
+            .map(|n| (n.to_string(), schedule(n)))
+            .collect();
     mixes.extend((0..3).map(|k| (format!("random commanded mix {k}"), random_mix(k))));
     for (what, s) in mixes {
         let v = engines::verilog(&s).unwrap();
@@ -232,10 +233,11 @@ fn icarus_testbench_converts_what_the_words_select() {
     if !tools::require_tools(&["iverilog", "vvp"]) {
         return;
     }
-    let mut runs: Vec<(String, Schedule, Stimulus)> = ["cmd-mcp3208", "cmd-ad7689", "cmd-both"]
-        .iter()
-        .map(|n| (n.to_string(), schedule(n), Stimulus::Pattern))
-        .collect();
+    let mut runs: Vec<(String, Schedule, Stimulus)> =
+        ["cmd-mcp3208", "cmd-ad7689", "cmd-both", "cmd-ads7953"]
+            .iter()
+            .map(|n| (n.to_string(), schedule(n), Stimulus::Pattern))
+            .collect();
     runs.push((
         "cmd-both (step)".into(),
         schedule("cmd-both"),

@@ -20,8 +20,9 @@ use lut_gen::{CmdBit, Command};
 /// begins in the next cycle where SCLK falls from this cycle to the next,
 /// during a conversion; a CNV part's first period has no falling edge (SCK
 /// idles low), so a counter from the slot start (`start0`, cycle `t`)
-/// finds cycle `t + Su - 1`.  `sel` is the branch's mux field (the input
-/// the word of its next instant selects: `Plan`), loaded into the word at
+/// finds cycle `t + Su - 1`.  `sel` and `hi` are the branch's mux field
+/// (the input the word of its next instant selects, its bit 3 as device 1:
+/// `Plan`), loaded into the word at
 /// the slot start; bit `k` of the word goes on the lane for period `k + 1`
 /// and the lane returns to 0 when the conversion ends.
 ///
@@ -39,6 +40,8 @@ pub struct CmdUnit {
     pub qsclk: Signal<In, Bit>,
     pub qdone: Signal<In, Bit>,
     pub sel: Signal<In, Bits<3>>,
+    /// Channel bit 3 (a 16-channel converter): the branch's device enable 1.
+    pub hi: Signal<In, Bit>,
     pub done: Signal<In, Bit>,
     pub mosi: Signal<Out, Bit>,
     pub live: Signal<Out, Bit>,
@@ -66,6 +69,7 @@ impl CmdUnit {
             qsclk: Default::default(),
             qdone: Default::default(),
             sel: Default::default(),
+            hi: Default::default(),
             done: Default::default(),
             mosi: Default::default(),
             live: Default::default(),
@@ -81,8 +85,9 @@ impl CmdUnit {
         }
     }
 
-    /// The word for input `sel`, bit `k` = the `k`-th bit sent.
+    /// The word for input `sel` (bit 3 from `hi`), bit `k` = the `k`-th bit sent.
     fn word(&self, sel: u64) -> u64 {
+        let sel = sel | (self.hi.val() as u64) << 3;
         self._bits.iter().enumerate().fold(0, |w, (k, b)| {
             let v = match *b {
                 CmdBit::Zero => 0,
@@ -179,13 +184,17 @@ impl CmdUnit {
             .map(|b| match *b {
                 CmdBit::Zero => "1'b0".to_string(),
                 CmdBit::One => "1'b1".to_string(),
+                CmdBit::Channel(3) => "hi".to_string(),
                 CmdBit::Channel(j) => format!("sel[{j}]"),
             })
             .collect();
         let _ = writeln!(s, "wire [{}:0] word = {{{}}};", l - 1, bits.join(", "));
-        let unused: Vec<String> = (0..3u8)
+        let unused: Vec<String> = (0..4u8)
             .filter(|j| !self._bits.contains(&CmdBit::Channel(*j)))
-            .map(|j| format!("sel[{j}]"))
+            .map(|j| match j {
+                3 => "hi".to_string(),
+                j => format!("sel[{j}]"),
+            })
             .collect();
         if !unused.is_empty() {
             let _ = writeln!(

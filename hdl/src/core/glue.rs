@@ -73,7 +73,7 @@ fn command_units(s: &mut String, seq_of: &[usize], cmd_of: &[Option<usize>]) {
             format!("cmds${i}"),
         );
         s.push_str(&format!(
-            "  {c}$clock = clock;\n  {c}$rst = rst;\n  {c}$start0 = timing$start0;\n  {c}$pin = {u}$cs_n;\n  {c}$bsclk = {u}$sclk;\n  {c}$qsclk = {q}$sclk;\n  {c}$qdone = {q}$done;\n  {c}$sel = {u}$mux_sel;\n  {c}$done = {u}$done;\n"
+            "  {c}$clock = clock;\n  {c}$rst = rst;\n  {c}$start0 = timing$start0;\n  {c}$pin = {u}$cs_n;\n  {c}$bsclk = {u}$sclk;\n  {c}$qsclk = {q}$sclk;\n  {c}$qdone = {q}$done;\n  {c}$sel = {u}$mux_sel;\n  {c}$hi = {u}$mux_en[1];\n  {c}$done = {u}$done;\n"
         ));
         lanes.insert(0, format!("{c}$mosi"));
     }

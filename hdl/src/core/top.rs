@@ -219,6 +219,7 @@ fn feed_cmd(
     q.qsclk.next = q_sclk;
     q.qdone.next = q_done;
     q.sel.next = u.mux_sel.val();
+    q.hi.next = u.mux_en.val().get_bit(1);
     q.done.next = u.done.val();
 }
 
@@ -362,6 +363,7 @@ impl Logic for Core {
             q.qsclk.connect();
             q.qdone.connect();
             q.sel.connect();
+            q.hi.connect();
             q.done.connect();
         }
         for m in self.adc_mosi.iter_mut() {
