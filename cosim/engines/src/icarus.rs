@@ -207,7 +207,7 @@ fn port_decls(l: &Layout) -> String {
         };
     }
     let range = match l.mode_bits {
-        1 => String::new(),
+        0 | 1 => String::new(),
         w => format!("[{}:0] ", w - 1),
     };
     for p in l.mode_ports() {
