@@ -204,3 +204,100 @@ fn fill(s: &Schedule, b: usize, rom: &mut BranchRom, mode_bits: usize, slot_bits
     rom.addr_bits = slot_bits + mode_bits;
     rom.modes = Some(ModeRom { first, mode_bits });
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::{plan_with, LutForm};
+
+    fn schedule(text: &str) -> Schedule {
+        let path = std::env::temp_dir().join(format!("hdl-modeplan-{}.toml", std::process::id()));
+        std::fs::write(&path, text).unwrap();
+        let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
+        let _ = std::fs::remove_file(&path);
+        s
+    }
+
+    #[test]
+    fn every_modes_table_sits_at_its_mode_on_the_address() {
+        for name in ["modes-pin", "modes-auto", "eskin34-adaptive"] {
+            let s = lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap();
+            let p = plan_with(&s, LutForm::Auto).unwrap();
+            let mp = p.modes.as_ref().unwrap();
+            assert_eq!(mp.count, s.modes.len(), "{name}");
+            for (b, rom) in p.branches.iter().enumerate() {
+                let top = rom.word_bits() - 1;
+                let conv_bit = top - 1;
+                for (m, ms) in s.modes.iter().enumerate() {
+                    let mut left = false;
+                    for u in (0..s.grid.frame_slots).rev() {
+                        let w = rom.words[(m << mp.slot_bits) | u as usize];
+                        let at = ms.at(u, b);
+                        assert_eq!(
+                            w >> conv_bit & 1 == 1,
+                            at.is_some(),
+                            "{name} b{b} m{m} u{u}"
+                        );
+                        left |= at.is_some();
+                        assert_eq!(w >> top & 1 == 0, left, "{name} b{b} m{m} u{u}: w bit");
+                    }
+                    let used = (0..s.grid.frame_slots).any(|u| ms.at(u, b).is_some());
+                    assert_eq!(rom.modes.as_ref().unwrap().first[m].is_some(), used);
+                }
+            }
+        }
+        let s = lut_gen::synthesize(&lut_gen::load(&testkit::mix("tiny")).unwrap()).unwrap();
+        let p = plan_with(&s, LutForm::Auto).unwrap();
+        assert!(p.modes.is_none() && p.branches.iter().all(|r| r.modes.is_none()));
+    }
+
+    const MIX: &str = r#"
+name = "left-out"
+[clock]
+hz = 4_000_000
+[frame]
+period_us = 1_000
+slice_us = 500
+[[mode]]
+name = "a"
+[[mode]]
+name = "b"
+[modes]
+select = "pin"
+[[branch]]
+name = "x"
+adc = "ad7940"
+mux = "tmux1108"
+mux_devices = 1
+settle_ns = 1_000
+[[branch]]
+name = "y"
+adc = "ad7940"
+mux = "tmux1108"
+mux_devices = 1
+settle_ns = 1_000
+[[channel]]
+name = "X0"
+branch = "x"
+rate_hz = 2_000
+[[channel]]
+name = "Y0"
+branch = "y"
+rate_hz = 1_000
+rates = { a = 0 }
+"#;
+
+    #[test]
+    fn a_branch_the_reset_mode_leaves_out_is_refused_with_its_name() {
+        let s = schedule(MIX);
+        let e = plan_with(&s, LutForm::Auto).unwrap_err().to_string();
+        assert!(
+            e.contains("branch y") && e.contains("reset mode `a`"),
+            "{e}"
+        );
+        // in the reset mode, and left out of the other: built
+        let s = schedule(&MIX.replace("rates = { a = 0 }", "rates = { b = 0 }"));
+        assert!(plan_with(&s, LutForm::Auto).is_ok());
+        assert!(plan_with(&s, LutForm::Compact).is_err());
+    }
+}

@@ -402,3 +402,15 @@ fn the_links_fifo_is_block_ram() {
         assert!(dffs > 0 && dffs < 100, "{tag}: {dffs} flip-flops");
     }
 }
+
+/// Modes (issue 29): a pin-select mix, an auto mix with three modes and a
+/// UART, and the adaptive reference design: the mode block, every mode's
+/// table on the ROM address and the mode ports lint and synthesize clean.
+#[test]
+fn gates_modes() {
+    for name in ["modes-pin", "modes-auto", "eskin34-adaptive"] {
+        let path = common::root().join(format!("testkit/mixes/{name}.toml"));
+        let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
+        gates(&s, name);
+    }
+}

@@ -143,6 +143,10 @@ pub fn run(a: Args) -> u8 {
     }
     let started = std::time::Instant::now();
     if let Some(map) = &a.map {
+        // a capture maps no mode pins: it would be judged as the reset mode
+        if let Err(code) = super::one_mode(&s, &a.mix) {
+            return code;
+        }
         return run_capture(&a, &s, map);
     }
     let opts = CheckOptions {

@@ -157,8 +157,8 @@ pub fn load_checked(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8
     Ok(s)
 }
 
-/// [`load_checked`] for what follows mode switches (`verilog`, `sim
-/// --backend model`, `rusthdl`, `verilator`): a mix with modes is not refused.
+/// [`load_checked`] for what follows mode switches (`verilog`, `sim`,
+/// `check`): a mix with modes is not refused.
 pub fn load_any_modes(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
     let s = match limits {
         Limits::Contract => schedule_on_pins(path)?,
@@ -177,9 +177,9 @@ pub fn one_mode(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
         Some(m) if m.names.len() > 1 => {
             eprintln!(
                 "error: {}: the mix declares {} modes ({}): `audit`, `lut` and `verilog` \
-                 plan every mode and `sim --backend model`, `rusthdl` and `verilator` follow \
-                 the switches, but this command does not yet, so it would show the reset \
-                 mode `{}` alone; simulate it, or remove the [[mode]] tables to build one mode",
+                 plan every mode and `sim` and `check` follow the switches, but this \
+                 command does not yet, so it would show the reset mode `{}` alone; \
+                 simulate it, or remove the [[mode]] tables to build one mode",
                 file.display(),
                 m.names.len(),
                 m.names.join(", "),

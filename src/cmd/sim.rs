@@ -90,8 +90,7 @@ pub struct Args {
     /// requests, comma-separated (MODE a name or a number; e.g.
     /// `--modes 3=touch,9=rest`): from the first cycle of frame FRAME on the
     /// pin shows MODE, which by the contract runs from frame FRAME + 2.
-    /// Before the first request the pin shows 0.  --backend model,
-    /// rusthdl or verilator.
+    /// Before the first request the pin shows 0.  Every back end.
     #[arg(long, value_name = "FRAME=MODE,...")]
     pub modes: Option<String>,
 }
