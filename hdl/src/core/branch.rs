@@ -22,6 +22,11 @@ pub struct BranchUnit {
     pub miso: Signal<In, Bit>,
     /// The merger takes this branch's word at the end of this cycle.
     pub grant: Signal<In, Bit>,
+    /// The merger's queue form: take the next lane's channel and word at
+    /// the end of this cycle (tied low in the priority form).
+    pub mv: Signal<In, Bit>,
+    pub q_ch: Signal<In, Bits<CH_BITS>>,
+    pub q_val: Signal<In, Bits<VALUE_BITS>>,
     /// The conversion pin at its board polarity (CS low or CNV high while active).
     pub cs_n: Signal<Out, Bit>,
     pub sclk: Signal<Out, Bit>,
@@ -35,6 +40,9 @@ pub struct BranchUnit {
     pub res_val: Signal<Out, Bits<VALUE_BITS>>,
     /// More words of this conversion follow the one on `res_*`.
     pub more: Signal<Out, Bit>,
+    /// The branch converts in the slot of the next cycle (the queue form's
+    /// MISO routing reads it).
+    pub act_q: Signal<Out, Bit>,
     pub(super) rom: SlotRom,
     pub(super) reader: WordReader,
     /// The branch converts in the slot of cycle c + 1 (cycles t - 1 ..= t + S - 2).
@@ -76,6 +84,9 @@ impl BranchUnit {
             seq_done: Default::default(),
             miso: Default::default(),
             grant: Default::default(),
+            mv: Default::default(),
+            q_ch: Default::default(),
+            q_val: Default::default(),
             cs_n: Signal::new_with_default(!rom.cnv),
             sclk: Signal::new_with_default(!rom.cnv),
             mux_sel: Default::default(),
@@ -85,6 +96,7 @@ impl BranchUnit {
             res_ch: Default::default(),
             res_val: Default::default(),
             more: Default::default(),
+            act_q: Default::default(),
             rom: SlotRom::new(rom),
             reader: WordReader::new(rom),
             act: Default::default(),
@@ -118,6 +130,10 @@ impl Logic for BranchUnit {
         if self.start2.val() {
             // Cycle t - 2: the ROM describes the slot starting at t.
             self.act.d.next = self.rom.conv.val();
+        }
+        if self.mv.val() {
+            // the queue form: the lane above's channel moves up
+            self.cur_ch.d.next = self.q_ch.val();
         }
         if self.start1.val() {
             self.cur_ch.d.next = self.rom.ch.val();
@@ -153,6 +169,8 @@ impl Logic for BranchUnit {
         self.reader.cap.next = self.seq_cap.val();
         self.reader.miso.next = self.miso.val();
         self.reader.grant.next = self.grant.val();
+        self.reader.mv.next = self.mv.val();
+        self.reader.q_in.next = self.q_val.val();
         self.reader.lead.next = self.cur_ch.q.val();
         if self.rst.val() {
             self.act.d.next = self.k_conv0.val();
@@ -171,5 +189,6 @@ impl Logic for BranchUnit {
         self.res_ch.next = self.reader.ch.val();
         self.res_val.next = self.reader.val.val();
         self.more.next = self.reader.more.val();
+        self.act_q.next = self.act.q.val();
     }
 }

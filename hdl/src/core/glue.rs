@@ -3,16 +3,107 @@
 use crate::widths::*;
 
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
-pub(super) fn core_glue(nb: usize, devices: &[usize], seq_of: &[usize], nseq: usize) -> String {
+pub(super) fn core_glue(
+    nb: usize,
+    devices: &[usize],
+    seq_of: &[usize],
+    nseq: usize,
+    queue: Option<&[Vec<usize>]>,
+) -> String {
     let mut s = String::new();
     s.push_str("always @(*) begin\n");
     child_inputs(&mut s, nb, seq_of, nseq);
+    let act_read = queue_inputs(&mut s, nb, queue);
     lanes(&mut s, nb, devices);
     s.push_str(
         "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\nend\n",
     );
     unused_wires(&mut s, nb, devices);
+    let unread: Vec<String> = (0..nb)
+        .filter(|b| !act_read.contains(b))
+        .map(|b| format!("branches${b}$act_q"))
+        .collect();
+    if !unread.is_empty() {
+        s.push_str(&format!(
+            "// conversion flags the MISO routing does not need\nwire unused_act = |{{{}}};\n",
+            unread.join(", ")
+        ));
+    }
     s
+}
+
+/// The lane whose register captures branch `b`'s MISO is `j` when `b`
+/// converts and exactly `j` branches below it do: the routing of the
+/// merger's queue form (each lane takes the next one's word, so a slot's
+/// words must sit in lanes `0..n` in branch order). A lane with one source
+/// reads it unconditionally: in the slots it is used it is that one.
+pub(super) fn route_miso(queue: &[Vec<usize>], act: u64, miso: u64) -> u64 {
+    let mut out = 0u64;
+    for (j, srcs) in queue.iter().enumerate() {
+        let last = srcs.last().copied().unwrap_or(j);
+        let b = srcs[..srcs.len().saturating_sub(1)]
+            .iter()
+            .copied()
+            .find(|&b| (act >> b) & 1 == 1 && (act & ((1u64 << b) - 1)).count_ones() as usize == j)
+            .unwrap_or(last);
+        out |= ((miso >> b) & 1) << j;
+    }
+    out
+}
+
+/// The Verilog of [`route_miso`] and the queue's lane-to-lane wiring (or in
+/// the priority form, MISO straight and the queue inputs tied low); the
+/// branches whose `act_q` it reads.
+fn queue_inputs(s: &mut String, nb: usize, queue: Option<&[Vec<usize>]>) -> Vec<usize> {
+    let mut read = Vec::new();
+    for b in 0..nb {
+        let u = format!("branches${b}");
+        let Some(q) = queue else {
+            s.push_str(&format!(
+                "  {u}$miso = adc_miso[{b}];\n  {u}$mv = merge$mv;\n  {u}$q_ch = {CH_BITS}'h0;\n  {u}$q_val = {VALUE_BITS}'h0;\n"
+            ));
+            continue;
+        };
+        let srcs = &q[b];
+        let last = srcs.last().copied().unwrap_or(b);
+        let mut e = format!("adc_miso[{last}]");
+        for &src in srcs[..srcs.len().saturating_sub(1)].iter().rev() {
+            read.extend(0..=src);
+            e = format!("({}) ? adc_miso[{src}] : {e}", lanes_below_is(src, b));
+        }
+        s.push_str(&format!("  {u}$miso = {e};\n  {u}$mv = merge$mv;\n"));
+        if b + 1 < nb {
+            let n = format!("branches${}", b + 1);
+            s.push_str(&format!(
+                "  {u}$q_ch = {n}$res_ch;\n  {u}$q_val = {n}$res_val;\n"
+            ));
+        } else {
+            s.push_str(&format!(
+                "  {u}$q_ch = {CH_BITS}'h0;\n  {u}$q_val = {VALUE_BITS}'h0;\n"
+            ));
+        }
+    }
+    read.sort_unstable();
+    read.dedup();
+    read
+}
+
+/// Branch `src` converts with exactly `j` branches below it converting.
+fn lanes_below_is(src: usize, j: usize) -> String {
+    let act = |b: usize| format!("branches${b}$act_q");
+    let mut t = vec![act(src)];
+    if j == 0 {
+        t.extend((0..src).map(|b| format!("!{}", act(b))));
+    } else if j == src {
+        t.extend((0..src).map(act));
+    } else {
+        let w = usize::BITS as usize - src.leading_zeros() as usize;
+        let sum: Vec<String> = (0..src)
+            .map(|b| format!("{{{}'h0, {}}}", w - 1, act(b)))
+            .collect();
+        t.push(format!("({}) == {w}'d{j}", sum.join(" + ")));
+    }
+    t.join(" && ")
 }
 
 /// Clock, reset, slot strobes and sequencer levels into every child.
@@ -33,7 +124,7 @@ fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize) {
             "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = timing$start0;\n  {u}$addr = timing$addr;\n  {u}$slice = timing$slice;\n"
         ));
         s.push_str(&format!(
-            "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$miso = adc_miso[{b}];\n  {u}$grant = merge$grant[{b}];\n"
+            "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$grant = merge$grant[{b}];\n"
         ));
     }
 }
@@ -130,5 +221,29 @@ fn unused_wires(s: &mut String, nb: usize, devices: &[usize]) {
             MAX_BRANCHES - 1,
             nb
         ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::route_miso;
+
+    /// For every conversion pattern of up to 6 branches and every MISO
+    /// level, lane `j` captures the `j`-th converting branch's MISO, so a
+    /// slot's words sit in lanes `0..n` in branch order.
+    #[test]
+    fn lanes_capture_the_converting_branches_in_order() {
+        for nb in 1..=6usize {
+            let queue: Vec<Vec<usize>> = (0..nb).map(|j| (j..nb).collect()).collect();
+            for act in 0..1u64 << nb {
+                for miso in 0..1u64 << nb {
+                    let got = route_miso(&queue, act, miso);
+                    let on: Vec<usize> = (0..nb).filter(|b| act >> b & 1 == 1).collect();
+                    for (j, b) in on.iter().enumerate() {
+                        assert_eq!(got >> j & 1, miso >> b & 1, "nb {nb} act {act:b} lane {j}");
+                    }
+                }
+            }
+        }
     }
 }

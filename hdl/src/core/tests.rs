@@ -94,6 +94,7 @@ fn harness(div: u64, setup: u64) -> Harness {
             bits: 14,
         }],
         branches: vec![rom()],
+        queue: None,
     };
     let mut h = Harness {
         clock: Default::default(),

@@ -2,7 +2,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::glue::core_glue;
+use super::glue::{core_glue, route_miso};
 use super::{BranchUnit, Merger, SpiSeq, TimingGen};
 use crate::plan::Plan;
 use crate::widths::*;
@@ -27,6 +27,8 @@ pub struct Core {
     _devices: Vec<usize>,
     /// Sequencer of each branch.
     _seq_of: Vec<usize>,
+    /// The merger's queue form: each lane's MISO sources (`Plan::queue`).
+    _queue: Option<Vec<Vec<usize>>>,
     /// The value last written to `mux_en.next` (simulation only).
     _mux_en: u128,
     /// The value last written to `mux_sel.next` (simulation only).
@@ -49,9 +51,10 @@ impl Core {
             timing: TimingGen::new(plan),
             seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
             branches: plan.branches.iter().map(BranchUnit::new).collect(),
-            merge: Merger::new(plan.branches.len()),
+            merge: Merger::new(plan.branches.len(), plan.queue.is_some()),
             _devices: plan.branches.iter().map(|b| b.devices).collect(),
             _seq_of: plan.branches.iter().map(|b| b.seq).collect(),
+            _queue: plan.queue.clone(),
             _mux_en: 0,
             _mux_sel: 0,
         }
@@ -137,6 +140,23 @@ impl Core {
     }
 }
 
+impl Core {
+    /// Each branch's MISO input: the pin, or in the merger's queue form the
+    /// pin of the branch whose word the lane's register captures.
+    fn miso_lanes(&self) -> u64 {
+        let miso = self.adc_miso.val().to_u64();
+        let Some(q) = &self._queue else {
+            return miso;
+        };
+        let act = self
+            .branches
+            .iter()
+            .enumerate()
+            .fold(0u64, |a, (b, u)| a | (u.act_q.val() as u64) << b);
+        route_miso(q, act, miso)
+    }
+}
+
 impl Logic for Core {
     fn update(&mut self) {
         let clk = self.clock.val();
@@ -157,8 +177,9 @@ impl Logic for Core {
             q.start2.next = start;
             seq[i] = (q.cs_n.val(), q.sclk.val(), q.cap.val(), q.done.val());
         }
-        let miso = self.adc_miso.val().to_u64();
+        let miso = self.miso_lanes();
         let grant = self.merge.grant.val().to_u64();
+        let mv = self.merge.mv.val();
         let (mut cs, mut sclk, mut sel, mut en, mut done) = (0u64, 0u64, 0u64, 0u128, 0u64);
         let mut more = 0u64;
         let mut done_next = 0u64;
@@ -180,6 +201,7 @@ impl Logic for Core {
             u.seq_done.next = q_done;
             u.miso.next = (miso >> b) & 1 == 1;
             u.grant.next = (grant >> b) & 1 == 1;
+            u.mv.next = mv;
             more |= (u.more.val() as u64) << b;
             cs |= (u.cs_n.val() as u64) << b;
             sclk |= (u.sclk.val() as u64) << b;
@@ -214,6 +236,14 @@ impl Logic for Core {
         self.merge.done.next = done.into();
         self.merge.more.next = more.into();
         self.merge.done_next.next = done_next.into();
+        if self._queue.is_some() {
+            // the queue form: each lane reads the next lane's channel and word
+            for b in 0..nb - 1 {
+                let u = &mut self.branches[b];
+                u.q_ch.next = chs[b + 1].into();
+                u.q_val.next = vals[b + 1].into();
+            }
+        }
         // Lanes >= nb keep their default 0 (the glue ties them to zero).
         let m = &mut self.merge;
         for b in 0..nb {
@@ -249,6 +279,9 @@ impl Logic for Core {
             u.seq_done.connect();
             u.miso.connect();
             u.grant.connect();
+            u.mv.connect();
+            u.q_ch.connect();
+            u.q_val.connect();
         }
         self.merge.done.connect();
         self.merge.more.connect();
@@ -272,6 +305,7 @@ impl Logic for Core {
             &self._devices,
             &self._seq_of,
             self.seqs.len(),
+            self._queue.as_deref(),
         ))
     }
 }

@@ -20,6 +20,10 @@ pub struct WordReader {
     pub cap: Signal<In, Bit>,
     pub miso: Signal<In, Bit>,
     pub grant: Signal<In, Bit>,
+    /// Queue form of the merger: take the next lane's word `q_in` (a
+    /// single-word branch only; tied low otherwise).
+    pub mv: Signal<In, Bit>,
+    pub q_in: Signal<In, Bits<VALUE_BITS>>,
     /// The conversion's lead channel (its frame-table entry).
     pub lead: Signal<In, Bits<CH_BITS>>,
     pub val: Signal<Out, Bits<VALUE_BITS>>,
@@ -41,6 +45,8 @@ impl WordReader {
             cap: Default::default(),
             miso: Default::default(),
             grant: Default::default(),
+            mv: Default::default(),
+            q_in: Default::default(),
             lead: Default::default(),
             val: Default::default(),
             ch: Default::default(),
@@ -79,6 +85,8 @@ impl Logic for WordReader {
             }
             if self.cap.val() {
                 self._sh = ((self._sh << 1) | self.miso.val() as u128) & mask;
+            } else if self.mv.val() && self._chain == 1 {
+                self._sh = self.q_in.val().to_u64() as u128 & mask;
             } else if self.grant.val() && self._chain > 1 && !self.rst.val() {
                 if self._om + 1 < self._chain {
                     self._sh = (self._sh << self._bits) & mask;
@@ -129,12 +137,30 @@ impl Logic for WordReader {
         if n == 1 {
             let _ = writeln!(s, "\nalways @(posedge clock) begin");
             let _ = writeln!(s, "  if (cap) sh <= {shifted_in};");
+            let q = if w == VALUE_BITS {
+                "q_in".to_string()
+            } else {
+                format!("q_in[{}:0]", w - 1)
+            };
+            let _ = writeln!(
+                s,
+                "  // the merger's queue form: the next lane's word moves up"
+            );
+            let _ = writeln!(s, "  else if (mv) sh <= {q};");
             let _ = writeln!(s, "end\n");
             let _ = writeln!(s, "always @(*) begin");
             let _ = writeln!(s, "  val = {val};\n  ch = lead;\n  more = 1'b0;");
             let _ = writeln!(s, "end\n");
             let _ = writeln!(s, "// a single word: nothing to step through");
-            let _ = writeln!(s, "wire unused_reader = |{{grant, rst}};");
+            if w < VALUE_BITS {
+                let _ = writeln!(
+                    s,
+                    "wire unused_reader = |{{grant, rst, q_in[{}:{w}]}};",
+                    VALUE_BITS - 1
+                );
+            } else {
+                let _ = writeln!(s, "wire unused_reader = |{{grant, rst}};");
+            }
             return Verilog::Custom(s);
         }
         let last = n - 1;
@@ -161,6 +187,8 @@ impl Logic for WordReader {
             }
         }
         let _ = writeln!(s, "    default: ch = lead;\n  endcase\nend");
+        let _ = writeln!(s, "\n// a chain is never the merger's queue");
+        let _ = writeln!(s, "wire unused_queue = |{{mv, q_in}};");
         Verilog::Custom(s)
     }
 }
