@@ -11,6 +11,10 @@ SLOTFORGE = $(CARGO) run --quiet --release --bin slotforge --
 TOOLS = verilator g++ iverilog yosys nextpnr-ice40 sigrok-cli cvc5 chromium vcd2fst fst2vcd
 APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm sigrok-cli cvc5 chromium gtkwave
 
+# What `make tools` installs into .venv/ (the YoWASP yosys and nextpnr, fusesoc) is on every
+# recipe's PATH, so the tests find it on a fresh machine as they find Debian's tools.
+export PATH := $(CURDIR)/.venv/bin:$(PATH)
+
 # CI builds once from a fresh clone: incremental artefacts would only take disk.
 ifdef CI
 export CARGO_INCREMENTAL = 0

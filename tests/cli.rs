@@ -776,7 +776,7 @@ fn a_mix_with_modes_is_audited_and_refused_where_the_gateware_would_show_one_mod
         let out = d.path().join(name);
         let refused: [&[&str]; 5] = [
             &["verilog", "-o"],
-            &["sim", "--backend", "model", "--frames", "1", "--vcd"],
+            &["sim", "--backend", "verilator", "--frames", "1", "--vcd"],
             &["build", "--quiet", "-o"],
             &["golden", "--dir"],
             &["prove", "-o"],
@@ -796,4 +796,58 @@ fn a_mix_with_modes_is_audited_and_refused_where_the_gateware_would_show_one_mod
         }
         assert!(!out.join("slotforge_top.v").exists());
     }
+}
+
+/// `sim --backend model` follows mode switches: `--modes` drives `mode_sel`
+/// of a pin-select mix, `touch:` switches an auto mix; every frame is judged
+/// against its mode.  What needs the mode ports in a file (a VCD, the
+/// link's bytes) or a mode the mix does not have is refused with the reason.
+#[test]
+fn the_model_back_end_simulates_mode_switches() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let pin = root.join("testkit/mixes/modes-pin.toml");
+    let auto = root.join("testkit/mixes/modes-auto.toml");
+    let d = tempfile::tempdir().unwrap();
+    let sim = |mix: &Path, args: &[&str]| {
+        slotforge()
+            .args(["sim", "--quiet", "--json", "--frames", "14"])
+            .args(args)
+            .arg(mix)
+            .assert()
+    };
+    let a = sim(&pin, &["--modes", "2=slow,7=fast"]).success();
+    let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
+    // frames 0-3 and 9-13 fast, 4-8 slow: A0 4 a frame in fast, 1 in slow,
+    // less its instant at cycle 0 skipped at start-up; A2 only in fast
+    let ch = |v: &serde_json::Value, n: &str| {
+        let c = v["channels"].as_array().unwrap().iter();
+        c.filter(|c| c["name"] == n)
+            .map(|c| c["samples"].as_u64().unwrap())
+            .sum::<u64>()
+    };
+    assert_eq!(ch(&v, "A0"), 9 * 4 + 5 - 1, "{v}");
+    assert_eq!(ch(&v, "A2"), 9, "{v}");
+    let a = sim(&auto, &["--stimulus", "touch:T{0..3}@3-9"]).success();
+    let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
+    // 1 a frame at rest, 8 when touched
+    assert!(ch(&v, "T1") > 14 + 7, "{v}");
+    for (mix, args, why) in [
+        (&pin, vec!["--modes", "2=warp"], "no mode `warp`"),
+        (&pin, vec!["--modes", "two=slow"], "not a frame number"),
+        (&auto, vec!["--modes", "2=touch"], "triggers"),
+        (
+            &auto,
+            vec!["--stimulus", "touch:X@1-2"],
+            "no channel named `X`",
+        ),
+    ] {
+        sim(mix, &args)
+            .code(2)
+            .stderr(predicate::str::contains(why));
+    }
+    let vcd = d.path().join("w.vcd");
+    sim(&pin, &["--vcd", vcd.to_str().unwrap()])
+        .code(2)
+        .stderr(predicate::str::contains("mode ports"));
+    assert!(!vcd.exists());
 }

@@ -8,7 +8,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use lut_gen::{Dir, Layout, PORTS, TOP_MODULE};
+use lut_gen::{Dir, Layout, TOP_MODULE};
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
@@ -48,7 +48,7 @@ fn wrapper(mutate: bool) -> String {
     let inner = emitted().replacen(&format!("module {TOP_MODULE} ("), "module emitted_top (", 1);
     assert!(inner.contains("module emitted_top ("));
     let mut w = String::new();
-    let names: Vec<&str> = PORTS.iter().map(|p| p.name).collect();
+    let names: Vec<&str> = l.ports().map(|p| p.name).collect();
     let _ = writeln!(
         w,
         "\n// hand-written wrapper\nmodule {TOP_MODULE}({});",
@@ -59,7 +59,7 @@ fn wrapper(mutate: bool) -> String {
         "  parameter NB = {};\n  localparam SEL = 3 * NB;",
         l.branches
     );
-    for p in &PORTS {
+    for p in l.ports() {
         let width = l.width(p.role);
         let range = if !p.vector {
             String::new()
@@ -79,15 +79,15 @@ fn wrapper(mutate: bool) -> String {
             let _ = writeln!(w, "  wire {range}{}_i;", p.name);
         }
     }
-    let conns: Vec<String> = PORTS
-        .iter()
+    let conns: Vec<String> = l
+        .ports()
         .map(|p| match p.dir {
             Dir::In => format!(".{0}({0})", p.name),
             Dir::Out => format!(".{0}({0}_i)", p.name),
         })
         .collect();
     let _ = writeln!(w, "  emitted_top core({});", conns.join(", "));
-    for p in PORTS.iter().filter(|p| p.dir == Dir::Out) {
+    for p in l.ports().filter(|p| p.dir == Dir::Out) {
         let flip = if mutate && p.role == lut_gen::Role::SampleValue {
             " ^ 1'b1"
         } else {

@@ -195,7 +195,8 @@ fn core_lanes(r: Role) -> Option<(&'static str, usize)> {
         Role::MuxEn => Some(("core_mux_en", EN_TOTAL)),
         Role::SampleChannel => Some(("core_channel", CH_BITS)),
         Role::SampleValue => Some(("core_value", VALUE_BITS)),
-        Role::Clock | Role::Reset | Role::SampleValid => None,
+        // no mix the gateware takes has `adc_mosi` yet (`Layout::fits`)
+        Role::Clock | Role::Reset | Role::SampleValid | Role::Mosi => None,
     }
 }
 
@@ -313,7 +314,12 @@ fn core_wires(v: &mut String, p: &Plan, l: &Layout) -> Vec<(Role, &'static str, 
     for &(_, wire, cw) in &wired {
         let _ = writeln!(v, "    wire [{}:0] {wire};", cw - 1);
     }
+    // the core's slot starts, which the link counts for its slice boundary
+    let _ = writeln!(v, "    wire core_slot_tick;");
     let mut unused = vec![];
+    if p.link.is_none() {
+        unused.push("core_slot_tick".to_string());
+    }
     for &(r, wire, cw) in &wired {
         if p.link.is_some() && matches!(r, Role::SampleChannel | Role::SampleValue) {
             // the link reads the core's full-width channel and code
@@ -406,19 +412,24 @@ fn gaps(used: &[(usize, usize)], width: usize) -> Vec<(usize, usize)> {
     v
 }
 
+/// The contract's ports the core has: all but `adc_mosi`, which no mix the
+/// gateware takes has yet (`Layout::fits`).
+fn core_ports() -> impl Iterator<Item = &'static lut_gen::Port> {
+    PORTS.iter().filter(|p| p.role != Role::Mosi)
+}
+
 /// The core instance, its ports on the wires or straight on the wrapper's.
 fn core_instance(v: &mut String, wired: &[(Role, &'static str, usize)]) {
     let _ = writeln!(v);
     let _ = writeln!(v, "    {CORE} core (");
-    for (i, port) in PORTS.iter().enumerate() {
+    for port in core_ports() {
         let to = wired
             .iter()
             .find(|(r, ..)| *r == port.role)
             .map_or(port.name, |(_, wire, _)| *wire);
-        let sep = if i + 1 < PORTS.len() { "," } else { "" };
-        let _ = writeln!(v, "        .{}({to}){sep}", core_port_name(port.role));
+        let _ = writeln!(v, "        .{}({to}),", core_port_name(port.role));
     }
-    let _ = writeln!(v, "    );");
+    let _ = writeln!(v, "        .slot_tick(core_slot_tick)\n    );");
 }
 
 /// The link instance (UART or AXI4-Stream), when the mix has a link.
@@ -432,7 +443,7 @@ fn link_instance(v: &mut String, p: &Plan) {
         );
         let _ = writeln!(
             v,
-            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .tready({tr}),\n        .tdata({td}),\n        .tvalid({tv}),\n        .tlast({tl}),\n        .ovf({ovf})\n    );",
+            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .slot_tick(core_slot_tick),\n        .tready({tr}),\n        .tdata({td}),\n        .tvalid({tv}),\n        .tlast({tl}),\n        .ovf({ovf})\n    );",
             Role::Clock.name(),
             Role::Reset.name(),
             Role::SampleValid.name()
@@ -446,7 +457,7 @@ fn link_instance(v: &mut String, p: &Plan) {
         );
         let _ = writeln!(
             v,
-            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .tx({tx}),\n        .ovf({ovf})\n    );",
+            "    {LINK} link (\n        .clock({}),\n        .rst({}),\n        .valid({}),\n        .ch(core_channel),\n        .val(core_value),\n        .slot_tick(core_slot_tick),\n        .tx({tx}),\n        .ovf({ovf})\n    );",
             Role::Clock.name(),
             Role::Reset.name(),
             Role::SampleValid.name()
@@ -681,7 +692,12 @@ mod tests {
             .trim_end_matches(");")
             .split(',')
             .collect();
-        let want: Vec<&str> = PORTS.iter().map(|p| core_port_name(p.role)).collect();
+        // and one beyond the contract: the timebase's slot starts, which the
+        // link counts (wired inside the wrapper, never a pin)
+        let want: Vec<&str> = core_ports()
+            .map(|p| core_port_name(p.role))
+            .chain(["slot_tick"])
+            .collect();
         assert_eq!(ports, want);
         // and the wrapper exposes exactly the contract's ports, in order
         let top = format!("module {TOP_MODULE} (");
@@ -699,7 +715,7 @@ mod tests {
                     .to_string()
             })
             .collect();
-        let names: Vec<String> = PORTS.iter().map(|p| p.name.to_string()).collect();
+        let names: Vec<String> = core_ports().map(|p| p.name.to_string()).collect();
         assert_eq!(decl, names);
     }
 }

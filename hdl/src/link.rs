@@ -18,6 +18,9 @@ use crate::widths::{CH_BITS, VALUE_BITS};
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LinkParams {
     pub slice_cycles: u64,
+    /// Slots per slice: the link counts the core's slot starts
+    /// (`slot_tick`) to find a slice's first cycle.
+    pub slots_per_slice: u64,
     pub slices_per_frame: u64,
     /// Clock cycles per UART bit.
     pub div: u32,
@@ -41,6 +44,7 @@ impl LinkParams {
         let p = r.map_err(|e| e.message)?;
         Ok(Some(LinkParams {
             slice_cycles: s.grid.slice_cycles,
+            slots_per_slice: s.grid.slots_per_slice,
             slices_per_frame: s.grid.slices_per_frame,
             div: p.baud_divider.max(1),
             axis: p.axis().map(|a| a.tlast),
@@ -90,12 +94,13 @@ const RAM_BITS: usize = TOKEN_BITS - 1;
 /// The registers of the link (the Rust twin's state).
 #[derive(Debug, Clone, Default)]
 struct Regs {
-    /// The next cycle's position in the slice (0 after reset), and two
-    /// of its values registered: `npos == 1` (a boundary: this cycle
-    /// starts a slice) and `npos == slice_cycles - 1` (wrap to 0).
-    npos: u64,
+    /// The index in its slice of the slot that starts after the core's
+    /// next `slot_tick` (0 after reset, when the core's first slot is
+    /// next), and `bnd`: this cycle starts a slice (a tick at `spos == 0`
+    /// the cycle before). The core's timebase counts the cycles; the link
+    /// counts only slots.
+    spos: u64,
     bnd: bool,
-    wrap: bool,
     mem: Vec<u32>,
     wr: usize,
     rd: usize,
@@ -137,6 +142,8 @@ pub struct UartLink {
     pub valid: Signal<In, Bit>,
     pub ch: Signal<In, Bits<CH_BITS>>,
     pub val: Signal<In, Bits<VALUE_BITS>>,
+    /// The core's `slot_tick`: the next cycle starts a slot.
+    pub slot_tick: Signal<In, Bit>,
     pub tx: Signal<Out, Bit>,
     pub ovf: Signal<Out, Bit>,
     _p: LinkParams,
@@ -152,6 +159,8 @@ pub struct AxisLink {
     pub valid: Signal<In, Bit>,
     pub ch: Signal<In, Bits<CH_BITS>>,
     pub val: Signal<In, Bits<VALUE_BITS>>,
+    /// The core's `slot_tick`: the next cycle starts a slot.
+    pub slot_tick: Signal<In, Bit>,
     pub tready: Signal<In, Bit>,
     pub tdata: Signal<Out, Bits<8>>,
     pub tvalid: Signal<Out, Bit>,
@@ -169,6 +178,7 @@ impl AxisLink {
             valid: Default::default(),
             ch: Default::default(),
             val: Default::default(),
+            slot_tick: Default::default(),
             tready: Default::default(),
             tdata: Default::default(),
             tvalid: Default::default(),
@@ -194,7 +204,8 @@ impl Logic for AxisLink {
                     self.ch.val().to_u64() as u32,
                     self.val.val().to_u64() as u32,
                 );
-                edge(&self._p, &mut self._r, v, c, x, self.tready.val());
+                let t = self.slot_tick.val();
+                edge(&self._p, &mut self._r, v, c, x, t, self.tready.val());
             }
         }
         self.tdata.next = (self._r.tdata as u64).into();
@@ -220,9 +231,8 @@ impl Logic for AxisLink {
 fn reset_regs(p: &LinkParams, r: &mut Regs) {
     let mem = std::mem::take(&mut r.mem);
     *r = Regs {
-        npos: 0,
+        spos: 0,
         bnd: p.slice_cycles == 1,
-        wrap: p.slice_cycles == 1,
         mem,
         tok: r.tok,
         crc: 0xFFFF,
@@ -254,6 +264,7 @@ impl UartLink {
             valid: Default::default(),
             ch: Default::default(),
             val: Default::default(),
+            slot_tick: Default::default(),
             tx: Signal::new_with_default(true),
             ovf: Default::default(),
             _p: p,
@@ -267,14 +278,14 @@ impl UartLink {
         l
     }
 
-    fn edge(&mut self, valid: bool, ch: u32, val: u32) {
-        edge(&self._p, &mut self._r, valid, ch, val, false);
+    fn edge(&mut self, valid: bool, ch: u32, val: u32, tick: bool) {
+        edge(&self._p, &mut self._r, valid, ch, val, tick, false);
     }
 }
 
 /// The registers after one clock edge (the UART's, or with `p.axis` the
 /// AXIS master's, whose slave drives `tready` in the cycle the edge ends).
-fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bool) {
+fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tick: bool, tready: bool) {
     let p = *p;
     let bnd = r.bnd;
     let push = bnd || valid;
@@ -288,14 +299,10 @@ fn edge(p: &LinkParams, r: &mut Regs, valid: bool, ch: u32, val: u32, tready: bo
     let room = r.n < p.depth || pop;
     // next state, from the values before the edge
     let mut nx = r.clone();
-    let one = p.slice_cycles == 1;
-    nx.npos = if r.wrap { 0 } else { r.npos + 1 };
-    nx.bnd = if r.wrap { one } else { r.npos == 0 };
-    nx.wrap = if r.wrap {
-        one
-    } else {
-        r.npos + 2 == p.slice_cycles
-    };
+    nx.bnd = tick && r.spos == 0;
+    if tick {
+        nx.spos = (r.spos + 1) % p.slots_per_slice;
+    }
     if pop {
         let t = r.mem[r.rd];
         nx.tok = t;
@@ -428,7 +435,7 @@ impl Logic for UartLink {
                     self.ch.val().to_u64() as u32,
                     self.val.val().to_u64() as u32,
                 );
-                self.edge(v, c, x);
+                self.edge(v, c, x, self.slot_tick.val());
             }
         }
         self.tx.next = self._r.chr & 1 == 1;
@@ -453,7 +460,7 @@ fn width(n: u64) -> usize {
 /// The link's register and counter widths.
 #[derive(Clone, Copy)]
 struct Widths {
-    /// Slice position, FIFO address (`depth + 1` entries), FIFO count.
+    /// Slot in the slice, FIFO address (`depth + 1` entries), FIFO count.
     pw: usize,
     aw: usize,
     nw: usize,
@@ -474,7 +481,7 @@ fn link_verilog(p: &LinkParams) -> String {
     let mut s = String::new();
     let cb = p.char_bits() as usize;
     let w = Widths {
-        pw: width(p.slice_cycles - 1),
+        pw: width(p.slots_per_slice - 1),
         aw: width(p.depth as u64),
         nw: width(p.depth as u64),
         dw: width(p.div as u64 - 1),
@@ -526,13 +533,13 @@ fn declarations(s: &mut String, p: &LinkParams, w: Widths) {
             p.div, p.depth
         );
     }
-    // the next cycle's position in the slice, counting up from 0 (no
-    // flip-flop set: an unbroken carry chain), with the boundary and the
-    // wrap registered, not compares behind the chain
+    // the slice's boundary from the core's timebase: the link counts the
+    // core's slot starts (`slot_tick`), not cycles; `bnd` (this cycle
+    // starts a slice) is registered
     let one = (p.slice_cycles == 1) as u8;
     let _ = writeln!(
         s,
-        "reg [{}:0] npos;\ninitial npos = {};\nreg bnd;\ninitial bnd = 1'b{one};\nreg wrap;\ninitial wrap = 1'b{one};",
+        "// the index in its slice of the slot the core's next slot_tick announces\nreg [{}:0] spos;\ninitial spos = {};\nreg bnd;\ninitial bnd = 1'b{one};",
         pw - 1,
         lit(pw, 0)
     );
@@ -712,11 +719,7 @@ fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
         pw, aw, nw, dw, cb, ..
     } = w;
     let one = (p.slice_cycles == 1) as u8;
-    let _ = writeln!(
-        s,
-        "    npos <= {};\n    bnd <= 1'b{one};\n    wrap <= 1'b{one};",
-        lit(pw, 0),
-    );
+    let _ = writeln!(s, "    spos <= {};\n    bnd <= 1'b{one};", lit(pw, 0),);
     let out_reset = if p.axis.is_some() {
         "    tdata_r <= 8'd0;\n    tlast_r <= 1'b0;".to_string()
     } else {
@@ -735,14 +738,13 @@ fn register_reset(s: &mut String, p: &LinkParams, w: Widths) {
 /// The slice position and the token FIFO: push, pop, overflow, count.
 fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
     let Widths { pw, aw, nw, .. } = w;
-    let one = (p.slice_cycles == 1) as u8;
     let _ = writeln!(
         s,
-        "    npos <= wrap ? {} : npos + {};\n    bnd <= wrap ? 1'b{one} : (npos == {});\n    wrap <= wrap ? 1'b{one} : (npos == {});",
+        "    bnd <= slot_tick & (spos == {});\n    if (slot_tick) spos <= (spos == {}) ? {} : spos + {};",
         lit(pw, 0),
-        lit(pw, 1),
+        lit(pw, p.slots_per_slice - 1),
         lit(pw, 0),
-        lit(pw, p.slice_cycles.saturating_sub(2))
+        lit(pw, 1)
     );
     let wrap = |r: &str| {
         format!(

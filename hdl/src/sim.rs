@@ -32,6 +32,7 @@ macro_rules! clock_link {
         l.valid.next = c.sample_valid.val();
         l.ch.next = c.sample_channel.val();
         l.val.next = c.sample_value.val();
+        l.slot_tick.next = c.slot_tick.val();
         settle(l, $passes);
         l.clock.next = Clock::from(true);
         settle(l, $passes);

@@ -148,6 +148,31 @@ pub struct BranchAudit {
     pub free_mux_inputs: u32,
     /// How many more channels of each rate present in the mix would still fit.
     pub headroom: Vec<Headroom>,
+    /// The command word of a converter that takes one (`None`: it only listens).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub command: Option<CommandAudit>,
+}
+
+/// A branch's command word and the pipeline it implies.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct CommandAudit {
+    /// The word's template (`0`, `1`, `C` a channel bit), first bit first.
+    pub template: String,
+    /// Conversions ahead the word applies (0: the one it is sent in).
+    pub ahead: u32,
+    /// Conversions after reset that are prepared, never read as data.
+    pub prepared_conversions: u32,
+}
+
+impl CommandAudit {
+    fn of(mix: &crate::Mix, b: usize) -> Option<CommandAudit> {
+        mix.branches[b].adc.command.as_ref().map(|c| CommandAudit {
+            template: c.template(),
+            ahead: c.ahead,
+            // `Schedule::prepared_conversions`: the part's `ahead`.
+            prepared_conversions: c.ahead,
+        })
+    }
 }
 
 /// Which limit ends a branch's headroom at one rate.
@@ -383,6 +408,9 @@ impl AuditReport {
                     min_slot_cycles: 0,
                     free_mux_inputs: 0,
                     headroom: Vec::new(),
+                    command: mix
+                        .branch_index(&b.name)
+                        .and_then(|i| CommandAudit::of(mix, i)),
                 })
                 .collect(),
             channels: Vec::new(),
@@ -593,6 +621,7 @@ impl BranchAudit {
             min_slot_cycles: s.branches[b].min_slot_cycles,
             free_mux_inputs: free_inputs,
             headroom,
+            command: CommandAudit::of(mix, b),
         }
     }
 }

@@ -2,6 +2,7 @@
 //!
 //! - `mix`: the TOML format and its validation (errors name file, line, field);
 //! - `parts`: ADC and mux models as data, and the SPI timing they imply;
+//! - `command`: the command words sent to converters that take one, and their pipeline;
 //! - `synth`: slot-grid choice and jitter-free placement, or a diagnosis;
 //! - `validate`: an independent proof of a schedule's promises;
 //! - [`lut`]: the slot LUT as a full frame table and in compact form;
@@ -14,6 +15,7 @@
 //! - `audit`: rates, intervals, headroom, settling and Nyquist, as text or JSON.
 
 mod audit;
+mod command;
 mod fixes;
 mod fpga;
 mod hostlink;
@@ -32,12 +34,13 @@ mod validate;
 
 // The mix and its parts.
 pub use mix::{
-    load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError, ModeSelect, Modes,
-    Trigger, When, MAX_BAUD_ERROR_PCT,
+    expand_names, load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError,
+    ModeSelect, Modes, Trigger, When, MAX_BAUD_ERROR_PCT,
 };
-pub use parts::{ns_to_cycles, AdcPart, MuxPart, SpiTiming, Start, TimingError};
+pub use parts::{ns_to_cycles, AdcPart, CmdBit, Command, MuxPart, SpiTiming, Start, TimingError};
 
 // The schedule: synthesis, its independent proof, and what it promises.
+pub use command::CommandSent;
 pub use schedule::{
     seconds, BranchPlan, ChannelSlots, FrameGrid, Placement, SamplingInstant, Schedule,
 };
@@ -51,8 +54,8 @@ pub use switching::{first_instant, pin_latency, trigger_latency, TriggerLatency}
 
 // The audit, and the fixes offered for an infeasible mix.
 pub use audit::{
-    AuditReport, BranchAudit, ChannelAudit, FinerGrid, Headroom, Limit, ModeAudit, ModeBranch,
-    ModeChannel, ModeLink, PartAudit, TriggerAudit,
+    AuditReport, BranchAudit, ChannelAudit, CommandAudit, FinerGrid, Headroom, Limit, ModeAudit,
+    ModeBranch, ModeChannel, ModeLink, PartAudit, TriggerAudit,
 };
 pub use fixes::{
     search as search_fixes, search_link as search_fixes_link,

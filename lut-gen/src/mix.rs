@@ -27,6 +27,7 @@ mod raw;
 mod tests;
 mod words;
 
+pub use bulk::expand_names;
 use check::Cx;
 pub use modes::{ModeSelect, Modes, Trigger, When};
 use raw::RawMix;

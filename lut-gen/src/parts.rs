@@ -2,8 +2,9 @@
 //! generator, the ADC model and the checker all read, and the cycle-level SPI
 //! timing derived from them.
 //!
-//! Sources: the AD7940, AD7685 and TMUX1108 datasheets.  Numbers not
-//! confirmed there stay parameters here rather than constants in logic.
+//! Sources: the AD7940, AD7685, MCP3208, AD7689 and TMUX1108 datasheets.
+//! Numbers not confirmed there stay parameters here rather than constants in
+//! logic.  A part may take a command word on its data input ([`Command`]).
 //! A mix may declare its own parts (`[[adc_part]]`, `crate::mix`); they use
 //! the same two conversion styles ([`Start`]).
 
@@ -77,6 +78,120 @@ pub struct AdcPart {
     pub data_hold_ns: u64,
     /// How many parts may share one port in a daisy chain.
     pub chain_max: u32,
+    /// The command word the part takes on DIN (its own multiplexer's
+    /// channel); `None`: the part only listens.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub command: Option<Command>,
+}
+
+/// One bit of a command word, as its template spells it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum CmdBit {
+    Zero,
+    One,
+    /// Bit `k` of the channel number (0: its LSB).
+    Channel(u8),
+}
+
+/// A command word sent on DIN (the FPGA's `adc_mosi`) while a conversion is
+/// read: one bit per SCLK period from the first, first bit first, held for
+/// the whole period (the part latches DIN on the rising SCLK edge in the
+/// middle of it); bits past the word are 0.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize)]
+pub struct Command {
+    pub bits: Vec<CmdBit>,
+    /// Which conversion the word selects, counted from the one whose read
+    /// carries it: 0 the same (MCP3208: the channel is in the transaction),
+    /// 2 the conversion after next (AD7689's CFG).
+    pub ahead: u32,
+}
+
+impl Command {
+    /// A template: `0`, `1` and `C` (a channel bit, MSB first), `_` as a
+    /// separator.  At least one `C`, at most 32 bits; 3 `C`s give 8 channels.
+    pub fn parse(template: &str, ahead: u32) -> Result<Command, String> {
+        let chars: Vec<char> = template.chars().filter(|&c| c != '_').collect();
+        let width = chars.iter().filter(|&&c| c == 'C' || c == 'c').count();
+        if width == 0 {
+            return Err(format!(
+                "`{template}` has no channel bit: write the channel's bits as C (MSB first)"
+            ));
+        }
+        if width > 4 || chars.len() > 32 {
+            return Err(format!(
+                "`{template}`: at most 32 bits and 4 channel bits (16 channels)"
+            ));
+        }
+        let mut k = width;
+        let mut bits = Vec::new();
+        for c in chars {
+            bits.push(match c {
+                '0' => CmdBit::Zero,
+                '1' => CmdBit::One,
+                'C' | 'c' => {
+                    k -= 1;
+                    CmdBit::Channel(k as u8)
+                }
+                other => {
+                    return Err(format!(
+                        "`{template}`: `{other}` is not a bit (0, 1, C for a channel bit, _)"
+                    ))
+                }
+            });
+        }
+        Ok(Command { bits, ahead })
+    }
+
+    /// The template spelling ([`Command::parse`] of it gives `self`).
+    pub fn template(&self) -> String {
+        self.bits
+            .iter()
+            .map(|b| match b {
+                CmdBit::Zero => '0',
+                CmdBit::One => '1',
+                CmdBit::Channel(_) => 'C',
+            })
+            .collect()
+    }
+
+    /// Channels the word can select: 2 to the number of channel bits.
+    pub fn channels(&self) -> u32 {
+        let w = self
+            .bits
+            .iter()
+            .filter(|b| matches!(b, CmdBit::Channel(_)))
+            .count();
+        1 << w
+    }
+
+    /// The word that selects `channel`, first bit first.
+    pub fn word(&self, channel: u32) -> Vec<bool> {
+        self.bits
+            .iter()
+            .map(|b| match *b {
+                CmdBit::Zero => false,
+                CmdBit::One => true,
+                CmdBit::Channel(k) => channel >> k & 1 == 1,
+            })
+            .collect()
+    }
+
+    /// The channel a received word selects (the inverse of [`Command::word`]
+    /// on the channel bits), or `None` when a fixed bit differs or the word
+    /// is short: the part would not convert a channel the mix asked for.
+    pub fn channel_of(&self, word: &[bool]) -> Option<u32> {
+        let mut ch = 0;
+        for (i, b) in self.bits.iter().enumerate() {
+            let v = *word.get(i)?;
+            match *b {
+                CmdBit::Zero if v => return None,
+                CmdBit::One if !v => return None,
+                CmdBit::Channel(k) => ch |= (v as u32) << k,
+                _ => {}
+            }
+        }
+        Some(ch)
+    }
 }
 
 impl AdcPart {
@@ -97,6 +212,7 @@ impl AdcPart {
             data_access_ns: 120,
             data_hold_ns: 10,
             chain_max: 1,
+            command: None,
         }
     }
 
@@ -121,6 +237,70 @@ impl AdcPart {
             data_access_ns: 35,
             data_hold_ns: 5,
             chain_max: 8,
+            command: None,
+        }
+    }
+
+    /// MCP3208 (Microchip DS21298E), the VDD = 2.7 V column of Table 1-1
+    /// (the conservative one): f_CLK 1 MHz max, 50 ksps; t_SUCS (CS fall to
+    /// the first rising clock) 100 ns, t_CSH (CS disable) 500 ns, t_DO (clock
+    /// fall to data valid) 200 ns; below 10 kHz the sample capacitor droops
+    /// (section 6.2).  Section 5.0 and Figure 6-1 give the word: the start
+    /// bit and SGL/DIFF, then D2 D1 D0 on the first five rising clocks; one
+    /// more clock completes the sample (its hold is about 5.5 SCLK periods
+    /// after CS falls, a fixed offset), the null bit follows and B11..B0 are
+    /// read on rising edges 8..19: eight serial bits before the MSB, one
+    /// clock after the LSB.  SPI mode 1,1: SCLK idles high, the same style as
+    /// the AD7940.
+    pub fn mcp3208() -> AdcPart {
+        AdcPart {
+            name: "mcp3208".into(),
+            bits: 12,
+            start: Start::Cs,
+            leading_bits: 8,
+            trailing_bits: 0,
+            sclk_min_hz: 10_000,
+            sclk_max_hz: 1_000_000,
+            duty_min_pct: 40,
+            max_sps: 50_000,
+            setup_ns: 100,
+            quiet_ns: 500,
+            conversion_ns: 0,
+            data_access_ns: 200,
+            data_hold_ns: 0,
+            chain_max: 1,
+            command: Some(Command::parse("11CCC", 0).expect("a valid template")),
+        }
+    }
+
+    /// AD7689 (Analog Devices AD7682/AD7689 Rev. D), Table 4 (timing):
+    /// t_CONV 2.2 us max, t_CYC 4 us (250 kSPS), t_DSDO 25 ns at VIO 1.8 V
+    /// or more (the slowest column); SCK limited to 12.5 MHz here as for the
+    /// AD7685.  "Digital Interface": the 14-bit CFG is written on the first
+    /// 14 SCK rising edges of the read-back and applies to the conversion
+    /// after next (from power-up the first results are undefined: "two
+    /// dummy conversions are required").  CFG, MSB first: CFG = 1 (write),
+    /// INCC = 111 (unipolar, INx referenced to GND), INx = the channel, BW
+    /// = 1 (full), REF = 001 (internal 4.096 V), SEQ = 00 (no sequencer),
+    /// RB = 1 (no read-back of the CFG).
+    pub fn ad7689() -> AdcPart {
+        AdcPart {
+            name: "ad7689".into(),
+            bits: 16,
+            start: Start::Cnv,
+            leading_bits: 0,
+            trailing_bits: 0,
+            sclk_min_hz: 1,
+            sclk_max_hz: 12_500_000,
+            duty_min_pct: 40,
+            max_sps: 250_000,
+            setup_ns: 10,
+            quiet_ns: 10,
+            conversion_ns: 2_200,
+            data_access_ns: 25,
+            data_hold_ns: 4,
+            chain_max: 1,
+            command: Some(Command::parse("1111_CCC_1_001_00_1", 2).expect("a valid template")),
         }
     }
 
@@ -133,12 +313,14 @@ impl AdcPart {
         match name.to_ascii_lowercase().as_str() {
             "ad7940" => Some(Self::ad7940()),
             "ad7685" => Some(Self::ad7685()),
+            "mcp3208" => Some(Self::mcp3208()),
+            "ad7689" => Some(Self::ad7689()),
             _ => None,
         }
     }
 
     pub fn known() -> Vec<&'static str> {
-        vec!["ad7940", "ad7685"]
+        vec!["ad7940", "ad7685", "mcp3208", "ad7689"]
     }
 }
 
@@ -166,6 +348,24 @@ impl MuxPart {
         select_bits: 0,
     };
 
+    /// The converter's own multiplexer (`mux = "internal"`), chosen by its
+    /// command word: `channels` inputs, no pins of the FPGA's own (no
+    /// `mux_sel`, no `mux_en`).
+    pub fn internal(channels: u32) -> MuxPart {
+        MuxPart {
+            name: "internal",
+            inputs: channels,
+            select_bits: 0,
+        }
+    }
+
+    /// Whether this is the converter's own multiplexer.
+    pub fn is_internal(&self) -> bool {
+        self.name == "internal"
+    }
+
+    /// An external part by name (`internal` depends on the converter: see
+    /// [`MuxPart::internal`]).
     pub fn by_name(name: &str) -> Option<MuxPart> {
         match name.to_ascii_lowercase().as_str() {
             "tmux1108" => Some(Self::TMUX1108),
@@ -175,7 +375,7 @@ impl MuxPart {
     }
 
     pub fn known() -> Vec<&'static str> {
-        vec!["tmux1108", "none"]
+        vec!["tmux1108", "none", "internal"]
     }
 }
 
@@ -377,6 +577,71 @@ mod tests {
         assert_eq!(t.min_period_cycles, 412); // read + quiet: longer than 200 kSPS
                                               // so the chain gives 4 x 48 MHz / 412 samples/s, not 4 x 200 kSPS
         assert_eq!(t.max_samples_hz(48_000_000).floor(), 466_019.0);
+    }
+
+    #[test]
+    fn mcp3208_word_reads_b11_at_rising_edge_8() {
+        let p = AdcPart::mcp3208();
+        let t = SpiTiming::derive(&p, 48_000_000, p.sclk_max_hz, 1).unwrap();
+        assert_eq!(t.sclk_div, 48); // 1 MHz
+        assert_eq!(t.sclks(), 20);
+        // B11 is serial bit 8, read at rising edge 8; B0 at edge 19.
+        let caps: Vec<(u64, u64)> = t.captures().collect();
+        assert_eq!(caps.first().unwrap().1, 1);
+        assert_eq!(caps.last().unwrap().1, 19);
+        let c = p.command.unwrap();
+        assert_eq!(c.ahead, 0);
+        assert_eq!(c.channels(), 8);
+        // Start, single-ended, then D2 D1 D0 = 1 0 1 for channel 5.
+        assert_eq!(c.word(5), vec![true, true, true, false, true]);
+    }
+
+    #[test]
+    fn ad7689_cfg_word() {
+        let c = AdcPart::ad7689().command.unwrap();
+        assert_eq!(c.ahead, 2);
+        assert_eq!(c.bits.len(), 14);
+        assert_eq!(c.template(), "1111CCC1001001");
+        let w: String = c
+            .word(6)
+            .iter()
+            .map(|&b| if b { '1' } else { '0' })
+            .collect();
+        assert_eq!(w, "11111101001001");
+    }
+
+    #[test]
+    fn every_word_reads_back_as_its_channel() {
+        for p in AdcPart::known() {
+            let Some(c) = AdcPart::by_name(p).unwrap().command else {
+                continue;
+            };
+            for ch in 0..c.channels() {
+                assert_eq!(c.channel_of(&c.word(ch)), Some(ch), "{p} {ch}");
+                let mut w = c.word(ch);
+                // Flipping a fixed bit is not a channel; a channel bit is another one.
+                for i in 0..w.len() {
+                    w[i] = !w[i];
+                    let got = c.channel_of(&w);
+                    match c.bits[i] {
+                        CmdBit::Channel(k) => assert_eq!(got, Some(ch ^ (1 << k))),
+                        _ => assert_eq!(got, None),
+                    }
+                    w[i] = !w[i];
+                }
+                assert_eq!(c.channel_of(&w[..w.len() - 1]), None);
+            }
+        }
+    }
+
+    #[test]
+    fn templates_are_checked() {
+        assert!(Command::parse("1100", 0).is_err());
+        assert!(Command::parse("11CCCCC", 0).is_err());
+        assert!(Command::parse("1x CCC", 0).is_err());
+        let c = Command::parse("1_0cc", 1).unwrap();
+        assert_eq!(c.template(), "10CC");
+        assert_eq!(c.word(2), vec![true, false, true, false]);
     }
 
     #[test]

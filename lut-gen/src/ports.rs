@@ -55,6 +55,9 @@ pub enum Role {
     Miso,
     CsN,
     Sclk,
+    /// `adc_mosi`: the command word of a converter that takes one; one bit
+    /// per such branch, absent from a mix without one.
+    Mosi,
     MuxSel,
     MuxEn,
     SampleValid,
@@ -103,12 +106,13 @@ pub struct Port {
 
 /// The ports of `slotforge_top`, in the order of docs/timing.md's port
 /// table (and of the Verilog port list, `ports.json` and the PCF).
-pub const PORTS: [Port; 10] = [
+pub const PORTS: [Port; 11] = [
     port(Role::Clock, "clk", Dir::In, false, "clock"),
     port(Role::Reset, "rst", Dir::In, false, "reset"),
     port(Role::Miso, "adc_miso", Dir::In, true, "miso"),
     port(Role::CsN, "adc_cs_n", Dir::Out, true, "cs_n"),
     port(Role::Sclk, "adc_sclk", Dir::Out, true, "sclk"),
+    port(Role::Mosi, "adc_mosi", Dir::Out, true, "mosi"),
     port(Role::MuxSel, "mux_sel", Dir::Out, true, "mux_sel"),
     port(Role::MuxEn, "mux_en", Dir::Out, true, "mux_en"),
     port(Role::SampleValid, "sample_valid", Dir::Out, false, "valid"),
@@ -123,8 +127,8 @@ pub const PORTS: [Port; 10] = [
 ];
 
 /// The names of [`PORTS`], in the same order.
-pub const PORT_NAMES: [&str; 10] = {
-    let mut n = [""; 10];
+pub const PORT_NAMES: [&str; 11] = {
+    let mut n = [""; 11];
     let mut i = 0;
     while i < PORTS.len() {
         n[i] = PORTS[i].name;
@@ -145,12 +149,13 @@ const fn port(role: Role, name: &'static str, dir: Dir, vector: bool, key: &'sta
 
 impl Role {
     /// Every role, in port order.
-    pub const ALL: [Role; 10] = [
+    pub const ALL: [Role; 11] = [
         Role::Clock,
         Role::Reset,
         Role::Miso,
         Role::CsN,
         Role::Sclk,
+        Role::Mosi,
         Role::MuxSel,
         Role::MuxEn,
         Role::SampleValid,
@@ -173,7 +178,14 @@ impl Role {
     }
 
     /// The roles with one lane per branch, in port order.
-    pub const LANES: [Role; 5] = [Role::Miso, Role::CsN, Role::Sclk, Role::MuxSel, Role::MuxEn];
+    pub const LANES: [Role; 6] = [
+        Role::Miso,
+        Role::CsN,
+        Role::Sclk,
+        Role::Mosi,
+        Role::MuxSel,
+        Role::MuxEn,
+    ];
 }
 
 impl Pins {
@@ -182,6 +194,7 @@ impl Pins {
     pub const LOW: Pins = Pins {
         cs_n: 0,
         sclk: 0,
+        mosi: 0,
         mux_sel: 0,
         mux_en: 0,
         sample_valid: false,
@@ -193,6 +206,8 @@ impl Pins {
         axis_tvalid: false,
         axis_tlast: false,
         axis_tready: false,
+        mode_sel: 0,
+        mode: 0,
     };
 
     /// The value of output port `r` (inputs read as 0); `u128` because
@@ -203,6 +218,7 @@ impl Pins {
             Role::Clock | Role::Reset | Role::Miso => 0,
             Role::CsN => self.cs_n as u128,
             Role::Sclk => self.sclk as u128,
+            Role::Mosi => self.mosi as u128,
             Role::MuxSel => self.mux_sel as u128,
             Role::MuxEn => self.mux_en,
             Role::SampleValid => self.sample_valid as u128,
@@ -222,6 +238,9 @@ impl Pins {
 pub struct Pins {
     pub cs_n: u16,
     pub sclk: u16,
+    /// `adc_mosi`: bit `i` is the `i`-th branch with a command word
+    /// ([`Layout::mosi_lo`]).
+    pub mosi: u16,
     pub mux_sel: u64,
     pub mux_en: u128,
     pub sample_valid: bool,
@@ -237,6 +256,11 @@ pub struct Pins {
     pub axis_tvalid: bool,
     pub axis_tlast: bool,
     pub axis_tready: bool,
+    /// A mix with modes: `mode_sel` (an input, pin select only, recorded so
+    /// the judge sees the request of every cycle) and `mode`, the mode in
+    /// force (docs/timing.md, "Mode switches"); 0 without modes.
+    pub mode_sel: u8,
+    pub mode: u8,
 }
 
 /// A port of the link to the host: present only when the mix has a
@@ -330,6 +354,7 @@ const _: () = {
 pub enum Signal {
     CsN(usize),
     Sclk(usize),
+    Mosi(usize),
     MuxSel(usize),
     MuxEn(usize),
     Miso(usize),
@@ -353,6 +378,7 @@ impl Signal {
         Some(match *self {
             Signal::CsN(_) => Role::CsN,
             Signal::Sclk(_) => Role::Sclk,
+            Signal::Mosi(_) => Role::Mosi,
             Signal::MuxSel(_) => Role::MuxSel,
             Signal::MuxEn(_) => Role::MuxEn,
             Signal::Miso(_) => Role::Miso,
@@ -387,6 +413,7 @@ impl Signal {
         match *self {
             Signal::CsN(b) => (p.cs_n >> b) as u64 & 1,
             Signal::Sclk(b) => (p.sclk >> b) as u64 & 1,
+            Signal::Mosi(b) => layout.mosi(p, b) as u64,
             Signal::Miso(_) => 0,
             Signal::MuxSel(b) => layout.sel(p, b) as u64,
             Signal::MuxEn(b) => layout.en(p, b),
@@ -407,6 +434,7 @@ impl Signal {
         match *self {
             Signal::CsN(b)
             | Signal::Sclk(b)
+            | Signal::Mosi(b)
             | Signal::MuxSel(b)
             | Signal::MuxEn(b)
             | Signal::Miso(b) => Some(b),
@@ -433,6 +461,9 @@ pub struct Layout {
     pub en_n: Vec<u32>,
     /// Total mux devices (width of `mux_en`).
     pub mux_devices: u32,
+    /// The `adc_mosi` bit of each branch whose converter takes a command
+    /// word (`None`: no lane); the bits count up in branch order.
+    pub mosi_lo: Vec<Option<u32>>,
     /// Width of `sample_channel`.
     pub channel_bits: u32,
     /// Width of `sample_value`: the widest part's data bits.
@@ -459,7 +490,7 @@ impl Layout {
     /// When `s` exceeds [`limits`]; callers that take user mixes check
     /// [`Layout::fits`] first.
     pub fn new(s: &Schedule) -> Layout {
-        if let Err(m) = Layout::fits(s) {
+        if let Err(m) = Layout::fits_limits(s) {
             panic!("{m}");
         }
         let nb = s.branches.len();
@@ -497,6 +528,14 @@ impl Layout {
             en_lo,
             en_n,
             mux_devices: acc,
+            mosi_lo: (0..nb)
+                .scan(0u32, |n, b| {
+                    Some(s.has_command(b).then(|| {
+                        *n += 1;
+                        *n - 1
+                    }))
+                })
+                .collect(),
             channel_bits: s.channel_bits(),
             value_bits: s.mix.branches.iter().map(|b| b.adc.bits).max().unwrap_or(1),
             starts: s.mix.branches.iter().map(|b| b.adc.start).collect(),
@@ -524,8 +563,22 @@ impl Layout {
         }
     }
 
-    /// Whether `s` fits the gateware's [`limits`], or which limit it exceeds.
+    /// Whether the gateware and the judge take `s`: it fits [`limits`], and
+    /// no converter takes a command word (the gateware does not drive
+    /// `adc_mosi` yet, nor does the judge model it: issue 30).
     pub fn fits(s: &Schedule) -> Result<(), String> {
+        Layout::fits_limits(s)?;
+        if let Some(b) = (0..s.branches.len()).find(|&b| s.has_command(b)) {
+            return Err(format!(
+                "branch {}: converter `{}` takes a command word on adc_mosi, which the gateware does not drive yet",
+                s.branches[b].name, s.mix.branches[b].adc.name
+            ));
+        }
+        Ok(())
+    }
+
+    /// Whether `s` fits the gateware's [`limits`], or which limit it exceeds.
+    fn fits_limits(s: &Schedule) -> Result<(), String> {
         use limits::*;
         let nb = s.branches.len();
         if nb == 0 || nb > MAX_BRANCHES {
@@ -564,6 +617,7 @@ impl Layout {
         match r {
             Role::Clock | Role::Reset | Role::SampleValid => 1,
             Role::Miso | Role::CsN | Role::Sclk => nb,
+            Role::Mosi => self.mosi_lo.iter().flatten().count() as u32,
             Role::MuxSel => MUX_SELECT_BITS * self.muxed.iter().filter(|&&m| m).count() as u32,
             Role::MuxEn => self.mux_devices,
             Role::SampleChannel => self.channel_bits,
@@ -573,7 +627,7 @@ impl Layout {
 
     /// Width of each port of [`PORTS`], in the same order (0: a port the
     /// top does not have, see [`Layout::has`]).
-    pub fn port_widths(&self) -> [u32; 10] {
+    pub fn port_widths(&self) -> [u32; 11] {
         Role::ALL.map(|r| self.width(r))
     }
 
@@ -594,6 +648,7 @@ impl Layout {
         match r {
             Role::Miso | Role::CsN | Role::Sclk => true,
             Role::MuxSel | Role::MuxEn => self.muxed[b],
+            Role::Mosi => self.mosi_lo[b].is_some(),
             _ => false,
         }
     }
@@ -625,6 +680,10 @@ impl Layout {
         let b32 = b as u32;
         match r {
             Role::Miso | Role::CsN | Role::Sclk => (b32, b32),
+            Role::Mosi => {
+                let i = self.mosi_lo[b].unwrap_or_default();
+                (i, i)
+            }
             Role::MuxSel => (self.sel_lo[b] + MUX_SELECT_BITS - 1, self.sel_lo[b]),
             Role::MuxEn => (self.en_lo[b] + self.en_n[b] - 1, self.en_lo[b]),
             _ => unreachable!(),
@@ -663,6 +722,12 @@ impl Layout {
             }
         }
         v
+    }
+
+    /// Branch `b`'s `adc_mosi` bit (low for a branch without one).
+    #[inline]
+    pub fn mosi(&self, p: &Pins, b: usize) -> bool {
+        self.mosi_lo[b].is_some_and(|i| p.mosi >> i & 1 == 1)
     }
 
     /// Branch `b`'s select (0 for a branch without a mux).
@@ -721,6 +786,9 @@ impl Layout {
         for b in 0..self.branches {
             v.push(Signal::CsN(b));
             v.push(Signal::Sclk(b));
+            if self.mosi_lo[b].is_some() {
+                v.push(Signal::Mosi(b));
+            }
             if self.muxed[b] {
                 v.push(Signal::MuxSel(b));
                 v.push(Signal::MuxEn(b));
@@ -773,6 +841,11 @@ pub fn manifest(s: &Schedule) -> String {
                 o.insert("adc".into(), json!(s.mix.branches[b].adc.name));
                 o.insert("chain".into(), json!(s.mix.branches[b].chain));
                 o.insert("conversion_cycles".into(), json!(bp.spi.conv_cycles));
+            }
+            if let Some(c) = &s.mix.branches[b].adc.command {
+                o.insert("adc".into(), json!(s.mix.branches[b].adc.name));
+                o.insert("command".into(), json!(c.template()));
+                o.insert("command_ahead".into(), json!(c.ahead));
             }
             o.insert("sclk_div".into(), json!(bp.spi.sclk_div));
             o.insert("setup_cycles".into(), json!(bp.spi.setup_cycles));
@@ -893,6 +966,52 @@ mod tests {
         let (hi, lo) = l.lane_bits(Role::MuxEn, l.branches - 1);
         assert_eq!(hi + 1, l.mux_devices);
         assert!(lo <= hi);
+    }
+
+    /// A mix with a listening branch between two converters that take a
+    /// command word: `adc_mosi` has one bit per commanded branch, in branch
+    /// order, and `ports.json` names each one's lane and word.
+    #[test]
+    fn commanded_branches_have_a_mosi_lane() {
+        let text = "name = \"cmd\"\n[clock]\nhz = 48000000\n[frame]\nperiod_us = 1000\n\
+                    slice_us = 1000\n\
+                    [[branch]]\nname = \"m\"\nadc = \"mcp3208\"\nmux = \"internal\"\n\
+                    [[branch]]\nname = \"l\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n\
+                    [[branch]]\nname = \"a\"\nadc = \"ad7689\"\nmux = \"internal\"\n\
+                    [[channel]]\nname = \"x\"\nbranch = \"m\"\nrate_hz = 1000\ninput = 3\n\
+                    [[channel]]\nname = \"y\"\nbranch = \"l\"\nrate_hz = 1000\n\
+                    [[channel]]\nname = \"z\"\nbranch = \"a\"\nrate_hz = 2000\ninput = 5\n";
+        let m = crate::mix::parse(std::path::Path::new("cmd.toml"), text).unwrap();
+        let s = crate::synthesize(&m).unwrap();
+        assert!(Layout::fits(&s).unwrap_err().contains("adc_mosi"));
+        let l = Layout::new(&s);
+        assert_eq!(l.mosi_lo, vec![Some(0), None, Some(1)]);
+        assert_eq!(l.width(Role::Mosi), 2);
+        assert_eq!(l.lane(Role::Mosi, 2), "adc_mosi[1]");
+        assert_eq!(l.muxed, vec![false, true, false]);
+        let total: u32 = l.port_widths().iter().sum();
+        assert_eq!(l.bits().len() as u32, total);
+        let p = Pins {
+            mosi: 0b10,
+            ..Pins::default()
+        };
+        assert!(!l.mosi(&p, 0) && !l.mosi(&p, 1) && l.mosi(&p, 2));
+        assert_eq!(Signal::Mosi(2).get(&l, &p), 1);
+        assert!(!l.signals().contains(&Signal::Mosi(1)));
+        let j: serde_json::Value = serde_json::from_str(&manifest(&s)).unwrap();
+        assert_eq!(j["branches"][0]["mosi"], "adc_mosi[0]");
+        assert_eq!(j["branches"][2]["command"], "1111CCC1001001");
+        assert_eq!(j["branches"][2]["command_ahead"], 2);
+        assert!(j["branches"][1].get("mosi").is_none());
+        // A mix without a commanded converter has no `adc_mosi` at all.
+        let plain = crate::mix::parse(
+            std::path::Path::new("cnvmix.toml"),
+            include_str!("../../hdl/tests/data/cnvmix.toml"),
+        )
+        .unwrap();
+        let l = Layout::new(&crate::synthesize(&plain).unwrap());
+        assert!(!l.has(Role::Mosi));
+        assert!(l.ports().all(|p| p.role != Role::Mosi));
     }
 
     /// cnvmix: branch 1 (`lone`, `mux = "none"`) between two branches with a

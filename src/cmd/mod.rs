@@ -152,12 +152,19 @@ pub enum Limits {
 /// checks or proves starts with.  On failure the message is printed and
 /// the exit code returned.
 pub fn load_checked(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
+    let s = load_any_modes(path, limits)?;
+    one_mode(&s, path)?;
+    Ok(s)
+}
+
+/// [`load_checked`] for what follows mode switches without gateware (`sim
+/// --backend model`): a mix with modes is not refused.
+pub fn load_any_modes(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
     let s = match limits {
         Limits::Contract => schedule_on_pins(path)?,
         Limits::Emitter => schedule(path)?,
     };
     link_fits(&s, path)?;
-    one_mode(&s, path)?;
     Ok(s)
 }
 
@@ -170,9 +177,9 @@ pub fn one_mode(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
         Some(m) if m.names.len() > 1 => {
             eprintln!(
                 "error: {}: the mix declares {} modes ({}): `audit` and `lut` plan every \
-                 mode, but the gateware does not switch modes yet, so this command would \
-                 show the reset mode `{}` alone; audit it, or remove the [[mode]] tables \
-                 to build one mode",
+                 mode and `sim --backend model` follows the switches, but the gateware does \
+                 not switch modes yet, so this command would show the reset mode `{}` alone; \
+                 audit it, simulate its model, or remove the [[mode]] tables to build one mode",
                 file.display(),
                 m.names.len(),
                 m.names.join(", "),

@@ -42,7 +42,11 @@ pub struct Args {
     /// ADC input: pattern (unique code per channel and slot), sine (a
     /// channel-specific frequency below its Nyquist limit), sine:HZ (every
     /// channel at HZ, e.g. sine:600 or sine:1.5e3; above Nyquist it aliases),
-    /// step or chirp.
+    /// step or chirp; or a scene of contact: touch:NAMES@FROM-TO presses the
+    /// named channels (names or bulk patterns, comma-separated; codes 1/32
+    /// below full scale) in frames FROM to TO (exclusive), low (1/64 of full
+    /// scale) elsewhere; stroke:NAMES@FROM-TO presses them one after the
+    /// other, each for an equal share of the interval.
     #[arg(long, default_value = "pattern")]
     pub stimulus: String,
     /// Write every sample as CSV: `cycle,sampled_s,channel,value` (cycle:
@@ -82,6 +86,92 @@ pub struct Args {
     /// `ready_within`-th cycle, the case the FIFO depth is computed for).
     #[arg(long, default_value = "always", value_parser = parse_tready)]
     pub tready: link::ReadyPattern,
+    /// A mix with pin-selected modes: drive `mode_sel` with FRAME=MODE
+    /// requests, comma-separated (MODE a name or a number; e.g.
+    /// `--modes 3=touch,9=rest`): from the first cycle of frame FRAME on the
+    /// pin shows MODE, which by the contract runs from frame FRAME + 2.
+    /// Before the first request the pin shows 0.  --backend model only (the
+    /// gateware does not switch modes yet).
+    #[arg(long, value_name = "FRAME=MODE,...")]
+    pub modes: Option<String>,
+}
+
+/// What is refused before the mix is read: a stimulus that names no
+/// channel and is not one, no frames.
+fn early_checks(a: &Args) -> Result<(), String> {
+    // a scene names channels: it is read once the mix is loaded
+    let scene = ["touch:", "stroke:"]
+        .iter()
+        .any(|p| a.stimulus.starts_with(p));
+    if !scene {
+        a.stimulus.parse::<Stimulus>()?;
+    }
+    if a.frames == 0 {
+        return Err("--frames must be at least 1".into());
+    }
+    Ok(())
+}
+
+/// `--stimulus` (a scene names the mix's channels) and `--modes`.
+fn scene_and_modes(a: &Args, s: &lut_gen::Schedule) -> Result<(Stimulus, Vec<(u64, u8)>), String> {
+    if s.modes.len() > 1 {
+        // The VCD writer and the link's packets do not carry the mode yet.
+        let file = match (&a.vcd, &a.link_bytes) {
+            (Some(_), _) => Some("--vcd"),
+            (_, Some(_)) => Some("--link-bytes"),
+            _ => None,
+        };
+        if let Some(opt) = file {
+            return Err(format!(
+                "{opt}: mix `{}` switches modes, and this file would not carry the mode ports \
+                 (mode_sel, mode) nor the mode in the link's packets yet; --samples writes \
+                 the run's samples",
+                s.mix.name
+            ));
+        }
+    }
+    let stimulus = Stimulus::parse_for(&a.stimulus, s)?;
+    let modes = a.modes.as_deref().map(|t| parse_modes(t, s)).transpose()?;
+    Ok((stimulus, modes.unwrap_or_default()))
+}
+
+/// `--modes FRAME=MODE,...` against the mix's modes.
+fn parse_modes(text: &str, s: &lut_gen::Schedule) -> Result<Vec<(u64, u8)>, String> {
+    let plan = match s.mode_plan() {
+        Some(p) if p.select == lut_gen::ModeSelect::Pin => p,
+        Some(_) => {
+            return Err(format!(
+                "--modes {text}: mix `{}` chooses its modes by triggers (select = \"auto\"), not by the mode_sel pin",
+                s.mix.name
+            ))
+        }
+        None => return Err(format!("--modes {text}: mix `{}` has no [[mode]] tables", s.mix.name)),
+    };
+    text.split(',')
+        .map(|item| {
+            let (f, m) = item.trim().split_once('=').ok_or_else(|| {
+                format!(
+                    "--modes: `{item}` is not FRAME=MODE (e.g. 3={})",
+                    plan.names[plan.names.len() - 1]
+                )
+            })?;
+            let frame: u64 = f
+                .trim()
+                .parse()
+                .map_err(|_| format!("--modes: `{item}`: `{f}` is not a frame number"))?;
+            let m = m.trim();
+            let mode = plan
+                .index(m)
+                .or_else(|| m.parse::<usize>().ok().filter(|&n| n < plan.names.len()))
+                .ok_or_else(|| {
+                    format!(
+                        "--modes: `{item}`: no mode `{m}` (the mix's modes: {})",
+                        plan.names.join(", ")
+                    )
+                })?;
+            Ok((frame, mode as u8))
+        })
+        .collect()
 }
 
 fn parse_tready(s: &str) -> Result<link::ReadyPattern, String> {
@@ -135,28 +225,27 @@ fn to_fst(
 
 pub fn run(a: Args) -> u8 {
     let backend = a.backend;
-    let stimulus: Stimulus = match a.stimulus.parse() {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
-    };
-    if a.frames == 0 {
-        eprintln!("error: --frames must be at least 1");
+    if let Err(e) = early_checks(&a) {
+        eprintln!("error: {e}");
         return 2;
     }
-    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
+    // The model follows mode switches; the gateware does not yet.
+    let load = match backend {
+        Backend::Model => super::load_any_modes,
+        _ => super::load_checked,
+    };
+    let s = match load(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    let prepared = window(&a, &s).and_then(|(from, to)| {
+    let prepared = scene_and_modes(&a, &s).and_then(|(k, modes)| {
+        let (from, to) = window(&a, &s)?;
         let (vcd, fst) = waveform_paths(&a)?;
         samples_path_free(&a)?;
         link_bytes_path_free(&a, &s)?;
-        Ok((from, to, vcd, fst))
+        Ok((k, modes, from, to, vcd, fst))
     });
-    let (from, to, vcd, fst) = match prepared {
+    let (stimulus, modes, from, to, vcd, fst) = match prepared {
         Ok(p) => p,
         Err(e) => {
             eprintln!("error: {e}");
@@ -183,6 +272,7 @@ pub fn run(a: Args) -> u8 {
             .map(|(d, _)| d.path().join(measure::NETLIST_SIM_FILE))
             .or_else(|| a.rtl.clone()),
         tready: a.tready,
+        modes,
         ..SimOptions::default()
     };
     let mut logs = Logs {

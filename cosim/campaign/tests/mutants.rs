@@ -357,15 +357,13 @@ fn a_few_mutants_run_through_the_campaign_on_icarus() {
         .iter()
         .find(|k| k.name == FaultClass::Mutant("stuck".into()))
         .expect("the stuck output's class");
-    // measured: #0 changes a pin, #1 (a constant already all ones) is
-    // proved equivalent by the miter, not dropped
+    // measured: both change a pin (since the core's `slot_tick` port moved
+    // the evenly spaced picks, neither is the constant already all ones
+    // that the miter proved equivalent; the long test's six stuck outputs
+    // still reach the equivalence check)
     assert_eq!(stuck.injected, 2, "{stuck:?}");
-    assert_eq!(stuck.detected_by[&Detector::Model], 1, "{stuck:?}");
-    assert_eq!(stuck.proved_equivalent.len(), 1, "{stuck:?}");
-    assert!(matches!(
-        stuck.proved_equivalent[0].equivalence,
-        Some(campaign::Equivalence::Proved { .. })
-    ));
+    assert_eq!(stuck.detected_by[&Detector::Model], 2, "{stuck:?}");
+    assert!(stuck.proved_equivalent.is_empty(), "{stuck:?}");
     assert!(c.column(Detector::Prove).unwrap().not_run.is_some());
 }
 

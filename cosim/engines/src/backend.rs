@@ -22,6 +22,9 @@ pub fn run(
 ) -> Result<Verdict, SimError> {
     no_rtl_in_process(backend, opts)?;
     match backend {
+        // The slot-level model has one frame template: a mix that switches
+        // modes runs the cycle-level model, which follows the switches.
+        Backend::Model if s.modes.len() > 1 => run_traced(s, backend, frames, opts, None),
         Backend::Model => {
             if let Some(v) = &opts.vcd {
                 // The slot-level model has no pins: the cycle model draws the window.
@@ -168,6 +171,7 @@ fn in_process(
         trace.map(|t| &mut *t as &mut dyn Observer),
     );
     let obs = (tee.0.is_some() || tee.1.is_some()).then_some(&mut tee as &mut dyn Observer);
+    let dut = judge::ModeRequests::new(s, dut, &opts.modes);
     let mut dut = judge::with_slave(s, dut, opts.tready);
     let report = run_dut(s, &mut *dut, frames, &ro, source, obs);
     if let Some(w) = writer {

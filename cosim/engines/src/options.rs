@@ -90,6 +90,9 @@ pub struct SimOptions {
     /// How the AXI4-Stream slave drives `m_axis_tready` (a mix with an
     /// `axis` link only).
     pub tready: link::ReadyPattern,
+    /// A mix with pin-selected modes: `mode_sel` requests `(frame, mode)`,
+    /// each shown from the first cycle of its frame on (`sim --modes`).
+    pub modes: Vec<(u64, u8)>,
 }
 
 impl Default for SimOptions {
@@ -101,6 +104,7 @@ impl Default for SimOptions {
             reset_cycles: 4,
             rtl: None,
             tready: link::ReadyPattern::Always,
+            modes: Vec::new(),
         }
     }
 }

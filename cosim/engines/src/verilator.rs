@@ -554,6 +554,8 @@ impl Dut for VerilatedDut {
         Pins {
             cs_n: self.out.cs_n,
             sclk: self.out.sclk,
+            // no mix the gateware takes has `adc_mosi` yet (`Layout::fits`)
+            mosi: 0,
             mux_sel: self.out.mux_sel,
             mux_en: self.out.mux_en[0] as u128 | (self.out.mux_en[1] as u128) << 64,
             sample_valid: self.out.sample_valid != 0,
@@ -565,6 +567,9 @@ impl Dut for VerilatedDut {
             axis_tvalid: self.out.axis_tvalid != 0,
             axis_tlast: self.out.axis_tlast != 0,
             axis_tready: false,
+            // the emitted gateware has no mode ports yet (one_mode refuses it)
+            mode_sel: 0,
+            mode: 0,
         }
     }
 

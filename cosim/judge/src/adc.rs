@@ -9,6 +9,13 @@
 //!   falling edge; after the last word the first part's SDI (tied low)
 //!   follows, so the line reads 0.
 //!
+//! - parts with a command word (MCP3208, AD7689): the part latches DIN
+//!   (`adc_mosi`) on each rising SCLK edge of the read; the word selects the
+//!   input of the same conversion (`ahead` 0: the part samples once the word
+//!   is in, before its first data bit) or of the conversion `ahead` later (a
+//!   pipeline; the first `ahead` conversions after reset, and any conversion
+//!   whose word was malformed, convert an input no channel is on).
+//!
 //! Datasheet edges (the AD7940's): bit 0 is driven after CS
 //! falls, bit `i` after SCLK falling edge `i`, the line is invalid from 10 ns
 //! (t7, hold) to 80..120 ns (t4, access) after each falling edge and high-Z
@@ -37,6 +44,108 @@ pub enum Stimulus {
     Step,
     /// A linear chirp per channel from 0 to its Nyquist frequency over each frame.
     Chirp,
+    /// Contact on named channels (`touch:` / `stroke:`, [`Scene`]); built
+    /// with [`Stimulus::parse_for`], which needs the mix's channel names.
+    Scene(&'static Scene),
+}
+
+/// A scene of contact: the named channels are pressed (codes near full
+/// scale) inside frames `[from, to)` and low outside; a stroke presses them
+/// one after the other, each for an equal share of the interval (seed 003's
+/// Figure 11: a finger sliding over a row of taxels).  Every other channel
+/// stays low.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Scene {
+    pub stroke: bool,
+    /// Channel indices, in the order given.
+    pub channels: Vec<usize>,
+    pub from: u64,
+    pub to: u64,
+}
+
+impl Scene {
+    /// Whether channel `id` is pressed in `cycle` (frames of `frame_cycles`).
+    fn pressed(&self, id: usize, cycle: u64, frame_cycles: u64) -> bool {
+        let (a, b) = (self.from * frame_cycles, self.to * frame_cycles);
+        if cycle < a || cycle >= b {
+            return false;
+        }
+        let Some(k) = self.channels.iter().position(|&c| c == id) else {
+            return false;
+        };
+        if !self.stroke {
+            return true;
+        }
+        let n = self.channels.len() as u64;
+        let share = (cycle - a) * n / (b - a);
+        share == k as u64
+    }
+
+    /// The `bits`-bit code of channel `id` in `cycle`: pressed, 1/32 below
+    /// full scale; else 1/64 of it (a few codes apart per channel).
+    fn code(&self, id: u64, cycle: u64, frame_cycles: u64, bits: u32) -> u16 {
+        let full = (1u32 << bits) - 1;
+        let v = if self.pressed(id as usize, cycle, frame_cycles) {
+            full - full / 32 - (id % 8) as u32
+        } else {
+            full / 64 + (id % 8) as u32
+        };
+        v as u16
+    }
+}
+
+impl Stimulus {
+    /// A stimulus as the command line writes it, with `touch:NAMES@FROM-TO`
+    /// and `stroke:NAMES@FROM-TO` (NAMES: channel names or bulk patterns,
+    /// comma-separated; FROM-TO: frames, TO exclusive) resolved against the
+    /// mix.  The scene lives as long as the program: a stimulus is `Copy`.
+    pub fn parse_for(text: &str, s: &Schedule) -> Result<Stimulus, String> {
+        let (stroke, rest) = match (text.strip_prefix("touch:"), text.strip_prefix("stroke:")) {
+            (Some(r), _) => (false, r),
+            (_, Some(r)) => (true, r),
+            _ => return text.parse(),
+        };
+        let (names, span) = rest.rsplit_once('@').ok_or_else(|| {
+            format!("stimulus `{text}`: NAMES@FROM-TO expected (e.g. touch:T0,T1@4-12, frames)")
+        })?;
+        let (a, b) = span
+            .split_once('-')
+            .and_then(|(a, b)| Some((a.trim().parse::<u64>().ok()?, b.trim().parse::<u64>().ok()?)))
+            .filter(|(a, b)| a < b)
+            .ok_or_else(|| {
+                format!(
+                    "stimulus `{text}`: `{span}` is not FROM-TO, two frame numbers with FROM < TO"
+                )
+            })?;
+        let mut channels = Vec::new();
+        for written in names.split(',').map(str::trim) {
+            for name in
+                lut_gen::expand_names(written).map_err(|e| format!("stimulus `{text}`: {e}"))?
+            {
+                let c = s
+                    .mix
+                    .channels
+                    .iter()
+                    .position(|c| c.name == name)
+                    .ok_or_else(|| {
+                        format!(
+                            "stimulus `{text}`: mix `{}` has no channel named `{name}`",
+                            s.mix.name
+                        )
+                    })?;
+                if !channels.contains(&c) {
+                    channels.push(c);
+                }
+            }
+        }
+        let scene = Scene {
+            stroke,
+            channels,
+            from: a,
+            to: b,
+        };
+        Ok(Stimulus::Scene(Box::leak(Box::new(scene))))
+    }
 }
 
 impl std::str::FromStr for Stimulus {
@@ -61,7 +170,7 @@ impl std::str::FromStr for Stimulus {
             "step" => Ok(Stimulus::Step),
             "chirp" => Ok(Stimulus::Chirp),
             _ => Err(format!(
-                "unknown stimulus `{s}` (pattern, sine, sine:HZ, step, chirp)"
+                "unknown stimulus `{s}` (pattern, sine, sine:HZ, step, chirp, touch:NAMES@FROM-TO, stroke:NAMES@FROM-TO)"
             )),
         }
     }
@@ -112,11 +221,16 @@ impl Analog {
     /// `cycle` (the 14-bit [`Analog::code`] for 14 bits).
     #[inline]
     pub fn code_bits(&self, id: u64, cycle: u64, bits: u32) -> u16 {
+        if let Stimulus::Scene(sc) = self.kind {
+            if id < self.channels {
+                return sc.code(id, cycle, self.frame_cycles, bits);
+            }
+        }
         if bits == 14 {
             return self.code(id, cycle);
         }
         let mask = ((1u32 << bits) - 1) as u16;
-        if self.kind == Stimulus::Pattern || id >= self.channels {
+        if matches!(self.kind, Stimulus::Pattern | Stimulus::Scene(_)) || id >= self.channels {
             let n = (cycle / self.slot_cycles) * (self.channels + 64) + id;
             return (n.wrapping_mul(0x2F5B).wrapping_add(0x1A5) as u16) & mask;
         }
@@ -133,7 +247,10 @@ impl Analog {
     /// `id < channels` is a channel; larger ids are unconnected inputs.
     #[inline]
     pub fn code(&self, id: u64, cycle: u64) -> u16 {
-        if self.kind == Stimulus::Pattern || id >= self.channels {
+        if let (Stimulus::Scene(sc), true) = (self.kind, id < self.channels) {
+            return sc.code(id, cycle, self.frame_cycles, 14);
+        }
+        if matches!(self.kind, Stimulus::Pattern | Stimulus::Scene(_)) || id >= self.channels {
             let n = (cycle / self.slot_cycles) * (self.channels + 64) + id;
             return ((n.wrapping_mul(0x2F5B) + 0x1A5) & 0x3fff) as u16;
         }
@@ -153,7 +270,7 @@ impl Analog {
                 let span = self.frame_cycles as f64 / self.clock_hz;
                 (PI * self.freq[i] / span * tf * tf).sin()
             }
-            Stimulus::Pattern => unreachable!(),
+            Stimulus::Pattern | Stimulus::Scene(_) => unreachable!(),
         };
         (8192.0 + 8000.0 * x).round().clamp(0.0, 16383.0) as u16
     }
@@ -174,12 +291,20 @@ impl Analog {
     }
 }
 
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 struct AdcState {
     /// The serial stream of the conversion, first bit in the top of `len` bits.
     stream: u128,
     len: u32,
     falls: u32,
+    /// DIN bits latched in this read (first in the top) and their count.
+    din: u64,
+    nin: u32,
+    /// Parts with a command word `ahead` > 0: the input each coming
+    /// conversion converts (`None`: no word of ours selected it).
+    queue: std::collections::VecDeque<Option<u32>>,
+    /// The cycle of this conversion's start.
+    t: u64,
 }
 
 /// One branch's part(s), as the model needs them.
@@ -192,6 +317,9 @@ struct PartModel {
     /// Per lead channel: the channel of each chain member.
     groups: Vec<Vec<Option<usize>>>,
     chain: u32,
+    command: Option<lut_gen::Command>,
+    /// Input of the converter's own multiplexer -> channel on this branch.
+    inputs: Vec<Option<u16>>,
 }
 
 /// The ADCs of all branches, at cycle level.
@@ -223,6 +351,24 @@ impl Adc {
                 word_sclks: b.adc.word_sclks(),
                 groups: s.groups.clone(),
                 chain: b.chain,
+                command: b.adc.command.clone(),
+                inputs: Vec::new(),
+            })
+            .collect();
+        let mut parts = parts;
+        let layout = Layout::new(s);
+        for (b, pm) in parts.iter_mut().enumerate() {
+            pm.inputs = layout.lookup[b].clone();
+        }
+        let st: Vec<AdcState> = parts
+            .iter()
+            .map(|pm| AdcState {
+                queue: std::iter::repeat_n(
+                    None,
+                    pm.command.as_ref().map_or(0, |c| c.ahead) as usize,
+                )
+                .collect(),
+                ..AdcState::default()
             })
             .collect();
         let flip = parts
@@ -232,8 +378,8 @@ impl Adc {
             .fold(0u16, |a, (b, _)| a | 1 << b);
         Adc {
             analog: Analog::new(s, kind),
-            layout: Layout::new(s),
-            st: vec![AdcState::default(); nb],
+            layout,
+            st,
             parts,
             flip,
             prev_cs: all,
@@ -256,12 +402,21 @@ impl Adc {
         let fell_sclk =
             (self.prev_sclk & !sclk & !self.flip) | (!self.prev_sclk & sclk & self.flip);
         let fell_sclk = fell_sclk & !cs_n;
+        // DIN is latched on the real SCLK's rising edges while selected.
+        let real_prev = self.prev_sclk ^ self.flip;
+        let rose_real = !real_prev & p.sclk & !cs_n;
+        let rose_cs = !self.prev_cs & cs_n;
         let mut miso = 0u64;
         for b in 0..self.st.len() {
             let bit = 1u16 << b;
             let pm = &self.parts[b];
             let st = &mut self.st[b];
-            if fell_cs & bit != 0 {
+            if rose_cs & bit != 0 {
+                Self::end_of_read(pm, st);
+            }
+            if fell_cs & bit != 0 && pm.command.is_some() {
+                Self::start_commanded(&self.analog, pm, st, cycle, b);
+            } else if fell_cs & bit != 0 {
                 let id = self.analog.input_id(&self.layout, p, b);
                 st.stream = 0;
                 st.len = 0;
@@ -280,6 +435,9 @@ impl Adc {
                     st.stream = (st.stream << pm.word_sclks) | (code << trailing);
                     st.len += pm.word_sclks;
                 }
+            }
+            if rose_real & bit != 0 && pm.command.is_some() {
+                Self::latch(&self.analog, pm, st, self.layout.mosi(p, b), b);
             }
             if fell_sclk & bit != 0 {
                 st.falls = st.falls.saturating_add(1);
@@ -303,5 +461,67 @@ impl Adc {
         self.prev_sclk = sclk;
         self.miso = miso;
         miso
+    }
+
+    /// An id no channel has: the converter's input when no word of ours
+    /// selected one (branch `b`).
+    fn unselected(analog: &Analog, b: usize) -> u64 {
+        analog.channels + 1 + b as u64
+    }
+
+    /// The code stream of a single part converting `id` at `t`.
+    fn fill(analog: &Analog, pm: &PartModel, st: &mut AdcState, id: u64) {
+        let code = analog.code_bits(id, st.t, pm.bits) as u128;
+        let trailing = pm.word_sclks - pm.leading - pm.bits;
+        st.stream = code << trailing;
+    }
+
+    /// The id of the channel on input `input` of the part's multiplexer.
+    fn id_of(analog: &Analog, pm: &PartModel, input: Option<u32>, b: usize) -> u64 {
+        input
+            .and_then(|i| pm.inputs.get(i as usize).copied().flatten())
+            .map_or(Self::unselected(analog, b), |c| c as u64)
+    }
+
+    /// A conversion of a part with a command word starts at `cycle`.
+    fn start_commanded(analog: &Analog, pm: &PartModel, st: &mut AdcState, cycle: u64, b: usize) {
+        st.t = cycle;
+        st.len = pm.word_sclks;
+        st.falls = 0;
+        st.din = 0;
+        st.nin = 0;
+        st.stream = 0;
+        if pm.command.as_ref().is_some_and(|c| c.ahead > 0) {
+            let input = st.queue.pop_front().flatten();
+            Self::fill(analog, pm, st, Self::id_of(analog, pm, input, b));
+        }
+    }
+
+    /// DIN bit `v` latched; with `ahead` 0 the last bit of the word selects
+    /// the input this conversion samples.
+    fn latch(analog: &Analog, pm: &PartModel, st: &mut AdcState, v: bool, b: usize) {
+        let Some(cmd) = &pm.command else { return };
+        st.din = (st.din << 1) | v as u64;
+        st.nin += 1;
+        if cmd.ahead == 0 && st.nin as usize == cmd.bits.len() {
+            let input = cmd.channel_of(&Self::word(st));
+            Self::fill(analog, pm, st, Self::id_of(analog, pm, input, b));
+        }
+    }
+
+    /// The DIN bits latched so far, first first.
+    fn word(st: &AdcState) -> Vec<bool> {
+        (0..st.nin).rev().map(|i| st.din >> i & 1 == 1).collect()
+    }
+
+    /// The read ends: a pipelined part takes the word for a later conversion.
+    fn end_of_read(pm: &PartModel, st: &mut AdcState) {
+        if let Some(cmd) = pm.command.as_ref().filter(|c| c.ahead > 0) {
+            let w = Self::word(st);
+            st.queue.push_back(cmd.channel_of(&w));
+            while st.queue.len() > cmd.ahead as usize {
+                st.queue.pop_front();
+            }
+        }
     }
 }

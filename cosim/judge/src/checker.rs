@@ -132,13 +132,14 @@ fn same(a: &Pins, b: &Pins) -> bool {
         | (((a.sclk ^ b.sclk) as u128) << 80)
         | (((a.sample_channel ^ b.sample_channel) as u128) << 96)
         | (((a.sample_value ^ b.sample_value) as u128) << 112);
+    let modes = (a.mode ^ b.mode) | (a.mode_sel ^ b.mode_sel);
     let flags = (a.sample_valid ^ b.sample_valid)
         | (a.link_tx ^ b.link_tx)
         | (a.link_overflow ^ b.link_overflow)
         | (a.axis_tvalid ^ b.axis_tvalid)
         | (a.axis_tlast ^ b.axis_tlast)
         | (a.axis_tready ^ b.axis_tready);
-    words == 0 && (a.axis_tdata ^ b.axis_tdata) == 0 && !flags
+    words == 0 && (a.axis_tdata ^ b.axis_tdata) | modes == 0 && !flags
 }
 const CONTEXT_AFTER: u8 = 2;
 
@@ -178,6 +179,8 @@ pub struct Checker {
     divergence_count: u64,
     divergences: Vec<Divergence>,
     div_active: bool,
+    /// The `mode` output differed from the model's in the last cycle.
+    mode_diverging: bool,
     xz_seen: bool,
     rst_x_seen: bool,
     /// The model cycle checking began at (0: at reset; later: joined mid-stream).
@@ -271,6 +274,7 @@ impl Checker {
             divergence_count: 0,
             divergences: Vec::new(),
             div_active: false,
+            mode_diverging: false,
             xz_seen: false,
             rst_x_seen: false,
             origin: 0,
@@ -449,8 +453,9 @@ impl Checker {
         let c = self.c;
         let mut expected = None;
         if let Some(m) = &mut self.model {
-            // tready is the slave's: the model takes it from the pins
+            // tready and mode_sel are inputs: the model takes them from the pins
             m.set_tready(p.axis_tready);
+            m.set_mode_sel(p.mode_sel);
             if let Some(j) = &mut self.link_join {
                 if let Some((tx, joined)) = j.cycle(c, p, m.pins()) {
                     m.set_tx(tx);
@@ -459,8 +464,9 @@ impl Checker {
                 }
             }
             let e = *m.pins();
-            if !same(&e, p) || !same(xz, &NO_XZ) || self.div_active {
+            if !same(&e, p) || !same(xz, &NO_XZ) || self.div_active || self.mode_diverging {
                 self.compare(c, &e, p, xz);
+                self.compare_mode(c, &e, p);
             }
             expected = Some(e);
             self.model.as_mut().unwrap().step(miso);
@@ -477,6 +483,7 @@ impl Checker {
         if let Some(l) = &mut self.line {
             l.cycle(c, p, &mut self.inv);
         }
+        self.inv.mode_cycle(c, p.mode_sel, p.mode);
         if !same(p, &self.prev) || p.sample_valid || !same(xz, &NO_XZ) {
             self.edges(c, p, xz);
         }
@@ -590,6 +597,33 @@ impl Checker {
             self.divergence_count += 1;
         }
         self.div_active = any;
+    }
+
+    /// The `mode` output against the model's (not a [`Signal`]: a mix
+    /// with modes only), once per run of cycles it differs in.
+    fn compare_mode(&mut self, c: u64, e: &Pins, p: &Pins) {
+        let bad = e.mode != p.mode;
+        if bad && !self.mode_diverging && !crate::switch::disabled("model") {
+            self.divergence_count += 1;
+            if self.divergences.len() < self.opts.max_records {
+                let (cycle, frame, slot) = self.inv.place(c);
+                self.divergences.push(Divergence {
+                    cycle,
+                    frame,
+                    slot,
+                    signal: "mode".into(),
+                    expected: json!(e.mode),
+                    actual: json!(p.mode),
+                    branch: None,
+                    channel: None,
+                    context: vec![format!(
+                        "mode_sel={} mode={} | expected mode={}",
+                        p.mode_sel, p.mode, e.mode
+                    )],
+                });
+            }
+        }
+        self.mode_diverging = bad;
     }
 
     fn add_context(&mut self, c: u64, p: &Pins, e: Option<Pins>) {

@@ -9,6 +9,7 @@ use lut_gen::Role;
 use lut_gen::{FrameGrid, Schedule};
 use serde_json::json;
 
+use crate::modecheck::ModeCheck;
 use crate::rule::Rule;
 use crate::verdict::{ChannelStats, Verdict, Violation};
 
@@ -84,11 +85,26 @@ pub struct Invariants {
     conversions: u64,
     /// The model cycle the check began at (0: at reset).
     origin: u64,
+    /// A mix with switches: per mode, each channel's samples per frame and
+    /// interval (0: not sampled), the mode rules, and the mode whose
+    /// intervals hold now.
+    spf_m: Vec<Vec<u64>>,
+    interval_m: Vec<Vec<u64>>,
+    mc: Option<Box<ModeCheck>>,
+    cur_mode: usize,
 }
 
 impl Invariants {
     pub fn new(s: &Schedule, max_records: usize) -> Invariants {
         let mix = &s.mix;
+        let per_mode = |f: &dyn Fn(&lut_gen::Mix, &lut_gen::Channel) -> u64| -> Vec<Vec<u64>> {
+            s.modes
+                .iter()
+                .map(|m| m.mix.channels.iter().map(|c| f(&m.mix, c)).collect())
+                .collect()
+        };
+        let spf_m = per_mode(&|m, c| m.samples_per_frame(c.rate_hz));
+        let interval_m = per_mode(&|m, c| m.clock_hz.checked_div(c.rate_hz).unwrap_or(0));
         let n = mix.channels.len();
         let spf: Vec<u64> = mix
             .channels
@@ -121,7 +137,7 @@ impl Invariants {
             interval: mix
                 .channels
                 .iter()
-                .map(|c| mix.clock_hz / c.rate_hz)
+                .map(|c| mix.clock_hz.checked_div(c.rate_hz).unwrap_or(0))
                 .collect(),
             spf,
             spf0,
@@ -138,6 +154,30 @@ impl Invariants {
             emitted: 0,
             conversions: 0,
             origin: 0,
+            spf_m,
+            interval_m,
+            mc: ModeCheck::new(s).map(Box::new),
+            cur_mode: 0,
+        }
+    }
+
+    /// A mix with switches: cycle `c`'s `mode_sel` and `mode` (before its
+    /// instants): the mode rules, and at a frame start the counts and
+    /// intervals of the mode the design shows (intervals restart at a switch).
+    #[inline]
+    pub fn mode_cycle(&mut self, c: u64, mode_sel: u8, mode: u8) {
+        let Some(mc) = &mut self.mc else {
+            return;
+        };
+        let v = mc.cycle(c, mode_sel, mode);
+        let shown = mc.shown;
+        if let Some(v) = v {
+            self.rec.record(v);
+        }
+        if shown != self.cur_mode {
+            self.cur_mode = shown;
+            self.interval.clone_from(&self.interval_m[shown]);
+            self.has_last.iter_mut().for_each(|h| *h = false);
         }
     }
 
@@ -165,10 +205,10 @@ impl Invariants {
     pub fn close_frames(&mut self, c: u64) {
         while (self.frame + 1) * self.frame_cycles <= c {
             let end = (self.frame + 1) * self.frame_cycles - 1;
-            let spf = if self.frame == 0 {
-                &self.spf0
-            } else {
-                &self.spf
+            let spf = match &self.mc {
+                _ if self.frame == 0 => &self.spf0,
+                Some(mc) => &self.spf_m[mc.shown],
+                None => &self.spf,
             };
             let partial = self.frame * self.frame_cycles < self.origin;
             for (ch, &want) in spf.iter().enumerate() {
@@ -189,6 +229,9 @@ impl Invariants {
                     );
                 }
                 self.in_frame[ch] = 0;
+            }
+            if let Some(mc) = &mut self.mc {
+                mc.frame_start();
             }
             self.frame += 1;
         }
@@ -225,7 +268,7 @@ impl Invariants {
             let d = t - self.last[ch];
             self.imin[ch] = self.imin[ch].min(d);
             self.imax[ch] = self.imax[ch].max(d);
-            if d != self.interval[ch] {
+            if d != self.interval[ch] && self.interval[ch] != 0 {
                 let name = self.names[ch].clone();
                 self.rec.record(
                     Violation::new(Rule::Interval, t)
@@ -274,6 +317,9 @@ impl Invariants {
         instant: u64,
     ) {
         self.conversions += 1;
+        if let (Some(mc), Some(ch), Some(v)) = (&mut self.mc, channel, code) {
+            mc.track.sample(ch as usize, v);
+        }
         self.expire(c);
         self.queue.push_back(Pending {
             complete: c,

@@ -45,7 +45,9 @@ mod linkbytes;
 mod linkjoin;
 mod linkline;
 mod lock;
+mod modecheck;
 mod model;
+mod modes;
 mod rule;
 mod run;
 mod samples;
@@ -62,18 +64,19 @@ mod verdict;
 pub use lut_gen::{Layout, Pins, Signal};
 
 // The reference model, its ADC and the checker.
-pub use adc::{Adc, Analog, Stimulus};
+pub use adc::{Adc, Analog, Scene, Stimulus};
 pub use checker::{CheckOptions, Checker};
 pub use invariants::Invariants;
 pub use model::{CycleModel, SlotModel};
+pub use modes::ModeTrack;
 pub use rule::Rule;
 pub use verdict::{ChannelStats, Divergence, Verdict, Violation};
 
 // Running a design (any `Dut`) against the model, with faults on its pins.
 pub use faults::{FaultyDut, PinFault};
 pub use run::{
-    reset_cycles, run_dut, run_model, run_unchecked, with_slave, AxisSlave, Dut, ModelDut,
-    Observer, RunOptions,
+    reset_cycles, run_dut, run_model, run_unchecked, with_slave, AxisSlave, Dut, ModeRequests,
+    ModelDut, Observer, RunOptions,
 };
 
 // Waveforms: VCD and FST in, VCD and GTKWave save files out, windows locked

@@ -12,6 +12,8 @@ use lut_gen::Schedule;
 
 use lut_gen::{Layout, Pins};
 
+use crate::modes::ModeTrack;
+
 /// One conversion's word in the periodic frame template (a chained
 /// conversion gives one per chain member read).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -148,16 +150,23 @@ impl SlotModel {
 
 #[derive(Debug, Clone)]
 struct BranchModel {
-    /// (cycle in frame, channel) of this branch's instants.
-    inst: Vec<(u64, u16)>,
-    /// Current instant (the last one at or before the model's cycle).
+    /// Per mode (one without modes): (cycle in frame, channel) of this
+    /// branch's instants.
+    inst: Vec<Vec<(u64, u16)>>,
+    /// Current instant (the last one at or before the model's cycle) and
+    /// its frame's mode.
     t: Option<u64>,
     tch: u16,
-    /// Next instant: index in `inst` and frame.
+    tmode: usize,
+    /// Next instant: index in its frame's list and frame.
     ni: usize,
     nf: u64,
     tn: u64,
     tnch: u16,
+    tnmode: usize,
+    /// The next instant lies past the frames whose mode is decided: it is
+    /// looked for again at the next frame start (the mux holds).
+    waiting: bool,
     /// Cycle offsets after an instant where this branch's pins change or MISO is captured.
     offs: Vec<u64>,
     oi: usize,
@@ -184,12 +193,18 @@ struct BranchModel {
     leading: u64,
     /// (device, select) of each channel (indexed by channel).
     addr: Vec<(u32, u32)>,
+    /// A converter with a command word: the word each instant of `inst`
+    /// sends on `adc_mosi` (`Schedule::commands_in_frame`), the current
+    /// one, and the conversions after reset still prepared, not data.
+    words: Vec<Vec<bool>>,
+    wi: usize,
+    prepared: u32,
 }
 
 impl BranchModel {
     /// Branch `b`'s model, before its first instant (`addr`: each channel's
     /// (device, select)).
-    fn new(s: &Schedule, b: usize, addr: &[(u32, u32)]) -> BranchModel {
+    fn new(s: &Schedule, b: usize, addr: &[(u32, u32)], track: &ModeTrack) -> BranchModel {
         let g = &s.grid;
         let plan = &s.branches[b];
         let spi = &plan.spi;
@@ -214,17 +229,27 @@ impl BranchModel {
         offs.retain(|&o| o > 0);
         offs.sort_unstable();
         offs.dedup();
-        let inst: Vec<(u64, u16)> = (0..g.frame_slots)
-            .filter_map(|slot| s.at(slot, b).map(|ch| (slot * g.slot_cycles, ch as u16)))
-            .collect();
+        let of = |ms: &Schedule| -> Vec<(u64, u16)> {
+            (0..g.frame_slots)
+                .filter_map(|slot| ms.at(slot, b).map(|ch| (slot * g.slot_cycles, ch as u16)))
+                .collect()
+        };
+        let inst: Vec<Vec<(u64, u16)>> = if s.modes.is_empty() {
+            vec![of(s)]
+        } else {
+            s.modes.iter().map(of).collect()
+        };
         let mut m = BranchModel {
             inst,
             t: None,
             tch: 0,
+            tmode: 0,
             ni: 0,
             nf: 0,
             tn: u64::MAX,
             tnch: 0,
+            tnmode: 0,
+            waiting: false,
             offs,
             oi: 0,
             next: 0,
@@ -242,21 +267,41 @@ impl BranchModel {
             bits: spi.bits,
             leading: spi.leading_bits as u64,
             addr: addr.to_vec(),
+            words: s.commands_in_frame(b).into_iter().map(|c| c.word).collect(),
+            wi: 0,
+            prepared: s.prepared_conversions(b),
         };
-        m.advance_next_instant(g.frame_cycles);
+        m.advance_next_instant(g.frame_cycles, track);
         m
     }
 
-    fn advance_next_instant(&mut self, frame_cycles: u64) {
-        if self.inst.is_empty() {
+    /// The next instant after the current one, in the frames whose mode is
+    /// decided (else `waiting`).
+    fn advance_next_instant(&mut self, frame_cycles: u64, track: &ModeTrack) {
+        self.waiting = false;
+        if self.inst.iter().all(|l| l.is_empty()) {
             self.tn = u64::MAX;
             return;
         }
-        let (off, ch) = self.inst[self.ni];
-        self.tn = self.nf * frame_cycles + off;
-        self.tnch = ch;
-        self.ni += 1;
-        if self.ni == self.inst.len() {
+        loop {
+            let Some(mode) = track.mode_of(self.nf) else {
+                self.tn = u64::MAX;
+                self.waiting = true;
+                return;
+            };
+            let list = &self.inst[mode];
+            if self.ni < list.len() {
+                let (off, ch) = list[self.ni];
+                self.tn = self.nf * frame_cycles + off;
+                self.tnch = ch;
+                self.tnmode = mode;
+                self.ni += 1;
+                if self.ni == list.len() {
+                    self.ni = 0;
+                    self.nf += 1;
+                }
+                return;
+            }
             self.ni = 0;
             self.nf += 1;
         }
@@ -277,7 +322,12 @@ pub struct CycleModel {
     /// Per branch: (channel, value) of the words waiting, first to leave first.
     pend: Vec<std::collections::VecDeque<(u16, u16)>>,
     capture: u16,
-    groups: Vec<Vec<Option<usize>>>,
+    /// Per mode (one without modes): each channel's chain members read.
+    groups: Vec<Vec<Vec<Option<usize>>>>,
+    /// The modes of the frame in force and the next (docs/timing.md, "Mode
+    /// switches"), and `mode_sel` in the current cycle.
+    track: ModeTrack,
+    mode_sel: u64,
     /// The link's transmitter, fed the predicted sample stream (a mix with
     /// a `[link]`).
     tx: Option<link::TxModel>,
@@ -291,9 +341,15 @@ impl CycleModel {
         let layout = Layout::new(s);
         let g = &s.grid;
         let addr: Vec<(u32, u32)> = s.channels.iter().map(|c| (c.device, c.select)).collect();
+        let track = ModeTrack::new(s);
         let br: Vec<BranchModel> = (0..s.branches.len())
-            .map(|b| BranchModel::new(s, b, &addr))
+            .map(|b| BranchModel::new(s, b, &addr, &track))
             .collect();
+        let groups = if s.modes.is_empty() {
+            vec![s.groups.clone()]
+        } else {
+            s.modes.iter().map(|m| m.groups.clone()).collect()
+        };
         // Idle levels: CS high / SCLK high, CNV low / SCK low.
         let cs_idle = br
             .iter()
@@ -328,7 +384,9 @@ impl CycleModel {
             pending: 0,
             pend: vec![Default::default(); s.branches.len()],
             capture: 0,
-            groups: s.groups.clone(),
+            groups,
+            track,
+            mode_sel: 0,
             tx,
             axis,
         };
@@ -346,6 +404,19 @@ impl CycleModel {
             t.clock(false, valid.then_some((ch, v)));
             self.link_pins();
         }
+    }
+
+    /// `mode_sel` in the current cycle (pin select: an input the model takes
+    /// from the pins it is compared with), before [`CycleModel::step`].
+    #[inline]
+    pub fn set_mode_sel(&mut self, v: u8) {
+        self.mode_sel = v as u64;
+        self.pins.mode_sel = v;
+    }
+
+    /// The modes decided so far: the frame in force, its mode and the next.
+    pub fn modes(&self) -> &ModeTrack {
+        &self.track
     }
 
     /// The link's transmitter configuration (a mix with a `[link]`).
@@ -535,14 +606,20 @@ impl CycleModel {
     fn process(&mut self) {
         let c = self.c;
         let mut next = u64::MAX;
+        if self.track.switches() {
+            self.frame_start(c);
+            next = (self.track.frame() + 1) * self.frame_cycles;
+        }
         for b in 0..self.br.len() {
             let m = &mut self.br[b];
             if m.next <= c {
                 if c == m.tn {
                     m.t = Some(m.tn);
                     m.tch = m.tnch;
+                    m.tmode = m.tnmode;
                     m.conv = settled_at_startup(m.tn, m.settle);
-                    m.advance_next_instant(self.frame_cycles);
+                    m.wi = m.ni.checked_sub(1).unwrap_or(m.inst[m.tmode].len() - 1);
+                    m.advance_next_instant(self.frame_cycles, &self.track);
                     m.oi = 0;
                     m.word = 0;
                 }
@@ -568,15 +645,19 @@ impl CycleModel {
                             self.capture |= bit;
                         }
                     }
-                    if k == m.r && m.conv {
+                    if k == m.r && m.conv && m.prepared > 0 {
+                        // A prepared conversion: its word was never ours.
+                        m.prepared -= 1;
+                    } else if k == m.r && m.conv {
                         // Bit j of the serial stream sits at sclks-1-j of `word`.
                         self.pending |= bit;
                         let mask = (1u128 << m.bits) - 1;
-                        for (w, c) in self.groups[m.tch as usize].iter().enumerate() {
+                        for (w, c) in self.groups[m.tmode][m.tch as usize].iter().enumerate() {
                             if let Some(c) = c {
                                 let end = w as u64 * m.word_sclks + m.leading + m.bits as u64;
                                 let v = (m.word >> (m.sclks - end)) & mask;
                                 self.pend[b].push_back((*c as u16, v as u16));
+                                self.track.sample(*c, v as u16);
                             }
                         }
                     }
@@ -597,6 +678,11 @@ impl CycleModel {
                 }
                 self.pins.cs_n = (self.pins.cs_n & !bit) | if cs { bit } else { 0 };
                 self.pins.sclk = (self.pins.sclk & !bit) | if sclk { bit } else { 0 };
+                if let Some(i) = self.layout.mosi_lo[b] {
+                    let v = Self::mosi_at(&self.br[b], c);
+                    self.pins.mosi = (self.pins.mosi & !(1 << i)) | (v as u16) << i;
+                }
+                let m = &mut self.br[b];
                 if m.tn != u64::MAX || m.t.is_some() {
                     let (dev, sel) = m.addr[ch as usize];
                     self.layout.set_mux(&mut self.pins, b, dev, sel);
@@ -605,5 +691,38 @@ impl CycleModel {
             next = next.min(self.br[b].next);
         }
         self.next_event = next;
+    }
+
+    /// `adc_mosi` of a commanded branch in cycle `c`: bit `k` of the
+    /// conversion's word through SCLK period `k + 1` (docs/timing.md,
+    /// "Command words"), else 0.
+    fn mosi_at(m: &BranchModel, c: u64) -> bool {
+        let Some(t) = m.t else { return false };
+        let k = c - t;
+        if !m.conv || k < m.su || k >= m.r {
+            return false;
+        }
+        let i = ((k - m.su) / m.d) as usize;
+        m.words
+            .get(m.wi)
+            .and_then(|w| w.get(i))
+            .copied()
+            .unwrap_or(false)
+    }
+
+    /// At the edge that begins a frame (cycle `c`): the mode of the frame
+    /// after it is decided from `mode_sel` of the cycle before or the
+    /// windows closed, `mode` shows the new frame's, and a branch that had
+    /// no instant in the frames decided looks again.
+    fn frame_start(&mut self, c: u64) {
+        if c != (self.track.frame() + 1) * self.frame_cycles {
+            return;
+        }
+        self.track.frame_start(self.mode_sel);
+        self.pins.mode = self.track.mode() as u8;
+        for m in self.br.iter_mut().filter(|m| m.waiting) {
+            m.advance_next_instant(self.frame_cycles, &self.track);
+            m.next = c;
+        }
     }
 }

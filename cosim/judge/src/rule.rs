@@ -73,6 +73,12 @@ pub enum Rule {
     LinkPacketLost,
     /// A packet's records differ from the samples emitted in its slice.
     LinkSamples,
+    /// The `mode` output changed inside a frame (a switch takes effect at a
+    /// frame start only).
+    ModeSwitch,
+    /// A frame's mode is not the one the contract decides: a request
+    /// ignored, or a switch without its request or trigger condition.
+    ModeDecision,
 }
 
 impl Rule {
@@ -112,6 +118,8 @@ impl Rule {
             Rule::LinkSequence => "link-sequence",
             Rule::LinkPacketLost => "link-packet-lost",
             Rule::LinkSamples => "link-samples",
+            Rule::ModeSwitch => "mode-switch",
+            Rule::ModeDecision => "mode-decision",
         }
     }
 }

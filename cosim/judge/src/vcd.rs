@@ -295,6 +295,7 @@ const RST: usize = Role::Reset as usize;
 const MISO: usize = Role::Miso as usize;
 const CS: usize = Role::CsN as usize;
 const SCLK: usize = Role::Sclk as usize;
+const MOSI: usize = Role::Mosi as usize;
 const SEL: usize = Role::MuxSel as usize;
 const EN: usize = Role::MuxEn as usize;
 const VALID: usize = Role::SampleValid as usize;
@@ -328,7 +329,7 @@ struct Resolved {
     /// `rst` is dumped (without it, every cycle counts as out of reset).
     has_rst: bool,
     scope: String,
-    widths: [u32; 10],
+    widths: [u32; 11],
     /// The link's ports, read after [`PORT_NAMES`] (none without a link).
     link: &'static [LinkPort],
 }
@@ -396,7 +397,7 @@ impl<'a> PortSearch<'a> {
 
     /// The scope holding the design's ports: the one named `want`, or the
     /// one with all of them at this mix's widths.
-    fn scope(&self, want: Option<&str>, widths: [u32; 10]) -> Result<&'a str, VcdError> {
+    fn scope(&self, want: Option<&str>, widths: [u32; 11]) -> Result<&'a str, VcdError> {
         let mut scopes: Vec<&str> = self.h.vars.iter().map(|v| v.scope.as_str()).collect();
         scopes.sort_unstable();
         scopes.dedup();
@@ -464,7 +465,7 @@ impl<'a> PortSearch<'a> {
     fn of_mix_widths(
         &self,
         candidates: Vec<&'a str>,
-        widths: [u32; 10],
+        widths: [u32; 11],
     ) -> Result<Vec<&'a str>, VcdError> {
         let exact: Vec<&str> = candidates
             .iter()
@@ -525,7 +526,7 @@ impl<'a> PortSearch<'a> {
     fn port_sinks(
         &self,
         scope: &str,
-        widths: [u32; 10],
+        widths: [u32; 11],
         ids: &mut HashMap<Vec<u8>, Vec<Sink>>,
     ) -> Result<(bool, bool), VcdError> {
         // clk may sit in an enclosing scope (a testbench) if the DUT's is not dumped.
@@ -795,6 +796,7 @@ impl State {
             Pins {
                 cs_n: g(CS) as u16,
                 sclk: g(SCLK) as u16,
+                mosi: g(MOSI) as u16,
                 mux_sel: g(SEL) as u64,
                 mux_en: g(EN),
                 sample_valid: g(VALID) & 1 == 1,
@@ -806,6 +808,9 @@ impl State {
                 axis_tvalid: self.axis && g(LINK + 1) & 1 == 1,
                 axis_tlast: self.axis && g(LINK + 2) & 1 == 1,
                 axis_tready: self.axis && g(LINK + 3) & 1 == 1,
+                // the mode ports are not read from a VCD yet
+                mode_sel: 0,
+                mode: 0,
             }
         };
         (pick(|p| p.v), pick(|p| p.x))

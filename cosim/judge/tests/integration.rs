@@ -4,6 +4,9 @@
 #[path = "capture.rs"]
 mod capture;
 
+#[path = "command.rs"]
+mod command;
+
 #[path = "fuzz_regressions.rs"]
 mod fuzz_regressions;
 
@@ -15,3 +18,6 @@ mod model_check;
 
 #[path = "vcd.rs"]
 mod vcd;
+
+#[path = "modes.rs"]
+mod modes;

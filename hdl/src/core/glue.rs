@@ -16,7 +16,7 @@ pub(super) fn core_glue(
     let act_read = queue_inputs(&mut s, nb, queue);
     lanes(&mut s, nb, devices);
     s.push_str(
-        "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\nend\n",
+        "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
     );
     unused_wires(&mut s, nb, devices);
     let unread: Vec<String> = (0..nb)

@@ -19,6 +19,8 @@ pub struct Core {
     pub sample_valid: Signal<Out, Bit>,
     pub sample_channel: Signal<Out, Bits<CH_BITS>>,
     pub sample_value: Signal<Out, Bits<VALUE_BITS>>,
+    /// The timebase's `start1` (the next cycle starts a slot), for the link.
+    pub slot_tick: Signal<Out, Bit>,
     pub timing: TimingGen,
     pub seqs: Vec<SpiSeq>,
     pub branches: Vec<BranchUnit>,
@@ -48,6 +50,7 @@ impl Core {
             sample_valid: Default::default(),
             sample_channel: Default::default(),
             sample_value: Default::default(),
+            slot_tick: Default::default(),
             timing: TimingGen::new(plan),
             seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
             branches: plan.branches.iter().map(BranchUnit::new).collect(),
@@ -253,6 +256,7 @@ impl Logic for Core {
         self.sample_valid.next = self.merge.valid.val();
         self.sample_channel.next = self.merge.channel.val();
         self.sample_value.next = self.merge.value.val();
+        self.slot_tick.next = start1;
     }
 
     fn connect(&mut self) {
@@ -297,6 +301,7 @@ impl Logic for Core {
         self.sample_valid.connect();
         self.sample_channel.connect();
         self.sample_value.connect();
+        self.slot_tick.connect();
     }
 
     fn hdl(&self) -> Verilog {

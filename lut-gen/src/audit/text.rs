@@ -94,6 +94,26 @@ impl AuditReport {
                 "of ADC = demanded samples/s over the ADC's maximum; of grid = conversions over the slots of the slot grid"
             );
             self.headroom_lines(o);
+            self.command_lines(o);
+        }
+    }
+
+    /// Branches whose converter takes a command word: the word and its pipeline.
+    fn command_lines(&self, o: &mut String) {
+        for b in &self.branches {
+            let Some(c) = &b.command else { continue };
+            let when = match c.ahead {
+                0 => "selects the conversion it is sent in".to_string(),
+                n => format!(
+                    "selects the conversion {n} ahead; the first {} conversion(s) after reset are prepared, not data",
+                    c.prepared_conversions
+                ),
+            };
+            let _ = writeln!(
+                o,
+                "command: {} sends {} on adc_mosi (C: channel bits); it {when}",
+                b.name, c.template
+            );
         }
     }
 

@@ -2,7 +2,7 @@
 
 use super::raw::*;
 use super::*;
-use crate::parts::{AdcPart, Start};
+use crate::parts::{AdcPart, Command, Start};
 
 impl Cx<'_> {
     /// A `[[adc_part]]` table, checked like every other field.
@@ -84,7 +84,69 @@ impl Cx<'_> {
             data_access_ns: self.nonneg(&p.data_access_ns, &f("data_access_ns"), 0)?,
             data_hold_ns: 0,
             chain_max: chain_max as u32,
+            command: self.adc_part_command(i, p, chain_max, leading_bits + bits + trailing_bits)?,
         })
+    }
+
+    /// `adc_part.command` and `command_ahead`: a template of the word on
+    /// DIN, and which conversion it selects (0: the one it is sent in).
+    pub(super) fn adc_part_command(
+        &self,
+        i: usize,
+        p: &RawAdcPart,
+        chain_max: u64,
+        word_sclks: u64,
+    ) -> Result<Option<Command>, MixError> {
+        let f = |k: &str| format!("adc_part[{i}].{k}");
+        let Some(t) = &p.command else {
+            if let Some(a) = &p.command_ahead {
+                return Err(self.at(
+                    a.span(),
+                    f("command_ahead"),
+                    "applies to a command word: declare `command` as well",
+                ));
+            }
+            return Ok(None);
+        };
+        let ahead = self.nonneg(&p.command_ahead, &f("command_ahead"), 0)?;
+        if ahead > 4 {
+            return Err(self.at(
+                p.command_ahead.as_ref().unwrap().span(),
+                f("command_ahead"),
+                format!("{ahead} conversions ahead: at most 4"),
+            ));
+        }
+        if chain_max > 1 {
+            return Err(self.at(
+                t.span(),
+                f("command"),
+                "a part with a command word is not daisy-chained here: leave chain_max at 1",
+            ));
+        }
+        let c = Command::parse(t.get_ref(), ahead as u32)
+            .map_err(|m| self.at(t.span(), f("command"), m))?;
+        let lead = self.nonneg(&p.leading_bits, &f("leading_bits"), 0)?;
+        if c.bits.len() as u64 > word_sclks {
+            return Err(self.at(
+                t.span(),
+                f("command"),
+                format!(
+                    "{} bits: longer than the part's {word_sclks} serial clocks per word",
+                    c.bits.len()
+                ),
+            ));
+        }
+        if ahead == 0 && c.bits.len() as u64 > lead {
+            return Err(self.at(
+                t.span(),
+                f("command"),
+                format!(
+                    "{} bits select the conversion they are sent in: the part must have at least as many leading_bits ({lead}) before its first data bit",
+                    c.bits.len()
+                ),
+            ));
+        }
+        Ok(Some(c))
     }
 
     /// `adc_part.name`: lower case, not blank, not a built-in part's.

@@ -64,17 +64,7 @@ impl Cx<'_> {
                 )
             })?;
         let chain = self.branch_chain(i, b, &adc)?;
-        let mux = MuxPart::by_name(b.mux.get_ref()).ok_or_else(|| {
-            self.at(
-                b.mux.span(),
-                f("mux"),
-                format!(
-                    "unknown mux `{}` (known: {})",
-                    b.mux.get_ref(),
-                    MuxPart::known().join(", ")
-                ),
-            )
-        })?;
+        let mux = self.branch_mux(i, b, &adc)?;
         let sclk_hz = self.branch_sclk(i, b, &adc)?;
         if t.clock_hz < 2 * adc.sclk_min_hz {
             return Err(self.at(
@@ -152,7 +142,50 @@ impl Cx<'_> {
         Ok(v)
     }
 
-    /// `branch.mux_devices`: 1 to 32, and only with a mux.
+    /// `branch.mux`: an external part, or `internal` (the converter's own,
+    /// chosen by its command word).  A part with a command word takes
+    /// `internal`: an external mux in front of it is not supported yet.
+    pub(super) fn branch_mux(
+        &self,
+        i: usize,
+        b: &RawBranch,
+        adc: &AdcPart,
+    ) -> Result<MuxPart, MixError> {
+        let f = format!("branch[{i}].mux");
+        let wanted = b.mux.get_ref().to_ascii_lowercase();
+        match (&adc.command, wanted.as_str()) {
+            (Some(c), "internal") => Ok(MuxPart::internal(c.channels())),
+            (None, "internal") => Err(self.at(
+                b.mux.span(),
+                f,
+                format!(
+                    "`{}` has no multiplexer of its own (no command word): use an external mux or \"none\"",
+                    adc.name
+                ),
+            )),
+            (Some(_), _) if MuxPart::by_name(&wanted).is_some() => Err(self.at(
+                b.mux.span(),
+                f,
+                format!(
+                    "`{}` selects its input with its command word: write mux = \"internal\" (an external mux in front of it is not supported yet)",
+                    adc.name
+                ),
+            )),
+            _ => MuxPart::by_name(&wanted).ok_or_else(|| {
+                self.at(
+                    b.mux.span(),
+                    f,
+                    format!(
+                        "unknown mux `{}` (known: {})",
+                        b.mux.get_ref(),
+                        MuxPart::known().join(", ")
+                    ),
+                )
+            }),
+        }
+    }
+
+    /// `branch.mux_devices`: 1 to 32, and only with an external mux.
     pub(super) fn branch_mux_devices(
         &self,
         i: usize,
@@ -166,6 +199,11 @@ impl Cx<'_> {
                 m.span(),
                 f("mux_devices"),
                 "a branch with mux = \"none\" has no mux devices",
+            )),
+            Some(m) if mux.is_internal() => Err(self.at(
+                m.span(),
+                f("mux_devices"),
+                "the converter's own multiplexer (mux = \"internal\") has no devices to count",
             )),
             Some(m) => {
                 let v = self.positive(m, &f("mux_devices"))?;

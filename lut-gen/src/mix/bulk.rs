@@ -182,3 +182,13 @@ impl Cx<'_> {
         Ok(out)
     }
 }
+
+/// The channel names a name or bulk pattern stands for (`T{0..3}`: `T0`,
+/// ..., `T3`), for a command-line list of channels; the error in the user's
+/// words.
+pub fn expand_names(written: &str) -> Result<Vec<String>, String> {
+    Ok(match Range::parse(written)? {
+        None => vec![written.to_string()],
+        Some(r) => (0..r.count()).map(|s| r.name(s)).collect(),
+    })
+}

@@ -192,6 +192,20 @@ impl Cx<'_> {
         used: &mut BTreeMap<(u32, u32), String>,
     ) -> Result<u32, MixError> {
         let capacity = b.mux.inputs * b.mux_devices;
+        if b.mux.is_internal() && (*v.get_ref() < 0 || *v.get_ref() >= capacity as i64) {
+            return Err(self.at(
+                v.span(),
+                d.field("input"),
+                d.say(format!(
+                    "input {}{} is beyond branch `{}`: its converter `{}` has channels 0..={}",
+                    v.get_ref(),
+                    counted_from(*v.get_ref(), d.step),
+                    b.name,
+                    b.adc.name,
+                    capacity - 1
+                )),
+            ));
+        }
         if *v.get_ref() < 0 || *v.get_ref() >= capacity as i64 {
             return Err(self.at(
                 v.span(),

@@ -101,6 +101,10 @@ pub(super) struct RawAdcPart {
     pub(super) data_access_ns: Option<Spanned<i64>>,
     pub(super) max_sps: Spanned<i64>,
     pub(super) chain_max: Option<Spanned<i64>>,
+    /// The command word's template (`crate::parts::Command::parse`).
+    pub(super) command: Option<Spanned<String>>,
+    /// Conversions ahead the command applies (0: the same one).
+    pub(super) command_ahead: Option<Spanned<i64>>,
 }
 
 #[derive(Deserialize, Clone)]

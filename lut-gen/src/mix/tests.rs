@@ -221,3 +221,92 @@ fn declared_parts_are_validated() {
     let e = err(&good.replace("sclk_max_hz = 20_000_000\n", ""));
     assert_eq!(e.field, "adc_part[0].sclk_max_hz", "{e}");
 }
+
+/// The line of the first occurrence of `needle` in `text` (1-based).
+fn line_of(text: &str, needle: &str) -> usize {
+    text[..text.find(needle).unwrap()].lines().count() + 1
+}
+
+#[test]
+fn converters_with_a_command_word_use_their_own_mux() {
+    let cmd = GOOD
+        .replace("adc = \"ad7940\"", "adc = \"mcp3208\"")
+        .replace("mux = \"tmux1108\"", "mux = \"internal\"")
+        .replace("bandwidth_hz = 400", "bandwidth_hz = 400\ninput = 7");
+    let m = parse(Path::new("m.toml"), &cmd).unwrap();
+    assert!(m.branches[0].mux.is_internal());
+    assert_eq!(m.branches[0].mux.inputs, 8);
+    assert_eq!(m.channels[0].input, 7);
+    // An input beyond the converter's channels, in its words.
+    let bad = cmd.replace("input = 7", "input = 8");
+    let e = err(&bad);
+    assert_eq!(
+        (e.field.as_str(), e.line),
+        ("channel[0].input", line_of(&bad, "input = 8"))
+    );
+    assert!(
+        e.message.contains("converter `mcp3208` has channels 0..=7"),
+        "{e}"
+    );
+    // A listening part has no mux of its own; a commanded one needs it.
+    let e = err(&GOOD.replace("mux = \"tmux1108\"", "mux = \"internal\""));
+    assert_eq!(e.field, "branch[0].mux");
+    assert!(
+        e.message.contains("`ad7940` has no multiplexer of its own"),
+        "{e}"
+    );
+    let e = err(&cmd.replace("mux = \"internal\"", "mux = \"tmux1108\""));
+    assert_eq!(e.field, "branch[0].mux");
+    assert!(e.message.contains("write mux = \"internal\""), "{e}");
+    let e = err(&cmd.replace("mux = \"internal\"", "mux = \"internal\"\nmux_devices = 2"));
+    assert_eq!(e.field, "branch[0].mux_devices");
+}
+
+#[test]
+fn a_declared_part_may_take_a_command_word() {
+    let part = "[[adc_part]]\nname = \"ads7953\"\nbits = 12\nstart = \"cs\"\nleading_bits = 4\n\
+                sclk_max_hz = 20_000_000\nmax_sps = 1_000_000\ncommand = \"0001_1_CCCC_00000\"\n\
+                command_ahead = 2\n";
+    let mix = |p: &str| {
+        format!("{GOOD}{p}")
+            .replace("adc = \"ad7940\"", "adc = \"ads7953\"")
+            .replace("mux = \"tmux1108\"", "mux = \"internal\"")
+    };
+    let m = parse(Path::new("m.toml"), &mix(part)).unwrap();
+    let c = m.branches[0].adc.command.as_ref().unwrap();
+    assert_eq!((c.ahead, c.channels()), (2, 16));
+    assert_eq!(c.template(), "00011CCCC00000");
+    for (from, to, field, says) in [
+        (
+            "\"0001_1_CCCC_00000\"",
+            "\"00011\"",
+            "adc_part[0].command",
+            "no channel bit",
+        ),
+        (
+            "\"0001_1_CCCC_00000\"",
+            "\"0001_x_CCCC\"",
+            "adc_part[0].command",
+            "`x` is not a bit",
+        ),
+        (
+            "command_ahead = 2",
+            "command_ahead = 9",
+            "adc_part[0].command_ahead",
+            "at most 4",
+        ),
+        (
+            "command = \"0001_1_CCCC_00000\"\n",
+            "",
+            "adc_part[0].command_ahead",
+            "declare `command`",
+        ),
+    ] {
+        let text = mix(&part.replace(from, to));
+        let e = err(&text);
+        assert_eq!(e.field, field, "{e}");
+        assert!(e.message.contains(says), "{e}");
+        let key = field.rsplit('.').next().unwrap();
+        assert_eq!(e.line, line_of(&text, &format!("{key} =")), "{e}");
+    }
+}
