@@ -18,11 +18,14 @@ pub(super) fn core_glue(
     s.push_str(
         "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
     );
-    unused_wires(&mut s, nb, devices);
+    unused_wires(&mut s, nb, devices, nseq);
     let unread: Vec<String> = (0..nb)
         .filter(|b| !act_read.contains(b))
         .map(|b| format!("branches${b}$act_q"))
         .collect();
+    if queue.is_none() {
+        s.push_str("// the queue form's lane enables (zero in the priority form)\nwire unused_queue_en = merge$sh_en | merge$ch_en;\n");
+    }
     if !unread.is_empty() {
         s.push_str(&format!(
             "// conversion flags the MISO routing does not need\nwire unused_act = |{{{}}};\n",
@@ -60,7 +63,7 @@ fn queue_inputs(s: &mut String, nb: usize, queue: Option<&[Vec<usize>]>) -> Vec<
         let u = format!("branches${b}");
         let Some(q) = queue else {
             s.push_str(&format!(
-                "  {u}$miso = adc_miso[{b}];\n  {u}$mv = merge$mv;\n  {u}$q_ch = {CH_BITS}'h0;\n  {u}$q_val = {VALUE_BITS}'h0;\n"
+                "  {u}$miso = adc_miso[{b}];\n  {u}$sh_en = 1'b0;\n  {u}$ch_en = 1'b0;\n  {u}$q_ch = {CH_BITS}'h0;\n  {u}$q_val = {VALUE_BITS}'h0;\n"
             ));
             continue;
         };
@@ -71,7 +74,9 @@ fn queue_inputs(s: &mut String, nb: usize, queue: Option<&[Vec<usize>]>) -> Vec<
             read.extend(0..=src);
             e = format!("({}) ? adc_miso[{src}] : {e}", lanes_below_is(src, b));
         }
-        s.push_str(&format!("  {u}$miso = {e};\n  {u}$mv = merge$mv;\n"));
+        s.push_str(&format!(
+            "  {u}$miso = {e};\n  {u}$sh_en = merge$sh_en;\n  {u}$ch_en = merge$ch_en;\n"
+        ));
         if b + 1 < nb {
             let n = format!("branches${}", b + 1);
             s.push_str(&format!(
@@ -117,6 +122,8 @@ fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize) {
             "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = timing$start2;\n"
         ));
     }
+    // the queue form's single sequencer (unused by the priority form)
+    s.push_str("  merge$cap_next = seqs$0$cap_next;\n  merge$start2 = timing$start2;\n");
     for (b, seq) in seq_of.iter().enumerate().take(nb) {
         let u = format!("branches${b}");
         let q = format!("seqs${seq}");
@@ -204,7 +211,7 @@ fn lanes(s: &mut String, nb: usize, devices: &[usize]) {
 
 /// Inputs the mix leaves unused, OR-reduced into named wires so that lint
 /// sees them read.
-fn unused_wires(s: &mut String, nb: usize, devices: &[usize]) {
+fn unused_wires(s: &mut String, nb: usize, devices: &[usize], nseq: usize) {
     let unused: Vec<String> = (0..nb)
         .filter(|&b| devices[b] < EN_BITS)
         .map(|b| format!("branches${b}$mux_en[{}:{}]", EN_BITS - 1, devices[b]))
@@ -213,6 +220,13 @@ fn unused_wires(s: &mut String, nb: usize, devices: &[usize]) {
         s.push_str(&format!(
             "\n// enables of devices a branch does not have are always zero\nwire unused_mux_en = |{{{}}};\n",
             unused.join(", ")
+        ));
+    }
+    if nseq > 1 {
+        let caps: Vec<String> = (1..nseq).map(|i| format!("seqs${i}$cap_next")).collect();
+        s.push_str(&format!(
+            "// only a single sequencer's mix has the merger's queue form\nwire unused_cap_next = |{{{}}};\n",
+            caps.join(", ")
         ));
     }
     if nb < MAX_BRANCHES {

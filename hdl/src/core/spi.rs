@@ -33,6 +33,9 @@ pub struct SpiSeq {
     pub cs_n: Signal<Out, Bit>,
     pub sclk: Signal<Out, Bit>,
     pub cap: Signal<Out, Bit>,
+    /// `cap` of the next cycle (the D input of its flip-flop), for the
+    /// merger's queue form's registered shift enable.
+    pub cap_next: Signal<Out, Bit>,
     pub done: Signal<Out, Bit>,
     pub(super) r_cs_n: DFF<Bit>,
     pub(super) r_sclk: DFF<Bit>,
@@ -109,6 +112,7 @@ impl SpiSeq {
             cs_n: Default::default(),
             sclk: Default::default(),
             cap: Default::default(),
+            cap_next: Default::default(),
             done: Default::default(),
             r_cs_n: Default::default(),
             r_sclk: Default::default(),
@@ -233,6 +237,7 @@ impl Logic for SpiSeq {
         self.cs_n.next = self.r_cs_n.q.val();
         self.sclk.next = self.r_sclk.q.val();
         self.cap.next = self.r_cap.q.val();
+        self.cap_next.next = self.r_cap.d.val();
         self.done.next = self.r_done.q.val();
     }
 }

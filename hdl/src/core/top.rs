@@ -53,7 +53,11 @@ impl Core {
             slot_tick: Default::default(),
             timing: TimingGen::new(plan),
             seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
-            branches: plan.branches.iter().map(BranchUnit::new).collect(),
+            branches: plan
+                .branches
+                .iter()
+                .map(|b| BranchUnit::new(b, plan.queue.is_some()))
+                .collect(),
             merge: Merger::new(plan.branches.len(), plan.queue.is_some()),
             _devices: plan.branches.iter().map(|b| b.devices).collect(),
             _seq_of: plan.branches.iter().map(|b| b.seq).collect(),
@@ -140,6 +144,8 @@ impl Core {
         drive(&mut m.r_val.clock, k);
         drive(&mut m.pend.clock, k);
         drive(&mut m.r_any.clock, k);
+        drive(&mut m.r_shen.clock, k);
+        drive(&mut m.r_chen.clock, k);
     }
 }
 
@@ -182,7 +188,6 @@ impl Logic for Core {
         }
         let miso = self.miso_lanes();
         let grant = self.merge.grant.val().to_u64();
-        let mv = self.merge.mv.val();
         let (mut cs, mut sclk, mut sel, mut en, mut done) = (0u64, 0u64, 0u64, 0u128, 0u64);
         let mut more = 0u64;
         let mut done_next = 0u64;
@@ -204,7 +209,7 @@ impl Logic for Core {
             u.seq_done.next = q_done;
             u.miso.next = (miso >> b) & 1 == 1;
             u.grant.next = (grant >> b) & 1 == 1;
-            u.mv.next = mv;
+            (u.sh_en.next, u.ch_en.next) = (self.merge.sh_en.val(), self.merge.ch_en.val());
             more |= (u.more.val() as u64) << b;
             cs |= (u.cs_n.val() as u64) << b;
             sclk |= (u.sclk.val() as u64) << b;
@@ -239,6 +244,9 @@ impl Logic for Core {
         self.merge.done.next = done.into();
         self.merge.more.next = more.into();
         self.merge.done_next.next = done_next.into();
+        // the queue form's single sequencer (unused in the priority form)
+        self.merge.cap_next.next = self.seqs[0].cap_next.val();
+        self.merge.start2.next = start;
         if self._queue.is_some() {
             // the queue form: each lane reads the next lane's channel and word
             for b in 0..nb - 1 {
@@ -283,13 +291,16 @@ impl Logic for Core {
             u.seq_done.connect();
             u.miso.connect();
             u.grant.connect();
-            u.mv.connect();
+            u.sh_en.connect();
+            u.ch_en.connect();
             u.q_ch.connect();
             u.q_val.connect();
         }
         self.merge.done.connect();
         self.merge.more.connect();
         self.merge.done_next.connect();
+        self.merge.cap_next.connect();
+        self.merge.start2.connect();
         for b in 0..MAX_BRANCHES {
             self.merge.ch[b].connect();
             self.merge.v[b].connect();
