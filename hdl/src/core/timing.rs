@@ -145,10 +145,11 @@ impl Logic for TimingGen {
             self.nxt_sl.next = self.k_sl_zero.val();
         }
         self.slot.d.next = self.nxt.val() & self.k_slot_mask.val();
-        // The successor of the registered slot, not of `nxt`: one cycle
-        // stale after a slot start, and right again long before the next
-        // (slots are longer than a read), so the compare and increment
-        // start at a flip-flop rather than behind the `nxt` multiplexer.
+        // The successor of the registered slot, not of `nxt`, so the
+        // compare and increment start at a flip-flop rather than behind the
+        // `nxt` multiplexer: stale in the cycle after a slot start only,
+        // and right again by the next start (slots are at least 2 cycles,
+        // `plan`).
         if self.slot.q.val() == self.k_slot_last.val() {
             self.succ.d.next = self.k_slot_zero.val();
         } else {
