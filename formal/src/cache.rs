@@ -99,6 +99,7 @@ mod tests {
             netlist: None,
             note: "n".into(),
             not_covered: not_covered.iter().map(|s| s.to_string()).collect(),
+            netlist_caveats: Vec::new(),
             counterexample: None,
             cycle: None,
         }

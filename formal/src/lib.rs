@@ -135,6 +135,11 @@ pub struct Proof {
     /// Empty when the properties cover the whole contract.  Required in a
     /// remembered proof too (`cache`): one stored without it is not loaded.
     pub not_covered: Vec<String>,
+    /// `prove --netlist`: what a proof of a netlist says nothing of beyond
+    /// the contract (the cells are yosys' models of the silicon; no place
+    /// and route, no timing). Empty for RTL.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub netlist_caveats: Vec<String>,
     pub counterexample: Option<Counterexample>,
     /// `counterexample.cycle`, repeated at the top level (docs/json.md).
     pub cycle: Option<i64>,
@@ -156,7 +161,7 @@ pub struct ProveOptions {
     pub own_design: bool,
     /// The design is this part's gate-level netlist with the cell models
     /// (reported as [`Proof::netlist`]), and what proving it leaves out
-    /// (the models stand for the silicon, no timing): added to `not_covered`.
+    /// (the models stand for the silicon, no timing): `netlist_caveats`.
     pub netlist: Option<(String, Vec<String>)>,
 }
 
@@ -202,10 +207,12 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         Solver::Abc => strategy::abc(&prep, f, opts)?,
         Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work.path(), f, opts)?,
     };
-    let mut not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
-    if let Some((_, also)) = &opts.netlist {
-        not_covered.extend(also.iter().cloned());
-    }
+    let not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
+    let netlist_caveats = opts
+        .netlist
+        .as_ref()
+        .map(|(_, c)| c.clone())
+        .unwrap_or_default();
     let note = scoped_note(result, note, not_covered.len());
     let solver_seconds = t1.elapsed().as_secs_f64();
     let mut properties: Vec<PropertyResult> = h
@@ -243,6 +250,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         netlist: opts.netlist.as_ref().map(|(part, _)| part.clone()),
         note,
         not_covered,
+        netlist_caveats,
         counterexample,
         cycle,
     })
@@ -498,6 +506,12 @@ impl Proof {
         if !self.not_covered.is_empty() {
             let _ = writeln!(s, "  not covered (the harness does not assert it, so neither a proof nor a bound says anything of it):");
             for n in &self.not_covered {
+                let _ = writeln!(s, "    - {n}");
+            }
+        }
+        if !self.netlist_caveats.is_empty() {
+            let _ = writeln!(s, "  of a netlist, this proof also says nothing of:");
+            for n in &self.netlist_caveats {
                 let _ = writeln!(s, "    - {n}");
             }
         }

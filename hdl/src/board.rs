@@ -11,7 +11,8 @@ use serde::Deserialize;
 
 use crate::HdlError;
 
-/// A board file: which package pin each port bit goes to.
+/// A board file: which package pin each port bit goes to (docs/ports.md,
+/// "Board files").
 ///
 /// ```toml
 /// name = "..."
@@ -19,8 +20,8 @@ use crate::HdlError;
 /// device = "hx8k"        # as the vendor names it (for the reader)
 /// package = "ct256"
 /// io_type = "LVCMOS33"   # LPF/CST I/O standard (default LVCMOS33)
-/// [io_types]             # pins in a bank at another voltage
-/// "10" = "LVCMOS18"
+/// [io_types]             # by pin name: pins in a bank at another voltage
+/// "B11" = "LVCMOS18"
 /// [pins]                 # explicit bits, e.g. clk = "J3", "adc_cs_n[0]" = "B6"
 /// clk = "J3"
 /// [pool]                 # remaining bits take these pins, in port-table order
@@ -157,14 +158,17 @@ impl Board {
             .count()
             + pool.clone().count();
         if have < bits.len() {
-            return Err(err(format!(
+            return Err(HdlError::Pins {
+                path: path.display().to_string(),
+                message: format!(
                 "mix \"{}\" has {} port bits, but board \"{}\" ({}) offers {have} pins ([pins] and [pool]): \
-                 a mix with fewer branches or mux devices, a link instead of the parallel sample port, or a larger package fits",
+                 a mix with fewer branches or mux devices, or a board with more pins, fits",
                 s.mix.name,
                 bits.len(),
                 self.name,
                 self.fpga.part_number()
-            )));
+                ),
+            });
         }
         let mut used: Vec<&str> = vec![];
         let mut placed = vec![];

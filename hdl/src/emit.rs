@@ -111,7 +111,7 @@ pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Em
         constraints,
     ];
     let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
-    let core = crate::fusesoc::core_file(s, &names);
+    let core = crate::fusesoc::core_file(s, &names, board.is_some());
     files.push((crate::fusesoc::CORE_FILE.to_string(), core));
     files.sort();
     Ok(Emitted { files })

@@ -88,8 +88,10 @@ fn fileset(t: &mut String, name: &str, files: &[&str], file_type: &str, copy: bo
     let _ = writeln!(t, "    file_type: {file_type}");
 }
 
-/// The CAPI2 text for a schedule whose emitted files are `names`.
-pub fn core_file(s: &Schedule, names: &[&str]) -> String {
+/// The CAPI2 text for a schedule whose emitted files are `names`; `pinned`:
+/// the constraint file is a board's (else the PCF is a template with no
+/// pin, which no flow may read).
+pub fn core_file(s: &Schedule, names: &[&str], pinned: bool) -> String {
     let mut names = names.to_vec();
     names.sort_unstable();
     let mut t = String::from("CAPI=2:\n");
@@ -113,7 +115,7 @@ pub fn core_file(s: &Schedule, names: &[&str]) -> String {
     fileset(&mut t, "rom", &roms, "user", true);
     let mut sets: Vec<(String, Option<Fpga>)> = vec![];
     for n in &names {
-        if let Some((ty, fpga)) = constraint_kind(n) {
+        if let Some((ty, fpga)) = constraint_kind(n).filter(|(_, f)| pinned || f.is_none()) {
             let set = format!("constraints_{}", ty.to_ascii_lowercase());
             fileset(&mut t, &set, &[n], ty, false);
             sets.push((set, fpga));
@@ -145,14 +147,35 @@ pub fn core_file(s: &Schedule, names: &[&str]) -> String {
 }
 
 /// The synthesis target of one part, with its family's constraint files.
+/// A part with none gets a target only where its place and route takes
+/// ports without pins (iCE40, told so); `verilog --board` writes the file.
 fn targets(t: &mut String, f: Fpga, sets: &[(String, Option<Fpga>)]) {
-    let (tool, options) = flow(f);
+    let (tool, mut options) = flow(f);
     let mut filesets = vec!["rtl".to_string(), "rom".to_string()];
     filesets.extend(
         sets.iter()
             .filter(|(_, p)| *p == Some(f))
             .map(|(n, _)| n.clone()),
     );
+    if filesets.len() == 2 {
+        match f {
+            Fpga::Ice40Hx8k => {
+                let o = &mut options
+                    .iter_mut()
+                    .find(|(k, _)| *k == "nextpnr_options")
+                    .expect("ice40 options")
+                    .1;
+                *o = format!("{}, --pcf-allow-unconstrained]", o.trim_end_matches(']'));
+            }
+            _ => {
+                let _ = writeln!(
+                    t,
+                    "  # {f}: no target: its place and route needs the pins (`verilog --board`)"
+                );
+                return;
+            }
+        }
+    }
     let _ = writeln!(
         t,
         "  # {f}: yosys + nextpnr through Edalize's {tool} flow\n  {}:\n    default_tool: {tool}\n    filesets: [{}]\n    toplevel: {TOP_MODULE}\n    tools:\n      {tool}:",

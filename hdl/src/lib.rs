@@ -51,6 +51,10 @@ pub enum HdlError {
     /// The board file is unreadable, malformed or lacks pins.
     #[error("board file {path}: {message}")]
     Board { path: String, message: String },
+    /// The board has fewer pins than the mix has port bits: the mix does
+    /// not fit it (not bad input).
+    #[error("board file {path}: {message}")]
+    Pins { path: String, message: String },
     /// rust-hdl's stock `Simulation` engine failed (design check, no
     /// convergence, testbench panic).
     #[error("rust-hdl simulation: {0}")]

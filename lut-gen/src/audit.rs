@@ -40,6 +40,10 @@ pub struct AuditReport {
     pub lut_entries_compact: usize,
     pub lut_entries_full: usize,
     pub errors: Vec<String>,
+    /// Which of `errors` is the link's (a line the mix's worst mode cannot
+    /// carry): the mode tables leave it to the report's own.
+    #[serde(skip)]
+    pub link_error: Option<String>,
     pub warnings: Vec<String>,
     /// Facts worth knowing that are neither errors nor warnings (e.g. an
     /// SCLK the clock cannot give exactly).
@@ -288,11 +292,13 @@ impl AuditReport {
         let aggregate_hz: u64 = mix.channels.iter().map(|c| c.rate_hz).sum();
         let adc_limit_hz = adc_limit_hz(mix);
         let lut = CompactLut::from_schedule(s);
+        let mut link_error = None;
         let link = match crate::hostlink::plan(s) {
             None => None,
             Some(Ok(p)) => Some(p),
             Some(Err(e)) => {
-                errors.push(e.message);
+                errors.push(e.message.clone());
+                link_error = Some(e.message);
                 None
             }
         };
@@ -320,6 +326,7 @@ impl AuditReport {
             lut_entries_compact: lut.entries(),
             lut_entries_full: g.frame_slots as usize * nb,
             errors,
+            link_error,
             warnings,
             notes,
             branches,
@@ -383,6 +390,7 @@ impl AuditReport {
             lut_entries_compact: 0,
             lut_entries_full: 0,
             errors,
+            link_error: None,
             warnings: Vec::new(),
             notes: Vec::new(),
             branches: why

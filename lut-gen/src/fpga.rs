@@ -26,6 +26,16 @@ pub enum Family {
     Gowin,
 }
 
+/// Where a part's yosys and nextpnr come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Toolchain {
+    /// Programs of the machine (Debian's), which read any path.
+    Native,
+    /// The YoWASP builds from PyPI (`make tools`): they see only their
+    /// working folder, and yosys' share folder is its Python package's.
+    Yowasp,
+}
+
 impl Fpga {
     /// Every part, in the order tables list them.
     pub const ALL: [Fpga; 3] = [Fpga::Ice40Hx8k, Fpga::Ecp5_25k, Fpga::Gw1n9];
@@ -54,6 +64,15 @@ impl Fpga {
             Fpga::Ice40Hx8k => ("iCE40-HX8K Breakout Board", "ice40-hx8k-breakout.toml"),
             Fpga::Ecp5_25k => ("ULX3S", "ulx3s-25f.toml"),
             Fpga::Gw1n9 => ("Tang Nano 9K", "tang-nano-9k.toml"),
+        }
+    }
+
+    /// Where its tools come from: Debian's packages for iCE40, the YoWASP
+    /// builds (WebAssembly, sandboxed to their working folder) for the rest.
+    pub fn toolchain(self) -> Toolchain {
+        match self {
+            Fpga::Ice40Hx8k => Toolchain::Native,
+            Fpga::Ecp5_25k | Fpga::Gw1n9 => Toolchain::Yowasp,
         }
     }
 

@@ -61,9 +61,9 @@ pub struct LinkPlan {
     #[serde(skip)]
     pub line: Line,
     /// A mix with modes: the mode whose frame carries the most bytes (the
-    /// figures above are its, but `fifo_depth`, `latency_*` and `min_baud`
-    /// are the worst of every mode and switch), and the FIFO across each
-    /// switch between two modes.
+    /// figures above are its, but `latency_*` and `min_baud` are the worst
+    /// mode's and `fifo_depth` the most of every mode and switch), and the
+    /// FIFO across each switch between two modes.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub worst_mode: Option<String>,
     #[serde(skip_serializing_if = "Vec::is_empty")]

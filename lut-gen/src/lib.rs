@@ -70,7 +70,7 @@ pub use ports::{
 };
 
 // The FPGA parts slotforge synthesizes for.
-pub use fpga::{Constraints, Family, Fpga};
+pub use fpga::{Constraints, Family, Fpga, Toolchain};
 
 // The link to the host, planned from the schedule.
 pub use hostlink::{

@@ -45,8 +45,9 @@ pub struct TriggerLatency {
     /// Cycles from the first watched sample past the level to the first
     /// sample of mode `to`.
     pub cycles: u64,
-    /// That first sample past the level: its channel (the conversion's
-    /// lead) and its instant in cycles from its frame's start.
+    /// That first sample past the level: its channel (a watched one: in a
+    /// chain, the first watched member of the conversion) and its instant in
+    /// cycles from its frame's start.
     pub channel: usize,
     pub instant: u64,
 }
@@ -77,7 +78,7 @@ pub fn trigger_latency(s: &Schedule, k: usize) -> Option<TriggerLatency> {
 
 /// For each watched instant `t0` of a frame of `from` (taken in frame 1,
 /// after a whole frame of `from`): the latency if `t0` is the first sample
-/// past the level, `(cycles, lead channel, t0 - F)`.
+/// past the level, `(cycles, watched channel, t0 - F)`.
 ///
 /// Closed form: windows hold from `w0` on, where `w0` is `t0`'s window for
 /// `above` (the sample itself is past the level, and every later window has
@@ -87,13 +88,19 @@ pub fn trigger_latency(s: &Schedule, k: usize) -> Option<TriggerLatency> {
 /// after that: the switch is at frame `w0 + n + 1`.
 fn latencies(from: &Schedule, t: &crate::mix::Trigger, first_to: u64) -> Vec<(u64, usize, u64)> {
     let f = from.grid.frame_cycles;
-    let leads: Vec<usize> = t.channels.iter().map(|&c| from.mix.lead_of(c)).collect();
+    // an instant converts its lead's chain: name the watched member in it
+    let watched = |lead: usize| {
+        t.channels
+            .iter()
+            .copied()
+            .find(|&c| from.mix.lead_of(c) == lead)
+    };
     let seen: Vec<(u64, u64, usize)> = from
         .instants(2)
-        .filter(|i| leads.contains(&i.channel))
-        .map(|i| {
+        .filter_map(|i| {
+            let c = watched(i.channel)?;
             let e = i.cycle + from.branches[i.branch].spi.read_cycles;
-            (i.cycle, e / f, i.channel)
+            Some((i.cycle, e / f, c))
         })
         .collect();
     let n = t.for_frames as u64;

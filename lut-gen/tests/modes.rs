@@ -187,6 +187,13 @@ fn check_schedule(s: &Schedule) -> Result<(), TestCaseError> {
             .max()
             .unwrap();
         prop_assert_eq!(got.cycles, walked, "trigger {}", k);
+        // the sample the audit names is one the trigger watches
+        prop_assert!(
+            t.channels.contains(&got.channel),
+            "trigger {}: channel {}",
+            k,
+            got.channel
+        );
     }
     text_and_json_agree(s);
     Ok(())

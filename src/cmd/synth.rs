@@ -93,10 +93,12 @@ fn prepare(a: &Args, s: &lut_gen::Schedule, dir: &Path) -> Result<PathBuf, u8> {
                 2u8
             })?;
             if b.fpga != a.fpga {
+                let (_, stock) = a.fpga.board();
                 eprintln!(
-                    "error: board file {}: its part is {} (fpga = \"{}\"), not --fpga {}",
+                    "error: board file {} is for {} (its `fpga`), not --fpga {}: use --fpga {}, or a board file of {} (constraints/{stock})",
                     p.display(),
                     b.fpga,
+                    a.fpga,
                     b.fpga,
                     a.fpga
                 );
@@ -111,7 +113,16 @@ fn prepare(a: &Args, s: &lut_gen::Schedule, dir: &Path) -> Result<PathBuf, u8> {
         }
     };
     let e = hdl::emit(s, Some(&board)).map_err(|e| {
-        eprintln!("error: {}: {e}", a.mix.display());
+        // the stock board is named as it ships, not by its copy in `dir`
+        let (_, file) = a.fpga.board();
+        let shown = board.display().to_string();
+        let message = match a.board {
+            None => e
+                .to_string()
+                .replace(&shown, &format!("constraints/{file}")),
+            Some(_) => e.to_string(),
+        };
+        eprintln!("error: {}: {message}", a.mix.display());
         match (&e, &a.board) {
             (hdl::HdlError::Board { .. }, Some(_)) => 2u8,
             _ => 1,

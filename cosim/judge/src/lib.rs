@@ -70,7 +70,7 @@ pub use invariants::Invariants;
 pub use model::{CycleModel, SlotModel};
 pub use modes::ModeTrack;
 pub use rule::Rule;
-pub use verdict::{ChannelStats, Divergence, Verdict, Violation};
+pub use verdict::{counted, ChannelStats, Divergence, Verdict, Violation};
 
 // Running a design (any `Dut`) against the model, with faults on its pins.
 pub use faults::{FaultyDut, PinFault};

@@ -253,7 +253,6 @@ impl Verdict {
     }
 }
 
-/// `n` and the noun, plural unless `n` is 1: "1 frame", "2 frames".
 /// The first line's verdict, for a window and for a capture alike: a pass
 /// whose link was never joined says so rather than reading as a whole pass.
 pub(crate) fn verdict_word(ok: bool, link_judged: Option<bool>) -> &'static str {
@@ -264,10 +263,12 @@ pub(crate) fn verdict_word(ok: bool, link_judged: Option<bool>) -> &'static str 
     }
 }
 
-fn counted(n: u64, noun: &str) -> String {
-    if n == 1 {
-        format!("1 {noun}")
-    } else {
-        format!("{n} {noun}s")
+/// `n` of a countable noun, singular or plural as `n` needs ("1 frame",
+/// "2 frames", "3 random mixes"): every count a user reads says it so.
+pub fn counted(n: u64, noun: &str) -> String {
+    match n {
+        1 => format!("1 {noun}"),
+        _ if noun.ends_with('x') || noun.ends_with('s') => format!("{n} {noun}es"),
+        _ => format!("{n} {noun}s"),
     }
 }

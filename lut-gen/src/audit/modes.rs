@@ -161,7 +161,10 @@ impl AuditReport {
             if m > 0 {
                 let said = |x: &String| format!("in mode `{name}`: {x}");
                 // (a link a mode cannot carry is the report's own error already)
-                let own = r.errors.iter().filter(|e| !e.starts_with("line "));
+                let own = r
+                    .errors
+                    .iter()
+                    .filter(|e| Some(*e) != r.link_error.as_ref());
                 self.errors.extend(own.map(said));
                 self.warnings.extend(r.warnings.iter().map(said));
             }

@@ -308,7 +308,7 @@ impl AuditReport {
 /// With modes, the link's words and bytes are its worst mode's: say whose.
 fn worst_mode(l: &crate::hostlink::LinkPlan) -> String {
     match &l.worst_mode {
-        Some(m) => format!(" in mode `{m}` (the most bytes per frame; FIFO, latency and minimum baud the worst of every mode and switch)"),
+        Some(m) => format!(" in mode `{m}` (the most bytes per frame; FIFO the most of every mode and switch, latency and minimum baud the worst mode's)"),
         None => String::new(),
     }
 }

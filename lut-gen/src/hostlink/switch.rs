@@ -97,16 +97,15 @@ pub fn switch_backlog(a: &Schedule, b: &Schedule, line: Line) -> usize {
         Line::Uart(_) => None,
     };
     let end = (frames.len() as u64 + 1) * g.frame_cycles;
-    // by cycle: the sample on `sample_valid`, if any
-    let mut valid: Vec<Option<u16>> = vec![None; end as usize];
-    for &(v, _, ch) in stream.iter().filter(|&&(v, _, _)| v < end) {
-        valid[v as usize] = Some(ch);
-    }
-    for v in valid {
+    // the stream is in cycle order, one sample a cycle at most: a cursor
+    // (not a table by cycle, which a long frame would make gigabytes)
+    let mut next = stream.iter().filter(|&&(v, _, _)| v < end).peekable();
+    for c in 0..end {
         if let Some(d) = slave.as_mut() {
             let r = d.ready(t.tvalid());
             t.set_tready(r);
         }
+        let v = next.next_if(|&&(v, _, _)| v <= c).map(|&(_, _, ch)| ch);
         t.clock(false, v.map(|ch| (ch, 0)));
         if t.max_backlog > MAX_FIFO_DEPTH {
             break;

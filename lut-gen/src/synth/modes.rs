@@ -18,8 +18,16 @@ pub(super) fn synthesize_modes(mix: &Mix, budget: u64) -> Result<Schedule, Infea
             Err(why) => return Err(in_mode(mix, name, why)),
         }
     }
+    let mut cut_short = false;
     for sps in candidate_slots_per_slice(mix, min_slot) {
-        if let Some(modes) = on_grid(mix, sps, budget) {
+        let modes = match on_grid(mix, sps, budget) {
+            Ok(modes) => modes,
+            Err(verdict) => {
+                cut_short |= verdict == Verdict::Unknown;
+                continue;
+            }
+        };
+        {
             let mut top = modes[0].clone();
             top.mix = mix.in_mode(0);
             top.modes = modes;
@@ -39,6 +47,16 @@ pub(super) fn synthesize_modes(mix: &Mix, budget: u64) -> Result<Schedule, Infea
         .map(|(n, s)| format!("mode `{n}` alone: {s} slots per slice"))
         .collect::<Vec<_>>()
         .join(", ");
+    if cut_short {
+        let mut why = alone(
+            mix,
+            vec![format!(
+                "every mode fits a grid of its own ({each}), but the search for one slot grid that places every mode stopped at its bound of {budget} placements on some grid: the mix may fit (a larger `--search-limit` decides more)"
+            )],
+        );
+        why.verdict = Verdict::Unknown;
+        return Err(why);
+    }
     Err(alone(
         mix,
         vec![format!(
@@ -47,19 +65,19 @@ pub(super) fn synthesize_modes(mix: &Mix, budget: u64) -> Result<Schedule, Infea
     ))
 }
 
-/// Every mode's schedule at `sps` slots per slice, or `None` if one of them
-/// does not fit it.
-fn on_grid(mix: &Mix, sps: u64, budget: u64) -> Option<Vec<Schedule>> {
+/// Every mode's schedule at `sps` slots per slice, or the verdict of the
+/// first mode that does not fit it (`Unknown`: its search was cut short).
+fn on_grid(mix: &Mix, sps: u64, budget: u64) -> Result<Vec<Schedule>, Verdict> {
     let mut out = Vec::new();
     for m in 0..mix.mode_count() {
         let mut mm = one_mode(mix, m);
         mm.slots_per_slice = Some(sps);
-        let mut s = synthesize_one(&mm, budget).ok()?;
+        let mut s = synthesize_one(&mm, budget).map_err(|why| why.verdict)?;
         // The grid was forced here, not by the user.
         s.mix.slots_per_slice = mix.slots_per_slice;
         out.push(s);
     }
-    Some(out)
+    Ok(out)
 }
 
 /// Mode `m` as a mix of its own: its rates, no modes.
@@ -148,6 +166,30 @@ mod tests {
         forced.slots_per_slice = Some(1);
         let why = synthesize(&forced).unwrap_err();
         assert!(why.to_string().contains("in mode `fast`: "), "{why}");
+    }
+
+    /// A grid's verdict is the failing mode's: a count proves a grid too
+    /// small, a search cut at its bound is unknown (and so is the mix, if
+    /// no grid places every mode: exit 3, never "infeasible").
+    #[test]
+    fn a_grid_cut_short_is_unknown_not_infeasible() {
+        let mix = testkit("modes-pin");
+        assert_eq!(
+            on_grid(&mix, 1, SEARCH_BUDGET).unwrap_err(),
+            Verdict::Infeasible
+        );
+        let sps = synthesize(&mix).unwrap().grid.slots_per_slice;
+        assert!(on_grid(&mix, sps, SEARCH_BUDGET).is_ok());
+        // rates that are not harmonic need the exact search (the mix of
+        // synth.rs' bound test, in two modes): cut at 2 placements, it
+        // stops with neither a schedule nor a proof
+        let text = format!(
+            "{}\n[[mode]]\nname = \"a\"\n[[mode]]\nname = \"b\"\n[modes]\nselect = \"pin\"\n",
+            include_str!("../../tests/data/missed.toml")
+        );
+        let odd = crate::parse(std::path::Path::new("missed.toml"), &text).unwrap();
+        assert_eq!(on_grid(&odd, 96, 2).unwrap_err(), Verdict::Unknown);
+        assert!(on_grid(&odd, 96, SEARCH_BUDGET).is_ok());
     }
 
     #[test]

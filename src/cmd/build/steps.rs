@@ -25,30 +25,44 @@ fn sim_backend() -> Backend {
 /// other processes, so on two cores they run beside the simulations.
 type Background = std::thread::JoinHandle<(Result<measure::Synth, String>, f64)>;
 
-fn start_synth(out: &std::path::Path, s: &Schedule, fpga: lut_gen::Fpga) -> Option<Background> {
+/// Why place and route did not start.
+enum NotStarted {
+    /// yosys or nextpnr for the part is not installed.
+    Missing,
+    /// Its files could not be written (the message says which).
+    Io(String),
+}
+
+fn start_synth(
+    out: &std::path::Path,
+    s: &Schedule,
+    fpga: lut_gen::Fpga,
+) -> Result<Background, NotStarted> {
     let (pnr, _) = fpga.nextpnr();
     if measure::find_program(fpga.yosys()).is_err() || measure::find_program(pnr).is_err() {
-        return None;
+        return Err(NotStarted::Missing);
     }
     let dir = out.join("synth");
+    let io =
+        |p: &std::path::Path, e: std::io::Error| NotStarted::Io(format!("{}: {e}", p.display()));
     // iCE40: IO left unconstrained, as the estimate always was; the other
     // parts on their board (Gowin's nextpnr places no unconstrained port)
     let board = (fpga != lut_gen::Fpga::Ice40Hx8k).then(|| dir.join(fpga.board().1));
-    std::fs::create_dir_all(&dir).ok()?;
+    std::fs::create_dir_all(&dir).map_err(|e| io(&dir, e))?;
     if let Some(b) = &board {
-        std::fs::write(b, hdl::stock_board(fpga)).ok()?;
+        std::fs::write(b, hdl::stock_board(fpga)).map_err(|e| io(b, e))?;
     }
     let clock = s.grid.clock_hz;
     let e = hdl::emit(s, board.as_deref());
     if let Ok(e) = &e {
-        super::super::write_atomic(&dir, hdl::VERILOG_FILE, e.verilog()).ok()?;
-        if board.is_some() {
-            let c = fpga.family().constraints().file();
-            super::super::write_atomic(&dir, c, e.file(c)?).ok()?;
+        super::super::write_atomic(&dir, hdl::VERILOG_FILE, e.verilog()).map_err(NotStarted::Io)?;
+        let c = fpga.family().constraints().file();
+        if let (true, Some(text)) = (board.is_some(), e.file(c)) {
+            super::super::write_atomic(&dir, c, text).map_err(NotStarted::Io)?;
         }
     }
     let constraints = board.map(|_| dir.join(fpga.family().constraints().file()));
-    Some(std::thread::spawn(move || {
+    Ok(std::thread::spawn(move || {
         let t = std::time::Instant::now();
         let r = match e {
             Ok(_) => measure::place_and_route_for(fpga, &dir, constraints.as_deref(), clock, 1),
@@ -63,11 +77,9 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
     // engines run clean outside the campaign, for the speed chart
     let mut clean: Vec<measure::CleanRun> = Vec::new();
     let mut campaign = None;
-    let mut background = if plan.contains(&(Step::Synth, Run::Yes)) {
-        start_synth(&job.out, s, a.fpga)
-    } else {
-        None
-    };
+    let mut background = plan
+        .contains(&(Step::Synth, Run::Yes))
+        .then(|| start_synth(&job.out, s, a.fpga));
     for &(step, run) in plan {
         if let Run::Skip(why) = run {
             job.not_run(step, &format!("not run ({why})"));
@@ -92,7 +104,12 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
                 &mut clean,
             ),
             Step::Prove => prove(j, s, &mut clean),
-            Step::Synth => synth(j, s, a.fpga, background.take()),
+            Step::Synth => synth(
+                j,
+                s,
+                a.fpga,
+                background.take().unwrap_or(Err(NotStarted::Missing)),
+            ),
             Step::Netlist => netlist(j, s),
             Step::Timing => timing(j, s),
             Step::Figure7 => figure7(s),
@@ -265,10 +282,10 @@ fn sim(
     let sec = Section {
         title: "Co-simulation".into(),
         paragraphs: vec![format!(
-            "{} frames of the emitted design in {}, every cycle compared with the reference model and every invariant checked: {}. Sample counts and intervals as the run measured them, by branch and rate (jitter = largest minus smallest interval; the channels themselves are listed once, in the audit).",
-            r.frames,
+            "{} of the emitted design in {}, every cycle compared with the reference model and every invariant checked: {}. Sample counts and intervals as the run measured them, by branch and rate (jitter = largest minus smallest interval; the channels themselves are listed once, in the audit).",
+            counted(r.frames, "frame"),
             backend.name(),
-            if r.ok { "no divergence, no violation".to_string() } else { format!("{} divergences, {} violations", r.divergence_count, r.violation_count) }
+            if r.ok { "no divergence, no violation".to_string() } else { format!("{}, {}", counted(r.divergence_count, "divergence"), counted(r.violation_count, "violation")) }
         )],
         tables: vec![("Intervals measured, by branch and rate".into(), measure::interval_table(s, &r))],
         links: vec![
@@ -290,16 +307,17 @@ fn sim(
     ];
     let d = if r.ok {
         Done::ok(format!(
-            "{}: {} frames, {} samples, every cycle equal to the model, no violation",
+            "{}: {}, {}, every cycle equal to the model, no violation",
             backend.name(),
-            r.frames,
-            r.samples
+            counted(r.frames, "frame"),
+            counted(r.samples, "sample")
         ))
     } else {
         Done::failed(
             format!(
-                "{} divergences, {} violations",
-                r.divergence_count, r.violation_count
+                "{}, {}",
+                counted(r.divergence_count, "divergence"),
+                counted(r.violation_count, "violation")
             ),
             r.summary(),
         )
@@ -308,16 +326,16 @@ fn sim(
         Glance::Checked,
         if r.ok {
             format!(
-                "yes: {} frames of the emitted Verilog on {}, every pin every cycle equal to the reference model, no violation",
-                r.frames,
+                "yes: {} of the emitted Verilog on {}, every pin every cycle equal to the reference model, no violation",
+                counted(r.frames, "frame"),
                 backend.name()
             )
         } else {
             format!(
-                "NO: {} divergences, {} violations in {} frames on {}",
-                r.divergence_count,
-                r.violation_count,
-                r.frames,
+                "NO: {}, {} in {} on {}",
+                counted(r.divergence_count, "divergence"),
+                counted(r.violation_count, "violation"),
+                counted(r.frames, "frame"),
                 backend.name()
             )
         },
@@ -518,17 +536,29 @@ fn proved(
     d.files(&files).section(shown.section)
 }
 
-fn synth(j: &mut Job, s: &Schedule, fpga: lut_gen::Fpga, background: Option<Background>) -> Done {
+fn synth(
+    j: &mut Job,
+    s: &Schedule,
+    fpga: lut_gen::Fpga,
+    background: Result<Background, NotStarted>,
+) -> Done {
     let (pnr, _) = fpga.nextpnr();
-    let Some(h) = background else {
-        j.answer(
-            Glance::Size,
-            format!("not measured: {} or {pnr} not installed", fpga.yosys()),
-        );
-        return Done::skipped(format!(
-            "{} or {pnr} not installed (make tools)",
-            fpga.yosys()
-        ));
+    let h = match background {
+        Ok(h) => h,
+        Err(NotStarted::Missing) => {
+            j.answer(
+                Glance::Size,
+                format!("not measured: {} or {pnr} not installed", fpga.yosys()),
+            );
+            return Done::skipped(format!(
+                "{} or {pnr} not installed (make tools)",
+                fpga.yosys()
+            ));
+        }
+        Err(NotStarted::Io(why)) => {
+            j.answer(Glance::Size, format!("not measured: {why}"));
+            return Done::failed(format!("not measured: {why}"), "");
+        }
     };
     let Ok((r, secs)) = h.join() else {
         return Done::failed("place and route stopped unexpectedly", "");
@@ -619,13 +649,17 @@ fn netlist(j: &mut Job, s: &Schedule) -> Done {
     let w = j.write("", &[("netlist.json", json)]);
     let line = if r.ok {
         format!(
-            "{}: {} frame, {} samples, every cycle equal to the model, no violation",
-            r.source, r.frames, r.samples
+            "{}: {}, {}, every cycle equal to the model, no violation",
+            r.source,
+            counted(r.frames, "frame"),
+            counted(r.samples, "sample")
         )
     } else {
         format!(
-            "{}: {} divergences, {} violations",
-            r.source, r.divergence_count, r.violation_count
+            "{}: {}, {}",
+            r.source,
+            counted(r.divergence_count, "divergence"),
+            counted(r.violation_count, "violation")
         )
     };
     let sec = Section {
