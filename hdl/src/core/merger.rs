@@ -310,18 +310,13 @@ fn queue_text(nb: usize) -> String {
         w - nb + 1,
         nb - 1
     ));
-    // The output registers' load and reset as gates rather than an
-    // enable: yosys would make `r_any | rst` their enable (an iCE40
-    // flip-flop resets only when enabled), one LUT into a global buffer on
-    // the core's critical path; as gates it is a LUT per bit, in the
-    // bit's own logic cell.
-    for (r, src, n) in [("r_ch", "ch$0", CH_BITS), ("r_val", "v$0", VALUE_BITS)] {
-        s.push_str(&format!(
-            "  {r}$d = ({{{n}{{r_any$q}}}} & {src} | {{{n}{{!r_any$q}}}} & {r}$q) & {{{n}{{!rst}}}};\n"
-        ));
-    }
+    // The output registers under `r_any | rst` (an iCE40 flip-flop resets
+    // only when enabled). As gates (a LUT per bit, no enable) they were
+    // faster, but `prove --netlist` then cannot see them renewed every
+    // frame (the held value's feedback LUT), and says bounded, not proved.
+    s.push_str("  if (r_any$q) begin\n    r_ch$d = ch$0;\n    r_val$d = v$0;\n  end\n");
     s.push_str(&format!(
-        "  if (rst) begin\n    r_valid$d = 1'b0;\n    pend$d = {w}'h0;\n  end\n"
+        "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = {VALUE_BITS}'h0;\n    pend$d = {w}'h0;\n  end\n"
     ));
     s.push_str(&format!(
         "  r_any$d = !rst & |{{pend$d[0], done_next[{}:0]}};\n",
