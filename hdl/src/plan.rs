@@ -161,6 +161,11 @@ pub struct Plan {
     pub link: Option<crate::link::LinkParams>,
     /// The mode block, when the mix has modes.
     pub modes: Option<ModePlan>,
+    /// The merger's form: `Some(sources)` when the branches' shift registers
+    /// are the output queue (see [`queue_sources`]), `sources[j]` the
+    /// branches whose MISO lane `j`'s register ever captures; `None` for the
+    /// pending-set merger with its own output multiplexer.
+    pub queue: Option<Vec<Vec<usize>>>,
 }
 
 pub fn addr_bits(frame_slots: u64) -> usize {
@@ -244,9 +249,19 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
     let mut branches = Vec::with_capacity(s.branches.len());
     let mut en_offset = 0usize;
     for b in 0..s.branches.len() {
-        let rom = branch_rom(s, b, compact, words, en_offset, &mut seqs)?;
+        let rom = branch_rom(s, b, compact, words, en_offset, &mut seqs, None)?;
         en_offset += rom.devices;
         branches.push(rom);
+    }
+    let queue = queue_sources(s, &seqs, &branches);
+    if queue.is_some() {
+        // lane b's ROM names the channel of the slot's b-th converting branch
+        let lanes = lane_channels(s);
+        let mut en_offset = 0usize;
+        for (b, rom) in branches.iter_mut().enumerate() {
+            *rom = branch_rom(s, b, compact, words, en_offset, &mut seqs, Some(&lanes[b]))?;
+            en_offset += rom.devices;
+        }
     }
     let mut p = Plan {
         compact,
@@ -258,10 +273,67 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         seqs,
         branches,
         link: crate::link::LinkParams::of(s).map_err(unsupported)?,
+        queue,
         modes: None,
     };
     crate::modeplan::apply(s, &mut p)?;
     Ok(p)
+}
+
+/// `lanes[j][u]`: the channel of the `j`-th branch (in branch order) that
+/// converts in frame slot `u`.
+fn lane_channels(s: &Schedule) -> Vec<Vec<Option<usize>>> {
+    let nb = s.branches.len();
+    let mut lanes = vec![vec![None; s.grid.frame_slots as usize]; nb];
+    for u in 0..s.grid.frame_slots {
+        let conv = (0..nb).filter_map(|b| s.at(u, b));
+        for (j, c) in conv.enumerate() {
+            lanes[j][u as usize] = Some(c);
+        }
+    }
+    lanes
+}
+
+/// Whether the branches' MISO shift registers can be the merger's queue
+/// (hdl/DESIGN.md, "Merger"), and if so, for each lane `j`, the branches
+/// whose MISO its register captures (the `j`-th converting branch of some
+/// slot). It can when every branch completes in the same cycle of its slot
+/// (one SPI sequencer) with one word (no chain), so a slot's words leave in
+/// branch order from lane 0 while each lane takes the next one's register;
+/// and when the start-up skip (docs/timing.md, "Start-up") drops only
+/// branches above every branch that converts in slot 0, so that the lanes
+/// the ROM names for slot 0 are the ones that capture.
+fn queue_sources(s: &Schedule, seqs: &[SeqTiming], roms: &[BranchRom]) -> Option<Vec<Vec<usize>>> {
+    let nb = roms.len();
+    if nb < 2 || seqs.len() != 1 || roms.iter().any(|r| r.chain != 1) {
+        return None;
+    }
+    // modes put every mode's table on the ROM address and a command unit
+    // reads the mux field: both keep the pending-set merger
+    if !s.modes.is_empty() || roms.iter().any(|r| r.command.is_some()) {
+        return None;
+    }
+    let conv: Vec<bool> = (0..nb).map(|b| s.at(0, b).is_some()).collect();
+    let kept = (0..nb).filter(|&b| conv[b] && roms[b].conv0).max();
+    let skipped = (0..nb).filter(|&b| conv[b] && !roms[b].conv0).min();
+    if let (Some(k), Some(x)) = (kept, skipped) {
+        if x < k {
+            return None;
+        }
+    }
+    let mut sources = vec![Vec::new(); nb];
+    for u in 0..s.grid.frame_slots {
+        let on = (0..nb).filter(|&b| s.at(u, b).is_some());
+        for (j, b) in on.enumerate() {
+            if !sources[j].contains(&b) {
+                sources[j].push(b);
+            }
+        }
+    }
+    for src in sources.iter_mut() {
+        src.sort_unstable();
+    }
+    Some(sources)
 }
 
 /// The grid against the gateware's counters and ROMs; whether the slot LUT
@@ -327,6 +399,7 @@ fn branch_rom(
     words: u64,
     en_offset: usize,
     seqs: &mut Vec<SeqTiming>,
+    lane: Option<&[Option<usize>]>,
 ) -> Result<BranchRom, HdlError> {
     let g = &s.grid;
     let bp = &s.branches[b];
@@ -390,7 +463,9 @@ fn branch_rom(
         command: adc.command.clone(),
         modes: None,
     };
-    fill_rom(s, &mut rom, &slots, &next, compact);
+    // the ROM's channel field: the branch's own, or in the queue form its
+    // lane's (the conversion and mux fields stay the branch's)
+    fill_rom(s, &mut rom, &slots, lane.unwrap_or(&slots), &next, compact);
     if let Some((sel, dev)) = next[0] {
         rom.reset_sel = sel;
         rom.reset_en = 1u64 << dev;
@@ -560,6 +635,7 @@ fn fill_rom(
     s: &Schedule,
     rom: &mut BranchRom,
     slots: &[Option<usize>],
+    chans: &[Option<usize>],
     next: &[Option<(u32, u32)>],
     compact: bool,
 ) {
@@ -573,7 +649,7 @@ fn fill_rom(
         let table: Vec<u32> = (0..n)
             .map(|u| {
                 let (sel, dev) = mux(next[(u + 1) % n]);
-                rom.word(slots[u].is_some(), slots[u].unwrap_or(0) as u32, sel, dev)
+                rom.word(slots[u].is_some(), chans[u].unwrap_or(0) as u32, sel, dev)
             })
             .collect();
         let c = compact_words(&table, sps as usize, k as usize, rom.word_bits());
@@ -585,9 +661,46 @@ fn fill_rom(
         let mut words = vec![0u32; 1 << rom.addr_bits];
         for u in 0..n {
             let (sel, dev) = mux(next[u]);
-            let ch = slots[u].unwrap_or(0) as u32;
+            let ch = chans[u].unwrap_or(0) as u32;
             words[u] = rom.word(slots[u].is_some(), ch, sel, dev);
         }
         rom.words = words;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn schedule(mix: &str) -> Schedule {
+        let path = testkit::root().join("mixes").join(mix);
+        let text = std::fs::read_to_string(&path).unwrap();
+        lut_gen::synthesize(&lut_gen::parse(&path, &text).unwrap()).unwrap()
+    }
+
+    /// The queue form where one sequencer completes every branch's single
+    /// word (eskin34, whose slot 1 has branches 0 and 2 only), the
+    /// priority form for a chain (vibrotactile8k); in the queue form lane
+    /// `j`'s ROM names the channel of the slot's `j`-th converting branch.
+    #[test]
+    fn queue_form_where_one_sequencer_completes_single_words() {
+        let s = schedule("eskin34.toml");
+        let p = plan_with(&s, LutForm::Full).unwrap();
+        let q = p.queue.as_ref().expect("eskin34: queue form");
+        assert_eq!(q[1], vec![1, 2]);
+        for u in 0..s.grid.frame_slots {
+            let on: Vec<usize> = (0..p.branches.len()).filter_map(|b| s.at(u, b)).collect();
+            for (b, rom) in p.branches.iter().enumerate() {
+                let w = rom.words[u as usize];
+                let conv = w >> (rom.ch_bits + 3 + rom.dev_bits) & 1 == 1;
+                let ch = (w >> (3 + rom.dev_bits)) as usize & ((1 << rom.ch_bits) - 1);
+                assert_eq!(conv, s.at(u, b).is_some(), "slot {u} branch {b}");
+                if let Some(&c) = on.get(b) {
+                    assert_eq!(ch, c, "slot {u} lane {b}");
+                }
+            }
+        }
+        let v = schedule("vibrotactile8k.toml");
+        assert!(plan_with(&v, LutForm::Full).unwrap().queue.is_none());
     }
 }

@@ -22,6 +22,15 @@ pub struct BranchUnit {
     pub miso: Signal<In, Bit>,
     /// The merger takes this branch's word at the end of this cycle.
     pub grant: Signal<In, Bit>,
+    /// The merger's queue form: its registered enables (`Merger::sh_en`,
+    /// `ch_en`): the shift register loads (MISO if `seq_cap`, else the next
+    /// lane's word `q_val`), the channel loads (the ROM's if `start1`,
+    /// else the next lane's `q_ch`) at the end of this cycle. Tied low in
+    /// the priority form.
+    pub sh_en: Signal<In, Bit>,
+    pub ch_en: Signal<In, Bit>,
+    pub q_ch: Signal<In, Bits<CH_BITS>>,
+    pub q_val: Signal<In, Bits<VALUE_BITS>>,
     /// The conversion pin at its board polarity (CS low or CNV high while active).
     pub cs_n: Signal<Out, Bit>,
     pub sclk: Signal<Out, Bit>,
@@ -35,6 +44,9 @@ pub struct BranchUnit {
     pub res_val: Signal<Out, Bits<VALUE_BITS>>,
     /// More words of this conversion follow the one on `res_*`.
     pub more: Signal<Out, Bit>,
+    /// The branch converts in the slot of the next cycle (the queue form's
+    /// MISO routing reads it).
+    pub act_q: Signal<Out, Bit>,
     pub(super) rom: SlotRom,
     pub(super) reader: WordReader,
     /// The branch converts in the slot of cycle c + 1 (cycles t - 1 ..= t + S - 2).
@@ -51,6 +63,8 @@ pub struct BranchUnit {
     pub(super) p_sel: DFF<Bits<3>>,
     pub(super) p_dev: DFF<Bits<DEV_BITS>>,
     k_compact: Constant<Bit>,
+    /// The merger's queue form.
+    k_queue: Constant<Bit>,
     /// The conversion pin is a CNV (active high); SCLK's idle level.
     k_cnv: Constant<Bit>,
     k_sclk_idle: Constant<Bit>,
@@ -61,7 +75,7 @@ pub struct BranchUnit {
 }
 
 impl BranchUnit {
-    pub(super) fn new(rom: &BranchRom) -> BranchUnit {
+    pub(super) fn new(rom: &BranchRom, queue: bool) -> BranchUnit {
         BranchUnit {
             clock: Default::default(),
             rst: Default::default(),
@@ -76,6 +90,10 @@ impl BranchUnit {
             seq_done: Default::default(),
             miso: Default::default(),
             grant: Default::default(),
+            sh_en: Default::default(),
+            ch_en: Default::default(),
+            q_ch: Default::default(),
+            q_val: Default::default(),
             cs_n: Signal::new_with_default(!rom.cnv),
             sclk: Signal::new_with_default(!rom.cnv),
             mux_sel: Default::default(),
@@ -85,8 +103,9 @@ impl BranchUnit {
             res_ch: Default::default(),
             res_val: Default::default(),
             more: Default::default(),
+            act_q: Default::default(),
             rom: SlotRom::new(rom),
-            reader: WordReader::new(rom),
+            reader: WordReader::new(rom, queue),
             act: Default::default(),
             r_cs_n: Default::default(),
             r_sclk: Default::default(),
@@ -97,6 +116,7 @@ impl BranchUnit {
             p_sel: Default::default(),
             p_dev: Default::default(),
             k_compact: Constant::new(rom.compact.is_some()),
+            k_queue: Constant::new(queue),
             k_cnv: Constant::new(rom.cnv),
             k_sclk_idle: Constant::new(!rom.cnv),
             k_sel_rst: c(rom.reset_sel as u64),
@@ -119,12 +139,22 @@ impl Logic for BranchUnit {
             // Cycle t - 2: the ROM describes the slot starting at t.
             self.act.d.next = self.rom.conv.val();
         }
-        if self.start1.val() {
-            self.cur_ch.d.next = self.rom.ch.val();
-            if self.k_compact.val() {
-                self.p_sel.d.next = self.rom.msel.val();
-                self.p_dev.d.next = self.rom.mdev.val();
+        if self.k_queue.val() {
+            // the lane above's channel moves up, or the slot's is loaded,
+            // under one registered enable
+            if self.ch_en.val() {
+                if self.start1.val() {
+                    self.cur_ch.d.next = self.rom.ch.val();
+                } else {
+                    self.cur_ch.d.next = self.q_ch.val();
+                }
             }
+        } else if self.start1.val() {
+            self.cur_ch.d.next = self.rom.ch.val();
+        }
+        if self.start1.val() & self.k_compact.val() {
+            self.p_sel.d.next = self.rom.msel.val();
+            self.p_dev.d.next = self.rom.mdev.val();
         }
         if self.start0.val() {
             if self.k_compact.val() {
@@ -153,6 +183,8 @@ impl Logic for BranchUnit {
         self.reader.cap.next = self.seq_cap.val();
         self.reader.miso.next = self.miso.val();
         self.reader.grant.next = self.grant.val();
+        self.reader.en.next = self.sh_en.val();
+        self.reader.q_in.next = self.q_val.val();
         self.reader.lead.next = self.cur_ch.q.val();
         if self.rst.val() {
             self.act.d.next = self.k_conv0.val();
@@ -171,5 +203,6 @@ impl Logic for BranchUnit {
         self.res_ch.next = self.reader.ch.val();
         self.res_val.next = self.reader.val.val();
         self.more.next = self.reader.more.val();
+        self.act_q.next = self.act.q.val();
     }
 }

@@ -12,6 +12,7 @@ pub(super) fn core_glue(
     nseq: usize,
     cmd_of: &[Option<usize>],
     modes: Option<(bool, usize)>,
+    queue: Option<&[Vec<usize>]>,
 ) -> String {
     let mut s = String::new();
     s.push_str("always @(*) begin\n");
@@ -19,16 +20,106 @@ pub(super) fn core_glue(
     if let Some((pin, lanes)) = modes {
         mode_inputs(&mut s, nb, pin, lanes);
     }
+    let act_read = queue_inputs(&mut s, nb, queue);
     command_units(&mut s, seq_of, cmd_of);
     lanes(&mut s, nb, devices, cmd_of);
     s.push_str(
         "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
     );
-    unused_wires(&mut s, nb, devices);
+    unused_wires(&mut s, nb, devices, nseq);
     if modes.is_some() {
         s.push_str("// the mode block gives the branches their ROM address\nwire unused_slice = |timing$slice;\n");
     }
+    let unread: Vec<String> = (0..nb)
+        .filter(|b| !act_read.contains(b))
+        .map(|b| format!("branches${b}$act_q"))
+        .collect();
+    if queue.is_none() {
+        s.push_str("// the queue form's lane enables (zero in the priority form)\nwire unused_queue_en = merge$sh_en | merge$ch_en;\n");
+    }
+    if !unread.is_empty() {
+        s.push_str(&format!(
+            "// conversion flags the MISO routing does not need\nwire unused_act = |{{{}}};\n",
+            unread.join(", ")
+        ));
+    }
     s
+}
+
+/// The lane whose register captures branch `b`'s MISO is `j` when `b`
+/// converts and exactly `j` branches below it do: the routing of the
+/// merger's queue form (each lane takes the next one's word, so a slot's
+/// words must sit in lanes `0..n` in branch order). A lane with one source
+/// reads it unconditionally: in the slots it is used it is that one.
+pub(super) fn route_miso(queue: &[Vec<usize>], act: u64, miso: u64) -> u64 {
+    let mut out = 0u64;
+    for (j, srcs) in queue.iter().enumerate() {
+        let last = srcs.last().copied().unwrap_or(j);
+        let b = srcs[..srcs.len().saturating_sub(1)]
+            .iter()
+            .copied()
+            .find(|&b| (act >> b) & 1 == 1 && (act & ((1u64 << b) - 1)).count_ones() as usize == j)
+            .unwrap_or(last);
+        out |= ((miso >> b) & 1) << j;
+    }
+    out
+}
+
+/// The Verilog of [`route_miso`] and the queue's lane-to-lane wiring (or in
+/// the priority form, MISO straight and the queue inputs tied low); the
+/// branches whose `act_q` it reads.
+fn queue_inputs(s: &mut String, nb: usize, queue: Option<&[Vec<usize>]>) -> Vec<usize> {
+    let mut read = Vec::new();
+    for b in 0..nb {
+        let u = format!("branches${b}");
+        let Some(q) = queue else {
+            s.push_str(&format!(
+                "  {u}$miso = adc_miso[{b}];\n  {u}$sh_en = 1'b0;\n  {u}$ch_en = 1'b0;\n  {u}$q_ch = {CH_BITS}'h0;\n  {u}$q_val = {VALUE_BITS}'h0;\n"
+            ));
+            continue;
+        };
+        let srcs = &q[b];
+        let last = srcs.last().copied().unwrap_or(b);
+        let mut e = format!("adc_miso[{last}]");
+        for &src in srcs[..srcs.len().saturating_sub(1)].iter().rev() {
+            read.extend(0..=src);
+            e = format!("({}) ? adc_miso[{src}] : {e}", lanes_below_is(src, b));
+        }
+        s.push_str(&format!(
+            "  {u}$miso = {e};\n  {u}$sh_en = merge$sh_en;\n  {u}$ch_en = merge$ch_en;\n"
+        ));
+        if b + 1 < nb {
+            let n = format!("branches${}", b + 1);
+            s.push_str(&format!(
+                "  {u}$q_ch = {n}$res_ch;\n  {u}$q_val = {n}$res_val;\n"
+            ));
+        } else {
+            s.push_str(&format!(
+                "  {u}$q_ch = {CH_BITS}'h0;\n  {u}$q_val = {VALUE_BITS}'h0;\n"
+            ));
+        }
+    }
+    read.sort_unstable();
+    read.dedup();
+    read
+}
+
+/// Branch `src` converts with exactly `j` branches below it converting.
+fn lanes_below_is(src: usize, j: usize) -> String {
+    let act = |b: usize| format!("branches${b}$act_q");
+    let mut t = vec![act(src)];
+    if j == 0 {
+        t.extend((0..src).map(|b| format!("!{}", act(b))));
+    } else if j == src {
+        t.extend((0..src).map(act));
+    } else {
+        let w = usize::BITS as usize - src.leading_zeros() as usize;
+        let sum: Vec<String> = (0..src)
+            .map(|b| format!("{{{}'h0, {}}}", w - 1, act(b)))
+            .collect();
+        t.push(format!("({}) == {w}'d{j}", sum.join(" + ")));
+    }
+    t.join(" && ")
 }
 
 /// Clock, reset, slot strobes and sequencer levels into every child.
@@ -44,6 +135,8 @@ fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize, timeba
             "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = timing$start2;\n"
         ));
     }
+    // the queue form's single sequencer (unused by the priority form)
+    s.push_str("  merge$cap_next = seqs$0$cap_next;\n  merge$start2 = timing$start2;\n");
     for (b, seq) in seq_of.iter().enumerate().take(nb) {
         let u = format!("branches${b}");
         let q = format!("seqs${seq}");
@@ -56,7 +149,7 @@ fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize, timeba
             ));
         }
         s.push_str(&format!(
-            "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$miso = adc_miso[{b}];\n  {u}$grant = merge$grant[{b}];\n"
+            "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$grant = merge$grant[{b}];\n"
         ));
     }
 }
@@ -201,7 +294,7 @@ fn lanes(s: &mut String, nb: usize, devices: &[usize], cmd_of: &[Option<usize>])
 
 /// Inputs the mix leaves unused, OR-reduced into named wires so that lint
 /// sees them read.
-fn unused_wires(s: &mut String, nb: usize, devices: &[usize]) {
+fn unused_wires(s: &mut String, nb: usize, devices: &[usize], nseq: usize) {
     let unused: Vec<String> = (0..nb)
         .filter(|&b| devices[b] < EN_BITS)
         .map(|b| format!("branches${b}$mux_en[{}:{}]", EN_BITS - 1, devices[b]))
@@ -212,11 +305,42 @@ fn unused_wires(s: &mut String, nb: usize, devices: &[usize]) {
             unused.join(", ")
         ));
     }
+    if nseq > 1 {
+        let caps: Vec<String> = (1..nseq).map(|i| format!("seqs${i}$cap_next")).collect();
+        s.push_str(&format!(
+            "// only a single sequencer's mix has the merger's queue form\nwire unused_cap_next = |{{{}}};\n",
+            caps.join(", ")
+        ));
+    }
     if nb < MAX_BRANCHES {
         s.push_str(&format!(
             "// lanes of branches the mix does not have\nwire unused_miso = |adc_miso[{}:{}];\nwire unused_grant = |merge$grant[{0}:{1}];\n",
             MAX_BRANCHES - 1,
             nb
         ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::route_miso;
+
+    /// For every conversion pattern of up to 6 branches and every MISO
+    /// level, lane `j` captures the `j`-th converting branch's MISO, so a
+    /// slot's words sit in lanes `0..n` in branch order.
+    #[test]
+    fn lanes_capture_the_converting_branches_in_order() {
+        for nb in 1..=6usize {
+            let queue: Vec<Vec<usize>> = (0..nb).map(|j| (j..nb).collect()).collect();
+            for act in 0..1u64 << nb {
+                for miso in 0..1u64 << nb {
+                    let got = route_miso(&queue, act, miso);
+                    let on: Vec<usize> = (0..nb).filter(|b| act >> b & 1 == 1).collect();
+                    for (j, b) in on.iter().enumerate() {
+                        assert_eq!(got >> j & 1, miso >> b & 1, "nb {nb} act {act:b} lane {j}");
+                    }
+                }
+            }
+        }
     }
 }

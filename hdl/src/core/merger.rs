@@ -25,8 +25,20 @@ pub struct Merger {
     pub done_next: Signal<In, Bits<MAX_BRANCHES>>,
     pub ch: [Signal<In, Bits<CH_BITS>>; MAX_BRANCHES],
     pub v: [Signal<In, Bits<VALUE_BITS>>; MAX_BRANCHES],
+    /// Queue form: the sequencer's `cap` of the next cycle and the timing
+    /// generator's `start2`, for the registered lane enables below.
+    pub cap_next: Signal<In, Bit>,
+    pub start2: Signal<In, Bit>,
     /// The lane whose word is taken at the end of this cycle (one-hot).
     pub grant: Signal<Out, Bits<MAX_BRANCHES>>,
+    /// Queue form: the lanes' shift registers load (`cap | mv`) and their
+    /// channel registers load (`start1 | mv`) at the end of this cycle,
+    /// where `mv` (= `r_any`) moves every lane's word and channel to the
+    /// lane below, lane 0's leaving. Zero in the priority form.
+    /// Each is a flip-flop kept equal to its OR, so the enables of about 60
+    /// flip-flops (global buffers in nextpnr) have no LUT in front of them.
+    pub sh_en: Signal<Out, Bit>,
+    pub ch_en: Signal<Out, Bit>,
     pub valid: Signal<Out, Bit>,
     pub channel: Signal<Out, Bits<CH_BITS>>,
     pub value: Signal<Out, Bits<VALUE_BITS>>,
@@ -36,12 +48,18 @@ pub struct Merger {
     pub(super) pend: DFF<Bits<MAX_BRANCHES>>,
     /// P(c) is not empty (kept equal to `(pend | done) != 0`).
     pub(super) r_any: DFF<Bit>,
+    pub(super) r_shen: DFF<Bit>,
+    pub(super) r_chen: DFF<Bit>,
     /// Branches of the mix (lanes `0..nb` are used).
     _nb: usize,
+    /// The queue form (`Plan::queue`): the branches' registers are the
+    /// queue, lane 0 its head; `pend` is then a thermometer of the words
+    /// still queued behind the head.
+    _queue: bool,
 }
 
 impl Merger {
-    pub(super) fn new(nb: usize) -> Merger {
+    pub(super) fn new(nb: usize, queue: bool) -> Merger {
         Merger {
             clock: Default::default(),
             rst: Default::default(),
@@ -50,7 +68,11 @@ impl Merger {
             done_next: Default::default(),
             ch: std::array::from_fn(|_| Default::default()),
             v: std::array::from_fn(|_| Default::default()),
+            cap_next: Default::default(),
+            start2: Default::default(),
             grant: Default::default(),
+            sh_en: Default::default(),
+            ch_en: Default::default(),
             valid: Default::default(),
             channel: Default::default(),
             value: Default::default(),
@@ -59,14 +81,60 @@ impl Merger {
             r_val: Default::default(),
             pend: Default::default(),
             r_any: Default::default(),
+            r_shen: Default::default(),
+            r_chen: Default::default(),
             _nb: nb,
+            _queue: queue,
         }
+    }
+}
+
+impl Merger {
+    /// The queue form's update: P(c) is the words queued behind the head
+    /// plus this cycle's completions, which all fall in one cycle (one SPI
+    /// sequencer) and sit in lanes `0..n` in branch order; P(c) as a
+    /// thermometer, lane 0 leaves and every lane moves up one.
+    fn update_queue(&mut self) {
+        let n = self.done.val().to_u64().count_ones();
+        let p = self.pend.q.val().to_u64() | ((1u64 << n) - 1);
+        self.r_valid.d.next = p & 1 == 1;
+        let mut pend = p >> 1;
+        self.grant.next = 0u64.into();
+        if self.r_any.q.val() {
+            self.r_ch.d.next = self.ch[0].val();
+            self.r_val.d.next = self.v[0].val();
+        }
+        if self.rst.val() {
+            self.r_valid.d.next = false;
+            self.r_ch.d.next = 0u64.into();
+            self.r_val.d.next = 0u64.into();
+            pend = 0;
+        }
+        self.pend.d.next = pend.into();
+        let any = !self.rst.val() & ((pend & 1) | self.done_next.val().to_u64() != 0);
+        self.r_any.d.next = any;
+        // start1 of the next cycle is start2 or reset in this one
+        self.r_shen.d.next = self.cap_next.val() | any;
+        self.r_chen.d.next = self.start2.val() | self.rst.val() | any;
+        self.sh_en.next = self.r_shen.q.val();
+        self.ch_en.next = self.r_chen.q.val();
     }
 }
 
 impl Logic for Merger {
     fn update(&mut self) {
-        dff_setup!(self, clock, r_valid, r_ch, r_val, pend, r_any);
+        dff_setup!(self, clock, r_valid, r_ch, r_val, pend, r_any, r_shen, r_chen);
+        self.valid.next = self.r_valid.q.val();
+        self.channel.next = self.r_ch.q.val();
+        self.value.next = self.r_val.q.val();
+        if self._queue {
+            self.update_queue();
+            return;
+        }
+        self.sh_en.next = false;
+        self.ch_en.next = false;
+        self.r_shen.d.next = false;
+        self.r_chen.d.next = false;
         let p = self.pend.q.val().to_u64() | self.done.val().to_u64();
         self.r_valid.d.next = p != 0;
         let mut pend = 0u64;
@@ -97,9 +165,6 @@ impl Logic for Merger {
         }
         self.pend.d.next = pend.into();
         self.r_any.d.next = !self.rst.val() & ((pend | self.done_next.val().to_u64()) != 0);
-        self.valid.next = self.r_valid.q.val();
-        self.channel.next = self.r_ch.q.val();
-        self.value.next = self.r_val.q.val();
     }
 
     fn connect(&mut self) {
@@ -113,13 +178,22 @@ impl Logic for Merger {
         self.pend.d.connect();
         self.r_any.clock.connect();
         self.r_any.d.connect();
+        self.r_shen.clock.connect();
+        self.r_shen.d.connect();
+        self.r_chen.clock.connect();
+        self.r_chen.d.connect();
         self.grant.connect();
+        self.sh_en.connect();
+        self.ch_en.connect();
         self.valid.connect();
         self.channel.connect();
         self.value.connect();
     }
 
     fn hdl(&self) -> Verilog {
+        if self._queue {
+            return Verilog::Custom(queue_text(self._nb));
+        }
         let nb = self._nb;
         let w = MAX_BRANCHES;
         let mut s = format!(
@@ -127,7 +201,9 @@ impl Logic for Merger {
             nb - 1
         );
         s.push_str("always @(*) begin\n");
-        for f in ["r_valid", "r_ch", "r_val", "pend", "r_any"] {
+        for f in [
+            "r_valid", "r_ch", "r_val", "pend", "r_any", "r_shen", "r_chen",
+        ] {
             s.push_str(&format!("  {f}$clock = clock;\n"));
         }
         s.push_str(&format!(
@@ -174,8 +250,13 @@ impl Logic for Merger {
             "  r_any$d = !rst & |{{pend$d[{0}:0], done_next[{0}:0]}};\n",
             nb - 1
         ));
-        s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
-        let mut unused: Vec<String> = Vec::new();
+        s.push_str(
+            "  r_shen$d = 1'b0;\n  r_chen$d = 1'b0;\n  sh_en = 1'b0;\n  ch_en = 1'b0;\n  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n",
+        );
+        // the queue form's inputs and enables (unused here)
+        let mut unused: Vec<String> = ["cap_next", "start2", "r_shen$q", "r_chen$q"]
+            .map(String::from)
+            .to_vec();
         if nb < w {
             unused.push(format!("done[{}:{nb}]", w - 1));
             unused.push(format!("more[{}:{nb}]", w - 1));
@@ -186,12 +267,77 @@ impl Logic for Merger {
                 unused.push(format!("v${b}"));
             }
         }
-        if !unused.is_empty() {
+        {
             s.push_str(&format!(
-                "\n// lanes of branches the mix does not have (tied to zero by the core)\nwire unused_lanes = |{{{}}};\n",
+                "\n// lanes of branches the mix does not have (tied to zero by the core),\n// the queue form's inputs\nwire unused_lanes = |{{{}}};\n",
                 unused.join(", ")
             ));
         }
         Verilog::Custom(s)
     }
+}
+
+/// The queue form's Verilog (the twin is `Merger::update_queue`): no word
+/// multiplexer, the output registers load lane 0, the head of the queue.
+fn queue_text(nb: usize) -> String {
+    let w = MAX_BRANCHES;
+    let cb = usize::BITS as usize - nb.leading_zeros() as usize;
+    let sum: Vec<String> = (0..nb)
+        .map(|b| format!("{{{}'h0, done[{b}]}}", cb - 1))
+        .collect();
+    let therm: Vec<String> = (0..nb)
+        .rev()
+        .map(|j| format!("(n_done > {cb}'d{j})"))
+        .collect();
+    let mut s = format!(
+        "// the mix's {nb} lanes are the queue, lane 0 its head: this cycle's\n\
+         // completions fill lanes 0..n_done-1, pend holds the words behind the head\n\
+         wire [{}:0] n_done = {};\n\
+         wire [{top}:0] p = pend$q[{top}:0] | {{{}}};\n\n",
+        cb - 1,
+        sum.join(" + "),
+        therm.join(", "),
+        top = nb - 1,
+    );
+    s.push_str("always @(*) begin\n");
+    for f in [
+        "r_valid", "r_ch", "r_val", "pend", "r_any", "r_shen", "r_chen",
+    ] {
+        s.push_str(&format!("  {f}$clock = clock;\n"));
+    }
+    s.push_str(&format!(
+        "  r_valid$d = p[0];\n  r_ch$d = r_ch$q;\n  r_val$d = r_val$q;\n  pend$d = {{{}'h0, p[{}:1]}};\n  grant = {w}'h0;\n",
+        w - nb + 1,
+        nb - 1
+    ));
+    // The output registers under `r_any | rst` (an iCE40 flip-flop resets
+    // only when enabled). As gates (a LUT per bit, no enable) they were
+    // faster, but `prove --netlist` then cannot see them renewed every
+    // frame (the held value's feedback LUT), and says bounded, not proved.
+    s.push_str("  if (r_any$q) begin\n    r_ch$d = ch$0;\n    r_val$d = v$0;\n  end\n");
+    s.push_str(&format!(
+        "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = {VALUE_BITS}'h0;\n    pend$d = {w}'h0;\n  end\n"
+    ));
+    s.push_str(&format!(
+        "  r_any$d = !rst & |{{pend$d[0], done_next[{}:0]}};\n",
+        nb - 1
+    ));
+    s.push_str("  // the lanes' enables, registered: start1 is start2 or reset a cycle late\n");
+    s.push_str("  r_shen$d = cap_next | r_any$d;\n  r_chen$d = start2 | rst | r_any$d;\n");
+    s.push_str("  sh_en = r_shen$q;\n  ch_en = r_chen$q;\n");
+    s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
+    let mut unused: Vec<String> = vec!["more".to_string(), format!("pend$q[{}:{nb}]", w - 1)];
+    if nb < w {
+        unused.push(format!("done[{}:{nb}]", w - 1));
+        unused.push(format!("done_next[{}:{nb}]", w - 1));
+    }
+    for b in 1..w {
+        unused.push(format!("ch${b}"));
+        unused.push(format!("v${b}"));
+    }
+    s.push_str(&format!(
+        "\n// lanes behind the head are read by the lane below, not here\nwire unused_lanes = |{{{}}};\n",
+        unused.join(", ")
+    ));
+    s
 }

@@ -33,6 +33,9 @@ pub struct SpiSeq {
     pub cs_n: Signal<Out, Bit>,
     pub sclk: Signal<Out, Bit>,
     pub cap: Signal<Out, Bit>,
+    /// `cap` of the next cycle (the D input of its flip-flop), for the
+    /// merger's queue form's registered shift enable.
+    pub cap_next: Signal<Out, Bit>,
     pub done: Signal<Out, Bit>,
     pub(super) r_cs_n: DFF<Bit>,
     pub(super) r_sclk: DFF<Bit>,
@@ -59,6 +62,8 @@ pub struct SpiSeq {
     init: Signal<Local, Bit>,
     step: Signal<Local, Bit>,
     rise: Signal<Local, Bit>,
+    /// A converting period ends (SCLK falls, or the conversion's last).
+    wrap: Signal<Local, Bit>,
     k_ph_start: Constant<Bits<PH_BITS>>,
     k_ph_zero: Constant<Bits<PH_BITS>>,
     /// The phase before the period's end (its middle), modulo the
@@ -109,6 +114,7 @@ impl SpiSeq {
             cs_n: Default::default(),
             sclk: Default::default(),
             cap: Default::default(),
+            cap_next: Default::default(),
             done: Default::default(),
             r_cs_n: Default::default(),
             r_sclk: Default::default(),
@@ -125,6 +131,7 @@ impl SpiSeq {
             init: Default::default(),
             step: Default::default(),
             rise: Default::default(),
+            wrap: Default::default(),
             k_ph_start: c(ph_start),
             k_ph_zero: c(0),
             k_ph_pre_last: c((t.sclk_div - 2) % ph_mod),
@@ -187,21 +194,16 @@ impl Logic for SpiSeq {
                     // Cycle t + R - 2: the pin is released (and SCLK back at
                     // idle) at the edge that begins t + R.
                     self.r_cs_n.d.next = true;
-                    self.r_sclk.d.next = self.k_sclk_idle.val();
                     self.r_done.d.next = true;
                 } else {
                     self.nfall.d.next =
                         (self.nfall.q.val() + self.k_nf_one.val()) & self.k_nf_mask.val();
-                    self.f_nz.d.next = true;
-                    self.f_end.d.next = self.nfall.q.val() == self.k_nf_pre_end.val();
-                    self.r_sclk.d.next = false;
                 }
             }
         }
         if self.rise.val() {
             // Capture the serial bit this edge reads at the end of the next
             // cycle, if that bit is a data bit.
-            self.r_sclk.d.next = true;
             if self.wbit.q.val() == self.k_wb_last.val() {
                 self.wbit.d.next = self.k_wb_zero.val();
             } else {
@@ -216,6 +218,19 @@ impl Logic for SpiSeq {
                 self.r_cap.d.next = true;
             }
         }
+        // SCLK and the falling-edge flags as gates, not as flip-flops with
+        // an enable: an iCE40 flip-flop's reset (`init`) acts only when
+        // enabled, so an enable would have `init` in it, three LUT levels
+        // from `start2` (the core's critical path); as gates `init` is
+        // their synchronous set or reset alone. SCLK rises at `rise`, and
+        // at a period's end falls, or returns to idle after the last.
+        self.wrap.next = self.step.val() & self.f_wrap.q.val();
+        self.r_sclk.d.next = self.rise.val()
+            | (!self.wrap.val() & self.r_sclk.q.val())
+            | (self.wrap.val() & self.f_end.q.val() & self.k_sclk_idle.val());
+        self.f_nz.d.next = self.f_nz.q.val() | (self.wrap.val() & !self.f_end.q.val());
+        self.f_end.d.next = self.f_end.q.val()
+            | (self.wrap.val() & (self.nfall.q.val() == self.k_nf_pre_end.val()));
         if self.init.val() {
             self.r_cs_n.d.next = false;
             self.r_sclk.d.next = self.k_sclk_idle.val();
@@ -233,6 +248,7 @@ impl Logic for SpiSeq {
         self.cs_n.next = self.r_cs_n.q.val();
         self.sclk.next = self.r_sclk.q.val();
         self.cap.next = self.r_cap.q.val();
+        self.cap_next.next = self.r_cap.d.val();
         self.done.next = self.r_done.q.val();
     }
 }

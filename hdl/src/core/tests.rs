@@ -97,6 +97,7 @@ fn harness(div: u64, setup: u64) -> Harness {
             bits: 14,
         }],
         branches: vec![rom()],
+        queue: None,
     };
     let mut h = Harness {
         clock: Default::default(),
@@ -104,7 +105,7 @@ fn harness(div: u64, setup: u64) -> Harness {
         miso: Default::default(),
         timing: TimingGen::new(&plan),
         seq: SpiSeq::new(&plan.seqs[0]),
-        unit: BranchUnit::new(&plan.branches[0]),
+        unit: BranchUnit::new(&plan.branches[0], false),
     };
     h.connect_all();
     h

@@ -53,6 +53,8 @@ pub struct TimingGen {
     k_slot_last: Constant<Bits<SLOT_BITS>>,
     k_slot_zero: Constant<Bits<SLOT_BITS>>,
     k_slot_one: Constant<Bits<SLOT_BITS>>,
+    /// The slot after slot 0 (`succ` in reset).
+    k_succ_rst: Constant<Bits<SLOT_BITS>>,
     /// The mix's own counter widths, as masks.
     k_cnt_mask: Constant<Bits<CNT_BITS>>,
     k_slot_mask: Constant<Bits<SLOT_BITS>>,
@@ -97,6 +99,7 @@ impl TimingGen {
             k_slot_last: c(slot_last),
             k_slot_zero: c(0),
             k_slot_one: c(1),
+            k_succ_rst: c(if slot_last == 0 { 0 } else { 1 }),
             k_cnt_mask: c(mask(plan.slot_cycles - 1)),
             k_slot_mask: c(mask(slot_last)),
         }
@@ -142,10 +145,18 @@ impl Logic for TimingGen {
             self.nxt_sl.next = self.k_sl_zero.val();
         }
         self.slot.d.next = self.nxt.val() & self.k_slot_mask.val();
-        if self.nxt.val() == self.k_slot_last.val() {
+        // The successor of the registered slot, not of `nxt`, so the
+        // compare and increment start at a flip-flop rather than behind the
+        // `nxt` multiplexer: stale in the cycle after a slot start only,
+        // and right again by the next start (slots are at least 2 cycles,
+        // `plan`).
+        if self.slot.q.val() == self.k_slot_last.val() {
             self.succ.d.next = self.k_slot_zero.val();
         } else {
-            self.succ.d.next = (self.nxt.val() + self.k_slot_one.val()) & self.k_slot_mask.val();
+            self.succ.d.next = (self.slot.q.val() + self.k_slot_one.val()) & self.k_slot_mask.val();
+        }
+        if self.rst.val() {
+            self.succ.d.next = self.k_succ_rst.val();
         }
         self.sl.d.next = self.nxt_sl.val();
         self.addr.next = self.nxt.val();

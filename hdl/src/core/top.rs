@@ -2,7 +2,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::glue::core_glue;
+use super::glue::{core_glue, route_miso};
 use super::{BranchUnit, CmdUnit, Merger, ModeGen, SpiSeq, TimingGen};
 use crate::plan::Plan;
 use crate::widths::*;
@@ -43,6 +43,8 @@ pub struct Core {
     _devices: Vec<usize>,
     /// Sequencer of each branch.
     _seq_of: Vec<usize>,
+    /// The merger's queue form: each lane's MISO sources (`Plan::queue`).
+    _queue: Option<Vec<Vec<usize>>>,
     /// The value last written to `mux_en.next` (simulation only).
     _mux_en: u128,
     /// The value last written to `mux_sel.next` (simulation only).
@@ -82,15 +84,20 @@ impl Core {
             mode: plan.modes.iter().map(|_| Default::default()).collect(),
             timing: TimingGen::new(plan),
             seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
-            branches: plan.branches.iter().map(BranchUnit::new).collect(),
+            branches: plan
+                .branches
+                .iter()
+                .map(|b| BranchUnit::new(b, plan.queue.is_some()))
+                .collect(),
             cmds,
             _cmd_of: cmd_of,
-            merge: Merger::new(plan.branches.len()),
+            merge: Merger::new(plan.branches.len(), plan.queue.is_some()),
             modes: (plan.modes.iter())
                 .map(|m| ModeGen::new(m, plan.branches.len()))
                 .collect(),
             _devices: plan.branches.iter().map(|b| b.devices).collect(),
             _seq_of: plan.branches.iter().map(|b| b.seq).collect(),
+            _queue: plan.queue.clone(),
             _mux_en: 0,
             _mux_sel: 0,
         }
@@ -179,6 +186,25 @@ impl Core {
         for g in self.modes.iter_mut() {
             drive(&mut g.clock, k);
         }
+        drive(&mut m.r_shen.clock, k);
+        drive(&mut m.r_chen.clock, k);
+    }
+}
+
+impl Core {
+    /// Each branch's MISO input: the pin, or in the merger's queue form the
+    /// pin of the branch whose word the lane's register captures.
+    fn miso_lanes(&self) -> u64 {
+        let miso = self.adc_miso.val().to_u64();
+        let Some(q) = &self._queue else {
+            return miso;
+        };
+        let act = self
+            .branches
+            .iter()
+            .enumerate()
+            .fold(0u64, |a, (b, u)| a | (u.act_q.val() as u64) << b);
+        route_miso(q, act, miso)
     }
 }
 
@@ -242,7 +268,7 @@ impl Logic for Core {
             q.start2.next = start;
             seq[i] = (q.cs_n.val(), q.sclk.val(), q.cap.val(), q.done.val());
         }
-        let miso = self.adc_miso.val().to_u64();
+        let miso = self.miso_lanes();
         let grant = self.merge.grant.val().to_u64();
         let (mut cs, mut sclk, mut sel, mut en, mut done) = (0u64, 0u64, 0u64, 0u128, 0u64);
         let mut more = 0u64;
@@ -266,6 +292,7 @@ impl Logic for Core {
             u.seq_done.next = q_done;
             u.miso.next = (miso >> b) & 1 == 1;
             u.grant.next = (grant >> b) & 1 == 1;
+            (u.sh_en.next, u.ch_en.next) = (self.merge.sh_en.val(), self.merge.ch_en.val());
             more |= (u.more.val() as u64) << b;
             cs |= (u.cs_n.val() as u64) << b;
             sclk |= (u.sclk.val() as u64) << b;
@@ -317,6 +344,17 @@ impl Logic for Core {
         self.merge.done.next = done.into();
         self.merge.more.next = more.into();
         self.merge.done_next.next = done_next.into();
+        // the queue form's single sequencer (unused in the priority form)
+        self.merge.cap_next.next = self.seqs[0].cap_next.val();
+        self.merge.start2.next = start;
+        if self._queue.is_some() {
+            // the queue form: each lane reads the next lane's channel and word
+            for b in 0..nb - 1 {
+                let u = &mut self.branches[b];
+                u.q_ch.next = chs[b + 1].into();
+                u.q_val.next = vals[b + 1].into();
+            }
+        }
         // Lanes >= nb keep their default 0 (the glue ties them to zero).
         let m = &mut self.merge;
         for b in 0..nb {
@@ -353,6 +391,10 @@ impl Logic for Core {
             u.seq_done.connect();
             u.miso.connect();
             u.grant.connect();
+            u.sh_en.connect();
+            u.ch_en.connect();
+            u.q_ch.connect();
+            u.q_val.connect();
         }
         for q in self.cmds.iter_mut() {
             q.clock.connect();
@@ -372,6 +414,8 @@ impl Logic for Core {
         self.merge.done.connect();
         self.merge.more.connect();
         self.merge.done_next.connect();
+        self.merge.cap_next.connect();
+        self.merge.start2.connect();
         for b in 0..MAX_BRANCHES {
             self.merge.ch[b].connect();
             self.merge.v[b].connect();
@@ -407,6 +451,7 @@ impl Logic for Core {
             self.modes
                 .first()
                 .map(|g| (!self.mode_sel.is_empty(), g.ch.len())),
+            self._queue.as_deref(),
         ))
     }
 }

@@ -20,6 +20,12 @@ pub struct WordReader {
     pub cap: Signal<In, Bit>,
     pub miso: Signal<In, Bit>,
     pub grant: Signal<In, Bit>,
+    /// Queue form of the merger (a single-word branch only): the next
+    /// lane's word.
+    pub q_in: Signal<In, Bits<VALUE_BITS>>,
+    /// Queue form: the register loads at the end of this cycle (a
+    /// flip-flop equal to `cap | mv`), MISO if `cap` else `q_in`.
+    pub en: Signal<In, Bit>,
     /// The conversion's lead channel (its frame-table entry).
     pub lead: Signal<In, Bits<CH_BITS>>,
     pub val: Signal<Out, Bits<VALUE_BITS>>,
@@ -28,19 +34,22 @@ pub struct WordReader {
     _bits: usize,
     _chain: usize,
     _members: Vec<(u32, Vec<u32>)>,
+    _queue: bool,
     /// The shift register and the member of the word on `val`.
     _sh: u128,
     _om: usize,
 }
 
 impl WordReader {
-    pub(super) fn new(rom: &BranchRom) -> WordReader {
+    pub(super) fn new(rom: &BranchRom, queue: bool) -> WordReader {
         WordReader {
             clock: Default::default(),
             rst: Default::default(),
             cap: Default::default(),
             miso: Default::default(),
             grant: Default::default(),
+            q_in: Default::default(),
+            en: Default::default(),
             lead: Default::default(),
             val: Default::default(),
             ch: Default::default(),
@@ -48,6 +57,7 @@ impl WordReader {
             _bits: rom.bits as usize,
             _chain: rom.chain as usize,
             _members: rom.members.clone(),
+            _queue: queue && rom.chain == 1,
             _sh: 0,
             _om: 0,
         }
@@ -77,7 +87,13 @@ impl Logic for WordReader {
             if self.rst.val() {
                 self._om = 0;
             }
-            if self.cap.val() {
+            if self._queue {
+                if self.en.val() && self.cap.val() {
+                    self._sh = ((self._sh << 1) | self.miso.val() as u128) & mask;
+                } else if self.en.val() {
+                    self._sh = self.q_in.val().to_u64() as u128 & mask;
+                }
+            } else if self.cap.val() {
                 self._sh = ((self._sh << 1) | self.miso.val() as u128) & mask;
             } else if self.grant.val() && self._chain > 1 && !self.rst.val() {
                 if self._om + 1 < self._chain {
@@ -128,13 +144,33 @@ impl Logic for WordReader {
         };
         if n == 1 {
             let _ = writeln!(s, "\nalways @(posedge clock) begin");
-            let _ = writeln!(s, "  if (cap) sh <= {shifted_in};");
+            let q = if w == VALUE_BITS {
+                "q_in".to_string()
+            } else {
+                format!("q_in[{}:0]", w - 1)
+            };
+            if self._queue {
+                let _ = writeln!(
+                    s,
+                    "  // the merger's queue form: MISO, or the next lane's word moving up"
+                );
+                let _ = writeln!(s, "  if (en) sh <= cap ? {shifted_in} : {q};");
+            } else {
+                let _ = writeln!(s, "  if (cap) sh <= {shifted_in};");
+            }
             let _ = writeln!(s, "end\n");
             let _ = writeln!(s, "always @(*) begin");
             let _ = writeln!(s, "  val = {val};\n  ch = lead;\n  more = 1'b0;");
             let _ = writeln!(s, "end\n");
             let _ = writeln!(s, "// a single word: nothing to step through");
-            let _ = writeln!(s, "wire unused_reader = |{{grant, rst}};");
+            let unused = if !self._queue {
+                "grant, rst, en, q_in".to_string()
+            } else if w < VALUE_BITS {
+                format!("grant, rst, q_in[{}:{w}]", VALUE_BITS - 1)
+            } else {
+                "grant, rst".to_string()
+            };
+            let _ = writeln!(s, "wire unused_reader = |{{{unused}}};");
             return Verilog::Custom(s);
         }
         let last = n - 1;
@@ -161,6 +197,8 @@ impl Logic for WordReader {
             }
         }
         let _ = writeln!(s, "    default: ch = lead;\n  endcase\nend");
+        let _ = writeln!(s, "\n// a chain is never the merger's queue");
+        let _ = writeln!(s, "wire unused_queue = |{{en, q_in}};");
         Verilog::Custom(s)
     }
 }
