@@ -861,6 +861,21 @@ fn place(demand: &[u64], n: u64, k: u64, sps: u64, frame_slots: u64) -> bool {
     true
 }
 
+/// What the gateware does not do as a built-in part's datasheet says.
+fn part_warnings(mix: &crate::Mix) -> Vec<String> {
+    let ad7689 = crate::parts::AdcPart::ad7689();
+    mix.branches
+        .iter()
+        .filter(|b| b.adc == ad7689)
+        .map(|b| {
+            format!(
+                "branch {}: the built-in ad7689 is driven as the ad7685 is (CNV high through the read-back), but the real AD7689 drives SDO and takes its word only while CNV is low after the conversion (datasheet Rev. D, Figure 41): on a board it would read nothing (docs/mix-format.md, \"Converters with a command word\")",
+                b.name
+            )
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1086,19 +1101,4 @@ mod tests {
         let h = b.headroom.iter().find(|h| h.rate_hz == 4_000).unwrap();
         assert_eq!(h.by_adc_throughput, (478_469 - 16_000) / 4_000);
     }
-}
-
-/// What the gateware does not do as a built-in part's datasheet says.
-fn part_warnings(mix: &crate::Mix) -> Vec<String> {
-    let ad7689 = crate::parts::AdcPart::ad7689();
-    mix.branches
-        .iter()
-        .filter(|b| b.adc == ad7689)
-        .map(|b| {
-            format!(
-                "branch {}: the built-in ad7689 is driven as the ad7685 is (CNV high through the read-back), but the real AD7689 drives SDO and takes its word only while CNV is low after the conversion (datasheet Rev. D, Figure 41): on a board it would read nothing (docs/mix-format.md, \"Converters with a command word\")",
-                b.name
-            )
-        })
-        .collect()
 }
