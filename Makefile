@@ -24,7 +24,7 @@ endif
 # `PROPTEST_RNG_SEED=random make test` explores new cases.
 export PROPTEST_RNG_SEED ?= 1
 
-.PHONY: test-long run test tools venv lut audit verilog cosim golden golden-update synth synth-bench bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
+.PHONY: baseline test-long run test tools venv lut audit verilog cosim golden golden-update synth synth-bench bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 # The main job on the reference mix: audit, LUT, Verilog, co-simulation, golden,
 # faults, synthesis estimate, and build/eskin34/report.html with its charts.
@@ -162,3 +162,19 @@ update-snapshots:
 
 clean:
 	rm -rf out build
+
+# Every mix's audit (text and JSON), LUT and Verilog into OUT, for a change
+# that must leave them byte-identical: `make baseline OUT=/tmp/a`, change,
+# `make baseline OUT=/tmp/b`, then `diff -r /tmp/a /tmp/b`.
+baseline:
+	@test -n "$(OUT)" || { echo "usage: make baseline OUT=DIR"; exit 2; }
+	cargo build --quiet --bin slotforge
+	rm -rf $(OUT) && mkdir -p $(OUT)
+	@for m in mixes/*.toml testkit/mixes/*.toml; do \
+	  n=$$(basename $$m .toml); \
+	  target/debug/slotforge audit $$m > $(OUT)/$$n.audit.txt 2>&1; echo "rc=$$?" >> $(OUT)/$$n.audit.txt; \
+	  target/debug/slotforge audit $$m --json > $(OUT)/$$n.audit.json 2>&1; echo "rc=$$?" >> $(OUT)/$$n.audit.json; \
+	  target/debug/slotforge lut $$m -o $(OUT)/$$n.lut > $(OUT)/$$n.lut.log 2>&1; \
+	  target/debug/slotforge verilog $$m -o $(OUT)/$$n.v > $(OUT)/$$n.v.log 2>&1; \
+	done
+	@echo "baseline of every mix in $(OUT)"
