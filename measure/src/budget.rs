@@ -156,9 +156,9 @@ fn facts(r: &AuditReport) -> Table {
     row(
         "Warnings and errors",
         format!(
-            "{} warning(s), {} error(s){}",
-            r.warnings.len(),
-            r.errors.len(),
+            "{}, {}{}",
+            judge::counted(r.warnings.len() as u64, "warning"),
+            judge::counted(r.errors.len() as u64, "error"),
             if r.warnings.is_empty() && r.errors.is_empty() {
                 ""
             } else {

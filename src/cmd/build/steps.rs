@@ -138,12 +138,12 @@ fn audit(j: &mut Job, s: &Schedule) -> Done {
         &[("audit.txt", r.to_text()), ("audit.json", r.to_json())],
     );
     let line = format!(
-        "feasible, {} slots per slice, {} samples/s of the converters' {:.0} ({:.1} %); {} warning(s)",
+        "feasible, {} slots per slice, {} samples/s of the converters' {:.0} ({:.1} %); {}",
         s.grid.slots_per_slice,
         r.aggregate_hz,
         r.adc_limit_hz,
         r.adc_utilization * 100.0,
-        r.warnings.len()
+        counted(r.warnings.len() as u64, "warning")
     );
     let mut sec = Section {
         title: "Audit".into(),
