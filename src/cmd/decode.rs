@@ -267,13 +267,16 @@ fn report(a: &Args, st: &Stats, rows: u64) {
         msg.push_str(": clean");
     } else {
         msg.push_str(&format!(
-            "; {} CRC error(s), {} lost packet(s), {} resync(s), {} byte(s) skipped{}",
-            st.crc_errors,
-            st.lost_packets,
-            st.resyncs,
-            st.skipped_bytes,
+            "; {}, {}, {}, {} skipped{}",
+            super::counted(st.crc_errors, "CRC error"),
+            super::counted(st.lost_packets, "lost packet"),
+            super::counted(st.resyncs, "resync"),
+            super::counted(st.skipped_bytes, "byte"),
             if st.overflows > 0 {
-                format!(", the gateware's FIFO overflowed {} time(s)", st.overflows)
+                format!(
+                    ", the gateware's FIFO overflowed {}",
+                    super::counted(st.overflows.into(), "time")
+                )
             } else {
                 String::new()
             },
@@ -281,8 +284,8 @@ fn report(a: &Args, st: &Stats, rows: u64) {
     }
     if st.in_flight > 0 {
         msg.push_str(&format!(
-            "; {} byte(s) of a packet still in flight when the capture ends (not a loss)",
-            st.in_flight
+            "; {} of a packet still in flight when the capture ends (not a loss)",
+            super::counted(st.in_flight, "byte")
         ));
     }
     eprintln!("{msg}");
