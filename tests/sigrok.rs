@@ -151,7 +151,11 @@ impl PartDecoder {
         let cnv = part.start == lut_gen::Start::Cnv;
         // Mode 3 reads stream bits 1..=w at the w rising edges (bit 0 comes
         // before the first); mode 0 reads bits 0..w.
-        let (options, shift) = if cnv {
+        let low = cnv && part.read == lut_gen::CnvRead::CnvLow;
+        let (options, shift) = if low {
+            // CNV low frames the read, as an active-low CS
+            ("cs_polarity=active-low:cpol=0:cpha=0", part.trailing_bits)
+        } else if cnv {
             ("cs_polarity=active-high:cpol=0:cpha=0", part.trailing_bits)
         } else {
             (

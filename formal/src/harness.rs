@@ -528,7 +528,12 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
     } = sclk_phases(spi, cb);
     let (cs_exp, sclk_exp) = if spi.style == Start::Cnv {
         (
-            format!("busy{b}"),
+            // read with CNV low: CNV is high for the conversion alone
+            if spi.pin_cycles < spi.read_cycles {
+                format!("conv{b} && cyc < {cb}'d{}", spi.pin_cycles)
+            } else {
+                format!("busy{b}")
+            },
             format!("conv{b} && ({})", ranges(cb, &high)),
         )
     } else {

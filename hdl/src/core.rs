@@ -12,6 +12,7 @@
 //!  |    |- rom: SlotRom   that branch's column of the frame table (BRAM-friendly)
 //!  |    `- DFFs           "converts this slot" flag, CS/SCLK outputs gated by it,
 //!  |                      MISO shift register, channel, mux control
+//!  |- pulses: Vec<CnvPulse> one per sequencer whose part is read with CNV low
 //!  |- cmds: Vec<CmdUnit>  one per branch with a command word: adc_mosi, prepared conversions
 //!  `- merge: Merger       pending set + lowest-branch-first sample stream (Verilog over the mix's lanes)
 //! ```
@@ -24,6 +25,7 @@ mod command;
 mod glue;
 mod merger;
 mod modes;
+mod pulse;
 mod slot_rom;
 mod spi;
 #[cfg(test)]
@@ -38,6 +40,7 @@ use branch::BranchUnit;
 use command::CmdUnit;
 use merger::Merger;
 use modes::ModeGen;
+use pulse::CnvPulse;
 use slot_rom::SlotRom;
 use spi::SpiSeq;
 use timing::TimingGen;

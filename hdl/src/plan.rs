@@ -36,6 +36,11 @@ pub struct SeqTiming {
     /// Conversion start to the first SCLK period (CNV parts: t_CONV too).
     pub setup_cycles: u64,
     pub read_cycles: u64,
+    /// Cycles the conversion pin stays active: `read_cycles`, or for a part
+    /// read with CNV low the conversion alone (a [`CnvPulse`] times it).
+    ///
+    /// [`CnvPulse`]: crate::core
+    pub pin_cycles: u64,
     /// CNV style: SCK idles low, and the last rising edge captures too.
     pub cnv: bool,
     /// SCLK periods per conversion (every word of the chain).
@@ -47,6 +52,12 @@ pub struct SeqTiming {
 }
 
 impl SeqTiming {
+    /// The conversion pin is released before the read: CNV falls when the
+    /// conversion ends (a part read with CNV low).
+    pub fn pulsed(&self) -> bool {
+        self.pin_cycles < self.read_cycles
+    }
+
     /// The serial bit index (within its word) that rising edge 1 captures:
     /// a CS part drives bit 0 before any clock and edge `i` captures bit
     /// `i`; a CNV part's edge `i` captures bit `i - 1`.
@@ -414,6 +425,7 @@ fn branch_rom(
         sclk_half: spi.sclk_half,
         setup_cycles: spi.setup_cycles,
         read_cycles: spi.read_cycles,
+        pin_cycles: spi.pin_cycles,
         cnv,
         sclks: adc.word_sclks() as u64 * chain as u64,
         word_sclks: adc.word_sclks() as u64,

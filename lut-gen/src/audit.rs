@@ -277,7 +277,6 @@ impl AuditReport {
         let channels = (0..mix.channels.len())
             .map(|c| ChannelAudit::of(s, c, &branch_slots, &mut errors, &mut warnings))
             .collect();
-        warnings.extend(part_warnings(mix));
 
         let mut rates: Vec<u64> = mix.channels.iter().map(|c| c.rate_hz).collect();
         rates.sort_unstable();
@@ -861,21 +860,6 @@ fn place(demand: &[u64], n: u64, k: u64, sps: u64, frame_slots: u64) -> bool {
     true
 }
 
-/// What the gateware does not do as a built-in part's datasheet says.
-fn part_warnings(mix: &crate::Mix) -> Vec<String> {
-    let ad7689 = crate::parts::AdcPart::ad7689();
-    mix.branches
-        .iter()
-        .filter(|b| b.adc == ad7689)
-        .map(|b| {
-            format!(
-                "branch {}: the built-in ad7689 is driven as the ad7685 is (CNV high through the read-back), but the real AD7689 drives SDO and takes its word only while CNV is low after the conversion (datasheet Rev. D, Figure 41): on a board it would read nothing (docs/mix-format.md, \"Converters with a command word\")",
-                b.name
-            )
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -902,22 +886,6 @@ mod tests {
             "[[channel]]\nname = \"A\"\nbranch = \"slow\"\nrate_hz = 2_000\nbandwidth_hz = {bw_2k}\n"
         );
         crate::parse(Path::new("t.toml"), &t).unwrap()
-    }
-
-    /// The built-in ad7689 is warned of (the gateware does not read it as
-    /// the part needs); a part it reads right is not.
-    #[test]
-    fn the_ad7689s_read_is_warned_of() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../testkit/mixes");
-        let warned = |name: &str| {
-            let m = crate::load(&dir.join(format!("{name}.toml"))).unwrap();
-            audit(&m)
-                .warnings
-                .iter()
-                .any(|w| w.contains("the real AD7689"))
-        };
-        assert!(warned("cmd-ad7689"));
-        assert!(!warned("cmd-mcp3208"));
     }
 
     fn audit(m: &crate::Mix) -> AuditReport {

@@ -37,7 +37,9 @@ pub use mix::{
     expand_names, load, parse, toml_words, Branch, Channel, LinkKind, LinkSpec, Mix, MixError,
     ModeSelect, Modes, Trigger, When, MAX_BAUD_ERROR_PCT,
 };
-pub use parts::{ns_to_cycles, AdcPart, CmdBit, Command, MuxPart, SpiTiming, Start, TimingError};
+pub use parts::{
+    ns_to_cycles, AdcPart, CmdBit, CnvRead, Command, MuxPart, SpiTiming, Start, TimingError,
+};
 
 // The schedule: synthesis, its independent proof, and what it promises.
 pub use command::CommandSent;

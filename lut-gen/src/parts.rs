@@ -49,6 +49,34 @@ impl Start {
     }
 }
 
+/// How a CNV part is read once its conversion ends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CnvRead {
+    /// CNV stays high through the read-back (the AD7685's chain mode; CS
+    /// parts hold CS low likewise).
+    #[default]
+    CnvHigh,
+    /// CNV returns low when the conversion ends and the word is read while
+    /// it is low: the part drives SDO and latches DIN only then (the AD7689's
+    /// read after conversion, the AD768x "CS mode, 3-wire").
+    CnvLow,
+}
+
+impl CnvRead {
+    /// The mix file's spelling.
+    pub fn key(self) -> &'static str {
+        match self {
+            CnvRead::CnvHigh => "cnv-high",
+            CnvRead::CnvLow => "cnv-low",
+        }
+    }
+
+    fn is_cnv_high(&self) -> bool {
+        *self == CnvRead::CnvHigh
+    }
+}
+
 /// A SAR ADC with a serial read-out, as data.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct AdcPart {
@@ -56,6 +84,9 @@ pub struct AdcPart {
     /// Data bits per word, MSB first.
     pub bits: u32,
     pub start: Start,
+    /// CNV parts: whether CNV is high or low while the word is read.
+    #[serde(skip_serializing_if = "CnvRead::is_cnv_high")]
+    pub read: CnvRead,
     /// Serial clocks before the MSB (the AD7940's two leading zeros).
     pub leading_bits: u32,
     /// Serial clocks after the LSB.
@@ -200,6 +231,7 @@ impl AdcPart {
             name: "ad7940".into(),
             bits: 14,
             start: Start::Cs,
+            read: CnvRead::CnvHigh,
             leading_bits: 2,
             trailing_bits: 0,
             sclk_min_hz: 250_000,
@@ -225,6 +257,7 @@ impl AdcPart {
             name: "ad7685".into(),
             bits: 16,
             start: Start::Cnv,
+            read: CnvRead::CnvHigh,
             leading_bits: 0,
             trailing_bits: 0,
             sclk_min_hz: 1,
@@ -257,6 +290,7 @@ impl AdcPart {
             name: "mcp3208".into(),
             bits: 12,
             start: Start::Cs,
+            read: CnvRead::CnvHigh,
             leading_bits: 8,
             trailing_bits: 0,
             sclk_min_hz: 10_000,
@@ -276,7 +310,10 @@ impl AdcPart {
     /// AD7689 (Analog Devices AD7682/AD7689 Rev. D), Table 4 (timing):
     /// t_CONV 2.2 us max, t_CYC 4 us (250 kSPS), t_DSDO 25 ns at VIO 1.8 V
     /// or more (the slowest column); SCK limited to 12.5 MHz here as for the
-    /// AD7685.  "Digital Interface": the 14-bit CFG is written on the first
+    /// AD7685.  Read after conversion (Figure 41, "General Timing Without a
+    /// Busy Indicator"): CNV high for t_CONV, then low; SDO and DIN are
+    /// enabled only while CNV is low (t_EN, CNV low to the MSB, 25 ns at the
+    /// slowest VIO, is the setup; t_CLSCK, CNV low to SCK, 10 ns, is within it).  "Digital Interface": the 14-bit CFG is written on the first
     /// 14 SCK rising edges of the read-back and applies to the conversion
     /// after next (from power-up the first results are undefined: "two
     /// dummy conversions are required").  CFG, MSB first: CFG = 1 (write),
@@ -288,13 +325,14 @@ impl AdcPart {
             name: "ad7689".into(),
             bits: 16,
             start: Start::Cnv,
+            read: CnvRead::CnvLow,
             leading_bits: 0,
             trailing_bits: 0,
             sclk_min_hz: 1,
             sclk_max_hz: 12_500_000,
             duty_min_pct: 40,
             max_sps: 250_000,
-            setup_ns: 10,
+            setup_ns: 25,
             quiet_ns: 10,
             conversion_ns: 2_200,
             data_access_ns: 25,
@@ -404,8 +442,14 @@ pub struct SpiTiming {
     pub sclk_hz: f64,
     pub setup_cycles: u64,
     pub quiet_cycles: u64,
-    /// Cycles the conversion pin stays active: setup plus every SCLK period.
+    /// Cycles from the instant to the end of the read: setup plus every
+    /// SCLK period.
     pub read_cycles: u64,
+    /// Cycles the conversion pin stays active from the instant: the whole
+    /// read, or for a part read with CNV low ([`CnvRead::CnvLow`]) the
+    /// conversion alone.
+    #[serde(skip)]
+    pub pin_cycles: u64,
     /// Shortest distance between two conversion starts of this branch.
     pub min_period_cycles: u64,
     #[serde(skip)]
@@ -475,6 +519,10 @@ impl SpiTiming {
         let sclks = adc.word_sclks() as u64 * chain as u64;
         let read_cycles = setup_cycles + sclks * div;
         let throughput_cycles = clock_hz.div_ceil(adc.max_sps);
+        let pin_cycles = match (adc.start, adc.read) {
+            (Start::Cnv, CnvRead::CnvLow) => conv_cycles,
+            _ => read_cycles,
+        };
         Ok(SpiTiming {
             sclk_div: div,
             sclk_half: half,
@@ -482,6 +530,7 @@ impl SpiTiming {
             setup_cycles,
             quiet_cycles,
             read_cycles,
+            pin_cycles,
             min_period_cycles: (read_cycles + quiet_cycles).max(throughput_cycles),
             style: adc.start,
             words: chain,

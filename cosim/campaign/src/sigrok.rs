@@ -20,7 +20,7 @@ use std::time::Duration;
 use judge::Observer;
 use lut_gen::Pins;
 use lut_gen::Schedule;
-use lut_gen::{AdcPart, Start};
+use lut_gen::{AdcPart, CnvRead, Start};
 
 use judge::tools::{self, ToolError};
 
@@ -102,7 +102,10 @@ impl PartDecoder {
     fn of(part: &AdcPart) -> PartDecoder {
         // Mode 3 (CS parts) reads stream bits 1..=w at the w rising edges:
         // bit 0, a leading zero, comes before the first; mode 0 reads 0..w.
-        let (options, shift) = if part.start == Start::Cnv {
+        let (options, shift) = if part.start == Start::Cnv && part.read == CnvRead::CnvLow {
+            // read while CNV is low: CNV frames the read as an active-low CS
+            ("cs_polarity=active-low:cpol=0:cpha=0", part.trailing_bits)
+        } else if part.start == Start::Cnv {
             ("cs_polarity=active-high:cpol=0:cpha=0", part.trailing_bits)
         } else {
             (

@@ -391,10 +391,18 @@ impl Adcs<'_> {
         let part = &self.s.mix.branches[b].adc;
         let chain = self.s.mix.branches[b].chain as usize;
         let len = part.word_sclks() as usize * chain;
+        // read with CNV low (never chained): SDO driven while CNV is low,
+        // released after the last bit
+        let low = part.read == lut_gen::CnvRead::CnvLow;
+        let (after, at_rise, at_fall, reading) = match low {
+            true => ("1'bz", 0, 1, "!"),
+            false => ("1'b0", 1, 0, ""),
+        };
         let _ = writeln!(
             self.text,
-            "  // {chain} x {} in CNV chain mode: {len} serial bits per conversion\n  reg [{}:0] stream{b};\n  reg [15:0] falls{b};\n  reg drive{b} = 0;\n  reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [63:0] mid{b};\n  reg [15:0] code{b};\n  assign {miso}[{b}] = drive{b} ? (falls{b} >= 16'd{len} ? 1'b0 : stream{b}[{}-falls{b}]) : 1'bz;",
+            "  // {chain} x {} in CNV {} mode: {len} serial bits per conversion\n  reg [{}:0] stream{b};\n  reg [15:0] falls{b};\n  reg drive{b} = 0;\n  reg [63:0] n{b} = 0;\n  reg [63:0] id{b};\n  reg [63:0] mid{b};\n  reg [15:0] code{b};\n  assign {miso}[{b}] = drive{b} ? (falls{b} >= 16'd{len} ? {after} : stream{b}[{}-falls{b}]) : 1'bz;",
             part.name,
+            if low { "read-low" } else { "chain" },
             len - 1,
             len - 1,
             miso = Role::Miso.name()
@@ -404,7 +412,7 @@ impl Adcs<'_> {
         let members: String = (0..chain).map(|m| self.cnv_member(b, m, table)).collect();
         let _ = write!(
             self.text,
-            "  always @(posedge {cs}[{b}]) if (!{rst}) begin\n{id_case}    stream{b} = {len}'h0;\n{members}    falls{b} = 0;\n    drive{b} = 1;\n  end\n  always @(negedge {cs}[{b}]) drive{b} = 0;\n  always @(negedge {sclk}[{b}]) if ({cs}[{b}]) falls{b} = falls{b} + 1;\n\n",
+            "  always @(posedge {cs}[{b}]) if (!{rst}) begin\n{id_case}    stream{b} = {len}'h0;\n{members}    falls{b} = 0;\n    drive{b} = {at_rise};\n  end\n  always @(negedge {cs}[{b}]) drive{b} = {at_fall};\n  always @(negedge {sclk}[{b}]) if ({reading}{cs}[{b}]) falls{b} = falls{b} + 1;\n\n",
             cs = Role::CsN.name(),
             sclk = Role::Sclk.name(),
             rst = Role::Reset.name(),

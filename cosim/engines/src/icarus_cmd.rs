@@ -25,6 +25,8 @@ pub(crate) fn part(s: &Schedule, b: usize, mosi_lane: u32, table: &str) -> Strin
     let adc = &s.mix.branches[b].adc;
     let cmd = adc.command.as_ref().expect("a part with a command word");
     let cnv = adc.start == lut_gen::Start::Cnv;
+    // read with CNV low: the part drives SDO and takes DIN while CNV is low
+    let low = cnv && adc.read == lut_gen::CnvRead::CnvLow;
     let ws = adc.word_sclks() as usize;
     let l = cmd.bits.len();
     let trailing = ws - adc.leading_bits as usize - adc.bits as usize;
@@ -35,7 +37,9 @@ pub(crate) fn part(s: &Schedule, b: usize, mosi_lane: u32, table: &str) -> Strin
         Role::Mosi.name(),
         Role::Reset.name(),
     );
-    let (start, stop, sel, rise) = if cnv {
+    let (start, stop, sel, rise) = if low {
+        ("posedge", "negedge", format!("!{cs}[{b}]"), "posedge")
+    } else if cnv {
         ("posedge", "negedge", format!("{cs}[{b}]"), "posedge")
     } else {
         ("negedge", "posedge", format!("!{cs}[{b}]"), "posedge")
@@ -44,7 +48,7 @@ pub(crate) fn part(s: &Schedule, b: usize, mosi_lane: u32, table: &str) -> Strin
     let shift = "negedge";
     // after the last bit: a CS part releases the line, a CNV part's SDI
     // (tied low) comes through
-    let after = if cnv { "1'b0" } else { "1'bz" };
+    let after = if cnv && !low { "1'b0" } else { "1'bz" };
     let mask = (1u32 << adc.bits) - 1;
     let mut t = String::new();
     let _ = writeln!(
@@ -78,9 +82,23 @@ pub(crate) fn part(s: &Schedule, b: usize, mosi_lane: u32, table: &str) -> Strin
     } else {
         String::new()
     };
+    let push = if cmd.ahead > 0 {
+        // the queue holds ahead entries: the word joins at the end
+        let mut p = select(s, b, cmd, "    ");
+        let _ = writeln!(p, "    q{b}_{} = id{b};", cmd.ahead - 1);
+        p
+    } else {
+        String::new()
+    };
+    // read with CNV low: the read ends when the next conversion starts, and
+    // SDO is driven from CNV falling
+    let (ended, drive) = match low {
+        true => (push.as_str(), "0"),
+        false => ("", "1"),
+    };
     let _ = write!(
         t,
-        "  always @({start} {cs}[{b}]) if (!{rst}) begin\n    t{b} = cyc;\n    falls{b} = 0;\n    nin{b} = 0;\n    stream{b} = {ws}'h0;\n    drive{b} = 1;\n{pop}  end\n"
+        "  always @({start} {cs}[{b}]) if (!{rst}) begin\n{ended}    t{b} = cyc;\n    falls{b} = 0;\n    nin{b} = 0;\n    stream{b} = {ws}'h0;\n    drive{b} = {drive};\n{pop}  end\n"
     );
     let same = if cmd.ahead == 0 {
         format!(
@@ -95,17 +113,13 @@ pub(crate) fn part(s: &Schedule, b: usize, mosi_lane: u32, table: &str) -> Strin
         "  always @({rise} {sclk}[{b}]) if ({sel}) begin\n    if (nin{b} < 16'd{l}) cw{b}[{}-nin{b}] = {mosi}[{mosi_lane}];\n    nin{b} = nin{b} + 1;\n{same}  end\n",
         l - 1
     );
-    let push = if cmd.ahead > 0 {
-        // the queue holds ahead entries: the word joins at the end
-        let mut p = select(s, b, cmd, "    ");
-        let _ = writeln!(p, "    q{b}_{} = id{b};", cmd.ahead - 1);
-        p
-    } else {
-        String::new()
+    let stop_body = match low {
+        true => format!("    drive{b} = 1;\n"),
+        false => format!("    drive{b} = 0;\n{push}"),
     };
     let _ = write!(
         t,
-        "  always @({stop} {cs}[{b}]) begin\n    drive{b} = 0;\n{push}  end\n  always @({shift} {sclk}[{b}]) if ({sel}) falls{b} = falls{b} + 1;\n\n"
+        "  always @({stop} {cs}[{b}]) if (!{rst}) begin\n{stop_body}  end\n  always @({shift} {sclk}[{b}]) if ({sel}) falls{b} = falls{b} + 1;\n\n"
     );
     t
 }

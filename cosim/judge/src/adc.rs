@@ -311,6 +311,9 @@ struct AdcState {
 #[derive(Debug, Clone)]
 struct PartModel {
     cnv: bool,
+    /// Read with CNV low: the conversion starts at CNV rising and the part
+    /// drives SDO and latches DIN only while CNV is low.
+    low_read: bool,
     bits: u32,
     leading: u32,
     word_sclks: u32,
@@ -329,8 +332,13 @@ pub struct Adc {
     layout: Layout,
     st: Vec<AdcState>,
     parts: Vec<PartModel>,
-    /// Conversion-pin levels in the CS-active-low view (CNV lanes inverted).
+    /// The CS-active-low view: "selected" is low (CNV lanes held high
+    /// through the read inverted; a CNV read with CNV low is selected
+    /// while low, as it is), SCLK's shifting edge a fall (CNV lanes inverted).
     flip: u16,
+    flip_sclk: u16,
+    /// Lanes read with CNV low: their conversion starts when the view rises.
+    low_read: u16,
     prev_cs: u16,
     prev_sclk: u16,
     miso: u64,
@@ -346,6 +354,8 @@ impl Adc {
             .iter()
             .map(|b| PartModel {
                 cnv: b.adc.start == lut_gen::Start::Cnv,
+                low_read: b.adc.start == lut_gen::Start::Cnv
+                    && b.adc.read == lut_gen::CnvRead::CnvLow,
                 bits: b.adc.bits,
                 leading: b.adc.leading_bits,
                 word_sclks: b.adc.word_sclks(),
@@ -371,18 +381,23 @@ impl Adc {
                 ..AdcState::default()
             })
             .collect();
-        let flip = parts
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| p.cnv)
-            .fold(0u16, |a, (b, _)| a | 1 << b);
+        let mask = |f: &dyn Fn(&PartModel) -> bool| {
+            (parts.iter().enumerate())
+                .filter(|(_, p)| f(p))
+                .fold(0u16, |a, (b, _)| a | 1 << b)
+        };
+        let flip_sclk = mask(&|p| p.cnv);
+        let low_read = mask(&|p| p.low_read);
         Adc {
             analog: Analog::new(s, kind),
             layout,
             st,
             parts,
-            flip,
-            prev_cs: all,
+            flip: flip_sclk & !low_read,
+            flip_sclk,
+            low_read,
+            // every pin at its idle level in the view (CNV read low idles low)
+            prev_cs: all & !low_read,
             prev_sclk: all,
             miso: (1u64 << nb) - 1,
         }
@@ -392,20 +407,22 @@ impl Adc {
     #[inline]
     pub fn drive(&mut self, cycle: u64, p: &Pins) -> u64 {
         // CS view: conversion active low, shifting clock edge = a fall.
-        let (cs_n, sclk) = (p.cs_n ^ self.flip, p.sclk ^ self.flip);
+        let (cs_n, sclk) = (p.cs_n ^ self.flip, p.sclk ^ self.flip_sclk);
         if cs_n == self.prev_cs && sclk == self.prev_sclk {
             return self.miso;
         }
-        let fell_cs = self.prev_cs & !cs_n;
+        let rose_cs = !self.prev_cs & cs_n;
+        // A conversion starts where the view falls, or for a part read with
+        // CNV low where CNV rises (which ends the read before it too).
+        let fell_cs = (self.prev_cs & !cs_n & !self.low_read) | (rose_cs & self.low_read);
         // CS parts shift on SCLK falling edges; CNV parts on SCK falling
         // edges, which are rises in the inverted view.
         let fell_sclk =
-            (self.prev_sclk & !sclk & !self.flip) | (!self.prev_sclk & sclk & self.flip);
+            (self.prev_sclk & !sclk & !self.flip_sclk) | (!self.prev_sclk & sclk & self.flip_sclk);
         let fell_sclk = fell_sclk & !cs_n;
         // DIN is latched on the real SCLK's rising edges while selected.
-        let real_prev = self.prev_sclk ^ self.flip;
+        let real_prev = self.prev_sclk ^ self.flip_sclk;
         let rose_real = !real_prev & p.sclk & !cs_n;
-        let rose_cs = !self.prev_cs & cs_n;
         let mut miso = 0u64;
         for b in 0..self.st.len() {
             let bit = 1u16 << b;
@@ -445,9 +462,9 @@ impl Adc {
             let v = if cs_n & bit != 0 {
                 1 // high-Z, weak pull-up
             } else if st.falls >= st.len {
-                // CS parts: high-Z after the last bit; a chain: the first
-                // part's SDI (tied low) comes through.
-                if pm.cnv {
+                // CS parts (and a CNV read low): high-Z after the last bit;
+                // a chain: the first part's SDI (tied low) comes through.
+                if pm.cnv && !pm.low_read {
                     0
                 } else {
                     1

@@ -47,6 +47,7 @@ mod linkbytes;
 mod linkjoin;
 mod linkline;
 mod lock;
+mod lowread;
 mod modecheck;
 mod model;
 mod modes;

@@ -182,6 +182,9 @@ struct BranchModel {
     d: u64,
     h: u64,
     r: u64,
+    /// Cycles the conversion pin is active (`r`, or the conversion alone
+    /// for a part read with CNV low).
+    pin: u64,
     /// CNV style: the pin is active high and SCK idles low.
     cnv: bool,
     /// Captures per conversion (rising edges that read a bit).
@@ -217,7 +220,7 @@ impl BranchModel {
         let cnv = spi.style == lut_gen::Start::Cnv;
         let sclks = spi.sclks();
         let caps = if cnv { sclks } else { sclks - 1 };
-        let mut offs = vec![1, r];
+        let mut offs = vec![1, r, spi.pin_cycles];
         for i in 0..sclks {
             let fall = su + i * d;
             offs.push(fall);
@@ -260,6 +263,7 @@ impl BranchModel {
             d,
             h,
             r,
+            pin: spi.pin_cycles,
             cnv,
             caps,
             sclks,
@@ -666,7 +670,8 @@ impl CycleModel {
                         m.tn
                     };
                     if k < m.r && m.conv {
-                        cs = false;
+                        // the pin: through the read, or the conversion alone
+                        cs = k >= m.pin;
                         if k >= m.su && (k - m.su) % m.d < m.h {
                             sclk = false;
                         }

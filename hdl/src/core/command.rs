@@ -48,6 +48,9 @@ pub struct CmdUnit {
     _bits: Vec<CmdBit>,
     _ahead: u64,
     _cnv: bool,
+    /// The conversion pin is held through the read (else a CNV part read
+    /// with CNV low: the pin is active at the slot start only).
+    _held: bool,
     _setup: u64,
     _branch: usize,
     /// The twin's registers: the word still to send (bit 0 next), the
@@ -56,10 +59,13 @@ pub struct CmdUnit {
     _mosi: bool,
     _cnt: u64,
     _prep: u64,
+    /// Read with CNV low: the branch converts in this slot (its pin was
+    /// active at the slot start).
+    _conv: bool,
 }
 
 impl CmdUnit {
-    pub(super) fn new(cmd: &Command, cnv: bool, setup: u64, branch: usize) -> CmdUnit {
+    pub(super) fn new(cmd: &Command, cnv: bool, held: bool, setup: u64, branch: usize) -> CmdUnit {
         CmdUnit {
             clock: Default::default(),
             rst: Default::default(),
@@ -76,12 +82,14 @@ impl CmdUnit {
             _bits: cmd.bits.clone(),
             _ahead: cmd.ahead as u64,
             _cnv: cnv,
+            _held: held,
             _setup: setup,
             _branch: branch,
             _sh: 0,
             _mosi: false,
             _cnt: 0,
             _prep: cmd.ahead as u64,
+            _conv: false,
         }
     }
 
@@ -98,10 +106,16 @@ impl CmdUnit {
         })
     }
 
-    /// Whether the next cycle begins an SCLK period of a conversion.
+    /// Whether the next cycle begins an SCLK period of a conversion.  Read
+    /// with CNV low, the pin is not active in the read: a fall of the
+    /// branch's SCK is one of its conversions (it idles low otherwise), and
+    /// the first period is one when the pin was active at the slot start.
     fn period_starts(&self) -> bool {
-        let act = self.pin.val() == self._cnv;
         let fall = self.bsclk.val() & !self.qsclk.val();
+        if !self._held {
+            return fall || (self._cnt == 1 && self._conv);
+        }
+        let act = self.pin.val() == self._cnv;
         let first = self._cnv
             && if self._setup == 1 {
                 self.start0.val()
@@ -145,6 +159,9 @@ impl Logic for CmdUnit {
                 self._cnt = self._setup - 1;
             } else if self._cnt != 0 {
                 self._cnt -= 1;
+            }
+            if self.start0.val() {
+                self._conv = self.pin.val();
             }
             if self.rst.val() {
                 self._prep = self._ahead;
@@ -206,12 +223,23 @@ impl CmdUnit {
         let _ = writeln!(s, "reg [{}:0] sh;\ninitial sh = {l}'h0;", l - 1);
         let _ = writeln!(s, "reg r_mosi;\ninitial r_mosi = 1'b0;");
         let _ = writeln!(s, "wire [{}:0] src = start0 ? word : sh;", l - 1);
-        let act = if self._cnv { "pin" } else { "~pin" };
         let first = self.first_strobe(&mut s);
-        let _ = writeln!(
-            s,
-            "// an SCLK period of a conversion begins in the next cycle\nwire per = {act} & ((bsclk & ~qsclk){first});"
-        );
+        if self._held {
+            let act = if self._cnv { "pin" } else { "~pin" };
+            let _ = writeln!(
+                s,
+                "// an SCLK period of a conversion begins in the next cycle\nwire per = {act} & ((bsclk & ~qsclk){first});"
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "// read with CNV low: the branch converts in this slot if CNV was high at its start\nreg conv;\ninitial conv = 1'b0;\nalways @(posedge clock) if (start0) conv <= pin;"
+            );
+            let _ = writeln!(
+                s,
+                "// an SCLK period of a conversion begins in the next cycle (SCK idles low between conversions)\nwire per = (bsclk & ~qsclk) | (first & conv);"
+            );
+        }
         let shifted = if l == 1 {
             "1'b0".to_string()
         } else {

@@ -3,20 +3,22 @@
 use crate::widths::*;
 
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
-/// `modes`: a mix with modes (pin select, the branches whose words the
+/// `pulse_of`: per sequencer, its CNV pulse if its part is read with CNV
+/// low. `modes`: a mix with modes (pin select, the branches whose words the
 /// mode block reads).
 pub(super) fn core_glue(
     nb: usize,
     devices: &[usize],
     seq_of: &[usize],
-    nseq: usize,
+    pulse_of: &[Option<usize>],
     cmd_of: &[Option<usize>],
     modes: Option<(bool, usize)>,
     queue: Option<&[Vec<usize>]>,
 ) -> String {
     let mut s = String::new();
+    let nseq = pulse_of.len();
     s.push_str("always @(*) begin\n");
-    child_inputs(&mut s, nb, seq_of, nseq, modes.is_none());
+    child_inputs(&mut s, nb, seq_of, pulse_of, modes.is_none());
     if let Some((pin, lanes)) = modes {
         mode_inputs(&mut s, nb, pin, lanes);
     }
@@ -27,6 +29,16 @@ pub(super) fn core_glue(
         "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
     );
     unused_wires(&mut s, nb, devices, nseq);
+    let released: Vec<String> = (0..nseq)
+        .filter(|&i| pulse_of[i].is_some())
+        .map(|i| format!("seqs${i}$cs_n"))
+        .collect();
+    if !released.is_empty() {
+        s.push_str(&format!(
+            "// sequencers whose branches take the CNV pulse as their pin\nwire unused_seq_cs_n = |{{{}}};\n",
+            released.join(", ")
+        ));
+    }
     if modes.is_some() {
         s.push_str("// the mode block gives the branches their ROM address\nwire unused_slice = |timing$slice;\n");
     }
@@ -122,15 +134,28 @@ fn lanes_below_is(src: usize, j: usize) -> String {
     t.join(" && ")
 }
 
-/// Clock, reset, slot strobes and sequencer levels into every child.
+/// Clock, reset, slot strobes and sequencer levels into every child (a
+/// branch whose sequencer has a CNV pulse takes the pulse as its pin).
 /// `timebase`: the branches' ROM address is the timing generator's (else
 /// the mode block's, [`mode_inputs`]).
-fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize, timebase: bool) {
+fn child_inputs(
+    s: &mut String,
+    nb: usize,
+    seq_of: &[usize],
+    pulse_of: &[Option<usize>],
+    timebase: bool,
+) {
     for (who, _) in [("timing", 0), ("merge", 0)] {
         s.push_str(&format!("  {who}$clock = clock;\n  {who}$rst = rst;\n"));
     }
-    for i in 0..nseq {
+    for i in 0..pulse_of.len() {
         let q = format!("seqs${i}");
+        s.push_str(&format!(
+            "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = timing$start2;\n"
+        ));
+    }
+    for p in pulse_of.iter().flatten() {
+        let q = format!("pulses${p}");
         s.push_str(&format!(
             "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = timing$start2;\n"
         ));
@@ -148,8 +173,12 @@ fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], nseq: usize, timeba
                 "  {u}$addr = timing$addr;\n  {u}$slice = timing$slice;\n"
             ));
         }
+        let pin = match pulse_of[*seq] {
+            Some(p) => format!("pulses${p}$pin_n"),
+            None => format!("{q}$cs_n"),
+        };
         s.push_str(&format!(
-            "  {u}$seq_cs_n = {q}$cs_n;\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$grant = merge$grant[{b}];\n"
+            "  {u}$seq_cs_n = {pin};\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$grant = merge$grant[{b}];\n"
         ));
     }
 }

@@ -90,6 +90,7 @@ fn harness(div: u64, setup: u64) -> Harness {
             sclk_half: div / 2,
             setup_cycles: setup,
             read_cycles: setup + 16 * div,
+            pin_cycles: setup + 16 * div,
             cnv: false,
             sclks: 16,
             word_sclks: 16,

@@ -3,7 +3,7 @@
 use rust_hdl::prelude::*;
 
 use super::glue::{core_glue, route_miso};
-use super::{BranchUnit, CmdUnit, Merger, ModeGen, SpiSeq, TimingGen};
+use super::{BranchUnit, CmdUnit, CnvPulse, Merger, ModeGen, SpiSeq, TimingGen};
 use crate::plan::Plan;
 use crate::widths::*;
 
@@ -32,6 +32,10 @@ pub struct Core {
     pub mode: Vec<Signal<Out, Bits<MODE_BITS>>>,
     pub timing: TimingGen,
     pub seqs: Vec<SpiSeq>,
+    /// The CNV pulse of each sequencer whose part is read with CNV low.
+    pub pulses: Vec<CnvPulse>,
+    /// The pulse of each sequencer, if it has one.
+    _pulse_of: Vec<Option<usize>>,
     pub branches: Vec<BranchUnit>,
     /// One command unit per branch with a command word, in branch order.
     pub cmds: Vec<CmdUnit>,
@@ -53,13 +57,20 @@ pub struct Core {
 
 impl Core {
     pub fn new(plan: &Plan) -> Core {
+        let mut pulse_of = vec![None; plan.seqs.len()];
+        let mut pulses = vec![];
+        for (i, q) in plan.seqs.iter().enumerate().filter(|(_, q)| q.pulsed()) {
+            pulse_of[i] = Some(pulses.len());
+            pulses.push(CnvPulse::new(q.pin_cycles));
+        }
         let mut cmd_of = vec![None; plan.branches.len()];
         let mut cmds = vec![];
         for (b, r) in plan.branches.iter().enumerate() {
             if let Some(c) = &r.command {
                 cmd_of[b] = Some(cmds.len());
                 let setup = plan.seqs[r.seq].setup_cycles;
-                cmds.push(CmdUnit::new(c, r.cnv, setup, b));
+                let held = !plan.seqs[r.seq].pulsed();
+                cmds.push(CmdUnit::new(c, r.cnv, held, setup, b));
             }
         }
         Core {
@@ -84,6 +95,8 @@ impl Core {
             mode: plan.modes.iter().map(|_| Default::default()).collect(),
             timing: TimingGen::new(plan),
             seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
+            pulses,
+            _pulse_of: pulse_of,
             branches: plan
                 .branches
                 .iter()
@@ -174,6 +187,9 @@ impl Core {
             drive(&mut u.p_dev.clock, k);
         }
         for u in self.cmds.iter_mut() {
+            drive(&mut u.clock, k);
+        }
+        for u in self.pulses.iter_mut() {
             drive(&mut u.clock, k);
         }
         let m = &mut self.merge;
@@ -267,6 +283,15 @@ impl Logic for Core {
             q.rst.next = rst;
             q.start2.next = start;
             seq[i] = (q.cs_n.val(), q.sclk.val(), q.cap.val(), q.done.val());
+        }
+        for (i, p) in self._pulse_of.iter().enumerate() {
+            let Some(p) = p else { continue };
+            let u = &mut self.pulses[*p];
+            u.clock.next = clk;
+            u.rst.next = rst;
+            u.start2.next = start;
+            // the branches register the pulse in place of the sequencer's pin
+            seq[i].0 = u.pin_n.val();
         }
         let miso = self.miso_lanes();
         let grant = self.merge.grant.val().to_u64();
@@ -396,6 +421,11 @@ impl Logic for Core {
             u.q_ch.connect();
             u.q_val.connect();
         }
+        for q in self.pulses.iter_mut() {
+            q.clock.connect();
+            q.rst.connect();
+            q.start2.connect();
+        }
         for q in self.cmds.iter_mut() {
             q.clock.connect();
             q.rst.connect();
@@ -446,7 +476,7 @@ impl Logic for Core {
             self.branches.len(),
             &self._devices,
             &self._seq_of,
-            self.seqs.len(),
+            &self._pulse_of,
             &self._cmd_of,
             self.modes
                 .first()

@@ -2,7 +2,7 @@
 
 use super::raw::*;
 use super::*;
-use crate::parts::{AdcPart, Command, Start};
+use crate::parts::{AdcPart, CnvRead, Command, Start};
 
 impl Cx<'_> {
     /// A `[[adc_part]]` table, checked like every other field.
@@ -67,11 +67,27 @@ impl Cx<'_> {
             ));
         }
         let max_sps = self.positive(&p.max_sps, &f("max_sps"))?;
+        let read = self.adc_part_read(i, p, start)?;
+        if read == CnvRead::CnvLow && conversion_ns == 0 {
+            return Err(self.at(
+                p.read.as_ref().unwrap().span(),
+                f("conversion_ns"),
+                "a part read with CNV low holds CNV high for the conversion: give its conversion_ns (t_CONV max)",
+            ));
+        }
         let chain_max = self.adc_part_chain(i, p, start)?;
+        if read == CnvRead::CnvLow && chain_max > 1 {
+            return Err(self.at(
+                p.chain_max.as_ref().unwrap().span(),
+                f("chain_max"),
+                "a chain is read with CNV high (chain mode): a part read with CNV low is not chained here",
+            ));
+        }
         Ok(AdcPart {
             name,
             bits: bits as u32,
             start,
+            read,
             leading_bits: leading_bits as u32,
             trailing_bits: trailing_bits as u32,
             sclk_min_hz,
@@ -167,6 +183,38 @@ impl Cx<'_> {
             ));
         }
         Ok(name)
+    }
+
+    /// `adc_part.read`: how a "cnv" part is read (CNV high unless given).
+    pub(super) fn adc_part_read(
+        &self,
+        i: usize,
+        p: &RawAdcPart,
+        start: Start,
+    ) -> Result<CnvRead, MixError> {
+        let Some(r) = &p.read else {
+            return Ok(CnvRead::CnvHigh);
+        };
+        let key = format!("adc_part[{i}].read");
+        let read = match r.get_ref().as_str() {
+            "cnv-high" => CnvRead::CnvHigh,
+            "cnv-low" => CnvRead::CnvLow,
+            other => {
+                return Err(self.at(
+                    r.span(),
+                    key,
+                    format!("unknown read `{other}` (\"cnv-high\": CNV stays high through the read, as in the AD7685's chain mode; \"cnv-low\": CNV returns low when the conversion ends and the word is read while it is low, as the AD7689 is)"),
+                ))
+            }
+        };
+        if start == Start::Cs {
+            return Err(self.at(
+                r.span(),
+                key,
+                "a \"cs\" part is read while CS is low: `read` applies to \"cnv\" parts only",
+            ));
+        }
+        Ok(read)
     }
 
     pub(super) fn unknown_start(&self, i: usize, p: &RawAdcPart, other: &str) -> MixError {

@@ -90,6 +90,8 @@ pub(super) struct RawAdcPart {
     pub(super) name: Spanned<String>,
     pub(super) bits: Spanned<i64>,
     pub(super) start: Spanned<String>,
+    /// "cnv" parts: `cnv-high` (CNV held through the read) or `cnv-low`.
+    pub(super) read: Option<Spanned<String>>,
     pub(super) leading_bits: Option<Spanned<i64>>,
     pub(super) trailing_bits: Option<Spanned<i64>>,
     pub(super) sclk_min_hz: Option<Spanned<i64>>,

@@ -310,3 +310,57 @@ fn a_declared_part_may_take_a_command_word() {
         assert_eq!(e.line, line_of(&text, &format!("{key} =")), "{e}");
     }
 }
+
+/// `[[adc_part]] read`: a "cnv" part read with CNV low (its pin active for
+/// the conversion alone), refused with the field and line where it cannot
+/// be (a "cs" part, a chain, no conversion time, an unknown word).
+#[test]
+fn a_declared_cnv_part_may_be_read_with_cnv_low() {
+    let part = "[[adc_part]]\nname = \"ad7686\"\nbits = 16\nstart = \"cnv\"\nread = \"cnv-low\"\n\
+                conversion_ns = 1_600\nsetup_ns = 22\nsclk_max_hz = 20_000_000\nmax_sps = 500_000\n";
+    let mix = |p: &str| format!("{GOOD}{p}").replace("adc = \"ad7940\"", "adc = \"ad7686\"");
+    let m = parse(Path::new("m.toml"), &mix(part)).unwrap();
+    let adc = &m.branches[0].adc;
+    assert_eq!(adc.read, crate::CnvRead::CnvLow);
+    let t = crate::SpiTiming::derive(adc, 48_000_000, adc.sclk_max_hz, 1).unwrap();
+    // CNV falls when the conversion ends, before the read
+    assert_eq!(t.pin_cycles, t.conv_cycles);
+    assert!(t.pin_cycles < t.setup_cycles && t.setup_cycles < t.read_cycles);
+    let held = parse(
+        Path::new("m.toml"),
+        &mix(&part.replace("read = \"cnv-low\"\n", "")),
+    )
+    .unwrap();
+    assert_eq!(held.branches[0].adc.read, crate::CnvRead::CnvHigh);
+    for (from, to, field, says) in [
+        (
+            "\"cnv-low\"",
+            "\"low\"",
+            "adc_part[0].read",
+            "unknown read `low`",
+        ),
+        (
+            "start = \"cnv\"\nread = \"cnv-low\"\nconversion_ns = 1_600",
+            "start = \"cs\"\nleading_bits = 1\nread = \"cnv-low\"",
+            "adc_part[0].read",
+            "\"cnv\" parts only",
+        ),
+        (
+            "conversion_ns = 1_600\n",
+            "",
+            "adc_part[0].conversion_ns",
+            "give its conversion_ns",
+        ),
+        (
+            "max_sps = 500_000\n",
+            "max_sps = 500_000\nchain_max = 2\n",
+            "adc_part[0].chain_max",
+            "not chained",
+        ),
+    ] {
+        let text = mix(&part.replace(from, to));
+        let e = err(&text);
+        assert_eq!(e.field, field, "{e}");
+        assert!(e.message.contains(says), "{e}");
+    }
+}
