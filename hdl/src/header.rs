@@ -94,6 +94,14 @@ pub(crate) fn blocks(s: &Schedule, p: &Plan) -> String {
             "\"Command words\"",
         );
     }
+    for i in 0..p.seqs.iter().filter(|q| q.pulsed()).count() {
+        row(
+            &mut v,
+            &format!("slotforge_cnv_pulse{i}"),
+            "CNV high for the conversion alone (a part read with CNV low)",
+            "\"Reading with CNV low\"",
+        );
+    }
     row(
         &mut v,
         "slotforge_merger",
@@ -114,6 +122,13 @@ pub(crate) fn blocks(s: &Schedule, p: &Plan) -> String {
         "a W-bit register (rust-hdl's DFF), one module per width",
         "-",
     );
+    branch_timing(&mut v, s, p);
+    v
+}
+
+/// Where each branch's SPI timing lives (and its CNV pulse, if read with
+/// CNV low), one line each.
+fn branch_timing(v: &mut String, s: &Schedule, p: &Plan) {
     for (b, bp) in s.branches.iter().enumerate() {
         let m = spi_seq_module(p.branches[b].seq);
         let q = &p.seqs[p.branches[b].seq];
@@ -122,8 +137,17 @@ pub(crate) fn blocks(s: &Schedule, p: &Plan) -> String {
             "// SPI timing of branch {b} \"{}\": sclk_div {} sclk_half {} setup_cycles {} read_cycles {}, in module {m} (search \"module {m}(\")",
             bp.name, q.sclk_div, q.sclk_half, q.setup_cycles, q.read_cycles
         );
+        if q.pulsed() {
+            let n = (p.seqs[..p.branches[b].seq].iter())
+                .filter(|q| q.pulsed())
+                .count();
+            let _ = writeln!(
+                v,
+                "//   read with CNV low: CNV high for the conversion's {} cycles alone, in module slotforge_cnv_pulse{n} (docs/timing.md, \"Reading with CNV low\")",
+                q.pin_cycles
+            );
+        }
     }
-    v
 }
 
 /// The per-mix constants the design is built from, named, from the plan.

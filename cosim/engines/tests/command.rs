@@ -342,3 +342,41 @@ fn a_gateware_sending_the_wrong_channel_bits_fails_on_both_verilog_engines() {
         assert!(beside.diff.is_some(), "{name}: Icarus ran the mutant clean");
     }
 }
+
+/// The emitted Verilog with the ad7689's CNV held high through the read (its
+/// branches take the sequencer's pin instead of the CNV pulse): the part
+/// would leave SDO high-impedance and ignore DIN.
+pub fn cnv_held_through_the_read(verilog: &str) -> String {
+    let mut n = 0;
+    let out: Vec<String> = verilog
+        .lines()
+        .map(|l| match l.find("_seq_cs_n = cnv_pulse") {
+            Some(_) => {
+                n += 1;
+                let seq = l.split("_seq_cs_n").next().unwrap();
+                format!("{seq}_seq_cs_n = spi_seq0_cs_n;")
+            }
+            None => l.to_string(),
+        })
+        .collect();
+    assert!(n > 0, "no CNV pulse in the design");
+    out.join("\n") + "\n"
+}
+
+/// A gateware that holds the ad7689's CNV high through the read differs
+/// from the model on its CNV pin, on both Verilog engines.
+#[test]
+fn a_gateware_holding_cnv_through_the_read_fails_on_both_verilog_engines() {
+    if !tools::require_tools(&["verilator", "g++", "iverilog", "vvp"]) {
+        return;
+    }
+    let s = schedule("cmd-ad7689");
+    let bad = cnv_held_through_the_read(&engines::verilog(&s).unwrap());
+    let (mut dut, _) = VerilatedDut::new(&bad).unwrap();
+    let (diff, _, _) = first_difference(&s, &mut dut, 1);
+    let d = diff.expect("Verilator ran the mutant clean");
+    assert!(d.contains("cs_n"), "{d}");
+    let mut beside = BesideModel::new(&s);
+    icarus_beside(&s, Some(&bad), Stimulus::Pattern, 1, &mut beside);
+    assert!(beside.diff.is_some(), "Icarus ran the mutant clean");
+}

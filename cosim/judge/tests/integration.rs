@@ -27,3 +27,6 @@ mod modevcd;
 
 #[path = "modelink.rs"]
 mod modelink;
+
+#[path = "cnvlow.rs"]
+mod cnvlow;
