@@ -889,6 +889,30 @@ fn a_gateware_sending_the_wrong_channel_bits_fails_prove() {
     assert_eq!(failed, ["mosi[cmd]"], "{}", p.summary());
 }
 
+/// A gateware that holds the AD7689's CNV high through the read (its
+/// branch takes the sequencer's pin instead of the CNV pulse) fails
+/// `prove` on the conversion pin, at the cycle the conversion ends.
+#[test]
+fn a_gateware_holding_the_ad7689s_cnv_through_the_read_fails_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/cmd-ad7689.toml");
+    let bad = edit(
+        &emitted(&s),
+        "branch0_seq_cs_n = cnv_pulse0_pin_n;",
+        "branch0_seq_cs_n = spi_seq0_cs_n;",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &bad, dir.path());
+    assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
+    let failed: Vec<&str> = (p.properties.iter())
+        .filter(|q| q.result == Outcome::Failed)
+        .map(|q| q.name.as_str())
+        .collect();
+    assert_eq!(failed, ["conversion[cfg]"], "{}", p.summary());
+}
+
 /// Random mixes of `campaign::random_mix` with converters that take a
 /// command word beside listening ones prove (no test was written for them).
 #[test]
