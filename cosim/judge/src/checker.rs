@@ -177,10 +177,8 @@ pub struct Checker {
     br: Vec<BranchState>,
     /// CNV lanes of `adc_cs_n`/`adc_sclk` (inverted into the CS view).
     flip: u16,
-    /// Lanes read with CNV low, given their read's window in the CS view;
-    /// the view of the last pins that changed.
+    /// Lanes read with CNV low, given their read's window in the CS view.
     low: LowRead,
-    prev_view: Pins,
     /// Per channel: the channels read in its conversion, by chain member.
     groups: Vec<Vec<Option<usize>>>,
     next_frame_at: u64,
@@ -268,7 +266,6 @@ impl Checker {
         Checker {
             flip,
             low: LowRead::new(s),
-            prev_view: Pins::default(),
             groups: s.groups.clone(),
             opts,
             mix_name: mix.name.clone(),
@@ -471,10 +468,7 @@ impl Checker {
                 }
             }
         }
-        // (a lane read with CNV low is in a conversion while CNV is high:
-        // its view is the inverted pin's, as every CNV lane's)
         let rp = self.view(&rp);
-        self.prev_view = rp;
         for b in 0..self.layout.branches {
             let st = &mut self.br[b];
             st.mux_from_reset = true;
@@ -728,9 +722,10 @@ impl Checker {
     }
 
     fn edges(&mut self, c: u64, p: &Pins, xz: &Pins) {
+        let mut prev = self.view(&self.prev);
+        self.low.last_view(&mut prev);
         let mut v = self.view(p);
         (self.low).view(c, &self.prev, p, &mut v, &self.layout, &mut self.inv);
-        let prev = std::mem::replace(&mut self.prev_view, v);
         let p = &v;
         let dcs = prev.cs_n ^ p.cs_n;
         let dsclk = prev.sclk ^ p.sclk;

@@ -452,24 +452,14 @@ impl LinkLine {
         let ends = self.byte(c, byte, inv);
         let clean = self.seen.crc_errors == before.crc_errors
             && self.seen.skipped_bytes == before.skipped_bytes;
-        let want =
-            ends.is_some_and(|slice| fmt.tlast == Tlast::Slice || slice as u64 + 1 == self.slices);
-        if self.synced && clean && !self.lost_place && tlast != want {
+        let wrong = tlast_wrong(fmt, ends, self.slices, tlast, byte);
+        if let Some(detail) = wrong.filter(|_| self.synced && clean && !self.lost_place) {
             inv.record(
                 Violation::new(Rule::AxisTlast, c)
                     .signal("m_axis_tlast".to_string())
-                    .expected(json!(want as u8))
+                    .expected(json!(!tlast as u8))
                     .actual(json!(tlast as u8))
-                    .detail(format!(
-                        "tlast is {} on the beat of byte {byte:#04x}, which {} (tlast = \"{}\")",
-                        tlast as u8,
-                        if ends.is_some() {
-                            "ends a packet"
-                        } else {
-                            "does not end a packet"
-                        },
-                        fmt.tlast.name()
-                    )),
+                    .detail(detail),
             );
         }
     }
@@ -692,4 +682,30 @@ impl LinkLine {
                 )),
         );
     }
+}
+
+/// The AXI4-Stream rule for `tlast` on the beat of `byte`, whose packet
+/// (if it completed one) ended slice `ends` of `slices`: `None` when `tlast`
+/// is where the format puts it, else what is wrong, in words.  The cycle
+/// judge and the capture judge both ask it.
+pub(crate) fn tlast_wrong(
+    fmt: AxisFormat,
+    ends: Option<u16>,
+    slices: u64,
+    tlast: bool,
+    byte: u8,
+) -> Option<String> {
+    let want = ends.is_some_and(|sl| fmt.tlast == Tlast::Slice || sl as u64 + 1 == slices);
+    (tlast != want).then(|| {
+        format!(
+            "tlast is {} on the beat of byte {byte:#04x}, which {} (tlast = \"{}\")",
+            tlast as u8,
+            if ends.is_some() {
+                "ends a packet"
+            } else {
+                "does not end a packet"
+            },
+            fmt.tlast.name()
+        )
+    })
 }

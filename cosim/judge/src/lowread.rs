@@ -24,6 +24,9 @@ use crate::verdict::Violation;
 struct Lane {
     /// The window is open (converting, or reading after CNV fell).
     open: bool,
+    /// The window in the last view given (`None` before the first: the
+    /// pin's own level stands for it).
+    active: Option<bool>,
     /// SCK falling edges since CNV fell.
     falls: u32,
     rose_at: u64,
@@ -60,6 +63,17 @@ impl LowRead {
             });
         }
         LowRead { mask, lanes }
+    }
+
+    /// The lanes' windows as [`LowRead::view`] last gave them, into `view`
+    /// (the CS view of the pins it was given).
+    pub(crate) fn last_view(&self, view: &mut Pins) {
+        for (b, l) in self.lanes.iter().enumerate() {
+            if let Some(a) = l.active.filter(|_| self.mask >> b & 1 == 1) {
+                let bit = 1u16 << b;
+                view.cs_n = (view.cs_n & !bit) | if a { 0 } else { bit };
+            }
+        }
     }
 
     /// `view` (the CS view of `p`, CNV lanes inverted) with each lane read
@@ -118,6 +132,7 @@ impl LowRead {
                 l.open = l.falls < l.sclks;
             }
             let active = cnv || l.open;
+            l.active = Some(active);
             view.cs_n = (view.cs_n & !bit) | if active { 0 } else { bit };
         }
     }

@@ -323,8 +323,8 @@ fn decode(
             false => lost_place || st.skipped_bytes > before.skipped_bytes,
         };
         let clean = st.crc_errors == before.crc_errors && st.skipped_bytes == before.skipped_bytes;
-        let want = ends.is_some_and(|sl| fmt.tlast == Tlast::Slice || sl as u64 + 1 == slices);
-        if join.is_some() && clean && tlast != want {
+        let wrong = crate::linkline::tlast_wrong(fmt, ends, slices, tlast, byte);
+        if let Some(detail) = wrong.filter(|_| join.is_some() && clean) {
             tlast_wrong += 1;
             if tlast_wrong <= 3 {
                 out.violations.push(crate::timed::TimedViolation {
@@ -332,16 +332,7 @@ fn decode(
                     channel: lane.channel.clone(),
                     port_bit: "m_axis_tlast".into(),
                     rule: "link tlast".into(),
-                    detail: format!(
-                        "tlast is {} on the beat of byte 0x{byte:02x}, which {} (tlast = \"{}\")",
-                        tlast as u8,
-                        if ends.is_some() {
-                            "ends a packet"
-                        } else {
-                            "does not end a packet"
-                        },
-                        fmt.tlast.name()
-                    ),
+                    detail,
                 });
             }
         }
