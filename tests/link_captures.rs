@@ -34,8 +34,20 @@ fn judged(
     phase: u64,
     out: &Path,
 ) -> [judge::TimedReport; 2] {
+    judged_drifting(s, pins, w, phase, 0.0, out)
+}
+
+/// [`judged`] by an analyser `ppm` parts per million off the design's clock.
+fn judged_drifting(
+    s: &Schedule,
+    pins: &[Pins],
+    w: (u64, u64),
+    phase: u64,
+    ppm: f64,
+    out: &Path,
+) -> [judge::TimedReport; 2] {
     let (_, map) = analyser::lanes(s);
-    analyser::resample(s, pins, w.0, w.1, 10_000, phase, out);
+    analyser::resample_drifting(s, pins, w, (10_000, phase), ppm, out);
     let text = std::fs::read_to_string(out).unwrap().replace(
         "$enddefinitions $end\n",
         "$comment\n  Acquisition at 100 MHz\n$end\n$enddefinitions $end\n",
@@ -173,6 +185,53 @@ fn captures_of_the_link_presets_at_random_offsets_pass() {
     }
 }
 
+/// A board's crystal and an analyser's differ by tens of ppm: a capture of
+/// the link presets over most of a frame, the analyser 100 ppm fast or
+/// slow, passes as a capture with exact clocks does.
+#[test]
+fn captures_by_an_analyser_100_ppm_off_pass() {
+    let d = tempfile::tempdir().unwrap();
+    for name in ["eskin34-uart.toml", "eskin34-axis.toml"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("mixes")
+            .join(name);
+        let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
+        let f = s.grid.frame_cycles;
+        let p = pins(&s, 3);
+        for (i, ppm) in [100.0, -100.0].into_iter().enumerate() {
+            let w = (f / 2, 2 * f);
+            let out = d.path().join(format!("{i}.vcd"));
+            let r = judged_drifting(&s, &p, w, 3_000, ppm, &out);
+            assert_clean(&format!("{name} at {ppm} ppm"), &s, &r);
+            for r in &r {
+                // the analyser fast by `ppm`: the design's clock slow by it
+                let got = r.clock_ppm.expect("the clock measured");
+                assert!((got + ppm).abs() < 2.0, "{name}: {got} ppm");
+                assert!(r.summary().contains(&format!("{got:+.1} ppm")), "{name}");
+            }
+        }
+    }
+}
+
+/// A capture at the mix's own clock is checked as it was taken (no offset
+/// the fit can tell from none), on every link preset.
+#[test]
+fn captures_at_the_mixs_clock_are_not_scaled() {
+    let d = tempfile::tempdir().unwrap();
+    for name in ["eskin34-uart.toml", "eskin34-axis.toml"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("mixes")
+            .join(name);
+        let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
+        let f = s.grid.frame_cycles;
+        let p = pins(&s, 3);
+        let r = judged(&s, &p, (f / 3, 2 * f), 7_000, &d.path().join("a.vcd"));
+        for r in &r {
+            assert_eq!(r.clock_ppm, None, "{name}: {}", r.summary());
+        }
+    }
+}
+
 /// The UART mixes of the random link mixes from seed 1.
 fn uart_mix() -> Schedule {
     random_link_mixes(1, 4)
@@ -244,6 +303,44 @@ fn a_fault_after_the_join_fails_the_capture_at_its_time() {
     );
     // intact bytes: the decoder alone does not see a timing fault
     assert!(dec.ok, "{}", dec.summary());
+}
+
+/// With the analyser 100 ppm off, a start bit two bits late is still
+/// failed by the model, at its time in the capture's own timebase.
+#[test]
+fn a_late_start_bit_fails_a_drifting_capture_at_its_time() {
+    let s = uart_mix();
+    let d = tempfile::tempdir().unwrap();
+    let f = s.grid.frame_cycles;
+    let clean = pins(&s, 4);
+    let (w, phase, ppm) = ((f / 2, f / 2 + 2 * f), 2_000, 100.0);
+    let at = w.0 + f;
+    let st = (at as usize..clean.len())
+        .find(|&c| !clean[c].link_tx && clean[c - 1].link_tx)
+        .unwrap();
+    let div = lut_gen::plan_link(&s).unwrap().unwrap().baud_divider as usize;
+    let mut late = clean.clone();
+    for c in st..late.len() {
+        late[c].link_tx = if c < st + 2 * div {
+            true
+        } else {
+            clean[c - 2 * div].link_tx
+        };
+    }
+    let out = d.path().join("late.vcd");
+    let [m, dec] = judged_drifting(&s, &late, w, phase, ppm, &out);
+    let text = m.summary();
+    assert!(!m.ok && dec.ok, "{text}");
+    assert!(m.clock_ppm.is_some(), "{text}");
+    let v = &m.violations[0];
+    assert!(v.rule.contains("link timing"), "{text}");
+    // the capture's time of the late start: the cycle's, stretched by ppm
+    let t = at_ps(&s, st as u64, w.0, phase) as f64 * (1.0 + ppm * 1e-6);
+    let span = at_ps(&s, w.0 + 3 * div as u64, w.0, 0) as f64;
+    assert!(
+        (t..t + span).contains(&(v.time_ps as f64)),
+        "the late start bit at {t} ps: {text}"
+    );
 }
 
 /// The line before the first whole packet is not judged and the report

@@ -94,6 +94,7 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
             "ok": r.ok,
             "mode": "time-level capture",
             "locked_at_ps": r.locked_at_ps,
+            "clock_ppm": r.clock_ppm,
             "slot": r.slot,
             "phases": r.phases,
             "edges_checked": r.edges_checked,

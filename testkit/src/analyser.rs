@@ -152,7 +152,37 @@ pub fn resample_lanes(
     phase_ps: u64,
     out: &Path,
 ) {
-    let tc = 1e12 / s.mix.clock_hz as f64;
+    resample_scaled(s, lanes, level, (from, to), (ts_ps, phase_ps), 0.0, out);
+}
+
+/// [`resample`] by an analyser whose clock is `ppm` parts per million off
+/// the design's (positive: the analyser runs fast, so its timestamps
+/// stretch each of the design's cycles by that much): a board's crystal
+/// against an analyser's.
+pub fn resample_drifting(
+    s: &Schedule,
+    pins: &[Pins],
+    (from, to): (u64, u64),
+    (ts_ps, phase_ps): (u64, u64),
+    ppm: f64,
+    out: &Path,
+) {
+    let (lanes, _) = lanes(s);
+    let level = |c: usize, r: Option<Role>, b: u32| bit(&pins[c], r, b);
+    resample_scaled(s, &lanes, &level, (from, to), (ts_ps, phase_ps), ppm, out);
+}
+
+fn resample_scaled(
+    s: &Schedule,
+    lanes: &[(Option<Role>, u32)],
+    level: &dyn Fn(usize, Option<Role>, u32) -> bool,
+    (from, to): (u64, u64),
+    (ts_ps, phase_ps): (u64, u64),
+    ppm: f64,
+    out: &Path,
+) {
+    // the design's cycle in the analyser's time
+    let tc = 1e12 / s.mix.clock_hz as f64 * (1.0 + ppm * 1e-6);
     let names: Vec<String> = (0..lanes.len()).map(|i| format!("D{i}")).collect();
     let names: Vec<&str> = names.iter().map(String::as_str).collect();
     let mut text = wire_header("1 ps", "libsigrok", &names);

@@ -38,6 +38,7 @@ mod adc;
 mod axishold;
 mod capture;
 mod checker;
+mod clockfit;
 mod cmdword;
 mod events;
 mod faults;

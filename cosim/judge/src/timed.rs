@@ -151,6 +151,11 @@ pub struct TimedReport {
     pub not_proved: Vec<String>,
     /// A UART line decoded from the capture: where it was joined.
     pub link_join: Option<LineJoin>,
+    /// The design's clock measured from the conversion starts, in ppm from
+    /// the mix's in the analyser's timebase (positive: faster), when the
+    /// capture's times were scaled by it; every time above is the capture's
+    /// own.
+    pub clock_ppm: Option<f64>,
 }
 
 impl TimedReport {
@@ -171,6 +176,12 @@ impl TimedReport {
             self.violations_total,
             crate::verdict::verdict_word(self.ok, self.link_join.as_ref().map(|j| j.judged))
         );
+        if let Some(ppm) = self.clock_ppm {
+            let _ = writeln!(
+                s,
+                "clock: the conversion starts put the design's clock {ppm:+.1} ppm from the mix's (the board's crystal against the analyser's); the capture was checked at that clock"
+            );
+        }
         if let Some(j) = &self.link_join {
             let _ = writeln!(s, "{}", j.text());
         }
@@ -483,6 +494,23 @@ pub fn check_capture_with(
     skew_ps: u64,
     model: bool,
 ) -> Result<TimedReport, TimedError> {
+    match crate::clockfit::fit(s, cap).filter(|f| f.worth_scaling()) {
+        Some(f) => {
+            let mut r = check_at_mix_clock(s, &f.scaled(cap), skew_ps, model)?;
+            f.unscale(&mut r);
+            Ok(r)
+        }
+        None => check_at_mix_clock(s, cap, skew_ps, model),
+    }
+}
+
+/// [`check_capture_with`] with the capture's times taken as the mix's clock.
+fn check_at_mix_clock(
+    s: &Schedule,
+    cap: &Capture,
+    skew_ps: u64,
+    model: bool,
+) -> Result<TimedReport, TimedError> {
     let clock = s.mix.clock_hz as i128;
     let tc_ps = 1e12 / s.mix.clock_hz as f64;
     let mut not_proved = Vec::new();
@@ -555,6 +583,7 @@ pub fn check_capture_with(
         proved,
         not_proved,
         link_join,
+        clock_ppm: None,
     })
 }
 
