@@ -80,17 +80,22 @@ pub(super) fn plan_modes(s: &Schedule, spec: &LinkSpec) -> Result<LinkPlan, Link
     Ok(plan)
 }
 
-/// Frames each side of a switch: past any mode's steady state, which the
-/// steady-state measurement reaches in a few frames.
-const SIDE_FRAMES: u64 = 4;
+/// Frames each side of a switch: one past the frames the slower of the two
+/// modes takes to reach its steady state on this line (the transmitter's
+/// state at a frame start repeats: `link::steady_state`), so the run
+/// enters the switch with `a`'s worst backlog and runs `b` to its own.
+fn side_frames(a: &Schedule, b: &Schedule, line: Line) -> u64 {
+    let settle = |m: &Schedule| measure(m, line, &merged_frame(m)).map_or(MAX_FRAMES, |x| x.frames);
+    settle(a).max(settle(b)) + 1
+}
 
-/// The FIFO's largest backlog over `SIDE_FRAMES` frames of `a` then
-/// `SIDE_FRAMES` frames of `b` (AXI4-Stream: the slowest slave the
-/// guarantee allows), from reset; it stops counting just past
-/// `MAX_FIFO_DEPTH`.
+/// The FIFO's largest backlog over [`side_frames`] frames of `a` then as
+/// many of `b` (AXI4-Stream: the slowest slave the guarantee allows), from
+/// reset; it stops counting just past `MAX_FIFO_DEPTH`.
 pub fn switch_backlog(a: &Schedule, b: &Schedule, line: Line) -> usize {
-    let frames: Vec<&Schedule> = (0..2 * SIDE_FRAMES)
-        .map(|f| if f < SIDE_FRAMES { a } else { b })
+    let side = side_frames(a, b, line);
+    let frames: Vec<&Schedule> = (0..2 * side)
+        .map(|f| if f < side { a } else { b })
         .collect();
     let stream = merged_run(&frames);
     let g = &a.grid;
