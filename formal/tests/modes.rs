@@ -38,15 +38,120 @@ fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
     p
 }
 
+/// `design` with `from` replaced by `to` (exactly once).
+fn edit(design: &str, from: &str, to: &str) -> String {
+    assert_eq!(
+        design.matches(from).count(),
+        1,
+        "`{from}` once in the design"
+    );
+    design.replace(from, to)
+}
+
+/// A failed proof whose counterexample the judge rejects at the cycle
+/// `prove` names, with one of `properties` among the failing ones.
+fn assert_fails(s: &lut_gen::Schedule, p: &Proof, properties: &[&str]) {
+    assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
+    let c = p.counterexample.as_ref().expect("a counterexample");
+    assert!(c.reproduced, "the replay reproduces it: {}", p.summary());
+    let failed: Vec<&str> = (p.properties.iter())
+        .filter(|q| q.result == Outcome::Failed)
+        .map(|q| q.name.as_str())
+        .collect();
+    assert!(
+        failed.iter().any(|f| properties.contains(f)),
+        "fails {failed:?}, none of {properties:?}"
+    );
+    let report = judge::check_vcd(s, &c.vcd, Some(formal::DUT_SCOPE)).expect("VCD reads");
+    assert!(
+        !report.ok,
+        "check accepts the counterexample:\n{}",
+        report.summary()
+    );
+    assert_eq!(
+        formal::first_rejected(&report),
+        Some(c.cycle as u64),
+        "check fails at another cycle than prove:\n{}",
+        p.summary()
+    );
+}
+
+/// The harness of a mix with modes: `mode_sel` a free input (pin select
+/// only), a `mode` property, `Clause::Mode` covered, every mode's table.
+#[test]
+fn the_harness_of_a_mode_mix_asserts_mode_and_frees_mode_sel() {
+    let s = schedule("testkit/mixes/modes-pin.toml");
+    let h = formal::generate(&s).expect("a harness");
+    let names: Vec<&str> = h.inputs.iter().map(|i| i.name.as_str()).collect();
+    assert_eq!(names, ["adc_miso", "mode_sel"]);
+    assert!(h
+        .properties
+        .iter()
+        .any(|p| p.name == "mode" && p.covers == [formal::Clause::Mode]));
+    assert!(h.not_covered.is_empty(), "{:?}", h.not_covered);
+    assert!(h.verilog.contains(".mode_sel(mode_sel), .mode(mode)"));
+    assert_eq!(
+        formal::generate(&s).unwrap().verilog,
+        h.verilog,
+        "deterministic"
+    );
+    let a = schedule("testkit/mixes/modes-auto.toml");
+    let h = formal::generate(&a).expect("a harness");
+    let names: Vec<&str> = h.inputs.iter().map(|i| i.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["adc_miso"],
+        "auto select: MISO is the only free input"
+    );
+    assert!(
+        h.verilog.contains("wire held2 = na2 && !nn2;"),
+        "trigger 2 is `below`"
+    );
+    assert!(h.properties.iter().any(|p| p.name == "mode"));
+    // a mix without modes gets no mode property and keeps its ports
+    let t = schedule("testkit/mixes/tiny.toml");
+    let h = formal::generate(&t).unwrap();
+    assert!(!h.verilog.contains("mcur") && h.properties.iter().all(|p| p.name != "mode"));
+}
+
 #[test]
 fn pin_select_mix_proves_for_every_sequence_of_requests() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
     let s = schedule("testkit/mixes/modes-pin.toml");
-    let h = formal::generate(&s).expect("a harness");
-    std::fs::write("/work/tmp-s10-prove/h.v", &h.verilog).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &emitted(&s), dir.path());
     assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
+}
+
+/// The gateware's mode block as emitted for a pin-select mix.
+const DECIDED: &str = "wire [0:0] decided = mode_sel[0:0];";
+const SWITCH: &str = "cur <= nxt;\n          nxt <= decided;";
+
+#[test]
+fn a_gateware_that_ignores_mode_sel_fails_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/modes-pin.toml");
+    let design = edit(&emitted(&s), DECIDED, "wire [0:0] decided = nxt;");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &design, dir.path());
+    assert_fails(&s, &p, &["mode", "mux[fast]", "mux[slow]"]);
+}
+
+#[test]
+fn a_gateware_that_switches_a_frame_early_fails_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/modes-pin.toml");
+    let early = "cur <= decided;\n          nxt <= decided;";
+    let design = edit(&emitted(&s), SWITCH, early);
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &design, dir.path());
+    assert_fails(&s, &p, &["mode", "mux[fast]", "mux[slow]"]);
 }
