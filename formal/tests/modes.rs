@@ -155,3 +155,59 @@ fn a_gateware_that_switches_a_frame_early_fails_prove() {
     let p = prove(&s, &design, dir.path());
     assert_fails(&s, &p, &["mode", "mux[fast]", "mux[slow]"]);
 }
+
+/// A random pin-select mix with two modes on a 4 MHz clock and a 1 ms
+/// frame: 1 to 3 branches (every one sampled in the reset mode, the other
+/// mode may leave one out), channels at harmonic rates per mode; `None`
+/// when the other mode samples nothing or the draw has no schedule.
+fn random_pin_mix(seed: u64) -> Option<lut_gen::Schedule> {
+    use std::fmt::Write;
+    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut next = move |n: u64| {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x % n
+    };
+    const RATES: [u64; 4] = [0, 1_000, 2_000, 4_000];
+    let nb = 1 + next(3) as usize;
+    let mut t = format!(
+        "name = \"random-pin-{seed}\"\n[clock]\nhz = 4_000_000\n[frame]\nperiod_us = 1_000\n\
+         slice_us = 500\n[[mode]]\nname = \"a\"\n[[mode]]\nname = \"b\"\n[modes]\nselect = \"pin\"\n"
+    );
+    for b in 0..nb {
+        let _ = write!(
+            t,
+            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 2\nsettle_ns = {}\n",
+            [0, 1_000][next(2) as usize]
+        );
+    }
+    let mut used = false;
+    for c in 0..nb + next(6) as usize {
+        let a = RATES[next(4) as usize].max(if c < nb { 1_000 } else { 0 });
+        let b = RATES[next(4) as usize];
+        used |= b > 0;
+        let _ = write!(
+            t,
+            "[[channel]]\nname = \"c{c}\"\nbranch = \"b{}\"\ninput = {}\nrate_hz = {}\nrates = {{ a = {a}, b = {b} }}\n",
+            c % nb,
+            c / nb + 8 * next(2) as usize,
+            a.max(1_000)
+        );
+    }
+    let mix = lut_gen::parse(Path::new("random-pin.toml"), &t).ok()?;
+    used.then(|| lut_gen::synthesize(&mix).ok()).flatten()
+}
+
+#[test]
+fn a_random_pin_select_mix_proves() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let (seed, s) = (1..50u64)
+        .find_map(|seed| random_pin_mix(seed).map(|s| (seed, s)))
+        .expect("a feasible draw");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "seed {seed}: {}", p.summary());
+}
