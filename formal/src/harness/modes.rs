@@ -374,3 +374,34 @@ fn triggers(v: &mut String, s: &Schedule, layout: &Layout, m: &lut_gen::Modes) -
         mb - 1
     )
 }
+
+/// What a bounded result leaves out for a mix with modes (none for a proof
+/// or a counterexample): every cycle past the search, said in the modes'
+/// terms, so the report's `not_covered` names what was bounded.
+pub(crate) fn bounded_modes(s: &Schedule, result: crate::Outcome, steps: u64) -> Option<String> {
+    let m = modes(s).filter(|_| result == crate::Outcome::Bounded)?;
+    let f = s.grid.frame_cycles;
+    let cycles = steps.saturating_sub(2);
+    let why = match m.select {
+        ModeSelect::Auto => {
+            "auto select decides each frame's mode from every earlier frame's codes \
+             (the triggers' windows and runs of windows), so the state does not come round after \
+             whole frames"
+        }
+        ModeSelect::Pin => {
+            "the mode registers keep a request older than a frame (a mode_sel value \
+             that names no mode keeps the decided mode), so the state does not come round after \
+             whole frames"
+        }
+    };
+    Some(format!(
+        "every mode switch and every pin after cycle {cycles} (frame {} on): the search from reset \
+         covered {cycles} cycles ({:.2} frames), every sequence of {} within them, nothing beyond; {why}",
+        cycles / f,
+        cycles as f64 / f as f64,
+        match m.select {
+            ModeSelect::Auto => "MISO codes and so of trigger firings",
+            ModeSelect::Pin => "mode requests and MISO codes",
+        }
+    ))
+}
