@@ -257,9 +257,9 @@ fn the_auto_select_mix_is_honestly_bounded() {
 
 /// A trigger one code off (above 12001, not 12000) fails: MISO chosen at
 /// the level's next code in frame 0 fires the harness's trigger, not the
-/// design's. About 2 minutes under load.
+/// design's: `mode` fails at cycle 2F (the first frame a trigger can
+/// switch). About 25 s under load.
 #[test]
-#[ignore = "long: make test-long"]
 fn an_auto_gateware_with_a_trigger_level_off_by_one_fails_prove() {
     if !tools::require_tools(&TOOLS) {
         return;
