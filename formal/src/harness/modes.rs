@@ -382,21 +382,17 @@ pub(crate) fn bounded_modes(s: &Schedule, result: crate::Outcome, steps: u64) ->
     let m = modes(s).filter(|_| result == crate::Outcome::Bounded)?;
     let f = s.grid.frame_cycles;
     let cycles = steps.saturating_sub(2);
+    // auto select never comes round; pin select may, so the note says why
+    // its search stopped (depth, time limit, or a request kept)
     let why = match m.select {
-        ModeSelect::Auto => {
-            "auto select decides each frame's mode from every earlier frame's codes \
-             (the triggers' windows and runs of windows), so the state does not come round after \
-             whole frames"
-        }
-        ModeSelect::Pin => {
-            "the mode registers keep a request older than a frame (a mode_sel value \
-             that names no mode keeps the decided mode), so the state does not come round after \
-             whole frames"
-        }
+        ModeSelect::Auto => "; auto select decides each frame's mode from every earlier frame's \
+             codes (the triggers' windows and runs of windows), so the state does not come round \
+             after whole frames",
+        ModeSelect::Pin => "",
     };
     Some(format!(
         "every mode switch and every pin after cycle {cycles} (frame {} on): the search from reset \
-         covered {cycles} cycles ({:.2} frames), every sequence of {} within them, nothing beyond; {why}",
+         covered {cycles} cycles ({:.2} frames), every sequence of {} within them, nothing beyond{why}",
         cycles / f,
         cycles as f64 / f as f64,
         match m.select {
