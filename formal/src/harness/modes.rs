@@ -385,9 +385,11 @@ pub(crate) fn bounded_modes(s: &Schedule, result: crate::Outcome, steps: u64) ->
     // auto select never comes round; pin select may, so the note says why
     // its search stopped (depth, time limit, or a request kept)
     let why = match m.select {
-        ModeSelect::Auto => "; auto select decides each frame's mode from every earlier frame's \
+        ModeSelect::Auto => {
+            "; auto select decides each frame's mode from every earlier frame's \
              codes (the triggers' windows and runs of windows), so the state does not come round \
-             after whole frames",
+             after whole frames"
+        }
         ModeSelect::Pin => "",
     };
     Some(format!(
