@@ -98,6 +98,66 @@ fn an_axi_stream_mix_proves_and_a_cut_search_is_bounded() {
     assert!(h.contains("assign m_axis_tready = tready_any || waited >= 3'd7;"));
 }
 
+/// A mix with modes goes through `prove` (it was refused, exit 2): a search
+/// cut short is bounded (exit 3), the JSON says whether `mode_sel` was free,
+/// the harness asserts `mode`, and `not_covered` names the cycles beyond
+/// the search; the emitted Verilog passes as `--rtl` (its mode ports are
+/// the contract's). The proofs themselves: `formal/tests/modes.rs`.
+#[test]
+fn a_mix_with_modes_goes_through_prove() {
+    if !tools::require_tools(&["yosys", "yosys-abc"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for (name, pin) in [("modes-pin", true), ("modes-auto", false)] {
+        let mix = crate::common_cli::root().join(format!("testkit/mixes/{name}.toml"));
+        let v = prove_json(
+            &[mix.to_str().unwrap(), "--depth", "100"],
+            &[],
+            dir.path(),
+            3,
+        );
+        assert_eq!(v["result"], "bounded", "{name}");
+        assert_eq!(v["mode_sel"], pin, "{name}");
+        assert!(v["properties"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|p| p["name"] == "mode"));
+        let beyond = v["not_covered"].as_array().unwrap().iter().any(|n| {
+            n.as_str()
+                .unwrap()
+                .starts_with("every mode switch and every pin after cycle 98 (frame 0 on)")
+        });
+        assert!(beyond, "{name}: {}", v["not_covered"]);
+    }
+    let mix = crate::common_cli::root().join("testkit/mixes/modes-pin.toml");
+    let out = dir.path().join("v");
+    slotforge()
+        .args([
+            "verilog",
+            mix.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .assert()
+        .success();
+    let rtl = out.join("slotforge_top.v");
+    let v = prove_json(
+        &[
+            mix.to_str().unwrap(),
+            "--rtl",
+            rtl.to_str().unwrap(),
+            "--depth",
+            "100",
+        ],
+        &[],
+        dir.path(),
+        3,
+    );
+    assert_eq!(v["own_design"], false);
+}
+
 #[test]
 fn rtl_off_the_port_contract_exits_2() {
     let dir = tempfile::tempdir().unwrap();

@@ -96,6 +96,7 @@ mod tests {
             seconds: 1.0,
             solver_seconds: 0.5,
             own_design: true,
+            mode_sel: false,
             netlist: None,
             note: "n".into(),
             not_covered: not_covered.iter().map(|s| s.to_string()).collect(),

@@ -23,8 +23,10 @@ mod command;
 mod compact;
 mod contract;
 mod link;
+mod modes;
 pub use contract::{contract, not_covered, Clause};
 pub use link::TREADY_ANY;
+pub(crate) use modes::{bounded_modes, MODE_SEL};
 
 /// The module name of the harness.
 pub const HARNESS_MODULE: &str = "slotforge_formal";
@@ -175,6 +177,7 @@ pub fn free_inputs(s: &Schedule) -> Vec<FreeInput> {
         width: s.branches.len() as u32,
     }];
     inputs.extend(link::inputs(&Layout::new(s)));
+    inputs.extend(modes::inputs(s));
     inputs
 }
 
@@ -200,6 +203,15 @@ pub fn generate_with(s: &Schedule, form: TableForm) -> Result<Harness, HarnessEr
     if form == TableForm::Compact && (0..nb).any(|b| s.has_command(b)) {
         return Err(HarnessError(format!(
             "mix `{}`: a frame of {} slots with a command word is beyond the formal harness (its words are tabled per slot, at most {FULL_TABLE_MAX_SLOTS})",
+            s.mix.name, g.frame_slots
+        )));
+    }
+    if let Some(why) = modes::refused(s) {
+        return Err(HarnessError(why));
+    }
+    if form == TableForm::Compact && modes::bits(s) > 0 {
+        return Err(HarnessError(format!(
+            "mix `{}`: a frame of {} slots with modes is beyond the formal harness (every mode's table is full, at most {FULL_TABLE_MAX_SLOTS} slots)",
             s.mix.name, g.frame_slots
         )));
     }
@@ -232,6 +244,7 @@ pub fn generate_with(s: &Schedule, form: TableForm) -> Result<Harness, HarnessEr
         branch(&mut v, &mut props, s, &layout, b, table);
     }
     merger(&mut v, &mut props, s, &layout);
+    modes::decide(&mut v, &mut props, s, &layout);
     if layout.link {
         link::properties(&mut v, &mut props, s, &layout);
     }
@@ -277,10 +290,11 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout, form: TableForm) {
     let g = &s.grid;
     let nb = s.branches.len();
     let w = |r: Role| layout.width(r);
-    let extra: String = link::inputs(layout)
+    let mut extra: String = link::inputs(layout)
         .iter()
         .map(|i| format!(",\n  input {}", i.name))
         .collect();
+    extra.push_str(&modes::ports(s));
     let _ = writeln!(
         v,
         "// slotforge prove: formal harness of mix `{}`, generated from its schedule.\n\
@@ -304,7 +318,7 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout, form: TableForm) {
     );
     // A mix with a link has its ports after the contract's (Layout::link_ports).
     link::declare(v, s, layout);
-    let link_ports = link::connections(layout);
+    let link_ports = link::connections(layout) + &modes::connections(s);
     let _ = writeln!(
         v,
         "  {TOP_MODULE} dut (.clk(clk), .rst(rst), .adc_miso(adc_miso), .adc_cs_n(adc_cs_n),\n    \
@@ -335,6 +349,7 @@ fn header(v: &mut String, s: &Schedule, layout: &Layout, form: TableForm) {
     if form == TableForm::Compact {
         compact::counters(v, g);
     }
+    modes::declare(v, s);
 }
 
 /// `cyc` within any of the half-open ranges.
@@ -360,6 +375,9 @@ fn slot_table(
     let rows = branch_rows(s, b);
     let (chb, en_n) = (layout.channel_bits, row_en(layout, b));
     let word = |r: &Row| r.verilog(chb, en_n);
+    if modes::bits(s) > 0 {
+        return Ok(modes::table(s, b, &modes::rows(s, b), &word));
+    }
     match form {
         TableForm::Full => Ok(full_table(s, b, &rows, &word)),
         TableForm::Compact => compact::table(s, b, &rows, &word, row_bits(chb, en_n)),
@@ -550,20 +568,50 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
         "1'b1".to_string() // no mux pins; its property is not listed
     };
     let (lo1, lo_e1, lo0, lo_e0) = (row.sel1, row.en1, row.sel0, row.en0);
+    let (e0, e1) = ((lo_e0 + en_n - 1, lo_e0), (lo_e1 + en_n - 1, lo_e1));
+    if modes::bits(s) > 0 {
+        // across frames: the mode in force's rows, the next frame's first instant
+        let _ = writeln!(
+            v,
+            "  wire [{}:0] m0{b} = {{tab{b}[{}:{}], tab{b}[{}:{lo0}]}};\n  \
+             wire [{}:0] m1{b} = {{tab{b}[{}:{}], tab{b}[{}:{lo1}]}};",
+            en_n + 2,
+            e0.0,
+            e0.1,
+            lo0 + 2,
+            en_n + 2,
+            e1.0,
+            e1.1,
+            lo1 + 2
+        );
+        modes::mux(v, s, b, &modes::rows(s, b), en_n);
+        let _ = writeln!(
+            v,
+            "  wire [{}:0] exp_en{b} = exp_m{b}[{}:3];\n  wire [2:0] exp_sel{b} = exp_m{b}[2:0];",
+            en_n - 1,
+            en_n + 2
+        );
+    } else {
+        let _ = writeln!(
+            v,
+            "  wire [{}:0] exp_en{b} = cyc == {cb}'d0 ? tab{b}[{}:{}] : tab{b}[{}:{}];\n  \
+             wire [2:0] exp_sel{b} = cyc == {cb}'d0 ? tab{b}[{}:{lo0}] : tab{b}[{}:{lo1}];",
+            en_n - 1,
+            e0.0,
+            e0.1,
+            e1.0,
+            e1.1,
+            lo0 + 2,
+            lo1 + 2
+        );
+    }
     let _ = writeln!(
         v,
         "  wire exp_cs{b} = {cs_exp};\n  wire exp_sclk{b} = {sclk_exp};\n  \
-         wire [{}:0] exp_en{b} = cyc == {cb}'d0 ? tab{b}[{}:{lo_e0}] : tab{b}[{}:{lo_e1}];\n  \
-         wire [2:0] exp_sel{b} = cyc == {cb}'d0 ? tab{b}[{}:{lo0}] : tab{b}[{}:{lo1}];\n  \
          wire cap{b} = conv{b} && ({});\n  \
          reg [{}:0] w{b} = 0;\n  always @(posedge clk) if (cap{b}) w{b} <= {{w{b}[{}:0], adc_miso[{b}]}};\n  \
          wire ok_cs{b} = adc_cs_n[{b}] == exp_cs{b};\n  wire ok_sclk{b} = adc_sclk[{b}] == exp_sclk{b};\n  \
          wire ok_mux{b} = {ok_mux};",
-        en_n - 1,
-        lo_e0 + en_n - 1,
-        lo_e1 + en_n - 1,
-        lo0 + 2,
-        lo1 + 2,
         capc.join(" || "),
         n - 1,
         n.saturating_sub(2),
@@ -624,8 +672,15 @@ fn merger_queue(v: &mut String, s: &Schedule, layout: &Layout, b: usize) {
     let spi = &s.branches[b].spi;
     let maxw = spi.words as u64;
     let nwb = width(maxw + 1);
-    let mut leads: Vec<usize> = (0..s.grid.frame_slots)
-        .filter_map(|slot| s.at(slot, b))
+    // every mode's leads (one schedule without modes)
+    let all = std::slice::from_ref(s);
+    let scheds = if s.modes.is_empty() {
+        all
+    } else {
+        &s.modes[..]
+    };
+    let mut leads: Vec<usize> = (scheds.iter())
+        .flat_map(|ms| (0..s.grid.frame_slots).filter_map(move |slot| ms.at(slot, b)))
         .collect();
     leads.sort_unstable();
     leads.dedup();

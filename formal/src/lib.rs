@@ -124,6 +124,10 @@ pub struct Proof {
     pub solver_seconds: f64,
     /// Whether the design is slotforge's own emitted Verilog.
     pub own_design: bool,
+    /// A mix with pin-selected modes: `mode_sel` was a free input in every
+    /// cycle (the proof covers every sequence of mode requests).
+    #[serde(default)]
+    pub mode_sel: bool,
     /// `prove --netlist`: the part whose gate-level netlist (with yosys'
     /// cell models, flattened) was proved, e.g. `ice40-hx8k`; null for RTL.
     #[serde(default)]
@@ -207,7 +211,8 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         Solver::Abc => strategy::abc(&prep, f, opts)?,
         Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work.path(), f, opts)?,
     };
-    let not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
+    let mut not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
+    not_covered.extend(harness::bounded_modes(s, result, depth));
     let netlist_caveats = opts
         .netlist
         .as_ref()
@@ -247,6 +252,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         seconds: t0.elapsed().as_secs_f64(),
         solver_seconds,
         own_design: opts.own_design,
+        mode_sel: h.inputs.iter().any(|i| i.name == harness::MODE_SEL),
         netlist: opts.netlist.as_ref().map(|(part, _)| part.clone()),
         note,
         not_covered,
@@ -368,7 +374,7 @@ fn symbolic(
             Outcome::Proved,
             steps,
             format!(
-                "{PROVED}: {}every step from reset to step {steps} simulated exactly with every MISO bit a free variable ({} latches, {} gates; {} assertion checks went to a SAT solver), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
+                "{PROVED}: {}every step from reset to step {steps} simulated exactly with every free input bit a variable of its step (MISO; mode_sel too for pin-selected modes; {} latches, {} gates; {} assertion checks went to a SAT solver), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
                 parts_note(&st.parts),
                 g.latches.len(),
                 g.ands.len(),
@@ -482,13 +488,18 @@ impl Proof {
         let _ = writeln!(s, "  {}", self.note);
         let _ = writeln!(
             s,
-            "  design: {}; properties at the ports only, no internal names; any MISO input, one reset cycle",
+            "  design: {}; properties at the ports only, no internal names; any MISO input{}, one reset cycle",
             match (&self.netlist, self.own_design) {
                 (Some(part), _) => format!(
                     "the {part} netlist of slotforge's emitted Verilog (yosys, with the cell models flattened in)"
                 ),
                 (None, true) => "slotforge's emitted Verilog".to_string(),
                 (None, false) => "outside Verilog (--rtl)".to_string(),
+            },
+            if self.mode_sel {
+                ", any sequence of mode_sel requests"
+            } else {
+                ""
             }
         );
         for p in &self.properties {

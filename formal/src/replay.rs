@@ -13,7 +13,7 @@ use lut_gen::Role;
 use lut_gen::Schedule;
 
 use crate::engine::run_tool;
-use crate::harness::Harness;
+use crate::harness::{self, FreeInput, Harness};
 use crate::ProveError;
 
 pub mod witness;
@@ -53,10 +53,35 @@ fn testbench(h: &Harness, steps: u64, period_ps: u64) -> String {
         .iter()
         .map(|i| format!(", .{0}({0})", i.name))
         .collect();
-    let concat: Vec<&str> = h.inputs.iter().rev().map(|i| i.name.as_str()).collect();
+    // `mode_sel` is an input the judge reads with the outputs (its value
+    // once an edge's timestep has closed is that cycle's): it changes in the
+    // edge's timestep (nonblocking, so the edge samples the cycle before's),
+    // MISO a quarter period after it (read before the next edge).
+    let at_edge = |i: &FreeInput| i.name == harness::MODE_SEL;
+    let concat: Vec<String> = (h.inputs.iter().rev())
+        .map(|i| match at_edge(i) {
+            true => format!("{}_next", i.name),
+            false => i.name.clone(),
+        })
+        .collect();
+    let (mut lo, mut edge) = (0, String::new());
+    for i in &h.inputs {
+        if at_edge(i) {
+            let _ = writeln!(
+                edge,
+                "  reg [{w}:0] {n}_next = 0;\n  integer {n}_k = 0;\n  \
+                 always @(posedge clk) begin\n    {n}_k = {n}_k + 1;\n    \
+                 {n} <= stim[{n}_k][{}:{lo}];\n  end",
+                lo + i.width - 1,
+                w = i.width - 1,
+                n = i.name
+            );
+        }
+        lo += i.width;
+    }
     let _ = writeln!(
         v,
-        "  reg [{}:0] stim [0:{}];\n  integer i;\n  slotforge_formal h (.clk(clk){ports});\n  \
+        "  reg [{}:0] stim [0:{}];\n  integer i;\n{edge}  slotforge_formal h (.clk(clk){ports});\n  \
          // Rising edges at k * period (k >= 1) only: an X-to-1 start would be one.\n  \
          always begin #{} clk = 1'b0; #{} clk = 1'b1; end\n  initial begin\n    $readmemb(\"stim.mem\", stim);\n    \
          $dumpfile(\"trace.vcd\");\n    $dumpvars(1, h.dut);\n    $dumpvars(1, h);\n    \

@@ -5,6 +5,10 @@
 //! the checker's diagnosis), or a link too slow for the mix; 2: bad input
 //! or a tool that cannot run;
 //! 3: bounded only (no violation within the depth, not a proof).
+//!
+//! A mix with modes is proved across its switches: `mode_sel` free in every
+//! cycle (pin select) or the triggers evaluated on the recorded words (auto
+//! select); docs/formal.md, "Mixes with modes".
 
 use std::path::PathBuf;
 
@@ -71,7 +75,9 @@ fn solver(s: &str) -> Result<Solver, String> {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
+    // A mix with modes is proved across its switches (the harness follows
+    // every sequence of requests, or the triggers on the recorded words).
+    let s = match super::load_any_modes(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };

@@ -49,6 +49,9 @@ pub enum Clause {
     AxisPayloadHeld,
     /// The bytes the link carries: packets, records, frame counter, CRC.
     LinkPackets,
+    /// `mode` shows the mode in force, switching only at the frame starts
+    /// the contract decides (a mix with modes).
+    Mode,
 }
 
 /// The clauses `s`'s design owes at its outputs, in report order.
@@ -82,6 +85,9 @@ pub fn contract(s: &Schedule, layout: &Layout) -> Vec<Clause> {
             c.push(Clause::UartCharacters);
         }
         c.push(Clause::LinkPackets);
+    }
+    if layout.mode_bits > 0 {
+        c.push(Clause::Mode);
     }
     c
 }
@@ -139,14 +145,20 @@ impl Clause {
             }
             Clause::LinkPackets => format!(
                 "the packets the link carries on {} (each slice's header with the frame \
-                 counter and slice, one record per sample with its channel and code, the \
+                 counter{} and slice, one record per sample with its channel and code, the \
                  trailer with the overflow count and CRC-16/MODBUS; docs/packet-format.md)",
                 if Layout::new(s).axis {
                     "m_axis_tdata"
                 } else {
                     "link_tx"
+                },
+                if Layout::new(s).mode_bits > 0 {
+                    ", the mode"
+                } else {
+                    ""
                 }
             ),
+            Clause::Mode => mode_sentence(s),
         }
     }
 }
@@ -167,4 +179,20 @@ fn uart_characters(s: &Schedule) -> String {
         _ => String::new(),
     };
     format!("the UART's bit stream on link_tx, character by character{frame}; the line idles high")
+}
+
+/// The mode clause: what `mode` and the switches owe, by the select kind.
+fn mode_sentence(s: &Schedule) -> String {
+    let auto = s
+        .mode_plan()
+        .is_some_and(|m| m.select == lut_gen::ModeSelect::Auto);
+    format!(
+        "mode shows the mode in force and every switch takes effect at the frame start \
+         the contract decides ({}; docs/timing.md, \"Mode switches\")",
+        if auto {
+            "the triggers on the watched words"
+        } else {
+            "mode_sel in a frame's last cycle"
+        }
+    )
 }

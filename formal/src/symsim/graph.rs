@@ -197,8 +197,13 @@ impl Graph {
 
     /// An assignment of the variables under `lit` that makes it true,
     /// `Ok(None)` if none does (Tseitin encoding of its cone, splr), `Err`
-    /// if the solver gave no answer (never read as "holds").
-    pub(super) fn satisfy(&self, lit: u32) -> Result<Option<Vec<Assigned>>, String> {
+    /// if the solver gave no answer (never read as "holds"), e.g. within
+    /// `limit` (at least a second; none: no limit).
+    pub(super) fn satisfy(
+        &self,
+        lit: u32,
+        limit: Option<std::time::Duration>,
+    ) -> Result<Option<Vec<Assigned>>, String> {
         let mut index: HashMap<usize, i32> = HashMap::new();
         let mut stack = vec![(lit >> 1) as usize];
         let mut cone = Vec::new();
@@ -233,7 +238,7 @@ impl Graph {
                 clauses.push(vec![o, -x, -y]);
             }
         }
-        match splr::Certificate::try_from(clauses) {
+        match solve(clauses, limit) {
             Ok(splr::Certificate::SAT(model)) => {
                 let value: HashMap<i32, bool> = model.iter().map(|&m| (m.abs(), m > 0)).collect();
                 Ok(Some(
@@ -246,5 +251,26 @@ impl Graph {
             Ok(splr::Certificate::UNSAT) => Ok(None),
             Err(e) => Err(format!("{e:?}")),
         }
+    }
+}
+
+/// splr on `clauses`, stopped (`Err`) past `limit` (whole seconds, at least one).
+fn solve(
+    clauses: Vec<Vec<i32>>,
+    limit: Option<std::time::Duration>,
+) -> Result<splr::Certificate, splr::SolverError> {
+    use splr::SolveIF;
+    let Some(limit) = limit else {
+        return splr::Certificate::try_from(clauses);
+    };
+    let config = splr::Config {
+        c_timeout: limit.as_secs().max(1) as f64,
+        ..Default::default()
+    };
+    match splr::Solver::try_from((config, clauses.as_slice())) {
+        Ok(mut solver) => solver.solve(),
+        Err(Ok(cert)) => Ok(cert),
+        Err(Err(splr::SolverError::EmptyClause)) => Ok(splr::Certificate::UNSAT),
+        Err(Err(e)) => Err(e),
     }
 }

@@ -31,5 +31,5 @@ pub fn step_case(g: &Aig, k: u64) -> Result<bool, String> {
     }
     let bad = evaluate(g, &ands, &mut gr, &mut val, &mut state, k + 1);
     let fails = gr.and(held, bad);
-    Ok(gr.satisfy(fails)?.is_none())
+    Ok(gr.satisfy(fails, None)?.is_none())
 }

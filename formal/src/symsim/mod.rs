@@ -262,6 +262,8 @@ struct Sim<'a> {
     pending_any: u32,
     stats: SymStats,
     gc_at: usize,
+    /// The run's deadline: a SAT check still running then gives no verdict.
+    deadline: Option<Instant>,
 }
 
 impl<'a> Sim<'a> {
@@ -291,11 +293,13 @@ impl<'a> Sim<'a> {
             pending_any: 0,
             stats: SymStats::default(),
             gc_at: 1 << 20,
+            deadline: None,
         }
     }
 
     /// Runs to a verdict, `lim.max_steps` or the deadline.
     fn run(mut self, lim: &Limits) -> (Found, SymStats) {
+        self.deadline = lim.deadline;
         // every boundary's state, canonical: a state equal to an earlier
         // boundary's closes the search (a FIFO's pointers may need several
         // periods to come round)
@@ -369,7 +373,10 @@ impl<'a> Sim<'a> {
         let any = std::mem::replace(&mut self.pending_any, 0);
         let first = pending[0].0;
         self.stats.sat_calls += 1;
-        match self.gr.satisfy(any) {
+        let limit = self
+            .deadline
+            .map(|d| d.saturating_duration_since(Instant::now()));
+        match self.gr.satisfy(any, limit) {
             Ok(None) => return None,
             Ok(Some(_)) => {}
             // no answer is no verdict: nothing is claimed from here on
@@ -377,7 +384,7 @@ impl<'a> Sim<'a> {
         }
         for (step, bad) in pending {
             self.stats.sat_calls += 1;
-            match self.gr.satisfy(bad) {
+            match self.gr.satisfy(bad, limit) {
                 Ok(Some(assign)) => return Some(self.violation(step, assign)),
                 Ok(None) => {}
                 Err(_) => return Some(Found::Bounded { steps: step }),

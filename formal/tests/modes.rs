@@ -1,0 +1,308 @@
+//! `prove` of mixes with modes (docs/timing.md, "Mode switches"): the
+//! harness follows every sequence of mode requests (pin select: `mode_sel`
+//! free in every cycle) or evaluates the triggers on the words it recorded
+//! (auto select: MISO free), each mode's own table from `Schedule::modes`.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use formal::{Outcome, Proof, ProveOptions};
+
+use testkit::tools;
+
+const TOOLS: [&str; 4] = ["yosys", "yosys-abc", "iverilog", "vvp"];
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn schedule(rel: &str) -> lut_gen::Schedule {
+    let mix = lut_gen::load(&root().join(rel)).expect("mix loads");
+    lut_gen::synthesize(&mix).expect("mix is feasible")
+}
+
+fn emitted(s: &lut_gen::Schedule) -> String {
+    hdl::emit(s, None).expect("emits").verilog().to_string()
+}
+
+fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
+    prove_to(s, design, out, None)
+}
+
+/// `prove` with the search from reset stopped at `depth` steps.
+fn prove_to(s: &lut_gen::Schedule, design: &str, out: &Path, depth: Option<u64>) -> Proof {
+    let mut o = ProveOptions::new(out);
+    o.depth = depth;
+    let t = Instant::now();
+    let p = formal::prove(s, design, &o).expect("prove runs");
+    eprintln!(
+        "{} in {:.1} s\n{}",
+        s.mix.name,
+        t.elapsed().as_secs_f64(),
+        p.summary()
+    );
+    p
+}
+
+/// `design` with `from` replaced by `to` (exactly once).
+fn edit(design: &str, from: &str, to: &str) -> String {
+    assert_eq!(
+        design.matches(from).count(),
+        1,
+        "`{from}` once in the design"
+    );
+    design.replace(from, to)
+}
+
+/// A failed proof whose counterexample the judge rejects at the cycle
+/// `prove` names, with one of `properties` among the failing ones.
+fn assert_fails(s: &lut_gen::Schedule, p: &Proof, properties: &[&str]) {
+    assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
+    let c = p.counterexample.as_ref().expect("a counterexample");
+    assert!(c.reproduced, "the replay reproduces it: {}", p.summary());
+    let failed: Vec<&str> = (p.properties.iter())
+        .filter(|q| q.result == Outcome::Failed)
+        .map(|q| q.name.as_str())
+        .collect();
+    assert!(
+        failed.iter().any(|f| properties.contains(f)),
+        "fails {failed:?}, none of {properties:?}"
+    );
+    let report = judge::check_vcd(s, &c.vcd, Some(formal::DUT_SCOPE)).expect("VCD reads");
+    assert!(
+        !report.ok,
+        "check accepts the counterexample:\n{}",
+        report.summary()
+    );
+    assert_eq!(
+        formal::first_rejected(&report),
+        Some(c.cycle as u64),
+        "check fails at another cycle than prove:\n{}",
+        p.summary()
+    );
+}
+
+/// The harness of a mix with modes: `mode_sel` a free input (pin select
+/// only), a `mode` property, `Clause::Mode` covered, every mode's table.
+#[test]
+fn the_harness_of_a_mode_mix_asserts_mode_and_frees_mode_sel() {
+    let s = schedule("testkit/mixes/modes-pin.toml");
+    let h = formal::generate(&s).expect("a harness");
+    let names: Vec<&str> = h.inputs.iter().map(|i| i.name.as_str()).collect();
+    assert_eq!(names, ["adc_miso", "mode_sel"]);
+    assert!(h
+        .properties
+        .iter()
+        .any(|p| p.name == "mode" && p.covers == [formal::Clause::Mode]));
+    assert!(h.not_covered.is_empty(), "{:?}", h.not_covered);
+    assert!(h.verilog.contains(".mode_sel(mode_sel), .mode(mode)"));
+    assert_eq!(
+        formal::generate(&s).unwrap().verilog,
+        h.verilog,
+        "deterministic"
+    );
+    let a = schedule("testkit/mixes/modes-auto.toml");
+    let h = formal::generate(&a).expect("a harness");
+    let names: Vec<&str> = h.inputs.iter().map(|i| i.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["adc_miso"],
+        "auto select: MISO is the only free input"
+    );
+    assert!(
+        h.verilog.contains("wire held2 = na2 && !nn2;"),
+        "trigger 2 is `below`"
+    );
+    assert!(h.properties.iter().any(|p| p.name == "mode"));
+    // a mix without modes gets no mode property and keeps its ports
+    let t = schedule("testkit/mixes/tiny.toml");
+    let h = formal::generate(&t).unwrap();
+    assert!(!h.verilog.contains("mcur") && h.properties.iter().all(|p| p.name != "mode"));
+}
+
+#[test]
+fn pin_select_mix_proves_for_every_sequence_of_requests() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/modes-pin.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
+}
+
+/// The gateware's mode block as emitted for a pin-select mix.
+const DECIDED: &str = "wire [0:0] decided = mode_sel[0:0];";
+const SWITCH: &str = "cur <= nxt;\n          nxt <= decided;";
+
+#[test]
+fn a_gateware_that_ignores_mode_sel_fails_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/modes-pin.toml");
+    let design = edit(&emitted(&s), DECIDED, "wire [0:0] decided = nxt;");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &design, dir.path());
+    assert_fails(&s, &p, &["mode", "mux[fast]", "mux[slow]"]);
+}
+
+#[test]
+fn a_gateware_that_switches_a_frame_early_fails_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/modes-pin.toml");
+    let early = "cur <= decided;\n          nxt <= decided;";
+    let design = edit(&emitted(&s), SWITCH, early);
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &design, dir.path());
+    assert_fails(&s, &p, &["mode", "mux[fast]", "mux[slow]"]);
+}
+
+/// A random pin-select mix with two modes on a 4 MHz clock and a 1 ms
+/// frame: 1 to 3 branches (every one sampled in the reset mode, the other
+/// mode may leave one out), channels at harmonic rates per mode; `None`
+/// when the other mode samples nothing or the draw has no schedule.
+fn random_pin_mix(seed: u64) -> Option<lut_gen::Schedule> {
+    use std::fmt::Write;
+    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut next = move |n: u64| {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x % n
+    };
+    const RATES: [u64; 4] = [0, 1_000, 2_000, 4_000];
+    let nb = 1 + next(3) as usize;
+    let mut t = format!(
+        "name = \"random-pin-{seed}\"\n[clock]\nhz = 4_000_000\n[frame]\nperiod_us = 1_000\n\
+         slice_us = 500\n[[mode]]\nname = \"a\"\n[[mode]]\nname = \"b\"\n[modes]\nselect = \"pin\"\n"
+    );
+    for b in 0..nb {
+        let _ = write!(
+            t,
+            "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 2\nsettle_ns = {}\n",
+            [0, 1_000][next(2) as usize]
+        );
+    }
+    let mut used = false;
+    for c in 0..nb + next(6) as usize {
+        let a = RATES[next(4) as usize].max(if c < nb { 1_000 } else { 0 });
+        let b = RATES[next(4) as usize];
+        used |= b > 0;
+        let _ = write!(
+            t,
+            "[[channel]]\nname = \"c{c}\"\nbranch = \"b{}\"\ninput = {}\nrate_hz = {}\nrates = {{ a = {a}, b = {b} }}\n",
+            c % nb,
+            c / nb + 8 * next(2) as usize,
+            a.max(1_000)
+        );
+    }
+    let mix = lut_gen::parse(Path::new("random-pin.toml"), &t).ok()?;
+    used.then(|| lut_gen::synthesize(&mix).ok()).flatten()
+}
+
+/// About 140 s under load (the first feasible draw, 2 branches).
+#[test]
+#[ignore = "long: make test-long"]
+fn a_random_pin_select_mix_proves() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let (seed, s) = (1..50u64)
+        .find_map(|seed| random_pin_mix(seed).map(|s| (seed, s)))
+        .expect("a feasible draw");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "seed {seed}: {}", p.summary());
+}
+
+/// A bounded result of a mix with modes: no property failed, none is
+/// called proved, and `not_covered` names the cycles beyond the search.
+fn assert_honestly_bounded(p: &Proof) {
+    assert_eq!(p.result, Outcome::Bounded, "{}", p.summary());
+    assert!(p.properties.iter().all(|q| q.result == Outcome::Bounded));
+    let beyond = format!(
+        "every mode switch and every pin after cycle {}",
+        p.depth - 2
+    );
+    assert!(
+        p.not_covered.iter().any(|n| n.starts_with(&beyond)),
+        "{:?}",
+        p.not_covered
+    );
+    assert!(p.note.starts_with("NOT a proof"), "{}", p.note);
+}
+
+/// Auto select does not come round (each frame's mode depends on every
+/// earlier frame's codes): the search from reset past the first possible
+/// switch (frame 2) finds nothing and says what it left out. About 2
+/// minutes under load.
+#[test]
+#[ignore = "long: make test-long"]
+fn the_auto_select_mix_is_honestly_bounded() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/modes-auto.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let depth = 2 * s.grid.frame_cycles + 2_000;
+    let p = prove_to(&s, &emitted(&s), dir.path(), Some(depth));
+    assert_honestly_bounded(&p);
+    assert_eq!(p.depth, depth);
+}
+
+/// A trigger one code off (above 12001, not 12000) fails: MISO chosen at
+/// the level's next code in frame 0 fires the harness's trigger, not the
+/// design's: `mode` fails at cycle 2F (the first frame a trigger can
+/// switch). About 25 s under load.
+#[test]
+fn an_auto_gateware_with_a_trigger_level_off_by_one_fails_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/modes-auto.toml");
+    let design = edit(
+        &emitted(&s),
+        "wire cab0 = wab0 | (hit0_0 & (v_0 > 16'd12000));",
+        "wire cab0 = wab0 | (hit0_0 & (v_0 > 16'd12001));",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove_to(
+        &s,
+        &design,
+        dir.path(),
+        Some(2 * s.grid.frame_cycles + 2_000),
+    );
+    let names: Vec<String> = p.properties.iter().map(|q| q.name.clone()).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    assert_fails(&s, &p, &names);
+}
+
+/// The preset (48 MHz, 10 ms frames, auto select over a UART): bounded
+/// honestly, or proved; never failed. The search stops at its time limit.
+#[test]
+#[ignore = "long: make test-long"]
+fn the_adaptive_preset_is_proved_or_honestly_bounded() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("mixes/eskin34-adaptive.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let mut o = ProveOptions::new(dir.path());
+    o.timeout_s = 600;
+    let t = Instant::now();
+    let p = formal::prove(&s, &emitted(&s), &o).expect("prove runs");
+    eprintln!(
+        "{} in {:.1} s\n{}",
+        s.mix.name,
+        t.elapsed().as_secs_f64(),
+        p.summary()
+    );
+    if p.result != Outcome::Proved {
+        assert_honestly_bounded(&p);
+    }
+}
