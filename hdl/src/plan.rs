@@ -339,17 +339,23 @@ fn decode_by_logic(p: &mut Plan, forced: bool) -> Result<(), HdlError> {
     Ok(())
 }
 
-/// Estimated LCs of the ROM's slot pointer, of the logic form's two
-/// counters, and of its decoding.
+/// Block RAM bits (an iCE40 SB_RAM40_4K): a ROM under this is built of
+/// LUTs by yosys (induction5k-adc12's 1,280-bit tables: no block RAM;
+/// eskin34's 6 kbit ones: five), then its words cost logic like the
+/// decoding's.
+const BRAM_BITS: usize = 4096;
+
+/// Estimated LCs of the ROM form (the slot pointer, and the tables where
+/// they are too small for block RAM), of the logic form's two counters,
+/// and of its decoding.
 fn logic_costs(p: &Plan, logic: &[SlotLogic]) -> (usize, usize, usize) {
     let ab = addr_bits(p.frame_slots);
     let l = &logic[0];
     let refs: Vec<&SlotLogic> = logic.iter().collect();
-    (
-        2 * ab + 2,
-        l.slot_bits + l.slice_bits + 2,
-        SlotLogic::cost(&refs),
-    )
+    let decode = SlotLogic::cost(&refs);
+    let in_luts = p.branches.iter().all(|r| (r.word_bits() << ab) < BRAM_BITS);
+    let rom = 2 * ab + 2 + if in_luts { decode } else { 0 };
+    (rom, l.slot_bits + l.slice_bits + 2, decode)
 }
 
 /// `lanes[j][u]`: the channel of the `j`-th branch (in branch order) that
