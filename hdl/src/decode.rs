@@ -154,25 +154,49 @@ impl SlotLogic {
 
     fn var_name(&self, v: usize) -> String {
         if v < self.slot_bits {
-            format!("address[{v}]")
+            format!("a[{v}]")
         } else {
-            format!("slice[{}]", v - self.slot_bits)
+            format!("j[{}]", v - self.slot_bits)
         }
     }
 
-    /// The Verilog: `q`, the word, from `address` (slot in slice) and `slice`.
+    /// The Verilog: `q`, the word, from `address` (slot in slice) and
+    /// `slice` registered as `a` and `j` (the timing generator's own
+    /// counter registers again, one cycle behind its next-value outputs,
+    /// so `q` is the word a ROM read at `{slice, address}` would give).
     pub fn verilog(&self, wb: usize) -> String {
-        let mut s = format!(
-            "// the word of slot `address` (in the slice) of slice `slice`, as logic:\n// each bit a truth table over the counter bits it depends on\nreg [{}:0] q;\n",
+        let (sb, kb) = (self.slot_bits, self.slice_bits);
+        let used = |r: std::ops::Range<usize>| {
+            self.bits
+                .iter()
+                .any(|f| f.vars.iter().any(|v| r.contains(v)))
+        };
+        let mut s = String::new();
+        let mut clocked = String::new();
+        if used(0..sb) {
+            s.push_str(&format!("reg [{}:0] a;\n", sb - 1));
+            clocked.push_str(&format!("  a <= address[{}:0];\n", sb - 1));
+        }
+        if used(sb..sb + kb) {
+            s.push_str(&format!("reg [{}:0] j;\n", kb - 1));
+            clocked.push_str(&format!("  j <= slice[{}:0];\n", kb - 1));
+        }
+        if !clocked.is_empty() {
+            s = format!(
+                "// the slot in the slice and the slice, registered (as the timing generator's counters)\n{s}always @(posedge clock) begin\n{clocked}end\n\n"
+            );
+        }
+        s.push_str(&format!(
+            "// their slot's word as logic: each bit a truth table over the counter bits it depends on\nwire [{}:0] q;\n",
             wb - 1
-        );
+        ));
         let mut body = String::new();
         for (i, f) in self.bits.iter().enumerate() {
             let names: Vec<String> = f.vars.iter().rev().map(|&v| self.var_name(v)).collect();
             match f.vars.len() {
-                0 => body.push_str(&format!("  q[{i}] = 1'b{};\n", f.table[0] as u8)),
+                0 => body.push_str(&format!("assign q[{i}] = 1'b{};\n", f.table[0] as u8)),
                 1 if f.table == [false, true] => {
-                    body.push_str(&format!("  q[{i}] = {};\n", names[0]))
+                    body.push_str(&format!("assign q[{i}] = {};\n", names[0]))
                 }
                 n => {
                     let bits: String = f
@@ -186,33 +210,40 @@ impl SlotLogic {
                         (1 << n) - 1,
                         1 << n
                     ));
-                    body.push_str(&format!("  q[{i}] = k_q{i}[{{{}}}];\n", names.join(", ")));
+                    body.push_str(&format!(
+                        "assign q[{i}] = k_q{i}[{{{}}}];\n",
+                        names.join(", ")
+                    ));
                 }
             }
         }
-        s.push_str(&format!("\nalways @(*) begin\n{body}end\n\n"));
+        s.push_str(&format!("{body}\n"));
         s
     }
 
-    /// The counter bits no word bit reads (for the `unused` wire).
+    /// The registered counter bits no word bit reads, and the inputs'
+    /// bits above the counters' (for the `unused` wire).
     pub fn unused(&self) -> Vec<String> {
+        let (sb, kb) = (self.slot_bits, self.slice_bits);
         let used = |v: usize| self.bits.iter().any(|f| f.vars.contains(&v));
+        let any = |r: std::ops::Range<usize>| r.clone().any(used);
         let mut u = vec![];
-        let range = |name: &str, lo: usize, hi: usize, u: &mut Vec<String>| {
-            if lo < hi {
-                u.push(format!("{name}[{}:{lo}]", hi - 1));
+        for (r, name, width, full) in [
+            (0..sb, "address", sb, SLOT_BITS),
+            (sb..sb + kb, "slice", kb, SLICE_BITS),
+        ] {
+            if any(r.clone()) {
+                u.extend(r.filter(|&v| !used(v)).map(|v| self.var_name(v)));
+                if width < full {
+                    u.push(format!("{name}[{}:{width}]", full - 1));
+                }
+            } else if full > 0 {
+                u.push(name.to_string());
             }
-        };
-        let single = |v: usize, u: &mut Vec<String>| {
-            if !used(v) {
-                u.push(self.var_name(v));
-            }
-        };
-        for v in 0..self.slot_bits + self.slice_bits {
-            single(v, &mut u);
         }
-        range("address", self.slot_bits, SLOT_BITS, &mut u);
-        range("slice", self.slice_bits, SLICE_BITS, &mut u);
+        if !any(0..sb + kb) {
+            u.push("clock".to_string());
+        }
         u
     }
 }

@@ -25,8 +25,9 @@ pub struct SlotRom {
     _ch_bits: usize,
     _dev_bits: usize,
     _compact: Option<CompactRom>,
-    /// Logic decoding: the word of `{slice, address}` (the registered
-    /// counters), evaluated once from the same truth tables as the Verilog.
+    /// Logic decoding: the word of `{slice, address}` registered (the
+    /// timing generator's counters again, which synthesis merges with
+    /// them), evaluated once from the same truth tables as the Verilog.
     _logic: Option<(SlotLogic, Vec<u32>)>,
     /// A mix with modes: the mode is on the address above the slot, and
     /// `slice` carries the next frame's mode (low bits) and whether the
@@ -210,10 +211,12 @@ impl Logic for SlotRom {
     fn update(&mut self) {
         let wb = self.word_bits();
         if let Some((l, w)) = &self._logic {
-            let p = self.address.val().to_u64() as usize & ((1 << l.slot_bits) - 1);
-            let j = self.slice.val().to_u64() as usize & ((1 << l.slice_bits) - 1);
-            let w = w[j << l.slot_bits | p];
-            self.set_outputs(w as u64);
+            if self.clock.pos_edge() {
+                let p = self.address.val().to_u64() as usize & ((1 << l.slot_bits) - 1);
+                let j = self.slice.val().to_u64() as usize & ((1 << l.slice_bits) - 1);
+                let w = w[j << l.slot_bits | p];
+                self.set_outputs(w as u64);
+            }
         } else if let Some(m) = self._modes.take() {
             self.read_modes(&m);
             self._modes = Some(m);
@@ -272,7 +275,6 @@ impl Logic for SlotRom {
         if let Some((l, _)) = &self._logic {
             s.push_str(&l.verilog(wb));
             unused = l.unused();
-            unused.push("clock".to_string());
             unused.push("rst".to_string());
             used_addr = SLOT_BITS;
         } else if let Some(c) = &self._compact {

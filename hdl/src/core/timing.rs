@@ -35,20 +35,14 @@ pub struct TimingGen {
     pub(super) st2: DFF<Bit>,
     pub(super) st0: DFF<Bit>,
     /// Index of the next slot start (> c): in the frame (full LUT) or in the
-    /// slice (compact LUT), with its slice in `sl`.
+    /// slice (compact LUT, logic decoding), with its slice in `sl`.
     pub(super) slot: DFF<Bits<SLOT_BITS>>,
     pub(super) sl: DFF<Bits<SLICE_BITS>>,
     /// The slot after `slot` (wrapping at the last), kept in step with it.
     pub(super) succ: DFF<Bits<SLOT_BITS>>,
     nxt: Signal<Local, Bits<SLOT_BITS>>,
     nxt_sl: Signal<Local, Bits<SLICE_BITS>>,
-    /// Counts slots in the slice and slices (compact LUT or logic
-    /// decoding), not slots in the frame.
     k_compact: Constant<Bit>,
-    /// Logic decoding: `addr`/`slice` are the registered counters (the
-    /// slot the ROM's word would describe), and no successor register.
-    k_logic: Constant<Bit>,
-    inc: Signal<Local, Bits<SLOT_BITS>>,
     k_sl_last: Constant<Bits<SLICE_BITS>>,
     k_sl_zero: Constant<Bits<SLICE_BITS>>,
     k_sl_one: Constant<Bits<SLICE_BITS>>,
@@ -68,6 +62,7 @@ pub struct TimingGen {
 
 impl TimingGen {
     pub(super) fn new(plan: &Plan) -> TimingGen {
+        // the compact LUT and the logic decoding count slots in the slice
         let in_slice = plan.compact || plan.logic;
         let slot_last = if in_slice {
             plan.slots_per_slice - 1
@@ -92,8 +87,6 @@ impl TimingGen {
             nxt: Default::default(),
             nxt_sl: Default::default(),
             k_compact: Constant::new(in_slice),
-            k_logic: Constant::new(plan.logic),
-            inc: Default::default(),
             k_sl_last: c(if in_slice {
                 plan.slices_per_frame - 1
             } else {
@@ -133,21 +126,10 @@ impl Logic for TimingGen {
         self.st2.d.next = self.cnt.q.val() == self.k_cnt_last.val();
         self.st.d.next = self.st2.q.val();
         self.st0.d.next = self.st.q.val();
-        // The successor of the registered slot (wrapping at the last).
-        if self.slot.q.val() == self.k_slot_last.val() {
-            self.inc.next = self.k_slot_zero.val();
-        } else {
-            self.inc.next = (self.slot.q.val() + self.k_slot_one.val()) & self.k_slot_mask.val();
-        }
         self.nxt.next = self.slot.q.val();
         self.nxt_sl.next = self.sl.q.val();
         if self.st.q.val() {
-            if self.k_logic.val() {
-                // nothing reads `nxt` but the counter: no successor register
-                self.nxt.next = self.inc.val();
-            } else {
-                self.nxt.next = self.succ.q.val();
-            }
+            self.nxt.next = self.succ.q.val();
             if (self.slot.q.val() == self.k_slot_last.val()) & self.k_compact.val() {
                 if self.sl.q.val() == self.k_sl_last.val() {
                     self.nxt_sl.next = self.k_sl_zero.val();
@@ -170,18 +152,17 @@ impl Logic for TimingGen {
         // `nxt` multiplexer: stale in the cycle after a slot start only,
         // and right again by the next start (slots are at least 2 cycles,
         // `plan`).
-        self.succ.d.next = self.inc.val();
+        if self.slot.q.val() == self.k_slot_last.val() {
+            self.succ.d.next = self.k_slot_zero.val();
+        } else {
+            self.succ.d.next = (self.slot.q.val() + self.k_slot_one.val()) & self.k_slot_mask.val();
+        }
         if self.rst.val() {
             self.succ.d.next = self.k_succ_rst.val();
         }
         self.sl.d.next = self.nxt_sl.val();
-        if self.k_logic.val() {
-            self.addr.next = self.slot.q.val();
-            self.slice.next = self.sl.q.val();
-        } else {
-            self.addr.next = self.nxt.val();
-            self.slice.next = self.nxt_sl.val();
-        }
+        self.addr.next = self.nxt.val();
+        self.slice.next = self.nxt_sl.val();
         self.start2.next = self.st2.q.val();
         self.start1.next = self.st.q.val();
         self.start0.next = self.st0.q.val();
