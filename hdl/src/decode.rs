@@ -174,16 +174,16 @@ impl SlotLogic {
         let mut s = String::new();
         let mut clocked = String::new();
         if used(0..sb) {
-            s.push_str(&format!("reg [{}:0] a;\n", sb - 1));
+            s.push_str(&format!("reg [{}:0] a;\ninitial a = {sb}'d0;\n", sb - 1));
             clocked.push_str(&format!("  a <= address[{}:0];\n", sb - 1));
         }
         if used(sb..sb + kb) {
-            s.push_str(&format!("reg [{}:0] j;\n", kb - 1));
+            s.push_str(&format!("reg [{}:0] j;\ninitial j = {kb}'d0;\n", kb - 1));
             clocked.push_str(&format!("  j <= slice[{}:0];\n", kb - 1));
         }
         if !clocked.is_empty() {
             s = format!(
-                "// the slot in the slice and the slice, registered (as the timing generator's counters)\n{s}always @(posedge clock) begin\n{clocked}end\n\n"
+                "// the slot in the slice and the slice, registered: the timing generator's counters again,\n// with their power-on value, so synthesis merges the two\n{s}always @(posedge clock) begin\n{clocked}end\n\n"
             );
         }
         s.push_str(&format!(

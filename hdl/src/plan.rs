@@ -346,8 +346,8 @@ fn decode_by_logic(p: &mut Plan, forced: bool) -> Result<(), HdlError> {
 const BRAM_BITS: usize = 4096;
 
 /// Estimated LCs of the ROM form (the slot pointer, and the tables where
-/// they are too small for block RAM), of the logic form's two counters,
-/// and of its decoding.
+/// they are too small for block RAM), of the logic form's counters, and
+/// of its decoding.
 fn logic_costs(p: &Plan, logic: &[SlotLogic]) -> (usize, usize, usize) {
     let ab = addr_bits(p.frame_slots);
     let l = &logic[0];
@@ -355,7 +355,9 @@ fn logic_costs(p: &Plan, logic: &[SlotLogic]) -> (usize, usize, usize) {
     let decode = SlotLogic::cost(&refs);
     let in_luts = p.branches.iter().all(|r| (r.word_bits() << ab) < BRAM_BITS);
     let rom = 2 * ab + 2 + if in_luts { decode } else { 0 };
-    (rom, l.slot_bits + l.slice_bits + 2, decode)
+    // the logic form's timing counts slots in the slice (with their
+    // successor register, as the compact form's) and slices
+    (rom, 2 * l.slot_bits + l.slice_bits + 2, decode)
 }
 
 /// `lanes[j][u]`: the channel of the `j`-th branch (in branch order) that
