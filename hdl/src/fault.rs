@@ -114,8 +114,8 @@ impl GatewareFault {
                 w.swap(a, b);
             }
             GatewareFault::SlotWrap { delta } => {
-                if p.compact {
-                    return Err(bad("the plan has a compact LUT".into()));
+                if p.compact || p.logic {
+                    return Err(bad("the plan has no frame-wide slot counter".into()));
                 }
                 p.frame_slots = wrap(p.frame_slots, delta)?;
             }
@@ -156,8 +156,8 @@ impl GatewareFault {
 
 /// Branch `b`'s full-frame ROM words.
 fn rom(p: &mut Plan, b: usize) -> Result<&mut Vec<u32>, String> {
-    if p.compact {
-        return Err("the plan has a compact LUT".into());
+    if p.compact || p.logic {
+        return Err("the plan has no full-frame slot ROM".into());
     }
     p.branches
         .get_mut(b)

@@ -63,6 +63,7 @@ pub(crate) fn blocks(s: &Schedule, p: &Plan) -> String {
             "\"Per branch `b`\", \"CNV-style parts and daisy chains\"",
         );
     }
+    let as_logic = if p.logic { " as logic" } else { "" };
     for b in 0..p.branches.len() {
         let m = branch_module(b);
         row(
@@ -74,7 +75,7 @@ pub(crate) fn blocks(s: &Schedule, p: &Plan) -> String {
         row(
             &mut v,
             &format!("{m}_rom"),
-            &format!("branch {b}'s column of the slot table (slot_rom.hex)"),
+            &format!("branch {b}'s column of the slot table{as_logic} (slot_rom.hex)"),
             "\"Time\" (instants)",
         );
         row(
@@ -169,7 +170,13 @@ pub(crate) fn constants(s: &Schedule, p: &Plan) -> String {
         p.frame_slots * p.slot_cycles
     );
     let _ = writeln!(v, "//   channel_bits       {}", p.channel_bits);
-    let form = if p.compact { "compact" } else { "full" };
+    let form = if p.compact {
+        "compact"
+    } else if p.logic {
+        "logic (the full table as logic of the slot-in-slice and slice counters)"
+    } else {
+        "full"
+    };
     let _ = writeln!(v, "//   slot_lut           {form}");
     for (i, q) in p.seqs.iter().enumerate() {
         let _ = writeln!(

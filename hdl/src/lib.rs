@@ -18,6 +18,7 @@
 
 mod board;
 mod core;
+mod decode;
 mod emit;
 mod fault;
 mod fusesoc;

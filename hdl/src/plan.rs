@@ -3,6 +3,7 @@
 
 use lut_gen::Schedule;
 
+use crate::decode::SlotLogic;
 use crate::modeplan::{ModePlan, ModeRom};
 use crate::HdlError;
 
@@ -117,11 +118,29 @@ pub struct BranchRom {
     /// A mix with modes: every mode's table in `words` (the mode above the
     /// slot on the address, a `w` bit above each word), see `modeplan`.
     pub modes: Option<ModeRom>,
+    /// Arithmetic slot decoding (a logic plan): `words` as logic of the
+    /// slot-in-slice and slice counters, in place of the ROM.
+    pub logic: Option<SlotLogic>,
+    /// Per frame slot (full table): the word's channel field names a
+    /// conversion (the branch's, or in the queue form its lane's).
+    pub ch_used: Vec<bool>,
 }
 
 impl BranchRom {
     pub fn word_bits(&self) -> usize {
         1 + self.ch_bits + 3 + self.dev_bits + self.modes.is_some() as usize
+    }
+
+    /// The bits of frame slot `u`'s word nothing reads: its channel when
+    /// no conversion's word is in the branch's lane in that slot (the
+    /// merger and the word reader read the channel only with a word).
+    pub fn free_bits(&self, u: usize) -> u32 {
+        let (cw, dw) = (self.ch_bits, self.dev_bits);
+        if self.ch_used.get(u).copied().unwrap_or(true) {
+            0
+        } else {
+            ((1 << cw) - 1) << (3 + dw)
+        }
     }
 
     /// Pack one ROM word.
@@ -142,6 +161,9 @@ pub enum LutForm {
     Full,
     /// A slice table plus rotation groups indexed by a slice counter.
     Compact,
+    /// The full table's words as logic of the slot-in-slice and slice
+    /// counters (`decode`), no ROM; `Auto` takes it where it costs less.
+    Logic,
 }
 
 /// A branch's compact LUT: `slice_words[p]` for slot-in-slice `p` is
@@ -161,6 +183,9 @@ pub struct CompactRom {
 pub struct Plan {
     /// Compact LUT (then every branch has `compact`), else full frame table.
     pub compact: bool,
+    /// The full table decoded by logic from slot-in-slice and slice
+    /// counters (then every branch has `logic`), not read from ROM.
+    pub logic: bool,
     pub slots_per_slice: u64,
     pub slices_per_frame: u64,
     pub slot_cycles: u64,
@@ -276,6 +301,7 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
     }
     let mut p = Plan {
         compact,
+        logic: false,
         slots_per_slice: g.slots_per_slice,
         slices_per_frame: g.slices_per_frame,
         slot_cycles: g.slot_cycles,
@@ -288,7 +314,61 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         modes: None,
     };
     crate::modeplan::apply(s, &mut p)?;
+    if !compact && form != LutForm::Full {
+        decode_by_logic(&mut p, form == LutForm::Logic)?;
+    }
     Ok(p)
+}
+
+/// Arithmetic slot decoding (hdl/DESIGN.md, "Slot LUT") where it costs
+/// less than the ROM's frame-wide slot pointer (two registers of the
+/// address's width and a compare), or always when `forced`. Mixes with
+/// modes (every mode's table on the ROM address) and command words keep
+/// the ROM.
+fn decode_by_logic(p: &mut Plan, forced: bool) -> Result<(), HdlError> {
+    if p.modes.is_some() || p.branches.iter().any(|r| r.command.is_some()) {
+        if forced {
+            return Err(unsupported(
+                "the logic slot decoding is not for mixes with modes or command words".into(),
+            ));
+        }
+        return Ok(());
+    }
+    let (sps, k) = (p.slots_per_slice as usize, p.slices_per_frame as usize);
+    let logic: Vec<SlotLogic> = p
+        .branches
+        .iter()
+        .map(|r| SlotLogic::of(&r.words, r.word_bits(), sps, k, |u| r.free_bits(u)))
+        .collect();
+    let (rom, counters, decode) = logic_costs(p, &logic);
+    if forced || counters + decode < rom {
+        p.logic = true;
+        for (r, l) in p.branches.iter_mut().zip(logic) {
+            r.logic = Some(l);
+        }
+    }
+    Ok(())
+}
+
+/// Block RAM bits (an iCE40 SB_RAM40_4K): a ROM under this is built of
+/// LUTs by yosys (induction5k-adc12's 1,280-bit tables: no block RAM;
+/// eskin34's 6 kbit ones: five), then its words cost logic like the
+/// decoding's.
+const BRAM_BITS: usize = 4096;
+
+/// Estimated LCs of the ROM form (the slot pointer, and the tables where
+/// they are too small for block RAM), of the logic form's counters, and
+/// of its decoding.
+fn logic_costs(p: &Plan, logic: &[SlotLogic]) -> (usize, usize, usize) {
+    let ab = addr_bits(p.frame_slots);
+    let l = &logic[0];
+    let refs: Vec<&SlotLogic> = logic.iter().collect();
+    let decode = SlotLogic::cost(&refs);
+    let in_luts = p.branches.iter().all(|r| (r.word_bits() << ab) < BRAM_BITS);
+    let rom = 2 * ab + 2 + if in_luts { decode } else { 0 };
+    // the logic form's timing counts slots in the slice (with their
+    // successor register, as the compact form's) and slices
+    (rom, 2 * l.slot_bits + l.slice_bits + 2, decode)
 }
 
 /// `lanes[j][u]`: the channel of the `j`-th branch (in branch order) that
@@ -371,7 +451,7 @@ fn check_grid(s: &Schedule, form: LutForm) -> Result<bool, HdlError> {
         .unwrap_or(1);
     let full_bits = (1u64 << addr_bits(g.frame_slots)) * (4 + cw + max_dev_bits) as u64 * nb as u64;
     let compact = match form {
-        LutForm::Full => false,
+        LutForm::Full | LutForm::Logic => false,
         LutForm::Compact => true,
         LutForm::Auto => g.frame_slots > MAX_FRAME_SLOTS || full_bits > FULL_LUT_MAX_BITS,
     };
@@ -474,6 +554,8 @@ fn branch_rom(
         compact: None,
         command: adc.command.clone(),
         modes: None,
+        logic: None,
+        ch_used: vec![],
     };
     // the ROM's channel field: the branch's own, or in the queue form its
     // lane's (the conversion and mux fields stay the branch's)
@@ -677,6 +759,7 @@ fn fill_rom(
             words[u] = rom.word(slots[u].is_some(), ch, sel, dev);
         }
         rom.words = words;
+        rom.ch_used = chans.iter().map(|c| c.is_some()).collect();
     }
 }
 
@@ -714,5 +797,63 @@ mod tests {
         }
         let v = schedule("vibrotactile8k.toml");
         assert!(plan_with(&v, LutForm::Full).unwrap().queue.is_none());
+    }
+
+    /// Every preset, shared test mix and gateware test mix: where `Auto`
+    /// decodes slots by logic, and wherever the logic form is forced, each
+    /// branch's logic gives the full table's word at every slot of the
+    /// frame (its channel free where the branch does not convert), and
+    /// `Auto` took it only where the estimate says it costs less.
+    #[test]
+    fn logic_decoding_equals_the_table_and_is_chosen_by_cost() {
+        let mut mixes: Vec<std::path::PathBuf> = vec![];
+        for d in ["mixes", "testkit/mixes", "hdl/tests/data"] {
+            let mut v: Vec<_> = std::fs::read_dir(testkit::root().join(d))
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+                .collect();
+            v.sort();
+            mixes.extend(v);
+        }
+        let (mut chosen, mut kept) = (0, 0);
+        for path in &mixes {
+            let text = std::fs::read_to_string(path).unwrap();
+            let Ok(s) = lut_gen::synthesize(&lut_gen::parse(path, &text).unwrap()) else {
+                continue;
+            };
+            let Ok(full) = plan_with(&s, LutForm::Full) else {
+                continue;
+            };
+            let auto = plan_with(&s, LutForm::Auto).unwrap();
+            let Ok(forced) = plan_with(&s, LutForm::Logic) else {
+                assert!(full.modes.is_some() || full.branches.iter().any(|r| r.command.is_some()));
+                assert!(!auto.logic);
+                continue;
+            };
+            let logic: Vec<SlotLogic> = forced
+                .branches
+                .iter()
+                .map(|r| r.logic.clone().unwrap())
+                .collect();
+            let (rom, counters, decode) = logic_costs(&full, &logic);
+            assert_eq!(auto.logic, counters + decode < rom, "{}", path.display());
+            if auto.logic {
+                chosen += 1;
+            } else {
+                kept += 1;
+            }
+            let sps = s.grid.slots_per_slice as usize;
+            for (b, r) in full.branches.iter().enumerate() {
+                let l = &logic[b];
+                for u in 0..s.grid.frame_slots as usize {
+                    let (w, d) = (r.words[u], l.word(u % sps, u / sps));
+                    let care = !r.free_bits(u);
+                    assert_eq!(d & care, w & care, "{} branch {b} slot {u}", path.display());
+                }
+            }
+        }
+        // the presets have both kinds
+        assert!(chosen >= 3 && kept >= 2, "{chosen} {kept}");
     }
 }

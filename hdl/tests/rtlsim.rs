@@ -133,6 +133,17 @@ fn eskin34_compact_lut_matches_timing_contract() {
     run_and_compare_with(&s, 2 * s.grid.frame_cycles, hdl::LutForm::Compact);
 }
 
+/// The reference mix (three branches, the merger's queue form) and 16
+/// branches with the slot decoding by logic instead of the ROM (where
+/// `Auto` keeps the ROM): same pins.
+#[test]
+fn logic_slot_decoding_matches_timing_contract() {
+    let s = eskin34();
+    run_and_compare_with(&s, 2 * s.grid.frame_cycles, hdl::LutForm::Logic);
+    let s = data_mix("b16");
+    run_and_compare_with(&s, s.grid.frame_cycles, hdl::LutForm::Logic);
+}
+
 /// A frame of more slots than the full-frame ROM takes: compact LUT.
 #[test]
 fn long_frame_needs_and_uses_the_compact_lut() {

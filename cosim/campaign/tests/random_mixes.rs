@@ -6,6 +6,15 @@ use std::path::Path;
 use judge::{run_dut, ModelDut, RunOptions};
 use judge::{FaultyDut, PinFault};
 
+/// The twin with the slot decoding by logic, as a judge DUT.
+struct Logic(hdl::RtlSim);
+
+impl judge::Dut for Logic {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::Pins {
+        self.0.step(rst, miso)
+    }
+}
+
 /// Twelve seeds in the default suite, 40 in `make test-long`.
 #[test]
 fn random_feasible_mixes() {
@@ -49,6 +58,12 @@ fn random_feasible_mixes_from(seeds: std::ops::Range<u64>) {
         if let Ok(mut dut) = engines::RustHdlDut::new(&s) {
             let r = run_dut(&s, &mut dut, 2, &opts, "rusthdl", None);
             assert!(r.ok, "seed {seed} rusthdl:\n{text}\n{}", r.summary());
+        }
+        // the slot decoding by logic (hdl/DESIGN.md, "Slot LUT"), forced
+        // whether or not it is the cheaper form for this mix
+        if let Ok(sim) = hdl::RtlSim::with_form(&s, hdl::LutForm::Logic) {
+            let r = run_dut(&s, &mut Logic(sim), 2, &opts, "rusthdl-logic", None);
+            assert!(r.ok, "seed {seed} logic:\n{text}\n{}", r.summary());
         }
         let at = s.grid.frame_cycles / 3 + 11;
         for f in PinFault::all(&s) {

@@ -8,7 +8,9 @@
 //! - 3: model back end vs real time;
 //! - 4: `check` of a VCD vs a bare streaming parse with the same reader;
 //! - 5: `check` vs the `wellen` crate's bare load of the same VCD (single-
-//!   and multi-threaded).
+//!   and multi-threaded);
+//! - 6: the slot decoding by logic vs the ROM (hdl/DESIGN.md, "Slot LUT"),
+//!   RtlSim and Verilator, unchecked, on eskin34 and vibrotactile8k.
 
 use std::path::Path;
 use std::time::Instant;
@@ -148,4 +150,46 @@ fn main() {
         twm / tk
     );
     let _ = std::fs::remove_dir_all(&dir);
+    for m in ["eskin34", "vibrotactile8k"] {
+        slot_forms(m, frames);
+    }
+}
+
+/// `hdl::RtlSim` with a chosen slot LUT form, as a judge DUT.
+struct Form(hdl::RtlSim);
+
+impl judge::Dut for Form {
+    fn step(&mut self, rst: bool, miso: u64) -> lut_gen::Pins {
+        self.0.step(rst, miso)
+    }
+}
+
+/// 6: the same mix with its slot table in ROM and as logic, side by side.
+fn slot_forms(name: &str, frames: u64) {
+    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../mixes/{name}.toml"));
+    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    let (rom, logic) = (hdl::LutForm::Full, hdl::LutForm::Logic);
+    let hf = (frames / 5).max(1);
+    let rate = |form, n: u64| {
+        let mut d = Form(hdl::RtlSim::with_form(&s, form).unwrap());
+        let (t, _) = secs(|| run_unchecked(&s, &mut d, n, Stimulus::Pattern));
+        (n * s.grid.frame_cycles) as f64 / t / 1e6
+    };
+    let (hr, hl) = (rate(rom, hf), rate(logic, hf));
+    let vrate = |form| {
+        let v = hdl::emit_with(&s, None, form)
+            .unwrap()
+            .verilog()
+            .to_string();
+        let (mut d, _) = VerilatedDut::new(&v).unwrap();
+        let (t, _) = secs(|| run_unchecked(&s, &mut d, frames, Stimulus::Pattern));
+        (frames * s.grid.frame_cycles) as f64 / t / 1e6
+    };
+    let (vr, vl) = (vrate(rom), vrate(logic));
+    println!(
+        "slot decoding {name}: RtlSim ROM {hr:.3} / logic {hl:.3} Mcycles/s (ratio {:.2}); \
+         verilator ROM {vr:.2} / logic {vl:.2} Mcycles/s (ratio {:.2})",
+        hl / hr,
+        vl / vr
+    );
 }

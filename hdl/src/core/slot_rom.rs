@@ -2,6 +2,7 @@
 
 use rust_hdl::prelude::*;
 
+use crate::decode::SlotLogic;
 use crate::modeplan::ModeRom;
 use crate::plan::{BranchRom, CompactRom};
 use crate::widths::*;
@@ -24,6 +25,10 @@ pub struct SlotRom {
     _ch_bits: usize,
     _dev_bits: usize,
     _compact: Option<CompactRom>,
+    /// Logic decoding: the word of `{slice, address}` registered (the
+    /// timing generator's counters again, which synthesis merges with
+    /// them), evaluated once from the same truth tables as the Verilog.
+    _logic: Option<(SlotLogic, Vec<u32>)>,
     /// A mix with modes: the mode is on the address above the slot, and
     /// `slice` carries the next frame's mode (low bits) and whether the
     /// address is in the next frame (the bit above); see `read_modes`.
@@ -56,6 +61,13 @@ impl SlotRom {
             _ch_bits: rom.ch_bits,
             _dev_bits: rom.dev_bits,
             _compact: rom.compact.clone(),
+            _logic: rom.logic.clone().map(|l| {
+                let n = 1usize << (l.slot_bits + l.slice_bits);
+                let w = (0..n)
+                    .map(|x| l.word(x & ((1 << l.slot_bits) - 1), x >> l.slot_bits))
+                    .collect();
+                (l, w)
+            }),
             _modes: rom.modes.clone(),
             _reset: (rom.reset_sel, rom.reset_en.trailing_zeros() % 64),
             _qm: 0,
@@ -198,7 +210,14 @@ impl SlotRom {
 impl Logic for SlotRom {
     fn update(&mut self) {
         let wb = self.word_bits();
-        if let Some(m) = self._modes.take() {
+        if let Some((l, w)) = &self._logic {
+            if self.clock.pos_edge() {
+                let p = self.address.val().to_u64() as usize & ((1 << l.slot_bits) - 1);
+                let j = self.slice.val().to_u64() as usize & ((1 << l.slice_bits) - 1);
+                let w = w[j << l.slot_bits | p];
+                self.set_outputs(w as u64);
+            }
+        } else if let Some(m) = self._modes.take() {
             self.read_modes(&m);
             self._modes = Some(m);
         } else if let Some(c) = &self._compact {
@@ -253,7 +272,12 @@ impl Logic for SlotRom {
         };
         let mut unused = vec![];
         let used_addr;
-        if let Some(c) = &self._compact {
+        if let Some((l, _)) = &self._logic {
+            s.push_str(&l.verilog(wb));
+            unused = l.unused();
+            unused.push("rst".to_string());
+            used_addr = SLOT_BITS;
+        } else if let Some(c) = &self._compact {
             let (payload, a0) = Self::compact_numbers(c, wb);
             let sw = 1 + payload;
             let (gb, sb) = (c.group_bits, c.slice_bits);

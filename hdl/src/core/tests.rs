@@ -64,6 +64,8 @@ fn rom() -> BranchRom {
         compact: None,
         command: None,
         modes: None,
+        logic: None,
+        ch_used: vec![],
     };
     // mux fields: the first instant at this slot or later
     r.words = vec![
@@ -80,6 +82,7 @@ fn harness(div: u64, setup: u64) -> Harness {
         link: None,
         modes: None,
         compact: false,
+        logic: false,
         slots_per_slice: 4,
         slices_per_frame: 1,
         slot_cycles: SLOT,

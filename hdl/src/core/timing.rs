@@ -35,7 +35,7 @@ pub struct TimingGen {
     pub(super) st2: DFF<Bit>,
     pub(super) st0: DFF<Bit>,
     /// Index of the next slot start (> c): in the frame (full LUT) or in the
-    /// slice (compact LUT), with its slice in `sl`.
+    /// slice (compact LUT, logic decoding), with its slice in `sl`.
     pub(super) slot: DFF<Bits<SLOT_BITS>>,
     pub(super) sl: DFF<Bits<SLICE_BITS>>,
     /// The slot after `slot` (wrapping at the last), kept in step with it.
@@ -62,7 +62,9 @@ pub struct TimingGen {
 
 impl TimingGen {
     pub(super) fn new(plan: &Plan) -> TimingGen {
-        let slot_last = if plan.compact {
+        // the compact LUT and the logic decoding count slots in the slice
+        let in_slice = plan.compact || plan.logic;
+        let slot_last = if in_slice {
             plan.slots_per_slice - 1
         } else {
             plan.frame_slots - 1
@@ -84,8 +86,8 @@ impl TimingGen {
             succ: Default::default(),
             nxt: Default::default(),
             nxt_sl: Default::default(),
-            k_compact: Constant::new(plan.compact),
-            k_sl_last: c(if plan.compact {
+            k_compact: Constant::new(in_slice),
+            k_sl_last: c(if in_slice {
                 plan.slices_per_frame - 1
             } else {
                 0
