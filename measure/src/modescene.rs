@@ -383,3 +383,7 @@ pub fn mode_section(
     };
     (sec, line, glance)
 }
+
+#[cfg(test)]
+#[path = "modescene_tests.rs"]
+mod tests;

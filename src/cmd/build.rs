@@ -159,9 +159,9 @@ pub fn run(a: Args) -> u8 {
         // the count the progress's `[n/N]` counted, and the steps not run
         let not_run = job.doc.steps.len() - job.total;
         println!(
-            "{}: {} steps run{}, {} failed; report in {}",
+            "{}: {} run{}, {} failed; report in {}",
             s.mix.name,
-            job.total,
+            super::counted(job.total as u64, "step"),
             if not_run > 0 {
                 format!(" ({not_run} not asked for)")
             } else {

@@ -2,7 +2,7 @@
 //! the frames. A mix without modes runs `--stimulus` (default `pattern`)
 //! for `--frames` (default 3). A mix with modes runs a scene that switches
 //! it, long enough to come back: auto select a stroke over the channels its
-//! reset mode's triggers watch (seed 003's Figure 11: a finger sliding over
+//! reset mode's triggers watch (the paper's Figure 11: a finger sliding over
 //! a row of taxels) unless `--stimulus` says otherwise; pin select a request
 //! of every mode in turn and back to the first.
 
