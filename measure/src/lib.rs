@@ -24,6 +24,7 @@ mod budget;
 mod dft;
 mod figure7;
 mod modescene;
+mod names;
 mod netlist;
 mod proof;
 mod reaction;
@@ -38,6 +39,7 @@ mod yosys;
 // Each measurement: a report section and its one-line summary.
 pub use figure7::figure7;
 pub use modescene::{mode_scene, mode_section, one_mode, ModeScene};
+pub use names::short_names;
 pub use proof::{cached_proof, proof, ShownProof};
 pub use reaction::Reaction;
 pub use scenelog::FrameFigures;

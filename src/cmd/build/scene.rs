@@ -20,6 +20,22 @@ pub struct Scene {
     pub frames: u64,
 }
 
+impl Scene {
+    /// The scene as the command line would write it: the stimulus, and the
+    /// requests as `sim --modes` takes them (`pattern, --modes 2=slow,8=fast`).
+    pub fn words(&self, s: &Schedule) -> String {
+        let Some(m) = s.mix.modes.as_ref().filter(|_| !self.requests.is_empty()) else {
+            return self.stimulus.clone();
+        };
+        let r: Vec<String> = self
+            .requests
+            .iter()
+            .map(|&(f, k)| format!("{f}={}", m.names[k as usize]))
+            .collect();
+        format!("{}, --modes {}", self.stimulus, r.join(","))
+    }
+}
+
 /// Frames of the default stroke, and the quiet frames before it.
 const STROKE_FRAMES: u64 = 10;
 const STROKE_FROM: u64 = 3;
@@ -96,55 +112,7 @@ fn default_stroke(s: &Schedule) -> String {
         .collect();
     format!(
         "stroke:{}@{STROKE_FROM}-{}",
-        bulk(&names),
+        measure::short_names(&names),
         STROKE_FROM + STROKE_FRAMES
     )
-}
-
-/// Names written short: runs of a prefix with consecutive numbers as the
-/// mix's bulk patterns write them (`CH{1..25}`), the rest as they are.
-fn bulk(names: &[&str]) -> String {
-    let split = |n: &str| {
-        let d = n.trim_end_matches(|c: char| c.is_ascii_digit());
-        let digits = &n[d.len()..];
-        let plain = !digits.is_empty() && (digits == "0" || !digits.starts_with('0'));
-        plain
-            .then(|| digits.parse::<u64>().ok().map(|k| (d.to_string(), k)))
-            .flatten()
-    };
-    let mut out: Vec<String> = Vec::new();
-    let mut i = 0;
-    while i < names.len() {
-        let mut j = i + 1;
-        if let Some((p, k)) = split(names[i]) {
-            while j < names.len() && split(names[j]) == Some((p.clone(), k + (j - i) as u64)) {
-                j += 1;
-            }
-            if j - i > 2 {
-                out.push(format!("{p}{{{k}..{}}}", k + (j - i - 1) as u64));
-                i = j;
-                continue;
-            }
-        }
-        out.push(names[i].to_string());
-        i += 1;
-    }
-    out.join(",")
-}
-
-#[cfg(test)]
-mod tests {
-    use super::bulk;
-
-    #[test]
-    fn runs_of_numbered_names_are_written_as_bulk_patterns() {
-        assert_eq!(
-            bulk(&["CH1", "CH2", "CH3", "CH5", "CH6", "T0", "T1", "T2", "T3"]),
-            "CH{1..3},CH5,CH6,T{0..3}"
-        );
-        assert_eq!(bulk(&["A01", "A02", "A03"]), "A01,A02,A03");
-        for written in bulk(&["CH1", "CH2", "CH3", "X"]).split(',') {
-            assert!(lut_gen::expand_names(written).is_ok(), "{written}");
-        }
-    }
 }

@@ -138,12 +138,32 @@ fn audit(j: &mut Job, s: &Schedule) -> Done {
         "",
         &[("audit.txt", r.to_text()), ("audit.json", r.to_json())],
     );
+    // a mix with modes: every mode's rate, not the reset mode's alone
+    let rate = if r.modes.len() > 1 {
+        r.modes
+            .iter()
+            .map(|m| {
+                format!(
+                    "{} samples/s in `{}` ({:.1} %)",
+                    m.aggregate_hz,
+                    m.name,
+                    m.adc_utilization * 100.0
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+            + &format!(" of the converters' {:.0}", r.adc_limit_hz)
+    } else {
+        format!(
+            "{} samples/s of the converters' {:.0} ({:.1} %)",
+            r.aggregate_hz,
+            r.adc_limit_hz,
+            r.adc_utilization * 100.0
+        )
+    };
     let line = format!(
-        "feasible, {} slots per slice, {} samples/s of the converters' {:.0} ({:.1} %); {}",
+        "feasible, {} slots per slice, {rate}; {}",
         s.grid.slots_per_slice,
-        r.aggregate_hz,
-        r.adc_limit_hz,
-        r.adc_utilization * 100.0,
         counted(r.warnings.len() as u64, "warning")
     );
     let mut sec = Section {
@@ -299,12 +319,12 @@ fn sim(
     });
     let json = serde_json::to_string_pretty(&r).expect("report");
     let w = j.write("", &[("sim.json", json)]);
-    let d = checked(j, s, &r, backend, &scene.stimulus);
+    let d = checked(j, s, &r, backend, &scene.words(s));
     *keep = Some(r);
     let Some(m) = modes else {
         return written(w, d);
     };
-    let (sec, line, glance) = measure::mode_section(s, &m, &scene.stimulus, backend.name());
+    let (sec, line, glance) = measure::mode_section(s, &m, &scene.words(s), backend.name());
     j.answer(Glance::Modes, glance);
     let problems = m.problems(s);
     let d = match (&d.outcome, problems.is_empty()) {
