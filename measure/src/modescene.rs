@@ -248,7 +248,16 @@ fn chart(s: &Schedule, m: &ModeScene, t: &Table) -> Figure {
             if m.bytes { "Bytes the host received" } else { "Samples on the sample port" },
             ms(s, g.frame_cycles)
         ),
-        svg: report::draw(&axes, &[without, with], 820, 380),
+        // without a one-mode run (it could not run) the chart has one line
+        svg: report::draw(
+            &axes,
+            &[without, with]
+                .into_iter()
+                .filter(|x| !x.points.is_empty())
+                .collect::<Vec<_>>(),
+            820,
+            380,
+        ),
         table: t.clone(),
     }
 }
