@@ -409,7 +409,7 @@ fn the_links_fifo_is_block_ram() {
 #[test]
 fn gates_modes() {
     for name in ["modes-pin", "modes-auto", "eskin34-adaptive"] {
-        let path = common::root().join(format!("testkit/mixes/{name}.toml"));
+        let path = testkit::mix(name);
         let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
         gates(&s, name);
     }

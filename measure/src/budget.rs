@@ -103,9 +103,92 @@ pub fn budget_tables(r: &AuditReport) -> Vec<(String, Table)> {
             link(l, r.clock_hz),
         ));
     }
+    if r.modes.len() > 1 {
+        out.push((
+            "Modes: the tables above are the reset mode's; each mode's own figures".into(),
+            modes(r),
+        ));
+    }
+    if !r.triggers.is_empty() {
+        out.push(("Triggers and their worst reaction".into(), triggers(r)));
+    }
     out.push(("Converters".into(), parts(r)));
     out.push(("Channels".into(), channels(r)));
     out
+}
+
+/// Each mode's figures, from the audit's per-mode tables.
+fn modes(r: &AuditReport) -> Table {
+    let pin = r.modes.iter().any(|m| m.pin_latency_us.is_some());
+    let mut cols = vec![
+        "mode",
+        "samples per frame",
+        "samples/s",
+        "converters used",
+        "what binds",
+        "link bytes per frame",
+        "link use",
+    ];
+    if pin {
+        cols.push("switch by the pin, worst (us)");
+    }
+    let mut t = Table::new(&cols);
+    for m in &r.modes {
+        let mut row = vec![
+            m.name.clone(),
+            m.samples_per_frame.to_string(),
+            m.aggregate_hz.to_string(),
+            pct(m.adc_utilization),
+            format!(
+                "{} of {}, {}",
+                m.binding.describe(),
+                m.binding_branch,
+                pct(m.utilization)
+            ),
+            m.link
+                .as_ref()
+                .map_or("-".into(), |l| l.bytes_per_frame.to_string()),
+            m.link.as_ref().map_or("-".into(), |l| pct(l.utilization)),
+        ];
+        if pin {
+            row.push(m.pin_latency_us.map_or("-".into(), |u| format!("{u:.1}")));
+        }
+        t.push(row);
+    }
+    t
+}
+
+/// Each trigger: what it watches and its worst reaction.
+fn triggers(r: &AuditReport) -> Table {
+    let mut t = Table::new(&[
+        "trigger",
+        "condition",
+        "watches",
+        "worst reaction (ms)",
+        "worst when",
+    ]);
+    for x in &r.triggers {
+        t.push(vec![
+            format!("{} to {}", x.from.join(", "), x.to),
+            format!(
+                "{} {} for {}",
+                match x.when {
+                    lut_gen::When::Above => "above",
+                    lut_gen::When::Below => "below",
+                },
+                x.level,
+                if x.for_frames == 1 {
+                    "1 frame".to_string()
+                } else {
+                    format!("{} frames", x.for_frames)
+                }
+            ),
+            crate::short_names(&x.channels.iter().map(String::as_str).collect::<Vec<_>>()),
+            format!("{:.2}", x.latency_us / 1e3),
+            format!("in {}, on {}", x.worst_from, x.worst_channel),
+        ]);
+    }
+    t
 }
 
 /// The mix's figures as label and value.

@@ -14,14 +14,21 @@
 //! - `proof`: the formal proof of the gateware (or its cached result);
 //! - `budget`: the audit as a datasheet (what binds, the margin, each
 //!   budget its own table);
+//! - `modescene`: a mix with modes over a scene against its one-mode twin
+//!   (`scenelog`: each frame's mode, samples and link bytes off the pins;
+//!   `reaction`: each switch's reaction, measured);
 //! - `tables`: the slot table (Table 1), per-channel intervals
 //!   and the fault campaign as report tables.
 
 mod budget;
 mod dft;
 mod figure7;
+mod modescene;
+mod names;
 mod netlist;
 mod proof;
+mod reaction;
+mod scenelog;
 mod schedulability;
 mod speed;
 mod synth;
@@ -31,7 +38,11 @@ mod yosys;
 
 // Each measurement: a report section and its one-line summary.
 pub use figure7::figure7;
+pub use modescene::{mode_scene, mode_section, one_mode, ModeScene};
+pub use names::short_names;
 pub use proof::{cached_proof, proof, ShownProof};
+pub use reaction::Reaction;
+pub use scenelog::FrameFigures;
 pub use schedulability::schedulability;
 pub use speed::{speed, CleanRun};
 pub use timing::timing;

@@ -17,6 +17,7 @@
 
 mod job;
 mod plan;
+mod scene;
 mod steps;
 
 use std::path::PathBuf;
@@ -30,9 +31,18 @@ pub struct Args {
     /// Output directory (created if missing; only the job's files are written).
     #[arg(short = 'o', long = "out")]
     pub out: PathBuf,
-    /// Frames the co-simulation runs, fully checked.
-    #[arg(long, value_parser = super::whole_number, default_value_t = 3)]
-    pub frames: u64,
+    /// Frames the co-simulation runs, fully checked (default 3; a mix with
+    /// modes: its scene, and the slowest reaction after it, the audit's).
+    #[arg(long, value_parser = super::whole_number)]
+    pub frames: Option<u64>,
+    /// The co-simulation's ADC input, as `sim --stimulus` takes it (default
+    /// `pattern`). A mix with modes runs a scene that switches it and charts
+    /// its data rate against the same scene with one mode: auto select by
+    /// default a stroke over the channels its reset mode's triggers watch,
+    /// from frame 3 for 10 frames (`stroke:NAMES@3-13`); pin select the
+    /// pattern with a request of every mode in turn on `mode_sel`.
+    #[arg(long, value_name = "STIMULUS")]
+    pub stimulus: Option<String>,
     /// Run the fault campaign on the gateware (rust-hdl: also faults built
     /// into its slot ROM and counters; slower) instead of the model's pins.
     #[arg(long)]
@@ -97,7 +107,7 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
-    let s = match super::load_checked(&a.mix, super::Limits::Contract) {
+    let s = match super::load_any_modes(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
@@ -113,9 +123,16 @@ pub fn run(a: Args) -> u8 {
         eprintln!("error: {}: cannot create directory: {why}", a.out.display());
         return 2;
     }
-    let plan = plan::with_remembered_proof(plan, &s, &a.out);
+    let scene = match scene::scene(&a, &s) {
+        Ok(x) => x,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let plan = plan::with_remembered_proof(plan::for_modes(plan, &s), &s, &a.out);
     let mut job = Job::new(&a, &s, plan.iter().filter(|p| p.1.runs()).count());
-    steps::run_all(&mut job, &a, &s, &plan);
+    steps::run_all(&mut job, &a, &s, &plan, &scene);
     if let Err(e) = job.finish() {
         eprintln!("error: {e}");
         return 2;
@@ -142,9 +159,9 @@ pub fn run(a: Args) -> u8 {
         // the count the progress's `[n/N]` counted, and the steps not run
         let not_run = job.doc.steps.len() - job.total;
         println!(
-            "{}: {} steps run{}, {} failed; report in {}",
+            "{}: {} run{}, {} failed; report in {}",
             s.mix.name,
-            job.total,
+            super::counted(job.total as u64, "step"),
             if not_run > 0 {
                 format!(" ({not_run} not asked for)")
             } else {

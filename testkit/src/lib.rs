@@ -4,7 +4,7 @@
 //! - [`tools`]: the rule for tests that drive external tools (run, skip
 //!   loudly, or fail under `CI`);
 //! - [`presets`]: every preset mix;
-//! - [`mix`]: the shared test mixes in `testkit/mixes/`;
+//! - [`mix`]: the shared test mixes in `testkit/mixes/` (or a preset by name);
 //! - [`tb_judge`]: the verdict of the independent Icarus testbench
 //!   (`tests/tb/adc_tb.v`) on its log;
 //! - [`mutate`]: the Verilog mutator (mutation testing of the checkers);
@@ -25,9 +25,17 @@ pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// A shared test mix, `testkit/mixes/<name>.toml`.
+/// A shared test mix, `testkit/mixes/<name>.toml`, or else the preset of
+/// that name, `mixes/<name>.toml`: a preset a test also needs by name
+/// (`eskin34-adaptive`) is one file, not a copy that could drift.
 pub fn mix(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
+    let file = format!("{name}.toml");
+    let own = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("mixes")
-        .join(format!("{name}.toml"))
+        .join(&file);
+    if own.exists() {
+        own
+    } else {
+        root().join("mixes").join(file)
+    }
 }

@@ -78,13 +78,16 @@ pub enum Glance {
     Faults,
     Proved,
     Size,
+    /// A mix with modes only.
+    Modes,
 }
 
 impl Glance {
-    const ALL: [Glance; 6] = [
+    const ALL: [Glance; 7] = [
         Glance::Fits,
         Glance::Binds,
         Glance::Checked,
+        Glance::Modes,
         Glance::Faults,
         Glance::Proved,
         Glance::Size,
@@ -98,7 +101,22 @@ impl Glance {
             Glance::Faults => "Does the check catch faults?",
             Glance::Proved => "Is it proved?",
             Glance::Size => "How big and fast is it?",
+            Glance::Modes => "What do the modes save, and how fast do they switch?",
         }
+    }
+}
+
+/// Samples per frame; a mix with modes names each mode's.
+fn samples_per_frame(s: &Schedule) -> String {
+    match s.mix.modes.as_ref().filter(|_| s.modes.len() > 1) {
+        Some(m) => s
+            .modes
+            .iter()
+            .zip(&m.names)
+            .map(|(x, n)| format!("{} in `{n}`", x.samples_per_frame()))
+            .collect::<Vec<_>>()
+            .join(", "),
+        None => s.samples_per_frame().to_string(),
     }
 }
 
@@ -146,11 +164,12 @@ impl Job {
                     g.slices_per_frame,
                     g.slots_per_slice,
                     g.slot_cycles,
-                    s.samples_per_frame(),
+                    samples_per_frame(s),
                     std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
                 ),
                 glance: Glance::ALL
                     .iter()
+                    .filter(|&&g| g != Glance::Modes || s.modes.len() > 1)
                     .map(|g| (g.question().to_string(), "not run in this build".to_string()))
                     .collect(),
                 ..Document::default()
@@ -176,11 +195,9 @@ impl Job {
 
     /// Answers one question of the first screen.
     pub fn answer(&mut self, g: Glance, text: impl Into<String>) {
-        let i = Glance::ALL
-            .iter()
-            .position(|x| *x == g)
-            .expect("every question is shown");
-        self.doc.glance[i].1 = text.into();
+        if let Some(row) = self.doc.glance.iter_mut().find(|r| r.0 == g.question()) {
+            row.1 = text.into();
+        }
     }
 
     /// Records a step that was not asked for.

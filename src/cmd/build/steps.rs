@@ -6,8 +6,9 @@ use engines::{Backend, SimOptions, VcdOut};
 use lut_gen::{AuditReport, Schedule};
 use report::Section;
 
-use super::job::{Done, Glance, Job};
+use super::job::{Done, Glance, Job, Outcome};
 use super::plan::{only_names, Run, Step};
+use super::scene::Scene;
 use super::{Args, Charts};
 use crate::cmd::counted;
 
@@ -72,7 +73,7 @@ fn start_synth(
     }))
 }
 
-pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
+pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)], scene: &Scene) {
     let mut sim_report = None;
     // engines run clean outside the campaign, for the speed chart
     let mut clean: Vec<measure::CleanRun> = Vec::new();
@@ -95,7 +96,7 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)]) {
             Step::Audit => audit(j, s),
             Step::Lut => lut(j, s),
             Step::Verilog => verilog(j, s),
-            Step::Sim => sim(j, a, s, &mut sim_report, &mut clean),
+            Step::Sim => sim(j, scene, s, &mut sim_report, &mut clean),
             Step::Golden => golden(j, a, s),
             Step::Faults => faults(j, a, s, &mut campaign),
             Step::Prove if run == Run::Remembered => proved(
@@ -137,12 +138,32 @@ fn audit(j: &mut Job, s: &Schedule) -> Done {
         "",
         &[("audit.txt", r.to_text()), ("audit.json", r.to_json())],
     );
+    // a mix with modes: every mode's rate, not the reset mode's alone
+    let rate = if r.modes.len() > 1 {
+        r.modes
+            .iter()
+            .map(|m| {
+                format!(
+                    "{} samples/s in `{}` ({:.1} %)",
+                    m.aggregate_hz,
+                    m.name,
+                    m.adc_utilization * 100.0
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+            + &format!(" of the converters' {:.0}", r.adc_limit_hz)
+    } else {
+        format!(
+            "{} samples/s of the converters' {:.0} ({:.1} %)",
+            r.aggregate_hz,
+            r.adc_limit_hz,
+            r.adc_utilization * 100.0
+        )
+    };
     let line = format!(
-        "feasible, {} slots per slice, {} samples/s of the converters' {:.0} ({:.1} %); {}",
+        "feasible, {} slots per slice, {rate}; {}",
         s.grid.slots_per_slice,
-        r.aggregate_hz,
-        r.adc_limit_hz,
-        r.adc_utilization * 100.0,
         counted(r.warnings.len() as u64, "warning")
     );
     let mut sec = Section {
@@ -172,12 +193,21 @@ fn audit(j: &mut Job, s: &Schedule) -> Done {
 /// The first screen's answers from the audit: whether it fits, and the
 /// limit that binds with its margin (and the link's budget).
 fn answer_audit(j: &mut Job, r: &AuditReport) {
+    // a mix with modes: each mode's use, not the reset mode's alone
+    let used = if r.modes.len() > 1 {
+        r.modes
+            .iter()
+            .map(|m| format!("{:.1} % in `{}`", m.adc_utilization * 100.0, m.name))
+            .collect::<Vec<_>>()
+            .join(", ")
+    } else {
+        format!("{:.1} %", r.adc_utilization * 100.0)
+    };
     j.answer(
         Glance::Fits,
         format!(
-            "yes: {} channels, each at its rate with zero jitter; the converters {:.1} % used",
+            "yes: {} channels, each at its rate with zero jitter; the converters {used} used",
             r.channels.len(),
-            r.adc_utilization * 100.0
         ),
     );
     let mut binds = measure::Tightest::of(r).map_or("-".into(), |t| t.words());
@@ -248,14 +278,14 @@ fn verilog(j: &mut Job, s: &Schedule) -> Done {
 
 fn sim(
     j: &mut Job,
-    a: &Args,
+    scene: &Scene,
     s: &Schedule,
     keep: &mut Option<judge::Verdict>,
     clean: &mut Vec<measure::CleanRun>,
 ) -> Done {
     let g = &s.grid;
     let backend = sim_backend();
-    let frames = a.frames.max(1);
+    let frames = scene.frames;
     let opts = SimOptions {
         vcd: Some(VcdOut {
             path: j.out.join("frame0.vcd"),
@@ -263,31 +293,74 @@ fn sim(
             to: g.frame_cycles,
             gtkw: true,
         }),
+        stimulus: engines::Stimulus::parse_for(&scene.stimulus, s).unwrap_or_default(),
+        modes: scene.requests.clone(),
         ..SimOptions::default()
     };
     let t = std::time::Instant::now();
-    let r = match engines::run(s, backend, frames, &opts) {
-        Ok(r) => r,
-        Err(e) => return Done::failed(format!("{e}"), ""),
+    let (r, modes) = if s.modes.len() > 1 {
+        match measure::mode_scene(s, backend, frames, &opts) {
+            Ok(m) => (m.verdict.clone(), Some(m)),
+            Err(e) => return Done::failed(e, ""),
+        }
+    } else {
+        match engines::run(s, backend, frames, &opts) {
+            Ok(r) => (r, None),
+            Err(e) => return Done::failed(format!("{e}"), ""),
+        }
     };
     clean.push(measure::CleanRun {
         method: format!("engine: {}", backend.name()),
         wall_seconds: t.elapsed().as_secs_f64(),
         how: format!(
-            "the co-simulation step: {frames} frames of the emitted design under the checker, with a waveform written"
+            "the co-simulation step: {frames} frames of the emitted design under the checker, with a waveform written{}",
+            if modes.is_some() { ", and the same scene on the mix with one mode" } else { "" }
         ),
     });
     let json = serde_json::to_string_pretty(&r).expect("report");
     let w = j.write("", &[("sim.json", json)]);
+    let d = checked(j, s, &r, backend, &scene.words(s));
+    *keep = Some(r);
+    let Some(m) = modes else {
+        return written(w, d);
+    };
+    let (sec, line, glance) = measure::mode_section(s, &m, &scene.words(s), backend.name());
+    j.answer(Glance::Modes, glance);
+    let problems = m.problems(s);
+    let d = match (&d.outcome, problems.is_empty()) {
+        (Outcome::Ok(_), true) => Done {
+            outcome: Outcome::Ok(line),
+            ..d
+        },
+        (Outcome::Ok(_), false) => Done {
+            outcome: Outcome::Failed(line, problems.join("\n")),
+            ..d
+        },
+        _ => d,
+    };
+    written(
+        w,
+        d.files(&["modes-rate.svg", "modes-rate.csv"]).section(sec),
+    )
+}
+
+/// The co-simulation's step and section from its verdict.
+fn checked(
+    j: &mut Job,
+    s: &Schedule,
+    r: &judge::Verdict,
+    backend: Backend,
+    stimulus: &str,
+) -> Done {
     let sec = Section {
         title: "Co-simulation".into(),
         paragraphs: vec![format!(
-            "{} of the emitted design in {}, every cycle compared with the reference model and every invariant checked: {}. Sample counts and intervals as the run measured them, by branch and rate (jitter = largest minus smallest interval; the channels themselves are listed once, in the audit).",
+            "{} of the emitted design in {} (stimulus `{stimulus}`), every cycle compared with the reference model and every invariant checked: {}. Sample counts and intervals as the run measured them, by branch and rate (jitter = largest minus smallest interval; the channels themselves are listed once, in the audit).",
             counted(r.frames, "frame"),
             backend.name(),
             if r.ok { "no divergence, no violation".to_string() } else { format!("{}, {}", counted(r.divergence_count, "divergence"), counted(r.violation_count, "violation")) }
         )],
-        tables: vec![("Intervals measured, by branch and rate".into(), measure::interval_table(s, &r))],
+        tables: vec![("Intervals measured, by branch and rate".into(), measure::interval_table(s, r))],
         links: vec![
             ("frame0.vcd".into(), "frame 0 with its reset cycles (VCD)".into()),
             ("frame0.gtkw".into(), "GTKWave save file for it".into()),
@@ -340,8 +413,7 @@ fn sim(
             )
         },
     );
-    *keep = Some(r);
-    written(w, d.files(&files).section(sec))
+    d.files(&files).section(sec)
 }
 
 fn golden(j: &mut Job, a: &Args, s: &Schedule) -> Done {
