@@ -222,10 +222,17 @@ pub fn check_ports(s: &Schedule, file: &Path, text: &str) -> Result<(), RtlError
 
 /// An input or inout outside the contract would be driven by nothing; the
 /// mix's link ports (a UART's or AXI4-Stream's, `m_axis_tready` an input the
-/// testbench drives) are the contract's too. Extra outputs are ignored.
+/// testbench drives) and its mode ports are the contract's too. Extra
+/// outputs are ignored.
 fn no_extra_input(file: &Path, layout: &Layout, ports: &[PortDecl]) -> Result<(), RtlError> {
     let link = layout.link_ports();
-    let contract = |n: &str| PORTS.iter().any(|p| p.name == n) || link.iter().any(|p| p.name == n);
+    // a mix with modes: `mode_sel` (pin select) is the testbench's to drive
+    let modes = layout.mode_ports();
+    let contract = |n: &str| {
+        PORTS.iter().any(|p| p.name == n)
+            || link.iter().any(|p| p.name == n)
+            || modes.iter().any(|p| p.name == n)
+    };
     let Some(x) = ports
         .iter()
         .find(|d| !contract(&d.name) && d.dir != Some(PortDir::Output))
@@ -244,6 +251,7 @@ fn no_extra_input(file: &Path, layout: &Layout, ports: &[PortDecl]) -> Result<()
                 .iter()
                 .map(|p| p.name)
                 .chain(link.iter().map(|p| p.name))
+                .chain(modes.iter().map(|p| p.name))
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
