@@ -819,11 +819,8 @@ fn a_mix_with_modes_is_built_and_refused_where_a_command_would_show_one_mode() {
         let modes = lut_gen::load(&mix).unwrap().modes.unwrap().names;
         slotforge().arg("audit").arg(&mix).assert().success();
         let out = d.path().join(name);
-        let refused: [&[&str]; 3] = [
-            &["build", "--quiet", "-o"],
-            &["golden", "--dir"],
-            &["prove", "-o"],
-        ];
+        // `golden` and `synth` take it now (tests/modes_cli.rs)
+        let refused: [&[&str]; 2] = [&["build", "--quiet", "-o"], &["prove", "-o"]];
         for args in refused {
             let a = slotforge()
                 .args(args)
@@ -931,8 +928,8 @@ fn the_model_back_end_simulates_mode_switches() {
 }
 
 /// `faults` on a mix with modes runs its switching scenario on the model
-/// and counts the `mode` output's classes; the gateware back end, which
-/// does not switch yet, is refused.
+/// and counts the `mode` output's classes (the gateware's campaign:
+/// tests/modes_cli.rs).
 #[test]
 fn faults_on_a_mode_mix_run_on_the_model_with_the_mode_classes() {
     let pin = Path::new(env!("CARGO_MANIFEST_DIR")).join("testkit/mixes/modes-pin.toml");
@@ -959,12 +956,6 @@ fn faults_on_a_mode_mix_run_on_the_model_with_the_mode_classes() {
     for class in ["mode-early", "mode-stuck", "mode-unasked"] {
         assert!(names.contains(&class), "{names:?}");
     }
-    slotforge()
-        .args(["faults", "--quiet", "--backend", "rusthdl"])
-        .arg(&pin)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("this command does not yet"));
 }
 
 /// Converters with a command word on the judge's side: `sim --backend

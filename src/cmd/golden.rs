@@ -368,27 +368,10 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         }
     };
     let events_path = dir.join(EVENTS);
-    let (golden, recorded) = match load_events(a, &s, mix, &events_path, o) {
+    let (golden, scene, (stimulus, modes)) = match load_golden(a, &s, mix, &events_path, o) {
         Ok(g) => g,
         Err(code) => return code,
     };
-    // the scene given, else the one the golden was recorded under
-    let scene = a.scene.or(&recorded);
-    let (stimulus, modes) = match scene.resolve(&s) {
-        Ok(k) => k,
-        Err(e) => {
-            errln!(o, "error: {e}");
-            return 2;
-        }
-    };
-    if golden.is_some() && scene.header() != recorded.header() {
-        errln!(
-            o,
-            "note: the golden was recorded under{}; this run drives{}",
-            or_default(&recorded.options()),
-            or_default(&scene.options())
-        );
-    }
 
     // One run covers the event log and every window.
     let f = s.grid.frame_cycles;
@@ -399,16 +382,16 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         ..SimOptions::default()
     };
     let reset = judge::reset_cycles(&s, opts.reset_cycles);
-    let mut windows = Vec::new();
-    for w in &manifest.window {
-        match window_cycles(&s, w, reset, &manifest_path) {
-            Ok(k) => windows.push((w, k)),
-            Err(e) => {
-                errln!(o, "error: {e}");
-                return 2;
-            }
+    let windows: Vec<WindowAt> = match (manifest.window.iter())
+        .map(|w| Ok((w, window_cycles(&s, w, reset, &manifest_path)?)))
+        .collect::<Result<_, String>>()
+    {
+        Ok(w) => w,
+        Err(e) => {
+            errln!(o, "error: {e}");
+            return 2;
         }
-    }
+    };
     let frames = windows
         .iter()
         .map(|(_, (_, k1))| (k1 - reset).div_ceil(f))
@@ -468,6 +451,48 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
     } else {
         0
     }
+}
+
+/// The golden's event log ([`load_events`]), the scene this run drives
+/// and its stimulus and `mode_sel` requests ([`drive`]).
+type Loaded = (Option<EventLog>, Scene, (engines::Stimulus, Vec<(u64, u8)>));
+
+fn load_golden(
+    a: &Args,
+    s: &Schedule,
+    mix: &Path,
+    events_path: &Path,
+    o: &mut Output,
+) -> Result<Loaded, u8> {
+    let (golden, recorded) = load_events(a, s, mix, events_path, o)?;
+    // the scene given, else the one the golden was recorded under
+    let scene = a.scene.or(&recorded);
+    let k = drive(s, &scene, golden.as_ref().map(|_| &recorded), o)?;
+    Ok((golden, scene, k))
+}
+
+/// The stimulus and `mode_sel` requests of `scene` (the options given,
+/// else the one the golden was `recorded` under); a scene other than the
+/// recorded one is noted, so a difference reads as what it is.
+fn drive(
+    s: &Schedule,
+    scene: &Scene,
+    recorded: Option<&Scene>,
+    o: &mut Output,
+) -> Result<(engines::Stimulus, Vec<(u64, u8)>), u8> {
+    let k = scene.resolve(s).map_err(|e| {
+        errln!(o, "error: {e}");
+        2u8
+    })?;
+    if let Some(r) = recorded.filter(|r| r.header() != scene.header()) {
+        errln!(
+            o,
+            "note: the golden was recorded under{}; this run drives{}",
+            or_default(&r.options()),
+            or_default(&scene.options())
+        );
+    }
+    Ok(k)
 }
 
 /// The golden event log at `events_path` and the scene it was recorded
