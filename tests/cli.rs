@@ -807,9 +807,9 @@ fn deep_faults_escape_every_simulation_column_and_prove_catches_them() {
 }
 
 /// A mix with modes is planned by `audit` and `lut` and built by `verilog`
-/// (with its mode ports; `build` charts it, tests/build.rs); every command that does not follow the switches
-/// yet refuses it, naming its modes, rather than show the reset mode alone
-/// as if it were the mix.
+/// (with its mode ports; `build` charts it, tests/build.rs); `check --map`,
+/// which does not follow the switches of a capture yet, refuses it, naming
+/// its modes, rather than show the reset mode alone as if it were the mix.
 #[test]
 fn a_mix_with_modes_is_built_and_refused_where_a_command_would_show_one_mode() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -819,19 +819,20 @@ fn a_mix_with_modes_is_built_and_refused_where_a_command_would_show_one_mode() {
         let modes = lut_gen::load(&mix).unwrap().modes.unwrap().names;
         slotforge().arg("audit").arg(&mix).assert().success();
         let out = d.path().join(name);
-        let refused: [&[&str]; 2] = [&["golden", "--dir"], &["prove", "-o"]];
-        for args in refused {
-            let a = slotforge()
-                .args(args)
-                .arg(&out)
-                .arg(&mix)
-                .assert()
-                .code(2)
-                .stderr(predicate::str::contains("does not yet"));
-            let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
-            for m in &modes {
-                assert!(err.contains(m.as_str()), "{args:?}: {err}");
-            }
+        // `golden`, `synth`, `prove` and `build` take it now (tests/modes_cli.rs,
+        // formal/tests, tests/build.rs); an analyser capture maps no mode pins
+        let a = slotforge()
+            .arg("check")
+            .arg(&mix)
+            .arg(out.join("capture.vcd"))
+            .arg("--map")
+            .arg(out.join("probes.map"))
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains("does not yet"));
+        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
+        for m in &modes {
+            assert!(err.contains(m.as_str()), "check --map: {err}");
         }
         assert!(!out.join("slotforge_top.v").exists());
         slotforge()
@@ -927,8 +928,8 @@ fn the_model_back_end_simulates_mode_switches() {
 }
 
 /// `faults` on a mix with modes runs its switching scenario on the model
-/// and counts the `mode` output's classes; the gateware back end, which
-/// does not switch yet, is refused.
+/// and counts the `mode` output's classes (the gateware's campaign:
+/// tests/modes_cli.rs).
 #[test]
 fn faults_on_a_mode_mix_run_on_the_model_with_the_mode_classes() {
     let pin = Path::new(env!("CARGO_MANIFEST_DIR")).join("testkit/mixes/modes-pin.toml");
@@ -955,12 +956,6 @@ fn faults_on_a_mode_mix_run_on_the_model_with_the_mode_classes() {
     for class in ["mode-early", "mode-stuck", "mode-unasked"] {
         assert!(names.contains(&class), "{names:?}");
     }
-    slotforge()
-        .args(["faults", "--quiet", "--backend", "rusthdl"])
-        .arg(&pin)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("this command does not yet"));
 }
 
 /// Converters with a command word on the judge's side: `sim --backend

@@ -46,6 +46,9 @@ mod link_captures;
 #[path = "link_windows.rs"]
 mod link_windows;
 
+#[path = "modes_cli.rs"]
+mod modes_cli;
+
 #[path = "netlist.rs"]
 mod netlist;
 

@@ -142,7 +142,9 @@ impl Board {
                 // Pins for bits another mix has (e.g. adc_cs_n[7]) are fine; only
                 // names that can never be a port bit are errors.
                 let base = k.split('[').next().unwrap_or("");
-                if !PORTS.iter().any(|p| p.name == base) {
+                if !PORTS.iter().any(|p| p.name == base)
+                    && !lut_gen::MODE_PORTS.iter().any(|p| p.name == base)
+                {
                     return Err(err(format!("[pins] names `{k}`, which is not a port bit")));
                 }
             }

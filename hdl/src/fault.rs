@@ -27,6 +27,10 @@ pub enum GatewareFault {
     LinkBaud { delta: i32 },
     /// The link's CRC starts from 0 instead of 0xFFFF.
     LinkCrcInit,
+    /// A mix with modes: the mode register never leaves the reset mode
+    /// (pin select: it takes only mode 0 from `mode_sel`; auto select: no
+    /// trigger's level can be crossed).
+    ModeStuck,
 }
 
 /// The fault in a report's words (fault campaigns name each injection by it).
@@ -54,6 +58,7 @@ impl std::fmt::Display for GatewareFault {
                 write!(f, "link baud divider {delta:+} cycles per bit")
             }
             GatewareFault::LinkCrcInit => write!(f, "link CRC starts from 0"),
+            GatewareFault::ModeStuck => write!(f, "mode register never leaves the reset mode"),
         }
     }
 }
@@ -66,7 +71,8 @@ impl GatewareFault {
             // the link does not depend on the LUT's form
             GatewareFault::LinkFifoShort
             | GatewareFault::LinkBaud { .. }
-            | GatewareFault::LinkCrcInit => LutForm::Auto,
+            | GatewareFault::LinkCrcInit
+            | GatewareFault::ModeStuck => LutForm::Auto,
             _ => LutForm::Full,
         }
     }
@@ -85,6 +91,15 @@ impl GatewareFault {
             v.insert(1, ("link-baud-fast", GatewareFault::LinkBaud { delta: -1 }));
         }
         v
+    }
+
+    /// The mode faults of a mix with modes (none without).
+    pub fn mode_faults(s: &lut_gen::Schedule) -> Vec<(&'static str, GatewareFault)> {
+        if s.modes.len() > 1 {
+            vec![("mode-stuck", GatewareFault::ModeStuck)]
+        } else {
+            Vec::new()
+        }
     }
 
     pub(crate) fn apply(&self, p: &mut Plan) -> Result<(), HdlError> {
@@ -124,6 +139,22 @@ impl GatewareFault {
                     return Err(bad("the plan has a full LUT".into()));
                 }
                 p.slices_per_frame = wrap(p.slices_per_frame, delta)?;
+            }
+            GatewareFault::ModeStuck => {
+                let m = p
+                    .modes
+                    .as_mut()
+                    .ok_or_else(|| bad("the mix has no modes".into()))?;
+                // pin: a request names a mode only below `count`
+                m.count = 1;
+                // auto: no code is above the top one or below 0
+                for t in &mut m.triggers {
+                    t.level = if t.above {
+                        (1 << crate::widths::VALUE_BITS) - 1
+                    } else {
+                        0
+                    };
+                }
             }
             GatewareFault::LinkFifoShort
             | GatewareFault::LinkBaud { .. }
@@ -195,6 +226,7 @@ mod tests {
             GatewareFault::LinkFifoShort,
             GatewareFault::LinkBaud { delta: -1 },
             GatewareFault::LinkCrcInit,
+            GatewareFault::ModeStuck,
         ] {
             let t = f.to_string();
             assert!(!t.contains('{') && !t.contains("Link"), "{t}");

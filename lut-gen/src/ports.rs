@@ -714,6 +714,8 @@ impl Layout {
                 v.extend((0..p.width).map(|i| (format!("{}[{i}]", p.name), p.dir)));
             }
         }
+        // a mix with modes: its mode ports last, so a board places them too
+        v.extend(self.mode_port_bits());
         v
     }
 

@@ -50,25 +50,20 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> u8 {
-    // The model follows mode switches (the campaign runs a switching
-    // scenario); the gateware does not switch yet.
+    // A mix with modes runs its switching scenario on every target and
+    // engine (docs/faults.md, "Mode switches").
     let s = match super::load_any_modes(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if a.backend != engines::Backend::Model {
-        if let Err(code) = super::one_mode(&s, &a.mix) {
-            return code;
-        }
-    }
-    // One back-end name everywhere (engines::Backend); the campaign injects
-    // into the designs it can build in process.
+    // One back-end name everywhere (engines::Backend); pin faults go into
+    // a design in process, the Verilog engines run faulty designs.
     let target = match a.backend {
         engines::Backend::Model => Target::Model,
         engines::Backend::RustHdl => Target::Rusthdl,
         other => {
             eprintln!(
-                "error: --backend {}: the fault campaign injects into model or rusthdl (faults built into the gateware need the design in process)",
+                "error: --backend {0}: pin faults are injected into a design in process (model or rusthdl); the gateware's faults and the deep faults run as Verilog on {0} with `--backend rusthdl --engines {0}`",
                 other.name()
             );
             return 2;
@@ -97,6 +92,9 @@ pub fn run(a: Args) -> u8 {
                 return 2;
             }
         };
+        // and one fault of each gateware class, as the Verilog it emits
+        plan.verilog_faults
+            .extend(campaign::gateware_as_verilog(&s));
     }
     // Progress goes to stderr, so `--json` on stdout keeps it.
     let progress = std::sync::Arc::new(super::progress::Counter::new(

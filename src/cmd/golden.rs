@@ -47,6 +47,91 @@ pub struct Args {
     /// No progress display.
     #[arg(long)]
     pub quiet: bool,
+    /// The scene the run is driven with (a mix with modes switches in it).
+    #[command(flatten)]
+    pub scene: Scene,
+}
+
+/// The scene of a golden run: recorded in the golden's header by
+/// `--update`, so a run without these options replays the recorded scene;
+/// given, they replace it (a different scene then differs from the golden).
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct Scene {
+    /// A mix with pin-selected modes: drive `mode_sel` with FRAME=MODE
+    /// requests, as `sim --modes` does (e.g. `--modes 2=slow,7=fast`).
+    #[arg(long, value_name = "FRAME=MODE,...")]
+    pub modes: Option<String>,
+    /// The ADC input, as `sim --stimulus` takes it (pattern, sine, step,
+    /// chirp, or a scene of contact: touch:NAMES@FROM-TO,
+    /// stroke:NAMES@FROM-TO); default pattern.
+    #[arg(long)]
+    pub stimulus: Option<String>,
+}
+
+/// The header lines that record a scene in `events.log`.
+const SCENE_MODES: &str = "# scene --modes: ";
+const SCENE_STIMULUS: &str = "# scene --stimulus: ";
+
+impl Scene {
+    /// The scene recorded in a golden's event log (none: pattern, no requests).
+    fn recorded(log: &str) -> Scene {
+        let line = |prefix: &str| {
+            log.lines()
+                .find_map(|l| l.strip_prefix(prefix))
+                .map(|v| v.trim().to_string())
+        };
+        Scene {
+            modes: line(SCENE_MODES),
+            stimulus: line(SCENE_STIMULUS),
+        }
+    }
+
+    /// The options given, else the recorded ones, each on its own.
+    fn or(&self, recorded: &Scene) -> Scene {
+        Scene {
+            modes: self.modes.clone().or_else(|| recorded.modes.clone()),
+            stimulus: self.stimulus.clone().or_else(|| recorded.stimulus.clone()),
+        }
+    }
+
+    fn stimulus_text(&self) -> &str {
+        self.stimulus.as_deref().unwrap_or("pattern")
+    }
+
+    /// The header lines recording it (none for the default scene, so a
+    /// golden of a mix without modes reads as before).
+    fn header(&self) -> Vec<String> {
+        let mut h = Vec::new();
+        if let Some(m) = &self.modes {
+            h.push(format!("{}{m}", &SCENE_MODES[2..]));
+        }
+        if let Some(k) = self.stimulus.as_ref().filter(|k| *k != "pattern") {
+            h.push(format!("{}{k}", &SCENE_STIMULUS[2..]));
+        }
+        h
+    }
+
+    /// The stimulus and the `mode_sel` requests, resolved against the mix.
+    fn resolve(&self, s: &Schedule) -> Result<(engines::Stimulus, Vec<(u64, u8)>), String> {
+        let stimulus = engines::Stimulus::parse_for(self.stimulus_text(), s)?;
+        let modes = match &self.modes {
+            Some(m) => super::sim::parse_modes(m, s)?,
+            None => Vec::new(),
+        };
+        Ok((stimulus, modes))
+    }
+
+    /// The options that give this scene, for a command line.
+    fn options(&self) -> String {
+        let mut o = String::new();
+        if let Some(m) = &self.modes {
+            o += &format!(" --modes {m}");
+        }
+        if let Some(k) = &self.stimulus {
+            o += &format!(" --stimulus '{k}'");
+        }
+        o
+    }
 }
 
 /// `golden/<mix>/golden.toml`: what the golden holds.
@@ -273,9 +358,6 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(code) = super::one_mode(&s, mix) {
-        return code;
-    }
     let dir = a.dir.join(&s.mix.name);
     let manifest_path = dir.join(MANIFEST);
     let manifest = match load_manifest(&manifest_path) {
@@ -286,7 +368,7 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         }
     };
     let events_path = dir.join(EVENTS);
-    let golden = match load_events(a, &s, mix, &events_path, o) {
+    let (golden, scene, (stimulus, modes)) = match load_golden(a, &s, mix, &events_path, o) {
         Ok(g) => g,
         Err(code) => return code,
     };
@@ -295,19 +377,21 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
     let f = s.grid.frame_cycles;
     let opts = SimOptions {
         rtl: a.rtl.clone(),
+        stimulus,
+        modes,
         ..SimOptions::default()
     };
     let reset = judge::reset_cycles(&s, opts.reset_cycles);
-    let mut windows = Vec::new();
-    for w in &manifest.window {
-        match window_cycles(&s, w, reset, &manifest_path) {
-            Ok(k) => windows.push((w, k)),
-            Err(e) => {
-                errln!(o, "error: {e}");
-                return 2;
-            }
+    let windows: Vec<WindowAt> = match (manifest.window.iter())
+        .map(|w| Ok((w, window_cycles(&s, w, reset, &manifest_path)?)))
+        .collect::<Result<_, String>>()
+    {
+        Ok(w) => w,
+        Err(e) => {
+            errln!(o, "error: {e}");
+            return 2;
         }
-    }
+    };
     let frames = windows
         .iter()
         .map(|(_, (_, k1))| (k1 - reset).div_ceil(f))
@@ -339,7 +423,7 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
     if a.update {
         return update(
             o,
-            &s,
+            (&s, &scene),
             &dir,
             golden.as_ref(),
             &log,
@@ -369,18 +453,61 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
     }
 }
 
-/// The golden event log at `events_path`: `None` when `--update` records
-/// a new one; a missing or unreadable one is an error (printed: exit 2).
+/// The golden's event log ([`load_events`]), the scene this run drives
+/// and its stimulus and `mode_sel` requests ([`drive`]).
+type Loaded = (Option<EventLog>, Scene, (engines::Stimulus, Vec<(u64, u8)>));
+
+fn load_golden(
+    a: &Args,
+    s: &Schedule,
+    mix: &Path,
+    events_path: &Path,
+    o: &mut Output,
+) -> Result<Loaded, u8> {
+    let (golden, recorded) = load_events(a, s, mix, events_path, o)?;
+    // the scene given, else the one the golden was recorded under
+    let scene = a.scene.or(&recorded);
+    let k = drive(s, &scene, golden.as_ref().map(|_| &recorded), o)?;
+    Ok((golden, scene, k))
+}
+
+/// The stimulus and `mode_sel` requests of `scene` (the options given,
+/// else the one the golden was `recorded` under); a scene other than the
+/// recorded one is noted, so a difference reads as what it is.
+fn drive(
+    s: &Schedule,
+    scene: &Scene,
+    recorded: Option<&Scene>,
+    o: &mut Output,
+) -> Result<(engines::Stimulus, Vec<(u64, u8)>), u8> {
+    let k = scene.resolve(s).map_err(|e| {
+        errln!(o, "error: {e}");
+        2u8
+    })?;
+    if let Some(r) = recorded.filter(|r| r.header() != scene.header()) {
+        errln!(
+            o,
+            "note: the golden was recorded under{}; this run drives{}",
+            or_default(&r.options()),
+            or_default(&scene.options())
+        );
+    }
+    Ok(k)
+}
+
+/// The golden event log at `events_path` and the scene it was recorded
+/// under: `None` when `--update` records a new one; a missing or
+/// unreadable one is an error (printed: exit 2).
 fn load_events(
     a: &Args,
     s: &Schedule,
     mix: &Path,
     events_path: &Path,
     o: &mut Output,
-) -> Result<Option<EventLog>, u8> {
+) -> Result<(Option<EventLog>, Scene), u8> {
     if !events_path.exists() {
         if a.update {
-            return Ok(None);
+            return Ok((None, Scene::default()));
         }
         errln!(
             o,
@@ -399,11 +526,12 @@ fn load_events(
             return Err(2);
         }
     };
+    let recorded = Scene::recorded(&text);
     match EventLog::parse(&text) {
-        Ok(l) => Ok(Some(l)),
+        Ok(l) => Ok((Some(l), recorded)),
         Err(e) if a.update => {
             errln!(o, "note: {}: {e}; replacing it", events_path.display());
-            Ok(None)
+            Ok((None, recorded))
         }
         Err(e) => {
             errln!(o, "error: {}: {e}", events_path.display());
@@ -513,7 +641,7 @@ fn compare_windows(
 #[allow(clippy::too_many_arguments)]
 fn update(
     o: &mut Output,
-    s: &Schedule,
+    (s, scene): (&Schedule, &Scene),
     dir: &Path,
     old: Option<&EventLog>,
     log: &EventLog,
@@ -549,10 +677,13 @@ fn update(
         }
     }
     // nothing run-specific (path, back end): every simulator must give this file
-    let header = [format!(
-        "recorded by `slotforge golden --update` (pattern stimulus, {} reset cycles); change it only that way",
+    let mut header = vec![format!(
+        "recorded by `slotforge golden --update` ({} stimulus, {} reset cycles); change it only that way",
+        scene.stimulus_text(),
         trace.cycle_zero().unwrap_or(0)
     )];
+    // the scene a run without options replays
+    header.extend(scene.header());
     let text = log.render(s, &header);
     if let Err(code) = super::write_files(dir, &[(EVENTS, text)]) {
         return code;
@@ -577,6 +708,15 @@ fn update(
     0
 }
 
+/// A scene's options in words: none is the default scene.
+fn or_default(options: &str) -> String {
+    if options.is_empty() {
+        " the default scene (pattern, no mode requests)".into()
+    } else {
+        options.to_string()
+    }
+}
+
 /// The command that records `mix`'s golden with the options the user gave
 /// (back end, Verilog, folder), so the hint works as printed.
 fn update_command(a: &Args, mix: &Path) -> String {
@@ -596,6 +736,7 @@ fn update_command(a: &Args, mix: &Path) -> String {
     if let Some(rtl) = &a.rtl {
         cmd += &format!(" --rtl {}", quote(rtl));
     }
+    cmd += &a.scene.options();
     if a.dir != Path::new("golden") {
         cmd += &format!(" --dir {}", quote(&a.dir));
     }

@@ -153,12 +153,12 @@ pub enum Limits {
 /// the exit code returned.
 pub fn load_checked(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
     let s = load_any_modes(path, limits)?;
-    one_mode(&s, path)?;
+    one_mode(&s, path, "this command")?;
     Ok(s)
 }
 
-/// [`load_checked`] for what follows mode switches (`verilog`, `sim`,
-/// `check`): a mix with modes is not refused.
+/// [`load_checked`] for what follows mode switches (`verilog`, `synth`,
+/// `sim`, `check`, `golden`, `faults`): a mix with modes is not refused.
 pub fn load_any_modes(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
     let s = match limits {
         Limits::Contract => schedule_on_pins(path)?,
@@ -168,18 +168,17 @@ pub fn load_any_modes(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, 
     Ok(s)
 }
 
-/// Refuses a mix with modes in every command past the plan (`audit` and
-/// `lut` plan every mode): the gateware, its simulation, proof and the
-/// host's decoder follow the reset mode only, so running them would show a
-/// design that never switches as if it were the mix.  Exit 2.
-pub fn one_mode(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
+/// Refuses a mix with modes in a command that does not follow mode
+/// switches yet (`command`, as the user typed it), so it never shows the
+/// reset mode alone as if it were the mix.  Exit 2.
+pub fn one_mode(s: &lut_gen::Schedule, file: &Path, command: &str) -> Result<(), u8> {
     match &s.mix.modes {
         Some(m) if m.names.len() > 1 => {
             eprintln!(
-                "error: {}: the mix declares {} modes ({}): `audit`, `lut` and `verilog` \
-                 plan every mode and `sim` and `check` follow the switches, but this \
-                 command does not yet, so it would show the reset mode `{}` alone; \
-                 simulate it, or remove the [[mode]] tables to build one mode",
+                "error: {}: the mix declares {} modes ({}): {command} does not yet follow \
+                 mode switches, so it would show the reset mode `{}` alone (`audit`, `lut`, \
+                 `verilog`, `synth`, `sim`, `check` of a VCD, `golden`, `faults` and `decode` \
+                 take the mix); remove the [[mode]] tables to build one mode",
                 file.display(),
                 m.names.len(),
                 m.names.join(", "),

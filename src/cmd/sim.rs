@@ -119,7 +119,7 @@ fn scene_and_modes(a: &Args, s: &lut_gen::Schedule) -> Result<(Stimulus, Vec<(u6
 }
 
 /// `--modes FRAME=MODE,...` against the mix's modes.
-fn parse_modes(text: &str, s: &lut_gen::Schedule) -> Result<Vec<(u64, u8)>, String> {
+pub(super) fn parse_modes(text: &str, s: &lut_gen::Schedule) -> Result<Vec<(u64, u8)>, String> {
     let plan = match s.mode_plan() {
         Some(p) if p.select == lut_gen::ModeSelect::Pin => p,
         Some(_) => {

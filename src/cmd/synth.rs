@@ -33,7 +33,9 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> u8 {
-    let s = match super::load_checked(&a.mix, super::Limits::Emitter) {
+    // Modes are ROM tables and a mode register in the same Verilog: placed
+    // like any other design.
+    let s = match super::load_any_modes(&a.mix, super::Limits::Emitter) {
         Ok(s) => s,
         Err(code) => return code,
     };
@@ -168,11 +170,24 @@ fn to_text(s: &lut_gen::Schedule, r: &measure::Synth, board: &str, seed: u64) ->
     for (k, v) in rows {
         t.push_str(&format!("  {k:<12} {v}\n"));
     }
+    if let Some((names, select)) = modes(s) {
+        t.push_str(&format!(
+            "  {:<12} {} (select {select}): every mode's tables in this gateware\n",
+            "modes",
+            names.join(", ")
+        ));
+    }
     t.push_str(&format!("{pnr}'s cells used (of available):\n"));
     for (c, used, avail) in &r.cells {
         t.push_str(&format!("  {c:<14} {used:>6} of {avail}\n"));
     }
     t
+}
+
+/// A mix with modes: their names and how they are chosen (`pin`, `auto`).
+fn modes(s: &lut_gen::Schedule) -> Option<(Vec<String>, &'static str)> {
+    let m = s.mode_plan().filter(|m| m.names.len() > 1)?;
+    Some((m.names.clone(), m.select.name()))
 }
 
 /// The same figures as JSON (fields in docs/json.md).
@@ -197,6 +212,7 @@ fn to_json(s: &lut_gen::Schedule, r: &measure::Synth, board: &str, seed: u64) ->
         "fmax_mhz": (r.fmax_mhz * 100.0).round() / 100.0,
         "fmax_over_clock": (r.fmax_mhz / mhz * 100.0).round() / 100.0,
         "cells": cells,
+        "modes": modes(s).map(|(names, select)| serde_json::json!({"names": names, "select": select})),
     });
     serde_json::to_string_pretty(&v).expect("JSON of plain values")
 }

@@ -40,7 +40,9 @@ mod modes;
 mod verilog;
 pub use class::{FaultClass, Level};
 pub use methods::{methods, sample as methods_sample, Engine, MethodRun};
-pub use verilog::{deep_faults, prove, prove_unavailable, ProveVerdict, VerilogFault};
+pub use verilog::{
+    deep_faults, gateware_as_verilog, prove, prove_unavailable, ProveVerdict, VerilogFault,
+};
 
 /// A detector of the judge, measured apart from the others.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -81,7 +83,7 @@ impl Detector {
             (Detector::Sigrok, _) if class.on_mux_pins() => Some("the SPI decode reads CS, SCLK and MISO only: mux pins are outside its view, and the design emits whatever code MISO carried"),
             (Detector::Prove, Level::Pins | Level::Reset) => Some("the fault is injected into a simulation's pins, not built into a design: prove reads a design, so it has nothing to prove it against"),
             (Detector::Sigrok, _) if class.on_link() => Some("the SPI decode reads CS, SCLK and MISO only: the link's pins are outside its view"),
-            (Detector::Sigrok, _) if class.on_mode_pin() => Some("the SPI decode reads CS, SCLK and MISO only: the `mode` output is outside its view"),
+            (Detector::Sigrok, Level::Pins) if class.on_mode_pin() => Some("the SPI decode reads CS, SCLK and MISO only: the `mode` output is outside its view"),
             _ => None,
         }
     }
@@ -472,6 +474,7 @@ pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(FaultClass, hdl::Gatew
     v.extend(
         hdl::GatewareFault::link_faults(s)
             .into_iter()
+            .chain(hdl::GatewareFault::mode_faults(s))
             .map(|(_, f)| f),
     );
     v.into_iter()
@@ -483,7 +486,7 @@ pub fn one_gateware_fault_per_class(s: &Schedule) -> Vec<(FaultClass, hdl::Gatew
 /// the campaign's slave for an AXI4-Stream link).
 pub fn gateware_dut(s: &Schedule, f: hdl::GatewareFault) -> Result<Box<dyn Dut>, SimError> {
     hdl::RtlSim::with_fault(s, f)
-        .map(|sim| slave(s, Box::new(GatewareDut(sim))))
+        .map(|sim| slave(s, modes::with_requests(s, Box::new(GatewareDut(sim)))))
         .map_err(|e| SimError::Hdl(e.to_string()))
 }
 
@@ -626,7 +629,7 @@ fn target_dut(s: &Schedule, target: Target) -> Result<Box<dyn Dut>, SimError> {
     let d: Box<dyn Dut> = match target {
         // a mix with modes runs its switching scenario
         Target::Model => modes::with_requests(s, Box::new(ModelDut::new(s))),
-        Target::Rusthdl => Box::new(RustHdlDut::new(s)?),
+        Target::Rusthdl => modes::with_requests(s, Box::new(RustHdlDut::new(s)?)),
     };
     Ok(slave(s, d))
 }
@@ -711,8 +714,11 @@ fn design_cases(s: &Schedule, sites: &[Site]) -> Vec<DesignCase> {
             });
         }
     }
-    // the link stage's faults (a mix with a [link])
-    for (_, fault) in hdl::GatewareFault::link_faults(s) {
+    // the link stage's faults (a mix with a [link]), the mode block's (modes)
+    let more = hdl::GatewareFault::link_faults(s)
+        .into_iter()
+        .chain(hdl::GatewareFault::mode_faults(s));
+    for (_, fault) in more {
         design.push(DesignCase {
             fault,
             site: sites[0],
@@ -741,7 +747,7 @@ fn gateware_injections(
             let Ok(sim) = hdl::RtlSim::with_fault(s, c.fault) else {
                 return Ok(None);
             };
-            let mut dut = slave(s, Box::new(GatewareDut(sim)));
+            let mut dut = slave(s, modes::with_requests(s, Box::new(GatewareDut(sim))));
             let mut j = judge_run(s, &mut dut, frames, sigrok)?;
             let mut inj = outcome(name, &c.site, &j, "rusthdl");
             let pair = hdl::verilog_pair(s, c.fault).map_err(|e| e.to_string());
@@ -776,7 +782,11 @@ fn gateware_injections(
 fn classes(judged: Vec<Judgement>, ran: &[Detector]) -> Vec<ClassOutcome> {
     let mut classes: Vec<ClassOutcome> = Vec::new();
     for (class, level, inj, _) in judged {
-        let c = match classes.iter().position(|c| c.name == class) {
+        // a class at two levels (mode-stuck on the pins, in the gateware) is two rows
+        let c = match classes
+            .iter()
+            .position(|c| c.name == class && c.level == level)
+        {
             Some(i) => &mut classes[i],
             None => {
                 let cannot_see: BTreeMap<Detector, String> = Detector::ALL
@@ -832,11 +842,12 @@ fn columns(
                 Detector::Sigrok => (cost.sigrok_runs, cost.sigrok_cycles, cost.sigrok_seconds),
                 Detector::Prove => (cost.prove_runs, 0, cost.prove_seconds),
             };
+            // what it caught of the classes it can see, over their injections
             let seen = classes.iter().filter(|c| !c.cannot_see.contains_key(&d));
             Column {
                 detector: d,
-                detected: classes
-                    .iter()
+                detected: seen
+                    .clone()
                     .map(|c| c.detected_by.get(&d).copied().unwrap_or(0))
                     .sum(),
                 injected: if why.is_some() {
@@ -1006,6 +1017,9 @@ impl Dut for GatewareDut {
     }
     fn set_tready(&mut self, ready: bool) {
         self.0.set_tready(ready)
+    }
+    fn set_mode_sel(&mut self, sel: u8) {
+        self.0.set_mode_sel(sel)
     }
 }
 

@@ -9,18 +9,21 @@
 //! - `sigrok`: sigrok-cli's SPI decode of the pins as a detector;
 //! - `equiv`: a faulty gateware proved equivalent to the clean one at the
 //!   ports (yosys miter, ABC), or not;
-//! - `mixgen`: random feasible mixes for false-alarm runs and charts.
+//! - `mixgen`: random feasible mixes for false-alarm runs and charts;
+//!   `modemix`: random mixes with modes, for tests.
 
 // The modules are private: what other crates use is the list below.
 mod equiv;
 mod faults;
 mod mixgen;
+mod modemix;
 mod sigrok;
 
 pub use equiv::{check as check_equivalence, verdict as equivalence_verdict, Equivalence};
 pub use faults::{
-    campaign_with, deep_faults, gateware_dut, methods, methods_sample,
+    campaign_with, deep_faults, gateware_as_verilog, gateware_dut, methods, methods_sample,
     one_gateware_fault_per_class, prove, prove_unavailable, sites, Campaign, Detector, Engine,
     FaultClass, Level, MethodRun, OnRun, Plan, ProveVerdict, Target, VerilogFault, TREADY,
 };
 pub use mixgen::{random_mix, LinkShape, Shape};
+pub use modemix::random_mode_mix;

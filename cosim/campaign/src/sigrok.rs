@@ -37,6 +37,12 @@ pub struct SpiCapture {
     end: u64,
     /// Cycles seen as a [`CycleSink`] (a VCD's cycles carry no number).
     seen: u64,
+    /// A mix with modes: the `mode` pin at each frame's first cycle, so
+    /// each frame is decoded against its mode's schedule (sigrok sees no
+    /// mode rule: the model and the invariants judge the switches).
+    modes: Vec<u8>,
+    reset: u64,
+    frame_cycles: u64,
 }
 
 impl SpiCapture {
@@ -52,12 +58,18 @@ impl SpiCapture {
             samples: Vec::new(),
             end: 0,
             seen: 0,
+            modes: Vec::new(),
+            reset,
+            frame_cycles: s.grid.frame_cycles,
         }
     }
 }
 
 impl Observer for SpiCapture {
     fn cycle(&mut self, cycle: u64, rst: bool, p: &Pins, miso: u64) {
+        if !rst && cycle >= self.reset && (cycle - self.reset).is_multiple_of(self.frame_cycles) {
+            self.modes.push(p.mode);
+        }
         if rst || cycle < self.from {
             return;
         }
@@ -222,19 +234,30 @@ pub fn check(
 }
 
 /// Branch `b`'s conversions in the window (frame 1 on) whose read ends
-/// more than `margin` cycles before the run: (its index among the branch's
-/// conversions in its frame, its channel).
-fn window_conversions(s: &Schedule, b: usize, frames: u64, margin: u64) -> Vec<(usize, usize)> {
+/// more than `margin` cycles before the run: (the schedule of its frame's
+/// mode, shown on `modes`; its index among the branch's conversions in
+/// that frame; its channel).
+fn window_conversions<'a>(
+    s: &'a Schedule,
+    modes: &[u8],
+    b: usize,
+    frames: u64,
+    margin: u64,
+) -> Vec<(&'a Schedule, usize, usize)> {
     let f = s.grid.frame_cycles;
     let read = s.branches[b].spi.read_cycles;
     let mut out = Vec::new();
     for frame in 1..frames {
-        let mine = s
-            .instants(frames)
+        let m = modes
+            .get(frame as usize)
+            .and_then(|&m| s.modes.get(m as usize))
+            .unwrap_or(s);
+        let mine = m
+            .instants(frame + 1)
             .filter(|i| i.branch == b && i.cycle / f == frame);
         for (k, i) in mine.enumerate() {
             if i.cycle + read + margin < frames * f {
-                out.push((k, i.channel));
+                out.push((m, k, i.channel));
             }
         }
     }
@@ -254,9 +277,9 @@ fn check_branch(
     let name = &s.branches[b].name;
     let slack = s.mix.branches.iter().map(|b| b.chain as u64).sum::<u64>() + 2;
     let count = |margin: u64| -> usize {
-        window_conversions(s, b, frames, margin)
+        window_conversions(s, &cap.modes, b, frames, margin)
             .iter()
-            .map(|&(_, ch)| s.words_of(ch).count())
+            .map(|&(m, _, ch)| m.words_of(ch).count())
             .sum()
     };
     let words = decode(file, part)?;
@@ -268,7 +291,7 @@ fn check_branch(
         )));
     }
     if s.has_command(b) {
-        if let Err(e) = check_commands(s, frames, b, file)? {
+        if let Err(e) = check_commands(s, &cap.modes, frames, b, file)? {
             return Ok(Err(e));
         }
     }
@@ -306,16 +329,16 @@ fn check_branch(
 /// word the schedule sends in that conversion.
 fn check_commands(
     s: &Schedule,
+    modes: &[u8],
     frames: u64,
     b: usize,
     file: &Path,
 ) -> Result<Result<(), String>, String> {
     let name = &s.branches[b].name;
-    let sent = s.commands_in_frame(b);
     let got = decode_commands(file, &s.mix.branches[b].adc)?;
-    let want: Vec<&lut_gen::CommandSent> = window_conversions(s, b, frames, 0)
+    let want: Vec<lut_gen::CommandSent> = window_conversions(s, modes, b, frames, 0)
         .iter()
-        .map(|&(k, _)| &sent[k])
+        .map(|&(m, k, _)| m.commands_in_frame(b)[k].clone())
         .collect();
     let bits = |w: &[bool]| -> String { w.iter().map(|&v| if v { '1' } else { '0' }).collect() };
     if got.len() != want.len() {
@@ -372,10 +395,9 @@ mod tests {
                     &s.mix.branches[b].adc,
                 )
                 .unwrap();
-                let sent = s.commands_in_frame(b);
-                let want: Vec<Vec<bool>> = window_conversions(&s, b, frames, 0)
+                let want: Vec<Vec<bool>> = window_conversions(&s, &cap.modes, b, frames, 0)
                     .iter()
-                    .map(|&(k, _)| sent[k].word.clone())
+                    .map(|&(m, k, _)| m.commands_in_frame(b)[k].word.clone())
                     .collect();
                 assert!(!got.is_empty(), "{name} branch {b}");
                 assert_eq!(got, want, "{name} branch {b}");

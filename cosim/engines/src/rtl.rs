@@ -222,7 +222,8 @@ pub fn check_ports(s: &Schedule, file: &Path, text: &str) -> Result<(), RtlError
 
 /// An input or inout outside the contract would be driven by nothing; the
 /// mix's link ports (a UART's or AXI4-Stream's, `m_axis_tready` an input the
-/// testbench drives) are the contract's too. Extra outputs are ignored.
+/// testbench drives) and its mode ports are the contract's too. Extra
+/// outputs are ignored.
 fn no_extra_input(file: &Path, layout: &Layout, ports: &[PortDecl]) -> Result<(), RtlError> {
     let link = layout.link_ports();
     // a mix with modes: `mode_sel` (pin select) is the contract's too

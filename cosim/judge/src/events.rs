@@ -14,7 +14,8 @@
 //! at cycle 0 every branch lane is listed, after that only changes.  Per
 //! branch (in mix order): `mux_sel`, `mux_en` (binary, one digit per device;
 //! neither for a branch without a mux), `cs_n` (`cnv` for a CNV-started
-//! part such as the AD7685), `sclk`; then each `sample_valid` strobe as `sample <channel>
+//! part such as the AD7685), `sclk`; a mix with modes then `modes mode` (the
+//! mode in force); then each `sample_valid` strobe as `sample <channel>
 //! <code>`.  The time column (exact, rounded once to 1 ps) and the `#` notes
 //! are for the reader; the comparison ignores them.
 
@@ -165,6 +166,34 @@ fn link_events(
     }
 }
 
+/// The scope of the mode pins' events in a log (a mix with modes only, so
+/// a log of a mix without them is as before).
+pub const MODE_SCOPE: &str = "modes";
+
+/// A mix with modes: `mode`, the mode in force, at cycle 0 and at each
+/// change, the mode named in the note.  `mode_sel` is an input, like MISO:
+/// the stimulus, not what the design did (simulators differ in the cycle
+/// they show its change in; the design samples it once a frame).
+fn mode_events(events: &mut Vec<Event>, s: &Schedule, c: u64, p: &Pins, prev: Option<&Pins>) {
+    let Some(plan) = s.mode_plan().filter(|m| m.names.len() > 1) else {
+        return;
+    };
+    if prev.is_some_and(|q| q.mode == p.mode) {
+        return;
+    }
+    events.push(Event {
+        cycle: c,
+        scope: MODE_SCOPE.into(),
+        signal: "mode".into(),
+        value: p.mode.to_string(),
+        note: plan
+            .names
+            .get(p.mode as usize)
+            .cloned()
+            .unwrap_or_else(|| "no mode".into()),
+    });
+}
+
 impl EventLog {
     /// The events of `trace` over `cycles` cycles from cycle 0 (fewer if the
     /// trace is shorter).
@@ -222,6 +251,7 @@ impl EventLog {
                     });
                 }
             }
+            mode_events(&mut events, s, c, p, prev.as_ref());
             if p.sample_valid {
                 let idx = p.sample_channel as usize;
                 events.push(Event {

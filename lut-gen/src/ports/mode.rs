@@ -41,8 +41,8 @@ impl Layout {
     }
 
     /// Every mode port bit with its direction (`mode_sel[0]`, ...), in port
-    /// order: the rows a board's constraints add once the gateware drives
-    /// them (not yet part of [`Layout::bits`]).
+    /// order: the last rows of [`Layout::bits`], which a board's
+    /// constraints place.
     pub fn mode_port_bits(&self) -> Vec<(String, Dir)> {
         self.mode_ports()
             .iter()
@@ -108,6 +108,8 @@ mod tests {
                 ("mode[0]".to_string(), Dir::Out)
             ]
         );
+        // a board places them: they end the port bits
+        assert!(l.bits().ends_with(&l.mode_port_bits()));
     }
 
     #[test]

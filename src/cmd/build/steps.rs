@@ -429,6 +429,7 @@ fn golden(j: &mut Job, a: &Args, s: &Schedule) -> Done {
         dir: a.golden.clone(),
         junit: None,
         quiet: true,
+        scene: Default::default(),
     };
     let mut o = super::super::golden::Output::default();
     let code = super::super::golden::execute(&ga, &a.mix, &mut o);

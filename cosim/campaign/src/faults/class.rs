@@ -136,6 +136,7 @@ impl FaultClass {
             GatewareFault::LinkBaud { delta } if delta < 0 => C::LinkBaudFast,
             GatewareFault::LinkBaud { .. } => C::LinkBaudSlow,
             GatewareFault::LinkCrcInit => C::LinkCrcInit,
+            GatewareFault::ModeStuck => C::ModeStuck,
         }
     }
 
@@ -198,6 +199,27 @@ impl FaultClass {
     pub fn on_mux_pins(&self) -> bool {
         use FaultClass as C;
         matches!(self, C::MuxLate | C::TwoMuxEn | C::WrongMux | C::SelectSwap)
+    }
+
+    /// The level a fault of this class given as Verilog is counted at: a
+    /// gateware class's Verilog is that gateware fault
+    /// ([`crate::faults::gateware_as_verilog`]); the rest are Verilog faults.
+    pub fn level_as_verilog(&self) -> Level {
+        use FaultClass as C;
+        match self {
+            C::RomWord
+            | C::RomSwap
+            | C::SlotWrapEarly
+            | C::SlotWrapLate
+            | C::SliceCountShort
+            | C::SliceCountLong
+            | C::LinkFifoShort
+            | C::LinkBaudFast
+            | C::LinkBaudSlow
+            | C::LinkCrcInit
+            | C::ModeStuck => Level::Gateware,
+            _ => Level::Verilog,
+        }
     }
 
     /// A fault of the `mode` output (a mix with modes).

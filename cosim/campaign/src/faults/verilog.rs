@@ -15,7 +15,7 @@ use judge::reset_cycles;
 use lut_gen::Schedule;
 use serde::Serialize;
 
-use super::{parallel, Cost, Detector, FaultClass, Injection, Judged, Judgement, Level, Runs};
+use super::{parallel, Cost, Detector, FaultClass, Injection, Judged, Judgement, Runs};
 use crate::equiv::Equivalence;
 use crate::sigrok::SpiCapture;
 use engines::{Backend, SimOptions};
@@ -51,6 +51,24 @@ pub fn deep_faults(s: &Schedule, frames: u64) -> Result<Vec<VerilogFault>, Strin
         })
     })
     .collect()
+}
+
+/// One fault of each gateware class (`hdl::GatewareFault`) as the faulty
+/// Verilog the emitter writes for it, so the Verilog engines run the
+/// classes the rusthdl target builds into the gateware (counted at the
+/// gateware level); a fault the mix's gateware cannot hold is left out.
+pub fn gateware_as_verilog(s: &Schedule) -> Vec<VerilogFault> {
+    super::one_gateware_fault_per_class(s)
+        .into_iter()
+        .filter_map(|(class, f)| {
+            let (_, gate) = hdl::verilog_pair(s, f).ok()?;
+            Some(VerilogFault {
+                name: format!("{class}: {f}"),
+                class,
+                verilog: gate,
+            })
+        })
+        .collect()
 }
 
 /// What `prove` said of one design.
@@ -119,9 +137,13 @@ pub(super) fn judge_verilog(
     let dir = tempfile::tempdir().map_err(|e| e.to_string())?;
     let rtl = dir.path().join("faulty.v");
     std::fs::write(&rtl, verilog).map_err(|e| e.to_string())?;
+    // a mix with modes: the campaign's switching scenario
+    let (modes, stimulus) = super::modes::scenario(s, frames);
     let opts = SimOptions {
         rtl: Some(rtl),
         tready: super::TREADY,
+        modes,
+        stimulus: stimulus.unwrap_or_default(),
         ..SimOptions::default()
     };
     let mut cap = SpiCapture::new(s, reset_cycles(s, opts.reset_cycles));
@@ -173,7 +195,12 @@ pub(super) fn verilog_injections(
             slot: 0,
         };
         let inj = super::outcome(f.name.clone(), &site, &j, e.name());
-        Ok(Some((f.class.clone(), Level::Verilog, inj, j.cost)))
+        Ok(Some((
+            f.class.clone(),
+            f.class.level_as_verilog(),
+            inj,
+            j.cost,
+        )))
     });
     let mut out: Vec<Judgement> = runs
         .into_iter()
