@@ -250,11 +250,6 @@ fn every_preset_on_every_part() {
     }
     let dir = tempfile::tempdir().unwrap();
     for mix in crate::common_presets::presets(&root()) {
-        // `synth` refuses a mix with modes until it takes them (exit 2,
-        // its modes named): drop this skip once it does.
-        if lut_gen::load(&mix).unwrap().modes.is_some() {
-            continue;
-        }
         for f in Fpga::ALL {
             let out = dir
                 .path()

@@ -149,16 +149,9 @@ pub enum Limits {
 
 /// The mix loaded and scheduled, its limits checked, and its link to the
 /// host checked ([`link_fits`]): what every command that emits, simulates,
-/// checks or proves starts with.  On failure the message is printed and
-/// the exit code returned.
-pub fn load_checked(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
-    let s = load_any_modes(path, limits)?;
-    one_mode(&s, path, "this command")?;
-    Ok(s)
-}
-
-/// [`load_checked`] for what follows mode switches (`verilog`, `synth`,
-/// `sim`, `check`, `golden`, `faults`): a mix with modes is not refused.
+/// checks or proves starts with (a mix with modes too: each follows the
+/// switches; `check --map` refuses one with [`one_mode`]).  On failure the
+/// message is printed and the exit code returned.
 pub fn load_any_modes(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
     let s = match limits {
         Limits::Contract => schedule_on_pins(path)?,
@@ -177,8 +170,8 @@ pub fn one_mode(s: &lut_gen::Schedule, file: &Path, command: &str) -> Result<(),
             eprintln!(
                 "error: {}: the mix declares {} modes ({}): {command} does not yet follow \
                  mode switches, so it would show the reset mode `{}` alone (`audit`, `lut`, \
-                 `verilog`, `synth`, `sim`, `check` of a VCD, `golden`, `faults` and `decode` \
-                 take the mix); remove the [[mode]] tables to build one mode",
+                 `verilog`, `synth`, `sim`, `check` of a VCD, `golden`, `faults`, `prove`, \
+                 `build` and `decode` take the mix); remove the [[mode]] tables to build one mode",
                 file.display(),
                 m.names.len(),
                 m.names.join(", "),

@@ -123,9 +123,6 @@ pub enum SkipReason {
     ChartsNone,
     /// The speed chart without the fault step it draws.
     FaultsLeftOut,
-    /// A command that does not take a mix with modes yet (`golden`, `prove`):
-    /// it would show the reset mode alone as if it were the mix.
-    ModesNotYet,
 }
 
 impl std::fmt::Display for SkipReason {
@@ -136,7 +133,6 @@ impl std::fmt::Display for SkipReason {
             SkipReason::ProveOptIn => "proves for all time (minutes): --charts all or --only prove; a cached proof of the same Verilog is shown",
             SkipReason::ChartsNone => "--charts none",
             SkipReason::FaultsLeftOut => "draws this build's fault campaign, which is left out",
-            SkipReason::ModesNotYet => "does not take a mix with modes yet: it would show the reset mode alone",
         })
     }
 }
@@ -206,21 +202,6 @@ fn speed_needs_faults(mut plan: Vec<(Step, Run)>) -> Vec<(Step, Run)> {
         .filter(|p| p.0 == Step::Speed && p.1.runs() && !faults)
     {
         p.1 = Run::Skip(SkipReason::FaultsLeftOut);
-    }
-    plan
-}
-
-/// A mix with modes: the steps whose commands do not take one yet are left
-/// out, said why (the golden comparison and the proof follow the reset mode
-/// alone).
-pub fn for_modes(mut plan: Vec<(Step, Run)>, s: &Schedule) -> Vec<(Step, Run)> {
-    if s.modes.len() > 1 {
-        for p in plan
-            .iter_mut()
-            .filter(|p| matches!(p.0, Step::Golden | Step::Prove))
-        {
-            p.1 = Run::Skip(SkipReason::ModesNotYet);
-        }
     }
     plan
 }
