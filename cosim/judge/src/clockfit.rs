@@ -22,6 +22,11 @@ pub(crate) struct ClockFit {
     /// The fit's standard error, in ppm (the analyser's sampling puts up
     /// to a sample period on each start).
     sigma: f64,
+    /// The most the sampling can tilt the line, in ppm: a sample period at
+    /// each end of the starts' span, twice.  The sampling's error is not
+    /// noise when the sample period and the slot beat (it sweeps slowly
+    /// across the starts), so the standard error alone understates it.
+    bias: f64,
     /// The capture's first time, which scaling keeps.
     t0: u64,
 }
@@ -91,16 +96,25 @@ pub(crate) fn fit(s: &lut_gen::Schedule, cap: &Capture) -> Option<ClockFit> {
         .map(|(ki, &ti)| (ti as f64 - icpt - slope * ki).powi(2))
         .sum();
     let sigma = (sq / (n - 2.0)).sqrt() / var.sqrt() / slot_ps * 1e6;
+    let span = (t[t.len() - 1] - t[0]) as f64;
+    let bias = 2.0 * 2.0 * cap.period_ps as f64 / span * 1e6;
     let t0 = cap.steps.first().map_or(0, |x| x.0);
-    Some(ClockFit { ppm, sigma, t0 })
+    Some(ClockFit {
+        ppm,
+        sigma,
+        bias,
+        t0,
+    })
 }
 
 impl ClockFit {
     /// Whether the capture is scaled: an offset a crystal can have, and
-    /// one the fit tells from none (three standard errors), so a capture at
-    /// the mix's clock is checked as it was taken.
+    /// one the fit tells from none (beyond three standard errors and the
+    /// sampling's tilt), so a capture at the mix's clock is checked as it
+    /// was taken.
     pub(crate) fn worth_scaling(&self) -> bool {
-        self.ppm.abs() > 3.0 * self.sigma && self.ppm.abs() <= MAX_PPM
+        let a = self.ppm.abs();
+        a > 3.0 * self.sigma && a > self.bias && a <= MAX_PPM
     }
 
     fn factor(&self) -> f64 {
