@@ -14,6 +14,15 @@ fn schedule(p: &Path) -> lut_gen::Schedule {
     lut_gen::synthesize(&lut_gen::load(p).unwrap()).unwrap()
 }
 
+/// The samples of `frames` whole frames from reset. A mix with modes (the
+/// adaptive preset) switches under the stimulus, so its count is each
+/// frame's mode's, which the verdict holds it to (`ok`), not one figure.
+fn assert_whole(s: &lut_gen::Schedule, samples: u64, frames: u64) {
+    if s.modes.is_empty() {
+        assert_eq!(samples, frames * s.samples_per_frame() - s.startup_skips());
+    }
+}
+
 // Missing tools fail under CI=true, skip loudly elsewhere.
 use crate::tools;
 
@@ -31,7 +40,7 @@ fn model_backend_100_frames() {
         let s = schedule(&p);
         let r = run(&s, Backend::Model, 100, &SimOptions::default()).unwrap();
         assert!(r.ok, "{}: {}", p.display(), r.summary());
-        assert_eq!(r.samples, 100 * s.samples_per_frame() - s.startup_skips());
+        assert_whole(&s, r.samples, 100);
     }
 }
 
@@ -41,7 +50,7 @@ fn rusthdl_backend_2_frames() {
         let s = schedule(&p);
         let r = run(&s, Backend::RustHdl, 2, &one_cycle_reset()).unwrap();
         assert!(r.ok, "{}: {}", p.display(), r.summary());
-        assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
+        assert_whole(&s, r.samples, 2);
         assert!(r.model_compared);
     }
 }
@@ -55,7 +64,7 @@ fn verilator_backend_2_frames() {
         let s = schedule(&p);
         let r = run(&s, Backend::Verilator, 2, &one_cycle_reset()).unwrap();
         assert!(r.ok, "{}: {}", p.display(), r.summary());
-        assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
+        assert_whole(&s, r.samples, 2);
     }
 }
 
@@ -78,7 +87,7 @@ fn largest_mixes_one_frame() {
         for b in backends {
             let r = run(&s, b, 1, &one_cycle_reset()).unwrap();
             assert!(r.ok, "{name} {b:?}: {}", r.summary());
-            assert_eq!(r.samples, s.samples_per_frame() - s.startup_skips());
+            assert_whole(&s, r.samples, 1);
         }
     }
 }
@@ -135,6 +144,6 @@ fn cnv_chain_and_cs_parts(p: &Path, icarus: bool) {
     for b in backends {
         let r = run(&s, b, 2, &opts).unwrap();
         assert!(r.ok, "{} on {}: {}", s.mix.name, b.name(), r.summary());
-        assert_eq!(r.samples, 2 * s.samples_per_frame() - s.startup_skips());
+        assert_whole(&s, r.samples, 2);
     }
 }
