@@ -31,6 +31,21 @@ fn model_backend_100_frames() {
         let s = schedule(&p);
         let r = run(&s, Backend::Model, 100, &SimOptions::default()).unwrap();
         assert!(r.ok, "{}: {}", p.display(), r.summary());
+        if s.modes.len() > 1 {
+            // the pattern's codes switch a preset with modes: the judge
+            // holds each frame to its mode's counts (`r.ok`); the total lies
+            // between 100 frames of its leanest mode and of its fullest
+            let per = s.modes.iter().map(|m| m.samples_per_frame());
+            let (lo, hi) = (per.clone().min().unwrap(), per.max().unwrap());
+            let within = 100 * lo - s.startup_skips()..=100 * hi;
+            assert!(
+                within.contains(&r.samples),
+                "{}: {}",
+                p.display(),
+                r.samples
+            );
+            continue;
+        }
         assert_eq!(r.samples, 100 * s.samples_per_frame() - s.startup_skips());
     }
 }
