@@ -759,8 +759,6 @@ fn reports_of_unseen_mixes_read_like_datasheets() {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        // A mix with modes is audited only (tests/cli.rs: the refusal).
-        .filter(|p| lut_gen::load(p).unwrap().modes.is_none())
         .collect();
     mixes.sort();
     mixes.push(root.join("mixes/eskin34-uart.toml"));

@@ -692,6 +692,12 @@ fn port_patterns(s: &Schedule) -> Vec<(String, Dir)> {
             .iter()
             .map(|p| (pattern(p.name, p.width > 1), p.dir)),
     );
+    let mode_bits = l.mode_port_bits().len() / l.mode_ports().len().max(1);
+    v.extend(
+        l.mode_ports()
+            .iter()
+            .map(|p| (pattern(p.name, mode_bits > 1), p.dir)),
+    );
     v
 }
 
@@ -745,7 +751,7 @@ fn xdc(s: &Schedule) -> String {
             .join(" ")
     );
     let _ = writeln!(t, "# Pin locations: uncomment and fill in for your board.");
-    let bits = Layout::new(s).bits();
+    let bits = crate::board::port_bits(s);
     for (bit, _) in &bits {
         let _ = writeln!(
             t,

@@ -229,11 +229,16 @@ proptest! {
     }
 }
 
+/// A shared test mix, or else the preset of that name (as `testkit::mix`).
 fn testkit(name: &str) -> lut_gen::Mix {
-    lut_gen::load(
-        &Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../testkit/mixes/{name}.toml")),
-    )
-    .unwrap()
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let own = root.join(format!("testkit/mixes/{name}.toml"));
+    let p = if own.exists() {
+        own
+    } else {
+        root.join(format!("mixes/{name}.toml"))
+    };
+    lut_gen::load(&p).unwrap()
 }
 
 #[test]
