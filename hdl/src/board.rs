@@ -132,7 +132,7 @@ impl Board {
     /// Every port bit's pin: named in [pins], else the pool's next, as
     /// `(name as place and route calls it, pin, direction)`.
     fn place(&self, s: &Schedule, path: &Path) -> Result<Vec<(String, String, Dir)>, HdlError> {
-        let bits = port_bits(s);
+        let bits = Layout::new(s).bits();
         let err = |m: String| HdlError::Board {
             path: path.display().to_string(),
             message: m,
@@ -191,16 +191,6 @@ impl Board {
 
 /// The name place-and-route tools give a port bit: yosys and nextpnr call
 /// the only bit of a 1-bit vector port by the port's name.
-/// Every port bit of the top with its direction, in port order: the
-/// contract's and the link's ([`Layout::bits`]), then the mode ports' (a mix
-/// with modes: `mode_sel` must have a pin, `mode` should).
-pub(crate) fn port_bits(s: &Schedule) -> Vec<(String, Dir)> {
-    let l = Layout::new(s);
-    let mut v = l.bits();
-    v.extend(l.mode_port_bits());
-    v
-}
-
 pub(crate) fn pnr_name(bits: &[(String, Dir)], bit: &str) -> String {
     if let Some(base) = bit.strip_suffix("[0]") {
         let wider = format!("{base}[1]");
@@ -223,7 +213,7 @@ pub(crate) fn pcf_template(s: &Schedule) -> String {
         t,
         "# No board file was given: replace every <pin> and uncomment, or emit with a board file."
     );
-    let bits = port_bits(s);
+    let bits = Layout::new(s).bits();
     for (bit, dir) in &bits {
         let _ = writeln!(
             t,

@@ -751,7 +751,7 @@ fn xdc(s: &Schedule) -> String {
             .join(" ")
     );
     let _ = writeln!(t, "# Pin locations: uncomment and fill in for your board.");
-    let bits = crate::board::port_bits(s);
+    let bits = Layout::new(s).bits();
     for (bit, _) in &bits {
         let _ = writeln!(
             t,
