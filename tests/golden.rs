@@ -34,13 +34,7 @@ fn golden_copy(name: &str) -> tempfile::TempDir {
 #[test]
 #[ignore = "long: make test-long"]
 fn every_preset_has_a_golden_and_matches_it_in_process() {
-    // Not the presets with modes while `golden` refuses them (it would
-    // record the reset mode alone): drop this filter once it takes them.
-    let presets: Vec<PathBuf> = presets()
-        .into_iter()
-        .filter(|p| lut_gen::load(p).unwrap().modes.is_none())
-        .collect();
-    goldens_match_in_process(&presets);
+    goldens_match_in_process(&presets());
 }
 
 /// The reference mix (event log and Figure 6 windows) on rusthdl.
