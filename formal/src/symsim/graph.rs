@@ -249,20 +249,42 @@ impl Graph {
                 ))
             }
             Ok(splr::Certificate::UNSAT) => Ok(None),
-            Err(e) => Err(format!("{e:?}")),
+            Err(e) => Err(e),
         }
     }
 }
 
-/// splr on `clauses`, stopped (`Err`) past `limit` (whole seconds, at least one).
+/// splr on `clauses`, stopped (`Err`) past `limit` (whole seconds, at least
+/// one).  splr reads its own time limit only between search stages, so a
+/// hard instance can run far past it: with a limit the solver runs on a
+/// thread of its own, and its answer is abandoned (the thread left to the
+/// process's end) a second past the limit.
 fn solve(
     clauses: Vec<Vec<i32>>,
     limit: Option<std::time::Duration>,
+) -> Result<splr::Certificate, String> {
+    let Some(limit) = limit else {
+        return splr::Certificate::try_from(clauses).map_err(|e| format!("{e:?}"));
+    };
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(solve_within(clauses, limit).map_err(|e| format!("{e:?}")));
+    });
+    let grace = limit.max(std::time::Duration::from_secs(1)) + std::time::Duration::from_secs(1);
+    rx.recv_timeout(grace).unwrap_or_else(|_| {
+        Err(format!(
+            "no answer within {} s (the solver was abandoned)",
+            grace.as_secs()
+        ))
+    })
+}
+
+/// splr with its own (soft) time limit.
+fn solve_within(
+    clauses: Vec<Vec<i32>>,
+    limit: std::time::Duration,
 ) -> Result<splr::Certificate, splr::SolverError> {
     use splr::SolveIF;
-    let Some(limit) = limit else {
-        return splr::Certificate::try_from(clauses);
-    };
     let config = splr::Config {
         c_timeout: limit.as_secs().max(1) as f64,
         ..Default::default()
@@ -272,5 +294,38 @@ fn solve(
         Err(Ok(cert)) => Ok(cert),
         Err(Err(splr::SolverError::EmptyClause)) => Ok(splr::Certificate::UNSAT),
         Err(Err(e)) => Err(e),
+    }
+}
+
+#[cfg(test)]
+mod limit_tests {
+    use super::solve;
+    use std::time::{Duration, Instant};
+
+    /// The pigeonhole principle for `n + 1` pigeons in `n` holes: unsatisfiable,
+    /// and exponential for resolution, so a CDCL solver takes long on it.
+    fn pigeons(n: i32) -> Vec<Vec<i32>> {
+        let v = |p: i32, h: i32| p * n + h + 1;
+        let mut c: Vec<Vec<i32>> = (0..=n).map(|p| (0..n).map(|h| v(p, h)).collect()).collect();
+        for h in 0..n {
+            for p in 0..=n {
+                for q in p + 1..=n {
+                    c.push(vec![-v(p, h), -v(q, h)]);
+                }
+            }
+        }
+        c
+    }
+
+    /// A hard instance under a one-second limit answers within a few
+    /// seconds (no answer, never "holds"); an easy one answers in full.
+    #[test]
+    fn a_limit_holds_however_hard_the_instance() {
+        let t = Instant::now();
+        let r = solve(pigeons(12), Some(Duration::from_secs(1)));
+        assert!(t.elapsed() < Duration::from_secs(5), "{:?}", t.elapsed());
+        assert!(!matches!(r, Ok(splr::Certificate::SAT(_))), "{r:?}");
+        let easy = solve(pigeons(3), Some(Duration::from_secs(5)));
+        assert!(matches!(easy, Ok(splr::Certificate::UNSAT)), "{easy:?}");
     }
 }
