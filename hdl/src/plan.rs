@@ -499,6 +499,14 @@ fn branch_rom(
     let cnv = adc.start == lut_gen::Start::Cnv;
     let spi = &bp.spi;
     check_spi(s, b, words)?;
+    if s.mix.branches[b].fronted {
+        // The ROM's mux field carries either the pins or the word's
+        // channel: a fronted branch needs both (not built yet).
+        return Err(unsupported(format!(
+            "branch {}: an external mux in front of the converter's own (front_mux) is not in the gateware yet",
+            bp.name
+        )));
+    }
     let devices = bp.mux_devices.max(1) as usize;
     let timing = SeqTiming {
         sclk_div: spi.sclk_div,

@@ -588,12 +588,12 @@ impl BranchAudit {
         let mix = &s.mix;
         let used = used_slots.len() as u64;
         let br = &mix.branches[b];
-        let inputs = br.mux_devices * br.mux.inputs;
+        let inputs = front_capacity(mix, b).unwrap_or(br.input_capacity());
         let taken = mix
             .channels
             .iter()
             .filter(|c| c.branch == b)
-            .map(|c| c.input)
+            .map(|c| (c.input, c.front_input))
             .collect::<std::collections::BTreeSet<_>>()
             .len() as u32;
         // A chain of N parts gives N samples per conversion.
@@ -858,6 +858,23 @@ fn place(demand: &[u64], n: u64, k: u64, sps: u64, frame_slots: u64) -> bool {
         }
     }
     true
+}
+
+/// Inputs a fronted branch can sample: each converter input wired through
+/// the front mux carries all its inputs, the others one sensor each.
+fn front_capacity(mix: &crate::Mix, b: usize) -> Option<u32> {
+    let br = &mix.branches[b];
+    if !br.fronted {
+        return None;
+    }
+    let fronted: std::collections::BTreeSet<u32> = mix
+        .channels
+        .iter()
+        .filter(|c| c.branch == b && c.front_input.is_some())
+        .map(|c| c.input)
+        .collect();
+    let n = fronted.len() as u32;
+    Some(br.input_capacity() - n + n * br.mux.inputs * br.mux_devices)
 }
 
 #[cfg(test)]

@@ -18,6 +18,8 @@ mod bulk;
 mod bulk_tests;
 mod channels;
 mod check;
+#[cfg(test)]
+mod front_tests;
 mod link_table;
 mod modes;
 #[cfg(test)]
@@ -143,14 +145,30 @@ pub struct Branch {
     pub sclk_hz: u64,
     /// Whether `sclk_hz` was written in the mix (else it is the default).
     pub sclk_explicit: bool,
+    /// The multiplexer whose pins (`mux_sel`, `mux_en`) the branch drives:
+    /// the external part, `none`, the converter's own (`internal`, no pins)
+    /// or, on a `fronted` branch, the external mux in front of it.
     pub mux: MuxPart,
     pub mux_devices: u32,
+    /// `mux = "internal"` with `front_mux`: the converter selects among its
+    /// inputs with its command word and `mux` (`mux_devices` devices) is
+    /// wired in front of some of them (`Channel::front_input`).
+    pub fronted: bool,
     pub settle_ns: u64,
     /// Parts of `adc` daisy-chained on this branch's port (1: no chain).
     pub chain: u32,
 }
 
 impl Branch {
+    /// Inputs a channel's `input` may name: the converter's channels on a
+    /// branch with its own multiplexer (fronted or not), else the mux's.
+    pub fn input_capacity(&self) -> u32 {
+        match (&self.adc.command, self.fronted) {
+            (Some(c), true) => c.channels(),
+            _ => self.mux.inputs * self.mux_devices,
+        }
+    }
+
     /// The SPI timing of this branch's port at `clock_hz`.
     pub fn timing(
         &self,
@@ -176,8 +194,14 @@ pub struct Channel {
     /// Index into [`Mix::branches`].
     pub branch: usize,
     pub rate_hz: u64,
-    /// Mux input on its branch: device = input / 8, select = input % 8.
+    /// Mux input on its branch: device = input / 8, select = input % 8; on
+    /// a converter with a command word, its channel.
     pub input: u32,
+    /// On a `fronted` branch, the front mux's input the channel is wired
+    /// to (device = front_input / 8, select = front_input % 8); `input` is
+    /// then the converter's channel the front mux's output drives.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub front_input: Option<u32>,
     pub kind: Option<String>,
     pub bandwidth_hz: Option<f64>,
     pub sync: Option<String>,
@@ -190,7 +214,28 @@ pub struct Channel {
     pub rates: Vec<u64>,
 }
 
+impl Channel {
+    /// Whether `o` is read in the same conversion (same branch, same
+    /// converter input, same front mux input).
+    pub fn same_conversion(&self, o: &Channel) -> bool {
+        self.branch == o.branch && self.input == o.input && self.front_input == o.front_input
+    }
+}
+
 impl Mix {
+    /// The input channel `c`'s mux pins address (device = it / 8, select =
+    /// it % 8): its `input`, or on a `fronted` branch its `front_input` (0
+    /// for a channel wired straight to the converter: the front mux's pins
+    /// are then of no consequence and rest at its first input).
+    pub fn pin_input(&self, c: usize) -> u32 {
+        let ch = &self.channels[c];
+        if self.branches[ch.branch].fronted {
+            ch.front_input.unwrap_or(0)
+        } else {
+            ch.input
+        }
+    }
+
     pub fn frame_cycles(&self) -> u64 {
         self.clock_hz * self.frame_us / 1_000_000
     }
@@ -235,7 +280,7 @@ impl Mix {
         let ch = &self.channels[c];
         let mut g = vec![None; self.branches[ch.branch].chain as usize];
         for (i, o) in self.channels.iter().enumerate() {
-            if o.branch == ch.branch && o.input == ch.input {
+            if o.same_conversion(ch) {
                 g[o.member as usize] = Some(i);
             }
         }
@@ -248,7 +293,7 @@ impl Mix {
         let ch = &self.channels[c];
         self.channels
             .iter()
-            .position(|o| o.branch == ch.branch && o.input == ch.input)
+            .position(|o| o.same_conversion(ch))
             .unwrap_or(c)
     }
 }

@@ -447,8 +447,8 @@ fn build(
                     period_slots: u.period,
                     offset_slot: o,
                     interval_cycles: mix.clock_hz / ch.rate_hz,
-                    device: ch.input / 8,
-                    select: ch.input % 8,
+                    device: mix.pin_input(c) / 8,
+                    select: mix.pin_input(c) % 8,
                 });
             }
             for s in (o..grid.frame_slots).step_by(u.period as usize) {
@@ -463,10 +463,11 @@ fn build(
         channels: channels
             .into_iter()
             .zip(&mix.channels)
-            .map(|(c, ch)| {
+            .enumerate()
+            .map(|(i, (c, _))| {
                 c.unwrap_or(ChannelSlots {
-                    device: ch.input / 8,
-                    select: ch.input % 8,
+                    device: mix.pin_input(i) / 8,
+                    select: mix.pin_input(i) % 8,
                     ..UNSAMPLED
                 })
             })

@@ -242,10 +242,15 @@ fn check_channel(s: &Schedule, c: usize, got: &[u64], bad: &mut Vec<String>) {
                 ch.name
             ));
         }
-        if cs.device * 8 + cs.select != ch.input {
+        // The pins address the front mux's input on a fronted branch.
+        let pin = match (mix.branches[ch.branch].fronted, ch.front_input) {
+            (true, f) => f.unwrap_or(0),
+            (false, _) => ch.input,
+        };
+        if cs.device * 8 + cs.select != pin {
             bad.push(format!(
                 "`{}`: mux address disagrees with input {}",
-                ch.name, ch.input
+                ch.name, pin
             ));
         }
     } else {

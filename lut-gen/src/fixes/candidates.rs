@@ -163,7 +163,7 @@ fn moves(
             .collect();
         used.sort_unstable();
         used.dedup();
-        let capacity = tb.mux.inputs * tb.mux_devices;
+        let capacity = tb.input_capacity();
         let short = (used.len() + moved.len()).saturating_sub(capacity as usize) as u32;
         let mut edits: Vec<Edit> = moved
             .iter()

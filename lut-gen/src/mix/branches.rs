@@ -77,6 +77,21 @@ impl Cx<'_> {
             ));
         }
         let mux_devices = self.branch_mux_devices(i, b, &mux)?;
+        let (mux, mux_devices, fronted) = match &b.front_mux {
+            Some(fm) => (
+                self.branch_front(i, b, &adc, &mux, fm)?,
+                self.front_devices(i, b)?,
+                true,
+            ),
+            None if b.front_mux_devices.is_some() => {
+                return Err(self.at(
+                    b.front_mux_devices.as_ref().unwrap().span(),
+                    f("front_mux_devices"),
+                    "counts the devices of a front mux: name it with front_mux as well",
+                ))
+            }
+            None => (mux, mux_devices, false),
+        };
         let settle_ns = match &b.settle_ns {
             None => 0,
             Some(s) if *s.get_ref() < 0 => {
@@ -91,6 +106,7 @@ impl Cx<'_> {
             sclk_explicit: b.sclk_hz.is_some(),
             mux,
             mux_devices,
+            fronted,
             settle_ns,
             chain,
         })
@@ -144,7 +160,7 @@ impl Cx<'_> {
 
     /// `branch.mux`: an external part, or `internal` (the converter's own,
     /// chosen by its command word).  A part with a command word takes
-    /// `internal`: an external mux in front of it is not supported yet.
+    /// `internal`; an external mux in front of it is `front_mux`.
     pub(super) fn branch_mux(
         &self,
         i: usize,
@@ -167,8 +183,8 @@ impl Cx<'_> {
                 b.mux.span(),
                 f,
                 format!(
-                    "`{}` selects its input with its command word: write mux = \"internal\" (an external mux in front of it is not supported yet)",
-                    adc.name
+                    "`{}` selects its input with its command word: write mux = \"internal\" (and front_mux = \"{}\" for an external mux wired in front of its inputs)",
+                    adc.name, wanted
                 ),
             )),
             _ => MuxPart::by_name(&wanted).ok_or_else(|| {
@@ -183,6 +199,82 @@ impl Cx<'_> {
                 )
             }),
         }
+    }
+
+    /// `branch.front_mux`: an external mux wired in front of the
+    /// converter's own, where the part permits it.  The front mux's pins
+    /// follow an external-mux branch's rule (docs/timing.md): they address
+    /// a conversion's input from the cycle after the branch's previous
+    /// instant through the instant itself, and move on one cycle after it.
+    /// A part whose word applies to the conversion that carries it
+    /// (`ahead` 0: the MCP3208, Figure 6-1, samples from the 4th rising SCLK
+    /// after the start bit to the 5th falling one, inside the transaction)
+    /// would sample the next conversion's front input: refused.  A part that
+    /// samples at its instant (CNV rising, or a CS part whose word applies
+    /// to a later conversion, as the AD7689 and the ADS7953) has its front
+    /// input settled there, whatever its word selects.
+    pub(super) fn branch_front(
+        &self,
+        i: usize,
+        b: &RawBranch,
+        adc: &AdcPart,
+        mux: &MuxPart,
+        fm: &toml::Spanned<String>,
+    ) -> Result<MuxPart, MixError> {
+        let f = format!("branch[{i}].front_mux");
+        if !mux.is_internal() {
+            return Err(self.at(
+                fm.span(),
+                f,
+                format!(
+                    "names a mux in front of the converter's own: it needs mux = \"internal\" (this branch has mux = \"{}\")",
+                    b.mux.get_ref()
+                ),
+            ));
+        }
+        let wanted = fm.get_ref().to_ascii_lowercase();
+        let front = MuxPart::by_name(&wanted)
+            .filter(|m| *m != MuxPart::NONE)
+            .ok_or_else(|| {
+                let known: Vec<&str> = MuxPart::known()
+                    .into_iter()
+                    .filter(|k| !matches!(*k, "none" | "internal"))
+                    .collect();
+                self.at(
+                    fm.span(),
+                    f.clone(),
+                    format!(
+                        "unknown front mux `{}` (known: {})",
+                        fm.get_ref(),
+                        known.join(", ")
+                    ),
+                )
+            })?;
+        let ahead = adc.command.as_ref().map_or(0, |c| c.ahead);
+        if ahead == 0 {
+            return Err(self.at(
+                fm.span(),
+                f,
+                format!(
+                    "`{}` samples its input inside the transaction that carries its word (the word applies to the same conversion), after the front mux's pins have moved on to the next conversion (one cycle after CS falls): a front mux needs a part that samples at its CS or CNV edge and applies its word to a later conversion (command_ahead >= 1, as the ad7689)",
+                    adc.name
+                ),
+            ));
+        }
+        Ok(front)
+    }
+
+    /// `branch.front_mux_devices`: 1 to 32 (1 unless given).
+    pub(super) fn front_devices(&self, i: usize, b: &RawBranch) -> Result<u32, MixError> {
+        let Some(m) = &b.front_mux_devices else {
+            return Ok(1);
+        };
+        let f = format!("branch[{i}].front_mux_devices");
+        let v = self.positive(m, &f)?;
+        if v > 32 {
+            return Err(self.at(m.span(), f, "at most 32 front mux devices per branch"));
+        }
+        Ok(v as u32)
     }
 
     /// `branch.mux_devices`: 1 to 32, and only with an external mux.

@@ -169,7 +169,12 @@ impl Cx<'_> {
             for step in 0..range.count() {
                 let mut one = c.clone();
                 one.name = Spanned::new(c.name.span(), range.name(step));
-                one.input = counted(&c.input, step);
+                // Behind a front mux the block counts the front mux's inputs:
+                // its output is one wire into one converter input.
+                match &c.front_input {
+                    Some(_) => one.front_input = counted(&c.front_input, step),
+                    None => one.input = counted(&c.input, step),
+                }
                 one.member = counted(&c.member, step);
                 out.push(Declared {
                     table,

@@ -12,12 +12,15 @@ use super::raw::*;
 use super::words::*;
 use super::*;
 
+/// (converter or mux input, chain member, front mux input).
+pub(super) type InputKey = (u32, u32, Option<u32>);
+
 /// The channels as read, before automatic inputs are assigned.
 pub(super) struct ChannelDraft {
     pub(super) channels: Vec<Channel>,
-    /// Per branch: (input, chain member) -> the channel that has it, to name
-    /// it in a clash.
-    pub(super) used_inputs: Vec<BTreeMap<(u32, u32), String>>,
+    /// Per branch: (input, chain member, front mux input) -> the channel
+    /// that has it, to name it in a clash.
+    pub(super) used_inputs: Vec<BTreeMap<InputKey, String>>,
     /// Channels without an explicit input, in file order.
     pub(super) pending_auto: Vec<usize>,
     /// Sync tag -> (channel, where its `sync` is written).
@@ -92,6 +95,7 @@ impl Cx<'_> {
             ));
         }
         let member = self.channel_member(d, &branches[branch])?;
+        let front_input = self.channel_front(d, &branches[branch])?;
         let input = match &c.input {
             None => {
                 draft.pending_auto.push(i);
@@ -100,7 +104,7 @@ impl Cx<'_> {
             Some(v) => {
                 let b = &branches[branch];
                 let used = &mut draft.used_inputs[branch];
-                self.channel_input(d, v, member, b, used)?
+                self.channel_input(d, v, (member, front_input), b, used)?
             }
         };
         let bandwidth_hz = self.channel_bandwidth(d)?;
@@ -123,6 +127,7 @@ impl Cx<'_> {
             branch,
             rate_hz,
             input,
+            front_input,
             kind: c.kind.clone(),
             bandwidth_hz,
             sync,
@@ -181,18 +186,53 @@ impl Cx<'_> {
         Ok(*m.get_ref() as u32)
     }
 
+    /// `channel.front_input`: only on a branch with a front mux, within its
+    /// devices, and with the converter `input` its output is wired to.
+    pub(super) fn channel_front(&self, d: &Declared, b: &Branch) -> Result<Option<u32>, MixError> {
+        let Some(v) = &d.raw.front_input else {
+            return Ok(None);
+        };
+        let say = |m: String| self.at(v.span(), d.field("front_input"), d.say(m));
+        if !b.fronted {
+            return Err(say(format!(
+                "branch `{}` has no front mux: front_input needs front_mux on the branch (with mux = \"internal\")",
+                b.name
+            )));
+        }
+        let capacity = b.mux.inputs * b.mux_devices;
+        if *v.get_ref() < 0 || *v.get_ref() >= capacity as i64 {
+            return Err(say(format!(
+                "front input {}{} is beyond branch `{}`: {} front mux device(s) give front inputs 0..={}",
+                v.get_ref(),
+                counted_from(*v.get_ref(), d.step),
+                b.name,
+                b.mux_devices,
+                capacity - 1
+            )));
+        }
+        if d.raw.input.is_none() {
+            return Err(say(
+                "name the converter input the front mux's output is wired to with `input` as well"
+                    .into(),
+            ));
+        }
+        Ok(Some(*v.get_ref() as u32))
+    }
+
     /// An explicit `channel.input`: on the branch's muxes and not taken by
-    /// another channel of the same chain member.
+    /// another channel of the same chain member (and front mux input).
     pub(super) fn channel_input(
         &self,
         d: &Declared,
         v: &Spanned<i64>,
-        member: u32,
+        (member, front): (u32, Option<u32>),
         b: &Branch,
-        used: &mut BTreeMap<(u32, u32), String>,
+        used: &mut BTreeMap<InputKey, String>,
     ) -> Result<u32, MixError> {
-        let capacity = b.mux.inputs * b.mux_devices;
-        if b.mux.is_internal() && (*v.get_ref() < 0 || *v.get_ref() >= capacity as i64) {
+        let capacity = b.input_capacity();
+        if (b.mux.is_internal() || b.fronted)
+            && (*v.get_ref() < 0 || *v.get_ref() >= capacity as i64)
+        {
             return Err(self.at(
                 v.span(),
                 d.field("input"),
@@ -221,11 +261,11 @@ impl Cx<'_> {
             ));
         }
         let inp = *v.get_ref() as u32;
-        if let Some(other) = used.insert((inp, member), d.raw.name.get_ref().clone()) {
-            let which = if b.chain > 1 {
-                format!(" (chain member {member})")
-            } else {
-                String::new()
+        if let Some(other) = used.insert((inp, member, front), d.raw.name.get_ref().clone()) {
+            let which = match front {
+                Some(f) => format!(" with front_input {f}"),
+                None if b.chain > 1 => format!(" (chain member {member})"),
+                None => String::new(),
             };
             return Err(self.at(
                 v.span(),
@@ -279,10 +319,11 @@ impl Cx<'_> {
         let channels = &mut draft.channels;
         for &i in &draft.pending_auto {
             let b = channels[i].branch;
-            let capacity = branches[b].mux.inputs * branches[b].mux_devices;
+            let capacity = branches[b].input_capacity();
             let m = channels[i].member;
             let used_inputs = &mut draft.used_inputs;
-            let free = (0..capacity).find(|k| !used_inputs[b].contains_key(&(*k, m))).ok_or_else(|| {
+            let taken = |k: u32| used_inputs[b].keys().any(|&(i, mm, _)| i == k && mm == m);
+            let free = (0..capacity).find(|&k| !taken(k)).ok_or_else(|| {
                 self.at(
                     decl[i].raw.name.span(),
                     decl[i].field("input"),
@@ -292,8 +333,47 @@ impl Cx<'_> {
                     )),
                 )
             })?;
-            used_inputs[b].insert((free, m), channels[i].name.clone());
+            used_inputs[b].insert((free, m, None), channels[i].name.clone());
             channels[i].input = free;
+        }
+        Ok(())
+    }
+
+    /// On a fronted branch a converter input is wired either straight to
+    /// a sensor or to the front mux's output, not both.
+    pub(super) fn check_front_wiring(
+        &self,
+        decl: &[Declared],
+        branches: &[Branch],
+        channels: &[Channel],
+    ) -> Result<(), MixError> {
+        for (i, c) in channels.iter().enumerate() {
+            let Some(o) = channels[..i].iter().find(|o| {
+                o.branch == c.branch
+                    && o.input == c.input
+                    && o.front_input.is_some() != c.front_input.is_some()
+            }) else {
+                continue;
+            };
+            let (fronted, straight) = if c.front_input.is_some() {
+                (c, o)
+            } else {
+                (o, c)
+            };
+            let d = &decl[i];
+            let span = d.raw.input.as_ref().map_or(d.raw.name.span(), |v| v.span());
+            return Err(self.at(
+                span,
+                d.field("input"),
+                d.say(format!(
+                    "converter input {} of branch `{}` is wired through the front mux (`{}` has front_input {}) and straight (`{}` has none): a converter input is one or the other",
+                    c.input,
+                    branches[c.branch].name,
+                    fronted.name,
+                    fronted.front_input.unwrap_or(0),
+                    straight.name
+                )),
+            ));
         }
         Ok(())
     }
@@ -309,7 +389,7 @@ impl Cx<'_> {
         for i in 0..channels.len() {
             for j in 0..i {
                 let (a, c) = (&channels[j], &channels[i]);
-                if a.branch == c.branch && a.input == c.input && a.rate_hz != c.rate_hz {
+                if a.same_conversion(c) && a.rate_hz != c.rate_hz {
                     return Err(self.at(
                         decl[i].raw.rate_hz.span(),
                         decl[i].field("rate_hz"),
@@ -349,7 +429,7 @@ impl Cx<'_> {
                     ));
                 }
                 if let Some(other) = seen.insert(c.branch, *i) {
-                    if channels[other].input == c.input {
+                    if channels[other].same_conversion(c) {
                         // Members of one chained conversion: one instant anyway.
                         continue;
                     }
@@ -376,7 +456,7 @@ impl Cx<'_> {
         for i in 0..channels.len() {
             for j in 0..i {
                 let (a, c) = (&channels[j], &channels[i]);
-                if a.branch == c.branch && a.input == c.input && a.sync != c.sync {
+                if a.same_conversion(c) && a.sync != c.sync {
                     let d = &decl[i];
                     let span = d
                         .raw

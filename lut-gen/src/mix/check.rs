@@ -116,6 +116,7 @@ impl Cx<'_> {
         let mut draft = self.channels(&decl, &branches, &t)?;
         self.assign_auto_inputs(&decl, &branches, &mut draft)?;
         let mut channels = draft.channels;
+        self.check_front_wiring(&decl, &branches, &channels)?;
         self.check_chain_rates(&decl, &branches, &channels)?;
         self.check_sync_groups(&decl, &branches, &channels, &draft.sync_groups)?;
         self.check_chain_sync(&decl, &channels)?;

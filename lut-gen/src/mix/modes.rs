@@ -232,7 +232,7 @@ impl Cx<'_> {
         for i in 0..channels.len() {
             for j in 0..i {
                 let (a, c) = (&channels[j], &channels[i]);
-                let chained = a.branch == c.branch && a.input == c.input;
+                let chained = a.same_conversion(c);
                 let synced = a.sync.is_some() && a.sync == c.sync;
                 let Some(m) = (0..names.len()).find(|&m| a.rates[m] != c.rates[m]) else {
                     continue;

@@ -80,6 +80,10 @@ pub(super) struct RawBranch {
     pub(super) sclk_hz: Option<Spanned<i64>>,
     pub(super) mux: Spanned<String>,
     pub(super) mux_devices: Option<Spanned<i64>>,
+    /// An external mux wired in front of the converter's own (`mux =
+    /// "internal"`), and how many of its devices.
+    pub(super) front_mux: Option<Spanned<String>>,
+    pub(super) front_mux_devices: Option<Spanned<i64>>,
     pub(super) settle_ns: Option<Spanned<i64>>,
     pub(super) chain: Option<Spanned<i64>>,
 }
@@ -116,6 +120,8 @@ pub(super) struct RawChannel {
     pub(super) branch: Spanned<String>,
     pub(super) rate_hz: Spanned<i64>,
     pub(super) input: Option<Spanned<i64>>,
+    /// The front mux's input (`branch.front_mux`) the channel is on.
+    pub(super) front_input: Option<Spanned<i64>>,
     pub(super) kind: Option<String>,
     /// Integer or float: TOML keeps the two apart.
     pub(super) bandwidth_hz: Option<Spanned<toml::Value>>,

@@ -1,0 +1,219 @@
+//! An external mux in front of a converter's own (`front_mux`,
+//! `front_input`): what the mix means, and the refusals in the user's words.
+
+use super::*;
+use crate::synthesize;
+
+const AD: &str = r#"
+name = "t"
+[clock]
+hz = 40_000_000
+[frame]
+period_us = 1_000
+slice_us = 1_000
+[[branch]]
+name = "a"
+adc = "ad7689"
+mux = "internal"
+front_mux = "tmux1108"
+front_mux_devices = 2
+settle_ns = 1_000
+[[channel]]
+name = "F{0..9}"
+branch = "a"
+rate_hz = 1_000
+input = 4
+front_input = 5
+[[channel]]
+name = "S"
+branch = "a"
+rate_hz = 2_000
+input = 1
+"#;
+
+fn err(text: &str) -> MixError {
+    parse(Path::new("m.toml"), text).unwrap_err()
+}
+
+fn line_of(text: &str, needle: &str) -> usize {
+    text[..text.find(needle).unwrap()].lines().count() + 1
+}
+
+/// A bulk block behind a front mux counts its front inputs (the converter
+/// input stays); the schedule's pins address the front input, the words
+/// select the converter's.
+#[test]
+fn a_front_mux_drives_the_pins_and_the_word_selects_the_converter_input() {
+    let m = parse(Path::new("m.toml"), AD).unwrap();
+    let b = &m.branches[0];
+    assert!(b.fronted && b.mux == crate::MuxPart::TMUX1108 && b.mux_devices == 2);
+    for k in 0..10 {
+        assert_eq!(
+            (m.channels[k].input, m.channels[k].front_input),
+            (4, Some(5 + k as u32))
+        );
+    }
+    assert_eq!(
+        (m.channels[10].input, m.channels[10].front_input),
+        (1, None)
+    );
+    let s = synthesize(&m).unwrap();
+    for (c, cs) in s.channels.iter().enumerate() {
+        assert_eq!(
+            cs.device * 8 + cs.select,
+            m.channels[c].front_input.unwrap_or(0)
+        );
+        assert_eq!(s.groups[c], vec![Some(c)], "one conversion per channel");
+    }
+    let sent = s.commands_in_frame(0);
+    assert_eq!(sent.len(), 12);
+    for w in &sent {
+        assert_eq!(w.input, m.channels[w.selects].input);
+    }
+}
+
+#[test]
+fn a_front_mux_is_refused_where_the_part_or_the_branch_does_not_permit_it() {
+    let cases: Vec<(String, &str, &str, &str)> = vec![
+        (
+            AD.replace("adc = \"ad7689\"", "adc = \"mcp3208\""),
+            "branch[0].front_mux",
+            "front_mux = ",
+            "samples its input inside the transaction",
+        ),
+        (
+            AD.replace(
+                "adc = \"ad7689\"\nmux = \"internal\"",
+                "adc = \"ad7940\"\nmux = \"tmux1108\"",
+            ),
+            "branch[0].front_mux",
+            "front_mux = ",
+            "it needs mux = \"internal\"",
+        ),
+        (
+            AD.replace("front_mux = \"tmux1108\"", "front_mux = \"tmux9\""),
+            "branch[0].front_mux",
+            "front_mux = ",
+            "unknown front mux `tmux9` (known: tmux1108)",
+        ),
+        (
+            AD.replace("front_mux_devices = 2", "front_mux_devices = 33"),
+            "branch[0].front_mux_devices",
+            "front_mux_devices",
+            "at most 32",
+        ),
+        (
+            AD.replace("front_mux = \"tmux1108\"\n", ""),
+            "branch[0].front_mux_devices",
+            "front_mux_devices",
+            "name it with front_mux",
+        ),
+        (
+            AD.replace("front_input = 5", "front_input = 12"),
+            "channel[0].front_input",
+            "front_input",
+            "front inputs 0..=15",
+        ),
+        (
+            AD.replace("input = 4\nfront_input", "front_input"),
+            "channel[0].front_input",
+            "front_input",
+            "with `input` as well",
+        ),
+        (
+            AD.replace("input = 1\n", "input = 4\n"),
+            "channel[1].input",
+            "input = 4\n\"",
+            "wired through the front mux (`F0` has front_input 5) and straight (`S` has none)",
+        ),
+        (
+            AD.replace("input = 1\n", "input = 4\nfront_input = 9\n"),
+            "channel[1].input",
+            "input = 4\nfront_input = 9",
+            "input 4 with front_input 9 of branch `a` is already taken by channel `F4`",
+        ),
+        (
+            AD.replace("input = 1\n", "input = 8\n"),
+            "channel[1].input",
+            "input = 8",
+            "converter `ad7689` has channels 0..=7",
+        ),
+    ];
+    for (text, field, at, says) in cases {
+        let e = err(&text);
+        assert_eq!(e.field, field, "{e}");
+        assert!(e.message.contains(says), "{e}");
+        if !at.ends_with('"') {
+            assert_eq!(e.line, line_of(&text, at), "{e}");
+        }
+    }
+    // front_input on a branch without a front mux
+    let plain = AD.replace("front_mux = \"tmux1108\"\nfront_mux_devices = 2\n", "");
+    let e = err(&plain);
+    assert_eq!(e.field, "channel[0].front_input", "{e}");
+    assert!(e.message.contains("has no front mux"), "{e}");
+}
+
+/// Random fronted mixes (a seed loop): every one that parses and
+/// schedules has its pins on the front input and its words on the
+/// converter's, and a straight channel never shares a converter input with a
+/// fronted one.
+#[test]
+fn random_fronted_mixes_keep_pins_and_words_apart() {
+    let mut state = 0x2545_f491_u64;
+    let mut next = |n: u64| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state % n
+    };
+    let mut scheduled = 0;
+    for _ in 0..40 {
+        let devices = 1 + next(3);
+        let mut t = format!(
+            "name = \"r\"\n[clock]\nhz = 40_000_000\n[frame]\nperiod_us = 2_000\nslice_us = 1_000\n\
+             [[branch]]\nname = \"a\"\nadc = \"ad7689\"\nmux = \"internal\"\nfront_mux = \"tmux1108\"\n\
+             front_mux_devices = {devices}\nsettle_ns = {}\n",
+            100 * next(20)
+        );
+        let fronted_input = next(8);
+        let n = 1 + next(6);
+        for k in 0..n {
+            let (input, front) = if k % 2 == 0 {
+                (
+                    fronted_input,
+                    format!("front_input = {}\n", next(8 * devices)),
+                )
+            } else {
+                ((fronted_input + 1 + k) % 8, String::new())
+            };
+            t += &format!(
+                "[[channel]]\nname = \"c{k}\"\nbranch = \"a\"\nrate_hz = {}\ninput = {input}\n{front}",
+                [500, 1_000, 2_000][next(3) as usize]
+            );
+        }
+        let Ok(m) = parse(Path::new("r.toml"), &t) else {
+            continue;
+        };
+        let s = synthesize(&m).unwrap();
+        scheduled += 1;
+        for (c, ch) in m.channels.iter().enumerate() {
+            let cs = &s.channels[c];
+            assert_eq!(
+                cs.device * 8 + cs.select,
+                ch.front_input.unwrap_or(0),
+                "{t}"
+            );
+            let straight = m
+                .channels
+                .iter()
+                .any(|o| o.input == ch.input && o.front_input.is_none());
+            assert!(!(straight && ch.front_input.is_some()), "{t}");
+        }
+        for w in s.commands_in_frame(0) {
+            assert_eq!(w.input, m.channels[w.selects].input, "{t}");
+        }
+        assert!(crate::validate(&s).is_ok(), "{t}");
+    }
+    assert!(scheduled >= 10, "only {scheduled} random mixes scheduled");
+}
