@@ -115,6 +115,9 @@ pub struct BranchRom {
     /// conversion's word selects (`Schedule::commands_in_frame`), under the
     /// same rule (the branch's first instant at slot `u` or later).
     pub command: Option<lut_gen::Command>,
+    /// A converter with a command word behind a front mux (`front_mux`):
+    /// the mux field is the front mux's, the words come from this table.
+    pub front: Option<FrontWords>,
     /// A mix with modes: every mode's table in `words` (the mode above the
     /// slot on the address, a `w` bit above each word), see `modeplan`.
     pub modes: Option<ModeRom>,
@@ -124,6 +127,14 @@ pub struct BranchRom {
     /// Per frame slot (full table): the word's channel field names a
     /// conversion (the branch's, or in the queue form its lane's).
     pub ch_used: Vec<bool>,
+}
+
+/// The inputs a fronted branch's words select, one per conversion of the
+/// frame in slot order, and the first one's index after reset.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FrontWords {
+    pub inputs: Vec<u32>,
+    pub first: u32,
 }
 
 impl BranchRom {
@@ -499,11 +510,10 @@ fn branch_rom(
     let cnv = adc.start == lut_gen::Start::Cnv;
     let spi = &bp.spi;
     check_spi(s, b, words)?;
-    if s.mix.branches[b].fronted {
-        // The ROM's mux field carries either the pins or the word's
-        // channel: a fronted branch needs both (not built yet).
+    let fronted = s.mix.branches[b].fronted;
+    if fronted && s.mix.modes.is_some() {
         return Err(unsupported(format!(
-            "branch {}: an external mux in front of the converter's own (front_mux) is not in the gateware yet",
+            "branch {}: a front mux (front_mux) in a mix with modes is not in the gateware",
             bp.name
         )));
     }
@@ -528,7 +538,11 @@ fn branch_rom(
         }
     };
     let slots: Vec<Option<usize>> = (0..g.frame_slots).map(|t| s.at(t, b)).collect();
-    for c in slots.iter().flatten().filter(|_| !s.has_command(b)) {
+    for c in slots
+        .iter()
+        .flatten()
+        .filter(|_| !s.has_command(b) || fronted)
+    {
         let ch = &s.channels[*c];
         if ch.select > 7 || ch.device as usize >= devices {
             return Err(unsupported(format!(
@@ -561,6 +575,7 @@ fn branch_rom(
         members,
         compact: None,
         command: adc.command.clone(),
+        front: front_words(s, b, &slots)?,
         modes: None,
         logic: None,
         ch_used: vec![],
@@ -575,10 +590,38 @@ fn branch_rom(
     Ok(rom)
 }
 
+/// A fronted branch's command unit: the input each of the frame's words
+/// selects, in instant order, and the instant its counter starts at after
+/// reset (1 when the instant at cycle 0 is skipped: docs/timing.md,
+/// "Start-up").  The mux field carries the front mux's pins, so the words
+/// need their own table; indexed by the branch's conversions in the frame,
+/// it is as long as the frame's words, not its slots.
+fn front_words(
+    s: &Schedule,
+    b: usize,
+    slots: &[Option<usize>],
+) -> Result<Option<FrontWords>, HdlError> {
+    if !s.mix.branches[b].fronted {
+        return Ok(None);
+    }
+    let inputs: Vec<u32> = s.commands_in_frame(b).iter().map(|w| w.input).collect();
+    if let Some(i) = inputs.iter().find(|&&i| i > 15) {
+        return Err(unsupported(format!(
+            "branch {}: its word selects input {i}: the gateware sends at most 4 channel bits",
+            s.branches[b].name
+        )));
+    }
+    let skipped = slots[0].is_some() && s.branches[b].settle_cycles > 1;
+    Ok(Some(FrontWords {
+        inputs,
+        first: skipped as u32,
+    }))
+}
+
 /// The mux field of each frame slot where branch `b` converts: the
-/// channel's (select, device), or for a converter with a command word the
-/// input its word selects (its low 3 bits as the select, bit 3 as the
-/// device).
+/// channel's (select, device), or for a converter with a command word and
+/// no front mux the input its word selects (its low 3 bits as the select,
+/// bit 3 as the device).
 fn mux_fields(
     s: &Schedule,
     b: usize,
@@ -588,6 +631,9 @@ fn mux_fields(
         .iter()
         .map(|c| c.map(|c| (s.channels[c].select, s.channels[c].device)))
         .collect();
+    if s.mix.branches[b].fronted {
+        return Ok(f);
+    }
     // inputs 0..=15 (`Command::parse` allows at most 4 channel bits): the
     // low 3 in the select field, the 4th in the device field (one bit for
     // a branch without mux devices, `BranchRom::dev_bits`)

@@ -73,7 +73,7 @@ pub(crate) fn part(s: &Schedule, b: usize, mosi_lane: u32, table: &str) -> Strin
         "    code{b} = pattern16(t{b}, id{b}) & 16'h{mask:x};\n{table}    n{b} = n{b} + 1;\n    stream{b} = {{{pad}{code}}} << {trailing};\n"
     );
     let pop = if cmd.ahead > 0 {
-        let mut p = format!("    id{b} = q{b}_0;\n");
+        let mut p = format!("    id{b} = q{b}_0;\n{}", front_case(s, b));
         for k in 1..cmd.ahead {
             let _ = writeln!(p, "    q{b}_{} = q{b}_{k};", k - 1);
         }
@@ -122,6 +122,41 @@ pub(crate) fn part(s: &Schedule, b: usize, mosi_lane: u32, table: &str) -> Strin
         "  always @({stop} {cs}[{b}]) if (!{rst}) begin\n{stop_body}  end\n  always @({shift} {sclk}[{b}]) if ({sel}) falls{b} = falls{b} + 1;\n\n"
     );
     t
+}
+
+/// `id<b>` of a word that selected converter input `i` wired to a front
+/// mux: `FRONT + i` until the conversion's start reads the front pins.
+const FRONT: u64 = 1 << 40;
+
+/// At a conversion's start, a fronted input's channel from the front mux's
+/// pins (one device enabled; anything else an unselected input, as
+/// judge::Adc has it); nothing for a branch without a front mux.
+fn front_case(s: &Schedule, b: usize) -> String {
+    if !s.mix.branches[b].fronted {
+        return String::new();
+    }
+    let l = lut_gen::Layout::new(s);
+    let (lo, n, sl) = (l.en_lo[b], l.en_n[b], l.sel_lo[b]);
+    let mut v = format!(
+        "    if (id{b} >= 64'd{FRONT}) case ({{id{b}[3:0], {en}[{}:{lo}], {sel}[{}:{sl}]}})\n",
+        lo + n - 1,
+        sl + 2,
+        en = Role::MuxEn.name(),
+        sel = Role::MuxSel.name(),
+    );
+    for (c, ch) in s.mix.channels.iter().enumerate() {
+        let Some(f) = ch.front_input.filter(|_| ch.branch == b) else {
+            continue;
+        };
+        let key = ((ch.input as u64) << (n + 3)) | (1u64 << (f / 8)) << 3 | (f % 8) as u64;
+        let _ = writeln!(v, "      {}'d{key}: id{b} = 64'd{c};", n + 7);
+    }
+    let _ = writeln!(
+        v,
+        "      default: id{b} = 64'd{};\n    endcase",
+        unselected(s, b)
+    );
+    v
 }
 
 /// The pipeline's queue (`ahead` > 0): the ids of the coming conversions,
@@ -177,13 +212,19 @@ fn select(s: &Schedule, b: usize, cmd: &Command, ind: &str) -> String {
         key.join(", ")
     );
     for input in 0..1u32 << w {
-        let ch = s
-            .mix
-            .channels
-            .iter()
-            .position(|c| c.branch == b && c.input == input);
-        if let Some(c) = ch {
-            let _ = writeln!(v, "{ind}  {w}'d{input}: id{b} = 64'd{c};");
+        let mut on = s.mix.channels.iter().enumerate();
+        let ch = on.find(|(_, c)| c.branch == b && c.input == input);
+        match ch {
+            // behind a front mux: settled by its pins at the conversion
+            Some((_, c)) if c.front_input.is_some() => {
+                let _ = writeln!(
+                    v,
+                    "{ind}  {w}'d{input}: id{b} = 64'd{};",
+                    FRONT + input as u64
+                );
+            }
+            Some((c, _)) => _ = writeln!(v, "{ind}  {w}'d{input}: id{b} = 64'd{c};"),
+            None => {}
         }
     }
     let _ = writeln!(v, "{ind}  default: id{b} = 64'd{un};\n{ind}endcase");

@@ -321,8 +321,12 @@ struct PartModel {
     groups: Vec<Vec<Option<usize>>>,
     chain: u32,
     command: Option<lut_gen::Command>,
-    /// Input of the converter's own multiplexer -> channel on this branch.
+    /// Input of the converter's own multiplexer -> channel on this branch
+    /// (wired straight).
     inputs: Vec<Option<u16>>,
+    /// Behind a front mux: per converter input wired to it, front input
+    /// (device * 8 + select) -> channel; empty for a straight input.
+    front: Vec<std::collections::BTreeMap<u32, u16>>,
 }
 
 /// The ADCs of all branches, at cycle level.
@@ -363,12 +367,16 @@ impl Adc {
                 chain: b.chain,
                 command: b.adc.command.clone(),
                 inputs: Vec::new(),
+                front: Vec::new(),
             })
             .collect();
         let mut parts = parts;
         let layout = Layout::new(s);
         for (b, pm) in parts.iter_mut().enumerate() {
             pm.inputs = layout.lookup[b].clone();
+            if s.mix.branches[b].fronted {
+                (pm.inputs, pm.front) = Self::fronted_inputs(s, b);
+            }
         }
         let st: Vec<AdcState> = parts
             .iter()
@@ -432,7 +440,10 @@ impl Adc {
                 Self::end_of_read(pm, st);
             }
             if fell_cs & bit != 0 && pm.command.is_some() {
-                Self::start_commanded(&self.analog, pm, st, cycle, b);
+                let en = self.layout.en(p, b);
+                let pin = (!pm.front.is_empty() && en.count_ones() == 1)
+                    .then(|| en.trailing_zeros() * 8 + self.layout.sel(p, b));
+                Self::start_commanded(&self.analog, pm, st, (cycle, b), pin);
             } else if fell_cs & bit != 0 {
                 let id = self.analog.input_id(&self.layout, p, b);
                 st.stream = 0;
@@ -480,6 +491,28 @@ impl Adc {
         miso
     }
 
+    /// A fronted branch's channels by converter input: wired straight, and
+    /// through the front mux by its input.
+    #[allow(clippy::type_complexity)]
+    fn fronted_inputs(
+        s: &Schedule,
+        b: usize,
+    ) -> (Vec<Option<u16>>, Vec<std::collections::BTreeMap<u32, u16>>) {
+        let n = s.mix.branches[b].input_capacity() as usize;
+        let mut straight = vec![None; n];
+        let mut front = vec![std::collections::BTreeMap::new(); n];
+        for (c, ch) in s.mix.channels.iter().enumerate() {
+            if ch.branch != b || ch.input as usize >= n {
+                continue;
+            }
+            match ch.front_input {
+                Some(f) => _ = front[ch.input as usize].insert(f, c as u16),
+                None => straight[ch.input as usize] = Some(c as u16),
+            }
+        }
+        (straight, front)
+    }
+
     /// An id no channel has: the converter's input when no word of ours
     /// selected one (branch `b`).
     fn unselected(analog: &Analog, b: usize) -> u64 {
@@ -493,15 +526,31 @@ impl Adc {
         st.stream = code << trailing;
     }
 
-    /// The id of the channel on input `input` of the part's multiplexer.
-    fn id_of(analog: &Analog, pm: &PartModel, input: Option<u32>, b: usize) -> u64 {
-        input
-            .and_then(|i| pm.inputs.get(i as usize).copied().flatten())
-            .map_or(Self::unselected(analog, b), |c| c as u64)
+    /// The id of the channel on input `input` of the part's multiplexer;
+    /// an input wired to a front mux converts the channel on the front
+    /// input `pin` its pins address at the sampling instant.
+    fn id_of(
+        analog: &Analog,
+        pm: &PartModel,
+        input: Option<u32>,
+        b: usize,
+        pin: Option<u32>,
+    ) -> u64 {
+        let ch = input.and_then(|i| match pm.front.get(i as usize) {
+            Some(f) if !f.is_empty() => pin.and_then(|p| f.get(&p).copied()),
+            _ => pm.inputs.get(i as usize).copied().flatten(),
+        });
+        ch.map_or(Self::unselected(analog, b), |c| c as u64)
     }
 
     /// A conversion of a part with a command word starts at `cycle`.
-    fn start_commanded(analog: &Analog, pm: &PartModel, st: &mut AdcState, cycle: u64, b: usize) {
+    fn start_commanded(
+        analog: &Analog,
+        pm: &PartModel,
+        st: &mut AdcState,
+        (cycle, b): (u64, usize),
+        pin: Option<u32>,
+    ) {
         st.t = cycle;
         st.len = pm.word_sclks;
         st.falls = 0;
@@ -510,7 +559,7 @@ impl Adc {
         st.stream = 0;
         if pm.command.as_ref().is_some_and(|c| c.ahead > 0) {
             let input = st.queue.pop_front().flatten();
-            Self::fill(analog, pm, st, Self::id_of(analog, pm, input, b));
+            Self::fill(analog, pm, st, Self::id_of(analog, pm, input, b, pin));
         }
     }
 
@@ -522,7 +571,7 @@ impl Adc {
         st.nin += 1;
         if cmd.ahead == 0 && st.nin as usize == cmd.bits.len() {
             let input = cmd.channel_of(&Self::word(st));
-            Self::fill(analog, pm, st, Self::id_of(analog, pm, input, b));
+            Self::fill(analog, pm, st, Self::id_of(analog, pm, input, b, None));
         }
     }
 

@@ -828,7 +828,7 @@ impl Checker {
             );
         }
         if self.cmds[b].is_some() {
-            self.cs_fall_commanded(b, c);
+            self.cs_fall_commanded(b, c, p, xz);
             return;
         }
         let sel_x = self.layout.sel(xz, b) != 0 || self.layout.en(xz, b) != 0;
@@ -881,8 +881,9 @@ impl Checker {
     /// one its command word selected (docs/timing.md, "Command words"), not
     /// the mux pins' (it has none); a part that converts in the same read
     /// holds the instant until the word is in.
-    fn cs_fall_commanded(&mut self, b: usize, c: u64) {
-        let sel = self.cmds[b].as_mut().and_then(|r| r.start(c));
+    fn cs_fall_commanded(&mut self, b: usize, c: u64, p: &Pins, xz: &Pins) {
+        let pin = self.front_pin(b, c, p, xz);
+        let sel = self.cmds[b].as_mut().and_then(|r| r.start(c, pin));
         let st = &mut self.br[b];
         st.low = true;
         st.t = c;
@@ -897,6 +898,34 @@ impl Checker {
             None => self.held.push_back((c, b, None, true)),
             Some(sel) => self.selected(b, c, sel),
         }
+    }
+
+    /// A fronted branch's front mux input at its sampling instant `c`
+    /// (device * 8 + select), held to the mux rules of an external-mux
+    /// branch (one device enabled, settled); `None` on a branch without one.
+    fn front_pin(&mut self, b: usize, c: u64, p: &Pins, xz: &Pins) -> Option<u32> {
+        if !self.cmds[b].as_ref().is_some_and(CommandRead::fronted) {
+            return None;
+        }
+        if self.layout.sel(xz, b) != 0 || self.layout.en(xz, b) != 0 {
+            self.mux_settle(b, c, None);
+            return None;
+        }
+        let en = self.layout.en(p, b);
+        if en.count_ones() != 1 {
+            self.inv.record(
+                Violation::new(Rule::MuxSelect, c)
+                    .signal(Signal::MuxEn(b).name(&self.layout))
+                    .actual(json!(en))
+                    .detail(
+                        "at the sampling instant: not one front mux device enabled".to_string(),
+                    ),
+            );
+            return None;
+        }
+        let pin = en.trailing_zeros() * 8 + self.layout.sel(p, b);
+        self.mux_settle(b, c, None);
+        Some(pin)
     }
 
     /// Branch `b`'s conversion at `t` converts what `sel` says.

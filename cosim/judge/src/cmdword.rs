@@ -6,7 +6,7 @@
 //! channel each conversion converted, so a sample can be held to the channel
 //! its command selected, not to the one the design claims.
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 
 use lut_gen::{Command, Schedule};
 
@@ -39,11 +39,20 @@ pub(crate) struct CommandRead {
     cmd: Command,
     /// The channel on each input of the converter's own multiplexer.
     inputs: Vec<Option<u16>>,
+    /// Behind a front mux (`front_mux`): per converter input wired to it,
+    /// the channel on each front input (device * 8 + select); empty for an
+    /// input wired straight.  Such a conversion converts the channel of the
+    /// input its word selected AND the front pins at its sampling instant.
+    front: Vec<BTreeMap<u32, u16>>,
+    /// The front mux's input the pins addressed at the conversion's start.
+    pin: Option<u32>,
     /// DIN bits latched in the conversion in progress (first first), and its start.
     din: Vec<bool>,
     t: u64,
-    /// What the coming conversions convert (a pipelined part: `ahead` long).
-    queue: VecDeque<Selected>,
+    /// What the coming conversions convert (a pipelined part: `ahead`
+    /// long), and the converter input the word selected (the front pins
+    /// at the conversion settle the channel of a fronted one).
+    queue: VecDeque<(Selected, Option<u32>)>,
 }
 
 impl CommandRead {
@@ -51,15 +60,21 @@ impl CommandRead {
     pub fn new(s: &Schedule, b: usize) -> Option<CommandRead> {
         let cmd = s.mix.branches[b].adc.command.clone()?;
         let mut inputs = vec![None; cmd.channels() as usize];
+        let mut front = vec![BTreeMap::new(); inputs.len()];
         for (c, ch) in s.mix.channels.iter().enumerate() {
             if ch.branch == b && (ch.input as usize) < inputs.len() {
-                inputs[ch.input as usize] = Some(c as u16);
+                match ch.front_input {
+                    Some(f) => _ = front[ch.input as usize].insert(f, c as u16),
+                    None => inputs[ch.input as usize] = Some(c as u16),
+                }
             }
         }
-        let queue = std::iter::repeat_n(Selected::Prepared, cmd.ahead as usize).collect();
+        let queue = std::iter::repeat_n((Selected::Prepared, None), cmd.ahead as usize).collect();
         Some(CommandRead {
             cmd,
             inputs,
+            front,
+            pin: None,
             din: Vec::new(),
             t: 0,
             queue,
@@ -68,7 +83,7 @@ impl CommandRead {
 
     /// A check that joins mid-stream: the words in flight were not seen.
     pub fn join(&mut self) {
-        self.queue.iter_mut().for_each(|q| *q = Selected::Unknown);
+        self.queue.iter_mut().for_each(|q| q.0 = Selected::Unknown);
         self.t = u64::MAX;
     }
 
@@ -77,12 +92,40 @@ impl CommandRead {
         self.cmd.bits.len()
     }
 
-    /// A conversion begins at `c`: what it converts, if its word came
-    /// earlier (a pipelined part), else `None` (the word is in this read).
-    pub fn start(&mut self, c: u64) -> Option<Selected> {
+    /// Whether some input is wired through a front mux (the branch's mux
+    /// pins are then the front mux's).
+    pub fn fronted(&self) -> bool {
+        self.front.iter().any(|f| !f.is_empty())
+    }
+
+    /// A conversion begins at `c` with the front mux's pins on input `pin`
+    /// (`None`: no front mux, or not one device enabled): what it converts,
+    /// if its word came earlier (a pipelined part), else `None` (the word is
+    /// in this read).
+    pub fn start(&mut self, c: u64, pin: Option<u32>) -> Option<Selected> {
         self.din.clear();
         self.t = c;
-        (self.cmd.ahead > 0).then(|| self.queue.pop_front().unwrap_or(Selected::Unknown))
+        self.pin = pin;
+        if self.cmd.ahead == 0 {
+            return None;
+        }
+        let (sel, input) = self.queue.pop_front().unwrap_or((Selected::Unknown, None));
+        Some(match (sel, input) {
+            (Selected::Word { sent_at, .. }, Some(i)) => Selected::Word {
+                sent_at,
+                channel: self.channel_on(i),
+            },
+            (sel, _) => sel,
+        })
+    }
+
+    /// The channel on converter input `i` under the front pins of this
+    /// conversion.
+    fn channel_on(&self, i: u32) -> Option<u16> {
+        match self.front.get(i as usize) {
+            Some(f) if !f.is_empty() => self.pin.and_then(|p| f.get(&p).copied()),
+            _ => self.inputs.get(i as usize).copied().flatten(),
+        }
     }
 
     /// DIN `v` latched at a rising edge of the serial clock; once the word
@@ -98,7 +141,10 @@ impl CommandRead {
     pub fn end(&mut self) -> Option<Selected> {
         let sel = self.selected();
         if self.cmd.ahead > 0 {
-            self.queue.push_back(sel);
+            let input = (self.t != u64::MAX)
+                .then(|| self.cmd.channel_of(&self.din))
+                .flatten();
+            self.queue.push_back((sel, input));
             return None;
         }
         (self.din.len() < self.len()).then_some(sel)
@@ -112,7 +158,7 @@ impl CommandRead {
         let channel = self
             .cmd
             .channel_of(&self.din)
-            .and_then(|i| self.inputs.get(i as usize).copied().flatten());
+            .and_then(|i| self.channel_on(i));
         Selected::Word {
             sent_at: self.t,
             channel,
@@ -143,7 +189,10 @@ impl CommandRead {
                     "a fixed bit differs from the part's word {}",
                     self.cmd.template()
                 ),
-                Some(i) if self.inputs.get(i as usize).copied().flatten().is_none() => {
+                Some(i)
+                    if self.inputs.get(i as usize).copied().flatten().is_none()
+                        && self.front.get(i as usize).is_none_or(|f| f.is_empty()) =>
+                {
                     format!("it selects input {i}, where the branch has no channel")
                 }
                 Some(_) => return None,

@@ -8,6 +8,8 @@ use rust_hdl::prelude::*;
 
 use lut_gen::{CmdBit, Command};
 
+use crate::plan::FrontWords;
+
 /// One per branch whose converter takes a command word (none in a mix
 /// without one, so the other mixes' Verilog has no trace of it).  Custom
 /// Verilog, like the word reader, so the word register is exactly the
@@ -53,6 +55,9 @@ pub struct CmdUnit {
     _held: bool,
     _setup: u64,
     _branch: usize,
+    /// Behind a front mux: the words' inputs by conversion (`sel`/`hi`
+    /// then carry the front mux's pins and are not read).
+    _front: Option<FrontWords>,
     /// The twin's registers: the word still to send (bit 0 next), the
     /// lane, the CNV first-period counter, the prepared conversions left.
     _sh: u64,
@@ -62,10 +67,28 @@ pub struct CmdUnit {
     /// Read with CNV low: the branch converts in this slot (its pin was
     /// active at the slot start).
     _conv: bool,
+    /// Behind a front mux: the conversion of the frame whose word is next.
+    _k: u64,
+}
+
+/// How a command unit is wired: its part's pin style and its branch.
+pub(super) struct CmdWiring {
+    pub cnv: bool,
+    pub held: bool,
+    pub setup: u64,
+    pub branch: usize,
+    pub front: Option<FrontWords>,
 }
 
 impl CmdUnit {
-    pub(super) fn new(cmd: &Command, cnv: bool, held: bool, setup: u64, branch: usize) -> CmdUnit {
+    pub(super) fn new(cmd: &Command, w: CmdWiring) -> CmdUnit {
+        let CmdWiring {
+            cnv,
+            held,
+            setup,
+            branch,
+            front,
+        } = w;
         CmdUnit {
             clock: Default::default(),
             rst: Default::default(),
@@ -85,6 +108,8 @@ impl CmdUnit {
             _held: held,
             _setup: setup,
             _branch: branch,
+            _k: front.as_ref().map_or(0, |f| f.first as u64),
+            _front: front,
             _sh: 0,
             _mosi: false,
             _cnt: 0,
@@ -95,7 +120,10 @@ impl CmdUnit {
 
     /// The word for input `sel` (bit 3 from `hi`), bit `k` = the `k`-th bit sent.
     fn word(&self, sel: u64) -> u64 {
-        let sel = sel | (self.hi.val() as u64) << 3;
+        let sel = match &self._front {
+            Some(f) => f.inputs[self._k as usize] as u64,
+            None => sel | (self.hi.val() as u64) << 3,
+        };
         self._bits.iter().enumerate().fold(0, |w, (k, b)| {
             let v = match *b {
                 CmdBit::Zero => 0,
@@ -163,6 +191,13 @@ impl Logic for CmdUnit {
             if self.start0.val() {
                 self._conv = self.pin.val();
             }
+            if let Some(f) = &self._front {
+                if self.rst.val() {
+                    self._k = f.first as u64;
+                } else if self.start0.val() && self.pin.val() == self._cnv {
+                    self._k = (self._k + 1) % f.inputs.len() as u64;
+                }
+            }
             if self.rst.val() {
                 self._prep = self._ahead;
             } else if self.done.val() && self._prep != 0 {
@@ -197,16 +232,19 @@ impl CmdUnit {
             "// branch {}: command word {tmpl} (first bit first) on the MOSI lane, selecting the conversion {} later",
             self._branch, self._ahead
         );
+        let front = self.front_table(&mut s);
         let bits: Vec<String> = (self._bits.iter().rev())
             .map(|b| match *b {
                 CmdBit::Zero => "1'b0".to_string(),
                 CmdBit::One => "1'b1".to_string(),
+                CmdBit::Channel(j) if front => format!("chn[{j}]"),
                 CmdBit::Channel(3) => "hi".to_string(),
                 CmdBit::Channel(j) => format!("sel[{j}]"),
             })
             .collect();
         let _ = writeln!(s, "wire [{}:0] word = {{{}}};", l - 1, bits.join(", "));
         let unused: Vec<String> = (0..4u8)
+            .filter(|_| !front)
             .filter(|j| !self._bits.contains(&CmdBit::Channel(*j)))
             .map(|j| match j {
                 3 => "hi".to_string(),
@@ -258,6 +296,60 @@ impl CmdUnit {
             self.live_expr()
         );
         s
+    }
+
+    /// Behind a front mux (`sel`, `hi`: the front mux's pins, unread): the
+    /// conversion counter and the input its word selects (`chn`).  Whether
+    /// there is one.
+    fn front_table(&self, s: &mut String) -> bool {
+        let Some(f) = &self._front else {
+            return false;
+        };
+        let n = f.inputs.len() as u64;
+        let kw = (64 - (n - 1).leading_zeros()).max(1) as usize;
+        let cw = self._bits.iter().filter_map(|b| match b {
+            CmdBit::Channel(j) => Some(*j as usize + 1),
+            _ => None,
+        });
+        let cw = cw.max().unwrap_or(1);
+        let act = if self._cnv { "pin" } else { "~pin" };
+        let _ = writeln!(
+            s,
+            "// behind a front mux (its pins on sel/hi): the input each of the frame's {n} words selects, by conversion
+wire unused_sel = |{{sel, hi}};"
+        );
+        let _ = writeln!(
+            s,
+            "reg [{}:0] k;
+initial k = {kw}'d{};",
+            kw - 1,
+            f.first
+        );
+        let _ = writeln!(s, "always @(posedge clock) begin");
+        let _ = writeln!(s, "  if (rst) k <= {kw}'d{};", f.first);
+        let _ = writeln!(
+            s,
+            "  else if (start0 & {act}) k <= (k == {kw}'d{}) ? {kw}'d0 : k + {kw}'d1;",
+            n - 1
+        );
+        let _ = writeln!(s, "end");
+        let _ = writeln!(
+            s,
+            "reg [{}:0] chn;
+always @(*) begin
+  case (k)",
+            cw - 1
+        );
+        for (i, v) in f.inputs.iter().enumerate() {
+            let _ = writeln!(s, "    {kw}'d{i}: chn = {cw}'d{v};");
+        }
+        let _ = writeln!(
+            s,
+            "    default: chn = {cw}'d0;
+  endcase
+end"
+        );
+        true
     }
 
     /// The CNV part's first period (no falling edge): ` | first` and its

@@ -63,6 +63,7 @@ fn rom() -> BranchRom {
         members: vec![],
         compact: None,
         command: None,
+        front: None,
         modes: None,
         logic: None,
         ch_used: vec![],

@@ -70,7 +70,14 @@ impl Core {
                 cmd_of[b] = Some(cmds.len());
                 let setup = plan.seqs[r.seq].setup_cycles;
                 let held = !plan.seqs[r.seq].pulsed();
-                cmds.push(CmdUnit::new(c, r.cnv, held, setup, b));
+                let w = super::command::CmdWiring {
+                    cnv: r.cnv,
+                    held,
+                    setup,
+                    branch: b,
+                    front: r.front.clone(),
+                };
+                cmds.push(CmdUnit::new(c, w));
             }
         }
         Core {
