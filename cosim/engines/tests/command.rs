@@ -10,7 +10,7 @@ use lut_gen::{Pins, Schedule};
 
 use crate::tools;
 
-fn schedule(name: &str) -> Schedule {
+pub(crate) fn schedule(name: &str) -> Schedule {
     lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap()
 }
 
@@ -71,7 +71,11 @@ fn random_mix(seed: u64) -> Schedule {
 /// The first cycle at which `dut`'s pins differ from the model's, in
 /// `frames` frames under the ADC model (fed the DUT's pins); the number of
 /// samples and of `adc_mosi` high cycles seen.
-fn first_difference<D: Dut>(s: &Schedule, dut: &mut D, frames: u64) -> (Option<String>, u64, u64) {
+pub(crate) fn first_difference<D: Dut>(
+    s: &Schedule,
+    dut: &mut D,
+    frames: u64,
+) -> (Option<String>, u64, u64) {
     let mut model = ModelDut::new(s);
     let mut adc = Adc::new(s, Stimulus::Pattern);
     let mut miso = (1u64 << s.branches.len()) - 1;
@@ -122,7 +126,7 @@ fn differing(a: &Pins, b: &Pins) -> Vec<&'static str> {
     v
 }
 
-fn assert_same<D: Dut>(what: &str, s: &Schedule, dut: &mut D, frames: u64) {
+pub(crate) fn assert_same<D: Dut>(what: &str, s: &Schedule, dut: &mut D, frames: u64) {
     let (diff, samples, mosi) = first_difference(s, dut, frames);
     if let Some(e) = diff {
         panic!("{what}: {e}");
@@ -177,17 +181,17 @@ fn verilator_drives_the_command_words() {
 /// Steps the judge's cycle model beside a back end's run (each cycle's
 /// pins as the engine or its VCD gives them) and keeps the first
 /// difference: the comparison without the checker.
-struct BesideModel {
+pub(crate) struct BesideModel {
     model: ModelDut,
     miso: u64,
-    cycles: u64,
-    samples: u64,
-    mosi: u64,
-    diff: Option<String>,
+    pub(crate) cycles: u64,
+    pub(crate) samples: u64,
+    pub(crate) mosi: u64,
+    pub(crate) diff: Option<String>,
 }
 
 impl BesideModel {
-    fn new(s: &Schedule) -> BesideModel {
+    pub(crate) fn new(s: &Schedule) -> BesideModel {
         BesideModel {
             model: ModelDut::new(s),
             miso: (1u64 << s.branches.len()) - 1,
@@ -263,7 +267,7 @@ fn icarus_testbench_converts_what_the_words_select() {
 
 /// Runs the Icarus testbench (`engines::icarus_testbench`, the back end's
 /// own) on the emitted Verilog and hands every cycle of its VCD to `sink`.
-fn icarus_beside(
+pub(crate) fn icarus_beside(
     s: &Schedule,
     design: Option<&str>,
     stimulus: Stimulus,

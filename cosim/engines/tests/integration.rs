@@ -7,6 +7,9 @@ mod backends;
 #[path = "command.rs"]
 mod command;
 
+#[path = "front.rs"]
+mod front;
+
 #[path = "icarus.rs"]
 mod icarus;
 
