@@ -1105,3 +1105,113 @@ fn a_vcd_with_mode_switches_passes_check_and_fails_with_a_request_removed() {
         .code(1)
         .stdout(predicate::str::contains("mode-decision"));
 }
+
+/// An external mux in front of the AD7689's own (`testkit` mix
+/// `cmd-front`): the Verilator run's VCD passes `check` with and without the
+/// model; the emitted Verilog with the front select's bit 0 inverted fails
+/// with the model at cycle 0 on `mux_sel` (the reset value is already
+/// wrong), and without it at the first fronted conversion it moves onto
+/// another channel's front input: the sample claims the schedule's channel,
+/// the word and the front pins at the instant selected the other one.
+#[test]
+fn a_fronted_mix_passes_check_and_a_wrong_front_select_fails_at_its_cycle() {
+    if !tools::require_tools(&["verilator", "g++"]) {
+        return;
+    }
+    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("testkit/mixes/cmd-front.toml");
+    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    let d = tempfile::tempdir().unwrap();
+    let run = |rtl: Option<&Path>, vcd: &Path| {
+        let mut c = slotforge();
+        c.args([
+            "sim",
+            "--quiet",
+            "--backend",
+            "verilator",
+            "--frames",
+            "2",
+            "--vcd",
+        ])
+        .arg(vcd);
+        if let Some(r) = rtl {
+            c.arg("--rtl").arg(r);
+        }
+        c.arg(&mix).assert()
+    };
+    let check = |wave: &Path, extra: &[&str]| {
+        let a = slotforge()
+            .args(["check", "--json"])
+            .args(extra)
+            .arg(&mix)
+            .arg(wave)
+            .assert();
+        let out = a.get_output().stdout.clone();
+        (
+            a,
+            serde_json::from_slice::<serde_json::Value>(&out).unwrap(),
+        )
+    };
+    let good = d.path().join("good.vcd");
+    run(None, &good).success();
+    for extra in [&[][..], &["--no-model"]] {
+        let (a, v) = check(&good, extra);
+        a.success();
+        assert!(v["samples"].as_u64().unwrap() > 20, "{v}");
+    }
+    let out = d.path().join("v");
+    slotforge()
+        .arg("verilog")
+        .arg(&mix)
+        .arg("-o")
+        .arg(&out)
+        .assert()
+        .success();
+    let text = std::fs::read_to_string(out.join("slotforge_top.v")).unwrap();
+    let line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("assign mux_sel = core_mux_sel["))
+        .unwrap();
+    let bad_rtl = d.path().join("bad.v");
+    std::fs::write(
+        &bad_rtl,
+        text.replacen(line, &line.replace(";", " ^ 6'd1;"), 1),
+    )
+    .unwrap();
+    let bad = d.path().join("bad.vcd");
+    run(Some(&bad_rtl), &bad).code(1);
+    let (a, v) = check(&bad, &[]);
+    a.code(1);
+    assert_eq!(v["divergences"][0]["cycle"], 0, "{v}");
+    assert!(
+        v["divergences"][0]["signal"]
+            .as_str()
+            .unwrap()
+            .starts_with("mux_sel"),
+        "{v}"
+    );
+    let (a, v) = check(&bad, &["--no-model"]);
+    a.code(1);
+    let first = &v["violations"][0];
+    assert_eq!(first["rule"], "command-channel", "{v}");
+    // The schedule's first data conversion of branch cfg (0; past an
+    // instant at cycle 0 the mux cannot have settled for, and the prepared
+    // ones) whose front input with bit 0 inverted is another channel's on
+    // the same converter input.
+    let g = &s.grid;
+    let m = &s.mix;
+    let convs = (0..g.frame_slots).filter_map(|u| s.at(u, 0).map(|c| (u, c)));
+    let skipped = (s.at(0, 0).is_some() && s.branches[0].settle_cycles > 1) as usize;
+    let mut data = convs.skip(skipped + s.prepared_conversions(0) as usize);
+    let moved = data.find_map(|(u, c)| {
+        let f = m.channels[c].front_input? ^ 1;
+        let on = |o: &lut_gen::Channel| o.input == m.channels[c].input && o.front_input == Some(f);
+        Some((u * g.slot_cycles, m.channels.iter().position(on)?))
+    });
+    let (instant, other) = moved.unwrap();
+    let cycle = first["cycle"].as_u64().unwrap();
+    assert!(
+        cycle > instant && cycle < instant + g.slot_cycles,
+        "{first} vs instant {instant}"
+    );
+    assert_eq!(first["channel"], m.channels[other].name.as_str(), "{first}");
+}

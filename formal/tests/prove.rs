@@ -947,3 +947,41 @@ fn unseen_random_mixes_with_command_words_prove() {
     }
     assert_eq!(proved, 2, "too few feasible commanded random mixes");
 }
+
+/// External muxes in front of converters with their own (`testkit` mix
+/// `cmd-front`: an AD7689 behind two TMUX1108s, a declared ADS7953-like
+/// part behind one, an MCP3208 without): the harness asserts the front
+/// mux's pins as an external-mux branch's and the words bit for bit, and
+/// the gateware proves; with the wrapper's select bit 0 inverted it fails on
+/// the fronted branch's mux.
+#[test]
+fn a_fronted_mix_proves_and_a_wrong_front_select_fails_on_its_mux() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/cmd-front.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    for name in ["mux[cfg]", "mosi[cfg]", "mux[ads]", "mosi[ads]"] {
+        assert!(
+            (p.properties.iter()).any(|q| q.name == name && q.result == Outcome::Proved),
+            "{name}: {}",
+            p.summary()
+        );
+    }
+    let good = emitted(&s);
+    let line = good
+        .lines()
+        .find(|l| l.trim_start().starts_with("assign mux_sel = core_mux_sel["))
+        .unwrap();
+    let bad = edit(&good, line, &line.replace(';', " ^ 6'd1;"));
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &bad, dir.path());
+    assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
+    let failed: Vec<&str> = (p.properties.iter())
+        .filter(|q| q.result == Outcome::Failed)
+        .map(|q| q.name.as_str())
+        .collect();
+    assert!(failed.contains(&"mux[cfg]"), "{}", p.summary());
+}
