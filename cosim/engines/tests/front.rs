@@ -48,16 +48,14 @@ pub(crate) fn random_fronted(seed: u64) -> Schedule {
         t += "[[branch]]\nname = \"e\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n";
     }
     let fronted: Vec<u64> = vec![r.next(4), 4 + r.next(4)][..1 + r.next(2) as usize].to_vec();
-    let mut n = 0;
     let mut fronts: Vec<u64> = (0..8 * devices).collect();
-    for _ in 0..2 + r.next(4) {
+    for n in 0..2 + r.next(4) {
         let input = fronted[r.next(fronted.len() as u64) as usize];
         let f = fronts.remove(r.next(fronts.len() as u64) as usize);
         let rate = [1000, 2000, 4000][r.next(3) as usize];
         t += &format!(
             "[[channel]]\nname = \"c{n}\"\nbranch = \"f\"\nrate_hz = {rate}\ninput = {input}\nfront_input = {f}\n"
         );
-        n += 1;
     }
     let straight: Vec<u64> = (0..8).filter(|i| !fronted.contains(i)).collect();
     for k in 0..r.next(3) {
