@@ -153,6 +153,7 @@ pub struct Branch {
     /// `mux = "internal"` with `front_mux`: the converter selects among its
     /// inputs with its command word and `mux` (`mux_devices` devices) is
     /// wired in front of some of them (`Channel::front_input`).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub fronted: bool,
     pub settle_ns: u64,
     /// Parts of `adc` daisy-chained on this branch's port (1: no chain).
