@@ -117,7 +117,7 @@ impl Clause {
                 Layout::new(s).mosi_lo[b].unwrap_or_default()
             ),
             Clause::CommandEffect(b) => format!(
-                "that branch {}'s {} converts the input each word selects ({}): the part's own \
+                "that branch {}'s {} converts the input each word selects ({}){}: the part's own \
                  behaviour; adc_miso is free in the proof, so any code it returns is taken as \
                  the channel the schedule names",
                 name(b),
@@ -125,6 +125,10 @@ impl Clause {
                 match s.prepared_conversions(b) {
                     0 => "in the same conversion".to_string(),
                     n => format!("{n} conversions later"),
+                },
+                match s.mix.branches[b].fronted {
+                    true => ", behind the front mux input its pins address at the instant",
+                    false => "",
                 }
             ),
             Clause::StreamValid => "sample_valid: one strobe per converted word".into(),
