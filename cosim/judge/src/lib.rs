@@ -59,6 +59,7 @@ pub mod switch;
 mod timed;
 mod timedaxis;
 mod timedlink;
+mod timedmodes;
 pub mod tools;
 mod vcd;
 mod vcdlex;
@@ -96,6 +97,7 @@ pub use vcdout::{channels_path, edge_ps, id_code, wire_header, write_gtkw, write
 // Logic-analyser captures, judged at time level.
 pub use capture::{parse_map, read as read_capture, read_progress as read_capture_progress};
 pub use timed::{check_capture, check_capture_with, LineJoin, TimedReport};
+pub use timedmodes::ModesSeen;
 
 // Logs: a run's pins as events (golden tests), its samples as CSV, the
 // bytes its link carried.
