@@ -20,20 +20,21 @@ use crate::link_windows::rng;
 const SEL: u32 = 200;
 const MODE: u32 = 300;
 
+/// Every cycle's pins and MISO (bit b: branch b) after reset.
 #[derive(Default)]
-struct Rec(Vec<Pins>);
+struct Rec(Vec<(Pins, u64)>);
 
 impl Observer for Rec {
-    fn cycle(&mut self, _: u64, rst: bool, p: &Pins, _: u64) {
+    fn cycle(&mut self, _: u64, rst: bool, p: &Pins, miso: u64) {
         if !rst {
-            self.0.push(*p);
+            self.0.push((*p, miso));
         }
     }
 }
 
 /// Every cycle's pins of `frames` frames of rust-hdl's gateware, `mode_sel`
 /// driven by `requests` (frame, mode), the ADC by `stimulus`.
-fn pins(s: &Schedule, frames: u64, requests: &[(u64, u8)], stimulus: &str) -> Vec<Pins> {
+fn pins(s: &Schedule, frames: u64, requests: &[(u64, u8)], stimulus: &str) -> Vec<(Pins, u64)> {
     let dut = engines::RustHdlDut::new(s).expect("rust-hdl builds");
     let mut dut = ModeRequests::new(s, dut, requests);
     let opts = RunOptions {
@@ -45,11 +46,12 @@ fn pins(s: &Schedule, frames: u64, requests: &[(u64, u8)], stimulus: &str) -> Ve
     r.0
 }
 
-/// The core's timing lanes (no link: judged elsewhere) and the mode ports
-/// asked for, with the `--map` naming them.
+/// The core's timing lanes (no link: judged elsewhere), every MISO bit
+/// and the mode ports asked for, with the `--map` naming them.
 fn lanes(s: &Schedule, sel: bool, mode: bool) -> (Vec<(Option<Role>, u32)>, String) {
     let (all, _) = analyser::lanes(s);
     let mut v: Vec<_> = all.into_iter().filter(|l| l.0.is_some()).collect();
+    v.extend((0..s.mix.branches.len() as u32).map(|b| (Some(Role::Miso), b)));
     let bits = Layout::new(s).mode_bits;
     for (on, base) in [(sel, SEL), (mode, MODE)] {
         if on {
@@ -67,8 +69,9 @@ fn lanes(s: &Schedule, sel: bool, mode: bool) -> (Vec<(Option<Role>, u32)>, Stri
     (v, map)
 }
 
-fn level(p: &Pins, r: Option<Role>, b: u32) -> bool {
+fn level(&(ref p, miso): &(Pins, u64), r: Option<Role>, b: u32) -> bool {
     match (r, b) {
+        (Some(Role::Miso), b) => miso >> b & 1 == 1,
         (None, b) if b >= MODE => p.mode >> (b - MODE) & 1 == 1,
         (None, b) => p.mode_sel >> (b - SEL) & 1 == 1,
         _ => analyser::bit(p, r, b),
@@ -79,7 +82,7 @@ fn level(p: &Pins, r: Option<Role>, b: u32) -> bool {
 /// records of cycles `w`, judged.
 fn judged(
     s: &Schedule,
-    pins: &[Pins],
+    pins: &[(Pins, u64)],
     w: (u64, u64),
     phase: u64,
     (sel, mode): (bool, bool),
@@ -112,10 +115,11 @@ fn at_ps(s: &Schedule, c: u64, from: u64, phase: u64) -> i64 {
 }
 
 /// Frames (from `from`) whose mode differs from the frame before's.
-fn switch_frames(s: &Schedule, pins: &[Pins], from: u64) -> Vec<u64> {
+fn switch_frames(s: &Schedule, pins: &[(Pins, u64)], from: u64) -> Vec<u64> {
     let f = s.grid.frame_cycles;
+    let mode = |c: u64| pins[c as usize].0.mode;
     (from / f + 1..pins.len() as u64 / f)
-        .filter(|&k| pins[(k * f) as usize].mode != pins[(k * f - 1) as usize].mode)
+        .filter(|&k| mode(k * f) != mode(k * f - 1))
         .collect()
 }
 
@@ -124,7 +128,7 @@ fn switch_frames(s: &Schedule, pins: &[Pins], from: u64) -> Vec<u64> {
 /// of their frames' starts.
 fn passes_at_random_offsets(
     s: &Schedule,
-    pins: &[Pins],
+    pins: &[(Pins, u64)],
     ports: (bool, bool),
     seed: u64,
     what: &str,
@@ -178,7 +182,7 @@ fn captures_of_a_pin_select_mix_follow_mode_sel() {
     // decision at frame 4's start makes frame 5 fast, the design ran slow
     let mut bad = p.clone();
     for q in &mut bad[(3 * f) as usize..(4 * f) as usize] {
-        q.mode_sel = 0;
+        q.0.mode_sel = 0;
     }
     let d = tempfile::tempdir().unwrap();
     let (from, phase) = (f / 3, 4_321);
@@ -204,16 +208,55 @@ fn captures_of_a_pin_select_mix_follow_mode_sel() {
 }
 
 /// Auto select under a touch: the capture's `mode` pins say each frame's
-/// mode; it passes at random offsets through the switch to contact and back.
+/// mode, the triggers on the samples its MISO carried judge each switch;
+/// it passes at random offsets through the switch to contact and back.  The
+/// same capture with MISO low through the touch (the design switched
+/// without its condition) fails at the switch's frame.
 #[test]
 fn captures_of_an_auto_mix_under_a_touch_pass() {
     let s = shared("modes-auto");
-    let p = pins(&s, 14, &[], "touch:T0@3-7");
-    assert!(
-        switch_frames(&s, &p, 0).len() >= 2,
-        "the touch switches and back"
-    );
+    let f = s.grid.frame_cycles;
+    let p = pins(&s, 20, &[], "touch:T0@8-12");
+    let sw = switch_frames(&s, &p, 0);
+    assert!(sw.len() >= 2, "the touch switches and back: {sw:?}");
     passes_at_random_offsets(&s, &p, (false, true), 4, "touch");
+    let d = tempfile::tempdir().unwrap();
+    let (from, phase) = (f / 2, 1_234);
+    let r = judged(
+        &s,
+        &p,
+        (from, 20 * f),
+        phase,
+        (false, true),
+        &d.path().join("c.vcd"),
+    )
+    .unwrap();
+    let said = r.summary();
+    assert!(r.ok, "{said}");
+    assert!(said.contains("proved: the switch decisions of 1"), "{said}");
+    let mut bad = p.clone();
+    for q in &mut bad[(8 * f) as usize..(12 * f) as usize] {
+        q.1 = 0;
+    }
+    let r = judged(
+        &s,
+        &bad,
+        (from, 20 * f),
+        phase,
+        (false, true),
+        &d.path().join("b.vcd"),
+    )
+    .unwrap();
+    assert!(!r.ok, "{}", r.summary());
+    let v = &r.violations[0];
+    assert!(v.rule.contains("mode decision"), "{}", r.summary());
+    let at = at_ps(&s, sw[0] * f, from, phase);
+    assert!(
+        (v.time_ps as i64 - at).abs() < 1_000_000,
+        "{} vs {at}: {}",
+        v.time_ps,
+        r.summary()
+    );
 }
 
 /// Without the mode pins, a capture of a mode mix is refused, the message

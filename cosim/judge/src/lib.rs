@@ -60,6 +60,7 @@ mod timed;
 mod timedaxis;
 mod timedlink;
 mod timedmodes;
+mod timedtrig;
 pub mod tools;
 mod vcd;
 mod vcdlex;

@@ -699,13 +699,16 @@ fn check_at_mix_clock(
     let span_ps = (end / clock) as u64 - scan.conv_start.unwrap_or(0);
     let mut conversions =
         (span_ps as f64 / (tpl.frame as f64 * tc_ps) * tpl.conversions_per_frame as f64) as u64;
-    let modes_seen = modes_seen(s, &ctx, &cands, scan.conv_start.unwrap_or(0), end);
-    if let Some((_, n)) = &modes_seen {
-        conversions = *n;
-    }
-    let modes_seen = modes_seen.map(|m| m.0);
     let (mut proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
     not_proved.extend(np);
+    let modes_seen = modes_seen(s, cap, &ctx, &cands, scan.conv_start.unwrap_or(0), end);
+    let modes_seen = modes_seen.map(|(seen, n, trig)| {
+        conversions = n;
+        trig.violations.into_iter().for_each(|v| found.push(v));
+        proved.extend(trig.proved);
+        not_proved.extend(trig.not_proved);
+        seen
+    });
     let link_join = check_link_lane(
         s,
         cap,
@@ -737,23 +740,29 @@ fn check_at_mix_clock(
 }
 
 /// A mix with modes: the modes of the frames from the lock (`from`, ps) to
-/// the end as the first phase places them, and the conversions they hold.
+/// the end as the first phase places them, the conversions they hold, and
+/// (auto select) the switch decisions judged.
 fn modes_seen(
     s: &Schedule,
+    cap: &Capture,
     ctx: &Ctx,
     cands: &[Cand],
     from: u64,
     end: i128,
-) -> Option<(crate::timedmodes::ModesSeen, u64)> {
+) -> Option<(
+    crate::timedmodes::ModesSeen,
+    u64,
+    crate::timedtrig::TriggerCheck,
+)> {
     let (src, modal, c) = (ctx.src.as_ref()?, ctx.tpl.modal.as_ref()?, cands.first()?);
-    Some(crate::timedmodes::seen(
-        s,
-        src,
-        modal,
-        (c.lo, c.hi, c.c0),
-        &c.modes,
-        (from, end),
-    ))
+    let (seen, n) =
+        crate::timedmodes::seen(s, src, modal, (c.lo, c.hi, c.c0), &c.modes, (from, end));
+    // the decisions are judged at a unique phase, from the `mode` output's modes
+    let trig = match cands.len() == 1 && seen.by == "mode" {
+        true => crate::timedtrig::check(s, cap, src, (c.lo, c.hi), &c.modes),
+        false => Default::default(),
+    };
+    Some((seen, n, trig))
 }
 
 /// The capture's lanes the resolution lets us check edge by edge; why each

@@ -146,19 +146,19 @@ pub(crate) fn template(s: &Schedule, lanes: &[Lane], n: usize) -> Modal {
 
 /// Where a capture says which mode each frame runs in.
 pub(crate) struct ModeSource<'a> {
-    steps: &'a [(u64, u64)],
+    pub(crate) steps: &'a [(u64, u64)],
     /// Capture lane of each bit of the port read.
-    bits: Vec<usize>,
+    pub(crate) bits: Vec<usize>,
     /// `mode_sel` (the decision, two frames ahead) or `mode` (the frame's own).
-    by_sel: bool,
-    n: usize,
-    frame: i128,
+    pub(crate) by_sel: bool,
+    pub(crate) n: usize,
+    pub(crate) frame: i128,
     /// Capture start and end, the resolution, one cycle: in units.
-    start: i128,
-    end: i128,
-    res: i128,
-    tc: i128,
-    clock: i128,
+    pub(crate) start: i128,
+    pub(crate) end: i128,
+    pub(crate) res: i128,
+    pub(crate) tc: i128,
+    pub(crate) clock: i128,
 }
 
 impl<'a> ModeSource<'a> {
@@ -216,6 +216,14 @@ impl<'a> ModeSource<'a> {
             tc,
             clock,
         })
+    }
+
+    /// The analyser channels the modes are read from.
+    pub fn lane_names(&self, cap: &Capture) -> String {
+        (self.bits.iter().rev())
+            .map(|&l| cap.lanes[l].channel.as_str())
+            .collect::<Vec<_>>()
+            .join(",")
     }
 
     /// The port's value at `t` (units).
