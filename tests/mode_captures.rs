@@ -50,7 +50,7 @@ fn pins(s: &Schedule, frames: u64, requests: &[(u64, u8)], stimulus: &str) -> Ve
 /// and the mode ports asked for, with the `--map` naming them.
 fn lanes(s: &Schedule, sel: bool, mode: bool) -> (Vec<(Option<Role>, u32)>, String) {
     let (all, _) = analyser::lanes(s);
-    let mut v: Vec<_> = all.into_iter().filter(|l| l.0.is_some()).collect();
+    let mut v: Vec<_> = all.into_iter().collect();
     v.extend((0..s.mix.branches.len() as u32).map(|b| (Some(Role::Miso), b)));
     let bits = Layout::new(s).mode_bits;
     for (on, base) in [(sel, SEL), (mode, MODE)] {
@@ -62,6 +62,7 @@ fn lanes(s: &Schedule, sel: bool, mode: bool) -> (Vec<(Option<Role>, u32)>, Stri
         .map(|(i, (r, b))| match r {
             Some(r) => format!("D{i}={}[{b}]", r.name()),
             None if *b >= MODE => format!("D{i}=mode[{}]", b - MODE),
+            None if *b < SEL => format!("D{i}=link_tx"),
             None => format!("D{i}=mode_sel[{}]", b - SEL),
         })
         .collect::<Vec<_>>()
@@ -73,6 +74,7 @@ fn level(&(ref p, miso): &(Pins, u64), r: Option<Role>, b: u32) -> bool {
     match (r, b) {
         (Some(Role::Miso), b) => miso >> b & 1 == 1,
         (None, b) if b >= MODE => p.mode >> (b - MODE) & 1 == 1,
+        (None, b) if b < SEL => analyser::bit(p, None, b),
         (None, b) => p.mode_sel >> (b - SEL) & 1 == 1,
         _ => analyser::bit(p, r, b),
     }
@@ -178,13 +180,13 @@ fn captures_of_a_pin_select_mix_follow_mode_sel() {
     passes_at_random_offsets(&s, &p, (true, true), 1, "mode_sel and mode");
     passes_at_random_offsets(&s, &p, (true, false), 2, "mode_sel");
     passes_at_random_offsets(&s, &p, (false, true), 3, "mode");
+    let d = tempfile::tempdir().unwrap();
     // frame 3 asks for `fast` (0) where the run asked for `slow`: the
     // decision at frame 4's start makes frame 5 fast, the design ran slow
     let mut bad = p.clone();
     for q in &mut bad[(3 * f) as usize..(4 * f) as usize] {
         q.0.mode_sel = 0;
     }
-    let d = tempfile::tempdir().unwrap();
     let (from, phase) = (f / 3, 4_321);
     for ports in [(true, true), (true, false)] {
         let r = judged(
