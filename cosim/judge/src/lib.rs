@@ -18,6 +18,8 @@
 //! - `vcd` / `vcdout`: reading a VCD from any simulator, writing one;
 //! - `timed` / `capture`: logic-analyser captures (no clock, any
 //!   sample rate) checked at time level, the channel map, sigrok input;
+//!   `timedmodes` / `timedtrig`: a mix with modes, frame by frame, and its
+//!   switch decisions;
 //! - `fst`: FST input, through the `wellen` crate;
 //! - `linkjoin`: the model's link joined from the line, for a check that
 //!   joins a run mid-stream;
