@@ -807,33 +807,17 @@ fn deep_faults_escape_every_simulation_column_and_prove_catches_them() {
 }
 
 /// A mix with modes is planned by `audit` and `lut` and built by `verilog`
-/// (with its mode ports; `build` charts it, tests/build.rs); `check --map`,
-/// which does not follow the switches of a capture yet, refuses it, naming
-/// its modes, rather than show the reset mode alone as if it were the mix.
+/// (with its mode ports; `build` charts it, tests/build.rs).
 #[test]
-fn a_mix_with_modes_is_built_and_refused_where_a_command_would_show_one_mode() {
+fn a_mix_with_modes_is_planned_and_built() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let d = tempfile::tempdir().unwrap();
     for name in ["modes-pin", "modes-auto"] {
         let mix = root.join("testkit/mixes").join(format!("{name}.toml"));
-        let modes = lut_gen::load(&mix).unwrap().modes.unwrap().names;
         slotforge().arg("audit").arg(&mix).assert().success();
         let out = d.path().join(name);
-        // `golden`, `synth`, `prove` and `build` take it now (tests/modes_cli.rs,
-        // formal/tests, tests/build.rs); an analyser capture maps no mode pins
-        let a = slotforge()
-            .arg("check")
-            .arg(&mix)
-            .arg(out.join("capture.vcd"))
-            .arg("--map")
-            .arg(out.join("probes.map"))
-            .assert()
-            .code(2)
-            .stderr(predicate::str::contains("does not yet"));
-        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
-        for m in &modes {
-            assert!(err.contains(m.as_str()), "check --map: {err}");
-        }
+        // `golden`, `synth`, `prove`, `build` and `check --map` take it
+        // (tests/modes_cli.rs, formal/tests, tests/build.rs, tests/mode_captures.rs)
         assert!(!out.join("slotforge_top.v").exists());
         slotforge()
             .args(["verilog", "-o"])

@@ -46,6 +46,8 @@ mod link_captures;
 #[path = "link_windows.rs"]
 mod link_windows;
 
+#[path = "mode_captures.rs"]
+mod mode_captures;
 #[path = "modes_cli.rs"]
 mod modes_cli;
 

@@ -1,8 +1,8 @@
 //! The commands past the simulation on mixes with modes: `synth` places
 //! them, `golden` replays a recorded scene on every back end (and a
 //! different switch differs), `faults` injects into the gateware and its
-//! Verilog with the switching scenario, `check --map` still refuses, naming
-//! itself.  Each on the shared pin and auto mixes and on random mode mixes
+//! Verilog with the switching scenario (`check --map`:
+//! tests/mode_captures.rs).  Each on the shared pin and auto mixes and on random mode mixes
 //! drawn here.
 
 use std::path::{Path, PathBuf};
@@ -262,27 +262,4 @@ fn gateware_faults_of_a_mode_mix_run_as_verilog_on_both_engines() {
     assert_eq!(stuck["injected"], 3, "rusthdl, verilator, icarus: {stuck}");
     assert_eq!(v["false_alarms"]["rejected"], 0, "{v}");
     assert_eq!(code, Some(1), "{v}");
-}
-
-/// An analyser capture is judged against one mode's frame: `check --map`
-/// of a mix with modes is refused, the message naming `check --map` and
-/// the modes, nothing judged.
-#[test]
-fn check_map_of_a_mode_mix_is_refused_naming_itself() {
-    let d = tempfile::tempdir().unwrap();
-    let cap = d.path().join("cap.vcd");
-    std::fs::write(&cap, "$timescale 1 ns $end\n").unwrap();
-    for mix in [shared("modes-pin"), shared("modes-auto")] {
-        let a = slotforge()
-            .args(["check", "--map", "D0=adc_cs_n[0]"])
-            .arg(&mix)
-            .arg(&cap)
-            .assert()
-            .code(2)
-            .stderr(predicate::str::contains("`check --map`"));
-        let err = String::from_utf8_lossy(&a.get_output().stderr).to_string();
-        for m in modes_of(&mix) {
-            assert!(err.contains(&m), "{err}");
-        }
-    }
 }

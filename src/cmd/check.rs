@@ -95,6 +95,12 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
             "mode": "time-level capture",
             "locked_at_ps": r.locked_at_ps,
             "clock_ppm": r.clock_ppm,
+            "modes": r.modes.as_ref().map(|m| serde_json::json!({
+                "by": m.by,
+                "first": m.first,
+                "switches": m.switches.iter().map(|(ps, to)| serde_json::json!({
+                    "time_ps": ps, "to": to})).collect::<Vec<_>>(),
+            })),
             "slot": r.slot,
             "phases": r.phases,
             "edges_checked": r.edges_checked,
@@ -129,7 +135,7 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
 }
 
 pub fn run(a: Args) -> u8 {
-    // A VCD carries the mode ports; a logic-analyser capture's map does not.
+    // A VCD carries the mode ports; a capture's map names them.
     let s = match super::load_any_modes(&a.mix, super::Limits::Contract) {
         Ok(s) => s,
         Err(code) => return code,
@@ -139,12 +145,8 @@ pub fn run(a: Args) -> u8 {
     }
     let started = std::time::Instant::now();
     if let Some(map) = &a.map {
-        // the time-level check of a capture holds one mode's frame as its
-        // template: a capture with switches would be judged as the reset mode
-        let what = "`check --map` (an analyser capture, judged against one mode's frame)";
-        if let Err(code) = super::one_mode(&s, &a.mix, what) {
-            return code;
-        }
+        // a mix with modes: each frame judged against its mode, read from
+        // the map's `mode_sel` or `mode` (refused without either)
         return run_capture(&a, &s, map);
     }
     let opts = CheckOptions {

@@ -150,7 +150,7 @@ pub enum Limits {
 /// The mix loaded and scheduled, its limits checked, and its link to the
 /// host checked ([`link_fits`]): what every command that emits, simulates,
 /// checks or proves starts with (a mix with modes too: each follows the
-/// switches; `check --map` refuses one with [`one_mode`]).  On failure the
+/// switches).  On failure the
 /// message is printed and the exit code returned.
 pub fn load_any_modes(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, u8> {
     let s = match limits {
@@ -159,28 +159,6 @@ pub fn load_any_modes(path: &Path, limits: Limits) -> Result<lut_gen::Schedule, 
     };
     link_fits(&s, path)?;
     Ok(s)
-}
-
-/// Refuses a mix with modes in a command that does not follow mode
-/// switches yet (`command`, as the user typed it), so it never shows the
-/// reset mode alone as if it were the mix.  Exit 2.
-pub fn one_mode(s: &lut_gen::Schedule, file: &Path, command: &str) -> Result<(), u8> {
-    match &s.mix.modes {
-        Some(m) if m.names.len() > 1 => {
-            eprintln!(
-                "error: {}: the mix declares {} modes ({}): {command} does not yet follow \
-                 mode switches, so it would show the reset mode `{}` alone (`audit`, `lut`, \
-                 `verilog`, `synth`, `sim`, `check` of a VCD, `golden`, `faults`, `prove`, \
-                 `build` and `decode` take the mix); remove the [[mode]] tables to build one mode",
-                file.display(),
-                m.names.len(),
-                m.names.join(", "),
-                m.names[0]
-            );
-            Err(2)
-        }
-        _ => Ok(()),
-    }
 }
 
 /// [`schedule`], then the contract's limits checked ([`fits_pins`]).

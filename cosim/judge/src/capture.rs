@@ -9,7 +9,7 @@ use std::path::Path;
 use lut_gen::Schedule;
 use lut_gen::{Layout, Role, Signal, AXIS_PORTS, LINK_PORTS, PORT_NAMES};
 
-use crate::timed::{Capture, Lane};
+use crate::timed::{Capture, Lane, ModePin};
 
 /// Parses `--map`: `CH=PORT[BIT],...` inline, or the path of a file with one
 /// `CH = PORT[BIT]` per line (`#` comments).  Errors name the line and field.
@@ -47,7 +47,14 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
             }
             None => (port, 0),
         };
-        let (role, link) = lane_port(&layout, name, bit).map_err(at)?;
+        let mode = mode_port(&layout, name, bit).map_err(at)?;
+        let (role, link) = match mode {
+            Some(_) => (None, None),
+            None => lane_port(&layout, name, bit).map_err(at)?,
+        };
+        if mode.is_some() && lanes.iter().any(|x| x.mode == mode && x.bit == bit) {
+            return Err(at(format!("`{name}[{bit}]` is mapped twice")));
+        }
         if let Some(l) = link.filter(|_| lanes.iter().any(|x| x.link == link && x.bit == bit)) {
             return Err(at(format!("`{}` is mapped twice", l.name(&layout))));
         }
@@ -59,6 +66,7 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
             role,
             bit,
             link,
+            mode,
         });
     }
     if lanes.is_empty() {
@@ -71,6 +79,27 @@ pub fn parse_map(spec: &str, s: &Schedule) -> Result<Vec<Lane>, String> {
         ));
     }
     Ok(lanes)
+}
+
+/// `name[bit]` when it is a mode port (`mode_sel`, `mode`): the ones this
+/// mix has, or a message saying why not.
+fn mode_port(layout: &Layout, name: &str, bit: u32) -> Result<Option<ModePin>, String> {
+    let Some(k) = lut_gen::MODE_PORTS.iter().position(|p| p.name == name) else {
+        return Ok(None);
+    };
+    if !layout.mode_ports().iter().any(|p| p.name == name) {
+        return Err(match layout.mode_bits {
+            0 => format!("`{name}`: this mix has no [[mode]]"),
+            _ => format!("`{name}`: this mix selects its modes automatically (`select = \"auto\"`): it has `mode` only"),
+        });
+    }
+    if bit >= layout.mode_bits {
+        return Err(format!(
+            "`{name}` has {} bit(s) in this mix, no bit {bit}",
+            layout.mode_bits
+        ));
+    }
+    Ok(Some([ModePin::Sel, ModePin::Mode][k]))
 }
 
 /// The port bit `name[bit]` names: a core port's role, or the link's port

@@ -148,6 +148,11 @@ impl ClockFit {
             j.header_ps = j.header_ps.map(|t| self.back(t));
             j.unjudged_ps = self.back(j.unjudged_ps);
         }
+        if let Some(m) = &mut r.modes {
+            for sw in &mut m.switches {
+                sw.0 = self.back(sw.0);
+            }
+        }
         r.clock_ppm = Some(-self.ppm);
     }
 }

@@ -18,6 +18,8 @@
 //! - `vcd` / `vcdout`: reading a VCD from any simulator, writing one;
 //! - `timed` / `capture`: logic-analyser captures (no clock, any
 //!   sample rate) checked at time level, the channel map, sigrok input;
+//!   `timedmodes` / `timedtrig`: a mix with modes, frame by frame, and its
+//!   switch decisions;
 //! - `fst`: FST input, through the `wellen` crate;
 //! - `linkjoin`: the model's link joined from the line, for a check that
 //!   joins a run mid-stream;
@@ -59,6 +61,8 @@ pub mod switch;
 mod timed;
 mod timedaxis;
 mod timedlink;
+mod timedmodes;
+mod timedtrig;
 pub mod tools;
 mod vcd;
 mod vcdlex;
@@ -96,6 +100,7 @@ pub use vcdout::{channels_path, edge_ps, id_code, wire_header, write_gtkw, write
 // Logic-analyser captures, judged at time level.
 pub use capture::{parse_map, read as read_capture, read_progress as read_capture_progress};
 pub use timed::{check_capture, check_capture_with, LineJoin, TimedReport};
+pub use timedmodes::ModesSeen;
 
 // Logs: a run's pins as events (golden tests), its samples as CSV, the
 // bytes its link carried.

@@ -434,6 +434,11 @@ impl CycleModel {
         m
     }
 
+    /// The modes, to keep their decisions ([`ModeTrack::keep_decisions`]).
+    pub(crate) fn modes_mut(&mut self) -> &mut ModeTrack {
+        &mut self.track
+    }
+
     /// The link's transmitter configuration (a mix with a `[link]`).
     pub fn tx_config(&self) -> Option<link::TxConfig> {
         self.tx.as_ref().map(|t| *t.config())

@@ -69,6 +69,10 @@ pub struct ModeTrack {
     /// that joins a run mid-way starts its model with the modes the run's
     /// `mode` pin showed (`lock`), and the lock's templates run one mode.
     forced: Vec<(u64, usize)>,
+    /// When kept: every decision the pins or the windows made, `(frame,
+    /// mode)`, before a forced mode replaced it (a capture's check holds
+    /// the modes the design ran to the triggers on the samples it read).
+    decisions: Option<Vec<(u64, usize)>>,
 }
 
 impl ModeTrack {
@@ -109,6 +113,7 @@ impl ModeTrack {
             next: 0,
             prev: 0,
             forced: Vec::new(),
+            decisions: None,
         };
         m.open_windows();
         m
@@ -154,6 +159,17 @@ impl ModeTrack {
         if mode < self.count {
             self.forced.push((frame, mode));
         }
+    }
+
+    /// Keeps every decision from now on, before a forced mode replaces it
+    /// ([`ModeTrack::decisions`]).
+    pub(crate) fn keep_decisions(&mut self) {
+        self.decisions = Some(Vec::new());
+    }
+
+    /// The decisions kept: `(frame, mode)` the pins or the windows decided.
+    pub(crate) fn decisions(&self) -> &[(u64, usize)] {
+        self.decisions.as_deref().unwrap_or(&[])
     }
 
     /// A check that joined a run in frame `frame`, whose mode it does not
@@ -248,6 +264,9 @@ impl ModeTrack {
                 .find(|t| t.armed_in(m) && self.cur == m && t.run >= t.for_frames)
                 .map_or(m, |t| t.to),
         };
+        if let Some(d) = &mut self.decisions {
+            d.push((self.frame + 2, decided));
+        }
         let decided = self
             .forced
             .iter()

@@ -38,12 +38,27 @@ pub struct Lane {
     pub bit: u32,
     /// The link's port, when `role` is None.
     pub link: Option<Signal>,
+    /// A mode port's bit (`mode_sel[i]`, `mode[i]`), when `role` is None.
+    pub mode: Option<ModePin>,
+}
+
+/// The mode ports of a mix with modes (docs/timing.md, "Mode switches").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModePin {
+    /// `mode_sel`: the request, read at each frame's decision cycle.
+    Sel,
+    /// `mode`: the mode in force, timed like every output.
+    Mode,
 }
 
 impl Lane {
     pub fn port_bit(&self) -> String {
         match (self.role, self.link) {
             (Some(r), _) => format!("{}[{}]", r.name(), self.bit),
+            (None, _) if self.mode.is_some() => {
+                let k = usize::from(self.mode == Some(ModePin::Mode));
+                format!("{}[{}]", lut_gen::MODE_PORTS[k].name, self.bit)
+            }
             (None, Some(Signal::AxisTdata)) => format!("m_axis_tdata[{}]", self.bit),
             (None, l) => lut_gen::LINK_PORTS
                 .iter()
@@ -56,14 +71,19 @@ impl Lane {
 
     /// Whether this lane carries the UART's line.
     pub(crate) fn is_line(&self) -> bool {
-        self.role.is_none() && self.link.is_none_or(|l| l == Signal::LinkTx)
+        self.role.is_none() && self.mode.is_none() && self.link.is_none_or(|l| l == Signal::LinkTx)
+    }
+
+    /// Whether this lane carries a link port's bit (not a core or mode port).
+    pub(crate) fn is_link(&self) -> bool {
+        self.role.is_none() && self.mode.is_none()
     }
 
     fn is(&self, r: Role) -> bool {
         self.role == Some(r)
     }
 
-    fn get(&self, p: &Pins) -> bool {
+    pub(crate) fn get(&self, p: &Pins) -> bool {
         let v = match self.role {
             Some(Role::CsN) => p.cs_n as u128,
             Some(Role::Sclk) => p.sclk as u128,
@@ -71,6 +91,8 @@ impl Lane {
             Some(Role::MuxSel) => p.mux_sel as u128,
             Some(Role::MuxEn) => p.mux_en,
             Some(Role::SampleValid) => p.sample_valid as u128,
+            None if self.mode == Some(ModePin::Sel) => p.mode_sel as u128,
+            None if self.mode == Some(ModePin::Mode) => p.mode as u128,
             None => match self.link {
                 Some(Signal::AxisTdata) => p.axis_tdata as u128,
                 Some(Signal::AxisTvalid) => p.axis_tvalid as u128,
@@ -86,17 +108,18 @@ impl Lane {
 
     /// Lanes the model predicts without MISO: timing and control outputs.
     fn predictable(&self) -> bool {
-        matches!(
-            self.role,
-            Some(
-                Role::CsN
-                    | Role::Sclk
-                    | Role::Mosi
-                    | Role::MuxSel
-                    | Role::MuxEn
-                    | Role::SampleValid
+        self.mode == Some(ModePin::Mode)
+            || matches!(
+                self.role,
+                Some(
+                    Role::CsN
+                        | Role::Sclk
+                        | Role::Mosi
+                        | Role::MuxSel
+                        | Role::MuxEn
+                        | Role::SampleValid
+                )
             )
-        )
     }
 
     fn what(&self) -> &'static str {
@@ -106,6 +129,7 @@ impl Lane {
             Some(Role::Mosi) => "command words (every bit, at its time)",
             Some(Role::MuxSel | Role::MuxEn) => "mux switching (slot order, settling before CS)",
             Some(Role::SampleValid) => "sample stream timing",
+            None if self.mode.is_some() => "mode in force (switches at frame starts, as decided)",
             None => "link samples (order on the line)",
             _ => "",
         }
@@ -156,6 +180,9 @@ pub struct TimedReport {
     /// capture's times were scaled by it; every time above is the capture's
     /// own.
     pub clock_ppm: Option<f64>,
+    /// A mix with modes: the mode of each frame the capture holds, as the
+    /// phase found places them.
+    pub modes: Option<crate::timedmodes::ModesSeen>,
 }
 
 impl TimedReport {
@@ -184,6 +211,9 @@ impl TimedReport {
         }
         if let Some(j) = &self.link_join {
             let _ = writeln!(s, "{}", j.text());
+        }
+        if let Some(m) = &self.modes {
+            let _ = writeln!(s, "{}", m.text());
         }
         for v in &self.violations {
             let _ = writeln!(
@@ -270,6 +300,8 @@ struct Tpl {
     /// Per branch: the least cycles from a mux change to the next instant.
     settle_margin: Vec<Option<u64>>,
     conversions_per_frame: u64,
+    /// A mix with modes: a frame of edges per triple of modes.
+    modal: Option<crate::timedmodes::Modal>,
 }
 
 fn template(s: &Schedule, lanes: &[Lane]) -> Tpl {
@@ -323,6 +355,29 @@ fn template(s: &Schedule, lanes: &[Lane]) -> Tpl {
         min_gap,
         settle_margin: margin,
         conversions_per_frame: conversions,
+        modal: None,
+    }
+}
+
+/// [`template`] of a mix with modes: a frame per triple of modes, and the
+/// figures over all of them.
+fn template_modal(s: &Schedule, lanes: &[Lane], n: usize) -> Tpl {
+    let m = crate::timedmodes::template(s, lanes, n);
+    Tpl {
+        frame: s.grid.frame_cycles,
+        edges: vec![Vec::new(); lanes.len()],
+        min_gap: m.min_gap.clone(),
+        settle_margin: m.settle_margin.clone(),
+        conversions_per_frame: m.conversions.iter().copied().max().unwrap_or(0),
+        modal: Some(m),
+    }
+}
+
+/// The template of `lanes`, per mode triple for a mix with modes.
+fn template_any(s: &Schedule, lanes: &[Lane]) -> Tpl {
+    match s.mode_plan().map(|p| p.names.len()).filter(|&n| n > 1) {
+        Some(n) => template_modal(s, lanes, n),
+        None => template(s, lanes),
     }
 }
 
@@ -346,6 +401,8 @@ struct Cand {
     /// own time (not reported again until one fits).
     resync: Vec<bool>,
     c0: u64,
+    /// A mix with modes: the mode of each frame, as this phase places them.
+    modes: crate::timedmodes::Modes,
 }
 
 struct Ctx<'a> {
@@ -356,19 +413,87 @@ struct Ctx<'a> {
     /// One cycle in units (1e12).
     tc: i128,
     clock: i128,
+    /// A mix with modes: where the capture says each frame's mode.
+    src: Option<crate::timedmodes::ModeSource<'a>>,
 }
 
 impl Ctx<'_> {
-    fn abs(&self, lane: usize, (w, j): (u64, usize)) -> u64 {
-        w * self.tpl.frame + self.tpl.edges[lane][j].0
+    /// Lane `lane`'s edges in frame `w` of phase `c`.
+    /// Whether frames 0..=2 of phase `c` may run `modes`: the capture
+    /// says nothing else of those it tells.
+    fn assume(&self, c: &Cand, modes: &[u8; 3]) -> bool {
+        let Some(src) = &self.src else {
+            return true;
+        };
+        (0..3).all(|w| {
+            src.decide(c.lo, c.hi, w as u64, &modes[..w])
+                .is_none_or(|d| d == modes[w])
+        })
     }
 
-    fn next(&self, lane: usize, (w, j): (u64, usize)) -> (u64, usize) {
-        if j + 1 == self.tpl.edges[lane].len() {
-            (w + 1, 0)
-        } else {
-            (w, j + 1)
+    /// Phases equal in all but the modes assumed before the capture told
+    /// them: one stands for all (a phase's future depends only on the
+    /// modes the capture tells).
+    fn dedupe(&self, cands: &mut Vec<Cand>) {
+        let Some(src) = &self.src else {
+            return;
+        };
+        let key = |c: &Cand| {
+            let w = c.ptr.iter().flatten().map(|p| p.0).min().unwrap_or(0);
+            let m: Vec<usize> = (w.saturating_sub(1)..w + 2)
+                .map(|k| c.modes.of(src, c.lo, c.hi, k))
+                .collect();
+            (c.lo, c.hi, c.ptr.clone(), c.resync.clone(), c.c0, m)
+        };
+        let mut seen = Vec::new();
+        cands.retain(|c| {
+            let k = key(c);
+            let new = !seen.contains(&k);
+            if new {
+                seen.push(k);
+            }
+            new
+        });
+    }
+
+    fn frame_edges<'t>(&'t self, c: &Cand, lane: usize, w: u64) -> &'t [(u64, bool)] {
+        let (Some(m), Some(src)) = (&self.tpl.modal, &self.src) else {
+            return &self.tpl.edges[lane];
+        };
+        let at = |k: u64| c.modes.of(src, c.lo, c.hi, k);
+        let b = at(w);
+        let a = if w == 0 { b } else { at(w - 1) };
+        &m.frames[m.triple((a, b, at(w + 1)))][lane]
+    }
+
+    /// Template edge `(w, j)` of `lane`: its model cycle and level (None
+    /// past the frame's edges: a frame of a mode without any).
+    fn edge_at(&self, c: &Cand, lane: usize, (w, j): (u64, usize)) -> Option<(u64, bool)> {
+        let e = self.frame_edges(c, lane, w).get(j)?;
+        Some((w * self.tpl.frame + e.0, e.1))
+    }
+
+    fn abs(&self, c: &Cand, lane: usize, p: (u64, usize)) -> u64 {
+        self.edge_at(c, lane, p)
+            .map_or((p.0 + 1) * self.tpl.frame, |e| e.0)
+    }
+
+    /// The edge after `(w, j)`: in a mix with modes, frames of modes
+    /// without an edge on the lane are passed over (up to the capture's
+    /// end, where an empty frame stands for "no more").
+    fn next(&self, c: &Cand, lane: usize, (w, j): (u64, usize)) -> (u64, usize) {
+        if j + 1 < self.frame_edges(c, lane, w).len() {
+            return (w, j + 1);
         }
+        let Some(src) = &self.src else {
+            return (w + 1, 0);
+        };
+        let end = src.end_frame(c.lo).max(w + 1);
+        let mut n = w + 1;
+        while n < end && self.frame_edges(c, lane, n).is_empty() {
+            n += 1;
+        }
+        (n, 0)
     }
 
     /// Narrows `c`'s interval with an edge of `lane` at `t` (units) that is
@@ -393,8 +518,7 @@ impl Ctx<'_> {
     fn start(&self, c: &mut Cand, lane: usize, t: i128, v: bool) -> Result<(), String> {
         let level = |x: bool| if x { "rising" } else { "falling" };
         let none = || format!("{} edge at no time the schedule has one", level(v));
-        let e = &self.tpl.edges[lane];
-        if e.is_empty() {
+        if self.src.is_none() && self.tpl.edges[lane].is_empty() {
             return Err(none());
         }
         let back = ((self.t + 2 * self.skew) / self.tc) as u64 + 2;
@@ -407,20 +531,27 @@ impl Ctx<'_> {
         };
         let (mut w, mut j) = (from / self.tpl.frame, 0usize);
         let in_frame = from % self.tpl.frame;
+        let e = self.frame_edges(c, lane, w);
         while j < e.len() && e[j].0 < in_frame {
             j += 1;
         }
         if j == e.len() {
-            w += 1;
-            j = 0;
+            (w, j) = self.next(c, lane, (w, e.len().saturating_sub(1)));
         }
-        for _ in 0..=e.len() {
-            let cyc = self.abs(lane, (w, j));
-            if e[j].1 == v {
+        // one frame's edges (a mode mix: up to the capture's end)
+        let bound = match &self.src {
+            Some(_) => usize::MAX,
+            None => self.tpl.edges[lane].len() + 1,
+        };
+        for _ in 0..bound {
+            let Some((cyc, lv)) = self.edge_at(c, lane, (w, j)) else {
+                return Err(none());
+            };
+            if lv == v {
                 let mut d = c.clone();
                 if self.fit(&mut d, cyc, t) {
                     *c = d;
-                    c.ptr[lane] = Some(self.next(lane, (w, j)));
+                    c.ptr[lane] = Some(self.next(c, lane, (w, j)));
                     return Ok(());
                 }
             }
@@ -433,11 +564,11 @@ impl Ctx<'_> {
                 return Err(format!(
                     "{} edge where the schedule's {} edge at frame cycle {} came first: an edge is missing",
                     level(v),
-                    level(e[j].1),
+                    level(lv),
                     cyc % self.tpl.frame
                 ));
             }
-            (w, j) = self.next(lane, (w, j));
+            (w, j) = self.next(c, lane, (w, j));
         }
         Err(none())
     }
@@ -446,8 +577,12 @@ impl Ctx<'_> {
         let Some(p) = c.ptr[lane] else {
             return self.start(c, lane, t, v);
         };
-        let cyc = self.abs(lane, p);
-        let want = self.tpl.edges[lane][p.1].1;
+        let Some((cyc, want)) = self.edge_at(c, lane, p) else {
+            return Err(format!(
+                "{} edge where the schedule has none (the modes of the frames since)",
+                if v { "rising" } else { "falling" }
+            ));
+        };
         let at = |x: i128| x as f64 / self.clock as f64 / 1e3;
         let (elo, ehi) = (
             c.lo + cyc as i128 * self.tc - self.skew,
@@ -475,7 +610,7 @@ impl Ctx<'_> {
                 cyc % self.tpl.frame
             ));
         }
-        c.ptr[lane] = Some(self.next(lane, p));
+        c.ptr[lane] = Some(self.next(c, lane, p));
         Ok(())
     }
 }
@@ -504,6 +639,9 @@ pub fn check_capture_with(
     }
 }
 
+/// One cycle, in units of 1/clock ps.
+const TC: i128 = 1_000_000_000_000;
+
 /// [`check_capture_with`] with the capture's times taken as the mix's clock.
 fn check_at_mix_clock(
     s: &Schedule,
@@ -516,7 +654,7 @@ fn check_at_mix_clock(
     let mut not_proved = Vec::new();
     let checked = checked_lanes(s, cap, skew_ps, &mut not_proved);
     let lanes: Vec<Lane> = checked.iter().map(|&i| cap.lanes[i].clone()).collect();
-    let tpl = template(s, &lanes);
+    let tpl = template_any(s, &lanes);
     // The lock waits for the first conversion start on any CS lane: the
     // earliest evidence of the frame phase (a lane whose branch converts
     // late, or is not probed, does not delay it).
@@ -528,12 +666,17 @@ fn check_at_mix_clock(
             "no mapped CS (or CNV) lane the capture's resolution can check: the frame phase cannot be found; map adc_cs_n[N] to an analyser channel".into(),
         ));
     }
+    let (t, skew, tc) = (cap.period_ps as i128 * clock, skew_ps as i128 * clock, TC);
+    let src = (tpl.modal.as_ref())
+        .map(|_| crate::timedmodes::ModeSource::new(s, cap, (t + 2 * skew, tc, clock)))
+        .transpose()?;
     let ctx = Ctx {
         tpl: &tpl,
-        t: cap.period_ps as i128 * clock,
-        skew: skew_ps as i128 * clock,
-        tc: 1_000_000_000_000,
+        t,
+        skew,
+        tc,
         clock,
+        src,
     };
     let mut scan = Scan::default();
     scan.run(&ctx, &lanes, &checked, cap, cnv_mask(s));
@@ -554,10 +697,18 @@ fn check_at_mix_clock(
         missing_edges(&ctx, &lanes, &cands[0], end, &mut found);
     }
     let span_ps = (end / clock) as u64 - scan.conv_start.unwrap_or(0);
-    let conversions =
+    let mut conversions =
         (span_ps as f64 / (tpl.frame as f64 * tc_ps) * tpl.conversions_per_frame as f64) as u64;
     let (mut proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
     not_proved.extend(np);
+    let modes_seen = modes_seen(s, cap, &ctx, &cands, scan.conv_start.unwrap_or(0), end);
+    let modes_seen = modes_seen.map(|(seen, n, trig)| {
+        conversions = n;
+        trig.violations.into_iter().for_each(|v| found.push(v));
+        proved.extend(trig.proved);
+        not_proved.extend(trig.not_proved);
+        seen
+    });
     let link_join = check_link_lane(
         s,
         cap,
@@ -584,7 +735,34 @@ fn check_at_mix_clock(
         not_proved,
         link_join,
         clock_ppm: None,
+        modes: modes_seen,
     })
+}
+
+/// A mix with modes: the modes of the frames from the lock (`from`, ps) to
+/// the end as the first phase places them, the conversions they hold, and
+/// (auto select) the switch decisions judged.
+fn modes_seen(
+    s: &Schedule,
+    cap: &Capture,
+    ctx: &Ctx,
+    cands: &[Cand],
+    from: u64,
+    end: i128,
+) -> Option<(
+    crate::timedmodes::ModesSeen,
+    u64,
+    crate::timedtrig::TriggerCheck,
+)> {
+    let (src, modal, c) = (ctx.src.as_ref()?, ctx.tpl.modal.as_ref()?, cands.first()?);
+    let (seen, n) =
+        crate::timedmodes::seen(s, src, modal, (c.lo, c.hi, c.c0), &c.modes, (from, end));
+    // the decisions are judged at a unique phase, from the `mode` output's modes
+    let trig = match cands.len() == 1 && seen.by == "mode" {
+        true => crate::timedtrig::check(s, cap, src, (c.lo, c.hi), &c.modes),
+        false => Default::default(),
+    };
+    Some((seen, n, trig))
 }
 
 /// The capture's lanes the resolution lets us check edge by edge; why each
@@ -598,12 +776,20 @@ fn checked_lanes(
     let tc_ps = 1e12 / s.mix.clock_hz as f64;
     let res_ps = cap.period_ps + 2 * skew_ps;
     let all = &cap.lanes;
-    let tpl_all = template(s, all);
+    let tpl_all = template_any(s, all);
     (0..all.len())
         .filter(|&i| {
             let lane = &all[i];
-            if lane.role.is_none() {
+            if lane.is_link() {
                 // The link's line: decoded below, not timed edge by edge.
+                return false;
+            }
+            if lane.mode == Some(ModePin::Sel) {
+                not_proved.push(format!(
+                    "{} ({}): an input; read at each frame's decision cycle for the mode of the frame after next, not timed",
+                    lane.channel,
+                    lane.port_bit()
+                ));
                 return false;
             }
             if !lane.predictable() {
@@ -717,21 +903,33 @@ impl Scan {
         } = at;
         let tpl = ctx.tpl;
         let mut c = Vec::new();
-        for (j, &(cyc, lv)) in tpl.edges[li].iter().enumerate() {
-            if lv != level {
-                continue;
-            }
-            let abs = tpl.frame + cyc;
-            let mut cand = Cand {
-                lo: i128::MIN / 4,
-                hi: i128::MAX / 4,
-                ptr: vec![None; nlanes],
-                resync: vec![false; nlanes],
-                c0: abs,
+        // A mix with modes: the lock's frame (1) and its neighbours in every
+        // mode the capture does not rule out.
+        let n = tpl.modal.as_ref().map_or(1, |m| m.n);
+        for k in 0..n * n * n {
+            let modes = [k / (n * n), k / n % n, k % n].map(|x| x as u8);
+            let edges = match &tpl.modal {
+                Some(m) => &m.frames[k][li],
+                None => &tpl.edges[li],
             };
-            if ctx.fit(&mut cand, abs, t) {
-                cand.ptr[li] = Some(ctx.next(li, (1, j)));
-                c.push(cand);
+            for (j, &(cyc, lv)) in edges.iter().enumerate() {
+                if lv != level {
+                    continue;
+                }
+                let abs = tpl.frame + cyc;
+                let mut cand = Cand {
+                    lo: i128::MIN / 4,
+                    hi: i128::MAX / 4,
+                    ptr: vec![None; nlanes],
+                    resync: vec![false; nlanes],
+                    c0: abs,
+                    modes: Default::default(),
+                };
+                if ctx.fit(&mut cand, abs, t) && ctx.assume(&cand, &modes) {
+                    *cand.modes.0.borrow_mut() = modes.to_vec();
+                    cand.ptr[li] = Some(ctx.next(&cand, li, (1, j)));
+                    c.push(cand);
+                }
             }
         }
         if self.lost.is_none() {
@@ -789,6 +987,7 @@ impl Scan {
                 false
             }
         });
+        ctx.dedupe(c);
         let start_edge = starts(cnv, lane, level);
         if !c.is_empty() && start_edge {
             self.seg.starts += 1;
@@ -881,7 +1080,7 @@ fn no_conversion_start(lanes: &[Lane], cs_lanes: &[usize]) -> TimedError {
 fn missing_edges(ctx: &Ctx, lanes: &[Lane], c: &Cand, end: i128, found: &mut Found) {
     for (li, lane) in lanes.iter().enumerate() {
         if let Some(p) = c.ptr[li] {
-            let latest = c.hi + ctx.abs(li, p) as i128 * ctx.tc + ctx.t + ctx.skew;
+            let latest = c.hi + ctx.abs(c, li, p) as i128 * ctx.tc + ctx.t + ctx.skew;
             if latest < end {
                 found.push(TimedViolation {
                     time_ps: (latest / ctx.clock) as u64,
@@ -919,7 +1118,7 @@ fn check_link_lane(
         })
         .collect();
     let line = cap.lanes.iter().position(|l| l.is_line());
-    let axis = cap.lanes.iter().any(|l| l.role.is_none()) && layout.axis;
+    let axis = cap.lanes.iter().any(|l| l.is_link()) && layout.axis;
     let lk = match line {
         _ if axis => crate::timedaxis::check_axis(s, cap, &phases, model),
         Some(li) if !layout.axis => crate::timedlink::check_link(s, cap, li, &phases, model),

@@ -288,7 +288,7 @@ fn decode(
             }
             ends = Some(d.slice);
             let chans = d.records.iter().map(|r| r.0).collect();
-            packets.push((t as f64, d.frame, d.slice, chans));
+            packets.push((t as f64, d.frame, d.slice, chans, (d.mode, d.prev_mode)));
         }
         let st = *dec.stats();
         if st.crc_errors > crc {

@@ -99,6 +99,22 @@ pub(crate) fn packet_order(s: &Schedule) -> Vec<Vec<u16>> {
     per_slice
 }
 
+/// [`packet_order`] of a frame in mode `m` after a frame in mode `p` (a
+/// mix with modes): the samples whose `sample_valid` falls in each slice
+/// of it.
+fn packet_order_across(s: &Schedule, (m, p): (u8, u8)) -> Vec<Vec<u16>> {
+    let g = &s.grid;
+    let f = g.frame_cycles;
+    let (sm, sp) = (&s.modes[m as usize], &s.modes[p as usize]);
+    let mut per_slice = vec![Vec::new(); g.slices_per_frame as usize];
+    for (cycle, _, ch) in lut_gen::merged_run(&[sp, sp, sm, sm]) {
+        if (2 * f..3 * f).contains(&cycle) {
+            per_slice[((cycle - 2 * f) / g.slice_cycles) as usize].push(ch);
+        }
+    }
+    per_slice
+}
+
 /// Decodes lane `li` of `cap` (the line) and checks it against `s`; with
 /// the model and the frame phase (the one of `phases`, the candidates the
 /// pins fit, that the line's characters fit), also every byte's timing
@@ -209,8 +225,9 @@ pub(crate) fn order_violation(lane: &Lane, t: f64, detail: String) -> TimedViola
     }
 }
 
-/// A decoded packet: (time, frame, slice, channels).
-pub(crate) type LinePacket = (f64, u64, u16, Vec<u16>);
+/// A decoded packet: (time, frame, slice, channels, (mode, mode of the
+/// frame before): 0 without modes).
+pub(crate) type LinePacket = (f64, u64, u16, Vec<u16>, (u8, u8));
 
 /// What the host's receiver and decoder read from the line.
 pub(crate) struct LineRead {
@@ -358,7 +375,7 @@ fn read_line(
                 join = Some((if sync { i } else { chars.len() }, d.frame as u8, d.slice));
             }
             let chans = d.records.iter().map(|r| r.0).collect();
-            packets.push((t, d.frame, d.slice, chans));
+            packets.push((t, d.frame, d.slice, chans, (d.mode, d.prev_mode)));
         }
         let st = dec.stats();
         if st.crc_errors > crc {
@@ -391,8 +408,12 @@ fn read_line(
 pub(crate) fn check_order(s: &Schedule, lane: &Lane, packets: &[LinePacket], out: &mut LinkCheck) {
     let order = packet_order(s);
     let mut wrong = 0;
-    for (t, frame, slice, chans) in packets {
-        let want = order.get(*slice as usize).cloned().unwrap_or_default();
+    for (t, frame, slice, chans, modes) in packets {
+        let want = match s.modes.len() > 1 {
+            true => packet_order_across(s, *modes),
+            false => order.clone(),
+        };
+        let want = want.get(*slice as usize).cloned().unwrap_or_default();
         if *chans != want {
             wrong += 1;
             if wrong <= 3 {
@@ -506,6 +527,10 @@ fn predict(s: &Schedule, cap: &Capture, ph: LinkPhase, clock: i128) -> Predictio
         record: vec![false; s.mix.channels.len()],
     };
     let cnv = crate::timed::cnv_mask(s);
+    let sel: Vec<(u32, usize)> = (cap.lanes.iter().enumerate())
+        .filter(|(_, l)| l.mode == Some(crate::timed::ModePin::Sel))
+        .map(|(i, l)| (l.bit, i))
+        .collect();
     let mut out = Vec::new();
     let mut prev = *m.pins();
     for c in first..=last {
@@ -560,6 +585,15 @@ fn predict(s: &Schedule, cap: &Capture, ph: LinkPhase, clock: i128) -> Predictio
                     None => known.cur[*br as usize] = false,
                 }
             }
+        }
+        if !sel.is_empty() {
+            // pin select: the requests as the capture shows them mid-cycle
+            let ps = ((mid + c * TC + TC / 2).div_euclid(clock)).max(0) as u64;
+            let v = cap.steps[cap.steps.partition_point(|x| x.0 <= ps).max(1) - 1].1;
+            let bits = sel
+                .iter()
+                .fold(0u8, |a, &(k, l)| a | ((v >> l & 1) as u8) << k);
+            m.set_mode_sel(bits);
         }
         m.step(miso);
     }
