@@ -222,7 +222,8 @@ fn first_pin_mix(n: usize) -> (u64, lut_gen::Schedule) {
         .expect("a feasible draw")
 }
 
-/// About 140 s under load (the first feasible draw, 2 branches).
+/// About 20 s under load (the first feasible draw, 2 branches; 140 s
+/// before the run was split on `mode_sel`).
 #[test]
 #[ignore = "long: make test-long"]
 fn a_random_pin_select_mix_proves() {
