@@ -38,7 +38,11 @@ fn main() {
     let choices: Vec<usize> = std::env::var("CHOICES")
         .map(|c| c.split(',').map(|x| num(x, "CHOICES") as usize).collect())
         .unwrap_or_default();
-    let (found, st) = formal::prove_aig(&g, &choices, period, 2, max, Some(deadline));
+    // SPLITS=i,j: input indices the run is split on (mode_sel)
+    let splits: Vec<usize> = std::env::var("SPLITS")
+        .map(|c| c.split(',').map(|x| num(x, "SPLITS") as usize).collect())
+        .unwrap_or_default();
+    let (found, st) = formal::prove_aig(&g, &choices, &splits, period, 2, max, Some(deadline));
     let verdict = match &found {
         formal::Found::Violated { step, .. } => format!("violated at step {step}"),
         other => format!("{other:?}"),

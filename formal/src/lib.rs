@@ -367,9 +367,22 @@ fn symbolic(
     }
     let limit = opts.depth.unwrap_or(DEEP_FRAMES * f + 2);
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
-    let choices = choice_inputs(prep);
-    let (found, st) = symsim::prove(&g, &choices, f, 2, limit, Some(deadline));
+    let choices = named_inputs(prep, harness::TREADY_ANY);
+    let splits = named_inputs(prep, harness::MODE_SEL);
+    let (found, st) = symsim::prove(&g, &choices, &splits, f, 2, limit, Some(deadline));
     Ok(match found {
+        symsim::Found::Proved { steps, .. } if st.branches > 0 => (
+            Outcome::Proved,
+            steps,
+            format!(
+                "{PROVED}: {}every step from reset simulated exactly with every free input bit a variable of its step (MISO), split on mode_sel where a step reads it (one path per value, every value taken; {} latches, {} gates; {} assertion checks went to a SAT solver), until every path reached a frame start whose state, up to renaming, a path had reached before ({} distinct states at frame starts, the deepest at step {steps}), so those paths reach every reachable state (symbolic simulation split on requests)",
+                parts_note(&st.parts),
+                g.latches.len(),
+                g.ands.len(),
+                st.sat_calls,
+                st.branches
+            ),
+        ),
         symsim::Found::Proved { steps, since } => (
             Outcome::Proved,
             steps,
@@ -412,14 +425,15 @@ fn symbolic(
     })
 }
 
-/// The AIG inputs that are an environment's choices, not data: an
-/// AXI4-Stream slave's `tready_any` (yosys's map names them).
-fn choice_inputs(prep: &engine::Prepared) -> Vec<usize> {
+/// The AIG inputs (bits) of the harness input `name` (yosys's map): an
+/// AXI4-Stream slave's `tready_any` (an environment's choice, not data),
+/// pin-selected modes' `mode_sel` (a request the run is split on).
+fn named_inputs(prep: &engine::Prepared, name: &str) -> Vec<usize> {
     let aim = std::fs::read_to_string(prep.dir.join("design.aim")).unwrap_or_default();
     aim.lines()
         .filter_map(|l| {
             let f: Vec<&str> = l.split_whitespace().collect();
-            let named = f.len() == 4 && f[0] == "input" && f[3] == harness::TREADY_ANY;
+            let named = f.len() == 4 && f[0] == "input" && f[3] == name;
             named.then(|| f[1].parse().ok()).flatten()
         })
         .collect()

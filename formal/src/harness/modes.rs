@@ -383,12 +383,15 @@ pub(crate) fn bounded_modes(s: &Schedule, result: crate::Outcome, steps: u64) ->
     let f = s.grid.frame_cycles;
     let cycles = steps.saturating_sub(2);
     // auto select never comes round; pin select may, so the note says why
-    // its search stopped (depth, time limit, or a request kept)
+    // its search stopped (depth or time limit) in the note
     let why = match m.select {
         ModeSelect::Auto => {
-            "; auto select decides each frame's mode from every earlier frame's \
-             codes (the triggers' windows and runs of windows), so the state does not come round \
-             after whole frames"
+            "; auto select: each frame start decides the mode from the triggers' windows, which \
+             compare the watched codes (MISO data) with the levels, else keeps the mode decided \
+             before, so the mode and run registers are functions of every earlier frame's codes, \
+             one frame deeper at each frame start, and the state never comes round; the split \
+             that closes pin select (on the few bits of mode_sel) would have to enumerate the \
+             codes instead (docs/formal.md, \"Mixes with modes\")"
         }
         ModeSelect::Pin => "",
     };

@@ -38,6 +38,7 @@ mod cone;
 mod explicit;
 mod graph;
 mod induction;
+mod split;
 use graph::Graph;
 #[cfg(test)]
 use graph::VAR;
@@ -74,16 +75,20 @@ pub struct SymStats {
     /// With choice inputs (`prove`): the parts of the assertion proved by
     /// symbolic simulation, by 2-induction and by explicit-state search.
     pub parts: [usize; 3],
+    /// A run split on requests (`split.rs`): the distinct states at frame
+    /// boundaries it simulated from (0: not split).
+    pub branches: usize,
 }
 
 /// Steps between the checks of the assertions that did not fold (one SAT
 /// call on their disjunction), from each period's first step.
 const CHECK: u64 = 256;
 
-/// Simulates `g` from power-on: the state at each step `offset + k *
+/// Simulates `g` from power-on (no input split): the state at each step `offset + k *
 /// period` is compared (up to renaming) with those of the earlier such
 /// steps; the run stops at a recurrence, a failing assertion, `max_steps`
 /// or `deadline`.
+#[cfg(test)]
 pub fn run(
     g: &Aig,
     period: u64,
@@ -113,13 +118,20 @@ pub fn run(
 pub fn prove(
     g: &Aig,
     choices: &[usize],
+    splits: &[usize],
     period: u64,
     offset: u64,
     max_steps: u64,
     deadline: Option<Instant>,
 ) -> (Found, SymStats) {
     if choices.is_empty() {
-        let (f, mut st) = run(g, period, offset, max_steps, deadline);
+        let lim = Limits {
+            period,
+            offset,
+            max_steps,
+            deadline,
+        };
+        let (f, mut st) = Sim::split_on(g, splits).run(&lim);
         st.parts = [1, 0, 0];
         return (f, st);
     }
@@ -167,16 +179,17 @@ pub fn prove(
                 None => {
                     // too many inputs to enumerate: simulated symbolically
                     stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
-                    Sim::new(&sub).run(&lim)
+                    Sim::split_on(&sub, splits).run(&lim)
                 }
             },
-            _ => Sim::new(&sub).run(&lim),
+            _ => Sim::split_on(&sub, splits).run(&lim),
         };
         let found = lift(found, &c.latches, g.inputs.len(), g.latches.len());
         stats.sat_calls += st.sat_calls;
         stats.peak_nodes = stats.peak_nodes.max(st.peak_nodes);
         if how == 0 {
             stats.state_nodes = st.state_nodes;
+            stats.branches = st.branches;
             stats.kept = st.kept.iter().map(|&j| c.latches[j]).collect();
         }
         // the inductive parts' base case is a bounded search: it holds if
@@ -264,9 +277,25 @@ struct Sim<'a> {
     gc_at: usize,
     /// The run's deadline: a SAT check still running then gives no verdict.
     deadline: Option<Instant>,
+    /// Inputs split on where the state reads them (`split.rs`), and the
+    /// values the path being simulated fixed: (input, step, value).
+    splits: Vec<usize>,
+    fixed: Vec<graph::Assigned>,
+    /// A split run's paths waiting, by the step they continue at.
+    queue: std::collections::BTreeMap<(u64, u64), split::Branch>,
 }
 
 impl<'a> Sim<'a> {
+    /// A simulation split on `splits` (none past `split::MAX_SPLIT_BITS`:
+    /// they stay variables).
+    fn split_on(g: &'a Aig, splits: &[usize]) -> Sim<'a> {
+        let mut sim = Sim::new(g);
+        if splits.len() <= split::MAX_SPLIT_BITS {
+            sim.splits = splits.to_vec();
+        }
+        sim
+    }
+
     fn new(g: &'a Aig) -> Sim<'a> {
         let mut gr = Graph::new();
         let ni = g.inputs.len() as u32;
@@ -294,11 +323,17 @@ impl<'a> Sim<'a> {
             stats: SymStats::default(),
             gc_at: 1 << 20,
             deadline: None,
+            splits: Vec::new(),
+            fixed: Vec::new(),
+            queue: Default::default(),
         }
     }
 
     /// Runs to a verdict, `lim.max_steps` or the deadline.
     fn run(mut self, lim: &Limits) -> (Found, SymStats) {
+        if !self.splits.is_empty() {
+            return self.run_split(lim);
+        }
         self.deadline = lim.deadline;
         // every boundary's state, canonical: a state equal to an earlier
         // boundary's closes the search (a FIFO's pointers may need several
@@ -400,7 +435,7 @@ impl<'a> Sim<'a> {
         let mut inputs = vec![vec![false; ni]; step as usize + 1];
         // after step 0's inputs, each latch's power-on value
         inputs[0].resize(ni + self.g.latches.len(), false);
-        for (input, s, v) in assign {
+        for (input, s, v) in assign.into_iter().chain(self.fixed.iter().copied()) {
             inputs[s as usize][input as usize] = v;
         }
         Found::Violated { step, inputs }
@@ -412,19 +447,26 @@ impl<'a> Sim<'a> {
             return;
         }
         self.stats.peak_nodes = self.stats.peak_nodes.max(self.gr.a.len());
-        let (n, m) = (self.state.len(), self.prev_state.len());
-        let mut roots = std::mem::take(&mut self.state);
-        roots.append(&mut self.prev_state);
+        // every literal held: this path's, then each waiting path's
+        let mut held: Vec<&mut Vec<u32>> = vec![&mut self.state, &mut self.prev_state];
+        for b in self.queue.values_mut() {
+            held.push(&mut b.state);
+            held.push(&mut b.prev_state);
+        }
+        let mut roots: Vec<u32> = held.iter().flat_map(|v| v.iter().copied()).collect();
         roots.extend(self.pending.iter().map(|&(_, b)| b));
         roots.push(self.pending_any);
         self.gr.collect(&mut roots);
-        self.pending_any = roots.pop().unwrap_or(0);
-        for (p, r) in self.pending.iter_mut().zip(&roots[n + m..]) {
+        let mut at = 0;
+        for v in held {
+            let n = v.len();
+            v.copy_from_slice(&roots[at..at + n]);
+            at += n;
+        }
+        for (p, r) in self.pending.iter_mut().zip(&roots[at..]) {
             p.1 = *r;
         }
-        roots.truncate(n + m);
-        self.prev_state = roots.split_off(n);
-        self.state = roots;
+        self.pending_any = roots.pop().unwrap_or(0);
         self.gc_at = (1 << 20).max(4 * self.gr.a.len());
     }
 }
@@ -440,8 +482,24 @@ fn evaluate(
     state: &mut [u32],
     step: u64,
 ) -> u32 {
-    for (k, &i) in g.inputs.iter().enumerate() {
-        val[(i >> 1) as usize] = gr.var(k as u32, step as u32);
+    let inputs: Vec<u32> = (0..g.inputs.len())
+        .map(|k| gr.var(k as u32, step as u32))
+        .collect();
+    evaluate_with(g, ands, gr, val, state, &inputs)
+}
+
+/// [`evaluate`] with each input's literal given (a variable, or a constant
+/// where a split fixed it).
+fn evaluate_with(
+    g: &Aig,
+    ands: &[(u32, u32, u32)],
+    gr: &mut Graph,
+    val: &mut [u32],
+    state: &mut [u32],
+    inputs: &[u32],
+) -> u32 {
+    for (&i, &lit) in g.inputs.iter().zip(inputs) {
+        val[(i >> 1) as usize] = lit;
     }
     for (j, &(l, _, _)) in g.latches.iter().enumerate() {
         val[(l >> 1) as usize] = state[j];

@@ -1,0 +1,298 @@
+//! A run split on a few inputs: requests such as pin-selected modes'
+//! `mode_sel`, which a design keeps for as long as it likes.
+//!
+//! Why: a request that names no mode keeps the mode decided before, so the
+//! mode register's value is a function of every earlier request (a chain of
+//! `sel valid ? sel : older`) that grows a frame at a time: the state never
+//! recurs, and each SAT check has to equate the harness's chain with the
+//! design's.  But the mode takes a few values only.  So in a step whose
+//! next state (or assertion) reads a split input's variable of that step,
+//! the step is simulated once per value of the split inputs, each a path of
+//! its own with those values fixed (equal successors kept once); on every
+//! path the mode registers are constants again, and everything folds as for
+//! one mode.
+//!
+//! Soundness: the states reachable at a step are the union, over the values
+//! of the split inputs, of the states each path reaches (every value is
+//! taken), so nothing is left out and nothing is added.  A path's state at
+//! a frame boundary that is, up to renaming, a state some path reached at
+//! an earlier or the same boundary adds no new state (the argument of
+//! `mod.rs`, per path: its successors are the earlier state's); when every
+//! path has ended so, every reachable state was simulated, each step
+//! checked exactly: proved for all time.  A violation on a path is a real
+//! trace: the values fixed on the path and the SAT model of the rest.
+
+use std::collections::HashMap;
+
+use super::graph::Assigned;
+use super::{evaluate_with, kept, Found, Limits, Sim, SymStats, CHECK};
+
+/// At most this many split input bits (2^n values in a step that reads
+/// them); a design with more is simulated with them as variables.
+pub(super) const MAX_SPLIT_BITS: usize = 8;
+
+/// At most this many states at boundaries and paths waiting: past it the
+/// run stops, bounded (a mode mix has a state per pair of modes and data).
+const MAX_PATHS: usize = 4096;
+
+/// A path waiting at the step it continues from.
+pub(super) struct Branch {
+    pub(super) state: Vec<u32>,
+    /// Its state at the last boundary (for `kept`).
+    pub(super) prev_state: Vec<u32>,
+    fixed: Vec<Assigned>,
+}
+
+impl Sim<'_> {
+    /// Runs every path to a boundary whose state was seen, a violation,
+    /// `lim.max_steps` or the deadline; paths are taken by their step, so a
+    /// bound covers every path to it.
+    pub(super) fn run_split(mut self, lim: &Limits) -> (Found, SymStats) {
+        self.deadline = lim.deadline;
+        let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
+        let (mut seq, mut closed) = (0u64, None);
+        let start = Branch {
+            state: std::mem::take(&mut self.state),
+            prev_state: Vec::new(),
+            fixed: Vec::new(),
+        };
+        self.queue.insert((0, 0), start);
+        // the earliest violation so far: later paths stop before it
+        let mut first: Option<(u64, Found)> = None;
+        while let Some(((from, _), b)) = self.queue.pop_first() {
+            let stop = first.as_ref().map_or(lim.max_steps, |f| f.0);
+            if from >= stop && first.is_some() {
+                continue; // at or past the earliest violation
+            }
+            if from >= stop {
+                // a path that reached the last step: nothing is said beyond
+                self.stats.branches = seen.len();
+                return (Found::Bounded { steps: from }, self.stats);
+            }
+            if seen.len() + self.queue.len() > MAX_PATHS {
+                // the split does not come round (a request kept with data
+                // of its age, say): bounded where every path got to
+                self.stats.branches = seen.len();
+                let steps = self.covered(from);
+                return (first.map_or(Found::Bounded { steps }, |f| f.1), self.stats);
+            }
+            (self.state, self.prev_state, self.fixed) = (b.state, b.prev_state, b.fixed);
+            self.pending.clear();
+            self.pending_any = 0;
+            let path_lim = Limits {
+                max_steps: stop,
+                ..*lim
+            };
+            match self.run_path(from, &path_lim, &mut seen) {
+                Ok(Path::Closed(step)) => closed = closed.max(Some(step)),
+                Ok(Path::Split(step, children)) => {
+                    for c in children {
+                        seq += 1;
+                        self.queue.insert((step, seq), c);
+                    }
+                }
+                Err(Found::Violated { step, inputs }) => {
+                    first = Some((step, Found::Violated { step, inputs }));
+                }
+                // the search stopped at the earliest violation's step
+                Err(Found::Bounded { .. }) if first.is_some() && stop < lim.max_steps => {}
+                Err(found) => {
+                    self.stats.branches = seen.len();
+                    return (first.map_or(found, |f| f.1), self.stats);
+                }
+            }
+        }
+        self.stats.branches = seen.len();
+        if let Some((_, f)) = first {
+            return (f, self.stats);
+        }
+        let steps = closed.unwrap_or(lim.offset);
+        (
+            Found::Proved {
+                steps,
+                since: lim.offset,
+            },
+            self.stats,
+        )
+    }
+
+    /// The steps every path has been simulated to: `step` on this one, the
+    /// first waiting path's start on the others.
+    fn covered(&self, step: u64) -> u64 {
+        self.queue
+            .first_key_value()
+            .map_or(step, |(k, _)| k.0.min(step))
+    }
+
+    /// This path from `from` until it closes at a boundary or splits.
+    fn run_path(
+        &mut self,
+        from: u64,
+        lim: &Limits,
+        seen: &mut HashMap<Vec<u64>, u64>,
+    ) -> Result<Path, Found> {
+        for step in from..lim.max_steps {
+            let phase = step.checked_sub(lim.offset).map(|p| p % lim.period);
+            if phase.is_some_and(|p| p % CHECK == 0) {
+                if let Some(f) = self.check_pending() {
+                    return Err(self.bounded_at(f));
+                }
+            }
+            if phase == Some(0) {
+                let now = self.gr.canonical(&self.state, step as u32);
+                // a state seen at this step or before: its successors are
+                // covered (one seen later may hide an earlier violation)
+                if seen.get(&now).is_some_and(|&at| at <= step) {
+                    return Ok(Path::Closed(step));
+                }
+                if step > lim.offset && !self.prev_state.is_empty() {
+                    self.stats.kept =
+                        kept(&self.gr, &self.prev_state, &self.state, step, lim.period);
+                }
+                seen.insert(now, step);
+                self.prev_state.clone_from(&self.state);
+            }
+            if step.is_multiple_of(256) && lim.deadline.is_some_and(|d| Instant::now() > d) {
+                let found = self.check_pending();
+                let steps = self.covered(step);
+                return Err(self.bounded_at(found.unwrap_or(Found::Bounded { steps })));
+            }
+            if let Some(children) = self.step_split(step)? {
+                return Ok(Path::Split(step + 1, children));
+            }
+            self.collect_if_large();
+        }
+        let found = self.check_pending();
+        let steps = self.covered(lim.max_steps);
+        Err(self.bounded_at(found.unwrap_or(Found::Bounded { steps })))
+    }
+
+    /// A bound of this path as a bound of the run (no further than every
+    /// waiting path got).
+    fn bounded_at(&self, f: Found) -> Found {
+        match f {
+            Found::Bounded { steps } => Found::Bounded {
+                steps: self.covered(steps),
+            },
+            other => other,
+        }
+    }
+
+    /// One step; `Some(paths)` when its successor reads a split input of
+    /// the step: one path per value of the split inputs (equal successors
+    /// once), the step's assertion checked on each.
+    fn step_split(&mut self, step: u64) -> Result<Option<Vec<Branch>>, Found> {
+        let (g, ni) = (self.g, self.g.inputs.len());
+        let mark = self.gr.a.len();
+        // the split inputs' variables first: a node older than them reads none
+        let mut inputs = vec![0u32; ni];
+        for &k in &self.splits {
+            inputs[k] = self.gr.var(k as u32, step as u32);
+        }
+        for (k, lit) in inputs.iter_mut().enumerate() {
+            if !self.splits.contains(&k) {
+                *lit = self.gr.var(k as u32, step as u32);
+            }
+        }
+        let mut next = self.state.clone();
+        let bad = evaluate_with(
+            g,
+            &self.ands,
+            &mut self.gr,
+            &mut self.val,
+            &mut next,
+            &inputs,
+        );
+        let vars: Vec<usize> = self
+            .splits
+            .iter()
+            .map(|&k| (inputs[k] >> 1) as usize)
+            .collect();
+        let roots = next.iter().copied().chain([bad]);
+        if !reads(&self.gr, roots, mark, &vars) {
+            self.state = next;
+            if bad != 0 {
+                self.pending.push((step, bad));
+                self.pending_any = self.gr.and(self.pending_any ^ 1, bad ^ 1) ^ 1;
+            }
+            return Ok(None);
+        }
+        // the steps before are checked first, so that the paths start clean
+        if let Some(f) = self.check_pending() {
+            return Err(self.bounded_at(f));
+        }
+        let mut paths: Vec<Branch> = Vec::new();
+        for a in 0u32..1 << self.splits.len() {
+            let mut fixed = self.fixed.clone();
+            for (i, &k) in self.splits.iter().enumerate() {
+                inputs[k] = (a >> i) & 1;
+                fixed.push((k as u32, step as u32, (a >> i) & 1 == 1));
+            }
+            let mut next = self.state.clone();
+            let bad = evaluate_with(
+                g,
+                &self.ands,
+                &mut self.gr,
+                &mut self.val,
+                &mut next,
+                &inputs,
+            );
+            if bad != 0 {
+                self.stats.sat_calls += 1;
+                let limit = (self.deadline).map(|d| d.saturating_duration_since(Instant::now()));
+                match self.gr.satisfy(bad, limit) {
+                    Ok(None) => {}
+                    Ok(Some(assign)) => {
+                        self.fixed = fixed;
+                        return Err(self.violation(step, assign));
+                    }
+                    Err(_) => return Err(self.bounded_at(Found::Bounded { steps: step })),
+                }
+            }
+            if paths.iter().all(|p| p.state != next) {
+                paths.push(Branch {
+                    state: next,
+                    prev_state: self.prev_state.clone(),
+                    fixed,
+                });
+            }
+        }
+        Ok(Some(paths))
+    }
+}
+
+use std::time::Instant;
+
+/// How a path's simulation ended.
+enum Path {
+    /// At a boundary (this step) whose state was seen.
+    Closed(u64),
+    /// Split: the paths continuing from this step.
+    Split(u64, Vec<Branch>),
+}
+
+/// Whether any of `roots` reads a node of `vars`: only nodes made since
+/// `mark` can (the variables were made first, and a node's fanins are
+/// older than it).
+fn reads(
+    gr: &super::graph::Graph,
+    roots: impl Iterator<Item = u32>,
+    mark: usize,
+    vars: &[usize],
+) -> bool {
+    let mut seen = std::collections::HashSet::new();
+    let mut stack: Vec<usize> = roots.map(|r| (r >> 1) as usize).collect();
+    while let Some(n) = stack.pop() {
+        if n < mark || !seen.insert(n) {
+            continue;
+        }
+        if vars.contains(&n) {
+            return true;
+        }
+        if !gr.is_var(n) {
+            stack.push((gr.a[n] >> 1) as usize);
+            stack.push((gr.b[n] >> 1) as usize);
+        }
+    }
+    false
+}
