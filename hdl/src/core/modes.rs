@@ -150,12 +150,16 @@ impl Logic for ModeGen {
             }
             self._z = addr == 0;
         }
-        let fend = self.start1.val() && self._z;
+        // in reset the ROM reads mode 0's first slot: `nxt` and `z` may
+        // still hold their power-on values at the first edge
+        let rst = self.rst.val();
+        let fend = self.start1.val() && self._z && !rst;
         let anx = addr == 0;
-        let amode = if anx || fend { self._nxt } else { self._cur };
+        let nxt = if rst { 0 } else { self._nxt };
+        let amode = if anx || fend { nxt } else { self._cur };
         self.mode.next = (self._cur as u64).into();
         self.maddr.next = ((amode << self._p.slot_bits) as u64 | addr).into();
-        let info = ((anx && !fend) as u64) << self._p.bits | self._nxt as u64;
+        let info = ((anx && !fend) as u64) << self._p.bits | nxt as u64;
         self.minfo.next = info.into();
     }
 
@@ -177,7 +181,7 @@ fn mode_verilog(p: &ModePlan, nb: usize) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "// the modes of the frame in force and of the next; the first frame start seen\n// (frames 0 and 1 run the reset mode); the next slot start is a frame's\nreg [{}:0] cur;\nreg [{0}:0] nxt;\nreg go;\nreg z;\nwire fend = start1 & z;\nwire anx = addr == {SLOT_BITS}'h0;\n",
+        "// the modes of the frame in force and of the next; the first frame start seen\n// (frames 0 and 1 run the reset mode); the next slot start is a frame's\nreg [{}:0] cur;\nreg [{0}:0] nxt;\nreg go;\nreg z;\n// in reset the ROM reads mode 0's first slot (nxt and z may hold power-on values)\nwire fend = start1 & z & ~rst;\nwire anx = addr == {SLOT_BITS}'h0;\nwire [{0}:0] nxt0 = rst ? {mb}'d0 : nxt;\n",
         mb - 1
     );
     if !p.pin {
@@ -219,11 +223,11 @@ fn mode_verilog(p: &ModePlan, nb: usize) -> String {
         "always @(*) begin\n  mode = {};\n  maddr = {};\n  minfo = {};\nend",
         pad("cur".into(), mb, MODE_BITS),
         pad(
-            format!("{{((anx | fend) ? nxt : cur), addr[{}:0]}}", sb - 1),
+            format!("{{((anx | fend) ? nxt0 : cur), addr[{}:0]}}", sb - 1),
             mb + sb,
             SLOT_BITS
         ),
-        pad("{anx & ~fend, nxt}".into(), mb + 1, SLICE_BITS),
+        pad("{anx & ~fend, nxt0}".into(), mb + 1, SLICE_BITS),
     );
     if !unused.is_empty() {
         let _ = writeln!(
