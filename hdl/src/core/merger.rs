@@ -56,10 +56,23 @@ pub struct Merger {
     /// queue, lane 0 its head; `pend` is then a thermometer of the words
     /// still queued behind the head.
     _queue: bool,
+    /// One chained branch (priority form, [`stepped_reader`]): `sh_en` is
+    /// the registered `cap | r_any` the word reader's register steps under.
+    _step: bool,
+}
+
+/// Whether the merger gives the word reader a registered shift enable in
+/// the priority form: one branch, chained, no modes (the mode block reads
+/// the reader's word). Its grant is then `r_any` (P(c) is that lane alone),
+/// and the reader's 64-odd flip-flops step under `sh_en`, a flip-flop, not
+/// under the priority chain's grant through a LUT and a global buffer
+/// (vibrotactile8k's critical path).
+pub(crate) fn stepped_reader(p: &crate::plan::Plan) -> bool {
+    p.queue.is_none() && p.modes.is_none() && p.branches.len() == 1 && p.branches[0].chain > 1
 }
 
 impl Merger {
-    pub(super) fn new(nb: usize, queue: bool) -> Merger {
+    pub(super) fn new(nb: usize, queue: bool, step: bool) -> Merger {
         Merger {
             clock: Default::default(),
             rst: Default::default(),
@@ -85,11 +98,17 @@ impl Merger {
             r_chen: Default::default(),
             _nb: nb,
             _queue: queue,
+            _step: step,
         }
     }
 }
 
 impl Merger {
+    /// The word reader steps under `sh_en` ([`stepped_reader`]).
+    pub(super) fn stepped(&self) -> bool {
+        self._step
+    }
+
     /// The queue form's update: P(c) is the words queued behind the head
     /// plus this cycle's completions, which all fall in one cycle (one SPI
     /// sequencer) and sit in lanes `0..n` in branch order; P(c) as a
@@ -164,7 +183,12 @@ impl Logic for Merger {
             pend = 0;
         }
         self.pend.d.next = pend.into();
-        self.r_any.d.next = !self.rst.val() & ((pend | self.done_next.val().to_u64()) != 0);
+        let any = !self.rst.val() & ((pend | self.done_next.val().to_u64()) != 0);
+        self.r_any.d.next = any;
+        if self._step {
+            self.r_shen.d.next = self.cap_next.val() | any;
+            self.sh_en.next = self.r_shen.q.val();
+        }
     }
 
     fn connect(&mut self) {
@@ -250,13 +274,23 @@ impl Logic for Merger {
             "  r_any$d = !rst & |{{pend$d[{0}:0], done_next[{0}:0]}};\n",
             nb - 1
         ));
-        s.push_str(
-            "  r_shen$d = 1'b0;\n  r_chen$d = 1'b0;\n  sh_en = 1'b0;\n  ch_en = 1'b0;\n  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n",
-        );
+        if self._step {
+            s.push_str("  // the chained reader's shift enable, registered\n  r_shen$d = cap_next | r_any$d;\n  sh_en = r_shen$q;\n");
+            s.push_str("  r_chen$d = 1'b0;\n  ch_en = 1'b0;\n");
+        } else {
+            s.push_str(
+                "  r_shen$d = 1'b0;\n  r_chen$d = 1'b0;\n  sh_en = 1'b0;\n  ch_en = 1'b0;\n",
+            );
+        }
+        s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
         // the queue form's inputs and enables (unused here)
-        let mut unused: Vec<String> = ["cap_next", "start2", "r_shen$q", "r_chen$q"]
-            .map(String::from)
-            .to_vec();
+        let mut unused: Vec<String> = if self._step {
+            vec!["start2".into(), "r_chen$q".into()]
+        } else {
+            ["cap_next", "start2", "r_shen$q", "r_chen$q"]
+                .map(String::from)
+                .to_vec()
+        };
         if nb < w {
             unused.push(format!("done[{}:{nb}]", w - 1));
             unused.push(format!("more[{}:{nb}]", w - 1));

@@ -2,7 +2,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::glue::{core_glue, route_miso};
+use super::glue::{core_glue, route_miso, LaneForm};
 use super::{BranchUnit, CmdUnit, CnvPulse, Merger, ModeGen, SpiSeq, TimingGen};
 use crate::plan::Plan;
 use crate::widths::*;
@@ -57,6 +57,7 @@ pub struct Core {
 
 impl Core {
     pub fn new(plan: &Plan) -> Core {
+        let step = super::merger::stepped_reader(plan);
         let mut pulse_of = vec![None; plan.seqs.len()];
         let mut pulses = vec![];
         for (i, q) in plan.seqs.iter().enumerate().filter(|(_, q)| q.pulsed()) {
@@ -100,11 +101,11 @@ impl Core {
             branches: plan
                 .branches
                 .iter()
-                .map(|b| BranchUnit::new(b, plan.queue.is_some()))
+                .map(|b| BranchUnit::new(b, plan.queue.is_some(), step))
                 .collect(),
             cmds,
             _cmd_of: cmd_of,
-            merge: Merger::new(plan.branches.len(), plan.queue.is_some()),
+            merge: Merger::new(plan.branches.len(), plan.queue.is_some(), step),
             modes: (plan.modes.iter())
                 .map(|m| ModeGen::new(m, plan.branches.len()))
                 .collect(),
@@ -481,7 +482,12 @@ impl Logic for Core {
             self.modes
                 .first()
                 .map(|g| (!self.mode_sel.is_empty(), g.ch.len())),
-            self._queue.as_deref(),
+            match self._queue.as_deref() {
+                Some(q) => LaneForm::Queue(q),
+                None => LaneForm::Priority {
+                    stepped: self.merge.stepped(),
+                },
+            },
         ))
     }
 }
