@@ -202,6 +202,24 @@ pub struct Plan {
     /// branches whose MISO lane `j`'s register ever captures; `None` for the
     /// pending-set merger with its own output multiplexer.
     pub queue: Option<Vec<Vec<usize>>>,
+    /// The queue form with the full table: the channel of each word out,
+    /// from the merger's own table (see [`LaneChannels`]), not from the
+    /// lanes' channel registers.
+    pub lane_ch: Option<LaneChannels>,
+}
+
+/// The queue form's channel table (hdl/DESIGN.md, "Merger"): the merger
+/// reads the channel of the `k`-th word a slot's completion puts out from a
+/// block RAM at `{a, k}`, `a` the timing generator's ROM address during
+/// that slot (the next slot's), `k` the words already out; the lanes then
+/// carry no channel registers (eskin34: 16 flip-flops and their
+/// multiplexers).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LaneChannels {
+    /// At `(a << k_bits) | k`.
+    pub words: Vec<u32>,
+    pub addr_bits: usize,
+    pub k_bits: usize,
 }
 
 pub fn addr_bits(frame_slots: u64) -> usize {
@@ -311,12 +329,14 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         branches,
         link: crate::link::LinkParams::of(s).map_err(unsupported)?,
         queue,
+        lane_ch: None,
         modes: None,
     };
     crate::modeplan::apply(s, &mut p)?;
     if !compact && form != LutForm::Full {
         decode_by_logic(&mut p, form == LutForm::Logic)?;
     }
+    p.lane_ch = lane_channel_table(s, &p);
     Ok(p)
 }
 
@@ -369,6 +389,41 @@ fn logic_costs(p: &Plan, logic: &[SlotLogic]) -> (usize, usize, usize) {
     // the logic form's timing counts slots in the slice (with their
     // successor register, as the compact form's) and slices
     (rom, 2 * l.slot_bits + l.slice_bits + 2, decode)
+}
+
+/// The queue form's channel table, for the full table's ROM address (not
+/// the compact or logic forms, whose address is the slot in the slice):
+/// during frame slot `u` the address is `u + 1` (the ROM reads a slot
+/// ahead). Only when a slot's words are all out before the address moves:
+/// the completion comes at most `read_cycles` after the slot start, then
+/// a word a cycle, and the address moves in the slot's last cycles.
+fn lane_channel_table(s: &Schedule, p: &Plan) -> Option<LaneChannels> {
+    let nb = p.branches.len();
+    let q = p.seqs.first()?;
+    if p.queue.is_none() || p.compact || p.logic || p.modes.is_some() {
+        return None;
+    }
+    if q.setup_cycles + q.read_cycles + nb as u64 + 4 > p.slot_cycles {
+        return None;
+    }
+    let (fs, ab, kb) = (
+        p.frame_slots,
+        addr_bits(p.frame_slots),
+        addr_bits(nb as u64),
+    );
+    let mut words = vec![0u32; 1 << (ab + kb)];
+    for u in 0..fs {
+        let a = ((u + 1) % fs) as usize;
+        let conv = (0..nb).filter_map(|b| s.at(u, b));
+        for (k, c) in conv.enumerate() {
+            words[(a << kb) | k] = c as u32;
+        }
+    }
+    Some(LaneChannels {
+        words,
+        addr_bits: ab,
+        k_bits: kb,
+    })
 }
 
 /// `lanes[j][u]`: the channel of the `j`-th branch (in branch order) that

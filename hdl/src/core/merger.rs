@@ -2,6 +2,7 @@
 
 use rust_hdl::prelude::*;
 
+use crate::plan::LaneChannels;
 use crate::widths::*;
 
 /// P(c) = pending completions plus this cycle's; the lowest branch in it
@@ -29,6 +30,8 @@ pub struct Merger {
     /// generator's `start2`, for the registered lane enables below.
     pub cap_next: Signal<In, Bit>,
     pub start2: Signal<In, Bit>,
+    /// The timing generator's ROM address (the queue form's channel table).
+    pub addr: Signal<In, Bits<SLOT_BITS>>,
     /// The lane whose word is taken at the end of this cycle (one-hot).
     pub grant: Signal<Out, Bits<MAX_BRANCHES>>,
     /// Queue form: the lanes' shift registers load (`cap | mv`) and their
@@ -59,6 +62,11 @@ pub struct Merger {
     /// One chained branch (priority form, [`stepped_reader`]): `sh_en` is
     /// the registered `cap | r_any` the word reader's register steps under.
     _step: bool,
+    /// The queue form's channel table (`Plan::lane_ch`), the words out
+    /// since the last idle cycle (`kcnt`) and the table's registered read.
+    _lane_ch: Option<LaneChannels>,
+    _kcnt: usize,
+    _chq: u32,
 }
 
 /// Whether the merger gives the word reader a registered shift enable in
@@ -72,7 +80,7 @@ pub(crate) fn stepped_reader(p: &crate::plan::Plan) -> bool {
 }
 
 impl Merger {
-    pub(super) fn new(nb: usize, queue: bool, step: bool) -> Merger {
+    pub(super) fn new(nb: usize, queue: bool, step: bool, lane_ch: Option<LaneChannels>) -> Merger {
         Merger {
             clock: Default::default(),
             rst: Default::default(),
@@ -83,6 +91,7 @@ impl Merger {
             v: std::array::from_fn(|_| Default::default()),
             cap_next: Default::default(),
             start2: Default::default(),
+            addr: Default::default(),
             grant: Default::default(),
             sh_en: Default::default(),
             ch_en: Default::default(),
@@ -99,6 +108,9 @@ impl Merger {
             _nb: nb,
             _queue: queue,
             _step: step,
+            _lane_ch: lane_ch,
+            _kcnt: 0,
+            _chq: 0,
         }
     }
 }
@@ -119,8 +131,24 @@ impl Merger {
         self.r_valid.d.next = p & 1 == 1;
         let mut pend = p >> 1;
         self.grant.next = 0u64.into();
+        if let Some(t) = &self._lane_ch {
+            // the table's read a cycle ahead: the next word's index
+            let kd = if self.r_any.q.val() {
+                (self._kcnt + 1) & ((1 << t.k_bits) - 1)
+            } else {
+                0
+            };
+            if self.clock.pos_edge() {
+                let a = self.addr.val().to_u64() as usize & ((1 << t.addr_bits) - 1);
+                self._chq = t.words[(a << t.k_bits) | kd];
+                self._kcnt = kd;
+            }
+        }
         if self.r_any.q.val() {
-            self.r_ch.d.next = self.ch[0].val();
+            self.r_ch.d.next = match self._lane_ch {
+                Some(_) => (self._chq as u64).into(),
+                None => self.ch[0].val(),
+            };
             self.r_val.d.next = self.v[0].val();
         }
         if self.rst.val() {
@@ -216,7 +244,7 @@ impl Logic for Merger {
 
     fn hdl(&self) -> Verilog {
         if self._queue {
-            return Verilog::Custom(queue_text(self._nb));
+            return Verilog::Custom(queue_text(self._nb, self._lane_ch.as_ref()));
         }
         let nb = self._nb;
         let w = MAX_BRANCHES;
@@ -285,9 +313,9 @@ impl Logic for Merger {
         s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
         // the queue form's inputs and enables (unused here)
         let mut unused: Vec<String> = if self._step {
-            vec!["start2".into(), "r_chen$q".into()]
+            vec!["start2".into(), "r_chen$q".into(), "addr".into()]
         } else {
-            ["cap_next", "start2", "r_shen$q", "r_chen$q"]
+            ["cap_next", "start2", "r_shen$q", "r_chen$q", "addr"]
                 .map(String::from)
                 .to_vec()
         };
@@ -313,7 +341,7 @@ impl Logic for Merger {
 
 /// The queue form's Verilog (the twin is `Merger::update_queue`): no word
 /// multiplexer, the output registers load lane 0, the head of the queue.
-fn queue_text(nb: usize) -> String {
+fn queue_text(nb: usize, lane_ch: Option<&LaneChannels>) -> String {
     let w = MAX_BRANCHES;
     let cb = usize::BITS as usize - nb.leading_zeros() as usize;
     let sum: Vec<String> = (0..nb)
@@ -333,6 +361,9 @@ fn queue_text(nb: usize) -> String {
         therm.join(", "),
         top = nb - 1,
     );
+    if let Some(t) = lane_ch {
+        s.push_str(&channel_table_text(t));
+    }
     s.push_str("always @(*) begin\n");
     for f in [
         "r_valid", "r_ch", "r_val", "pend", "r_any", "r_shen", "r_chen",
@@ -348,7 +379,13 @@ fn queue_text(nb: usize) -> String {
     // only when enabled). As gates (a LUT per bit, no enable) they were
     // faster, but `prove --netlist` then cannot see them renewed every
     // frame (the held value's feedback LUT), and says bounded, not proved.
-    s.push_str("  if (r_any$q) begin\n    r_ch$d = ch$0;\n    r_val$d = v$0;\n  end\n");
+    let head_ch = match lane_ch {
+        Some(_) => format!("{{{}'h0, chq}}", CH_BITS - lane_ch.map_or(0, table_bits)),
+        None => "ch$0".to_string(),
+    };
+    s.push_str(&format!(
+        "  if (r_any$q) begin\n    r_ch$d = {head_ch};\n    r_val$d = v$0;\n  end\n"
+    ));
     s.push_str(&format!(
         "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = {VALUE_BITS}'h0;\n    pend$d = {w}'h0;\n  end\n"
     ));
@@ -365,6 +402,18 @@ fn queue_text(nb: usize) -> String {
         unused.push(format!("done[{}:{nb}]", w - 1));
         unused.push(format!("done_next[{}:{nb}]", w - 1));
     }
+    if lane_ch.is_some() {
+        unused.push("ch$0".to_string());
+        if lane_ch.map_or(0, |t| t.addr_bits) < SLOT_BITS {
+            unused.push(format!(
+                "addr[{}:{}]",
+                SLOT_BITS - 1,
+                lane_ch.map_or(0, |t| t.addr_bits)
+            ));
+        }
+    } else {
+        unused.push("addr".to_string());
+    }
     for b in 1..w {
         unused.push(format!("ch${b}"));
         unused.push(format!("v${b}"));
@@ -372,6 +421,39 @@ fn queue_text(nb: usize) -> String {
     s.push_str(&format!(
         "\n// lanes behind the head are read by the lane below, not here\nwire unused_lanes = |{{{}}};\n",
         unused.join(", ")
+    ));
+    s
+}
+
+/// Bits of the channel table's words: the widest channel it names.
+fn table_bits(t: &LaneChannels) -> usize {
+    let max = t.words.iter().copied().max().unwrap_or(0);
+    (u32::BITS - max.leading_zeros()).max(1) as usize
+}
+
+/// The queue form's channel table (`Plan::lane_ch`): a block RAM read a
+/// cycle ahead at `{addr, kcnt_d}`, `kcnt_d` the index of the word that
+/// leaves in the next cycle (the words out since the last idle cycle).
+fn channel_table_text(t: &LaneChannels) -> String {
+    let (ab, kb, cw) = (t.addr_bits, t.k_bits, table_bits(t));
+    let digits = cw.div_ceil(4);
+    let mut s = format!(
+        "// the channel of each word out, by the slot's ROM address and the words\n\
+         // already out (no channel registers in the lanes)\n\
+         reg [{}:0] chmem [0:{}];\ninitial begin\n",
+        cw - 1,
+        t.words.len() - 1
+    );
+    for (a, w) in t.words.iter().enumerate() {
+        s.push_str(&format!("  chmem[{a}] = {cw}'h{w:0digits$x};\n"));
+    }
+    s.push_str(&format!(
+        "end\nreg [{k}:0] kcnt;\ninitial kcnt = {kb}'h0;\nwire [{k}:0] kcnt_d = r_any$q ? kcnt + {kb}'h1 : {kb}'h0;\n\
+         // a block RAM's read register: no initial value, read only after a read\n\
+         reg [{c}:0] chq;\nalways @(posedge clock) begin\n  kcnt <= kcnt_d;\n  chq <= chmem[{{addr[{a}:0], kcnt_d}}];\nend\n\n",
+        k = kb - 1,
+        c = cw - 1,
+        a = ab - 1,
     ));
     s
 }

@@ -102,6 +102,7 @@ fn harness(div: u64, setup: u64) -> Harness {
         }],
         branches: vec![rom()],
         queue: None,
+        lane_ch: None,
     };
     let mut h = Harness {
         clock: Default::default(),

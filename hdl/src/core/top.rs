@@ -105,7 +105,12 @@ impl Core {
                 .collect(),
             cmds,
             _cmd_of: cmd_of,
-            merge: Merger::new(plan.branches.len(), plan.queue.is_some(), step),
+            merge: Merger::new(
+                plan.branches.len(),
+                plan.queue.is_some(),
+                step,
+                plan.lane_ch.clone(),
+            ),
             modes: (plan.modes.iter())
                 .map(|m| ModeGen::new(m, plan.branches.len()))
                 .collect(),
@@ -373,6 +378,7 @@ impl Logic for Core {
         // the queue form's single sequencer (unused in the priority form)
         self.merge.cap_next.next = self.seqs[0].cap_next.val();
         self.merge.start2.next = start;
+        self.merge.addr.next = self.timing.addr.val();
         if self._queue.is_some() {
             // the queue form: each lane reads the next lane's channel and word
             for b in 0..nb - 1 {
@@ -447,6 +453,7 @@ impl Logic for Core {
         self.merge.done_next.connect();
         self.merge.cap_next.connect();
         self.merge.start2.connect();
+        self.merge.addr.connect();
         for b in 0..MAX_BRANCHES {
             self.merge.ch[b].connect();
             self.merge.v[b].connect();
