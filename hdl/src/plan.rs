@@ -216,8 +216,10 @@ pub struct Plan {
 /// multiplexers).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LaneChannels {
-    /// At `(a << k_bits) | k`.
+    /// At `(a << k_bits) | k`: the channel, and above it (bit
+    /// `ch_bits`) whether another word of the slot follows.
     pub words: Vec<u32>,
+    pub ch_bits: usize,
     pub addr_bits: usize,
     pub k_bits: usize,
 }
@@ -411,18 +413,21 @@ fn lane_channel_table(s: &Schedule, p: &Plan) -> Option<LaneChannels> {
         addr_bits(p.frame_slots),
         addr_bits(nb as u64),
     );
+    let cw = (p.channel_bits as usize).max(1);
     let mut words = vec![0u32; 1 << (ab + kb)];
     for u in 0..fs {
         let a = ((u + 1) % fs) as usize;
-        let conv = (0..nb).filter_map(|b| s.at(u, b));
-        for (k, c) in conv.enumerate() {
-            words[(a << kb) | k] = c as u32;
+        let conv: Vec<usize> = (0..nb).filter_map(|b| s.at(u, b)).collect();
+        for (k, c) in conv.iter().enumerate() {
+            let next = (k + 1 < conv.len()) as u32;
+            words[(a << kb) | k] = next << cw | *c as u32;
         }
     }
     Some(LaneChannels {
         words,
         addr_bits: ab,
         k_bits: kb,
+        ch_bits: cw,
     })
 }
 

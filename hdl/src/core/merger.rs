@@ -126,29 +126,17 @@ impl Merger {
     /// sequencer) and sit in lanes `0..n` in branch order; P(c) as a
     /// thermometer, lane 0 leaves and every lane moves up one.
     fn update_queue(&mut self) {
+        if self._lane_ch.is_some() {
+            self.update_table();
+            return;
+        }
         let n = self.done.val().to_u64().count_ones();
         let p = self.pend.q.val().to_u64() | ((1u64 << n) - 1);
         self.r_valid.d.next = p & 1 == 1;
         let mut pend = p >> 1;
         self.grant.next = 0u64.into();
-        if let Some(t) = &self._lane_ch {
-            // the table's read a cycle ahead: the next word's index
-            let kd = if self.r_any.q.val() {
-                (self._kcnt + 1) & ((1 << t.k_bits) - 1)
-            } else {
-                0
-            };
-            if self.clock.pos_edge() {
-                let a = self.addr.val().to_u64() as usize & ((1 << t.addr_bits) - 1);
-                self._chq = t.words[(a << t.k_bits) | kd];
-                self._kcnt = kd;
-            }
-        }
         if self.r_any.q.val() {
-            self.r_ch.d.next = match self._lane_ch {
-                Some(_) => (self._chq as u64).into(),
-                None => self.ch[0].val(),
-            };
+            self.r_ch.d.next = self.ch[0].val();
             self.r_val.d.next = self.v[0].val();
         }
         if self.rst.val() {
@@ -163,6 +151,51 @@ impl Merger {
         // start1 of the next cycle is start2 or reset in this one
         self.r_shen.d.next = self.cap_next.val() | any;
         self.r_chen.d.next = self.start2.val() | self.rst.val() | any;
+        self.sh_en.next = self.r_shen.q.val();
+        self.ch_en.next = self.r_chen.q.val();
+    }
+}
+
+impl Merger {
+    /// The queue form with the channel table (`queue_table_text`): the
+    /// head's channel and whether another word follows it come from the
+    /// table, read a cycle ahead at `{addr, kcnt_d}`; no pending set
+    /// (P(c)'s lowest bit is `r_any`, a word leaves in the next cycle when
+    /// the slot completes then or another word follows this one).
+    fn update_table(&mut self) {
+        let Some(t) = &self._lane_ch else { return };
+        let any_q = self.r_any.q.val();
+        let kd = if any_q {
+            (self._kcnt + 1) & ((1 << t.k_bits) - 1)
+        } else {
+            0
+        };
+        let next = self._chq >> t.ch_bits & 1 == 1;
+        let ch = self._chq & ((1 << t.ch_bits) - 1);
+        if self.clock.pos_edge() {
+            let a = self.addr.val().to_u64() as usize & ((1 << t.addr_bits) - 1);
+            self._chq = t.words[(a << t.k_bits) | kd];
+            self._kcnt = kd;
+        }
+        let rst = self.rst.val();
+        self.grant.next = 0u64.into();
+        self.r_valid.d.next = any_q & !rst;
+        if any_q {
+            self.r_ch.d.next = (ch as u64).into();
+            self.r_val.d.next = self.v[0].val();
+        }
+        if rst {
+            self.r_ch.d.next = 0u64.into();
+            self.r_val.d.next = 0u64.into();
+        }
+        self.pend.d.next = 0u64.into();
+        let dn = self.done_next.val().to_u64() != 0;
+        let any = !rst & (dn || any_q && next);
+        self.r_any.d.next = any;
+        // `cap | mv` and a cycle after the last word (the lanes move once
+        // more, harmless: a capture refills them): not behind the table's read
+        self.r_shen.d.next = self.cap_next.val() | dn | any_q;
+        self.r_chen.d.next = self.start2.val() | rst | any;
         self.sh_en.next = self.r_shen.q.val();
         self.ch_en.next = self.r_chen.q.val();
     }
@@ -342,6 +375,9 @@ impl Logic for Merger {
 /// The queue form's Verilog (the twin is `Merger::update_queue`): no word
 /// multiplexer, the output registers load lane 0, the head of the queue.
 fn queue_text(nb: usize, lane_ch: Option<&LaneChannels>) -> String {
+    if let Some(t) = lane_ch {
+        return queue_table_text(nb, t);
+    }
     let w = MAX_BRANCHES;
     let cb = usize::BITS as usize - nb.leading_zeros() as usize;
     let sum: Vec<String> = (0..nb)
@@ -361,9 +397,6 @@ fn queue_text(nb: usize, lane_ch: Option<&LaneChannels>) -> String {
         therm.join(", "),
         top = nb - 1,
     );
-    if let Some(t) = lane_ch {
-        s.push_str(&channel_table_text(t));
-    }
     s.push_str("always @(*) begin\n");
     for f in [
         "r_valid", "r_ch", "r_val", "pend", "r_any", "r_shen", "r_chen",
@@ -379,13 +412,7 @@ fn queue_text(nb: usize, lane_ch: Option<&LaneChannels>) -> String {
     // only when enabled). As gates (a LUT per bit, no enable) they were
     // faster, but `prove --netlist` then cannot see them renewed every
     // frame (the held value's feedback LUT), and says bounded, not proved.
-    let head_ch = match lane_ch {
-        Some(_) => format!("{{{}'h0, chq}}", CH_BITS - lane_ch.map_or(0, table_bits)),
-        None => "ch$0".to_string(),
-    };
-    s.push_str(&format!(
-        "  if (r_any$q) begin\n    r_ch$d = {head_ch};\n    r_val$d = v$0;\n  end\n"
-    ));
+    s.push_str("  if (r_any$q) begin\n    r_ch$d = ch$0;\n    r_val$d = v$0;\n  end\n");
     s.push_str(&format!(
         "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = {VALUE_BITS}'h0;\n    pend$d = {w}'h0;\n  end\n"
     ));
@@ -402,18 +429,7 @@ fn queue_text(nb: usize, lane_ch: Option<&LaneChannels>) -> String {
         unused.push(format!("done[{}:{nb}]", w - 1));
         unused.push(format!("done_next[{}:{nb}]", w - 1));
     }
-    if lane_ch.is_some() {
-        unused.push("ch$0".to_string());
-        if lane_ch.map_or(0, |t| t.addr_bits) < SLOT_BITS {
-            unused.push(format!(
-                "addr[{}:{}]",
-                SLOT_BITS - 1,
-                lane_ch.map_or(0, |t| t.addr_bits)
-            ));
-        }
-    } else {
-        unused.push("addr".to_string());
-    }
+    unused.push("addr".to_string());
     for b in 1..w {
         unused.push(format!("ch${b}"));
         unused.push(format!("v${b}"));
@@ -425,35 +441,79 @@ fn queue_text(nb: usize, lane_ch: Option<&LaneChannels>) -> String {
     s
 }
 
-/// Bits of the channel table's words: the widest channel it names.
-fn table_bits(t: &LaneChannels) -> usize {
-    let max = t.words.iter().copied().max().unwrap_or(0);
-    (u32::BITS - max.leading_zeros()).max(1) as usize
-}
-
-/// The queue form's channel table (`Plan::lane_ch`): a block RAM read a
-/// cycle ahead at `{addr, kcnt_d}`, `kcnt_d` the index of the word that
-/// leaves in the next cycle (the words out since the last idle cycle).
-fn channel_table_text(t: &LaneChannels) -> String {
-    let (ab, kb, cw) = (t.addr_bits, t.k_bits, table_bits(t));
-    let digits = cw.div_ceil(4);
+/// The queue form with the channel table (`Plan::lane_ch`; the twin is
+/// `Merger::update_table`): a block RAM read a cycle ahead at `{addr,
+/// kcnt_d}`, `kcnt_d` the index of the word that leaves in the next cycle
+/// (the words out since the last idle cycle), gives the head's channel and
+/// whether another word follows; the lanes carry no channel and the merger
+/// no pending set.
+fn queue_table_text(nb: usize, t: &LaneChannels) -> String {
+    let w = MAX_BRANCHES;
+    let (ab, kb, cw) = (t.addr_bits, t.k_bits, t.ch_bits);
+    let digits = (cw + 1).div_ceil(4);
     let mut s = format!(
-        "// the channel of each word out, by the slot's ROM address and the words\n\
-         // already out (no channel registers in the lanes)\n\
-         reg [{}:0] chmem [0:{}];\ninitial begin\n",
-        cw - 1,
+        "// the mix's {nb} lanes are the queue, lane 0 its head; the channel of each\n\
+         // word out (and whether another follows) by the slot's ROM address and\n\
+         // the words already out\n\
+         reg [{cw}:0] chmem [0:{}];\ninitial begin\n",
         t.words.len() - 1
     );
-    for (a, w) in t.words.iter().enumerate() {
-        s.push_str(&format!("  chmem[{a}] = {cw}'h{w:0digits$x};\n"));
+    for (a, x) in t.words.iter().enumerate() {
+        s.push_str(&format!("  chmem[{a}] = {}'h{x:0digits$x};\n", cw + 1));
     }
     s.push_str(&format!(
         "end\nreg [{k}:0] kcnt;\ninitial kcnt = {kb}'h0;\nwire [{k}:0] kcnt_d = r_any$q ? kcnt + {kb}'h1 : {kb}'h0;\n\
          // a block RAM's read register: no initial value, read only after a read\n\
-         reg [{c}:0] chq;\nalways @(posedge clock) begin\n  kcnt <= kcnt_d;\n  chq <= chmem[{{addr[{a}:0], kcnt_d}}];\nend\n\n",
+         reg [{cw}:0] chq;\nalways @(posedge clock) begin\n  kcnt <= kcnt_d;\n  chq <= chmem[{{addr[{a}:0], kcnt_d}}];\nend\n\n",
         k = kb - 1,
-        c = cw - 1,
         a = ab - 1,
+    ));
+    s.push_str("always @(*) begin\n");
+    for f in [
+        "r_valid", "r_ch", "r_val", "pend", "r_any", "r_shen", "r_chen",
+    ] {
+        s.push_str(&format!("  {f}$clock = clock;\n"));
+    }
+    let pad = if cw < CH_BITS {
+        format!("{{{}'h0, chq[{}:0]}}", CH_BITS - cw, cw - 1)
+    } else {
+        format!("chq[{}:0]", cw - 1)
+    };
+    s.push_str(&format!(
+        "  // P(c)'s lowest bit is r_any: a word leaves in this cycle\n  r_valid$d = r_any$q;\n  r_ch$d = r_ch$q;\n  r_val$d = r_val$q;\n  pend$d = {w}'h0;\n  grant = {w}'h0;\n"
+    ));
+    s.push_str(&format!(
+        "  if (r_any$q) begin\n    r_ch$d = {pad};\n    r_val$d = v$0;\n  end\n"
+    ));
+    s.push_str(&format!(
+        "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = {VALUE_BITS}'h0;\n  end\n"
+    ));
+    s.push_str(&format!(
+        "  // a word leaves next: the slot completes now, or another follows this one\n  r_any$d = !rst & (|done_next[{}:0] | r_any$q & chq[{cw}]);\n",
+        nb - 1
+    ));
+    s.push_str("  // the lanes' enables, registered: cap | mv, and a cycle after the last\n  // word (a capture refills the lanes) so not behind the table's read\n");
+    s.push_str(&format!(
+        "  r_shen$d = cap_next | (|done_next[{}:0]) | r_any$q;\n  r_chen$d = start2 | rst | r_any$d;\n",
+        nb - 1
+    ));
+    s.push_str("  sh_en = r_shen$q;\n  ch_en = r_chen$q;\n");
+    s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
+    let mut unused: Vec<String> =
+        vec!["more".into(), "done".into(), "pend$q".into(), "ch$0".into()];
+    if nb < w {
+        unused.push(format!("done_next[{}:{nb}]", w - 1));
+    }
+    if ab < SLOT_BITS {
+        unused.push(format!("addr[{}:{ab}]", SLOT_BITS - 1));
+    }
+    for b in 1..w {
+        unused.push(format!("ch${b}"));
+        unused.push(format!("v${b}"));
+    }
+    s.push_str(&format!(
+        "\n// lanes behind the head are read by the lane below, the channels and the\n// words behind the head come from the table\nwire unused_lanes = |{{{}}};\n",
+        unused.join(", ")
     ));
     s
 }
