@@ -177,7 +177,7 @@ fn child_inputs(
         ));
     }
     // the queue form's single sequencer (unused by the priority form)
-    s.push_str("  merge$cap_next = seqs$0$cap_next;\n  merge$start2 = timing$start2;\n  merge$addr = timing$addr;\n");
+    s.push_str("  merge$cap_next = seqs$0$cap_next;\n  merge$start2 = timing$start2;\n  merge$addr = timing$addr;\n  merge$seq_done = seqs$0$done;\n");
     for (b, seq) in seq_of.iter().enumerate().take(nb) {
         let u = format!("branches${b}");
         let q = format!("seqs${seq}");

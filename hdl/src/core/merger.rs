@@ -30,8 +30,10 @@ pub struct Merger {
     /// generator's `start2`, for the registered lane enables below.
     pub cap_next: Signal<In, Bit>,
     pub start2: Signal<In, Bit>,
-    /// The timing generator's ROM address (the queue form's channel table).
+    /// The timing generator's ROM address and the sequencer's done strobe
+    /// (the queue form with the channel table).
     pub addr: Signal<In, Bits<SLOT_BITS>>,
+    pub seq_done: Signal<In, Bit>,
     /// The lane whose word is taken at the end of this cycle (one-hot).
     pub grant: Signal<Out, Bits<MAX_BRANCHES>>,
     /// Queue form: the lanes' shift registers load (`cap | mv`) and their
@@ -92,6 +94,7 @@ impl Merger {
             cap_next: Default::default(),
             start2: Default::default(),
             addr: Default::default(),
+            seq_done: Default::default(),
             grant: Default::default(),
             sh_en: Default::default(),
             ch_en: Default::default(),
@@ -189,12 +192,12 @@ impl Merger {
             self.r_val.d.next = 0u64.into();
         }
         self.pend.d.next = 0u64.into();
-        let dn = self.done_next.val().to_u64() != 0;
-        let any = !rst & (dn || any_q && next);
+        let any = !rst & (self.done_next.val().to_u64() != 0 || any_q && next);
         self.r_any.d.next = any;
-        // `cap | mv` and a cycle after the last word (the lanes move once
-        // more, harmless: a capture refills them): not behind the table's read
-        self.r_shen.d.next = self.cap_next.val() | dn | any_q;
+        // `cap | mv`, and also at every completion of the sequencer and a
+        // cycle after the last word (the lanes move, harmless: the next
+        // capture refills them): flip-flops only, not the table's read
+        self.r_shen.d.next = self.cap_next.val() | self.seq_done.val() | any_q;
         self.r_chen.d.next = self.start2.val() | rst | any;
         self.sh_en.next = self.r_shen.q.val();
         self.ch_en.next = self.r_chen.q.val();
@@ -346,11 +349,18 @@ impl Logic for Merger {
         s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
         // the queue form's inputs and enables (unused here)
         let mut unused: Vec<String> = if self._step {
-            vec!["start2".into(), "r_chen$q".into(), "addr".into()]
+            vec![
+                "start2".into(),
+                "r_chen$q".into(),
+                "addr".into(),
+                "seq_done".into(),
+            ]
         } else {
-            ["cap_next", "start2", "r_shen$q", "r_chen$q", "addr"]
-                .map(String::from)
-                .to_vec()
+            [
+                "cap_next", "start2", "r_shen$q", "r_chen$q", "addr", "seq_done",
+            ]
+            .map(String::from)
+            .to_vec()
         };
         if nb < w {
             unused.push(format!("done[{}:{nb}]", w - 1));
@@ -430,6 +440,7 @@ fn queue_text(nb: usize, lane_ch: Option<&LaneChannels>) -> String {
         unused.push(format!("done_next[{}:{nb}]", w - 1));
     }
     unused.push("addr".to_string());
+    unused.push("seq_done".to_string());
     for b in 1..w {
         unused.push(format!("ch${b}"));
         unused.push(format!("v${b}"));
@@ -492,11 +503,10 @@ fn queue_table_text(nb: usize, t: &LaneChannels) -> String {
         "  // a word leaves next: the slot completes now, or another follows this one\n  r_any$d = !rst & (|done_next[{}:0] | r_any$q & chq[{cw}]);\n",
         nb - 1
     ));
-    s.push_str("  // the lanes' enables, registered: cap | mv, and a cycle after the last\n  // word (a capture refills the lanes) so not behind the table's read\n");
-    s.push_str(&format!(
-        "  r_shen$d = cap_next | (|done_next[{}:0]) | r_any$q;\n  r_chen$d = start2 | rst | r_any$d;\n",
-        nb - 1
-    ));
+    s.push_str("  // the lanes' enables, registered: cap | mv, and also at every completion\n  // and a cycle after the last word (the next capture refills the lanes):\n  // flip-flops only, not the table's read\n");
+    s.push_str(
+        "  r_shen$d = cap_next | seq_done | r_any$q;\n  r_chen$d = start2 | rst | r_any$d;\n",
+    );
     s.push_str("  sh_en = r_shen$q;\n  ch_en = r_chen$q;\n");
     s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
     let mut unused: Vec<String> =

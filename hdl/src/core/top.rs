@@ -379,6 +379,7 @@ impl Logic for Core {
         self.merge.cap_next.next = self.seqs[0].cap_next.val();
         self.merge.start2.next = start;
         self.merge.addr.next = self.timing.addr.val();
+        self.merge.seq_done.next = seq[0].3;
         if self._queue.is_some() {
             // the queue form: each lane reads the next lane's channel and word
             for b in 0..nb - 1 {
@@ -454,6 +455,7 @@ impl Logic for Core {
         self.merge.cap_next.connect();
         self.merge.start2.connect();
         self.merge.addr.connect();
+        self.merge.seq_done.connect();
         for b in 0..MAX_BRANCHES {
             self.merge.ch[b].connect();
             self.merge.v[b].connect();
