@@ -859,6 +859,39 @@ mod tests {
         assert!(plan_with(&v, LutForm::Full).unwrap().queue.is_none());
     }
 
+    /// The queue form's channel table, as the merger reads it: during frame
+    /// slot `u` (ROM address `u + 1`), word `k` out is the slot's `k`-th
+    /// converting branch's channel, flagged while another follows; the
+    /// entries no completion reads are zero. Only with the full table.
+    #[test]
+    fn the_channel_table_names_each_slots_words_in_branch_order() {
+        let s = schedule("eskin34.toml");
+        let p = plan_with(&s, LutForm::Full).unwrap();
+        let t = p.lane_ch.as_ref().expect("eskin34: the channel table");
+        let (fs, nb) = (s.grid.frame_slots, p.branches.len());
+        assert_eq!(t.words.len(), 1 << (t.addr_bits + t.k_bits));
+        let mut read = vec![false; t.words.len()];
+        for u in 0..fs {
+            let on: Vec<usize> = (0..nb).filter_map(|b| s.at(u, b)).collect();
+            let a = ((u + 1) % fs) as usize;
+            for (k, &c) in on.iter().enumerate() {
+                let w = t.words[(a << t.k_bits) | k];
+                assert_eq!(w & ((1 << t.ch_bits) - 1), c as u32, "slot {u} word {k}");
+                assert_eq!(w >> t.ch_bits == 1, k + 1 < on.len(), "slot {u} word {k}");
+                read[(a << t.k_bits) | k] = true;
+            }
+        }
+        assert!((0..t.words.len()).all(|i| read[i] || t.words[i] == 0));
+        // the frame's first slot reads the table at address 1
+        assert_eq!(
+            t.words[1 << t.k_bits] & ((1 << t.ch_bits) - 1),
+            s.at(0, 0).unwrap() as u32
+        );
+        for form in [LutForm::Compact, LutForm::Logic] {
+            assert!(plan_with(&s, form).unwrap().lane_ch.is_none(), "{form:?}");
+        }
+    }
+
     /// Every preset, shared test mix and gateware test mix: where `Auto`
     /// decodes slots by logic, and wherever the logic form is forced, each
     /// branch's logic gives the full table's word at every slot of the

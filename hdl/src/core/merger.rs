@@ -347,7 +347,22 @@ impl Logic for Merger {
             );
         }
         s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
-        // the queue form's inputs and enables (unused here)
+        let unused = self.priority_unused();
+        {
+            s.push_str(&format!(
+                "\n// lanes of branches the mix does not have (tied to zero by the core),\n// the queue form's inputs\nwire unused_lanes = |{{{}}};\n",
+                unused.join(", ")
+            ));
+        }
+        Verilog::Custom(s)
+    }
+}
+
+impl Merger {
+    /// The priority form's unused inputs: the queue form's inputs and
+    /// enables, and the lanes of branches the mix does not have.
+    fn priority_unused(&self) -> Vec<String> {
+        let (nb, w) = (self._nb, MAX_BRANCHES);
         let mut unused: Vec<String> = if self._step {
             vec![
                 "start2".into(),
@@ -372,13 +387,7 @@ impl Logic for Merger {
                 unused.push(format!("v${b}"));
             }
         }
-        {
-            s.push_str(&format!(
-                "\n// lanes of branches the mix does not have (tied to zero by the core),\n// the queue form's inputs\nwire unused_lanes = |{{{}}};\n",
-                unused.join(", ")
-            ));
-        }
-        Verilog::Custom(s)
+        unused
     }
 }
 
