@@ -16,7 +16,13 @@ fn main() {
         std::process::exit(1)
     });
     let board = args.get(3).map(Path::new);
-    let out = hdl::emit(&s, board).unwrap_or_else(|e| {
+    // SLOTFORGE_LUT=full|logic forces the slot LUT form (measuring one against the other)
+    let form = match std::env::var("SLOTFORGE_LUT").as_deref() {
+        Ok("full") => hdl::LutForm::Full,
+        Ok("logic") => hdl::LutForm::Logic,
+        _ => hdl::LutForm::Auto,
+    };
+    let out = hdl::emit_with(&s, board, form).unwrap_or_else(|e| {
         eprintln!("{e}");
         std::process::exit(1)
     });

@@ -119,6 +119,7 @@ impl GatewareFault {
                     return Err(bad("slot outside the frame".into()));
                 }
                 w[s] = w[f];
+                set_table_channels(p, branch, &[(s, f)]);
             }
             GatewareFault::RomSwap { branch, a, b } => {
                 let w = rom(p, branch).map_err(bad)?;
@@ -127,6 +128,7 @@ impl GatewareFault {
                     return Err(bad("slot outside the frame".into()));
                 }
                 w.swap(a, b);
+                set_table_channels(p, branch, &[(a, b), (b, a)]);
             }
             GatewareFault::SlotWrap { delta } => {
                 if p.compact || p.logic {
@@ -194,6 +196,25 @@ fn rom(p: &mut Plan, b: usize) -> Result<&mut Vec<u32>, String> {
         .get_mut(b)
         .map(|r| &mut r.words)
         .ok_or_else(|| format!("no branch {b}"))
+}
+
+/// A ROM fault where the queue form's channels come from the merger's
+/// table (`Plan::lane_ch`): for each `(s, f)`, the channel lane `lane` puts
+/// out in frame slot `s` becomes slot `f`'s (read before any is written), as
+/// the lane's ROM channel field did before the table.
+fn set_table_channels(p: &mut Plan, lane: usize, moves: &[(usize, usize)]) {
+    let fs = p.frame_slots as usize;
+    let Some(t) = p.lane_ch.as_mut() else { return };
+    if lane >= 1 << t.k_bits {
+        return;
+    }
+    let at = |u: usize| (((u + 1) % fs) << t.k_bits) | lane;
+    let mask = (1u32 << t.ch_bits) - 1;
+    let chans: Vec<u32> = moves.iter().map(|&(_, f)| t.words[at(f)] & mask).collect();
+    for (&(s, _), ch) in moves.iter().zip(chans) {
+        let i = at(s);
+        t.words[i] = (t.words[i] & !mask) | ch;
+    }
 }
 
 #[cfg(test)]

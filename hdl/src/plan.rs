@@ -213,6 +213,26 @@ pub struct Plan {
     /// branches whose MISO lane `j`'s register ever captures; `None` for the
     /// pending-set merger with its own output multiplexer.
     pub queue: Option<Vec<Vec<usize>>>,
+    /// The queue form with the full table: the channel of each word out,
+    /// from the merger's own table (see [`LaneChannels`]), not from the
+    /// lanes' channel registers.
+    pub lane_ch: Option<LaneChannels>,
+}
+
+/// The queue form's channel table (hdl/DESIGN.md, "Merger"): the merger
+/// reads the channel of the `k`-th word a slot's completion puts out from a
+/// block RAM at `{a, k}`, `a` the timing generator's ROM address during
+/// that slot (the next slot's), `k` the words already out; the lanes then
+/// carry no channel registers (eskin34: 16 flip-flops and their
+/// multiplexers).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct LaneChannels {
+    /// At `(a << k_bits) | k`: the channel, and above it (bit
+    /// `ch_bits`) whether another word of the slot follows.
+    pub words: Vec<u32>,
+    pub ch_bits: usize,
+    pub addr_bits: usize,
+    pub k_bits: usize,
 }
 
 pub fn addr_bits(frame_slots: u64) -> usize {
@@ -322,12 +342,14 @@ pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
         branches,
         link: crate::link::LinkParams::of(s).map_err(unsupported)?,
         queue,
+        lane_ch: None,
         modes: None,
     };
     crate::modeplan::apply(s, &mut p)?;
     if !compact && form != LutForm::Full {
         decode_by_logic(&mut p, form == LutForm::Logic)?;
     }
+    p.lane_ch = lane_channel_table(s, &p);
     Ok(p)
 }
 
@@ -380,6 +402,44 @@ fn logic_costs(p: &Plan, logic: &[SlotLogic]) -> (usize, usize, usize) {
     // the logic form's timing counts slots in the slice (with their
     // successor register, as the compact form's) and slices
     (rom, 2 * l.slot_bits + l.slice_bits + 2, decode)
+}
+
+/// The queue form's channel table, for the full table's ROM address (not
+/// the compact or logic forms, whose address is the slot in the slice):
+/// during frame slot `u` the address is `u + 1` (the ROM reads a slot
+/// ahead). Only when a slot's words are all out before the address moves:
+/// the completion comes at most `read_cycles` after the slot start, then
+/// a word a cycle, and the address moves in the slot's last cycles.
+fn lane_channel_table(s: &Schedule, p: &Plan) -> Option<LaneChannels> {
+    let nb = p.branches.len();
+    let q = p.seqs.first()?;
+    if p.queue.is_none() || p.compact || p.logic || p.modes.is_some() {
+        return None;
+    }
+    if q.setup_cycles + q.read_cycles + nb as u64 + 4 > p.slot_cycles {
+        return None;
+    }
+    let (fs, ab, kb) = (
+        p.frame_slots,
+        addr_bits(p.frame_slots),
+        addr_bits(nb as u64),
+    );
+    let cw = (p.channel_bits as usize).max(1);
+    let mut words = vec![0u32; 1 << (ab + kb)];
+    for u in 0..fs {
+        let a = ((u + 1) % fs) as usize;
+        let conv: Vec<usize> = (0..nb).filter_map(|b| s.at(u, b)).collect();
+        for (k, c) in conv.iter().enumerate() {
+            let next = (k + 1 < conv.len()) as u32;
+            words[(a << kb) | k] = next << cw | *c as u32;
+        }
+    }
+    Some(LaneChannels {
+        words,
+        addr_bits: ab,
+        k_bits: kb,
+        ch_bits: cw,
+    })
 }
 
 /// `lanes[j][u]`: the channel of the `j`-th branch (in branch order) that
@@ -851,6 +911,39 @@ mod tests {
         }
         let v = schedule("vibrotactile8k.toml");
         assert!(plan_with(&v, LutForm::Full).unwrap().queue.is_none());
+    }
+
+    /// The queue form's channel table, as the merger reads it: during frame
+    /// slot `u` (ROM address `u + 1`), word `k` out is the slot's `k`-th
+    /// converting branch's channel, flagged while another follows; the
+    /// entries no completion reads are zero. Only with the full table.
+    #[test]
+    fn the_channel_table_names_each_slots_words_in_branch_order() {
+        let s = schedule("eskin34.toml");
+        let p = plan_with(&s, LutForm::Full).unwrap();
+        let t = p.lane_ch.as_ref().expect("eskin34: the channel table");
+        let (fs, nb) = (s.grid.frame_slots, p.branches.len());
+        assert_eq!(t.words.len(), 1 << (t.addr_bits + t.k_bits));
+        let mut read = vec![false; t.words.len()];
+        for u in 0..fs {
+            let on: Vec<usize> = (0..nb).filter_map(|b| s.at(u, b)).collect();
+            let a = ((u + 1) % fs) as usize;
+            for (k, &c) in on.iter().enumerate() {
+                let w = t.words[(a << t.k_bits) | k];
+                assert_eq!(w & ((1 << t.ch_bits) - 1), c as u32, "slot {u} word {k}");
+                assert_eq!(w >> t.ch_bits == 1, k + 1 < on.len(), "slot {u} word {k}");
+                read[(a << t.k_bits) | k] = true;
+            }
+        }
+        assert!((0..t.words.len()).all(|i| read[i] || t.words[i] == 0));
+        // the frame's first slot reads the table at address 1
+        assert_eq!(
+            t.words[1 << t.k_bits] & ((1 << t.ch_bits) - 1),
+            s.at(0, 0).unwrap() as u32
+        );
+        for form in [LutForm::Compact, LutForm::Logic] {
+            assert!(plan_with(&s, form).unwrap().lane_ch.is_none(), "{form:?}");
+        }
     }
 
     /// Every preset, shared test mix and gateware test mix: where `Auto`

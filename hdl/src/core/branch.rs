@@ -75,7 +75,7 @@ pub struct BranchUnit {
 }
 
 impl BranchUnit {
-    pub(super) fn new(rom: &BranchRom, queue: bool) -> BranchUnit {
+    pub(super) fn new(rom: &BranchRom, queue: bool, step: bool) -> BranchUnit {
         BranchUnit {
             clock: Default::default(),
             rst: Default::default(),
@@ -105,7 +105,7 @@ impl BranchUnit {
             more: Default::default(),
             act_q: Default::default(),
             rom: SlotRom::new(rom),
-            reader: WordReader::new(rom, queue),
+            reader: WordReader::new(rom, queue, step),
             act: Default::default(),
             r_cs_n: Default::default(),
             r_sclk: Default::default(),

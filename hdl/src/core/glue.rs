@@ -2,6 +2,14 @@
 
 use crate::widths::*;
 
+/// The merger's form as the glue wires it: the queue (each lane's MISO
+/// sources) or the priority form, with a stepped chain's reader
+/// (`merger::stepped_reader`) or not.
+pub(super) enum LaneForm<'a> {
+    Queue(&'a [Vec<usize>]),
+    Priority { stepped: bool },
+}
+
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
 /// `pulse_of`: per sequencer, its CNV pulse if its part is read with CNV
 /// low. `modes`: a mix with modes (pin select, the branches whose words the
@@ -13,8 +21,12 @@ pub(super) fn core_glue(
     pulse_of: &[Option<usize>],
     cmd_of: &[Option<usize>],
     modes: Option<(bool, usize)>,
-    queue: Option<&[Vec<usize>]>,
+    lanes_form: LaneForm,
 ) -> String {
+    let (queue, step) = match lanes_form {
+        LaneForm::Queue(q) => (Some(q), false),
+        LaneForm::Priority { stepped } => (None, stepped),
+    };
     let mut s = String::new();
     let nseq = pulse_of.len();
     s.push_str("always @(*) begin\n");
@@ -22,7 +34,7 @@ pub(super) fn core_glue(
     if let Some((pin, lanes)) = modes {
         mode_inputs(&mut s, nb, pin, lanes);
     }
-    let act_read = queue_inputs(&mut s, nb, queue);
+    let act_read = queue_inputs(&mut s, nb, queue, step);
     command_units(&mut s, seq_of, cmd_of);
     lanes(&mut s, nb, devices, cmd_of);
     s.push_str(
@@ -46,7 +58,9 @@ pub(super) fn core_glue(
         .filter(|b| !act_read.contains(b))
         .map(|b| format!("branches${b}$act_q"))
         .collect();
-    if queue.is_none() {
+    if queue.is_none() && step {
+        s.push_str("// the queue form's channel enable (zero in the priority form)\nwire unused_queue_en = merge$ch_en;\n");
+    } else if queue.is_none() {
         s.push_str("// the queue form's lane enables (zero in the priority form)\nwire unused_queue_en = merge$sh_en | merge$ch_en;\n");
     }
     if !unread.is_empty() {
@@ -80,13 +94,15 @@ pub(super) fn route_miso(queue: &[Vec<usize>], act: u64, miso: u64) -> u64 {
 /// The Verilog of [`route_miso`] and the queue's lane-to-lane wiring (or in
 /// the priority form, MISO straight and the queue inputs tied low); the
 /// branches whose `act_q` it reads.
-fn queue_inputs(s: &mut String, nb: usize, queue: Option<&[Vec<usize>]>) -> Vec<usize> {
+fn queue_inputs(s: &mut String, nb: usize, queue: Option<&[Vec<usize>]>, step: bool) -> Vec<usize> {
     let mut read = Vec::new();
+    // a stepped chain's reader loads under the merger's registered enable
+    let sh_en = if step { "merge$sh_en" } else { "1'b0" };
     for b in 0..nb {
         let u = format!("branches${b}");
         let Some(q) = queue else {
             s.push_str(&format!(
-                "  {u}$miso = adc_miso[{b}];\n  {u}$sh_en = 1'b0;\n  {u}$ch_en = 1'b0;\n  {u}$q_ch = {CH_BITS}'h0;\n  {u}$q_val = {VALUE_BITS}'h0;\n"
+                "  {u}$miso = adc_miso[{b}];\n  {u}$sh_en = {sh_en};\n  {u}$ch_en = 1'b0;\n  {u}$q_ch = {CH_BITS}'h0;\n  {u}$q_val = {VALUE_BITS}'h0;\n"
             ));
             continue;
         };
@@ -161,7 +177,7 @@ fn child_inputs(
         ));
     }
     // the queue form's single sequencer (unused by the priority form)
-    s.push_str("  merge$cap_next = seqs$0$cap_next;\n  merge$start2 = timing$start2;\n");
+    s.push_str("  merge$cap_next = seqs$0$cap_next;\n  merge$start2 = timing$start2;\n  merge$addr = timing$addr;\n  merge$seq_done = seqs$0$done;\n");
     for (b, seq) in seq_of.iter().enumerate().take(nb) {
         let u = format!("branches${b}");
         let q = format!("seqs${seq}");

@@ -2,6 +2,7 @@
 
 use rust_hdl::prelude::*;
 
+use crate::plan::LaneChannels;
 use crate::widths::*;
 
 /// P(c) = pending completions plus this cycle's; the lowest branch in it
@@ -29,6 +30,10 @@ pub struct Merger {
     /// generator's `start2`, for the registered lane enables below.
     pub cap_next: Signal<In, Bit>,
     pub start2: Signal<In, Bit>,
+    /// The timing generator's ROM address and the sequencer's done strobe
+    /// (the queue form with the channel table).
+    pub addr: Signal<In, Bits<SLOT_BITS>>,
+    pub seq_done: Signal<In, Bit>,
     /// The lane whose word is taken at the end of this cycle (one-hot).
     pub grant: Signal<Out, Bits<MAX_BRANCHES>>,
     /// Queue form: the lanes' shift registers load (`cap | mv`) and their
@@ -56,10 +61,28 @@ pub struct Merger {
     /// queue, lane 0 its head; `pend` is then a thermometer of the words
     /// still queued behind the head.
     _queue: bool,
+    /// One chained branch (priority form, [`stepped_reader`]): `sh_en` is
+    /// the registered `cap | r_any` the word reader's register steps under.
+    _step: bool,
+    /// The queue form's channel table (`Plan::lane_ch`), the words out
+    /// since the last idle cycle (`kcnt`) and the table's registered read.
+    _lane_ch: Option<LaneChannels>,
+    _kcnt: usize,
+    _chq: u32,
+}
+
+/// Whether the merger gives the word reader a registered shift enable in
+/// the priority form: one branch, chained, no modes (the mode block reads
+/// the reader's word). Its grant is then `r_any` (P(c) is that lane alone),
+/// and the reader's 64-odd flip-flops step under `sh_en`, a flip-flop, not
+/// under the priority chain's grant through a LUT and a global buffer
+/// (vibrotactile8k's critical path).
+pub(crate) fn stepped_reader(p: &crate::plan::Plan) -> bool {
+    p.queue.is_none() && p.modes.is_none() && p.branches.len() == 1 && p.branches[0].chain > 1
 }
 
 impl Merger {
-    pub(super) fn new(nb: usize, queue: bool) -> Merger {
+    pub(super) fn new(nb: usize, queue: bool, step: bool, lane_ch: Option<LaneChannels>) -> Merger {
         Merger {
             clock: Default::default(),
             rst: Default::default(),
@@ -70,6 +93,8 @@ impl Merger {
             v: std::array::from_fn(|_| Default::default()),
             cap_next: Default::default(),
             start2: Default::default(),
+            addr: Default::default(),
+            seq_done: Default::default(),
             grant: Default::default(),
             sh_en: Default::default(),
             ch_en: Default::default(),
@@ -85,16 +110,29 @@ impl Merger {
             r_chen: Default::default(),
             _nb: nb,
             _queue: queue,
+            _step: step,
+            _lane_ch: lane_ch,
+            _kcnt: 0,
+            _chq: 0,
         }
     }
 }
 
 impl Merger {
+    /// The word reader steps under `sh_en` ([`stepped_reader`]).
+    pub(super) fn stepped(&self) -> bool {
+        self._step
+    }
+
     /// The queue form's update: P(c) is the words queued behind the head
     /// plus this cycle's completions, which all fall in one cycle (one SPI
     /// sequencer) and sit in lanes `0..n` in branch order; P(c) as a
     /// thermometer, lane 0 leaves and every lane moves up one.
     fn update_queue(&mut self) {
+        if self._lane_ch.is_some() {
+            self.update_table();
+            return;
+        }
         let n = self.done.val().to_u64().count_ones();
         let p = self.pend.q.val().to_u64() | ((1u64 << n) - 1);
         self.r_valid.d.next = p & 1 == 1;
@@ -116,6 +154,51 @@ impl Merger {
         // start1 of the next cycle is start2 or reset in this one
         self.r_shen.d.next = self.cap_next.val() | any;
         self.r_chen.d.next = self.start2.val() | self.rst.val() | any;
+        self.sh_en.next = self.r_shen.q.val();
+        self.ch_en.next = self.r_chen.q.val();
+    }
+}
+
+impl Merger {
+    /// The queue form with the channel table (`queue_table_text`): the
+    /// head's channel and whether another word follows it come from the
+    /// table, read a cycle ahead at `{addr, kcnt_d}`; no pending set
+    /// (P(c)'s lowest bit is `r_any`, a word leaves in the next cycle when
+    /// the slot completes then or another word follows this one).
+    fn update_table(&mut self) {
+        let Some(t) = &self._lane_ch else { return };
+        let any_q = self.r_any.q.val();
+        let kd = if any_q {
+            (self._kcnt + 1) & ((1 << t.k_bits) - 1)
+        } else {
+            0
+        };
+        let next = self._chq >> t.ch_bits & 1 == 1;
+        let ch = self._chq & ((1 << t.ch_bits) - 1);
+        if self.clock.pos_edge() {
+            let a = self.addr.val().to_u64() as usize & ((1 << t.addr_bits) - 1);
+            self._chq = t.words[(a << t.k_bits) | kd];
+            self._kcnt = kd;
+        }
+        let rst = self.rst.val();
+        self.grant.next = 0u64.into();
+        self.r_valid.d.next = any_q & !rst;
+        if any_q {
+            self.r_ch.d.next = (ch as u64).into();
+            self.r_val.d.next = self.v[0].val();
+        }
+        if rst {
+            self.r_ch.d.next = 0u64.into();
+            self.r_val.d.next = 0u64.into();
+        }
+        self.pend.d.next = 0u64.into();
+        let any = !rst & (self.done_next.val().to_u64() != 0 || any_q && next);
+        self.r_any.d.next = any;
+        // `cap | mv`, and also at every completion of the sequencer and a
+        // cycle after the last word (the lanes move, harmless: the next
+        // capture refills them): flip-flops only, not the table's read
+        self.r_shen.d.next = self.cap_next.val() | self.seq_done.val() | any_q;
+        self.r_chen.d.next = self.start2.val() | rst | any;
         self.sh_en.next = self.r_shen.q.val();
         self.ch_en.next = self.r_chen.q.val();
     }
@@ -164,7 +247,12 @@ impl Logic for Merger {
             pend = 0;
         }
         self.pend.d.next = pend.into();
-        self.r_any.d.next = !self.rst.val() & ((pend | self.done_next.val().to_u64()) != 0);
+        let any = !self.rst.val() & ((pend | self.done_next.val().to_u64()) != 0);
+        self.r_any.d.next = any;
+        if self._step {
+            self.r_shen.d.next = self.cap_next.val() | any;
+            self.sh_en.next = self.r_shen.q.val();
+        }
     }
 
     fn connect(&mut self) {
@@ -192,7 +280,7 @@ impl Logic for Merger {
 
     fn hdl(&self) -> Verilog {
         if self._queue {
-            return Verilog::Custom(queue_text(self._nb));
+            return Verilog::Custom(queue_text(self._nb, self._lane_ch.as_ref()));
         }
         let nb = self._nb;
         let w = MAX_BRANCHES;
@@ -250,23 +338,16 @@ impl Logic for Merger {
             "  r_any$d = !rst & |{{pend$d[{0}:0], done_next[{0}:0]}};\n",
             nb - 1
         ));
-        s.push_str(
-            "  r_shen$d = 1'b0;\n  r_chen$d = 1'b0;\n  sh_en = 1'b0;\n  ch_en = 1'b0;\n  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n",
-        );
-        // the queue form's inputs and enables (unused here)
-        let mut unused: Vec<String> = ["cap_next", "start2", "r_shen$q", "r_chen$q"]
-            .map(String::from)
-            .to_vec();
-        if nb < w {
-            unused.push(format!("done[{}:{nb}]", w - 1));
-            unused.push(format!("more[{}:{nb}]", w - 1));
-            unused.push(format!("done_next[{}:{nb}]", w - 1));
-            unused.push(format!("pend$q[{}:{nb}]", w - 1));
-            for b in nb..w {
-                unused.push(format!("ch${b}"));
-                unused.push(format!("v${b}"));
-            }
+        if self._step {
+            s.push_str("  // the chained reader's shift enable, registered\n  r_shen$d = cap_next | r_any$d;\n  sh_en = r_shen$q;\n");
+            s.push_str("  r_chen$d = 1'b0;\n  ch_en = 1'b0;\n");
+        } else {
+            s.push_str(
+                "  r_shen$d = 1'b0;\n  r_chen$d = 1'b0;\n  sh_en = 1'b0;\n  ch_en = 1'b0;\n",
+            );
         }
+        s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
+        let unused = self.priority_unused();
         {
             s.push_str(&format!(
                 "\n// lanes of branches the mix does not have (tied to zero by the core),\n// the queue form's inputs\nwire unused_lanes = |{{{}}};\n",
@@ -277,9 +358,45 @@ impl Logic for Merger {
     }
 }
 
+impl Merger {
+    /// The priority form's unused inputs: the queue form's inputs and
+    /// enables, and the lanes of branches the mix does not have.
+    fn priority_unused(&self) -> Vec<String> {
+        let (nb, w) = (self._nb, MAX_BRANCHES);
+        let mut unused: Vec<String> = if self._step {
+            vec![
+                "start2".into(),
+                "r_chen$q".into(),
+                "addr".into(),
+                "seq_done".into(),
+            ]
+        } else {
+            [
+                "cap_next", "start2", "r_shen$q", "r_chen$q", "addr", "seq_done",
+            ]
+            .map(String::from)
+            .to_vec()
+        };
+        if nb < w {
+            unused.push(format!("done[{}:{nb}]", w - 1));
+            unused.push(format!("more[{}:{nb}]", w - 1));
+            unused.push(format!("done_next[{}:{nb}]", w - 1));
+            unused.push(format!("pend$q[{}:{nb}]", w - 1));
+            for b in nb..w {
+                unused.push(format!("ch${b}"));
+                unused.push(format!("v${b}"));
+            }
+        }
+        unused
+    }
+}
+
 /// The queue form's Verilog (the twin is `Merger::update_queue`): no word
 /// multiplexer, the output registers load lane 0, the head of the queue.
-fn queue_text(nb: usize) -> String {
+fn queue_text(nb: usize, lane_ch: Option<&LaneChannels>) -> String {
+    if let Some(t) = lane_ch {
+        return queue_table_text(nb, t);
+    }
     let w = MAX_BRANCHES;
     let cb = usize::BITS as usize - nb.leading_zeros() as usize;
     let sum: Vec<String> = (0..nb)
@@ -331,12 +448,90 @@ fn queue_text(nb: usize) -> String {
         unused.push(format!("done[{}:{nb}]", w - 1));
         unused.push(format!("done_next[{}:{nb}]", w - 1));
     }
+    unused.push("addr".to_string());
+    unused.push("seq_done".to_string());
     for b in 1..w {
         unused.push(format!("ch${b}"));
         unused.push(format!("v${b}"));
     }
     s.push_str(&format!(
         "\n// lanes behind the head are read by the lane below, not here\nwire unused_lanes = |{{{}}};\n",
+        unused.join(", ")
+    ));
+    s
+}
+
+/// The queue form with the channel table (`Plan::lane_ch`; the twin is
+/// `Merger::update_table`): a block RAM read a cycle ahead at `{addr,
+/// kcnt_d}`, `kcnt_d` the index of the word that leaves in the next cycle
+/// (the words out since the last idle cycle), gives the head's channel and
+/// whether another word follows; the lanes carry no channel and the merger
+/// no pending set.
+fn queue_table_text(nb: usize, t: &LaneChannels) -> String {
+    let w = MAX_BRANCHES;
+    let (ab, kb, cw) = (t.addr_bits, t.k_bits, t.ch_bits);
+    let digits = (cw + 1).div_ceil(4);
+    let mut s = format!(
+        "// the mix's {nb} lanes are the queue, lane 0 its head; the channel of each\n\
+         // word out (and whether another follows) by the slot's ROM address and\n\
+         // the words already out\n\
+         reg [{cw}:0] chmem [0:{}];\ninitial begin\n",
+        t.words.len() - 1
+    );
+    for (a, x) in t.words.iter().enumerate() {
+        s.push_str(&format!("  chmem[{a}] = {}'h{x:0digits$x};\n", cw + 1));
+    }
+    s.push_str(&format!(
+        "end\nreg [{k}:0] kcnt;\ninitial kcnt = {kb}'h0;\nwire [{k}:0] kcnt_d = r_any$q ? kcnt + {kb}'h1 : {kb}'h0;\n\
+         // a block RAM's read register: no initial value, read only after a read\n\
+         reg [{cw}:0] chq;\nalways @(posedge clock) begin\n  kcnt <= kcnt_d;\n  chq <= chmem[{{addr[{a}:0], kcnt_d}}];\nend\n\n",
+        k = kb - 1,
+        a = ab - 1,
+    ));
+    s.push_str("always @(*) begin\n");
+    for f in [
+        "r_valid", "r_ch", "r_val", "pend", "r_any", "r_shen", "r_chen",
+    ] {
+        s.push_str(&format!("  {f}$clock = clock;\n"));
+    }
+    let pad = if cw < CH_BITS {
+        format!("{{{}'h0, chq[{}:0]}}", CH_BITS - cw, cw - 1)
+    } else {
+        format!("chq[{}:0]", cw - 1)
+    };
+    s.push_str(&format!(
+        "  // P(c)'s lowest bit is r_any: a word leaves in this cycle\n  r_valid$d = r_any$q;\n  r_ch$d = r_ch$q;\n  r_val$d = r_val$q;\n  pend$d = {w}'h0;\n  grant = {w}'h0;\n"
+    ));
+    s.push_str(&format!(
+        "  if (r_any$q) begin\n    r_ch$d = {pad};\n    r_val$d = v$0;\n  end\n"
+    ));
+    s.push_str(&format!(
+        "  if (rst) begin\n    r_valid$d = 1'b0;\n    r_ch$d = {CH_BITS}'h0;\n    r_val$d = {VALUE_BITS}'h0;\n  end\n"
+    ));
+    s.push_str(&format!(
+        "  // a word leaves next: the slot completes now, or another follows this one\n  r_any$d = !rst & (|done_next[{}:0] | r_any$q & chq[{cw}]);\n",
+        nb - 1
+    ));
+    s.push_str("  // the lanes' enables, registered: cap | mv, and also at every completion\n  // and a cycle after the last word (the next capture refills the lanes):\n  // flip-flops only, not the table's read\n");
+    s.push_str(
+        "  r_shen$d = cap_next | seq_done | r_any$q;\n  r_chen$d = start2 | rst | r_any$d;\n",
+    );
+    s.push_str("  sh_en = r_shen$q;\n  ch_en = r_chen$q;\n");
+    s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
+    let mut unused: Vec<String> =
+        vec!["more".into(), "done".into(), "pend$q".into(), "ch$0".into()];
+    if nb < w {
+        unused.push(format!("done_next[{}:{nb}]", w - 1));
+    }
+    if ab < SLOT_BITS {
+        unused.push(format!("addr[{}:{ab}]", SLOT_BITS - 1));
+    }
+    for b in 1..w {
+        unused.push(format!("ch${b}"));
+        unused.push(format!("v${b}"));
+    }
+    s.push_str(&format!(
+        "\n// lanes behind the head are read by the lane below, the channels and the\n// words behind the head come from the table\nwire unused_lanes = |{{{}}};\n",
         unused.join(", ")
     ));
     s

@@ -103,6 +103,7 @@ fn harness(div: u64, setup: u64) -> Harness {
         }],
         branches: vec![rom()],
         queue: None,
+        lane_ch: None,
     };
     let mut h = Harness {
         clock: Default::default(),
@@ -110,7 +111,7 @@ fn harness(div: u64, setup: u64) -> Harness {
         miso: Default::default(),
         timing: TimingGen::new(&plan),
         seq: SpiSeq::new(&plan.seqs[0]),
-        unit: BranchUnit::new(&plan.branches[0], false),
+        unit: BranchUnit::new(&plan.branches[0], false, false),
     };
     h.connect_all();
     h

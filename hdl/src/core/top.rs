@@ -2,7 +2,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::glue::{core_glue, route_miso};
+use super::glue::{core_glue, route_miso, LaneForm};
 use super::{BranchUnit, CmdUnit, CnvPulse, Merger, ModeGen, SpiSeq, TimingGen};
 use crate::plan::Plan;
 use crate::widths::*;
@@ -57,6 +57,7 @@ pub struct Core {
 
 impl Core {
     pub fn new(plan: &Plan) -> Core {
+        let step = super::merger::stepped_reader(plan);
         let mut pulse_of = vec![None; plan.seqs.len()];
         let mut pulses = vec![];
         for (i, q) in plan.seqs.iter().enumerate().filter(|(_, q)| q.pulsed()) {
@@ -107,11 +108,16 @@ impl Core {
             branches: plan
                 .branches
                 .iter()
-                .map(|b| BranchUnit::new(b, plan.queue.is_some()))
+                .map(|b| BranchUnit::new(b, plan.queue.is_some(), step))
                 .collect(),
             cmds,
             _cmd_of: cmd_of,
-            merge: Merger::new(plan.branches.len(), plan.queue.is_some()),
+            merge: Merger::new(
+                plan.branches.len(),
+                plan.queue.is_some(),
+                step,
+                plan.lane_ch.clone(),
+            ),
             modes: (plan.modes.iter())
                 .map(|m| ModeGen::new(m, plan.branches.len()))
                 .collect(),
@@ -379,6 +385,8 @@ impl Logic for Core {
         // the queue form's single sequencer (unused in the priority form)
         self.merge.cap_next.next = self.seqs[0].cap_next.val();
         self.merge.start2.next = start;
+        self.merge.addr.next = self.timing.addr.val();
+        self.merge.seq_done.next = seq[0].3;
         if self._queue.is_some() {
             // the queue form: each lane reads the next lane's channel and word
             for b in 0..nb - 1 {
@@ -453,6 +461,8 @@ impl Logic for Core {
         self.merge.done_next.connect();
         self.merge.cap_next.connect();
         self.merge.start2.connect();
+        self.merge.addr.connect();
+        self.merge.seq_done.connect();
         for b in 0..MAX_BRANCHES {
             self.merge.ch[b].connect();
             self.merge.v[b].connect();
@@ -488,7 +498,12 @@ impl Logic for Core {
             self.modes
                 .first()
                 .map(|g| (!self.mode_sel.is_empty(), g.ch.len())),
-            self._queue.as_deref(),
+            match self._queue.as_deref() {
+                Some(q) => LaneForm::Queue(q),
+                None => LaneForm::Priority {
+                    stepped: self.merge.stepped(),
+                },
+            },
         ))
     }
 }

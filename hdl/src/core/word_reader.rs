@@ -35,13 +35,16 @@ pub struct WordReader {
     _chain: usize,
     _members: Vec<(u32, Vec<u32>)>,
     _queue: bool,
+    /// A chain stepped under the merger's registered `en` (`cap | r_any`,
+    /// `merger::stepped_reader`) rather than under `grant`.
+    _step: bool,
     /// The shift register and the member of the word on `val`.
     _sh: u128,
     _om: usize,
 }
 
 impl WordReader {
-    pub(super) fn new(rom: &BranchRom, queue: bool) -> WordReader {
+    pub(super) fn new(rom: &BranchRom, queue: bool, step: bool) -> WordReader {
         WordReader {
             clock: Default::default(),
             rst: Default::default(),
@@ -58,6 +61,7 @@ impl WordReader {
             _chain: rom.chain as usize,
             _members: rom.members.clone(),
             _queue: queue && rom.chain == 1,
+            _step: step && rom.chain > 1,
             _sh: 0,
             _om: 0,
         }
@@ -71,6 +75,30 @@ impl WordReader {
         match self._members.iter().find(|(l, _)| *l == lead) {
             Some((_, chans)) => chans[m],
             None => lead,
+        }
+    }
+}
+
+impl WordReader {
+    /// A clock edge of the stepped chain (the Verilog's `_step` text): the
+    /// member steps on a grant as before; the register loads under `en`,
+    /// MISO on `cap`, else the next word up (also after the last word and
+    /// in reset, when nothing reads it before the next capture refills it).
+    fn step_edge(&mut self, mask: u128) {
+        let (cap, grant, rst) = (self.cap.val(), self.grant.val(), self.rst.val());
+        if !cap && grant && !rst {
+            self._om = if self._om + 1 < self._chain {
+                self._om + 1
+            } else {
+                0
+            };
+        }
+        if self.en.val() {
+            self._sh = if cap {
+                (self._sh << 1) | self.miso.val() as u128
+            } else {
+                self._sh << self._bits
+            } & mask;
         }
     }
 }
@@ -93,6 +121,8 @@ impl Logic for WordReader {
                 } else if self.en.val() {
                     self._sh = self.q_in.val().to_u64() as u128 & mask;
                 }
+            } else if self._step {
+                self.step_edge(mask);
             } else if self.cap.val() {
                 self._sh = ((self._sh << 1) | self.miso.val() as u128) & mask;
             } else if self.grant.val() && self._chain > 1 && !self.rst.val() {
@@ -178,6 +208,19 @@ impl Logic for WordReader {
         let _ = writeln!(s, "reg [{}:0] om;\ninitial om = {mb}'h0;\n", mb - 1);
         let _ = writeln!(s, "always @(posedge clock) begin");
         let _ = writeln!(s, "  if (rst) om <= {mb}'h0;");
+        if self._step {
+            let _ = writeln!(s, "  if (!cap && grant && !rst) om <= (om != {mb}'h{last:x}) ? om + {mb}'h1 : {mb}'h0;");
+            let _ = writeln!(
+                s,
+                "  // under the merger's registered cap | r_any: no LUT before the enable"
+            );
+            let _ = writeln!(
+                s,
+                "  if (en) sh <= cap ? {shifted_in} : {{sh[{}:0], {bits}'h0}};\nend\n",
+                w - bits - 1
+            );
+            return self.chain_outputs(s);
+        }
         let _ = writeln!(s, "  if (cap) sh <= {shifted_in};");
         let _ = writeln!(s, "  else if (grant && !rst) begin");
         let _ = writeln!(s, "    if (om != {mb}'h{last:x}) begin");
@@ -185,6 +228,21 @@ impl Logic for WordReader {
         let _ = writeln!(s, "      om <= om + {mb}'h1;");
         let _ = writeln!(s, "    end else om <= {mb}'h0;");
         let _ = writeln!(s, "  end\nend\n");
+        self.chain_outputs(s)
+    }
+}
+
+impl WordReader {
+    /// A chain's word, `more` and member table (the end of `hdl`'s text).
+    fn chain_outputs(&self, mut s: String) -> Verilog {
+        let (bits, n, w, mb) = (self._bits, self._chain, self.width(), MEMBER_BITS);
+        let last = n - 1;
+        let top = format!("sh[{}:{}]", w - 1, w - bits);
+        let val = if bits < VALUE_BITS {
+            format!("{{{}'h0, {top}}}", VALUE_BITS - bits)
+        } else {
+            top
+        };
         let _ = writeln!(s, "always @(*) begin");
         let _ = writeln!(s, "  val = {val};");
         let _ = writeln!(s, "  more = om != {mb}'h{last:x};");
@@ -198,7 +256,11 @@ impl Logic for WordReader {
         }
         let _ = writeln!(s, "    default: ch = lead;\n  endcase\nend");
         let _ = writeln!(s, "\n// a chain is never the merger's queue");
-        let _ = writeln!(s, "wire unused_queue = |{{en, q_in}};");
+        if self._step {
+            let _ = writeln!(s, "wire unused_queue = |q_in;");
+        } else {
+            let _ = writeln!(s, "wire unused_queue = |{{en, q_in}};");
+        }
         Verilog::Custom(s)
     }
 }
