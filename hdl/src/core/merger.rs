@@ -443,8 +443,10 @@ fn queue_text(nb: usize, lane_ch: Option<&LaneChannels>) -> String {
     s.push_str("  r_shen$d = cap_next | r_any$d;\n  r_chen$d = start2 | rst | r_any$d;\n");
     s.push_str("  sh_en = r_shen$q;\n  ch_en = r_chen$q;\n");
     s.push_str("  valid = r_valid$q;\n  channel = r_ch$q;\n  value = r_val$q;\nend\n");
-    let mut unused: Vec<String> = vec!["more".to_string(), format!("pend$q[{}:{nb}]", w - 1)];
+    let mut unused: Vec<String> = vec!["more".to_string()];
+    // a mix with every lane (16 branches) reads the whole pending set
     if nb < w {
+        unused.push(format!("pend$q[{}:{nb}]", w - 1));
         unused.push(format!("done[{}:{nb}]", w - 1));
         unused.push(format!("done_next[{}:{nb}]", w - 1));
     }
