@@ -246,6 +246,12 @@ pub struct ChannelAudit {
     pub first_sample_cycle: u64,
     pub device: u32,
     pub select: u32,
+    /// On a branch whose converter picks its input (`mux = "internal"`):
+    /// that input; `device`/`select` are then a front mux's pins (0.0 for a
+    /// channel wired straight), or, without a front mux, the input again.
+    pub adc_input: Option<u32>,
+    /// Whether the channel is behind a front mux (`front_input`).
+    pub front_mux: bool,
     /// Shortest time the mux has to settle before one of this channel's instants.
     pub settle_available_ns: f64,
     pub settle_required_ns: u64,
@@ -509,6 +515,11 @@ impl ChannelAudit {
             first_sample_cycle: slots.first().copied().unwrap_or(0) * g.slot_cycles,
             device: s.channels[c].device,
             select: s.channels[c].select,
+            adc_input: {
+                let b = &mix.branches[ch.branch];
+                (b.mux.is_internal() || b.fronted).then_some(ch.input)
+            },
+            front_mux: ch.front_input.is_some(),
             settle_available_ns,
             settle_required_ns: required,
             bandwidth_hz: ch.bandwidth_hz,

@@ -222,7 +222,7 @@ impl AuditReport {
                     c.interval_cycles,
                     c.jitter_cycles,
                     c.first_sample_cycle,
-                    format!("{}.{}", c.device, c.select),
+                    mux_cell(c),
                     format!("{:.0}/{}", c.settle_available_ns, c.settle_required_ns),
                     match c.bandwidth_hz {
                         Some(bw) => format!("{bw}/{}", c.nyquist_hz),
@@ -237,7 +237,12 @@ impl AuditReport {
             );
             let _ = writeln!(
                 o,
-                "interval, first: cycles (first = first sampling instant after cycle 0); dev.sel = mux device.select; alias = where a tone at bw shows when bw is above Nyquist"
+                "interval, first: cycles (first = first sampling instant after cycle 0); dev.sel = mux device.select{}; alias = where a tone at bw shows when bw is above Nyquist",
+                if self.channels.iter().any(|c| c.adc_input.is_some()) {
+                    " (inK: the converter's own input K; inK/d.s: through a front mux's device d, select s)"
+                } else {
+                    ""
+                }
             );
         }
     }
@@ -310,5 +315,15 @@ fn worst_mode(l: &crate::hostlink::LinkPlan) -> String {
     match &l.worst_mode {
         Some(m) => format!(" in mode `{m}` (the most bytes per frame; FIFO the most of every mode and switch, latency and minimum baud the worst mode's)"),
         None => String::new(),
+    }
+}
+
+/// The `dev.sel` cell: an external mux's device and select, or the
+/// converter's own input (and the front mux's pins in front of it).
+fn mux_cell(c: &super::ChannelAudit) -> String {
+    match c.adc_input {
+        None => format!("{}.{}", c.device, c.select),
+        Some(k) if c.front_mux => format!("in{k}/{}.{}", c.device, c.select),
+        Some(k) => format!("in{k}"),
     }
 }

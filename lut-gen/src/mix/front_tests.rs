@@ -217,3 +217,27 @@ fn random_fronted_mixes_keep_pins_and_words_apart() {
     }
     assert!(scheduled >= 10, "only {scheduled} random mixes scheduled");
 }
+
+/// The audit names both: the converter input a channel is on and, behind a
+/// front mux, the pins that address it (its `dev.sel` cell and JSON fields).
+#[test]
+fn the_audit_shows_the_converter_input_and_the_front_pins() {
+    let m = parse(Path::new("m.toml"), AD).unwrap();
+    let s = synthesize(&m).unwrap();
+    let a = crate::AuditReport::of_schedule(&s);
+    let text = a.to_text();
+    for (c, ch) in a.channels.iter().enumerate() {
+        let mc = &m.channels[c];
+        assert_eq!(ch.adc_input, Some(mc.input));
+        assert_eq!(ch.front_mux, mc.front_input.is_some());
+        let cell = match mc.front_input {
+            Some(f) => format!("in{}/{}.{}", mc.input, f / 8, f % 8),
+            None => format!("in{}", mc.input),
+        };
+        let row = text
+            .lines()
+            .find(|l| l.split_whitespace().next() == Some(&ch.name))
+            .unwrap();
+        assert!(row.split_whitespace().any(|w| w == cell), "{row}");
+    }
+}
