@@ -222,10 +222,10 @@ fn first_pin_mix(n: usize) -> (u64, lut_gen::Schedule) {
         .expect("a feasible draw")
 }
 
-/// About 20 s under load (the first feasible draw, 2 branches; 140 s
-/// before the run was split on `mode_sel`).
+/// The first feasible draw, 2 branches: 2 s (20 s before frame starts
+/// were compared up to any renaming, 140 s before the run was split on
+/// `mode_sel`).
 #[test]
-#[ignore = "long: make test-long"]
 fn a_random_pin_select_mix_proves() {
     if !tools::require_tools(&TOOLS) {
         return;
