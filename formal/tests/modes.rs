@@ -222,9 +222,8 @@ fn first_pin_mix(n: usize) -> (u64, lut_gen::Schedule) {
         .expect("a feasible draw")
 }
 
-/// The first feasible draw, 2 branches: 2 s (20 s before frame starts
-/// were compared up to any renaming, 140 s before the run was split on
-/// `mode_sel`).
+/// The first feasible draw, 2 branches: 2 s (140 s before the run was
+/// split on `mode_sel`).
 #[test]
 fn a_random_pin_select_mix_proves() {
     if !tools::require_tools(&TOOLS) {
