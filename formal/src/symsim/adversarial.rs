@@ -891,3 +891,47 @@ fn a_kept_request_proves_when_split_and_its_violation_is_found() {
     let (f, _) = judged_by(&g, 1, 2, || split_on(&g, &[0, 1], 1, 2, 60));
     assert!(matches!(f, Found::Violated { .. }), "{f:?}");
 }
+
+/// A data bit captured when the request (input 0) is high and held while
+/// it is low, the way a branch a mode leaves idle keeps its last data: the
+/// held bit is a variable of any age, so frame starts recur only up to a
+/// renaming that is no shift.  Bad: two copies of it differ (never), or it
+/// is high after three held steps in a row (reachable, from old data).
+fn held_data(bad_when_held_long: bool) -> Aig {
+    let mut b = B::default();
+    let (req, d) = (b.input(), b.input());
+    let mut copies = Vec::new();
+    for _ in 0..2 {
+        let h = b.latch(Init::Zero);
+        let (take, keep) = (b.and(req, d), b.and(req ^ 1, h));
+        let n = b.or(take, keep);
+        b.next(h, n);
+        copies.push(h);
+    }
+    let mut bad = b.xor(copies[0], copies[1]);
+    if bad_when_held_long {
+        let mut held = req ^ 1;
+        for _ in 0..3 {
+            let k = b.latch(Init::Zero);
+            b.next(k, held);
+            held = b.and(req ^ 1, k);
+        }
+        let long = b.and(held, copies[0]);
+        bad = b.or(bad, long);
+    }
+    b.bad.push(bad);
+    b.aig()
+}
+
+#[test]
+fn data_held_for_any_number_of_frames_proves_when_split_and_its_violation_is_found() {
+    let g = held_data(false);
+    let (f, _) = run(&g, 1, 2, 60, None);
+    assert!(matches!(f, Found::Bounded { .. }), "{f:?}");
+    let (f, st) = judged_by(&g, 1, 2, || split_on(&g, &[0], 1, 2, 60));
+    assert!(matches!(f, Found::Proved { .. }), "{f:?}");
+    assert!(st.branches >= 2, "{st:?}");
+    let g = held_data(true);
+    let (f, _) = judged_by(&g, 1, 2, || split_on(&g, &[0], 1, 2, 60));
+    assert!(matches!(f, Found::Violated { .. }), "{f:?}");
+}

@@ -116,14 +116,31 @@ impl Graph {
     /// (children are ordered by a structural hash; a tie or a collision can
     /// only make equal states differ, never different states equal).
     pub(super) fn canonical(&self, roots: &[u32], now: u32) -> Vec<u64> {
-        let leaf = |n: usize| -> u64 {
+        self.form(roots, |n: usize| -> u64 {
             let (input, step) = (u64::from(self.a[n] & !VAR), self.b[n]);
             if step == 0 {
                 input << 33
             } else {
                 (input << 33) | (1 << 32) | u64::from(now - step)
             }
-        };
+        })
+    }
+
+    /// The state `roots` up to any one-to-one renaming of its variables
+    /// that keeps each one's input: every variable is a free bit of its
+    /// own, so such states stand for the same set of values.  Why not
+    /// `canonical`: a value held for as long as the environment likes (an
+    /// idle branch's last data while a mode leaves it idle) grows older
+    /// without end, and no shift by whole frames equates it.
+    pub(super) fn canonical_any(&self, roots: &[u32]) -> Vec<u64> {
+        self.form(roots, |n: usize| u64::from(self.a[n] & !VAR))
+    }
+
+    /// `roots` serialized with each variable named by `leaf` (children by
+    /// a structural hash, nodes numbered in depth-first order): equal
+    /// sequences are the same graph up to a renaming of variables that
+    /// keeps `leaf`.
+    fn form(&self, roots: &[u32], leaf: impl Fn(usize) -> u64) -> Vec<u64> {
         let mix = |x: u64| {
             let x = (x ^ (x >> 31)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
             x ^ (x >> 29)

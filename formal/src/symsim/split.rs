@@ -17,7 +17,11 @@
 //! taken), so nothing is left out and nothing is added.  A path's state at
 //! a frame boundary that is, up to renaming, a state some path reached at
 //! an earlier or the same boundary adds no new state (the argument of
-//! `mod.rs`, per path: its successors are the earlier state's); when every
+//! `mod.rs`, per path: its successors are the earlier state's).  Any
+//! one-to-one renaming of the variables will do, not only a shift by whole
+//! frames (`Graph::canonical_any`): each is a free bit of its own, so both
+//! states stand for the same values, and a mode that leaves a branch idle
+//! keeps its last data for any number of frames; when every
 //! path has ended so, every reachable state was simulated, each step
 //! checked exactly: proved for all time.  A violation on a path is a real
 //! trace: the values fixed on the path and the SAT model of the rest.
@@ -139,7 +143,7 @@ impl Sim<'_> {
                 }
             }
             if phase == Some(0) {
-                let now = self.gr.canonical(&self.state, step as u32);
+                let now = self.gr.canonical_any(&self.state);
                 // a state seen at this step or before: its successors are
                 // covered (one seen later may hide an earlier violation)
                 if seen.get(&now).is_some_and(|&at| at <= step) {
