@@ -249,7 +249,11 @@ pub fn sites(text: &str) -> Vec<Site> {
         let body = t.strip_prefix("assign ").unwrap_or(t);
         if let Some((lhs, _)) = body.split_once(" = ") {
             if outputs.iter().any(|o| o == lhs.trim()) {
-                if let Some((_, (rs, re))) = assignment(code) {
+                // a constant output is the Const operator's: stuck at a
+                // literal is that literal again or a constant changed
+                if let Some((_, (rs, re))) = assignment(code)
+                    .filter(|(_, (rs, _))| !code[*rs..].starts_with(|c: char| c.is_ascii_digit()))
+                {
                     let v = &code[rs..re];
                     out.push(Site {
                         op: Operator::Stuck,
