@@ -599,7 +599,6 @@ impl BranchAudit {
         let mix = &s.mix;
         let used = used_slots.len() as u64;
         let br = &mix.branches[b];
-        let inputs = front_capacity(mix, b).unwrap_or(br.input_capacity());
         let taken = mix
             .channels
             .iter()
@@ -607,9 +606,9 @@ impl BranchAudit {
             .map(|c| (c.input, c.front_input))
             .collect::<std::collections::BTreeSet<_>>()
             .len() as u32;
+        let free_inputs = front_free(mix, b).unwrap_or(br.input_capacity().saturating_sub(taken));
         // A chain of N parts gives N samples per conversion.
         let adc_max_sps = br.max_samples_hz(mix.clock_hz);
-        let free_inputs = inputs.saturating_sub(taken);
         let demand_sps: u64 = mix
             .channels
             .iter()
@@ -871,21 +870,33 @@ fn place(demand: &[u64], n: u64, k: u64, sps: u64, frame_slots: u64) -> bool {
     true
 }
 
-/// Inputs a fronted branch can sample: each converter input wired through
-/// the front mux carries all its inputs, the others one sensor each.
-fn front_capacity(mix: &crate::Mix, b: usize) -> Option<u32> {
+/// Free places on a fronted branch: converter inputs no channel uses (one
+/// sensor each), the free inputs of each front device already wired to a
+/// converter input (a device has one output), and a device with no channel
+/// yet on a free converter input (its other inputs).
+fn front_free(mix: &crate::Mix, b: usize) -> Option<u32> {
     let br = &mix.branches[b];
     if !br.fronted {
         return None;
     }
-    let fronted: std::collections::BTreeSet<u32> = mix
-        .channels
+    let mine: Vec<&crate::mix::Channel> = mix.channels.iter().filter(|c| c.branch == b).collect();
+    let wired: std::collections::BTreeSet<u32> = mine.iter().map(|c| c.input).collect();
+    let straight_free = br.input_capacity() - wired.len() as u32;
+    let per = br.mux.inputs;
+    let mut on_device = vec![std::collections::BTreeSet::new(); br.mux_devices as usize];
+    for c in &mine {
+        if let Some(f) = c.front_input {
+            on_device[(f / per) as usize].insert(f);
+        }
+    }
+    let spare: u32 = on_device
         .iter()
-        .filter(|c| c.branch == b && c.front_input.is_some())
-        .map(|c| c.input)
-        .collect();
-    let n = fronted.len() as u32;
-    Some(br.input_capacity() - n + n * br.mux.inputs * br.mux_devices)
+        .filter(|d| !d.is_empty())
+        .map(|d| per - d.len() as u32)
+        .sum();
+    // a front device with no channel yet takes a free converter input
+    let idle = on_device.iter().filter(|d| d.is_empty()).count() as u32;
+    Some(straight_free + spare + (per - 1) * idle.min(straight_free))
 }
 
 #[cfg(test)]

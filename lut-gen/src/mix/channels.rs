@@ -348,6 +348,7 @@ impl Cx<'_> {
         channels: &[Channel],
     ) -> Result<(), MixError> {
         for (i, c) in channels.iter().enumerate() {
+            self.check_front_device(decl, branches, channels, i)?;
             let Some(o) = channels[..i].iter().find(|o| {
                 o.branch == c.branch
                     && o.input == c.input
@@ -376,6 +377,49 @@ impl Cx<'_> {
             ));
         }
         Ok(())
+    }
+
+    /// A front mux device has one output, wired to one converter input:
+    /// the channels on its inputs name the same `input`.
+    fn check_front_device(
+        &self,
+        decl: &[Declared],
+        branches: &[Branch],
+        channels: &[Channel],
+        i: usize,
+    ) -> Result<(), MixError> {
+        let c = &channels[i];
+        let Some(f) = c.front_input else {
+            return Ok(());
+        };
+        let per = branches[c.branch].mux.inputs;
+        let Some(o) = channels[..i].iter().find(|o| {
+            o.branch == c.branch
+                && o.input != c.input
+                && o.front_input.is_some_and(|g| g / per == f / per)
+        }) else {
+            return Ok(());
+        };
+        let d = &decl[i];
+        let span = d
+            .raw
+            .front_input
+            .as_ref()
+            .map_or(d.raw.name.span(), |v| v.span());
+        let dev = f / per;
+        Err(self.at(
+            span,
+            d.field("front_input"),
+            d.say(format!(
+                "front mux device {dev} of branch `{}` (front inputs {}..={}) has one output, wired to converter input {} by `{}`: front_input {f} would put it on input {} too",
+                branches[c.branch].name,
+                dev * per,
+                dev * per + per - 1,
+                o.input,
+                o.name,
+                c.input
+            )),
+        ))
     }
 
     /// Channels of one branch on one mux input are read in one conversion

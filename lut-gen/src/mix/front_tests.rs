@@ -241,3 +241,37 @@ fn the_audit_shows_the_converter_input_and_the_front_pins() {
         assert!(row.split_whitespace().any(|w| w == cell), "{row}");
     }
 }
+
+/// One front device, one output: its channels name one converter input.
+#[test]
+fn a_front_device_feeds_one_converter_input() {
+    let text = format!(
+        "{AD}[[channel]]\nname = \"X\"\nbranch = \"a\"\nrate_hz = 1_000\ninput = 2\nfront_input = 15\n"
+    );
+    let e = err(&text);
+    let msg = e.to_string();
+    assert!(msg.contains("channel[2].front_input"), "{msg}");
+    assert!(
+        msg.contains("front mux device 1 of branch `a` (front inputs 8..=15) has one output, wired to converter input 4 by `F3`"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains(&format!("m.toml:{}:", line_of(&text, "front_input = 15"))),
+        "{msg}"
+    );
+}
+
+/// The audit's free inputs on a fronted branch, counted by hand: `AD` wires
+/// devices 0 and 1 (F0..F9 on front inputs 5..14) to converter input 4 and S
+/// straight to input 1: 6 converter inputs free, 5 + 1 front inputs free.
+#[test]
+fn the_audit_counts_free_places_behind_and_beside_the_front_mux() {
+    let s = synthesize(&parse(Path::new("m.toml"), AD).unwrap()).unwrap();
+    let a = crate::AuditReport::of_schedule(&s);
+    assert_eq!(a.branches[0].free_mux_inputs, 6 + 5 + 1);
+    // one device without a channel takes a free converter input for its 8
+    let one = AD.replace("front_mux_devices = 2", "front_mux_devices = 3");
+    let s = synthesize(&parse(Path::new("m.toml"), &one).unwrap()).unwrap();
+    let a = crate::AuditReport::of_schedule(&s);
+    assert_eq!(a.branches[0].free_mux_inputs, 6 + 5 + 1 + 7);
+}
