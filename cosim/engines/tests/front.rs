@@ -50,8 +50,9 @@ pub(crate) fn random_fronted(seed: u64) -> Schedule {
     let fronted: Vec<u64> = vec![r.next(4), 4 + r.next(4)][..1 + r.next(2) as usize].to_vec();
     let mut fronts: Vec<u64> = (0..8 * devices).collect();
     for n in 0..2 + r.next(4) {
-        let input = fronted[r.next(fronted.len() as u64) as usize];
         let f = fronts.remove(r.next(fronts.len() as u64) as usize);
+        // a front device has one output: its inputs share a converter input
+        let input = fronted[(f / 8) as usize % fronted.len()];
         let rate = [1000, 2000, 4000][r.next(3) as usize];
         t += &format!(
             "[[channel]]\nname = \"c{n}\"\nbranch = \"f\"\nrate_hz = {rate}\ninput = {input}\nfront_input = {f}\n"
