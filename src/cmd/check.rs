@@ -95,6 +95,7 @@ fn run_capture(a: &Args, s: &lut_gen::Schedule, map: &str) -> u8 {
             "mode": "time-level capture",
             "locked_at_ps": r.locked_at_ps,
             "clock_ppm": r.clock_ppm,
+            "clock_uncertainty_ps": r.clock_uncertainty_ps,
             "modes": r.modes.as_ref().map(|m| serde_json::json!({
                 "by": m.by,
                 "first": m.first,

@@ -264,6 +264,30 @@ pub fn check(s: &Schedule, map: &str, file: &Path) -> TimedReport {
     check_capture(s, &cap, 0).unwrap()
 }
 
+/// What an analyser at `ts_ps` running `ppm` off the design's clock
+/// ([`resample_drifting`]) records of cycles `window` of `pins`, its rate
+/// said in the VCD as sigrok-cli says it, checked at time level.
+pub fn check_drifting(
+    s: &Schedule,
+    pins: &[Pins],
+    window: (u64, u64),
+    (ts_ps, phase_ps): (u64, u64),
+    ppm: f64,
+    vcd: &Path,
+) -> TimedReport {
+    let (_, map) = lanes(s);
+    resample_drifting(s, pins, window, (ts_ps, phase_ps), ppm, vcd);
+    let text = std::fs::read_to_string(vcd).unwrap().replace(
+        "$enddefinitions $end\n",
+        &format!(
+            "$comment\n  Acquisition at {} Hz\n$end\n$enddefinitions $end\n",
+            1e12 / ts_ps as f64
+        ),
+    );
+    std::fs::write(vcd, text).unwrap();
+    check(s, &map, vcd)
+}
+
 /// A fault made on the recorded pins of branch 0 at the first conversion at
 /// or after cycle `at`.
 #[derive(Debug, Clone, Copy)]

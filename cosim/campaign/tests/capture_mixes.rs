@@ -2,7 +2,8 @@
 //! RtlSim) of random mixes (`campaign::mixgen`), as a logic analyser records
 //! them (resampled at 24 and 100 MHz with an arbitrary phase, from the
 //! middle of a frame, no clock or reset, channels D0..Dn), pass the
-//! time-level check as sigrok `.sr` sessions and as sigrok-cli's VCD; the
+//! time-level check as sigrok `.sr` sessions and as sigrok-cli's VCD (and
+//! by an analyser some ppm off the design's clock); the
 //! same captures of mutated gateware (a design-level fault of every class
 //! built in, and faults made on the recorded pins) fail.
 
@@ -70,6 +71,21 @@ fn captures_of_random_mixes(seed: u64, n: usize, classes: usize) {
                 );
                 assert!(r.edges_checked > 20, "mix {k}: {}", r.summary());
             }
+        }
+        // An analyser off the design's clock by up to ±300 ppm, as crystals
+        // are: passes, the offset measured within its stated uncertainty.
+        let ppm = (20 + k * 37 % 280) as f64 * if k % 2 == 0 { 1.0 } else { -1.0 };
+        let v = d.path().join(format!("drift{k}.vcd"));
+        let r = analyser::check_drifting(&s, &clean, window, (10_000, 2_345), ppm, &v);
+        assert!(r.ok, "mix {k} at {ppm} ppm: {}", r.summary());
+        if let Some(got) = r.clock_ppm {
+            let span_ps = (window.1 - window.0) as f64 * 1e12 / s.mix.clock_hz as f64;
+            let err_ps = (got + ppm).abs() * 1e-6 * span_ps;
+            assert!(
+                err_ps <= r.clock_uncertainty_ps as f64 + 1.0,
+                "mix {k} at {ppm} ppm: {}",
+                r.summary()
+            );
         }
         // Mutated gateware: one design-level fault of every class.
         let reference = d.path().join(format!("ref{k}.vcd"));

@@ -19,14 +19,12 @@ const MAX_PPM: f64 = 1000.0;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct ClockFit {
     pub ppm: f64,
-    /// The fit's standard error, in ppm (the analyser's sampling puts up
-    /// to a sample period on each start).
-    sigma: f64,
-    /// The most the sampling can tilt the line, in ppm: a sample period at
-    /// each end of the starts' span, twice.  The sampling's error is not
-    /// noise when the sample period and the slot beat (it sweeps slowly
-    /// across the starts), so the standard error alone understates it.
-    bias: f64,
+    /// Whether the mix's own clock fits every start (the capture is then
+    /// checked as it was taken).
+    nominal_fits: bool,
+    /// How far the times scaled by `ppm` can stray from the design's clock
+    /// over the capture, in ps.
+    uncertainty_ps: f64,
     /// The capture's first time, which scaling keeps.
     t0: u64,
 }
@@ -54,18 +52,11 @@ fn starts(s: &lut_gen::Schedule, cap: &Capture) -> Vec<u64> {
     out
 }
 
-/// Fits the conversion starts to a slot grid: each gap is a whole number
-/// of slots at the nominal clock (rounded), and a least-squares line
-/// through (slot index, time) gives the slot's length in the capture's
-/// time.  `None` when there are too few starts, or the gaps do not sit on
-/// a grid (a design that starts conversions off the slot grid is judged at
-/// the nominal clock, where its edges fail).
-pub(crate) fn fit(s: &lut_gen::Schedule, cap: &Capture) -> Option<ClockFit> {
-    let slot_ps = s.grid.slot_cycles as f64 * 1e12 / s.mix.clock_hz as f64;
-    let t = starts(s, cap);
-    if t.len() < 8 {
-        return None;
-    }
+/// Each start's slot on the grid: every gap is a whole number of slots at
+/// the nominal clock (rounded).  `None` when a gap is not (a design that
+/// starts conversions off the slot grid is judged at the nominal clock,
+/// where its edges fail).
+fn slots(t: &[u64], slot_ps: f64) -> Option<Vec<f64>> {
     let mut k = vec![0f64];
     for w in t.windows(2) {
         let gap = (w[1] - w[0]) as f64 / slot_ps;
@@ -76,45 +67,85 @@ pub(crate) fn fit(s: &lut_gen::Schedule, cap: &Capture) -> Option<ClockFit> {
         }
         k.push(k.last().unwrap() + n);
     }
+    Some(k)
+}
+
+/// The least-squares slope (ps per slot) of the starts `t` at slots `k`.
+fn least_squares(k: &[f64], t: &[u64]) -> Option<f64> {
     let n = k.len() as f64;
-    let (mk, mt) = (
-        k.iter().sum::<f64>() / n,
-        t.iter().map(|&x| x as f64).sum::<f64>() / n,
-    );
+    let mk = k.iter().sum::<f64>() / n;
+    let mt = t.iter().map(|&x| x as f64).sum::<f64>() / n;
     let (mut cov, mut var) = (0.0, 0.0);
-    for (ki, &ti) in k.iter().zip(&t) {
+    for (ki, &ti) in k.iter().zip(t) {
         cov += (ki - mk) * (ti as f64 - mt);
         var += (ki - mk) * (ki - mk);
     }
-    if var == 0.0 {
+    (var > 0.0).then(|| cov / var)
+}
+
+/// The slopes (ps per slot) of every line through all the starts when each
+/// happened up to `slack_ps` before the time the capture shows it (a
+/// sample period, plus the lanes' skew on either side): for two starts `i`
+/// before `j`, the slope lies within `(t_j - t_i -+ slack) / (k_j - k_i)`.
+/// Taken over the pairs of at most 512 starts spread over the capture (a
+/// subset's bounds hold for the whole, only looser).  `None` when no line
+/// fits: the starts are not on one clock.
+fn feasible_slopes(k: &[f64], t: &[u64], slack_ps: f64) -> Option<(f64, f64)> {
+    let n = k.len();
+    let pick: Vec<usize> = (0..n.min(512))
+        .map(|i| i * (n - 1) / (n.min(512) - 1).max(1))
+        .collect();
+    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+    for (a, &i) in pick.iter().enumerate() {
+        for &j in &pick[a + 1..] {
+            let dk = k[j] - k[i];
+            if dk > 0.0 {
+                let dt = t[j] as f64 - t[i] as f64;
+                lo = lo.max((dt - slack_ps) / dk);
+                hi = hi.min((dt + slack_ps) / dk);
+            }
+        }
+    }
+    (lo <= hi && lo.is_finite()).then_some((lo, hi))
+}
+
+/// Fits the conversion starts to a slot grid: the slot's length in the
+/// capture's time is the least-squares slope through (slot index, time),
+/// kept within the slopes every start allows given the sampling (see
+/// [`feasible_slopes`]), which also bound its error.  `None` when there
+/// are too few starts, they do not sit on a grid, or no one clock fits them.
+pub(crate) fn fit(s: &lut_gen::Schedule, cap: &Capture, skew_ps: u64) -> Option<ClockFit> {
+    let slot_ps = s.grid.slot_cycles as f64 * 1e12 / s.mix.clock_hz as f64;
+    let t = starts(s, cap);
+    if t.len() < 8 {
         return None;
     }
-    let slope = cov / var;
-    let ppm = (slope / slot_ps - 1.0) * 1e6;
-    let icpt = mt - slope * mk;
-    let sq: f64 = (k.iter().zip(&t))
-        .map(|(ki, &ti)| (ti as f64 - icpt - slope * ki).powi(2))
-        .sum();
-    let sigma = (sq / (n - 2.0)).sqrt() / var.sqrt() / slot_ps * 1e6;
-    let span = (t[t.len() - 1] - t[0]) as f64;
-    let bias = 2.0 * 2.0 * cap.period_ps as f64 / span * 1e6;
+    let k = slots(&t, slot_ps)?;
+    let (lo, hi) = feasible_slopes(&k, &t, (cap.period_ps + 2 * skew_ps) as f64)?;
+    let slope = least_squares(&k, &t)?.clamp(lo, hi);
     let t0 = cap.steps.first().map_or(0, |x| x.0);
+    let span_slots = cap.steps.last().map_or(0, |x| x.0 - t0) as f64 / slot_ps;
     Some(ClockFit {
-        ppm,
-        sigma,
-        bias,
+        ppm: (slope / slot_ps - 1.0) * 1e6,
+        nominal_fits: (lo..=hi).contains(&slot_ps),
+        uncertainty_ps: (slope - lo).max(hi - slope) * span_slots,
         t0,
     })
 }
 
 impl ClockFit {
-    /// Whether the capture is scaled: an offset a crystal can have, and
-    /// one the fit tells from none (beyond three standard errors and the
-    /// sampling's tilt), so a capture at the mix's clock is checked as it
-    /// was taken.
+    /// Whether the capture is scaled: an offset a crystal can have, and the
+    /// mix's own clock does not fit every start (a capture at the mix's
+    /// clock is checked as it was taken).
     pub(crate) fn worth_scaling(&self) -> bool {
-        let a = self.ppm.abs();
-        a > 3.0 * self.sigma && a > self.bias && a <= MAX_PPM
+        !self.nominal_fits && self.ppm.abs() <= MAX_PPM
+    }
+
+    /// How far the scaled times can stray from the design's clock by the
+    /// end of the capture, in ps (from the slopes the starts allow).  The
+    /// time checks widen each edge's tolerance by it, as by a skew.
+    pub(crate) fn uncertainty_ps(&self) -> u64 {
+        self.uncertainty_ps.ceil() as u64
     }
 
     fn factor(&self) -> f64 {
@@ -154,5 +185,6 @@ impl ClockFit {
             }
         }
         r.clock_ppm = Some(-self.ppm);
+        r.clock_uncertainty_ps = self.uncertainty_ps();
     }
 }

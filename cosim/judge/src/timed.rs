@@ -180,6 +180,10 @@ pub struct TimedReport {
     /// capture's times were scaled by it; every time above is the capture's
     /// own.
     pub clock_ppm: Option<f64>,
+    /// With `clock_ppm`: how far the scaled times can stray by the end of
+    /// the capture (the fit's uncertainty), by which each edge's tolerance
+    /// was widened; 0 otherwise.
+    pub clock_uncertainty_ps: u64,
     /// A mix with modes: the mode of each frame the capture holds, as the
     /// phase found places them.
     pub modes: Option<crate::timedmodes::ModesSeen>,
@@ -206,7 +210,8 @@ impl TimedReport {
         if let Some(ppm) = self.clock_ppm {
             let _ = writeln!(
                 s,
-                "clock: the conversion starts put the design's clock {ppm:+.1} ppm from the mix's (the board's crystal against the analyser's); the capture was checked at that clock"
+                "clock: the conversion starts put the design's clock {ppm:+.1} ppm from the mix's (the board's crystal against the analyser's); the capture was checked at that clock, each edge's tolerance widened by the fit's uncertainty ({:.1} ns over the capture)",
+                self.clock_uncertainty_ps as f64 / 1e3
             );
         }
         if let Some(j) = &self.link_join {
@@ -629,13 +634,32 @@ pub fn check_capture_with(
     skew_ps: u64,
     model: bool,
 ) -> Result<TimedReport, TimedError> {
-    match crate::clockfit::fit(s, cap).filter(|f| f.worth_scaling()) {
+    match crate::clockfit::fit(s, cap, skew_ps).filter(|f| f.worth_scaling()) {
         Some(f) => {
-            let mut r = check_at_mix_clock(s, &f.scaled(cap), skew_ps, model)?;
+            let tol = Tolerance {
+                skew_ps,
+                fit_ps: f.uncertainty_ps(),
+            };
+            let mut r = check_at_mix_clock(s, &f.scaled(cap), tol, model)?;
             f.unscale(&mut r);
             Ok(r)
         }
-        None => check_at_mix_clock(s, cap, skew_ps, model),
+        None => check_at_mix_clock(s, cap, Tolerance { skew_ps, fit_ps: 0 }, model),
+    }
+}
+
+/// What an edge's time may be off by besides the sample period, in ps: the
+/// user's skew between lanes, and the clock fit's uncertainty when the
+/// capture was scaled.  Both widen each side of an edge's window.
+#[derive(Debug, Clone, Copy)]
+struct Tolerance {
+    skew_ps: u64,
+    fit_ps: u64,
+}
+
+impl Tolerance {
+    fn each_side_ps(self) -> u64 {
+        self.skew_ps + self.fit_ps
     }
 }
 
@@ -646,9 +670,10 @@ const TC: i128 = 1_000_000_000_000;
 fn check_at_mix_clock(
     s: &Schedule,
     cap: &Capture,
-    skew_ps: u64,
+    tol: Tolerance,
     model: bool,
 ) -> Result<TimedReport, TimedError> {
+    let skew_ps = tol.each_side_ps();
     let clock = s.mix.clock_hz as i128;
     let tc_ps = 1e12 / s.mix.clock_hz as f64;
     let mut not_proved = Vec::new();
@@ -699,7 +724,7 @@ fn check_at_mix_clock(
     let span_ps = (end / clock) as u64 - scan.conv_start.unwrap_or(0);
     let mut conversions =
         (span_ps as f64 / (tpl.frame as f64 * tc_ps) * tpl.conversions_per_frame as f64) as u64;
-    let (mut proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, skew_ps);
+    let (mut proved, np) = what_was_proved(s, &lanes, &tpl, cap.period_ps, tol);
     not_proved.extend(np);
     let modes_seen = modes_seen(s, cap, &ctx, &cands, scan.conv_start.unwrap_or(0), end);
     let modes_seen = modes_seen.map(|(seen, n, trig)| {
@@ -735,6 +760,7 @@ fn check_at_mix_clock(
         not_proved,
         link_join,
         clock_ppm: None,
+        clock_uncertainty_ps: 0,
         modes: modes_seen,
     })
 }
@@ -1217,17 +1243,25 @@ fn what_was_proved(
     lanes: &[Lane],
     tpl: &Tpl,
     period_ps: u64,
-    skew_ps: u64,
+    tol: Tolerance,
 ) -> (Vec<String>, Vec<String>) {
     let tc_ps = 1e12 / s.mix.clock_hz as f64;
-    let res = (period_ps + 2 * skew_ps) as f64;
+    let res = (period_ps + 2 * tol.each_side_ps()) as f64;
     let mut yes = Vec::new();
     let mut no = Vec::new();
+    let fit = if tol.fit_ps > 0 {
+        format!(
+            " and twice the clock fit's uncertainty {:.1} ns",
+            tol.fit_ps as f64 / 1e3
+        )
+    } else {
+        String::new()
+    };
     yes.push(format!(
-        "every checked edge within {:.1} ns of the schedule's time (sample period {:.1} ns plus twice the skew {:.1} ns): rates, intervals and slot order of the mapped conversion lanes to ±{:.1} ns",
+        "every checked edge within {:.1} ns of the schedule's time (sample period {:.1} ns plus twice the skew {:.1} ns{fit}): rates, intervals and slot order of the mapped conversion lanes to ±{:.1} ns",
         res / 1e3,
         period_ps as f64 / 1e3,
-        skew_ps as f64 / 1e3,
+        tol.skew_ps as f64 / 1e3,
         res / 1e3
     ));
     if res >= tc_ps {
@@ -1295,7 +1329,7 @@ fn what_was_proved(
                         m as f64 * tc_ps / 1e3,
                         res / 1e3,
                         shown / 1e3,
-                        (m as f64 * tc_ps / 1e3 - settle_ns) * 1e3 / 1e3 - 2.0 * skew_ps as f64 / 1e3
+                        (m as f64 * tc_ps / 1e3 - settle_ns) * 1e3 / 1e3 - 2.0 * tol.each_side_ps() as f64 / 1e3
                     ));
                 }
             }

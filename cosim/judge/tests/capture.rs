@@ -394,3 +394,47 @@ fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
         "{text}"
     );
 }
+
+/// A board's crystal and an analyser's differ by tens of ppm: captures of
+/// mixes without a link by 100 and 24 MHz analysers 3 to 500 ppm fast or
+/// slow, over two frames from odd offsets, pass; the offset measured is
+/// said, and its stated uncertainty covers its real error over the capture
+/// (an offset the fit puts under half a sample period over the capture is
+/// not scaled).
+#[test]
+fn captures_by_an_analyser_off_the_design_clock_pass() {
+    let d = tempfile::tempdir().unwrap();
+    let ppms = [100.0, -100.0, 37.0, -250.0, 10.0, 500.0, -3.0];
+    for mix in [
+        "../../testkit/mixes/tiny.toml",
+        "../../mixes/softslip1k.toml",
+        "../../mixes/vibrotactile8k.toml",
+    ] {
+        let s = load(mix);
+        let f = s.grid.frame_cycles;
+        let clean = run(&s, &mut ModelDut::new(&s), 3);
+        for (i, ppm) in ppms.into_iter().enumerate() {
+            let i = i as u64;
+            let w = (f / 7 * i + 13 * i, f / 7 * i + 2 * f);
+            let ts = [10_000, 41_667][i as usize % 2];
+            let out = d.path().join(format!("{i}.vcd"));
+            let r = analyser::check_drifting(&s, &clean, w, (ts, 777 * i + 1), ppm, &out);
+            let what = format!("{mix} at {ppm} ppm, {ts} ps");
+            assert!(r.ok, "{what}: {}", r.summary());
+            let span_ps = (w.1 - w.0) as f64 * 1e12 / s.mix.clock_hz as f64;
+            // the analyser fast by `ppm`: the design's clock slow by it
+            let Some(got) = r.clock_ppm else {
+                // checked as taken: the drift stays within a sample period
+                assert!(ppm.abs() * 1e-6 * span_ps < ts as f64, "{what}");
+                continue;
+            };
+            let err_ps = (got + ppm).abs() * 1e-6 * span_ps;
+            assert!(
+                err_ps <= r.clock_uncertainty_ps as f64 + 1.0,
+                "{what}: {got} ppm, {err_ps:.0} ps off, said {} ps",
+                r.clock_uncertainty_ps
+            );
+            assert!(r.summary().contains(&format!("{got:+.1} ppm")), "{what}");
+        }
+    }
+}
