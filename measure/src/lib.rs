@@ -55,8 +55,8 @@ pub use netlist::{netlist, Netlist, NETLIST_SIM_FILE};
 // FPGA part; yosys for a part (the synthesized JSON, the gate-level netlist
 // and the family's cell models, for `sim --netlist`).
 pub use synth::{
-    anchor, median_fmax, place_and_route, place_and_route_for, place_and_route_seeds, Anchor,
-    Synth, HAND_ANCHORS,
+    anchor, logic_cell_says, median_fmax, place_and_route, place_and_route_for,
+    place_and_route_seeds, Anchor, Synth, HAND_ANCHORS,
 };
 pub use yosys::{find_program, synthesize_for, Synthesized, NETLIST_FILE, SYNTH_JSON};
 

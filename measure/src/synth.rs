@@ -203,6 +203,16 @@ fn place(
     parse(fpga, &text, &y.cells).map_err(|e| format!("{}: {e}", report.display()))
 }
 
+/// What `Synth::lcs` counts on `fpga`: nextpnr's cell, and what it holds.
+pub fn logic_cell_says(fpga: Fpga) -> String {
+    let what = match fpga.family() {
+        Family::Ice40 => "each a LUT4, a flip-flop or both",
+        Family::Ecp5 => "half a slice each",
+        Family::Gowin => "the LUTs placed, the router's route-through ones included",
+    };
+    format!("{}: {what}", names(fpga).logic_cell)
+}
+
 /// The family's names for what the report counts: nextpnr's logic cell
 /// and block RAM, and yosys' LUT and flip-flop cells.
 struct Names {

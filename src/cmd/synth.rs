@@ -153,11 +153,19 @@ fn to_text(s: &lut_gen::Schedule, r: &measure::Synth, board: &str, seed: u64) ->
         r.fpga.part_number(),
         r.fpga.yosys()
     );
+    let yosys = r.fpga.yosys();
     let rows = [
-        ("LUTs", r.lut4.to_string()),
-        ("flip-flops", r.dff.to_string()),
-        ("block RAMs", r.brams.to_string()),
-        ("logic cells", r.lcs.to_string()),
+        ("LUTs", format!("{:<6} mapped by {yosys}", r.lut4)),
+        ("flip-flops", format!("{:<6} mapped by {yosys}", r.dff)),
+        ("block RAMs", format!("{:<6} placed by {pnr}", r.brams)),
+        (
+            "logic cells",
+            format!(
+                "{:<6} placed by {pnr} ({})",
+                r.lcs,
+                measure::logic_cell_says(r.fpga)
+            ),
+        ),
         (
             "Fmax",
             format!(
