@@ -381,14 +381,14 @@ impl Invariants {
         self.expire(c);
         // The merged stream sends the lowest branch's waiting word first
         // (a chain's words in member order); within a branch, in order.
-        let pick = self
-            .queue
-            .iter()
-            .enumerate()
-            .filter(|(_, q)| q.complete < c)
-            .min_by_key(|(i, q)| (q.branch, *i))
-            .map(|(i, _)| i)
-            .unwrap_or(0);
+        // (one word waiting, as in most cycles: no search)
+        let pick = match self.queue.len() {
+            1 => 0,
+            _ => (self.queue.iter().enumerate())
+                .filter(|(_, q)| q.complete < c)
+                .min_by_key(|(i, q)| (q.branch, *i))
+                .map_or(0, |(i, _)| i),
+        };
         let Some(p) = self.queue.remove(pick) else {
             self.rec.record(
                 Violation::new(Rule::SampleUnexpected, c)
