@@ -24,7 +24,7 @@ endif
 # `PROPTEST_RNG_SEED=random make test` explores new cases.
 export PROPTEST_RNG_SEED ?= 1
 
-.PHONY: baseline test-long run test tools venv lut audit verilog cosim golden golden-update synth synth-bench bench update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
+.PHONY: baseline test-long run test tools venv lut audit verilog cosim golden golden-update synth synth-bench bench bench-before update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 # The main job on the reference mix: audit, LUT, Verilog, co-simulation, golden,
 # faults, synthesis estimate, and build/eskin34/report.html with its charts.
@@ -132,6 +132,12 @@ bench:
 	$(CARGO) bench -p lut-gen --features bench --bench synthesis
 	$(CARGO) bench -p engines --bench cosim
 	$(CARGO) bench -p formal --bench engines
+
+# The co-simulation bench at BASE and at the working tree, alternately
+# (docs/performance.md): the simulation speed the lean gateware gave.
+BASE ?= cc7b699
+bench-before:
+	bash cosim/engines/benches/before_after.sh $(BASE)
 
 # Long-running fuzzing of the mix parser and the VCD reader (not part of `make test`;
 # docs/fuzzing.md).  Crashes and hangs land in fuzz/crashes/; exit 1 if any.
