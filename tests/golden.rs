@@ -64,6 +64,41 @@ fn goldens_match_in_process(mixes: &[PathBuf]) {
     }
 }
 
+/// The mix with modes keeps a golden that switches: its recorded scene
+/// touches a watched taxel, the log holds the switch to `contact` two frames
+/// after the touch (docs/timing.md, the mode of the frame after next), and
+/// the model's replay of the recorded scene matches it.
+#[test]
+fn the_adaptive_golden_holds_a_touch_and_its_switch() {
+    let log = std::fs::read_to_string(root().join("golden/eskin34-adaptive/events.log")).unwrap();
+    assert!(
+        log.contains("# scene --stimulus: touch:"),
+        "no touch recorded"
+    );
+    let switches: Vec<(u64, &str)> = log
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .filter_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            (w.get(2) == Some(&"modes") && w.get(3) == Some(&"mode"))
+                .then(|| (w[0].parse().unwrap(), w[4]))
+        })
+        .collect();
+    let frame = 480_000;
+    assert_eq!(switches, [(0, "0"), (2 * frame, "1")], "the modes lines");
+    slotforge()
+        .current_dir(root())
+        .args([
+            "golden",
+            "--backend",
+            "model",
+            "mixes/eskin34-adaptive.toml",
+        ])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("same as"));
+}
+
 #[test]
 fn reference_golden_keeps_figure_6_windows() {
     let g = root().join("golden/eskin34");
