@@ -345,3 +345,47 @@ fn captures_of_random_mode_mixes_pass() {
     }
     assert_eq!(done, 6, "six random mode mixes");
 }
+
+/// A capture that begins after a switch (in a mode other than the reset
+/// mode) passes, its UART line too: the line's model runs in the modes the
+/// capture shows, not from the reset mode; the same capture with the line
+/// held idle for a while after the join fails on the line.
+#[test]
+fn a_capture_beginning_in_another_mode_passes_its_line_too() {
+    let s = shared("modes-auto");
+    let f = s.grid.frame_cycles;
+    let p = pins(&s, 24, &[], "touch:T0@8-12");
+    let sw = switch_frames(&s, &p, 0);
+    assert!(sw.len() >= 2, "the touch switches and back: {sw:?}");
+    let d = tempfile::tempdir().unwrap();
+    let starts = [
+        sw[0] * f + f / 3,
+        sw[0] * f + 1_234,
+        (sw[0] + 1) * f + 777,
+        sw[1] * f - f / 2,
+    ];
+    for (k, from) in starts.into_iter().enumerate() {
+        let out = d.path().join(format!("c{k}.vcd"));
+        let r = judged(&s, &p, (from, 24 * f), 3_210, (false, true), &out).unwrap();
+        let said = r.summary();
+        assert!(r.ok, "from cycle {from}: {said}");
+        let j = r.link_join.as_ref().expect("the line joined");
+        assert_eq!(j.by, "model", "{said}");
+        assert!(said.contains("characters' start bits within"), "{said}");
+    }
+    // the line idle for two slices after the join: packets go missing
+    let from = sw[0] * f + f / 3;
+    let mut bad = p.clone();
+    let at = (from + f / 2) as usize;
+    for q in &mut bad[at..at + 2 * s.grid.slice_cycles as usize] {
+        q.0.link_tx = true;
+    }
+    let out = d.path().join("bad.vcd");
+    let r = judged(&s, &bad, (from, 24 * f), 3_210, (false, true), &out).unwrap();
+    assert!(!r.ok, "{}", r.summary());
+    assert!(
+        r.violations.iter().any(|v| v.rule.contains("link")),
+        "{}",
+        r.summary()
+    );
+}

@@ -1145,9 +1145,12 @@ fn check_link_lane(
         .collect();
     let line = cap.lanes.iter().position(|l| l.is_line());
     let axis = cap.lanes.iter().any(|l| l.is_link()) && layout.axis;
+    let modes = phase_modes(s, cap, ctx, cands);
     let lk = match line {
         _ if axis => crate::timedaxis::check_axis(s, cap, &phases, model),
-        Some(li) if !layout.axis => crate::timedlink::check_link(s, cap, li, &phases, model),
+        Some(li) if !layout.axis => {
+            crate::timedlink::check_link(s, cap, li, &phases, &modes, model)
+        }
         _ if layout.axis => {
             not_proved.push("the link's samples (map m_axis_tdata[7:0], m_axis_tvalid, m_axis_tready and m_axis_tlast to analyser channels to read its beats)".into());
             return None;
@@ -1166,6 +1169,24 @@ fn check_link_lane(
     proved.extend(lk.proved);
     not_proved.extend(lk.not_proved);
     lk.join
+}
+
+/// A mix with modes: per phase, the mode of each of its frames to the
+/// capture's end, as the capture showed them (empty without modes).
+fn phase_modes(s: &Schedule, cap: &Capture, ctx: &Ctx, cands: &[Cand]) -> Vec<Vec<usize>> {
+    let Some(src) = ctx.src.as_ref() else {
+        return vec![Vec::new(); cands.len()];
+    };
+    let f = s.grid.frame_cycles as i128 * ctx.tc;
+    let end = cap.steps.last().map_or(0, |x| x.0) as i128 * ctx.clock;
+    (cands.iter())
+        .map(|c| {
+            let frames = ((end - c.lo).max(0) / f + 1) as u64;
+            (0..=frames)
+                .map(|w| c.modes.of(src, c.lo, c.hi, w))
+                .collect()
+        })
+        .collect()
 }
 
 /// Conversion starts a stretch of the capture must fit at their times (after

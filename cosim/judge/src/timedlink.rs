@@ -124,6 +124,7 @@ pub fn check_link(
     cap: &Capture,
     li: usize,
     phases: &[LinkPhase],
+    modes: &[Vec<usize>],
     model: bool,
 ) -> LinkCheck {
     let lane = &cap.lanes[li];
@@ -209,7 +210,7 @@ pub fn check_link(
             "{} (link_tx): the bytes' timing and the sample codes (no frame phase to time them against)",
             lane.channel
         )),
-        (true, _) => hold_bytes(s, cap, li, phases, (&line.chars, from), &mut out),
+        (true, _) => hold_bytes(s, cap, li, (phases, modes), (&line.chars, from), &mut out),
     }
     out
 }
@@ -484,6 +485,26 @@ impl MisoReader<'_> {
     }
 }
 
+/// The modes the model is held to, `(model frame, mode)` for its frames 2
+/// to `to`: model frame `k` is the phase's frame `k - shift` (`seen`'s
+/// first mode before it, its last after it).
+fn forced_modes(seen: &[usize], shift: i128, to: i128) -> Vec<(u64, usize)> {
+    let Some(&first) = seen.first() else {
+        return Vec::new();
+    };
+    (2..=to.max(2))
+        .map(|k| {
+            let w = k - shift;
+            let m = if w < 0 {
+                first
+            } else {
+                seen[(w as usize).min(seen.len() - 1)]
+            };
+            (k as u64, m)
+        })
+        .collect()
+}
+
 /// What the model predicts of the line along the capture.
 struct Prediction {
     bytes: Vec<Predicted>,
@@ -505,16 +526,29 @@ struct Known {
 /// in steady state: the capture may start before the phase's cycle 0 is a
 /// frame old) and collects the bytes it puts on the line.  MISO, where it is
 /// captured, is fed as read at each edge that reads it (0 where unknown).
-fn predict(s: &Schedule, cap: &Capture, ph: LinkPhase, clock: i128) -> Prediction {
+/// A mix with modes: `seen` is the mode of each of the phase's frames as the
+/// capture showed them, which the model runs in (the frames before the
+/// first in its mode), not the reset mode's.
+fn predict(
+    s: &Schedule,
+    cap: &Capture,
+    (ph, seen): (LinkPhase, &[usize]),
+    clock: i128,
+) -> Prediction {
     let f = s.grid.frame_cycles as i128;
     let mid = (ph.lo + ph.hi) / 2;
     let t0 = cap.steps.first().map_or(0, |x| x.0) as i128 * clock;
     let end = cap.steps.last().map_or(0, |x| x.0) as i128 * clock;
     let first = (t0 - mid).div_euclid(TC) - 1;
     let last = (end - mid).div_euclid(TC) + 1;
-    // The least whole number of frames that puts `first` in frame 1 or later.
-    let shift = f * (((f - first).max(0) + f - 1) / f).max(1);
-    let mut m = CycleModel::at(s, (first + shift) as u64);
+    // The least whole number of frames that puts `first` in frame 1 or later
+    // (with modes, frame 2: the first whose mode can be other than reset's).
+    let least = if seen.is_empty() { 1 } else { 2 };
+    let shift = f * (((least * f - first).max(0) + f - 1) / f).max(least);
+    let mut m = CycleModel::with_modes(s, &forced_modes(seen, shift / f, (last + shift) / f));
+    while (m.cycle() as i128) < first + shift {
+        m.step(0);
+    }
     let mut readers: Vec<(u32, MisoReader)> = miso_lanes(cap)
         .into_iter()
         .map(|(lane, b)| (b, MisoReader { cap, lane, k: 0 }))
@@ -610,7 +644,7 @@ fn hold_bytes(
     s: &Schedule,
     cap: &Capture,
     li: usize,
-    phases: &[LinkPhase],
+    (phases, modes): (&[LinkPhase], &[Vec<usize>]),
     (chars, from): (&[(u64, u8)], usize),
     out: &mut LinkCheck,
 ) {
@@ -618,8 +652,9 @@ fn hold_bytes(
     let clock = s.mix.clock_hz as i128;
     let misos = miso_lanes(cap);
     let mut best: Option<(LinkPhase, Held, LinkCheck)> = None;
-    for &ph in phases.iter().take(MAX_PHASES) {
-        let Prediction { bytes: pred } = predict(s, cap, ph, clock);
+    for (k, &ph) in phases.iter().enumerate().take(MAX_PHASES) {
+        let seen = modes.get(k).map_or(&[][..], Vec::as_slice);
+        let Prediction { bytes: pred } = predict(s, cap, (ph, seen), clock);
         let mut scratch = LinkCheck {
             violations: Vec::new(),
             proved: Vec::new(),
