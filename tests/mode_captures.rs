@@ -36,7 +36,9 @@ impl Observer for Rec {
 /// driven by `requests` (frame, mode), the ADC by `stimulus`.
 fn pins(s: &Schedule, frames: u64, requests: &[(u64, u8)], stimulus: &str) -> Vec<(Pins, u64)> {
     let dut = engines::RustHdlDut::new(s).expect("rust-hdl builds");
-    let mut dut = ModeRequests::new(s, dut, requests);
+    let dut = ModeRequests::new(s, dut, requests);
+    // an AXI4-Stream link's slave, ready at random within its bound
+    let mut dut = judge::with_slave(s, dut, ::link::ReadyPattern::Random { seed: 5 });
     let opts = RunOptions {
         stimulus: Stimulus::parse_for(stimulus, s).unwrap(),
         ..RunOptions::default()
@@ -62,7 +64,11 @@ fn lanes(s: &Schedule, sel: bool, mode: bool) -> (Vec<(Option<Role>, u32)>, Stri
         .map(|(i, (r, b))| match r {
             Some(r) => format!("D{i}={}[{b}]", r.name()),
             None if *b >= MODE => format!("D{i}=mode[{}]", b - MODE),
-            None if *b < SEL => format!("D{i}=link_tx"),
+            None if *b < analyser::AXIS_LANE => format!("D{i}=link_tx"),
+            None if *b < SEL => format!(
+                "D{i}={}",
+                analyser::AXIS_LANES[(b - analyser::AXIS_LANE) as usize]
+            ),
             None => format!("D{i}=mode_sel[{}]", b - SEL),
         })
         .collect::<Vec<_>>()
@@ -347,41 +353,61 @@ fn captures_of_random_mode_mixes_pass() {
 }
 
 /// A capture that begins after a switch (in a mode other than the reset
-/// mode) passes, its UART line too: the line's model runs in the modes the
-/// capture shows, not from the reset mode; the same capture with the line
-/// held idle for a while after the join fails on the line.
+/// mode) passes, its link too: the link's model runs in the modes the
+/// capture shows, not from the reset mode (a UART line, and the same mix
+/// with an AXI4-Stream link); the same capture with the UART line held idle
+/// for two slices after the join fails on the line.
 #[test]
-fn a_capture_beginning_in_another_mode_passes_its_line_too() {
-    let s = shared("modes-auto");
-    let f = s.grid.frame_cycles;
-    let p = pins(&s, 24, &[], "touch:T0@8-12");
-    let sw = switch_frames(&s, &p, 0);
-    assert!(sw.len() >= 2, "the touch switches and back: {sw:?}");
+fn a_capture_beginning_in_another_mode_passes_its_link_too() {
+    let uart = shared("modes-auto");
+    let text = std::fs::read_to_string(root().join("testkit/mixes/modes-auto.toml")).unwrap();
+    let text = text.replace(
+        "kind = \"uart\"\nbaud = 2_000_000",
+        "kind = \"axis\"\ntlast = \"slice\"\nready_within = 8",
+    );
     let d = tempfile::tempdir().unwrap();
-    let starts = [
-        sw[0] * f + f / 3,
-        sw[0] * f + 1_234,
-        (sw[0] + 1) * f + 777,
-        sw[1] * f - f / 2,
-    ];
-    for (k, from) in starts.into_iter().enumerate() {
-        let out = d.path().join(format!("c{k}.vcd"));
-        let r = judged(&s, &p, (from, 24 * f), 3_210, (false, true), &out).unwrap();
-        let said = r.summary();
-        assert!(r.ok, "from cycle {from}: {said}");
-        let j = r.link_join.as_ref().expect("the line joined");
-        assert_eq!(j.by, "model", "{said}");
-        assert!(said.contains("characters' start bits within"), "{said}");
+    let axis_file = d.path().join("modes-auto-axis.toml");
+    std::fs::write(&axis_file, text).unwrap();
+    let axis = schedule(&axis_file);
+    for s in [&uart, &axis] {
+        let f = s.grid.frame_cycles;
+        let p = pins(s, 24, &[], "touch:T0@8-12");
+        let sw = switch_frames(s, &p, 0);
+        assert!(sw.len() >= 2, "the touch switches and back: {sw:?}");
+        let starts = [
+            sw[0] * f + f / 3,
+            sw[0] * f + 1_234,
+            (sw[0] + 1) * f + 777,
+            sw[1] * f - f / 2,
+        ];
+        for (k, from) in starts.into_iter().enumerate() {
+            let out = d.path().join(format!("c{k}.vcd"));
+            let r = judged(s, &p, (from, 24 * f), 3_210, (false, true), &out).unwrap();
+            let said = r.summary();
+            assert!(
+                r.ok,
+                "{} from cycle {from}: {said}",
+                s.mix.link.as_ref().unwrap().kind.name()
+            );
+            let j = r.link_join.as_ref().expect("the link joined");
+            assert_eq!(j.by, "model", "{said}");
+            assert!(
+                said.contains("start bits within") || said.contains("held to the model"),
+                "{said}"
+            );
+        }
     }
-    // the line idle for two slices after the join: packets go missing
-    let from = sw[0] * f + f / 3;
+    // the UART line idle for two slices after the join: packets go missing
+    let (s, f) = (&uart, uart.grid.frame_cycles);
+    let p = pins(s, 24, &[], "touch:T0@8-12");
+    let from = switch_frames(s, &p, 0)[0] * f + f / 3;
     let mut bad = p.clone();
     let at = (from + f / 2) as usize;
     for q in &mut bad[at..at + 2 * s.grid.slice_cycles as usize] {
         q.0.link_tx = true;
     }
     let out = d.path().join("bad.vcd");
-    let r = judged(&s, &bad, (from, 24 * f), 3_210, (false, true), &out).unwrap();
+    let r = judged(s, &bad, (from, 24 * f), 3_210, (false, true), &out).unwrap();
     assert!(!r.ok, "{}", r.summary());
     assert!(
         r.violations.iter().any(|v| v.rule.contains("link")),

@@ -1147,7 +1147,7 @@ fn check_link_lane(
     let axis = cap.lanes.iter().any(|l| l.is_link()) && layout.axis;
     let modes = phase_modes(s, cap, ctx, cands);
     let lk = match line {
-        _ if axis => crate::timedaxis::check_axis(s, cap, &phases, model),
+        _ if axis => crate::timedaxis::check_axis(s, cap, (&phases, &modes), model),
         Some(li) if !layout.axis => {
             crate::timedlink::check_link(s, cap, li, &phases, &modes, model)
         }

@@ -78,7 +78,7 @@ type Beat = (u64, u8, bool);
 pub(crate) fn check_axis(
     s: &Schedule,
     cap: &Capture,
-    phases: &[LinkPhase],
+    (phases, modes): (&[LinkPhase], &[Vec<usize>]),
     model: bool,
 ) -> LinkCheck {
     let mut out = LinkCheck {
@@ -146,7 +146,7 @@ pub(crate) fn check_axis(
         (true, []) => out.not_proved.push(
             "m_axis_*: the beats' cycles against the model (no frame phase to hold them at)".into(),
         ),
-        (true, _) => hold(s, cap, &ports, &clocked, phases, &mut out),
+        (true, _) => hold(s, cap, (&ports, &clocked), (phases, modes), &mut out),
     }
     out
 }
@@ -156,9 +156,8 @@ pub(crate) fn check_axis(
 fn hold(
     s: &Schedule,
     cap: &Capture,
-    ports: &Ports,
-    clocked: &[(u64, u64)],
-    phases: &[LinkPhase],
+    (ports, clocked): (&Ports, &[(u64, u64)]),
+    (phases, modes): (&[LinkPhase], &[Vec<usize>]),
     out: &mut LinkCheck,
 ) {
     let lanes = BeatLanes {
@@ -169,8 +168,12 @@ fn hold(
     };
     let best = phases
         .iter()
+        .enumerate()
         .take(16)
-        .filter_map(|&ph| crate::axishold::run(s, cap, &lanes, clocked, ph))
+        .filter_map(|(k, &ph)| {
+            let seen = modes.get(k).map_or(&[][..], Vec::as_slice);
+            crate::axishold::run(s, cap, &lanes, clocked, (ph, seen))
+        })
         .min_by_key(|r| (r.wrong, std::cmp::Reverse(r.cycles)));
     let Some(r) = best else {
         out.not_proved.push(

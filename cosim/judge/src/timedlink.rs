@@ -488,7 +488,7 @@ impl MisoReader<'_> {
 /// The modes the model is held to, `(model frame, mode)` for its frames 2
 /// to `to`: model frame `k` is the phase's frame `k - shift` (`seen`'s
 /// first mode before it, its last after it).
-fn forced_modes(seen: &[usize], shift: i128, to: i128) -> Vec<(u64, usize)> {
+pub(crate) fn forced_modes(seen: &[usize], shift: i128, to: i128) -> Vec<(u64, usize)> {
     let Some(&first) = seen.first() else {
         return Vec::new();
     };
