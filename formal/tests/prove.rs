@@ -15,31 +15,17 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use formal::DeepFault;
 use formal::{Outcome, Proof, ProveOptions};
 
+use common::{assert_fails_exactly, edit, emitted, failed, rejected, root, schedule, TOOLS};
 use testkit::mutate;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
 use testkit::tools;
-
-const TOOLS: [&str; 4] = ["yosys", "yosys-abc", "iverilog", "vvp"];
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn schedule(rel: &str) -> lut_gen::Schedule {
-    let mix = lut_gen::load(&root().join(rel)).expect("mix loads");
-    lut_gen::synthesize(&mix).expect("mix is feasible")
-}
-
-fn emitted(s: &lut_gen::Schedule) -> String {
-    hdl::emit(s, None).expect("emits").verilog().to_string()
-}
 
 fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
     let mut o = ProveOptions::new(out);
@@ -59,12 +45,7 @@ fn assert_counterexample(s: &lut_gen::Schedule, p: &Proof) {
         "the replay names the failing property: {}",
         p.summary()
     );
-    let report = judge::check_vcd(s, &c.vcd, Some(formal::DUT_SCOPE)).expect("VCD reads");
-    assert!(
-        !report.ok,
-        "check accepts the counterexample:\n{}",
-        report.summary()
-    );
+    let report = rejected(s, c);
     if c.cycle >= 0 {
         assert_eq!(
             formal::first_rejected(&report),
@@ -283,17 +264,6 @@ fn bmc(s: &lut_gen::Schedule, design: &str, steps: u64) -> formal::SolverVerdict
     formal::bmc(&prep, steps, 300).expect("bmc3 runs")
 }
 
-/// `design` with `from` replaced by `to` exactly once (the test fails if
-/// the emitted link no longer has the line, rather than testing nothing).
-fn edit(design: &str, from: &str, to: &str) -> String {
-    assert_eq!(
-        design.matches(from).count(),
-        1,
-        "`{from}` in the emitted link"
-    );
-    design.replacen(from, to, 1)
-}
-
 #[test]
 fn axis_harness_models_the_slave_and_names_the_link_properties() {
     let s = schedule("mixes/eskin34-axis.toml");
@@ -473,12 +443,7 @@ fn assert_mutant_fails(s: &lut_gen::Schedule, design: &str, property: &str) {
         let p = prove(s, design, dir.path());
         eprintln!("{}", p.summary());
         assert_counterexample(s, &p);
-        let failed: Vec<&str> = p
-            .properties
-            .iter()
-            .filter(|q| q.result == Outcome::Failed)
-            .map(|q| q.name.as_str())
-            .collect();
+        let failed = failed(&p);
         assert!(
             failed.contains(&property),
             "fails {failed:?}, not {property}"
@@ -882,14 +847,9 @@ fn a_gateware_sending_the_wrong_channel_bits_fails_prove() {
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &bad, dir.path());
     eprintln!("{}", p.summary());
-    assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
+    assert_fails_exactly(&p, &["mosi[cmd]"]);
     let c = p.counterexample.as_ref().expect("a counterexample");
     assert!(c.reproduced, "{}", p.summary());
-    let failed: Vec<&str> = (p.properties.iter())
-        .filter(|q| q.result == Outcome::Failed)
-        .map(|q| q.name.as_str())
-        .collect();
-    assert_eq!(failed, ["mosi[cmd]"], "{}", p.summary());
 }
 
 /// A gateware that holds the AD7689's CNV high through the read (its
@@ -908,12 +868,7 @@ fn a_gateware_holding_the_ad7689s_cnv_through_the_read_fails_prove() {
     );
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &bad, dir.path());
-    assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
-    let failed: Vec<&str> = (p.properties.iter())
-        .filter(|q| q.result == Outcome::Failed)
-        .map(|q| q.name.as_str())
-        .collect();
-    assert_eq!(failed, ["conversion[cfg]"], "{}", p.summary());
+    assert_fails_exactly(&p, &["conversion[cfg]"]);
 }
 
 /// Random mixes of `campaign::random_mix` with converters that take a
@@ -979,9 +934,5 @@ fn a_fronted_mix_proves_and_a_wrong_front_select_fails_on_its_mux() {
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &bad, dir.path());
     assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
-    let failed: Vec<&str> = (p.properties.iter())
-        .filter(|q| q.result == Outcome::Failed)
-        .map(|q| q.name.as_str())
-        .collect();
-    assert!(failed.contains(&"mux[cfg]"), "{}", p.summary());
+    assert!(failed(&p).contains(&"mux[cfg]"), "{}", p.summary());
 }
