@@ -10,7 +10,8 @@ use std::time::Instant;
 
 use formal::{Outcome, Proof, ProveOptions};
 
-use common::{edit, emitted, failed, rejected, root, schedule, TOOLS};
+use common::TOOLS;
+use common::{assert_rejected_at_its_cycle, edit, emitted, failed, rejected, root, schedule};
 use testkit::tools;
 
 fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
@@ -43,13 +44,7 @@ fn assert_fails(s: &lut_gen::Schedule, p: &Proof, properties: &[&str]) {
         failed.iter().any(|f| properties.contains(f)),
         "fails {failed:?}, none of {properties:?}"
     );
-    let report = rejected(s, c);
-    assert_eq!(
-        formal::first_rejected(&report),
-        Some(c.cycle as u64),
-        "check fails at another cycle than prove:\n{}",
-        p.summary()
-    );
+    assert_rejected_at_its_cycle(&rejected(s, c), p, c);
 }
 
 /// The harness of a mix with modes: `mode_sel` a free input (pin select

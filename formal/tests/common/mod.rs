@@ -84,3 +84,13 @@ pub fn quick_proof_shape(muxless: u64) -> campaign::Shape {
         link: None,
     }
 }
+
+/// The judge's first rejected cycle in `report` is the counterexample's.
+pub fn assert_rejected_at_its_cycle(report: &judge::Verdict, p: &Proof, c: &Counterexample) {
+    assert_eq!(
+        formal::first_rejected(report),
+        Some(c.cycle as u64),
+        "check fails at another cycle than prove:\n{}",
+        p.summary()
+    );
+}
