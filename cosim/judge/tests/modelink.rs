@@ -122,22 +122,19 @@ fn packets_carry_the_modes_of_pin_and_auto_runs() {
     check_run(&s, 14, &[], k);
 }
 
-/// A random mix with 2 or 3 modes (pin select) over a UART; `None` when a
-/// mode would sample nothing.
-fn random_mode_mix(seed: u64) -> Option<String> {
-    let shape = PinShape {
-        header: "[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 250\n[link]\nkind = \"uart\"\nbaud = 2_000_000\n",
-        mux_devices: 1,
-        more_channels: 7,
-    };
-    random_pin_mode_mix(seed, &shape)
-}
+/// The random mixes: 2 or 3 modes (pin select) over a UART, 2 branches and
+/// 2 to 8 channels at harmonic rates per mode.
+const RANDOM_MODES: PinShape = PinShape {
+    header: "[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 250\n[link]\nkind = \"uart\"\nbaud = 2_000_000\n",
+    mux_devices: 1,
+    more_channels: 7,
+};
 
 #[test]
 fn random_mode_mixes_send_their_modes() {
     let mut ran = 0;
     for seed in 1..30u64 {
-        let Some(text) = random_mode_mix(seed) else {
+        let Some(text) = random_pin_mode_mix(seed, &RANDOM_MODES) else {
             continue;
         };
         let Ok(s) = std::panic::catch_unwind(|| schedule_of(&text, &format!("r{seed}"))) else {

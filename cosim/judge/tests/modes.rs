@@ -390,24 +390,20 @@ fn scenes_name_the_mixs_channels() {
     assert!(Stimulus::parse_for("sine:600", &s).is_ok());
 }
 
-/// A random mix with 2 or 3 modes (pin select), 2 branches and up to 10
-/// channels at harmonic rates per mode (0: not sampled); `None` when the
-/// draw leaves a mode sampling nothing.
-fn random_mode_mix(seed: u64) -> Option<String> {
-    let shape = PinShape {
-        header: "[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 500\n",
-        mux_devices: 2,
-        more_channels: 9,
-    };
-    random_pin_mode_mix(seed, &shape)
-}
+/// The random mixes: 2 or 3 modes (pin select), 2 branches and up to 10
+/// channels at harmonic rates per mode (0: not sampled).
+const RANDOM_MODES: PinShape = PinShape {
+    header: "[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 500\n",
+    mux_devices: 2,
+    more_channels: 9,
+};
 
 #[test]
 fn random_mode_mixes_follow_random_requests() {
     let dir = std::env::temp_dir();
     let mut ran = 0;
     for seed in 1..40u64 {
-        let Some(text) = random_mode_mix(seed) else {
+        let Some(text) = random_pin_mode_mix(seed, &RANDOM_MODES) else {
             continue;
         };
         let path = dir.join(format!(
