@@ -342,13 +342,8 @@ pub(crate) fn rewrite_lines(
 /// on `adc_mosi` first, and the ADC models then convert the wrong input.
 #[test]
 fn a_gateware_sending_the_wrong_channel_bits_fails_on_both_verilog_engines() {
-    if !tools::require_tools(&["verilator", "g++", "iverilog", "vvp"]) {
-        return;
-    }
     for name in ["cmd-mcp3208", "cmd-ad7689"] {
-        let s = schedule(name);
-        let bad = wrong_channel_bits(&engines::verilog(&s).unwrap());
-        fails_on_both_verilog_engines(name, &s, &bad, "differs in [\"mosi\"]");
+        fails_on_both_verilog_engines(name, wrong_channel_bits, "differs in [\"mosi\"]");
     }
 }
 
@@ -368,17 +363,18 @@ pub fn cnv_held_through_the_read(verilog: &str) -> String {
 /// from the model on its CNV pin, on both Verilog engines.
 #[test]
 fn a_gateware_holding_cnv_through_the_read_fails_on_both_verilog_engines() {
+    fails_on_both_verilog_engines("cmd-ad7689", cnv_held_through_the_read, "cs_n");
+}
+
+/// The gateware of mix `name` made faulty by `mutate` differs from the
+/// model in its first frame on Verilator (the difference naming `pin`) and
+/// on Icarus (skipped, loudly, without the tools).
+pub(crate) fn fails_on_both_verilog_engines(name: &str, mutate: fn(&str) -> String, pin: &str) {
     if !tools::require_tools(&["verilator", "g++", "iverilog", "vvp"]) {
         return;
     }
-    let s = schedule("cmd-ad7689");
-    let bad = cnv_held_through_the_read(&engines::verilog(&s).unwrap());
-    fails_on_both_verilog_engines("cmd-ad7689", &s, &bad, "cs_n");
-}
-
-/// The gateware `bad` of mix `name` differs from the model in its first
-/// frame on Verilator (the difference naming `pin`) and on Icarus.
-pub(crate) fn fails_on_both_verilog_engines(name: &str, s: &Schedule, bad: &str, pin: &str) {
+    let s = &schedule(name);
+    let bad = &mutate(&engines::verilog(s).unwrap());
     let (mut dut, _) = VerilatedDut::new(bad).unwrap();
     let (diff, _, _) = first_difference(s, &mut dut, 1);
     let d = diff.unwrap_or_else(|| panic!("{name}: Verilator ran the mutant clean"));
