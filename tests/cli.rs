@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use predicates::prelude::*;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-use crate::common_cli::{column, slotforge, tiny};
+use crate::common_cli::{column, refused, slotforge, tiny};
 use crate::{progress, tools};
 
 fn preset(name: &str) -> PathBuf {
@@ -18,6 +18,27 @@ fn write_mix(dir: &Path, text: &str) -> PathBuf {
     let p = dir.join("mix.toml");
     std::fs::write(&p, text).unwrap();
     p
+}
+
+/// `sim --quiet` of `frames` frames of `mix` on `backend` (and `extra`),
+/// every one of them into `vcd`; the run must pass.
+fn sim_to_vcd(mix: &Path, backend: &str, frames: &str, extra: &[&str], vcd: &Path) {
+    slotforge()
+        .args(["sim", "--quiet", "--backend", backend])
+        .args(["--frames", frames, "--to", frames])
+        .args(extra)
+        .arg("--vcd")
+        .arg(vcd)
+        .arg(mix)
+        .assert()
+        .success();
+}
+
+/// Field `field` of every object in the JSON array `list`, as text.
+fn strings<'a>(list: &'a serde_json::Value, field: &str) -> Vec<&'a str> {
+    (list.as_array().unwrap().iter())
+        .map(|x| x[field].as_str().unwrap())
+        .collect()
 }
 
 const SMALL: &str =
@@ -157,15 +178,10 @@ fn a_search_cut_short_by_search_limit_is_unknown_exit_3() {
     assert!(!out.exists(), "nothing written for an unknown mix");
     // the default bound finds its schedule; a bad limit is refused in words
     slotforge().arg("audit").arg(&missed).assert().code(0);
-    slotforge()
-        .arg("lut")
-        .arg(&missed)
-        .args(["--search-limit", "many", "-o"])
-        .arg(&out)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("--search-limit"))
-        .stderr(predicate::str::contains("whole number"));
+    refused(
+        &[&"lut", &missed, &"--search-limit", &"many", &"-o", &out],
+        &["--search-limit", "whole number"],
+    );
 }
 
 #[test]
@@ -175,30 +191,17 @@ fn bad_input_names_file_line_and_field_and_exits_2() {
         dir.path(),
         &SMALL.replace("rate_hz = 1_000", "rate_hz = 1_000\nrate = 5"),
     );
-    slotforge()
-        .arg("audit")
-        .arg(&p)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("mix.toml:15:"))
-        .stderr(predicate::str::contains("channel[0].rate"))
+    refused(&[&"audit", &p], &["mix.toml:15:", "channel[0].rate"])
         .stderr(predicate::str::contains("panicked").not());
     let p = write_mix(
         dir.path(),
         &SMALL.replace("branch = \"a\"\nrate_hz", "branch = \"nope\"\nrate_hz"),
     );
-    slotforge()
-        .arg("audit")
-        .arg(&p)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("unknown branch `nope`"));
-    slotforge()
-        .arg("audit")
-        .arg(dir.path().join("missing.toml"))
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("cannot read"));
+    refused(&[&"audit", &p], &["unknown branch `nope`"]);
+    refused(
+        &[&"audit", &dir.path().join("missing.toml")],
+        &["cannot read"],
+    );
 }
 
 /// Words of Rust's types and serde's phrasing, which a user of the mix
@@ -662,12 +665,7 @@ fn faults_on_the_reference_mix() {
             assert_eq!(c["detected_by"]["invariants"], c["injected"], "{c}");
         }
     }
-    let names: Vec<&str> = v["classes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c["name"].as_str().unwrap())
-        .collect();
+    let names = strings(&v["classes"], "name");
     assert!(names.contains(&"select-swap"), "{names:?}");
 }
 
@@ -931,12 +929,7 @@ fn faults_on_a_mode_mix_run_on_the_model_with_the_mode_classes() {
         .assert()
         .success();
     let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
-    let names: Vec<&str> = v["classes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|c| c["name"].as_str().unwrap())
-        .collect();
+    let names = strings(&v["classes"], "name");
     for class in ["mode-early", "mode-stuck", "mode-unasked"] {
         assert!(names.contains(&class), "{names:?}");
     }
@@ -953,22 +946,7 @@ fn a_commanded_mix_is_simulated_on_the_model_and_checked() {
     let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("testkit/mixes/cmd-pair.toml");
     let d = tempfile::tempdir().unwrap();
     let vcd = d.path().join("w.vcd");
-    slotforge()
-        .args([
-            "sim",
-            "--quiet",
-            "--backend",
-            "model",
-            "--frames",
-            "4",
-            "--to",
-            "4",
-            "--vcd",
-        ])
-        .arg(&vcd)
-        .arg(&mix)
-        .assert()
-        .success();
+    sim_to_vcd(&mix, "model", "4", &[], &vcd);
     let check = |wave: &Path, extra: &[&str]| {
         slotforge()
             .args(["check", "--json"])
@@ -1023,12 +1001,7 @@ fn a_commanded_mix_is_simulated_on_the_model_and_checked() {
     );
     let a = check(&flipped, &["--no-model"]).code(1);
     let v: serde_json::Value = serde_json::from_slice(&a.get_output().stdout).unwrap();
-    let rules: Vec<&str> = v["violations"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x["rule"].as_str().unwrap())
-        .collect();
+    let rules = strings(&v["violations"], "rule");
     assert!(rules.iter().any(|r| r.starts_with("command-")), "{rules:?}");
 }
 
@@ -1042,22 +1015,8 @@ fn a_vcd_with_mode_switches_passes_check_and_fails_with_a_request_removed() {
     let pin = root.join("testkit/mixes/modes-pin.toml");
     let d = tempfile::tempdir().unwrap();
     let vcd = d.path().join("w.vcd");
-    slotforge()
-        .args([
-            "sim",
-            "--quiet",
-            "--backend",
-            "verilator",
-            "--frames",
-            "12",
-            "--to",
-            "12",
-        ])
-        .args(["--modes", "2=slow,6=fast,7=slow,8=fast", "--vcd"])
-        .arg(&vcd)
-        .arg(&pin)
-        .assert()
-        .success();
+    let modes = ["--modes", "2=slow,6=fast,7=slow,8=fast"];
+    sim_to_vcd(&pin, "verilator", "12", &modes, &vcd);
     let check = |file: &Path, extra: &[&str]| {
         slotforge()
             .arg("check")

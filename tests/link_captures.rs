@@ -7,12 +7,13 @@
 //! time; a fault before it passes inside the time reported as not judged;
 //! a capture with no whole packet says the link was not judged.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use lut_gen::LinkKind;
 use lut_gen::Pins;
 use lut_gen::Schedule;
 use testkit::analyser;
+use testkit::analyser::{start_bit, two_bits_late};
 
 use crate::link_windows::{random_link_mixes, rng};
 
@@ -221,6 +222,61 @@ fn preset(name: &str) -> Schedule {
     lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap()
 }
 
+/// A 100 MHz capture of the preset `mixes/NAME` (2 frames of pins), from
+/// cycle `f / 3 + after` (first sample `phase` ps in) to the middle of the
+/// second frame, as `capture.vcd` in `dir`: the preset's file, its
+/// schedule, the capture and both reports.
+fn preset_capture(
+    name: &str,
+    after: u64,
+    phase: u64,
+    dir: &Path,
+) -> (PathBuf, Schedule, PathBuf, [judge::TimedReport; 2]) {
+    let mix = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("mixes")
+        .join(name);
+    let s = preset(name);
+    let f = s.grid.frame_cycles;
+    let wave = dir.join("capture.vcd");
+    let reports = judged(&s, &pins(&s, 2), (f / 3 + after, f + f / 2), phase, &wave);
+    (mix, s, wave, reports)
+}
+
+/// `check --json`'s `link_join`: judged by `by`, at the header and with
+/// the bytes skipped that the library's report `mj` says.
+fn join_in_json(j: &serde_json::Value, by: &str, mj: &judge::LineJoin) {
+    assert_eq!(j["by"], by, "{j}");
+    assert_eq!(j["judged"], true, "{j}");
+    assert_eq!(j["header_ps"], mj.header_ps.unwrap(), "{j}");
+    assert_eq!(j["skipped_bytes"], mj.skipped_bytes, "{j}");
+}
+
+/// A report that fails a link fault at `t` ps, within `within` ps of it,
+/// having joined the line before it (its first violation).
+fn fails_after_the_join(r: &judge::TimedReport, t: u64, within: u64) {
+    let text = r.summary();
+    assert!(!r.ok, "{text}");
+    let j = r.link_join.as_ref().unwrap();
+    assert!(j.header_ps.unwrap() < t, "joined before the fault: {text}");
+    let v = &r.violations[0];
+    assert!(v.rule.contains("link"), "{text}");
+    assert!(
+        (t..t + within).contains(&v.time_ps),
+        "fault at {t} ps: {text}"
+    );
+}
+
+/// A report that passes a fault at `t` ps before its join: the line joined
+/// after it, bytes skipped, and the time before said not judged.
+fn unseen_before_the_join(r: &judge::TimedReport, t: u64) {
+    let text = r.summary();
+    let j = r.link_join.as_ref().unwrap();
+    assert!(r.ok, "unseen before the join: {text}");
+    assert!(j.judged && j.unjudged_ps > t, "{text}");
+    assert!(j.skipped_bytes > 0, "{text}");
+    assert!(text.contains("the line before it was not judged"), "{text}");
+}
+
 /// The UART mixes of the random link mixes from seed 1.
 fn uart_mix() -> Schedule {
     random_link_mixes(1, 4)
@@ -242,12 +298,7 @@ fn a_fault_after_the_join_fails_the_capture_at_its_time() {
     let clean = pins(&s, 4);
     let (w, phase) = ((f / 2 + 1_234, f / 2 + 1_234 + 2 * f), 4_321);
     let at = w.0 + f;
-    let start = |p: &[Pins]| {
-        (at as usize..p.len())
-            .find(|&c| !p[c].link_tx && p[c - 1].link_tx)
-            .unwrap()
-    };
-    let st = start(&clean);
+    let st = start_bit(&clean, at);
     let t = at_ps(&s, st as u64, w.0, phase);
     // the packet's end at the latest: a slice and the link's latency on
     let plan = lut_gen::plan_link(&s).unwrap().unwrap();
@@ -260,26 +311,10 @@ fn a_fault_after_the_join_fails_the_capture_at_its_time() {
     let mut flipped = clean.clone();
     analyser::mutate(&s, &mut flipped, analyser::Mutation::LinkBitsFlipped, at);
     for r in judged(&s, &flipped, w, phase, &d.path().join("flip.vcd")) {
-        let text = r.summary();
-        assert!(!r.ok, "{text}");
-        let j = r.link_join.as_ref().unwrap();
-        assert!(j.header_ps.unwrap() < t, "joined before the fault: {text}");
-        let v = &r.violations[0];
-        assert!(v.rule.contains("link"), "{text}");
-        assert!(
-            (t..t + within).contains(&v.time_ps),
-            "fault at {t} ps: {text}"
-        );
+        fails_after_the_join(&r, t, within);
     }
     let div = plan.baud_divider as usize;
-    let mut late = clean.clone();
-    for c in st..late.len() {
-        late[c].link_tx = if c < st + 2 * div {
-            true
-        } else {
-            clean[c - 2 * div].link_tx
-        };
-    }
+    let late = two_bits_late(&clean, st, div);
     let [m, dec] = judged(&s, &late, w, phase, &d.path().join("late.vcd"));
     let text = m.summary();
     assert!(!m.ok, "{text}");
@@ -303,19 +338,9 @@ fn a_late_start_bit_fails_a_drifting_capture_at_its_time() {
     let f = s.grid.frame_cycles;
     let clean = pins(&s, 4);
     let (w, phase, ppm) = ((f / 2, f / 2 + 2 * f), 2_000, 100.0);
-    let at = w.0 + f;
-    let st = (at as usize..clean.len())
-        .find(|&c| !clean[c].link_tx && clean[c - 1].link_tx)
-        .unwrap();
+    let st = start_bit(&clean, w.0 + f);
     let div = lut_gen::plan_link(&s).unwrap().unwrap().baud_divider as usize;
-    let mut late = clean.clone();
-    for c in st..late.len() {
-        late[c].link_tx = if c < st + 2 * div {
-            true
-        } else {
-            clean[c - 2 * div].link_tx
-        };
-    }
+    let late = two_bits_late(&clean, st, div);
     let out = d.path().join("late.vcd");
     let [m, dec] = judged_drifting(&s, &late, w, phase, ppm, &out);
     let text = m.summary();
@@ -352,15 +377,11 @@ fn the_line_before_the_join_is_reported_as_not_judged() {
     analyser::mutate(&s, &mut bad, analyser::Mutation::LinkBitsFlipped, from);
     let t = at_ps(&s, from + 5, from, phase);
     for r in judged(&s, &bad, w, phase, &d.path().join("before.vcd")) {
-        let text = r.summary();
         let j = r.link_join.as_ref().unwrap();
         if j.header_ps.is_some_and(|h| h <= t) {
-            panic!("the capture's first character is a header: {text}");
+            panic!("the capture's first character is a header: {}", r.summary());
         }
-        assert!(r.ok, "unseen before the join: {text}");
-        assert!(j.judged && j.unjudged_ps > t, "{text}");
-        assert!(j.skipped_bytes > 0, "{text}");
-        assert!(text.contains("the line before it was not judged"), "{text}");
+        unseen_before_the_join(&r, t);
     }
     // a third of a slice: no whole packet
     let w = (from, from + s.grid.slice_cycles / 3);
@@ -379,13 +400,8 @@ fn the_line_before_the_join_is_reported_as_not_judged() {
 /// `link_join` in the JSON with what joined the line and what was skipped.
 #[test]
 fn check_map_reports_where_it_joined_the_line() {
-    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("mixes/eskin34-uart.toml");
-    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
-    let f = s.grid.frame_cycles;
-    let p = pins(&s, 2);
     let d = tempfile::tempdir().unwrap();
-    let wave = d.path().join("capture.vcd");
-    let [m, _] = judged(&s, &p, (f / 3 + 999, f + f / 2), 1_234, &wave);
+    let (mix, s, wave, [m, _]) = preset_capture("eskin34-uart.toml", 999, 1_234, d.path());
     let (_, map) = analyser::lanes(&s);
     for (flags, by) in [(vec![], "model"), (vec!["--no-model"], "decoder")] {
         let run = |json: bool| {
@@ -406,12 +422,9 @@ fn check_map_reports_where_it_joined_the_line() {
         let out = run(true);
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         let j = &v["link_join"];
-        assert_eq!(j["by"], by, "{j}");
-        assert_eq!(j["judged"], true, "{j}");
         let mj = m.link_join.as_ref().unwrap();
-        assert_eq!(j["header_ps"], mj.header_ps.unwrap(), "{j}");
+        join_in_json(j, by, mj);
         assert_eq!(j["unjudged_ps"], mj.unjudged_ps, "{j}");
-        assert_eq!(j["skipped_bytes"], mj.skipped_bytes, "{j}");
         assert_eq!(j["frame_counter"], mj.frame_counter.unwrap(), "{j}");
         assert!(text.contains(j["text"].as_str().unwrap()), "{j}");
     }
@@ -462,20 +475,10 @@ fn an_axis_fault_after_the_join_fails_the_capture_at_its_time() {
         flipped[c].axis_tdata ^= 4;
         let t = at_ps(&s, c as u64, w.0, phase);
         for r in judged(&s, &flipped, w, phase, &d.path().join("flip.vcd")) {
+            fails_after_the_join(&r, t, within);
             let text = r.summary();
-            assert!(!r.ok, "{text}");
-            let j = r.link_join.as_ref().unwrap();
-            assert!(
-                j.judged && j.header_ps.unwrap() < t,
-                "joined before: {text}"
-            );
-            let v = &r.violations[0];
-            assert!(v.rule.contains("link"), "{text}");
-            assert!(
-                (t..t + within).contains(&v.time_ps),
-                "fault at {t} ps: {text}"
-            );
-            assert!(v.detail.contains(what), "{what}: {text}");
+            assert!(r.link_join.as_ref().unwrap().judged, "{text}");
+            assert!(r.violations[0].detail.contains(what), "{what}: {text}");
         }
     }
     // a packet's last beat without tlast
@@ -550,12 +553,7 @@ fn axis_beats_before_the_join_are_reported_as_not_judged() {
     bad[from as usize + 3].axis_tdata ^= 0x10;
     let t = at_ps(&s, from + 3, from, phase);
     for r in judged(&s, &bad, w, phase, &d.path().join("before.vcd")) {
-        let text = r.summary();
-        let j = r.link_join.as_ref().unwrap();
-        assert!(r.ok, "unseen before the join: {text}");
-        assert!(j.judged && j.unjudged_ps > t, "{text}");
-        assert!(j.skipped_bytes > 0, "{text}");
-        assert!(text.contains("the line before it was not judged"), "{text}");
+        unseen_before_the_join(&r, t);
     }
 }
 
@@ -563,13 +561,8 @@ fn axis_beats_before_the_join_are_reported_as_not_judged() {
 /// `m_axis_*` ports and `link_overflow`; exit 0, `link_join` in the JSON.
 #[test]
 fn check_map_reads_an_axis_links_beats() {
-    let mix = Path::new(env!("CARGO_MANIFEST_DIR")).join("mixes/eskin34-axis.toml");
-    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
-    let f = s.grid.frame_cycles;
-    let p = pins(&s, 2);
     let d = tempfile::tempdir().unwrap();
-    let wave = d.path().join("capture.vcd");
-    let reports = judged(&s, &p, (f / 3 + 555, f + f / 2), 4_321, &wave);
+    let (mix, s, wave, reports) = preset_capture("eskin34-axis.toml", 555, 4_321, d.path());
     let (_, map) = analyser::lanes(&s);
     assert!(map.contains("m_axis_tdata[7]") && map.contains("link_overflow"));
     for (flags, m) in [(vec![], &reports[0]), (vec!["--no-model"], &reports[1])] {
@@ -580,12 +573,8 @@ fn check_map_reads_an_axis_links_beats() {
         let out = cmd.arg(&mix).arg(&wave).output().unwrap();
         let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(out.status.code(), Some(0), "{flags:?}: {v}");
-        let j = &v["link_join"];
-        assert_eq!(j["judged"], true, "{j}");
         let mj = m.link_join.as_ref().unwrap();
-        assert_eq!(j["by"], mj.by, "{j}");
-        assert_eq!(j["header_ps"], mj.header_ps.unwrap(), "{j}");
-        assert_eq!(j["skipped_bytes"], mj.skipped_bytes, "{j}");
+        join_in_json(&v["link_join"], mj.by, mj);
     }
     // link_tx is not a port of an AXI4-Stream mix: the message says which are
     let e = judge::parse_map("D0=link_tx", &s).unwrap_err();

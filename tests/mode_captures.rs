@@ -317,7 +317,7 @@ fn captures_of_random_mode_mixes_pass() {
         if done == 6 {
             break;
         }
-        let Some(text) = campaign::random_mode_mix(seed) else {
+        let Some(text) = testkit::modemix::random_mode_mix(seed) else {
             continue;
         };
         let path = d.path().join(format!("m{seed}.toml"));

@@ -21,7 +21,7 @@ fn shared(name: &str) -> PathBuf {
 /// schedules and fits the pin contract, written into `dir`.
 fn random_mode_mix(dir: &Path, seed: u64, select: lut_gen::ModeSelect) -> PathBuf {
     let (k, text) = (seed..seed + 100)
-        .filter_map(|k| Some((k, campaign::random_mode_mix(k)?)))
+        .filter_map(|k| Some((k, testkit::modemix::random_mode_mix(k)?)))
         .find(|(_, t)| {
             lut_gen::parse(Path::new("r.toml"), t)
                 .ok()

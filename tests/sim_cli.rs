@@ -3,6 +3,7 @@
 //! its corrupted copies fail with the divergence named, and bad input of any
 //! kind exits 2 with a message and no panic.
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 
 use predicates::prelude::*;
@@ -12,7 +13,7 @@ fn eskin34() -> PathBuf {
 }
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
-use crate::common_cli::{root, sim_window, slotforge, tiny};
+use crate::common_cli::{refused, root, sim_window, slotforge, tiny};
 use crate::{progress, tools};
 
 /// Runs `sim --json` and checks its documented fields; returns the report.
@@ -305,34 +306,15 @@ fn check_truncated_and_missing_files_exit_2() {
     }
     let p = d.path().join("truncated.vcd");
     std::fs::write(&p, &text[..cut]).unwrap();
-    slotforge()
-        .arg("check")
-        .arg(tiny())
-        .arg(&p)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("truncated VCD"))
-        .stderr(predicate::str::contains("truncated.vcd"))
-        .stderr(predicate::str::contains("panicked").not());
+    let check_refused = |wave: &Path, says: &[&str]| {
+        refused(&[&"check", &tiny(), &wave], says)
+            .stderr(predicate::str::contains("panicked").not());
+    };
+    check_refused(&p, &["truncated VCD", "truncated.vcd"]);
     // cut inside the header
     std::fs::write(&p, &text[..200]).unwrap();
-    slotforge()
-        .arg("check")
-        .arg(tiny())
-        .arg(&p)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("truncated VCD"))
-        .stderr(predicate::str::contains("panicked").not());
-    let missing = d.path().join("missing.vcd");
-    slotforge()
-        .arg("check")
-        .arg(tiny())
-        .arg(&missing)
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("missing.vcd"))
-        .stderr(predicate::str::contains("panicked").not());
+    check_refused(&p, &["truncated VCD"]);
+    check_refused(&d.path().join("missing.vcd"), &["missing.vcd"]);
     // a VCD of another mix: ports that do not fit
     slotforge()
         .arg("check")
@@ -365,51 +347,25 @@ fn bad_input_exits_2() {
             .stderr(predicate::str::contains("rat"))
             .stderr(predicate::str::contains("panicked").not());
     }
-    slotforge()
-        .arg("sim")
-        .arg(d.path().join("nope.toml"))
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("nope.toml"));
-    slotforge()
-        .arg("sim")
-        .arg(tiny())
-        .args(["--backend", "ghdl"])
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("unknown back end `ghdl`"))
-        .stderr(predicate::str::contains("icarus"));
-    slotforge()
-        .arg("sim")
-        .arg(tiny())
-        .args(["--stimulus", "noise"])
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("unknown stimulus"));
-    slotforge()
-        .arg("sim")
-        .arg(tiny())
-        .args(["--frames", "0"])
-        .assert()
-        .code(2)
-        .stderr(predicate::str::contains("--frames"));
-    slotforge()
-        .arg("sim")
-        .arg(tiny())
-        .args(["--vcd", "x.vcd", "--from", "2", "--to", "1"])
-        .assert()
-        .code(2);
+    refused(&[&"sim", &d.path().join("nope.toml")], &["nope.toml"]);
+    let tiny = tiny();
+    let sim_refused = |args: &[&str], says: &[&str]| {
+        let mut all: Vec<&dyn AsRef<OsStr>> = vec![&"sim", &tiny];
+        all.extend(args.iter().map(|a| a as &dyn AsRef<OsStr>));
+        refused(&all, says);
+    };
+    sim_refused(
+        &["--backend", "ghdl"],
+        &["unknown back end `ghdl`", "icarus"],
+    );
+    sim_refused(&["--stimulus", "noise"], &["unknown stimulus"]);
+    sim_refused(&["--frames", "0"], &["--frames"]);
+    sim_refused(&["--vcd", "x.vcd", "--from", "2", "--to", "1"], &[]);
     // a window beyond the run is refused before it runs
-    slotforge()
-        .arg("sim")
-        .arg(tiny())
-        .args(["--frames", "1", "--vcd", "x.vcd", "--to", "3"])
-        .assert()
-        .code(2)
-        .stderr(
-            predicate::str::contains("is beyond the run")
-                .and(predicate::str::contains("--frames 3")),
-        );
+    sim_refused(
+        &["--frames", "1", "--vcd", "x.vcd", "--to", "3"],
+        &["is beyond the run", "--frames 3"],
+    );
 }
 
 /// A file the user named that is not there is told in words ("no such

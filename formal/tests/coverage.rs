@@ -10,9 +10,7 @@ use std::path::{Path, PathBuf};
 use formal::{contract, not_covered, Clause};
 use lut_gen::Layout;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+use common::root;
 
 /// `text` with `link` appended as its `[link]` table; `None` when the mix
 /// has no schedule (an overloaded random draw, a link too slow for it).

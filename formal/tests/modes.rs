@@ -3,27 +3,16 @@
 //! free in every cycle) or evaluates the triggers on the words it recorded
 //! (auto select: MISO free), each mode's own table from `Schedule::modes`.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::time::Instant;
 
 use formal::{Outcome, Proof, ProveOptions};
 
+use common::TOOLS;
+use common::{assert_rejected_at_its_cycle, edit, emitted, failed, rejected, root, schedule};
 use testkit::tools;
-
-const TOOLS: [&str; 4] = ["yosys", "yosys-abc", "iverilog", "vvp"];
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn schedule(rel: &str) -> lut_gen::Schedule {
-    let mix = lut_gen::load(&root().join(rel)).expect("mix loads");
-    lut_gen::synthesize(&mix).expect("mix is feasible")
-}
-
-fn emitted(s: &lut_gen::Schedule) -> String {
-    hdl::emit(s, None).expect("emits").verilog().to_string()
-}
 
 fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
     prove_to(s, design, out, None)
@@ -44,42 +33,18 @@ fn prove_to(s: &lut_gen::Schedule, design: &str, out: &Path, depth: Option<u64>)
     p
 }
 
-/// `design` with `from` replaced by `to` (exactly once).
-fn edit(design: &str, from: &str, to: &str) -> String {
-    assert_eq!(
-        design.matches(from).count(),
-        1,
-        "`{from}` once in the design"
-    );
-    design.replace(from, to)
-}
-
 /// A failed proof whose counterexample the judge rejects at the cycle
 /// `prove` names, with one of `properties` among the failing ones.
 fn assert_fails(s: &lut_gen::Schedule, p: &Proof, properties: &[&str]) {
     assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
     let c = p.counterexample.as_ref().expect("a counterexample");
     assert!(c.reproduced, "the replay reproduces it: {}", p.summary());
-    let failed: Vec<&str> = (p.properties.iter())
-        .filter(|q| q.result == Outcome::Failed)
-        .map(|q| q.name.as_str())
-        .collect();
+    let failed = failed(p);
     assert!(
         failed.iter().any(|f| properties.contains(f)),
         "fails {failed:?}, none of {properties:?}"
     );
-    let report = judge::check_vcd(s, &c.vcd, Some(formal::DUT_SCOPE)).expect("VCD reads");
-    assert!(
-        !report.ok,
-        "check accepts the counterexample:\n{}",
-        report.summary()
-    );
-    assert_eq!(
-        formal::first_rejected(&report),
-        Some(c.cycle as u64),
-        "check fails at another cycle than prove:\n{}",
-        p.summary()
-    );
+    assert_rejected_at_its_cycle(&rejected(s, c), p, c);
 }
 
 /// The harness of a mix with modes: `mode_sel` a free input (pin select
@@ -169,14 +134,9 @@ fn a_gateware_that_switches_a_frame_early_fails_prove() {
 /// schedule.
 fn random_pin_mix(seed: u64, n: usize) -> Option<lut_gen::Schedule> {
     use std::fmt::Write;
-    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = move |n: u64| {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x % n
-    };
-    const RATES: [u64; 4] = [0, 1_000, 2_000, 4_000];
+    use testkit::modemix::{Draw, RATES};
+    let mut d = Draw::new(seed);
+    let mut next = move |n: u64| d.below(n);
     let nb = 1 + next(3) as usize;
     let mut t = format!(
         "name = \"random-pin{n}-{seed}\"\n[clock]\nhz = 4_000_000\n[frame]\nperiod_us = 1_000\n\

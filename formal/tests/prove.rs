@@ -15,37 +15,33 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use formal::DeepFault;
 use formal::{Outcome, Proof, ProveOptions};
 
+use common::{assert_fails_exactly, assert_rejected_at_its_cycle, edit, emitted, failed};
+use common::{rejected, root, schedule, TOOLS};
 use testkit::mutate;
 
 // Missing tools fail under CI=true, skip loudly elsewhere.
 use testkit::tools;
-
-const TOOLS: [&str; 4] = ["yosys", "yosys-abc", "iverilog", "vvp"];
-
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn schedule(rel: &str) -> lut_gen::Schedule {
-    let mix = lut_gen::load(&root().join(rel)).expect("mix loads");
-    lut_gen::synthesize(&mix).expect("mix is feasible")
-}
-
-fn emitted(s: &lut_gen::Schedule) -> String {
-    hdl::emit(s, None).expect("emits").verilog().to_string()
-}
 
 fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
     let mut o = ProveOptions::new(out);
     o.timeout_s = 1200;
     o.bmc_timeout_s = 1200;
     formal::prove(s, design, &o).expect("prove runs")
+}
+
+/// `prove` of the design emitted for the mix at `rel` with `from` edited
+/// to `to`, in a fresh folder (kept while the proof is read).
+fn prove_edited(rel: &str, from: &str, to: &str) -> (Proof, tempfile::TempDir) {
+    let s = schedule(rel);
+    let bad = edit(&emitted(&s), from, to);
+    let dir = tempfile::tempdir().unwrap();
+    (prove(&s, &bad, dir.path()), dir)
 }
 
 /// The checker must reject the counterexample's VCD, at the cycle prove names.
@@ -59,19 +55,9 @@ fn assert_counterexample(s: &lut_gen::Schedule, p: &Proof) {
         "the replay names the failing property: {}",
         p.summary()
     );
-    let report = judge::check_vcd(s, &c.vcd, Some(formal::DUT_SCOPE)).expect("VCD reads");
-    assert!(
-        !report.ok,
-        "check accepts the counterexample:\n{}",
-        report.summary()
-    );
+    let report = rejected(s, c);
     if c.cycle >= 0 {
-        assert_eq!(
-            formal::first_rejected(&report),
-            Some(c.cycle as u64),
-            "check fails at another cycle than prove:\n{}",
-            p.summary()
-        );
+        assert_rejected_at_its_cycle(&report, p, c);
     }
 }
 
@@ -283,17 +269,6 @@ fn bmc(s: &lut_gen::Schedule, design: &str, steps: u64) -> formal::SolverVerdict
     formal::bmc(&prep, steps, 300).expect("bmc3 runs")
 }
 
-/// `design` with `from` replaced by `to` exactly once (the test fails if
-/// the emitted link no longer has the line, rather than testing nothing).
-fn edit(design: &str, from: &str, to: &str) -> String {
-    assert_eq!(
-        design.matches(from).count(),
-        1,
-        "`{from}` in the emitted link"
-    );
-    design.replacen(from, to, 1)
-}
-
 #[test]
 fn axis_harness_models_the_slave_and_names_the_link_properties() {
     let s = schedule("mixes/eskin34-axis.toml");
@@ -473,12 +448,7 @@ fn assert_mutant_fails(s: &lut_gen::Schedule, design: &str, property: &str) {
         let p = prove(s, design, dir.path());
         eprintln!("{}", p.summary());
         assert_counterexample(s, &p);
-        let failed: Vec<&str> = p
-            .properties
-            .iter()
-            .filter(|q| q.result == Outcome::Failed)
-            .map(|q| q.name.as_str())
-            .collect();
+        let failed = failed(&p);
         assert!(
             failed.contains(&property),
             "fails {failed:?}, not {property}"
@@ -873,23 +843,15 @@ fn a_gateware_sending_the_wrong_channel_bits_fails_prove() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
-    let s = schedule("testkit/mixes/cmd-mcp3208.toml");
-    let bad = edit(
-        &emitted(&s),
+    let (p, _dir) = prove_edited(
+        "testkit/mixes/cmd-mcp3208.toml",
         "word = {sel[0], sel[1], sel[2], 1'b1, 1'b1};",
         "word = {sel[1], sel[1], sel[2], 1'b1, 1'b1};",
     );
-    let dir = tempfile::tempdir().unwrap();
-    let p = prove(&s, &bad, dir.path());
     eprintln!("{}", p.summary());
-    assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
+    assert_fails_exactly(&p, &["mosi[cmd]"]);
     let c = p.counterexample.as_ref().expect("a counterexample");
     assert!(c.reproduced, "{}", p.summary());
-    let failed: Vec<&str> = (p.properties.iter())
-        .filter(|q| q.result == Outcome::Failed)
-        .map(|q| q.name.as_str())
-        .collect();
-    assert_eq!(failed, ["mosi[cmd]"], "{}", p.summary());
 }
 
 /// A gateware that holds the AD7689's CNV high through the read (its
@@ -900,20 +862,12 @@ fn a_gateware_holding_the_ad7689s_cnv_through_the_read_fails_prove() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
-    let s = schedule("testkit/mixes/cmd-ad7689.toml");
-    let bad = edit(
-        &emitted(&s),
+    let (p, _dir) = prove_edited(
+        "testkit/mixes/cmd-ad7689.toml",
         "branch0_seq_cs_n = cnv_pulse0_pin_n;",
         "branch0_seq_cs_n = spi_seq0_cs_n;",
     );
-    let dir = tempfile::tempdir().unwrap();
-    let p = prove(&s, &bad, dir.path());
-    assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
-    let failed: Vec<&str> = (p.properties.iter())
-        .filter(|q| q.result == Outcome::Failed)
-        .map(|q| q.name.as_str())
-        .collect();
-    assert_eq!(failed, ["conversion[cfg]"], "{}", p.summary());
+    assert_fails_exactly(&p, &["conversion[cfg]"]);
 }
 
 /// Random mixes of `campaign::random_mix` with converters that take a
@@ -979,9 +933,5 @@ fn a_fronted_mix_proves_and_a_wrong_front_select_fails_on_its_mux() {
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &bad, dir.path());
     assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
-    let failed: Vec<&str> = (p.properties.iter())
-        .filter(|q| q.result == Outcome::Failed)
-        .map(|q| q.name.as_str())
-        .collect();
-    assert!(failed.contains(&"mux[cfg]"), "{}", p.summary());
+    assert!(failed(&p).contains(&"mux[cfg]"), "{}", p.summary());
 }

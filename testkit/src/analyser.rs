@@ -312,6 +312,29 @@ impl Mutation {
     ];
 }
 
+/// The first start bit on the UART line (`link_tx` falling) at or after
+/// cycle `at`.
+pub fn start_bit(pins: &[Pins], at: u64) -> usize {
+    (at as usize..pins.len())
+        .find(|&c| !pins[c].link_tx && pins[c - 1].link_tx)
+        .unwrap()
+}
+
+/// `pins` with the UART line two bit times (`div` cycles each) late from
+/// the start bit at `st` on, idle (high) in between: every byte intact,
+/// only the timing wrong.
+pub fn two_bits_late(pins: &[Pins], st: usize, div: usize) -> Vec<Pins> {
+    let mut late = pins.to_vec();
+    for c in st..late.len() {
+        late[c].link_tx = if c < st + 2 * div {
+            true
+        } else {
+            pins[c - 2 * div].link_tx
+        };
+    }
+    late
+}
+
 pub fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {
     let at = at as usize;
     let fall = (at..pins.len())
@@ -321,9 +344,7 @@ pub fn mutate(s: &Schedule, pins: &mut [Pins], m: Mutation, at: u64) {
     if let Mutation::LinkBitsFlipped = m {
         let div = lut_gen::plan_link(s).unwrap().unwrap().baud_divider as usize;
         // A start bit at or after `at`, then its bits 2-4 inverted.
-        let st = (at..pins.len())
-            .find(|&c| !pins[c].link_tx && pins[c - 1].link_tx)
-            .unwrap();
+        let st = start_bit(pins, at as u64);
         for p in &mut pins[st + 2 * div..st + 5 * div] {
             p.link_tx = !p.link_tx;
         }

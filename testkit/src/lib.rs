@@ -9,10 +9,12 @@
 //!   (`tests/tb/adc_tb.v`) on its log;
 //! - [`mutate`]: the Verilog mutator (mutation testing of the checkers);
 //! - [`analyser`]: logic-analyser captures made from a run's pins;
-//! - [`bulk`]: mixes rewritten with bulk channels (`T{0..47}`) and back.
+//! - [`bulk`]: mixes rewritten with bulk channels (`T{0..47}`) and back;
+//! - [`modemix`]: random mixes with modes, from one seeded xorshift.
 
 pub mod analyser;
 pub mod bulk;
+pub mod modemix;
 pub mod mutate;
 pub mod presets;
 pub mod tb_judge;

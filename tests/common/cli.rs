@@ -1,9 +1,12 @@
 //! What the root crate's CLI tests share: the binary, the repository, the
-//! small two-branch mix, and a `sim --vcd` window of it.
+//! small two-branch mix, a `sim --vcd` window of it, and a refusal.
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 
+use assert_cmd::assert::Assert;
 use assert_cmd::Command;
+use predicates::prelude::*;
 
 /// The `slotforge` binary under test.
 pub fn slotforge() -> Command {
@@ -13,6 +16,19 @@ pub fn slotforge() -> Command {
 /// The repository's root.
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `slotforge ARGS` is refused: exit 2, each of `says` on stderr (the
+/// `Assert` for what else a test holds it to).
+pub fn refused(args: &[&dyn AsRef<OsStr>], says: &[&str]) -> Assert {
+    let mut a = slotforge()
+        .args(args.iter().map(|a| a.as_ref()))
+        .assert()
+        .code(2);
+    for s in says {
+        a = a.stderr(predicate::str::contains(*s));
+    }
+    a
 }
 
 /// A two-branch mix with a 4000-cycle frame (fast in every simulator).

@@ -9,14 +9,13 @@
 //! - `sigrok`: sigrok-cli's SPI decode of the pins as a detector;
 //! - `equiv`: a faulty gateware proved equivalent to the clean one at the
 //!   ports (yosys miter, ABC), or not;
-//! - `mixgen`: random feasible mixes for false-alarm runs and charts;
-//!   `modemix`: random mixes with modes, for tests.
+//! - `mixgen`: random feasible mixes for false-alarm runs and charts
+//!   (random mixes with modes, only tests draw: `testkit::modemix`).
 
 // The modules are private: what other crates use is the list below.
 mod equiv;
 mod faults;
 mod mixgen;
-mod modemix;
 mod sigrok;
 
 pub use equiv::{check as check_equivalence, verdict as equivalence_verdict, Equivalence};
@@ -26,4 +25,3 @@ pub use faults::{
     FaultClass, Level, MethodRun, OnRun, Plan, ProveVerdict, Target, VerilogFault, TREADY,
 };
 pub use mixgen::{random_mix, LinkShape, Shape};
-pub use modemix::random_mode_mix;

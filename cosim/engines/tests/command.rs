@@ -311,39 +311,39 @@ pub(crate) fn icarus_beside(
 /// channel bit 1: a gateware that sends the wrong channel bits (the mutant
 /// the issue names).
 pub fn wrong_channel_bits(verilog: &str) -> String {
+    let (out, n) = rewrite_lines(verilog, |l| {
+        (l.trim_start().starts_with("wire [") && l.contains(" word = {"))
+            .then(|| l.replacen("sel[0]", "sel[1]", 1))
+    });
+    assert!(n > 0, "no command word in the design");
+    out
+}
+
+/// `verilog` with every line `edit` rewrites rewritten (each line ended by
+/// a newline), and how many it rewrote.
+pub(crate) fn rewrite_lines(
+    verilog: &str,
+    mut edit: impl FnMut(&str) -> Option<String>,
+) -> (String, usize) {
     let mut n = 0;
-    let out: Vec<String> = verilog
-        .lines()
-        .map(|l| {
-            if l.trim_start().starts_with("wire [") && l.contains(" word = {") {
+    let out: Vec<String> = (verilog.lines())
+        .map(|l| match edit(l) {
+            Some(new) => {
                 n += 1;
-                l.replacen("sel[0]", "sel[1]", 1)
-            } else {
-                l.to_string()
+                new
             }
+            None => l.to_string(),
         })
         .collect();
-    assert!(n > 0, "no command word in the design");
-    out.join("\n") + "\n"
+    (out.join("\n") + "\n", n)
 }
 
 /// The wrong-channel mutant differs from the model on both Verilog engines:
 /// on `adc_mosi` first, and the ADC models then convert the wrong input.
 #[test]
 fn a_gateware_sending_the_wrong_channel_bits_fails_on_both_verilog_engines() {
-    if !tools::require_tools(&["verilator", "g++", "iverilog", "vvp"]) {
-        return;
-    }
     for name in ["cmd-mcp3208", "cmd-ad7689"] {
-        let s = schedule(name);
-        let bad = wrong_channel_bits(&engines::verilog(&s).unwrap());
-        let (mut dut, _) = VerilatedDut::new(&bad).unwrap();
-        let (diff, _, _) = first_difference(&s, &mut dut, 1);
-        let d = diff.unwrap_or_else(|| panic!("{name}: Verilator ran the mutant clean"));
-        assert!(d.contains("differs in [\"mosi\"]"), "{name}: {d}");
-        let mut beside = BesideModel::new(&s);
-        icarus_beside(&s, Some(&bad), Stimulus::Pattern, 1, &mut beside);
-        assert!(beside.diff.is_some(), "{name}: Icarus ran the mutant clean");
+        fails_on_both_verilog_engines(name, wrong_channel_bits, "differs in [\"mosi\"]");
     }
 }
 
@@ -351,36 +351,35 @@ fn a_gateware_sending_the_wrong_channel_bits_fails_on_both_verilog_engines() {
 /// branches take the sequencer's pin instead of the CNV pulse): the part
 /// would leave SDO high-impedance and ignore DIN.
 pub fn cnv_held_through_the_read(verilog: &str) -> String {
-    let mut n = 0;
-    let out: Vec<String> = verilog
-        .lines()
-        .map(|l| match l.find("_seq_cs_n = cnv_pulse") {
-            Some(_) => {
-                n += 1;
-                let seq = l.split("_seq_cs_n").next().unwrap();
-                format!("{seq}_seq_cs_n = spi_seq0_cs_n;")
-            }
-            None => l.to_string(),
-        })
-        .collect();
+    let (out, n) = rewrite_lines(verilog, |l| {
+        let seq = l.split("_seq_cs_n").next().unwrap();
+        (l.contains("_seq_cs_n = cnv_pulse")).then(|| format!("{seq}_seq_cs_n = spi_seq0_cs_n;"))
+    });
     assert!(n > 0, "no CNV pulse in the design");
-    out.join("\n") + "\n"
+    out
 }
 
 /// A gateware that holds the ad7689's CNV high through the read differs
 /// from the model on its CNV pin, on both Verilog engines.
 #[test]
 fn a_gateware_holding_cnv_through_the_read_fails_on_both_verilog_engines() {
+    fails_on_both_verilog_engines("cmd-ad7689", cnv_held_through_the_read, "cs_n");
+}
+
+/// The gateware of mix `name` made faulty by `mutate` differs from the
+/// model in its first frame on Verilator (the difference naming `pin`) and
+/// on Icarus (skipped, loudly, without the tools).
+pub(crate) fn fails_on_both_verilog_engines(name: &str, mutate: fn(&str) -> String, pin: &str) {
     if !tools::require_tools(&["verilator", "g++", "iverilog", "vvp"]) {
         return;
     }
-    let s = schedule("cmd-ad7689");
-    let bad = cnv_held_through_the_read(&engines::verilog(&s).unwrap());
-    let (mut dut, _) = VerilatedDut::new(&bad).unwrap();
-    let (diff, _, _) = first_difference(&s, &mut dut, 1);
-    let d = diff.expect("Verilator ran the mutant clean");
-    assert!(d.contains("cs_n"), "{d}");
-    let mut beside = BesideModel::new(&s);
-    icarus_beside(&s, Some(&bad), Stimulus::Pattern, 1, &mut beside);
-    assert!(beside.diff.is_some(), "Icarus ran the mutant clean");
+    let s = &schedule(name);
+    let bad = &mutate(&engines::verilog(s).unwrap());
+    let (mut dut, _) = VerilatedDut::new(bad).unwrap();
+    let (diff, _, _) = first_difference(s, &mut dut, 1);
+    let d = diff.unwrap_or_else(|| panic!("{name}: Verilator ran the mutant clean"));
+    assert!(d.contains(pin), "{name}: {d}");
+    let mut beside = BesideModel::new(s);
+    icarus_beside(s, Some(bad), Stimulus::Pattern, 1, &mut beside);
+    assert!(beside.diff.is_some(), "{name}: Icarus ran the mutant clean");
 }

@@ -9,7 +9,9 @@ use engines::{RustHdlDut, VerilatedDut};
 use judge::Stimulus;
 use lut_gen::Schedule;
 
-use crate::command::{assert_same, first_difference, icarus_beside, schedule, BesideModel};
+use crate::command::{
+    assert_same, fails_on_both_verilog_engines, icarus_beside, rewrite_lines, schedule, BesideModel,
+};
 use crate::tools;
 
 /// A small deterministic generator.
@@ -109,40 +111,21 @@ fn verilator_and_icarus_drive_fronted_branches_as_the_model() {
 /// inverted: the fronted branch of `cmd-front` addresses the wrong front
 /// input at every conversion.
 pub fn wrong_front_select(verilog: &str) -> String {
-    let mut n = 0;
-    let out: Vec<String> = verilog
-        .lines()
-        .map(|l| {
-            let t = l.trim_start();
-            match t.strip_prefix("assign mux_sel = core_mux_sel[") {
-                Some(rest) => {
-                    n += 1;
-                    let hi: u32 = rest.split(':').next().unwrap().parse().unwrap();
-                    format!(
-                        "{};",
-                        l.trim_end_matches(';').to_string() + &format!(" ^ {}'d1", hi + 1)
-                    )
-                }
-                None => l.to_string(),
-            }
-        })
-        .collect();
+    let (out, n) = rewrite_lines(verilog, |l| {
+        let rest = l
+            .trim_start()
+            .strip_prefix("assign mux_sel = core_mux_sel[")?;
+        let hi: u32 = rest.split(':').next().unwrap().parse().unwrap();
+        Some(format!(
+            "{};",
+            l.trim_end_matches(';').to_string() + &format!(" ^ {}'d1", hi + 1)
+        ))
+    });
     assert_eq!(n, 1, "the wrapper's mux_sel assignment");
-    out.join("\n") + "\n"
+    out
 }
 
 #[test]
 fn a_gateware_driving_the_wrong_front_select_fails_on_both_verilog_engines() {
-    if !tools::require_tools(&["verilator", "g++", "iverilog", "vvp"]) {
-        return;
-    }
-    let s = schedule("cmd-front");
-    let bad = wrong_front_select(&engines::verilog(&s).unwrap());
-    let (mut dut, _) = VerilatedDut::new(&bad).unwrap();
-    let (diff, _, _) = first_difference(&s, &mut dut, 1);
-    let d = diff.expect("Verilator ran the mutant clean");
-    assert!(d.contains("\"mux\""), "{d}");
-    let mut beside = BesideModel::new(&s);
-    icarus_beside(&s, Some(&bad), Stimulus::Pattern, 1, &mut beside);
-    assert!(beside.diff.is_some(), "Icarus ran the mutant clean");
+    fails_on_both_verilog_engines("cmd-front", wrong_front_select, "\"mux\"");
 }

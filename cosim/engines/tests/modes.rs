@@ -6,6 +6,7 @@
 use engines::{Backend, SimOptions, Stimulus, VerilatedDut};
 use judge::{Dut, Observer};
 use lut_gen::{Pins, Schedule};
+use testkit::modemix::random_mode_mix;
 
 fn schedule_of(text: &str, name: &str) -> Option<Schedule> {
     let path =
@@ -167,71 +168,6 @@ fn auto_select_switches_to_contact_and_back_under_touch() {
     let (vv, gv) = run(&s, &mut ver, frames, &[], touch);
     assert!(vv.ok, "verilator: {}", vv.summary());
     assert_eq!(gv, got, "rusthdl and verilator agree");
-}
-
-/// A random mix with 2 to 4 modes, pin or auto select, 1 to 3 branches
-/// (every one sampled in the reset mode; some modes may leave one out),
-/// channels at harmonic rates per mode; `None` when a mode samples nothing.
-fn random_mode_mix(seed: u64) -> Option<String> {
-    use std::fmt::Write;
-    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = move |n: u64| {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x % n
-    };
-    const RATES: [u64; 4] = [0, 1_000, 2_000, 4_000];
-    let modes = 2 + next(3) as usize;
-    let auto = next(2) == 1;
-    let nb = 1 + next(3) as usize;
-    let mut t = format!(
-        "name = \"random-modes-{seed}\"\n[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 500\n"
-    );
-    for m in 0..modes {
-        let _ = write!(t, "[[mode]]\nname = \"m{m}\"\n");
-    }
-    let _ = write!(
-        t,
-        "[modes]\nselect = \"{}\"\n",
-        if auto { "auto" } else { "pin" }
-    );
-    if auto {
-        // up from every mode on c0, back to m0 when it is low for 2 frames
-        let _ = write!(t, "[[trigger]]\nto = \"m{}\"\nfrom = \"m0\"\nwhen = \"above\"\nlevel = {}\nchannels = [\"c0\"]\n", 1 + next(modes as u64 - 1), 4000 + next(8000));
-        let _ = write!(t, "[[trigger]]\nto = \"m0\"\nwhen = \"below\"\nlevel = 2000\nchannels = [\"c0\"]\nfor_frames = {}\n", 1 + next(3));
-    }
-    for b in 0..nb {
-        let _ = write!(t, "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 2\nsettle_ns = 500\n");
-    }
-    let n = nb + next(8) as usize;
-    let mut used = vec![false; modes];
-    for c in 0..n {
-        let mut rates: Vec<u64> = (0..modes).map(|_| RATES[next(4) as usize]).collect();
-        if c < nb || c == 0 {
-            // every branch in the reset mode; c0 (watched) in every mode
-            rates[0] = rates[0].max(1_000);
-        }
-        if c == 0 && auto {
-            rates.iter_mut().for_each(|r| *r = (*r).max(1_000));
-        }
-        for (m, r) in rates.iter().enumerate() {
-            used[m] |= *r > 0;
-        }
-        let per: Vec<String> = rates
-            .iter()
-            .enumerate()
-            .map(|(m, r)| format!("m{m} = {r}"))
-            .collect();
-        let _ = write!(
-            t,
-            "[[channel]]\nname = \"c{c}\"\nbranch = \"b{}\"\ninput = {}\nrate_hz = 1_000\nrates = {{ {} }}\n",
-            c % nb,
-            c / nb + 8 * next(2) as usize,
-            per.join(", ")
-        );
-    }
-    used.iter().all(|&u| u).then_some(t)
 }
 
 #[test]

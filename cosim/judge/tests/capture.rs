@@ -357,17 +357,8 @@ fn the_link_bytes_are_timed_and_carry_the_codes_miso_carried() {
 
     // The line two bit times late from the first start bit after frame 1.
     let div = lut_gen::plan_link(&s).unwrap().unwrap().baud_divider as usize;
-    let st = (f..pins.len())
-        .find(|&c| !pins[c].link_tx && pins[c - 1].link_tx)
-        .unwrap();
-    let mut late = pins.clone();
-    for c in st..late.len() {
-        late[c].link_tx = if c < st + 2 * div {
-            true
-        } else {
-            pins[c - 2 * div].link_tx
-        };
-    }
+    let st = analyser::start_bit(&pins, f as u64);
+    let late = analyser::two_bits_late(&pins, st, div);
     let r = judged(&late, &miso, "late.vcd");
     let text = r.summary();
     assert!(!r.ok, "{text}");

@@ -5,6 +5,7 @@
 
 use judge::{Adc, Dut, ModeRequests, ModelDut, Stimulus};
 use lut_gen::{Pins, Schedule};
+use testkit::modemix::{random_pin_mode_mix, PinShape};
 
 fn schedule_of(text: &str, tag: &str) -> Schedule {
     let path =
@@ -121,55 +122,19 @@ fn packets_carry_the_modes_of_pin_and_auto_runs() {
     check_run(&s, 14, &[], k);
 }
 
-/// A random mix with 2 or 3 modes (pin select) over a UART; `None` when a
-/// mode would sample nothing.
-fn random_mode_mix(seed: u64) -> Option<String> {
-    use std::fmt::Write;
-    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = move |n: u64| {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x % n
-    };
-    const RATES: [u64; 4] = [0, 1_000, 2_000, 4_000];
-    let modes = 2 + next(2) as usize;
-    let mut t = String::from(
-        "name = \"random-modes\"\n[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 250\n[link]\nkind = \"uart\"\nbaud = 2_000_000\n",
-    );
-    for m in 0..modes {
-        let _ = write!(t, "[[mode]]\nname = \"m{m}\"\n");
-    }
-    t.push_str("[modes]\nselect = \"pin\"\n");
-    for b in 0..2 {
-        let _ = write!(t, "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 1\nsettle_ns = 500\n");
-    }
-    let mut used = vec![false; modes];
-    for c in 0..2 + next(7) as usize {
-        let rates: Vec<u64> = (0..modes).map(|_| RATES[next(4) as usize]).collect();
-        let per: Vec<String> = rates
-            .iter()
-            .enumerate()
-            .map(|(m, r)| format!("m{m} = {r}"))
-            .collect();
-        for (m, r) in rates.iter().enumerate() {
-            used[m] |= *r > 0;
-        }
-        let _ = write!(
-            t,
-            "[[channel]]\nname = \"c{c}\"\nbranch = \"b{}\"\nrate_hz = 1_000\nrates = {{ {} }}\n",
-            c % 2,
-            per.join(", ")
-        );
-    }
-    used.iter().all(|&u| u).then_some(t)
-}
+/// The random mixes: 2 or 3 modes (pin select) over a UART, 2 branches and
+/// 2 to 8 channels at harmonic rates per mode.
+const RANDOM_MODES: PinShape = PinShape {
+    header: "[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 250\n[link]\nkind = \"uart\"\nbaud = 2_000_000\n",
+    mux_devices: 1,
+    more_channels: 7,
+};
 
 #[test]
 fn random_mode_mixes_send_their_modes() {
     let mut ran = 0;
     for seed in 1..30u64 {
-        let Some(text) = random_mode_mix(seed) else {
+        let Some(text) = random_pin_mode_mix(seed, &RANDOM_MODES) else {
             continue;
         };
         let Ok(s) = std::panic::catch_unwind(|| schedule_of(&text, &format!("r{seed}"))) else {

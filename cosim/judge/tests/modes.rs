@@ -7,6 +7,7 @@
 
 use judge::{Adc, CycleModel, Layout, Stimulus};
 use lut_gen::Schedule;
+use testkit::modemix::{random_pin_mode_mix, PinShape};
 
 fn schedule(path: &std::path::Path) -> Schedule {
     lut_gen::synthesize(&lut_gen::load(path).unwrap()).unwrap()
@@ -389,58 +390,20 @@ fn scenes_name_the_mixs_channels() {
     assert!(Stimulus::parse_for("sine:600", &s).is_ok());
 }
 
-/// A random mix with 2 or 3 modes (pin select), 2 branches and up to 10
-/// channels at harmonic rates per mode (0: not sampled); `None` when the
-/// draw leaves a mode sampling nothing.
-fn random_mode_mix(seed: u64) -> Option<String> {
-    use std::fmt::Write;
-    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = move |n: u64| {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x % n
-    };
-    const RATES: [u64; 4] = [0, 1_000, 2_000, 4_000];
-    let modes = 2 + next(2) as usize;
-    let mut t = String::from(
-        "name = \"random-modes\"\n[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 500\n",
-    );
-    for m in 0..modes {
-        let _ = write!(t, "[[mode]]\nname = \"m{m}\"\n");
-    }
-    t.push_str("[modes]\nselect = \"pin\"\n");
-    for b in 0..2 {
-        let _ = write!(t, "[[branch]]\nname = \"b{b}\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\nmux_devices = 2\nsettle_ns = 500\n");
-    }
-    let n = 2 + next(9) as usize;
-    let mut used = vec![false; modes];
-    for c in 0..n {
-        let rates: Vec<u64> = (0..modes).map(|_| RATES[next(4) as usize]).collect();
-        for (m, r) in rates.iter().enumerate() {
-            used[m] |= *r > 0;
-        }
-        let per: Vec<String> = rates
-            .iter()
-            .enumerate()
-            .map(|(m, r)| format!("m{m} = {r}"))
-            .collect();
-        let _ = write!(
-            t,
-            "[[channel]]\nname = \"c{c}\"\nbranch = \"b{}\"\nrate_hz = 1_000\nrates = {{ {} }}\n",
-            c % 2,
-            per.join(", ")
-        );
-    }
-    used.iter().all(|&u| u).then_some(t)
-}
+/// The random mixes: 2 or 3 modes (pin select), 2 branches and up to 10
+/// channels at harmonic rates per mode (0: not sampled).
+const RANDOM_MODES: PinShape = PinShape {
+    header: "[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 500\n",
+    mux_devices: 2,
+    more_channels: 9,
+};
 
 #[test]
 fn random_mode_mixes_follow_random_requests() {
     let dir = std::env::temp_dir();
     let mut ran = 0;
     for seed in 1..40u64 {
-        let Some(text) = random_mode_mix(seed) else {
+        let Some(text) = random_pin_mode_mix(seed, &RANDOM_MODES) else {
             continue;
         };
         let path = dir.join(format!(
