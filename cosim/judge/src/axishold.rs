@@ -63,19 +63,11 @@ pub(crate) fn run(
 ) -> Option<Run> {
     let clock = s.mix.clock_hz as i128;
     let mid = (ph.lo + ph.hi) / 2;
-    let f = s.grid.frame_cycles as i128;
     let c_of = |t: u64| (t as i128 * clock - mid).div_euclid(TC);
     let first = c_of(clocked.first()?.0);
     let last = c_of(clocked.last()?.0) + 1;
-    // whole frames on, so that the model is in steady state (with modes,
-    // from frame 2, and in the modes the capture shows: `timedlink`'s predict)
-    let least = if seen.is_empty() { 1 } else { 2 };
-    let shift = f * (((least * f - first).max(0) + f - 1) / f).max(least);
-    let forced = crate::timedlink::forced_modes(seen, shift / f, (last + shift) / f);
-    let mut m = CycleModel::with_modes(s, &forced);
-    while (m.cycle() as i128) < first + shift {
-        m.step(0);
-    }
+    // whole frames on, in steady state and in the modes the capture shows
+    let (mut m, shift) = crate::timedlink::steady_model(s, seen, (first, last));
     let cfg = m.tx_config()?;
     let mut lj = LinkJoin::new(
         cfg,

@@ -661,6 +661,23 @@ impl Tolerance {
     fn each_side_ps(self) -> u64 {
         self.skew_ps + self.fit_ps
     }
+
+    /// The claim the resolution makes, in words.
+    fn resolution_said(self, period_ps: u64) -> String {
+        let res = (period_ps + 2 * self.each_side_ps()) as f64 / 1e3;
+        let fit = match self.fit_ps {
+            0 => String::new(),
+            p => format!(
+                " and twice the clock fit's uncertainty {:.1} ns",
+                p as f64 / 1e3
+            ),
+        };
+        format!(
+            "every checked edge within {res:.1} ns of the schedule's time (sample period {:.1} ns plus twice the skew {:.1} ns{fit}): rates, intervals and slot order of the mapped conversion lanes to ±{res:.1} ns",
+            period_ps as f64 / 1e3,
+            self.skew_ps as f64 / 1e3,
+        )
+    }
 }
 
 /// One cycle, in units of 1/clock ps.
@@ -1270,21 +1287,7 @@ fn what_was_proved(
     let res = (period_ps + 2 * tol.each_side_ps()) as f64;
     let mut yes = Vec::new();
     let mut no = Vec::new();
-    let fit = if tol.fit_ps > 0 {
-        format!(
-            " and twice the clock fit's uncertainty {:.1} ns",
-            tol.fit_ps as f64 / 1e3
-        )
-    } else {
-        String::new()
-    };
-    yes.push(format!(
-        "every checked edge within {:.1} ns of the schedule's time (sample period {:.1} ns plus twice the skew {:.1} ns{fit}): rates, intervals and slot order of the mapped conversion lanes to ±{:.1} ns",
-        res / 1e3,
-        period_ps as f64 / 1e3,
-        tol.skew_ps as f64 / 1e3,
-        res / 1e3
-    ));
+    yes.push(tol.resolution_said(period_ps));
     if res >= tc_ps {
         no.push(format!(
             "cycle exactness: the capture cannot resolve one {:.1} ns clock cycle",

@@ -505,6 +505,25 @@ pub(crate) fn forced_modes(seen: &[usize], shift: i128, to: i128) -> Vec<(u64, u
         .collect()
 }
 
+/// The cycle model at the phase's cycle `first` plus a whole number of
+/// frames (returned): the least that puts `first` in frame 1 or later, in
+/// steady state (with modes, frame 2: the first whose mode can be other
+/// than reset's), held to the modes `seen` through the phase's `last`.
+pub(crate) fn steady_model(
+    s: &Schedule,
+    seen: &[usize],
+    (first, last): (i128, i128),
+) -> (CycleModel, i128) {
+    let f = s.grid.frame_cycles as i128;
+    let least = if seen.is_empty() { 1 } else { 2 };
+    let shift = f * (((least * f - first).max(0) + f - 1) / f).max(least);
+    let mut m = CycleModel::with_modes(s, &forced_modes(seen, shift / f, (last + shift) / f));
+    while (m.cycle() as i128) < first + shift {
+        m.step(0);
+    }
+    (m, shift)
+}
+
 /// What the model predicts of the line along the capture.
 struct Prediction {
     bytes: Vec<Predicted>,
@@ -535,20 +554,12 @@ fn predict(
     (ph, seen): (LinkPhase, &[usize]),
     clock: i128,
 ) -> Prediction {
-    let f = s.grid.frame_cycles as i128;
     let mid = (ph.lo + ph.hi) / 2;
     let t0 = cap.steps.first().map_or(0, |x| x.0) as i128 * clock;
     let end = cap.steps.last().map_or(0, |x| x.0) as i128 * clock;
     let first = (t0 - mid).div_euclid(TC) - 1;
     let last = (end - mid).div_euclid(TC) + 1;
-    // The least whole number of frames that puts `first` in frame 1 or later
-    // (with modes, frame 2: the first whose mode can be other than reset's).
-    let least = if seen.is_empty() { 1 } else { 2 };
-    let shift = f * (((least * f - first).max(0) + f - 1) / f).max(least);
-    let mut m = CycleModel::with_modes(s, &forced_modes(seen, shift / f, (last + shift) / f));
-    while (m.cycle() as i128) < first + shift {
-        m.step(0);
-    }
+    let (mut m, _) = steady_model(s, seen, (first, last));
     let mut readers: Vec<(u32, MisoReader)> = miso_lanes(cap)
         .into_iter()
         .map(|(lane, b)| (b, MisoReader { cap, lane, k: 0 }))
