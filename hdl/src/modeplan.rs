@@ -49,11 +49,24 @@ impl TrigPlan {
 /// A branch's mode-specific ROM numbers.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ModeRom {
-    /// Per mode: the mux (select, device) of the branch's first instant in
-    /// that mode's frame; `None` when the mode does not use the branch.
-    pub first: Vec<Option<(u32, u32)>>,
+    /// Per mode: the mux field a word with the `w` bit takes when the next
+    /// frame runs that mode, by the index `j` the word holds in its select
+    /// field: the (select, device) of the branch's first instant (`j` = 0),
+    /// or for a converter whose word selects the conversion `ahead` later,
+    /// the input of the frame's conversion `j` (`j < ahead`: the words of a
+    /// frame's last conversions select the next frame's first ones).
+    /// Empty when the mode does not use the branch.
+    pub first: Vec<Vec<(u32, u32)>>,
     /// Bits of the mode number on the address and in the `slice` input.
     pub mode_bits: usize,
+}
+
+impl ModeRom {
+    /// The `w` words index the next mode's fields (a converter whose word
+    /// selects a conversion two or more ahead): else every mode has one.
+    pub fn indexed(&self) -> bool {
+        self.first.iter().any(|f| f.len() > 1)
+    }
 }
 
 fn unsupported(m: String) -> HdlError {
@@ -178,9 +191,11 @@ fn all_members(s: &Schedule, b: usize, rom: &BranchRom) -> Result<Vec<(u32, Vec<
 }
 
 /// Branch `b`'s ROM: mode `m`'s word of slot `u` at address `m << slot_bits
-/// | u`, `{w, conv, ch, sel, dev}` with `w` set when the mode has no
-/// instant at slot `u` or later (the mux field is then the next frame's,
-/// chosen as the word is read).
+/// | u`, `{w, conv, ch, sel, dev}` with `w` set when the mux field is the
+/// next frame's, chosen as the word is read ([`ModeRom::first`], its index
+/// in the select field): when the mode has no instant at slot `u` or
+/// later, or when the word of the next instant selects a conversion of the
+/// next frame (a converter whose word selects one `ahead`).
 fn fill(s: &Schedule, b: usize, rom: &mut BranchRom, mode_bits: usize, slot_bits: usize) {
     let n = s.grid.frame_slots as usize;
     let top = rom.word_bits();
@@ -188,21 +203,75 @@ fn fill(s: &Schedule, b: usize, rom: &mut BranchRom, mode_bits: usize, slot_bits
     let mut first = vec![];
     for (m, ms) in s.modes.iter().enumerate() {
         let slots: Vec<Option<usize>> = (0..n as u64).map(|u| ms.at(u, b)).collect();
-        let mux = |c: usize| (s.channels[c].select, s.channels[c].device);
-        let mut next: Option<usize> = None;
+        let fields = mode_fields(s, b, &slots);
+        let mut next = None;
         for u in (0..n).rev() {
-            if let Some(c) = slots[u] {
-                next = Some(c);
+            if slots[u].is_some() {
+                next = fields[u];
             }
-            let (sel, dev) = next.map_or((0, 0), mux);
+            // no instant left: the next frame's first (index 0)
+            let (wrap, (sel, dev)) = next.map_or((true, (0, 0)), |f| match f {
+                Field::Here(sel, dev) => (false, (sel, dev)),
+                Field::Next(j) => (true, (j, 0)),
+            });
             let w = rom.word(slots[u].is_some(), slots[u].unwrap_or(0) as u32, sel, dev);
-            words[(m << slot_bits) | u] = w | (next.is_none() as u32) << top;
+            words[(m << slot_bits) | u] = w | (wrap as u32) << top;
         }
-        first.push(next.map(mux));
+        first.push(first_fields(s, b, &slots));
     }
     rom.words = words;
     rom.addr_bits = slot_bits + mode_bits;
     rom.modes = Some(ModeRom { first, mode_bits });
+}
+
+/// The mux field of an instant: in the word, or the next frame's `j`-th.
+#[derive(Debug, Clone, Copy)]
+enum Field {
+    Here(u32, u32),
+    Next(u32),
+}
+
+/// The mux field of each instant of one mode's frame: the channel's
+/// (select, device), or for a converter with a command word the input its
+/// word selects, `ahead` conversions later (docs/timing.md, "Command
+/// words"), past the frame's end the next frame's conversion `j`.
+fn mode_fields(s: &Schedule, b: usize, slots: &[Option<usize>]) -> Vec<Option<Field>> {
+    let mux = |c: usize| Field::Here(s.channels[c].select, s.channels[c].device);
+    let Some(cmd) = &s.mix.branches[b].adc.command else {
+        return slots.iter().map(|c| c.map(mux)).collect();
+    };
+    let convs: Vec<usize> = slots.iter().flatten().copied().collect();
+    let input = |c: usize| s.mix.channels[c].input;
+    let mut k = 0;
+    let mut out = vec![None; slots.len()];
+    for (u, c) in slots.iter().enumerate() {
+        if c.is_some() {
+            let i = k + cmd.ahead as usize;
+            out[u] = Some(match convs.get(i) {
+                Some(&c) => Field::Here(input(c) & 7, input(c) >> 3),
+                None => Field::Next((i - convs.len()) as u32),
+            });
+            k += 1;
+        }
+    }
+    out
+}
+
+/// [`ModeRom::first`] of one mode: what a `w` word with index `j` takes
+/// when the next frame runs this mode (empty when it does not use the
+/// branch).
+fn first_fields(s: &Schedule, b: usize, slots: &[Option<usize>]) -> Vec<(u32, u32)> {
+    let convs: Vec<usize> = slots.iter().flatten().copied().collect();
+    let Some(cmd) = &s.mix.branches[b].adc.command else {
+        let mux = |&c: &usize| (s.channels[c].select, s.channels[c].device);
+        return convs.first().map(mux).into_iter().collect();
+    };
+    let input = |&c: &usize| (s.mix.channels[c].input & 7, s.mix.channels[c].input >> 3);
+    match cmd.ahead {
+        // the word of the next frame's first instant selects its own
+        0 => convs.first().map(input).into_iter().collect(),
+        a => convs.iter().take(a as usize).map(input).collect(),
+    }
 }
 
 #[cfg(test)]
@@ -242,7 +311,7 @@ mod tests {
                         assert_eq!(w >> top & 1 == 0, left, "{name} b{b} m{m} u{u}: w bit");
                     }
                     let used = (0..s.grid.frame_slots).any(|u| ms.at(u, b).is_some());
-                    assert_eq!(rom.modes.as_ref().unwrap().first[m].is_some(), used);
+                    assert_eq!(!rom.modes.as_ref().unwrap().first[m].is_empty(), used);
                 }
             }
         }

@@ -109,13 +109,55 @@ impl SlotRom {
     /// The mux field out of the word read (see [`SlotRom::read_modes`]).
     fn mode_field(&self, m: &ModeRom) -> (u32, u32) {
         let nm = self.slice.val().to_u64() as usize & ((1 << m.mode_bits) - 1);
-        let first = m.first.get(nm).copied().flatten();
         let dw = self._dev_bits;
+        // the index into the next mode's fields sits in the select field
+        let j = if m.indexed() { self._qm >> dw & 7 } else { 0 };
+        let first = (m.first.get(nm)).and_then(|f| f.get(j as usize).copied());
         match (self._qm >> self.word_bits() & 1 == 1, self._qn, first) {
             (false, ..) => (self._qm >> dw & 7, self._qm & ((1 << dw) - 1)),
             (true, false, Some(f)) => f,
             _ => self._held,
         }
+    }
+
+    /// The mux field a `w` word takes from the next frame's mode
+    /// (`slice[mb-1:0]`): its first instant's, or where the words select
+    /// conversions ahead, the one its index (the word's select field,
+    /// `q[hi:hi-2]`) names.
+    fn first_verilog(m: &ModeRom, dw: usize, hi: usize) -> String {
+        let mb = m.mode_bits;
+        let (key, kb, what) = if m.indexed() {
+            let key = format!("{{slice[{}:0], q[{hi}:{}]}}", mb - 1, hi - 2);
+            let what = format!("the input of the next frame's conversion the word's index names (next mode: slice[{}:0], index: q[{hi}:{}])", mb - 1, hi - 2);
+            (key, mb + 3, what)
+        } else {
+            let key = format!("slice[{}:0]", mb - 1);
+            let what = format!("the first instant of the next frame's mode ({key})");
+            (key, mb, what)
+        };
+        let mut s = format!(
+            "// {what}, if it uses this branch\nreg fuse;\nreg [2:0] fsel;\nreg [{}:0] fdev;\nalways @(*) begin\n  case ({key})\n",
+            dw - 1
+        );
+        let mut labels = 0;
+        for (k, f) in m.first.iter().enumerate() {
+            let per = if m.indexed() { f.len().max(1) } else { 1 };
+            for j in 0..per {
+                let (u, (sel, dev)) = f.get(j).map_or((0, (0, 0)), |x| (1, *x));
+                let label = if m.indexed() { k << 3 | j } else { k };
+                labels += 1;
+                s.push_str(&format!(
+                    "    {kb}'d{label}: begin fuse = 1'b{u}; fsel = 3'd{sel}; fdev = {dw}'d{dev}; end\n"
+                ));
+            }
+        }
+        if labels < 1 << kb {
+            s.push_str(&format!(
+                "    default: begin fuse = 1'b0; fsel = 3'd0; fdev = {dw}'d0; end\n"
+            ));
+        }
+        s.push_str("  endcase\nend\n\n");
+        s
     }
 
     /// Compact form: the payload width of a slice-table word and the
@@ -149,24 +191,7 @@ impl SlotRom {
             "// the word (its mode's table at {{mode, slot}}; bit {wb}: no instant left in that mode's frame),\n// whether its frame is the next one, and the mux field last output\nreg [{wb}:0] q;\nreg qn;\nreg [2:0] hsel;\nreg [{}:0] hdev;\n\n",
             dw - 1
         );
-        s.push_str(&format!(
-            "// the first instant of the next frame's mode (slice[{}:0]), if it uses this branch\nreg fuse;\nreg [2:0] fsel;\nreg [{}:0] fdev;\nalways @(*) begin\n  case (slice[{}:0])\n",
-            mb - 1,
-            dw - 1,
-            mb - 1
-        ));
-        for (k, f) in m.first.iter().enumerate() {
-            let (u, sel, dev) = f.map_or((0, 0, 0), |(a, b)| (1, a, b));
-            s.push_str(&format!(
-                "    {mb}'d{k}: begin fuse = 1'b{u}; fsel = 3'd{sel}; fdev = {dw}'d{dev}; end\n"
-            ));
-        }
-        if m.first.len() < 1 << mb {
-            s.push_str(&format!(
-                "    default: begin fuse = 1'b0; fsel = 3'd0; fdev = {dw}'d0; end\n"
-            ));
-        }
-        s.push_str("  endcase\nend\n\n");
+        s.push_str(&Self::first_verilog(m, dw, dw + 2));
         let (rsel, rdev) = self._reset;
         s.push_str(&format!(
             "wire hold = q[{wb}] & (qn | ~fuse);\nalways @(posedge clock) begin\n  q <= mem[address[{}:0]];\n  qn <= slice[{mb}];\n  if (rst) begin\n    hsel <= 3'd{rsel};\n    hdev <= {dw}'d{rdev};\n  end else begin\n    hsel <= msel;\n    hdev <= mdev[{}:0];\n  end\nend\n\n",

@@ -164,6 +164,7 @@ impl Cx<'_> {
         };
         self.check_mode_rates(decl, channels, &names)?;
         self.check_modes_sample(raw, &names, channels)?;
+        self.check_mode_commands(raw, &names, branches, channels, t)?;
         let triggers = self.triggers(raw, &names, select, branches, channels)?;
         Ok(Some(Modes {
             names,

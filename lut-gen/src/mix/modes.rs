@@ -285,6 +285,46 @@ impl Cx<'_> {
         }
     }
 
+    /// A converter whose word selects a later conversion (`command_ahead`,
+    /// the AD7689's 2) sends, in a frame's last conversions, the words of
+    /// the next frame's first ones: the next frame's mode is decided while
+    /// this one runs, the one after it is not.  So every mode converts such
+    /// a branch at least `ahead` times per frame.  A converter behind a
+    /// front mux takes its words from one frame's table, so it has one
+    /// table in a mix with modes: refused there.
+    pub(super) fn check_mode_commands(
+        &self,
+        raw: &RawMix,
+        names: &[String],
+        branches: &[Branch],
+        channels: &[Channel],
+        t: &Timing,
+    ) -> Result<(), MixError> {
+        for (b, br) in branches.iter().enumerate() {
+            let Some(cmd) = &br.adc.command else { continue };
+            let span = raw.branch[b].get_ref().adc.span();
+            if br.fronted {
+                return Err(self.at(span, format!("branch[{b}].front_mux"), format!(
+                    "branch `{}`: a converter with a command word behind a front mux is not supported in a mix with modes (its words come from one frame's table); drop the front mux or the [[mode]] tables",
+                    br.name
+                )));
+            }
+            let ahead = cmd.ahead as u64;
+            for (m, name) in names.iter().enumerate() {
+                let per_frame: u64 = (channels.iter().filter(|c| c.branch == b && c.member == 0))
+                    .map(|c| c.rates[m] * t.frame_us / 1_000_000)
+                    .sum();
+                if ahead > 0 && per_frame < ahead {
+                    return Err(self.at(span, format!("branch[{b}].adc"), format!(
+                        "branch `{}`: the {} word selects the conversion {ahead} ahead, but mode `{name}` converts it {per_frame} time(s) per frame: across a switch its last words would select conversions of a frame whose mode is not decided yet; give the branch at least {ahead} conversions per frame in every mode",
+                        br.name, br.adc.name
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Every `[[trigger]]`, resolved and checked against the modes' rates.
     pub(super) fn triggers(
         &self,

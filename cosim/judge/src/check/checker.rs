@@ -196,9 +196,9 @@ pub struct Checker {
     /// The model cycle checking began at (0: at reset; later: joined mid-stream).
     origin: u64,
     /// Per branch: its command words read from `adc_mosi` (a converter that
-    /// takes one), and the words the schedule sends (for reports).
+    /// takes one); each channel's input (for reports).
     cmds: Vec<Option<CommandRead>>,
-    words: Vec<Vec<lut_gen::CommandSent>>,
+    inputs: Vec<u32>,
     /// Sampling instants held back, in time order, while a commanded
     /// branch's word (a part that converts in the same read) is still being
     /// clocked in: (cycle, branch, channel, still open).  Frames do not close
@@ -303,9 +303,7 @@ impl Checker {
             cmds: (0..s.branches.len())
                 .map(|b| CommandRead::new(s, b))
                 .collect(),
-            words: (0..s.branches.len())
-                .map(|b| s.commands_in_frame(b))
-                .collect(),
+            inputs: s.mix.channels.iter().map(|c| c.input).collect(),
             held: Default::default(),
         }
     }
@@ -1008,17 +1006,17 @@ impl Checker {
     /// of a wrong `adc_mosi` bit (`want`: the model's bit).
     fn command_context(&self, b: usize, m: &CycleModel, want: u64) -> String {
         let name = &self.branch_names[b];
-        let Some((wi, k, t)) = m.command_bit(b) else {
+        let Some((sel, k, t)) = m.command_bit(b) else {
             return format!("branch {name}: no command word is being sent here (adc_mosi idles low between words), expected {want}");
         };
-        let w = &self.words[b][wi];
-        let bits: String = w.word.iter().map(|&v| if v { '1' } else { '0' }).collect();
-        let ch = self.names.get(w.selects).map_or("?", String::as_str);
+        let bits: String = (m.command_word(b).iter())
+            .map(|&v| if v { '1' } else { '0' })
+            .collect();
+        let ch = self.names.get(sel).map_or("?", String::as_str);
+        let (at, _, slot) = self.inv.place(t);
         format!(
-            "branch {name}: bit {k} (0 = the first) of the command word {bits} of the conversion at cycle {} (slot {}), which selects {ch} (input {}); expected {want}",
-            self.inv.place(t).0,
-            w.slot,
-            w.input
+            "branch {name}: bit {k} (0 = the first) of the command word {bits} of the conversion at cycle {at} (slot {slot}), which selects {ch} (input {}); expected {want}",
+            self.inputs[sel]
         )
     }
 

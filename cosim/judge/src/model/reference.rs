@@ -196,11 +196,14 @@ struct BranchModel {
     leading: u64,
     /// (device, select) of each channel (indexed by channel).
     addr: Vec<(u32, u32)>,
-    /// A converter with a command word: the word each instant of `inst`
-    /// sends on `adc_mosi` (`Schedule::commands_in_frame`), the current
-    /// one, and the conversions after reset still prepared, not data.
-    words: Vec<Vec<bool>>,
+    /// A converter with a command word: its word, the index of the current
+    /// instant in its frame's list, the channel the current conversion's
+    /// word selects (docs/timing.md, "Command words"), each channel's input,
+    /// and the conversions after reset still prepared, not data.
+    cmd: Option<lut_gen::Command>,
     wi: usize,
+    sel: usize,
+    inputs: Vec<u32>,
     prepared: u32,
 }
 
@@ -271,8 +274,10 @@ impl BranchModel {
             bits: spi.bits,
             leading: spi.leading_bits as u64,
             addr: addr.to_vec(),
-            words: s.commands_in_frame(b).into_iter().map(|c| c.word).collect(),
+            cmd: s.mix.branches[b].adc.command.clone(),
             wi: 0,
+            sel: 0,
+            inputs: s.mix.channels.iter().map(|c| c.input).collect(),
             prepared: s.prepared_conversions(b),
         };
         m.advance_next_instant(g.frame_cycles, track);
@@ -309,6 +314,39 @@ impl BranchModel {
             self.ni = 0;
             self.nf += 1;
         }
+    }
+}
+
+impl BranchModel {
+    /// The channel the word of the current conversion selects: the one
+    /// `ahead` conversions later on this branch, counted through the frames
+    /// in the modes decided (the next frame's is decided while this one
+    /// runs; the audit refuses a mode with fewer than `ahead` conversions
+    /// of a commanded branch, so the count never runs past it).
+    fn selected(&self, frame_cycles: u64, track: &ModeTrack) -> usize {
+        let ahead = self.cmd.as_ref().map_or(0, |c| c.ahead as usize);
+        let (mut f, mut mode) = (self.t.unwrap_or(0) / frame_cycles, self.tmode);
+        let mut i = self.wi + ahead;
+        while i >= self.inst[mode].len() {
+            i -= self.inst[mode].len();
+            f += 1;
+            match track.mode_of(f) {
+                Some(m) if !self.inst[m].is_empty() => mode = m,
+                // past the frames decided: the steady frame's word
+                _ => {
+                    return self.inst[self.tmode][(self.wi + ahead) % self.inst[self.tmode].len()].1
+                        as usize
+                }
+            }
+        }
+        self.inst[mode][i].1 as usize
+    }
+
+    /// The word the current conversion sends (empty without a command word).
+    fn command_word(&self) -> Vec<bool> {
+        self.cmd
+            .as_ref()
+            .map_or(vec![], |c| c.word(self.inputs[self.sel]))
     }
 }
 
@@ -538,19 +576,26 @@ impl CycleModel {
         }
     }
 
-    /// The command word branch `b` is sending in the current cycle: (its
-    /// index in `Schedule::commands_in_frame`, the bit on the lane, the
-    /// conversion's instant), or `None` outside a word (the lane idles low).
-    /// For the checker's report of a wrong `adc_mosi` bit.
+    /// The command word branch `b` is sending in the current cycle: (the
+    /// channel it selects, the bit on the lane, the conversion's instant),
+    /// or `None` outside a word (the lane idles low).  For the checker's
+    /// report of a wrong `adc_mosi` bit.
     pub fn command_bit(&self, b: usize) -> Option<(usize, usize, u64)> {
         let m = &self.br[b];
         let t = m.t?;
         let k = self.c.checked_sub(t)?;
-        if !m.conv || m.words.is_empty() || k < m.su || k >= m.r {
+        let len = m.cmd.as_ref()?.bits.len();
+        if !m.conv || k < m.su || k >= m.r {
             return None;
         }
         let i = ((k - m.su) / m.d) as usize;
-        (i < m.words.get(m.wi)?.len()).then_some((m.wi, i, t))
+        (i < len).then_some((m.sel, i, t))
+    }
+
+    /// The command word branch `b`'s current conversion sends (empty
+    /// without a command word or before its first conversion).
+    pub fn command_word(&self, b: usize) -> Vec<bool> {
+        self.br[b].command_word()
     }
 
     /// No conversion that began before the current cycle is still running or
@@ -657,6 +702,7 @@ impl CycleModel {
                     m.tmode = m.tnmode;
                     m.conv = settled_at_startup(m.tn, m.settle);
                     m.wi = m.ni.checked_sub(1).unwrap_or(m.inst[m.tmode].len() - 1);
+                    m.sel = m.selected(self.frame_cycles, &self.track);
                     m.advance_next_instant(self.frame_cycles, &self.track);
                     m.oi = 0;
                     m.word = 0;
@@ -742,11 +788,14 @@ impl CycleModel {
             return false;
         }
         let i = ((k - m.su) / m.d) as usize;
-        m.words
-            .get(m.wi)
-            .and_then(|w| w.get(i))
-            .copied()
-            .unwrap_or(false)
+        m.cmd
+            .as_ref()
+            .and_then(|w| w.bits.get(i))
+            .is_some_and(|b| match *b {
+                lut_gen::CmdBit::Zero => false,
+                lut_gen::CmdBit::One => true,
+                lut_gen::CmdBit::Channel(j) => m.inputs[m.sel] >> j & 1 == 1,
+            })
     }
 
     /// At the edge that begins a frame (cycle `c`): the mode of the frame
