@@ -39,6 +39,9 @@ mod icarus;
 #[path = "link.rs"]
 mod link;
 
+#[path = "matrix.rs"]
+mod matrix;
+
 #[path = "link_bytes.rs"]
 mod link_bytes;
 #[path = "link_captures.rs"]

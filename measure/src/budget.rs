@@ -42,7 +42,10 @@ pub struct Tightest {
 impl Tightest {
     pub fn of(r: &AuditReport) -> Option<Tightest> {
         let mut all: Vec<Tightest> = Vec::new();
-        for b in &r.branches {
+        // a mix with modes: every mode's limits, each named with its mode
+        // (the top-level tables are the reset mode's; the busiest may be another)
+        let modal = r.modes.len() > 1;
+        for b in r.branches.iter().filter(|_| !modal) {
             all.push(Tightest {
                 what: format!("branch `{}`'s slots", b.name),
                 used: b.utilization,
@@ -52,11 +55,32 @@ impl Tightest {
                 used: b.adc_utilization,
             });
         }
-        if let Some(l) = &r.link {
+        if let Some(l) = r.link.as_ref().filter(|_| !modal) {
             all.push(Tightest {
                 what: format!("the {} link's line", link_kind(l)),
                 used: l.utilization,
             });
+        }
+        for m in r.modes.iter().filter(|_| modal) {
+            for b in &m.branches {
+                all.push(Tightest {
+                    what: format!("branch `{}`'s slots in mode `{}`", b.name, m.name),
+                    used: b.utilization,
+                });
+                all.push(Tightest {
+                    what: format!(
+                        "branch `{}`'s converter throughput in mode `{}`",
+                        b.name, m.name
+                    ),
+                    used: b.adc_utilization,
+                });
+            }
+            if let (Some(l), Some(ml)) = (&r.link, &m.link) {
+                all.push(Tightest {
+                    what: format!("the {} link's line in mode `{}`", link_kind(l), m.name),
+                    used: ml.utilization,
+                });
+            }
         }
         // the first of the most used, so ties keep the mix's order
         all.into_iter()
@@ -597,12 +621,31 @@ mod tests {
                 tables.iter().any(|t| t.0.starts_with("Link budget"))
             );
             let tight = Tightest::of(&r).unwrap();
-            let most = r
-                .branches
-                .iter()
-                .flat_map(|b| [b.utilization, b.adc_utilization])
-                .chain(r.link.iter().map(|l| l.utilization))
-                .fold(0.0, f64::max);
+            let most = if r.modes.len() > 1 {
+                // every mode's figures, the busiest named with its mode
+                let m = (r.modes.iter())
+                    .flat_map(|m| {
+                        let l = m.link.as_ref().map(|l| l.utilization);
+                        m.branches
+                            .iter()
+                            .flat_map(|b| [b.utilization, b.adc_utilization])
+                            .chain(l)
+                    })
+                    .fold(0.0, f64::max);
+                assert!(
+                    tight.what.contains("in mode `"),
+                    "{}: {}",
+                    mix.name,
+                    tight.what
+                );
+                m
+            } else {
+                r.branches
+                    .iter()
+                    .flat_map(|b| [b.utilization, b.adc_utilization])
+                    .chain(r.link.iter().map(|l| l.utilization))
+                    .fold(0.0, f64::max)
+            };
             assert_eq!(tight.used, most, "{}", mix.name);
         }
     }

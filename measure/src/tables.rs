@@ -129,6 +129,9 @@ fn span(lo: u64, hi: u64) -> String {
 /// themselves are listed once, in the audit): channels, samples each,
 /// the interval the schedule promises and the least and most measured.
 pub fn interval_table(s: &Schedule, r: &judge::Verdict) -> Table {
+    if s.modes.len() > 1 {
+        return mode_interval_table(s, r);
+    }
     let mut t = Table::new(&[
         "branch",
         "rate (Hz)",
@@ -177,6 +180,63 @@ pub fn interval_table(s: &Schedule, r: &judge::Verdict) -> Table {
             },
             jitter.map_or("-".into(), |j| j.to_string()),
         ]);
+    }
+    t
+}
+
+/// [`interval_table`] of a mix with modes: a row per mode, branch and rate
+/// in that mode, from the run's figures in each mode (intervals restart at
+/// a switch, so a jitter-free run shows none across one).
+fn mode_interval_table(s: &Schedule, r: &judge::Verdict) -> Table {
+    let mut t = Table::new(&[
+        "mode",
+        "branch",
+        "rate (Hz)",
+        "channels",
+        "samples each",
+        "interval promised (cycles)",
+        "interval measured (cycles)",
+        "jitter (cycles)",
+    ]);
+    for (m, ms) in s.modes.iter().enumerate() {
+        let rate = |i: usize| ms.mix.channels.get(i).map_or(0, |c| c.rate_hz);
+        let mut keys: Vec<(String, u64)> = Vec::new();
+        for (i, c) in r.channels.iter().enumerate() {
+            if rate(i) > 0 && !keys.contains(&(c.branch.clone(), rate(i))) {
+                keys.push((c.branch.clone(), rate(i)));
+            }
+        }
+        for (branch, hz) in keys {
+            let group: Vec<(&str, &judge::ModeStats)> = (r.channels.iter().enumerate())
+                .filter(|(i, c)| c.branch == branch && rate(*i) == hz)
+                .filter_map(|(_, c)| Some((c.name.as_str(), c.modes.get(m)?)))
+                .collect();
+            let Some(mode) = group.first().map(|g| g.1.mode.clone()) else {
+                continue;
+            };
+            let list: Vec<&str> = group.iter().map(|g| g.0).collect();
+            let st: Vec<&judge::ModeStats> = group.iter().map(|g| g.1).collect();
+            let mm =
+                |v: Vec<u64>| span(*v.iter().min().unwrap_or(&0), *v.iter().max().unwrap_or(&0));
+            let lo = st.iter().filter_map(|c| c.interval_cycles_min).min();
+            let hi = st.iter().filter_map(|c| c.interval_cycles_max).max();
+            let jitter = (st.iter())
+                .filter_map(|c| Some(c.interval_cycles_max? - c.interval_cycles_min?))
+                .max();
+            t.push(vec![
+                mode,
+                branch,
+                hz.to_string(),
+                names(&list),
+                mm(st.iter().map(|c| c.samples).collect()),
+                mm(st.iter().map(|c| c.interval_cycles).collect()),
+                match (lo, hi) {
+                    (Some(a), Some(b)) => span(a, b),
+                    _ => "-".into(),
+                },
+                jitter.map_or("-".into(), |j| j.to_string()),
+            ]);
+        }
     }
     t
 }

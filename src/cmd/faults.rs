@@ -133,6 +133,21 @@ pub fn run(a: Args) -> u8 {
 /// The campaign as text: the matrix, then what was missed and why.
 fn text(c: &Campaign) -> String {
     let mut o = String::new();
+    if !c.clean.ok {
+        let _ = writeln!(
+            o,
+            "faults on {}: its clean run on {} FAILS, so no fault was injected (a checker that rejects the clean design would \"detect\" every fault):\n  {}",
+            c.mix,
+            c.clean.engine,
+            c.clean.why.as_deref().unwrap_or("").replace('\n', "\n  ")
+        );
+        return o;
+    }
+    let _ = writeln!(
+        o,
+        "clean run of {} on {}: PASS ({} cycles, checked against the model)",
+        c.mix, c.clean.engine, c.clean.cycles
+    );
     header(&mut o, c);
     matrix(&mut o, c);
     columns(&mut o, c);

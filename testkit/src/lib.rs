@@ -10,10 +10,12 @@
 //! - [`mutate`]: the Verilog mutator (mutation testing of the checkers);
 //! - [`analyser`]: logic-analyser captures made from a run's pins;
 //! - [`bulk`]: mixes rewritten with bulk channels (`T{0..47}`) and back;
-//! - [`modemix`]: random mixes with modes, from one seeded xorshift.
+//! - [`modemix`]: random mixes with modes, from one seeded xorshift;
+//! - [`matrix`]: the feature matrix, mixes across every dimension (pairwise).
 
 pub mod analyser;
 pub mod bulk;
+pub mod matrix;
 pub mod modemix;
 pub mod mutate;
 pub mod presets;

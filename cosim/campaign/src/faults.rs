@@ -237,12 +237,14 @@ pub struct Campaign {
     pub undetected: u64,
     pub proved_equivalent: u64,
     pub false_alarms: FalseAlarms,
+    /// The mix's own clean run: when it fails, no fault was injected.
+    pub clean: CleanRun,
 }
 
 impl Campaign {
     /// Nothing undetected and no clean run rejected.
     pub fn ok(&self) -> bool {
-        self.undetected == 0 && self.false_alarms.rejected == 0
+        self.clean.ok && self.undetected == 0 && self.false_alarms.rejected == 0
     }
 
     pub fn column(&self, d: Detector) -> Option<&Column> {
@@ -866,18 +868,43 @@ fn columns(
 
 /// A clean run of the target under the checker, with and without the
 /// model, timed: [(cycles, seconds) with the model, without].
-fn clean_target_runs(s: &Schedule, target: Target, frames: u64) -> [(u64, f64); 2] {
-    let timed = |model: bool| -> (u64, f64) {
+fn clean_target_runs(s: &Schedule, target: Target, frames: u64) -> ([(u64, f64); 2], CleanRun) {
+    let timed = |model: bool| -> (u64, f64, Option<String>) {
         let Ok(mut dut) = target_dut(s, target) else {
-            return (0, 0.0);
+            return (
+                0,
+                0.0,
+                Some(format!("{} could not be built", engine_name(target))),
+            );
         };
         let mut opts = modes::run_options(s, frames);
         opts.check.model = model;
         let t = Instant::now();
-        let r = run_dut(s, &mut dut, frames, &opts, "timing", None);
-        (r.cycles, t.elapsed().as_secs_f64())
+        let r = run_dut(s, &mut dut, frames, &opts, "clean", None);
+        let why = (!r.ok).then(|| r.summary().trim_end().to_string());
+        (r.cycles, t.elapsed().as_secs_f64(), why)
     };
-    [timed(true), timed(false)]
+    let (a, b) = (timed(true), timed(false));
+    let clean = CleanRun {
+        engine: engine_name(target),
+        cycles: a.0,
+        ok: a.2.is_none(),
+        why: a.2,
+    };
+    ([(a.0, a.1), (b.0, b.1)], clean)
+}
+
+/// The mix's own clean run on the campaign's target, checked against the
+/// model: unless it passes, no detection means anything (a checker that
+/// rejects the clean design "detects" every fault), so none is reported.
+#[derive(Debug, Clone, Serialize)]
+pub struct CleanRun {
+    pub engine: &'static str,
+    pub cycles: u64,
+    pub ok: bool,
+    /// Why it failed: the verdict's summary.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub why: Option<String>,
 }
 
 /// Per engine: injections through it, those some detector caught, and a
@@ -917,23 +944,26 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
         done: 0.into(),
         total: planned_runs(s, plan, &sites),
     };
+    // the mix's own clean run first: a campaign on a design that fails
+    // clean would vouch for nothing
+    let (clean, clean_run) = clean_target_runs(s, target, frames);
+    count.one();
+    let judge_faults = plan.builtin && clean_run.ok;
     let mut judged = Vec::new();
-    if plan.builtin {
+    if judge_faults {
         judged = pin_injections(s, target, &sites, frames, sigrok, &count).map_err(SimError::Io)?;
     }
-    if plan.builtin && target == Target::Rusthdl {
+    if judge_faults && target == Target::Rusthdl {
         judged.extend(
             gateware_injections(s, &sites, frames, sigrok, prove, &count).map_err(SimError::Io)?,
         );
     }
-    let clean = clean_target_runs(s, target, frames);
-    count.one();
     let mut engine_costs = Vec::new();
     if plan.builtin {
         engine_costs.push((engine_name(target), clean[0].0, clean[0].1));
     }
     let mut false_alarms = counted_false_alarms(target, plan.false_alarm_mixes, sigrok, &count);
-    if !plan.verilog_faults.is_empty() {
+    if !plan.verilog_faults.is_empty() && clean_run.ok {
         for &e in &plan.verilog_engines {
             let (cycles, secs, why) =
                 verilog::clean_engine_run(s, e, frames, sigrok).map_err(SimError::Io)?;
@@ -985,6 +1015,7 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
         proved_equivalent: sum(|c| c.proved_equivalent.len() as u64),
         classes,
         false_alarms,
+        clean: clean_run,
     })
 }
 

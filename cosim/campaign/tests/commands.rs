@@ -171,3 +171,29 @@ fn verilog_sending_wrong_or_late_words_fails_on_icarus() {
         }
     }
 }
+
+/// A campaign judges the mix's own clean run first: on a design that fails
+/// clean (here a schedule whose table moved one conversion, so the model
+/// the gateware would follow breaks the mix's intervals) it injects
+/// nothing and vouches for nothing; on the design as synthesized it runs.
+#[test]
+fn a_campaign_on_a_design_that_fails_clean_reports_no_detection() {
+    let good = load("tiny");
+    let mut bad = good.clone();
+    let nb = bad.branches.len();
+    let (from, to) = (0..bad.grid.frame_slots as usize)
+        .find_map(|u| {
+            let free = (u + 1..bad.grid.frame_slots as usize)
+                .find(|&v| bad.frame_table[v * nb].is_none())?;
+            bad.frame_table[u * nb].map(|_| (u, free))
+        })
+        .expect("a conversion with a free slot after it");
+    bad.frame_table.swap(from * nb, to * nb);
+    for (s, clean) in [(&good, true), (&bad, false)] {
+        let c = campaign_with(s, &Plan::new(Target::Model, 3, 0)).unwrap();
+        assert_eq!(c.clean.ok, clean, "{:?}", c.clean);
+        assert_eq!(c.injected > 0, clean, "{}", c.injected);
+        assert_eq!(c.ok(), clean);
+        assert_eq!(c.clean.why.is_some(), !clean);
+    }
+}

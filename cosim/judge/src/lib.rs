@@ -45,8 +45,8 @@ pub use lut_gen::{Layout, Pins, Signal};
 pub use check::{CheckOptions, Checker};
 pub use converter::{Adc, Analog, Scene, Stimulus};
 pub use model::{
-    counted, ChannelStats, CycleModel, Divergence, Invariants, ModeTrack, Rule, SlotModel, Verdict,
-    Violation,
+    counted, ChannelStats, CycleModel, Divergence, Invariants, ModeStats, ModeTrack, Rule,
+    SlotModel, Verdict, Violation,
 };
 
 // Running a design (any `Dut`) against the model, with faults on its pins.

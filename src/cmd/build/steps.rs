@@ -507,7 +507,13 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campa
     } else {
         "cycle model (the reference model's pins)"
     };
-    let line = format!(
+    let line = match &c.clean.why {
+        Some(why) => format!(
+            "the mix's own clean run on {} fails, so no fault was injected: {}",
+            c.clean.engine,
+            why.lines().next().unwrap_or("")
+        ),
+        None => format!(
         "{} of {} injections detected ({} undetected, {} proved equivalent) over {} classes and {} ({target_name}{}); {} false alarms in {}",
         c.detected,
         c.injected,
@@ -518,7 +524,8 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campa
         if full { "" } else { "; quick" },
         c.false_alarms.rejected,
         counted(c.false_alarms.runs, "clean run")
-    );
+        ),
+    };
     let sec = Section {
         title: "Fault campaign".into(),
         paragraphs: vec![format!(
@@ -538,9 +545,9 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campa
     } else {
         Done::failed(line, "see faults.json")
     };
-    j.answer(
-        Glance::Faults,
-        format!(
+    let glance = match c.clean.ok {
+        false => format!("none: the mix's own clean run on {} fails", c.clean.engine),
+        true => format!(
             "{} of {} injected faults detected, {} false alarms in {} ({})",
             c.detected,
             c.injected,
@@ -552,7 +559,8 @@ fn faults(j: &mut Job, a: &Args, s: &Schedule, keep: &mut Option<campaign::Campa
                 "the quick campaign"
             }
         ),
-    );
+    };
+    j.answer(Glance::Faults, glance);
     *keep = Some(c);
     written(w, d.files(&["faults.json"]).section(sec))
 }

@@ -11,7 +11,7 @@ use serde_json::json;
 
 use crate::model::mode_rules::ModeCheck;
 use crate::model::rule::Rule;
-use crate::model::verdict::{ChannelStats, Verdict, Violation};
+use crate::model::verdict::{ChannelStats, ModeStats, Verdict, Violation};
 
 /// Collects violations; shared by both layers.
 #[derive(Debug, Clone)]
@@ -95,6 +95,11 @@ pub struct Invariants {
     interval_m: Vec<Vec<u64>>,
     mc: Option<Box<ModeCheck>>,
     cur_mode: usize,
+    /// A mix with modes: per mode, its name and each channel's samples and
+    /// least and most interval within that mode (intervals restart at a
+    /// switch), so a report shows each mode's own figures.
+    mode_names: Vec<String>,
+    stat_m: Vec<Vec<(u64, u64, u64)>>,
     /// (frame, channel) of each prepared conversion after reset (converters
     /// with a command word: no word of ours selected it, so it is no
     /// sample), and the last cycle a conversion's channel could not be
@@ -167,6 +172,8 @@ impl Invariants {
             interval_m,
             mc: ModeCheck::new(s).map(Box::new),
             cur_mode: 0,
+            mode_names: (s.mix.modes.as_ref()).map_or(vec![], |m| m.names.clone()),
+            stat_m: vec![vec![(0, u64::MAX, 0); n]; s.modes.len()],
             prepared: prepared_conversions(s),
             blind_until: None,
         }
@@ -292,10 +299,17 @@ impl Invariants {
         }
         self.in_frame[ch] += 1;
         self.samples[ch] += 1;
+        let mut per = self.stat_m.get_mut(self.cur_mode).map(|m| &mut m[ch]);
+        if let Some(p) = per.as_deref_mut() {
+            p.0 += 1;
+        }
         if self.has_last[ch] {
             let d = t - self.last[ch];
             self.imin[ch] = self.imin[ch].min(d);
             self.imax[ch] = self.imax[ch].max(d);
+            if let Some(p) = per {
+                (p.1, p.2) = (p.1.min(d), p.2.max(d));
+            }
             if d != self.interval[ch] && self.interval[ch] != 0 {
                 let name = self.names[ch].clone();
                 self.rec.record(
@@ -511,10 +525,31 @@ impl Invariants {
                 interval_cycles: self.interval[c],
                 interval_cycles_min: (self.imin[c] != u64::MAX).then_some(self.imin[c]),
                 interval_cycles_max: (self.imin[c] != u64::MAX).then_some(self.imax[c]),
+                modes: self.mode_stats(c),
             })
             .collect();
         let first_whole = self.origin.div_ceil(self.frame_cycles);
         (frames.saturating_sub(first_whole), channels)
+    }
+
+    /// Channel `c`'s figures in each mode (empty without modes).
+    fn mode_stats(&self, c: usize) -> Vec<ModeStats> {
+        (self.stat_m.iter().enumerate())
+            .map(|(m, st)| {
+                let (samples, lo, hi) = st[c];
+                ModeStats {
+                    mode: self
+                        .mode_names
+                        .get(m)
+                        .cloned()
+                        .unwrap_or_else(|| m.to_string()),
+                    samples,
+                    interval_cycles: self.interval_m[m][c],
+                    interval_cycles_min: (lo != u64::MAX).then_some(lo),
+                    interval_cycles_max: (lo != u64::MAX).then_some(hi),
+                }
+            })
+            .collect()
     }
 
     /// Records a violation found outside the conversion-level checks.

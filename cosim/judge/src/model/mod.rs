@@ -16,5 +16,5 @@ pub use modes::ModeTrack;
 pub(crate) use reference::Conversion;
 pub use reference::{CycleModel, SlotModel};
 pub use rule::Rule;
-pub use verdict::{counted, ChannelStats, Divergence, Verdict, Violation};
+pub use verdict::{counted, ChannelStats, Divergence, ModeStats, Verdict, Violation};
 pub(crate) use verdict::{verdict_word, LinkJoin};

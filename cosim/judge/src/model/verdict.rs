@@ -15,6 +15,21 @@ pub struct ChannelStats {
     pub interval_cycles: u64,
     pub interval_cycles_min: Option<u64>,
     pub interval_cycles_max: Option<u64>,
+    /// A mix with modes: the same figures in each mode (intervals restart
+    /// at a switch); the fields above span every mode.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub modes: Vec<ModeStats>,
+}
+
+/// A channel's figures in one mode of a run.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct ModeStats {
+    pub mode: String,
+    pub samples: u64,
+    /// Nominal interval in that mode (0: not sampled in it).
+    pub interval_cycles: u64,
+    pub interval_cycles_min: Option<u64>,
+    pub interval_cycles_max: Option<u64>,
 }
 
 /// A difference between the design's pins and the reference model.
