@@ -132,6 +132,7 @@ pub fn budget_tables(r: &AuditReport) -> Vec<(String, Table)> {
             "Modes: the tables above are the reset mode's; each mode's own figures".into(),
             modes(r),
         ));
+        out.push(("Branch budgets in every mode".into(), mode_branches(r)));
     }
     if !r.triggers.is_empty() {
         out.push(("Triggers and their worst reaction".into(), triggers(r)));
@@ -296,15 +297,47 @@ fn branch_caption(r: &AuditReport) -> String {
             .max(a.adc_utilization)
             .total_cmp(&b.utilization.max(b.adc_utilization))
     });
+    // a mix with modes: these are the reset mode's budgets (every mode's
+    // follow in their own table)
+    let mode = match r.modes.first().filter(|_| r.modes.len() > 1) {
+        Some(m) => format!(" in the reset mode `{}`", m.name),
+        None => String::new(),
+    };
     match tight {
         Some(b) => format!(
-            "Branch budgets: `{}` is the most used ({} of its slots, {} of its converter)",
+            "Branch budgets{mode}: `{}` is the most used ({} of its slots, {} of its converter)",
             b.name,
             pct(b.utilization),
             pct(b.adc_utilization)
         ),
-        None => "Branch budgets".into(),
+        None => format!("Branch budgets{mode}"),
     }
+}
+
+/// A mix with modes: every branch's budget in every mode, from the audit's
+/// per-mode tables.
+fn mode_branches(r: &AuditReport) -> Table {
+    let mut t = Table::new(&[
+        "mode",
+        "branch",
+        "conversions per frame",
+        "slots used",
+        "converter use (samples/s)",
+        "converter used",
+    ]);
+    for m in &r.modes {
+        for b in &m.branches {
+            t.push(vec![
+                m.name.clone(),
+                b.name.clone(),
+                b.conversions_per_frame.to_string(),
+                pct(b.utilization),
+                b.demand_sps.to_string(),
+                pct(b.adc_utilization),
+            ]);
+        }
+    }
+    t
 }
 
 /// A row per branch, led by what binds and the room left.

@@ -72,12 +72,21 @@ fn ms(v: &[(f64, f64)]) -> Vec<(f64, f64)> {
     v.iter().map(|p| (p.0 * 1e3, p.1)).collect()
 }
 
-/// The mix's rates, fastest first, each with its first channel.
-fn rates(s: &Schedule) -> Vec<(u64, usize)> {
-    let mut v: Vec<(u64, usize)> = Vec::new();
-    for (i, c) in s.mix.channels.iter().enumerate() {
-        if !v.iter().any(|r| r.0 == c.rate_hz) {
-            v.push((c.rate_hz, i));
+/// The mix's rates, fastest first, each with the schedule that samples it
+/// (a mix with modes: every mode's rates, each in the first mode that has
+/// it) and its first channel there.
+fn rates(s: &Schedule) -> Vec<(u64, &Schedule, usize)> {
+    let scheds: Vec<&Schedule> = if s.modes.len() > 1 {
+        s.modes.iter().collect()
+    } else {
+        vec![s]
+    };
+    let mut v: Vec<(u64, &Schedule, usize)> = Vec::new();
+    for ms in scheds {
+        for (i, c) in ms.mix.channels.iter().enumerate() {
+            if c.rate_hz > 0 && !v.iter().any(|r| r.0 == c.rate_hz) {
+                v.push((c.rate_hz, ms, i));
+            }
         }
     }
     v.sort_by_key(|r| std::cmp::Reverse(r.0));
@@ -88,8 +97,8 @@ fn rates(s: &Schedule) -> Vec<(u64, usize)> {
 pub fn figure7(s: &Schedule) -> Result<(Section, String), String> {
     let mut figures = Vec::new();
     let mut lines = Vec::new();
-    for (rate, ch) in rates(s) {
-        let (fig_t, fig_s, line) = aliasing(s, rate as f64, ch)?;
+    for (rate, ms, ch) in rates(s) {
+        let (fig_t, fig_s, line) = aliasing(ms, rate as f64, ch)?;
         figures.push(fig_t);
         figures.push(fig_s);
         lines.push(line);
@@ -101,7 +110,7 @@ pub fn figure7(s: &Schedule) -> Result<(Section, String), String> {
         Section {
             title: "Figure 7: sampling rate against what a channel sees".into(),
             paragraphs: vec![
-                format!("The paper's Figure 7 for this mix's own rates: the sampling instants of this schedule (the slot-level model's, which the co-simulation checks against the gateware cycle by cycle) and the ADC model's codes of a sine on every input. For each rate a tone at {:.1} x its Nyquist frequency is sampled by a channel of that rate: the samples (markers) follow a slower sine, and the spectrum of the samples peaks at the folded frequency |f - rate|, not at f.", 2.0 * TONE),
+                format!("The paper's Figure 7 for this mix's own rates{}: the sampling instants of this schedule (the slot-level model's, which the co-simulation checks against the gateware cycle by cycle) and the ADC model's codes of a sine on every input. For each rate a tone at {:.1} x its Nyquist frequency is sampled by a channel of that rate: the samples (markers) follow a slower sine, and the spectrum of the samples peaks at the folded frequency |f - rate|, not at f.", modal_words(s), 2.0 * TONE),
                 "The last panel is the other half of the figure: a slow signal on the mix's slowest channel keeps its shape, shown against that channel's own input signal (not another channel's).".into(),
                 format!("{line}."),
             ],
@@ -110,6 +119,15 @@ pub fn figure7(s: &Schedule) -> Result<(Section, String), String> {
         },
         line,
     ))
+}
+
+/// What "this mix's rates" are in a mix with modes.
+fn modal_words(s: &Schedule) -> &'static str {
+    if s.modes.len() > 1 {
+        " in every mode (each rate on the schedule of the first mode that samples at it)"
+    } else {
+        ""
+    }
 }
 
 /// The time and spectrum panels of a tone above `rate`'s Nyquist frequency.
@@ -243,7 +261,7 @@ fn where_aliasing_puts_it(f: f64, rate: f64, seen: f64, want: f64) -> Result<(),
 /// that channel's own input.
 fn slow(s: &Schedule) -> Result<(Figure, String), String> {
     let all = rates(s);
-    let (&(rate, ch), fastest) = (all.last().ok_or("no channels")?, all[0].0);
+    let (&(rate, s, ch), fastest) = (all.last().ok_or("no channels")?, all[0].0);
     let rate = rate as f64;
     let f = rate / 10.0;
     let tr = run(s, f, frames_for(s, 2.0 / f), ch);

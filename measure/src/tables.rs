@@ -273,6 +273,42 @@ pub fn fault_table(c: &campaign::Campaign) -> Table {
 mod tests {
     use super::*;
 
+    /// A mode mix run through a switch and back: the intervals table has a
+    /// row per mode, branch and rate, each row's promised interval is the
+    /// audit's for that mode and channel, and a jitter-free run shows no
+    /// jitter (the figures spanning both modes showed the switch's gap).
+    #[test]
+    fn a_mode_mixs_intervals_are_each_modes_own_and_jitter_free() {
+        let path = testkit::mix("modes-pin");
+        let mix = lut_gen::load(&path).unwrap();
+        let s = lut_gen::synthesize(&mix).unwrap();
+        let r = lut_gen::AuditReport::of_schedule(&s);
+        let mut dut = judge::ModeRequests::new(&s, judge::ModelDut::new(&s), &[(1, 1), (5, 0)]);
+        let v = judge::run_dut(
+            &s,
+            &mut dut,
+            9,
+            &judge::RunOptions::default(),
+            "model",
+            None,
+        );
+        assert!(v.ok, "{}", v.summary());
+        let t = interval_table(&s, &v);
+        assert_eq!(t.columns[0], "mode");
+        let mut modes_seen = std::collections::BTreeSet::new();
+        for row in &t.rows {
+            let m = r.modes.iter().find(|m| m.name == row[0]).unwrap();
+            modes_seen.insert(row[0].clone());
+            for name in row[3].split(", ") {
+                let c = m.channels.iter().find(|c| c.name == name).unwrap();
+                assert_eq!(row[2], c.rate_hz.to_string(), "{row:?}");
+                assert_eq!(row[5], c.interval_cycles.to_string(), "{row:?}");
+            }
+            assert_eq!(row[7], "0", "{row:?}");
+        }
+        assert_eq!(modes_seen.len(), r.modes.len());
+    }
+
     /// 20 slices and fewer rotation groups: a row per slice, a column per
     /// group (a column per slice, 21 wide, overflowed the report's page).
     #[test]

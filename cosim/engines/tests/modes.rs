@@ -170,6 +170,38 @@ fn auto_select_switches_to_contact_and_back_under_touch() {
     assert_eq!(gv, got, "rusthdl and verilator agree");
 }
 
+/// Converters with a command word in mode mixes (an MCP3208 whose rate
+/// changes, an AD7689 whose word selects the conversion after next, a
+/// listening AD7940): under pin requests and under a touch of the AD7689's
+/// watched channel, rust-hdl and Verilator switch as the model decides and
+/// pass it in every cycle (the AD7689's words across a switch, the
+/// model's words after one, and a trigger window that saw the AD7689's
+/// prepared conversions were each wrong).
+#[test]
+fn command_word_converters_switch_modes_on_rusthdl_and_verilator() {
+    for (name, req, stim) in [
+        ("cmd-modes", vec![(1, 1), (4, 0)], "pattern"),
+        ("cmd-modes-auto", vec![], "touch:C7@1-3"),
+    ] {
+        let s = schedule(name);
+        let stim = Stimulus::parse_for(stim, &s).unwrap();
+        let frames = 9;
+        let mut rtl = engines::RustHdlDut::new(&s).unwrap();
+        let (v, got) = run(&s, &mut rtl, frames, &req, stim);
+        assert!(v.ok, "{name} rusthdl: {}", v.summary());
+        let modes: Vec<u8> = got.iter().map(|f| f.0).collect();
+        assert!(
+            modes.contains(&1) && modes[0] == 0 && *modes.last().unwrap() == 0,
+            "{name}: {modes:?}"
+        );
+        counts_follow_modes(&s, &got, name);
+        let (mut ver, _) = VerilatedDut::new(&engines::verilog(&s).unwrap()).unwrap();
+        let (vv, gv) = run(&s, &mut ver, frames, &req, stim);
+        assert!(vv.ok, "{name} verilator: {}", vv.summary());
+        assert_eq!(gv, got, "{name}: rusthdl and verilator agree");
+    }
+}
+
 #[test]
 fn random_mode_mixes_switch_on_rusthdl_as_the_model_decides() {
     let (mut ran, mut holds) = ((0, 0), 0);

@@ -32,7 +32,7 @@ pub(super) fn core_glue(
     s.push_str("always @(*) begin\n");
     child_inputs(&mut s, nb, seq_of, pulse_of, modes.is_none());
     if let Some((pin, lanes)) = modes {
-        mode_inputs(&mut s, nb, pin, lanes);
+        mode_inputs(&mut s, nb, pin, lanes, cmd_of);
     }
     let act_read = queue_inputs(&mut s, nb, queue, step);
     command_units(&mut s, seq_of, cmd_of);
@@ -225,7 +225,7 @@ fn command_units(s: &mut String, seq_of: &[usize], cmd_of: &[Option<usize>]) {
 
 /// The mode block's inputs, the ROM address and mode information it gives
 /// every branch in place of the timing generator's, and the `mode` port.
-fn mode_inputs(s: &mut String, nb: usize, pin: bool, lanes: usize) {
+fn mode_inputs(s: &mut String, nb: usize, pin: bool, lanes: usize, cmd_of: &[Option<usize>]) {
     let g = "modes$0";
     s.push_str(&format!(
         "  {g}$clock = clock;\n  {g}$rst = rst;\n  {g}$start1 = timing$start1;\n  {g}$addr = timing$addr;\n"
@@ -235,9 +235,14 @@ fn mode_inputs(s: &mut String, nb: usize, pin: bool, lanes: usize) {
     } else {
         s.push_str(&format!("  {g}$mode_sel = {MODE_BITS}'h0;\n"));
     }
+    // a prepared conversion (selected by no word of ours) is no sample, so
+    // no trigger's window sees it: gated as the merger's `done` (the twin's)
     let done: Vec<String> = (0..nb)
         .rev()
-        .map(|b| format!("branches${b}$done"))
+        .map(|b| match cmd_of[b] {
+            Some(i) => format!("(branches${b}$done & cmds${i}$live)"),
+            None => format!("branches${b}$done"),
+        })
         .collect();
     let pad = if nb < MAX_BRANCHES {
         format!("{}'h0, ", MAX_BRANCHES - nb)
