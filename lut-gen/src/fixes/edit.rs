@@ -28,6 +28,13 @@ pub(super) enum Edit {
 /// table an edit names is missing (the candidate is then not offered).
 pub(super) fn apply(text: &str, edits: &[Edit]) -> Option<String> {
     let mut doc: DocumentMut = text.parse().ok()?;
+    let named: Vec<&str> = (edits.iter())
+        .filter_map(|e| match e {
+            Edit::MoveChannel { name, .. } | Edit::Rate { name, .. } => Some(name.as_str()),
+            _ => None,
+        })
+        .collect();
+    write_out_rows(&mut doc, &named)?;
     for e in edits {
         apply_one(&mut doc, e)?;
     }
@@ -69,6 +76,56 @@ fn apply_one(doc: &mut DocumentMut, e: &Edit) -> Option<()> {
             doc.get_mut("link")?
                 .as_table_like_mut()?
                 .insert("baud", value(*baud as i64));
+        }
+    }
+    Some(())
+}
+
+/// Every bulk row (`name = "P{0..7}"`) holding one of `names`, written out
+/// in place as the channels it stands for (each counter it has counted up
+/// as the loader counts it), so that an edit can change one of them: the
+/// mix is the same, its rows now one table each.
+fn write_out_rows(doc: &mut DocumentMut, names: &[&str]) -> Option<()> {
+    let Some(aot) = doc
+        .get_mut("channel")
+        .and_then(Item::as_array_of_tables_mut)
+    else {
+        return Some(());
+    };
+    let rows: Vec<(Table, Vec<String>)> = (aot.iter())
+        .map(|t| {
+            let written = t.get("name").and_then(Item::as_str).unwrap_or("");
+            let each = crate::mix::expand_names(written).unwrap_or_default();
+            (t.clone(), each)
+        })
+        .collect();
+    if !rows
+        .iter()
+        .any(|(_, each)| each.len() > 1 && each.iter().any(|n| names.contains(&n.as_str())))
+    {
+        return Some(());
+    }
+    aot.clear();
+    for (t, each) in rows {
+        if each.len() < 2 || !each.iter().any(|n| names.contains(&n.as_str())) {
+            aot.push(t);
+            continue;
+        }
+        // behind a front mux the row counts `front_input`, else `input`
+        let counted = if t.contains_key("front_input") {
+            "front_input"
+        } else {
+            "input"
+        };
+        for (step, name) in each.iter().enumerate() {
+            let mut one = t.clone();
+            one.insert("name", value(name.as_str()));
+            for key in [counted, "member"] {
+                if let Some(v) = t.get(key).and_then(Item::as_integer) {
+                    one.insert(key, value(v + step as i64));
+                }
+            }
+            aot.push(one);
         }
     }
     Some(())

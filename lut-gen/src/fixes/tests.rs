@@ -162,3 +162,27 @@ fn a_forced_grid_that_cannot_hold_the_mix_is_freed() {
     let keys = found.fixes[0].text.lines().filter(|l| !l.starts_with('#'));
     assert!(!keys.into_iter().any(|l| l.contains("slots_per_slice")));
 }
+
+/// A mix written with bulk rows is the mix written out: its fixes are the
+/// same, and each fixed text (the rows it touches written out) is feasible.
+#[test]
+fn a_bulk_row_gets_the_fixes_of_its_channels_written_out() {
+    let rows = format!(
+        "{HEAD}{}{}[[channel]]\nname = \"P{{0..43}}\"\nbranch = \"taxels\"\nrate_hz = 2_500\n[[channel]]\nname = \"S{{0..5}}\"\nbranch = \"slow\"\nrate_hz = 500\n",
+        branch("taxels", 6),
+        branch("slow", 1)
+    );
+    let written = over_full_taxels().replace("name = \"T", "name = \"P");
+    let found = |text: &str| {
+        let (mix, why) = infeasible(text);
+        search(Path::new("t.toml"), text, &mix, &why)
+    };
+    let (a, b) = (found(&rows), found(&written));
+    assert!(!a.fixes.is_empty(), "{a}");
+    let words = |f: &FixSearch| f.fixes.iter().map(|x| x.says.clone()).collect::<Vec<_>>();
+    assert_eq!(words(&a), words(&b));
+    for f in &a.fixes {
+        let mix = crate::parse(Path::new("fix.toml"), &f.text).unwrap();
+        assert!(crate::synthesize(&mix).is_ok(), "{}", f.text);
+    }
+}
