@@ -70,6 +70,12 @@ fn edges(sig: &[(u64, u128)], b: usize) -> Vec<(u64, bool)> {
 /// part holding its input: CS falling, or (`after` = Some(n)) the falling
 /// SCLK after the n-th rising SCLK since CS fell.
 fn measured(w: &Wave, b: usize, after: Option<usize>) -> Vec<u64> {
+    held(w, b, after, false)
+}
+
+/// [`measured`] of a lane whose conversion starts at a rising edge (`cnv`:
+/// a CNV part's lane of `adc_cs_n`) or a falling one.
+fn held(w: &Wave, b: usize, after: Option<usize>, cnv: bool) -> Vec<u64> {
     let (clk, rst) = (&w["clk"], &w["rst"]);
     // cycle 0 begins at the first rising clock edge that samples rst low
     let t0 = clk
@@ -80,7 +86,7 @@ fn measured(w: &Wave, b: usize, after: Option<usize>) -> Vec<u64> {
     let cs = edges(&w["adc_cs_n"], b);
     let sclk = edges(&w["adc_sclk"], b);
     let mut out = Vec::new();
-    for &(t, _) in cs.iter().filter(|e| !e.1) {
+    for &(t, _) in cs.iter().filter(|e| e.1 == cnv) {
         let held = match after {
             None => Some(t),
             Some(n) => {
@@ -111,6 +117,7 @@ fn run(mix: &Path, frames: u64, dir: &Path) -> (Wave, Vec<(String, u64)>) {
         ])
         .arg("--vcd")
         .arg(&vcd)
+        .args(["--to", &frames.to_string()])
         .arg("--samples")
         .arg(&csv)
         .assert()
@@ -272,4 +279,51 @@ fn the_vdd_advice_works_as_printed() {
     let text = slotforge().arg("audit").arg(&m).assert().success();
     let t = String::from_utf8_lossy(&text.get_output().stdout).to_string();
     assert!(t.contains("VDD") && t.contains("+3.104us"), "{t}");
+}
+
+/// Random mixes of an MCP3208 (at a random SCLK and supply), a listening
+/// AD7940 and an AD7689, channels on random inputs at random rates: every
+/// `sampled_s` is an instant the waveform shows its part holding its input.
+#[test]
+fn random_mixes_are_sampled_where_the_waveform_says() {
+    let dir = tempfile::tempdir().unwrap();
+    for seed in 1..=4u64 {
+        let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+        let mut next = |n: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % n
+        };
+        let (vdd, sclk) =
+            [("", 1_000_000), ("vdd = 5.0\n", 2_000_000), ("", 500_000)][(seed % 3) as usize];
+        let mut t = format!(
+            "name = \"r{seed}\"\n[clock]\nhz = 24000000\n[frame]\nperiod_us = 1000\nslice_us = 500\n\
+             [[branch]]\nname = \"m\"\nadc = \"mcp3208\"\nmux = \"internal\"\nsclk_hz = {sclk}\n{vdd}\
+             [[branch]]\nname = \"l\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n\
+             [[branch]]\nname = \"a\"\nadc = \"ad7689\"\nmux = \"internal\"\n"
+        );
+        let mut names: Vec<Vec<String>> = vec![Vec::new(); 3];
+        for (b, branch) in ["m", "l", "a"].iter().enumerate() {
+            let mut inputs: Vec<u64> = (0..8).collect();
+            for _ in 0..2 + next(3) {
+                let input = inputs.remove(next(inputs.len() as u64) as usize);
+                let rate = [2000, 4000][next(2) as usize];
+                let name = format!("{branch}{input}");
+                t += &format!(
+                    "[[channel]]\nname = \"{name}\"\nbranch = \"{branch}\"\nrate_hz = {rate}\ninput = {input}\n"
+                );
+                names[b].push(name);
+            }
+        }
+        let m = dir.path().join(format!("r{seed}.toml"));
+        std::fs::write(&m, &t).unwrap();
+        let (w, samples) = run(&m, 2, dir.path());
+        let on = |b: usize| names[b].iter().map(String::as_str).collect::<Vec<_>>();
+        agree(&samples, &on(0), &held(&w, 0, Some(6), false));
+        agree(&samples, &on(1), &held(&w, 1, None, false));
+        // the AD7689's first two conversions are prepared, never data
+        let a = held(&w, 2, None, true);
+        agree(&samples, &on(2), &a);
+    }
 }
