@@ -327,3 +327,60 @@ fn random_mixes_are_sampled_where_the_waveform_says() {
         agree(&samples, &on(2), &a);
     }
 }
+
+/// `decode`'s `sampled_s` is the part's instant too: an MCP3208 mix with a
+/// UART decodes to the samples `sim --samples` wrote, with their
+/// `sampled_s` (each MCP3208 sample 6.104 us after a slot's start).
+#[test]
+fn decode_gives_each_part_its_instant() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("testkit/mixes/cmd-mcp3208.toml")).unwrap();
+    let m = dir.path().join("uart.toml");
+    std::fs::write(&m, text + "\n[link]\nkind = \"uart\"\nbaud = 3_000_000\n").unwrap();
+    let (line, sim, dec) = (
+        dir.path().join("line.bin"),
+        dir.path().join("s.csv"),
+        dir.path().join("d.csv"),
+    );
+    slotforge()
+        .arg("sim")
+        .arg(&m)
+        .args(["--backend", "rusthdl", "--frames", "3", "--link-bytes"])
+        .arg(&line)
+        .arg("--samples")
+        .arg(&sim)
+        .assert()
+        .success();
+    slotforge()
+        .arg("decode")
+        .arg(&m)
+        .arg(&line)
+        .arg("-o")
+        .arg(&dec)
+        .assert()
+        .success();
+    let rows = |p: &Path, ch: usize, v: usize, t: usize| -> Vec<(String, String, String)> {
+        let text = std::fs::read_to_string(p).unwrap();
+        let f = |l: &str| l.split(',').map(str::to_string).collect::<Vec<_>>();
+        text.lines()
+            .skip(1)
+            .map(|l| {
+                let r = f(l);
+                (r[ch].clone(), r[v].clone(), r[t].clone())
+            })
+            .collect()
+    };
+    let (s, d) = (rows(&sim, 2, 3, 1), rows(&dec, 2, 3, 4));
+    assert!(d.len() > 20, "{d:?}");
+    let mut mcp = 0;
+    for r in &d {
+        assert!(s.contains(r), "decoded {r:?} is no sample of the run");
+        if r.0.starts_with('M') {
+            // slots of 6000 cycles at 48 MHz: 293 cycles into one
+            let cycles: f64 = r.2.parse::<f64>().unwrap() * 48e6;
+            assert_eq!(cycles.round() as u64 % 6000, 293, "{r:?}");
+            mcp += 1;
+        }
+    }
+    assert!(mcp > 5);
+}
