@@ -381,13 +381,14 @@ impl AdcPart {
     }
 
     /// MCP3208 (Microchip DS21298E), the VDD = 2.7 V column of Table 1-1
-    /// (the conservative one): f_CLK 1 MHz max, 50 ksps; t_SUCS (CS fall to
+    /// (the conservative one, its lowest supply; `supplies` holds the 5 V
+    /// column, [`AdcPart::at_supply`]): f_CLK 1 MHz max, 50 ksps; t_SUCS (CS fall to
     /// the first rising clock) 100 ns, t_CSH (CS disable) 500 ns, t_DO (clock
     /// fall to data valid) 200 ns; below 10 kHz the sample capacitor droops
     /// (section 6.2).  Section 5.0 and Figure 6-1 give the word: the start
     /// bit and SGL/DIFF, then D2 D1 D0 on the first five rising clocks; one
-    /// more clock completes the sample (its hold is about 5.5 SCLK periods
-    /// after CS falls, a fixed offset), the null bit follows and B11..B0 are
+    /// more clock completes the sample (the input is held at the falling
+    /// edge after rising edge 6, [`SampleAt::SclkFall`]), the null bit follows and B11..B0 are
     /// read on rising edges 8..19: eight serial bits before the MSB, one
     /// clock after the LSB.  SPI mode 1,1: SCLK idles high, the same style as
     /// the AD7940.

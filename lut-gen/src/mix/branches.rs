@@ -323,9 +323,10 @@ impl Cx<'_> {
     /// a conversion's input from the cycle after the branch's previous
     /// instant through the instant itself, and move on one cycle after it.
     /// A part whose word applies to the conversion that carries it
-    /// (`ahead` 0: the MCP3208, Figure 6-1, samples from the 4th rising SCLK
-    /// after the start bit to the 5th falling one, inside the transaction)
-    /// would sample the next conversion's front input: refused.  A part that
+    /// (`ahead` 0: the MCP3208, section 5.0, holds its input at the falling
+    /// SCLK after the 6th rising one since CS fell, inside the transaction)
+    /// would sample the next conversion's front input: refused, as is any
+    /// part that samples after its start edge ([`crate::parts::SampleAt`]).  A part that
     /// samples at its instant (CNV rising, or a CS part whose word applies
     /// to a later conversion, as the AD7689 and the ADS7953) has its front
     /// input settled there, whatever its word selects.
