@@ -36,6 +36,9 @@ mod hints;
 #[path = "icarus.rs"]
 mod icarus;
 
+#[path = "instants.rs"]
+mod instants;
+
 #[path = "link.rs"]
 mod link;
 

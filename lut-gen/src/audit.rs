@@ -96,6 +96,19 @@ pub struct PartAudit {
     /// branch's `adc_max_sps`, the same value.
     pub max_conversions_hz: f64,
     pub max_samples_hz: f64,
+    /// The supply whose datasheet figures (`max_sps`, `sclk_max_hz`,
+    /// `conversion_ns`) apply, in volts: the branch's `vdd`, or the part's
+    /// lowest supply when the mix says none (`vdd_given` false); `None`
+    /// for a declared part (one set of figures).
+    pub vdd_v: Option<f64>,
+    pub vdd_given: bool,
+    /// Where the part holds its input: at the conversion's start edge, or
+    /// at a falling SCLK edge inside its transaction; and how long after
+    /// the start edge that is (cycles, and ns): what `sampled_s` adds to
+    /// the conversion's start.
+    pub sample_at: crate::parts::SampleAt,
+    pub sample_after_cycles: u64,
+    pub sample_after_ns: f64,
 }
 
 impl PartAudit {
@@ -121,6 +134,11 @@ impl PartAudit {
             read_cycles: spi.map(|t| t.read_cycles).unwrap_or(0),
             max_conversions_hz: samples_hz / br.chain as f64,
             max_samples_hz: samples_hz,
+            vdd_v: br.supply_mv().map(|mv| mv as f64 / 1000.0),
+            vdd_given: br.vdd_mv.is_some(),
+            sample_at: a.sample,
+            sample_after_cycles: spi.map_or(0, |t| t.sample_cycles),
+            sample_after_ns: cycles_to_ns(spi.map_or(0, |t| t.sample_cycles), mix.clock_hz),
         }
     }
 }
@@ -512,7 +530,8 @@ impl ChannelAudit {
             samples_per_frame: n as u64,
             interval_cycles: lo,
             jitter_cycles: hi - lo,
-            first_sample_cycle: slots.first().copied().unwrap_or(0) * g.slot_cycles,
+            first_sample_cycle: slots.first().copied().unwrap_or(0) * g.slot_cycles
+                + s.sample_after(ch.branch),
             device: s.channels[c].device,
             select: s.channels[c].select,
             adc_input: {

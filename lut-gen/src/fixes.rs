@@ -70,6 +70,16 @@ pub enum Change {
     /// A faster UART (`[link].baud`): a standard baud the clock divides
     /// within the audit's tolerance.
     RaiseBaud { from: u64, to: u64 },
+    /// A branch's converter supply said (`vdd`): its datasheet's figures at
+    /// that supply instead of its lowest's (true only if the board runs the
+    /// part at it).
+    Supply {
+        branch: String,
+        part: String,
+        vdd_mv: u32,
+        sclk_max_hz: u64,
+        max_sps: u64,
+    },
 }
 
 /// A change that was applied, synthesized and audited feasible.
@@ -234,6 +244,19 @@ fn run(path: &Path, text: &str, mut cands: Vec<Candidate>) -> FixSearch {
     out
 }
 
+/// `text` with `vdd` set on the named branches (millivolts), or `None`
+/// when the text is not TOML or a branch is missing.
+pub(crate) fn with_vdd(text: &str, branches: &[(String, u32)]) -> Option<String> {
+    let edits: Vec<Edit> = branches
+        .iter()
+        .map(|(name, mv)| Edit::Vdd {
+            name: name.clone(),
+            mv: *mv,
+        })
+        .collect();
+    edit::apply(text, &edits)
+}
+
 /// Whether mix text audits feasible (parsed and validated, scheduled,
 /// within the gateware's limits, its link planned): its slots per slice.
 pub fn feasible(path: &Path, text: &str, budget: u64) -> Option<u64> {
@@ -308,6 +331,19 @@ pub fn words(c: &Change) -> String {
             "add a branch `{name}` built like `{like}` (its own ADC and mux) and move {} to it",
             names(channels)
         ),
+        Change::Supply {
+            branch,
+            part,
+            vdd_mv,
+            sclk_max_hz,
+            max_sps,
+        } => {
+            let v = crate::parts::volts(*vdd_mv);
+            format!(
+                "say `vdd = {v}` on branch `{branch}` if its {part} runs at {v} V (its datasheet's figures there: SCLK up to {}, {max_sps} S/s)",
+                crate::mix::hz_words(*sclk_max_hz)
+            )
+        }
         Change::RaiseBaud { from, to } => {
             format!("raise the link's baud from {from} to {to} (`[link] baud = {to}`)")
         }

@@ -371,7 +371,8 @@ pub fn merged_frame(s: &Schedule) -> Vec<(u64, u64, u16)> {
 /// the previous frame's end that left in this frame's first slice).
 #[derive(Debug, Clone)]
 pub struct PacketInstants {
-    per_slice: Vec<Vec<(u16, i64)>>,
+    /// (channel, conversion start, cycles to the sampling instant after it)
+    per_slice: Vec<Vec<(u16, i64, i64)>>,
     frame_cycles: u64,
     clock_hz: u64,
 }
@@ -384,7 +385,9 @@ impl PacketInstants {
             let w = v / g.slice_cycles;
             let k = (w % g.slices_per_frame) as usize;
             let shift = (w / g.slices_per_frame * g.frame_cycles) as i64;
-            per_slice[k].push((ch, i as i64 - shift));
+            // the part holds its input this long after its conversion starts
+            let held = s.sample_after(s.mix.channels[ch as usize].branch);
+            per_slice[k].push((ch, i as i64 - shift, held as i64));
         }
         PacketInstants {
             per_slice,
@@ -419,7 +422,8 @@ impl PacketInstants {
         ) else {
             return vec![None; channels.len()];
         };
-        let list: Vec<(u16, i64)> = before
+        // a conversion belongs to the frame it starts in
+        let list: Vec<(u16, i64, i64)> = before
             .iter()
             .filter(|e| e.1 < 0)
             .chain(own.iter().filter(|e| e.1 >= 0))
@@ -431,7 +435,11 @@ impl PacketInstants {
             .iter()
             .map(|&c| {
                 let m = channels.iter().filter(|&&x| x == c).count();
-                let have: Vec<i64> = list.iter().filter(|e| e.0 == c).map(|e| e.1).collect();
+                let have: Vec<i64> = list
+                    .iter()
+                    .filter(|e| e.0 == c)
+                    .map(|e| e.1 + e.2)
+                    .collect();
                 let i = seen.entry(c).or_insert(0);
                 let k = (have.len() + *i).checked_sub(m);
                 *i += 1;
@@ -549,7 +557,13 @@ mod tests {
             let stream = merged_frame(&s);
             assert!(!stream.is_empty());
             for (v, i, ch) in stream {
-                assert_eq!(s.sampled_at(ch as usize, v + f), Some(i + f), "{}", m.name);
+                let held = s.sample_after(s.mix.channels[ch as usize].branch);
+                assert_eq!(
+                    s.sampled_at(ch as usize, v + f),
+                    Some(i + f + held),
+                    "{}",
+                    m.name
+                );
             }
         }
     }

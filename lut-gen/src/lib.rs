@@ -38,7 +38,8 @@ pub use mix::{
     ModeSelect, Modes, Trigger, When, MAX_BAUD_ERROR_PCT,
 };
 pub use parts::{
-    ns_to_cycles, AdcPart, CmdBit, CnvRead, Command, MuxPart, SpiTiming, Start, TimingError,
+    ns_to_cycles, volts, AdcPart, CmdBit, CnvRead, Command, MuxPart, SampleAt, SpiTiming, Start,
+    Supply, TimingError,
 };
 
 // The schedule: synthesis, its independent proof, and what it promises.

@@ -26,10 +26,14 @@ mod modes;
 mod modes_tests;
 mod raw;
 #[cfg(test)]
+mod supply_tests;
+#[cfg(test)]
 mod tests;
 mod words;
 
+pub(crate) use branches::hz_words;
 pub use bulk::expand_names;
+pub(crate) use channels::SYNC_TOLERANCE_NS;
 use check::Cx;
 pub use modes::{ModeSelect, Modes, Trigger, When};
 use raw::RawMix;
@@ -158,6 +162,11 @@ pub struct Branch {
     pub settle_ns: u64,
     /// Parts of `adc` daisy-chained on this branch's port (1: no chain).
     pub chain: u32,
+    /// `vdd` as the mix gives it, in millivolts (`None`: not given, and
+    /// `adc` has its lowest supply's figures).  `adc` is the part at this
+    /// supply ([`AdcPart::at_supply`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vdd_mv: Option<u32>,
 }
 
 impl Branch {
@@ -168,6 +177,14 @@ impl Branch {
             (Some(c), true) => c.channels(),
             _ => self.mux.inputs * self.mux_devices,
         }
+    }
+
+    /// The supply whose datasheet figures `adc` has, in millivolts: `vdd`
+    /// as given, or the part's lowest (`None`: a part without a supply
+    /// table).
+    pub fn supply_mv(&self) -> Option<u32> {
+        self.vdd_mv
+            .or_else(|| self.adc.vdd_range_mv().map(|(lo, _)| lo))
     }
 
     /// The SPI timing of this branch's port at `clock_hz`.
@@ -314,8 +331,68 @@ pub fn load(path: &Path) -> Result<Mix, MixError> {
 }
 
 /// Parses and validates mix text; `file` is only used in messages.
+///
+/// A refusal that a higher supply would lift (an SCLK above the part's
+/// figure at its lowest supply, no `vdd`) suggests the `vdd` only after
+/// the mix with it (and any further `vdd` the mix then needs) has been
+/// parsed, scheduled and audited feasible.
 pub fn parse(file: &Path, text: &str) -> Result<Mix, MixError> {
-    let cx = Cx { file, text };
-    let raw: RawMix = toml::from_str(text).map_err(|e| cx.toml_error(&e))?;
-    cx.validate(raw)
+    let (r, hint) = parse_once(file, text);
+    match (r, hint) {
+        (Err(mut e), Some(h)) => {
+            if let Some(said) = supply_advice(file, text, h) {
+                e.message.push_str(&said);
+            }
+            Err(e)
+        }
+        (r, _) => r,
+    }
+}
+
+/// Parses and validates once: the result, and the supply a refusal hints at.
+fn parse_once(file: &Path, text: &str) -> (Result<Mix, MixError>, Option<check::SupplyHint>) {
+    let cx = Cx {
+        file,
+        text,
+        hint: Default::default(),
+    };
+    let r = toml::from_str::<RawMix>(text)
+        .map_err(|e| cx.toml_error(&e))
+        .and_then(|raw| cx.validate(raw));
+    let hint = cx.hint.borrow_mut().take();
+    (r, hint)
+}
+
+/// The advice for a supply hint, when the mix with that `vdd` (and any
+/// further ones its branches then need, at most one per branch) audits
+/// feasible: `; say ...`.
+fn supply_advice(file: &Path, text: &str, first: check::SupplyHint) -> Option<String> {
+    let mut hints = vec![first];
+    loop {
+        let edits: Vec<(String, u32)> =
+            hints.iter().map(|h| (h.branch.clone(), h.vdd_mv)).collect();
+        let edited = crate::fixes::with_vdd(text, &edits)?;
+        match parse_once(file, &edited) {
+            (Ok(_), _) => {
+                crate::fixes::feasible(file, &edited, crate::fixes::CANDIDATE_BUDGET)?;
+                break;
+            }
+            (Err(_), Some(h)) if !hints.iter().any(|x| x.branch == h.branch) => hints.push(h),
+            _ => return None,
+        }
+    }
+    let said: Vec<String> = hints
+        .iter()
+        .map(|h| {
+            let v = crate::parts::volts(h.vdd_mv);
+            format!(
+                "say `vdd = {v}` on branch `{}` if its {} runs at {v} V",
+                h.branch, h.part
+            )
+        })
+        .collect();
+    Some(format!(
+        "; {} (the mix then audits feasible)",
+        said.join(", and ")
+    ))
 }

@@ -77,6 +77,74 @@ impl CnvRead {
     }
 }
 
+/// Where in its transaction a part holds its input (its sampling instant),
+/// as its datasheet says.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SampleAt {
+    /// At the edge that starts the conversion: CS falling (AD7940, a "cs"
+    /// part) or CNV rising (AD7685, AD7689, a "cnv" part).
+    #[default]
+    Start,
+    /// At the falling SCLK edge after rising SCLK edge `n`, counted from CS
+    /// falling: the end of the part's sample window inside its
+    /// transaction (MCP3208: `n` = 6, DS21298E section 5.0).
+    SclkFall(u32),
+}
+
+impl SampleAt {
+    fn is_start(&self) -> bool {
+        *self == SampleAt::Start
+    }
+
+    /// The instant in words, as the audit and errors say it.
+    pub fn words(self, start: Start) -> String {
+        match (self, start) {
+            (SampleAt::Start, Start::Cs) => "at its CS fall".into(),
+            (SampleAt::Start, Start::Cnv) => "at its CNV rise".into(),
+            (SampleAt::SclkFall(n), _) => {
+                format!(
+                    "at the falling SCLK edge after the {}{} rising one since CS fell",
+                    n,
+                    ordinal(n)
+                )
+            }
+        }
+    }
+}
+
+fn ordinal(n: u32) -> &'static str {
+    match (n % 10, n % 100) {
+        (1, x) if x != 11 => "st",
+        (2, x) if x != 12 => "nd",
+        (3, x) if x != 13 => "rd",
+        _ => "th",
+    }
+}
+
+/// A part's datasheet figures at one supply: they hold from `from_mv` up to
+/// the next figure's supply (or the part's `vdd_max_mv`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub struct Supply {
+    /// The lowest VDD, in millivolts, these figures hold at.
+    pub from_mv: u32,
+    pub sclk_max_hz: u64,
+    pub max_sps: u64,
+    /// CNV parts: t_CONV max at this supply; 0 for CS parts.
+    pub conversion_ns: u64,
+}
+
+/// Millivolts as volts the way a user writes them: `5.0`, `2.7`, `4.5`.
+pub fn volts(mv: u32) -> String {
+    let s = format!("{:.2}", mv as f64 / 1000.0);
+    let s = s.trim_end_matches('0');
+    if s.ends_with('.') {
+        format!("{s}0")
+    } else {
+        s.to_string()
+    }
+}
+
 /// A SAR ADC with a serial read-out, as data.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 pub struct AdcPart {
@@ -113,6 +181,18 @@ pub struct AdcPart {
     /// channel); `None`: the part only listens.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub command: Option<Command>,
+    /// Where in its transaction the part holds its input.
+    #[serde(skip_serializing_if = "SampleAt::is_start")]
+    pub sample: SampleAt,
+    /// The datasheet's figures by supply, lowest supply first (`sclk_max_hz`,
+    /// `max_sps` and `conversion_ns` above are the first's until
+    /// [`AdcPart::at_supply`] picks another); empty for a declared part (one
+    /// set of figures, no supply range).
+    #[serde(skip)]
+    pub supplies: Vec<Supply>,
+    /// The highest VDD the part takes, in millivolts (0: no supply range).
+    #[serde(skip)]
+    pub vdd_max_mv: u32,
 }
 
 /// One bit of a command word, as its template spells it.
@@ -245,6 +325,15 @@ impl AdcPart {
             data_hold_ns: 10,
             chain_max: 1,
             command: None,
+            sample: SampleAt::Start,
+            // Rev. A, Table 2: one column for VDD 2.5 V to 5.5 V
+            supplies: vec![Supply {
+                from_mv: 2_500,
+                sclk_max_hz: 2_500_000,
+                max_sps: 100_000,
+                conversion_ns: 0,
+            }],
+            vdd_max_mv: 5_500,
         }
     }
 
@@ -271,17 +360,35 @@ impl AdcPart {
             data_hold_ns: 5,
             chain_max: 8,
             command: None,
+            sample: SampleAt::Start,
+            // Rev. D, Tables 4 and 5: t_CONV 2.2 us, t_CYC 4 us from 4.5 V
+            supplies: vec![
+                Supply {
+                    from_mv: 2_300,
+                    sclk_max_hz: 12_500_000,
+                    max_sps: 200_000,
+                    conversion_ns: 3_200,
+                },
+                Supply {
+                    from_mv: 4_500,
+                    sclk_max_hz: 12_500_000,
+                    max_sps: 250_000,
+                    conversion_ns: 2_200,
+                },
+            ],
+            vdd_max_mv: 5_500,
         }
     }
 
     /// MCP3208 (Microchip DS21298E), the VDD = 2.7 V column of Table 1-1
-    /// (the conservative one): f_CLK 1 MHz max, 50 ksps; t_SUCS (CS fall to
+    /// (the conservative one, its lowest supply; `supplies` holds the 5 V
+    /// column, [`AdcPart::at_supply`]): f_CLK 1 MHz max, 50 ksps; t_SUCS (CS fall to
     /// the first rising clock) 100 ns, t_CSH (CS disable) 500 ns, t_DO (clock
     /// fall to data valid) 200 ns; below 10 kHz the sample capacitor droops
     /// (section 6.2).  Section 5.0 and Figure 6-1 give the word: the start
     /// bit and SGL/DIFF, then D2 D1 D0 on the first five rising clocks; one
-    /// more clock completes the sample (its hold is about 5.5 SCLK periods
-    /// after CS falls, a fixed offset), the null bit follows and B11..B0 are
+    /// more clock completes the sample (the input is held at the falling
+    /// edge after rising edge 6, [`SampleAt::SclkFall`]), the null bit follows and B11..B0 are
     /// read on rising edges 8..19: eight serial bits before the MSB, one
     /// clock after the LSB.  SPI mode 1,1: SCLK idles high, the same style as
     /// the AD7940.
@@ -304,6 +411,27 @@ impl AdcPart {
             data_hold_ns: 0,
             chain_max: 1,
             command: Some(Command::parse("11CCC", 0).expect("a valid template")),
+            // Section 5.0: the sample window opens on the 4th rising clock
+            // after the start bit and ends on the falling edge of the 5th
+            // clock after it; the start bit is latched on rising edge 1, so
+            // the input is held at the falling edge after rising edge 6.
+            sample: SampleAt::SclkFall(6),
+            // Table 1-1: f_CLK 1 MHz / 50 ksps at VDD 2.7 V, 2 MHz / 100 ksps at 5 V
+            supplies: vec![
+                Supply {
+                    from_mv: 2_700,
+                    sclk_max_hz: 1_000_000,
+                    max_sps: 50_000,
+                    conversion_ns: 0,
+                },
+                Supply {
+                    from_mv: 5_000,
+                    sclk_max_hz: 2_000_000,
+                    max_sps: 100_000,
+                    conversion_ns: 0,
+                },
+            ],
+            vdd_max_mv: 5_500,
         }
     }
 
@@ -339,7 +467,48 @@ impl AdcPart {
             data_hold_ns: 4,
             chain_max: 1,
             command: Some(Command::parse("1111_CCC_1_001_00_1", 2).expect("a valid template")),
+            sample: SampleAt::Start,
+            // Rev. D, Table 4: one column for VDD 2.3 V to 5.5 V
+            supplies: vec![Supply {
+                from_mv: 2_300,
+                sclk_max_hz: 12_500_000,
+                max_sps: 250_000,
+                conversion_ns: 2_200,
+            }],
+            vdd_max_mv: 5_500,
         }
+    }
+
+    /// The part at supply `vdd_mv` (`None`: its lowest supply): its SCLK,
+    /// throughput and conversion figures from the datasheet's column for
+    /// the highest supply at or below it.  A part without a supply table
+    /// is itself.
+    pub fn at_supply(&self, vdd_mv: Option<u32>) -> AdcPart {
+        let mut p = self.clone();
+        if let Some(f) = self.supply_figure(vdd_mv) {
+            p.sclk_max_hz = f.sclk_max_hz;
+            p.max_sps = f.max_sps;
+            p.conversion_ns = f.conversion_ns;
+        }
+        p
+    }
+
+    /// The datasheet column that holds at `vdd_mv` (`None`: the lowest).
+    pub fn supply_figure(&self, vdd_mv: Option<u32>) -> Option<Supply> {
+        let v = vdd_mv.unwrap_or(0);
+        self.supplies
+            .iter()
+            .rev()
+            .find(|f| f.from_mv <= v)
+            .or(self.supplies.first())
+            .copied()
+    }
+
+    /// The supply range the part takes, in millivolts (`None`: a declared
+    /// part without one).
+    pub fn vdd_range_mv(&self) -> Option<(u32, u32)> {
+        let lo = self.supplies.first()?.from_mv;
+        Some((lo, self.vdd_max_mv))
     }
 
     /// Serial clocks per word: leading bits, data bits, trailing bits.
@@ -468,6 +637,12 @@ pub struct SpiTiming {
     /// CNV parts: cycles from CNV rising to data available.
     #[serde(skip)]
     pub conv_cycles: u64,
+    /// Cycles from the transaction's start (CS falling, CNV rising) to the
+    /// part's sampling instant ([`SampleAt`]): 0 at the start edge; for
+    /// [`SampleAt::SclkFall`]`(n)` the cycle SCLK falls after rising edge
+    /// `n`, the start of serial period `n + 1`.
+    #[serde(skip)]
+    pub sample_cycles: u64,
 }
 
 /// Why a branch's part cannot be driven from this clock.
@@ -519,6 +694,10 @@ impl SpiTiming {
         let sclks = adc.word_sclks() as u64 * chain as u64;
         let read_cycles = setup_cycles + sclks * div;
         let throughput_cycles = clock_hz.div_ceil(adc.max_sps);
+        let sample_cycles = match adc.sample {
+            SampleAt::Start => 0,
+            SampleAt::SclkFall(n) => setup_cycles + n as u64 * div,
+        };
         let pin_cycles = match (adc.start, adc.read) {
             (Start::Cnv, CnvRead::CnvLow) => conv_cycles,
             _ => read_cycles,
@@ -538,6 +717,7 @@ impl SpiTiming {
             bits: adc.bits,
             leading_bits: adc.leading_bits,
             conv_cycles,
+            sample_cycles,
         })
     }
 
@@ -641,8 +821,36 @@ mod tests {
         let c = p.command.unwrap();
         assert_eq!(c.ahead, 0);
         assert_eq!(c.channels(), 8);
+        // held at the falling SCLK after rising edge 6: setup (100 ns = 5
+        // cycles) and six periods, 6.104 us after CS falls
+        assert_eq!(t.sample_cycles, 5 + 6 * 48);
+        let at5v = AdcPart::mcp3208().at_supply(Some(5_000));
+        let t5 = SpiTiming::derive(&at5v, 48_000_000, at5v.sclk_max_hz, 1).unwrap();
+        assert_eq!((t5.sclk_div, t5.sample_cycles), (24, 5 + 6 * 24));
         // Start, single-ended, then D2 D1 D0 = 1 0 1 for channel 5.
         assert_eq!(c.word(5), vec![true, true, true, false, true]);
+    }
+
+    #[test]
+    fn supplies_pick_the_datasheet_column_at_or_below_the_vdd() {
+        let m = AdcPart::mcp3208();
+        assert_eq!(m.sclk_max_hz, 1_000_000);
+        assert_eq!(m.at_supply(None), m);
+        assert_eq!(m.at_supply(Some(4_999)).sclk_max_hz, 1_000_000);
+        let hi = m.at_supply(Some(5_000));
+        assert_eq!((hi.sclk_max_hz, hi.max_sps), (2_000_000, 100_000));
+        assert_eq!(m.vdd_range_mv(), Some((2_700, 5_500)));
+        let a = AdcPart::ad7685().at_supply(Some(5_000));
+        assert_eq!((a.max_sps, a.conversion_ns), (250_000, 2_200));
+        for p in AdcPart::known() {
+            let p = AdcPart::by_name(p).unwrap();
+            // without a vdd, every built-in part is its lowest supply's
+            assert_eq!(p.at_supply(None), p, "{}", p.name);
+        }
+        assert_eq!(volts(5_000), "5.0");
+        assert_eq!(volts(2_700), "2.7");
+        assert_eq!(volts(3_300), "3.3");
+        assert_eq!(volts(2_750), "2.75");
     }
 
     #[test]

@@ -197,15 +197,27 @@ impl Schedule {
         })
     }
 
-    /// First sampling instant of a channel after reset.
+    /// First sampling instant of a channel after reset: its first
+    /// conversion's start plus its part's [`Schedule::sample_after`].
     pub fn first_sample_cycle(&self, channel: usize) -> u64 {
         self.channels[channel].offset_slot * self.grid.slot_cycles
+            + self.sample_after(self.mix.channels[channel].branch)
+    }
+
+    /// Cycles from the start of a conversion of `branch` (its CS fall or
+    /// CNV rise, the cycle [`Schedule::instants`] gives) to the instant
+    /// its part holds its input (`SpiTiming::sample_cycles`): 0 for a part
+    /// that samples at that edge; the MCP3208's falling SCLK edge after its
+    /// 6th rising one.
+    pub fn sample_after(&self, branch: usize) -> u64 {
+        self.branches[branch].spi.sample_cycles
     }
 
     /// The sampling instant of the sample of `channel` that leaves on
     /// `sample_valid` in cycle `strobe` (docs/timing.md, "Merged sample
-    /// stream"): the channel's last instant `t` with `t + R + 1 <= strobe`,
-    /// `R` its branch's read.  A word waits behind other branches' words for
+    /// stream"): for the channel's last conversion start `t` with
+    /// `t + R + 1 <= strobe`, `R` its branch's read, the instant its part
+    /// holds its input, `t + sample_after(branch)`.  A word waits behind other branches' words for
     /// fewer cycles than the channel's interval, so no later instant can have
     /// completed first; `None` when no instant of the channel has completed
     /// by `strobe` (or the channel does not exist).
@@ -218,7 +230,7 @@ impl Schedule {
         let first = ch.offset_slot * self.grid.slot_cycles;
         let last = strobe.checked_sub(self.branches[branch].spi.read_cycles + 1)?;
         let n = last.checked_sub(first)? / ch.interval_cycles.max(1);
-        Some(first + n * ch.interval_cycles)
+        Some(first + n * ch.interval_cycles + self.sample_after(branch))
     }
 
     /// The mix's modes (select kind, names, triggers), if it has any.

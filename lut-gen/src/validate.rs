@@ -275,6 +275,16 @@ fn check_sync(s: &Schedule, slots_of: &[Vec<u64>], bad: &mut Vec<String>) {
                     mix.channels[w[0]].name, mix.channels[w[1]].name
                 ));
             }
+            // within a shared slot, each part holds its input its own time
+            // after the transaction starts
+            let after = |c: usize| s.branches[mix.channels[c].branch].spi.sample_cycles;
+            let apart = crate::parts::cycles_to_ns(after(w[0]).abs_diff(after(w[1])), mix.clock_hz);
+            if apart > crate::mix::SYNC_TOLERANCE_NS as f64 {
+                bad.push(format!(
+                    "sync `{tag}`: `{}` and `{}` are sampled {apart:.0} ns apart",
+                    mix.channels[w[0]].name, mix.channels[w[1]].name
+                ));
+            }
         }
     }
 }

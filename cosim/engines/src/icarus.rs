@@ -307,7 +307,7 @@ impl Adcs<'_> {
                 } else {
                     i.channel as u64
                 };
-                let code = self.analog.code_bits(id, i.cycle, bits);
+                let code = self.analog.code_bits(id, i.cycle + s.sample_after(b), bits);
                 let _ = writeln!(hex, "{:04x}{:08x}{:04x}", id as u16, i.cycle as u32, code);
                 len += 1;
             }
@@ -363,7 +363,8 @@ impl Adcs<'_> {
         let mut len = 0u64;
         let bits = self.s.mix.branches[b].adc.bits;
         for i in self.conversions(b) {
-            let code = self.analog.code_bits(i.channel as u64, i.cycle, bits) & 0x3fff;
+            let held = i.cycle + self.s.sample_after(b);
+            let code = self.analog.code_bits(i.channel as u64, held, bits) & 0x3fff;
             let _ = writeln!(
                 hex,
                 "{:04x}{:08x}{:04x}",
@@ -431,7 +432,8 @@ impl Adcs<'_> {
         let mut words = 0u64;
         for i in self.conversions(b) {
             for (_, c) in self.s.words_of(i.channel) {
-                let code = self.analog.code_bits(c as u64, i.cycle, part.bits) as u32 & mask;
+                let held = i.cycle + self.s.sample_after(b);
+                let code = self.analog.code_bits(c as u64, held, part.bits) as u32 & mask;
                 let _ = writeln!(hex, "{:04x}{:08x}{:04x}", c as u16, i.cycle as u32, code);
                 words += 1;
             }

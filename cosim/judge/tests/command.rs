@@ -92,7 +92,7 @@ fn expected(s: &Schedule, frames: u64) -> Vec<Vec<(u16, u16)>> {
         let bits = s.mix.branches[i.branch].adc.bits;
         want[i.branch].push((
             i.channel as u16,
-            analog.code_bits(i.channel as u64, i.cycle, bits),
+            analog.code_bits(i.channel as u64, i.cycle + s.sample_after(i.branch), bits),
         ));
     }
     for (b, w) in want.iter_mut().enumerate() {

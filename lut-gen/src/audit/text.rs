@@ -155,9 +155,10 @@ impl AuditReport {
         if !self.parts.is_empty() {
             let _ = writeln!(
                 o,
-                "\n{:<16} {:<10} {:>5} {:>5} {:>6} {:>9} {:>10} {:>9} {:>13} {:>13}",
+                "\n{:<16} {:<10} {:>5} {:>5} {:>5} {:>6} {:>9} {:>10} {:>9} {:>13} {:>13} {:>9}",
                 "branch",
                 "adc",
+                "VDD",
                 "start",
                 "bits",
                 "chain",
@@ -165,14 +166,23 @@ impl AuditReport {
                 "SCLK max",
                 "t_conv",
                 "conv/s max",
-                "samples/s max"
+                "samples/s max",
+                "sampled"
             );
             for p in &self.parts {
                 let _ = writeln!(
                     o,
-                    "{:<16} {:<10} {:>5} {:>5} {:>6} {:>9} {:>10} {:>9} {:>13.0} {:>13.0}",
+                    "{:<16} {:<10} {:>5} {:>5} {:>5} {:>6} {:>9} {:>10} {:>9} {:>13.0} {:>13.0} {:>9}",
                     p.branch,
                     p.adc,
+                    match p.vdd_v {
+                        None => "-".to_string(),
+                        Some(v) => format!(
+                            "{}{}",
+                            crate::parts::volts((v * 1000.0).round() as u32),
+                            if p.vdd_given { "" } else { "*" }
+                        ),
+                    },
                     match p.start {
                         crate::parts::Start::Cs => "cs",
                         crate::parts::Start::Cnv => "cnv",
@@ -183,9 +193,18 @@ impl AuditReport {
                     p.sclk_max_hz,
                     format!("{}ns", p.conversion_ns),
                     p.max_conversions_hz,
-                    p.max_samples_hz
+                    p.max_samples_hz,
+                    match p.sample_at {
+                        crate::parts::SampleAt::Start => "at start".to_string(),
+                        crate::parts::SampleAt::SclkFall(_) =>
+                            format!("+{:.3}us", p.sample_after_ns / 1000.0),
+                    }
                 );
             }
+            let _ = writeln!(
+                o,
+                "VDD: the supply whose datasheet figures apply (*: the part's lowest, no `vdd` given); sampled: where the part holds its input, at its start edge (CS falling, CNV rising) or this long after it (sampled_s and the first instants below include it)"
+            );
         }
     }
 

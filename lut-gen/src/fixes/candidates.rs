@@ -11,6 +11,7 @@ const WIDTH: usize = 3;
 
 pub(super) fn for_schedule(mix: &Mix, why: &Infeasible) -> Vec<Candidate> {
     let mut out = grids(mix);
+    out.extend(supplies(mix, why));
     let slots = why
         .slots_per_slice
         .map(|s| s * mix.slices_per_frame())
@@ -28,6 +29,46 @@ pub(super) fn for_schedule(mix: &Mix, why: &Infeasible) -> Vec<Candidate> {
     out.extend(each.into_iter().flatten());
     troubled(mix, why, slots, &mut out);
     out
+}
+
+/// Over-full branches whose part is held to its lowest supply's figures
+/// (no `vdd`) and runs faster at a higher supply: that supply, said.
+fn supplies(mix: &Mix, why: &Infeasible) -> Vec<Candidate> {
+    let mut changes = Vec::new();
+    let mut edits = Vec::new();
+    for (b, d) in why.branches.iter().enumerate() {
+        let br = &mix.branches[b];
+        if d.demand_slots_per_frame <= d.capacity_slots_per_frame && d.unplaced.is_empty() {
+            continue;
+        }
+        let Some(top) = br.adc.supplies.last().filter(|_| br.vdd_mv.is_none()) else {
+            continue;
+        };
+        let low = br.adc.supply_figure(None).expect("a supply table");
+        if top.max_sps <= low.max_sps && top.sclk_max_hz <= low.sclk_max_hz {
+            continue;
+        }
+        changes.push(Change::Supply {
+            branch: br.name.clone(),
+            part: br.adc.name.clone(),
+            vdd_mv: top.from_mv,
+            sclk_max_hz: top.sclk_max_hz,
+            max_sps: top.max_sps,
+        });
+        edits.push(Edit::Vdd {
+            name: br.name.clone(),
+            mv: top.from_mv,
+        });
+    }
+    if changes.is_empty() {
+        return Vec::new();
+    }
+    vec![Candidate {
+        changes,
+        edits,
+        parts_added: 0,
+        channels_changed: 0,
+    }]
 }
 
 /// Several over-full branches need a change each: the first candidate

@@ -22,6 +22,8 @@ pub(super) enum Edit {
     BranchLike { name: String, like: String },
     /// `[link].baud`.
     Baud(u64),
+    /// Branch `name`'s converter supply, `vdd`, in millivolts.
+    Vdd { name: String, mv: u32 },
 }
 
 /// `text` with `edits` applied, or `None` when the text is not TOML or a
@@ -71,6 +73,9 @@ fn apply_one(doc: &mut DocumentMut, e: &Edit) -> Option<()> {
             // a copy keeps its place after the original's siblings
             t.set_position(usize::MAX);
             doc.get_mut("branch")?.as_array_of_tables_mut()?.push(t);
+        }
+        Edit::Vdd { name, mv } => {
+            named(doc, "branch", name)?.insert("vdd", value(*mv as f64 / 1000.0));
         }
         Edit::Baud(baud) => {
             doc.get_mut("link")?

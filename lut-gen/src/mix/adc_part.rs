@@ -2,7 +2,7 @@
 
 use super::raw::*;
 use super::*;
-use crate::parts::{AdcPart, CnvRead, Command, Start};
+use crate::parts::{AdcPart, CnvRead, Command, SampleAt, Start};
 
 impl Cx<'_> {
     /// A `[[adc_part]]` table, checked like every other field.
@@ -101,7 +101,42 @@ impl Cx<'_> {
             data_hold_ns: 0,
             chain_max: chain_max as u32,
             command: self.adc_part_command(i, p, chain_max, leading_bits + bits + trailing_bits)?,
+            sample: self.adc_part_sample(i, p, start, leading_bits + bits + trailing_bits)?,
+            supplies: Vec::new(),
+            vdd_max_mv: 0,
         })
+    }
+
+    /// `adc_part.sample_after_rising`: the rising SCLK edge (counted from CS
+    /// falling) whose falling edge after it is the sampling instant; a "cs"
+    /// part's only, inside its word.  Absent: the CS or CNV edge.
+    pub(super) fn adc_part_sample(
+        &self,
+        i: usize,
+        p: &RawAdcPart,
+        start: Start,
+        word_sclks: u64,
+    ) -> Result<SampleAt, MixError> {
+        let Some(n) = &p.sample_after_rising else {
+            return Ok(SampleAt::Start);
+        };
+        let f = format!("adc_part[{i}].sample_after_rising");
+        let v = self.positive(n, &f)?;
+        if start == Start::Cnv {
+            return Err(self.at(
+                n.span(),
+                f,
+                "a \"cnv\" part samples at CNV rising: sample_after_rising applies to \"cs\" parts only",
+            ));
+        }
+        if v >= word_sclks {
+            return Err(self.at(
+                n.span(),
+                f,
+                format!("rising edge {v}: the word has {word_sclks} serial clocks, and the instant is the falling edge after it, inside the word (at most {})", word_sclks - 1),
+            ));
+        }
+        Ok(SampleAt::SclkFall(v as u32))
     }
 
     /// `adc_part.command` and `command_ahead`: a template of the word on

@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 
-use super::check::Timing;
+use super::check::{SupplyHint, Timing};
 use super::raw::*;
 use super::*;
 use crate::parts::{AdcPart, MuxPart};
@@ -63,9 +63,11 @@ impl Cx<'_> {
                     ),
                 )
             })?;
+        let vdd_mv = self.branch_vdd(i, b, &adc)?;
+        let adc = adc.at_supply(vdd_mv);
         let chain = self.branch_chain(i, b, &adc)?;
         let mux = self.branch_mux(i, b, &adc)?;
-        let sclk_hz = self.branch_sclk(i, b, &adc)?;
+        let sclk_hz = self.branch_sclk(i, b, &name, &adc, vdd_mv)?;
         if t.clock_hz < 2 * adc.sclk_min_hz {
             return Err(self.at(
                 t.clock_span.clone(),
@@ -76,6 +78,7 @@ impl Cx<'_> {
                 ),
             ));
         }
+        self.check_late_sampler(i, b, &adc, &mux)?;
         let mux_devices = self.branch_mux_devices(i, b, &mux)?;
         let (mux, mux_devices, fronted) = match &b.front_mux {
             Some(fm) => (
@@ -109,7 +112,55 @@ impl Cx<'_> {
             fronted,
             settle_ns,
             chain,
+            vdd_mv,
         })
+    }
+
+    /// `branch.vdd`: the converter's supply in volts, within the part's
+    /// range; only for a part with a supply table (every built-in one).
+    pub(super) fn branch_vdd(
+        &self,
+        i: usize,
+        b: &RawBranch,
+        adc: &AdcPart,
+    ) -> Result<Option<u32>, MixError> {
+        let Some(v) = &b.vdd else { return Ok(None) };
+        let f = format!("branch[{i}].vdd");
+        let volts = match v.get_ref() {
+            toml::Value::Integer(n) => *n as f64,
+            toml::Value::Float(x) if x.is_finite() => *x,
+            other => {
+                return Err(self.at(
+                    v.span(),
+                    f,
+                    format!("got `{other}`, expected the supply in volts, e.g. vdd = 5.0"),
+                ))
+            }
+        };
+        let Some((lo, hi)) = adc.vdd_range_mv() else {
+            return Err(self.at(
+                v.span(),
+                f,
+                format!(
+                    "`{}` is declared with one set of figures, not per supply: leave vdd out",
+                    adc.name
+                ),
+            ));
+        };
+        let mv = (volts * 1000.0).round();
+        if mv < lo as f64 || mv > hi as f64 {
+            return Err(self.at(
+                v.span(),
+                f,
+                format!(
+                    "{volts} V is outside the {} supply range {}..={} V",
+                    adc.name,
+                    crate::parts::volts(lo),
+                    crate::parts::volts(hi)
+                ),
+            ));
+        }
+        Ok(Some(mv as u32))
     }
 
     /// `branch.chain`: how many parts, within the part's limit.
@@ -134,17 +185,57 @@ impl Cx<'_> {
         Ok(v as u32)
     }
 
-    /// `branch.sclk_hz`: the part's maximum unless given, and within its range.
+    /// `branch.sclk_hz`: the part's maximum unless given, and within its
+    /// range at its supply (`adc` is the part at `vdd_mv`).  Above the
+    /// maximum at the lowest supply (no `vdd`) but within a higher supply's,
+    /// the error names the supply and leaves a [`SupplyHint`] for `parse`
+    /// to try.
     pub(super) fn branch_sclk(
         &self,
         i: usize,
         b: &RawBranch,
+        branch: &str,
         adc: &AdcPart,
+        vdd_mv: Option<u32>,
     ) -> Result<u64, MixError> {
         let Some(s) = &b.sclk_hz else {
             return Ok(adc.sclk_max_hz);
         };
         let v = self.positive(s, &format!("branch[{i}].sclk_hz"))?;
+        if v > adc.sclk_max_hz && adc.vdd_range_mv().is_some() {
+            let at = vdd_mv
+                .or(adc.supply_figure(None).map(|f| f.from_mv))
+                .unwrap_or(0);
+            let higher = adc
+                .supplies
+                .iter()
+                .find(|f| f.sclk_max_hz >= v && f.from_mv > at);
+            let mut m = format!(
+                "{} SCLK {} exceeds its {} at {} V",
+                adc.name.to_ascii_uppercase(),
+                hz_words(v),
+                hz_words(adc.sclk_max_hz),
+                crate::parts::volts(at)
+            );
+            if vdd_mv.is_none() {
+                m.push_str(" (its lowest supply: the figure without `vdd`)");
+            }
+            if let Some(h) = higher {
+                m.push_str(&format!(
+                    "; its datasheet allows {} from {} V",
+                    hz_words(h.sclk_max_hz),
+                    crate::parts::volts(h.from_mv)
+                ));
+                if vdd_mv.is_none() {
+                    self.hint.borrow_mut().replace(SupplyHint {
+                        branch: branch.to_string(),
+                        vdd_mv: h.from_mv,
+                        part: adc.name.clone(),
+                    });
+                }
+            }
+            return Err(self.at(s.span(), format!("branch[{i}].sclk_hz"), m));
+        }
         if v > adc.sclk_max_hz || v < adc.sclk_min_hz {
             return Err(self.at(
                 s.span(),
@@ -156,6 +247,31 @@ impl Cx<'_> {
             ));
         }
         Ok(v)
+    }
+
+    /// A part that samples inside its transaction (after its CS edge)
+    /// cannot have an external mux: its pins move on one cycle after CS
+    /// falls (docs/timing.md), before the part holds its input.
+    pub(super) fn check_late_sampler(
+        &self,
+        i: usize,
+        b: &RawBranch,
+        adc: &AdcPart,
+        mux: &MuxPart,
+    ) -> Result<(), MixError> {
+        if adc.sample == crate::parts::SampleAt::Start || mux.is_internal() || *mux == MuxPart::NONE
+        {
+            return Ok(());
+        }
+        Err(self.at(
+            b.mux.span(),
+            format!("branch[{i}].mux"),
+            format!(
+                "`{}` holds its input {}, after an external mux's pins have moved on to the next conversion (one cycle after CS falls): use mux = \"none\"",
+                adc.name,
+                adc.sample.words(adc.start)
+            ),
+        ))
     }
 
     /// `branch.mux`: an external part, or `internal` (the converter's own,
@@ -207,9 +323,10 @@ impl Cx<'_> {
     /// a conversion's input from the cycle after the branch's previous
     /// instant through the instant itself, and move on one cycle after it.
     /// A part whose word applies to the conversion that carries it
-    /// (`ahead` 0: the MCP3208, Figure 6-1, samples from the 4th rising SCLK
-    /// after the start bit to the 5th falling one, inside the transaction)
-    /// would sample the next conversion's front input: refused.  A part that
+    /// (`ahead` 0: the MCP3208, section 5.0, holds its input at the falling
+    /// SCLK after the 6th rising one since CS fell, inside the transaction)
+    /// would sample the next conversion's front input: refused, as is any
+    /// part that samples after its start edge ([`crate::parts::SampleAt`]).  A part that
     /// samples at its instant (CNV rising, or a CS part whose word applies
     /// to a later conversion, as the AD7689 and the ADS7953) has its front
     /// input settled there, whatever its word selects.
@@ -251,7 +368,7 @@ impl Cx<'_> {
                 )
             })?;
         let ahead = adc.command.as_ref().map_or(0, |c| c.ahead);
-        if ahead == 0 {
+        if ahead == 0 || adc.sample != crate::parts::SampleAt::Start {
             return Err(self.at(
                 fm.span(),
                 f,
@@ -310,4 +427,17 @@ impl Cx<'_> {
             }
         }
     }
+}
+
+/// Hz as a datasheet writes them: `2 MHz`, `2.5 MHz`, `250 kHz`.
+pub(crate) fn hz_words(hz: u64) -> String {
+    let (v, unit) = if hz >= 1_000_000 {
+        (hz as f64 / 1e6, "MHz")
+    } else if hz >= 1_000 {
+        (hz as f64 / 1e3, "kHz")
+    } else {
+        (hz as f64, "Hz")
+    };
+    let t = format!("{v:.3}");
+    format!("{} {unit}", t.trim_end_matches('0').trim_end_matches('.'))
 }

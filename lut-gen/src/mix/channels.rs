@@ -11,6 +11,10 @@ use super::check::Timing;
 use super::raw::*;
 use super::words::*;
 use super::*;
+use crate::parts::cycles_to_ns;
+
+/// How far apart a sync group's sampling instants may be, in ns.
+pub(crate) const SYNC_TOLERANCE_NS: u64 = 1_000;
 
 /// (converter or mux input, chain member, front mux input).
 pub(super) type InputKey = (u32, u32, Option<u32>);
@@ -456,8 +460,10 @@ impl Cx<'_> {
         branches: &[Branch],
         channels: &[Channel],
         sync_groups: &BTreeMap<String, Vec<(usize, Range<usize>)>>,
+        clock_hz: u64,
     ) -> Result<(), MixError> {
         for (tag, members) in sync_groups {
+            self.check_sync_instants(decl, branches, channels, tag, members, clock_hz)?;
             let mut seen = BTreeMap::new();
             let rate = channels[members[0].0].rate_hz;
             for (i, span) in members {
@@ -487,6 +493,65 @@ impl Cx<'_> {
                     ));
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// A sync group's conversions start together, so its parts must hold
+    /// their inputs at the same point of their transactions, within
+    /// [`SYNC_TOLERANCE_NS`]: an MCP3208 holds its input 6 us after an
+    /// AD7940 whose CS falls with its own.
+    pub(super) fn check_sync_instants(
+        &self,
+        decl: &[Declared],
+        branches: &[Branch],
+        channels: &[Channel],
+        tag: &str,
+        members: &[(usize, Range<usize>)],
+        clock_hz: u64,
+    ) -> Result<(), MixError> {
+        let after = |c: usize| {
+            let b = &branches[channels[c].branch];
+            b.timing(clock_hz).ok().map(|t| t.sample_cycles)
+        };
+        let mut known = members
+            .iter()
+            .filter_map(|(c, _)| after(*c).map(|a| (*c, a)));
+        let Some(first) = known.next() else {
+            return Ok(());
+        };
+        for (c, a) in known {
+            let apart = cycles_to_ns(a.abs_diff(first.1), clock_hz);
+            if apart <= SYNC_TOLERANCE_NS as f64 {
+                continue;
+            }
+            let span = &members.iter().find(|m| m.0 == c).expect("a member").1;
+            let say = |c: usize, a: u64| {
+                let b = &branches[channels[c].branch];
+                let when = match a {
+                    0 => b.adc.sample.words(b.adc.start),
+                    _ => format!(
+                        "{:.3} us after its transaction starts ({})",
+                        cycles_to_ns(a, clock_hz) / 1000.0,
+                        b.adc.sample.words(b.adc.start)
+                    ),
+                };
+                format!(
+                    "`{}` on branch `{}` ({}) holds its input {when}",
+                    channels[c].name, b.name, b.adc.name
+                )
+            };
+            return Err(self.at(
+                span.clone(),
+                decl[c].field("sync"),
+                decl[c].say(format!(
+                    "sync group `{tag}` cannot sample at one instant: {}, {}; the group's conversions start together, so their instants are {:.3} us apart (at most {:.3} us): sync parts that hold their input at the same point of their transaction",
+                    say(first.0, first.1),
+                    say(c, a),
+                    apart / 1000.0,
+                    SYNC_TOLERANCE_NS as f64 / 1000.0
+                )),
+            ));
         }
         Ok(())
     }

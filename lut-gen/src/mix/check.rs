@@ -16,6 +16,17 @@ use crate::parts::AdcPart;
 pub(super) struct Cx<'a> {
     pub(super) file: &'a Path,
     pub(super) text: &'a str,
+    /// Set by a refusal a higher supply would lift (`branch_sclk`): the
+    /// `vdd` that `parse` tries before it suggests it.
+    pub(super) hint: std::cell::RefCell<Option<SupplyHint>>,
+}
+
+/// A `vdd` a branch could say, for `parse` to try on the mix.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) struct SupplyHint {
+    pub(super) branch: String,
+    pub(super) vdd_mv: u32,
+    pub(super) part: String,
 }
 
 /// The clock and frame numbers every later check measures against.
@@ -118,7 +129,7 @@ impl Cx<'_> {
         let mut channels = draft.channels;
         self.check_front_wiring(&decl, &branches, &channels)?;
         self.check_chain_rates(&decl, &branches, &channels)?;
-        self.check_sync_groups(&decl, &branches, &channels, &draft.sync_groups)?;
+        self.check_sync_groups(&decl, &branches, &channels, &draft.sync_groups, t.clock_hz)?;
         self.check_chain_sync(&decl, &channels)?;
         self.check_branches_used(&raw, &branches, &channels)?;
         if channels.len() > u16::MAX as usize {

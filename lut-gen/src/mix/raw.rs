@@ -86,6 +86,9 @@ pub(super) struct RawBranch {
     pub(super) front_mux_devices: Option<Spanned<i64>>,
     pub(super) settle_ns: Option<Spanned<i64>>,
     pub(super) chain: Option<Spanned<i64>>,
+    /// The converter's supply in volts (integer or float: TOML keeps the
+    /// two apart).
+    pub(super) vdd: Option<Spanned<toml::Value>>,
 }
 
 #[derive(Deserialize)]
@@ -111,6 +114,9 @@ pub(super) struct RawAdcPart {
     pub(super) command: Option<Spanned<String>>,
     /// Conversions ahead the command applies (0: the same one).
     pub(super) command_ahead: Option<Spanned<i64>>,
+    /// The rising SCLK edge (from CS falling) whose next falling edge is the
+    /// sampling instant; absent: the CS or CNV edge.
+    pub(super) sample_after_rising: Option<Spanned<i64>>,
 }
 
 #[derive(Deserialize, Clone)]

@@ -343,7 +343,10 @@ pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usi
             if skipped.contains(&(t, cv.branch)) {
                 continue;
             }
-            let code = analog.code_bits(cv.channel as u64, t, s.mix.branches[cv.branch].adc.bits);
+            // the input's value where the part holds it
+            let held = t + s.sample_after(cv.branch);
+            let code =
+                analog.code_bits(cv.channel as u64, held, s.mix.branches[cv.branch].adc.bits);
             inv.completion(
                 base + cv.complete,
                 cv.branch,

@@ -1,7 +1,9 @@
 //! ADC models from the part data (`lut_gen::AdcPart`):
 //!
 //! - CS parts (AD7940): sample the analog input the branch's mux selects at
-//!   the CS falling edge and shift the word out on MISO (the leading bits as
+//!   the CS falling edge (a part that holds its input later in its
+//!   transaction, the MCP3208, takes its input's value at that instant,
+//!   `Schedule::sample_after`) and shift the word out on MISO (the leading bits as
 //!   zeros, then the code MSB first), one bit per SCLK falling edge;
 //! - CNV parts (AD7685, chain mode): every part of the chain samples its own
 //!   input at the CNV rising edge; the chain then shifts all words out of the
@@ -327,6 +329,9 @@ struct PartModel {
     /// Behind a front mux: per converter input wired to it, front input
     /// (device * 8 + select) -> channel; empty for a straight input.
     front: Vec<std::collections::BTreeMap<u32, u16>>,
+    /// Cycles from the conversion's start to the instant the part holds
+    /// its input (`Schedule::sample_after`): the input is sampled there.
+    after: u64,
 }
 
 /// The ADCs of all branches, at cycle level.
@@ -368,11 +373,13 @@ impl Adc {
                 command: b.adc.command.clone(),
                 inputs: Vec::new(),
                 front: Vec::new(),
+                after: 0,
             })
             .collect();
         let mut parts = parts;
         let layout = Layout::new(s);
         for (b, pm) in parts.iter_mut().enumerate() {
+            pm.after = s.sample_after(b);
             pm.inputs = layout.lookup[b].clone();
             if s.mix.branches[b].fronted {
                 (pm.inputs, pm.front) = Self::fronted_inputs(s, b);
@@ -458,7 +465,7 @@ impl Adc {
                         None if m == 0 => id,
                         None => id + 100 + m as u64,
                     };
-                    let code = self.analog.code_bits(mid, cycle, pm.bits) as u128;
+                    let code = self.analog.code_bits(mid, cycle + pm.after, pm.bits) as u128;
                     let trailing = pm.word_sclks - pm.leading - pm.bits;
                     st.stream = (st.stream << pm.word_sclks) | (code << trailing);
                     st.len += pm.word_sclks;
@@ -521,7 +528,7 @@ impl Adc {
 
     /// The code stream of a single part converting `id` at `t`.
     fn fill(analog: &Analog, pm: &PartModel, st: &mut AdcState, id: u64) {
-        let code = analog.code_bits(id, st.t, pm.bits) as u128;
+        let code = analog.code_bits(id, st.t + pm.after, pm.bits) as u128;
         let trailing = pm.word_sclks - pm.leading - pm.bits;
         st.stream = code << trailing;
     }
