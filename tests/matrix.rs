@@ -77,6 +77,23 @@ fn rows(path: &Path) -> Vec<(String, String, String)> {
     out
 }
 
+/// What the error of each crossing docs/mix-format.md ("Combinations
+/// refused") lists says: the phrase after "the error says".
+fn refused_crossings() -> Vec<String> {
+    let doc =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/mix-format.md"))
+            .unwrap();
+    let section = doc.split("## Combinations refused").nth(1).unwrap();
+    let section = section.split("\n## ").next().unwrap();
+    let said: Vec<String> = section
+        .split("the error says `")
+        .skip(1)
+        .filter_map(|s| s.split('`').next().map(str::to_string))
+        .collect();
+    assert!(said.len() >= 4, "{said:?}");
+    said
+}
+
 /// One mix through every feature; `wide`: also Icarus and `prove`.
 /// `Ok(false)` when the audit refused it (with a reason), `Err` with every
 /// failure otherwise.
@@ -91,14 +108,14 @@ fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
     if !audit.status.success() {
         let why = String::from_utf8_lossy(&audit.stderr).to_string()
             + &String::from_utf8_lossy(&audit.stdout);
-        // a refusal says why: an `error:` line naming the mix, or the
-        // audit's infeasible verdict with its reasons
-        let named =
-            why.contains("error:") || why.contains("infeasible") || why.contains("INFEASIBLE");
-        return match (audit.status.code(), named) {
+        // a refusal is a crossing docs/mix-format.md lists as refused, said
+        // in its words; or a mix that does not fit, with the audit's reasons
+        let listed = refused_crossings().iter().any(|r| why.contains(r.as_str()));
+        let infeasible = audit.status.code() == Some(1) && why.contains("no jitter-free schedule");
+        return match (audit.status.code(), listed || infeasible) {
             (Some(1 | 2), true) => Ok(false),
             _ => Err(format!(
-                "{p:?}: audit exit {:?} without a reason:\n{why}\n{text}",
+                "{p:?}: audit exit {:?}, not a refusal docs/mix-format.md lists:\n{why}\n{text}",
                 audit.status.code()
             )),
         };
@@ -223,7 +240,7 @@ fn prove(f: &mut Faults, mix: &Path) {
 }
 
 /// Runs `points` (seeded by their index) and fails with every broken one;
-/// at most a quarter may be refused, so the matrix keeps its meaning.
+/// at most a third may be refused, so the matrix keeps its meaning.
 fn draw(points: &[Point], seed0: u64, wide: bool) {
     let (mut refused, mut bad) = (0, vec![]);
     for (i, p) in points.iter().enumerate() {
@@ -241,7 +258,7 @@ fn draw(points: &[Point], seed0: u64, wide: bool) {
         bad.join("\n\n")
     );
     assert!(
-        refused * 4 <= points.len(),
+        refused * 3 <= points.len(),
         "{refused} of {} refused",
         points.len()
     );

@@ -285,7 +285,8 @@ impl Cx<'_> {
         }
     }
 
-    /// A converter whose word selects a later conversion (`command_ahead`,
+    /// Every branch a mode uses runs in the reset mode.  A converter whose
+    /// word selects a later conversion (`command_ahead`,
     /// the AD7689's 2) sends, in a frame's last conversions, the words of
     /// the next frame's first ones: the next frame's mode is decided while
     /// this one runs, the one after it is not.  So every mode converts such
@@ -301,6 +302,15 @@ impl Cx<'_> {
         t: &Timing,
     ) -> Result<(), MixError> {
         for (b, br) in branches.iter().enumerate() {
+            // a mode that uses a branch the reset mode leaves out: the
+            // branch's mux would have no reset value to hold
+            let on = |m: usize| channels.iter().any(|c| c.branch == b && c.rates[m] > 0);
+            if let Some(m) = (1..names.len()).find(|&m| !on(0) && on(m)) {
+                return Err(self.at(raw.branch[b].get_ref().name.span(), format!("branch[{b}].name"), format!(
+                    "branch `{}`: the reset mode `{}` does not use it but mode `{}` does: its pins would have no reset value to hold (give it a channel in `{}`)",
+                    br.name, names[0], names[m], names[0]
+                )));
+            }
             let Some(cmd) = &br.adc.command else { continue };
             let span = raw.branch[b].get_ref().adc.span();
             if br.fronted {
