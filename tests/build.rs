@@ -310,7 +310,7 @@ fn unknown_steps_are_refused_before_anything_runs() {
         .assert()
         .code(2)
         .stderr(predicates::str::contains(
-            "the folder /nonexistent/dir does not exist",
+            "--junit /nonexistent/dir/x.xml: no such folder",
         ));
 }
 
