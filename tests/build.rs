@@ -728,6 +728,14 @@ fn assert_reads_like_a_datasheet(mix: &Path, out: &Path) {
     ] {
         assert!(first.2.iter().any(|r| r[0].starts_with(q)), "{what}: {q}");
     }
+    // every link of report.md resolves, beside the report
+    assert!(md_link_targets(&md).len() >= 5, "{what}: links");
+    for target in md_link_targets(&md) {
+        assert!(
+            !target.starts_with('#') && out.join(&target).is_file(),
+            "{what}: report.md links `{target}`, which is not a file beside it"
+        );
+    }
     // every file the report links is there
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     for href in html
@@ -742,6 +750,14 @@ fn assert_reads_like_a_datasheet(mix: &Path, out: &Path) {
             );
         }
     }
+}
+
+/// The target of every Markdown link and image in `md` (`[text](target)`).
+fn md_link_targets(md: &str) -> Vec<String> {
+    md.split("](")
+        .skip(1)
+        .filter_map(|rest| rest.split_once(')').map(|(t, _)| t.to_string()))
+        .collect()
 }
 
 /// The channel names of a mix (upper or lower case: the report lists them
