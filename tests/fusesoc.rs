@@ -70,6 +70,22 @@ fn names_under(build: &Path) -> Vec<String> {
     v
 }
 
+/// The text of the flow's Makefile under `build`.
+fn makefile_under(build: &Path) -> String {
+    let mut stack = vec![build.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.file_name().is_some_and(|n| n == "Makefile") {
+                return std::fs::read_to_string(p).unwrap();
+            }
+        }
+    }
+    panic!("no Makefile under {}", build.display())
+}
+
 fn lint_passes(mix: &Path, tag: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("fusesoc-{tag}"));
     emit(mix, &dir);
@@ -144,6 +160,11 @@ fn a_boards_constraints_join_its_familys_target() {
         let (ok, text, build) = fusesoc(&dir, target, true);
         assert!(ok, "fusesoc --setup --target {target} ({board}):\n{text}");
         assert!(names_under(&build).contains(&file.to_string()), "{board}");
+        // nextpnr checks timing at the mix's clock (tiny: 4 MHz), not at
+        // its default 12 MHz
+        let make = makefile_under(&build);
+        let pnr = make.lines().find(|l| l.contains("nextpnr-")).unwrap_or("");
+        assert!(pnr.contains(" --freq 4 "), "{target}: {make}");
     }
 }
 
