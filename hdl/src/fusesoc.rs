@@ -13,6 +13,14 @@ use lut_gen::{Fpga, Schedule, TOP_MODULE};
 /// The emitted core description's file name.
 pub const CORE_FILE: &str = "slotforge_top.core";
 
+/// The launcher written beside the core: FuseSoC's `EDALIZE_LAUNCHER` that
+/// runs each tool a flow calls, or its YoWASP build when only that is
+/// installed (and Edalize's `nextpnr-gowin` as nextpnr-himbaechel).
+pub const LAUNCHER_FILE: &str = "edalize-launcher.sh";
+
+/// The launcher's text.
+pub const LAUNCHER: &str = include_str!("edalize-launcher.sh");
+
 /// A constraint file's kind, by its extension: CAPI2's `file_type` and the
 /// family whose flow reads it (`None`: every flow may, e.g. timing).
 fn constraint_kind(name: &str) -> Option<(&'static str, Option<Fpga>)> {
@@ -111,6 +119,10 @@ pub fn core_file(s: &Schedule, names: &[&str], pinned: bool) -> String {
     let _ = writeln!(
         t,
         "# FuseSoC core of slotforge's gateware, generated with the files beside it; do not edit."
+    );
+    let _ = writeln!(
+        t,
+        "# ecp5 and gowin with only the YoWASP tools (or nextpnr-himbaechel): set\n# EDALIZE_LAUNCHER=\"sh $PWD/{LAUNCHER_FILE}\" (the file beside this one)"
     );
     let _ = writeln!(t, "name: {}", vlnv(s));
     let desc = format!("slotforge acquisition gateware for mix {}", s.mix.name);
