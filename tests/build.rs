@@ -310,7 +310,7 @@ fn unknown_steps_are_refused_before_anything_runs() {
         .assert()
         .code(2)
         .stderr(predicates::str::contains(
-            "the folder /nonexistent/dir does not exist",
+            "--junit /nonexistent/dir/x.xml: no such folder",
         ));
 }
 
@@ -716,6 +716,26 @@ fn assert_reads_like_a_datasheet(mix: &Path, out: &Path) {
             .count();
         assert_eq!(n, 1, "{what}: channel {name} is a row {n} times");
     }
+    // each channel's wiring reads as the CLI's audit writes it (`dev.sel`,
+    // or `in<k>` for a converter's own input)
+    let (_, head, rows) = tables
+        .iter()
+        .find(|t| t.1.get(2).is_some_and(|h| h.starts_with("mux")))
+        .expect("the channel table");
+    assert!(head[2].contains("converter's input"), "{what}: {head:?}");
+    for c in audit_json(mix)["channels"].as_array().unwrap() {
+        let cli = match (c["adc_input"].as_u64(), c["front_mux"].as_bool()) {
+            (None, _) => format!("{}.{}", c["device"], c["select"]),
+            (Some(k), Some(true)) => format!("in{k}/{}.{}", c["device"], c["select"]),
+            (Some(k), _) => format!("in{k}"),
+        };
+        let row = rows.iter().find(|r| r[0] == c["name"].as_str().unwrap());
+        assert_eq!(
+            row.map(|r| r[2].trim_matches('`')),
+            Some(cli.as_str()),
+            "{what}: {c}"
+        );
+    }
     // the first screen answers first: fit, binds, checked, proved, size
     let first = &tables[0];
     assert_eq!(first.1, ["question", "answer"], "{what}");
@@ -727,6 +747,14 @@ fn assert_reads_like_a_datasheet(mix: &Path, out: &Path) {
         "How big",
     ] {
         assert!(first.2.iter().any(|r| r[0].starts_with(q)), "{what}: {q}");
+    }
+    // every link of report.md resolves, beside the report
+    assert!(md_link_targets(&md).len() >= 5, "{what}: links");
+    for target in md_link_targets(&md) {
+        assert!(
+            !target.starts_with('#') && out.join(&target).is_file(),
+            "{what}: report.md links `{target}`, which is not a file beside it"
+        );
     }
     // every file the report links is there
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
@@ -742,6 +770,24 @@ fn assert_reads_like_a_datasheet(mix: &Path, out: &Path) {
             );
         }
     }
+}
+
+/// `slotforge audit --json MIX`.
+fn audit_json(mix: &Path) -> serde_json::Value {
+    let out = slotforge()
+        .args(["audit", "--json"])
+        .arg(mix)
+        .output()
+        .unwrap();
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// The target of every Markdown link and image in `md` (`[text](target)`).
+fn md_link_targets(md: &str) -> Vec<String> {
+    md.split("](")
+        .skip(1)
+        .filter_map(|rest| rest.split_once(')').map(|(t, _)| t.to_string()))
+        .collect()
 }
 
 /// The channel names of a mix (upper or lower case: the report lists them

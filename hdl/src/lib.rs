@@ -35,7 +35,7 @@ mod widths;
 pub use board::{stock_board, Board};
 pub use emit::{emit, emit_with, verilog_pair, Emitted, MANIFEST_FILE, VERILOG_FILE};
 pub use fault::GatewareFault;
-pub use fusesoc::{vlnv, CORE_FILE};
+pub use fusesoc::{vlnv, CORE_FILE, LAUNCHER_FILE};
 pub use plan::{
     LutForm, FULL_LUT_MAX_BITS, MAX_FRAME_SLOTS, MAX_SCLK_DIV, MAX_SLICES_PER_FRAME,
     MAX_SLOTS_PER_SLICE, MAX_SLOT_CYCLES,

@@ -250,16 +250,24 @@ fn merge_dffs(text: &str) -> String {
     let mut shared: BTreeMap<String, String> = BTreeMap::new();
     let mut map: BTreeMap<String, String> = BTreeMap::new();
     let mut keep = vec![];
+    // each chunk's text as written (a register's with its parameter)
+    let mut texts: Vec<String> = vec![];
+    let mut inits: Vec<(String, String)> = vec![];
     for c in cs.iter() {
         let Ok(c) = c else {
             keep.push(true);
+            texts.push(String::new());
             continue;
         };
         let Some(w) = dff_width(c) else {
             keep.push(true);
+            texts.push(c.text.to_string());
             continue;
         };
-        let body = c.text.replace(&c.name, "");
+        // the initial value (the register's reset value) is the shared
+        // module's parameter `INIT`, set by each instance
+        let (text, init) = with_init_parameter(c.text, w);
+        let body = text.replace(&c.name, "");
         let first = !shared.contains_key(&body);
         let name = shared
             .entry(body)
@@ -271,12 +279,16 @@ fn merge_dffs(text: &str) -> String {
             .clone();
         map.insert(c.name.clone(), name);
         keep.push(first);
+        texts.push(text);
+        if let Some(lit) = init {
+            inits.push((c.name.clone(), lit));
+        }
     }
     let mut out = String::with_capacity(text.len());
-    for (c, k) in cs.iter().zip(keep) {
+    for ((c, k), text) in cs.iter().zip(keep).zip(&texts) {
         match (c, k) {
             (Err(t), _) => out.push_str(t),
-            (Ok(c), true) => out.push_str(c.text),
+            (Ok(_), true) => out.push_str(text),
             // the separating blank line of a dropped module goes with it
             (Ok(_), false) => {
                 if out.ends_with("\n\n") {
@@ -285,7 +297,56 @@ fn merge_dffs(text: &str) -> String {
             }
         }
     }
-    replace(&out, &map)
+    replace(&set_inits(&out, &inits), &map)
+}
+
+/// A flip-flop module's text with its initial value as a parameter `INIT`
+/// (default 0), and that value when it is not 0.
+fn with_init_parameter(text: &str, width: u32) -> (String, Option<String>) {
+    let Some(at) = text.find("q = ") else {
+        return (text.to_string(), None);
+    };
+    let Some(end) = text[at..].find(';').map(|e| at + e) else {
+        return (text.to_string(), None);
+    };
+    let lit = text[at + 4..end].to_string();
+    let mut t = format!("{}q = INIT{}", &text[..at], &text[end..]);
+    let Some(decl) = t.find("    // Module arguments") else {
+        return (text.to_string(), None);
+    };
+    let param = format!(
+        "    // the initial value: the register's reset value (set per instance)\n    parameter [{}:0] INIT = {width}'h0;\n\n",
+        width - 1
+    );
+    t.insert_str(decl, &param);
+    let zero = lit.ends_with("'h0");
+    (t, (!zero).then_some(lit))
+}
+
+/// Every instance of the flip-flop modules `inits` names given its initial
+/// value (`name #(.INIT(1'h1)) inst(`).
+fn set_inits(text: &str, inits: &[(String, String)]) -> String {
+    if inits.is_empty() {
+        return text.to_string();
+    }
+    let by_name: BTreeMap<&str, &str> = inits
+        .iter()
+        .map(|(n, l)| (n.as_str(), l.as_str()))
+        .collect();
+    let mut out = String::with_capacity(text.len() + 64 * inits.len());
+    for line in text.split_inclusive('\n') {
+        let t = line.trim_start();
+        let indent = &line[..line.len() - t.len()];
+        let module = t.split(' ').next().unwrap_or("");
+        match by_name.get(module) {
+            Some(lit) if !indent.is_empty() && t.trim_end().ends_with('(') => {
+                let rest = &t[module.len()..];
+                out.push_str(&format!("{indent}{module} #(.INIT({lit})){rest}"));
+            }
+            _ => out.push_str(line),
+        }
+    }
+    out
 }
 
 /// rust-hdl's text with readable names: no `$` in any identifier, one

@@ -260,3 +260,41 @@ fn settle<B: Block>(uut: &mut B, passes: &mut u64) -> bool {
     }
     false
 }
+
+/// Every flip-flop of the core as it stands after the first rising edge
+/// with `rst` high (its reset value: the value the design gives it in
+/// reset), by the module path rust-hdl names its `DFF` module with
+/// (`top$branches$0$r_cs_n`), as a Verilog literal (`1'h1`).  The emitter
+/// makes it each register's initial value, so the pins show their reset
+/// levels from power-on, before any clock edge.
+pub(crate) fn reset_values(p: &plan::Plan) -> std::collections::BTreeMap<String, String> {
+    let mut sim = RtlSim::from_plan(p);
+    sim.step(true, 0);
+    let mut probe = RegisterValues::default();
+    sim.core.accept("top", &mut probe);
+    probe.values
+}
+
+/// A probe that reads each block's `q` (a `DFF`'s output) by block path.
+#[derive(Default)]
+struct RegisterValues {
+    path: Vec<String>,
+    values: std::collections::BTreeMap<String, String>,
+}
+
+impl Probe for RegisterValues {
+    fn visit_start_scope(&mut self, name: &str, _node: &dyn Block) {
+        self.path.push(name.to_string());
+    }
+
+    fn visit_atom(&mut self, name: &str, signal: &dyn Atom) {
+        if name == "q" {
+            let v = format!("{:x}", signal.verilog());
+            self.values.insert(self.path.join("$"), v);
+        }
+    }
+
+    fn visit_end_scope(&mut self, _name: &str, _node: &dyn Block) {
+        self.path.pop();
+    }
+}

@@ -201,6 +201,7 @@ fn emission_is_deterministic() {
     assert_eq!(
         names,
         [
+            "edalize-launcher.sh",
             "ports.json",
             "slot_rom.hex",
             "slotforge.pcf",

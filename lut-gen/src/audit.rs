@@ -281,6 +281,20 @@ pub struct ChannelAudit {
     pub alias_hz: Option<f64>,
 }
 
+impl ChannelAudit {
+    /// Where the channel is wired, as the audit's `dev.sel` column and the
+    /// report write it: an external mux's device and select (`0.3`), the
+    /// converter's own input on a branch with `mux = "internal"` (`in2`),
+    /// or both with a front mux (`in2/0.3`).
+    pub fn mux_words(&self) -> String {
+        match self.adc_input {
+            None => format!("{}.{}", self.device, self.select),
+            Some(k) if self.front_mux => format!("in{k}/{}.{}", self.device, self.select),
+            Some(k) => format!("in{k}"),
+        }
+    }
+}
+
 impl AuditReport {
     pub fn of_schedule(s: &Schedule) -> AuditReport {
         let g = &s.grid;

@@ -83,10 +83,12 @@ pub struct BranchDiagnosis {
 impl fmt::Display for Infeasible {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         // An over-full branch is the headline: demand against capacity.
+        // (a channel faster than its part comes before it)
         let lead = self
             .reasons
             .iter()
-            .find(|r| r.contains("conversions per slice"));
+            .find(|r| r.contains("conversions per slice"))
+            .filter(|_| !self.reasons[0].contains("can convert"));
         match (self.verdict, lead) {
             (Verdict::Unknown, _) => writeln!(
                 f,
@@ -325,8 +327,39 @@ pub fn synthesize_within(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible>
     }
 }
 
-/// One mode (or a mix without modes): the grid and the placement.
+/// Each channel whose rate is more than its branch's converter converts
+/// per second at this clock (a chain converts all its members at once, so
+/// a channel's limit is the chain's conversions), in words.
+fn too_fast_for_the_part(mix: &Mix) -> Vec<String> {
+    (mix.channels.iter())
+        .filter_map(|c| {
+            let b = &mix.branches[c.branch];
+            let most = b.max_samples_hz(mix.clock_hz) / b.chain.max(1) as f64;
+            (c.rate_hz as f64 > most).then(|| {
+                format!(
+                    "channel `{}`: {} Hz is faster than branch `{}`'s {} can convert: at most {:.0} samples/s at {} Hz (its datasheet: {})",
+                    c.name, c.rate_hz, b.name, b.adc.name, most, mix.clock_hz, b.adc.max_sps
+                )
+            })
+        })
+        .collect()
+}
+
+/// One mode (or a mix without modes): the grid and the placement.  A
+/// channel faster than its converter converts is the first reason, before
+/// what any grid makes of it (a rate no grid spaces evenly, a full branch).
 fn synthesize_one(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible> {
+    synthesize_grid(mix, budget).map_err(|mut e| {
+        let mut first = too_fast_for_the_part(mix);
+        if !first.is_empty() && e.verdict == Verdict::Infeasible {
+            first.append(&mut e.reasons);
+            e.reasons = first;
+        }
+        e
+    })
+}
+
+fn synthesize_grid(mix: &Mix, budget: u64) -> Result<Schedule, Infeasible> {
     let fail = |reasons: Vec<String>, suggestions: Vec<String>| Infeasible {
         mix: mix.name.clone(),
         verdict: Verdict::Infeasible,
@@ -708,6 +741,28 @@ mod tests {
     fn three_branches() -> Mix {
         let text = include_str!("../tests/data/missed.toml");
         crate::parse(std::path::Path::new("missed.toml"), text).unwrap()
+    }
+
+    /// A 150 kHz channel on a 100 kS/s AD7940 is told as the part's limit
+    /// first, on a clock that divides the rate and on one that does not
+    /// (not as a rate no slot grid spaces evenly).
+    #[test]
+    fn a_channel_faster_than_its_part_is_told_as_the_parts_limit() {
+        for hz in ["48_000_000", "4_000_000"] {
+            let text = format!(
+                "name = \"f\"\n[clock]\nhz = {hz}\n[frame]\nperiod_us = 1_000\nslice_us = 500\n\
+                 [[branch]]\nname = \"a\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n\
+                 [[channel]]\nname = \"X\"\nbranch = \"a\"\nrate_hz = 150_000\n"
+            );
+            let mix = crate::parse(std::path::Path::new("f.toml"), &text).unwrap();
+            let e = synthesize(&mix).unwrap_err();
+            let first = &e.reasons[0];
+            assert!(
+                first.contains("150000 Hz is faster than branch `a`'s ad7940 can convert")
+                    && first.contains("at most 100000 samples/s"),
+                "{hz}: {e}"
+            );
+        }
     }
 
     #[test]

@@ -533,7 +533,7 @@ fn channels(r: &AuditReport) -> Table {
     let mut t = Table::new(&[
         "channel",
         "branch",
-        "mux device, input",
+        "mux (device.select, or the converter's input)",
         "rate (Hz)",
         "`sample_channel`",
         "interval (cycles)",
@@ -565,7 +565,7 @@ fn channel_row(c: &ChannelAudit) -> Vec<String> {
     vec![
         c.name.clone(),
         c.branch.clone(),
-        format!("{}, {}", c.device, c.select),
+        c.mux_words(),
         rate,
         c.sample_channel.to_string(),
         format!("{} (jitter {})", c.interval_cycles, c.jitter_cycles),

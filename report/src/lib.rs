@@ -228,6 +228,12 @@ fn html_table(t: &Table) -> String {
 }
 
 fn md_table(t: &Table) -> String {
+    md_table_with(t, None)
+}
+
+/// [`md_table`] with column `links` (if any) written as it is: Markdown
+/// links, whose targets must not become code spans.
+fn md_table_with(t: &Table, links: Option<usize>) -> String {
     let cell = |s: &str| md_inline(s).replace('|', "\\|");
     let mut m = format!(
         "| {} |\n|{}|\n",
@@ -246,7 +252,10 @@ fn md_table(t: &Table) -> String {
         let _ = writeln!(
             m,
             "| {} |",
-            r.iter().map(|c| cell(c)).collect::<Vec<_>>().join(" | ")
+            (r.iter().enumerate())
+                .map(|(i, c)| if Some(i) == links { c.clone() } else { cell(c) })
+                .collect::<Vec<_>>()
+                .join(" | ")
         );
     }
     m
@@ -460,7 +469,7 @@ pub fn markdown(d: &Document) -> String {
         m,
         "## Steps: {}\n\n{}",
         if d.ok() { "ok" } else { "FAILED" },
-        md_table(&steps_table(d))
+        md_table_with(&steps_table(d), Some(4))
     );
     for s in d
         .steps

@@ -98,9 +98,8 @@ impl Sink {
         if path == Path::new("-") {
             return Ok(Sink::Stdout);
         }
-        let name = path
-            .file_name()
-            .ok_or_else(|| format!("{}: not a file name", path.display()))?;
+        let path = &super::output_file("-o", path)?;
+        let name = path.file_name().expect("output_file names a file");
         let tmp = path.with_file_name(format!(".{}.tmp", name.to_string_lossy()));
         let f = std::fs::File::create(&tmp).map_err(|e| {
             format!(

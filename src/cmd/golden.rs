@@ -368,7 +368,7 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         }
     };
     let events_path = dir.join(EVENTS);
-    let (golden, scene, (stimulus, modes)) = match load_golden(a, &s, mix, &events_path, o) {
+    let (golden, scene, (stimulus, modes), other) = match load_golden(a, &s, mix, &events_path, o) {
         Ok(g) => g,
         Err(code) => return code,
     };
@@ -434,7 +434,11 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
         );
     }
     let golden = golden.expect("loaded above");
-    let mut differ = compare_events(o, &who, &s, &golden, &log, &events_path);
+    if let Some(why) = &other {
+        outln!(o, "{who}: DIFFERS from {}: {why}", events_path.display());
+    }
+    let mut differ = other.is_some();
+    differ |= compare_events(o, &who, &s, &golden, &log, &events_path, other.is_some());
     match compare_windows(
         o,
         &who,
@@ -454,8 +458,14 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
 }
 
 /// The golden's event log ([`load_events`]), the scene this run drives
-/// and its stimulus and `mode_sel` requests ([`drive`]).
-type Loaded = (Option<EventLog>, Scene, (engines::Stimulus, Vec<(u64, u8)>));
+/// and its stimulus and `mode_sel` requests ([`drive`]), and how that scene
+/// differs from the golden's (`None`: the same).
+type Loaded = (
+    Option<EventLog>,
+    Scene,
+    (engines::Stimulus, Vec<(u64, u8)>),
+    Option<String>,
+);
 
 fn load_golden(
     a: &Args,
@@ -467,32 +477,33 @@ fn load_golden(
     let (golden, recorded) = load_events(a, s, mix, events_path, o)?;
     // the scene given, else the one the golden was recorded under
     let scene = a.scene.or(&recorded);
-    let k = drive(s, &scene, golden.as_ref().map(|_| &recorded), o)?;
-    Ok((golden, scene, k))
-}
-
-/// The stimulus and `mode_sel` requests of `scene` (the options given,
-/// else the one the golden was `recorded` under); a scene other than the
-/// recorded one is noted, so a difference reads as what it is.
-fn drive(
-    s: &Schedule,
-    scene: &Scene,
-    recorded: Option<&Scene>,
-    o: &mut Output,
-) -> Result<(engines::Stimulus, Vec<(u64, u8)>), u8> {
     let k = scene.resolve(s).map_err(|e| {
         errln!(o, "error: {e}");
         2u8
     })?;
-    if let Some(r) = recorded.filter(|r| r.header() != scene.header()) {
-        errln!(
-            o,
-            "note: the golden was recorded under{}; this run drives{}",
-            or_default(&r.options()),
-            or_default(&scene.options())
-        );
+    let other = golden
+        .as_ref()
+        .and_then(|_| scene_differs(s, &recorded, &scene, &k));
+    Ok((golden, scene, k, other))
+}
+
+/// How `scene`, resolved as `k`, differs from the one the golden was
+/// `recorded` under (`None`: the same stimulus and the same requests,
+/// however written): a run under another scene is never "the same".
+fn scene_differs(
+    s: &Schedule,
+    recorded: &Scene,
+    scene: &Scene,
+    k: &(engines::Stimulus, Vec<(u64, u8)>),
+) -> Option<String> {
+    if recorded.resolve(s).as_ref() == Ok(k) {
+        return None;
     }
-    Ok(k)
+    Some(format!(
+        "the golden was recorded under{}; this run drives{}",
+        or_default(&recorded.options()),
+        or_default(&scene.options())
+    ))
 }
 
 /// The golden event log at `events_path` and the scene it was recorded
@@ -549,10 +560,18 @@ fn compare_events(
     golden: &EventLog,
     log: &EventLog,
     events_path: &Path,
+    other_scene: bool,
 ) -> bool {
     let cmp = compare(golden, log, SHOWN + 1);
     let mut differ = false;
-    if cmp.same() {
+    if cmp.same() && other_scene {
+        outln!(
+            o,
+            "  its {} events over {} cycles are alike; the scenes differ",
+            log.events.len(),
+            log.cycles
+        );
+    } else if cmp.same() {
         outln!(
             o,
             "{who}: same as {}: {} events over {} cycles",

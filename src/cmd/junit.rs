@@ -42,27 +42,12 @@ pub fn check_writable(path: Option<&Path>) -> Result<(), u8> {
     let Some(path) = path else {
         return Ok(());
     };
-    unwritable(path).map_err(|e| {
-        eprintln!("error: {e}");
-        2
-    })
-}
-
-fn unwritable(path: &Path) -> Result<(), String> {
-    if path.is_dir() {
-        return Err(format!(
-            "--junit {}: is a directory, not a file",
-            path.display()
-        ));
-    }
-    match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() && !d.is_dir() => Err(format!(
-            "--junit {}: the folder {} does not exist",
-            path.display(),
-            d.display()
-        )),
-        _ => Ok(()),
-    }
+    super::output_file("--junit", path)
+        .map(|_| ())
+        .map_err(|e| {
+            eprintln!("error: {e}");
+            2
+        })
 }
 
 /// The XML of one suite `suite` holding `cases`.

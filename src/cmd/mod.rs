@@ -14,7 +14,7 @@ pub mod sim;
 pub mod synth;
 pub mod verilog;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Loads and schedules a mix, printing the error and returning the exit code on failure.
 pub fn schedule(path: &Path) -> Result<lut_gen::Schedule, u8> {
@@ -187,6 +187,29 @@ pub fn link_fits(s: &lut_gen::Schedule, file: &Path) -> Result<(), u8> {
             Err(1)
         }
         _ => Ok(()),
+    }
+}
+
+/// A file the user named for one output (`--vcd`, `--samples`,
+/// `--link-bytes`, `--junit`, `--harness`, `decode -o`): checked before any
+/// work and never a folder created for it.  Refused (the message names
+/// `flag` and the path) when it is a folder or its folder does not exist
+/// ("no such folder"); otherwise returned absolute, so a file written
+/// beside it (a `.gtkw`) finds it from anywhere.
+pub fn output_file(flag: &str, path: &Path) -> Result<PathBuf, String> {
+    let refuse = |why: &str| format!("{flag} {}: {why}", path.display());
+    if path.is_dir() {
+        return Err(refuse("is a folder, not a file"));
+    }
+    let name = path.file_name().ok_or_else(|| refuse("not a file name"))?;
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    match dir.canonicalize() {
+        Ok(d) if d.is_dir() => Ok(d.join(name)),
+        Ok(_) => Err(refuse("a part of the path is a file, not a folder")),
+        Err(e) => Err(refuse(&lut_gen::write_words(&e))),
     }
 }
 

@@ -81,6 +81,17 @@ pub fn run(a: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
+    let harness = match a
+        .harness
+        .as_deref()
+        .map(|h| super::output_file("--harness", h))
+    {
+        Some(Err(e)) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+        h => h.and_then(Result::ok),
+    };
     let (design, own, netlist) = match design(&a, &s) {
         Ok(d) => d,
         Err(e) => {
@@ -88,7 +99,7 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
-    if let Some(path) = &a.harness {
+    if let Some(path) = &harness {
         match formal::generate(&s) {
             Ok(h) => {
                 let dir = path.parent().filter(|p| !p.as_os_str().is_empty());

@@ -162,31 +162,6 @@ fn parse_tready(s: &str) -> Result<link::ReadyPattern, String> {
         .ok_or_else(|| format!("`{s}`: always, worst, random or random:SEED (SEED > 0)"))
 }
 
-/// `path` made absolute, its folder created.
-fn absolute_in_new_folder(path: &std::path::Path) -> Result<PathBuf, String> {
-    if path.is_dir() {
-        return Err(format!("{}: is a folder, not a file", path.display()));
-    }
-    let name = path
-        .file_name()
-        .ok_or_else(|| format!("{}: not a file name", path.display()))?;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&dir).map_err(|e| {
-        format!(
-            "{}: cannot create the folder {}: {e}",
-            path.display(),
-            dir.display()
-        )
-    })?;
-    let dir = dir
-        .canonicalize()
-        .map_err(|e| format!("{}: {e}", dir.display()))?;
-    Ok(dir.join(name))
-}
-
 /// The run's VCD `vcd` as the FST `fst`, with its own save file and
 /// translate file; the VCD and the files named after it are removed.
 fn to_fst(
@@ -354,14 +329,11 @@ fn window(a: &Args, s: &lut_gen::Schedule) -> Result<(u64, u64), String> {
 /// The VCD the run writes and the FST it becomes (with `--fst` or a
 /// `.fst` name): (vcd, fst).
 fn waveform_paths(a: &Args) -> Result<(Option<PathBuf>, Option<PathBuf>), String> {
-    // The VCD's folder is created now, not found missing after the run; its
+    // A missing folder is refused now, not found missing after the run; the
     // path is made absolute so the .gtkw beside it finds it from anywhere.
-    let vcd = a
-        .vcd
-        .as_deref()
-        .map(absolute_in_new_folder)
-        .transpose()
-        .map_err(|e| format!("--vcd {e}"))?;
+    let vcd = (a.vcd.as_deref())
+        .map(|p| super::output_file("--vcd", p))
+        .transpose()?;
     // FST: the run writes a VCD beside it, converted at the end (in
     // process, through fst-writer).
     let fst = vcd.as_ref().and_then(|v| {
@@ -391,10 +363,7 @@ fn samples_path_free(a: &Args) -> Result<(), String> {
             p.display()
         ));
     }
-    if p.is_dir() {
-        return Err(format!("--samples {}: is a directory", p.display()));
-    }
-    Ok(())
+    super::output_file("--samples", p).map(|_| ())
 }
 
 /// `--link-bytes` needs a mix with a link and names a file of its own.
@@ -424,10 +393,7 @@ fn link_bytes_path_free(a: &Args, s: &lut_gen::Schedule) -> Result<(), String> {
             p.display()
         ));
     }
-    if p.is_dir() {
-        return Err(format!("--link-bytes {}: is a directory", p.display()));
-    }
-    Ok(())
+    super::output_file("--link-bytes", p).map(|_| ())
 }
 
 /// What a run logs beside its verdict: its samples (`--samples`) and its

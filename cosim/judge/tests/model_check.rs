@@ -599,3 +599,36 @@ fn a_packet_sent_twice_breaks_the_sequence() {
         r.summary()
     );
 }
+
+/// A divergence on a mux pin compares like with like: each select value
+/// with the channel it addresses (the wrong input's channel, or why there
+/// is none), never the expected channel beside the actual value.
+#[test]
+fn a_mux_divergence_names_the_channel_of_each_value() {
+    use judge::{FaultyDut, PinFault};
+    let s = eskin();
+    let at = s.grid.frame_cycles / 2 + 7;
+    let f = PinFault::WrongMux { branch: 0 };
+    let mut dut = FaultyDut::new(&s, ModelDut::new(&s), f, at);
+    let r = run_dut(&s, &mut dut, 2, &RunOptions::default(), "faulty", None);
+    let d = (r.divergences.iter())
+        .find(|d| d.signal.starts_with("mux_sel"))
+        .unwrap_or_else(|| panic!("{}", r.summary()));
+    let want = d.channel.clone().unwrap();
+    let actual = d.actual_channel.clone().unwrap();
+    // the select bit flipped: another input, so another channel (or none)
+    assert_ne!(actual, want, "{}", r.summary());
+    let line = r.summary();
+    let shown = |c: &str| match c.contains(' ') {
+        true => c.to_string(),
+        false => format!("channel {c}"),
+    };
+    let expected = format!(
+        "expected {} ({}) actual {} ({})",
+        d.expected,
+        shown(&want),
+        d.actual,
+        shown(&actual)
+    );
+    assert!(line.contains(&expected), "{line}");
+}

@@ -181,11 +181,11 @@ fn mode_verilog(p: &ModePlan, nb: usize) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "// the modes of the frame in force and of the next; the first frame start seen\n// (frames 0 and 1 run the reset mode); the next slot start is a frame's\nreg [{}:0] cur;\nreg [{0}:0] nxt;\nreg go;\nreg z;\n// in reset the ROM reads mode 0's first slot (nxt and z may hold power-on values)\nwire fend = start1 & z & ~rst;\nwire anx = addr == {SLOT_BITS}'h0;\nwire [{0}:0] nxt0 = rst ? {mb}'d0 : nxt;\n",
+        "// the modes of the frame in force and of the next; the first frame start seen\n// (frames 0 and 1 run the reset mode); the next slot start is a frame's\n// (initial values: their reset values, as the twin starts)\nreg [{}:0] cur = {mb}'d0;\nreg [{0}:0] nxt = {mb}'d0;\nreg go = 1'b0;\nreg z = 1'b1;\n// in reset the ROM reads mode 0's first slot\nwire fend = start1 & z & ~rst;\nwire anx = addr == {SLOT_BITS}'h0;\nwire [{0}:0] nxt0 = rst ? {mb}'d0 : nxt;\n",
         mb - 1
     );
     if !p.pin {
-        let _ = writeln!(s, "// the mode of the frame before (a run of windows stays in one mode)\nreg [{}:0] prev;", mb - 1);
+        let _ = writeln!(s, "// the mode of the frame before (a run of windows stays in one mode)\nreg [{}:0] prev = {mb}'d0;", mb - 1);
     }
     let mut unused = vec![];
     let decided = if p.pin {
@@ -249,7 +249,7 @@ fn triggers_verilog(s: &mut String, p: &ModePlan, nb: usize, unused: &mut Vec<St
         let n = t.for_frames;
         let _ = writeln!(
             s,
-            "// trigger {k}: to mode {}{}, {} {} for {n} frame(s)\nreg wany{k};\nreg wab{k};\nreg wbe{k};\nreg [{}:0] run{k};",
+            "// trigger {k}: to mode {}{}, {} {} for {n} frame(s)\nreg wany{k} = 1'b0;\nreg wab{k} = 1'b0;\nreg wbe{k} = 1'b1;\nreg [{}:0] run{k} = {rb}'d0;",
             t.to,
             t.from.map_or(String::new(), |f| format!(" from mode {f}")),
             if t.above { "above" } else { "below" },

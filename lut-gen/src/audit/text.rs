@@ -337,12 +337,7 @@ fn worst_mode(l: &crate::hostlink::LinkPlan) -> String {
     }
 }
 
-/// The `dev.sel` cell: an external mux's device and select, or the
-/// converter's own input (and the front mux's pins in front of it).
+/// The `dev.sel` cell: [`super::ChannelAudit::mux_words`].
 fn mux_cell(c: &super::ChannelAudit) -> String {
-    match c.adc_input {
-        None => format!("{}.{}", c.device, c.select),
-        Some(k) if c.front_mux => format!("in{k}/{}.{}", c.device, c.select),
-        Some(k) => format!("in{k}"),
-    }
+    c.mux_words()
 }

@@ -70,6 +70,7 @@ impl Cx<'_> {
         let message = (!named)
             .then(|| header_message(self.text, e.span(), &field))
             .flatten()
+            .or_else(|| unknown_words(e.message(), header_at(self.text, e.span())))
             .unwrap_or_else(|| toml_words(e.message(), &field));
         MixError {
             file: self.file.to_path_buf(),

@@ -364,3 +364,38 @@ fn a_declared_cnv_part_may_be_read_with_cnv_low() {
         assert!(e.message.contains(says), "{e}");
     }
 }
+
+/// A TOML syntax error is one line: file, line, column, the table, and
+/// toml's two lines joined.
+#[test]
+fn a_syntax_error_is_one_line_with_file_line_and_column() {
+    let e = err(&GOOD.replace("[clock]", "[clock"));
+    let text = e.to_string();
+    assert_eq!(text.lines().count(), 1, "{text}");
+    assert!(
+        text.starts_with("m.toml:3:7: clock: invalid table header: expected"),
+        "{text}"
+    );
+}
+
+/// A misspelt table is named as the user wrote it, at its header's line,
+/// with the closest table the format has; a misspelt key gets its closest
+/// key too.
+#[test]
+fn a_misspelt_table_is_named_as_written_with_the_closest_one() {
+    let e = err(&GOOD.replace("[frame]", "[frames]"));
+    assert_eq!((e.line, e.field.as_str()), (5, "frames"), "{e}");
+    assert_eq!(
+        e.message,
+        "unknown table `[frames]`; did you mean `[frame]`?"
+    );
+    let e = err(&GOOD.replace("[[channel]]", "[[chanel]]"));
+    assert_eq!((e.line, e.field.as_str()), (12, "chanel"), "{e}");
+    assert!(e.message.ends_with("did you mean `[[channel]]`?"), "{e}");
+    let e = err(&GOOD.replace("adc = ", "adx = "));
+    assert_eq!(e.field, "branch[0].adx", "{e}");
+    assert!(e.message.ends_with("; did you mean `adc`?"), "{e}");
+    // nothing near: the tables the format has
+    let e = err(&GOOD.replace("[frame]", "[zzzzzzzz]"));
+    assert!(e.message.contains("a mix has `name`"), "{e}");
+}

@@ -22,6 +22,12 @@ pub(super) fn field_from_toml_message(
     if let Some(rest) = message.strip_prefix("unknown field `") {
         if let Some(end) = rest.find('`') {
             let key = &rest[..end];
+            // a misspelt table's own header: the name as written
+            let own = header_at(text, span.clone())
+                .is_some_and(|h| h.trim_matches(|c| c == '[' || c == ']').trim() == key);
+            if own {
+                return key.to_string();
+            }
             return format!("{}{key}", table_prefix(text, span));
         }
     }
@@ -96,6 +102,11 @@ pub(super) fn table_prefix(text: &str, span: Option<Range<usize>>) -> String {
     let mut current = String::new();
     for line in upto.lines() {
         let t = line.trim();
+        // a header is whole (`[frame]`): the line the span begins in may be
+        // only its `[` so far
+        if !t.contains(']') {
+            continue;
+        }
         if let Some(name) = t.strip_prefix("[[").and_then(|r| r.split("]]").next()) {
             let name = name.trim().to_string();
             let n = counts.entry(name.clone()).or_insert(0);
@@ -106,6 +117,65 @@ pub(super) fn table_prefix(text: &str, span: Option<Range<usize>>) -> String {
         }
     }
     current
+}
+
+/// serde's "unknown field `x`, expected one of `a`, `b`" in the mix
+/// format's words: a table header the format does not have is an unknown
+/// table, written as the user wrote it; either way the closest known name
+/// is offered when one is near.
+pub(super) fn unknown_words(message: &str, header: Option<&str>) -> Option<String> {
+    let rest = message.strip_prefix("unknown field `")?;
+    let (key, rest) = rest.split_once('`')?;
+    let known: Vec<&str> = rest.split('`').skip(1).step_by(2).collect();
+    // the header names the key itself (`[frames]`), not its table's
+    let header = header.filter(|h| h.trim_matches(|c| c == '[' || c == ']').trim() == key);
+    let near = known
+        .iter()
+        .map(|k| (distance(key, k), *k))
+        .filter(|(d, k)| *d <= 2.max(k.len() / 3))
+        .min();
+    Some(match (header, near) {
+        (Some(h), Some((_, k))) => {
+            let like = h.replacen(key, k, 1);
+            format!("unknown table `{h}`; did you mean `{like}`?")
+        }
+        (Some(h), None) => format!(
+            "unknown table `{h}`; a mix has {}",
+            known
+                .iter()
+                .map(|k| format!("`{k}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+        (None, Some((_, k))) => format!("{}; did you mean `{k}`?", message.trim()),
+        (None, None) => message.trim().to_string(),
+    })
+}
+
+/// The table header (`[frames]`) on the line `span` begins in, if it is one.
+pub(super) fn header_at(text: &str, span: Option<Range<usize>>) -> Option<&str> {
+    let s = span?;
+    let start = text[..s.start.min(text.len())]
+        .rfind('\n')
+        .map_or(0, |p| p + 1);
+    let line = text[start..].lines().next()?.trim();
+    line.starts_with('[').then_some(line)
+}
+
+/// The edit distance of two names (insertions, deletions, substitutions).
+fn distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
 }
 
 /// Frame periods (whole slices, at most 10 s) in which `rate_hz` gives a
@@ -200,5 +270,12 @@ pub fn toml_words(m: &str, field: &str) -> String {
     ] {
         out = out.replace(rust, words);
     }
-    out
+    // toml's syntax errors come on two lines ("invalid table header" and
+    // "expected `.`, `]`"): one line, as every message
+    let lines: Vec<&str> = out
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    lines.join(": ")
 }

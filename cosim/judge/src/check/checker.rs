@@ -456,6 +456,7 @@ impl Checker {
                             actual: if ax != 0 { json!("x") } else { json!(av) },
                             branch: s.branch().map(|b| self.branch_names[b].clone()),
                             channel: None,
+                            actual_channel: None,
                             context: vec![format!(
                                 "reset: {} | expected {}",
                                 fmt_pins(&rp),
@@ -615,7 +616,12 @@ impl Checker {
                             json!(av)
                         },
                         branch: s.branch().map(|b| self.branch_names[b].clone()),
-                        channel: ch.and_then(|c| self.names.get(c as usize).cloned()),
+                        // a mux pin: the channel each select addresses
+                        channel: match self.selected_channel(s, e) {
+                            Some(c) => Some(c),
+                            None => ch.and_then(|c| self.names.get(c as usize).cloned()),
+                        },
+                        actual_channel: self.selected_channel(s, p),
                         context,
                     });
                     self.ctx_open
@@ -628,6 +634,19 @@ impl Checker {
             self.divergence_count += 1;
         }
         self.div_active = any;
+    }
+
+    /// For a divergence on a mux pin: the channel the pins `p` select
+    /// (its name), or why none is, in words.
+    fn selected_channel(&self, s: Signal, p: &Pins) -> Option<String> {
+        let b = match s {
+            Signal::MuxSel(b) | Signal::MuxEn(b) => b,
+            _ => return None,
+        };
+        Some(match self.layout.selected(p, b) {
+            Ok(c) => self.names.get(c as usize).cloned().unwrap_or_default(),
+            Err(why) => why,
+        })
     }
 
     /// The `mode` output against the model's (not a [`Signal`]: a mix
@@ -647,6 +666,7 @@ impl Checker {
                     actual: json!(p.mode),
                     branch: None,
                     channel: None,
+                    actual_channel: None,
                     context: vec![format!(
                         "mode_sel={} mode={} | expected mode={}",
                         p.mode_sel, p.mode, e.mode

@@ -42,9 +42,54 @@ pub struct Divergence {
     pub expected: Value,
     pub actual: Value,
     pub branch: Option<String>,
+    /// The channel of the expected value: for a mux pin, the channel the
+    /// expected pins select (or why none is).
     pub channel: Option<String>,
+    /// For a mux pin (`mux_sel`, `mux_en`): the channel the actual pins
+    /// select, or why none is, beside `channel` (then the channel the
+    /// expected pins select).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub actual_channel: Option<String>,
     /// A few cycles around the divergence: `cycle: actual | expected`.
     pub context: Vec<String>,
+}
+
+impl Divergence {
+    /// "expected X actual Y, branch B, channel C": a mux pin names the
+    /// channel of each value beside it (like with like), any other the
+    /// expected value's channel after the branch.
+    pub fn values_text(&self) -> String {
+        let branch = self
+            .branch
+            .as_ref()
+            .map(|b| format!(", branch {b}"))
+            .unwrap_or_default();
+        if let Some(actual) = &self.actual_channel {
+            let name = |c: &str| {
+                if c.starts_with("no ") || c.contains(' ') {
+                    c.to_string()
+                } else {
+                    format!("channel {c}")
+                }
+            };
+            let expected = name(self.channel.as_deref().unwrap_or(""));
+            return format!(
+                " expected {} ({expected}) actual {} ({}){branch}",
+                self.expected,
+                self.actual,
+                name(actual)
+            );
+        }
+        let channel = self
+            .channel
+            .as_ref()
+            .map(|c| format!(", channel {c}"))
+            .unwrap_or_default();
+        format!(
+            " expected {} actual {}{branch}{channel}",
+            self.expected, self.actual
+        )
+    }
 }
 
 /// A broken invariant (independent of the model).
@@ -226,21 +271,12 @@ impl Verdict {
         if let Some(d) = self.divergences.first() {
             let _ = writeln!(
                 s,
-                "first divergence: cycle {} (frame {}, slot {}): {} expected {} actual {}{}{}",
+                "first divergence: cycle {} (frame {}, slot {}): {}{}",
                 d.cycle,
                 d.frame,
                 d.slot,
                 d.signal,
-                d.expected,
-                d.actual,
-                d.branch
-                    .as_ref()
-                    .map(|b| format!(", branch {b}"))
-                    .unwrap_or_default(),
-                d.channel
-                    .as_ref()
-                    .map(|c| format!(", channel {c}"))
-                    .unwrap_or_default()
+                d.values_text()
             );
             for l in &d.context {
                 let _ = writeln!(s, "    {l}");
