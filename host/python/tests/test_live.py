@@ -56,7 +56,7 @@ class Board:
 @pytest.mark.parametrize("mix_of", ["preset", "unseen"])
 def test_a_line_at_its_pace_reads_live_to_the_files_samples(mix_of, tmp_path):
     if mix_of == "preset":
-        mix, frames = ROOT / "mixes/eskin34-uart.toml", 40
+        mix, frames = ROOT / "mixes/eskin34-uart.toml", 16
     else:
         link = 'kind = "uart"\nbaud = 1_000_000\nparity = "odd"\n'
         mix, frames = unseen_mix(tmp_path, link), 400
@@ -65,7 +65,7 @@ def test_a_line_at_its_pace_reads_live_to_the_files_samples(mix_of, tmp_path):
     rate = pace(mix)
     board = Board(line, rate)
     start = time.monotonic()
-    live = slotforge.open_serial(mix, board.port, idle=1.0)
+    live = slotforge.open_serial(mix, board.port, idle=0.5)
     board.go()
     batches = list(live)
     sent, took = board.done()
@@ -81,12 +81,12 @@ def test_a_line_at_its_pace_reads_live_to_the_files_samples(mix_of, tmp_path):
 def test_the_live_command_plots_a_line_into_a_file(tmp_path):
     mix = ROOT / "mixes/eskin34-uart.toml"
     line = tmp_path / "line.bin"
-    sim_bytes(mix, line, frames=20)
+    sim_bytes(mix, line, frames=8)
     board = Board(line, pace(mix))
     png = tmp_path / "live.png"
     p = subprocess.Popen(
         [sys.executable, "-m", "slotforge.live", str(mix), board.port, "--save", str(png),
-         "--idle", "1", "--window", "0.5"],
+         "--idle", "0.5", "--window", "0.05"],
         stderr=subprocess.PIPE, text=True)
     opened = p.stderr.readline()
     assert opened.startswith(f"reading {board.port}"), opened
@@ -104,3 +104,78 @@ def test_the_live_command_refuses_a_port_that_will_not_open(tmp_path):
          str(tmp_path / "no-such-port"), "--no-plot"],
         capture_output=True, text=True, timeout=60)
     assert p.returncode == 2 and "no-such-port" in p.stderr and "Traceback" not in p.stderr, p.stderr
+
+
+class FakeLsl:
+    """Stands in for pylsl: records each outlet's stream info and samples
+    (a real outlet would announce itself on the network)."""
+
+    def __init__(self):
+        import types
+
+        self.infos, self.pushed = [], {}
+        fake = self
+
+        class Desc:
+            def __init__(self, labels):
+                self.labels = labels
+
+            def append_child(self, name):
+                return self
+
+            def append_child_value(self, key, value):
+                self.labels.append(value)
+
+        class StreamInfo:
+            def __init__(self, name, kind, count, rate, fmt, source):
+                self.fields = dict(name=name, kind=kind, count=count, rate=rate, fmt=fmt, source=source)
+                self.labels = []
+                fake.infos.append(self)
+
+            def desc(self):
+                return Desc(self.labels)
+
+        class StreamOutlet:
+            def __init__(self, info):
+                self.name = info.fields["name"]
+                fake.pushed[self.name] = []
+
+            def push_sample(self, sample):
+                fake.pushed[self.name].append(list(sample))
+
+        self.module = types.ModuleType("pylsl")
+        self.module.StreamInfo, self.module.StreamOutlet = StreamInfo, StreamOutlet
+
+
+def test_lsl_has_an_outlet_per_rate_group_and_a_sample_per_round(tmp_path, monkeypatch):
+    mix = slotforge.Mix(ROOT / "mixes/eskin34-uart.toml")
+    line = tmp_path / "line.bin"
+    sim_bytes(mix_path := ROOT / "mixes/eskin34-uart.toml", line, frames=2)
+    cap = slotforge.read(mix_path, line)
+    lsl = FakeLsl()
+    monkeypatch.setitem(sys.modules, "pylsl", lsl.module)
+    from slotforge.live import Outlets, rate_groups
+
+    groups = rate_groups(mix)
+    assert [(r, len(c)) for r, c in groups] == [(2000, 2), (1000, 30), (100, 9)]
+    out = Outlets(mix, groups)
+    half = len(cap.rows) // 2  # in two batches, as a live line gives them
+    for part in (cap.rows[:half], cap.rows[half:]):
+        out.push(slotforge.Capture(mix, part, cap.counts))
+    for info, (rate, chans) in zip(lsl.infos, groups):
+        f = info.fields
+        assert (f["name"], f["kind"], f["count"], f["rate"], f["fmt"]) == (
+            f"eskin34-uart {rate} Hz", "slotforge", len(chans), rate, "int32")
+        assert info.labels == [mix.channels[c] for c in chans]
+        codes = [cap[mix.channels[c]][1].tolist() for c in chans]
+        rounds = min(len(c) for c in codes)
+        assert rounds > 0
+        assert lsl.pushed[f["name"]] == [[c[k] for c in codes] for k in range(rounds)]
+
+
+def test_lsl_without_pylsl_is_told(tmp_path):
+    code = ("import sys; sys.modules['pylsl'] = None; from slotforge.live import main; "
+            f"sys.exit(main([{str(ROOT / 'mixes/eskin34-uart.toml')!r}, '/dev/null', '--lsl', '--no-plot']))")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert p.returncode == 2 and "--lsl needs pylsl (pip install pylsl)" in p.stderr, p.stderr
+    assert "Traceback" not in p.stderr

@@ -35,7 +35,7 @@ class Outlets:
         try:
             import pylsl
         except ImportError as e:
-            raise SystemExit(f"error: --lsl needs pylsl (pip install pylsl): {e}") from None
+            raise ValueError(f"--lsl needs pylsl (pip install pylsl): {e}") from None
         self.outlets = []
         for rate, chans in groups:
             info = pylsl.StreamInfo(
