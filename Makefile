@@ -24,7 +24,7 @@ endif
 # `PROPTEST_RNG_SEED=random make test` explores new cases.
 export PROPTEST_RNG_SEED ?= 1
 
-.PHONY: baseline test-long run test tools venv lut audit verilog cosim golden golden-update synth synth-bench bench bench-before update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
+.PHONY: baseline test-long run test test-host host tools venv lut audit verilog cosim golden golden-update synth synth-bench bench bench-before update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 # The main job on the reference mix: audit, LUT, Verilog, co-simulation, golden,
 # faults, synthesis estimate, and build/eskin34/report.html with its charts.
@@ -45,6 +45,7 @@ else
 	$(CARGO) test --workspace --locked
 endif
 	$(MAKE) golden GOLDEN_SLOTFORGE=$${CARGO_TARGET_DIR:-target}/debug/slotforge
+	$(MAKE) test-host HOST_SLOTFORGE=$${CARGO_TARGET_DIR:-$(CURDIR)/target}/debug/slotforge
 
 # Campaigns, all-preset proofs and long runs: not in `make test` (which must stay
 # under 15 minutes on 2 cores); run before an issue is resolved.
@@ -101,6 +102,25 @@ $(VENV)/.installed:
 	$(VENV)/bin/pip install --quiet $(PIP_PACKAGES)
 	@for t in $(YOWASP_TOOLS); do echo "warming $$t (first run compiles it)"; $(VENV)/bin/$$t --version >/dev/null || exit 1; done
 	touch $@
+
+# The Python package (host/python: pyo3 over the `host` crate; docs/host.md) in .venv/,
+# with what its tests and `slotforge.live` use: `pip install ./host/python` as a user
+# runs it, with maturin from .venv (no build environment fetched each time).  Its Rust
+# part is not a workspace member (its own Cargo.lock; pyo3 unifies other features, so
+# the workspace's artefacts would not be reused anyway): it builds in HOST_TARGET,
+# outside the clone so that CI's fresh clones share it (cargo rebuilds what changed).
+HOST_PIP_PACKAGES = maturin pytest matplotlib
+HOST_TARGET ?= $(if $(HOME),$(HOME)/.cache/slotforge/host-python-target,$(CURDIR)/target/host-python)
+host: venv
+	$(VENV)/bin/pip install --quiet $(HOST_PIP_PACKAGES)
+	PATH=$(abspath $(VENV))/bin:$$PATH CARGO_TARGET_DIR=$(HOST_TARGET) MATURIN_PEP517_ARGS=--locked \
+	  $(VENV)/bin/pip install --quiet --no-build-isolation ./host/python
+
+# Its tests (pytest), which hold it to the CLI: HOST_SLOTFORGE is the binary they
+# compare with (`make test` passes its test build's, as to `golden`).
+HOST_SLOTFORGE ?= $(CURDIR)/target/debug/slotforge
+test-host: host
+	cd host/python/tests && SLOTFORGE=$(HOST_SLOTFORGE) $(abspath $(VENV))/bin/python -m pytest -q -p no:cacheprovider .
 
 audit:
 	$(SLOTFORGE) audit $(MIX)

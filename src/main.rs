@@ -44,6 +44,8 @@ enum Command {
     Prove(cmd::prove::Args),
     /// Host side: the raw bytes received from the link (a serial-port dump, or `-` for stdin), as samples.
     Decode(cmd::decode::Args),
+    /// Host side: write a sigrok protocol decoder of the mix's packets (for PulseView, sigrok-cli).
+    Sigrok(cmd::sigrok::Args),
 }
 
 fn main() -> ExitCode {
@@ -68,6 +70,7 @@ fn main() -> ExitCode {
         Command::Synth(a) => cmd::synth::run(a),
         Command::Prove(a) => cmd::prove::run(a),
         Command::Decode(a) => cmd::decode::run(a),
+        Command::Sigrok(a) => cmd::sigrok::run(a),
     };
     ExitCode::from(code)
 }

@@ -33,6 +33,9 @@ mod golden_rtl;
 #[path = "hints.rs"]
 mod hints;
 
+#[path = "host_sigrok.rs"]
+mod host_sigrok;
+
 #[path = "icarus.rs"]
 mod icarus;
 

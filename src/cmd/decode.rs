@@ -3,10 +3,10 @@
 //! a mix with modes adds `mode`, the name of the packet's frame's mode, whose
 //! schedule, and the frame before's, give `sampled_s`).
 //!
-//! The decoding is `link::Decoder` (the packet format's one home); the
-//! sampling instants come from the schedule (`lut_gen::PacketInstants`),
-//! written as `sim --samples` writes them (`lut_gen::seconds`), so the two
-//! CSVs agree on `sampled_s` for the same sample.
+//! The decoding is `host::Samples` (`link::Decoder`, the packet format's
+//! one home, with the sampling instants from the schedule), the decoder the
+//! Python package shares; `sampled_s` is written as `sim --samples` writes
+//! it (`lut_gen::seconds`), so the two CSVs agree for the same sample.
 //! `CAPTURE` may be `-`: stdin is decoded as it arrives and each packet's
 //! rows are written when its trailer arrives (with `-o -`, to stdout at once).
 //!
@@ -18,8 +18,7 @@
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
-use link::{Decoded, Decoder, Stats};
-use lut_gen::PacketInstants;
+use link::Stats;
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -41,43 +40,32 @@ pub const HEADER: &str = "frame,slice,channel,value,sampled_s";
 /// The CSV's first line for a mix with modes.
 pub const HEADER_MODES: &str = "frame,slice,mode,channel,value,sampled_s";
 
-/// Rows of decoded packets, with names and sampling times from the mix.
+/// The decoder's samples as CSV rows.
 struct Rows {
-    names: Vec<String>,
-    times: PacketInstants,
-    /// A mix with modes: each mode's name and packet instants.
-    modes: Vec<(String, PacketInstants)>,
+    dec: host::Samples,
+    /// A mix with modes: the modes' names (the `mode` column).
+    modes: Vec<String>,
     rows: u64,
+    got: Vec<host::Sample>,
 }
 
 impl Rows {
-    /// The rows of `d` (whole packets, in order), appended to `out`.
-    fn write(&mut self, d: &[Decoded], out: &mut String) {
+    /// The rows of the packets `bytes` complete, appended to `out`.
+    fn push(&mut self, bytes: &[u8], out: &mut String) {
         use std::fmt::Write as _;
-        for packet in d.chunk_by(|a, b| (a.frame, a.slice) == (b.frame, b.slice)) {
-            let chans: Vec<u16> = packet.iter().map(|x| x.channel).collect();
-            let (f, k) = (packet[0].frame, packet[0].slice);
-            let (times, mode) = match self.modes.get(packet[0].mode as usize) {
-                Some((name, own)) => {
-                    let prev = self
-                        .modes
-                        .get(packet[0].prev_mode as usize)
-                        .map_or(own, |m| &m.1);
-                    (own.cycles_after(prev, f, k, &chans), format!("{name},"))
+        self.got.clear();
+        self.dec.push(bytes, &mut self.got);
+        for x in &self.got {
+            let mode = match self.modes.is_empty() {
+                true => String::new(),
+                false => {
+                    let name = self.modes.get(x.mode as usize).map_or("", String::as_str);
+                    format!("{name},")
                 }
-                None => (self.times.cycles(f, k, &chans), String::new()),
             };
-            let hz = self.times.clock_hz();
-            for (x, t) in packet.iter().zip(times) {
-                let name = self
-                    .names
-                    .get(x.channel as usize)
-                    .cloned()
-                    .unwrap_or_else(|| format!("#{}", x.channel));
-                let t = t.map(|t| lut_gen::seconds(t, hz)).unwrap_or_default();
-                let _ = writeln!(out, "{},{},{mode}{name},{},{t}", x.frame, x.slice, x.value);
-                self.rows += 1;
-            }
+            let (name, t) = (self.dec.name(x.channel), self.dec.seconds(x));
+            let _ = writeln!(out, "{},{},{mode}{name},{},{t}", x.frame, x.slice, x.value);
+            self.rows += 1;
         }
     }
 }
@@ -139,13 +127,13 @@ pub fn run(a: Args) -> u8 {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if s.mix.link.is_none() {
+    let Some(dec) = host::Samples::new(&s) else {
         eprintln!(
             "error: {}: the mix has no [link]: its samples leave on the parallel sample port, there is nothing to decode",
             a.mix.display()
         );
         return 2;
-    }
+    };
     let mut input: Box<dyn Read> = if a.capture == Path::new("-") {
         Box::new(std::io::stdin().lock())
     } else {
@@ -168,19 +156,7 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
-    let names = s.mode_plan().map(|m| m.names.clone()).unwrap_or_default();
-    let modes: Vec<(String, PacketInstants)> = if s.modes.len() > 1 {
-        names
-            .into_iter()
-            .zip(s.modes.iter().map(PacketInstants::new))
-            .collect()
-    } else {
-        Vec::new()
-    };
-    let mode_bits = match lut_gen::plan_link(&s) {
-        Some(Ok(p)) => p.tx_config(&s).mode_bits,
-        _ => 0,
-    };
+    let modes: Vec<String> = dec.mode_names().iter().map(|m| m.to_string()).collect();
     let mut text = format!(
         "{}\n",
         if modes.is_empty() {
@@ -190,14 +166,12 @@ pub fn run(a: Args) -> u8 {
         }
     );
     let mut rows = Rows {
-        names: s.mix.channels.iter().map(|c| c.name.clone()).collect(),
-        times: PacketInstants::new(&s),
+        dec,
         modes,
         rows: 0,
+        got: Vec::new(),
     };
-    let mut dec = Decoder::with_modes(s.grid.slices_per_frame, mode_bits);
     let mut buf = vec![0u8; 1 << 16];
-    let mut got = Vec::new();
     loop {
         let n = match input.read(&mut buf) {
             Ok(0) => break,
@@ -209,9 +183,7 @@ pub fn run(a: Args) -> u8 {
                 return 2;
             }
         };
-        got.clear();
-        dec.push(&buf[..n], &mut got);
-        rows.write(&got, &mut text);
+        rows.push(&buf[..n], &mut text);
         if !text.is_empty() {
             if let Err(e) = sink.put(&text) {
                 let why = lut_gen::write_words(&e);
@@ -221,7 +193,7 @@ pub fn run(a: Args) -> u8 {
             text.clear();
         }
     }
-    let st = dec.finish();
+    let st = rows.dec.finish();
     if let Err(e) = sink.finish() {
         eprintln!("error: {e}");
         return 2;

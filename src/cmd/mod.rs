@@ -10,6 +10,7 @@ pub mod junit;
 pub mod lut;
 pub mod progress;
 pub mod prove;
+pub mod sigrok;
 pub mod sim;
 pub mod synth;
 pub mod verilog;
