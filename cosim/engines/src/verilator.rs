@@ -333,6 +333,11 @@ fn runtime_objects(inc: &Path, versions: &str) -> Result<Vec<PathBuf>, BackendEr
     if objects.iter().all(|o| o.exists()) {
         return Ok(objects);
     }
+    // one compile of the runtime: a second build waits for the first's
+    let _lock = BuildLock::take(&dir.with_extension("lock"));
+    if objects.iter().all(|o| o.exists()) {
+        return Ok(objects);
+    }
     let io = |e: std::io::Error| BackendError::Io(format!("{}: {e}", dir.display()));
     // built aside and renamed, as the models are: concurrent builds never
     // see a half-written object
@@ -415,6 +420,17 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
             key,
         });
     }
+    // One build per model: a build of the same Verilog in another test or
+    // process (parallel tests all start on an empty cache) waits for the
+    // first and loads its library rather than compiling it a second time.
+    let _lock = BuildLock::take(&dir.with_extension("lock"));
+    if lib.exists() {
+        return Ok(Built {
+            library: lib,
+            cached: true,
+            key,
+        });
+    }
     let io = io_at(&dir);
     let tmp = build_dir(&key);
     let _ = std::fs::remove_dir_all(&tmp);
@@ -444,6 +460,44 @@ pub fn build(verilog: &str) -> Result<Built, BackendError> {
         "g++ -shared",
     )?;
     install(&tmp, &dir, key)
+}
+
+/// An exclusive `flock` on a file beside a cache entry, held until dropped
+/// (the kernel releases it if the process dies). `None` when the file
+/// cannot be made or locked: the build then runs unlocked, as the unique
+/// work directory and the rename in [`install`] keep it correct anyway,
+/// only perhaps twice.
+struct BuildLock {
+    _file: std::fs::File,
+}
+
+impl BuildLock {
+    fn take(path: &Path) -> Option<BuildLock> {
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).ok()?;
+        }
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(path)
+            .ok()?;
+        #[cfg(unix)]
+        {
+            use std::os::unix::io::AsRawFd;
+            // SAFETY: flock on a descriptor this `File` owns and keeps open;
+            // retried when a signal interrupts the wait.
+            loop {
+                if unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX) } == 0 {
+                    break;
+                }
+                if std::io::Error::last_os_error().kind() != std::io::ErrorKind::Interrupted {
+                    return None;
+                }
+            }
+        }
+        Some(BuildLock { _file: file })
+    }
 }
 
 /// An I/O error's message, naming the cache directory `dir`.

@@ -231,29 +231,49 @@ impl judge::CycleSink for BesideModel {
 
 /// The emitted Verilog in Icarus with the testbench's own ADC models (the
 /// commanded parts' too, `icarus_cmd`): every pin of its VCD equals the
-/// cycle model's, under the pattern and a table stimulus.
+/// cycle model's. The default suite runs each commanded part's model once
+/// (`cmd-both`: the MCP3208 and the AD7689; `cmd-ads7953`), under the
+/// pattern stimulus: one Icarus run per kind.
 #[test]
 fn icarus_testbench_converts_what_the_words_select() {
+    icarus_converts_what_the_words_select(false);
+}
+
+/// Every test mix, a table stimulus and two random commanded mixes in Icarus
+/// (minutes): `make test-long`.
+#[test]
+#[ignore = "long: make test-long"]
+fn icarus_testbench_converts_what_the_words_select_on_every_mix() {
+    icarus_converts_what_the_words_select(true);
+}
+
+fn icarus_converts_what_the_words_select(every: bool) {
     if !tools::require_tools(&["iverilog", "vvp"]) {
         return;
     }
-    let mut runs: Vec<(String, Schedule, Stimulus)> =
-        ["cmd-mcp3208", "cmd-ad7689", "cmd-both", "cmd-ads7953"]
-            .iter()
-            .map(|n| (n.to_string(), schedule(n), Stimulus::Pattern))
-            .collect();
-    runs.push((
-        "cmd-both (step)".into(),
-        schedule("cmd-both"),
-        Stimulus::Step,
-    ));
-    runs.extend((3..5).map(|k| {
-        (
-            format!("random commanded mix {k}"),
-            random_mix(k),
-            Stimulus::Pattern,
-        )
-    }));
+    let names: &[&str] = if every {
+        &["cmd-mcp3208", "cmd-ad7689", "cmd-both", "cmd-ads7953"]
+    } else {
+        &["cmd-both", "cmd-ads7953"]
+    };
+    let mut runs: Vec<(String, Schedule, Stimulus)> = names
+        .iter()
+        .map(|n| (n.to_string(), schedule(n), Stimulus::Pattern))
+        .collect();
+    if every {
+        runs.push((
+            "cmd-both (step)".into(),
+            schedule("cmd-both"),
+            Stimulus::Step,
+        ));
+        runs.extend((3..5).map(|k| {
+            (
+                format!("random commanded mix {k}"),
+                random_mix(k),
+                Stimulus::Pattern,
+            )
+        }));
+    }
     for (what, s, stimulus) in runs {
         let mut beside = BesideModel::new(&s);
         icarus_beside(&s, None, stimulus, 2, &mut beside);

@@ -85,18 +85,37 @@ fn rusthdl_drives_fronted_branches_as_the_model() {
     }
 }
 
+/// `cmd-front` and two random fronted mixes on Verilator; in Icarus,
+/// `cmd-front` under the pattern stimulus (one Icarus run per kind).
 #[test]
 fn verilator_and_icarus_drive_fronted_branches_as_the_model() {
+    fronted_on_verilator_and_icarus(false);
+}
+
+/// Every mix in Icarus under the pattern and a step stimulus (minutes):
+/// `make test-long`.
+#[test]
+#[ignore = "long: make test-long"]
+fn verilator_and_icarus_drive_fronted_branches_as_the_model_every_stimulus() {
+    fronted_on_verilator_and_icarus(true);
+}
+
+fn fronted_on_verilator_and_icarus(every: bool) {
     if !tools::require_tools(&["verilator", "g++", "iverilog", "vvp"]) {
         return;
     }
     let mut mixes = vec![("cmd-front".to_string(), schedule("cmd-front"))];
     mixes.extend((8..10).map(|k| (format!("random fronted mix {k}"), random_fronted(k))));
-    for (what, s) in mixes {
+    for (i, (what, s)) in mixes.into_iter().enumerate() {
         let v = engines::verilog(&s).unwrap();
         let (mut dut, _) = VerilatedDut::new(&v).unwrap();
         assert_same(&what, &s, &mut dut, 2);
-        for stimulus in [Stimulus::Pattern, Stimulus::Step] {
+        let stimuli: &[Stimulus] = match (every, i) {
+            (true, _) => &[Stimulus::Pattern, Stimulus::Step],
+            (false, 0) => &[Stimulus::Pattern],
+            (false, _) => &[],
+        };
+        for &stimulus in stimuli {
             let mut beside = BesideModel::new(&s);
             icarus_beside(&s, None, stimulus, 2, &mut beside);
             if let Some(d) = beside.diff {

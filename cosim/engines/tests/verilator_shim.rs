@@ -61,3 +61,53 @@ fn standin_builds_loads_caches_and_is_checked() {
     assert!(again.cached);
     assert_eq!(again.key, built.key);
 }
+
+/// Two builds of one model at once (parallel tests on an empty cache)
+/// verilate and compile it once: the second waits for the first and loads
+/// its library. `verilator` is a wrapper on PATH that logs each run.
+#[test]
+fn concurrent_builds_of_one_model_verilate_it_once() {
+    if !tools::require_tools(&["verilator", "g++"]) {
+        return;
+    }
+    let cache = tempfile::tempdir().unwrap();
+    let bin = tempfile::tempdir().unwrap();
+    let log = bin.path().join("runs.log");
+    let real = std::env::split_paths(&std::env::var_os("PATH").unwrap())
+        .map(|d| d.join("verilator"))
+        .find(|p| p.is_file())
+        .unwrap();
+    let wrapper = bin.path().join("verilator");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\necho \"$*\" >> '{}'\nexec '{}' \"$@\"\n",
+            log.display(),
+            real.display()
+        ),
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let path = std::env::join_paths(
+        std::iter::once(bin.path().to_path_buf())
+            .chain(std::env::split_paths(&std::env::var_os("PATH").unwrap())),
+    )
+    .unwrap();
+    std::env::set_var("PATH", path);
+    std::env::set_var("SLOTFORGE_CACHE", cache.path());
+    let keys: Vec<(String, bool)> = std::thread::scope(|s| {
+        let h: Vec<_> = (0..2)
+            .map(|_| s.spawn(|| VerilatedDut::new(STANDIN).unwrap().1))
+            .collect();
+        h.into_iter()
+            .map(|h| h.join().unwrap())
+            .map(|b| (b.key, b.cached))
+            .collect()
+    });
+    assert_eq!(keys[0].0, keys[1].0);
+    assert_eq!(keys.iter().filter(|(_, cached)| !cached).count(), 1);
+    let runs = std::fs::read_to_string(&log).unwrap();
+    let verilated = runs.lines().filter(|l| l.contains("--cc")).count();
+    assert_eq!(verilated, 1, "verilator runs:\n{runs}");
+}

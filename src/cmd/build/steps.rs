@@ -631,10 +631,12 @@ fn synth(
                 Glance::Size,
                 format!("not measured: {} or {pnr} not installed", fpga.yosys()),
             );
-            return Done::skipped(format!(
-                "{} or {pnr} not installed (make tools)",
-                fpga.yosys()
-            ));
+            let make = if fpga == lut_gen::Fpga::Ice40Hx8k {
+                "make tools"
+            } else {
+                "make tools-extra"
+            };
+            return Done::skipped(format!("{} or {pnr} not installed ({make})", fpga.yosys()));
         }
         Err(NotStarted::Io(why)) => {
             j.answer(Glance::Size, format!("not measured: {why}"));
