@@ -223,7 +223,7 @@ fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
 /// `prove` proves (exit 0), or refuses or is bounded naming what it left
 /// out: never a counterexample.
 fn prove(f: &mut Faults, mix: &Path) {
-    let out = slotforge(&[&"prove", mix, &"--json", &"--quiet"]);
+    let out = slotforge(&[&"prove", &mix, &"--json", &"--quiet"]);
     let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
     let status = j["status"].as_str().unwrap_or("");
     let named = j["not_covered"].as_array().is_some_and(|a| !a.is_empty())

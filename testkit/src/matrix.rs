@@ -106,10 +106,10 @@ fn point(v: &[usize; 7]) -> Point {
 pub fn pairwise(seed: u64) -> Vec<Point> {
     let mut d = Draw::new(seed);
     let mut todo = std::collections::BTreeSet::new();
-    for i in 0..DIMS.len() {
-        for j in i + 1..DIMS.len() {
-            for a in 0..DIMS[i] {
-                for b in 0..DIMS[j] {
+    for (i, &ni) in DIMS.iter().enumerate() {
+        for (j, &nj) in DIMS.iter().enumerate().skip(i + 1) {
+            for a in 0..ni {
+                for b in 0..nj {
                     todo.insert((i, a, j, b));
                 }
             }
@@ -328,10 +328,10 @@ mod tests {
                 CLOCKS.iter().position(|c| *c == p.clock_mhz).unwrap(),
             ]
         };
-        for i in 0..DIMS.len() {
-            for j in i + 1..DIMS.len() {
-                for a in 0..DIMS[i] {
-                    for b in 0..DIMS[j] {
+        for (i, &ni) in DIMS.iter().enumerate() {
+            for (j, &nj) in DIMS.iter().enumerate().skip(i + 1) {
+                for a in 0..ni {
+                    for b in 0..nj {
                         assert!(
                             pts.iter().any(|p| vals(p)[i] == a && vals(p)[j] == b),
                             "dims {i}={a}, {j}={b}"
