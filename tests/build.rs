@@ -163,15 +163,11 @@ fn build_writes_the_artefacts_and_a_self_contained_report() {
         .filter(|n| n.has_tag_name("testcase"))
         .collect();
     assert_eq!(cases.len(), 13, "{xml}");
-    // the proof is opt-in (tests/prove_cli.rs builds with it); every other
-    // step runs
-    let prove = cases
-        .iter()
-        .find(|c| c.attribute("name") == Some("prove"))
-        .unwrap();
-    assert!(prove.children().any(|n| n.has_tag_name("skipped")), "{xml}");
-    assert_eq!(xml.matches("<skipped").count(), 1, "{xml}");
+    // every step runs, the proof too, and the first screen says so
+    assert_eq!(xml.matches("<skipped").count(), 0, "{xml}");
     assert!(!xml.contains("<failure"), "{xml}");
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("yes (proved in this build)"), "{md}");
     for f in [
         "audit.txt",
         "audit.json",

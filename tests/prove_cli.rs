@@ -199,11 +199,12 @@ fn proved_json_has_its_keys_and_exit_0() {
         .all(|p| p["result"] == "proved" && p["name"].is_string()));
 }
 
-/// `build --only prove` proves and shows it in the report; a later default
-/// build of the same Verilog shows the remembered proof (a fresh directory
-/// without one leaves the step out).
+/// A default build proves (the step is on unless skipped) and shows it in
+/// the report, "Is it proved?" answering yes; a later build of the same
+/// Verilog shows the remembered proof; `--skip prove` leaves it out and
+/// says so.
 #[test]
-fn build_shows_the_proof_and_a_default_build_shows_it_remembered() {
+fn a_default_build_proves_and_a_later_one_shows_it_remembered() {
     if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
         return;
     }
@@ -219,27 +220,30 @@ fn build_shows_the_proof_and_a_default_build_shows_it_remembered() {
         c.assert().success();
         std::fs::read_to_string(out.join("report.md")).unwrap()
     };
-    let md = build(&out, &["--only", "prove"]);
-    assert!(md.contains("Formal proof"), "{md}");
-    assert!(md.contains("proved for all time"), "{md}");
-    assert!(md.contains("stream.value"), "{md}");
-    assert!(!md.contains("remembered"), "{md}");
-    let cache: Vec<_> = std::fs::read_dir(out.join("prove/cache"))
-        .unwrap()
-        .collect();
-    assert_eq!(cache.len(), 1);
-    // The default build leaves the proof out unless it is remembered.
+    // every step but the slow ones the proof does not need
     let quick = [
         "--skip",
         "audit,lut,sim,golden,faults,synth,timing,figure7,schedulability",
     ];
     let md = build(&out, &quick);
+    assert!(md.contains("Formal proof"), "{md}");
+    assert!(md.contains("proved for all time"), "{md}");
+    assert!(md.contains("stream.value"), "{md}");
+    assert!(!md.contains("remembered"), "{md}");
+    assert!(md.contains("yes (proved in this build)"), "{md}");
+    let cache: Vec<_> = std::fs::read_dir(out.join("prove/cache"))
+        .unwrap()
+        .collect();
+    assert_eq!(cache.len(), 1);
+    let md = build(&out, &quick);
     assert!(md.contains("proved for all time"), "{md}");
     assert!(md.contains("remembered"), "{md}");
-    let fresh = dir.path().join("fresh");
-    let md = build(&fresh, &quick);
+    let skipped = dir.path().join("skipped");
+    let mut skip = quick.to_vec();
+    skip[1] = "audit,lut,sim,golden,faults,synth,timing,figure7,schedulability,prove";
+    let md = build(&skipped, &skip);
     assert!(!md.contains("Formal proof"), "{md}");
-    assert!(md.contains("--only prove"), "{md}");
+    assert!(md.contains("not in this build (--skip)"), "{md}");
 }
 
 /// A UART mix: `prove --json` names what its harness does not assert (the
@@ -315,4 +319,55 @@ fn a_uart_mix_says_what_it_does_not_prove() {
             assert!(plain.contains(n), "{n} not in {md}");
         }
     }
+}
+
+/// A counterexample names the command that replays it: `prove` prints
+/// `slotforge check MIX VCD --scope S` with the mix as it was given and
+/// `--json` has it as `counterexample.check`; that command rejects the VCD.
+#[test]
+fn a_counterexample_names_the_check_that_replays_it() {
+    if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let v = dir.path().join("v");
+    slotforge()
+        .args(["verilog", tiny().to_str().unwrap(), "-o"])
+        .arg(&v)
+        .assert()
+        .success();
+    let clean = std::fs::read_to_string(v.join("slotforge_top.v")).unwrap();
+    let line = "assign sample_value = core_value[13:0];";
+    assert!(clean.contains(line));
+    let bad = dir.path().join("bad.v");
+    let flipped = "assign sample_value = core_value[13:0] ^ 14'd1;";
+    std::fs::write(&bad, clean.replace(line, flipped)).unwrap();
+    let out = dir.path().join("cex");
+    let mix = tiny();
+    let args = [mix.to_str().unwrap(), "--rtl", bad.to_str().unwrap()];
+    let j = prove_json(&args, &[], &out, 1);
+    let c = &j["counterexample"];
+    let vcd = c["vcd"].as_str().unwrap();
+    let check = c["check"].as_str().unwrap();
+    assert_eq!(
+        check,
+        format!(
+            "slotforge check {} {vcd} --scope replay_tb.h.dut",
+            tiny().display()
+        )
+    );
+    let o = slotforge()
+        .arg("prove")
+        .args(args)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains(&format!("replay it: {check}")), "{text}");
+    // the command as printed: the checker rejects the trace
+    let words: Vec<&str> = check.split(' ').collect();
+    assert_eq!(words[..2], ["slotforge", "check"]);
+    slotforge().args(&words[1..]).assert().code(1);
 }

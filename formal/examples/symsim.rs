@@ -42,7 +42,16 @@ fn main() {
     let splits: Vec<usize> = std::env::var("SPLITS")
         .map(|c| c.split(',').map(|x| num(x, "SPLITS") as usize).collect())
         .unwrap_or_default();
-    let (found, st) = formal::prove_aig(&g, &choices, &splits, period, 2, max, Some(deadline));
+    let (found, st) = formal::prove_aig(
+        &g,
+        &choices,
+        &splits,
+        std::env::var_os("CASES").is_some(),
+        period,
+        2,
+        max,
+        Some(deadline),
+    );
     let verdict = match &found {
         formal::Found::Violated { step, .. } => format!("violated at step {step}"),
         other => format!("{other:?}"),

@@ -26,7 +26,7 @@ mod link;
 mod modes;
 pub use contract::{contract, not_covered, Clause};
 pub use link::TREADY_ANY;
-pub(crate) use modes::{bounded_modes, MODE_SEL};
+pub(crate) use modes::{auto_frames, bounded_modes, MODE_SEL};
 
 /// The module name of the harness.
 pub const HARNESS_MODULE: &str = "slotforge_formal";

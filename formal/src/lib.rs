@@ -106,6 +106,29 @@ pub struct Counterexample {
     /// engine chose freely and the replay cannot set: still a violation of
     /// "correct after one reset cycle from any power-on state".
     pub reproduced: bool,
+    /// The command that replays the VCD through the checker
+    /// ([`check_command`]): `slotforge check MIX VCD --scope S`.
+    #[serde(default)]
+    pub check: String,
+}
+
+/// `slotforge check MIX VCD --scope S`: the command that checks a
+/// counterexample's VCD against the mix, at the design's scope in it.
+pub fn check_command(mix: &Path, vcd: &Path) -> String {
+    let quote = |p: &Path| {
+        let t = p.display().to_string();
+        if t.contains(|c: char| c.is_whitespace() || c == '\'' || c == '"') {
+            format!("'{}'", t.replace('\'', r"'\''"))
+        } else {
+            t
+        }
+    };
+    format!(
+        "slotforge check {} {} --scope {}",
+        quote(mix),
+        quote(vcd),
+        replay::DUT_SCOPE
+    )
 }
 
 /// The result of `prove`, for the CLI and the build report.
@@ -207,7 +230,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     let t1 = Instant::now();
     let f = h.frame_cycles;
     let (result, depth, note) = match opts.solver {
-        Solver::Symbolic => symbolic(&prep, f, opts)?,
+        Solver::Symbolic => symbolic(&prep, f, harness::auto_frames(s), opts)?,
         Solver::Abc => strategy::abc(&prep, f, opts)?,
         Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work.path(), f, opts)?,
     };
@@ -339,7 +362,10 @@ fn counterexample(
             p.result = Outcome::Failed;
         }
     }
+    // the mix by its name until the caller, who read its file, names it
+    let mix = PathBuf::from(format!("{}.toml", x.s.mix.name));
     Ok(Counterexample {
+        check: check_command(&mix, &r.vcd),
         reproduced,
         cycle: step as i64 - 2,
         vcd: r.vcd,
@@ -354,6 +380,7 @@ fn counterexample(
 fn symbolic(
     prep: &engine::Prepared,
     f: u64,
+    auto: Option<u64>,
     opts: &ProveOptions,
 ) -> Result<(Outcome, u64, String), ProveError> {
     let text = std::fs::read_to_string(prep.dir.join("design.aag"))
@@ -365,12 +392,28 @@ fn symbolic(
             "the harness assumes something about its inputs, which the symbolic engine cannot honour; use --solver abc".into(),
         ));
     }
-    let limit = opts.depth.unwrap_or(DEEP_FRAMES * f + 2);
+    // auto select: split on the trigger decisions, and deep enough for
+    // every run of windows to come round
+    let cases = auto.is_some();
+    let limit = (opts.depth).unwrap_or((DEEP_FRAMES + auto.unwrap_or(0)) * f + 2);
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
     let choices = named_inputs(prep, harness::TREADY_ANY);
     let splits = named_inputs(prep, harness::MODE_SEL);
-    let (found, st) = symsim::prove(&g, &choices, &splits, f, 2, limit, Some(deadline));
+    let (found, st) = symsim::prove(&g, &choices, &splits, cases, f, 2, limit, Some(deadline));
     Ok(match found {
+        symsim::Found::Proved { steps, .. } if st.cases > 0 => (
+            Outcome::Proved,
+            steps,
+            format!(
+                "{PROVED}: {}every step from reset simulated exactly with every free input bit a variable of its step (MISO; {} latches, {} gates; {} satisfiability checks), split at each frame start on the values of the registers that are functions of the MISO codes there (the mode and trigger-run registers, the design's and the harness's: one path per value some input reaches, {} in all, each with its condition on the codes kept until those codes have left the state), until every path reached a frame start whose state and condition, up to renaming, a path had reached before ({} distinct states at frame starts, the deepest at step {steps}), so those paths reach every reachable state (symbolic simulation split on the trigger decisions)",
+                parts_note(&st.parts),
+                g.latches.len(),
+                g.ands.len(),
+                st.sat_calls,
+                st.cases,
+                st.branches
+            ),
+        ),
         symsim::Found::Proved { steps, .. } if st.branches > 0 => (
             Outcome::Proved,
             steps,
@@ -549,11 +592,12 @@ impl Proof {
             }
             let _ = writeln!(
                 s,
-                "counterexample: cycle {} ({} + {})\n{}",
+                "counterexample: cycle {} ({} + {})\n{}\nreplay it: {}",
                 c.cycle,
                 c.vcd.display(),
                 c.gtkw.display(),
-                c.diagnosis.trim_end()
+                c.diagnosis.trim_end(),
+                c.check
             );
         }
         s

@@ -130,7 +130,6 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
-    let plan = plan::with_remembered_proof(plan, &s, &a.out);
     let mut job = Job::new(&a, &s, plan.iter().filter(|p| p.1.runs()).count());
     steps::run_all(&mut job, &a, &s, &plan, &scene);
     if let Err(e) = job.finish() {

@@ -127,7 +127,12 @@ pub fn run(a: Args) -> u8 {
     opts.own_design = own;
     opts.netlist = netlist.map(|n| (n.fpga.name().to_string(), n.not_covered()));
     let proof = match formal::prove(&s, &design, &opts) {
-        Ok(p) => p,
+        Ok(mut p) => {
+            if let Some(c) = &mut p.counterexample {
+                c.check = formal::check_command(&a.mix, &c.vcd);
+            }
+            p
+        }
         Err(e) => {
             eprintln!("error: {e}");
             return 2;

@@ -28,6 +28,21 @@ fn modes(s: &Schedule) -> Option<&lut_gen::Modes> {
         .filter(|m| m.names.len() > 1 && !s.modes.is_empty())
 }
 
+/// With auto select (the engine then splits its paths on the mode and
+/// run registers, `symsim/cases.rs`), the frames the search may need beyond
+/// the default depth before every path has come round: two per frame of
+/// every trigger's run (a run counts up to `for_frames` in one mode, and the
+/// mode it switches to starts another); `None` without auto select.
+pub(crate) fn auto_frames(s: &Schedule) -> Option<u64> {
+    let m = modes(s).filter(|m| m.select == ModeSelect::Auto)?;
+    let runs: u64 = m
+        .triggers
+        .iter()
+        .map(|t| t.for_frames.max(1) as u64 + 1)
+        .sum();
+    Some(2 * runs)
+}
+
 /// Bits of the mode number (0: no modes).
 pub(super) fn bits(s: &Schedule) -> u32 {
     modes(s).map_or(0, |m| m.select_bits())
@@ -382,22 +397,10 @@ pub(crate) fn bounded_modes(s: &Schedule, result: crate::Outcome, steps: u64) ->
     let m = modes(s).filter(|_| result == crate::Outcome::Bounded)?;
     let f = s.grid.frame_cycles;
     let cycles = steps.saturating_sub(2);
-    // auto select never comes round; pin select may, so the note says why
-    // its search stopped (depth or time limit) in the note
-    let why = match m.select {
-        ModeSelect::Auto => {
-            "; auto select: each frame start decides the mode from the triggers' windows, which \
-             compare the watched codes (MISO data) with the levels, else keeps the mode decided \
-             before, so the mode and run registers are functions of every earlier frame's codes, \
-             one frame deeper at each frame start, and the state never comes round; the split \
-             that closes pin select (on the few bits of mode_sel) would have to enumerate the \
-             codes instead (docs/formal.md, \"Mixes with modes\")"
-        }
-        ModeSelect::Pin => "",
-    };
+    // the note says why the search stopped (depth or time limit)
     Some(format!(
         "every mode switch and every pin after cycle {cycles} (frame {} on): the search from reset \
-         covered {cycles} cycles ({:.2} frames), every sequence of {} within them, nothing beyond{why}",
+         covered {cycles} cycles ({:.2} frames), every sequence of {} within them, nothing beyond",
         cycles / f,
         cycles as f64 / f as f64,
         match m.select {

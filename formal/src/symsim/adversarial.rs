@@ -791,7 +791,7 @@ fn random_designs_split_by_a_choice_input_agree_with_an_explicit_state_search() 
         let (period, offset) = (1 + rng.below(4), rng.below(4));
         let choices: Vec<usize> = (0..g.inputs.len().min(1)).collect();
         let (f, st) = judged_by(&g, period, offset, || {
-            prove(&g, &choices, &[], period, offset, 40, None)
+            prove(&g, &choices, &[], false, period, offset, 40, None)
         });
         if !choices.is_empty() {
             (0..3).for_each(|k| parts[k] += st.parts[k]);
@@ -933,5 +933,78 @@ fn data_held_for_any_number_of_frames_proves_when_split_and_its_violation_is_fou
     assert!(st.branches >= 2, "{st:?}");
     let g = held_data(true);
     let (f, _) = judged_by(&g, 1, 2, || split_on(&g, &[0], 1, 2, 60));
+    assert!(matches!(f, Found::Violated { .. }), "{f:?}");
+}
+
+/// A run split on registers' values at period boundaries (as `prove`
+/// splits auto select's mode and run registers, `cases.rs`).
+fn cases_run(g: &Aig, period: u64, offset: u64, max_steps: u64) -> (Found, SymStats) {
+    let lim = Limits {
+        period,
+        offset,
+        max_steps,
+        deadline: None,
+    };
+    Sim::new(g).with_cases(true).run(&lim)
+}
+
+#[test]
+fn random_designs_split_on_registers_agree_with_an_explicit_state_search() {
+    let mut rng = Rng(0x5EED_CA5E_5B17_0001);
+    let (mut tally, mut split) = ([0usize; 3], 0);
+    // fewer designs than the other runs: each split is a few SAT calls
+    for _ in 0..500 {
+        let free = rng.below(2) == 0;
+        let g = random_design(&mut rng, free);
+        let (period, offset) = (1 + rng.below(4), rng.below(4));
+        let (f, st) = judged_by(&g, period, offset, || cases_run(&g, period, offset, 40));
+        split += usize::from(st.cases > 0);
+        tally[match f {
+            Found::Proved { .. } => 0,
+            Found::Violated { .. } => 1,
+            Found::Bounded { .. } => 2,
+        }] += 1;
+    }
+    assert!(tally[0] > 10 && tally[1] > 10, "{tally:?}");
+    assert!(split > 25, "{split} runs split on registers");
+}
+
+/// A decision register set by data and kept (`m' = d ? 1 : m`, input `d`),
+/// the way auto select keeps the mode its triggers decided: its value is
+/// the disjunction of every earlier `d`, so the unsplit run never recurs;
+/// split on its values at each boundary it proves (a copy `f` never
+/// differs), and a bad state that needs `m` high for two steps in a row is
+/// found with a witness that sets `d` in the right step (a condition
+/// dropped from the path, its inputs fixed).
+fn kept_decision(bad_when_held: bool) -> Aig {
+    let mut b = B::default();
+    let d = b.input();
+    let m = b.latch(Init::Zero);
+    let n = b.or(d, m);
+    b.next(m, n);
+    let f = b.latch(Init::Zero);
+    let nf = b.or(m, d);
+    b.next(f, nf);
+    let mut bad = b.xor(m, f);
+    if bad_when_held {
+        let k = b.latch(Init::Zero);
+        b.next(k, m);
+        let held = b.and(k, m);
+        bad = b.or(bad, held);
+    }
+    b.bad.push(bad);
+    b.aig()
+}
+
+#[test]
+fn a_decision_kept_from_data_proves_when_split_on_its_values_and_its_violation_replays() {
+    let g = kept_decision(false);
+    let (f, _) = run(&g, 1, 2, 60, None);
+    assert!(matches!(f, Found::Bounded { .. }), "{f:?}");
+    let (f, st) = judged_by(&g, 1, 2, || cases_run(&g, 1, 2, 60));
+    assert!(matches!(f, Found::Proved { .. }), "{f:?}");
+    assert!(st.cases >= 2, "{st:?}");
+    let g = kept_decision(true);
+    let (f, _) = judged_by(&g, 1, 2, || cases_run(&g, 1, 2, 60));
     assert!(matches!(f, Found::Violated { .. }), "{f:?}");
 }

@@ -9,8 +9,9 @@
 //! "a waiting beat keeps its data") is inductive on its own, whatever the
 //! rest of the state.
 
+use super::eval::Eval;
+use super::evaluate;
 use super::graph::Graph;
-use super::{evaluate, in_dependency_order};
 use crate::aiger::Aig;
 
 /// Whether the assertions are `k`-inductive: `Ok(true)` if no path of
@@ -22,14 +23,13 @@ pub fn step_case(g: &Aig, k: u64) -> Result<bool, String> {
     let mut state: Vec<u32> = (0..g.latches.len())
         .map(|j| gr.var(ni + j as u32, 0))
         .collect();
-    let ands = in_dependency_order(g);
-    let mut val = vec![0u32; g.max_var as usize + 1];
+    let mut ev = Eval::new(g);
     let mut held = 1u32;
     for step in 0..k {
-        let bad = evaluate(g, &ands, &mut gr, &mut val, &mut state, step + 1);
+        let bad = evaluate(g, &mut ev, &mut gr, &mut state, step + 1);
         held = gr.and(held, bad ^ 1);
     }
-    let bad = evaluate(g, &ands, &mut gr, &mut val, &mut state, k + 1);
+    let bad = evaluate(g, &mut ev, &mut gr, &mut state, k + 1);
     let fails = gr.and(held, bad);
     Ok(gr.satisfy(fails, None)?.is_none())
 }

@@ -34,7 +34,9 @@ use std::time::Instant;
 
 use crate::aiger::Aig;
 
+mod cases;
 mod cone;
+mod eval;
 mod explicit;
 mod graph;
 mod induction;
@@ -78,6 +80,9 @@ pub struct SymStats {
     /// A run split on requests (`split.rs`): the distinct states at frame
     /// boundaries it simulated from (0: not split).
     pub branches: usize,
+    /// A run split on registers' values at frame starts (`cases.rs`): the
+    /// paths those splits made.
+    pub cases: u64,
 }
 
 /// Steps between the checks of the assertions that did not fold (one SAT
@@ -115,10 +120,12 @@ pub fn run(
 /// explicit-state search (`explicit`), and if that cannot decide it, by
 /// `run`.  Every part holding in every reachable state is the
 /// whole assertion holding; a part's violation is the assertion's.
+#[allow(clippy::too_many_arguments)]
 pub fn prove(
     g: &Aig,
     choices: &[usize],
     splits: &[usize],
+    cases: bool,
     period: u64,
     offset: u64,
     max_steps: u64,
@@ -131,7 +138,7 @@ pub fn prove(
             max_steps,
             deadline,
         };
-        let (f, mut st) = Sim::split_on(g, splits).run(&lim);
+        let (f, mut st) = Sim::split_on(g, splits).with_cases(cases).run(&lim);
         st.parts = [1, 0, 0];
         return (f, st);
     }
@@ -179,10 +186,10 @@ pub fn prove(
                 None => {
                     // too many inputs to enumerate: simulated symbolically
                     stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
-                    Sim::split_on(&sub, splits).run(&lim)
+                    Sim::split_on(&sub, splits).with_cases(cases).run(&lim)
                 }
             },
-            _ => Sim::split_on(&sub, splits).run(&lim),
+            _ => Sim::split_on(&sub, splits).with_cases(cases).run(&lim),
         };
         let found = lift(found, &c.latches, g.inputs.len(), g.latches.len());
         stats.sat_calls += st.sat_calls;
@@ -190,6 +197,7 @@ pub fn prove(
         if how == 0 {
             stats.state_nodes = st.state_nodes;
             stats.branches = st.branches;
+            stats.cases = st.cases;
             stats.kept = st.kept.iter().map(|&j| c.latches[j]).collect();
         }
         // the inductive parts' base case is a bounded search: it holds if
@@ -263,9 +271,9 @@ struct Limits {
 /// assertions of the steps since the last check.
 struct Sim<'a> {
     g: &'a Aig,
-    ands: Vec<(u32, u32, u32)>,
+    /// Each gate's value, evaluated where a fanin changed (`eval.rs`).
+    ev: eval::Eval,
     gr: Graph,
-    val: Vec<u32>,
     state: Vec<u32>,
     /// The state at the last boundary (for `kept`).
     prev_state: Vec<u32>,
@@ -283,6 +291,11 @@ struct Sim<'a> {
     fixed: Vec<graph::Assigned>,
     /// A split run's paths waiting, by the step they continue at.
     queue: std::collections::BTreeMap<(u64, u64), split::Branch>,
+    /// Split at frame starts on the values of latches that are functions of
+    /// the inputs (`cases.rs`), and the path's condition: conjuncts on the
+    /// inputs that every state of the path satisfies.
+    split_cases: bool,
+    cond: Vec<u32>,
 }
 
 impl<'a> Sim<'a> {
@@ -294,6 +307,12 @@ impl<'a> Sim<'a> {
             sim.splits = splits.to_vec();
         }
         sim
+    }
+
+    /// Also split on registers' values at frame starts (`cases.rs`).
+    fn with_cases(mut self, on: bool) -> Sim<'a> {
+        self.split_cases = on;
+        self
     }
 
     fn new(g: &'a Aig) -> Sim<'a> {
@@ -313,9 +332,8 @@ impl<'a> Sim<'a> {
             .collect();
         Sim {
             g,
-            ands: in_dependency_order(g),
+            ev: eval::Eval::new(g),
             gr,
-            val: vec![0u32; g.max_var as usize + 1],
             state,
             prev_state: Vec::new(),
             pending: Vec::new(),
@@ -326,12 +344,14 @@ impl<'a> Sim<'a> {
             splits: Vec::new(),
             fixed: Vec::new(),
             queue: Default::default(),
+            split_cases: false,
+            cond: Vec::new(),
         }
     }
 
     /// Runs to a verdict, `lim.max_steps` or the deadline.
     fn run(mut self, lim: &Limits) -> (Found, SymStats) {
-        if !self.splits.is_empty() {
+        if !self.splits.is_empty() || self.split_cases {
             return self.run_split(lim);
         }
         self.deadline = lim.deadline;
@@ -391,7 +411,7 @@ impl<'a> Sim<'a> {
     /// (kept for the next check unless it folds to "holds"), the latches.
     fn step(&mut self, step: u64) {
         let (g, gr) = (self.g, &mut self.gr);
-        let bad = evaluate(g, &self.ands, gr, &mut self.val, &mut self.state, step);
+        let bad = evaluate(g, &mut self.ev, gr, &mut self.state, step);
         if bad != 0 {
             self.pending.push((step, bad));
             self.pending_any = gr.and(self.pending_any ^ 1, bad ^ 1) ^ 1;
@@ -406,6 +426,9 @@ impl<'a> Sim<'a> {
         }
         let pending = std::mem::take(&mut self.pending);
         let any = std::mem::replace(&mut self.pending_any, 0);
+        // a path split on registers' values: its states satisfy its condition
+        let cond = self.cond_lit();
+        let any = self.gr.and(any, cond);
         let first = pending[0].0;
         self.stats.sat_calls += 1;
         let limit = self
@@ -419,6 +442,7 @@ impl<'a> Sim<'a> {
         }
         for (step, bad) in pending {
             self.stats.sat_calls += 1;
+            let bad = self.gr.and(bad, cond);
             match self.gr.satisfy(bad, limit) {
                 Ok(Some(assign)) => return Some(self.violation(step, assign)),
                 Ok(None) => {}
@@ -449,14 +473,18 @@ impl<'a> Sim<'a> {
         self.stats.peak_nodes = self.stats.peak_nodes.max(self.gr.a.len());
         // every literal held: this path's, then each waiting path's
         let mut held: Vec<&mut Vec<u32>> = vec![&mut self.state, &mut self.prev_state];
+        held.push(&mut self.cond);
         for b in self.queue.values_mut() {
             held.push(&mut b.state);
             held.push(&mut b.prev_state);
+            held.push(&mut b.cond);
         }
         let mut roots: Vec<u32> = held.iter().flat_map(|v| v.iter().copied()).collect();
         roots.extend(self.pending.iter().map(|&(_, b)| b));
         roots.push(self.pending_any);
         self.gr.collect(&mut roots);
+        // the nodes were renumbered: every gate's value is evaluated again
+        self.ev.invalidate();
         let mut at = 0;
         for v in held {
             let n = v.len();
@@ -474,52 +502,11 @@ impl<'a> Sim<'a> {
 /// One step of `g` on the graph: input `k` is variable `(k, step)`,
 /// every latch starts from `state` and leaves it with its next value;
 /// returns the disjunction of the assertions (`val`: each gate's value).
-fn evaluate(
-    g: &Aig,
-    ands: &[(u32, u32, u32)],
-    gr: &mut Graph,
-    val: &mut [u32],
-    state: &mut [u32],
-    step: u64,
-) -> u32 {
+fn evaluate(g: &Aig, ev: &mut eval::Eval, gr: &mut Graph, state: &mut [u32], step: u64) -> u32 {
     let inputs: Vec<u32> = (0..g.inputs.len())
         .map(|k| gr.var(k as u32, step as u32))
         .collect();
-    evaluate_with(g, ands, gr, val, state, &inputs)
-}
-
-/// [`evaluate`] with each input's literal given (a variable, or a constant
-/// where a split fixed it).
-fn evaluate_with(
-    g: &Aig,
-    ands: &[(u32, u32, u32)],
-    gr: &mut Graph,
-    val: &mut [u32],
-    state: &mut [u32],
-    inputs: &[u32],
-) -> u32 {
-    for (&i, &lit) in g.inputs.iter().zip(inputs) {
-        val[(i >> 1) as usize] = lit;
-    }
-    for (j, &(l, _, _)) in g.latches.iter().enumerate() {
-        val[(l >> 1) as usize] = state[j];
-    }
-    for &(lhs, x, y) in ands {
-        let (x, y) = (
-            val[(x >> 1) as usize] ^ (x & 1),
-            val[(y >> 1) as usize] ^ (y & 1),
-        );
-        val[(lhs >> 1) as usize] = gr.and(x, y);
-    }
-    let lit = |l: u32| val[(l >> 1) as usize] ^ (l & 1);
-    let mut bad = 0u32;
-    for &b in &g.bad {
-        bad = gr.and(bad ^ 1, lit(b) ^ 1) ^ 1;
-    }
-    for (j, &(_, next, _)) in g.latches.iter().enumerate() {
-        state[j] = lit(next);
-    }
-    bad
+    ev.step(g, gr, state, &inputs)
 }
 
 /// The AND gates, each after its fanins (ASCII AIGER allows any order;

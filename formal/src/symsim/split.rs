@@ -29,7 +29,7 @@
 use std::collections::HashMap;
 
 use super::graph::Assigned;
-use super::{evaluate_with, kept, Found, Limits, Sim, SymStats, CHECK};
+use super::{kept, Found, Limits, Sim, SymStats, CHECK};
 
 /// At most this many split input bits (2^n values in a step that reads
 /// them); a design with more is simulated with them as variables.
@@ -44,7 +44,9 @@ pub(super) struct Branch {
     pub(super) state: Vec<u32>,
     /// Its state at the last boundary (for `kept`).
     pub(super) prev_state: Vec<u32>,
-    fixed: Vec<Assigned>,
+    pub(super) fixed: Vec<Assigned>,
+    /// Its condition (`cases.rs`): conjuncts its states satisfy.
+    pub(super) cond: Vec<u32>,
 }
 
 impl Sim<'_> {
@@ -54,11 +56,12 @@ impl Sim<'_> {
     pub(super) fn run_split(mut self, lim: &Limits) -> (Found, SymStats) {
         self.deadline = lim.deadline;
         let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
-        let (mut seq, mut closed) = (0u64, None);
+        let (mut seq, mut closed, mut ended) = (0u64, None, false);
         let start = Branch {
             state: std::mem::take(&mut self.state),
             prev_state: Vec::new(),
             fixed: Vec::new(),
+            cond: Vec::new(),
         };
         self.queue.insert((0, 0), start);
         // the earliest violation so far: later paths stop before it
@@ -81,6 +84,7 @@ impl Sim<'_> {
                 return (first.map_or(Found::Bounded { steps }, |f| f.1), self.stats);
             }
             (self.state, self.prev_state, self.fixed) = (b.state, b.prev_state, b.fixed);
+            self.cond = b.cond;
             self.pending.clear();
             self.pending_any = 0;
             let path_lim = Limits {
@@ -89,6 +93,8 @@ impl Sim<'_> {
             };
             match self.run_path(from, &path_lim, &mut seen) {
                 Ok(Path::Closed(step)) => closed = closed.max(Some(step)),
+                // the others, waiting at earlier steps, go on to it too
+                Ok(Path::End) => ended = true,
                 Ok(Path::Split(step, children)) => {
                     for c in children {
                         seq += 1;
@@ -109,6 +115,11 @@ impl Sim<'_> {
         self.stats.branches = seen.len();
         if let Some((_, f)) = first {
             return (f, self.stats);
+        }
+        if ended {
+            // every path reached the last step or closed before it
+            let steps = lim.max_steps;
+            return (Found::Bounded { steps }, self.stats);
         }
         let steps = closed.unwrap_or(lim.offset);
         (
@@ -143,7 +154,15 @@ impl Sim<'_> {
                 }
             }
             if phase == Some(0) {
-                let now = self.gr.canonical_any(&self.state);
+                if self.split_cases {
+                    self.prune_cond(step)?;
+                }
+                let mut roots = self.state.clone();
+                if !self.cond.is_empty() {
+                    // the path's condition is part of its set of states
+                    roots.push(self.cond_lit());
+                }
+                let now = self.gr.canonical_any(&roots);
                 // a state seen at this step or before: its successors are
                 // covered (one seen later may hide an earlier violation)
                 if seen.get(&now).is_some_and(|&at| at <= step) {
@@ -154,6 +173,14 @@ impl Sim<'_> {
                         kept(&self.gr, &self.prev_state, &self.state, step, lim.period);
                 }
                 seen.insert(now, step);
+                // auto select's decisions: one path per value of the
+                // registers that are functions of the codes (each compared
+                // at this step in turn, with the last boundary's state)
+                if self.split_cases {
+                    if let Some(children) = self.split_cases(step)? {
+                        return Ok(Path::Split(step, children));
+                    }
+                }
                 self.prev_state.clone_from(&self.state);
             }
             if step.is_multiple_of(256) && lim.deadline.is_some_and(|d| Instant::now() > d) {
@@ -166,14 +193,15 @@ impl Sim<'_> {
             }
             self.collect_if_large();
         }
-        let found = self.check_pending();
-        let steps = self.covered(lim.max_steps);
-        Err(self.bounded_at(found.unwrap_or(Found::Bounded { steps })))
+        match self.check_pending() {
+            Some(f) => Err(self.bounded_at(f)),
+            None => Ok(Path::End),
+        }
     }
 
     /// A bound of this path as a bound of the run (no further than every
     /// waiting path got).
-    fn bounded_at(&self, f: Found) -> Found {
+    pub(super) fn bounded_at(&self, f: Found) -> Found {
         match f {
             Found::Bounded { steps } => Found::Bounded {
                 steps: self.covered(steps),
@@ -186,6 +214,11 @@ impl Sim<'_> {
     /// the step: one path per value of the split inputs (equal successors
     /// once), the step's assertion checked on each.
     fn step_split(&mut self, step: u64) -> Result<Option<Vec<Branch>>, Found> {
+        if self.splits.is_empty() {
+            // split on registers only (`cases.rs`), at frame starts
+            self.step(step);
+            return Ok(None);
+        }
         let (g, ni) = (self.g, self.g.inputs.len());
         let mark = self.gr.a.len();
         // the split inputs' variables first: a node older than them reads none
@@ -199,14 +232,7 @@ impl Sim<'_> {
             }
         }
         let mut next = self.state.clone();
-        let bad = evaluate_with(
-            g,
-            &self.ands,
-            &mut self.gr,
-            &mut self.val,
-            &mut next,
-            &inputs,
-        );
+        let bad = self.ev.step(g, &mut self.gr, &mut next, &inputs);
         let vars: Vec<usize> = self
             .splits
             .iter()
@@ -233,14 +259,13 @@ impl Sim<'_> {
                 fixed.push((k as u32, step as u32, (a >> i) & 1 == 1));
             }
             let mut next = self.state.clone();
-            let bad = evaluate_with(
-                g,
-                &self.ands,
-                &mut self.gr,
-                &mut self.val,
-                &mut next,
-                &inputs,
-            );
+            let bad = self.ev.step(g, &mut self.gr, &mut next, &inputs);
+            let bad = if bad != 0 {
+                let cond = self.cond_lit();
+                self.gr.and(bad, cond)
+            } else {
+                0
+            };
             if bad != 0 {
                 self.stats.sat_calls += 1;
                 let limit = (self.deadline).map(|d| d.saturating_duration_since(Instant::now()));
@@ -258,6 +283,7 @@ impl Sim<'_> {
                     state: next,
                     prev_state: self.prev_state.clone(),
                     fixed,
+                    cond: self.cond.clone(),
                 });
             }
         }
@@ -273,6 +299,8 @@ enum Path {
     Closed(u64),
     /// Split: the paths continuing from this step.
     Split(u64, Vec<Branch>),
+    /// At the run's last step, without a violation.
+    End,
 }
 
 /// Whether any of `roots` reads a node of `vars`: only nodes made since

@@ -1,8 +1,6 @@
 //! The steps of `build` by the names `--only` and `--skip` take, and the
 //! plan: every step with whether it runs, or why it is left out.
 
-use lut_gen::Schedule;
-
 use super::{Args, Charts};
 
 /// A step of `build`, in the order it runs.
@@ -101,9 +99,6 @@ impl std::str::FromStr for Step {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Run {
     Yes,
-    /// `prove` left out by default, shown from the proof remembered for
-    /// the same Verilog (`measure::cached_proof`) without proving again.
-    Remembered,
     Skip(SkipReason),
 }
 
@@ -118,8 +113,6 @@ impl Run {
 pub enum SkipReason {
     NotInOnly,
     Skipped,
-    /// `prove` runs for minutes: opt-in.
-    ProveOptIn,
     ChartsNone,
     /// The speed chart without the fault step it draws.
     FaultsLeftOut,
@@ -130,7 +123,6 @@ impl std::fmt::Display for SkipReason {
         f.write_str(match self {
             SkipReason::NotInOnly => "not in --only",
             SkipReason::Skipped => "--skip",
-            SkipReason::ProveOptIn => "proves for all time (minutes): --charts all or --only prove; a cached proof of the same Verilog is shown",
             SkipReason::ChartsNone => "--charts none",
             SkipReason::FaultsLeftOut => "draws this build's fault campaign, which is left out",
         })
@@ -180,8 +172,6 @@ pub fn plan(a: &Args) -> Result<Vec<(Step, Run)>, String> {
                 }
             } else if skip.contains(&step) {
                 Run::Skip(SkipReason::Skipped)
-            } else if step == Step::Prove && a.charts != Charts::All {
-                Run::Skip(SkipReason::ProveOptIn)
             } else if step.is_mix_chart() && a.charts == Charts::None {
                 Run::Skip(SkipReason::ChartsNone)
             } else {
@@ -206,23 +196,6 @@ fn speed_needs_faults(mut plan: Vec<(Step, Run)>) -> Vec<(Step, Run)> {
     plan
 }
 
-/// A proof left out by default is still shown when one of the same Verilog
-/// and harness is remembered (`measure::cached_proof`).
-pub fn with_remembered_proof(
-    mut plan: Vec<(Step, Run)>,
-    s: &Schedule,
-    out: &std::path::Path,
-) -> Vec<(Step, Run)> {
-    for p in &mut plan {
-        if *p == (Step::Prove, Run::Skip(SkipReason::ProveOptIn))
-            && measure::cached_proof(s, out).is_some()
-        {
-            p.1 = Run::Remembered;
-        }
-    }
-    plan
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -234,6 +207,6 @@ mod tests {
         }
         assert_eq!("proof".parse::<Step>(), Err(()));
         assert_eq!(SkipReason::NotInOnly.to_string(), "not in --only");
-        assert!(Run::Remembered.runs() && !Run::Skip(SkipReason::Skipped).runs());
+        assert!(Run::Yes.runs() && !Run::Skip(SkipReason::Skipped).runs());
     }
 }

@@ -85,10 +85,7 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)], scen
         if let Run::Skip(why) = run {
             job.not_run(step, &format!("not run ({why})"));
             if step == Step::Prove {
-                job.answer(Glance::Proved, match why {
-                    super::plan::SkipReason::ProveOptIn => "not in this build, and no proof of this same Verilog is remembered: a proof takes minutes (`--charts all` or `--only prove` runs it)".to_string(),
-                    _ => format!("not in this build ({why})"),
-                });
+                job.answer(Glance::Proved, format!("not in this build ({why})"));
             }
             continue;
         }
@@ -99,11 +96,6 @@ pub fn run_all(job: &mut Job, a: &Args, s: &Schedule, plan: &[(Step, Run)], scen
             Step::Sim => sim(j, scene, s, &mut sim_report, &mut clean),
             Step::Golden => golden(j, a, s),
             Step::Faults => faults(j, a, s, &mut campaign),
-            Step::Prove if run == Run::Remembered => proved(
-                j,
-                measure::cached_proof(s, &j.out).ok_or("the remembered proof went away".into()),
-                &mut clean,
-            ),
             Step::Prove => prove(j, s, &mut clean),
             Step::Synth => synth(
                 j,
