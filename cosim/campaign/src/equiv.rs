@@ -52,12 +52,17 @@ impl Equivalence {
 /// Time ABC's pdr gets per fault.
 pub const PDR_SECONDS: u64 = 60;
 
+// Every register from zero (`setattr -unset init` drops the power-on
+// values the gateware declares, `setundef -zero -init` makes each 0),
+// `rst` free: every run after any reset is covered, and a fault's
+// difference shows from a state pdr reaches quickly (from the power-on
+// state it may need a whole frame's depth).
 const YOSYS_SCRIPT: &str = "\
-read_verilog gold.v; hierarchy -top slotforge_top; proc; flatten; opt_clean; rename slotforge_top gold; design -stash gold
-read_verilog gate.v; hierarchy -top slotforge_top; proc; flatten; opt_clean; rename slotforge_top gate; design -stash gate
+read_verilog gold.v; hierarchy -top slotforge_top; proc; setattr -unset init; flatten; opt_clean; rename slotforge_top gold; design -stash gold
+read_verilog gate.v; hierarchy -top slotforge_top; proc; setattr -unset init; flatten; opt_clean; rename slotforge_top gate; design -stash gate
 design -copy-from gold -as gold gold; design -copy-from gate -as gate gate
 miter -equiv -flatten -make_assert gold gate miter; hierarchy -top miter
-memory_map; opt -full; async2sync; setundef -zero; opt -full; techmap; opt -fast; dffunmap
+memory_map; opt -full; async2sync; setundef -zero -init; opt -full; techmap; opt -fast; dffunmap
 abc -g AND -fast; opt_clean; write_aiger -zinit miter.aig
 ";
 
