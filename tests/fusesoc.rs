@@ -202,6 +202,7 @@ fn fusesoc_lint_fails_on_a_warning_and_the_core_is_deterministic() {
 /// nextpnr-himbaechel for Edalize's nextpnr-gowin; each flow places and
 /// writes its bitstream.
 #[test]
+#[ignore = "long: make test-long (fusesoc and the YoWASP tools, of make tools-extra)"]
 fn ecp5_and_gowin_targets_run_through_the_launcher() {
     let need = [
         "fusesoc",
