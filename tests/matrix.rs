@@ -157,29 +157,11 @@ fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
     }
     // Verilator: the whole run's waveform, its samples and link bytes
     let (vcd, csv, bytes) = (d.join("run.vcd"), d.join("s.csv"), d.join("l.bin"));
-    let to = FRAMES;
-    let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![
-        &"sim",
-        &mix,
-        &"--quiet",
-        &"--frames",
-        &FRAMES,
-        &"--backend",
-        &"verilator",
-        &"--from",
-        &"0",
-        &"--to",
-        &to,
-        &"--vcd",
-        &vcd,
-        &"--samples",
-        &csv,
-    ];
+    let mut out: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![&"--samples", &csv];
     if p.link != matrix::Link::None {
-        a.extend([&"--link-bytes" as &dyn AsRef<std::ffi::OsStr>, &bytes]);
+        out.extend([&"--link-bytes" as &dyn AsRef<std::ffi::OsStr>, &bytes]);
     }
-    a.extend(sc.iter().copied());
-    if f.run("sim --backend verilator", &a).is_some() {
+    if verilator(&mut f, &mix, &sc, ("0", FRAMES, &vcd), &out) {
         f.run(
             "check --no-model of the run",
             &[&"check", &mix, &vcd, &"--no-model", &"--quiet"],
@@ -187,23 +169,7 @@ fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
         f.run("check of the run", &[&"check", &mix, &vcd, &"--quiet"]);
     }
     let win = d.join("win.vcd");
-    let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![
-        &"sim",
-        &mix,
-        &"--quiet",
-        &"--frames",
-        &FRAMES,
-        &"--backend",
-        &"verilator",
-        &"--from",
-        &"3",
-        &"--to",
-        &"6",
-        &"--vcd",
-        &win,
-    ];
-    a.extend(sc.iter().copied());
-    if f.run("sim of the window", &a).is_some() {
+    if verilator(&mut f, &mix, &sc, ("3", "6", &win), &[]) {
         f.run(
             "check of a window from the middle",
             &[&"check", &mix, &win, &"--quiet"],
@@ -231,6 +197,39 @@ fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
             f.0.join("\n  ")
         )),
     }
+}
+
+/// A Verilator run of the scene writing the VCD window `(from, to, path)`
+/// and `out`'s files; whether it passed.
+fn verilator(
+    f: &mut Faults,
+    mix: &Path,
+    scene: &[&dyn AsRef<std::ffi::OsStr>],
+    (from, to, vcd): (&str, &str, &Path),
+    out: &[&dyn AsRef<std::ffi::OsStr>],
+) -> bool {
+    let mut a: Vec<&dyn AsRef<std::ffi::OsStr>> = vec![
+        &"sim",
+        &mix,
+        &"--quiet",
+        &"--frames",
+        &FRAMES,
+        &"--backend",
+        &"verilator",
+        &"--from",
+        &from,
+        &"--to",
+        &to,
+        &"--vcd",
+        &vcd,
+    ];
+    a.extend(out.iter().copied());
+    a.extend(scene.iter().copied());
+    f.run(
+        &format!("sim --backend verilator --from {from} --to {to}"),
+        &a,
+    )
+    .is_some()
 }
 
 /// `prove` proves (exit 0), or refuses or is bounded naming what it left

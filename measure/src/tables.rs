@@ -158,30 +158,47 @@ pub fn interval_table(s: &Schedule, r: &judge::Verdict) -> Table {
             })
             .map(|x| x.1)
             .collect();
-        let list: Vec<&str> = group.iter().map(|c| c.name.as_str()).collect();
-        let samples: Vec<u64> = group.iter().map(|c| c.samples).collect();
-        let promised: Vec<u64> = group.iter().map(|c| c.interval_cycles).collect();
-        let lo = group.iter().filter_map(|c| c.interval_cycles_min).min();
-        let hi = group.iter().filter_map(|c| c.interval_cycles_max).max();
-        let jitter = group
-            .iter()
-            .filter_map(|c| Some(c.interval_cycles_max? - c.interval_cycles_min?))
-            .max();
-        let mm = |v: &[u64]| span(*v.iter().min().unwrap_or(&0), *v.iter().max().unwrap_or(&0));
-        t.push(vec![
-            branch,
-            rate.to_string(),
-            names(&list),
-            mm(&samples),
-            mm(&promised),
-            match (lo, hi) {
-                (Some(a), Some(b)) => span(a, b),
-                _ => "-".into(),
-            },
-            jitter.map_or("-".into(), |j| j.to_string()),
-        ]);
+        let g: Vec<Figures> = (group.iter())
+            .map(|c| {
+                (
+                    c.name.as_str(),
+                    c.samples,
+                    c.interval_cycles,
+                    c.interval_cycles_min,
+                    c.interval_cycles_max,
+                )
+            })
+            .collect();
+        let mut row = vec![branch, rate.to_string()];
+        row.extend(group_cells(&g));
+        t.push(row);
     }
     t
+}
+
+/// A channel's run figures: name, samples, interval promised, least and
+/// most measured.
+type Figures<'a> = (&'a str, u64, u64, Option<u64>, Option<u64>);
+
+/// The cells of a row of channels alike (one branch and rate): the names,
+/// samples each, the interval promised, the least to most measured, and
+/// the jitter (the largest spread of one channel's intervals).
+fn group_cells(g: &[Figures]) -> Vec<String> {
+    let list: Vec<&str> = g.iter().map(|c| c.0).collect();
+    let mm = |v: Vec<u64>| span(*v.iter().min().unwrap_or(&0), *v.iter().max().unwrap_or(&0));
+    let lo = g.iter().filter_map(|c| c.3).min();
+    let hi = g.iter().filter_map(|c| c.4).max();
+    let jitter = g.iter().filter_map(|c| Some(c.4? - c.3?)).max();
+    vec![
+        names(&list),
+        mm(g.iter().map(|c| c.1).collect()),
+        mm(g.iter().map(|c| c.2).collect()),
+        match (lo, hi) {
+            (Some(a), Some(b)) => span(a, b),
+            _ => "-".into(),
+        },
+        jitter.map_or("-".into(), |j| j.to_string()),
+    ]
 }
 
 /// [`interval_table`] of a mix with modes: a row per mode, branch and rate
@@ -214,28 +231,20 @@ fn mode_interval_table(s: &Schedule, r: &judge::Verdict) -> Table {
             let Some(mode) = group.first().map(|g| g.1.mode.clone()) else {
                 continue;
             };
-            let list: Vec<&str> = group.iter().map(|g| g.0).collect();
-            let st: Vec<&judge::ModeStats> = group.iter().map(|g| g.1).collect();
-            let mm =
-                |v: Vec<u64>| span(*v.iter().min().unwrap_or(&0), *v.iter().max().unwrap_or(&0));
-            let lo = st.iter().filter_map(|c| c.interval_cycles_min).min();
-            let hi = st.iter().filter_map(|c| c.interval_cycles_max).max();
-            let jitter = (st.iter())
-                .filter_map(|c| Some(c.interval_cycles_max? - c.interval_cycles_min?))
-                .max();
-            t.push(vec![
-                mode,
-                branch,
-                hz.to_string(),
-                names(&list),
-                mm(st.iter().map(|c| c.samples).collect()),
-                mm(st.iter().map(|c| c.interval_cycles).collect()),
-                match (lo, hi) {
-                    (Some(a), Some(b)) => span(a, b),
-                    _ => "-".into(),
-                },
-                jitter.map_or("-".into(), |j| j.to_string()),
-            ]);
+            let g: Vec<Figures> = (group.iter())
+                .map(|(n, c)| {
+                    (
+                        *n,
+                        c.samples,
+                        c.interval_cycles,
+                        c.interval_cycles_min,
+                        c.interval_cycles_max,
+                    )
+                })
+                .collect();
+            let mut row = vec![mode, branch, hz.to_string()];
+            row.extend(group_cells(&g));
+            t.push(row);
         }
     }
     t
