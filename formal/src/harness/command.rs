@@ -60,18 +60,23 @@ pub(super) fn mosi(
     };
     let sent = s.commands_in_frame(b);
     let l = sent.first().map_or(1, |c| c.word.len()).max(1);
-    let (cb, sb) = (width(s.grid.slot_cycles), width(s.grid.frame_slots));
+    let cb = width(s.grid.slot_cycles);
     let spi = &s.branches[b].spi;
-    let bits = |w: &[bool]| -> String { w.iter().map(|&x| if x { '1' } else { '0' }).collect() };
     let _ = writeln!(
         v,
         "  // The word each conversion of branch {b} sends, first bit on top."
     );
-    let _ = writeln!(v, "  reg [{}:0] cw{b};\n  always @* case (slot)", l - 1);
-    for c in &sent {
-        let _ = writeln!(v, "    {sb}'d{}: cw{b} = {l}'b{};", c.slot, bits(&c.word));
+    let _ = writeln!(v, "  reg [{}:0] cw{b};", l - 1);
+    if super::modes::bits(s) > 0 {
+        mode_words(v, s, b, l);
+    } else {
+        let sb = width(s.grid.frame_slots);
+        let _ = writeln!(v, "  always @* case (slot)");
+        for c in &sent {
+            let _ = writeln!(v, "    {sb}'d{}: cw{b} = {l}'b{};", c.slot, bits(&c.word));
+        }
+        let _ = writeln!(v, "    default: cw{b} = {l}'d0;\n  endcase");
     }
-    let _ = writeln!(v, "    default: cw{b} = {l}'d0;\n  endcase");
     let terms: Vec<String> = (0..l as u64)
         .filter(|&k| k < spi.sclks())
         .map(|k| {
@@ -97,4 +102,62 @@ pub(super) fn mosi(
                outside the word"
             .into(),
     });
+}
+
+fn bits(w: &[bool]) -> String {
+    w.iter().map(|&x| if x { '1' } else { '0' }).collect()
+}
+
+/// `cw{b}` in a mix with modes: each conversion's word selects the
+/// conversion `ahead` later in the mode in force; the last `ahead` of a
+/// frame select the next frame's first ones, in the mode decided for it
+/// (`mnext`), or, when that mode does not convert the branch, wrap within
+/// the frame in force (docs/timing.md, "Command words").  Words that do
+/// not depend on the next mode come from `{mcur, slot}`, the others from
+/// `{mnext, mcur, slot}`.
+fn mode_words(v: &mut String, s: &Schedule, b: usize, l: usize) {
+    let (mb, sb) = (super::modes::bits(s), width(s.grid.frame_slots));
+    let Some(cmd) = s.mix.branches[b].adc.command.as_ref() else {
+        return;
+    };
+    let ahead = cmd.ahead as usize;
+    let convs: Vec<Vec<(u64, usize)>> = (s.modes.iter())
+        .map(|ms| {
+            (0..s.grid.frame_slots)
+                .filter_map(|u| ms.at(u, b).map(|c| (u, c)))
+                .collect()
+        })
+        .collect();
+    let word = |c: usize| bits(&cmd.word(s.mix.channels[c].input));
+    let (mut own, mut tail) = (String::new(), String::new());
+    for (m, cv) in convs.iter().enumerate() {
+        let n = cv.len();
+        for (k, &(slot, _)) in cv.iter().enumerate() {
+            if k + ahead < n {
+                let w = word(cv[k + ahead].1);
+                let _ = writeln!(own, "    {{{mb}'d{m}, {sb}'d{slot}}}: cw{b} = {l}'b{w};");
+                continue;
+            }
+            for (m2, next) in convs.iter().enumerate() {
+                let j = k + ahead - n;
+                let c = next.get(j).map_or(cv[(k + ahead) % n].1, |x| x.1);
+                let _ = writeln!(
+                    tail,
+                    "    {{{mb}'d{m2}, {mb}'d{m}, {sb}'d{slot}}}: cw{b} = {l}'b{};",
+                    word(c)
+                );
+            }
+        }
+    }
+    let _ = writeln!(
+        v,
+        "  always @* begin\n  case ({{mcur, slot}})\n{own}    default: cw{b} = {l}'d0;\n  endcase"
+    );
+    if !tail.is_empty() {
+        let _ = writeln!(
+            v,
+            "  case ({{mnext, mcur, slot}})\n{tail}    default: ;\n  endcase"
+        );
+    }
+    let _ = writeln!(v, "  end");
 }
