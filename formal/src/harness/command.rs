@@ -60,29 +60,32 @@ pub(super) fn mosi(
     };
     let sent = s.commands_in_frame(b);
     let l = sent.first().map_or(1, |c| c.word.len()).max(1);
-    let cb = width(s.grid.slot_cycles);
+    let (cb, sb) = (width(s.grid.slot_cycles), width(s.grid.frame_slots));
     let spi = &s.branches[b].spi;
+    let bits = |w: &[bool]| -> String { w.iter().map(|&x| if x { '1' } else { '0' }).collect() };
     let _ = writeln!(
         v,
         "  // The word each conversion of branch {b} sends, first bit on top."
     );
-    let _ = writeln!(v, "  reg [{}:0] cw{b};", l - 1);
     if super::modes::bits(s) > 0 {
         mode_words(v, s, b, l);
     } else {
-        let sb = width(s.grid.frame_slots);
-        let _ = writeln!(v, "  always @* case (slot)");
+        let _ = writeln!(v, "  reg [{}:0] cw{b};\n  always @* case (slot)", l - 1);
         for c in &sent {
             let _ = writeln!(v, "    {sb}'d{}: cw{b} = {l}'b{};", c.slot, bits(&c.word));
         }
         let _ = writeln!(v, "    default: cw{b} = {l}'d0;\n  endcase");
     }
+    let word = match super::modes::bits(s) {
+        0 => format!("cw{b}"),
+        _ => format!("cwe{b}"),
+    };
     let terms: Vec<String> = (0..l as u64)
         .filter(|&k| k < spi.sclks())
         .map(|k| {
             let from = spi.setup_cycles + k * spi.sclk_div;
             format!(
-                "(cyc >= {cb}'d{from} && cyc < {cb}'d{} && cw{b}[{}])",
+                "(cyc >= {cb}'d{from} && cyc < {cb}'d{} && {word}[{}])",
                 from + spi.sclk_div,
                 l as u64 - 1 - k
             )
@@ -104,60 +107,64 @@ pub(super) fn mosi(
     });
 }
 
-fn bits(w: &[bool]) -> String {
-    w.iter().map(|&x| if x { '1' } else { '0' }).collect()
-}
-
-/// `cw{b}` in a mix with modes: each conversion's word selects the
-/// conversion `ahead` later in the mode in force; the last `ahead` of a
-/// frame select the next frame's first ones, in the mode decided for it
-/// (`mnext`), or, when that mode does not convert the branch, wrap within
-/// the frame in force (docs/timing.md, "Command words").  Words that do
-/// not depend on the next mode come from `{mcur, slot}`, the others from
-/// `{mnext, mcur, slot}`.
+/// `cw{b}` in a mix with modes: each mode's words from its own table on
+/// `{mcur, slot}`; a word of a frame's last `ahead` conversions selects
+/// the next frame's conversion `j`, whose input the next frame's mode
+/// (`mnext`, decided at the edge that began this frame) gives.
 fn mode_words(v: &mut String, s: &Schedule, b: usize, l: usize) {
-    let (mb, sb) = (super::modes::bits(s), width(s.grid.frame_slots));
-    let Some(cmd) = s.mix.branches[b].adc.command.as_ref() else {
+    let Some(cmd) = &s.mix.branches[b].adc.command else {
         return;
     };
     let ahead = cmd.ahead as usize;
-    let convs: Vec<Vec<(u64, usize)>> = (s.modes.iter())
-        .map(|ms| {
-            (0..s.grid.frame_slots)
-                .filter_map(|u| ms.at(u, b).map(|c| (u, c)))
-                .collect()
-        })
-        .collect();
+    let (mb, sb) = (super::modes::bits(s), width(s.grid.frame_slots));
+    let jw = width(ahead.max(1) as u64);
+    let bits = |w: &[bool]| -> String { w.iter().map(|&x| if x { '1' } else { '0' }).collect() };
     let word = |c: usize| bits(&cmd.word(s.mix.channels[c].input));
-    let (mut own, mut tail) = (String::new(), String::new());
-    for (m, cv) in convs.iter().enumerate() {
-        let n = cv.len();
-        for (k, &(slot, _)) in cv.iter().enumerate() {
-            if k + ahead < n {
-                let w = word(cv[k + ahead].1);
-                let _ = writeln!(own, "    {{{mb}'d{m}, {sb}'d{slot}}}: cw{b} = {l}'b{w};");
-                continue;
-            }
-            for (m2, next) in convs.iter().enumerate() {
-                let j = k + ahead - n;
-                let c = next.get(j).map_or(cv[(k + ahead) % n].1, |x| x.1);
-                let _ = writeln!(
-                    tail,
-                    "    {{{mb}'d{m2}, {mb}'d{m}, {sb}'d{slot}}}: cw{b} = {l}'b{};",
-                    word(c)
-                );
-            }
+    let _ = writeln!(
+        v,
+        "  reg [{}:0] cw{b}, cf{b};\n  reg cx{b};\n  reg [{}:0] cj{b};\n  always @* begin\n    \
+         cw{b} = {l}'d0; cx{b} = 1'b0; cj{b} = {jw}'d0;\n    case ({{mcur, slot}})",
+        l - 1,
+        jw - 1
+    );
+    let mut first = vec![];
+    for (m, ms) in s.modes.iter().enumerate() {
+        let convs: Vec<(u64, usize)> = (0..s.grid.frame_slots)
+            .filter_map(|u| ms.at(u, b).map(|c| (u, c)))
+            .collect();
+        let n = convs.len();
+        for (k, (u, _)) in convs.iter().enumerate() {
+            let key = format!("{{{mb}'d{m}, {sb}'d{u}}}");
+            let _ = match convs.get(k + ahead) {
+                Some(&(_, c)) => writeln!(v, "      {key}: cw{b} = {l}'b{};", word(c)),
+                None => writeln!(
+                    v,
+                    "      {key}: begin cx{b} = 1'b1; cj{b} = {jw}'d{}; end",
+                    k + ahead - n
+                ),
+            };
+        }
+        first.push(
+            convs
+                .iter()
+                .take(ahead)
+                .map(|&(_, c)| word(c))
+                .collect::<Vec<_>>(),
+        );
+    }
+    let _ = writeln!(
+        v,
+        "      default: ;\n    endcase\n  end\n  // The next frame's conversion j in the next frame's mode.\n  \
+         always @* case ({{mnext, cj{b}}})"
+    );
+    for (m, f) in first.iter().enumerate() {
+        for (j, w) in f.iter().enumerate() {
+            let _ = writeln!(v, "    {{{mb}'d{m}, {jw}'d{j}}}: cf{b} = {l}'b{w};");
         }
     }
     let _ = writeln!(
         v,
-        "  always @* begin\n  case ({{mcur, slot}})\n{own}    default: cw{b} = {l}'d0;\n  endcase"
+        "    default: cf{b} = {l}'d0;\n  endcase\n  wire [{}:0] cwe{b} = cx{b} ? cf{b} : cw{b};",
+        l - 1
     );
-    if !tail.is_empty() {
-        let _ = writeln!(
-            v,
-            "  case ({{mnext, mcur, slot}})\n{tail}    default: ;\n  endcase"
-        );
-    }
-    let _ = writeln!(v, "  end");
 }

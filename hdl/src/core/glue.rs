@@ -13,13 +13,14 @@ pub(super) enum LaneForm<'a> {
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
 /// `pulse_of`: per sequencer, its CNV pulse if its part is read with CNV
 /// low. `modes`: a mix with modes (pin select, the branches whose words the
-/// mode block reads).
+/// mode block reads). `cmds`: each branch's command unit, and per unit
+/// whether it reads the modes (behind a front mux in a mix with modes).
 pub(super) fn core_glue(
     nb: usize,
     devices: &[usize],
     seq_of: &[usize],
     pulse_of: &[Option<usize>],
-    cmd_of: &[Option<usize>],
+    (cmd_of, moded): (&[Option<usize>], &[bool]),
     modes: Option<(bool, usize)>,
     lanes_form: LaneForm,
 ) -> String {
@@ -35,7 +36,7 @@ pub(super) fn core_glue(
         mode_inputs(&mut s, nb, pin, lanes, cmd_of);
     }
     let act_read = queue_inputs(&mut s, nb, queue, step);
-    command_units(&mut s, seq_of, cmd_of);
+    command_units(&mut s, seq_of, cmd_of, moded);
     lanes(&mut s, nb, devices, cmd_of);
     s.push_str(
         "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
@@ -201,7 +202,7 @@ fn child_inputs(
 
 /// Each command unit's inputs (its branch's pins, its sequencer's levels,
 /// the slot start) and the `adc_mosi` lanes (absent without a unit).
-fn command_units(s: &mut String, seq_of: &[usize], cmd_of: &[Option<usize>]) {
+fn command_units(s: &mut String, seq_of: &[usize], cmd_of: &[Option<usize>], moded: &[bool]) {
     let mut lanes = vec![];
     for (b, i) in cmd_of.iter().enumerate() {
         let Some(i) = i else { continue };
@@ -213,6 +214,13 @@ fn command_units(s: &mut String, seq_of: &[usize], cmd_of: &[Option<usize>]) {
         s.push_str(&format!(
             "  {c}$clock = clock;\n  {c}$rst = rst;\n  {c}$start0 = timing$start0;\n  {c}$pin = {u}$cs_n;\n  {c}$bsclk = {u}$sclk;\n  {c}$qsclk = {q}$sclk;\n  {c}$qdone = {q}$done;\n  {c}$sel = {u}$mux_sel;\n  {c}$hi = {u}$mux_en[1];\n  {c}$done = {u}$done;\n"
         ));
+        if moded[*i] {
+            // the mode in force, and the next frame's (minfo's low bits)
+            s.push_str(&format!(
+                "  {c}$mode$0 = modes$0$mode;\n  {c}$nxt$0 = modes$0$minfo[{}:0];\n",
+                MODE_BITS - 1
+            ));
+        }
         lanes.insert(0, format!("{c}$mosi"));
     }
     if !lanes.is_empty() {
