@@ -445,3 +445,31 @@ fn the_whole_feature_matrix_passes_end_to_end_part_4() {
 fn the_whole_feature_matrix_passes_end_to_end_part_5() {
     wide_part(4);
 }
+
+/// The matrix's meaning: of the whole pairwise cover and the wide draw's
+/// free mixes, the audit refuses (a listed crossing, or no schedule) at
+/// most one in ten.
+#[test]
+fn the_audit_refuses_at_most_one_matrix_mix_in_ten() {
+    let mut pts = matrix::pairwise(1);
+    pts.extend(matrix::random(2, 12));
+    let dir = tempfile::tempdir().unwrap();
+    let mut refused = vec![];
+    for (i, p) in pts.iter().enumerate() {
+        let path = dir.path().join(format!("matrix-{i}.toml"));
+        std::fs::write(&path, matrix::mix(p, 100 + i as u64)).unwrap();
+        let out = slotforge(&[&"audit", &path]);
+        if !out.status.success() {
+            let why = String::from_utf8_lossy(&out.stderr).to_string()
+                + &String::from_utf8_lossy(&out.stdout);
+            refused.push(format!("{p:?}: {}", why.trim()));
+        }
+    }
+    assert!(
+        refused.len() * 10 <= pts.len(),
+        "{} of {} refused:\n{}",
+        refused.len(),
+        pts.len(),
+        refused.join("\n")
+    );
+}
