@@ -201,7 +201,7 @@ fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
         &[&"faults", &mix, &"--quiet", &"--false-alarm-mixes", &"1"],
     );
     if wide {
-        prove(&mut f, &mix);
+        prove(&mut f, &mix, &d.join("prove"));
     }
     match f.0.is_empty() {
         true => Ok(true),
@@ -356,21 +356,20 @@ fn verilator(
     .is_some()
 }
 
-/// `prove` proves (exit 0), or refuses or is bounded naming what it left
-/// out: never a counterexample.
-fn prove(f: &mut Faults, mix: &Path) {
-    let out = slotforge(&[&"prove", &mix, &"--json", &"--quiet"]);
+/// `prove` proves (exit 0), or refuses naming why (exit 2), or is bounded
+/// naming what it left out (exit 3): never a counterexample.
+fn prove(f: &mut Faults, mix: &Path, dir: &Path) {
+    let out = slotforge(&[&"prove", &mix, &"--json", &"-o", &dir]);
     let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
-    let status = j["status"].as_str().unwrap_or("");
-    let named = j["not_covered"].as_array().is_some_and(|a| !a.is_empty())
-        || j["reason"].as_str().is_some_and(|r| !r.is_empty());
-    match status {
-        "proved" => {}
-        "bounded" | "refused" if named => {}
-        _ => f.0.push(format!(
-            "prove: status {status:?} (exit {:?}): {}",
-            out.status.code(),
-            String::from_utf8_lossy(&out.stderr)
+    let result = j["result"].as_str().unwrap_or("");
+    let left_out = j["not_covered"].as_array().is_some_and(|a| !a.is_empty());
+    let why = String::from_utf8_lossy(&out.stderr);
+    match (out.status.code(), result) {
+        (Some(0), "proved") | (Some(3), "bounded") if result == "proved" || left_out => {}
+        (Some(2), _) if why.contains("error:") => {}
+        (code, _) => f.0.push(format!(
+            "prove: result {result:?} (exit {code:?}): {}{why}",
+            j["note"].as_str().unwrap_or("")
         )),
     }
 }

@@ -18,11 +18,17 @@ use crate::mix::When;
 use crate::schedule::Schedule;
 
 /// The first sampling instant of a frame of `s`, in cycles from the
-/// frame's start (`None`: the schedule samples nothing).
+/// frame's start: the earliest instant a part holds its input, a
+/// conversion's start plus its part's [`Schedule::sample_after`] (an
+/// MCP3208 holds its input 6 us into its transaction); `None`: the
+/// schedule samples nothing.
 pub fn first_instant(s: &Schedule) -> Option<u64> {
-    (0..s.grid.frame_slots)
-        .find(|&slot| (0..s.branches.len()).any(|b| s.at(slot, b).is_some()))
-        .map(|slot| slot * s.grid.slot_cycles)
+    (0..s.branches.len())
+        .filter_map(|b| {
+            let slot = (0..s.grid.frame_slots).find(|&slot| s.at(slot, b).is_some())?;
+            Some(slot * s.grid.slot_cycles + s.sample_after(b))
+        })
+        .min()
 }
 
 /// Worst cycles from the cycle `mode_sel` first shows mode `to` to the first
@@ -100,7 +106,8 @@ fn latencies(from: &Schedule, t: &crate::mix::Trigger, first_to: u64) -> Vec<(u6
         .filter_map(|i| {
             let c = watched(i.channel)?;
             let e = i.cycle + from.branches[i.branch].spi.read_cycles;
-            Some((i.cycle, e / f, c))
+            // the cause is the sample's instant, where its part held it
+            Some((i.cycle + from.sample_after(i.branch), e / f, c))
         })
         .collect();
     let n = t.for_frames as u64;

@@ -124,13 +124,25 @@ fn to_toml(s: &Spec) -> Option<String> {
 /// frame later; the latency runs to that frame's first instant of `to`.
 fn walk(from: &Schedule, to: &Schedule, t: &Trigger) -> u64 {
     let f = from.grid.frame_cycles;
-    let first_to = to.instants(1).map(|i| i.cycle).min().unwrap();
+    // instants where the parts hold their inputs (an MCP3208 6 us into its
+    // transaction), as a run measures causes and first samples
+    let first_to = to
+        .instants(1)
+        .map(|i| i.cycle + to.sample_after(i.branch))
+        .min()
+        .unwrap();
     let frames = 2 + t.for_frames as u64 + 4;
     let leads: Vec<usize> = t.channels.iter().map(|&c| from.mix.lead_of(c)).collect();
     let watched: Vec<(u64, u64)> = from
         .instants(frames)
         .filter(|i| leads.contains(&i.channel))
-        .map(|i| (i.cycle, i.cycle + from.branches[i.branch].spi.read_cycles))
+        .map(|i| {
+            let start = i.cycle;
+            (
+                start + from.sample_after(i.branch),
+                start + from.branches[i.branch].spi.read_cycles,
+            )
+        })
         .collect();
     let mut worst = 0;
     for &(t0, _) in watched.iter().filter(|&&(t0, _)| (f..2 * f).contains(&t0)) {
@@ -272,6 +284,47 @@ fn a_trigger_that_needs_more_frames_reacts_a_frame_later_per_frame() {
         lut_gen::pin_latency(&pin, 1),
         2 * pin.grid.frame_cycles + first
     );
+}
+
+/// A part that holds its input inside its transaction (the MCP3208, 6 us
+/// after CS falls): the worst reaction runs to that instant, not to the
+/// conversion's start (a run measured 4.006 ms against 4.000 ms).
+#[test]
+fn a_reaction_runs_to_the_instant_the_part_holds_its_input() {
+    let text = r#"
+name = "mcp-modes"
+[clock]
+hz = 24_000_000
+[frame]
+period_us = 2_000
+slice_us = 1_000
+[[mode]]
+name = "rest"
+[[mode]]
+name = "busy"
+[modes]
+select = "pin"
+[[branch]]
+name = "a"
+adc = "mcp3208"
+mux = "internal"
+[[channel]]
+name = "A0"
+branch = "a"
+rate_hz = 2_000
+rates = { rest = 1_000 }
+input = 0
+"#;
+    let mix = lut_gen::parse(Path::new("mcp-modes.toml"), text).unwrap();
+    let s = lut_gen::synthesize(&mix).unwrap();
+    let after = s.sample_after(0);
+    assert!(after > 100, "the MCP3208 holds its input {after} cycles in");
+    let start = s.modes[1].instants(1).map(|i| i.cycle).min().unwrap();
+    assert_eq!(
+        lut_gen::pin_latency(&s, 1),
+        2 * s.grid.frame_cycles + start + after
+    );
+    assert_eq!(lut_gen::first_instant(&s.modes[1]), Some(start + after));
 }
 
 /// The merged stream over a run of one mode is the steady frame's, frame
