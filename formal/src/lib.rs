@@ -248,7 +248,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     let mut not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
     not_covered.extend(harness::bounded_modes(s, result, depth));
     let bytes = match (reads_bytes, result) {
-        (true, Outcome::Proved) => Some(link_bytes(&h, design, f, opts)?),
+        (true, Outcome::Proved) => Some(link_bytes(&h, design, f, harness::auto_frames(s), opts)?),
         _ => None,
     };
     let (result, depth) = match &bytes {
@@ -327,9 +327,15 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
 /// The properties that read the link's bytes, searched apart ([`link_bytes`]).
 const LINK_BYTES: [&str; 2] = ["link.bytes", "link.packets"];
 
-/// Frames from reset the link's bytes are searched (every slice's packet of
-/// each, so the frame counter's step from one frame to the next is in it).
+/// Frames from reset the link's bytes are searched when a proof would cost
+/// too much (every slice's packet of each, so the frame counter's step from
+/// one frame to the next is in it).
 pub const LINK_FRAMES: u64 = 2;
+
+/// Steps of symbolic simulation the link's bytes may take to come round:
+/// the frame counter's 256 frames and the two the harness starts with.  A
+/// mix whose frame makes that longer is searched [`LINK_FRAMES`] only.
+pub const LINK_PROOF_STEPS: u64 = 2_000_000;
 
 /// The search of the link's bytes: its result and where it ran.
 struct BytesRun {
@@ -341,14 +347,16 @@ struct BytesRun {
 }
 
 /// `link.bytes` and `link.packets` (with every other property: the
-/// harness `h` asserts them all) searched from reset by the symbolic
-/// engine for [`LINK_FRAMES`] frames.  Not a proof: the packets' frame
-/// counter (the design's and the harness's) makes the state come round only
-/// after 256 frames, and the recurrence argument needs it to.
+/// harness `h` asserts them all) by the symbolic engine from reset: the
+/// packets' frame counter (the design's and the harness's) makes the state
+/// come round only after 256 frames, so a short frame is simulated until it
+/// does (a proof, [`LINK_PROOF_STEPS`]) and a longer one is searched for
+/// [`LINK_FRAMES`] frames (bounded).
 fn link_bytes(
     h: &Harness,
     design: &str,
     f: u64,
+    auto: Option<u64>,
     opts: &ProveOptions,
 ) -> Result<BytesRun, ProveError> {
     let work = work_dir()?;
@@ -357,9 +365,25 @@ fn link_bytes(
     let text = std::fs::read_to_string(prep.dir.join("design.aag"))
         .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
     let g = aiger::parse(&text).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
-    let limit = LINK_FRAMES * f + 2;
+    let whole = 258 * f + 2;
+    let limit = if whole <= LINK_PROOF_STEPS {
+        whole
+    } else {
+        LINK_FRAMES * f + 2
+    };
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
-    let (found, _) = symsim::prove(&g, &[], &[], false, f, 2, limit, Some(deadline));
+    // split as the main run is (mode requests, trigger decisions): exact
+    let splits = named_inputs(&prep, harness::MODE_SEL);
+    let (found, _) = symsim::prove(
+        &g,
+        &[],
+        &splits,
+        auto.is_some(),
+        f,
+        2,
+        limit,
+        Some(deadline),
+    );
     let (result, depth, note) = match found {
         symsim::Found::Violated { step, inputs } => {
             std::fs::write(prep.dir.join("cex.aiw"), symsim::witness_text(&g, &inputs))
@@ -373,11 +397,13 @@ fn link_bytes(
                 ),
             )
         }
-        symsim::Found::Proved { steps, .. } => (
+        symsim::Found::Proved { steps, since } => (
             Outcome::Proved,
             steps,
             format!(
-                "the link's bytes ({}) are {PROVED} too",
+                "the link's bytes ({}) are {PROVED} too: simulated the same way with the \
+                 harness's receiver and packet parser to step {steps}, whose state is the \
+                 state at step {since} (the frame counters come round after 256 frames)",
                 LINK_BYTES.join(", ")
             ),
         ),

@@ -5,14 +5,15 @@
 //! cycle of every slice (its own cycle count), a sample wherever its own
 //! merged stream (`exp_valid`, `exp_ch`, `exp_val`: the MISO bits it
 //! recorded) has a word.  The tokens wait in the harness's queue; each byte
-//! the line delivers (`rx_v`, `rx_b` from `uart.rs`) is compared with the
-//! byte the head token owes: a boundary the previous packet's trailer
+//! the line carries is compared, bit by bit as it arrives (`rx_d`, `rx_i`
+//! from `uart.rs`; the parser moves on at `rx_v`), with the byte the head
+//! token owes: a boundary the previous packet's trailer
 //! (`0x5A`, overflow count 0, CRC-16/MODBUS low then high, computed here
 //! over the header, the records and the trailer's first two bytes) once a
 //! header has been sent, then a header (`0xA5`, the frame counter the
 //! harness counts from 0, the slice field: with modes the mode in force in
 //! the slice's first cycle and the frame before's above the slice); a
-//! sample its record (channel index, code, big-endian).  A byte with no
+//! sample its record (channel index, code, big-endian).  A character with no
 //! token waiting, or more tokens waiting than the link's FIFO can hold and
 //! the serializer has in hand, fails too.
 
@@ -43,8 +44,9 @@ pub(super) fn monitor(
     let slb = 16 - 2 * mb;
     // entry: {bnd, smp, mode, mode before, ch, val}
     let ew = 2 + 2 * mb + chb + vb;
+    // a field the token does not own is 0 (no stale word kept in the queue)
     let modes = if mb > 0 {
-        "mcur, mprev, ".to_string()
+        format!("lbnd ? {{mcur, mprev}} : {}'d0, ", 2 * mb)
     } else {
         String::new()
     };
@@ -59,25 +61,23 @@ pub(super) fn monitor(
          endfunction\n  \
          reg [{}:0] lsc = 0;\n  always @(posedge clk) if (run) lsc <= lsc == {scb}'d{} ? {scb}'d0 : lsc + {scb}'d1;\n  \
          wire lbnd = run && lsc == {scb}'d0;\n  wire push = lbnd || (run && exp_valid);\n  \
-         wire [{}:0] entry = {{lbnd, exp_valid, {modes}exp_ch, exp_val}};",
+         wire [{}:0] entry = {{lbnd, exp_valid, {modes}exp_valid ? {{exp_ch, exp_val}} : {}'d0}};",
         scb - 1,
         g.slice_cycles - 1,
         ew - 1,
+        chb + vb,
     );
+    // a shift queue (the head in q0, emptied entries 0): no pointer that
+    // comes round only after several frames, no stale token kept
     let regs: Vec<String> = (0..q).map(|i| format!("q{i} = 0")).collect();
     let _ = writeln!(
         v,
-        "  reg [{}:0] {};\n  reg [{}:0] qrd = 0, qwr = 0, qn = 0;\n  reg qovf = 1'b0;\n  \
-         reg [{}:0] head;\n  always @* case (qrd)",
+        "  reg [{}:0] {};\n  reg [{}:0] qn = 0;\n  reg qovf = 1'b0;\n  wire [{}:0] head = q0;",
         ew - 1,
         regs.join(", "),
         qb - 1,
         ew - 1,
     );
-    for i in 0..q {
-        let _ = writeln!(v, "    {qb}'d{i}: head = q{i};");
-    }
-    let _ = writeln!(v, "    default: head = {ew}'d0;\n  endcase");
     let (lo_val, lo_ch) = (0, vb);
     let lo_mode = vb + chb;
     let _ = writeln!(
@@ -121,18 +121,25 @@ pub(super) fn monitor(
     );
     let _ = writeln!(
         v,
-        "  always @(posedge clk) begin\n    \
-         if (push) begin\n      case (qwr)"
+        "  // where a pushed token lands: after the waiting ones, one lower on a pop\n  \
+         wire [{}:0] qa = pop ? qn - {qb}'d1 : qn;\n  always @(posedge clk) begin",
+        qb - 1
     );
     for i in 0..q {
-        let _ = writeln!(v, "        {qb}'d{i}: q{i} <= entry;");
+        let next = if i + 1 < q {
+            format!("q{}", i + 1)
+        } else {
+            format!("{ew}'d0")
+        };
+        let _ = writeln!(
+            v,
+            "    q{i} <= (push && qa == {qb}'d{i}) ? entry : pop ? {next} : q{i};"
+        );
     }
     let _ = writeln!(
         v,
-        "        default: ;\n      endcase\n      qwr <= qwr == {qb}'d{} ? {qb}'d0 : qwr + {qb}'d1;\n    end\n    \
-         if (pop) qrd <= qrd == {qb}'d{} ? {qb}'d0 : qrd + {qb}'d1;\n    \
-         qn <= qn + (push ? {qb}'d1 : {qb}'d0) - (pop ? {qb}'d1 : {qb}'d0);\n    \
-         if (push && !pop && qn == {qb}'d{q}) qovf <= 1'b1;\n    \
+        "    if (push && !pop && qn == {qb}'d{q}) qovf <= 1'b1;\n    \
+         else qn <= qn + (push ? {qb}'d1 : {qb}'d0) - (pop ? {qb}'d1 : {qb}'d0);\n    \
          if (rx_v) begin\n      wpos <= wpos + 2'd1;\n      \
          if (ekind == 2'd0 && wpos == 2'd0) crc <= crc16_byte(16'hFFFF, rx_b);\n      \
          else if (ekind != 2'd2 || !wpos[1]) crc <= crc16_byte(crc, rx_b);\n    end\n    \
@@ -141,9 +148,7 @@ pub(super) fn monitor(
          esl <= esl == {slb}'d{} ? {slb}'d0 : esl + {slb}'d1;\n      \
          if (esl == {slb}'d{}) efc <= efc + 8'd1;\n    end\n    \
          if (pop) begin tdone <= 1'b0; hdone <= 1'b0; end\n  end\n  \
-         wire ok_link_packets = !qovf && !(rx_v && qn == {qb}'d0) && (!rx_v || rx_b == ebyte);",
-        q - 1,
-        q - 1,
+         wire ok_link_packets = !qovf && !(rx_s && qn == {qb}'d0) && (!rx_d || link_tx == ebyte[rx_i]);",
         k - 1,
         k - 1,
     );

@@ -7,7 +7,9 @@
 //! level over all of them; the line is high during reset.  A low level
 //! between characters starts a character, so "idle high" is the same rule.
 //! Each received byte is strobed (`rx_v`, `rx_b`) for the packet monitor
-//! (`packets.rs`).
+//! (`packets.rs`), which also compares each data bit in its first cycle
+//! (`rx_d`, `rx_i`; `rx_s` a start bit), so a wrong byte fails at its first
+//! wrong bit, the cycle `check` rejects.
 
 use std::fmt::Write;
 
@@ -61,6 +63,10 @@ pub(super) fn receiver(v: &mut String, props: &mut Vec<PropertyDef>, c: &Char) {
          reg [7:0] ush = 8'd0;\n  reg ulev = 1'b1;\n  reg rx_v = 1'b0;\n  reg [7:0] rx_b = 8'd0;\n  \
          wire u_in = run && (ubusy || !link_tx);\n  \
          wire [{}:0] ub = ubusy ? ubit : {bw}'d0;\n  wire [{}:0] uc = ubusy ? ucnt : {cw}'d0;\n  \
+         // a character starts (rx_s); data bit rx_i is on the line (rx_d, its first cycle)\n  \
+         wire rx_s = run && !ubusy && !link_tx;\n  \
+         wire rx_d = u_in && uc == {cw}'d0 && ub >= {bw}'d1 && ub <= {bw}'d8;\n  \
+         wire [{}:0] rx_i1 = ub - {bw}'d1;\n  wire [2:0] rx_i = rx_i1[2:0];\n  \
          always @(posedge clk) begin\n    \
          rx_v <= u_in && uc == {cw}'d0 && ub == {bw}'d8;\n    rx_b <= {{link_tx, ush[7:1]}};\n    \
          if (u_in && uc == {cw}'d0 && ub >= {bw}'d1 && ub <= {bw}'d8) begin\n      \
@@ -78,6 +84,7 @@ pub(super) fn receiver(v: &mut String, props: &mut Vec<PropertyDef>, c: &Char) {
         cw - 1,
         bw - 1,
         cw - 1,
+        bw - 1,
         d - 1,
         nb - 1,
     );
