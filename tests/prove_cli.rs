@@ -249,15 +249,26 @@ fn a_default_build_proves_and_a_later_one_shows_it_remembered() {
 /// A UART mix: the harness reads the line (`link.bytes`, `link.packets`),
 /// and on the tiny mix's 4,000-cycle frame both are proved for all time
 /// (the frame counters come round after 256 frames), so `prove` claims the
-/// whole contract with nothing listed as not covered.
+/// whole contract with nothing listed as not covered; with 8N1 and with an
+/// odd parity bit and two stop bits (the harness's receiver and the
+/// gateware agree on both).
 #[test]
 fn a_uart_mix_proves_its_line_and_packets() {
     if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let mix = tiny_uart(dir.path());
-    let v = prove_json(&[mix.to_str().unwrap()], &[], dir.path(), 0);
+    let plain = tiny_uart(dir.path());
+    let odd = dir.path().join("tiny-uart-o2.toml");
+    let text = std::fs::read_to_string(&plain).unwrap() + "parity = \"odd\"\nstop_bits = 2\n";
+    std::fs::write(&odd, text).unwrap();
+    for mix in [plain, odd] {
+        uart_mix_proves(&mix, dir.path());
+    }
+}
+
+fn uart_mix_proves(mix: &std::path::Path, dir: &std::path::Path) {
+    let v = prove_json(&[mix.to_str().unwrap()], &[], dir, 0);
     assert_eq!(v["result"], "proved");
     assert_eq!(v["not_covered"].as_array().unwrap().len(), 0, "{v}");
     for name in ["link.bytes", "link.packets"] {

@@ -24,7 +24,9 @@ use lut_gen::{Layout, Schedule};
 use super::{width, Clause, PropertyDef};
 
 /// Tokens the harness's queue holds beyond the link's FIFO depth: the one
-/// the serializer is sending and the one whose bytes the line still carries.
+/// the serializer holds, the one whose last byte the line still carries
+/// (the harness lets a token go at its last byte's eighth data bit), and
+/// one to spare.
 const IN_HAND: usize = 3;
 
 /// The token queue, the parser and the property `link.packets`.
