@@ -24,8 +24,10 @@ mod compact;
 mod contract;
 mod link;
 mod modes;
+mod packets;
+mod uart;
 pub use contract::{contract, not_covered, Clause};
-pub use link::TREADY_ANY;
+pub use link::{LinkBytes, TREADY_ANY};
 pub(crate) use modes::{auto_frames, bounded_modes, MODE_SEL};
 
 /// The module name of the harness.
@@ -190,6 +192,15 @@ pub fn generate(s: &Schedule) -> Result<Harness, HarnessError> {
 /// Generates the harness for `s` with its slot tables in `form` (both forms
 /// describe the same schedule; a test holds them to it).
 pub fn generate_with(s: &Schedule, form: TableForm) -> Result<Harness, HarnessError> {
+    generate_parts(s, form, LinkBytes::Asserted)
+}
+
+/// [`generate_with`], with the link's bytes asserted or left out.
+pub fn generate_parts(
+    s: &Schedule,
+    form: TableForm,
+    bytes: LinkBytes,
+) -> Result<Harness, HarnessError> {
     Layout::fits(s).map_err(HarnessError)?;
     let g = &s.grid;
     if form == TableForm::Full && g.frame_slots > FULL_TABLE_MAX_SLOTS {
@@ -246,7 +257,7 @@ pub fn generate_with(s: &Schedule, form: TableForm) -> Result<Harness, HarnessEr
     merger(&mut v, &mut props, s, &layout);
     modes::decide(&mut v, &mut props, s, &layout);
     if layout.link {
-        link::properties(&mut v, &mut props, s, &layout);
+        link::properties(&mut v, &mut props, s, &layout, bytes);
     }
     let _ = writeln!(v, "  wire ok = {};", {
         let w: Vec<&str> = props

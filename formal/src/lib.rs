@@ -224,8 +224,19 @@ fn write_inputs(dir: &Path, h: &Harness, design: &str) -> Result<(), ProveError>
 pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, ProveError> {
     let t0 = Instant::now();
     let h = harness::generate(s)?;
+    // the link's bytes are searched apart (`link_bytes`); the rest is proved
+    // by a harness without them, whose state comes round
+    let reads_bytes = h
+        .properties
+        .iter()
+        .any(|p| LINK_BYTES.contains(&p.name.as_str()));
+    let main = if reads_bytes {
+        harness::generate_parts(s, TableForm::for_schedule(s), harness::LinkBytes::Left)?
+    } else {
+        h.clone()
+    };
     let work = work_dir()?;
-    write_inputs(work.path(), &h, design)?;
+    write_inputs(work.path(), &main, design)?;
     let prep = engine::prepare(work.path(), opts.solver)?;
     let t1 = Instant::now();
     let f = h.frame_cycles;
@@ -236,29 +247,57 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     };
     let mut not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
     not_covered.extend(harness::bounded_modes(s, result, depth));
+    let bytes = match (reads_bytes, result) {
+        (true, Outcome::Proved) => Some(link_bytes(&h, design, f, harness::auto_frames(s), opts)?),
+        _ => None,
+    };
+    let (result, depth) = match &bytes {
+        Some(b) if b.result == Outcome::Failed => (Outcome::Failed, b.depth),
+        _ => (result, depth),
+    };
+    if let Some(b) = bytes.as_ref().filter(|b| b.result == Outcome::Bounded) {
+        not_covered.push(bounded_bytes_sentence(b.depth, f));
+    }
     let netlist_caveats = opts
         .netlist
         .as_ref()
         .map(|(_, c)| c.clone())
         .unwrap_or_default();
-    let note = scoped_note(result, note, not_covered.len());
+    let note = match &bytes {
+        Some(b) if b.result == Outcome::Failed => b.note.clone(),
+        Some(b) => format!(
+            "{}; {}",
+            scoped_note(result, note, not_covered.len()),
+            b.note
+        ),
+        None => scoped_note(result, note, not_covered.len()),
+    };
     let solver_seconds = t1.elapsed().as_secs_f64();
+    let bytes_result = bytes.as_ref().map_or(result, |b| b.result);
     let mut properties: Vec<PropertyResult> = h
         .properties
         .iter()
         .map(|p| PropertyResult {
             name: p.name.clone(),
-            result,
+            result: if LINK_BYTES.contains(&p.name.as_str()) {
+                bytes_result
+            } else {
+                result
+            },
             what: p.what.clone(),
         })
         .collect();
     let counterexample = if result == Outcome::Failed {
+        let (h, prep, work) = match &bytes {
+            Some(b) if b.result == Outcome::Failed => (&h, &b.prep, b.work.path()),
+            _ => (&main, &prep, work.path()),
+        };
         let failure = Failure {
             s,
-            h: &h,
+            h,
             design,
-            prep: &prep,
-            work: work.path(),
+            prep,
+            work,
             step: depth,
         };
         Some(counterexample(&failure, opts, &mut properties)?)
@@ -283,6 +322,120 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         counterexample,
         cycle,
     })
+}
+
+/// The properties that read the link's bytes, searched apart ([`link_bytes`]).
+const LINK_BYTES: [&str; 2] = ["link.bytes", "link.packets"];
+
+/// Frames from reset the link's bytes are searched when a proof would cost
+/// too much (every slice's packet of each, so the frame counter's step from
+/// one frame to the next is in it).
+pub const LINK_FRAMES: u64 = 2;
+
+/// Steps of symbolic simulation the link's bytes may take to come round:
+/// the frame counter's 256 frames and the two the harness starts with.  A
+/// mix whose frame makes that longer is searched [`LINK_FRAMES`] only.
+pub const LINK_PROOF_STEPS: u64 = 2_000_000;
+
+/// The search of the link's bytes: its result and where it ran.
+struct BytesRun {
+    result: Outcome,
+    depth: u64,
+    note: String,
+    prep: engine::Prepared,
+    work: tempfile::TempDir,
+}
+
+/// `link.bytes` and `link.packets` (with every other property: the
+/// harness `h` asserts them all) by the symbolic engine from reset: the
+/// packets' frame counter (the design's and the harness's) makes the state
+/// come round only after 256 frames, so a short frame is simulated until it
+/// does (a proof, [`LINK_PROOF_STEPS`]) and a longer one is searched for
+/// [`LINK_FRAMES`] frames (bounded).
+fn link_bytes(
+    h: &Harness,
+    design: &str,
+    f: u64,
+    auto: Option<u64>,
+    opts: &ProveOptions,
+) -> Result<BytesRun, ProveError> {
+    let work = work_dir()?;
+    write_inputs(work.path(), h, design)?;
+    let prep = engine::prepare(work.path(), Solver::Symbolic)?;
+    let text = std::fs::read_to_string(prep.dir.join("design.aag"))
+        .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
+    let g = aiger::parse(&text).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
+    let whole = 258 * f + 2;
+    let limit = if whole <= LINK_PROOF_STEPS {
+        whole
+    } else {
+        LINK_FRAMES * f + 2
+    };
+    let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
+    // split as the main run is (mode requests, trigger decisions): exact
+    let splits = named_inputs(&prep, harness::MODE_SEL);
+    let (found, _) = symsim::prove(
+        &g,
+        &[],
+        &splits,
+        auto.is_some(),
+        f,
+        2,
+        limit,
+        Some(deadline),
+    );
+    let (result, depth, note) = match found {
+        symsim::Found::Violated { step, inputs } => {
+            std::fs::write(prep.dir.join("cex.aiw"), symsim::witness_text(&g, &inputs))
+                .map_err(|e| ProveError::Tool(format!("cex.aiw: {e}")))?;
+            (
+                Outcome::Failed,
+                step,
+                format!(
+                    "a trace from reset violates the link's bytes at step {step} (cycle {})",
+                    step as i64 - 2
+                ),
+            )
+        }
+        symsim::Found::Proved { steps, since } => (
+            Outcome::Proved,
+            steps,
+            format!(
+                "the link's bytes ({}) are {PROVED} too: simulated the same way with the \
+                 harness's receiver and packet parser to step {steps}, whose state is the \
+                 state at step {since} (the frame counters come round after 256 frames)",
+                LINK_BYTES.join(", ")
+            ),
+        ),
+        symsim::Found::Bounded { steps } => (
+            Outcome::Bounded,
+            steps,
+            format!(
+                "the link's bytes ({}) are BOUNDED only: no violation from reset within {steps} \
+                 steps ({:.2} frames), every step simulated exactly with MISO free",
+                LINK_BYTES.join(", "),
+                steps.saturating_sub(2) as f64 / f as f64
+            ),
+        ),
+    };
+    Ok(BytesRun {
+        result,
+        depth,
+        note,
+        prep,
+        work,
+    })
+}
+
+/// What a bounded search of the link's bytes leaves out.
+fn bounded_bytes_sentence(depth: u64, f: u64) -> String {
+    format!(
+        "the link's bytes (link.bytes, link.packets) after cycle {}: they were searched from \
+         reset for {:.0} frames only (bounded), not proved for all time; the packets' 8-bit \
+         frame counter brings the state round only after 256 frames",
+        depth.saturating_sub(2),
+        depth.saturating_sub(2) as f64 / f as f64
+    )
 }
 
 /// How every engine's note for a proof begins.

@@ -291,14 +291,24 @@ fn the_auto_select_mix_proves() {
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &emitted(&s), dir.path());
     assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
-    assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
+    // the link's bytes are searched two frames (an 8,000-cycle frame's 256
+    // take more than formal::LINK_PROOF_STEPS), every other property proved
+    for q in &p.properties {
+        let bytes = q.name == "link.bytes" || q.name == "link.packets";
+        let want = if bytes {
+            Outcome::Bounded
+        } else {
+            Outcome::Proved
+        };
+        assert_eq!(q.result, want, "{}", p.summary());
+    }
     assert!(
         p.note
             .contains("split at each frame start on the values of the registers"),
         "{}",
         p.note
     );
-    // the UART's line is all that is left out, no mode switch
+    // the link's bytes after the search are all that is left out, no mode switch
     assert!(
         p.not_covered
             .iter()

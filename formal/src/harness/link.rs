@@ -18,7 +18,17 @@ use std::fmt::Write;
 use lut_gen::Schedule;
 use lut_gen::{Dir, Layout};
 
-use super::{width, Clause, FreeInput, PropertyDef};
+use super::{packets, uart, width, Clause, FreeInput, PropertyDef};
+
+/// Whether the harness reads the link's bytes (`link.bytes`,
+/// `link.packets`): a UART's receiver and packet parser.  `prove` proves
+/// the harness without them for all time and searches the one with them
+/// from reset (their frame counter keeps the state from coming round).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinkBytes {
+    Asserted,
+    Left,
+}
 
 /// The harness input that lets the slave take a beat early (any cycle).
 pub const TREADY_ANY: &str = "tready_any";
@@ -88,6 +98,7 @@ pub(super) fn properties(
     props: &mut Vec<PropertyDef>,
     s: &Schedule,
     layout: &Layout,
+    bytes: LinkBytes,
 ) {
     debug_assert!(layout
         .link_ports()
@@ -111,6 +122,13 @@ pub(super) fn properties(
         },
     });
     if within.is_none() {
+        if let (LinkBytes::Asserted, Some(c)) = (bytes, uart::Char::of(s)) {
+            uart::receiver(v, props, &c);
+            let depth = lut_gen::plan_link(s)
+                .and_then(Result::ok)
+                .map_or(0, |p| p.fifo_depth);
+            packets::monitor(v, props, s, layout, depth);
+        }
         return;
     }
     v.push_str(

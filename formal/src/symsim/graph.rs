@@ -221,6 +221,11 @@ impl Graph {
         lit: u32,
         limit: Option<std::time::Duration>,
     ) -> Result<Option<Vec<Assigned>>, String> {
+        // an OR of XOR miters (a CRC against a CRC): decided by affine
+        // forms, exactly; CDCL would not finish
+        if super::affine::never_true(self, lit) {
+            return Ok(None);
+        }
         let mut index: HashMap<usize, i32> = HashMap::new();
         let mut stack = vec![(lit >> 1) as usize];
         let mut cone = Vec::new();

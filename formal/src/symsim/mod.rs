@@ -34,6 +34,7 @@ use std::time::Instant;
 
 use crate::aiger::Aig;
 
+mod affine;
 mod cases;
 mod cone;
 mod eval;
