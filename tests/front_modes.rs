@@ -94,7 +94,7 @@ fn a_fronted_converter_switches_modes_on_every_engine_and_its_waveform_passes_ch
             assert!(samples_in(&v, "C0", "idle") > 0, "{name} {backend}");
         }
         let vcd = d.path().join(format!("{name}.vcd"));
-        let out = sim(&mix, "verilator", &[&"--vcd", &vcd]);
+        let out = sim(&mix, "verilator", &[&"--to", &FRAMES, &"--vcd", &vcd]);
         assert!(out.status.success(), "{name}");
         for extra in [&[][..], &["--no-model"]] {
             let o = slotforge()
@@ -145,7 +145,11 @@ fn a_front_select_wrong_in_one_mode_only_fails_check_in_that_modes_first_frame()
     let bad_line = line.replace(';', " ^ {5'd0, mode};");
     std::fs::write(&bad_rtl, text.replacen(line, &bad_line, 1)).unwrap();
     let vcd = d.path().join("bad.vcd");
-    let run = sim(&mix, "verilator", &[&"--rtl", &bad_rtl, &"--vcd", &vcd]);
+    let run = sim(
+        &mix,
+        "verilator",
+        &[&"--rtl", &bad_rtl, &"--to", &FRAMES, &"--vcd", &vcd],
+    );
     assert_eq!(
         run.status.code(),
         Some(1),
