@@ -393,7 +393,9 @@ fn a_random_three_mode_pin_mix_with_an_idle_branch_proves() {
 /// mode), and the gateware proves for every sequence of requests or
 /// codes (as does `cmd-modes`, command words with modes and no front
 /// mux); with the front select's bit 0 inverted while `mode` shows `busy`
-/// only, it fails on the fronted branch's mux.
+/// only, it fails on the fronted branch's mux, and with a frame's last
+/// words taken from the mode in force rather than the next frame's, on
+/// its words.
 #[test]
 fn a_fronted_mix_with_modes_proves_and_a_front_select_wrong_in_one_mode_fails() {
     if !tools::require_tools(&TOOLS) {
@@ -427,4 +429,9 @@ fn a_fronted_mix_with_modes_proves_and_a_front_select_wrong_in_one_mode_fails() 
     let bad = edit(&good, line, &line.replace(';', " ^ {5'd0, mode};"));
     let dir = tempfile::tempdir().unwrap();
     assert_fails(&s, &prove(&s, &bad, dir.path()), &["mux[cfg]"]);
+    // a frame's last words from the mode in force instead of the next
+    // frame's: right within a mode, wrong across a switch only
+    let stale = edit(&good, "nxm = nxt_0[0:0];", "nxm = cur;");
+    let dir = tempfile::tempdir().unwrap();
+    assert_fails(&s, &prove(&s, &stale, dir.path()), &["mosi[cfg]"]);
 }
