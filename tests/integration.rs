@@ -24,6 +24,9 @@ mod fixes;
 #[path = "fusesoc.rs"]
 mod fusesoc;
 
+#[path = "front_modes.rs"]
+mod front_modes;
+
 #[path = "golden.rs"]
 mod golden;
 

@@ -405,6 +405,26 @@ fn a_quick_draw_of_the_feature_matrix_passes_end_to_end() {
     draw(&matrix::pairwise(1)[..4], 1, false);
 }
 
+/// The cover's mixes with a fronted AD7689 in a mix with modes (the audit
+/// refused them before: matrix-19, -20 and -22 of `matrix_mixes`), each
+/// through the property (`make test-long` adds Icarus and `prove`).
+#[test]
+fn the_covers_fronted_converters_with_modes_pass_end_to_end() {
+    let pts = matrix::pairwise(1);
+    let fronted: Vec<(u64, &Point)> = (1u64..)
+        .zip(pts.iter())
+        .filter(|(_, p)| p.modes != Modes::None && p.converter == matrix::Converter::Ad7689Front)
+        .collect();
+    assert!(
+        fronted.len() >= 2,
+        "{} such mixes in the cover",
+        fronted.len()
+    );
+    for (seed, p) in fronted {
+        assert_eq!(through(p, seed, false), Ok(true), "matrix-{seed}: {p:?}");
+    }
+}
+
 /// The whole pairwise cover and free draws, with Icarus and `prove`, in
 /// five parts that nextest runs side by side (`make test-long`).
 fn wide_part(k: usize) {

@@ -395,6 +395,50 @@ fn a_random_three_mode_pin_mix_with_an_idle_branch_proves() {
     assert!(p.note.contains("split on mode_sel"), "{}", p.note);
 }
 
+/// A converter with a command word behind a front mux in a mix with modes
+/// (`testkit` mixes `front-modes`, pin select, and `front-modes-auto`,
+/// auto select on a fronted channel): the harness asserts the front pins
+/// from each mode's table and the words across every switch (a frame's
+/// last words select the next frame's conversions in the next frame's
+/// mode), and the gateware proves for every sequence of requests or
+/// codes; with the front select's bit 0 inverted while `mode` shows `busy`
+/// only, it fails on the fronted branch's mux, and with a frame's last
+/// words taken from the mode in force rather than the next frame's, on
+/// its words.
+#[test]
+fn a_fronted_mix_with_modes_proves_and_a_front_select_wrong_in_one_mode_fails() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    for name in ["front-modes", "front-modes-auto"] {
+        let s = schedule(&format!("testkit/mixes/{name}.toml"));
+        let dir = tempfile::tempdir().unwrap();
+        let p = prove(&s, &emitted(&s), dir.path());
+        assert_eq!(p.result, Outcome::Proved, "{name}: {}", p.summary());
+        for prop in ["mux[cfg]", "mosi[cfg]", "mode"] {
+            assert!(
+                (p.properties.iter()).any(|q| q.name == prop && q.result == Outcome::Proved),
+                "{name} {prop}: {}",
+                p.summary()
+            );
+        }
+    }
+    let s = schedule("testkit/mixes/front-modes.toml");
+    let good = emitted(&s);
+    let line = good
+        .lines()
+        .find(|l| l.trim_start().starts_with("assign mux_sel = core_mux_sel["))
+        .unwrap();
+    let bad = edit(&good, line, &line.replace(';', " ^ {5'd0, mode};"));
+    let dir = tempfile::tempdir().unwrap();
+    assert_fails(&s, &prove(&s, &bad, dir.path()), &["mux[cfg]"]);
+    // a frame's last words from the mode in force instead of the next
+    // frame's: right within a mode, wrong across a switch only
+    let stale = edit(&good, "nxm = nxt_0[0:0];", "nxm = cur;");
+    let dir = tempfile::tempdir().unwrap();
+    assert_fails(&s, &prove(&s, &stale, dir.path()), &["mosi[cfg]"]);
+}
+
 /// Converters with a command word in a pin-select mix (an MCP3208 whose
 /// rate changes between modes, an AD7689 whose word selects the conversion
 /// after next, so a frame's last words select the next frame's first

@@ -384,6 +384,42 @@ mod tests {
         assert!(p.modes.is_none() && p.branches.iter().all(|r| r.modes.is_none()));
     }
 
+    /// `front-modes`: each mode's words select the conversion two later in
+    /// its own frame, or the next frame's `j`-th; the front pins are the
+    /// mux field (one first instant per mode), not an index.
+    #[test]
+    fn a_fronted_branch_has_each_modes_words_and_its_front_pins_in_the_rom() {
+        let s = lut_gen::synthesize(&lut_gen::load(&testkit::mix("front-modes")).unwrap()).unwrap();
+        let p = plan_with(&s, LutForm::Auto).unwrap();
+        let rom = &p.branches[0];
+        let f = rom.front.as_ref().unwrap().modes.as_ref().unwrap();
+        let m = rom.modes.as_ref().unwrap();
+        assert!(!m.indexed(), "the mux field holds the front pins");
+        assert_ne!(f.words[0], f.words[1], "the modes' words differ");
+        for (k, ms) in s.modes.iter().enumerate() {
+            let convs: Vec<usize> = (0..s.grid.frame_slots)
+                .filter_map(|u| ms.at(u, 0))
+                .collect();
+            let n = convs.len();
+            assert_eq!(f.words[k].len(), n);
+            for (i, w) in f.words[k].iter().enumerate() {
+                let want = match convs.get(i + 2) {
+                    Some(&c) => FrontWord::Here(s.mix.channels[c].input),
+                    None => FrontWord::Next((i + 2 - n) as u32),
+                };
+                assert_eq!(*w, want, "mode {k} conversion {i}");
+            }
+            let input = |&c: &usize| s.mix.channels[c].input;
+            assert_eq!(f.first[k], convs[..2].iter().map(input).collect::<Vec<_>>());
+            let c = &s.channels[convs[0]];
+            assert_eq!(
+                m.first[k],
+                vec![(c.select, c.device)],
+                "mode {k}'s first front pins"
+            );
+        }
+    }
+
     const MIX: &str = r#"
 name = "left-out"
 [clock]

@@ -405,11 +405,19 @@ fn the_links_fifo_is_block_ram() {
 }
 
 /// Modes (issue 29): a pin-select mix, an auto mix with three modes and a
-/// UART, and the adaptive reference design: the mode block, every mode's
-/// table on the ROM address and the mode ports lint and synthesize clean.
+/// UART, the adaptive reference design, and an AD7689 behind a front mux
+/// with modes (pin and auto select: its command unit's per-mode words):
+/// the mode block, every mode's table on the ROM address and the mode
+/// ports lint and synthesize clean.
 #[test]
 fn gates_modes() {
-    for name in ["modes-pin", "modes-auto", "eskin34-adaptive"] {
+    for name in [
+        "modes-pin",
+        "modes-auto",
+        "eskin34-adaptive",
+        "front-modes",
+        "front-modes-auto",
+    ] {
         let path = testkit::mix(name);
         let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
         gates(&s, name);

@@ -275,3 +275,51 @@ fn the_audit_counts_free_places_behind_and_beside_the_front_mux() {
     let a = crate::AuditReport::of_schedule(&s);
     assert_eq!(a.branches[0].free_mux_inputs, 6 + 5 + 1 + 7);
 }
+
+/// With `[[mode]]` tables a fronted AD7689 is accepted when every mode
+/// converts it at least `command_ahead` (2) times per frame: each mode's
+/// schedule has its own front pins; a mode that converts it once is
+/// refused as any such converter's (its last word would select a frame
+/// whose mode is not decided yet), naming the branch and the mode.
+#[test]
+fn a_front_mux_in_a_mix_with_modes_takes_each_modes_table() {
+    let modes = AD.replace(
+        "[[branch]]",
+        "[[mode]]\nname = \"calm\"\n[[mode]]\nname = \"busy\"\n[modes]\nselect = \"pin\"\n[[branch]]",
+    );
+    let text = modes.replace(
+        "rate_hz = 2_000\n",
+        "rate_hz = 2_000\nrates = { busy = 4_000 }\n",
+    );
+    let m = parse(Path::new("m.toml"), &text).unwrap();
+    let s = synthesize(&m).unwrap();
+    let per = |k: usize| {
+        (0..s.grid.frame_slots)
+            .filter(|&u| s.modes[k].at(u, 0).is_some())
+            .count()
+    };
+    assert_eq!((per(0), per(1)), (12, 14));
+    // the pins of a fronted conversion address its front input in every mode
+    for ms in &s.modes {
+        for c in (0..s.grid.frame_slots).filter_map(|u| ms.at(u, 0)) {
+            let f = m.channels[c].front_input.unwrap_or(0);
+            assert_eq!(
+                (ms.channels[c].device, ms.channels[c].select),
+                (f / 8, f % 8)
+            );
+        }
+    }
+    let once = modes
+        .replace(
+            "rate_hz = 1_000\n",
+            "rate_hz = 1_000\nrates = { busy = 0 }\n",
+        )
+        .replace("rate_hz = 2_000\n", "rate_hz = 1_000\n");
+    let e = err(&once).to_string();
+    assert!(
+        e.contains("branch `a`")
+            && e.contains("mode `busy`")
+            && e.contains("whose mode is not decided yet"),
+        "{e}"
+    );
+}
