@@ -23,6 +23,7 @@
 mod branch;
 mod command;
 mod glue;
+mod holdoff;
 mod merger;
 mod modes;
 mod pulse;
@@ -38,6 +39,7 @@ use rust_hdl::prelude::*;
 
 use branch::BranchUnit;
 use command::CmdUnit;
+use holdoff::HoldOff;
 use merger::Merger;
 use modes::ModeGen;
 use pulse::CnvPulse;

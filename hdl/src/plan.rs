@@ -50,6 +50,9 @@ pub struct SeqTiming {
     pub word_sclks: u64,
     pub leading_bits: u64,
     pub bits: u64,
+    /// Cycles from the slot tick to the transaction's start (0, or at
+    /// least 2: a sync group's hold-off, `SpiTiming::holdoff_cycles`).
+    pub holdoff: u64,
 }
 
 impl SeqTiming {
@@ -589,7 +592,14 @@ fn branch_rom(
         word_sclks: adc.word_sclks() as u64,
         leading_bits: adc.leading_bits as u64,
         bits: adc.bits as u64,
+        holdoff: spi.holdoff_cycles,
     };
+    if timing.holdoff == 1 {
+        return Err(unsupported(format!(
+            "branch {}: a hold-off of one cycle (the gateware delays a transaction by 2 cycles or more)",
+            bp.name
+        )));
+    }
     let seq = match seqs.iter().position(|t| *t == timing) {
         Some(i) => i,
         None => {
