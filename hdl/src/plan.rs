@@ -635,7 +635,8 @@ fn branch_rom(
         // docs/timing.md, "Start-up": the mux takes its reset value at
         // the first reset edge, one cycle before cycle 0 at the least;
         // an instant at cycle 0 it cannot have settled for is skipped.
-        conv0: slots[0].is_some() && bp.settle_cycles <= 1,
+        // docs/timing.md "Start-up": skipped unless the mux has settled by the start
+        conv0: slots[0].is_some() && !s.skipped_at_startup(b, 0),
         devices,
         muxed: s.mix.branches[b].mux.select_bits > 0,
         en_offset,

@@ -84,7 +84,7 @@ impl Logic for HoldOff {
         if self.clock.pos_edge() {
             let fire = self._cnt == 1;
             if self.rst.val() {
-                self._cnt = self._hold - 1;
+                self._cnt = self._hold;
                 self._mask = true;
                 self._d1 = false;
                 self._d0 = false;
@@ -147,7 +147,7 @@ impl HoldOff {
         let _ = writeln!(
             s,
             "  if (rst) begin\n    cnt <= {w}'d{};\n    r_mask <= 1'b1;\n    r_d1 <= 1'b0;\n    r_d0 <= 1'b0;\n  end",
-            self._hold - 1
+            self._hold
         );
         let _ = writeln!(s, "  else begin");
         let _ = writeln!(s, "    if (start2) cnt <= {w}'d{};", self._hold);
