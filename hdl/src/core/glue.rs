@@ -11,16 +11,14 @@ pub(super) enum LaneForm<'a> {
 }
 
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
-/// `pulse_of`: per sequencer, its CNV pulse if its part is read with CNV
-/// low; `hold_of`: per sequencer, its hold-off if its transactions start
-/// after the slot tick. `modes`: a mix with modes (pin select, the branches whose words the
+/// `wires`: per sequencer, its CNV pulse if its part is read with CNV low
+/// and its hold-off if its transactions start after the slot tick. `modes`: a mix with modes (pin select, the branches whose words the
 /// mode block reads).
 pub(super) fn core_glue(
     nb: usize,
     devices: &[usize],
     seq_of: &[usize],
-    pulse_of: &[Option<usize>],
-    hold_of: &[Option<usize>],
+    wires: SeqWires,
     cmd_of: &[Option<usize>],
     modes: Option<(bool, usize)>,
     lanes_form: LaneForm,
@@ -30,9 +28,8 @@ pub(super) fn core_glue(
         LaneForm::Priority { stepped } => (None, stepped),
     };
     let mut s = String::new();
-    let nseq = pulse_of.len();
+    let nseq = wires.pulse_of.len();
     s.push_str("always @(*) begin\n");
-    let wires = SeqWires { pulse_of, hold_of };
     child_inputs(&mut s, nb, seq_of, &wires, modes.is_none());
     if let Some((pin, lanes)) = modes {
         mode_inputs(&mut s, nb, pin, lanes, cmd_of);
@@ -45,7 +42,7 @@ pub(super) fn core_glue(
     );
     unused_wires(&mut s, nb, devices, nseq);
     let released: Vec<String> = (0..nseq)
-        .filter(|&i| pulse_of[i].is_some())
+        .filter(|&i| wires.pulse_of[i].is_some())
         .map(|i| format!("seqs${i}$cs_n"))
         .collect();
     if !released.is_empty() {
@@ -155,9 +152,9 @@ fn lanes_below_is(src: usize, j: usize) -> String {
 
 /// Where each sequencer's levels come from and its start goes: its CNV
 /// pulse (`pulse_of`), its hold-off (`hold_of`).
-struct SeqWires<'a> {
-    pulse_of: &'a [Option<usize>],
-    hold_of: &'a [Option<usize>],
+pub(super) struct SeqWires<'a> {
+    pub(super) pulse_of: &'a [Option<usize>],
+    pub(super) hold_of: &'a [Option<usize>],
 }
 
 impl SeqWires<'_> {

@@ -2,7 +2,7 @@
 
 use rust_hdl::prelude::*;
 
-use super::glue::{core_glue, route_miso, LaneForm};
+use super::glue::{core_glue, route_miso, LaneForm, SeqWires};
 use super::{BranchUnit, CmdUnit, CnvPulse, HoldOff, Merger, ModeGen, SpiSeq, TimingGen};
 use crate::plan::Plan;
 use crate::widths::*;
@@ -535,8 +535,10 @@ impl Logic for Core {
             self.branches.len(),
             &self._devices,
             &self._seq_of,
-            &self._pulse_of,
-            &self._hold_of,
+            SeqWires {
+                pulse_of: &self._pulse_of,
+                hold_of: &self._hold_of,
+            },
             &self._cmd_of,
             self.modes
                 .first()

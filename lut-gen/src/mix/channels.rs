@@ -467,10 +467,8 @@ impl Cx<'_> {
                 decl,
                 branches,
                 channels,
-                tag,
-                members,
-                clock_hz,
-                slice_cycles,
+                (tag, members),
+                (clock_hz, slice_cycles),
             )?;
             let mut seen = BTreeMap::new();
             let rate = channels[members[0].0].rate_hz;
@@ -510,16 +508,13 @@ impl Cx<'_> {
     /// the difference (its hold-off, docs/timing.md "Hold-off"): refused
     /// when the wait and the transaction no longer fit a slice, or the
     /// branch's conversions per second at that length.
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn check_sync_instants(
         &self,
         decl: &[Declared],
         branches: &[Branch],
         channels: &[Channel],
-        tag: &str,
-        members: &[(usize, Range<usize>)],
-        clock_hz: u64,
-        slice_cycles: u64,
+        (tag, members): (&str, &[(usize, Range<usize>)]),
+        (clock_hz, slice_cycles): (u64, u64),
     ) -> Result<(), MixError> {
         let timing = |c: usize| branches[channels[c].branch].timing(clock_hz).ok();
         let known: Vec<(usize, crate::parts::SpiTiming)> = members
