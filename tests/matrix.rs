@@ -5,7 +5,8 @@
 //! draw) pass against the model under a scene that switches modes; the
 //! Verilator run's waveform passes `check --no-model`, a window from its
 //! middle passes `check`; `decode` of the link's bytes gives the samples
-//! `--samples` wrote; `faults` judges the mix's own clean run clean; and in
+//! `--samples` wrote; a mode mix's report gives each mode's figures as its
+//! audit does; `faults` judges the mix's own clean run clean; and in
 //! the wide draw `prove` proves, or says what it left out.
 //!
 //! A quick draw (the first points of the pairwise cover) runs in `make
@@ -183,6 +184,18 @@ fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
             f.0.extend(decoded_as_sampled(p, &csv, &dec));
         }
     }
+    if p.modes != Modes::None {
+        let out = d.join("b");
+        let only = "audit,lut,verilog,sim";
+        if f.run(
+            "build (report)",
+            &[&"build", &mix, &"--quiet", &"--only", &only, &"-o", &out],
+        )
+        .is_some()
+        {
+            f.0.extend(report_as_audited(&out));
+        }
+    }
     f.run(
         "faults (its clean run of this mix)",
         &[&"faults", &mix, &"--quiet", &"--false-alarm-mixes", &"1"],
@@ -197,6 +210,117 @@ fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
             f.0.join("\n  ")
         )),
     }
+}
+
+/// The rows of report.md's table whose header row starts with `first`.
+fn md_table(md: &str, first: &str) -> Vec<Vec<String>> {
+    let head = format!("| {first} |");
+    let mut lines = md.lines().skip_while(|l| !l.starts_with(&head)).skip(2);
+    let mut rows = vec![];
+    for l in lines.by_ref().take_while(|l| l.starts_with('|')) {
+        rows.push(
+            l.trim_matches('|')
+                .split(" | ")
+                .map(|c| c.trim().to_string())
+                .collect(),
+        );
+    }
+    rows
+}
+
+/// A list of channel names as the report's tables write it.
+fn names_cell(v: &[String]) -> String {
+    match v {
+        [] => "-".into(),
+        [a] => a.clone(),
+        [a, b] => format!("{a}, {b}"),
+        [a, .., z] => format!("{a} to {z} ({})", v.len()),
+    }
+}
+
+/// A mode mix's report against its audit (both from one `build`): each
+/// mode's samples per frame and per second, each interval row's channels'
+/// rates and promised intervals, measured equal to promised with no
+/// jitter (the co-simulation passed), and the first screen's binding the
+/// busiest mode's.
+fn report_as_audited(out: &Path) -> Vec<String> {
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap_or_default();
+    let audit: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("audit.json")).unwrap_or_default())
+            .unwrap_or_default();
+    let modes = audit["modes"].as_array().cloned().unwrap_or_default();
+    let mut bad = vec![];
+    let mode = |n: &str| modes.iter().find(|m| m["name"] == n);
+    let summary = md_table(&md, "mode | samples per frame");
+    for m in &modes {
+        let name = m["name"].as_str().unwrap_or("");
+        let row = summary.iter().find(|r| r[0] == name);
+        let want = [
+            m["samples_per_frame"].to_string(),
+            m["aggregate_hz"].to_string(),
+        ];
+        if row.map(|r| &r[1..3]) != Some(&want[..]) {
+            bad.push(format!(
+                "report's modes table row {row:?}, audit's {name}: {want:?}"
+            ));
+        }
+    }
+    let rows = md_table(&md, "mode | branch | rate (Hz) | channels");
+    if rows.is_empty() {
+        bad.push("report.md has no per-mode interval table".into());
+    }
+    let branch_of = |c: &serde_json::Value| {
+        let all = audit["channels"].as_array().cloned().unwrap_or_default();
+        let a = all.into_iter().find(|a| a["name"] == c["name"]);
+        a.map(|a| a["branch"].clone()).unwrap_or_default()
+    };
+    for r in &rows {
+        let Some(m) = mode(&r[0]) else {
+            bad.push(format!("interval row {r:?}: no such mode in audit.json"));
+            continue;
+        };
+        // the row's channels: the mode's channels of that branch at that rate
+        let group: Vec<serde_json::Value> = (m["channels"].as_array().into_iter().flatten())
+            .filter(|c| c["rate_hz"].as_u64() == r[2].parse().ok() && branch_of(c) == r[1].as_str())
+            .cloned()
+            .collect();
+        let names: Vec<String> = group
+            .iter()
+            .map(|c| c["name"].as_str().unwrap_or("").to_string())
+            .collect();
+        let promised = group
+            .iter()
+            .all(|c| c["interval_cycles"].as_u64() == r[5].parse().ok());
+        if names_cell(&names) != r[3] || !promised || r[6] != r[5] || r[7] != "0" {
+            bad.push(format!(
+                "interval row {r:?}: audit.json's {} at {} Hz on {}: {names:?}",
+                r[0], r[2], r[1]
+            ));
+        }
+    }
+    // the busiest mode (ties: any of them) names the binding on the first screen
+    let u = |m: &serde_json::Value| m["utilization"].as_f64().unwrap_or(0.0);
+    let top = modes.iter().map(u).fold(0.0, f64::max);
+    let says = |m: &serde_json::Value| {
+        format!(
+            "branch `{}`'s slots in mode `{}`, {:.1} % used",
+            m["binding_branch"].as_str().unwrap_or(""),
+            m["name"].as_str().unwrap_or(""),
+            100.0 * u(m)
+        )
+    };
+    let busiest: Vec<String> = modes.iter().filter(|m| u(m) == top).map(says).collect();
+    let front = md_table(&md, "question | answer");
+    let binds = front.iter().find(|r| r[0].starts_with("What binds"));
+    let on_grid = modes
+        .iter()
+        .any(|m| u(m) == top && m["binding"] == "slot_grid");
+    if on_grid && !binds.is_some_and(|r| busiest.iter().any(|b| r[1].starts_with(b.as_str()))) {
+        bad.push(format!(
+            "first screen's binding {binds:?}, the busiest mode's: {busiest:?}"
+        ));
+    }
+    bad
 }
 
 /// A Verilator run of the scene writing the VCD window `(from, to, path)`
@@ -282,11 +406,70 @@ fn a_quick_draw_of_the_feature_matrix_passes_end_to_end() {
     draw(&matrix::pairwise(1)[..4], 1, false);
 }
 
-/// The whole pairwise cover and free draws, with Icarus and `prove`.
-#[test]
-#[ignore = "the wide feature matrix: make test-long"]
-fn the_whole_feature_matrix_passes_end_to_end() {
+/// The whole pairwise cover and free draws, with Icarus and `prove`, in
+/// five parts that nextest runs side by side (`make test-long`).
+fn wide_part(k: usize) {
     let mut pts = matrix::pairwise(1);
     pts.extend(matrix::random(2, 12));
-    draw(&pts, 100, true);
+    let n = pts.len().div_ceil(5);
+    let part: Vec<Point> = pts.iter().skip(k * n).take(n).cloned().collect();
+    draw(&part, 100 + (k * n) as u64, true);
+}
+
+#[test]
+#[ignore = "the wide feature matrix: make test-long"]
+fn the_whole_feature_matrix_passes_end_to_end_part_1() {
+    wide_part(0);
+}
+
+#[test]
+#[ignore = "the wide feature matrix: make test-long"]
+fn the_whole_feature_matrix_passes_end_to_end_part_2() {
+    wide_part(1);
+}
+
+#[test]
+#[ignore = "the wide feature matrix: make test-long"]
+fn the_whole_feature_matrix_passes_end_to_end_part_3() {
+    wide_part(2);
+}
+
+#[test]
+#[ignore = "the wide feature matrix: make test-long"]
+fn the_whole_feature_matrix_passes_end_to_end_part_4() {
+    wide_part(3);
+}
+
+#[test]
+#[ignore = "the wide feature matrix: make test-long"]
+fn the_whole_feature_matrix_passes_end_to_end_part_5() {
+    wide_part(4);
+}
+
+/// The matrix's meaning: of the whole pairwise cover and the wide draw's
+/// free mixes, the audit refuses (a listed crossing, or no schedule) at
+/// most one in ten.
+#[test]
+fn the_audit_refuses_at_most_one_matrix_mix_in_ten() {
+    let mut pts = matrix::pairwise(1);
+    pts.extend(matrix::random(2, 12));
+    let dir = tempfile::tempdir().unwrap();
+    let mut refused = vec![];
+    for (i, p) in pts.iter().enumerate() {
+        let path = dir.path().join(format!("matrix-{i}.toml"));
+        std::fs::write(&path, matrix::mix(p, 100 + i as u64)).unwrap();
+        let out = slotforge(&[&"audit", &path]);
+        if !out.status.success() {
+            let why = String::from_utf8_lossy(&out.stderr).to_string()
+                + &String::from_utf8_lossy(&out.stdout);
+            refused.push(format!("{p:?}: {}", why.trim()));
+        }
+    }
+    assert!(
+        refused.len() * 10 <= pts.len(),
+        "{} of {} refused:\n{}",
+        refused.len(),
+        pts.len(),
+        refused.join("\n")
+    );
 }

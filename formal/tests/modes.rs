@@ -384,3 +384,65 @@ fn a_random_three_mode_pin_mix_with_an_idle_branch_proves() {
     assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
     assert!(p.note.contains("split on mode_sel"), "{}", p.note);
 }
+
+/// Converters with a command word in a pin-select mix (an MCP3208 whose
+/// rate changes between modes, an AD7689 whose word selects the conversion
+/// after next, so a frame's last words select the next frame's first
+/// conversions in the mode decided for it): every property proved, the
+/// words on `adc_mosi` included, for every sequence of requests.
+#[test]
+fn command_word_converters_in_a_pin_mode_mix_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/cmd-modes.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    for name in ["mosi[mcp]", "mosi[cfg]", "mode"] {
+        let q = p.properties.iter().find(|q| q.name == name);
+        assert!(q.is_some_and(|q| q.result == Outcome::Proved), "{name}");
+    }
+    assert!(
+        p.not_covered
+            .iter()
+            .all(|n| n.contains("converts the input each word selects")),
+        "only the parts' own behaviour is left out: {:?}",
+        p.not_covered
+    );
+}
+
+/// The AD7689's word for the second conversion of a frame that runs mode
+/// `fast`, sent in the frame before, selects the wrong input: only a run
+/// that switches to `fast` sends it, and `mosi[cfg]` fails there. About a
+/// minute (the failing run is two frames long, then replayed).
+#[test]
+#[ignore = "long: make test-long"]
+fn a_wrong_command_word_across_a_switch_fails_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/cmd-modes.toml");
+    let design = edit(
+        &emitted(&s),
+        "4'd9: begin fuse = 1'b1; fsel = 3'd2; fdev = 1'd0; end",
+        "4'd9: begin fuse = 1'b1; fsel = 3'd3; fdev = 1'd0; end",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &design, dir.path());
+    assert_fails(&s, &p, &["mosi[cfg]"]);
+}
+
+/// The same converters with auto select (triggers on the MCP3208's words).
+#[test]
+#[ignore = "long: make test-long"]
+fn command_word_converters_in_an_auto_mode_mix_prove() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/cmd-modes-auto.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
+}

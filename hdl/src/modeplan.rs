@@ -222,6 +222,9 @@ fn fill(s: &Schedule, b: usize, rom: &mut BranchRom, mode_bits: usize, slot_bits
     rom.words = words;
     rom.addr_bits = slot_bits + mode_bits;
     rom.modes = Some(ModeRom { first, mode_bits });
+    if let Some(f) = &mut rom.front {
+        f.modes = front_modes(s, b, mode_bits);
+    }
 }
 
 /// The mux field of an instant: in the word, or the next frame's `j`-th.
@@ -237,7 +240,7 @@ enum Field {
 /// words"), past the frame's end the next frame's conversion `j`.
 fn mode_fields(s: &Schedule, b: usize, slots: &[Option<usize>]) -> Vec<Option<Field>> {
     let mux = |c: usize| Field::Here(s.channels[c].select, s.channels[c].device);
-    let Some(cmd) = &s.mix.branches[b].adc.command else {
+    let Some(cmd) = word_in_mux_field(s, b) else {
         return slots.iter().map(|c| c.map(mux)).collect();
     };
     let convs: Vec<usize> = slots.iter().flatten().copied().collect();
@@ -257,12 +260,73 @@ fn mode_fields(s: &Schedule, b: usize, slots: &[Option<usize>]) -> Vec<Option<Fi
     out
 }
 
+/// The command word of branch `b` when the mux field carries the input it
+/// selects: a converter with a command word and no front mux (behind one,
+/// the field is the front mux's pins and the words are [`FrontModes`]).
+fn word_in_mux_field(s: &Schedule, b: usize) -> Option<&lut_gen::Command> {
+    let br = &s.mix.branches[b];
+    br.adc.command.as_ref().filter(|_| !br.fronted)
+}
+
+/// The word of one conversion of a fronted branch's frame: the converter
+/// input of a conversion of its own frame, or the index `j` of the next
+/// frame's conversion it selects (that frame's mode decides its input).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FrontWord {
+    Here(u32),
+    Next(u32),
+}
+
+/// A fronted branch's words in a mix with modes (the command unit's table
+/// on the mode in force and the conversion counter; docs/timing.md,
+/// "Command words"): every mode converts the branch at least `ahead`
+/// times per frame (the mix check refuses less), so a `Next(j)` word
+/// always finds the next frame's conversion `j`, in the mode decided
+/// while this frame runs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FrontModes {
+    /// Per mode, the word of each of its frame's conversions, in slot order.
+    pub words: Vec<Vec<FrontWord>>,
+    /// Per mode, the inputs of its frame's first `ahead` conversions.
+    pub first: Vec<Vec<u32>>,
+    /// Bits of the mode number.
+    pub mode_bits: usize,
+}
+
+/// Branch `b`'s [`FrontModes`] (`None` without a front mux).
+fn front_modes(s: &Schedule, b: usize, mode_bits: usize) -> Option<FrontModes> {
+    let br = &s.mix.branches[b];
+    let ahead = br.adc.command.as_ref().filter(|_| br.fronted)?.ahead as usize;
+    let input = |&c: &usize| s.mix.channels[c].input;
+    let (mut words, mut first) = (vec![], vec![]);
+    for ms in &s.modes {
+        let convs: Vec<usize> = (0..s.grid.frame_slots)
+            .filter_map(|u| ms.at(u, b))
+            .collect();
+        let n = convs.len();
+        words.push(
+            (0..n)
+                .map(|k| match convs.get(k + ahead) {
+                    Some(c) => FrontWord::Here(input(c)),
+                    None => FrontWord::Next((k + ahead - n) as u32),
+                })
+                .collect(),
+        );
+        first.push(convs.iter().take(ahead).map(input).collect());
+    }
+    Some(FrontModes {
+        words,
+        first,
+        mode_bits,
+    })
+}
+
 /// [`ModeRom::first`] of one mode: what a `w` word with index `j` takes
 /// when the next frame runs this mode (empty when it does not use the
 /// branch).
 fn first_fields(s: &Schedule, b: usize, slots: &[Option<usize>]) -> Vec<(u32, u32)> {
     let convs: Vec<usize> = slots.iter().flatten().copied().collect();
-    let Some(cmd) = &s.mix.branches[b].adc.command else {
+    let Some(cmd) = word_in_mux_field(s, b) else {
         let mux = |&c: &usize| (s.channels[c].select, s.channels[c].device);
         return convs.first().map(mux).into_iter().collect();
     };

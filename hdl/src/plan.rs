@@ -4,7 +4,7 @@
 use lut_gen::Schedule;
 
 use crate::decode::SlotLogic;
-use crate::modeplan::{ModePlan, ModeRom};
+use crate::modeplan::{FrontModes, ModePlan, ModeRom};
 use crate::HdlError;
 
 use crate::widths::{
@@ -133,11 +133,13 @@ pub struct BranchRom {
 }
 
 /// The inputs a fronted branch's words select, one per conversion of the
-/// frame in slot order, and the first one's index after reset.
+/// frame in slot order, and the first one's index after reset; in a mix
+/// with modes, every mode's (`inputs` is then the reset mode's, unread).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FrontWords {
     pub inputs: Vec<u32>,
     pub first: u32,
+    pub modes: Option<FrontModes>,
 }
 
 impl BranchRom {
@@ -574,12 +576,6 @@ fn branch_rom(
     let spi = &bp.spi;
     check_spi(s, b, words)?;
     let fronted = s.mix.branches[b].fronted;
-    if fronted && s.mix.modes.is_some() {
-        return Err(unsupported(format!(
-            "branch {}: a front mux (front_mux) in a mix with modes is not in the gateware",
-            bp.name
-        )));
-    }
     let devices = bp.mux_devices.max(1) as usize;
     let timing = SeqTiming {
         sclk_div: spi.sclk_div,
@@ -686,6 +682,7 @@ fn front_words(
     Ok(Some(FrontWords {
         inputs,
         first: skipped as u32,
+        modes: None,
     }))
 }
 

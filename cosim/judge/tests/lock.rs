@@ -222,3 +222,52 @@ fn uart_line_in_a_window_is_judged_without_the_model() {
         }
     }
 }
+
+/// Every cycle a message of a window's check names is a capture cycle, as
+/// its header is: the instants and conversions a detail refers to lie before
+/// the violation, inside the capture (the model's own cycles would lie a
+/// frame or more after it).
+#[test]
+fn a_windows_messages_count_cycles_from_the_capture() {
+    let s = tiny();
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path().join("bad.vcd");
+    for fault in [
+        PinFault::WrongMux { branch: 0 },
+        PinFault::PhaseShift { branch: 0 },
+    ] {
+        let mut dut = FaultyDut::new(&s, ModelDut::new(&s), fault, 9_000);
+        window(&s, &mut dut, 5_317, 17_000, &p);
+        let (r, _) = check(&s, &p).unwrap();
+        assert!(!r.ok, "{fault:?}");
+        let cited = regex_lite_cycles(&r.summary());
+        assert!(!cited.is_empty(), "{}", r.summary());
+        for (at, named) in cited {
+            assert!(
+                named <= at,
+                "{fault:?}: cycle {named} named at cycle {at}: {}",
+                r.summary()
+            );
+        }
+    }
+}
+
+/// (violation cycle, each `cycle N` its detail names) from a summary's
+/// `violation: cycle C (...): ...` lines.
+fn regex_lite_cycles(summary: &str) -> Vec<(u64, u64)> {
+    let mut out = Vec::new();
+    for line in summary.lines() {
+        let Some(rest) = line.strip_prefix("violation: cycle ") else {
+            continue;
+        };
+        let at: u64 = rest.split(' ').next().unwrap().parse().unwrap();
+        let detail = rest.split_once("): ").map_or("", |x| x.1);
+        for part in detail.split("cycle ").skip(1) {
+            let n: String = part.chars().take_while(char::is_ascii_digit).collect();
+            if let Ok(n) = n.parse() {
+                out.push((at, n));
+            }
+        }
+    }
+    out
+}

@@ -67,18 +67,26 @@ pub(super) fn mosi(
         v,
         "  // The word each conversion of branch {b} sends, first bit on top."
     );
-    let _ = writeln!(v, "  reg [{}:0] cw{b};\n  always @* case (slot)", l - 1);
-    for c in &sent {
-        let _ = writeln!(v, "    {sb}'d{}: cw{b} = {l}'b{};", c.slot, bits(&c.word));
+    if super::modes::bits(s) > 0 {
+        mode_words(v, s, b, l);
+    } else {
+        let _ = writeln!(v, "  reg [{}:0] cw{b};\n  always @* case (slot)", l - 1);
+        for c in &sent {
+            let _ = writeln!(v, "    {sb}'d{}: cw{b} = {l}'b{};", c.slot, bits(&c.word));
+        }
+        let _ = writeln!(v, "    default: cw{b} = {l}'d0;\n  endcase");
     }
-    let _ = writeln!(v, "    default: cw{b} = {l}'d0;\n  endcase");
+    let word = match super::modes::bits(s) {
+        0 => format!("cw{b}"),
+        _ => format!("cwe{b}"),
+    };
     let terms: Vec<String> = (0..l as u64)
         .filter(|&k| k < spi.sclks())
         .map(|k| {
             // after the branch's hold-off, if it has one
             let from = spi.holdoff_cycles + spi.setup_cycles + k * spi.sclk_div;
             format!(
-                "(cyc >= {cb}'d{from} && cyc < {cb}'d{} && cw{b}[{}])",
+                "(cyc >= {cb}'d{from} && cyc < {cb}'d{} && {word}[{}])",
                 from + spi.sclk_div,
                 l as u64 - 1 - k
             )
@@ -98,4 +106,66 @@ pub(super) fn mosi(
                outside the word"
             .into(),
     });
+}
+
+/// `cw{b}` in a mix with modes: each mode's words from its own table on
+/// `{mcur, slot}`; a word of a frame's last `ahead` conversions selects
+/// the next frame's conversion `j`, whose input the next frame's mode
+/// (`mnext`, decided at the edge that began this frame) gives.
+fn mode_words(v: &mut String, s: &Schedule, b: usize, l: usize) {
+    let Some(cmd) = &s.mix.branches[b].adc.command else {
+        return;
+    };
+    let ahead = cmd.ahead as usize;
+    let (mb, sb) = (super::modes::bits(s), width(s.grid.frame_slots));
+    let jw = width(ahead.max(1) as u64);
+    let bits = |w: &[bool]| -> String { w.iter().map(|&x| if x { '1' } else { '0' }).collect() };
+    let word = |c: usize| bits(&cmd.word(s.mix.channels[c].input));
+    let _ = writeln!(
+        v,
+        "  reg [{}:0] cw{b}, cf{b};\n  reg cx{b};\n  reg [{}:0] cj{b};\n  always @* begin\n    \
+         cw{b} = {l}'d0; cx{b} = 1'b0; cj{b} = {jw}'d0;\n    case ({{mcur, slot}})",
+        l - 1,
+        jw - 1
+    );
+    let mut first = vec![];
+    for (m, ms) in s.modes.iter().enumerate() {
+        let convs: Vec<(u64, usize)> = (0..s.grid.frame_slots)
+            .filter_map(|u| ms.at(u, b).map(|c| (u, c)))
+            .collect();
+        let n = convs.len();
+        for (k, (u, _)) in convs.iter().enumerate() {
+            let key = format!("{{{mb}'d{m}, {sb}'d{u}}}");
+            let _ = match convs.get(k + ahead) {
+                Some(&(_, c)) => writeln!(v, "      {key}: cw{b} = {l}'b{};", word(c)),
+                None => writeln!(
+                    v,
+                    "      {key}: begin cx{b} = 1'b1; cj{b} = {jw}'d{}; end",
+                    k + ahead - n
+                ),
+            };
+        }
+        first.push(
+            convs
+                .iter()
+                .take(ahead)
+                .map(|&(_, c)| word(c))
+                .collect::<Vec<_>>(),
+        );
+    }
+    let _ = writeln!(
+        v,
+        "      default: ;\n    endcase\n  end\n  // The next frame's conversion j in the next frame's mode.\n  \
+         always @* case ({{mnext, cj{b}}})"
+    );
+    for (m, f) in first.iter().enumerate() {
+        for (j, w) in f.iter().enumerate() {
+            let _ = writeln!(v, "    {{{mb}'d{m}, {jw}'d{j}}}: cf{b} = {l}'b{w};");
+        }
+    }
+    let _ = writeln!(
+        v,
+        "    default: cf{b} = {l}'d0;\n  endcase\n  wire [{}:0] cwe{b} = cx{b} ? cf{b} : cw{b};",
+        l - 1
+    );
 }

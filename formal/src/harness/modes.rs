@@ -84,12 +84,6 @@ pub(super) fn connections(s: &Schedule) -> String {
 pub(super) fn refused(s: &Schedule) -> Option<String> {
     modes(s)?;
     let nb = s.branches.len();
-    if let Some(b) = (0..nb).find(|&b| s.has_command(b)) {
-        return Some(format!(
-            "mix `{}`: branch {} takes a command word, which the formal harness does not follow across mode switches yet",
-            s.mix.name, s.branches[b].name
-        ));
-    }
     if s.grid.frame_slots < 2 {
         return Some(format!(
             "mix `{}`: a mix with modes needs at least 2 slots per frame",

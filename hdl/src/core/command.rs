@@ -8,7 +8,9 @@ use rust_hdl::prelude::*;
 
 use lut_gen::{CmdBit, Command};
 
+use crate::modeplan::{FrontModes, FrontWord};
 use crate::plan::FrontWords;
+use crate::widths::MODE_BITS;
 
 /// One per branch whose converter takes a command word (none in a mix
 /// without one, so the other mixes' Verilog has no trace of it).  Custom
@@ -45,6 +47,11 @@ pub struct CmdUnit {
     /// Channel bit 3 (a 16-channel converter): the branch's device enable 1.
     pub hi: Signal<In, Bit>,
     pub done: Signal<In, Bit>,
+    /// Behind a front mux in a mix with modes: the mode in force and the
+    /// next frame's (the mode block's `mode` and `minfo`), one each; none
+    /// otherwise, so every other unit keeps its ports.
+    pub mode: Vec<Signal<In, Bits<MODE_BITS>>>,
+    pub nxt: Vec<Signal<In, Bits<MODE_BITS>>>,
     pub mosi: Signal<Out, Bit>,
     pub live: Signal<Out, Bit>,
     _bits: Vec<CmdBit>,
@@ -89,6 +96,7 @@ impl CmdUnit {
             branch,
             front,
         } = w;
+        let moded = front.iter().filter(|f| f.modes.is_some());
         CmdUnit {
             clock: Default::default(),
             rst: Default::default(),
@@ -100,6 +108,8 @@ impl CmdUnit {
             sel: Default::default(),
             hi: Default::default(),
             done: Default::default(),
+            mode: moded.clone().map(|_| Default::default()).collect(),
+            nxt: moded.map(|_| Default::default()).collect(),
             mosi: Default::default(),
             live: Default::default(),
             _bits: cmd.bits.clone(),
@@ -121,7 +131,7 @@ impl CmdUnit {
     /// The word for input `sel` (bit 3 from `hi`), bit `k` = the `k`-th bit sent.
     fn word(&self, sel: u64) -> u64 {
         let sel = match &self._front {
-            Some(f) => f.inputs[self._k as usize] as u64,
+            Some(f) => self.front_input(f),
             None => sel | (self.hi.val() as u64) << 3,
         };
         self._bits.iter().enumerate().fold(0, |w, (k, b)| {
@@ -132,6 +142,47 @@ impl CmdUnit {
             };
             w | v << k
         })
+    }
+
+    /// The mode in force and the next frame's (mode mixes only).
+    fn modes_now(&self) -> (usize, usize) {
+        let v = |x: &[Signal<In, Bits<MODE_BITS>>]| x.first().map_or(0, |s| s.val().to_u64());
+        let mb = self
+            ._front
+            .as_ref()
+            .and_then(|f| f.modes.as_ref())
+            .map_or(0, |m| m.mode_bits);
+        let mask = (1u64 << mb) - 1;
+        (
+            (v(&self.mode) & mask) as usize,
+            (v(&self.nxt) & mask) as usize,
+        )
+    }
+
+    /// Conversions in the frame in force (the counter's wrap).
+    fn frame_words(&self, f: &FrontWords) -> u64 {
+        match &f.modes {
+            None => f.inputs.len() as u64,
+            Some(m) => m
+                .words
+                .get(self.modes_now().0)
+                .map_or(0, |w| w.len() as u64),
+        }
+    }
+
+    /// The input the word of the frame's conversion `_k` selects: in its
+    /// own frame, or the next frame's (the next mode's) conversion `j`.
+    fn front_input(&self, f: &FrontWords) -> u64 {
+        let Some(m) = &f.modes else {
+            return f.inputs[self._k as usize] as u64;
+        };
+        let (cur, nxt) = self.modes_now();
+        let i = match m.words.get(cur).and_then(|w| w.get(self._k as usize)) {
+            Some(FrontWord::Here(i)) => Some(*i),
+            Some(FrontWord::Next(j)) => m.first.get(nxt).and_then(|f| f.get(*j as usize)).copied(),
+            None => None,
+        };
+        i.unwrap_or(0) as u64
     }
 
     /// Whether the next cycle begins an SCLK period of a conversion.  Read
@@ -195,7 +246,7 @@ impl Logic for CmdUnit {
                 if self.rst.val() {
                     self._k = f.first as u64;
                 } else if self.start0.val() && self.pin.val() == self._cnv {
-                    self._k = (self._k + 1) % f.inputs.len() as u64;
+                    self._k = (self._k + 1) % self.frame_words(f).max(1);
                 }
             }
             if self.rst.val() {
@@ -305,17 +356,24 @@ impl CmdUnit {
         let Some(f) = &self._front else {
             return false;
         };
-        let n = f.inputs.len() as u64;
-        let kw = (64 - (n - 1).leading_zeros()).max(1) as usize;
+        let n = match &f.modes {
+            Some(m) => m.words.iter().map(Vec::len).max().unwrap_or(1) as u64,
+            None => f.inputs.len() as u64,
+        };
+        let kw = (64 - (n.max(1) - 1).leading_zeros()).max(1) as usize;
         let cw = self._bits.iter().filter_map(|b| match b {
             CmdBit::Channel(j) => Some(*j as usize + 1),
             _ => None,
         });
         let cw = cw.max().unwrap_or(1);
         let act = if self._cnv { "pin" } else { "~pin" };
+        let words = match f.modes {
+            Some(_) => "the word of each conversion of the frame in force".to_string(),
+            None => format!("each of the frame's {n} words"),
+        };
         let _ = writeln!(
             s,
-            "// behind a front mux (its pins on sel/hi): the input each of the frame's {n} words selects, by conversion
+            "// behind a front mux (its pins on sel/hi): the input {words} selects, by conversion
 wire unused_sel = |{{sel, hi}};"
         );
         let _ = writeln!(
@@ -327,12 +385,19 @@ initial k = {kw}'d{};",
         );
         let _ = writeln!(s, "always @(posedge clock) begin");
         let _ = writeln!(s, "  if (rst) k <= {kw}'d{};", f.first);
+        let last = match f.modes {
+            Some(_) => "kl".to_string(),
+            None => format!("{kw}'d{}", n - 1),
+        };
         let _ = writeln!(
             s,
-            "  else if (start0 & {act}) k <= (k == {kw}'d{}) ? {kw}'d0 : k + {kw}'d1;",
-            n - 1
+            "  else if (start0 & {act}) k <= (k == {last}) ? {kw}'d0 : k + {kw}'d1;"
         );
         let _ = writeln!(s, "end");
+        if let Some(m) = &f.modes {
+            front_modes_table(s, m, kw, cw);
+            return true;
+        }
         let _ = writeln!(
             s,
             "reg [{}:0] chn;
@@ -414,4 +479,97 @@ end"
             format!("prep == {}'h0", self.prep_bits())
         }
     }
+}
+
+/// A fronted unit's words in a mix with modes: the frame's last conversion
+/// in the mode in force (`kl`, the counter's wrap) and the input each word
+/// selects (`chn`): one of its own frame's conversions (`hchn`), or the
+/// next frame's conversion `j` in the next frame's mode (`fchn`, decided
+/// at the edge that began this frame).
+fn front_modes_table(s: &mut String, m: &FrontModes, kw: usize, cw: usize) {
+    let mb = m.mode_bits;
+    let ahead = m.first.iter().map(Vec::len).max().unwrap_or(1).max(1) as u64;
+    let jw = (64 - (ahead - 1).leading_zeros()).max(1) as usize;
+    let _ = writeln!(
+        s,
+        "// the mode in force and the next frame's
+wire [{}:0] cur = mode$0[{0}:0];
+wire [{0}:0] nxm = nxt$0[{0}:0];",
+        mb - 1
+    );
+    if mb < MODE_BITS {
+        let _ = writeln!(
+            s,
+            "wire unused_modes = |{{mode$0[{}:{mb}], nxt$0[{0}:{mb}]}};",
+            MODE_BITS - 1
+        );
+    }
+    let _ = writeln!(
+        s,
+        "reg [{}:0] kl;
+always @(*) begin
+  case (cur)",
+        kw - 1
+    );
+    for (i, w) in m.words.iter().enumerate() {
+        let _ = writeln!(s, "    {mb}'d{i}: kl = {kw}'d{};", w.len().max(1) - 1);
+    }
+    let _ = writeln!(
+        s,
+        "    default: kl = {kw}'d0;
+  endcase
+end"
+    );
+    let _ = writeln!(
+        s,
+        "reg nx;
+reg [{}:0] j;
+reg [{}:0] hchn;
+always @(*) begin
+  nx = 1'b0;
+  j = {jw}'d0;
+  hchn = {cw}'d0;
+  case ({{cur, k}})",
+        jw - 1,
+        cw - 1
+    );
+    let kb = mb + kw;
+    for (i, w) in m.words.iter().enumerate() {
+        for (k, x) in w.iter().enumerate() {
+            let key = (i << kw) | k;
+            let _ = match x {
+                FrontWord::Here(v) => writeln!(s, "    {kb}'d{key}: hchn = {cw}'d{v};"),
+                FrontWord::Next(v) => {
+                    writeln!(s, "    {kb}'d{key}: begin nx = 1'b1; j = {jw}'d{v}; end")
+                }
+            };
+        }
+    }
+    let _ = writeln!(
+        s,
+        "    default: ;
+  endcase
+end"
+    );
+    let _ = writeln!(
+        s,
+        "reg [{}:0] fchn;
+always @(*) begin
+  case ({{nxm, j}})",
+        cw - 1
+    );
+    let fb = mb + jw;
+    for (i, f) in m.first.iter().enumerate() {
+        for (j, v) in f.iter().enumerate() {
+            let _ = writeln!(s, "    {fb}'d{}: fchn = {cw}'d{v};", (i << jw) | j);
+        }
+    }
+    let _ = writeln!(
+        s,
+        "    default: fchn = {cw}'d0;
+  endcase
+end
+wire [{}:0] chn = nx ? fchn : hchn;",
+        cw - 1
+    );
 }

@@ -12,14 +12,16 @@ pub(super) enum LaneForm<'a> {
 
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
 /// `wires`: per sequencer, its CNV pulse if its part is read with CNV low
-/// and its hold-off if its transactions start after the slot tick. `modes`: a mix with modes (pin select, the branches whose words the
-/// mode block reads).
+/// and its hold-off if its transactions start after the slot tick. `modes`:
+/// a mix with modes (pin select, the branches whose words the mode block
+/// reads). `cmds`: each branch's command unit, and per unit whether it reads
+/// the modes (behind a front mux in a mix with modes).
 pub(super) fn core_glue(
     nb: usize,
     devices: &[usize],
     seq_of: &[usize],
     wires: SeqWires,
-    cmd_of: &[Option<usize>],
+    (cmd_of, moded): (&[Option<usize>], &[bool]),
     modes: Option<(bool, usize)>,
     lanes_form: LaneForm,
 ) -> String {
@@ -35,7 +37,7 @@ pub(super) fn core_glue(
         mode_inputs(&mut s, nb, pin, lanes, cmd_of);
     }
     let act_read = queue_inputs(&mut s, nb, queue, step);
-    command_units(&mut s, seq_of, &wires, cmd_of);
+    command_units(&mut s, seq_of, &wires, (cmd_of, moded));
     lanes(&mut s, nb, devices, cmd_of);
     s.push_str(
         "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
@@ -248,7 +250,12 @@ fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], w: &SeqWires, timeb
 
 /// Each command unit's inputs (its branch's pins, its sequencer's levels,
 /// the slot start) and the `adc_mosi` lanes (absent without a unit).
-fn command_units(s: &mut String, seq_of: &[usize], w: &SeqWires, cmd_of: &[Option<usize>]) {
+fn command_units(
+    s: &mut String,
+    seq_of: &[usize],
+    w: &SeqWires,
+    (cmd_of, moded): (&[Option<usize>], &[bool]),
+) {
     let mut lanes = vec![];
     for (b, i) in cmd_of.iter().enumerate() {
         let Some(i) = i else { continue };
@@ -259,6 +266,13 @@ fn command_units(s: &mut String, seq_of: &[usize], w: &SeqWires, cmd_of: &[Optio
             w.level(q, "sclk"),
             w.level(q, "done")
         ));
+        if moded[*i] {
+            // the mode in force, and the next frame's (minfo's low bits)
+            s.push_str(&format!(
+                "  {c}$mode$0 = modes$0$mode;\n  {c}$nxt$0 = modes$0$minfo[{}:0];\n",
+                MODE_BITS - 1
+            ));
+        }
         lanes.insert(0, format!("{c}$mosi"));
     }
     if !lanes.is_empty() {

@@ -280,7 +280,13 @@ fn feed_cmd(
     u: &BranchUnit,
     (clk, rst, start0): (Clock, bool, bool),
     (q_sclk, q_done): (bool, bool),
+    modes: Option<(Bits<MODE_BITS>, Bits<SLICE_BITS>)>,
 ) {
+    if let (Some(m), Some((mode, info))) = (q.mode.first_mut(), modes) {
+        m.next = mode;
+        // `minfo`'s low bits: the next frame's mode (the unit masks them)
+        q.nxt[0].next = (info.to_u64() & ((1 << MODE_BITS) - 1)).into();
+    }
     q.clock.next = clk;
     q.rst.next = rst;
     q.start0.next = start0;
@@ -305,6 +311,7 @@ impl Logic for Core {
         let start1 = self.timing.start1.val();
         let start0 = self.timing.start0.val();
         let (addr, slice) = self.mode_block_inputs(clk, rst);
+        let modes = self.modes.first().map(|g| (g.mode.val(), g.minfo.val()));
         let mut seq = [(false, false, false, false); MAX_BRANCHES];
         // each sequencer's start, and the slot start its branches see
         let mut starts = [(start, start0); MAX_BRANCHES];
@@ -375,7 +382,7 @@ impl Logic for Core {
             let mut live = true;
             if let Some(i) = self._cmd_of[b] {
                 let q = &mut self.cmds[i];
-                feed_cmd(q, u, (clk, rst, start0), (q_sclk, q_done));
+                feed_cmd(q, u, (clk, rst, start0), (q_sclk, q_done), modes);
                 live = q.live.val();
                 mosi |= (q.mosi.val() as u64) << i;
             }
@@ -494,6 +501,8 @@ impl Logic for Core {
             q.sel.connect();
             q.hi.connect();
             q.done.connect();
+            q.mode.iter_mut().for_each(|s| s.connect());
+            q.nxt.iter_mut().for_each(|s| s.connect());
         }
         for m in self.adc_mosi.iter_mut() {
             m.connect();
@@ -539,7 +548,14 @@ impl Logic for Core {
                 pulse_of: &self._pulse_of,
                 hold_of: &self._hold_of,
             },
-            &self._cmd_of,
+            (
+                &self._cmd_of,
+                &self
+                    .cmds
+                    .iter()
+                    .map(|q| !q.mode.is_empty())
+                    .collect::<Vec<_>>(),
+            ),
             self.modes
                 .first()
                 .map(|g| (!self.mode_sel.is_empty(), g.ch.len())),

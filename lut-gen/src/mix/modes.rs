@@ -290,9 +290,9 @@ impl Cx<'_> {
     /// the AD7689's 2) sends, in a frame's last conversions, the words of
     /// the next frame's first ones: the next frame's mode is decided while
     /// this one runs, the one after it is not.  So every mode converts such
-    /// a branch at least `ahead` times per frame.  A converter behind a
-    /// front mux takes its words from one frame's table, so it has one
-    /// table in a mix with modes: refused there.
+    /// a branch at least `ahead` times per frame.  Behind a front mux the
+    /// same holds: the front pins follow each mode's table, the words each
+    /// mode's conversions, and a frame's last words the next frame's mode.
     pub(super) fn check_mode_commands(
         &self,
         raw: &RawMix,
@@ -313,12 +313,6 @@ impl Cx<'_> {
             }
             let Some(cmd) = &br.adc.command else { continue };
             let span = raw.branch[b].get_ref().adc.span();
-            if br.fronted {
-                return Err(self.at(span, format!("branch[{b}].front_mux"), format!(
-                    "branch `{}`: a converter with a command word behind a front mux is not supported in a mix with modes (its words come from one frame's table); drop the front mux or the [[mode]] tables",
-                    br.name
-                )));
-            }
             let ahead = cmd.ahead as u64;
             for (m, name) in names.iter().enumerate() {
                 let per_frame: u64 = (channels.iter().filter(|c| c.branch == b && c.member == 0))

@@ -1069,7 +1069,7 @@ impl Checker {
                     .expected(json!(settle_min))
                     .actual(json!(c - since))
                     .channel(ch.and_then(|ch| self.names.get(ch as usize).cloned()))
-                    .detail(format!("mux switched in cycle {since}, {} cycles before the sampling instant; settling needs {}", c - since, settle_min)),
+                    .detail(format!("mux switched in cycle {}, {} cycles before the sampling instant; settling needs {}", self.inv.place(since).0, c - since, settle_min)),
             );
         }
     }
@@ -1175,7 +1175,7 @@ impl Checker {
                     .expected(json!(n))
                     .actual(json!(st.falls))
                     .channel(chname.clone())
-                    .detail(format!("{} SCLK falling and {} rising edges in the conversion window from cycle {}, expected {n}", st.falls, st.rises, st.t)),
+                    .detail(format!("{} SCLK falling and {} rising edges in the conversion window from cycle {}, expected {n}", st.falls, st.rises, self.inv.place(st.t).0)),
             );
         }
         if p.sclk >> b & 1 == 0 {

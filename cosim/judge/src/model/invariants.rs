@@ -30,7 +30,12 @@ impl Recorder {
     /// (cycle, frame, slot) of model cycle `c` as a report gives them.
     pub(crate) fn place(&self, c: u64) -> (u64, u64, u64) {
         let (frame, slot, _) = self.grid.locate(c);
-        (c - self.shift, frame - self.frame_base, slot)
+        (self.cycle(c), frame - self.frame_base, slot)
+    }
+
+    /// Capture cycle of model cycle `c`: every cycle a message names.
+    pub(crate) fn cycle(&self, c: u64) -> u64 {
+        c - self.shift
     }
 
     /// Counts `v` (built at a model cycle) and lists it while the list has room.
@@ -317,7 +322,7 @@ impl Invariants {
                         .expected(json!(self.interval[ch]))
                         .actual(json!(d))
                         .channel(name.clone())
-                        .detail(format!("{name} sampled {d} cycles after its previous instant (cycle {}), expected {}", self.last[ch], self.interval[ch])),
+                        .detail(format!("{name} sampled {d} cycles after its previous instant (cycle {}), expected {}", self.rec.cycle(self.last[ch]), self.interval[ch])),
                 );
             }
         }
@@ -340,7 +345,7 @@ impl Invariants {
                     .channel(self.name(p.channel))
                     .detail(format!(
                         "conversion of branch {} sampled at cycle {} completed at cycle {} but was never emitted",
-                        self.branch_names[p.branch], p.instant, p.complete
+                        self.branch_names[p.branch], self.rec.cycle(p.instant), self.rec.cycle(p.complete)
                     )),
             );
         }
@@ -423,8 +428,9 @@ impl Invariants {
                     .signal(Role::SampleValid.name().to_string())
                     .channel(self.name(p.channel))
                     .detail(format!(
-                        "sample emitted in cycle {c}, before its conversion completed (cycle {})",
-                        p.complete
+                        "sample emitted in cycle {}, before its conversion completed (cycle {})",
+                        self.rec.cycle(c),
+                        self.rec.cycle(p.complete)
                     )),
             );
         }
@@ -442,9 +448,10 @@ impl Invariants {
                         .actual(json!(channel))
                         .channel(self.name(Some(ch)))
                         .detail(format!(
-                            "{} {channel} but the command word sent in the conversion at cycle {at} selected {ch} ({name}) for the conversion sampled at cycle {}",
+                            "{} {channel} but the command word sent in the conversion at cycle {} selected {ch} ({name}) for the conversion sampled at cycle {}",
                             Role::SampleChannel.name(),
-                            p.instant
+                            self.rec.cycle(at),
+                            self.rec.cycle(p.instant)
                         )),
                 );
             }
@@ -461,7 +468,7 @@ impl Invariants {
                             Role::SampleChannel.name(),
                             ch,
                             self.names.get(ch as usize).map(String::as_str).unwrap_or("?"),
-                            p.instant
+                            self.rec.cycle(p.instant)
                         )),
                 );
             }
@@ -474,7 +481,7 @@ impl Invariants {
                         .expected(json!(code))
                         .actual(json!(value))
                         .channel(self.name(p.channel))
-                        .detail(format!("{} {value:#06x} but MISO carried {code:#06x} (conversion sampled at cycle {})", Role::SampleValue.name(), p.instant)),
+                        .detail(format!("{} {value:#06x} but MISO carried {code:#06x} (conversion sampled at cycle {})", Role::SampleValue.name(), self.rec.cycle(p.instant))),
                 );
             }
         }

@@ -85,7 +85,7 @@ impl ModeCheck {
                         .expected(json!(want))
                         .actual(json!(mode))
                         .detail(format!(
-                            "frame {f} runs mode {}, but {why} decide mode {}",
+                            "this frame runs mode {}, but {why} decide mode {}",
                             self.name(mode as usize),
                             self.name(want)
                         )),
@@ -98,7 +98,7 @@ impl ModeCheck {
                     .expected(json!(prev))
                     .actual(json!(mode))
                     .detail(format!(
-                        "mode changed from {} to {} inside frame {f} (a switch takes effect at a frame start only)",
+                        "mode changed from {} to {} inside the frame (a switch takes effect at a frame start only)",
                         self.name(prev as usize),
                         self.name(mode as usize)
                     )),
