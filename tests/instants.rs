@@ -2,12 +2,15 @@
 //! waveform: an AD7940 at its CS fall, an MCP3208 at the falling SCLK edge
 //! after the 6th rising one since its CS fell.  `sampled_s` of `sim
 //! --samples` is that instant for every sample of either part; a sync
-//! group holds at those instants, or the mix is refused naming the parts.
+//! group holds at one instant (the earlier part's transaction held off by
+//! the difference) on Verilator and Icarus alike, or the mix is refused
+//! naming the parts.
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
 use crate::common_cli::{refused, root, slotforge};
+use crate::tools;
 
 /// A waveform's top-level signals: name -> (time in ps, value) changes.
 type Wave = BTreeMap<String, Vec<(u64, u128)>>;
@@ -33,7 +36,9 @@ fn changes(vcd: &str) -> Wave {
             Some("$var") if depth == 1 => _ = names.insert(w[3].into(), w[4].into()),
             Some(x) if x.starts_with('#') => t = x[1..].parse().unwrap(),
             Some(x) if x.starts_with('b') => {
-                put(w[1], u128::from_str_radix(&x[1..], 2).unwrap(), t, &names)
+                // Icarus shows an undriven (x, z) bit: read as 0, no port measured here is one
+                let bits = x[1..].replace(['x', 'z', 'X', 'Z'], "0");
+                put(w[1], u128::from_str_radix(&bits, 2).unwrap(), t, &names)
             }
             Some(x) if x.starts_with(['0', '1']) => {
                 put(&x[1..], (x.as_bytes()[0] - b'0') as u128, t, &names)
@@ -103,13 +108,18 @@ fn held(w: &Wave, b: usize, after: Option<usize>, cnv: bool) -> Vec<u64> {
 /// `sim --backend rusthdl --vcd --samples` of `mix` for `frames`: the
 /// waveform's changes and the samples CSV's (channel, sampled_s in ps).
 fn run(mix: &Path, frames: u64, dir: &Path) -> (Wave, Vec<(String, u64)>) {
+    run_on(mix, frames, dir, "rusthdl")
+}
+
+/// [`run`] on `backend`; the waveform is left in `dir/run.vcd`.
+fn run_on(mix: &Path, frames: u64, dir: &Path, backend: &str) -> (Wave, Vec<(String, u64)>) {
     let (vcd, csv) = (dir.join("run.vcd"), dir.join("s.csv"));
     slotforge()
         .arg("sim")
         .arg(mix)
         .args([
             "--backend",
-            "rusthdl",
+            backend,
             "--frames",
             &frames.to_string(),
             "--stimulus",
@@ -180,36 +190,112 @@ fn each_part_is_sampled_at_its_own_instant_on_the_waveform() {
     agree(&samples, &["E0", "E3"], &ad);
 }
 
-#[test]
-fn a_sync_group_holds_at_the_parts_instants_or_is_refused_naming_them() {
-    let dir = tempfile::tempdir().unwrap();
+/// cmd-mcp3208 with M2 (its MCP3208) and E0 (on branch `ext`) in one sync
+/// group, 2 kHz each.
+fn grouped() -> String {
     let text = std::fs::read_to_string(root().join("testkit/mixes/cmd-mcp3208.toml")).unwrap();
-    // M2 (MCP3208) and E0 (AD7940), both 2 kHz, in one group: 6.1 us apart
-    let apart = text
-        .replace(
-            "rate_hz = 2_000\ninput = 2\n",
-            "rate_hz = 2_000\ninput = 2\nsync = \"s\"\n",
-        )
-        .replace(
-            "rate_hz = 2_000\ninput = 0\n",
-            "rate_hz = 2_000\ninput = 0\nsync = \"s\"\n",
-        );
-    let m = dir.path().join("apart.toml");
-    std::fs::write(&m, &apart).unwrap();
+    text.replace(
+        "rate_hz = 2_000\ninput = 2\n",
+        "rate_hz = 2_000\ninput = 2\nsync = \"s\"\n",
+    )
+    .replace(
+        "rate_hz = 2_000\ninput = 0\n",
+        "rate_hz = 2_000\ninput = 0\nsync = \"s\"\n",
+    )
+}
+
+/// The AD7940 behind its mux, or an AD7689 choosing its own input (a CNV
+/// part, sampling at CNV rising), on branch `ext`.
+const EXT: [(&str, &str, bool); 2] = [
+    (
+        "ad7940",
+        "adc = \"ad7940\"\nmux = \"tmux1108\"\nsettle_ns = 1_000",
+        false,
+    ),
+    ("ad7689", "adc = \"ad7689\"\nmux = \"internal\"", true),
+];
+
+/// A sync group of an MCP3208 (holding 6.1 us into its transaction) and an
+/// AD7940 or AD7689 (holding at its start edge): on the VCD of Verilator
+/// and of Icarus, every sample of the group is where both parts hold their
+/// inputs, within 1 us (the other part's transaction starts 6.1 us after the
+/// slot tick, so it is); and `check` passes the run with and without the model.
+#[test]
+fn a_sync_group_holds_at_one_instant_on_verilator_and_icarus() {
+    if !tools::require_tool("verilator") || !tools::require_tool("iverilog") {
+        return;
+    }
+    const US: u64 = 1_000_000; // ps
+    for (part, ext, cnv) in EXT {
+        let dir = tempfile::tempdir().unwrap();
+        let text = grouped().replace(EXT[0].1, ext);
+        let m = dir.path().join(format!("{part}.toml"));
+        std::fs::write(&m, &text).unwrap();
+        for backend in ["verilator", "icarus"] {
+            let (w, samples) = run_on(&m, 2, dir.path(), backend);
+            let (mcp, other) = (measured(&w, 0, Some(6)), held(&w, 1, None, cnv));
+            let sampled = |name: &str| -> Vec<u64> {
+                samples
+                    .iter()
+                    .filter(|s| s.0 == name)
+                    .map(|s| s.1)
+                    .collect()
+            };
+            let (m2, e0) = (sampled("M2"), sampled("E0"));
+            // an AD7689's first conversions after reset are prepared (no sample)
+            assert!(e0.len() >= 2, "{part} on {backend}: {e0:?}");
+            assert!(
+                m2.ends_with(&e0),
+                "{part} on {backend}: one instant per group sample: {m2:?} {e0:?}"
+            );
+            for t in &e0 {
+                let near = |x: &[u64], by: u64| x.iter().any(|i| i.abs_diff(*t) <= by);
+                assert!(
+                    near(&mcp, 1),
+                    "{part} on {backend}: {t} is no MCP3208 instant"
+                );
+                assert!(
+                    near(&other, US),
+                    "{part} on {backend}: the {part} holds no input within 1 us of {t}: {other:?}"
+                );
+            }
+            let vcd = dir.path().join("run.vcd");
+            for extra in [None, Some("--no-model")] {
+                slotforge()
+                    .arg("check")
+                    .arg(&m)
+                    .arg(&vcd)
+                    .args(extra)
+                    .assert()
+                    .success();
+            }
+        }
+    }
+}
+
+/// A hold-off that no longer fits a slice is refused naming the group and
+/// the parts; two MCP3208s at one SCLK need none.
+#[test]
+fn a_sync_group_that_cannot_hold_off_is_refused_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    // a slow AD7940 fits a 50 us slice, not after a 6.1 us hold-off
+    let slow = grouped()
+        .replace("slice_us = 500", "slice_us = 50")
+        .replace("settle_ns = 1_000", "settle_ns = 1_000\nsclk_hz = 330_000");
+    let m = dir.path().join("slow.toml");
+    std::fs::write(&m, &slow).unwrap();
     refused(
         &[&"audit", &m],
         &[
-            "sync group `s` cannot sample at one instant",
+            "sync group `s` cannot hold at one instant",
             "mcp3208",
             "ad7940",
-            "6.104 us apart",
+            "6.104 us after the slot tick",
+            "longer than a slice",
         ],
     );
-    // the same group with the AD7940 replaced by a second MCP3208: one instant
-    let both = apart.replace(
-        "adc = \"ad7940\"\nmux = \"tmux1108\"\nsettle_ns = 1_000",
-        "adc = \"mcp3208\"\nmux = \"internal\"",
-    );
+    // the group with the AD7940 replaced by a second MCP3208: one instant
+    let both = grouped().replace(EXT[0].1, "adc = \"mcp3208\"\nmux = \"internal\"");
     let m = dir.path().join("both.toml");
     std::fs::write(&m, &both).unwrap();
     let (w, samples) = run(&m, 1, dir.path());
@@ -383,4 +469,72 @@ fn decode_gives_each_part_its_instant() {
         }
     }
     assert!(mcp > 5);
+}
+
+/// The emitted Verilog of the MCP3208 + AD7940 group with the hold-off
+/// removed (the AD7940's sequencer and mux load at the slot tick again):
+/// its run fails `check`, with and without the model, where the emitted
+/// gateware's passes (above).
+#[test]
+fn a_verilog_mutant_without_the_hold_off_fails_check() {
+    if !tools::require_tool("verilator") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let m = dir.path().join("g.toml");
+    std::fs::write(&m, grouped()).unwrap();
+    let out = dir.path().join("v");
+    slotforge()
+        .arg("verilog")
+        .arg(&m)
+        .arg("-o")
+        .arg(&out)
+        .assert()
+        .success();
+    let v = std::fs::read_to_string(out.join("slotforge_top.v")).unwrap();
+    let cut = [
+        (
+            "spi_seq1_start2 = hold_off0_fire2;",
+            "spi_seq1_start2 = timing_start2;",
+        ),
+        (
+            "branch1_start0 = hold_off0_start0;",
+            "branch1_start0 = timing_start0;",
+        ),
+    ];
+    let mut mutant = v.clone();
+    for (from, to) in cut {
+        assert!(mutant.contains(from), "no `{from}` in the emitted Verilog");
+        mutant = mutant.replace(from, to);
+    }
+    let rtl = dir.path().join("mutant.v");
+    std::fs::write(&rtl, mutant).unwrap();
+    let vcd = dir.path().join("mutant.vcd");
+    slotforge()
+        .arg("sim")
+        .arg(&m)
+        .arg("--rtl")
+        .arg(&rtl)
+        .args([
+            "--backend",
+            "verilator",
+            "--frames",
+            "1",
+            "--quiet",
+            "--vcd",
+        ])
+        .arg(&vcd)
+        .assert()
+        .code(1);
+    for extra in [None, Some("--no-model")] {
+        let o = slotforge()
+            .arg("check")
+            .arg(&m)
+            .arg(&vcd)
+            .args(extra)
+            .assert()
+            .code(1);
+        let text = String::from_utf8_lossy(&o.get_output().stdout).to_string();
+        assert!(text.contains("FAIL"), "{extra:?}: {text}");
+    }
 }

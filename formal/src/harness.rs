@@ -226,13 +226,21 @@ pub fn generate_parts(
             s.mix.name, g.frame_slots
         )));
     }
+    if let Some(b) = (0..nb).find(|&b| modes::bits(s) > 0 && s.holdoff(b) > 0 && layout.muxed[b]) {
+        return Err(HarnessError(format!(
+            "branch {}: a mux that switches after a hold-off in a mix with modes is beyond the formal harness (its mode rows assume the switch at the slot tick)",
+            s.branches[b].name
+        )));
+    }
     let total_words: u64 = (0..nb).map(|b| u64::from(s.branches[b].spi.words)).sum();
     for (b, p) in s.branches.iter().enumerate() {
         let spi = &p.spi;
-        if spi.read_cycles >= g.slot_cycles {
+        if spi.tick_to_complete() >= g.slot_cycles {
             return Err(HarnessError(format!(
                 "branch {}: a conversion of {} cycles does not end within its slot of {}",
-                p.name, spi.read_cycles, g.slot_cycles
+                p.name,
+                spi.tick_to_complete(),
+                g.slot_cycles
             )));
         }
         // The harness reads a finished conversion's words from its capture
@@ -490,13 +498,18 @@ fn branch_conversion(v: &mut String, s: &Schedule, layout: &Layout, b: usize) {
     let (cb, sb) = (width(s.grid.slot_cycles), width(s.grid.frame_slots));
     let chb = layout.channel_bits;
     let row = RowFields::new(chb, row_en(layout, b));
-    let r = s.branches[b].spi.read_cycles;
+    // the conversion's window: its hold-off after the slot tick, then the read
+    let (h, r) = (s.holdoff(b), s.branches[b].spi.tick_to_complete());
     let skip = s.skipped_at_startup(b, 0);
+    let from = match h {
+        0 => String::new(),
+        _ => format!("cyc >= {cb}'d{h} && "),
+    };
     let _ = writeln!(
         v,
         "  wire act{b} = tab{b}[{}];\n  wire [{}:0] lead{b} = tab{b}[{}:{}];\n  \
          // Instants at cycle 0 whose mux cannot have settled are skipped (Start-up).\n  \
-         wire conv{b} = run && act{b}{};\n  wire busy{b} = conv{b} && cyc < {cb}'d{r};",
+         wire conv{b} = run && act{b}{};\n  wire busy{b} = conv{b} && {from}cyc < {cb}'d{r};",
         row.act,
         chb - 1,
         row.act - 1,
@@ -521,7 +534,12 @@ struct SclkPhases {
 }
 
 fn sclk_phases(spi: &SpiTiming, cb: u32) -> SclkPhases {
-    let (su, d, h) = (spi.setup_cycles, spi.sclk_div, spi.sclk_half);
+    // counted from the slot tick: the hold-off, then the setup
+    let (su, d, h) = (
+        spi.holdoff_cycles + spi.setup_cycles,
+        spi.sclk_div,
+        spi.sclk_half,
+    );
     let n = spi.sclks();
     let caps = if spi.style == Start::Cnv { n } else { n - 1 };
     let mut low = Vec::new();
@@ -549,7 +567,8 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
     let cb = width(s.grid.slot_cycles);
     let en_n = row_en(layout, b);
     let row = RowFields::new(layout.channel_bits, en_n);
-    let (r, n) = (spi.read_cycles, spi.sclks());
+    let (r, n) = (spi.tick_to_complete(), spi.sclks());
+    let hold = spi.holdoff_cycles;
     let SclkPhases {
         low,
         high,
@@ -559,7 +578,13 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
         (
             // read with CNV low: CNV is high for the conversion alone
             if spi.pin_cycles < spi.read_cycles {
-                format!("conv{b} && cyc < {cb}'d{}", spi.pin_cycles)
+                match hold {
+                    0 => format!("conv{b} && cyc < {cb}'d{}", spi.pin_cycles),
+                    _ => format!(
+                        "conv{b} && cyc >= {cb}'d{hold} && cyc < {cb}'d{}",
+                        hold + spi.pin_cycles
+                    ),
+                }
             } else {
                 format!("busy{b}")
             },
@@ -603,10 +628,15 @@ fn branch_expectations(v: &mut String, s: &Schedule, layout: &Layout, b: usize) 
             en_n + 2
         );
     } else {
+        // the mux holds this slot's instant until the conversion starts
+        let held = match hold {
+            0 => format!("cyc == {cb}'d0"),
+            _ => format!("cyc <= {cb}'d{hold}"),
+        };
         let _ = writeln!(
             v,
-            "  wire [{}:0] exp_en{b} = cyc == {cb}'d0 ? tab{b}[{}:{}] : tab{b}[{}:{}];\n  \
-             wire [2:0] exp_sel{b} = cyc == {cb}'d0 ? tab{b}[{}:{lo0}] : tab{b}[{}:{lo1}];",
+            "  wire [{}:0] exp_en{b} = {held} ? tab{b}[{}:{}] : tab{b}[{}:{}];\n  \
+             wire [2:0] exp_sel{b} = {held} ? tab{b}[{}:{lo0}] : tab{b}[{}:{lo1}];",
             en_n - 1,
             e0.0,
             e0.1,

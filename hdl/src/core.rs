@@ -13,6 +13,7 @@
 //!  |    `- DFFs           "converts this slot" flag, CS/SCLK outputs gated by it,
 //!  |                      MISO shift register, channel, mux control
 //!  |- pulses: Vec<CnvPulse> one per sequencer whose part is read with CNV low
+//!  |- holds: Vec<HoldOff> one per sequencer whose transactions start after the slot tick
 //!  |- cmds: Vec<CmdUnit>  one per branch with a command word: adc_mosi, prepared conversions
 //!  `- merge: Merger       pending set + lowest-branch-first sample stream (Verilog over the mix's lanes)
 //! ```
@@ -23,6 +24,7 @@
 mod branch;
 mod command;
 mod glue;
+mod holdoff;
 mod merger;
 mod modes;
 mod pulse;
@@ -38,6 +40,7 @@ use rust_hdl::prelude::*;
 
 use branch::BranchUnit;
 use command::CmdUnit;
+use holdoff::HoldOff;
 use merger::Merger;
 use modes::ModeGen;
 use pulse::CnvPulse;

@@ -74,6 +74,10 @@ fn parts(path: &str) -> Vec<String> {
                 out.push(format!("cnv_pulse{i}"));
                 k += 2;
             }
+            ("holds", Some(i)) => {
+                out.push(format!("hold_off{i}"));
+                k += 2;
+            }
             // the core's `adc_mosi` is a `Vec` of one signal (none in a mix
             // without a command word): the port reads as the contract's
             ("adc_mosi", Some(_)) if raw.len() == 2 => {

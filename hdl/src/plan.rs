@@ -50,6 +50,9 @@ pub struct SeqTiming {
     pub word_sclks: u64,
     pub leading_bits: u64,
     pub bits: u64,
+    /// Cycles from the slot tick to the transaction's start (0, or at
+    /// least 2: a sync group's hold-off, `SpiTiming::holdoff_cycles`).
+    pub holdoff: u64,
 }
 
 impl SeqTiming {
@@ -585,7 +588,14 @@ fn branch_rom(
         word_sclks: adc.word_sclks() as u64,
         leading_bits: adc.leading_bits as u64,
         bits: adc.bits as u64,
+        holdoff: spi.holdoff_cycles,
     };
+    if timing.holdoff == 1 {
+        return Err(unsupported(format!(
+            "branch {}: a hold-off of one cycle (the gateware delays a transaction by 2 cycles or more)",
+            bp.name
+        )));
+    }
     let seq = match seqs.iter().position(|t| *t == timing) {
         Some(i) => i,
         None => {
@@ -621,7 +631,8 @@ fn branch_rom(
         // docs/timing.md, "Start-up": the mux takes its reset value at
         // the first reset edge, one cycle before cycle 0 at the least;
         // an instant at cycle 0 it cannot have settled for is skipped.
-        conv0: slots[0].is_some() && bp.settle_cycles <= 1,
+        // docs/timing.md "Start-up": skipped unless the mux has settled by the start
+        conv0: slots[0].is_some() && !s.skipped_at_startup(b, 0),
         devices,
         muxed: s.mix.branches[b].mux.select_bits > 0,
         en_offset,

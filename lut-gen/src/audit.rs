@@ -109,6 +109,21 @@ pub struct PartAudit {
     pub sample_at: crate::parts::SampleAt,
     pub sample_after_cycles: u64,
     pub sample_after_ns: f64,
+    /// The branch's hold-off: cycles (and ns) from the slot tick to its
+    /// transaction's start, for a sync group whose other parts hold their
+    /// inputs later in theirs (absent when 0). `sampled_s` adds it too.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub holdoff_cycles: u64,
+    #[serde(skip_serializing_if = "is_zero_f")]
+    pub holdoff_ns: f64,
+}
+
+fn is_zero(v: &u64) -> bool {
+    *v == 0
+}
+
+fn is_zero_f(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl PartAudit {
@@ -139,6 +154,8 @@ impl PartAudit {
             sample_at: a.sample,
             sample_after_cycles: spi.map_or(0, |t| t.sample_cycles),
             sample_after_ns: cycles_to_ns(spi.map_or(0, |t| t.sample_cycles), mix.clock_hz),
+            holdoff_cycles: spi.map_or(0, |t| t.holdoff_cycles),
+            holdoff_ns: cycles_to_ns(spi.map_or(0, |t| t.holdoff_cycles), mix.clock_hz),
         }
     }
 }

@@ -330,7 +330,7 @@ pub fn merged_frame(s: &Schedule) -> Vec<(u64, u64, u16)> {
     // completions of the previous, this and the next frame, by cycle
     let mut done: BTreeMap<u64, Vec<(usize, u64, Vec<u16>)>> = BTreeMap::new();
     for i in s.instants(3) {
-        let e = i.cycle + s.branches[i.branch].spi.read_cycles;
+        let e = i.cycle + s.branches[i.branch].spi.tick_to_complete();
         let words: Vec<u16> = s.words_of(i.channel).map(|(_, c)| c as u16).collect();
         done.entry(e).or_default().push((i.branch, i.cycle, words));
     }
@@ -385,7 +385,7 @@ impl PacketInstants {
             let w = v / g.slice_cycles;
             let k = (w % g.slices_per_frame) as usize;
             let shift = (w / g.slices_per_frame * g.frame_cycles) as i64;
-            // the part holds its input this long after its conversion starts
+            // the part holds its input this long after the slot tick
             let held = s.sample_after(s.mix.channels[ch as usize].branch);
             per_slice[k].push((ch, i as i64 - shift, held as i64));
         }

@@ -18,6 +18,7 @@ mod audit;
 mod command;
 mod fixes;
 mod fpga;
+mod holdoff;
 mod hostlink;
 // A public namespace, not an export list: the slot table's three file forms
 // (`lut::to_hex`, `lut::to_csv`, `lut::to_markdown`) and its compact form

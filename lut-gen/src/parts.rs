@@ -643,6 +643,16 @@ pub struct SpiTiming {
     /// `n`, the start of serial period `n + 1`.
     #[serde(skip)]
     pub sample_cycles: u64,
+    /// Cycles from the slot tick to the transaction's start: 0 unless a
+    /// sync group links the branch to a part that holds its input later
+    /// in its transaction, whose instant this one's waits for
+    /// ([`SpiTiming::with_holdoff`]). CS/CNV stay idle meanwhile.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub holdoff_cycles: u64,
+}
+
+fn is_zero(v: &u64) -> bool {
+    *v == 0
 }
 
 /// Why a branch's part cannot be driven from this clock.
@@ -718,7 +728,28 @@ impl SpiTiming {
             leading_bits: adc.leading_bits,
             conv_cycles,
             sample_cycles,
+            holdoff_cycles: 0,
         })
+    }
+
+    /// This timing with its transaction started `holdoff` cycles after the
+    /// slot tick.
+    pub fn with_holdoff(self, holdoff: u64) -> SpiTiming {
+        SpiTiming {
+            holdoff_cycles: holdoff,
+            ..self
+        }
+    }
+
+    /// Cycles from the slot tick to the instant the part holds its input:
+    /// the hold-off plus the part's own [`SpiTiming::sample_cycles`].
+    pub fn tick_to_sample(&self) -> u64 {
+        self.holdoff_cycles + self.sample_cycles
+    }
+
+    /// Cycles from the slot tick to the end of the read (the pin released).
+    pub fn tick_to_complete(&self) -> u64 {
+        self.holdoff_cycles + self.read_cycles
     }
 
     /// Conversions per second the part allows on this port: one every

@@ -152,7 +152,7 @@ impl Schedule {
     /// Slots are longer than the settling time, so only an instant at cycle 0
     /// can be skipped.
     pub fn skipped_at_startup(&self, b: usize, t: u64) -> bool {
-        t + 1 < self.branches[b].settle_cycles
+        t + self.holdoff(b) + 1 < self.branches[b].settle_cycles
     }
 
     /// How many samples the instants of the first frame after reset that the
@@ -204,13 +204,20 @@ impl Schedule {
             + self.sample_after(self.mix.channels[channel].branch)
     }
 
-    /// Cycles from the start of a conversion of `branch` (its CS fall or
-    /// CNV rise, the cycle [`Schedule::instants`] gives) to the instant
-    /// its part holds its input (`SpiTiming::sample_cycles`): 0 for a part
-    /// that samples at that edge; the MCP3208's falling SCLK edge after its
-    /// 6th rising one.
+    /// Cycles from the slot tick of a conversion of `branch` (the cycle
+    /// [`Schedule::instants`] gives) to the instant its part holds its
+    /// input: the branch's hold-off ([`Schedule::holdoff`]) plus its part's
+    /// own `SpiTiming::sample_cycles` (0 for a part that samples at its
+    /// start edge; the MCP3208's falling SCLK edge after its 6th rising one).
     pub fn sample_after(&self, branch: usize) -> u64 {
-        self.branches[branch].spi.sample_cycles
+        self.branches[branch].spi.tick_to_sample()
+    }
+
+    /// Cycles from the slot tick to the start of a conversion of `branch`
+    /// (its CS fall or CNV rise): 0 unless a sync group holds the branch
+    /// back for a part that samples later in its transaction.
+    pub fn holdoff(&self, branch: usize) -> u64 {
+        self.branches[branch].spi.holdoff_cycles
     }
 
     /// The sampling instant of the sample of `channel` that leaves on
@@ -228,7 +235,7 @@ impl Schedule {
         }
         let branch = self.mix.channels[channel].branch;
         let first = ch.offset_slot * self.grid.slot_cycles;
-        let last = strobe.checked_sub(self.branches[branch].spi.read_cycles + 1)?;
+        let last = strobe.checked_sub(self.branches[branch].spi.tick_to_complete() + 1)?;
         let n = last.checked_sub(first)? / ch.interval_cycles.max(1);
         Some(first + n * ch.interval_cycles + self.sample_after(branch))
     }

@@ -105,7 +105,7 @@ fn latencies(from: &Schedule, t: &crate::mix::Trigger, first_to: u64) -> Vec<(u6
         .instants(2)
         .filter_map(|i| {
             let c = watched(i.channel)?;
-            let e = i.cycle + from.branches[i.branch].spi.read_cycles;
+            let e = i.cycle + from.branches[i.branch].spi.tick_to_complete();
             // the cause is the sample's instant, where its part held it
             Some((i.cycle + from.sample_after(i.branch), e / f, c))
         })

@@ -182,22 +182,37 @@ pub(crate) fn candidate_offsets(period: u64, slots_per_slice: u64) -> impl Itera
 }
 
 fn branch_plans(mix: &Mix) -> Result<Vec<BranchPlan>, String> {
-    mix.branches
+    let own: Vec<SpiTiming> = mix
+        .branches
         .iter()
         .map(|b| {
-            let spi = SpiTiming::derive(&b.adc, mix.clock_hz, b.sclk_hz, b.chain)
-                .map_err(|e| format!("branch `{}`: {}", b.name, e.0))?;
+            SpiTiming::derive(&b.adc, mix.clock_hz, b.sclk_hz, b.chain)
+                .map_err(|e| format!("branch `{}`: {}", b.name, e.0))
+        })
+        .collect::<Result<_, _>>()?;
+    let sample: Vec<u64> = own.iter().map(|t| t.sample_cycles).collect();
+    let holdoffs = crate::holdoff::holdoffs(mix, &sample);
+    Ok(mix
+        .branches
+        .iter()
+        .zip(own)
+        .zip(holdoffs)
+        .map(|((b, own), h)| {
+            let spi = own.with_holdoff(h);
             let settle_cycles = ns_to_cycles(b.settle_ns, mix.clock_hz);
-            Ok(BranchPlan {
+            // The transaction, after its hold-off, and the quiet time fit
+            // the slot (the conversions still start a slot apart).
+            let held = spi.tick_to_complete() + spi.quiet_cycles;
+            BranchPlan {
                 name: b.name.clone(),
                 spi,
                 settle_cycles,
                 // The mux switches in the cycle after a CS fall: it has slot-1 cycles to settle.
-                min_slot_cycles: spi.min_period_cycles.max(settle_cycles + 1),
+                min_slot_cycles: spi.min_period_cycles.max(held).max(settle_cycles + 1),
                 mux_devices: b.mux_devices,
-            })
+            }
         })
-        .collect()
+        .collect())
 }
 
 fn units_of(mix: &Mix, frame_slots: u64) -> Vec<Unit> {

@@ -129,8 +129,8 @@ fn check_datasheets(s: &Schedule, bad: &mut Vec<String>) {
                 plan.name, adc.name, adc.chain_max
             ));
         }
-        if g.slot_cycles < spi.read_cycles
-            || ns(g.slot_cycles - spi.read_cycles) < adc.quiet_ns as f64
+        if g.slot_cycles < spi.tick_to_complete()
+            || ns(g.slot_cycles - spi.tick_to_complete()) < adc.quiet_ns as f64
         {
             bad.push(format!(
                 "branch `{}`: slot leaves less than t_quiet = {} ns between conversions",
@@ -275,9 +275,9 @@ fn check_sync(s: &Schedule, slots_of: &[Vec<u64>], bad: &mut Vec<String>) {
                     mix.channels[w[0]].name, mix.channels[w[1]].name
                 ));
             }
-            // within a shared slot, each part holds its input its own time
-            // after the transaction starts
-            let after = |c: usize| s.branches[mix.channels[c].branch].spi.sample_cycles;
+            // within a shared slot, each part holds its input its hold-off
+            // plus its own time after the slot tick
+            let after = |c: usize| s.sample_after(mix.channels[c].branch);
             let apart = crate::parts::cycles_to_ns(after(w[0]).abs_diff(after(w[1])), mix.clock_hz);
             if apart > crate::mix::SYNC_TOLERANCE_NS as f64 {
                 bad.push(format!(

@@ -140,7 +140,7 @@ fn walk(from: &Schedule, to: &Schedule, t: &Trigger) -> u64 {
             let start = i.cycle;
             (
                 start + from.sample_after(i.branch),
-                start + from.branches[i.branch].spi.read_cycles,
+                start + from.branches[i.branch].spi.tick_to_complete(),
             )
         })
         .collect();

@@ -322,8 +322,10 @@ fn select_labels(view: &View, names: &[String], labels: &mut Series) {
         let r = row_of(&format!("{} mux_sel", br.name));
         let texts: Vec<(f64, String)> = s
             .instants(3)
-            .filter(|i| i.branch == b && (view.from..view.to).contains(&i.cycle))
-            .map(|i| (view.us(i.cycle), view.channel(i.channel)))
+            // at the conversion's start: the tick, or its hold-off later
+            .map(|i| (i.cycle + s.holdoff(b), i))
+            .filter(|(t, i)| i.branch == b && (view.from..view.to).contains(t))
+            .map(|(t, i)| (view.us(t), view.channel(i.channel)))
             .collect();
         for ((x, line), (_, text)) in stagger(&texts, &[], x0, span, 2).into_iter().zip(texts) {
             let y = [r + HIGH / 2.0 + 0.05, r + SELECT_LOW][line];

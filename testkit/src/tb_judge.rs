@@ -122,8 +122,10 @@ pub fn judge(
         let got: Vec<(u64, usize)> = convs.iter().map(|c| (c.cycle, c.channel)).collect();
         let expected: Vec<(u64, usize)> = s
             .instants(frames)
-            .filter(|i| i.branch == b && i.cycle < cycles - 2)
-            .map(|i| (i.cycle, i.channel))
+            // the conversion starts its branch's hold-off after the slot tick
+            .map(|i| (i.cycle + s.holdoff(i.branch), i.branch, i.channel))
+            .filter(|i| i.1 == b && i.0 < cycles - 2)
+            .map(|i| (i.0, i.2))
             .filter(|i| i.0 >= settle[b] || got.contains(i))
             .collect();
         if got != expected {

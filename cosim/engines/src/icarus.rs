@@ -271,10 +271,16 @@ impl Adcs<'_> {
         }
         let s = self.s;
         let f = s.grid.frame_cycles;
+        // the conversion starts (CS fall, CNV rise) its hold-off after the tick
         Box::new(
-            s.instants(self.frames).filter(move |i| {
-                i.branch == b && !(i.cycle < f && s.skipped_at_startup(b, i.cycle))
-            }),
+            s.instants(self.frames)
+                .filter(move |i| {
+                    i.branch == b && !(i.cycle < f && s.skipped_at_startup(b, i.cycle))
+                })
+                .map(move |i| lut_gen::SamplingInstant {
+                    cycle: i.cycle + s.holdoff(b),
+                    ..i
+                }),
         )
     }
 
@@ -307,7 +313,9 @@ impl Adcs<'_> {
                 } else {
                     i.channel as u64
                 };
-                let code = self.analog.code_bits(id, i.cycle + s.sample_after(b), bits);
+                let code =
+                    self.analog
+                        .code_bits(id, i.cycle + s.branches[b].spi.sample_cycles, bits);
                 let _ = writeln!(hex, "{:04x}{:08x}{:04x}", id as u16, i.cycle as u32, code);
                 len += 1;
             }
@@ -363,7 +371,7 @@ impl Adcs<'_> {
         let mut len = 0u64;
         let bits = self.s.mix.branches[b].adc.bits;
         for i in self.conversions(b) {
-            let held = i.cycle + self.s.sample_after(b);
+            let held = i.cycle + self.s.branches[b].spi.sample_cycles;
             let code = self.analog.code_bits(i.channel as u64, held, bits) & 0x3fff;
             let _ = writeln!(
                 hex,
@@ -432,7 +440,7 @@ impl Adcs<'_> {
         let mut words = 0u64;
         for i in self.conversions(b) {
             for (_, c) in self.s.words_of(i.channel) {
-                let held = i.cycle + self.s.sample_after(b);
+                let held = i.cycle + self.s.branches[b].spi.sample_cycles;
                 let code = self.analog.code_bits(c as u64, held, part.bits) as u32 & mask;
                 let _ = writeln!(hex, "{:04x}{:08x}{:04x}", c as u16, i.cycle as u32, code);
                 words += 1;

@@ -83,7 +83,8 @@ pub(super) fn mosi(
     let terms: Vec<String> = (0..l as u64)
         .filter(|&k| k < spi.sclks())
         .map(|k| {
-            let from = spi.setup_cycles + k * spi.sclk_div;
+            // after the branch's hold-off, if it has one
+            let from = spi.holdoff_cycles + spi.setup_cycles + k * spi.sclk_div;
             format!(
                 "(cyc >= {cb}'d{from} && cyc < {cb}'d{} && {word}[{}])",
                 from + spi.sclk_div,

@@ -11,15 +11,16 @@ pub(super) enum LaneForm<'a> {
 }
 
 /// The Verilog twin of `Core::update`: pure wiring, generated per mix.
-/// `pulse_of`: per sequencer, its CNV pulse if its part is read with CNV
-/// low. `modes`: a mix with modes (pin select, the branches whose words the
-/// mode block reads). `cmds`: each branch's command unit, and per unit
-/// whether it reads the modes (behind a front mux in a mix with modes).
+/// `wires`: per sequencer, its CNV pulse if its part is read with CNV low
+/// and its hold-off if its transactions start after the slot tick. `modes`:
+/// a mix with modes (pin select, the branches whose words the mode block
+/// reads). `cmds`: each branch's command unit, and per unit whether it reads
+/// the modes (behind a front mux in a mix with modes).
 pub(super) fn core_glue(
     nb: usize,
     devices: &[usize],
     seq_of: &[usize],
-    pulse_of: &[Option<usize>],
+    wires: SeqWires,
     (cmd_of, moded): (&[Option<usize>], &[bool]),
     modes: Option<(bool, usize)>,
     lanes_form: LaneForm,
@@ -29,21 +30,21 @@ pub(super) fn core_glue(
         LaneForm::Priority { stepped } => (None, stepped),
     };
     let mut s = String::new();
-    let nseq = pulse_of.len();
+    let nseq = wires.pulse_of.len();
     s.push_str("always @(*) begin\n");
-    child_inputs(&mut s, nb, seq_of, pulse_of, modes.is_none());
+    child_inputs(&mut s, nb, seq_of, &wires, modes.is_none());
     if let Some((pin, lanes)) = modes {
         mode_inputs(&mut s, nb, pin, lanes, cmd_of);
     }
     let act_read = queue_inputs(&mut s, nb, queue, step);
-    command_units(&mut s, seq_of, cmd_of, moded);
+    command_units(&mut s, seq_of, &wires, (cmd_of, moded));
     lanes(&mut s, nb, devices, cmd_of);
     s.push_str(
         "  sample_valid = merge$valid;\n  sample_channel = merge$channel;\n  sample_value = merge$value;\n  slot_tick = timing$start1;\nend\n",
     );
     unused_wires(&mut s, nb, devices, nseq);
     let released: Vec<String> = (0..nseq)
-        .filter(|&i| pulse_of[i].is_some())
+        .filter(|&i| wires.pulse_of[i].is_some())
         .map(|i| format!("seqs${i}$cs_n"))
         .collect();
     if !released.is_empty() {
@@ -151,68 +152,119 @@ fn lanes_below_is(src: usize, j: usize) -> String {
     t.join(" && ")
 }
 
+/// Where each sequencer's levels come from and its start goes: its CNV
+/// pulse (`pulse_of`), its hold-off (`hold_of`).
+pub(super) struct SeqWires<'a> {
+    pub(super) pulse_of: &'a [Option<usize>],
+    pub(super) hold_of: &'a [Option<usize>],
+}
+
+impl SeqWires<'_> {
+    /// The start of sequencer `i` (and of its pulse).
+    fn start2(&self, i: usize) -> String {
+        match self.hold_of[i] {
+            Some(h) => format!("holds${h}$fire2"),
+            None => "timing$start2".into(),
+        }
+    }
+
+    /// The slot start the branches (and command units) of sequencer `i` see.
+    fn start0(&self, i: usize) -> String {
+        match self.hold_of[i] {
+            Some(h) => format!("holds${h}$start0"),
+            None => "timing$start0".into(),
+        }
+    }
+
+    /// The sequencer's level `what` (`cs_n`, `sclk`, `cap`, `done`) as its
+    /// branches take it: through the hold-off's mask, the pin from the CNV pulse.
+    fn level(&self, i: usize, what: &str) -> String {
+        match (self.hold_of[i], what) {
+            (Some(h), _) => format!("holds${h}${what}"),
+            (None, "cs_n") => self.pin(i),
+            (None, _) => format!("seqs${i}${what}"),
+        }
+    }
+
+    fn pin(&self, i: usize) -> String {
+        match self.pulse_of[i] {
+            Some(p) => format!("pulses${p}$pin_n"),
+            None => format!("seqs${i}$cs_n"),
+        }
+    }
+}
+
 /// Clock, reset, slot strobes and sequencer levels into every child (a
 /// branch whose sequencer has a CNV pulse takes the pulse as its pin).
 /// `timebase`: the branches' ROM address is the timing generator's (else
 /// the mode block's, [`mode_inputs`]).
-fn child_inputs(
-    s: &mut String,
-    nb: usize,
-    seq_of: &[usize],
-    pulse_of: &[Option<usize>],
-    timebase: bool,
-) {
+fn child_inputs(s: &mut String, nb: usize, seq_of: &[usize], w: &SeqWires, timebase: bool) {
     for (who, _) in [("timing", 0), ("merge", 0)] {
         s.push_str(&format!("  {who}$clock = clock;\n  {who}$rst = rst;\n"));
     }
-    for i in 0..pulse_of.len() {
+    for i in 0..w.pulse_of.len() {
         let q = format!("seqs${i}");
         s.push_str(&format!(
-            "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = timing$start2;\n"
+            "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = {};\n",
+            w.start2(i)
         ));
     }
-    for p in pulse_of.iter().flatten() {
+    for (i, p) in w.pulse_of.iter().enumerate() {
+        let Some(p) = p else { continue };
         let q = format!("pulses${p}");
         s.push_str(&format!(
-            "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = timing$start2;\n"
+            "  {q}$clock = clock;\n  {q}$rst = rst;\n  {q}$start2 = {};\n",
+            w.start2(i)
+        ));
+    }
+    for (i, h) in w.hold_of.iter().enumerate() {
+        let Some(h) = h else { continue };
+        let (q, u) = (format!("seqs${i}"), format!("holds${h}"));
+        s.push_str(&format!(
+            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$cs_in = {};\n  {u}$sclk_in = {q}$sclk;\n  {u}$cap_in = {q}$cap;\n  {u}$done_in = {q}$done;\n",
+            w.pin(i)
         ));
     }
     // the queue form's single sequencer (unused by the priority form)
     s.push_str("  merge$cap_next = seqs$0$cap_next;\n  merge$start2 = timing$start2;\n  merge$addr = timing$addr;\n  merge$seq_done = seqs$0$done;\n");
-    for (b, seq) in seq_of.iter().enumerate().take(nb) {
+    for (b, &seq) in seq_of.iter().enumerate().take(nb) {
         let u = format!("branches${b}");
-        let q = format!("seqs${seq}");
         s.push_str(&format!(
-            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = timing$start0;\n"
+            "  {u}$clock = clock;\n  {u}$rst = rst;\n  {u}$start2 = timing$start2;\n  {u}$start1 = timing$start1;\n  {u}$start0 = {};\n",
+            w.start0(seq)
         ));
         if timebase {
             s.push_str(&format!(
                 "  {u}$addr = timing$addr;\n  {u}$slice = timing$slice;\n"
             ));
         }
-        let pin = match pulse_of[*seq] {
-            Some(p) => format!("pulses${p}$pin_n"),
-            None => format!("{q}$cs_n"),
-        };
         s.push_str(&format!(
-            "  {u}$seq_cs_n = {pin};\n  {u}$seq_sclk = {q}$sclk;\n  {u}$seq_cap = {q}$cap;\n  {u}$seq_done = {q}$done;\n  {u}$grant = merge$grant[{b}];\n"
+            "  {u}$seq_cs_n = {};\n  {u}$seq_sclk = {};\n  {u}$seq_cap = {};\n  {u}$seq_done = {};\n  {u}$grant = merge$grant[{b}];\n",
+            w.level(seq, "cs_n"),
+            w.level(seq, "sclk"),
+            w.level(seq, "cap"),
+            w.level(seq, "done")
         ));
     }
 }
 
 /// Each command unit's inputs (its branch's pins, its sequencer's levels,
 /// the slot start) and the `adc_mosi` lanes (absent without a unit).
-fn command_units(s: &mut String, seq_of: &[usize], cmd_of: &[Option<usize>], moded: &[bool]) {
+fn command_units(
+    s: &mut String,
+    seq_of: &[usize],
+    w: &SeqWires,
+    (cmd_of, moded): (&[Option<usize>], &[bool]),
+) {
     let mut lanes = vec![];
     for (b, i) in cmd_of.iter().enumerate() {
         let Some(i) = i else { continue };
-        let (u, q, c) = (
-            format!("branches${b}"),
-            format!("seqs${}", seq_of[b]),
-            format!("cmds${i}"),
-        );
+        let (u, q, c) = (format!("branches${b}"), seq_of[b], format!("cmds${i}"));
         s.push_str(&format!(
-            "  {c}$clock = clock;\n  {c}$rst = rst;\n  {c}$start0 = timing$start0;\n  {c}$pin = {u}$cs_n;\n  {c}$bsclk = {u}$sclk;\n  {c}$qsclk = {q}$sclk;\n  {c}$qdone = {q}$done;\n  {c}$sel = {u}$mux_sel;\n  {c}$hi = {u}$mux_en[1];\n  {c}$done = {u}$done;\n"
+            "  {c}$clock = clock;\n  {c}$rst = rst;\n  {c}$start0 = {};\n  {c}$pin = {u}$cs_n;\n  {c}$bsclk = {u}$sclk;\n  {c}$qsclk = {};\n  {c}$qdone = {};\n  {c}$sel = {u}$mux_sel;\n  {c}$hi = {u}$mux_en[1];\n  {c}$done = {u}$done;\n",
+            w.start0(q),
+            w.level(q, "sclk"),
+            w.level(q, "done")
         ));
         if moded[*i] {
             // the mode in force, and the next frame's (minfo's low bits)

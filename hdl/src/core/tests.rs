@@ -100,6 +100,7 @@ fn harness(div: u64, setup: u64) -> Harness {
             word_sclks: 16,
             leading_bits: 2,
             bits: 14,
+            holdoff: 0,
         }],
         branches: vec![rom()],
         queue: None,

@@ -2,8 +2,8 @@
 
 use rust_hdl::prelude::*;
 
-use super::glue::{core_glue, route_miso, LaneForm};
-use super::{BranchUnit, CmdUnit, CnvPulse, Merger, ModeGen, SpiSeq, TimingGen};
+use super::glue::{core_glue, route_miso, LaneForm, SeqWires};
+use super::{BranchUnit, CmdUnit, CnvPulse, HoldOff, Merger, ModeGen, SpiSeq, TimingGen};
 use crate::plan::Plan;
 use crate::widths::*;
 
@@ -36,6 +36,10 @@ pub struct Core {
     pub pulses: Vec<CnvPulse>,
     /// The pulse of each sequencer, if it has one.
     _pulse_of: Vec<Option<usize>>,
+    /// The hold-off of each sequencer whose transactions start after the
+    /// slot tick (none in a mix without one).
+    pub holds: Vec<HoldOff>,
+    _hold_of: Vec<Option<usize>>,
     pub branches: Vec<BranchUnit>,
     /// One command unit per branch with a command word, in branch order.
     pub cmds: Vec<CmdUnit>,
@@ -63,6 +67,12 @@ impl Core {
         for (i, q) in plan.seqs.iter().enumerate().filter(|(_, q)| q.pulsed()) {
             pulse_of[i] = Some(pulses.len());
             pulses.push(CnvPulse::new(q.pin_cycles));
+        }
+        let mut hold_of = vec![None; plan.seqs.len()];
+        let mut holds = vec![];
+        for (i, q) in plan.seqs.iter().enumerate().filter(|(_, q)| q.holdoff > 0) {
+            hold_of[i] = Some(holds.len());
+            holds.push(HoldOff::new(q.holdoff, !q.cnv));
         }
         let mut cmd_of = vec![None; plan.branches.len()];
         let mut cmds = vec![];
@@ -105,6 +115,8 @@ impl Core {
             seqs: plan.seqs.iter().map(SpiSeq::new).collect(),
             pulses,
             _pulse_of: pulse_of,
+            holds,
+            _hold_of: hold_of,
             branches: plan
                 .branches
                 .iter()
@@ -205,6 +217,9 @@ impl Core {
         for u in self.pulses.iter_mut() {
             drive(&mut u.clock, k);
         }
+        for u in self.holds.iter_mut() {
+            drive(&mut u.clock, k);
+        }
         let m = &mut self.merge;
         drive(&mut m.clock, k);
         drive(&mut m.r_valid.clock, k);
@@ -298,10 +313,20 @@ impl Logic for Core {
         let (addr, slice) = self.mode_block_inputs(clk, rst);
         let modes = self.modes.first().map(|g| (g.mode.val(), g.minfo.val()));
         let mut seq = [(false, false, false, false); MAX_BRANCHES];
+        // each sequencer's start, and the slot start its branches see
+        let mut starts = [(start, start0); MAX_BRANCHES];
+        for (i, h) in self._hold_of.iter().enumerate() {
+            let Some(h) = h else { continue };
+            let u = &mut self.holds[*h];
+            u.clock.next = clk;
+            u.rst.next = rst;
+            u.start2.next = start;
+            starts[i] = (u.fire2.val(), u.start0.val());
+        }
         for (i, q) in self.seqs.iter_mut().enumerate() {
             q.clock.next = clk;
             q.rst.next = rst;
-            q.start2.next = start;
+            q.start2.next = starts[i].0;
             seq[i] = (q.cs_n.val(), q.sclk.val(), q.cap.val(), q.done.val());
         }
         for (i, p) in self._pulse_of.iter().enumerate() {
@@ -309,9 +334,16 @@ impl Logic for Core {
             let u = &mut self.pulses[*p];
             u.clock.next = clk;
             u.rst.next = rst;
-            u.start2.next = start;
+            u.start2.next = starts[i].0;
             // the branches register the pulse in place of the sequencer's pin
             seq[i].0 = u.pin_n.val();
+        }
+        for (i, h) in self._hold_of.iter().enumerate() {
+            let Some(h) = h else { continue };
+            // the branches see the sequencer's levels through the hold-off's mask
+            let u = &mut self.holds[*h];
+            (u.cs_in.next, u.sclk_in.next, u.cap_in.next, u.done_in.next) = seq[i];
+            seq[i] = (u.cs_n.val(), u.sclk.val(), u.cap.val(), u.done.val());
         }
         let miso = self.miso_lanes();
         let grant = self.merge.grant.val().to_u64();
@@ -327,6 +359,7 @@ impl Logic for Core {
             u.rst.next = rst;
             u.start2.next = start;
             u.start1.next = start1;
+            let start0 = starts[self._seq_of[b]].1;
             u.start0.next = start0;
             u.addr.next = addr;
             u.slice.next = slice;
@@ -448,6 +481,15 @@ impl Logic for Core {
             q.rst.connect();
             q.start2.connect();
         }
+        for q in self.holds.iter_mut() {
+            q.clock.connect();
+            q.rst.connect();
+            q.start2.connect();
+            q.cs_in.connect();
+            q.sclk_in.connect();
+            q.cap_in.connect();
+            q.done_in.connect();
+        }
         for q in self.cmds.iter_mut() {
             q.clock.connect();
             q.rst.connect();
@@ -502,7 +544,10 @@ impl Logic for Core {
             self.branches.len(),
             &self._devices,
             &self._seq_of,
-            &self._pulse_of,
+            SeqWires {
+                pulse_of: &self._pulse_of,
+                hold_of: &self._hold_of,
+            },
             (
                 &self._cmd_of,
                 &self

@@ -194,17 +194,19 @@ impl AuditReport {
                     format!("{}ns", p.conversion_ns),
                     p.max_conversions_hz,
                     p.max_samples_hz,
-                    match p.sample_at {
-                        crate::parts::SampleAt::Start => "at start".to_string(),
-                        crate::parts::SampleAt::SclkFall(_) =>
-                            format!("+{:.3}us", p.sample_after_ns / 1000.0),
-                    }
+                    sampled_words(p)
                 );
             }
             let _ = writeln!(
                 o,
                 "VDD: the supply whose datasheet figures apply (*: the part's lowest, no `vdd` given); sampled: where the part holds its input, at its start edge (CS falling, CNV rising) or this long after it (sampled_s and the first instants below include it)"
             );
+            if self.parts.iter().any(|p| p.holdoff_cycles > 0) {
+                let _ = writeln!(
+                    o,
+                    "hold-off: the branch starts its transactions this long after the slot tick, so its sync group holds its inputs at one instant (sampled_s includes it)"
+                );
+            }
         }
     }
 
@@ -340,4 +342,17 @@ fn worst_mode(l: &crate::hostlink::LinkPlan) -> String {
 /// The `dev.sel` cell: [`super::ChannelAudit::mux_words`].
 fn mux_cell(c: &super::ChannelAudit) -> String {
     c.mux_words()
+}
+
+/// The parts table's "sampled" cell: where the part holds its input, after
+/// its branch's hold-off when it has one.
+fn sampled_words(p: &crate::audit::PartAudit) -> String {
+    let own = match p.sample_at {
+        crate::parts::SampleAt::Start => "at start".to_string(),
+        crate::parts::SampleAt::SclkFall(_) => format!("+{:.3}us", p.sample_after_ns / 1000.0),
+    };
+    match p.holdoff_cycles {
+        0 => own,
+        _ => format!("{own} after {:.3}us hold-off", p.holdoff_ns / 1000.0),
+    }
 }

@@ -139,7 +139,7 @@ pub fn merged_run(frames: &[&Schedule]) -> Vec<(u64, u64, u16)> {
     for (f, s) in frames.iter().enumerate() {
         let base = f as u64 * s.grid.frame_cycles;
         for i in s.instants(1) {
-            let e = base + i.cycle + s.branches[i.branch].spi.read_cycles;
+            let e = base + i.cycle + s.branches[i.branch].spi.tick_to_complete();
             let words = s.words_of(i.channel).map(|(_, c)| c as u16).collect();
             done.entry(e)
                 .or_default()

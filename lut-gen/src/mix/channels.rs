@@ -460,10 +460,16 @@ impl Cx<'_> {
         branches: &[Branch],
         channels: &[Channel],
         sync_groups: &BTreeMap<String, Vec<(usize, Range<usize>)>>,
-        clock_hz: u64,
+        (clock_hz, slice_cycles): (u64, u64),
     ) -> Result<(), MixError> {
         for (tag, members) in sync_groups {
-            self.check_sync_instants(decl, branches, channels, tag, members, clock_hz)?;
+            self.check_sync_instants(
+                decl,
+                branches,
+                channels,
+                (tag, members),
+                (clock_hz, slice_cycles),
+            )?;
             let mut seen = BTreeMap::new();
             let rate = channels[members[0].0].rate_hz;
             for (i, span) in members {
@@ -497,47 +503,62 @@ impl Cx<'_> {
         Ok(())
     }
 
-    /// A sync group's conversions start together, so its parts must hold
-    /// their inputs at the same point of their transactions, within
-    /// [`SYNC_TOLERANCE_NS`]: an MCP3208 holds its input 6 us after an
-    /// AD7940 whose CS falls with its own.
+    /// A sync group's conversions start at one slot tick, and a part that
+    /// holds its input earlier in its transaction than another member waits
+    /// the difference (its hold-off, docs/timing.md "Hold-off"): refused
+    /// when the wait and the transaction no longer fit a slice, or the
+    /// branch's conversions per second at that length.
     pub(super) fn check_sync_instants(
         &self,
         decl: &[Declared],
         branches: &[Branch],
         channels: &[Channel],
-        tag: &str,
-        members: &[(usize, Range<usize>)],
-        clock_hz: u64,
+        (tag, members): (&str, &[(usize, Range<usize>)]),
+        (clock_hz, slice_cycles): (u64, u64),
     ) -> Result<(), MixError> {
-        let after = |c: usize| {
-            let b = &branches[channels[c].branch];
-            b.timing(clock_hz).ok().map(|t| t.sample_cycles)
-        };
-        let mut known = members
+        let timing = |c: usize| branches[channels[c].branch].timing(clock_hz).ok();
+        let known: Vec<(usize, crate::parts::SpiTiming)> = members
             .iter()
-            .filter_map(|(c, _)| after(*c).map(|a| (*c, a)));
-        let Some(first) = known.next() else {
+            .filter_map(|(c, _)| timing(*c).map(|t| (*c, t)))
+            .collect();
+        let Some(&(late, lt)) = known
+            .iter()
+            .max_by_key(|(c, t)| (t.sample_cycles, usize::MAX - c))
+        else {
             return Ok(());
         };
-        for (c, a) in known {
-            let apart = cycles_to_ns(a.abs_diff(first.1), clock_hz);
-            if apart <= SYNC_TOLERANCE_NS as f64 {
+        for &(c, t) in &known {
+            let hold = lt.sample_cycles - t.sample_cycles;
+            if cycles_to_ns(hold, clock_hz) <= SYNC_TOLERANCE_NS as f64 {
                 continue;
             }
-            let span = &members.iter().find(|m| m.0 == c).expect("a member").1;
-            let say = |c: usize, a: u64| {
-                let b = &branches[channels[c].branch];
-                let when = match a {
-                    0 => b.adc.sample.words(b.adc.start),
-                    _ => format!(
-                        "{:.3} us after its transaction starts ({})",
-                        cycles_to_ns(a, clock_hz) / 1000.0,
-                        b.adc.sample.words(b.adc.start)
-                    ),
-                };
+            let held = hold + t.read_cycles + t.quiet_cycles;
+            let b = channels[c].branch;
+            let demand: u64 = channels
+                .iter()
+                .filter(|x| x.branch == b)
+                .map(|x| x.rate_hz)
+                .sum();
+            let why = if held > slice_cycles {
                 format!(
-                    "`{}` on branch `{}` ({}) holds its input {when}",
+                    "its hold-off and transaction take {:.3} us, longer than a slice ({:.3} us)",
+                    cycles_to_ns(held, clock_hz) / 1000.0,
+                    cycles_to_ns(slice_cycles, clock_hz) / 1000.0
+                )
+            } else if demand as u128 * held as u128 > clock_hz as u128 {
+                format!(
+                    "its hold-off and transaction take {:.3} us, so the branch converts at most {:.0} times per second, and its channels ask {demand}",
+                    cycles_to_ns(held, clock_hz) / 1000.0,
+                    clock_hz as f64 / held as f64
+                )
+            } else {
+                continue;
+            };
+            let span = &members.iter().find(|m| m.0 == c).expect("a member").1;
+            let part = |c: usize| {
+                let b = &branches[channels[c].branch];
+                format!(
+                    "`{}` on branch `{}` ({})",
                     channels[c].name, b.name, b.adc.name
                 )
             };
@@ -545,11 +566,12 @@ impl Cx<'_> {
                 span.clone(),
                 decl[c].field("sync"),
                 decl[c].say(format!(
-                    "sync group `{tag}` cannot sample at one instant: {}, {}; the group's conversions start together, so their instants are {:.3} us apart (at most {:.3} us): sync parts that hold their input at the same point of their transaction",
-                    say(first.0, first.1),
-                    say(c, a),
-                    apart / 1000.0,
-                    SYNC_TOLERANCE_NS as f64 / 1000.0
+                    "sync group `{tag}` cannot hold at one instant: {} holds its input {:.3} us after its transaction starts ({}), so {} starts its transaction {:.3} us after the slot tick, and {why}",
+                    part(late),
+                    cycles_to_ns(lt.sample_cycles, clock_hz) / 1000.0,
+                    branches[channels[late].branch].adc.sample.words(branches[channels[late].branch].adc.start),
+                    part(c),
+                    cycles_to_ns(hold, clock_hz) / 1000.0,
                 )),
             ));
         }

@@ -130,7 +130,14 @@ impl Cx<'_> {
         let mut channels = draft.channels;
         self.check_front_wiring(&decl, &branches, &channels)?;
         self.check_chain_rates(&decl, &branches, &channels)?;
-        self.check_sync_groups(&decl, &branches, &channels, &draft.sync_groups, t.clock_hz)?;
+        let slice_cycles = (t.slice_us as u128 * t.clock_hz as u128 / 1_000_000) as u64;
+        self.check_sync_groups(
+            &decl,
+            &branches,
+            &channels,
+            &draft.sync_groups,
+            (t.clock_hz, slice_cycles),
+        )?;
         self.check_chain_sync(&decl, &channels)?;
         self.check_branches_used(&raw, &branches, &channels)?;
         if channels.len() > u16::MAX as usize {

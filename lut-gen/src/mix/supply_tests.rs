@@ -45,20 +45,30 @@ fn each_part_is_sampled_where_its_datasheet_says() {
 }
 
 #[test]
-fn a_sync_group_whose_parts_sample_apart_is_refused_naming_them() {
-    let e = parse_text(&pair("", true)).unwrap_err();
-    assert_eq!(e.field, "channel[2].sync", "{e}");
-    for w in [
-        "`M0`",
-        "`A0`",
-        "mcp3208",
-        "ad7940",
-        "6.104 us",
-        "at its CS fall",
-    ] {
-        assert!(e.message.contains(w), "{w}: {e}");
-    }
-    // two MCP3208s at one SCLK hold their inputs at one instant
+fn a_sync_group_whose_parts_sample_apart_holds_back_the_earlier_one() {
+    let m = parse_text(&pair("", true)).unwrap();
+    let s = crate::synthesize(&m).unwrap();
+    // the AD7940 (at its CS fall) waits for the MCP3208's 6th falling edge
+    assert_eq!((s.holdoff(0), s.holdoff(1)), (0, 5 + 6 * 48));
+    assert_eq!(s.sample_after(1), s.sample_after(0));
+    assert_eq!(s.first_sample_cycle(0), s.first_sample_cycle(2));
+    // the branch outside any group, and the one holding latest, wait nothing;
+    // the slot holds the hold-off, the read and the quiet time
+    let a = &s.branches[1].spi;
+    assert!(s.grid.slot_cycles >= a.holdoff_cycles + a.read_cycles + a.quiet_cycles);
+    let audit = crate::AuditReport::of_schedule(&s);
+    assert_eq!(audit.parts[1].holdoff_cycles, 293);
+    assert!(
+        audit.to_text().contains("at start after 6.104us hold-off"),
+        "{}",
+        audit.to_text()
+    );
+    // no sync group: no hold-off, and the JSON does not name one
+    let free = crate::synthesize(&parse_text(&pair("", false)).unwrap()).unwrap();
+    assert_eq!((free.holdoff(0), free.holdoff(1)), (0, 0));
+    let json = serde_json::to_string(&crate::AuditReport::of_schedule(&free)).unwrap();
+    assert!(!json.contains("holdoff"), "{json}");
+    // two MCP3208s at one SCLK hold their inputs at one instant without one
     let two = pair("", true)
         .replace(
             "adc = \"ad7940\"\nmux = \"tmux1108\"",
@@ -68,16 +78,41 @@ fn a_sync_group_whose_parts_sample_apart_is_refused_naming_them() {
             "name = \"A0\"\nbranch = \"a\"",
             "name = \"A0\"\nbranch = \"a\"\ninput = 3",
         );
-    let m = parse_text(&two).unwrap();
-    let s = crate::synthesize(&m).unwrap();
-    assert_eq!(s.first_sample_cycle(0), s.first_sample_cycle(2));
-    // ... but not at two SCLKs: 6 periods of 1 MHz against 6 of 500 kHz
+    let s = crate::synthesize(&parse_text(&two).unwrap()).unwrap();
+    assert_eq!((s.holdoff(0), s.holdoff(1)), (0, 0));
+    // ... and at two SCLKs the faster one waits: 6 periods of 1 MHz against 6 of 500 kHz
     let slow = two.replace(
         "name = \"a\"\nadc = \"mcp3208\"",
         "name = \"a\"\nadc = \"mcp3208\"\nsclk_hz = 500_000",
     );
+    let s = crate::synthesize(&parse_text(&slow).unwrap()).unwrap();
+    assert_eq!((s.holdoff(0), s.holdoff(1)), (6 * 48, 0));
+    assert_eq!(s.first_sample_cycle(0), s.first_sample_cycle(2));
+}
+
+#[test]
+fn a_hold_off_that_does_not_fit_a_slice_is_refused_naming_group_and_parts() {
+    // a slow AD7940 (48 MHz / 146: 2 340 cycles with its quiet time) fits a
+    // 50 us slice, but not after the MCP3208's 293-cycle hold-off
+    let slow = pair("", true)
+        .replace("slice_us = 500", "slice_us = 50")
+        .replace(
+            "mux = \"tmux1108\"\n",
+            "mux = \"tmux1108\"\nsclk_hz = 330_000\n",
+        );
     let e = parse_text(&slow).unwrap_err();
-    assert!(e.message.contains("us apart"), "{e}");
+    assert_eq!(e.field, "channel[2].sync", "{e}");
+    for w in [
+        "sync group `s` cannot hold at one instant",
+        "`M0` on branch `m` (mcp3208) holds its input 6.104 us after its transaction starts",
+        "`A0` on branch `a` (ad7940) starts its transaction 6.104 us after the slot tick",
+        "longer than a slice (50.000 us)",
+    ] {
+        assert!(e.message.contains(w), "{w}: {e}");
+    }
+    // without the group the same mix audits feasible
+    let m = parse_text(&slow.replace("sync = \"s\"\n", "")).unwrap();
+    assert!(crate::synthesize(&m).is_ok());
 }
 
 #[test]

@@ -343,8 +343,9 @@ pub fn run_model(s: &Schedule, frames: u64, stimulus: Stimulus, max_records: usi
             if skipped.contains(&(t, cv.branch)) {
                 continue;
             }
-            // the input's value where the part holds it
-            let held = t + s.sample_after(cv.branch);
+            // the input's value where the part holds it: `t` is the
+            // conversion's start (after any hold-off), the part's own time later
+            let held = t + s.branches[cv.branch].spi.sample_cycles;
             let code =
                 analog.code_bits(cv.channel as u64, held, s.mix.branches[cv.branch].adc.bits);
             inv.completion(

@@ -330,7 +330,8 @@ struct PartModel {
     /// (device * 8 + select) -> channel; empty for a straight input.
     front: Vec<std::collections::BTreeMap<u32, u16>>,
     /// Cycles from the conversion's start to the instant the part holds
-    /// its input (`Schedule::sample_after`): the input is sampled there.
+    /// its input (`SpiTiming::sample_cycles`; `Schedule::sample_after`
+    /// counts from the slot tick, a hold-off earlier): the input is sampled there.
     after: u64,
 }
 
@@ -379,7 +380,7 @@ impl Adc {
         let mut parts = parts;
         let layout = Layout::new(s);
         for (b, pm) in parts.iter_mut().enumerate() {
-            pm.after = s.sample_after(b);
+            pm.after = s.branches[b].spi.sample_cycles;
             pm.inputs = layout.lookup[b].clone();
             if s.mix.branches[b].fronted {
                 (pm.inputs, pm.front) = Self::fronted_inputs(s, b);

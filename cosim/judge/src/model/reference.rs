@@ -18,7 +18,8 @@ use crate::model::modes::ModeTrack;
 /// conversion gives one per chain member read).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Conversion {
-    /// Sampling instant (CS falling or CNV rising), cycles from the start of the frame.
+    /// Conversion start (CS falling or CNV rising: the slot tick plus the
+    /// branch's hold-off), cycles from the start of the frame.
     pub instant: u64,
     pub branch: usize,
     pub channel: u16,
@@ -94,7 +95,8 @@ impl SlotModel {
         for slot in 0..g.frame_slots {
             for b in 0..nb {
                 if let Some(ch) = s.at(slot, b) {
-                    let instant = slot * g.slot_cycles;
+                    // the conversion starts at the slot tick, or its hold-off later
+                    let instant = slot * g.slot_cycles + s.holdoff(b);
                     for (m, c) in s.words_of(ch) {
                         conversions.push(Conversion {
                             instant,
@@ -237,7 +239,10 @@ impl BranchModel {
         offs.dedup();
         let of = |ms: &Schedule| -> Vec<(u64, u16)> {
             (0..g.frame_slots)
-                .filter_map(|slot| ms.at(slot, b).map(|ch| (slot * g.slot_cycles, ch as u16)))
+                .filter_map(|slot| {
+                    ms.at(slot, b)
+                        .map(|ch| (slot * g.slot_cycles + ms.holdoff(b), ch as u16))
+                })
                 .collect()
         };
         let inst: Vec<Vec<(u64, u16)>> = if s.modes.is_empty() {
