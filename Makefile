@@ -70,10 +70,13 @@ GOLDEN_BACKEND ?= verilator
 # `cargo run` would build the binary a second time without the test-only
 # detector switch).
 GOLDEN_SLOTFORGE ?= $(CARGO) run --quiet --locked --bin slotforge --
+# The presets run side by side, one per core (each line of output names its
+# mix; a fresh Verilator cache builds one model per preset): the target fails
+# when any preset does, after all have run.
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 golden: tools
-	@for m in $(PRESETS); do \
-	  $(GOLDEN_SLOTFORGE) golden $$m --backend $(GOLDEN_BACKEND) || exit 1; \
-	done
+	@printf '%s\n' $(PRESETS) | xargs -P $(JOBS) -I{} \
+	  $(GOLDEN_SLOTFORGE) golden {} --backend $(GOLDEN_BACKEND)
 
 # Goldens change only through this command; review the diff like code.
 golden-update: tools

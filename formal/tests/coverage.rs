@@ -3,7 +3,7 @@
 //! harness's properties, on every preset, the test mixes and random mixes
 //! with and without a link.  No external tool: the harness only.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

@@ -3,7 +3,7 @@
 //! free in every cycle) or evaluates the triggers on the words it recorded
 //! (auto select: MISO free), each mode's own table from `Schedule::modes`.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::time::Instant;

@@ -13,7 +13,7 @@
 //! engines agree; the AXI4-Stream link over a slice and its payload and
 //! FIFO faults.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::time::Instant;

@@ -224,12 +224,26 @@ fn the_save_file_shows_every_port_the_waveform_has() {
 }
 
 /// Random mixes with mux-less branches run clean on every engine: the
-/// judge reads the pins of tops without those mux lanes.
+/// judge reads the pins of tops without those mux lanes. Icarus (the
+/// slowest engine, about half the test's time) runs the first mix here and
+/// every mix in `make test-long`.
 #[test]
 fn random_muxless_mixes_run_clean_on_every_engine() {
+    muxless_mixes_run_clean(1);
+}
+
+#[test]
+#[ignore = "make test-long: Icarus on every random mux-less mix, not only the first"]
+fn random_muxless_mixes_run_clean_on_every_engine_icarus_on_each() {
+    muxless_mixes_run_clean(usize::MAX);
+}
+
+/// Two random mux-less mixes on the model, RustHDL and Verilator, and the
+/// first `on_icarus` of them on Icarus too.
+fn muxless_mixes_run_clean(on_icarus: usize) {
     use engines::{Backend, SimOptions};
     let tools_there = tools::require_tools(&["verilator", "g++", "iverilog", "vvp"]);
-    for (seed, text, s) in muxless_random_mixes(2) {
+    for (i, (seed, text, s)) in muxless_random_mixes(2).into_iter().enumerate() {
         let r = run_dut(
             &s,
             &mut ModelDut::new(&s),
@@ -241,7 +255,10 @@ fn random_muxless_mixes_run_clean_on_every_engine() {
         assert!(r.ok, "seed {seed}:\n{text}\n{}", r.summary());
         let mut backends = vec![Backend::RustHdl];
         if tools_there {
-            backends.extend([Backend::Verilator, Backend::Icarus]);
+            backends.push(Backend::Verilator);
+            if i < on_icarus {
+                backends.push(Backend::Icarus);
+            }
         }
         for be in backends {
             let v = engines::run(&s, be, 2, &SimOptions::default()).unwrap();

@@ -1,8 +1,5 @@
-//! What the formal crate's test binaries share: the mixes, the emitted
+//! What the formal crate's test files share: the mixes, the emitted
 //! design, its edits and the reading of a failed proof.
-
-// Each test binary uses its own part of the kit.
-#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 

@@ -1,0 +1,11 @@
+//! All of this crate's integration tests in one binary: each test file is
+//! a module here, so the crate is linked once, not once per file.
+
+#[path = "modes.rs"]
+mod modes;
+
+#[path = "properties.rs"]
+mod properties;
+
+#[path = "reference.rs"]
+mod reference;
