@@ -30,3 +30,6 @@ mod modelink;
 
 #[path = "cnvlow.rs"]
 mod cnvlow;
+
+#[path = "holdoff.rs"]
+mod holdoff;

@@ -375,7 +375,11 @@ impl<D: Dut> FaultyDut<D> {
             PinFault::SclkSlow { .. } => r_slow + spi.quiet_cycles + 1,
             _ => 0,
         };
+        // a sync group's hold-off moves the branch's whole conversion (CS,
+        // SCLK, words, mux switch) after its slot tick: the fault with it
+        let h = s.holdoff(b);
         let (prev, t) = target_instant(s, b, at, need);
+        let (prev, t) = (prev.saturating_add(h), t.saturating_add(h));
         let (hist_len, shift) = match fault {
             PinFault::ConversionMoved { .. } => ((slot + spi.read_cycles + 2) as usize, slot),
             PinFault::SclkSlow { .. } => ((r_slow + 2) as usize, r_slow),
