@@ -125,14 +125,23 @@ impl Row {
     /// `{act, lead, en0, sel0, en1, sel1}` as a Verilog constant.
     fn verilog(&self, chb: u32, en_n: u32) -> String {
         let (act, lead) = self.lead.map_or((0, 0), |l| (1, l));
-        let en = |d: u8| 1u128 << d;
         let ((d0, s0), (d1, s1)) = (self.mux0, self.mux1);
         format!(
-            "{{1'b{act}, {chb}'d{lead}, {en_n}'d{}, 3'd{s0}, {en_n}'d{}, 3'd{s1}}}",
-            en(d0),
-            en(d1)
+            "{{1'b{act}, {chb}'d{lead}, {}, 3'd{s0}, {}, 3'd{s1}}}",
+            en_const(d0, en_n),
+            en_const(d1, en_n)
         )
     }
+}
+
+/// Device `d`'s enable as an `en_n`-bit constant.  A branch without mux
+/// pins (an internal mux: one enable bit, never compared) may number its
+/// inputs past the first device; its bits beyond `en_n` are dropped here,
+/// as Verilog would drop them, so the constant fits its width.
+pub(crate) fn en_const(d: u8, en_n: u32) -> String {
+    let mask = 1u128.checked_shl(en_n).map_or(u128::MAX, |m| m - 1);
+    let v = 1u128.checked_shl(u32::from(d)).unwrap_or(0) & mask;
+    format!("{en_n}'d{v}")
 }
 
 /// Branch `b`'s row for every slot of the frame.

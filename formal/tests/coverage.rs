@@ -33,7 +33,7 @@ const AXIS: &str = "kind = \"axis\"\ntlast = \"slice\"\nready_within = 8";
 
 /// Every preset and test mix as it is, and each without a link given a
 /// UART and an AXI4-Stream link; random mixes the same way.
-fn mixes() -> Vec<(String, lut_gen::Schedule)> {
+pub(crate) fn mixes() -> Vec<(String, lut_gen::Schedule)> {
     let mut texts = Vec::new();
     for dir in ["mixes", "testkit/mixes"] {
         let mut files: Vec<PathBuf> = std::fs::read_dir(root().join(dir))

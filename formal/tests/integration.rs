@@ -12,3 +12,6 @@ mod prove;
 
 // Shared by the test files (one copy in this binary).
 mod common;
+
+#[path = "harness_lint.rs"]
+mod harness_lint;

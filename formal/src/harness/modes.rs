@@ -208,7 +208,7 @@ pub(super) fn mux(v: &mut String, s: &Schedule, b: usize, mr: &ModeRows, en_n: u
     let w = en_n + 3;
     let cst = |f: Option<(u8, u8)>| {
         let (d, sel) = f.unwrap_or((0, 0));
-        format!("{{{en_n}'d{}, 3'd{sel}}}", 1u128 << d)
+        format!("{{{}, 3'd{sel}}}", super::en_const(d, en_n))
     };
     let hold = mr.first.iter().any(|f| f.is_none());
     let _ = writeln!(v, "  reg [{}:0] nf{b};\n  reg nu{b}, cu{b};", w - 1);

@@ -85,13 +85,11 @@ pub(super) fn monitor(
     let _ = writeln!(
         v,
         "  wire hbnd = head[{}], hsmp = head[{}];\n  \
-         wire [15:0] hch = {{{}'d0, head[{}:{lo_ch}]}};\n  wire [15:0] hval = {{{}'d0, head[{}:{lo_val}]}};",
+         wire [15:0] hch = {};\n  wire [15:0] hval = {};",
         ew - 1,
         ew - 2,
-        16 - chb,
-        lo_ch + chb - 1,
-        16 - vb,
-        vb - 1,
+        to16(&format!("head[{}:{lo_ch}]", lo_ch + chb - 1), chb),
+        to16(&format!("head[{}:{lo_val}]", vb - 1), vb),
     );
     let field = if mb > 0 {
         format!(
@@ -171,4 +169,13 @@ pub(super) fn monitor(
             }
         ),
     });
+}
+
+/// `bits` of `expr` zero-extended to a record's 16-bit field (a 16-bit
+/// code as it is: Verilog has no zero-width constant).
+fn to16(expr: &str, bits: u32) -> String {
+    match 16 - bits {
+        0 => expr.to_string(),
+        pad => format!("{{{pad}'d0, {expr}}}"),
+    }
 }
