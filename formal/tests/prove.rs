@@ -758,8 +758,8 @@ fn tiny_uart() -> lut_gen::Schedule {
 
 /// A UART mix's proof reads the line (`link.bytes`, `link.packets`): the
 /// clean gateware proves the whole contract, the link's bytes for all time
-/// too (this 4,000-cycle frame's state comes round when the frame counters
-/// do, after 256 frames), so the fault campaign takes it as the excuse
+/// too (the frame counters generalised at frame starts: the state comes
+/// round after a few frames, not 256), so the fault campaign takes it as the excuse
 /// "contract proved"; a gateware whose `link_tx` is stuck high fails
 /// `link.packets` (its tokens pile up in the harness's queue) and is
 /// never excused.
@@ -774,6 +774,7 @@ fn a_uart_proof_reads_the_line_and_a_stuck_line_fails() {
     let p = prove(&s, &clean, dir.path());
     assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
     assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    assert!(p.depth < 20 * s.grid.frame_cycles, "{}", p.summary());
     for name in ["link.bytes", "link.packets"] {
         assert!(
             p.properties
