@@ -324,8 +324,8 @@ fn link_mutants_fail_where_check_does(mix: &std::path::Path, dir: &std::path::Pa
         ),
         (
             "slice",
-            "4'd7: byte_out = {4'd0, hslice[3:0]};",
-            "4'd7: byte_out = {4'd0, hslice[3:0] ^ 4'd1};",
+            "4'd7: byte_out = {",
+            "4'd7: byte_out = 8'd1 ^ {",
             "link.packets",
         ),
         (

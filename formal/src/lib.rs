@@ -260,15 +260,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     let work = work_dir()?;
     let (result, depth, note) = match decided {
         Some(g) => (g.run.result, g.run.depth, g.run.note.clone()),
-        None => {
-            write_inputs(work.path(), &main, design)?;
-            let prep = engine::prepare(work.path(), opts.solver)?;
-            match opts.solver {
-                Solver::Symbolic => symbolic(&prep, f, harness::auto_frames(s), opts)?,
-                Solver::Abc => strategy::abc(&prep, f, opts)?,
-                Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work.path(), f, opts)?,
-            }
-        }
+        None => main_run(s, &main, design, work.path(), opts)?,
     };
     let mut not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
     not_covered.extend(harness::bounded_modes(s, result, depth));
@@ -297,20 +289,9 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         .map(|(_, c)| c.clone())
         .unwrap_or_default();
     let note = match &bytes {
-        Some(b) if b.result == Outcome::Failed => b.note.clone(),
-        // the whole harness proved at once: its note is the proof's
-        Some(_) if whole => scoped_note(result, note, not_covered.len()),
-        Some(b) if result == Outcome::Bounded && main_result == Outcome::Proved => format!(
-            "NOT a proof of the link's bytes: {}; every other property: {}",
-            b.note,
-            scoped_note(main_result, note, not_covered.len())
-        ),
-        Some(b) => format!(
-            "{}; {}",
-            scoped_note(result, note, not_covered.len()),
-            b.note
-        ),
-        None => scoped_note(result, note, not_covered.len()),
+        Some(b) if !whole => joined_note(b, (main_result, result), note, not_covered.len()),
+        // the whole harness at once: its note is the proof's
+        _ => scoped_note(result, note, not_covered.len()),
     };
     let solver_seconds = t1.elapsed().as_secs_f64();
     let bytes_result = bytes.as_ref().map_or(result, |b| b.result);
@@ -368,6 +349,44 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         counterexample,
         cycle,
     })
+}
+
+/// The harness without the link's bytes (`main`) on `design` by the
+/// chosen engine.
+fn main_run(
+    s: &Schedule,
+    main: &Harness,
+    design: &str,
+    work: &Path,
+    opts: &ProveOptions,
+) -> Result<(Outcome, u64, String), ProveError> {
+    write_inputs(work, main, design)?;
+    let prep = engine::prepare(work, opts.solver)?;
+    let f = main.frame_cycles;
+    match opts.solver {
+        Solver::Symbolic => symbolic(&prep, f, harness::auto_frames(s), opts),
+        Solver::Abc => strategy::abc(&prep, f, opts),
+        Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work, f, opts),
+    }
+}
+
+/// The note of a proof whose link's bytes (`b`) ran apart from the rest
+/// (`note`, whose result was `main`; the proof's is `result`).
+fn joined_note(
+    b: &BytesRun,
+    (main, result): (Outcome, Outcome),
+    note: String,
+    uncovered: usize,
+) -> String {
+    match (b.result, result) {
+        (Outcome::Failed, _) => b.note.clone(),
+        (_, Outcome::Bounded) if main == Outcome::Proved => format!(
+            "NOT a proof of the link's bytes: {}; every other property: {}",
+            b.note,
+            scoped_note(main, note, uncovered)
+        ),
+        _ => format!("{}; {}", scoped_note(result, note, uncovered), b.note),
+    }
 }
 
 /// The properties that read the link's bytes, searched apart ([`link_bytes`]).
@@ -511,7 +530,7 @@ struct GeneralRun {
 /// Frames from reset the generalised run may simulate before it gives up
 /// (bounded): start-up, the frame before the first generalisation, and
 /// the periods of what else comes round (a FIFO's pointers).
-const GENERAL_FRAMES: u64 = 12;
+const GENERAL_FRAMES: u64 = DEEP_FRAMES + 1;
 
 /// The whole harness `h` (every property, the link's bytes too) by the
 /// symbolic engine from reset, with the design's frame counter
