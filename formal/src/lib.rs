@@ -528,19 +528,20 @@ struct GeneralRun {
 }
 
 /// Frames from reset the generalised run may simulate before it gives up
-/// (bounded): start-up, the frame before the first generalisation, and
-/// the periods of what else comes round (a FIFO's pointers).
+/// (bounded; the search of before then runs): as many as the plain run
+/// may take to come round, and one more.
 const GENERAL_FRAMES: u64 = DEEP_FRAMES + 1;
 
 /// The whole harness `h` (every property, the link's bytes too) by the
 /// symbolic engine from reset, with the design's frame counter
 /// (`opts.frame_counter`) and the harness's generalised at every frame
-/// start from the second on (`symsim::prove_generalised`): the state then
+/// start from the first on, step 2 (`symsim::prove_generalised`): the state then
 /// comes round after a few frames instead of 256.  `None` when it does
 /// not apply: another engine, modes (their runs are split), no counter of
-/// that name in the design.  A violation before the first generalisation
-/// is a trace from reset (`Failed`); a later one, or a state that does not
-/// come round, is `Bounded` and the caller searches as before.
+/// that name in the design.  A violation in the frame after the first
+/// generalisation that holds with the count pinned to its real value is a
+/// trace from reset (`Failed`); any other, or a state that does not come
+/// round, is `Bounded` and the caller searches as before.
 fn link_generalised(
     s: &Schedule,
     h: &Harness,

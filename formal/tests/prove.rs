@@ -818,11 +818,11 @@ fn a_uart_proof_reads_the_line_and_a_stuck_line_fails() {
 /// frame counters generalised (the default) and without, where this
 /// 4,000-cycle frame's 258 frames are simulated exactly (the truth for
 /// all time).  The generalised proof never claims more: proved only if
-/// the exact one proves, failed at the same cycle as the exact one (a
-/// trace from reset), and bounded (the link's bytes named as not covered)
-/// where it cannot tell.
+/// the exact one proves, failed no later than the exact one with a trace
+/// from reset the judge rejects at its cycle, and bounded (the link's
+/// bytes named as not covered) where it cannot tell.
 #[test]
-#[ignore = "long: make test-long (two proofs of each of 22 link mutants)"]
+#[ignore = "long: make test-long (two proofs of each of some 40 link mutants)"]
 fn generalised_frame_counters_agree_with_the_exact_search_on_link_mutants() {
     if !tools::require_tools(&TOOLS) {
         return;
@@ -874,9 +874,20 @@ fn generalised_frame_counters_agree_with_the_exact_search_on_link_mutants() {
                 assert!(general.not_covered.is_empty(), "{what}");
                 agree += 1;
             }
+            // the whole harness at once finds the earliest violation of any
+            // property; the search of before, the first of the rest (then
+            // it never reads the line): never later, and a trace from reset
             Outcome::Failed => {
                 assert_eq!(exact.result, Outcome::Failed, "{what}: {}", exact.summary());
-                assert_eq!(general.cycle, exact.cycle, "{what}");
+                assert!(
+                    general.cycle <= exact.cycle,
+                    "{what}: {}",
+                    general.summary()
+                );
+                let c = general.counterexample.as_ref().unwrap();
+                if c.reproduced && c.cycle >= 0 {
+                    assert_eq!(c.check_cycle, Some(c.cycle as u64), "{what}");
+                }
                 agree += 1;
             }
             // not a claim: the exact search may prove what a generalised
