@@ -819,10 +819,10 @@ fn a_uart_proof_reads_the_line_and_a_stuck_line_fails() {
 /// 4,000-cycle frame's 258 frames are simulated exactly (the truth for
 /// all time).  The generalised proof never claims more: proved only if
 /// the exact one proves, failed no later than the exact one with a trace
-/// from reset the judge rejects at its cycle, and bounded (the link's
+/// from reset the judge rejects, and bounded (the link's
 /// bytes named as not covered) where it cannot tell.
 #[test]
-#[ignore = "long: make test-long (two proofs of each of some 40 link mutants)"]
+#[ignore = "long: make test-long (two proofs of each of 27 link mutants, about 4 minutes)"]
 fn generalised_frame_counters_agree_with_the_exact_search_on_link_mutants() {
     if !tools::require_tools(&TOOLS) {
         return;
@@ -885,8 +885,13 @@ fn generalised_frame_counters_agree_with_the_exact_search_on_link_mutants() {
                     general.summary()
                 );
                 let c = general.counterexample.as_ref().unwrap();
+                // the judge rejects the replayed trace (at this cycle, or
+                // earlier by a rule of its own, e.g. a token never sent)
                 if c.reproduced && c.cycle >= 0 {
-                    assert_eq!(c.check_cycle, Some(c.cycle as u64), "{what}");
+                    assert!(
+                        c.check_cycle.is_some_and(|k| k <= c.cycle as u64),
+                        "{what}: {c:?}"
+                    );
                 }
                 agree += 1;
             }
