@@ -29,6 +29,7 @@ mod uart;
 pub use contract::{contract, not_covered, Clause};
 pub use link::{LinkBytes, TREADY_ANY};
 pub(crate) use modes::{auto_frames, bounded_modes, MODE_SEL};
+pub(crate) use packets::FRAME_COUNTER;
 
 /// The module name of the harness.
 pub const HARNESS_MODULE: &str = "slotforge_formal";

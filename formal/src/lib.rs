@@ -37,7 +37,9 @@ pub use engine::{bmc, prepare, Prepared, Solver, SolverVerdict};
 
 // The default engine on its own (symbolic simulation of an AIGER graph).
 pub use aiger::{parse as parse_aiger, Aig};
-pub use symsim::{prove as prove_aig, Found, SymStats};
+pub use symsim::{
+    prove as prove_aig, prove_generalised, CounterFailure, Counters, Found, SymStats,
+};
 
 // A counterexample's replay, and the faults that only a proof finds.
 pub use faults::DeepFault;
@@ -190,6 +192,13 @@ pub struct ProveOptions {
     /// (reported as [`Proof::netlist`]), and what proving it leaves out
     /// (the models stand for the silicon, no timing): `netlist_caveats`.
     pub netlist: Option<(String, Vec<String>)>,
+    /// The design's packet frame counter, the register's path under
+    /// `slotforge_top` (`hdl::LINK_FRAME_COUNTER` for slotforge's gateware):
+    /// the symbolic engine generalises it with the harness's own count at
+    /// frame starts (`link_generalised`), so a UART's bytes are proved
+    /// without simulating 256 frames.  `None`, or a name the design does
+    /// not have: the link's bytes are searched as before.
+    pub frame_counter: Option<String>,
 }
 
 impl ProveOptions {
@@ -202,6 +211,7 @@ impl ProveOptions {
             out_dir: out_dir.into(),
             own_design: true,
             netlist: None,
+            frame_counter: None,
         }
     }
 }
@@ -235,28 +245,43 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     } else {
         h.clone()
     };
-    let work = work_dir()?;
-    write_inputs(work.path(), &main, design)?;
-    let prep = engine::prepare(work.path(), opts.solver)?;
     let t1 = Instant::now();
     let f = h.frame_cycles;
-    let (result, depth, note) = match opts.solver {
-        Solver::Symbolic => symbolic(&prep, f, harness::auto_frames(s), opts)?,
-        Solver::Abc => strategy::abc(&prep, f, opts)?,
-        Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work.path(), f, opts)?,
+    // the whole harness with the frame counters generalised: when it
+    // decides (proved, or a trace from reset), it is the only run
+    let general = match reads_bytes {
+        true => link_generalised(s, &h, design, opts)?,
+        false => None,
+    };
+    let decided = general
+        .as_ref()
+        .filter(|g| g.run.result != Outcome::Bounded);
+    let whole = decided.is_some();
+    let work = work_dir()?;
+    let (result, depth, note) = match decided {
+        Some(g) => (g.run.result, g.run.depth, g.run.note.clone()),
+        None => main_run(s, &main, design, work.path(), opts)?,
     };
     let mut not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
     not_covered.extend(harness::bounded_modes(s, result, depth));
-    let bytes = match (reads_bytes, result) {
-        (true, Outcome::Proved) => Some(link_bytes(&h, design, f, harness::auto_frames(s), opts)?),
+    let failure = general.as_ref().and_then(|g| g.failure.clone());
+    // the generalised run found a state whose bytes fail: not a proof
+    let suspect = general.as_ref().is_some_and(|g| g.suspect);
+    let bytes = match (general, reads_bytes, result) {
+        (Some(g), _, _) if g.run.result != Outcome::Bounded => Some(g.run),
+        (_, true, Outcome::Proved) => Some(
+            link_bytes(&h, design, f, harness::auto_frames(s), opts)?.tried(failure.as_deref()),
+        ),
         _ => None,
     };
+    let main_result = result;
     let (result, depth) = match &bytes {
         Some(b) if b.result == Outcome::Failed => (Outcome::Failed, b.depth),
+        Some(b) if suspect && b.result == Outcome::Bounded => (Outcome::Bounded, b.depth),
         _ => (result, depth),
     };
     if let Some(b) = bytes.as_ref().filter(|b| b.result == Outcome::Bounded) {
-        not_covered.push(bounded_bytes_sentence(b.depth, f));
+        not_covered.push(bounded_bytes_sentence(b.depth, f, failure.as_deref()));
     }
     let netlist_caveats = opts
         .netlist
@@ -264,13 +289,9 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         .map(|(_, c)| c.clone())
         .unwrap_or_default();
     let note = match &bytes {
-        Some(b) if b.result == Outcome::Failed => b.note.clone(),
-        Some(b) => format!(
-            "{}; {}",
-            scoped_note(result, note, not_covered.len()),
-            b.note
-        ),
-        None => scoped_note(result, note, not_covered.len()),
+        Some(b) if !whole => joined_note(b, (main_result, result), note, not_covered.len()),
+        // the whole harness at once: its note is the proof's
+        _ => scoped_note(result, note, not_covered.len()),
     };
     let solver_seconds = t1.elapsed().as_secs_f64();
     let bytes_result = bytes.as_ref().map_or(result, |b| b.result);
@@ -282,15 +303,21 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
             result: if LINK_BYTES.contains(&p.name.as_str()) {
                 bytes_result
             } else {
-                result
+                main_result
             },
             what: p.what.clone(),
         })
         .collect();
     let counterexample = if result == Outcome::Failed {
+        let main_prep;
         let (h, prep, work) = match &bytes {
             Some(b) if b.result == Outcome::Failed => (&h, &b.prep, b.work.path()),
-            _ => (&main, &prep, work.path()),
+            _ => {
+                main_prep = engine::Prepared {
+                    dir: work.path().to_path_buf(),
+                };
+                (&main, &main_prep, work.path())
+            }
         };
         let failure = Failure {
             s,
@@ -322,6 +349,44 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         counterexample,
         cycle,
     })
+}
+
+/// The harness without the link's bytes (`main`) on `design` by the
+/// chosen engine.
+fn main_run(
+    s: &Schedule,
+    main: &Harness,
+    design: &str,
+    work: &Path,
+    opts: &ProveOptions,
+) -> Result<(Outcome, u64, String), ProveError> {
+    write_inputs(work, main, design)?;
+    let prep = engine::prepare(work, opts.solver)?;
+    let f = main.frame_cycles;
+    match opts.solver {
+        Solver::Symbolic => symbolic(&prep, f, harness::auto_frames(s), opts),
+        Solver::Abc => strategy::abc(&prep, f, opts),
+        Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work, f, opts),
+    }
+}
+
+/// The note of a proof whose link's bytes (`b`) ran apart from the rest
+/// (`note`, whose result was `main`; the proof's is `result`).
+fn joined_note(
+    b: &BytesRun,
+    (main, result): (Outcome, Outcome),
+    note: String,
+    uncovered: usize,
+) -> String {
+    match (b.result, result) {
+        (Outcome::Failed, _) => b.note.clone(),
+        (_, Outcome::Bounded) if main == Outcome::Proved => format!(
+            "NOT a proof of the link's bytes: {}; every other property: {}",
+            b.note,
+            scoped_note(main, note, uncovered)
+        ),
+        _ => format!("{}; {}", scoped_note(result, note, uncovered), b.note),
+    }
 }
 
 /// The properties that read the link's bytes, searched apart ([`link_bytes`]).
@@ -427,15 +492,190 @@ fn link_bytes(
     })
 }
 
-/// What a bounded search of the link's bytes leaves out.
-fn bounded_bytes_sentence(depth: u64, f: u64) -> String {
+impl BytesRun {
+    /// A bounded search's note says why the generalised run (tried first)
+    /// did not prove it, when it was tried.
+    fn tried(mut self, failure: Option<&str>) -> BytesRun {
+        if let (Outcome::Bounded, Some(why)) = (self.result, failure) {
+            self.note = format!("{}; {why}", self.note);
+        }
+        self
+    }
+}
+
+/// What a bounded search of the link's bytes leaves out (`failure`: why
+/// generalising the frame counters did not prove them, when tried).
+fn bounded_bytes_sentence(depth: u64, f: u64, failure: Option<&str>) -> String {
     format!(
         "the link's bytes (link.bytes, link.packets) after cycle {}: they were searched from \
-         reset for {:.0} frames only (bounded), not proved for all time; the packets' 8-bit \
-         frame counter brings the state round only after 256 frames",
+         reset for {:.0} frames only (bounded), not proved for all time; {}",
         depth.saturating_sub(2),
-        depth.saturating_sub(2) as f64 / f as f64
+        depth.saturating_sub(2) as f64 / f as f64,
+        failure.unwrap_or(
+            "the packets' 8-bit frame counter brings the state round only after 256 frames"
+        )
     )
+}
+
+/// The run of the whole harness with the packets' frame counters
+/// generalised, and why it did not prove, if it did not.
+struct GeneralRun {
+    run: BytesRun,
+    failure: Option<String>,
+    /// It failed on a state it reached (a count whose bytes fail, counters
+    /// that differ), not for want of time: `prove` is then not a proof.
+    suspect: bool,
+}
+
+/// Frames from reset the generalised run may simulate before it gives up
+/// (bounded; the search of before then runs): as many as the plain run
+/// may take to come round, and one more.
+const GENERAL_FRAMES: u64 = DEEP_FRAMES + 1;
+
+/// The whole harness `h` (every property, the link's bytes too) by the
+/// symbolic engine from reset, with the design's frame counter
+/// (`opts.frame_counter`) and the harness's generalised at every frame
+/// start from the first on, step 2 (`symsim::prove_generalised`): the state then
+/// comes round after a few frames instead of 256.  `None` when it does
+/// not apply: another engine, modes (their runs are split), no counter of
+/// that name in the design.  A violation in the frame after the first
+/// generalisation that holds with the count pinned to its real value is a
+/// trace from reset (`Failed`); any other, or a state that does not come
+/// round, is `Bounded` and the caller searches as before.
+fn link_generalised(
+    s: &Schedule,
+    h: &Harness,
+    design: &str,
+    opts: &ProveOptions,
+) -> Result<Option<GeneralRun>, ProveError> {
+    let modes = !s.modes.is_empty() || h.inputs.iter().any(|i| i.name == harness::MODE_SEL);
+    let name = match (&opts.frame_counter, opts.solver) {
+        (Some(n), Solver::Symbolic) if !modes && opts.depth.is_none() => n,
+        _ => return Ok(None),
+    };
+    let work = work_dir()?;
+    write_inputs(work.path(), h, design)?;
+    let prep = engine::prepare(work.path(), Solver::Symbolic)?;
+    let Some(pairs) = counter_pairs(&prep, &format!("dut.{name}"), harness::FRAME_COUNTER) else {
+        return Ok(None);
+    };
+    let text = std::fs::read_to_string(prep.dir.join("design.aag"))
+        .map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
+    let g = aiger::parse(&text).map_err(|e| ProveError::Tool(format!("design.aag: {e}")))?;
+    if !g.constraints.is_empty() {
+        return Ok(None);
+    }
+    let f = h.frame_cycles;
+    let counters = symsim::Counters { pairs, from: 2 };
+    let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
+    let limit = GENERAL_FRAMES * f + 2;
+    let (found, st) = symsim::prove_generalised(&g, counters, f, 2, limit, Some(deadline));
+    let what = format!(
+        "the frame counters ({name} and the harness's {})",
+        harness::FRAME_COUNTER
+    );
+    let (result, depth, note, failure) = match found {
+        symsim::Found::Violated { step, inputs } => {
+            std::fs::write(prep.dir.join("cex.aiw"), symsim::witness_text(&g, &inputs))
+                .map_err(|e| ProveError::Tool(format!("cex.aiw: {e}")))?;
+            let note = format!(
+                "a trace from reset violates the contract at step {step} (cycle {})",
+                step as i64 - 2
+            );
+            (Outcome::Failed, step, note, None)
+        }
+        symsim::Found::Proved { steps, since } => {
+            let note = general_note(&g, &st, &what, steps, since, f);
+            (Outcome::Proved, steps, note, None)
+        }
+        symsim::Found::Bounded { steps } => {
+            let why = counter_failure(st.counter_failure, &what, limit, opts.timeout_s);
+            (Outcome::Bounded, steps, why.clone(), Some(why))
+        }
+    };
+    Ok(Some(GeneralRun {
+        run: BytesRun {
+            result,
+            depth,
+            note,
+            prep,
+            work,
+        },
+        failure,
+        suspect: st.counter_failure.is_some(),
+    }))
+}
+
+/// The note of a proof with generalised frame counters.
+fn general_note(g: &Aig, st: &SymStats, what: &str, steps: u64, since: u64, f: u64) -> String {
+    let from = st.generalised.unwrap_or(since);
+    format!(
+        "{PROVED}: every step from reset to step {from} simulated exactly with every free \
+         input bit a variable of its step (MISO; {} latches, {} gates; {} satisfiability \
+         checks); from there, at each frame start, {what}, shown equal in every state, are \
+         replaced by one free 8-bit value, so the states simulated from it include every \
+         state reachable there; the state at step {steps}, so generalised, is the one at step \
+         {since} with every input {} frame(s) later, so those steps reach every reachable \
+         state, the link's bytes ({}) included (symbolic simulation with the frame counter \
+         generalised: an inductive invariant, checked)",
+        g.latches.len(),
+        g.ands.len(),
+        st.sat_calls,
+        (steps - since) / f,
+        LINK_BYTES.join(", "),
+    )
+}
+
+/// Why the generalised run did not prove, in words.
+fn counter_failure(
+    failure: Option<symsim::CounterFailure>,
+    what: &str,
+    limit: u64,
+    timeout_s: u64,
+) -> String {
+    match failure {
+        Some(symsim::CounterFailure::Violated { step, count }) => format!(
+            "with {what} generalised (one free value at frame starts), an assertion fails at \
+             step {step} from a frame start whose count is {count}: the link's bytes are not \
+             proved for every count (a state no search from reset reached, so no \
+             counterexample is claimed)"
+        ),
+        Some(symsim::CounterFailure::Unequal { step, count }) => format!(
+            "{what} are not equal in every state at the frame start of step {step}{}, so the \
+             link's bytes are not proved for every count",
+            count.map_or(String::new(), |c| format!(
+                " (after a frame that started at count {c}, a state no search from reset reached)"
+            ))
+        ),
+        None => format!(
+            "with {what} generalised, the state did not come round within {limit} steps or \
+             {timeout_s} s"
+        ),
+    }
+}
+
+/// The AIG latches of the design's counter `design` and the harness's
+/// `harness` (yosys's map), bit by bit; `None` unless both are there with
+/// the same width.
+fn counter_pairs(
+    prep: &engine::Prepared,
+    design: &str,
+    harness: &str,
+) -> Option<Vec<(usize, usize)>> {
+    let aim = std::fs::read_to_string(prep.dir.join("design.aim")).ok()?;
+    let bits = |name: &str| -> Option<Vec<usize>> {
+        let mut by_bit: std::collections::BTreeMap<usize, usize> = Default::default();
+        for l in aim.lines() {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            if f.len() == 4 && f[0] == "latch" && f[3] == name {
+                by_bit.insert(f[2].parse().ok()?, f[1].parse().ok()?);
+            }
+        }
+        let n = by_bit.len();
+        (n > 0 && by_bit.keys().copied().eq(0..n)).then(|| by_bit.into_values().collect())
+    };
+    let (d, h) = (bits(design)?, bits(harness)?);
+    (d.len() == h.len()).then(|| d.into_iter().zip(h).collect())
 }
 
 /// How every engine's note for a proof begins.

@@ -22,6 +22,7 @@ fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
 fn prove_to(s: &lut_gen::Schedule, design: &str, out: &Path, depth: Option<u64>) -> Proof {
     let mut o = ProveOptions::new(out);
     o.depth = depth;
+    o.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
     let t = Instant::now();
     let p = formal::prove(s, design, &o).expect("prove runs");
     eprintln!(

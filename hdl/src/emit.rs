@@ -23,6 +23,13 @@ const CORE: &str = "slotforge_core";
 /// Name of the link stage's module (a mix with a `[link]` only).
 const LINK: &str = "slotforge_link";
 
+/// The packets' frame counter in the emitted Verilog: the register's path
+/// under `slotforge_top` (the instance `link` of [`LINK`], its `hframe`).
+/// `prove` generalises it with its harness's own count (`formal`), so the
+/// link's bytes are proved without simulating the 256 frames it needs to
+/// come round; a name that no longer matches only costs that.
+pub const LINK_FRAME_COUNTER: &str = "link.hframe";
+
 /// The emitted Verilog file.
 pub const VERILOG_FILE: &str = "slotforge_top.v";
 /// The emitted port manifest.

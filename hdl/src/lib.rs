@@ -33,7 +33,9 @@ mod stock;
 mod widths;
 
 pub use board::{stock_board, Board};
-pub use emit::{emit, emit_with, verilog_pair, Emitted, MANIFEST_FILE, VERILOG_FILE};
+pub use emit::{
+    emit, emit_with, verilog_pair, Emitted, LINK_FRAME_COUNTER, MANIFEST_FILE, VERILOG_FILE,
+};
 pub use fault::GatewareFault;
 pub use fusesoc::{vlnv, CORE_FILE, LAUNCHER_FILE};
 pub use plan::{

@@ -66,8 +66,9 @@ pub fn proof(s: &Schedule, out: &Path) -> Result<ShownProof, String> {
     if let Some(p) = remembered(&dirs, &key, uncovered) {
         return Ok(shown(p, true));
     }
-    let p =
-        formal::prove(s, &design, &ProveOptions::new(out.join(DIR))).map_err(|e| e.to_string())?;
+    let mut opts = ProveOptions::new(out.join(DIR));
+    opts.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
+    let p = formal::prove(s, &design, &opts).map_err(|e| e.to_string())?;
     for d in &dirs {
         formal::cache::store(d, &key, &p)?;
     }

@@ -125,6 +125,10 @@ pub fn run(a: Args) -> u8 {
     opts.bmc_timeout_s = a.timeout;
     opts.depth = a.depth;
     opts.own_design = own;
+    // slotforge's gateware names it so; an --rtl design that does too gets
+    // the same generalisation (checked, so a name that means otherwise only
+    // leaves the search as it was)
+    opts.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
     opts.netlist = netlist.map(|n| (n.fpga.name().to_string(), n.not_covered()));
     let proof = match formal::prove(&s, &design, &opts) {
         Ok(mut p) => {

@@ -23,6 +23,11 @@ use lut_gen::{Layout, Schedule};
 
 use super::{width, Clause, PropertyDef};
 
+/// The harness's frame counter (the header's second byte), an 8-bit
+/// register of the harness module: `prove` generalises it with the
+/// design's (`ProveOptions::frame_counter`).
+pub(crate) const FRAME_COUNTER: &str = "efc";
+
 /// Tokens the harness's queue holds beyond the link's FIFO depth: the one
 /// the serializer holds, the one whose last byte the line still carries
 /// (the harness lets a token go at its last byte's eighth data bit), and

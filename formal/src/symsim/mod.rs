@@ -39,9 +39,11 @@ mod cases;
 mod cone;
 mod eval;
 mod explicit;
+mod generalise;
 mod graph;
 mod induction;
 mod split;
+pub use generalise::{CounterFailure, Counters};
 use graph::Graph;
 #[cfg(test)]
 use graph::VAR;
@@ -84,6 +86,11 @@ pub struct SymStats {
     /// A run split on registers' values at frame starts (`cases.rs`): the
     /// paths those splits made.
     pub cases: u64,
+    /// A run with generalised counters (`generalise.rs`): the first step
+    /// they were generalised at (the exact search from reset ends there).
+    pub generalised: Option<u64>,
+    /// Why such a run did not close, if it did not.
+    pub counter_failure: Option<CounterFailure>,
 }
 
 /// Steps between the checks of the assertions that did not fold (one SAT
@@ -259,6 +266,32 @@ fn combine(results: Vec<Found>) -> Found {
     }
 }
 
+/// [`prove`] without choices or splits, with `counters` generalised at
+/// every frame start from `counters.from` (`generalise.rs`): proved when a
+/// generalised frame start's state comes round; a violation is a trace from
+/// reset only before the first generalisation (later: `Bounded` at it, the
+/// count that failed in the stats).
+pub fn prove_generalised(
+    g: &Aig,
+    counters: Counters,
+    period: u64,
+    offset: u64,
+    max_steps: u64,
+    deadline: Option<Instant>,
+) -> (Found, SymStats) {
+    let lim = Limits {
+        period,
+        offset,
+        max_steps,
+        deadline,
+    };
+    let mut sim = Sim::new(g);
+    sim.counters = Some(counters);
+    let (f, mut st) = sim.run(&lim);
+    st.parts = [1, 0, 0];
+    (f, st)
+}
+
 /// Where a run stops and compares.
 #[derive(Clone, Copy)]
 struct Limits {
@@ -297,6 +330,15 @@ struct Sim<'a> {
     /// inputs that every state of the path satisfies.
     split_cases: bool,
     cond: Vec<u32>,
+    /// Counters generalised at frame starts (`generalise.rs`), and the
+    /// first step they were: no violation from there on is a trace.
+    counters: Option<Counters>,
+    generalised: Option<u64>,
+    /// How many frame starts generalised them, and the counter's literals
+    /// the first replaced (a violation in the frame after is pinned to them).
+    generalisations: u32,
+    pinned: Vec<u32>,
+    pinned_vars: Vec<u32>,
 }
 
 impl<'a> Sim<'a> {
@@ -347,14 +389,32 @@ impl<'a> Sim<'a> {
             queue: Default::default(),
             split_cases: false,
             cond: Vec::new(),
+            counters: None,
+            generalised: None,
+            generalisations: 0,
+            pinned: Vec::new(),
+            pinned_vars: Vec::new(),
         }
     }
 
     /// Runs to a verdict, `lim.max_steps` or the deadline.
-    fn run(mut self, lim: &Limits) -> (Found, SymStats) {
+    fn run(self, lim: &Limits) -> (Found, SymStats) {
         if !self.splits.is_empty() || self.split_cases {
             return self.run_split(lim);
         }
+        let (found, stats) = self.run_plain(lim);
+        // with generalised counters, the exact search ends where they were
+        let found = match (found, stats.generalised) {
+            (Found::Bounded { steps }, Some(g)) => Found::Bounded {
+                steps: steps.min(g),
+            },
+            (f, _) => f,
+        };
+        (found, stats)
+    }
+
+    /// [`Sim::run`] without splits.
+    fn run_plain(mut self, lim: &Limits) -> (Found, SymStats) {
         self.deadline = lim.deadline;
         // every boundary's state, canonical: a state equal to an earlier
         // boundary's closes the search (a FIFO's pointers may need several
@@ -395,6 +455,9 @@ impl<'a> Sim<'a> {
         lim: &Limits,
         seen: &mut HashMap<Vec<u64>, u64>,
     ) -> Option<Found> {
+        if let Err(found) = self.generalise(step) {
+            return Some(found);
+        }
         let now = self.gr.canonical(&self.state, step as u32);
         if let Some(&since) = seen.get(&now) {
             self.stats.state_nodes = live_nodes(&self.gr, &self.state);
@@ -445,7 +508,10 @@ impl<'a> Sim<'a> {
             self.stats.sat_calls += 1;
             let bad = self.gr.and(bad, cond);
             match self.gr.satisfy(bad, limit) {
-                Ok(Some(assign)) => return Some(self.violation(step, assign)),
+                Ok(Some(assign)) => {
+                    let general = self.generalised_violation(step, bad, &assign);
+                    return Some(general.unwrap_or_else(|| self.violation(step, assign)));
+                }
                 Ok(None) => {}
                 Err(_) => return Some(Found::Bounded { steps: step }),
             }
@@ -461,6 +527,9 @@ impl<'a> Sim<'a> {
         // after step 0's inputs, each latch's power-on value
         inputs[0].resize(ni + self.g.latches.len(), false);
         for (input, s, v) in assign.into_iter().chain(self.fixed.iter().copied()) {
+            if self.is_counter_input(input) {
+                continue;
+            }
             inputs[s as usize][input as usize] = v;
         }
         Found::Violated { step, inputs }
@@ -475,6 +544,8 @@ impl<'a> Sim<'a> {
         // every literal held: this path's, then each waiting path's
         let mut held: Vec<&mut Vec<u32>> = vec![&mut self.state, &mut self.prev_state];
         held.push(&mut self.cond);
+        held.push(&mut self.pinned);
+        held.push(&mut self.pinned_vars);
         for b in self.queue.values_mut() {
             held.push(&mut b.state);
             held.push(&mut b.prev_state);

@@ -98,6 +98,7 @@ pub fn prove(s: &Schedule, design: &str) -> (ProveVerdict, f64) {
             let mut o = formal::ProveOptions::new(dir.path());
             o.timeout_s = PROVE_SECONDS;
             o.bmc_timeout_s = PROVE_SECONDS;
+            o.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
             match formal::prove(s, design, &o) {
                 Err(e) => no(e.to_string()),
                 Ok(p) => match p.result {
