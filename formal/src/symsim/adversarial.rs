@@ -587,6 +587,26 @@ impl Rng {
     }
 }
 
+/// One to ten AND gates of random (possibly inverted) literals of `pool`,
+/// each added to `pool` as it is made: the random logic of every design
+/// these tests draw.
+fn random_gates(rng: &mut Rng, b: &mut B, pool: &mut Vec<u32>) {
+    for _ in 0..rng.below(10) + 1 {
+        let mut pick = || pool[rng.below(pool.len() as u64) as usize] ^ rng.below(2) as u32;
+        let (x, y) = (pick(), pick());
+        let a = b.and(x, y);
+        pool.push(a);
+    }
+}
+
+/// Each of `latches`' next value: a random (possibly inverted) literal of `pool`.
+fn random_next(rng: &mut Rng, b: &mut B, pool: &[u32], latches: &[u32]) {
+    for &l in latches {
+        let n = pool[rng.below(pool.len() as u64) as usize] ^ rng.below(2) as u32;
+        b.next(l, n);
+    }
+}
+
 fn random_design(rng: &mut Rng, free: bool) -> Aig {
     let mut b = B::default();
     let ni = rng.below(3);
@@ -606,18 +626,8 @@ fn random_design(rng: &mut Rng, free: bool) -> Aig {
         .chain(inputs)
         .chain(latches.clone())
         .collect();
-    for _ in 0..rng.below(10) + 1 {
-        let pick = |rng: &mut Rng, pool: &[u32]| {
-            pool[rng.below(pool.len() as u64) as usize] ^ rng.below(2) as u32
-        };
-        let (x, y) = (pick(rng, &pool), pick(rng, &pool));
-        let a = b.and(x, y);
-        pool.push(a);
-    }
-    for &l in &latches {
-        let n = pool[rng.below(pool.len() as u64) as usize] ^ rng.below(2) as u32;
-        b.next(l, n);
-    }
+    random_gates(rng, &mut b, &mut pool);
+    random_next(rng, &mut b, &pool, &latches);
     // bad: a conjunction of three, so that it is often unreachable
     let lits: Vec<u32> = (0..3)
         .map(|_| pool[1 + rng.below(pool.len() as u64 - 1) as usize] ^ rng.below(2) as u32)
@@ -1160,18 +1170,8 @@ fn random_counter_design(rng: &mut Rng) -> (Aig, Vec<(usize, usize)>) {
         .chain(h.clone())
         .chain(others.clone())
         .collect();
-    for _ in 0..rng.below(10) + 1 {
-        let pick = |rng: &mut Rng, pool: &[u32]| {
-            pool[rng.below(pool.len() as u64) as usize] ^ rng.below(2) as u32
-        };
-        let (x, y) = (pick(rng, &pool), pick(rng, &pool));
-        let a = b.and(x, y);
-        pool.push(a);
-    }
-    for &l in &others {
-        let n = pool[rng.below(pool.len() as u64) as usize] ^ rng.below(2) as u32;
-        b.next(l, n);
-    }
+    random_gates(rng, &mut b, &mut pool);
+    random_next(rng, &mut b, &pool, &others);
     let lits: Vec<u32> = (0..1 + rng.below(3))
         .map(|_| pool[1 + rng.below(pool.len() as u64 - 1) as usize] ^ rng.below(2) as u32)
         .collect();
