@@ -21,7 +21,8 @@ use lut_gen::{Dir, Layout};
 use super::{packets, uart, width, Clause, FreeInput, PropertyDef};
 
 /// Whether the harness reads the link's bytes (`link.bytes`,
-/// `link.packets`): a UART's receiver and packet parser.  `prove` proves
+/// `link.packets`): a UART's receiver, or an AXI4-Stream's beats taken,
+/// and the packet parser.  `prove` proves
 /// the harness without them for all time and searches the one with them
 /// from reset (their frame counter keeps the state from coming round).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -121,13 +122,12 @@ pub(super) fn properties(
             None => "the link's FIFO never overflows: link_overflow stays low for any input".into(),
         },
     });
+    let plan = lut_gen::plan_link(s).and_then(Result::ok);
+    let depth = plan.as_ref().map_or(0, |p| p.fifo_depth);
     if within.is_none() {
         if let (LinkBytes::Asserted, Some(c)) = (bytes, uart::Char::of(s)) {
             uart::receiver(v, props, &c);
-            let depth = lut_gen::plan_link(s)
-                .and_then(Result::ok)
-                .map_or(0, |p| p.fifo_depth);
-            packets::monitor(v, props, s, layout, depth);
+            packets::monitor(v, props, s, layout, depth, packets::Line::Uart);
         }
         return;
     }
@@ -155,4 +155,16 @@ pub(super) fn properties(
         covers: vec![Clause::AxisPayloadHeld],
         what: "m_axis_tdata and m_axis_tlast do not change while a beat waits for tready".into(),
     });
+    if bytes == LinkBytes::Asserted {
+        let per_frame = plan.as_ref().and_then(|p| p.tlast) == Some("frame");
+        packets::beats(v);
+        packets::monitor(
+            v,
+            props,
+            s,
+            layout,
+            depth,
+            packets::Line::Axis { per_frame },
+        );
+    }
 }
