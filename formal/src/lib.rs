@@ -29,7 +29,7 @@ use lut_gen::Schedule;
 // The harness: the pin contract as assertions on the ports of any design.
 pub use harness::{
     contract, generate, generate_with, not_covered, Clause, FreeInput, Harness, HarnessError,
-    PropertyDef, TableForm, FULL_TABLE_MAX_SLOTS, TREADY_ANY,
+    PropertyDef, TableForm, AXIS_BYTES_MAX_WAIT, FULL_TABLE_MAX_SLOTS, TREADY_ANY,
 };
 
 // The solvers, and the steps a test runs one at a time.

@@ -18,8 +18,10 @@ pub(super) struct Graph {
     table: FxHashMap<u64, u32>,
     /// Each (input, step)'s variable node: one per pair, so two paths of
     /// a split run (`split.rs`) that compute the same function of the
-    /// inputs hold the same literal and are merged.
+    /// inputs hold the same literal and are merged.  Only when `shared`
+    /// (a split run): a run of one path makes each variable once anyway.
     vars: FxHashMap<(u32, u32), u32>,
+    pub(super) shared: bool,
 }
 
 impl Graph {
@@ -29,6 +31,7 @@ impl Graph {
             b: vec![0],
             table: FxHashMap::default(),
             vars: FxHashMap::default(),
+            shared: false,
         }
     }
 
@@ -42,6 +45,9 @@ impl Graph {
     }
 
     pub(super) fn var(&mut self, input: u32, step: u32) -> u32 {
+        if !self.shared {
+            return self.fresh_var(input, step);
+        }
         let (a, b) = (&mut self.a, &mut self.b);
         *self.vars.entry((input, step)).or_insert_with(|| {
             a.push(VAR | input);
@@ -111,7 +117,9 @@ impl Graph {
             }
             map[i] = a.len() as u32;
             if self.is_var(i) {
-                vars.insert((self.a[i] & !VAR, self.b[i]), map[i] * 2);
+                if self.shared {
+                    vars.insert((self.a[i] & !VAR, self.b[i]), map[i] * 2);
+                }
                 a.push(self.a[i]);
                 b.push(self.b[i]);
             } else {

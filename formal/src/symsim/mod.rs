@@ -355,6 +355,8 @@ impl<'a> Sim<'a> {
         let mut sim = Sim::new(g);
         if splits.len() <= split::MAX_SPLIT_BITS {
             sim.splits = splits.to_vec();
+            // paths merge only if they share each input's variable
+            sim.gr.shared = !splits.is_empty();
         }
         sim
     }
