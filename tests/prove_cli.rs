@@ -66,10 +66,7 @@ fn an_axi_stream_mix_proves_and_a_cut_search_is_bounded() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let mix = dir.path().join("tiny-axis.toml");
-    let text = std::fs::read_to_string(tiny()).unwrap()
-        + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 8\n";
-    std::fs::write(&mix, text).unwrap();
+    let mix = tiny_axis(dir.path());
     let cut = prove_json(
         &[mix.to_str().unwrap(), "--depth", "40"],
         &[],
@@ -94,8 +91,26 @@ fn an_axi_stream_mix_proves_and_a_cut_search_is_bounded() {
     for want in ["link.overflow", "axis.tvalid", "axis.payload"] {
         assert!(names.contains(&want), "{want} missing from {names:?}");
     }
+    // the beats' bytes and packets too, for all time: nothing left out
+    for name in ["link.bytes", "link.packets"] {
+        let p = (v["properties"].as_array().unwrap().iter())
+            .find(|p| p["name"] == name)
+            .unwrap_or_else(|| panic!("no {name}: {v}"));
+        assert_eq!(p["result"], "proved", "{v}");
+    }
+    assert_eq!(v["not_covered"].as_array().unwrap().len(), 0, "{v}");
     let h = std::fs::read_to_string(&harness).unwrap();
     assert!(h.contains("assign m_axis_tready = tready_any || waited >= 3'd7;"));
+}
+
+/// `tiny` with an AXI4-Stream link whose slave takes every beat within 8
+/// cycles, written into `dir`.
+fn tiny_axis(dir: &std::path::Path) -> std::path::PathBuf {
+    let mix = dir.join("tiny-axis.toml");
+    let text = std::fs::read_to_string(tiny()).unwrap()
+        + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 8\n";
+    std::fs::write(&mix, text).unwrap();
+    mix
 }
 
 /// A mix with modes goes through `prove` (it was refused, exit 2): a search
@@ -294,40 +309,41 @@ fn tiny_uart(dir: &std::path::Path) -> std::path::PathBuf {
     mix
 }
 
+/// A mutant of the link gateware: its name, the text replaced, its
+/// replacement, the property that must fail.
+type Mutant = (&'static str, &'static str, &'static str, &'static str);
+
+/// The header's mode and slice fields, wrong (shared by both kinds of link).
+const FIELD_MUTANTS: [Mutant; 2] = [
+    (
+        "mode",
+        "4'd6: byte_out = 8'd0;",
+        "4'd6: byte_out = 8'h40;",
+        "link.packets",
+    ),
+    (
+        "slice",
+        "4'd7: byte_out = {",
+        "4'd7: byte_out = 8'd1 ^ {",
+        "link.packets",
+    ),
+];
+
+/// A frame counter that skips.
+const FRAME_MUTANT: Mutant = (
+    "frame",
+    "hframe <= hframe + 8'd1;",
+    "hframe <= hframe + 8'd2;",
+    "link.packets",
+);
+
 /// Mutants of a UART mix's link gateware (`hdl`'s `slotforge_link`): a
 /// wrong CRC polynomial, a frame counter that skips, a mode field in the
-/// header of a mix without modes, a wrong slice field, no stop bit.  Each
-/// fails `prove` on the
-/// link's bytes with a counterexample, and the judge rejects its VCD at the
-/// cycle `prove` names; the printed `check` command rejects it too.
-fn link_mutants_fail_where_check_does(mix: &std::path::Path, dir: &std::path::Path) {
-    let v = dir.join("v");
-    slotforge()
-        .args(["verilog", mix.to_str().unwrap(), "-o"])
-        .arg(&v)
-        .assert()
-        .success();
-    let clean = std::fs::read_to_string(v.join("slotforge_top.v")).unwrap();
-    let mutants = [
+/// header of a mix without modes, a wrong slice field, no stop bit.
+fn uart_mutants() -> Vec<Mutant> {
+    let mut m = vec![
         ("crc", "& 16'ha001);", "& 16'h8005);", "link.packets"),
-        (
-            "frame",
-            "hframe <= hframe + 8'd1;",
-            "hframe <= hframe + 8'd2;",
-            "link.packets",
-        ),
-        (
-            "mode",
-            "4'd6: byte_out = 8'd0;",
-            "4'd6: byte_out = 8'h40;",
-            "link.packets",
-        ),
-        (
-            "slice",
-            "4'd7: byte_out = {",
-            "4'd7: byte_out = 8'd1 ^ {",
-            "link.packets",
-        ),
+        FRAME_MUTANT,
         (
             "stop",
             "wire chr_end = bitn == 4'd9;",
@@ -335,7 +351,49 @@ fn link_mutants_fail_where_check_does(mix: &std::path::Path, dir: &std::path::Pa
             "link.bytes",
         ),
     ];
-    for (what, from, to, property) in mutants {
+    m.extend(FIELD_MUTANTS);
+    m
+}
+
+/// Mutants of an AXI4-Stream mix's link gateware: a wrong CRC polynomial,
+/// a frame counter that skips, wrong mode and slice fields, `tlast` on the
+/// trailer's third byte instead of its fourth.
+fn axis_mutants() -> Vec<Mutant> {
+    let mut m = vec![
+        (
+            "crc",
+            "((x >> 1) ^ 16'ha001)",
+            "((x >> 1) ^ 16'h8005)",
+            "link.packets",
+        ),
+        FRAME_MUTANT,
+        (
+            "tlast",
+            "tlast_r <= slot == 4'd3;",
+            "tlast_r <= slot == 4'd2;",
+            "link.bytes",
+        ),
+    ];
+    m.extend(FIELD_MUTANTS);
+    m
+}
+
+/// Each of `mutants` of `mix`'s link gateware fails `prove` on the link's
+/// bytes with a counterexample, and the judge rejects its VCD at the cycle
+/// `prove` names; the printed `check` command rejects it too.
+fn link_mutants_fail_where_check_does(
+    mix: &std::path::Path,
+    dir: &std::path::Path,
+    mutants: &[Mutant],
+) {
+    let v = dir.join("v");
+    slotforge()
+        .args(["verilog", mix.to_str().unwrap(), "-o"])
+        .arg(&v)
+        .assert()
+        .success();
+    let clean = std::fs::read_to_string(v.join("slotforge_top.v")).unwrap();
+    for &(what, from, to, property) in mutants {
         assert!(clean.contains(from), "{what}: `{from}` not in the gateware");
         let bad = dir.join(format!("{what}.v"));
         std::fs::write(&bad, clean.replace(from, to)).unwrap();
@@ -368,7 +426,20 @@ fn link_mutants_of_a_uart_mix_fail_prove_where_check_does() {
     }
     let dir = tempfile::tempdir().unwrap();
     let mix = tiny_uart(dir.path());
-    link_mutants_fail_where_check_does(&mix, dir.path());
+    link_mutants_fail_where_check_does(&mix, dir.path(), &uart_mutants());
+}
+
+/// The AXI4-Stream mutants on the tiny mix with a slave that takes every
+/// beat within 8 cycles: each fails `prove` with a trace from reset that
+/// `check` rejects at the same cycle.
+#[test]
+fn link_mutants_of_an_axi_stream_mix_fail_prove_where_check_does() {
+    if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mix = tiny_axis(dir.path());
+    link_mutants_fail_where_check_does(&mix, dir.path(), &axis_mutants());
 }
 
 /// The same mutants of the reference design's link (`eskin34-uart`, 48 MHz,
@@ -385,7 +456,7 @@ fn link_mutants_of_eskin34_uart_fail_prove_where_check_does() {
     }
     let dir = tempfile::tempdir().unwrap();
     let mix = crate::common_cli::root().join("mixes/eskin34-uart.toml");
-    link_mutants_fail_where_check_does(&mix, dir.path());
+    link_mutants_fail_where_check_does(&mix, dir.path(), &uart_mutants());
     let clean = std::fs::read_to_string(dir.path().join("v/slotforge_top.v")).unwrap();
     let from = "hframe <= hframe + 8'd1;";
     assert!(clean.contains(from));

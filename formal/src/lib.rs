@@ -29,7 +29,7 @@ use lut_gen::Schedule;
 // The harness: the pin contract as assertions on the ports of any design.
 pub use harness::{
     contract, generate, generate_with, not_covered, Clause, FreeInput, Harness, HarnessError,
-    PropertyDef, TableForm, FULL_TABLE_MAX_SLOTS, TREADY_ANY,
+    PropertyDef, TableForm, AXIS_BYTES_MAX_WAIT, FULL_TABLE_MAX_SLOTS, TREADY_ANY,
 };
 
 // The solvers, and the steps a test runs one at a time.
@@ -437,8 +437,10 @@ fn link_bytes(
         LINK_FRAMES * f + 2
     };
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
-    // split as the main run is (mode requests, trigger decisions): exact
-    let splits = named_inputs(&prep, harness::MODE_SEL);
+    // split as the main run is (mode requests, trigger decisions), and on
+    // an AXI4-Stream slave's choices: exact
+    let mut splits = named_inputs(&prep, harness::MODE_SEL);
+    splits.extend(named_inputs(&prep, harness::TREADY_ANY));
     let (found, _) = symsim::prove(
         &g,
         &[],
@@ -569,7 +571,11 @@ fn link_generalised(
     let counters = symsim::Counters { pairs, from: 2 };
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
     let limit = GENERAL_FRAMES * f + 2;
-    let (found, st) = symsim::prove_generalised(&g, counters, f, 2, limit, Some(deadline));
+    // an AXI4-Stream slave's choices: one path per choice where a step
+    // reads it, paths in the same state at a step merged (`symsim::split`)
+    let choices = named_inputs(&prep, harness::TREADY_ANY);
+    let (found, st) =
+        symsim::prove_generalised(&g, counters, &choices, f, 2, limit, Some(deadline));
     let what = format!(
         "the frame counters ({name} and the harness's {})",
         harness::FRAME_COUNTER
@@ -609,6 +615,9 @@ fn link_generalised(
 /// The note of a proof with generalised frame counters.
 fn general_note(g: &Aig, st: &SymStats, what: &str, steps: u64, since: u64, f: u64) -> String {
     let from = st.generalised.unwrap_or(since);
+    if st.branches > 0 {
+        return split_general_note(g, st, what, steps, f);
+    }
     format!(
         "{PROVED}: every step from reset to step {from} simulated exactly with every free \
          input bit a variable of its step (MISO; {} latches, {} gates; {} satisfiability \
@@ -622,6 +631,31 @@ fn general_note(g: &Aig, st: &SymStats, what: &str, steps: u64, since: u64, f: u
         g.ands.len(),
         st.sat_calls,
         (steps - since) / f,
+        LINK_BYTES.join(", "),
+    )
+}
+
+/// The same for a run split on an AXI4-Stream slave's choices
+/// (`symsim::split`): each path's state at a frame start is one some path
+/// had at an earlier or the same frame start.
+fn split_general_note(g: &Aig, st: &SymStats, what: &str, steps: u64, f: u64) -> String {
+    format!(
+        "{PROVED}: every step from reset simulated exactly with MISO a variable of its step \
+         and split on the slave's choices (tready_any: one path per value in each step that \
+         reads it, paths in the same state at a step merged: {} merged; {} latches, {} gates; \
+         {} satisfiability checks); at each frame start, {what}, shown equal in every state, \
+         are replaced by one free 8-bit value, so the states simulated from it include every \
+         state reachable there; by step {steps} ({:.0} frames) every path's state at a frame \
+         start, so generalised, was one some path had at an earlier frame start ({} distinct, \
+         up to renaming), so those steps reach every reachable state under every slave the \
+         guarantee allows, the link's bytes ({}) included (symbolic simulation with the frame \
+         counter generalised: an inductive invariant, checked)",
+        st.merged,
+        g.latches.len(),
+        g.ands.len(),
+        st.sat_calls,
+        steps.saturating_sub(2) as f64 / f as f64,
+        st.branches,
         LINK_BYTES.join(", "),
     )
 }

@@ -409,13 +409,37 @@ fn axis_gateware_proves_for_every_slave() {
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &emitted(&s), dir.path());
     assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
-    for how in [
-        "2-induction",
-        "explicit-state search",
-        "symbolic simulation",
-    ] {
+    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    for name in ["link.bytes", "link.packets", "link.overflow"] {
+        let r = p.properties.iter().find(|q| q.name == name).unwrap();
+        assert_eq!(r.result, Outcome::Proved, "{}", p.summary());
+    }
+    for how in ["split on the slave's choices", "frame counter generalised"] {
         assert!(p.note.contains(how), "{how}: {}", p.note);
     }
+}
+
+/// With `tlast = "frame"` (two slices a frame) the clean gateware proves
+/// its beats for all time, and the gateware of `tlast = "slice"` (tlast on
+/// every trailer, so on a beat where the frame's packet goes on) fails
+/// `link.bytes` with a trace `check` rejects at the same cycle.
+#[test]
+fn axis_tlast_per_frame_proves_and_tlast_per_slice_fails() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let slice = tiny_axis();
+    let path = root().join("testkit/mixes/tiny.toml");
+    let text = std::fs::read_to_string(&path).unwrap()
+        + "\n[link]\nkind = \"axis\"\ntlast = \"frame\"\nready_within = 8\n";
+    let mix = lut_gen::parse(Path::new("tiny-axis-frame.toml"), &text).expect("parses");
+    let s = lut_gen::synthesize(&mix).expect("feasible");
+    assert_eq!(s.grid.slices_per_frame, 2);
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    assert_mutant_fails(&s, &emitted(&slice), "link.bytes");
 }
 
 /// Mutants of the AXI4-Stream master fail the proof with a counterexample

@@ -41,7 +41,8 @@ pub enum Clause {
     /// The UART's characters on `link_tx`: start bit, data bits, parity,
     /// stop bits at the baud divider, idle high.
     UartCharacters,
-    /// When the AXI4-Stream offers each beat, and which beat has `tlast`.
+    /// The AXI4-Stream's beats taken: each the next byte of the packets,
+    /// and `tlast` on exactly the last byte of each (by slice or frame).
     AxisBeats,
     /// A beat offered and not taken stays offered (`tvalid`).
     AxisValidHeld,
@@ -138,8 +139,9 @@ impl Clause {
                 "link_overflow stays low (the link's FIFO never drops a token)".into()
             }
             Clause::UartCharacters => uart_characters(s),
-            Clause::AxisBeats => "when the AXI4-Stream offers each beat (m_axis_tvalid) and \
-                 which beat carries m_axis_tlast"
+            Clause::AxisBeats => "the AXI4-Stream's beats: each beat taken (m_axis_tvalid and \
+                 m_axis_tready) carries the next byte of the packets on m_axis_tdata, and \
+                 m_axis_tlast is high on exactly the last byte of each packet"
                 .into(),
             Clause::AxisValidHeld => {
                 "a beat offered and not taken stays offered (m_axis_tvalid)".into()

@@ -16,6 +16,11 @@
 //! sample its record (channel index, code, big-endian).  A character with no
 //! token waiting, or more tokens waiting than the link's FIFO can hold and
 //! the serializer has in hand, fails too.
+//!
+//! On an AXI4-Stream the bytes are the beats taken (`m_axis_tvalid &&
+//! m_axis_tready`, [`beats`]): each is compared whole in the cycle it is
+//! taken, and its `m_axis_tlast` with the parser's own "last byte of a
+//! packet" (`link.bytes` of such a link: the beats and where `tlast` is).
 
 use std::fmt::Write;
 
@@ -34,13 +39,38 @@ pub(crate) const FRAME_COUNTER: &str = "efc";
 /// one to spare.
 const IN_HAND: usize = 3;
 
-/// The token queue, the parser and the property `link.packets`.
+/// Where the parser's bytes come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Line {
+    /// The UART receiver's (`uart.rs`): compared bit by bit on `link_tx`.
+    Uart,
+    /// The AXI4-Stream's beats taken ([`beats`]), compared whole on
+    /// `m_axis_tdata`; `tlast` on every trailer's last byte, or (`per_frame`)
+    /// only on the trailer of a frame's last slice.
+    Axis { per_frame: bool },
+}
+
+/// The AXI4-Stream's bytes as the parser reads them: a beat is taken when
+/// `m_axis_tvalid` and `m_axis_tready` are both high, and its byte is
+/// `m_axis_tdata` in that cycle (`rx_s`/`rx_d`/`rx_v` the same strobe: the
+/// whole byte arrives at once, the parser moves on at the edge).
+pub(super) fn beats(v: &mut String) {
+    v.push_str(
+        "\n  // link.bytes on the AXI4-Stream: each beat taken is the next byte.\n  \
+         wire rx_s = run && m_axis_tvalid && m_axis_tready;\n  \
+         wire rx_d = rx_s, rx_v = rx_s;\n  wire [7:0] rx_b = m_axis_tdata;\n",
+    );
+}
+
+/// The token queue, the parser and the property `link.packets` (and, on
+/// an AXI4-Stream, `link.bytes`: where `tlast` is).
 pub(super) fn monitor(
     v: &mut String,
     props: &mut Vec<PropertyDef>,
     s: &Schedule,
     layout: &Layout,
     depth: usize,
+    line: Line,
 ) {
     let (chb, vb, mb) = (layout.channel_bits, layout.value_bits, layout.mode_bits);
     let q = depth + IN_HAND;
@@ -153,10 +183,17 @@ pub(super) fn monitor(
          esl <= esl == {slb}'d{} ? {slb}'d0 : esl + {slb}'d1;\n      \
          if (esl == {slb}'d{}) efc <= efc + 8'd1;\n    end\n    \
          if (pop) begin tdone <= 1'b0; hdone <= 1'b0; end\n  end\n  \
-         wire ok_link_packets = !qovf && !(rx_s && qn == {qb}'d0) && (!rx_d || link_tx == ebyte[rx_i]);",
+         wire ok_link_packets = !qovf && !(rx_s && qn == {qb}'d0) && (!rx_d || {});",
         k - 1,
         k - 1,
+        match line {
+            Line::Uart => "link_tx == ebyte[rx_i]",
+            Line::Axis { .. } => "m_axis_tdata == ebyte",
+        }
     );
+    if let Line::Axis { per_frame } = line {
+        tlast(v, props, per_frame.then(|| format!(" && esl == {slb}'d0")));
+    }
     props.push(PropertyDef {
         name: "link.packets".into(),
         wire: "ok_link_packets".into(),
@@ -171,6 +208,35 @@ pub(super) fn monitor(
                 ", the mode in force in the slice's first cycle and the frame before's"
             } else {
                 ""
+            }
+        ),
+    });
+}
+
+/// `link.bytes` of an AXI4-Stream: a beat taken has `m_axis_tlast` high
+/// exactly when it is a trailer's last byte (the CRC's high byte), with
+/// `per_frame` only the trailer of a frame's last slice (the parser's slice
+/// count `esl` has then come round to 0: it moves on at each header).
+fn tlast(v: &mut String, props: &mut Vec<PropertyDef>, first_slice: Option<String>) {
+    let per_frame = first_slice.is_some();
+    let _ = writeln!(
+        v,
+        "  wire elast = ekind == 2'd2 && wpos == 2'd3{};\n  \
+         wire ok_link_bytes = !rx_d || m_axis_tlast == elast;",
+        first_slice.unwrap_or_default()
+    );
+    props.push(PropertyDef {
+        name: "link.bytes".into(),
+        wire: "ok_link_bytes".into(),
+        covers: vec![Clause::AxisBeats],
+        what: format!(
+            "every beat taken (m_axis_tvalid && m_axis_tready) is the next byte of the packet \
+             stream (link.packets), for any slave that takes each beat within its guarantee, \
+             and m_axis_tlast is high on it exactly when it is the last byte of a {}",
+            if per_frame {
+                "frame's last packet (tlast = \"frame\")"
+            } else {
+                "packet (tlast = \"slice\")"
             }
         ),
     });

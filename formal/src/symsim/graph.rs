@@ -16,6 +16,12 @@ pub(super) struct Graph {
     pub(super) a: Vec<u32>,
     pub(super) b: Vec<u32>,
     table: FxHashMap<u64, u32>,
+    /// Each (input, step)'s variable node: one per pair, so two paths of
+    /// a split run (`split.rs`) that compute the same function of the
+    /// inputs hold the same literal and are merged.  Only when `shared`
+    /// (a split run): a run of one path makes each variable once anyway.
+    vars: FxHashMap<(u32, u32), u32>,
+    pub(super) shared: bool,
 }
 
 impl Graph {
@@ -24,13 +30,30 @@ impl Graph {
             a: vec![0],
             b: vec![0],
             table: FxHashMap::default(),
+            vars: FxHashMap::default(),
+            shared: false,
         }
     }
 
-    pub(super) fn var(&mut self, input: u32, step: u32) -> u32 {
+    /// A variable node of its own, not shared with `var`'s: a split
+    /// input's (`split.rs` finds what reads it among the nodes made after
+    /// it, which a shared, older variable would defeat).
+    pub(super) fn fresh_var(&mut self, input: u32, step: u32) -> u32 {
         self.a.push(VAR | input);
         self.b.push(step);
         (self.a.len() as u32 - 1) * 2
+    }
+
+    pub(super) fn var(&mut self, input: u32, step: u32) -> u32 {
+        if !self.shared {
+            return self.fresh_var(input, step);
+        }
+        let (a, b) = (&mut self.a, &mut self.b);
+        *self.vars.entry((input, step)).or_insert_with(|| {
+            a.push(VAR | input);
+            b.push(step);
+            (a.len() as u32 - 1) * 2
+        })
     }
 
     /// Nearly every gate's fanins are constants once the control has left
@@ -86,6 +109,7 @@ impl Graph {
         let mut map = vec![0u32; n];
         let (mut a, mut b) = (vec![0u32], vec![0u32]);
         let mut table = FxHashMap::default();
+        let mut vars = FxHashMap::default();
         let lit = |map: &[u32], l: u32| (map[(l >> 1) as usize] * 2) | (l & 1);
         for i in 1..n {
             if !live[i] {
@@ -93,6 +117,9 @@ impl Graph {
             }
             map[i] = a.len() as u32;
             if self.is_var(i) {
+                if self.shared {
+                    vars.insert((self.a[i] & !VAR, self.b[i]), map[i] * 2);
+                }
                 a.push(self.a[i]);
                 b.push(self.b[i]);
             } else {
@@ -108,6 +135,7 @@ impl Graph {
         self.a = a;
         self.b = b;
         self.table = table;
+        self.vars = vars;
     }
 
     /// The state `roots` as a canonical word sequence, inputs of step 0 by

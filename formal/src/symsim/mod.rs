@@ -91,6 +91,9 @@ pub struct SymStats {
     pub generalised: Option<u64>,
     /// Why such a run did not close, if it did not.
     pub counter_failure: Option<CounterFailure>,
+    /// A split run: paths dropped because another path had reached the
+    /// same state at the same step.
+    pub merged: u64,
 }
 
 /// Steps between the checks of the assertions that did not fold (one SAT
@@ -266,7 +269,7 @@ fn combine(results: Vec<Found>) -> Found {
     }
 }
 
-/// [`prove`] without choices or splits, with `counters` generalised at
+/// [`prove`] without choices, split on `splits`, with `counters` generalised at
 /// every frame start from `counters.from` (`generalise.rs`): proved when a
 /// generalised frame start's state comes round; a violation is a trace from
 /// reset only before the first generalisation (later: `Bounded` at it, the
@@ -274,6 +277,7 @@ fn combine(results: Vec<Found>) -> Found {
 pub fn prove_generalised(
     g: &Aig,
     counters: Counters,
+    splits: &[usize],
     period: u64,
     offset: u64,
     max_steps: u64,
@@ -285,7 +289,8 @@ pub fn prove_generalised(
         max_steps,
         deadline,
     };
-    let mut sim = Sim::new(g);
+    // split on `splits` (an AXI4-Stream slave's choices) where a step reads them
+    let mut sim = Sim::split_on(g, splits);
     sim.counters = Some(counters);
     let (f, mut st) = sim.run(&lim);
     st.parts = [1, 0, 0];
@@ -339,6 +344,8 @@ struct Sim<'a> {
     generalisations: u32,
     pinned: Vec<u32>,
     pinned_vars: Vec<u32>,
+    /// How many times the graph was collected (its literals renumbered).
+    collections: u64,
 }
 
 impl<'a> Sim<'a> {
@@ -348,6 +355,8 @@ impl<'a> Sim<'a> {
         let mut sim = Sim::new(g);
         if splits.len() <= split::MAX_SPLIT_BITS {
             sim.splits = splits.to_vec();
+            // paths merge only if they share each input's variable
+            sim.gr.shared = !splits.is_empty();
         }
         sim
     }
@@ -394,6 +403,7 @@ impl<'a> Sim<'a> {
             generalisations: 0,
             pinned: Vec::new(),
             pinned_vars: Vec::new(),
+            collections: 0,
         }
     }
 
@@ -555,6 +565,7 @@ impl<'a> Sim<'a> {
         roots.extend(self.pending.iter().map(|&(_, b)| b));
         roots.push(self.pending_any);
         self.gr.collect(&mut roots);
+        self.collections += 1;
         // the nodes were renumbered: every gate's value is evaluated again
         self.ev.invalidate();
         let mut at = 0;

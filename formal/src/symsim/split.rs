@@ -26,7 +26,7 @@
 //! checked exactly: proved for all time.  A violation on a path is a real
 //! trace: the values fixed on the path and the SAT model of the rest.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use super::graph::Assigned;
 use super::{kept, Found, Limits, Sim, SymStats, CHECK};
@@ -66,10 +66,23 @@ impl Sim<'_> {
         self.queue.insert((0, 0), start);
         // the earliest violation so far: later paths stop before it
         let mut first: Option<(u64, Found)> = None;
+        // the paths started at one step (by their state): paths are taken
+        // by their step, so a path whose state one of them had is the same
+        // machine in the same state and adds nothing (any of their inputs
+        // is a trace to it); cleared when the graph is collected
+        let mut started: (u64, u64, HashSet<Vec<u32>>) = (u64::MAX, 0, HashSet::new());
         while let Some(((from, _), b)) = self.queue.pop_first() {
             let stop = first.as_ref().map_or(lim.max_steps, |f| f.0);
             if from >= stop && first.is_some() {
                 continue; // at or past the earliest violation
+            }
+            if (started.0, started.1) != (from, self.collections) {
+                started = (from, self.collections, HashSet::new());
+            }
+            let key: Vec<u32> = b.state.iter().chain(&b.cond).copied().collect();
+            if !started.2.insert(key) {
+                self.stats.merged += 1;
+                continue;
             }
             if from >= stop {
                 // a path that reached the last step: nothing is said beyond
@@ -77,8 +90,6 @@ impl Sim<'_> {
                 return (Found::Bounded { steps: from }, self.stats);
             }
             if seen.len() + self.queue.len() > MAX_PATHS {
-                // the split does not come round (a request kept with data
-                // of its age, say): bounded where every path got to
                 self.stats.branches = seen.len();
                 let steps = self.covered(from);
                 return (first.map_or(Found::Bounded { steps }, |f| f.1), self.stats);
@@ -154,6 +165,9 @@ impl Sim<'_> {
                 }
             }
             if phase == Some(0) {
+                // the frame counters, once shown equal, become one free
+                // value (`generalise.rs`): on every path alike
+                self.generalise(step)?;
                 if self.split_cases {
                     self.prune_cond(step)?;
                 }
@@ -224,7 +238,7 @@ impl Sim<'_> {
         // the split inputs' variables first: a node older than them reads none
         let mut inputs = vec![0u32; ni];
         for &k in &self.splits {
-            inputs[k] = self.gr.var(k as u32, step as u32);
+            inputs[k] = self.gr.fresh_var(k as u32, step as u32);
         }
         for (k, lit) in inputs.iter_mut().enumerate() {
             if !self.splits.contains(&k) {
@@ -273,7 +287,8 @@ impl Sim<'_> {
                     Ok(None) => {}
                     Ok(Some(assign)) => {
                         self.fixed = fixed;
-                        return Err(self.violation(step, assign));
+                        let general = self.generalised_violation(step, bad, &assign);
+                        return Err(general.unwrap_or_else(|| self.violation(step, assign)));
                     }
                     Err(_) => return Err(self.bounded_at(Found::Bounded { steps: step })),
                 }
