@@ -17,6 +17,7 @@ use serde::Serialize;
 use crate::mix::{LinkKind, LinkSpec};
 use crate::schedule::Schedule;
 
+mod memo;
 mod switch;
 pub use switch::{merged_run, switch_backlog, SwitchFifo};
 
@@ -139,10 +140,10 @@ impl LinkPlan {
 /// The mix's link plan; `None` without `[link]`.
 pub fn plan(s: &Schedule) -> Option<Result<LinkPlan, LinkInfeasible>> {
     let spec = s.mix.link?;
-    Some(match s.modes.is_empty() {
+    Some(memo::plan(s, |s| match s.modes.is_empty() {
         true => plan_one(s, &spec),
         false => switch::plan_modes(s, &spec),
-    })
+    }))
 }
 
 /// One schedule's link (a mix without modes, or one mode).

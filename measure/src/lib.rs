@@ -21,6 +21,7 @@
 //!   and the fault campaign as report tables.
 
 mod budget;
+mod cell_prune;
 mod dft;
 mod figure7;
 mod modescene;

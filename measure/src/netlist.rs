@@ -126,12 +126,15 @@ pub fn netlist(s: &Schedule, fpga: Fpga, dir: &Path) -> Result<Netlist, String> 
             models.display()
         ));
     }
+    // only the models the netlist reaches: the whole library cost every
+    // reader of this file most of a minute (`crate::cell_prune`)
     let text = format!(
-        "// {} netlist of slotforge_top (yosys synth_{}) and the family's cell models ({})\n{}{nl}\n{cells_text}",
+        "// {} netlist of slotforge_top (yosys synth_{}) and the family's cell models it uses ({})\n{}{nl}\n{}",
         fpga,
         fpga.family().name(),
         models.display(),
-        prologue(fpga)
+        prologue(fpga),
+        crate::cell_prune::needed_models(&cells_text, &nl)
     );
     std::fs::write(dir.join(NETLIST_SIM_FILE), &text).map_err(|e| e.to_string())?;
     Ok(Netlist {
