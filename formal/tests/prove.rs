@@ -608,6 +608,8 @@ fn every_preset_and_the_largest_test_mixes_prove() {
     mixes.sort();
     mixes.push("hdl/tests/data/b16.toml".into());
     mixes.push("hdl/tests/data/ch1024.toml".into());
+    // 60 channels in 20 ms frames: the proof's cost against the frame length
+    mixes.push("formal/tests/data/ch60-20ms.toml".into());
     for m in mixes {
         let s = schedule(&m);
         let dir = tempfile::tempdir().unwrap();
