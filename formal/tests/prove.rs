@@ -788,7 +788,8 @@ fn tiny_uart() -> lut_gen::Schedule {
 /// round after a few frames, not 256), so the fault campaign takes it as the excuse
 /// "contract proved"; a gateware whose `link_tx` is stuck high fails
 /// `link.packets` (its tokens pile up in the harness's queue) and is
-/// never excused.
+/// never excused.  Each design is proved once, the campaign's way
+/// (`campaign::prove_in`): the proof and the verdict the campaign takes.
 #[test]
 fn a_uart_proof_reads_the_line_and_a_stuck_line_fails() {
     if !tools::require_tools(&TOOLS) {
@@ -797,7 +798,7 @@ fn a_uart_proof_reads_the_line_and_a_stuck_line_fails() {
     let s = tiny_uart();
     let clean = emitted(&s);
     let dir = tempfile::tempdir().unwrap();
-    let p = prove(&s, &clean, dir.path());
+    let (p, verdict) = campaign::prove_in(&s, &clean, dir.path()).expect("prove runs");
     assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
     assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
     assert!(p.depth < 20 * s.grid.frame_cycles, "{}", p.summary());
@@ -811,9 +812,10 @@ fn a_uart_proof_reads_the_line_and_a_stuck_line_fails() {
         );
     }
     assert!(p.summary().contains("PROVED (the whole contract)"));
+    assert_eq!(verdict, campaign::ProveVerdict::Proved);
     let stuck = edit(&clean, "      tx = chr[0];", "      tx = 1'b1;");
     let dir = tempfile::tempdir().unwrap();
-    let p = prove(&s, &stuck, dir.path());
+    let (p, verdict) = campaign::prove_in(&s, &stuck, dir.path()).expect("prove runs");
     assert_eq!(p.result, Outcome::Failed, "{}", p.summary());
     assert!(
         p.properties
@@ -822,21 +824,15 @@ fn a_uart_proof_reads_the_line_and_a_stuck_line_fails() {
         "{}",
         p.summary()
     );
-    assert!(matches!(
-        campaign::prove(&s, &stuck).0,
-        campaign::ProveVerdict::Failed { .. }
-    ));
+    assert!(matches!(verdict, campaign::ProveVerdict::Failed { .. }));
     // without a link the same proof is the whole contract, and excuses
     let s = schedule("testkit/mixes/tiny.toml");
     let dir = tempfile::tempdir().unwrap();
-    let p = prove(&s, &emitted(&s), dir.path());
+    let (p, verdict) = campaign::prove_in(&s, &emitted(&s), dir.path()).expect("prove runs");
     assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
     assert!(p.note.starts_with("proved for all time"), "{}", p.note);
     assert!(p.summary().contains("PROVED (the whole contract)"));
-    assert!(matches!(
-        campaign::prove(&s, &emitted(&s)).0,
-        campaign::ProveVerdict::Proved
-    ));
+    assert_eq!(verdict, campaign::ProveVerdict::Proved);
 }
 
 /// Mutants of the link module of the tiny mix with a UART (every operator,

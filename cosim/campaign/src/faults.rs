@@ -41,7 +41,8 @@ mod verilog;
 pub use class::{FaultClass, Level};
 pub use methods::{methods, sample as methods_sample, Engine, MethodRun};
 pub use verilog::{
-    deep_faults, gateware_as_verilog, prove, prove_unavailable, ProveVerdict, VerilogFault,
+    deep_faults, gateware_as_verilog, prove, prove_in, prove_unavailable, ProveVerdict,
+    VerilogFault,
 };
 
 /// A detector of the judge, measured apart from the others.

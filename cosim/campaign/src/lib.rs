@@ -21,7 +21,8 @@ mod sigrok;
 pub use equiv::{check as check_equivalence, verdict as equivalence_verdict, Equivalence};
 pub use faults::{
     campaign_with, deep_faults, gateware_as_verilog, gateware_dut, methods, methods_sample,
-    one_gateware_fault_per_class, prove, prove_unavailable, sites, Campaign, CleanRun, Detector,
-    Engine, FaultClass, Level, MethodRun, OnRun, Plan, ProveVerdict, Target, VerilogFault, TREADY,
+    one_gateware_fault_per_class, prove, prove_in, prove_unavailable, sites, Campaign, CleanRun,
+    Detector, Engine, FaultClass, Level, MethodRun, OnRun, Plan, ProveVerdict, Target,
+    VerilogFault, TREADY,
 };
 pub use mixgen::{random_mix, LinkShape, Shape};

@@ -9,6 +9,7 @@
 //! design, so it sees every fault that is one (and no pin fault, which
 //! exists only inside a simulation).
 
+use std::path::Path;
 use std::time::Instant;
 
 use judge::reset_cycles;
@@ -91,31 +92,48 @@ pub const PROVE_SECONDS: u64 = 300;
 /// `prove` on `design` against `s`.
 pub fn prove(s: &Schedule, design: &str) -> (ProveVerdict, f64) {
     let t = Instant::now();
-    let no = |why: String| ProveVerdict::NoVerdict { why };
     let v = match tempfile::tempdir() {
-        Err(e) => no(e.to_string()),
-        Ok(dir) => {
-            let mut o = formal::ProveOptions::new(dir.path());
-            o.timeout_s = PROVE_SECONDS;
-            o.bmc_timeout_s = PROVE_SECONDS;
-            o.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
-            match formal::prove(s, design, &o) {
-                Err(e) => no(e.to_string()),
-                Ok(p) => match p.result {
-                    formal::Outcome::Failed => ProveVerdict::Failed { cycle: p.cycle },
-                    // a proof that leaves part of the contract unasserted (a
-                    // link's line) cannot excuse a fault there
-                    formal::Outcome::Proved if p.not_covered.is_empty() => ProveVerdict::Proved,
-                    formal::Outcome::Proved => no(format!(
-                        "the asserted properties hold for all time, but prove does not assert: {}",
-                        p.not_covered.join("; ")
-                    )),
-                    formal::Outcome::Bounded => no(p.note),
-                },
-            }
-        }
+        Err(e) => Err(e.to_string()),
+        Ok(dir) => prove_in(s, design, dir.path()).map(|(_, v)| v),
     };
+    let v = v.unwrap_or_else(|why| ProveVerdict::NoVerdict { why });
     (v, t.elapsed().as_secs_f64())
+}
+
+/// The campaign's proof of `design` against `s`, its files in `dir`: the
+/// proof itself and the verdict the campaign takes from it (a test reads
+/// both from one proof rather than proving the design twice).
+pub fn prove_in(
+    s: &Schedule,
+    design: &str,
+    dir: &Path,
+) -> Result<(formal::Proof, ProveVerdict), String> {
+    let mut o = formal::ProveOptions::new(dir);
+    o.timeout_s = PROVE_SECONDS;
+    o.bmc_timeout_s = PROVE_SECONDS;
+    o.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
+    let p = formal::prove(s, design, &o).map_err(|e| e.to_string())?;
+    let v = verdict(&p);
+    Ok((p, v))
+}
+
+/// What the campaign takes from proof `p`.
+fn verdict(p: &formal::Proof) -> ProveVerdict {
+    match p.result {
+        formal::Outcome::Failed => ProveVerdict::Failed { cycle: p.cycle },
+        // a proof that leaves part of the contract unasserted (a
+        // link's line) cannot excuse a fault there
+        formal::Outcome::Proved if p.not_covered.is_empty() => ProveVerdict::Proved,
+        formal::Outcome::Proved => ProveVerdict::NoVerdict {
+            why: format!(
+                "the asserted properties hold for all time, but prove does not assert: {}",
+                p.not_covered.join("; ")
+            ),
+        },
+        formal::Outcome::Bounded => ProveVerdict::NoVerdict {
+            why: p.note.clone(),
+        },
+    }
 }
 
 /// Why `prove` cannot run here (`None`: it can).
