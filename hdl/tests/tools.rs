@@ -408,18 +408,27 @@ fn the_links_fifo_is_block_ram() {
 /// UART, the adaptive reference design, and an AD7689 behind a front mux
 /// with modes (pin and auto select: its command unit's per-mode words):
 /// the mode block, every mode's table on the ROM address and the mode
-/// ports lint and synthesize clean.
+/// ports lint and synthesize clean. The adaptive reference design is
+/// linted here and synthesized in `make test-long` (`gates_eskin34_adaptive`:
+/// its yosys run is half of this test's time).
 #[test]
 fn gates_modes() {
-    for name in [
-        "modes-pin",
-        "modes-auto",
-        "eskin34-adaptive",
-        "front-modes",
-        "front-modes-auto",
-    ] {
-        let path = testkit::mix(name);
-        let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
-        gates(&s, name);
+    for name in ["modes-pin", "modes-auto", "front-modes", "front-modes-auto"] {
+        gates(&mode_mix(name), name);
     }
+    let name = "eskin34-adaptive";
+    lint_in(&emit_to(&mode_mix(name), "eskin34-adaptive-lint"), name);
+}
+
+/// Long: the adaptive reference design (34 channels, two modes) linted and
+/// synthesized.
+#[test]
+#[ignore = "long: make test-long"]
+fn gates_eskin34_adaptive() {
+    gates(&mode_mix("eskin34-adaptive"), "eskin34-adaptive");
+}
+
+/// The schedule of the shared mix `name`.
+fn mode_mix(name: &str) -> Schedule {
+    lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap()
 }
