@@ -587,6 +587,15 @@ impl Rng {
     }
 }
 
+/// `f`'s place in a tally of proved / violated / bounded.
+fn verdict(f: &Found) -> usize {
+    match f {
+        Found::Proved { .. } => 0,
+        Found::Violated { .. } => 1,
+        Found::Bounded { .. } => 2,
+    }
+}
+
 /// One to ten AND gates of random (possibly inverted) literals of `pool`,
 /// each added to `pool` as it is made: the random logic of every design
 /// these tests draw.
@@ -645,11 +654,7 @@ fn random_designs_agree_with_an_explicit_state_search() {
         let g = random_design(&mut rng, false);
         let (period, offset) = (1 + rng.below(4), rng.below(4));
         let f = judged(&g, period, offset, 40);
-        tally[match f {
-            Found::Proved { .. } => 0,
-            Found::Violated { .. } => 1,
-            Found::Bounded { .. } => 2,
-        }] += 1;
+        tally[verdict(&f)] += 1;
     }
     // the check is only as good as the mix of verdicts it saw
     assert!(tally.iter().all(|&n| n > 100), "{tally:?}");
@@ -806,11 +811,7 @@ fn random_designs_split_by_a_choice_input_agree_with_an_explicit_state_search() 
         if !choices.is_empty() {
             (0..3).for_each(|k| parts[k] += st.parts[k]);
         }
-        verdicts[match f {
-            Found::Proved { .. } => 0,
-            Found::Violated { .. } => 1,
-            Found::Bounded { .. } => 2,
-        }] += 1;
+        verdicts[verdict(&f)] += 1;
     }
     assert!(parts.iter().all(|&n| n > 100), "parts {parts:?}");
     // designs with free power-on values: fewer stay bounded
@@ -852,11 +853,7 @@ fn random_designs_split_on_an_input_agree_with_an_explicit_state_search() {
         }
         let (period, offset) = (1 + rng.below(4), rng.below(4));
         let (f, _) = judged_by(&g, period, offset, || split_run(&g, period, offset, 40));
-        tally[match f {
-            Found::Proved { .. } => 0,
-            Found::Violated { .. } => 1,
-            Found::Bounded { .. } => 2,
-        }] += 1;
+        tally[verdict(&f)] += 1;
     }
     assert!(tally.iter().all(|&n| n > 50), "{tally:?}");
 }
@@ -969,11 +966,7 @@ fn random_designs_split_on_registers_agree_with_an_explicit_state_search() {
         let (period, offset) = (1 + rng.below(4), rng.below(4));
         let (f, st) = judged_by(&g, period, offset, || cases_run(&g, period, offset, 40));
         split += usize::from(st.cases > 0);
-        tally[match f {
-            Found::Proved { .. } => 0,
-            Found::Violated { .. } => 1,
-            Found::Bounded { .. } => 2,
-        }] += 1;
+        tally[verdict(&f)] += 1;
     }
     assert!(tally[0] > 10 && tally[1] > 10, "{tally:?}");
     assert!(split > 25, "{split} runs split on registers");
@@ -1210,11 +1203,7 @@ fn random_designs_with_generalised_counters_agree_with_an_explicit_state_search(
             .generalised
             .is_some_and(|at| matches!(f, Found::Violated { step, .. } if step >= at));
         pinned += usize::from(after);
-        tally[match f {
-            Found::Proved { .. } => 0,
-            Found::Violated { .. } => 1,
-            Found::Bounded { .. } => 2,
-        }] += 1;
+        tally[verdict(&f)] += 1;
     }
     // the check is only as good as the mix of verdicts it saw
     eprintln!("{tally:?} proved/violated/bounded, {generalised} generalised, {pinned} pinned");
@@ -1243,11 +1232,7 @@ fn random_designs_with_generalised_counters_split_on_a_choice_agree_with_an_expl
             generalised_split(&g, &pairs, from, &splits, (period, offset, 60))
         });
         merged += st.merged;
-        tally[match f {
-            Found::Proved { .. } => 0,
-            Found::Violated { .. } => 1,
-            Found::Bounded { .. } => 2,
-        }] += 1;
+        tally[verdict(&f)] += 1;
     }
     eprintln!("{tally:?} proved/violated/bounded, {merged} paths merged");
     assert!(tally.iter().all(|&n| n > 50), "{tally:?}");
