@@ -36,7 +36,7 @@ mod timing;
 mod top;
 mod word_reader;
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use branch::BranchUnit;
 use command::CmdUnit;

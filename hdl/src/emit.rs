@@ -7,9 +7,9 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use crate::rhdl::*;
 use lut_gen::Schedule;
 use lut_gen::{Dir, Layout, Role, PORTS, TOP_MODULE};
-use rust_hdl::prelude::*;
 
 use crate::board::{pcf_template, pnr_name, Board};
 use crate::core::Core;

@@ -28,6 +28,15 @@ mod modeplan;
 mod names;
 mod plan;
 mod sim;
+
+/// The two crates of rust-hdl 0.46 the gateware is written in: the language
+/// (`rust-hdl-core`) and its widgets (DFF, RAM, ROM). Not the `rust-hdl`
+/// facade, which adds its HLS and simulation-model crates that nothing here
+/// uses (about 30 s of CPU in each build, release and test).
+mod rhdl {
+    pub use rust_hdl_core::prelude::*;
+    pub use rust_hdl_widgets::prelude::*;
+}
 #[cfg(feature = "stock")]
 mod stock;
 mod widths;

@@ -10,7 +10,7 @@
 
 use std::fmt::Write as _;
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use crate::widths::{CH_BITS, VALUE_BITS};
 

@@ -1,7 +1,7 @@
 //! A fast in-process simulator of the gateware: rust-hdl's own model of the
 //! very blocks that are emitted as Verilog, driven by a direct clock loop.
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use lut_gen::Pins;
 

@@ -12,7 +12,7 @@
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use crate::core::Core;
 use crate::sim::{read_pins, PinReader};

@@ -1,6 +1,6 @@
 //! Branch: per-branch SPI outputs, shift register, mux control.
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use super::{c, SlotRom, WordReader};
 use crate::plan::BranchRom;

@@ -5,7 +5,7 @@
 
 use std::fmt::Write as _;
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 /// One per sequencer with a hold-off (none otherwise, so every other mix's
 /// Verilog has no trace of it).  It stands between the timing generator

@@ -1,6 +1,6 @@
 //! Merged sample stream.
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use crate::plan::LaneChannels;
 use crate::widths::*;

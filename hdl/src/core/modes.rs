@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use crate::modeplan::{ModePlan, TrigPlan};
 use crate::widths::*;

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 /// One per SPI sequencer whose part is read with CNV low (none otherwise,
 /// so every other mix's Verilog has no trace of it).  It runs beside the

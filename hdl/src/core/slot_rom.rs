@@ -1,6 +1,6 @@
 //! Slot ROM.
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use crate::decode::SlotLogic;
 use crate::modeplan::ModeRom;

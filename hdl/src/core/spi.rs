@@ -1,6 +1,6 @@
 //! SPI sequencer: one per distinct SPI timing, shared by its branches.
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use super::c;
 use super::timing::mask;

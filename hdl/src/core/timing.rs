@@ -1,6 +1,6 @@
 //! Timing generator.
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use super::c;
 use crate::plan::Plan;

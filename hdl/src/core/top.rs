@@ -1,6 +1,6 @@
 //! Core: fixed-maximum ports, per-mix children, generated glue.
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use super::glue::{core_glue, route_miso, LaneForm, SeqWires};
 use super::{BranchUnit, CmdUnit, CnvPulse, HoldOff, Merger, ModeGen, SpiSeq, TimingGen};

@@ -2,7 +2,7 @@
 
 use std::fmt::Write as _;
 
-use rust_hdl::prelude::*;
+use crate::rhdl::*;
 
 use crate::plan::BranchRom;
 use crate::widths::*;
