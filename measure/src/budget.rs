@@ -82,12 +82,7 @@ impl Tightest {
                 });
             }
         }
-        // the first of the most used, so ties keep the mix's order
-        all.into_iter()
-            .fold(None, |best: Option<Tightest>, t| match best {
-                Some(b) if b.used >= t.used => Some(b),
-                _ => Some(t),
-            })
+        first_most_used(all, |t| t.used)
     }
 
     /// "branch `standard`'s slots, 100.0 % used (0.0 % margin)".
@@ -291,12 +286,17 @@ fn own_headroom<'a>(r: &AuditReport, b: &'a BranchAudit) -> Option<&'a Headroom>
         .or(b.headroom.first())
 }
 
+/// The first of the most used of `items`, so that a tie keeps the mix's
+/// order: "What binds" and the branch table's caption name one branch.
+fn first_most_used<T>(items: impl IntoIterator<Item = T>, used: impl Fn(&T) -> f64) -> Option<T> {
+    items.into_iter().fold(None, |best, t| match best {
+        Some(b) if used(&b) >= used(&t) => Some(b),
+        _ => Some(t),
+    })
+}
+
 fn branch_caption(r: &AuditReport) -> String {
-    let tight = r.branches.iter().max_by(|a, b| {
-        a.utilization
-            .max(a.adc_utilization)
-            .total_cmp(&b.utilization.max(b.adc_utilization))
-    });
+    let tight = first_most_used(&r.branches, |b| b.utilization.max(b.adc_utilization));
     // a mix with modes: these are the reset mode's budgets (every mode's
     // follow in their own table)
     let mode = match r.modes.first().filter(|_| r.modes.len() > 1) {
@@ -614,9 +614,15 @@ mod tests {
                 mixes.push(lut_gen::parse(&p, &std::fs::read_to_string(&p).unwrap()).unwrap());
             }
         }
-        // a part whose throughput is not a whole number of samples/s
-        let cnv = root.join("hdl/tests/data/cnvmix.toml");
-        mixes.push(lut_gen::parse(&cnv, &std::fs::read_to_string(&cnv).unwrap()).unwrap());
+        // a part whose throughput is not a whole number of samples/s; two
+        // branches with every slot used (a tie for what binds)
+        for f in [
+            "hdl/tests/data/cnvmix.toml",
+            "formal/tests/data/ch60-20ms.toml",
+        ] {
+            let p = root.join(f);
+            mixes.push(lut_gen::parse(&p, &std::fs::read_to_string(&p).unwrap()).unwrap());
+        }
         for seed in 1..6 {
             let text = campaign::random_mix(seed, &campaign::Shape::default());
             mixes.push(lut_gen::parse(std::path::Path::new("r.toml"), &text).unwrap());
@@ -680,6 +686,18 @@ mod tests {
                     .fold(0.0, f64::max)
             };
             assert_eq!(tight.used, most, "{}", mix.name);
+            // without modes, a branch that binds is the one the branch
+            // table's caption names
+            let caption = branch_caption(&r);
+            if let (false, Some(b)) = (r.modes.len() > 1, tight.what.strip_prefix("branch `")) {
+                let name = &b[..b.find('`').unwrap()];
+                assert!(
+                    caption.contains(&format!("`{name}` is the most used")),
+                    "{}: {} / {caption}",
+                    mix.name,
+                    tight.what
+                );
+            }
         }
     }
 }
