@@ -348,11 +348,12 @@ fn vcd_times_are_exact(backends: &[&str]) {
     }
 }
 
-/// One preset on the three engines (every preset: `make test-long`); the
-/// goldens tie rusthdl and Verilator to one log for every preset already.
+/// The tiny mix on the three engines (a 4,000-cycle frame; every preset,
+/// the smallest a 120,000-cycle frame: `make test-long`); the goldens tie
+/// rusthdl and Verilator to one log for every preset already.
 #[test]
 fn rusthdl_verilator_and_icarus_give_identical_event_logs() {
-    identical_event_logs(&[root().join("mixes/softslip1k.toml")]);
+    identical_event_logs(&[root().join("testkit/mixes/tiny.toml")]);
 }
 
 #[test]

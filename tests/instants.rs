@@ -220,56 +220,70 @@ const EXT: [(&str, &str, bool); 2] = [
 /// and of Icarus, every sample of the group is where both parts hold their
 /// inputs, within 1 us (the other part's transaction starts 6.1 us after the
 /// slot tick, so it is); and `check` passes the run with and without the model.
+/// `make test` runs each part on one engine (the AD7940 on Verilator, the
+/// AD7689 on Icarus), `make test-long` the other two pairs.
 #[test]
 fn a_sync_group_holds_at_one_instant_on_verilator_and_icarus() {
     if !tools::require_tool("verilator") || !tools::require_tool("iverilog") {
         return;
     }
+    group_holds_at_one_instant(EXT[0], "verilator");
+    group_holds_at_one_instant(EXT[1], "icarus");
+}
+
+#[test]
+#[ignore = "long: make test-long (the AD7940 on Icarus, the AD7689 on Verilator)"]
+fn a_sync_group_holds_at_one_instant_on_the_other_engine_too() {
+    if !tools::require_tool("verilator") || !tools::require_tool("iverilog") {
+        return;
+    }
+    group_holds_at_one_instant(EXT[0], "icarus");
+    group_holds_at_one_instant(EXT[1], "verilator");
+}
+
+/// The group of the MCP3208 and `part` holds at one instant on `backend`.
+fn group_holds_at_one_instant((part, ext, cnv): (&str, &str, bool), backend: &str) {
     const US: u64 = 1_000_000; // ps
-    for (part, ext, cnv) in EXT {
-        let dir = tempfile::tempdir().unwrap();
-        let text = grouped().replace(EXT[0].1, ext);
-        let m = dir.path().join(format!("{part}.toml"));
-        std::fs::write(&m, &text).unwrap();
-        for backend in ["verilator", "icarus"] {
-            let (w, samples) = run_on(&m, 2, dir.path(), backend);
-            let (mcp, other) = (measured(&w, 0, Some(6)), held(&w, 1, None, cnv));
-            let sampled = |name: &str| -> Vec<u64> {
-                samples
-                    .iter()
-                    .filter(|s| s.0 == name)
-                    .map(|s| s.1)
-                    .collect()
-            };
-            let (m2, e0) = (sampled("M2"), sampled("E0"));
-            // an AD7689's first conversions after reset are prepared (no sample)
-            assert!(e0.len() >= 2, "{part} on {backend}: {e0:?}");
-            assert!(
-                m2.ends_with(&e0),
-                "{part} on {backend}: one instant per group sample: {m2:?} {e0:?}"
-            );
-            for t in &e0 {
-                let near = |x: &[u64], by: u64| x.iter().any(|i| i.abs_diff(*t) <= by);
-                assert!(
-                    near(&mcp, 1),
-                    "{part} on {backend}: {t} is no MCP3208 instant"
-                );
-                assert!(
-                    near(&other, US),
-                    "{part} on {backend}: the {part} holds no input within 1 us of {t}: {other:?}"
-                );
-            }
-            let vcd = dir.path().join("run.vcd");
-            for extra in [None, Some("--no-model")] {
-                slotforge()
-                    .arg("check")
-                    .arg(&m)
-                    .arg(&vcd)
-                    .args(extra)
-                    .assert()
-                    .success();
-            }
-        }
+    let dir = tempfile::tempdir().unwrap();
+    let text = grouped().replace(EXT[0].1, ext);
+    let m = dir.path().join(format!("{part}.toml"));
+    std::fs::write(&m, &text).unwrap();
+    let (w, samples) = run_on(&m, 2, dir.path(), backend);
+    let (mcp, other) = (measured(&w, 0, Some(6)), held(&w, 1, None, cnv));
+    let sampled = |name: &str| -> Vec<u64> {
+        samples
+            .iter()
+            .filter(|s| s.0 == name)
+            .map(|s| s.1)
+            .collect()
+    };
+    let (m2, e0) = (sampled("M2"), sampled("E0"));
+    // an AD7689's first conversions after reset are prepared (no sample)
+    assert!(e0.len() >= 2, "{part} on {backend}: {e0:?}");
+    assert!(
+        m2.ends_with(&e0),
+        "{part} on {backend}: one instant per group sample: {m2:?} {e0:?}"
+    );
+    for t in &e0 {
+        let near = |x: &[u64], by: u64| x.iter().any(|i| i.abs_diff(*t) <= by);
+        assert!(
+            near(&mcp, 1),
+            "{part} on {backend}: {t} is no MCP3208 instant"
+        );
+        assert!(
+            near(&other, US),
+            "{part} on {backend}: the {part} holds no input within 1 us of {t}: {other:?}"
+        );
+    }
+    let vcd = dir.path().join("run.vcd");
+    for extra in [None, Some("--no-model")] {
+        slotforge()
+            .arg("check")
+            .arg(&m)
+            .arg(&vcd)
+            .args(extra)
+            .assert()
+            .success();
     }
 }
 

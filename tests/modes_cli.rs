@@ -53,7 +53,9 @@ fn json(out: &std::process::Output) -> Value {
 
 /// `synth` places a mix with modes on the iCE40 board, its mode ports on
 /// the board's pins, and says which modes the gateware holds; the table
-/// says the same.
+/// says the same.  `make test` places the pin preset and a random pin mix
+/// (the table on the random one); the auto preset, with the table of each,
+/// is `make test-long`'s (each synthesis is 2 to 3 s of yosys and nextpnr).
 #[test]
 fn synth_places_mode_mixes_with_their_mode_ports_on_pins() {
     if !tools::require_tools(&["yosys", "nextpnr-ice40"]) {
@@ -61,56 +63,76 @@ fn synth_places_mode_mixes_with_their_mode_ports_on_pins() {
     }
     let d = tempfile::tempdir().unwrap();
     let random = random_mode_mix(d.path(), 7, lut_gen::ModeSelect::Pin);
-    for mix in [shared("modes-pin"), shared("modes-auto"), random] {
-        let out = d.path().join(mix.file_stem().unwrap());
-        let o = slotforge()
-            .args(["synth", "--json", "-o"])
-            .arg(&out)
-            .arg(&mix)
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        let v = json(&o);
-        let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
-        let plan = s.mode_plan().unwrap();
-        assert_eq!(v["modes"]["names"], serde_json::json!(plan.names), "{v}");
-        assert_eq!(v["modes"]["select"], plan.select.name(), "{v}");
-        assert!(v["logic_cells"].as_u64().unwrap() > 0, "{v}");
-        // every mode port bit has a pin in the constraint file nextpnr read
-        let pcf = std::fs::read_to_string(out.join("slotforge.pcf")).unwrap();
-        let l = lut_gen::Layout::new(&s);
-        for p in l.mode_ports() {
-            assert!(
-                pcf.lines()
-                    .any(|x| x.starts_with("set_io") && x.contains(&format!(" {}", p.name))),
-                "{} has no pin:\n{pcf}",
-                p.name
-            );
-        }
-        let t = slotforge()
-            .args(["synth", "-o"])
-            .arg(d.path().join("text"))
-            .arg(&mix)
-            .output()
-            .unwrap();
-        let t = String::from_utf8_lossy(&t.stdout).to_string();
-        let row = t.lines().find(|l| l.starts_with("  modes ")).unwrap();
-        assert!(row.contains(&plan.names.join(", ")), "{t}");
+    synth_places(d.path(), &shared("modes-pin"), false);
+    synth_places(d.path(), &random, true);
+}
+
+#[test]
+#[ignore = "long: make test-long (the auto preset, and the table of each)"]
+fn synth_places_the_auto_preset_and_tables_each_mixs_modes() {
+    if !tools::require_tools(&["yosys", "nextpnr-ice40"]) {
+        return;
     }
+    let d = tempfile::tempdir().unwrap();
+    for mix in [shared("modes-pin"), shared("modes-auto")] {
+        synth_places(d.path(), &mix, true);
+    }
+}
+
+/// `synth --json` of `mix` names its modes and select and puts every mode
+/// port on a pin; with `table`, the text table's `modes` row names them too.
+fn synth_places(d: &Path, mix: &Path, table: bool) {
+    let out = d.join(mix.file_stem().unwrap());
+    let o = slotforge()
+        .args(["synth", "--json", "-o"])
+        .arg(&out)
+        .arg(mix)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v = json(&o);
+    let s = lut_gen::synthesize(&lut_gen::load(mix).unwrap()).unwrap();
+    let plan = s.mode_plan().unwrap();
+    assert_eq!(v["modes"]["names"], serde_json::json!(plan.names), "{v}");
+    assert_eq!(v["modes"]["select"], plan.select.name(), "{v}");
+    assert!(v["logic_cells"].as_u64().unwrap() > 0, "{v}");
+    // every mode port bit has a pin in the constraint file nextpnr read
+    let pcf = std::fs::read_to_string(out.join("slotforge.pcf")).unwrap();
+    let l = lut_gen::Layout::new(&s);
+    for p in l.mode_ports() {
+        assert!(
+            pcf.lines()
+                .any(|x| x.starts_with("set_io") && x.contains(&format!(" {}", p.name))),
+            "{} has no pin:\n{pcf}",
+            p.name
+        );
+    }
+    if !table {
+        return;
+    }
+    let t = slotforge()
+        .args(["synth", "-o"])
+        .arg(d.join("text"))
+        .arg(mix)
+        .output()
+        .unwrap();
+    let t = String::from_utf8_lossy(&t.stdout).to_string();
+    let row = t.lines().find(|l| l.starts_with("  modes ")).unwrap();
+    assert!(row.contains(&plan.names.join(", ")), "{t}");
 }
 
 /// `golden --update` under a scene records it in the log's header; a run
 /// without options replays it on every back end and matches; a run with
 /// another switch differs (exit 1), and says which scene each was. Icarus
-/// (eight frames a run: nearly all of the test's time) replays the two
-/// presets' scenes here, the random mixes' too in `make test-long`.
+/// (eight frames a run, 3.5 to 6 s of CPU) replays the pin preset's scene
+/// here, the auto preset's and the random mixes' too in `make test-long`.
 #[test]
 fn golden_of_a_mode_mix_replays_its_scene_on_every_back_end() {
-    golden_replays_its_scene(2);
+    golden_replays_its_scene(1);
 }
 
 #[test]
-#[ignore = "long: make test-long (Icarus replays the random mode mixes' scenes too)"]
+#[ignore = "long: make test-long (Icarus replays every mix's scene)"]
 fn golden_of_a_mode_mix_replays_its_scene_on_every_back_end_icarus_on_each() {
     golden_replays_its_scene(usize::MAX);
 }
@@ -200,27 +222,15 @@ fn golden_replays_its_scene(on_icarus: usize) {
 /// The campaign on the gateware of a mix with modes runs its switching
 /// scenario: every pin class (the `mode` output's too) and every gateware
 /// class (mode-stuck built into the mode block too) is caught, the matrix
-/// naming the detectors.
+/// naming the detectors.  `make test` runs it on the pin preset and a
+/// random auto mix (11 s of CPU each); the auto preset is `make
+/// test-long`'s.
 #[test]
 fn faults_go_into_the_gateware_of_mode_mixes_and_each_class_is_caught() {
     let d = tempfile::tempdir().unwrap();
     let random = random_mode_mix(d.path(), 11, lut_gen::ModeSelect::Auto);
-    for mix in [shared("modes-pin"), shared("modes-auto"), random] {
-        let (v, code) = faults(&mix, &[]);
-        for name in ["mode-early", "mode-stuck", "mode-unasked"] {
-            let r = row(&v, name, "pins");
-            assert_eq!(r["detected"], r["injected"], "{r}");
-            assert!(r["detected_by"]["model"].as_u64().unwrap() > 0, "{r}");
-        }
-        let stuck = row(&v, "mode-stuck", "gateware");
-        assert!(
-            stuck["detected_by"]["invariants"].as_u64().unwrap() > 0,
-            "{stuck}"
-        );
-        for c in v["classes"].as_array().unwrap() {
-            assert_eq!(c["detected"], c["injected"], "{c}");
-        }
-        assert_eq!(code, Some(0), "{v}");
+    for mix in [shared("modes-pin"), random] {
+        every_class_caught(&mix);
     }
     // pin faults need a design in process: a Verilog engine as the target
     // is refused, pointing to --engines
@@ -230,6 +240,32 @@ fn faults_go_into_the_gateware_of_mode_mixes_and_each_class_is_caught() {
         .assert()
         .code(2)
         .stderr(predicate::str::contains("--engines icarus"));
+}
+
+#[test]
+#[ignore = "long: make test-long (the auto preset's campaign)"]
+fn faults_go_into_the_gateware_of_the_auto_preset_and_each_class_is_caught() {
+    every_class_caught(&shared("modes-auto"));
+}
+
+/// The campaign on `mix`: every mode pin class caught by the model,
+/// mode-stuck in the gateware by the invariants, every class caught.
+fn every_class_caught(mix: &Path) {
+    let (v, code) = faults(mix, &[]);
+    for name in ["mode-early", "mode-stuck", "mode-unasked"] {
+        let r = row(&v, name, "pins");
+        assert_eq!(r["detected"], r["injected"], "{r}");
+        assert!(r["detected_by"]["model"].as_u64().unwrap() > 0, "{r}");
+    }
+    let stuck = row(&v, "mode-stuck", "gateware");
+    assert!(
+        stuck["detected_by"]["invariants"].as_u64().unwrap() > 0,
+        "{stuck}"
+    );
+    for c in v["classes"].as_array().unwrap() {
+        assert_eq!(c["detected"], c["injected"], "{c}");
+    }
+    assert_eq!(code, Some(0), "{v}");
 }
 
 /// `faults --backend rusthdl --quiet --json --false-alarm-mixes 0` of

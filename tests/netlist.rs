@@ -43,18 +43,33 @@ fn sim_json(mix: &Path, args: &[&str], code: i32) -> serde_json::Value {
     serde_json::from_slice(&out.get_output().stdout).unwrap()
 }
 
+/// On Verilator; on Icarus in `make test-long` (a gate-level model on
+/// Icarus is the slowest run; `make test` runs the tiny mix's netlist, one
+/// LUT edited, on Icarus in `a_netlist_edit_fails_at_its_cycle_on_both_engines`).
 #[test]
 fn an_unseen_mixs_ice40_netlist_passes_on_verilator_and_icarus() {
-    if !tools::require_tools(&["yosys", "verilator", "iverilog"]) {
+    if !tools::require_tools(&["yosys", "verilator"]) {
         return;
     }
-    let mix = random_mix(3031, "random");
-    for backend in ["verilator", "icarus"] {
-        let v = sim_json(&mix, &["--backend", backend, "--netlist", "ice40"], 0);
-        assert_eq!(v["ok"], true, "{v}");
-        assert_eq!(v["source"], format!("{backend}, ice40-hx8k netlist"));
-        assert!(v["samples"].as_u64().unwrap() > 0, "{v}");
+    unseen_netlist_passes_on("verilator");
+}
+
+#[test]
+#[ignore = "long: make test-long (the unseen mix's netlist on Icarus)"]
+fn an_unseen_mixs_ice40_netlist_passes_on_icarus() {
+    if !tools::require_tools(&["yosys", "iverilog"]) {
+        return;
     }
+    unseen_netlist_passes_on("icarus");
+}
+
+/// The iCE40 netlist of an unseen random mix passes on `backend`.
+fn unseen_netlist_passes_on(backend: &str) {
+    let mix = random_mix(3031, &format!("random-{backend}"));
+    let v = sim_json(&mix, &["--backend", backend, "--netlist", "ice40"], 0);
+    assert_eq!(v["ok"], true, "{v}");
+    assert_eq!(v["source"], format!("{backend}, ice40-hx8k netlist"));
+    assert!(v["samples"].as_u64().unwrap() > 0, "{v}");
 }
 
 /// ECP5 and Gowin through the YoWASP yosys (`make tools-extra`): `make test-long`.
@@ -249,8 +264,26 @@ fn blackbox_cells_are_refused() {
     );
 }
 
+/// The tiny mix with an AXI4-Stream link: its iCE40 netlist, link stage
+/// included, passes; the reference design's (`eskin34-axis`, a frame of
+/// 480,000 cycles of a gate-level model) is `make test-long`'s.
 #[test]
 fn a_linked_mixs_netlist_passes() {
+    if !tools::require_tools(&["yosys", "verilator"]) {
+        return;
+    }
+    let axis = Path::new(env!("CARGO_TARGET_TMPDIR")).join("netlist-tiny-axis.toml");
+    let text = std::fs::read_to_string(tiny()).unwrap()
+        + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 8\n";
+    std::fs::write(&axis, text).unwrap();
+    let v = sim_json(&axis, &["--backend", "verilator", "--netlist", "ice40"], 0);
+    assert_eq!(v["ok"], true, "{v}");
+    assert!(v["samples"].as_u64().unwrap() > 0, "{v}");
+}
+
+#[test]
+#[ignore = "long: make test-long (the reference design's netlist, link included)"]
+fn the_linked_reference_designs_netlist_passes() {
     if !tools::require_tools(&["yosys", "verilator"]) {
         return;
     }

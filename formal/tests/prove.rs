@@ -938,34 +938,53 @@ fn generalised_frame_counters_agree_with_the_exact_search_on_link_mutants() {
 /// user-declared 16-channel part on inputs above 7): the
 /// harness asserts `adc_mosi` bit for bit and leaves the prepared
 /// conversions out of the stream, the emitted gateware proves, and the
-/// proof says it does not cover what the part does with the word.
+/// proof says it does not cover what the part does with the word.  `make
+/// test` proves the declared part's mix (a proof is 2 s of CPU); the
+/// other two are `make test-long`'s.
 #[test]
 fn commanded_mixes_prove_and_name_what_the_part_does_as_not_covered() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
-    for name in ["cmd-mcp3208", "cmd-ad7689", "cmd-ads7953"] {
-        let s = schedule(&format!("testkit/mixes/{name}.toml"));
-        let dir = tempfile::tempdir().unwrap();
-        let p = prove(&s, &emitted(&s), dir.path());
-        eprintln!("{name}: {}", p.summary());
-        assert_eq!(p.result, Outcome::Proved, "{name}: {}", p.summary());
-        let b = (0..s.branches.len()).find(|&b| s.has_command(b)).unwrap();
-        let mosi = format!("mosi[{}]", s.branches[b].name);
-        assert!(
-            p.properties
-                .iter()
-                .any(|q| q.name == mosi && q.result == Outcome::Proved),
-            "{name}: {}",
-            p.summary()
-        );
-        assert_eq!(p.not_covered.len(), 1, "{name}: {:?}", p.not_covered);
-        assert!(
-            p.not_covered[0].contains("converts the input each word selects"),
-            "{name}: {:?}",
-            p.not_covered
-        );
+    commanded_mix_proves("cmd-ads7953");
+}
+
+/// The MCP3208's and the AD7689's own mixes (`make test` proves both parts'
+/// words in `cmd-modes`, a mix with modes: `modes.rs`).
+#[test]
+#[ignore = "long: make test-long (make test proves these parts in cmd-modes)"]
+fn the_mcp3208s_and_the_ad7689s_mixes_prove_and_name_what_the_part_does() {
+    if !tools::require_tools(&TOOLS) {
+        return;
     }
+    for name in ["cmd-mcp3208", "cmd-ad7689"] {
+        commanded_mix_proves(name);
+    }
+}
+
+/// The emitted gateware of `testkit/mixes/NAME.toml` proves, its words
+/// on `adc_mosi` included, and only the part's conversion is not covered.
+fn commanded_mix_proves(name: &str) {
+    let s = schedule(&format!("testkit/mixes/{name}.toml"));
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    eprintln!("{name}: {}", p.summary());
+    assert_eq!(p.result, Outcome::Proved, "{name}: {}", p.summary());
+    let b = (0..s.branches.len()).find(|&b| s.has_command(b)).unwrap();
+    let mosi = format!("mosi[{}]", s.branches[b].name);
+    assert!(
+        p.properties
+            .iter()
+            .any(|q| q.name == mosi && q.result == Outcome::Proved),
+        "{name}: {}",
+        p.summary()
+    );
+    assert_eq!(p.not_covered.len(), 1, "{name}: {:?}", p.not_covered);
+    assert!(
+        p.not_covered[0].contains("converts the input each word selects"),
+        "{name}: {:?}",
+        p.not_covered
+    );
 }
 
 /// A gateware that takes channel bit 0 of the MCP3208's word from channel

@@ -77,17 +77,25 @@ fn tiny_mix_matches_timing_contract() {
     run_and_compare(&s, 3 * s.grid.frame_cycles);
 }
 
+/// A frame and its next slice: the frame's wrap, into the slice that
+/// starts the next frame (the pins are compared with the reference in
+/// every cycle).  Two whole frames of these mixes are `make test-long`'s
+/// (`two_frames_of_the_long_mixes_match_timing_contract`).
+fn frame_and_slice(s: &lut_gen::Schedule) -> u64 {
+    s.grid.frame_cycles + s.grid.slice_cycles
+}
+
 #[test]
 fn wide_mix_matches_timing_contract() {
     let s = wide();
-    run_and_compare(&s, 2 * s.grid.frame_cycles);
+    run_and_compare(&s, frame_and_slice(&s));
 }
 
 /// Three SPI timings: one shared sequencer each.
 #[test]
 fn three_speed_mix_matches_timing_contract() {
     let s = two_speed();
-    run_and_compare(&s, 2 * s.grid.frame_cycles);
+    run_and_compare(&s, frame_and_slice(&s));
 }
 
 /// Eight branches of 32 channels (256 channels, 4 mux devices each).
@@ -130,7 +138,7 @@ fn ch1024_matches_timing_contract() {
 #[test]
 fn eskin34_compact_lut_matches_timing_contract() {
     let s = eskin34();
-    run_and_compare_with(&s, 2 * s.grid.frame_cycles, hdl::LutForm::Compact);
+    run_and_compare_with(&s, frame_and_slice(&s), hdl::LutForm::Compact);
 }
 
 /// The reference mix (three branches, the merger's queue form) and 16
@@ -139,7 +147,7 @@ fn eskin34_compact_lut_matches_timing_contract() {
 #[test]
 fn logic_slot_decoding_matches_timing_contract() {
     let s = eskin34();
-    run_and_compare_with(&s, 2 * s.grid.frame_cycles, hdl::LutForm::Logic);
+    run_and_compare_with(&s, frame_and_slice(&s), hdl::LutForm::Logic);
     let s = data_mix("b16");
     run_and_compare_with(&s, s.grid.frame_cycles, hdl::LutForm::Logic);
 }
@@ -150,7 +158,22 @@ fn long_frame_needs_and_uses_the_compact_lut() {
     let s = long_frame();
     assert!(s.grid.frame_slots > hdl::MAX_FRAME_SLOTS);
     assert!(hdl::RtlSim::with_form(&s, hdl::LutForm::Full).is_err());
+    run_and_compare(&s, frame_and_slice(&s));
+}
+
+/// Two whole frames of the mixes `make test` runs for a frame and a slice.
+#[test]
+#[ignore = "long: make test-long (two frames of five mixes)"]
+fn two_frames_of_the_long_mixes_match_timing_contract() {
+    let s = long_frame();
     run_and_compare(&s, 2 * s.grid.frame_cycles);
+    for form in [hdl::LutForm::Compact, hdl::LutForm::Logic] {
+        let s = eskin34();
+        run_and_compare_with(&s, 2 * s.grid.frame_cycles, form);
+    }
+    for s in [wide(), two_speed()] {
+        run_and_compare(&s, 2 * s.grid.frame_cycles);
+    }
 }
 
 /// A slot longer than 65536 cycles (the slot counter is 20 bits).

@@ -134,15 +134,36 @@ fn gates_converter_parts() {
     }
 }
 
-/// The link to the host (issue 14): the reference design with its UART.
+/// The link to the host (issue 14): the tiny mix with a UART, emitted
+/// deterministically, linted and synthesized whole; the reference design
+/// with its UART in `make test-long` (`gates_uart_link_of_eskin34`: its
+/// yosys run is most of 10 s; `the_links_fifo_is_block_ram` synthesizes
+/// its link stage in `make test`).
 #[test]
 fn gates_uart_link() {
+    let tiny = std::fs::read_to_string(common::root().join("testkit/mixes/tiny.toml")).unwrap()
+        + "\n[link]\nkind = \"uart\"\nbaud = 1_000_000\n";
+    let mix = lut_gen::parse(Path::new("tiny-uart.toml"), &tiny).unwrap();
+    uart_link_gates(&lut_gen::synthesize(&mix).unwrap(), "tiny-uart");
+}
+
+#[test]
+#[ignore = "long: make test-long (the reference design's UART link synthesized)"]
+fn gates_uart_link_of_eskin34() {
     let path = common::root().join("mixes/eskin34-uart.toml");
-    let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
-    let v = hdl::emit(&s, None).unwrap();
+    uart_link_gates(
+        &lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap(),
+        "eskin34-uart",
+    );
+}
+
+/// `s`'s Verilog has the link stage, is emitted the same twice, and
+/// lints and synthesizes clean.
+fn uart_link_gates(s: &Schedule, tag: &str) {
+    let v = hdl::emit(s, None).unwrap();
     assert!(v.verilog().contains("module slotforge_link("));
-    assert_eq!(v, hdl::emit(&s, None).unwrap(), "deterministic");
-    gates(&s, "eskin34-uart");
+    assert_eq!(v, hdl::emit(s, None).unwrap(), "deterministic");
+    gates(s, tag);
 }
 
 fn eskin34_axis() -> Schedule {
@@ -411,13 +432,27 @@ fn the_links_fifo_is_block_ram() {
 /// ports lint and synthesize clean. The adaptive reference design is
 /// linted here and synthesized in `make test-long` (`gates_eskin34_adaptive`:
 /// its yosys run is half of this test's time).
+///
+/// `make test` synthesizes one mix of each select, one of them fronted
+/// (`modes-pin`, `front-modes-auto`) and lints the other two;
+/// `gates_modes_of_the_other_selects` synthesizes those in `make test-long`.
 #[test]
 fn gates_modes() {
-    for name in ["modes-pin", "modes-auto", "front-modes", "front-modes-auto"] {
+    for name in ["modes-pin", "front-modes-auto"] {
         gates(&mode_mix(name), name);
     }
-    let name = "eskin34-adaptive";
-    lint_in(&emit_to(&mode_mix(name), "eskin34-adaptive-lint"), name);
+    for name in ["modes-auto", "front-modes", "eskin34-adaptive"] {
+        lint_in(&emit_to(&mode_mix(name), &format!("{name}-lint")), name);
+    }
+}
+
+/// Long: the auto-select mix and the fronted pin-select mix synthesized.
+#[test]
+#[ignore = "long: make test-long (two more mode mixes synthesized)"]
+fn gates_modes_of_the_other_selects() {
+    for name in ["modes-auto", "front-modes"] {
+        gates(&mode_mix(name), name);
+    }
 }
 
 /// Long: the adaptive reference design (34 channels, two modes) linted and
