@@ -26,3 +26,13 @@ pub use faults::{
     VerilogFault, TREADY,
 };
 pub use mixgen::{random_mix, LinkShape, Shape};
+
+/// Private items that this crate's tests check directly (`tests/units/`):
+/// the crate has no unit-test harness (`[lib] test = false`, one build of
+/// it less in `make test`).  Not an API: no other crate uses it.
+#[doc(hidden)]
+pub mod for_tests {
+    pub use crate::sigrok::{
+        check as sigrok_check, decode_commands, window_conversions, SpiCapture,
+    };
+}

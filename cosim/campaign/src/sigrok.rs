@@ -46,6 +46,12 @@ pub struct SpiCapture {
 }
 
 impl SpiCapture {
+    /// The `mode` pin at each frame's first cycle (tests only, through
+    /// `for_tests`).
+    pub fn modes(&self) -> &[u8] {
+        &self.modes
+    }
+
     /// A capture for a run of `s` with `reset` reset cycles.
     pub fn new(s: &Schedule, reset: u64) -> SpiCapture {
         let nb = s.branches.len();
@@ -165,7 +171,7 @@ fn decode(file: &Path, part: &AdcPart) -> Result<Vec<u16>, String> {
 
 /// The command words sigrok decodes from one branch's `mosi` lane, first
 /// bit first (the word's bits are the top of each SPI word).
-fn decode_commands(file: &Path, part: &AdcPart) -> Result<Vec<Vec<bool>>, String> {
+pub fn decode_commands(file: &Path, part: &AdcPart) -> Result<Vec<Vec<bool>>, String> {
     let d = PartDecoder::of(part);
     let n = part.command.as_ref().map_or(0, |c| c.bits.len() as u32);
     let words = words(file, &d, "mosi")?;
@@ -237,7 +243,7 @@ pub fn check(
 /// more than `margin` cycles before the run: (the schedule of its frame's
 /// mode, shown on `modes`; its index among the branch's conversions in
 /// that frame; its channel).
-fn window_conversions<'a>(
+pub fn window_conversions<'a>(
     s: &'a Schedule,
     modes: &[u8],
     b: usize,
@@ -357,62 +363,4 @@ fn check_commands(
         )));
     }
     Ok(Ok(()))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use judge::{run_dut, Dut, FaultyDut, ModelDut, PinFault, RunOptions};
-
-    fn capture(s: &Schedule, dut: &mut dyn Dut, frames: u64) -> SpiCapture {
-        let opts = RunOptions::default();
-        let mut cap = SpiCapture::new(s, judge::reset_cycles(s, opts.reset_cycles));
-        run_dut(s, dut, frames, &opts, "sigrok", Some(&mut cap));
-        cap
-    }
-
-    /// sigrok's decoder reads the command words on `mosi`: on a clean run
-    /// of the shared commanded mixes they are the schedule's, every one;
-    /// a word with a wrong channel bit is named.
-    #[test]
-    fn sigrok_reads_the_command_words_on_mosi() {
-        if !testkit::tools::require_tool("sigrok-cli") {
-            return;
-        }
-        for name in ["cmd-pair", "cmd-solo"] {
-            let s = lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap();
-            let frames = 4;
-            let dir = tempfile::tempdir().unwrap();
-            let cap = capture(&s, &mut ModelDut::new(&s), frames);
-            assert_eq!(
-                check(&s, &cap, frames, dir.path()).unwrap(),
-                Ok(()),
-                "{name}"
-            );
-            for b in (0..s.branches.len()).filter(|&b| s.has_command(b)) {
-                let got = decode_commands(
-                    &dir.path().join(format!("b{b}.vcd")),
-                    &s.mix.branches[b].adc,
-                )
-                .unwrap();
-                let want: Vec<Vec<bool>> = window_conversions(&s, &cap.modes, b, frames, 0)
-                    .iter()
-                    .map(|&(m, k, _)| m.commands_in_frame(b)[k].word.clone())
-                    .collect();
-                assert!(!got.is_empty(), "{name} branch {b}");
-                assert_eq!(got, want, "{name} branch {b}");
-            }
-            let b = (0..s.branches.len()).find(|&b| s.has_command(b)).unwrap();
-            let at = s.grid.frame_cycles * 3 / 2;
-            let mut dut = FaultyDut::new(
-                &s,
-                ModelDut::new(&s),
-                PinFault::WrongChannelBits { branch: b },
-                at,
-            );
-            let cap = capture(&s, &mut dut, frames);
-            let e = check(&s, &cap, frames, dir.path()).unwrap().unwrap_err();
-            assert!(e.contains("command word"), "{name}: {e}");
-        }
-    }
 }

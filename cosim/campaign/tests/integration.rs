@@ -36,3 +36,8 @@ use testkit::tools;
 
 #[path = "modes.rs"]
 mod modes;
+
+// The modules' own tests (the crate has no unit-test harness: `[lib] test =
+// false`), through its public face and its `for_tests` items.
+#[path = "units/mod.rs"]
+mod units;

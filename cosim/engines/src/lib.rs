@@ -36,3 +36,12 @@ pub use options::{Backend, SimOptions, VcdOut};
 pub use rtl::load_rtl;
 pub use rusthdl::{verilog, RustHdlDut};
 pub use verilator::VerilatedDut;
+
+/// Private items that this crate's tests check directly
+/// (`tests/rtl_units.rs`): the crate has no unit-test harness (`[lib] test
+/// = false`, one build of it less in `make test`).  Not an API: no other
+/// crate uses it.
+#[doc(hidden)]
+pub mod for_tests {
+    pub use crate::rtl::{eval_const, scan_ports, PortDir};
+}

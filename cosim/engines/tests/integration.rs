@@ -19,5 +19,10 @@ mod modes;
 #[path = "verilator_shim.rs"]
 mod verilator_shim;
 
+// The port scan's own tests (the crate has no unit-test harness: `[lib]
+// test = false`), through its `for_tests` items.
+#[path = "rtl_units.rs"]
+mod rtl_units;
+
 // Shared by several test files (one copy in this binary).
 use testkit::tools;

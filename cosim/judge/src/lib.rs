@@ -72,3 +72,15 @@ pub use capture::{
 // Logs: a run's pins as events (golden tests), its samples as CSV, the
 // bytes its link carried.
 pub use logs::{compare_events, EventLog, LinkBytes, SampleLog, Trace};
+
+/// Private items that this crate's tests check directly (`tests/units/`):
+/// the crate has no unit-test harness (`[lib] test = false`, one build of
+/// it less in `make test`), so they are reached from the integration tests
+/// here.  Not an API: no other crate uses it.
+#[doc(hidden)]
+pub mod for_tests {
+    pub use crate::check::{same, History};
+    pub use crate::line::find_boundary;
+    pub use crate::logs::{time_us, write_atomic, Event};
+    pub use crate::wave::set_chunk_bytes;
+}

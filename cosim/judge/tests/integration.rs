@@ -33,3 +33,8 @@ mod cnvlow;
 
 #[path = "holdoff.rs"]
 mod holdoff;
+
+// The rooms' own tests (the crate has no unit-test harness: `[lib] test =
+// false`), through its public face and its `for_tests` items.
+#[path = "units/mod.rs"]
+mod units;

@@ -8,6 +8,8 @@ mod run;
 
 pub(crate) use checker::Join;
 pub use checker::{CheckOptions, Checker};
+// For this crate's tests only (`crate::for_tests`).
+pub use checker::{same, History};
 pub use faults::{FaultyDut, PinFault};
 pub use run::{
     reset_cycles, run_dut, run_model, run_unchecked, with_slave, AxisSlave, Dut, ModeRequests,

@@ -8,3 +8,5 @@ mod join;
 
 pub(crate) use decode::{decoder, tlast_wrong, LinkLine};
 pub(crate) use join::{Joined, LinkJoin};
+// For this crate's tests only (`crate::for_tests`).
+pub use join::find_boundary;

@@ -8,3 +8,6 @@ mod samples;
 pub use bytes::LinkBytes;
 pub use events::{compare as compare_events, EventLog, Trace};
 pub use samples::SampleLog;
+// For this crate's tests only (`crate::for_tests`).
+pub use events::{time_us, Event};
+pub use samples::write_atomic;

@@ -31,9 +31,9 @@ thread_local! {
     static CHUNK_BYTES: std::cell::Cell<usize> = const { std::cell::Cell::new(CHUNK) };
 }
 
-/// Sets this thread's chunk size (unit tests: cuts everywhere).
-#[cfg(test)]
-pub(crate) fn set_chunk_bytes(n: usize) {
+/// Sets this thread's chunk size (tests only, through `for_tests`: cuts
+/// everywhere).
+pub fn set_chunk_bytes(n: usize) {
     CHUNK_BYTES.with(|c| c.set(n.max(1)));
 }
 

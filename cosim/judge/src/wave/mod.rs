@@ -9,6 +9,8 @@ mod read;
 mod write;
 
 pub use fst::from_vcd as fst_from_vcd;
+// For this crate's tests only (`crate::for_tests`).
+pub use lex::set_chunk_bytes;
 pub use lock::{LockError, LockInfo, WindowCheck};
 pub use read::{
     check_vcd, check_vcd_progress, check_vcd_with, parse_only as parse_vcd, read_cycles, CycleSink,

@@ -1,0 +1,55 @@
+use campaign::for_tests::{decode_commands, sigrok_check as check, window_conversions, SpiCapture};
+use judge::{run_dut, Dut, FaultyDut, ModelDut, PinFault, RunOptions};
+use lut_gen::Schedule;
+
+fn capture(s: &Schedule, dut: &mut dyn Dut, frames: u64) -> SpiCapture {
+    let opts = RunOptions::default();
+    let mut cap = SpiCapture::new(s, judge::reset_cycles(s, opts.reset_cycles));
+    run_dut(s, dut, frames, &opts, "sigrok", Some(&mut cap));
+    cap
+}
+
+/// sigrok's decoder reads the command words on `mosi`: on a clean run
+/// of the shared commanded mixes they are the schedule's, every one;
+/// a word with a wrong channel bit is named.
+#[test]
+fn sigrok_reads_the_command_words_on_mosi() {
+    if !testkit::tools::require_tool("sigrok-cli") {
+        return;
+    }
+    for name in ["cmd-pair", "cmd-solo"] {
+        let s = lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap();
+        let frames = 4;
+        let dir = tempfile::tempdir().unwrap();
+        let cap = capture(&s, &mut ModelDut::new(&s), frames);
+        assert_eq!(
+            check(&s, &cap, frames, dir.path()).unwrap(),
+            Ok(()),
+            "{name}"
+        );
+        for b in (0..s.branches.len()).filter(|&b| s.has_command(b)) {
+            let got = decode_commands(
+                &dir.path().join(format!("b{b}.vcd")),
+                &s.mix.branches[b].adc,
+            )
+            .unwrap();
+            let want: Vec<Vec<bool>> = window_conversions(&s, cap.modes(), b, frames, 0)
+                .iter()
+                .map(|&(m, k, _)| m.commands_in_frame(b)[k].word.clone())
+                .collect();
+            assert!(!got.is_empty(), "{name} branch {b}");
+            assert_eq!(got, want, "{name} branch {b}");
+        }
+        let b = (0..s.branches.len()).find(|&b| s.has_command(b)).unwrap();
+        let at = s.grid.frame_cycles * 3 / 2;
+        let mut dut = FaultyDut::new(
+            &s,
+            ModelDut::new(&s),
+            PinFault::WrongChannelBits { branch: b },
+            at,
+        );
+        let cap = capture(&s, &mut dut, frames);
+        let e = check(&s, &cap, frames, dir.path()).unwrap().unwrap_err();
+        assert!(e.contains("command word"), "{name}: {e}");
+    }
+}
