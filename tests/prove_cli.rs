@@ -470,8 +470,10 @@ fn a_pin_mode_mix_with_a_uart_proves_its_line_and_packets() {
     uart_mix_proves(&mix, dir.path());
 }
 
-/// Its link mutants each fail `prove` with a trace from reset that `check`
-/// rejects at the same cycle.
+/// Its mode-field and CRC mutants each fail `prove` with a trace from
+/// reset that `check` rejects at the same cycle (found by the generalised
+/// run itself; the skipping frame counter, found by the search that
+/// follows it, is in the auto-select test below: about 10 s more).
 #[test]
 fn link_mutants_of_a_pin_mode_mix_fail_prove_where_check_does() {
     if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
@@ -479,7 +481,7 @@ fn link_mutants_of_a_pin_mode_mix_fail_prove_where_check_does() {
     }
     let dir = tempfile::tempdir().unwrap();
     let mix = crate::common_cli::root().join("formal/tests/data/modes-pin-uart.toml");
-    link_mutants_fail_where_check_does(&mix, dir.path(), &MODE_MIX_MUTANTS);
+    link_mutants_fail_where_check_does(&mix, dir.path(), &MODE_MIX_MUTANTS[..2]);
 }
 
 /// The same on the auto-select mix (`testkit/mixes/modes-auto.toml`, three
