@@ -538,21 +538,22 @@ const GENERAL_FRAMES: u64 = DEEP_FRAMES + 1;
 /// symbolic engine from reset, with the design's frame counter
 /// (`opts.frame_counter`) and the harness's generalised at every frame
 /// start from the first on, step 2 (`symsim::prove_generalised`): the state then
-/// comes round after a few frames instead of 256.  `None` when it does
-/// not apply: another engine, modes (their runs are split), no counter of
-/// that name in the design.  A violation in the frame after the first
-/// generalisation that holds with the count pinned to its real value is a
-/// trace from reset (`Failed`); any other, or a state that does not come
-/// round, is `Bounded` and the caller searches as before.
+/// comes round after a few frames instead of 256.  Split as the main run
+/// is: on an AXI4-Stream slave's choices and pin-selected modes' requests
+/// where a step reads them, on auto select's decisions at frame starts.
+/// `None` when it does not apply: another engine, a depth given, no
+/// counter of that name in the design.  A violation in the frame after a
+/// path's first generalisation that holds with the count pinned to its
+/// real value is a trace from reset (`Failed`); any other, or a state that
+/// does not come round, is `Bounded` and the caller searches as before.
 fn link_generalised(
     s: &Schedule,
     h: &Harness,
     design: &str,
     opts: &ProveOptions,
 ) -> Result<Option<GeneralRun>, ProveError> {
-    let modes = !s.modes.is_empty() || h.inputs.iter().any(|i| i.name == harness::MODE_SEL);
     let name = match (&opts.frame_counter, opts.solver) {
-        (Some(n), Solver::Symbolic) if !modes && opts.depth.is_none() => n,
+        (Some(n), Solver::Symbolic) if opts.depth.is_none() => n,
         _ => return Ok(None),
     };
     let work = work_dir()?;
@@ -570,12 +571,23 @@ fn link_generalised(
     let f = h.frame_cycles;
     let counters = symsim::Counters { pairs, from: 2 };
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
-    let limit = GENERAL_FRAMES * f + 2;
-    // an AXI4-Stream slave's choices: one path per choice where a step
-    // reads it, paths in the same state at a step merged (`symsim::split`)
-    let choices = named_inputs(&prep, harness::TREADY_ANY);
-    let (found, st) =
-        symsim::prove_generalised(&g, counters, &choices, f, 2, limit, Some(deadline));
+    // auto select: as deep as the main run may need for its windows
+    let auto = harness::auto_frames(s);
+    let limit = (GENERAL_FRAMES + auto.unwrap_or(0)) * f + 2;
+    // an AXI4-Stream slave's choices and mode requests: one path per value
+    // where a step reads them, paths in the same state at a step merged
+    // (`symsim::split`); auto select's decisions at frame starts (`cases`)
+    let splits = Splits::of(&prep, auto.is_some());
+    let (found, st) = symsim::prove_generalised(
+        &g,
+        counters,
+        &splits.bits(),
+        splits.auto,
+        f,
+        2,
+        limit,
+        Some(deadline),
+    );
     let what = format!(
         "the frame counters ({name} and the harness's {})",
         harness::FRAME_COUNTER
@@ -591,7 +603,7 @@ fn link_generalised(
             (Outcome::Failed, step, note, None)
         }
         symsim::Found::Proved { steps, since } => {
-            let note = general_note(&g, &st, &what, steps, since, f);
+            let note = general_note(&g, &st, (&what, &splits.words()), steps, since, f);
             (Outcome::Proved, steps, note, None)
         }
         symsim::Found::Bounded { steps } => {
@@ -613,10 +625,17 @@ fn link_generalised(
 }
 
 /// The note of a proof with generalised frame counters.
-fn general_note(g: &Aig, st: &SymStats, what: &str, steps: u64, since: u64, f: u64) -> String {
+fn general_note(
+    g: &Aig,
+    st: &SymStats,
+    (what, how): (&str, &str),
+    steps: u64,
+    since: u64,
+    f: u64,
+) -> String {
     let from = st.generalised.unwrap_or(since);
     if st.branches > 0 {
-        return split_general_note(g, st, what, steps, f);
+        return split_general_note(g, st, (what, how), steps, f);
     }
     format!(
         "{PROVED}: every step from reset to step {from} simulated exactly with every free \
@@ -635,29 +654,82 @@ fn general_note(g: &Aig, st: &SymStats, what: &str, steps: u64, since: u64, f: u
     )
 }
 
-/// The same for a run split on an AXI4-Stream slave's choices
-/// (`symsim::split`): each path's state at a frame start is one some path
-/// had at an earlier or the same frame start.
-fn split_general_note(g: &Aig, st: &SymStats, what: &str, steps: u64, f: u64) -> String {
+/// The same for a split run (`symsim::split`, `cases`): each path's state
+/// at a frame start is one some path had at an earlier or the same frame start.
+fn split_general_note(
+    g: &Aig,
+    st: &SymStats,
+    (what, how): (&str, &str),
+    steps: u64,
+    f: u64,
+) -> String {
     format!(
         "{PROVED}: every step from reset simulated exactly with MISO a variable of its step \
-         and split on the slave's choices (tready_any: one path per value in each step that \
-         reads it, paths in the same state at a step merged: {} merged; {} latches, {} gates; \
-         {} satisfiability checks); at each frame start, {what}, shown equal in every state, \
-         are replaced by one free 8-bit value, so the states simulated from it include every \
-         state reachable there; by step {steps} ({:.0} frames) every path's state at a frame \
-         start, so generalised, was one some path had at an earlier frame start ({} distinct, \
-         up to renaming), so those steps reach every reachable state under every slave the \
-         guarantee allows, the link's bytes ({}) included (symbolic simulation with the frame \
-         counter generalised: an inductive invariant, checked)",
+         and split {how} (paths in the same state at a step merged: {} merged; {} latches, \
+         {} gates; {} satisfiability checks); at each frame start, {what}, shown equal in \
+         every state, are replaced by one free 8-bit value, so the states simulated from it \
+         include every state reachable there; by step {steps} ({:.0} frames) every path's \
+         state at a frame start, so generalised, was one some path had at an earlier frame \
+         start ({} distinct, up to renaming), so those steps reach every reachable state{}, \
+         the link's bytes ({}) included (symbolic simulation with the frame counter \
+         generalised: an inductive invariant, checked)",
         st.merged,
         g.latches.len(),
         g.ands.len(),
         st.sat_calls,
         steps.saturating_sub(2) as f64 / f as f64,
         st.branches,
+        match how.contains("tready_any") {
+            true => " under every slave the guarantee allows",
+            false => "",
+        },
         LINK_BYTES.join(", "),
     )
+}
+
+/// The inputs a run is split on (`symsim::split`), by what they are, and
+/// whether it splits on auto select's decisions (`cases`).
+struct Splits {
+    mode_sel: Vec<usize>,
+    tready: Vec<usize>,
+    auto: bool,
+}
+
+impl Splits {
+    fn of(prep: &engine::Prepared, auto: bool) -> Splits {
+        Splits {
+            mode_sel: named_inputs(prep, harness::MODE_SEL),
+            tready: named_inputs(prep, harness::TREADY_ANY),
+            auto,
+        }
+    }
+
+    /// The AIG inputs split on where a step reads them.
+    fn bits(&self) -> Vec<usize> {
+        self.mode_sel.iter().chain(&self.tready).copied().collect()
+    }
+
+    /// What the run splits on, in words ("on ... and on ...").
+    fn words(&self) -> String {
+        let mut on = Vec::new();
+        if !self.mode_sel.is_empty() {
+            on.push(
+                "on the mode requests (mode_sel: one path per value in each step that reads it)",
+            );
+        }
+        if !self.tready.is_empty() {
+            on.push(
+                "on the slave's choices (tready_any: one path per value in each step that reads it)",
+            );
+        }
+        if self.auto {
+            on.push(
+                "on auto select's decisions (at each frame start, one path per value of the mode \
+                 and trigger-run registers some input reaches, with its condition on the codes)",
+            );
+        }
+        on.join(" and ")
+    }
 }
 
 /// Why the generalised run did not prove, in words.

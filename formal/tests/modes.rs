@@ -99,6 +99,34 @@ fn pin_select_mix_proves_for_every_sequence_of_requests() {
     assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
 }
 
+/// A pin-select mix with a UART proves the whole contract, the link's
+/// bytes included (the run split on `mode_sel` with the frame counters
+/// generalised); a header whose two mode fields are swapped is wrong only
+/// after a switch, and fails there with a trace `check` rejects.
+#[test]
+fn a_pin_mode_mix_with_a_uart_proves_its_packets_and_a_mode_field_swap_fails() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("formal/tests/data/modes-pin-uart.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
+    assert!(p.note.contains("split on the mode requests"), "{}", p.note);
+    let swapped = edit(
+        &emitted(&s),
+        "hfield = {fmode, pmode, ",
+        "hfield = {pmode, fmode, ",
+    );
+    let p = prove(&s, &swapped, dir.path());
+    assert_fails(&s, &p, &["link.packets"]);
+    // not before the first frame a request can switch the mode
+    let c = p.counterexample.as_ref().unwrap();
+    assert!(c.cycle >= s.grid.frame_cycles as i64, "{}", p.summary());
+}
+
 /// The gateware's mode block as emitted for a pin-select mix.
 const DECIDED: &str = "wire [0:0] decided = mode_sel[0:0];";
 const SWITCH: &str = "cur <= nxt;\n          nxt <= decided;";
@@ -292,9 +320,10 @@ fn assert_honestly_bounded(p: &Proof) {
 
 /// Auto select proves for all time: the paths split at frame starts on
 /// the values of the mode and run registers (each frame's decision is a
-/// function of the frame's codes), and nothing about the modes is left
-/// out; a search cut short is still honestly bounded. About a minute
-/// under load (13 frames, some 200 paths).
+/// function of the frame's codes), the link's bytes included (the frame
+/// counters generalised on every path), so nothing is left out; a search
+/// cut short is still honestly bounded. About a minute under load (14
+/// frames, some 300 states at frame starts).
 #[test]
 #[ignore = "long: make test-long"]
 fn the_auto_select_mix_proves() {
@@ -304,32 +333,7 @@ fn the_auto_select_mix_proves() {
     let s = schedule("testkit/mixes/modes-auto.toml");
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &emitted(&s), dir.path());
-    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
-    // the link's bytes are searched two frames (an 8,000-cycle frame's 256
-    // take more than formal::LINK_PROOF_STEPS), every other property proved
-    for q in &p.properties {
-        let bytes = q.name == "link.bytes" || q.name == "link.packets";
-        let want = if bytes {
-            Outcome::Bounded
-        } else {
-            Outcome::Proved
-        };
-        assert_eq!(q.result, want, "{}", p.summary());
-    }
-    assert!(
-        p.note
-            .contains("split at each frame start on the values of the registers"),
-        "{}",
-        p.note
-    );
-    // the link's bytes after the search are all that is left out, no mode switch
-    assert!(
-        p.not_covered
-            .iter()
-            .all(|n| !n.starts_with("every mode switch")),
-        "{:?}",
-        p.not_covered
-    );
+    assert_whole_contract_proved_split_on_decisions(&p);
     let depth = 2 * s.grid.frame_cycles + 2_000;
     let p = prove_to(&s, &emitted(&s), dir.path(), Some(depth));
     assert_honestly_bounded(&p);
@@ -362,7 +366,27 @@ fn an_auto_gateware_with_a_trigger_level_off_by_one_fails_prove() {
     assert_fails(&s, &p, &names);
 }
 
-/// The preset (48 MHz, 10 ms frames, auto select over a UART) proves.
+/// An auto-select mix with a UART proved whole: every property, the
+/// link's bytes too, in the run split on the trigger decisions with the
+/// frame counters generalised; nothing left uncovered.
+fn assert_whole_contract_proved_split_on_decisions(p: &Proof) {
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    assert!(
+        p.properties.iter().all(|q| q.result == Outcome::Proved),
+        "{}",
+        p.summary()
+    );
+    for how in [
+        "split on auto select's decisions",
+        "frame counter generalised",
+    ] {
+        assert!(p.note.contains(how), "{how}: {}", p.note);
+    }
+}
+
+/// The preset (48 MHz, 10 ms frames, auto select over a UART) proves the
+/// whole contract, its link's bytes included.
 #[test]
 #[ignore = "long: make test-long"]
 fn the_adaptive_preset_proves() {
@@ -372,7 +396,7 @@ fn the_adaptive_preset_proves() {
     let s = schedule("mixes/eskin34-adaptive.toml");
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &emitted(&s), dir.path());
-    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert_whole_contract_proved_split_on_decisions(&p);
 }
 
 /// Whether some mode of `s` samples no channel of some branch: that branch

@@ -1034,7 +1034,7 @@ fn generalised_split(
         pairs: pairs.to_vec(),
         from,
     };
-    prove_generalised(g, counters, splits, period, offset, max_steps, None)
+    prove_generalised(g, counters, splits, false, period, offset, max_steps, None)
 }
 
 /// A "frame counter" pair that only feeds data, the way the packets' frame
@@ -1046,6 +1046,16 @@ fn generalised_split(
 /// that skips after 200 frames).  Returns the AIG and the latch pairs of
 /// the two counts (AIG latch indices, LSB first).
 fn frame_counters(skip_at: Option<u64>) -> (Aig, Vec<(usize, usize)>) {
+    frame_counters_with(skip_at, |_, _, _| 0)
+}
+
+/// [`frame_counters`] with the design's byte's bit 0 flipped where `wrong`
+/// (given the builder, the design's count and the phase-3 strobe) says:
+/// the counts stay equal, so every frame start generalises them.
+fn frame_counters_with(
+    skip_at: Option<u64>,
+    wrong: impl FnOnce(&mut B, &[u32], u32) -> u32,
+) -> (Aig, Vec<(usize, usize)>) {
     let mut b = B::default();
     let phase = b.counter(2, 1);
     let at3 = b.eq(&phase, 3);
@@ -1064,11 +1074,16 @@ fn frame_counters(skip_at: Option<u64>) -> (Aig, Vec<(usize, usize)>) {
     let (bd, bh): (Vec<u32>, Vec<u32>) = (0..8)
         .map(|_| (b.latch(Init::Zero), b.latch(Init::Zero)))
         .unzip();
+    let wrong = wrong(&mut b, &d, at3);
     let mut differ = 0;
     for i in 0..8 {
         for (byte, count) in [(&bd, &d), (&bh, &h)] {
-            // byte <= at1 ? count : byte
-            let take = b.and(at1, count[i]);
+            // byte <= at1 ? count : byte (the design's bit 0 flipped when wrong)
+            let bit = match (i, std::ptr::eq(byte, &bd)) {
+                (0, true) => b.xor(count[i], wrong),
+                _ => count[i],
+            };
+            let take = b.and(at1, bit);
             let keep = b.and(at1 ^ 1, byte[i]);
             let n = b.or(take, keep);
             b.next(byte[i], n);
@@ -1140,6 +1155,45 @@ fn a_violation_in_the_first_generalised_frame_is_pinned_to_a_trace_from_reset() 
     let (f, st) = judged_by(&g, 4, 2, || generalised_run(&g, &pairs, 2, (4, 2, 200)));
     assert_eq!(f, Found::Bounded { steps: 2 });
     assert!(st.counter_failure.is_some(), "{st:?}");
+}
+
+/// The design's byte wrong from the third count on, whatever the count:
+/// two flags, the first set at the first count, the second at the next.
+fn from_the_third_count(b: &mut B, _: &[u32], at3: u32) -> u32 {
+    let (f1, f2) = (b.latch(Init::Zero), b.latch(Init::Zero));
+    let n1 = b.or(f1, at3);
+    b.next(f1, n1);
+    let both = b.and(f1, at3);
+    let n2 = b.or(f2, both);
+    b.next(f2, n2);
+    f2
+}
+
+#[test]
+fn a_violation_frames_after_the_first_generalisation_is_pinned_through_every_one() {
+    // wrong from the third frame on, for any count: the run meets it
+    // after two generalisations; solved with every generalisation's
+    // variables pinned to the count it replaced (a chain back to reset's
+    // 0), it is the trace from reset (judged), at the true step
+    let (g, pairs) = frame_counters_with(None, from_the_third_count);
+    let truth = Concrete::new(&g).first_bad().expect("reachable");
+    assert!(truth >= 10, "{truth}");
+    let (f, st) = judged_by(&g, 4, 2, || generalised_run(&g, &pairs, 2, (4, 2, 200)));
+    assert!(
+        matches!(f, Found::Violated { step, .. } if step == truth),
+        "{f:?} {st:?}"
+    );
+    assert_eq!(st.generalised, Some(2));
+    // wrong at count 200 only: the first violation the run meets needs a
+    // count no run has at that step, so no pinned model: bounded at the
+    // exact part, naming the count
+    let (g, pairs) = frame_counters_with(None, |b, d, _| b.eq(d, 200));
+    let (f, st) = judged_by(&g, 4, 2, || generalised_run(&g, &pairs, 2, (4, 2, 200)));
+    assert_eq!(f, Found::Bounded { steps: 2 });
+    assert!(
+        matches!(st.counter_failure, Some(CounterFailure::Violated { count, .. }) if (199..=200).contains(&count)),
+        "{st:?}"
+    );
 }
 
 /// Two copies of an `n`-bit count (up when `en`), random logic over them
@@ -1237,4 +1291,56 @@ fn random_designs_with_generalised_counters_split_on_a_choice_agree_with_an_expl
     eprintln!("{tally:?} proved/violated/bounded, {merged} paths merged");
     assert!(tally.iter().all(|&n| n > 50), "{tally:?}");
     assert!(merged > 100, "{merged} merged");
+}
+
+/// [`generalised_split`] also split on registers' values at frame starts
+/// (`cases.rs`), as `prove` runs the whole harness of a mode mix.
+fn generalised_cases(
+    g: &Aig,
+    pairs: &[(usize, usize)],
+    from: u64,
+    splits: &[usize],
+    (period, offset, max_steps): (u64, u64, u64),
+) -> (Found, SymStats) {
+    let counters = Counters {
+        pairs: pairs.to_vec(),
+        from,
+    };
+    prove_generalised(g, counters, splits, true, period, offset, max_steps, None)
+}
+
+/// The same random designs with generalised counters, split on none, one
+/// or two inputs where a step reads them and on the values of registers
+/// that are functions of the inputs at frame starts (as `prove` runs a
+/// mode mix: `mode_sel` and a slave's choices, auto select's decisions):
+/// never a wrong verdict, every witness replayed (pinned through every
+/// generalisation of its path), and the runs do split on registers.
+#[test]
+fn random_designs_with_generalised_counters_split_on_inputs_and_registers_agree_with_an_explicit_state_search(
+) {
+    let mut rng = Rng(0xCA5E_5EED_0B17_A5E5);
+    let (mut tally, mut cases, mut pinned) = ([0usize; 3], 0, 0);
+    // fewer designs than the unsplit run: each split is a few SAT calls
+    for _ in 0..600 {
+        let (g, pairs) = random_counter_design(&mut rng);
+        let (period, offset) = (4, rng.below(4));
+        let from = offset + period * rng.below(3);
+        let n = (rng.below(3) as usize).min(g.inputs.len());
+        let splits: Vec<usize> = (0..n).collect();
+        let (f, st) = judged_by(&g, period, offset, || {
+            generalised_cases(&g, &pairs, from, &splits, (period, offset, 60))
+        });
+        cases += usize::from(st.cases > 0);
+        let after = st
+            .generalised
+            .is_some_and(|at| matches!(f, Found::Violated { step, .. } if step >= at));
+        pinned += usize::from(after);
+        tally[verdict(&f)] += 1;
+    }
+    eprintln!("{tally:?} proved/violated/bounded, {cases} split on registers, {pinned} pinned");
+    assert!(tally.iter().all(|&n| n > 30), "{tally:?}");
+    assert!(
+        cases > 5 && pinned > 20,
+        "{cases} split on registers, {pinned} pinned"
+    );
 }

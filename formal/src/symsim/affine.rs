@@ -71,6 +71,13 @@ pub(super) fn never_true(gr: &Graph, lit: u32) -> bool {
     true
 }
 
+/// Whether `lit` is an affine function of its variables (an XOR of some,
+/// or its complement): data such as a CRC over the codes, which takes as
+/// many values as its variables allow.
+pub(super) fn is_affine(gr: &Graph, lit: u32) -> bool {
+    Forms::new(gr, lit).of(lit).is_some()
+}
+
 /// The affine forms of the nodes in a literal's cone (`None`: not affine).
 struct Forms {
     form: HashMap<usize, Option<Form>>,

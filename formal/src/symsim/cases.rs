@@ -7,7 +7,8 @@
 //! frame's codes, one frame deeper at each frame start, and the state never
 //! comes round.  But they take a few values only.  So at a frame start,
 //! every latch whose value is a function (a node that is not a single
-//! variable: data registers hold one variable per bit) is a case register,
+//! variable: data registers hold one variable per bit; nor an XOR of
+//! variables: a CRC over the codes is data too) is a case register,
 //! and the path is split into one path per value of those registers that
 //! some input reaches (found by SAT, each model blocked in turn), each with
 //! the case registers constant again and the case's condition (the
@@ -45,8 +46,11 @@ impl Sim<'_> {
     /// is a function of the inputs, or `None` when there is none (or too
     /// many values).
     pub(super) fn split_cases(&mut self, step: u64) -> Result<Option<Vec<Branch>>, Found> {
+        // a single variable, or an XOR of some (a CRC over the codes and the
+        // frame count), is data: as many values as its variables allow
         let regs: Vec<usize> = (0..self.state.len())
             .filter(|&j| self.state[j] >= 2 && !self.gr.is_var((self.state[j] >> 1) as usize))
+            .filter(|&j| !super::affine::is_affine(&self.gr, self.state[j]))
             .collect();
         if regs.is_empty() {
             return Ok(None);
@@ -87,13 +91,14 @@ impl Sim<'_> {
             let mut cond = self.cond.clone();
             cond.push(self.equal(&regs, &values));
             let mut fixed = self.fixed.clone();
-            let (cond, dropped) = prune(&self.gr, &state, cond);
+            let (cond, dropped) = prune(&self.gr, &self.live(&state), cond);
             fix(&self.gr, &dropped, &model, &mut fixed);
             paths.push(Branch {
                 state,
                 prev_state: self.prev_state.clone(),
                 fixed,
                 cond,
+                pin: self.pin.clone(),
             });
         }
         Ok(Some(paths))
@@ -115,7 +120,8 @@ impl Sim<'_> {
         if self.cond.is_empty() {
             return Ok(());
         }
-        let (kept, dropped) = prune(&self.gr, &self.state, std::mem::take(&mut self.cond));
+        let live = self.live(&self.state);
+        let (kept, dropped) = prune(&self.gr, &live, std::mem::take(&mut self.cond));
         self.cond = kept;
         if dropped.is_empty() {
             return Ok(());
@@ -135,6 +141,13 @@ impl Sim<'_> {
         let model: Model = model.into_iter().map(|(i, s, v)| ((i, s), v)).collect();
         fix(&self.gr, &dropped, &model, &mut self.fixed);
         Ok(())
+    }
+
+    /// What a conjunct of the condition must share a variable with to be
+    /// kept: the state, and the count a generalisation replaced (a pinned
+    /// model reads it, `generalise.rs`).
+    fn live(&self, state: &[u32]) -> Vec<u32> {
+        state.iter().chain(&self.pin.exact).copied().collect()
     }
 
     /// The path's condition, one literal (true when there is none).

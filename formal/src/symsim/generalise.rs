@@ -13,14 +13,22 @@
 //! that holds there holds in every reachable state, and a state equal (up
 //! to renaming) to an earlier frame start's closes the search as in
 //! `mod.rs`.  An inductive invariant, checked, not assumed.  What is lost
-//! is exactness: a violation after the first generalisation may come from a
-//! count no run reaches with that state, so it is not a trace from reset.
-//! Except in the frame after the first generalisation: there the
-//! violation is solved again with the counter pinned to the value it had
-//! (its literals before the replacement), and a model of that is a trace
-//! from reset (the state with that value is the exact one).  Otherwise the
-//! run ends `Bounded` at the first generalised step (the exact search
-//! before it), naming the count that failed.
+//! is exactness: a violation after a generalisation may come from a count
+//! no run reaches with that state, so it is not a trace from reset as it
+//! stands.  So it is solved again with every generalisation of the path
+//! pinned: each one's variables equal to the counter's literals it
+//! replaced (the count before it, a function of the previous
+//! generalisation's variables, so the chain goes back to the exact count
+//! from reset), and a model of that is a trace from reset (with every pin,
+//! the state is the exact one).  Without one, the run ends `Bounded` at the
+//! first generalised step (the exact search before it), naming the count
+//! that failed.
+//!
+//! A split run (`split.rs`, `cases.rs`) generalises on every path alike;
+//! each path keeps its own [`Pin`] (a path split off inherits its
+//! parent's), so the pinned model is that path's exact state, its
+//! condition and fixed inputs included.  The counters are shown
+//! equal under the path's condition: its states are the ones that satisfy it.
 
 use super::graph::{Assigned, Graph};
 use super::{Found, Sim};
@@ -35,6 +43,15 @@ pub struct Counters {
     /// The first frame-start step at which they are generalised; every
     /// step before it is simulated exactly from reset.
     pub from: u64,
+}
+
+/// One path's generalisations: the counter's literals each replaced, and
+/// the variables it put there, bit by bit, one generalisation after the
+/// other (a violation is pinned to them).
+#[derive(Debug, Clone, Default)]
+pub(super) struct Pin {
+    pub(super) exact: Vec<u32>,
+    pub(super) vars: Vec<u32>,
 }
 
 /// Why a run with generalised counters did not close.
@@ -73,7 +90,14 @@ impl Sim<'_> {
             let limit = self
                 .deadline
                 .map(|d| d.saturating_duration_since(std::time::Instant::now()));
-            let found = self.gr.satisfy(differ, limit);
+            let mut found = self.gr.satisfy(differ, limit);
+            if matches!(found, Ok(Some(_))) && !self.cond.is_empty() {
+                // the path's states are those that satisfy its condition
+                let cond = self.cond_lit();
+                let under = self.gr.and(differ, cond);
+                self.stats.sat_calls += 1;
+                found = self.gr.satisfy(under, limit);
+            }
             if !matches!(found, Ok(None)) {
                 let count = found.ok().flatten().and_then(|a| self.count_of(&a));
                 self.stats.counter_failure = Some(CounterFailure::Unequal { step, count });
@@ -82,19 +106,12 @@ impl Sim<'_> {
                 });
             }
         }
-        let first = self.generalised.is_none();
-        if first {
-            self.pinned = pairs.iter().map(|&(d, _)| self.state[d]).collect();
-            self.pinned_vars.clear();
-        }
-        self.generalisations += 1;
         for (b, &(d, h)) in pairs.iter().enumerate() {
             let v = self.gr.var(self.counter_input(b), step as u32);
+            self.pin.exact.push(self.state[d]);
+            self.pin.vars.push(v);
             self.state[d] = v;
             self.state[h] = v;
-            if first {
-                self.pinned_vars.push(v);
-            }
         }
         self.generalised.get_or_insert(step);
         self.stats.generalised = self.generalised;
@@ -102,25 +119,27 @@ impl Sim<'_> {
     }
 
     /// A violation `bad` at `step` found by the SAT model `assign`: `None`
-    /// when it is a trace from reset (before any generalisation); in the
-    /// frame after the first, the violation with the counter pinned to its
-    /// exact value, if there is one; else the run's verdict (bounded by the
-    /// exact part), the count it came from noted.
+    /// when it is a trace from reset (the path has not generalised); else
+    /// the violation with every generalisation pinned to the exact count,
+    /// if there is one; else the run's verdict (bounded by the exact part),
+    /// the count it came from noted.
     pub(super) fn generalised_violation(
         &mut self,
         step: u64,
         bad: u32,
         assign: &[Assigned],
     ) -> Option<Found> {
-        let g = self.generalised.filter(|&g| step >= g)?;
-        if self.generalisations == 1 {
-            if let Some(pinned) = self.pinned_model(bad) {
-                return Some(self.violation(step, pinned));
-            }
+        if self.pin.vars.is_empty() {
+            return None;
+        }
+        if let Some(pinned) = self.pinned_model(bad) {
+            return Some(self.violation(step, pinned));
         }
         let count = self.count_of(assign).unwrap_or(0);
         self.stats.counter_failure = Some(CounterFailure::Violated { step, count });
-        Some(Found::Bounded { steps: g })
+        Some(Found::Bounded {
+            steps: self.generalised.unwrap_or(step),
+        })
     }
 
     /// The count of the latest generalisation a model reads (its
@@ -136,15 +155,12 @@ impl Sim<'_> {
         Some(count)
     }
 
-    /// A model of `bad` with the first generalisation's variables equal to
-    /// the counter's literals it replaced (a trace from reset), if any.
+    /// A model of `bad` with every generalisation's variables equal to the
+    /// counter's literals they replaced (a trace from reset), if any.
     fn pinned_model(&mut self, bad: u32) -> Option<Vec<Assigned>> {
         let mut lit = bad;
-        let pins: Vec<(u32, u32)> = self
-            .pinned_vars
-            .iter()
-            .copied()
-            .zip(self.pinned.iter().copied())
+        let pins: Vec<(u32, u32)> = (self.pin.vars.iter().copied())
+            .zip(self.pin.exact.iter().copied())
             .collect();
         for (v, exact) in pins {
             let differ = xor(&mut self.gr, v, exact);

@@ -269,15 +269,19 @@ fn combine(results: Vec<Found>) -> Found {
     }
 }
 
-/// [`prove`] without choices, split on `splits`, with `counters` generalised at
-/// every frame start from `counters.from` (`generalise.rs`): proved when a
+/// [`prove`] without choices, split on `splits` and (`cases`) on registers'
+/// values at frame starts, with `counters` generalised at every frame start
+/// from `counters.from` (`generalise.rs`): proved when every path's
 /// generalised frame start's state comes round; a violation is a trace from
-/// reset only before the first generalisation (later: `Bounded` at it, the
-/// count that failed in the stats).
+/// reset before a path's first generalisation or, pinned to the count it
+/// replaced, in the frame after (else: `Bounded` at the first
+/// generalisation, the count that failed in the stats).
+#[allow(clippy::too_many_arguments)]
 pub fn prove_generalised(
     g: &Aig,
     counters: Counters,
     splits: &[usize],
+    cases: bool,
     period: u64,
     offset: u64,
     max_steps: u64,
@@ -289,8 +293,10 @@ pub fn prove_generalised(
         max_steps,
         deadline,
     };
-    // split on `splits` (an AXI4-Stream slave's choices) where a step reads them
-    let mut sim = Sim::split_on(g, splits);
+    // split on `splits` (an AXI4-Stream slave's choices, pin-selected
+    // modes' requests) where a step reads them, and on auto select's
+    // decisions at frame starts
+    let mut sim = Sim::split_on(g, splits).with_cases(cases);
     sim.counters = Some(counters);
     let (f, mut st) = sim.run(&lim);
     st.parts = [1, 0, 0];
@@ -339,11 +345,9 @@ struct Sim<'a> {
     /// first step they were: no violation from there on is a trace.
     counters: Option<Counters>,
     generalised: Option<u64>,
-    /// How many frame starts generalised them, and the counter's literals
-    /// the first replaced (a violation in the frame after is pinned to them).
-    generalisations: u32,
-    pinned: Vec<u32>,
-    pinned_vars: Vec<u32>,
+    /// This path's generalisations (`generalise::Pin`): a violation after
+    /// them is pinned to the counts they replaced.
+    pin: generalise::Pin,
     /// How many times the graph was collected (its literals renumbered).
     collections: u64,
 }
@@ -400,9 +404,7 @@ impl<'a> Sim<'a> {
             cond: Vec::new(),
             counters: None,
             generalised: None,
-            generalisations: 0,
-            pinned: Vec::new(),
-            pinned_vars: Vec::new(),
+            pin: generalise::Pin::default(),
             collections: 0,
         }
     }
@@ -500,6 +502,12 @@ impl<'a> Sim<'a> {
         }
         let pending = std::mem::take(&mut self.pending);
         let any = std::mem::replace(&mut self.pending_any, 0);
+        // a CRC miter shown never true by its affine forms is never true
+        // under the condition either (which is not affine: `satisfy` would
+        // not see it, and CDCL cannot decide such a miter)
+        if !self.cond.is_empty() && affine::never_true(&self.gr, any) {
+            return None;
+        }
         // a path split on registers' values: its states satisfy its condition
         let cond = self.cond_lit();
         let any = self.gr.and(any, cond);
@@ -554,12 +562,14 @@ impl<'a> Sim<'a> {
         // every literal held: this path's, then each waiting path's
         let mut held: Vec<&mut Vec<u32>> = vec![&mut self.state, &mut self.prev_state];
         held.push(&mut self.cond);
-        held.push(&mut self.pinned);
-        held.push(&mut self.pinned_vars);
+        held.push(&mut self.pin.exact);
+        held.push(&mut self.pin.vars);
         for b in self.queue.values_mut() {
             held.push(&mut b.state);
             held.push(&mut b.prev_state);
             held.push(&mut b.cond);
+            held.push(&mut b.pin.exact);
+            held.push(&mut b.pin.vars);
         }
         let mut roots: Vec<u32> = held.iter().flat_map(|v| v.iter().copied()).collect();
         roots.extend(self.pending.iter().map(|&(_, b)| b));

@@ -47,6 +47,8 @@ pub(super) struct Branch {
     pub(super) fixed: Vec<Assigned>,
     /// Its condition (`cases.rs`): conjuncts its states satisfy.
     pub(super) cond: Vec<u32>,
+    /// Its generalisations of the counters (`generalise.rs`).
+    pub(super) pin: super::generalise::Pin,
 }
 
 impl Sim<'_> {
@@ -62,6 +64,7 @@ impl Sim<'_> {
             prev_state: Vec::new(),
             fixed: Vec::new(),
             cond: Vec::new(),
+            pin: std::mem::take(&mut self.pin),
         };
         self.queue.insert((0, 0), start);
         // the earliest violation so far: later paths stop before it
@@ -96,6 +99,7 @@ impl Sim<'_> {
             }
             (self.state, self.prev_state, self.fixed) = (b.state, b.prev_state, b.fixed);
             self.cond = b.cond;
+            self.pin = b.pin;
             self.pending.clear();
             self.pending_any = 0;
             let path_lim = Limits {
@@ -274,11 +278,15 @@ impl Sim<'_> {
             }
             let mut next = self.state.clone();
             let bad = self.ev.step(g, &mut self.gr, &mut next, &inputs);
-            let bad = if bad != 0 {
-                let cond = self.cond_lit();
-                self.gr.and(bad, cond)
-            } else {
-                0
+            let bad = match bad {
+                0 => 0,
+                // never true by its affine forms: so under the condition
+                // too (`satisfy` would not see it through the condition)
+                _ if !self.cond.is_empty() && super::affine::never_true(&self.gr, bad) => 0,
+                _ => {
+                    let cond = self.cond_lit();
+                    self.gr.and(bad, cond)
+                }
             };
             if bad != 0 {
                 self.stats.sat_calls += 1;
@@ -299,6 +307,7 @@ impl Sim<'_> {
                     prev_state: self.prev_state.clone(),
                     fixed,
                     cond: self.cond.clone(),
+                    pin: self.pin.clone(),
                 });
             }
         }
