@@ -344,6 +344,24 @@ const PUBLIC_MODULES: &[(&str, &str, &str)] = &[
         "switch",
         "the test-only detector switch, behind the `test-switch` feature",
     ),
+    // The crates without a unit-test harness (`[lib] test = false`, so a
+    // test build compiles them once) reach the private items their tests
+    // check through one `#[doc(hidden)]` module, named for what it is.
+    (
+        "judge",
+        "for_tests",
+        "private items the crate's integration tests check, doc(hidden)",
+    ),
+    (
+        "engines",
+        "for_tests",
+        "private items the crate's integration tests check, doc(hidden)",
+    ),
+    (
+        "campaign",
+        "for_tests",
+        "private items the crate's integration tests check, doc(hidden)",
+    ),
 ];
 
 /// `testkit` is exempt: a dev-only toolbox whose modules are the helpers'
@@ -384,6 +402,12 @@ fn crates_keep_their_modules_private() {
                 found.push(format!(
                     "{}: `pub mod {m}` (keep it private and `pub use` its items, or add it \
                      to PUBLIC_MODULES with the reason its namespace is clearer)",
+                    lib.display()
+                ));
+            }
+            if m == "for_tests" && !text.contains("#[doc(hidden)]\npub mod for_tests") {
+                found.push(format!(
+                    "{}: `pub mod for_tests` is not `#[doc(hidden)]`",
                     lib.display()
                 ));
             }
