@@ -146,6 +146,15 @@ fn run_on(mix: &Path, frames: u64, dir: &Path, backend: &str) -> (Wave, Vec<(Str
     (changes(&std::fs::read_to_string(&vcd).unwrap()), samples)
 }
 
+/// The sampling instants (ps) of channel `name` in `samples`.
+fn sampled(samples: &[(String, u64)], name: &str) -> Vec<u64> {
+    samples
+        .iter()
+        .filter(|s| s.0 == name)
+        .map(|s| s.1)
+        .collect()
+}
+
 /// Every sample's `sampled_s` is one of its branch's measured instants
 /// (within the 1 ps rounding of each), and every instant but the run's
 /// last few has its sample.
@@ -250,14 +259,7 @@ fn group_holds_at_one_instant((part, ext, cnv): (&str, &str, bool), backend: &st
     std::fs::write(&m, &text).unwrap();
     let (w, samples) = run_on(&m, 2, dir.path(), backend);
     let (mcp, other) = (measured(&w, 0, Some(6)), held(&w, 1, None, cnv));
-    let sampled = |name: &str| -> Vec<u64> {
-        samples
-            .iter()
-            .filter(|s| s.0 == name)
-            .map(|s| s.1)
-            .collect()
-    };
-    let (m2, e0) = (sampled("M2"), sampled("E0"));
+    let (m2, e0) = (sampled(&samples, "M2"), sampled(&samples, "E0"));
     // an AD7689's first conversions after reset are prepared (no sample)
     assert!(e0.len() >= 2, "{part} on {backend}: {e0:?}");
     assert!(
@@ -314,14 +316,7 @@ fn a_sync_group_that_cannot_hold_off_is_refused_naming_them() {
     std::fs::write(&m, &both).unwrap();
     let (w, samples) = run(&m, 1, dir.path());
     let (a, b) = (measured(&w, 0, Some(6)), measured(&w, 1, Some(6)));
-    let sampled = |name: &str| -> Vec<u64> {
-        samples
-            .iter()
-            .filter(|s| s.0 == name)
-            .map(|s| s.1)
-            .collect()
-    };
-    let (m2, e0) = (sampled("M2"), sampled("E0"));
+    let (m2, e0) = (sampled(&samples, "M2"), sampled(&samples, "E0"));
     assert!(!m2.is_empty());
     assert_eq!(m2, e0, "the group's samples share their instants");
     for t in &m2 {

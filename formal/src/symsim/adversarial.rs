@@ -1028,13 +1028,9 @@ fn generalised_split(
     pairs: &[(usize, usize)],
     from: u64,
     splits: &[usize],
-    (period, offset, max_steps): (u64, u64, u64),
+    limits: (u64, u64, u64),
 ) -> (Found, SymStats) {
-    let counters = Counters {
-        pairs: pairs.to_vec(),
-        from,
-    };
-    prove_generalised(g, counters, splits, false, period, offset, max_steps, None)
+    generalised(g, pairs, from, splits, false, limits)
 }
 
 /// A "frame counter" pair that only feeds data, the way the packets' frame
@@ -1300,13 +1296,26 @@ fn generalised_cases(
     pairs: &[(usize, usize)],
     from: u64,
     splits: &[usize],
+    limits: (u64, u64, u64),
+) -> (Found, SymStats) {
+    generalised(g, pairs, from, splits, true, limits)
+}
+
+/// `prove_generalised` on `g` with the counters `pairs` from `from`, split
+/// on `splits` and, with `cases`, on registers' values at frame starts.
+fn generalised(
+    g: &Aig,
+    pairs: &[(usize, usize)],
+    from: u64,
+    splits: &[usize],
+    cases: bool,
     (period, offset, max_steps): (u64, u64, u64),
 ) -> (Found, SymStats) {
     let counters = Counters {
         pairs: pairs.to_vec(),
         from,
     };
-    prove_generalised(g, counters, splits, true, period, offset, max_steps, None)
+    prove_generalised(g, counters, splits, cases, period, offset, max_steps, None)
 }
 
 /// The same random designs with generalised counters, split on none, one
