@@ -24,7 +24,8 @@ use crate::synth::Infeasible;
 mod candidates;
 mod edit;
 
-use edit::Edit;
+// Public for this crate's tests only (`crate::for_tests`).
+pub use edit::{apply, Edit};
 
 /// Fixes offered at most (the cheapest that work).
 pub const MAX_OFFERED: usize = 5;
@@ -369,6 +370,3 @@ impl fmt::Display for FixSearch {
         Ok(())
     }
 }
-
-#[cfg(test)]
-mod tests;

@@ -84,3 +84,15 @@ pub use hostlink::{
 
 // What the OS says about a user's file, in words.
 pub use oswords::{io_words, write_words};
+
+/// Private items that this crate's tests check directly (`tests/units/`):
+/// the crate has no unit-test harness (`[lib] test = false`, one build of
+/// it less in `make test`), so they are reached from the integration tests
+/// here.  Not an API: no other crate uses it.
+#[doc(hidden)]
+pub mod for_tests {
+    pub use crate::audit::{alias_hz, compact, least};
+    pub use crate::fixes::{apply, cost, feasible, Edit, CANDIDATE_BUDGET};
+    pub use crate::hostlink::plan_one;
+    pub use crate::synth::{on_grid, one_mode};
+}

@@ -14,21 +14,11 @@ use crate::parts::{AdcPart, MuxPart};
 mod adc_part;
 mod branches;
 mod bulk;
-#[cfg(test)]
-mod bulk_tests;
 mod channels;
 mod check;
-#[cfg(test)]
-mod front_tests;
 mod link_table;
 mod modes;
-#[cfg(test)]
-mod modes_tests;
 mod raw;
-#[cfg(test)]
-mod supply_tests;
-#[cfg(test)]
-mod tests;
 mod words;
 
 pub(crate) use branches::hz_words;

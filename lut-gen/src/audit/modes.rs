@@ -305,7 +305,7 @@ impl AuditReport {
 /// Names as the mix's bulk syntax writes a run of them: `CH1..CH25` (each
 /// the next number after the same prefix) as `CH{1..25}`, the rest as they
 /// are, comma-separated.
-fn compact(names: &[String]) -> String {
+pub fn compact(names: &[String]) -> String {
     let split = |n: &str| {
         let digits = n.len() - n.bytes().rev().take_while(u8::is_ascii_digit).count();
         let (p, d) = n.split_at(digits);
@@ -333,21 +333,4 @@ fn compact(names: &[String]) -> String {
         i += 1;
     }
     out.join(",")
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn runs_of_names_read_as_the_bulk_syntax() {
-        let n = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
-        assert_eq!(
-            super::compact(&n(&["CH1", "CH2", "CH3", "X", "T0", "T1"])),
-            "CH{1..3},X,T0,T1"
-        );
-        assert_eq!(super::compact(&n(&["A01", "A02", "A03"])), "A01,A02,A03");
-        assert_eq!(
-            super::compact(&n(&["C9", "C10", "C11", "C13"])),
-            "C{9..11},C13"
-        );
-    }
 }

@@ -6,7 +6,7 @@ use toml_edit::{value, DocumentMut, Item, Table};
 
 /// One change to a mix file, in the mix format's own terms.
 #[derive(Debug, Clone, PartialEq)]
-pub(super) enum Edit {
+pub enum Edit {
     /// `[frame].slice_us = us`.
     SliceUs(u64),
     /// Leave the slot grid to the synthesizer (drop `[frame] slots_per_slice`).
@@ -28,7 +28,7 @@ pub(super) enum Edit {
 
 /// `text` with `edits` applied, or `None` when the text is not TOML or a
 /// table an edit names is missing (the candidate is then not offered).
-pub(super) fn apply(text: &str, edits: &[Edit]) -> Option<String> {
+pub fn apply(text: &str, edits: &[Edit]) -> Option<String> {
     let mut doc: DocumentMut = text.parse().ok()?;
     let named: Vec<&str> = (edits.iter())
         .filter_map(|e| match e {
@@ -142,55 +142,4 @@ fn named<'a>(doc: &'a mut DocumentMut, array: &str, name: &str) -> Option<&'a mu
         .as_array_of_tables_mut()?
         .iter_mut()
         .find(|t| t.get("name").and_then(Item::as_str) == Some(name))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn edits_keep_the_users_comments_and_change_only_what_they_name() {
-        let text = "# my mix\nname = \"m\"\n[frame]\nperiod_us = 1000 # one ms\nslice_us = 500\nslots_per_slice = 4\n\
-                    [[branch]]\nname = \"a\"\nmux_devices = 1\n[[channel]]\nname = \"x\"\nbranch = \"a\"\ninput = 3\nrate_hz = 1000\n";
-        let out = apply(
-            text,
-            &[
-                Edit::FreeGrid,
-                Edit::SliceUs(250),
-                Edit::MoveChannel {
-                    name: "x".into(),
-                    to: "b".into(),
-                },
-                Edit::Rate {
-                    name: "x".into(),
-                    hz: 500,
-                },
-                Edit::MuxDevices {
-                    name: "a".into(),
-                    devices: 2,
-                },
-                Edit::BranchLike {
-                    name: "b".into(),
-                    like: "a".into(),
-                },
-            ],
-        )
-        .unwrap();
-        assert!(out.starts_with("# my mix\n"), "{out}");
-        assert!(out.contains("period_us = 1000 # one ms"), "{out}");
-        assert!(!out.contains("slots_per_slice"), "{out}");
-        assert!(out.contains("slice_us = 250"), "{out}");
-        assert!(!out.contains("input"), "{out}");
-        assert!(out.contains("rate_hz = 500"), "{out}");
-        assert!(out.contains("mux_devices = 2"), "{out}");
-        assert_eq!(out.matches("[[branch]]").count(), 2, "{out}");
-        assert!(apply(
-            text,
-            &[Edit::Rate {
-                name: "nobody".into(),
-                hz: 1
-            }]
-        )
-        .is_none());
-    }
 }

@@ -1,6 +1,7 @@
 //! Modes in the mix: what parses, and every refusal named by line and field.
 
-use super::*;
+use lut_gen::{load, parse, Mix, MixError, ModeSelect, When};
+use std::path::Path;
 
 /// `testkit/mixes/<name>.toml`, parsed.
 fn testkit(name: &str) -> Mix {

@@ -4,7 +4,8 @@
 
 use proptest::prelude::*;
 
-use super::*;
+use lut_gen::{parse, Mix, MixError};
+use std::path::Path;
 
 const HEAD: &str = r#"
 name = "bulk"

@@ -1,4 +1,5 @@
-use super::*;
+use lut_gen::{parse, MixError};
+use std::path::Path;
 
 const GOOD: &str = r#"
 name = "t"
@@ -321,8 +322,8 @@ fn a_declared_cnv_part_may_be_read_with_cnv_low() {
     let mix = |p: &str| format!("{GOOD}{p}").replace("adc = \"ad7940\"", "adc = \"ad7686\"");
     let m = parse(Path::new("m.toml"), &mix(part)).unwrap();
     let adc = &m.branches[0].adc;
-    assert_eq!(adc.read, crate::CnvRead::CnvLow);
-    let t = crate::SpiTiming::derive(adc, 48_000_000, adc.sclk_max_hz, 1).unwrap();
+    assert_eq!(adc.read, lut_gen::CnvRead::CnvLow);
+    let t = lut_gen::SpiTiming::derive(adc, 48_000_000, adc.sclk_max_hz, 1).unwrap();
     // CNV falls when the conversion ends, before the read
     assert_eq!(t.pin_cycles, t.conv_cycles);
     assert!(t.pin_cycles < t.setup_cycles && t.setup_cycles < t.read_cycles);
@@ -331,7 +332,7 @@ fn a_declared_cnv_part_may_be_read_with_cnv_low() {
         &mix(&part.replace("read = \"cnv-low\"\n", "")),
     )
     .unwrap();
-    assert_eq!(held.branches[0].adc.read, crate::CnvRead::CnvHigh);
+    assert_eq!(held.branches[0].adc.read, lut_gen::CnvRead::CnvHigh);
     for (from, to, field, says) in [
         (
             "\"cnv-low\"",

@@ -1,8 +1,10 @@
 //! An external mux in front of a converter's own (`front_mux`,
 //! `front_input`): what the mix means, and the refusals in the user's words.
 
-use super::*;
-use crate::synthesize;
+use std::path::Path;
+
+use lut_gen::synthesize;
+use lut_gen::{parse, MixError};
 
 const AD: &str = r#"
 name = "t"
@@ -46,7 +48,7 @@ fn line_of(text: &str, needle: &str) -> usize {
 fn a_front_mux_drives_the_pins_and_the_word_selects_the_converter_input() {
     let m = parse(Path::new("m.toml"), AD).unwrap();
     let b = &m.branches[0];
-    assert!(b.fronted && b.mux == crate::MuxPart::TMUX1108 && b.mux_devices == 2);
+    assert!(b.fronted && b.mux == lut_gen::MuxPart::TMUX1108 && b.mux_devices == 2);
     for k in 0..10 {
         assert_eq!(
             (m.channels[k].input, m.channels[k].front_input),
@@ -213,7 +215,7 @@ fn random_fronted_mixes_keep_pins_and_words_apart() {
         for w in s.commands_in_frame(0) {
             assert_eq!(w.input, m.channels[w.selects].input, "{t}");
         }
-        assert!(crate::validate(&s).is_ok(), "{t}");
+        assert!(lut_gen::validate(&s).is_ok(), "{t}");
     }
     assert!(scheduled >= 10, "only {scheduled} random mixes scheduled");
 }
@@ -224,7 +226,7 @@ fn random_fronted_mixes_keep_pins_and_words_apart() {
 fn the_audit_shows_the_converter_input_and_the_front_pins() {
     let m = parse(Path::new("m.toml"), AD).unwrap();
     let s = synthesize(&m).unwrap();
-    let a = crate::AuditReport::of_schedule(&s);
+    let a = lut_gen::AuditReport::of_schedule(&s);
     let text = a.to_text();
     for (c, ch) in a.channels.iter().enumerate() {
         let mc = &m.channels[c];
@@ -267,12 +269,12 @@ fn a_front_device_feeds_one_converter_input() {
 #[test]
 fn the_audit_counts_free_places_behind_and_beside_the_front_mux() {
     let s = synthesize(&parse(Path::new("m.toml"), AD).unwrap()).unwrap();
-    let a = crate::AuditReport::of_schedule(&s);
+    let a = lut_gen::AuditReport::of_schedule(&s);
     assert_eq!(a.branches[0].free_mux_inputs, 6 + 5 + 1);
     // one device without a channel takes a free converter input for its 8
     let one = AD.replace("front_mux_devices = 2", "front_mux_devices = 3");
     let s = synthesize(&parse(Path::new("m.toml"), &one).unwrap()).unwrap();
-    let a = crate::AuditReport::of_schedule(&s);
+    let a = lut_gen::AuditReport::of_schedule(&s);
     assert_eq!(a.branches[0].free_mux_inputs, 6 + 5 + 1 + 7);
 }
 

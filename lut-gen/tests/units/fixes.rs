@@ -1,8 +1,12 @@
-use super::*;
+use std::path::Path;
+
+use lut_gen::for_tests::{cost, feasible};
+use lut_gen::{search_fixes as search, search_fixes_unloadable as search_unloadable};
+use lut_gen::{Change, FixSearch, Infeasible, Mix};
 
 fn infeasible(text: &str) -> (Mix, Infeasible) {
-    let mix = crate::parse(Path::new("t.toml"), text).unwrap();
-    match crate::synthesize(&mix) {
+    let mix = lut_gen::parse(Path::new("t.toml"), text).unwrap();
+    match lut_gen::synthesize(&mix) {
         Err(why) => (mix, why),
         Ok(_) => panic!("the test mix is feasible:\n{text}"),
     }
@@ -48,7 +52,7 @@ fn a_move_to_a_branch_without_free_inputs_brings_its_mux_devices() {
     assert!(!found.fixes.is_empty(), "{found}");
     for f in &found.fixes {
         assert!(
-            feasible(Path::new("fix.toml"), &f.text, crate::synth::SEARCH_BUDGET).is_some(),
+            feasible(Path::new("fix.toml"), &f.text, lut_gen::SEARCH_BUDGET).is_some(),
             "{}",
             f.says
         );
@@ -90,7 +94,7 @@ fn a_rate_too_high_for_the_adc_is_lowered_to_one_that_fits() {
         .collect();
     assert!(!lowered.is_empty(), "{found}");
     for f in &found.fixes {
-        assert!(feasible(Path::new("fix.toml"), &f.text, crate::synth::SEARCH_BUDGET).is_some());
+        assert!(feasible(Path::new("fix.toml"), &f.text, lut_gen::SEARCH_BUDGET).is_some());
     }
 }
 
@@ -99,7 +103,7 @@ fn a_rate_too_high_for_the_adc_is_lowered_to_one_that_fits() {
 #[test]
 fn too_many_channels_for_the_mux_get_the_devices_they_need() {
     let text = format!("{HEAD}{}{}", branch("a", 1), channels("C", "a", 11, 500));
-    assert!(crate::parse(Path::new("t.toml"), &text).is_err());
+    assert!(lut_gen::parse(Path::new("t.toml"), &text).is_err());
     let found = search_unloadable(Path::new("t.toml"), &text);
     assert_eq!(found.fixes.len(), 1, "{found}");
     assert_eq!(
@@ -146,7 +150,7 @@ fn the_first_fix_keeps_every_rate() {
 /// (the mix fits at 96 slots per slice, not the 48 forced).
 #[test]
 fn a_forced_grid_that_cannot_hold_the_mix_is_freed() {
-    let text = include_str!("../../tests/data/missed.toml")
+    let text = include_str!("../data/missed.toml")
         .replace("slice_us = ", "slots_per_slice = 48\nslice_us = ");
     let (mix, why) = infeasible(&text);
     let found = search(Path::new("m.toml"), &text, &mix, &why);
@@ -182,7 +186,7 @@ fn a_bulk_row_gets_the_fixes_of_its_channels_written_out() {
     let words = |f: &FixSearch| f.fixes.iter().map(|x| x.says.clone()).collect::<Vec<_>>();
     assert_eq!(words(&a), words(&b));
     for f in &a.fixes {
-        let mix = crate::parse(Path::new("fix.toml"), &f.text).unwrap();
-        assert!(crate::synthesize(&mix).is_ok(), "{}", f.text);
+        let mix = lut_gen::parse(Path::new("fix.toml"), &f.text).unwrap();
+        assert!(lut_gen::synthesize(&mix).is_ok(), "{}", f.text);
     }
 }

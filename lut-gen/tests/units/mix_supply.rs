@@ -1,8 +1,11 @@
 //! Where each part holds its input, sync groups at those instants, and the
 //! converter's supply (`vdd`).
 
-use super::*;
-use crate::parts::SampleAt;
+use std::path::Path;
+
+use lut_gen::for_tests::{feasible, CANDIDATE_BUDGET};
+use lut_gen::SampleAt;
+use lut_gen::{parse, Mix, MixError};
 
 /// An MCP3208 beside an AD7940, optionally in one sync group (`M0`, `A0`).
 fn pair(mcp: &str, sync: bool) -> String {
@@ -24,7 +27,7 @@ fn parse_text(text: &str) -> Result<Mix, MixError> {
 #[test]
 fn each_part_is_sampled_where_its_datasheet_says() {
     let m = parse_text(&pair("", false)).unwrap();
-    let s = crate::synthesize(&m).unwrap();
+    let s = lut_gen::synthesize(&m).unwrap();
     // MCP3208 at 1 MHz (48 MHz / 48): setup 5 cycles, then six periods
     assert_eq!(m.branches[0].adc.sample, SampleAt::SclkFall(6));
     assert_eq!(s.sample_after(0), 5 + 6 * 48);
@@ -37,7 +40,7 @@ fn each_part_is_sampled_where_its_datasheet_says() {
         let strobe = start + s.branches[b].spi.read_cycles + 1;
         assert_eq!(s.sampled_at(c, strobe), Some(start + s.sample_after(b)));
     }
-    let a = crate::AuditReport::of_schedule(&s);
+    let a = lut_gen::AuditReport::of_schedule(&s);
     assert_eq!(a.parts[0].sample_after_cycles, 293);
     assert!((a.parts[0].sample_after_ns - 6104.2).abs() < 0.1);
     assert_eq!(a.channels[0].first_sample_cycle, s.first_sample_cycle(0));
@@ -47,7 +50,7 @@ fn each_part_is_sampled_where_its_datasheet_says() {
 #[test]
 fn a_sync_group_whose_parts_sample_apart_holds_back_the_earlier_one() {
     let m = parse_text(&pair("", true)).unwrap();
-    let s = crate::synthesize(&m).unwrap();
+    let s = lut_gen::synthesize(&m).unwrap();
     // the AD7940 (at its CS fall) waits for the MCP3208's 6th falling edge
     assert_eq!((s.holdoff(0), s.holdoff(1)), (0, 5 + 6 * 48));
     assert_eq!(s.sample_after(1), s.sample_after(0));
@@ -56,7 +59,7 @@ fn a_sync_group_whose_parts_sample_apart_holds_back_the_earlier_one() {
     // the slot holds the hold-off, the read and the quiet time
     let a = &s.branches[1].spi;
     assert!(s.grid.slot_cycles >= a.holdoff_cycles + a.read_cycles + a.quiet_cycles);
-    let audit = crate::AuditReport::of_schedule(&s);
+    let audit = lut_gen::AuditReport::of_schedule(&s);
     assert_eq!(audit.parts[1].holdoff_cycles, 293);
     assert!(
         audit.to_text().contains("at start after 6.104us hold-off"),
@@ -64,9 +67,9 @@ fn a_sync_group_whose_parts_sample_apart_holds_back_the_earlier_one() {
         audit.to_text()
     );
     // no sync group: no hold-off, and the JSON does not name one
-    let free = crate::synthesize(&parse_text(&pair("", false)).unwrap()).unwrap();
+    let free = lut_gen::synthesize(&parse_text(&pair("", false)).unwrap()).unwrap();
     assert_eq!((free.holdoff(0), free.holdoff(1)), (0, 0));
-    let json = serde_json::to_string(&crate::AuditReport::of_schedule(&free)).unwrap();
+    let json = serde_json::to_string(&lut_gen::AuditReport::of_schedule(&free)).unwrap();
     assert!(!json.contains("holdoff"), "{json}");
     // two MCP3208s at one SCLK hold their inputs at one instant without one
     let two = pair("", true)
@@ -78,14 +81,14 @@ fn a_sync_group_whose_parts_sample_apart_holds_back_the_earlier_one() {
             "name = \"A0\"\nbranch = \"a\"",
             "name = \"A0\"\nbranch = \"a\"\ninput = 3",
         );
-    let s = crate::synthesize(&parse_text(&two).unwrap()).unwrap();
+    let s = lut_gen::synthesize(&parse_text(&two).unwrap()).unwrap();
     assert_eq!((s.holdoff(0), s.holdoff(1)), (0, 0));
     // ... and at two SCLKs the faster one waits: 6 periods of 1 MHz against 6 of 500 kHz
     let slow = two.replace(
         "name = \"a\"\nadc = \"mcp3208\"",
         "name = \"a\"\nadc = \"mcp3208\"\nsclk_hz = 500_000",
     );
-    let s = crate::synthesize(&parse_text(&slow).unwrap()).unwrap();
+    let s = lut_gen::synthesize(&parse_text(&slow).unwrap()).unwrap();
     assert_eq!((s.holdoff(0), s.holdoff(1)), (6 * 48, 0));
     assert_eq!(s.first_sample_cycle(0), s.first_sample_cycle(2));
 }
@@ -112,7 +115,7 @@ fn a_hold_off_that_does_not_fit_a_slice_is_refused_naming_group_and_parts() {
     }
     // without the group the same mix audits feasible
     let m = parse_text(&slow.replace("sync = \"s\"\n", "")).unwrap();
-    assert!(crate::synthesize(&m).is_ok());
+    assert!(lut_gen::synthesize(&m).is_ok());
 }
 
 #[test]
@@ -132,8 +135,8 @@ fn the_supply_sets_the_parts_limits_and_a_refusal_names_vdd() {
     let m = parse_text(&said).unwrap();
     assert_eq!(m.branches[0].vdd_mv, Some(5_000));
     assert_eq!(m.branches[0].adc.max_sps, 100_000);
-    let s = crate::synthesize(&m).unwrap();
-    let a = crate::AuditReport::of_schedule(&s);
+    let s = lut_gen::synthesize(&m).unwrap();
+    let a = lut_gen::AuditReport::of_schedule(&s);
     assert!(a.feasible);
     assert_eq!((a.parts[0].vdd_v, a.parts[0].vdd_given), (Some(5.0), true));
     assert_eq!((a.parts[1].vdd_v, a.parts[1].vdd_given), (Some(2.5), false));
@@ -246,12 +249,12 @@ fn an_overfull_branch_at_its_lowest_supply_is_offered_the_vdd_it_fits_at() {
         .replace("rate_hz = 2_000\ninput = 0", "rate_hz = 8_000\ninput = 0")
         .replace("rate_hz = 4_000\ninput = 1", "rate_hz = 8_000\ninput = 1");
     let m = parse_text(&text).unwrap();
-    let why = crate::synthesize(&m).unwrap_err();
-    let found = crate::search_fixes(Path::new("m.toml"), &text, &m, &why);
+    let why = lut_gen::synthesize(&m).unwrap_err();
+    let found = lut_gen::search_fixes(Path::new("m.toml"), &text, &m, &why);
     let fix = found
         .fixes
         .iter()
-        .find(|f| matches!(f.changes[0], crate::Change::Supply { .. }))
+        .find(|f| matches!(f.changes[0], lut_gen::Change::Supply { .. }))
         .expect("the supply offered");
     assert!(
         fix.says
@@ -260,10 +263,5 @@ fn an_overfull_branch_at_its_lowest_supply_is_offered_the_vdd_it_fits_at() {
         fix.says
     );
     assert!(fix.text.contains("vdd = 5.0"), "{}", fix.text);
-    assert!(crate::fixes::feasible(
-        Path::new("m.toml"),
-        &fix.text,
-        crate::fixes::CANDIDATE_BUDGET
-    )
-    .is_some());
+    assert!(feasible(Path::new("m.toml"), &fix.text, CANDIDATE_BUDGET).is_some());
 }

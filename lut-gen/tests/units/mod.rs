@@ -1,0 +1,23 @@
+//! lut-gen's tests of its modules' parts, one file per source file they
+//! test (they were that file's unit tests; `mix_*` were `src/mix/*_tests.rs`).
+
+mod audit;
+mod audit_modes;
+mod command;
+mod fixes;
+mod fixes_edit;
+mod fpga;
+mod hostlink;
+mod hostlink_memo;
+mod mix;
+mod mix_bulk;
+mod mix_front;
+mod mix_modes;
+mod mix_supply;
+mod oswords;
+mod parts;
+mod ports;
+mod ports_mode;
+mod schedule;
+mod synth;
+mod synth_modes;
