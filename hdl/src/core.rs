@@ -21,6 +21,8 @@
 //! No literal appears in a kernel: every number is a sized `Constant`, so the
 //! emitted Verilog has no 32-bit literals and lints clean.
 
+#[cfg(feature = "stock")]
+mod bench;
 mod branch;
 mod command;
 mod glue;
@@ -30,8 +32,6 @@ mod modes;
 mod pulse;
 mod slot_rom;
 mod spi;
-#[cfg(test)]
-mod tests;
 mod timing;
 mod top;
 mod word_reader;
@@ -48,6 +48,10 @@ use slot_rom::SlotRom;
 use spi::SpiSeq;
 use timing::TimingGen;
 pub use top::Core;
+// For this crate's tests only (`crate::for_tests`).
+#[cfg(feature = "stock")]
+pub use bench::{spi_trace, SpiTrace, NS as SPI_NS, SLOT as SPI_SLOT};
+pub use glue::route_miso;
 use word_reader::WordReader;
 
 /// A sized constant: every number in a kernel is one (see above).

@@ -19,9 +19,9 @@ use crate::widths::{CH_BITS, EN_TOTAL, MAX_BRANCHES, VALUE_BITS};
 use crate::HdlError;
 
 /// Name the rust-hdl `top` module gets in the emitted file.
-const CORE: &str = "slotforge_core";
+pub const CORE: &str = "slotforge_core";
 /// Name of the link stage's module (a mix with a `[link]` only).
-const LINK: &str = "slotforge_link";
+pub const LINK: &str = "slotforge_link";
 
 /// The packets' frame counter in the emitted Verilog: the register's path
 /// under `slotforge_top` (the instance `link` of [`LINK`], its `hframe`).
@@ -212,7 +212,7 @@ fn core_lanes(r: Role) -> Option<(&'static str, usize)> {
 
 /// The core's name for a port: the core (`core/top.rs`) names its ports as the
 /// contract does (a test compares them), except rust-hdl's own `clock`.
-fn core_port_name(r: Role) -> &'static str {
+pub fn core_port_name(r: Role) -> &'static str {
     match r {
         Role::Clock => "clock",
         r => r.name(),
@@ -468,7 +468,7 @@ fn gaps(used: &[(usize, usize)], width: usize) -> Vec<(usize, usize)> {
 
 /// The contract's ports the core has: all but `adc_mosi` for a mix without
 /// a command word (the core then has no such port: `Core::adc_mosi`).
-fn core_ports(l: &Layout) -> impl Iterator<Item = &'static lut_gen::Port> + '_ {
+pub fn core_ports(l: &Layout) -> impl Iterator<Item = &'static lut_gen::Port> + '_ {
     PORTS
         .iter()
         .filter(|p| p.role != Role::Mosi || l.width(Role::Mosi) > 0)
@@ -586,7 +586,7 @@ fn link_module(v: &mut String, p: &Plan) {
 
 /// The link's module for `lp`; with modes, its `mode` input (the core's
 /// mode in force, which each header carries: docs/packet-format.md).
-fn link_text(lp: crate::link::LinkParams) -> String {
+pub fn link_text(lp: crate::link::LinkParams) -> String {
     let text = if lp.axis.is_some() {
         let mut link = AxisLink::new(lp);
         link.connect_all();
@@ -795,120 +795,4 @@ fn xdc(s: &Schedule) -> String {
         );
     }
     t
-}
-
-#[cfg(test)]
-mod tests {
-    /// Two converters with a command word (one on each style) beside a
-    /// listening one.
-    const COMMAND_MIX: &str =
-        "name = \"cmd\"\n[clock]\nhz = 48000000\n[frame]\nperiod_us = 1000\nslice_us = 1000\n\
-        [[branch]]\nname = \"m\"\nadc = \"mcp3208\"\nmux = \"internal\"\n\
-        [[branch]]\nname = \"l\"\nadc = \"ad7940\"\nmux = \"tmux1108\"\n\
-        [[branch]]\nname = \"a\"\nadc = \"ad7689\"\nmux = \"internal\"\n\
-        [[channel]]\nname = \"m5\"\nbranch = \"m\"\nrate_hz = 2000\ninput = 5\n\
-        [[channel]]\nname = \"l0\"\nbranch = \"l\"\nrate_hz = 1000\ninput = 0\n\
-        [[channel]]\nname = \"a3\"\nbranch = \"a\"\nrate_hz = 1000\ninput = 3\n\
-        [[channel]]\nname = \"a6\"\nbranch = \"a\"\nrate_hz = 2000\ninput = 6\n";
-
-    use super::*;
-
-    /// A mode mix's link module (UART and AXI4-Stream, 3 mode bits) has
-    /// the `mode` input, and passes `verilator --lint-only -Wall` and
-    /// `iverilog -Wall` on its own.
-    #[test]
-    fn a_mode_link_module_lints_clean() {
-        if !testkit::tools::require_tools(&["verilator", "iverilog"]) {
-            return;
-        }
-        let dir = std::env::temp_dir().join(format!("hdl-mode-link-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        // 10 slices leave 12 bits of padding; 1,024 leave none
-        for (axis, slices) in [(None, 10), (Some(link::Tlast::Frame), 1024)] {
-            let lp = crate::link::LinkParams {
-                slice_cycles: 800,
-                slots_per_slice: 4,
-                slices_per_frame: slices,
-                div: 16,
-                parity: 1,
-                stop_bits: 1,
-                depth: 7,
-                crc_init: link::format::CRC_INIT,
-                axis,
-                mode_bits: 3,
-            };
-            let text = link_text(lp);
-            assert!(text.contains("input wire  [2:0] mode;"), "{text}");
-            let f = dir.join(format!("{LINK}.v"));
-            std::fs::write(&f, &text).unwrap();
-            let lint = testkit::tools::run_ok(
-                std::process::Command::new("verilator")
-                    .args(["--lint-only", "-Wall", "--top-module", LINK])
-                    .arg(&f),
-            );
-            let out = String::from_utf8_lossy(&lint.stderr).to_string();
-            assert!(!out.contains("%Warning"), "{axis:?}: {out}");
-            let ic = testkit::tools::run_ok(
-                std::process::Command::new("iverilog")
-                    .args(["-g2005", "-Wall", "-o", "/dev/null"])
-                    .arg(&f),
-            );
-            let out = String::from_utf8_lossy(&ic.stderr).to_string();
-            assert!(out.trim().is_empty(), "{axis:?}: {out}");
-        }
-        let _ = std::fs::remove_dir_all(&dir);
-    }
-
-    /// The core's ports are rust-hdl field names (`core/top.rs`), which cannot
-    /// be generated from the contract's table: this is where a port renamed
-    /// in `lut_gen::PORTS` without renaming the core's field fails.
-    #[test]
-    fn core_ports_are_the_contracts() {
-        // a mix with a command word has `adc_mosi` on both, the others not
-        for (name, text) in [
-            ("eskin34.toml", include_str!("../../mixes/eskin34.toml")),
-            ("cmd.toml", COMMAND_MIX),
-        ] {
-            let m = lut_gen::parse(Path::new(name), text).unwrap();
-            let s = lut_gen::synthesize(&m).unwrap();
-            let l = Layout::new(&s);
-            assert_eq!(l.width(Role::Mosi) > 0, name == "cmd.toml");
-            let v = emit(&s, None).unwrap();
-            let head = format!("module {CORE}(");
-            let line = v
-                .verilog()
-                .lines()
-                .find(|l| l.starts_with(&head))
-                .expect("the core module");
-            let ports: Vec<&str> = line[head.len()..]
-                .trim_end_matches(");")
-                .split(',')
-                .collect();
-            // and one beyond the contract: the timebase's slot starts, which the
-            // link counts (wired inside the wrapper, never a pin)
-            let want: Vec<&str> = core_ports(&l)
-                .map(|p| core_port_name(p.role))
-                .chain(["slot_tick"])
-                .collect();
-            assert_eq!(ports, want);
-            // and the wrapper exposes exactly the contract's ports, in order
-            let top = format!("module {TOP_MODULE} (");
-            let decl: Vec<String> = v
-                .verilog()
-                .lines()
-                .skip_while(|l| *l != top)
-                .skip(1)
-                .take_while(|l| *l != ");")
-                .map(|l| {
-                    l.trim_end_matches(',')
-                        .rsplit(' ')
-                        .next()
-                        .unwrap()
-                        .to_string()
-                })
-                .collect();
-            let names: Vec<String> = core_ports(&l).map(|p| p.name.to_string()).collect();
-            assert_eq!(decl, names);
-        }
-    }
 }

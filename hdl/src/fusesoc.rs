@@ -23,7 +23,7 @@ pub const LAUNCHER: &str = include_str!("edalize-launcher.sh");
 
 /// A constraint file's kind, by its extension: CAPI2's `file_type` and the
 /// family whose flow reads it (`None`: every flow may, e.g. timing).
-fn constraint_kind(name: &str) -> Option<(&'static str, Option<Fpga>)> {
+pub fn constraint_kind(name: &str) -> Option<(&'static str, Option<Fpga>)> {
     let ext = name.rsplit_once('.')?.1;
     match ext {
         "pcf" => Some(("PCF", Some(Fpga::Ice40Hx8k))),
@@ -65,7 +65,7 @@ fn mhz(hz: u64) -> String {
 
 /// A VLNV part: FuseSoC allows letters, digits, `_`, `.` and `-`; anything
 /// else in a mix's name becomes `_` (an empty name, `mix`).
-fn vlnv_part(name: &str) -> String {
+pub fn vlnv_part(name: &str) -> String {
     let t: String = name
         .chars()
         .map(|c| {
@@ -209,28 +209,5 @@ fn targets(t: &mut String, f: Fpga, sets: &[(String, Option<Fpga>)], clock_hz: u
     );
     for (k, v) in options {
         let _ = writeln!(t, "        {k}: {v}");
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn vlnv_parts_keep_what_fusesoc_allows() {
-        assert_eq!(vlnv_part("eskin34-axis"), "eskin34-axis");
-        assert_eq!(vlnv_part("my mix: v2"), "my_mix__v2");
-        assert_eq!(vlnv_part(""), "mix");
-    }
-
-    #[test]
-    fn constraints_go_to_their_family() {
-        assert_eq!(
-            constraint_kind("a.pcf"),
-            Some(("PCF", Some(Fpga::Ice40Hx8k)))
-        );
-        assert_eq!(constraint_kind("a.lpf").unwrap().1, Some(Fpga::Ecp5_25k));
-        assert_eq!(constraint_kind("a.cst").unwrap().1, Some(Fpga::Gw1n9));
-        assert_eq!(constraint_kind("a.hex"), None);
     }
 }

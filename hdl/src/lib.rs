@@ -79,3 +79,24 @@ pub enum HdlError {
         source: std::io::Error,
     },
 }
+
+/// Private items that this crate's tests check directly (`tests/units/`):
+/// the crate has no unit-test harness (`[lib] test = false`, one build of
+/// it less in `make test`), so they are reached from the integration tests
+/// here.  Not an API: no other crate uses it, and no item here names a
+/// rust-hdl type.
+#[doc(hidden)]
+pub mod for_tests {
+    pub use crate::board::board_constraints;
+    // The SPI bench, beside the other stock-simulator runs (`stock`).
+    pub use crate::core::route_miso;
+    #[cfg(feature = "stock")]
+    pub use crate::core::{spi_trace, SpiTrace, SPI_NS, SPI_SLOT};
+    pub use crate::decode::SlotLogic;
+    pub use crate::emit::{core_port_name, core_ports, link_text, CORE, LINK};
+    pub use crate::fusesoc::{constraint_kind, vlnv_part};
+    pub use crate::link::{LinkParams, Twin};
+    pub use crate::modeplan::FrontWord;
+    pub use crate::names::{candidate, readable, rename};
+    pub use crate::plan::{logic_costs, plan_with};
+}

@@ -314,6 +314,42 @@ impl UartLink {
     }
 }
 
+/// The link's Rust twin on its own, stepped by hand without the core: for
+/// this crate's tests (`crate::for_tests`), which drive its inputs and
+/// read its line and slice boundaries (no rust-hdl type in its face).
+pub struct Twin {
+    p: LinkParams,
+    r: Regs,
+}
+
+impl Twin {
+    /// The twin after reset, as [`UartLink::new`] starts it.
+    pub fn new(p: LinkParams) -> Twin {
+        let mut r = Regs {
+            mem: vec![0; p.depth + 1],
+            ..Default::default()
+        };
+        reset_regs(&p, &mut r);
+        Twin { p, r }
+    }
+
+    /// The UART line this cycle.
+    pub fn line(&self) -> bool {
+        self.r.chr & 1 == 1
+    }
+
+    /// Whether this cycle starts a slice.
+    pub fn boundary(&self) -> bool {
+        self.r.bnd
+    }
+
+    /// One clock edge: `input` is (valid, channel, code, mode) as for
+    /// [`edge`], `tick` the core's slot start.
+    pub fn edge(&mut self, input: (bool, u32, u32, u8), tick: bool) {
+        edge(&self.p, &mut self.r, input, tick, false);
+    }
+}
+
 /// The registers after one clock edge (the UART's, or with `p.axis` the
 /// AXIS master's, whose slave drives `tready` in the cycle the edge ends).
 /// `input`: the sample stream and the `mode` input, (valid, channel,
@@ -902,76 +938,4 @@ fn transmitter_update(s: &mut String, p: &LinkParams, w: Widths) {
         lit(w.hw, 0),
         lit(w.hw, 1)
     );
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The twin of a mode mix's link (2 mode bits, UART), driven with a
-    /// slot tick, sparse samples and a `mode` input that changes at frame
-    /// starts: its line decodes clean with the modes, and every header
-    /// names its frame's mode and the one before (docs/packet-format.md,
-    /// "Modes").
-    #[test]
-    fn headers_carry_the_mode_input() {
-        let p = LinkParams {
-            slice_cycles: 800,
-            slots_per_slice: 4,
-            slices_per_frame: 3,
-            div: 2,
-            parity: 0,
-            stop_bits: 1,
-            depth: 16,
-            crc_init: link::format::CRC_INIT,
-            axis: None,
-            mode_bits: 2,
-        };
-        let modes = [0u8, 2, 2, 1, 3, 0, 0, 1];
-        let mut r = Regs {
-            mem: vec![0; p.depth + 1],
-            ..Default::default()
-        };
-        reset_regs(&p, &mut r);
-        let fmt = link::UartFormat {
-            div: 2,
-            parity: link::Parity::None,
-            stop_bits: 1,
-        };
-        let mut rx = link::UartRx::new(fmt);
-        let mut dec = link::Decoder::with_modes(p.slices_per_frame, p.mode_bits);
-        let mut got = Vec::new();
-        let slot = p.slice_cycles / p.slots_per_slice;
-        let frame = p.slice_cycles * p.slices_per_frame;
-        let mut bounds = 0u64;
-        for c in 0..modes.len() as u64 * frame + 2000 {
-            if let Some(b) = rx.sample(r.chr & 1 == 1) {
-                dec.push_packets(&[b.byte], &mut got);
-            }
-            // the mode of the frame whose slice this cycle may start
-            bounds += r.bnd as u64;
-            let f = (bounds.saturating_sub(1) / p.slices_per_frame) as usize;
-            let mode = modes[f.min(modes.len() - 1)];
-            let valid = bounds > 0 && c % 151 == 5;
-            let input = (valid, (c % 5) as u32, c as u32 & 0xffff, mode);
-            edge(&p, &mut r, input, c % slot == slot - 1, false);
-        }
-        let st = dec.finish();
-        assert!(st.clean(), "{st:?}");
-        let got: Vec<_> = got
-            .into_iter()
-            .filter(|k| (k.frame as usize) < modes.len())
-            .collect();
-        assert!(got.len() >= modes.len() * 3 - 1, "{} packets", got.len());
-        for k in &got {
-            let f = k.frame as usize;
-            let before = if f == 0 { 0 } else { modes[f - 1] };
-            assert_eq!(
-                (k.mode, k.prev_mode),
-                (modes[f], before),
-                "frame {f} slice {}",
-                k.slice
-            );
-        }
-    }
 }

@@ -13,3 +13,8 @@ use testkit::tools as policy;
 // Shared by several test files (one copy in this binary).
 #[path = "common/mod.rs"]
 mod common;
+
+// The modules' own tests (the crate has no unit-test harness: `[lib] test =
+// false`), through its public face and its `for_tests` items.
+#[path = "units/mod.rs"]
+mod units;

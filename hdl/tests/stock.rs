@@ -1,6 +1,10 @@
 //! rust-hdl's stock threaded `Simulation` and `RtlSim` run the same core
-//! and must produce the same waveform, cycle for cycle.
+//! and must produce the same waveform, cycle for cycle; and one branch's
+//! SPI master in rust-hdl's simulator against a model ADC (`spi_bench`).
 mod common;
+
+#[path = "spi_bench.rs"]
+mod spi_bench;
 
 use common::*;
 use hdl::{rtlsim_cycles, stock_simulation_cycles, StockRun};
