@@ -65,3 +65,20 @@ pub use yosys::{find_program, synthesize_for, Synthesized, NETLIST_FILE, SYNTH_J
 // measured and the fault campaign.
 pub use budget::{budget_tables, Tightest};
 pub use tables::{fault_table, interval_table, slot_table};
+
+/// Private items that this crate's tests check directly (`tests/units/`):
+/// the crate has no unit-test harness (`[lib] test = false`, one build of
+/// it less in `make test`), so they are reached from the integration tests
+/// here.  Not an API: no other crate uses it.
+#[doc(hidden)]
+pub mod for_tests {
+    pub use crate::budget::branch_caption;
+    pub use crate::cell_prune::needed_models;
+    pub use crate::dft::{alias, peak, spectrum};
+    pub use crate::figure7::where_aliasing_puts_it;
+    pub use crate::netlist::hollow_cells;
+    pub use crate::synth::parse as parse_synth;
+    pub use crate::tables::MAX_COLUMNS;
+    pub use crate::timing::{label_width, stagger};
+    pub use crate::yosys::{built_venv, stat_cells};
+}

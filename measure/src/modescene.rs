@@ -392,7 +392,3 @@ pub fn mode_section(
     };
     (sec, line, glance)
 }
-
-#[cfg(test)]
-#[path = "modescene_tests.rs"]
-mod tests;

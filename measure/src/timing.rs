@@ -103,7 +103,7 @@ const SELECT_LOW: f64 = -0.69;
 /// The width of a label in the plot's x units: about 7.5 pixels a character
 /// of the 12-pixel sans-serif (capitals and `_` are wide), plus its 6-pixel
 /// offset, on the plot's ~860 pixels across `span`.
-fn label_width(t: &str, span: f64) -> f64 {
+pub fn label_width(t: &str, span: f64) -> f64 {
     (t.len() as f64 * 7.5 + 10.0) / 860.0 * span
 }
 
@@ -115,7 +115,7 @@ fn label_width(t: &str, span: f64) -> f64 {
 /// vertical `ticks` (the strobes): a label goes there only if no tick lies
 /// under its text, which starts 6 pixels right of its strobe (so the ticks
 /// of strobes a few cycles apart that share one label do not count).
-fn stagger(
+pub fn stagger(
     labels: &[(f64, String)],
     ticks: &[f64],
     x0: f64,
@@ -519,60 +519,4 @@ fn wavedrom(s: &Schedule, l: &Layout, w: &Window, _nb: usize) -> Result<(String,
         None => "WaveDrom: a conversion (its strobe falls outside the window)".into(),
     };
     Ok((text, line))
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn strobe_labels_a_slot_apart_alternate_lines() {
-        let l: Vec<(f64, String)> = (0..6).map(|k| (k as f64, "CH10".to_string())).collect();
-        // 30 slots in the window: a label is wider than a slot
-        let lines = |v: Vec<(f64, usize)>| v.into_iter().map(|p| p.1).collect::<Vec<_>>();
-        assert_eq!(
-            lines(super::stagger(&l, &[], 0.0, 30.0, 2)),
-            [0, 1, 0, 1, 0, 1]
-        );
-        // wider labels take a third line where there is one
-        let w: Vec<(f64, String)> = (0..6).map(|k| (k as f64, "CH1,CH26".into())).collect();
-        assert_eq!(
-            lines(super::stagger(&w, &[], 0.0, 30.0, 3)),
-            [0, 1, 2, 0, 1, 2]
-        );
-        // far apart: all on the first line
-        let far: Vec<(f64, String)> = l.iter().map(|(x, t)| (x * 10.0, t.clone())).collect();
-        assert_eq!(lines(super::stagger(&far, &[], 0.0, 60.0, 2)), [0; 6]);
-    }
-
-    /// A strobe's tick under a name on the first line (which sits among
-    /// the ticks) sends the name to a line below the trace: eskin34's
-    /// merged "CH1,CH26,CH35" crossed the next two strobes' ticks.
-    #[test]
-    fn no_strobe_tick_crosses_a_name_on_the_first_line() {
-        let width = super::label_width("CH1,CH26,CH35", 30.0);
-        let ticks = [0.0, 0.0 + width / 2.0, 5.0];
-        let l = vec![
-            (0.0, "CH1,CH26,CH35".to_string()),
-            (width / 2.0, "CH2".to_string()),
-            (5.0, "CH3".to_string()),
-        ];
-        let placed = super::stagger(&l, &ticks, 0.0, 30.0, 3);
-        assert_eq!(placed.iter().map(|p| p.1).collect::<Vec<_>>(), [1, 0, 0]);
-        for ((x, line), (_, t)) in placed.iter().zip(&l) {
-            let end = x + super::label_width(t, 30.0);
-            let under = ticks.iter().any(|&k| k > *x + 0.21 && k < end);
-            assert!(*line > 0 || !under, "{t} on line 0 over a tick");
-        }
-        // its own strobes' ticks, left of its text, do not count
-        let alone = super::stagger(&l[..1], &[0.0, 0.1], 0.0, 30.0, 3);
-        assert_eq!(alone[0].1, 0);
-    }
-
-    #[test]
-    fn a_label_at_the_right_edge_ends_inside_the_window() {
-        let l = vec![(9.0, "CH1".to_string()), (29.9, "CH1,CH26".to_string())];
-        let placed = super::stagger(&l, &[], 0.0, 30.0, 2);
-        assert_eq!(placed[0].0, 9.0, "a label with room stays at its strobe");
-        let end = placed[1].0 + super::label_width("CH1,CH26", 30.0);
-        assert!(end <= 30.0 + 1e-9 && placed[1].0 < 29.9, "{placed:?}");
-    }
 }

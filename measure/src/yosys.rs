@@ -58,7 +58,7 @@ pub fn find_program(name: &str) -> Result<PathBuf, String> {
 }
 
 /// `.venv/bin` of the checkout this crate was built in.
-fn built_venv() -> PathBuf {
+pub fn built_venv() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../.venv/bin")
 }
 
@@ -158,7 +158,7 @@ fn yowasp_share(script: &Path) -> Result<PathBuf, String> {
 
 /// Each cell type and its count in yosys' `stat -json` of the whole
 /// design (the top after synthesis flattens it), sorted by name.
-fn stat_cells(json: &str) -> Option<Vec<(String, u64)>> {
+pub fn stat_cells(json: &str) -> Option<Vec<(String, u64)>> {
     let v: serde_json::Value = serde_json::from_str(json).ok()?;
     let by_type = v.get("design")?.get("num_cells_by_type")?.as_object()?;
     let mut cells: Vec<(String, u64)> = by_type
@@ -167,49 +167,4 @@ fn stat_cells(json: &str) -> Option<Vec<(String, u64)>> {
         .collect();
     cells.sort();
     Some(cells)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A program nowhere says where it was looked for and how to get it;
-    /// the checkout's own `.venv/bin` is among the places.
-    #[test]
-    fn a_missing_program_names_the_places_and_make_tools() {
-        let e = find_program("slotforge-no-such-program").unwrap_err();
-        assert!(e.contains("neither on PATH"), "{e}");
-        assert!(e.contains(&built_venv().display().to_string()), "{e}");
-        assert!(
-            e.contains("`make tools-extra`")
-                && e.contains("`make tools`")
-                && e.contains("add that .venv/bin to PATH"),
-            "{e}"
-        );
-        let sh = find_program("sh").unwrap();
-        assert!(sh.is_file(), "{}", sh.display());
-    }
-
-    #[test]
-    fn stat_json_gives_the_designs_cells_by_type() {
-        let j = r#"{"creator":"Yosys","modules":{"\\slotforge_top":{"num_cells":3}},
-            "design":{"num_cells":20,"num_cells_by_type":{"SB_LUT4":12,"SB_DFF":5,"$scopeinfo":0,"SB_RAM40_4K":3}}}"#;
-        let c = stat_cells(j).unwrap();
-        assert_eq!(
-            c,
-            vec![
-                ("$scopeinfo".to_string(), 0),
-                ("SB_DFF".into(), 5),
-                ("SB_LUT4".into(), 12),
-                ("SB_RAM40_4K".into(), 3)
-            ]
-        );
-        assert!(stat_cells("{\"modules\":{}}").is_none());
-    }
-
-    #[test]
-    fn a_missing_program_names_make_tools() {
-        let e = find_program("yowasp-no-such-tool-5c1e").unwrap_err();
-        assert!(e.contains("make tools-extra"), "{e}");
-    }
 }

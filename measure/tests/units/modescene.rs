@@ -4,8 +4,7 @@
 
 use engines::{Backend, SimOptions, Stimulus};
 use lut_gen::Schedule;
-
-use super::*;
+use measure::{mode_scene, mode_section, one_mode, ModeScene};
 
 fn schedule(text: &str) -> Schedule {
     let m = lut_gen::parse(std::path::Path::new("t.toml"), text).unwrap();
