@@ -377,6 +377,11 @@ const PUBLIC_MODULES: &[(&str, &str, &str)] = &[
         "for_tests",
         "private items the crate's integration tests check, doc(hidden)",
     ),
+    (
+        "link",
+        "for_tests",
+        "private items the crate's integration tests check, doc(hidden)",
+    ),
 ];
 
 /// `testkit` is exempt: a dev-only toolbox whose modules are the helpers'

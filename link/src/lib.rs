@@ -32,3 +32,12 @@ pub use format::Token;
 pub use rx::{RxByte, UartRx};
 pub use tx::{steady_state, ByteOnLine, HeaderOnLine, Line, SteadyState, TxConfig, TxModel};
 pub use uart::{Parity, UartFormat};
+
+/// Private items that this crate's tests check directly (`tests/units/`):
+/// the crate has no unit-test harness (`[lib] test = false`, one build of
+/// it less in `make test`), so they are reached from the integration tests
+/// here.  Not an API: no other crate uses it.
+#[doc(hidden)]
+pub mod for_tests {
+    pub use crate::tx::header_state;
+}
