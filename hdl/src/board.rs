@@ -189,7 +189,7 @@ impl Board {
     }
 }
 
-/// [`Board::constraints`], for this crate's tests (`crate::for_tests`): the
+/// `Board::constraints`, for this crate's tests (`crate::for_tests`): the
 /// method stays off `Board`'s public face.
 pub fn board_constraints(
     b: &Board,

@@ -344,7 +344,7 @@ impl Twin {
     }
 
     /// One clock edge: `input` is (valid, channel, code, mode) as for
-    /// [`edge`], `tick` the core's slot start.
+    /// `edge`, `tick` the core's slot start.
     pub fn edge(&mut self, input: (bool, u32, u32, u8), tick: bool) {
         edge(&self.p, &mut self.r, input, tick, false);
     }
