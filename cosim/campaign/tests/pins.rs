@@ -228,10 +228,11 @@ fn the_save_file_shows_every_port_the_waveform_has() {
 /// Random mixes with mux-less branches run clean on every engine: the
 /// judge reads the pins of tops without those mux lanes. The engines' time
 /// is the mixes' cycles (Icarus, the slowest engine, was half of it): here
-/// the draws run at 12 MHz, a quarter of the generator's 48 MHz, the same
-/// branches and channels in a quarter of the cycles (the pins a mux-less
-/// branch has, or lacks, do not depend on the clock), and Icarus runs the
-/// first mix; `make test-long` runs them at 48 MHz, Icarus on each.
+/// the draws run at 12 MHz, a quarter of the generator's 48 MHz and of
+/// its cycles (a seed draws the same branches and channels at any clock,
+/// and the pins a mux-less branch has, or lacks, do not depend on it), and
+/// Icarus runs the first mix; `make test-long` runs them at 48 MHz, Icarus
+/// on each.
 #[test]
 fn random_muxless_mixes_run_clean_on_every_engine() {
     muxless_mixes_run_clean(1, 12_000_000);
