@@ -20,7 +20,21 @@ use crate::link_windows::{random_link_mixes, rng};
 /// Every cycle's pins after reset of `frames` frames of rust-hdl's model of
 /// the gateware behind the AXIS slave a back end puts in front of it.
 fn pins(s: &Schedule, frames: u64) -> Vec<Pins> {
-    let dut = engines::RustHdlDut::new(s).expect("rust-hdl builds");
+    pins_of(
+        s,
+        engines::RustHdlDut::new(s).expect("rust-hdl builds"),
+        frames,
+    )
+}
+
+/// [`pins`] from the judge's cycle model, which the gateware equals pin for
+/// pin (the engines' tests hold them so): a preset's 1.4 million cycles in
+/// a fraction of rust-hdl's time.
+fn model_pins(s: &Schedule, frames: u64) -> Vec<Pins> {
+    pins_of(s, judge::ModelDut::new(s), frames)
+}
+
+fn pins_of<D: judge::Dut>(s: &Schedule, dut: D, frames: u64) -> Vec<Pins> {
     let mut dut = judge::with_slave(s, dut, ::link::ReadyPattern::Random { seed: 11 });
     analyser::run(s, &mut dut, frames)
 }
@@ -162,38 +176,44 @@ fn captures_of_thirty_random_link_mixes_pass() {
     random_captures(200, 30, 4);
 }
 
-/// The link presets (3 frames of each: most of the time of the checks
-/// below, so one run serves both): captures at random offsets pass; and a
-/// board's crystal and an analyser's differ by tens of ppm, so a capture
-/// over most of a frame, the analyser 100 ppm fast or slow, passes as a
-/// capture with exact clocks does, the offset measured and said; at the
-/// mix's own clock the capture is checked as it was taken (no offset the
-/// fit can tell from none).  `make test` takes each offset once (the UART
-/// fast and exact, the AXI4-Stream slow), `make test-long` the other three.
+/// The link presets (3 frames of each: one run serves both checks):
+/// captures at random offsets pass; and a board's crystal and an
+/// analyser's differ by tens of ppm, so a capture over most of a frame, the
+/// analyser 100 ppm fast or slow, passes as a capture with exact clocks
+/// does, the offset measured and said; at the mix's own clock the capture
+/// is checked as it was taken (no offset the fit can tell from none).
+/// `make test` captures the cycle model's pins (rust-hdl's 3 frames of
+/// each preset were half of this test's time) and takes each offset once
+/// (the UART fast and exact, the AXI4-Stream slow); `make test-long`
+/// captures rust-hdl's, at every offset.
 #[test]
 fn captures_of_the_link_presets_at_random_offsets_and_100_ppm_off_pass() {
-    let d = tempfile::tempdir().unwrap();
-    for (name, offsets) in [
-        ("eskin34-uart.toml", &[0, 2][..]),
-        ("eskin34-axis.toml", &[1]),
-    ] {
-        let s = preset(name);
-        let p = pins(&s, 3);
-        captures_at_random_offsets_pass(name, &s, &p, d.path());
-        captures_off_by_ppm_pass(name, &s, &p, offsets, d.path());
-    }
+    link_preset_captures(
+        model_pins,
+        [("eskin34-uart.toml", &[0, 2]), ("eskin34-axis.toml", &[1])],
+    );
 }
 
 #[test]
-#[ignore = "long: make test-long (each link preset at the other offsets)"]
+#[ignore = "long: make test-long (rust-hdl's pins of each link preset, at every offset)"]
 fn captures_of_each_link_preset_at_every_offset_pass() {
+    link_preset_captures(
+        pins,
+        [
+            ("eskin34-uart.toml", &[0, 1, 2]),
+            ("eskin34-axis.toml", &[0, 1, 2]),
+        ],
+    );
+}
+
+/// Captures of 3 frames of each preset's pins from `pins_of`: at random
+/// offsets, and at the analyser's offsets given.
+fn link_preset_captures(pins_of: fn(&Schedule, u64) -> Vec<Pins>, presets: [(&str, &[usize]); 2]) {
     let d = tempfile::tempdir().unwrap();
-    for (name, offsets) in [
-        ("eskin34-uart.toml", &[1][..]),
-        ("eskin34-axis.toml", &[0, 2]),
-    ] {
+    for (name, offsets) in presets {
         let s = preset(name);
-        let p = pins(&s, 3);
+        let p = pins_of(&s, 3);
+        captures_at_random_offsets_pass(name, &s, &p, d.path());
         captures_off_by_ppm_pass(name, &s, &p, offsets, d.path());
     }
 }

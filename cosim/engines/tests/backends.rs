@@ -1,4 +1,4 @@
-//! Every preset mix on every back end: rusthdl and verilator for 2 frames, model for 100.
+//! Every preset mix on every back end: verilator for 2 frames, model for 100, rusthdl for 2 (three presets here, the five others in `make test-long`).
 
 use std::path::{Path, PathBuf};
 
@@ -50,9 +50,38 @@ fn model_backend_100_frames() {
     }
 }
 
+/// Two frames of three presets in process: the one with modes
+/// (eskin34-adaptive: its mode block switching under the stimulus), one
+/// with a link (eskin34-axis: the link's FIFO and AXI4-Stream master) and
+/// the one on another clock (softslip1k, 12 MHz); the five others are
+/// eskin34's core again, with a UART or wider branches, in `make test-long`
+/// (`rusthdl_backend_2_frames_of_the_other_presets`).  rust-hdl simulates
+/// every cycle of a preset's 10 ms frame (480,000 at 48 MHz): about 1.5 s
+/// of CPU a preset.  Verilator runs every preset's Verilog in
+/// `verilator_backend_2_frames`, and `make golden` all eight.
 #[test]
 fn rusthdl_backend_2_frames() {
-    for p in mixes() {
+    rusthdl_2_frames(|name| RUSTHDL_PRESETS.contains(&name));
+}
+
+#[test]
+#[ignore = "long: make test-long (rusthdl_backend_2_frames on the five other presets)"]
+fn rusthdl_backend_2_frames_of_the_other_presets() {
+    rusthdl_2_frames(|name| !RUSTHDL_PRESETS.contains(&name));
+}
+
+/// The presets `rusthdl_backend_2_frames` runs in `make test`.
+const RUSTHDL_PRESETS: [&str; 3] = ["eskin34-adaptive", "eskin34-axis", "softslip1k"];
+
+/// Two frames on rusthdl of every preset whose name `pick` takes.
+fn rusthdl_2_frames(pick: impl Fn(&str) -> bool) {
+    let name = |p: &PathBuf| p.file_stem().unwrap().to_str().unwrap().to_string();
+    let all = mixes();
+    let names: Vec<String> = all.iter().map(name).collect();
+    for n in RUSTHDL_PRESETS {
+        assert!(names.iter().any(|x| x == n), "no preset {n}: {names:?}");
+    }
+    for p in all.into_iter().filter(|p| pick(&name(p))) {
         let s = schedule(&p);
         let r = run(&s, Backend::RustHdl, 2, &one_cycle_reset()).unwrap();
         assert!(r.ok, "{}: {}", p.display(), r.summary());
