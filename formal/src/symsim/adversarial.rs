@@ -898,7 +898,7 @@ fn holding_design(rng: &mut Rng) -> Aig {
 
 #[test]
 fn random_designs_holding_a_request_agree_with_an_explicit_state_search() {
-    let mut rng = Rng(0x5EED_0F_4E1D_C0DE);
+    let mut rng = Rng(0x005E_ED0F_4E1D_C0DE);
     let mut tally = [0usize; 3];
     for _ in 0..3000 {
         let g = holding_design(&mut rng);
