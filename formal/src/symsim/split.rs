@@ -264,18 +264,10 @@ impl Sim<'_> {
             .collect();
         let roots = next.iter().copied().chain([bad]);
         let read = reads(&self.gr, roots, mark, &vars);
-        if (read || self.holding) && !self.computes(&next, bad, read) {
-            // a request only copied into registers (`defer.rs`): held as
-            // its variable until something computes with it
+        if !((read || self.holding) && self.computes(&next, bad, read)) {
+            // nothing computes with a split input: a request only copied
+            // into registers is held as its variable (`defer.rs`)
             self.holding |= read;
-            self.state = next;
-            if bad != 0 {
-                self.pending.push((step, bad));
-                self.pending_any = self.gr.and(self.pending_any ^ 1, bad ^ 1) ^ 1;
-            }
-            return Ok(None);
-        }
-        if !read && !self.holding {
             self.state = next;
             if bad != 0 {
                 self.pending.push((step, bad));
