@@ -573,7 +573,9 @@ fn link_generalised(
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
     // auto select: as deep as the main run may need for its windows
     let auto = harness::auto_frames(s);
-    let limit = (GENERAL_FRAMES + auto.unwrap_or(0)) * f + 2;
+    // `+ 1`: the frame start at the last step is compared too (a run that
+    // comes round there, as an unseen glove mix's did, closes)
+    let limit = (GENERAL_FRAMES + auto.unwrap_or(0)) * f + 2 + 1;
     // an AXI4-Stream slave's choices and mode requests: one path per value
     // where a step reads them, paths in the same state at a step merged
     // (`symsim::split`); auto select's decisions at frame starts (`cases`)

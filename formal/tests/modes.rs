@@ -127,6 +127,29 @@ fn a_pin_mode_mix_with_a_uart_proves_its_packets_and_a_mode_field_swap_fails() {
     assert!(c.cycle >= s.grid.frame_cycles as i64, "{}", p.summary());
 }
 
+/// A mix of an unseen glove's kind (`formal/tests/data/glove-pin-small.toml`:
+/// bulk rows of taxels on two TMUX1108s whose rate the mode sets, a second
+/// branch, pin select, a UART) proves the whole contract, its link's bytes
+/// for all time: the generalised run comes round at the frame start of its
+/// last step (it was searched two frames only before that step was
+/// compared), and a request copied into the mode registers is held as its
+/// variable until the gateware computes with it.
+#[test]
+fn a_glove_mix_proves_its_links_bytes_for_all_time() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("formal/tests/data/glove-pin-small.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    for q in &p.properties {
+        assert_eq!(q.result, Outcome::Proved, "{}: {}", q.name, p.summary());
+    }
+    assert!(p.note.contains("frame counters"), "{}", p.note);
+}
+
 /// The gateware's mode block as emitted for a pin-select mix.
 const DECIDED: &str = "wire [0:0] decided = mode_sel[0:0];";
 const SWITCH: &str = "cur <= nxt;\n          nxt <= decided;";

@@ -21,6 +21,12 @@ pub(super) struct Graph {
     /// inputs hold the same literal and are merged.  Only when `shared`
     /// (a split run): a run of one path makes each variable once anyway.
     vars: FxHashMap<(u32, u32), u32>,
+    /// A shared graph's inputs of a step, `0..n` (`step_vars`): one block
+    /// of `n` consecutive variable nodes, by its first node and `n`.  Why:
+    /// one lookup per step instead of one per input; a design with many
+    /// `anyseq` inputs (yosys's undriven bits) spent a third of a split
+    /// run in `var`'s lookups.
+    rows: FxHashMap<u32, (u32, u32)>,
     pub(super) shared: bool,
 }
 
@@ -31,8 +37,30 @@ impl Graph {
             b: vec![0],
             table: FxHashMap::default(),
             vars: FxHashMap::default(),
+            rows: FxHashMap::default(),
             shared: false,
         }
+    }
+
+    /// The variables of inputs `0..n` at `step` (what `var` gives each).
+    pub(super) fn step_vars(&mut self, n: u32, step: u32) -> Vec<u32> {
+        if !self.shared {
+            return (0..n).map(|k| self.fresh_var(k, step)).collect();
+        }
+        let &mut (first, len) = self.rows.entry(step).or_insert_with(|| {
+            let first = self.a.len() as u32;
+            for k in 0..n {
+                self.a.push(VAR | k);
+                self.b.push(step);
+            }
+            (first, n)
+        });
+        (0..n)
+            .map(|k| match k < len {
+                true => (first + k) * 2,
+                false => self.var(k, step),
+            })
+            .collect()
     }
 
     /// A variable node of its own, not shared with `var`'s: a split
@@ -47,6 +75,10 @@ impl Graph {
     pub(super) fn var(&mut self, input: u32, step: u32) -> u32 {
         if !self.shared {
             return self.fresh_var(input, step);
+        }
+        if let Some(&(first, n)) = self.rows.get(&step).filter(|r| input < r.1) {
+            debug_assert!(n > input);
+            return (first + input) * 2;
         }
         let (a, b) = (&mut self.a, &mut self.b);
         *self.vars.entry((input, step)).or_insert_with(|| {
@@ -106,6 +138,20 @@ impl Graph {
                 live[(self.b[i] >> 1) as usize] = true;
             }
         }
+        // a step's row of inputs stays whole (its nodes consecutive) while
+        // any of them is live, and goes when none is
+        self.rows.retain(|_, &mut (first, len)| {
+            let block = first as usize..(first + len) as usize;
+            let keep = live[block.clone()].iter().any(|&l| l);
+            if keep {
+                live[block].fill(true);
+            }
+            keep
+        });
+        let mut in_row = vec![false; n];
+        for &(first, len) in self.rows.values() {
+            in_row[first as usize..(first + len) as usize].fill(true);
+        }
         let mut map = vec![0u32; n];
         let (mut a, mut b) = (vec![0u32], vec![0u32]);
         let mut table = FxHashMap::default();
@@ -117,7 +163,7 @@ impl Graph {
             }
             map[i] = a.len() as u32;
             if self.is_var(i) {
-                if self.shared {
+                if self.shared && !in_row[i] {
                     vars.insert((self.a[i] & !VAR, self.b[i]), map[i] * 2);
                 }
                 a.push(self.a[i]);
@@ -131,6 +177,9 @@ impl Graph {
         }
         for r in roots.iter_mut() {
             *r = lit(&map, *r);
+        }
+        for row in self.rows.values_mut() {
+            row.0 = map[row.0 as usize];
         }
         self.a = a;
         self.b = b;

@@ -37,6 +37,7 @@ use crate::aiger::Aig;
 mod affine;
 mod cases;
 mod cone;
+mod defer;
 mod eval;
 mod explicit;
 mod generalise;
@@ -350,6 +351,11 @@ struct Sim<'a> {
     pin: generalise::Pin,
     /// How many times the graph was collected (its literals renumbered).
     collections: u64,
+    /// Whether the state may hold a split input's variable, only copied
+    /// (`defer.rs`), and which nodes read one (memo, per collection).
+    holding: bool,
+    dep: Vec<u8>,
+    dep_at: u64,
 }
 
 impl<'a> Sim<'a> {
@@ -406,6 +412,9 @@ impl<'a> Sim<'a> {
             generalised: None,
             pin: generalise::Pin::default(),
             collections: 0,
+            holding: false,
+            dep: Vec::new(),
+            dep_at: 0,
         }
     }
 
@@ -596,9 +605,7 @@ impl<'a> Sim<'a> {
 /// every latch starts from `state` and leaves it with its next value;
 /// returns the disjunction of the assertions (`val`: each gate's value).
 fn evaluate(g: &Aig, ev: &mut eval::Eval, gr: &mut Graph, state: &mut [u32], step: u64) -> u32 {
-    let inputs: Vec<u32> = (0..g.inputs.len())
-        .map(|k| gr.var(k as u32, step as u32))
-        .collect();
+    let inputs = gr.step_vars(g.inputs.len() as u32, step as u32);
     ev.step(g, gr, state, &inputs)
 }
 

@@ -100,6 +100,7 @@ impl Sim<'_> {
             (self.state, self.prev_state, self.fixed) = (b.state, b.prev_state, b.fixed);
             self.cond = b.cond;
             self.pin = b.pin;
+            self.holding = !self.held_requests().is_empty();
             self.pending.clear();
             self.pending_any = 0;
             let path_lim = Limits {
@@ -171,7 +172,11 @@ impl Sim<'_> {
             if phase == Some(0) {
                 // the frame counters, once shown equal, become one free
                 // value (`generalise.rs`): on every path alike
-                self.generalise(step)?;
+                // a bound here, not past a path waiting at an earlier step
+                // (it may still find a violation before this one)
+                if let Err(f) = self.generalise(step) {
+                    return Err(self.bounded_at(f));
+                }
                 if self.split_cases {
                     self.prune_cond(step)?;
                 }
@@ -244,9 +249,10 @@ impl Sim<'_> {
         for &k in &self.splits {
             inputs[k] = self.gr.fresh_var(k as u32, step as u32);
         }
+        let shared = self.gr.step_vars(ni as u32, step as u32);
         for (k, lit) in inputs.iter_mut().enumerate() {
             if !self.splits.contains(&k) {
-                *lit = self.gr.var(k as u32, step as u32);
+                *lit = shared[k];
             }
         }
         let mut next = self.state.clone();
@@ -257,7 +263,11 @@ impl Sim<'_> {
             .map(|&k| (inputs[k] >> 1) as usize)
             .collect();
         let roots = next.iter().copied().chain([bad]);
-        if !reads(&self.gr, roots, mark, &vars) {
+        let read = reads(&self.gr, roots, mark, &vars);
+        if !((read || self.holding) && self.computes(&next, bad, read)) {
+            // nothing computes with a split input: a request only copied
+            // into registers is held as its variable (`defer.rs`)
+            self.holding |= read;
             self.state = next;
             if bad != 0 {
                 self.pending.push((step, bad));
@@ -269,23 +279,41 @@ impl Sim<'_> {
         if let Some(f) = self.check_pending() {
             return Err(self.bounded_at(f));
         }
+        // the split variables the step computes with (this step's and held
+        // ones): one path per value of them, each with the held ones
+        // replaced in its state; the others stay held
+        let need = self.needed(&next, bad);
+        let held: Vec<usize> = (self.held_requests().into_iter())
+            .filter(|n| need.contains(n))
+            .collect();
+        let now: Vec<usize> = (self.splits.iter().copied())
+            .filter(|&k| need.contains(&((inputs[k] >> 1) as usize)))
+            .collect();
+        let ns = now.len();
         let mut paths: Vec<Branch> = Vec::new();
-        for a in 0u32..1 << self.splits.len() {
+        for a in 0u32..1 << (ns + held.len()) {
             let mut fixed = self.fixed.clone();
-            for (i, &k) in self.splits.iter().enumerate() {
+            for (i, &k) in now.iter().enumerate() {
                 inputs[k] = (a >> i) & 1;
                 fixed.push((k as u32, step as u32, (a >> i) & 1 == 1));
             }
-            let mut next = self.state.clone();
+            let fix: Vec<(usize, bool)> = (held.iter().enumerate())
+                .map(|(i, &n)| (n, (a >> (ns + i)) & 1 == 1))
+                .collect();
+            for &(n, v) in &fix {
+                let input = self.gr.a[n] & !super::graph::VAR;
+                fixed.push((input, self.gr.b[n], v));
+            }
+            let (mut next, cond, pin) = self.fixed_at(&fix);
             let bad = self.ev.step(g, &mut self.gr, &mut next, &inputs);
             let bad = match bad {
                 0 => 0,
                 // never true by its affine forms: so under the condition
                 // too (`satisfy` would not see it through the condition)
-                _ if !self.cond.is_empty() && super::affine::never_true(&self.gr, bad) => 0,
+                _ if !cond.is_empty() && super::affine::never_true(&self.gr, bad) => 0,
                 _ => {
-                    let cond = self.cond_lit();
-                    self.gr.and(bad, cond)
+                    let all = (cond.iter()).fold(1, |all, &c| self.gr.and(all, c));
+                    self.gr.and(bad, all)
                 }
             };
             if bad != 0 {
@@ -294,24 +322,79 @@ impl Sim<'_> {
                 match self.gr.satisfy(bad, limit) {
                     Ok(None) => {}
                     Ok(Some(assign)) => {
-                        self.fixed = fixed;
+                        (self.fixed, self.cond, self.pin) = (fixed, cond, pin);
                         let general = self.generalised_violation(step, bad, &assign);
-                        return Err(general.unwrap_or_else(|| self.violation(step, assign)));
+                        // a bound no further than every waiting path got
+                        let found = general.unwrap_or_else(|| self.violation(step, assign));
+                        return Err(self.bounded_at(found));
                     }
                     Err(_) => return Err(self.bounded_at(Found::Bounded { steps: step })),
                 }
             }
-            if paths.iter().all(|p| p.state != next) {
+            if paths.iter().all(|p| p.state != next || p.cond != cond) {
                 paths.push(Branch {
                     state: next,
                     prev_state: self.prev_state.clone(),
                     fixed,
-                    cond: self.cond.clone(),
-                    pin: self.pin.clone(),
+                    cond,
+                    pin,
                 });
             }
         }
         Ok(Some(paths))
+    }
+
+    /// Whether the next state (a latch whose value changes) or the
+    /// assertion computes with a split input's variable (`defer.rs`);
+    /// also when holding this step's (`read`) would split on too many bits
+    /// at once.
+    fn computes(&mut self, next: &[u32], bad: u32, read: bool) -> bool {
+        if bad >= 2 && self.reads_split((bad >> 1) as usize) {
+            return true;
+        }
+        if (0..next.len()).any(|j| next[j] != self.state[j] && self.computes_with_split(next[j])) {
+            return true;
+        }
+        if !read {
+            // only a step that reads its split inputs holds more
+            return false;
+        }
+        let mut held: Vec<usize> = (next.iter())
+            .map(|&l| (l >> 1) as usize)
+            .filter(|&n| n != 0 && self.gr.is_var(n) && self.reads_split(n))
+            .collect();
+        held.sort_unstable();
+        held.dedup();
+        held.len() + self.splits.len() > MAX_SPLIT_BITS
+    }
+
+    /// The split variables under the latches whose next value computes
+    /// with one, and under the assertion if it reads one.
+    fn needed(&mut self, next: &[u32], bad: u32) -> Vec<usize> {
+        let mut roots: Vec<u32> = (0..next.len())
+            .filter(|&j| next[j] != self.state[j] && self.computes_with_split(next[j]))
+            .map(|j| next[j])
+            .collect();
+        roots.push(bad);
+        let mut need = self.split_vars_under(&roots);
+        if need.is_empty() {
+            // more held than `MAX_SPLIT_BITS` allows: all of them
+            need = self.split_vars_under(next);
+        }
+        need
+    }
+
+    /// The path's state, condition and pins with the held requests `fix`
+    /// replaced by their values.
+    fn fixed_at(&mut self, fix: &[(usize, bool)]) -> (Vec<u32>, Vec<u32>, super::generalise::Pin) {
+        if fix.is_empty() {
+            return (self.state.clone(), self.cond.clone(), self.pin.clone());
+        }
+        let state = self.cofactor(&self.state.clone(), fix);
+        let cond = self.cofactor(&self.cond.clone(), fix);
+        let mut pin = self.pin.clone();
+        pin.exact = self.cofactor(&pin.exact, fix);
+        (state, cond, pin)
     }
 }
 
