@@ -1,7 +1,8 @@
 //! Converters with a command word in the fault campaign: the classes
 //! `wrong-channel-bits` and `late-command` are injected into every
-//! commanded branch of the shared test mixes (an MCP3208, an AD7689 and a
-//! listening AD7940; one AD7689 alone) and of random commanded mixes, and
+//! commanded branch of the shared test mixes (an MCP3208, an AD7689 and an
+//! ADS7953-like part; one AD7689 alone; in `make test-long` an MCP3208, an
+//! AD7689 and a listening AD7940) and of random commanded mixes, and
 //! each injection is caught by the model, by the invariants (the sample
 //! held to the channel its word selected) and by sigrok's SPI decode of
 //! `mosi`; clean runs pass every detector, sigrok's included.
@@ -15,7 +16,7 @@ use crate::tools;
 
 /// A random mix with an `mcp3208` and an `ad7689` branch (and a listening
 /// one), channels on random inputs at random rates, from `seed`.
-fn random_commanded(seed: u64) -> Schedule {
+fn random_commanded(seed: u64, mhz: u64) -> Schedule {
     let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
     let mut next = |n: u64| {
         x ^= x << 13;
@@ -23,8 +24,8 @@ fn random_commanded(seed: u64) -> Schedule {
         x ^= x << 17;
         x % n
     };
-    let mut t = String::from(
-        "name = \"rc\"\n[clock]\nhz = 24000000\n[frame]\nperiod_us = 1000\nslice_us = 500\n",
+    let mut t = format!(
+        "name = \"rc\"\n[clock]\nhz = {mhz}000000\n[frame]\nperiod_us = 1000\nslice_us = 500\n"
     );
     let branches = [
         ("m", "mcp3208", "internal"),
@@ -54,15 +55,36 @@ fn load(name: &str) -> Schedule {
     lut_gen::synthesize(&lut_gen::load(&testkit::mix(name)).unwrap()).unwrap()
 }
 
+/// Each run's cost is its cycles, most of them in sigrok's decodes of
+/// every branch: `make test` runs cmd-small (each kind of command word,
+/// 4,000 cycles a frame), cmd-solo (the AD7689 alone) and a random mix
+/// at 12 MHz (a listening AD7940 beside an MCP3208 and an AD7689);
+/// `make test-long` cmd-pair and two random mixes at 24 MHz.
 #[test]
 fn command_faults_join_the_campaign_and_every_detector_sees_them() {
+    let mixes = [load("cmd-small"), load("cmd-solo"), random_commanded(5, 12)];
+    command_faults_are_seen(&mixes, 3);
+}
+
+#[test]
+#[ignore = "long: make test-long (cmd-pair, and random mixes at 24 MHz)"]
+fn command_faults_of_cmd_pair_and_random_mixes_at_24_mhz_are_seen() {
+    let mixes = [
+        load("cmd-pair"),
+        random_commanded(5, 24),
+        random_commanded(9, 24),
+    ];
+    command_faults_are_seen(&mixes, 4);
+}
+
+/// The command classes of `mixes`' every commanded branch, each caught by
+/// the model, the invariants and sigrok, in runs of `frames` frames.
+fn command_faults_are_seen(mixes: &[Schedule], frames: u64) {
     if !tools::require_tool("sigrok-cli") {
         return;
     }
-    let mut mixes = vec![load("cmd-pair"), load("cmd-solo")];
-    mixes.extend([5, 9].map(random_commanded));
-    for s in &mixes {
-        let mut plan = Plan::new(Target::Model, 4, 0);
+    for s in mixes {
+        let mut plan = Plan::new(Target::Model, frames, 0);
         plan.sites = Some(
             sites(s)
                 .into_iter()
