@@ -18,6 +18,23 @@ fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
     prove_to(s, design, out, None)
 }
 
+/// The design of `s` proved whole: every property for all time, nothing
+/// left uncovered.
+fn proved_whole(s: &lut_gen::Schedule, out: &Path) -> Proof {
+    let p = prove(s, &emitted(s), out);
+    assert_whole(&p);
+    p
+}
+
+/// `p` proves every property for all time and leaves nothing uncovered.
+fn assert_whole(p: &Proof) {
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
+    for q in &p.properties {
+        assert_eq!(q.result, Outcome::Proved, "{}: {}", q.name, p.summary());
+    }
+}
+
 /// `prove` with the search from reset stopped at `depth` steps.
 fn prove_to(s: &lut_gen::Schedule, design: &str, out: &Path, depth: Option<u64>) -> Proof {
     let mut o = ProveOptions::new(out);
@@ -93,10 +110,7 @@ fn pin_select_mix_proves_for_every_sequence_of_requests() {
     }
     let s = schedule("testkit/mixes/modes-pin.toml");
     let dir = tempfile::tempdir().unwrap();
-    let p = prove(&s, &emitted(&s), dir.path());
-    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
-    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
-    assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
+    proved_whole(&s, dir.path());
 }
 
 /// A pin-select mix with a UART proves the whole contract, the link's
@@ -110,10 +124,7 @@ fn a_pin_mode_mix_with_a_uart_proves_its_packets_and_a_mode_field_swap_fails() {
     }
     let s = schedule("formal/tests/data/modes-pin-uart.toml");
     let dir = tempfile::tempdir().unwrap();
-    let p = prove(&s, &emitted(&s), dir.path());
-    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
-    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
-    assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
+    let p = proved_whole(&s, dir.path());
     assert!(p.note.contains("split on the mode requests"), "{}", p.note);
     let swapped = edit(
         &emitted(&s),
@@ -141,12 +152,7 @@ fn a_glove_mix_proves_its_links_bytes_for_all_time() {
     }
     let s = schedule("formal/tests/data/glove-pin-small.toml");
     let dir = tempfile::tempdir().unwrap();
-    let p = prove(&s, &emitted(&s), dir.path());
-    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
-    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
-    for q in &p.properties {
-        assert_eq!(q.result, Outcome::Proved, "{}: {}", q.name, p.summary());
-    }
+    let p = proved_whole(&s, dir.path());
     assert!(p.note.contains("frame counters"), "{}", p.note);
 }
 
@@ -393,13 +399,7 @@ fn an_auto_gateware_with_a_trigger_level_off_by_one_fails_prove() {
 /// link's bytes too, in the run split on the trigger decisions with the
 /// frame counters generalised; nothing left uncovered.
 fn assert_whole_contract_proved_split_on_decisions(p: &Proof) {
-    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
-    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
-    assert!(
-        p.properties.iter().all(|q| q.result == Outcome::Proved),
-        "{}",
-        p.summary()
-    );
+    assert_whole(p);
     for how in [
         "split on auto select's decisions",
         "frame counter generalised",

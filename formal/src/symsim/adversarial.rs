@@ -617,6 +617,16 @@ fn random_next(rng: &mut Rng, b: &mut B, pool: &[u32], latches: &[u32]) {
     }
 }
 
+/// The design's bad state: a conjunction of `n` random (possibly inverted)
+/// literals of `pool`, never its constant.
+fn random_bad(rng: &mut Rng, b: &mut B, pool: &[u32], n: u64) {
+    let lits: Vec<u32> = (0..n)
+        .map(|_| pool[1 + rng.below(pool.len() as u64 - 1) as usize] ^ rng.below(2) as u32)
+        .collect();
+    let bad = b.all(&lits);
+    b.bad.push(bad);
+}
+
 fn random_design(rng: &mut Rng, free: bool) -> Aig {
     let mut b = B::default();
     let ni = rng.below(3);
@@ -639,11 +649,7 @@ fn random_design(rng: &mut Rng, free: bool) -> Aig {
     random_gates(rng, &mut b, &mut pool);
     random_next(rng, &mut b, &pool, &latches);
     // bad: a conjunction of three, so that it is often unreachable
-    let lits: Vec<u32> = (0..3)
-        .map(|_| pool[1 + rng.below(pool.len() as u64 - 1) as usize] ^ rng.below(2) as u32)
-        .collect();
-    let bad = b.all(&lits);
-    b.bad.push(bad);
+    random_bad(rng, &mut b, &pool, 3);
     b.aig()
 }
 
@@ -888,11 +894,7 @@ fn holding_design(rng: &mut Rng) -> Aig {
     pool.extend(&latches);
     random_gates(rng, &mut b, &mut pool);
     random_next(rng, &mut b, &pool, &latches);
-    let lits: Vec<u32> = (0..3)
-        .map(|_| pool[1 + rng.below(pool.len() as u64 - 1) as usize] ^ rng.below(2) as u32)
-        .collect();
-    let bad = b.all(&lits);
-    b.bad.push(bad);
+    random_bad(rng, &mut b, &pool, 3);
     b.aig()
 }
 
@@ -1319,11 +1321,8 @@ fn random_counter_design(rng: &mut Rng) -> (Aig, Vec<(usize, usize)>) {
         .collect();
     random_gates(rng, &mut b, &mut pool);
     random_next(rng, &mut b, &pool, &others);
-    let lits: Vec<u32> = (0..1 + rng.below(3))
-        .map(|_| pool[1 + rng.below(pool.len() as u64 - 1) as usize] ^ rng.below(2) as u32)
-        .collect();
-    let bad = b.all(&lits);
-    b.bad.push(bad);
+    let n_bad = 1 + rng.below(3);
+    random_bad(rng, &mut b, &pool, n_bad);
     let g = b.aig();
     let index = |l: u32| g.latches.iter().position(|x| x.0 == l).unwrap();
     let pairs = (0..n).map(|i| (index(d[i]), index(h[i]))).collect();
