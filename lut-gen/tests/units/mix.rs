@@ -1,4 +1,5 @@
-use lut_gen::{parse, MixError};
+use super::{err, line_of};
+use lut_gen::parse;
 use std::path::Path;
 
 const GOOD: &str = r#"
@@ -18,10 +19,6 @@ branch = "a"
 rate_hz = 1_000
 bandwidth_hz = 400
 "#;
-
-fn err(text: &str) -> MixError {
-    parse(Path::new("m.toml"), text).unwrap_err()
-}
 
 #[test]
 fn messages_use_the_mix_format_words_not_rust_types() {
@@ -224,9 +221,6 @@ fn declared_parts_are_validated() {
 }
 
 /// The line of the first occurrence of `needle` in `text` (1-based).
-fn line_of(text: &str, needle: &str) -> usize {
-    text[..text.find(needle).unwrap()].lines().count() + 1
-}
 
 #[test]
 fn converters_with_a_command_word_use_their_own_mux() {

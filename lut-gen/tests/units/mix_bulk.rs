@@ -4,6 +4,7 @@
 
 use proptest::prelude::*;
 
+use super::{err, line_of};
 use lut_gen::{parse, Mix, MixError};
 use std::path::Path;
 
@@ -40,17 +41,8 @@ fn table(name: &str, branch: &str, input: Option<i64>, member: Option<i64>) -> S
 /// A four-part chain without a mux, declared after the channels that use it.
 const CHAIN: &str = "[[branch]]\nname = \"chain\"\nadc = \"ad7685\"\nmux = \"none\"\nchain = 4\n";
 
-/// The 1-based line of `needle`'s first occurrence.
-fn line_of(text: &str, needle: &str) -> usize {
-    text[..text.find(needle).expect(needle)].lines().count() + 1
-}
-
 fn parsed(text: &str) -> Result<Mix, MixError> {
     parse(Path::new("m.toml"), text)
-}
-
-fn err(text: &str) -> MixError {
-    parsed(text).unwrap_err()
 }
 
 #[test]

@@ -3,8 +3,9 @@
 
 use std::path::Path;
 
+use super::{err, line_of};
+use lut_gen::parse;
 use lut_gen::synthesize;
-use lut_gen::{parse, MixError};
 
 const AD: &str = r#"
 name = "t"
@@ -32,14 +33,6 @@ branch = "a"
 rate_hz = 2_000
 input = 1
 "#;
-
-fn err(text: &str) -> MixError {
-    parse(Path::new("m.toml"), text).unwrap_err()
-}
-
-fn line_of(text: &str, needle: &str) -> usize {
-    text[..text.find(needle).unwrap()].lines().count() + 1
-}
 
 /// A bulk block behind a front mux counts its front inputs (the converter
 /// input stays); the schedule's pins address the front input, the words

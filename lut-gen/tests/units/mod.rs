@@ -21,3 +21,13 @@ mod ports_mode;
 mod schedule;
 mod synth;
 mod synth_modes;
+
+/// The mix tests' bad input: `text` parsed as the mix file `m.toml`, its error.
+fn err(text: &str) -> lut_gen::MixError {
+    lut_gen::parse(std::path::Path::new("m.toml"), text).unwrap_err()
+}
+
+/// The line (from 1) of `needle`'s first occurrence in `text`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text[..text.find(needle).expect(needle)].lines().count() + 1
+}
