@@ -31,6 +31,13 @@ pub const MAX_CHOICE_BITS: usize = 6;
 /// depends on them.
 const MAX_OTHER_BITS: usize = 10;
 const MAX_FREE_INIT: usize = 12;
+/// At most this many states in a step's set: a cone that reads the data
+/// (an auto-select mix's FIFO fill depends on the mode, the mode on the
+/// codes, the codes on MISO, enumerated bit by bit) doubles its set every
+/// few steps and is not the control machine this search is for; past the
+/// bound it gives no verdict (symbolic simulation's turn).  Measured: an
+/// AXI4-Stream mix with auto select grew to 6.4 GB in 300 s before.
+const MAX_STATES: usize = 1 << 16;
 
 /// Searches `g` (a cone) from power-on, every input in `choices`
 /// enumerated at every step; `None` if the cone has too many choice bits
@@ -80,32 +87,73 @@ pub(super) fn run(g: &Aig, choices: &[usize], lim: &Limits) -> Option<Found> {
             return Some(Found::Bounded { steps: step });
         }
         let (next, bad) = m.step(&set)?;
+        history.push(step, &set);
         if let Some((state, combo)) = bad {
-            history.push(&set.parents);
             return Some(m.witness(&history, step, state, combo, &free));
         }
-        history.push(&set.parents);
+        if next.len() > MAX_STATES {
+            return None;
+        }
         set = next;
     }
     Some(Found::Bounded { steps: max_steps })
 }
 
 /// How each state of each step was first reached: (predecessor in the
-/// step before, input code), all steps in one list.
+/// step before, input code).  Kept whole only for the steps since the last
+/// mark; at every `MARK_EVERY`-th step the set itself is kept instead, and
+/// a witness re-runs the steps between two marks (the search is
+/// deterministic: the same set gives the same successors in the same
+/// order).  Why: one (u32, u32) per state per step grew by gigabytes over a
+/// long frame of an AXI4-Stream mix with modes, and the process was killed.
 #[derive(Default)]
 struct History {
-    parents: Vec<(u32, u32)>,
-    starts: Vec<usize>,
+    /// The set at steps 0, MARK_EVERY, 2 * MARK_EVERY, ...
+    marks: Vec<Snapshot>,
+    /// Per step after the last mark: its states' (predecessor, code).
+    recent: Vec<Vec<(u32, u32)>>,
 }
 
+/// A step's set of states, flat, and how each was first reached.
+struct Snapshot {
+    flat: Vec<u64>,
+    parents: Vec<(u32, u32)>,
+}
+
+/// Steps between two kept sets (see [`History`]).
+#[cfg(not(test))]
+const MARK_EVERY: u64 = 1024;
+/// In the unit tests a mark every 3 steps: the random designs' witnesses
+/// (checked against an explicit search and replayed) then cross marks.
+#[cfg(test)]
+const MARK_EVERY: u64 = 3;
+
 impl History {
-    fn push(&mut self, step: &[(u32, u32)]) {
-        self.starts.push(self.parents.len());
-        self.parents.extend_from_slice(step);
+    fn push(&mut self, step: u64, set: &States) {
+        if step.is_multiple_of(MARK_EVERY) {
+            self.recent.clear();
+            self.marks.push(Snapshot {
+                flat: set.flat.clone(),
+                parents: set.parents.clone(),
+            });
+        } else {
+            self.recent.push(set.parents.clone());
+        }
     }
 
-    fn get(&self, step: usize, state: u32) -> (u32, u32) {
-        self.parents[self.starts[step] + state as usize]
+    /// Per step from `from` (a mark) to the step before the next mark: its
+    /// states' (predecessor, code), by running the search again.
+    fn replay(&self, m: &mut Machine, from: u64) -> Vec<Vec<(u32, u32)>> {
+        let mark = &self.marks[(from / MARK_EVERY) as usize];
+        let mut set = States::of(m.words, mark.flat.clone(), mark.parents.clone());
+        let mut steps = vec![mark.parents.clone()];
+        for _ in 1..MARK_EVERY {
+            // the same steps ran without a violation before
+            let (next, _) = m.step(&set).expect("a step that ran once runs again");
+            steps.push(next.parents.clone());
+            set = next;
+        }
+        steps
     }
 }
 
@@ -125,6 +173,16 @@ impl States {
             flat: Vec::new(),
             index: HashMap::new(),
             parents: Vec::new(),
+        }
+    }
+
+    /// A set kept as a snapshot, for stepping (not for inserting).
+    fn of(words: usize, flat: Vec<u64>, parents: Vec<(u32, u32)>) -> States {
+        States {
+            words,
+            flat,
+            index: HashMap::new(),
+            parents,
         }
     }
 
@@ -299,7 +357,7 @@ impl<'a> Machine<'a> {
     /// `combo` (inputs outside the choices are 0; `inputs[0]` goes on with
     /// each latch's power-on value).
     fn witness(
-        &self,
+        &mut self,
         history: &History,
         step: u64,
         state: u32,
@@ -308,22 +366,33 @@ impl<'a> Machine<'a> {
     ) -> Found {
         let ni = self.g.inputs.len();
         let mut inputs = vec![vec![false; ni]; step as usize + 1];
-        let nc = self.choices.len();
-        let input_of = |v: u32| self.g.inputs.iter().position(|&l| l >> 1 == v);
+        // each choice bit's input, then each other input's
+        let bits: Vec<Option<usize>> = (self.choices.iter().map(|&i| Some(i)))
+            .chain((self.others.iter()).map(|&v| self.g.inputs.iter().position(|&l| l >> 1 == v)))
+            .collect();
         let set_choice = |row: &mut Vec<bool>, c: u32| {
-            for (b, &i) in self.choices.iter().enumerate() {
-                row[i] = c >> b & 1 == 1;
-            }
-            for (b, &v) in self.others.iter().enumerate() {
-                if let Some(i) = input_of(v) {
-                    row[i] = c >> (nc + b) & 1 == 1;
+            for (b, i) in bits.iter().enumerate() {
+                if let Some(i) = *i {
+                    row[i] = c >> b & 1 == 1;
                 }
             }
         };
         set_choice(&mut inputs[step as usize], combo);
         let mut at = state;
-        for s in (0..=step as usize).rev() {
-            let (from, c) = history.get(s, at);
+        let mark = step - step % MARK_EVERY;
+        // the steps since the last mark, then each stretch between two
+        // marks run again, back to power-on
+        let mut window: Vec<Vec<(u32, u32)>> = Vec::new();
+        for s in (0..=step).rev() {
+            let (base, i) = (s - s % MARK_EVERY, (s % MARK_EVERY) as usize);
+            if s < mark && i as u64 == MARK_EVERY - 1 {
+                window = history.replay(self, base);
+            }
+            let (from, c) = match (s >= mark, i) {
+                (_, 0) => history.marks[(base / MARK_EVERY) as usize].parents[at as usize],
+                (true, i) => history.recent[i - 1][at as usize],
+                (false, i) => window[i][at as usize],
+            };
             if s == 0 {
                 // a power-on state: `c` is the free latches' values
                 inputs[0].resize(ni + self.g.latches.len(), false);
@@ -332,7 +401,7 @@ impl<'a> Machine<'a> {
                 }
                 break;
             }
-            set_choice(&mut inputs[s - 1], c);
+            set_choice(&mut inputs[s as usize - 1], c);
             at = from;
         }
         Found::Violated { step, inputs }

@@ -174,53 +174,58 @@ pub fn prove(
         parts: [symbolic.len(), inductive.len(), explicit.len()],
         ..SymStats::default()
     };
-    let mut results = Vec::new();
     let whole = Limits {
         period,
         offset,
         max_steps,
         deadline,
     };
-    // the base case of 2-induction: no violation in the first steps
-    for (parts, how) in [(inductive, 1), (explicit, 2), (symbolic, 0)] {
-        if parts.is_empty() {
-            continue;
-        }
-        let c = cone::cone(&g, &parts);
-        let sub = cone::restrict(&g, &parts, &c);
-        let lim = Limits {
-            max_steps: if how == 1 { offset + 2 } else { max_steps },
-            ..whole
-        };
-        let (found, st) = match how {
-            2 => match explicit::run(&sub, choices, &lim) {
-                Some(f) => (f, SymStats::default()),
-                None => {
-                    // too many inputs to enumerate: simulated symbolically
-                    stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
-                    Sim::split_on(&sub, splits).with_cases(cases).run(&lim)
-                }
-            },
-            _ => Sim::split_on(&sub, splits).with_cases(cases).run(&lim),
-        };
-        let found = lift(found, &c.latches, g.inputs.len(), g.latches.len());
+    let mut results = Vec::new();
+    let (ni, nl) = (g.inputs.len(), g.latches.len());
+    // the parts on their cone, symbolically simulated within `max_steps`
+    let simulate = |parts: &[u32], max_steps: u64| {
+        let c = cone::cone(&g, parts);
+        let sub = cone::restrict(&g, parts, &c);
+        let lim = Limits { max_steps, ..whole };
+        let (found, st) = Sim::split_on(&sub, splits).with_cases(cases).run(&lim);
+        (lift(found, &c.latches, ni, nl), st, c)
+    };
+    if !inductive.is_empty() {
+        // the base case of 2-induction, a bounded search: it holds if it
+        // found no violation in the first steps
+        let (found, st, _) = simulate(&inductive, offset + 2);
         stats.sat_calls += st.sat_calls;
-        stats.peak_nodes = stats.peak_nodes.max(st.peak_nodes);
-        if how == 0 {
-            stats.state_nodes = st.state_nodes;
-            stats.branches = st.branches;
-            stats.cases = st.cases;
-            stats.kept = st.kept.iter().map(|&j| c.latches[j]).collect();
-        }
-        // the inductive parts' base case is a bounded search: it holds if
-        // it found no violation
-        let found = match (how, found) {
-            (1, Found::Bounded { steps }) if steps >= 2 => Found::Proved {
+        results.push(match found {
+            Found::Bounded { steps } if steps >= 2 => Found::Proved {
                 steps: offset + 2,
                 since: offset,
             },
-            (_, f) => f,
-        };
+            f => f,
+        });
+    }
+    if !explicit.is_empty() {
+        let c = cone::cone(&g, &explicit);
+        let sub = cone::restrict(&g, &explicit, &c);
+        match explicit::run(&sub, choices, &whole) {
+            Some(f) => results.push(lift(f, &c.latches, ni, nl)),
+            None => {
+                // too many inputs or states to enumerate: simulated with
+                // the symbolic parts, in one run that has the whole time
+                // limit (a run of its own took it all, and the other's
+                // bound was 0 steps)
+                stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
+                symbolic.extend(explicit);
+            }
+        }
+    }
+    if !symbolic.is_empty() {
+        let (found, st, c) = simulate(&symbolic, max_steps);
+        stats.sat_calls += st.sat_calls;
+        stats.peak_nodes = stats.peak_nodes.max(st.peak_nodes);
+        stats.state_nodes = st.state_nodes;
+        stats.branches = st.branches;
+        stats.cases = st.cases;
+        stats.kept = st.kept.iter().map(|&j| c.latches[j]).collect();
         results.push(found);
     }
     (combine(results), stats)
