@@ -102,7 +102,11 @@ fn choice_shift(n: u32) -> Aig {
         let next = if k == 0 { 2 } else { latch(k - 1) };
         t.push_str(&format!("{} {next} 0\n", latch(k)));
     }
-    t.push_str(&format!("{gate}\n{gate} {} {}\n", latch(n - 1), latch(n - 2)));
+    t.push_str(&format!(
+        "{gate}\n{gate} {} {}\n",
+        latch(n - 1),
+        latch(n - 2)
+    ));
     parse(&t).unwrap()
 }
 

@@ -1,5 +1,5 @@
 use campaign::for_tests::{decode_commands, sigrok_check as check, window_conversions, SpiCapture};
-use judge::{run_dut, Dut, FaultyDut, ModelDut, PinFault, RunOptions};
+use judge::{run_dut, Dut, FaultyDut, ModeRequests, ModelDut, PinFault, RunOptions};
 use lut_gen::Schedule;
 
 fn capture(s: &Schedule, dut: &mut dyn Dut, frames: u64) -> SpiCapture {
@@ -52,4 +52,47 @@ fn sigrok_reads_the_command_words_on_mosi() {
         let e = check(&s, &cap, frames, dir.path()).unwrap().unwrap_err();
         assert!(e.contains("command word"), "{name}: {e}");
     }
+}
+
+/// sigrok's detector counts each frame's conversions, and reads its
+/// command words, in the mode that frame ran in: a clean run of a mode mix
+/// whose MCP3208 converts more often in one mode passes once it switches,
+/// and its command words are each frame's mode's (judged against the
+/// schedule of one mode for every frame, the count would differ).
+#[test]
+fn sigrok_judges_each_frame_in_the_mode_it_ran_in() {
+    if !testkit::tools::require_tool("sigrok-cli") {
+        return;
+    }
+    let s = lut_gen::synthesize(&lut_gen::load(&testkit::mix("cmd-modes")).unwrap()).unwrap();
+    let frames = 4;
+    // requested from frame 0, mode 1 runs from frame 2: frame 1 in mode 0
+    let mut dut = ModeRequests::new(&s, ModelDut::new(&s), &[(0, 1)]);
+    let cap = capture(&s, &mut dut, frames);
+    assert_eq!(
+        &cap.modes()[1..frames as usize],
+        &[0, 1, 1],
+        "the run switches"
+    );
+    let b = (0..s.branches.len()).find(|&b| s.has_command(b)).unwrap();
+    let per_mode: Vec<usize> = (0..2)
+        .map(|m| s.modes[m].commands_in_frame(b).len())
+        .collect();
+    assert_ne!(
+        per_mode[0], per_mode[1],
+        "the modes convert as often: the test cannot fail"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    assert_eq!(check(&s, &cap, frames, dir.path()).unwrap(), Ok(()));
+    let got = decode_commands(
+        &dir.path().join(format!("b{b}.vcd")),
+        &s.mix.branches[b].adc,
+    )
+    .unwrap();
+    let want: Vec<Vec<bool>> = window_conversions(&s, cap.modes(), b, frames, 0)
+        .iter()
+        .map(|&(m, k, _)| m.commands_in_frame(b)[k].word.clone())
+        .collect();
+    assert_eq!(got.len(), per_mode[0] + 2 * per_mode[1], "{per_mode:?}");
+    assert_eq!(got, want);
 }
