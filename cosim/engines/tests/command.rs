@@ -190,6 +190,8 @@ pub(crate) struct BesideModel {
     pub(crate) samples: u64,
     pub(crate) mosi: u64,
     pub(crate) diff: Option<String>,
+    /// Each sample the gateware emitted: (channel, value).
+    pub(crate) emitted: Vec<(u16, u16)>,
 }
 
 impl BesideModel {
@@ -201,6 +203,7 @@ impl BesideModel {
             samples: 0,
             mosi: 0,
             diff: None,
+            emitted: Vec::new(),
         }
     }
 
@@ -215,6 +218,9 @@ impl BesideModel {
         self.miso = miso;
         self.cycles += 1;
         self.samples += (!rst && pins.sample_valid) as u64;
+        if !rst && pins.sample_valid {
+            self.emitted.push((pins.sample_channel, pins.sample_value));
+        }
         self.mosi += (pins.mosi != 0) as u64;
     }
 }
@@ -293,7 +299,52 @@ fn icarus_converts_what_the_words_select(every: bool) {
         }
         assert!(beside.cycles >= 2 * s.grid.frame_cycles, "{what}: cycles");
         assert!(beside.mosi > 0 && beside.samples > 0, "{what}");
+        // the model beside was fed the testbench's MISO, so it agrees with
+        // any part model: the codes themselves are compared with the
+        // judge's own converters' (each input's code per slot), which
+        // convert the input each word selected
+        let want = judged_samples(&s, stimulus, 2);
+        let n = beside.emitted.len().min(want.len());
+        assert!(
+            n > 0 && n + 8 >= want.len(),
+            "{what}: {n} of {}",
+            want.len()
+        );
+        if let Some(k) = (0..n).find(|&k| beside.emitted[k] != want[k]) {
+            panic!(
+                "{what}: sample {k}: the testbench's converter gave (channel, code) {:?}, the judge's {:?}",
+                beside.emitted[k], want[k]
+            );
+        }
     }
+}
+
+/// The samples (channel, code) of the cycle model run `frames` frames
+/// with the judge's converter models under `stimulus`.
+fn judged_samples(s: &Schedule, stimulus: Stimulus, frames: u64) -> Vec<(u16, u16)> {
+    struct Emitted(Vec<(u16, u16)>);
+    impl judge::Observer for Emitted {
+        fn cycle(&mut self, _: u64, rst: bool, pins: &Pins, _: u64) {
+            if !rst && pins.sample_valid {
+                self.0.push((pins.sample_channel, pins.sample_value));
+            }
+        }
+    }
+    let mut out = Emitted(Vec::new());
+    let opts = judge::RunOptions {
+        stimulus,
+        ..Default::default()
+    };
+    let v = judge::run_dut(
+        s,
+        &mut ModelDut::new(s),
+        frames,
+        &opts,
+        "model",
+        Some(&mut out),
+    );
+    assert!(v.ok, "{}", v.mix);
+    out.0
 }
 
 /// Runs the Icarus testbench (`engines::icarus_testbench`, the back end's

@@ -382,7 +382,10 @@ impl Adc {
         for (b, pm) in parts.iter_mut().enumerate() {
             pm.after = s.branches[b].spi.sample_cycles;
             pm.inputs = layout.lookup[b].clone();
-            if s.mix.branches[b].fronted {
+            // a part that selects by its word has its inputs by the mix's
+            // `input`: the mux layout's table stops at 8 per device, and a
+            // 16-input part's inputs 8 to 15 converted no channel's code
+            if s.mix.branches[b].fronted || pm.command.is_some() {
                 (pm.inputs, pm.front) = Self::fronted_inputs(s, b);
             }
         }
