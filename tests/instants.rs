@@ -230,31 +230,40 @@ const EXT: [(&str, &str, bool); 2] = [
 /// inputs, within 1 us (the other part's transaction starts 6.1 us after the
 /// slot tick, so it is); and `check` passes the run with and without the model.
 /// `make test` runs each part on one engine (the AD7940 on Verilator, the
-/// AD7689 on Icarus), `make test-long` the other two pairs.
+/// AD7689 on Icarus at 12 MHz: a quarter of the mix's 48 MHz cycles, whose
+/// Icarus run was half of this test), `make test-long` the other two pairs
+/// and the AD7689 on Icarus at 48 MHz.
 #[test]
 fn a_sync_group_holds_at_one_instant_on_verilator_and_icarus() {
     if !tools::require_tool("verilator") || !tools::require_tool("iverilog") {
         return;
     }
-    group_holds_at_one_instant(EXT[0], "verilator");
-    group_holds_at_one_instant(EXT[1], "icarus");
+    group_holds_at_one_instant(EXT[0], "verilator", GROUPED_HZ);
+    group_holds_at_one_instant(EXT[1], "icarus", "12_000_000");
 }
 
 #[test]
-#[ignore = "long: make test-long (the AD7940 on Icarus, the AD7689 on Verilator)"]
+#[ignore = "long: make test-long (the AD7940 on Icarus, the AD7689 on Verilator, and on Icarus at 48 MHz)"]
 fn a_sync_group_holds_at_one_instant_on_the_other_engine_too() {
     if !tools::require_tool("verilator") || !tools::require_tool("iverilog") {
         return;
     }
-    group_holds_at_one_instant(EXT[0], "icarus");
-    group_holds_at_one_instant(EXT[1], "verilator");
+    group_holds_at_one_instant(EXT[0], "icarus", GROUPED_HZ);
+    group_holds_at_one_instant(EXT[1], "verilator", GROUPED_HZ);
+    group_holds_at_one_instant(EXT[1], "icarus", GROUPED_HZ);
 }
 
-/// The group of the MCP3208 and `part` holds at one instant on `backend`.
-fn group_holds_at_one_instant((part, ext, cnv): (&str, &str, bool), backend: &str) {
+/// The clock of [`grouped`] (cmd-mcp3208's).
+const GROUPED_HZ: &str = "48_000_000";
+
+/// The group of the MCP3208 and `part` holds at one instant on `backend`,
+/// the mix clocked at `hz`.
+fn group_holds_at_one_instant((part, ext, cnv): (&str, &str, bool), backend: &str, hz: &str) {
     const US: u64 = 1_000_000; // ps
     let dir = tempfile::tempdir().unwrap();
-    let text = grouped().replace(EXT[0].1, ext);
+    let clock = format!("hz = {GROUPED_HZ}");
+    assert!(grouped().contains(&clock));
+    let text = (grouped().replace(EXT[0].1, ext)).replace(&clock, &format!("hz = {hz}"));
     let m = dir.path().join(format!("{part}.toml"));
     std::fs::write(&m, &text).unwrap();
     let (w, samples) = run_on(&m, 2, dir.path(), backend);

@@ -10,7 +10,8 @@
 //! the wide draw `prove` proves, or says what it left out.
 //!
 //! A quick draw (the first two points of the pairwise cover) runs in
-//! `make test`; its next two, the whole cover and free draws in `make
+//! `make test`, its campaign judged without sigrok's decodes; the first
+//! four points with sigrok, the whole cover and free draws in `make
 //! test-long`.
 
 use std::path::Path;
@@ -19,8 +20,13 @@ use std::process::{Command, Output};
 use testkit::matrix::{self, Modes, Point};
 
 fn slotforge(args: &[&dyn AsRef<std::ffi::OsStr>]) -> Output {
+    slotforge_with(args, &[])
+}
+
+fn slotforge_with(args: &[&dyn AsRef<std::ffi::OsStr>], env: &[(&str, &str)]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_slotforge"))
         .args(args.iter().map(|a| a.as_ref()))
+        .envs(env.iter().copied())
         .output()
         .unwrap()
 }
@@ -31,7 +37,17 @@ struct Faults(Vec<String>);
 impl Faults {
     /// Runs `args`; a non-zero exit is a failure named `what`.
     fn run(&mut self, what: &str, args: &[&dyn AsRef<std::ffi::OsStr>]) -> Option<Output> {
-        let out = slotforge(args);
+        self.run_with(what, args, &[])
+    }
+
+    /// [`Faults::run`] with the environment variables `env`.
+    fn run_with(
+        &mut self,
+        what: &str,
+        args: &[&dyn AsRef<std::ffi::OsStr>],
+        env: &[(&str, &str)],
+    ) -> Option<Output> {
+        let out = slotforge_with(args, env);
         if out.status.success() {
             return Some(out);
         }
@@ -117,10 +133,20 @@ fn refused_crossings() -> Vec<String> {
     said
 }
 
-/// One mix through every feature; `wide`: also Icarus and `prove`.
-/// `Ok(false)` when the audit refused it (with a reason), `Err` with every
-/// failure otherwise.
-fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
+/// How far a mix goes: `Quick` judges its fault campaign without sigrok's
+/// decodes (its injections' decodes were a third of the quick draw's
+/// time), `Full` with them, `Wide` also runs Icarus and `prove`.
+#[derive(Clone, Copy, PartialEq)]
+enum Depth {
+    Quick,
+    Full,
+    Wide,
+}
+
+/// One mix through every feature to `depth`.  `Ok(false)` when the audit
+/// refused it (with a reason), `Err` with every failure otherwise.
+fn through(p: &Point, seed: u64, depth: Depth) -> Result<bool, String> {
+    let wide = depth == Depth::Wide;
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let text = matrix::mix(p, seed);
@@ -197,9 +223,10 @@ fn through(p: &Point, seed: u64, wide: bool) -> Result<bool, String> {
             f.0.extend(report_as_audited(&out));
         }
     }
-    f.run(
+    f.run_with(
         "faults (its clean run of this mix)",
         &[&"faults", &mix, &"--quiet", &"--false-alarm-mixes", &"1"],
+        &[("SLOTFORGE_TEST_DISABLE_DETECTOR", sigrok_off(depth))],
     );
     if wide {
         prove(&mut f, &mix, &d.join("prove"));
@@ -387,12 +414,21 @@ fn prove(f: &mut Faults, mix: &Path, dir: &Path) {
     }
 }
 
+/// The detectors the campaign of a mix goes without at `depth` (the
+/// test-only switch, judge/src/switch.rs).
+fn sigrok_off(depth: Depth) -> &'static str {
+    match depth {
+        Depth::Quick => "sigrok",
+        Depth::Full | Depth::Wide => "",
+    }
+}
+
 /// Runs `points` (seeded by their index) and fails with every broken one;
 /// at most a third may be refused, so the matrix keeps its meaning.
-fn draw(points: &[Point], seed0: u64, wide: bool) {
+fn draw(points: &[Point], seed0: u64, depth: Depth) {
     let (mut refused, mut bad) = (0, vec![]);
     for (i, p) in points.iter().enumerate() {
-        match through(p, seed0 + i as u64, wide) {
+        match through(p, seed0 + i as u64, depth) {
             Ok(true) => {}
             Ok(false) => refused += 1,
             Err(e) => bad.push(e),
@@ -412,19 +448,21 @@ fn draw(points: &[Point], seed0: u64, wide: bool) {
     );
 }
 
-/// The quick draw: the first points of the pairwise cover (each about 9 s
-/// of CPU through every command); its next two points are `make
-/// test-long`'s, as the whole cover is.
+/// The quick draw: the first points of the pairwise cover (each about 6 s
+/// of CPU through every command), their campaigns without sigrok; these
+/// two with sigrok and the next two points are `make test-long`'s, as the
+/// whole cover is.
 #[test]
 fn a_quick_draw_of_the_feature_matrix_passes_end_to_end() {
-    draw(&matrix::pairwise(1)[..2], 1, false);
+    draw(&matrix::pairwise(1)[..2], 1, Depth::Quick);
 }
 
-/// The quick draw's third and fourth points, seeded as in a draw of four.
+/// The quick draw's points with sigrok judging their campaigns, and the
+/// next two points, seeded as in a draw of four.
 #[test]
-#[ignore = "long: make test-long (the quick draw's next two points)"]
+#[ignore = "long: make test-long (the quick draw with sigrok, and its next two points)"]
 fn the_quick_draws_next_points_pass_end_to_end() {
-    draw(&matrix::pairwise(1)[2..4], 3, false);
+    draw(&matrix::pairwise(1)[..4], 1, Depth::Full);
 }
 
 /// The cover's mixes with a fronted AD7689 in a mix with modes (the audit
@@ -446,7 +484,11 @@ fn the_covers_fronted_converters_with_modes_pass_end_to_end() {
         fronted.len()
     );
     for (seed, p) in fronted {
-        assert_eq!(through(p, seed, false), Ok(true), "matrix-{seed}: {p:?}");
+        assert_eq!(
+            through(p, seed, Depth::Full),
+            Ok(true),
+            "matrix-{seed}: {p:?}"
+        );
     }
 }
 
@@ -457,7 +499,7 @@ fn wide_part(k: usize) {
     pts.extend(matrix::random(2, 12));
     let n = pts.len().div_ceil(5);
     let part: Vec<Point> = pts.iter().skip(k * n).take(n).cloned().collect();
-    draw(&part, 100 + (k * n) as u64, true);
+    draw(&part, 100 + (k * n) as u64, Depth::Wide);
 }
 
 #[test]

@@ -140,76 +140,109 @@ impl PartDecoder {
     }
 }
 
-/// The branch's lanes as a VCD sigrok reads (1-bit signals `cs`, `sclk`,
-/// `miso`, `mosi`).
-fn vcd(changes: &[(u64, u8)], end: u64) -> String {
-    let mut out = judge::wire_header("1 ns", "top", &["cs", "sclk", "miso", "mosi"]);
-    let mut prev: Option<u8> = None;
-    for &(t, v) in changes {
-        let _ = writeln!(out, "#{t}");
-        for (k, id) in ['!', '"', '#', '$'].iter().enumerate() {
+/// Which lane of a branch a decoder reads: `miso` (the samples) or `mosi`
+/// (the command words).
+#[derive(Clone, Copy, PartialEq)]
+enum Wire {
+    Miso,
+    Mosi,
+}
+
+/// Every branch's lanes as one VCD sigrok reads: `cs{b}`, `sclk{b}`,
+/// `miso{b}` and `mosi{b}` for branch `b`, each 1 bit.
+fn vcd(cap: &SpiCapture) -> String {
+    const LANES: [&str; 4] = ["cs", "sclk", "miso", "mosi"];
+    let nb = cap.changes.len();
+    let names: Vec<String> = (0..nb)
+        .flat_map(|b| LANES.map(|l| format!("{l}{b}")))
+        .collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut out = judge::wire_header("1 ns", "top", &names);
+    // every branch's changes in time order (a VCD's times only increase)
+    let mut changes: Vec<(u64, usize, u8)> = (cap.changes.iter().enumerate())
+        .flat_map(|(b, c)| c.iter().map(move |&(t, v)| (t, b, v)))
+        .collect();
+    changes.sort_unstable_by_key(|&(t, b, _)| (t, b));
+    let mut prev: Vec<Option<u8>> = vec![None; nb];
+    let mut now = None;
+    for (t, b, v) in changes {
+        if now != Some(t) {
+            let _ = writeln!(out, "#{t}");
+            now = Some(t);
+        }
+        for k in 0..LANES.len() {
             let bit = v >> k & 1;
-            if prev.map(|p| p >> k & 1) != Some(bit) {
-                let _ = writeln!(out, "{bit}{id}");
+            if prev[b].map(|p| p >> k & 1) != Some(bit) {
+                let _ = writeln!(out, "{bit}{}", judge::id_code(LANES.len() * b + k));
             }
         }
-        prev = Some(v);
+        prev[b] = Some(v);
     }
-    let _ = writeln!(out, "#{end}");
+    let _ = writeln!(out, "#{}", cap.end);
     out
 }
 
-/// The codes sigrok decodes from one branch's VCD.
-fn decode(file: &Path, part: &AdcPart) -> Result<Vec<u16>, String> {
+/// The codes in the words sigrok decoded from a branch's `miso`.
+fn codes(words: &[u32], part: &AdcPart) -> Vec<u16> {
     let d = PartDecoder::of(part);
-    let words = words(file, &d, "miso")?;
-    Ok(words
-        .into_iter()
-        .map(|w| (w >> d.shift) as u16 & d.mask)
-        .collect())
+    (words.iter())
+        .map(|&w| (w >> d.shift) as u16 & d.mask)
+        .collect()
 }
 
-/// The command words sigrok decodes from one branch's `mosi` lane, first
-/// bit first (the word's bits are the top of each SPI word).
-pub fn decode_commands(file: &Path, part: &AdcPart) -> Result<Vec<Vec<bool>>, String> {
+/// The command words in the words sigrok decoded from a branch's `mosi`,
+/// first bit first (the word's bits are the top of each SPI word).
+fn command_bits(words: &[u32], part: &AdcPart) -> Vec<Vec<bool>> {
     let d = PartDecoder::of(part);
     let n = part.command.as_ref().map_or(0, |c| c.bits.len() as u32);
-    let words = words(file, &d, "mosi")?;
-    Ok(words
-        .into_iter()
-        .map(|w| (0..n).map(|i| w >> (d.wordsize - 1 - i) & 1 == 1).collect())
-        .collect())
+    (words.iter())
+        .map(|&w| (0..n).map(|i| w >> (d.wordsize - 1 - i) & 1 == 1).collect())
+        .collect()
 }
 
-/// The words sigrok-cli's SPI decoder reads on `lane` (`miso` or `mosi`).
-fn words(file: &Path, d: &PartDecoder, lane: &str) -> Result<Vec<u32>, String> {
-    let dec = format!(
-        "spi:clk=sclk:miso=miso:mosi=mosi:cs=cs:{}:wordsize={}",
-        d.options, d.wordsize
-    );
-    let ann = format!("spi={lane}-data");
-    let name = file
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or("spi.vcd");
+/// The command words sigrok decodes from branch `b`'s `mosi` lane of
+/// `file` (the VCD [`check`] writes, `spi.vcd`), first bit first.
+pub fn decode_commands(file: &Path, s: &Schedule, b: usize) -> Result<Vec<Vec<bool>>, String> {
+    let part = &s.mix.branches[b].adc;
+    let words = words(file, &[(b, Wire::Mosi, part)])?;
+    Ok(command_bits(&words[0], part))
+}
+
+/// The words sigrok-cli's SPI decoder reads on each of `lanes` (branch,
+/// wire, part) of `file`, in one run: one decoder instance a lane, each
+/// reading its wire as the decoder's `miso` (instance `k` prints its
+/// words as `spi-{k + 1}: XX`).  A run of sigrok-cli costs its start as
+/// much as a decode: one a lane was most of a campaign's decodes.
+fn words(file: &Path, lanes: &[(usize, Wire, &AdcPart)]) -> Result<Vec<Vec<u32>>, String> {
+    let mut args: Vec<String> = vec!["-I".into(), "vcd".into(), "-i".into()];
+    let name = file.file_name().and_then(|n| n.to_str());
+    args.push(name.unwrap_or("spi.vcd").into());
+    for &(b, wire, part) in lanes {
+        let d = PartDecoder::of(part);
+        let lane = if wire == Wire::Miso { "miso" } else { "mosi" };
+        args.push("-P".into());
+        args.push(format!(
+            "spi:clk=sclk{b}:miso={lane}{b}:cs=cs{b}:{}:wordsize={}",
+            d.options, d.wordsize
+        ));
+    }
+    args.extend(["-A".into(), "spi=miso-data".into()]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let dir = file.parent().unwrap_or(Path::new("."));
-    let out = tools::run(
-        "sigrok-cli",
-        &["-I", "vcd", "-i", name, "-P", &dec, "-A", &ann],
-        dir,
-        Duration::from_secs(120),
-    )
-    .map_err(|e| e.to_string())?;
+    let out = tools::run("sigrok-cli", &args, dir, Duration::from_secs(120))
+        .map_err(|e| e.to_string())?;
     if !out.success {
         return Err(format!("sigrok-cli failed: {}", out.stderr.trim()));
     }
-    out.stdout
-        .lines()
-        .map(|l| {
-            let w = l.rsplit(':').next().unwrap_or("").trim();
-            u32::from_str_radix(w, 16).map_err(|_| format!("sigrok-cli printed `{l}`"))
-        })
-        .collect()
+    let mut words = vec![Vec::new(); lanes.len()];
+    for l in out.stdout.lines() {
+        let bad = || format!("sigrok-cli printed `{l}`");
+        let (who, w) = l.split_once(':').ok_or_else(bad)?;
+        let k: usize = (who.strip_prefix("spi-").and_then(|k| k.parse().ok())).ok_or_else(bad)?;
+        let w = u32::from_str_radix(w.trim(), 16).map_err(|_| bad())?;
+        words.get_mut(k.wrapping_sub(1)).ok_or_else(bad)?.push(w);
+    }
+    Ok(words)
 }
 
 /// Whether sigrok-cli can run here.
@@ -222,21 +255,47 @@ pub fn available() -> Result<(), ToolError> {
 }
 
 /// The detector's verdict on a capture of `frames` frames: `Err` names the
-/// first branch where the decode and the design disagree.
+/// first branch where the decode and the design disagree.  Every branch's
+/// `miso` and every commanded branch's `mosi` are decoded in one run of
+/// sigrok-cli, from `spi.vcd` in `dir`.
 pub fn check(
     s: &Schedule,
     cap: &SpiCapture,
     frames: u64,
     dir: &Path,
 ) -> Result<Result<(), String>, String> {
-    for b in 0..s.branches.len() {
-        let file = dir.join(format!("b{b}.vcd"));
-        std::fs::write(&file, vcd(&cap.changes[b], cap.end)).map_err(|e| e.to_string())?;
-        if let Err(e) = check_branch(s, cap, frames, b, &file)? {
+    let file = dir.join("spi.vcd");
+    std::fs::write(&file, vcd(cap)).map_err(|e| e.to_string())?;
+    let nb = s.branches.len();
+    let part = |b: usize| &s.mix.branches[b].adc;
+    let mut lanes: Vec<(usize, Wire, &AdcPart)> =
+        (0..nb).map(|b| (b, Wire::Miso, part(b))).collect();
+    lanes.extend(
+        (0..nb)
+            .filter(|&b| s.has_command(b))
+            .map(|b| (b, Wire::Mosi, part(b))),
+    );
+    let words = words(&file, &lanes)?;
+    for b in 0..nb {
+        let commands = (lanes.iter().zip(&words))
+            .find(|((l, wire, _), _)| *l == b && *wire == Wire::Mosi)
+            .map(|(_, w)| command_bits(w, part(b)));
+        let decoded = Decoded {
+            codes: codes(&words[b], part(b)),
+            commands,
+        };
+        if let Err(e) = check_branch(s, cap, frames, b, &decoded) {
             return Ok(Err(e));
         }
     }
     Ok(Ok(()))
+}
+
+/// What sigrok decoded of one branch: the codes on `miso`, and the
+/// command words on `mosi` when the branch's part takes them.
+struct Decoded {
+    codes: Vec<u16>,
+    commands: Option<Vec<Vec<bool>>>,
 }
 
 /// Branch `b`'s conversions in the window (frame 1 on) whose read ends
@@ -277,9 +336,8 @@ fn check_branch(
     cap: &SpiCapture,
     frames: u64,
     b: usize,
-    file: &Path,
-) -> Result<Result<(), String>, String> {
-    let part = &s.mix.branches[b].adc;
+    decoded: &Decoded,
+) -> Result<(), String> {
     let name = &s.branches[b].name;
     let slack = s.mix.branches.iter().map(|b| b.chain as u64).sum::<u64>() + 2;
     let count = |margin: u64| -> usize {
@@ -288,18 +346,16 @@ fn check_branch(
             .map(|&(m, _, ch)| m.words_of(ch).count())
             .sum()
     };
-    let words = decode(file, part)?;
+    let words = &decoded.codes;
     if words.len() != count(0) {
-        return Ok(Err(format!(
+        return Err(format!(
             "branch {name}: sigrok decoded {} words, the schedule has {} conversions",
             words.len(),
             count(0)
-        )));
+        ));
     }
-    if s.has_command(b) {
-        if let Err(e) = check_commands(s, &cap.modes, frames, b, file)? {
-            return Ok(Err(e));
-        }
+    if let Some(got) = &decoded.commands {
+        check_commands(s, &cap.modes, frames, b, got)?;
     }
     // The prepared conversions after reset that fall in the window are
     // read on the wire, never emitted.
@@ -316,51 +372,50 @@ fn check_branch(
         .map(|&(_, v)| v)
         .collect();
     if let Some(k) = (0..words.len().min(values.len())).find(|&k| words[k] != values[k]) {
-        return Ok(Err(format!(
+        return Err(format!(
             "branch {name}: word {k}: SPI (sigrok) read {:#06x}, the design emitted {:#06x}",
             words[k], values[k]
-        )));
+        ));
     }
     if values.len() > words.len() || values.len() + prepared < count(slack) {
-        return Ok(Err(format!(
+        return Err(format!(
             "branch {name}: the design emitted {} samples for {} decoded words",
             values.len(),
             words.len()
-        )));
+        ));
     }
-    Ok(Ok(()))
+    Ok(())
 }
 
-/// Branch `b`'s command words as sigrok decodes them from `mosi`, each the
-/// word the schedule sends in that conversion.
+/// Branch `b`'s command words as sigrok decoded them from `mosi` (`got`),
+/// each the word the schedule sends in that conversion.
 fn check_commands(
     s: &Schedule,
     modes: &[u8],
     frames: u64,
     b: usize,
-    file: &Path,
-) -> Result<Result<(), String>, String> {
+    got: &[Vec<bool>],
+) -> Result<(), String> {
     let name = &s.branches[b].name;
-    let got = decode_commands(file, &s.mix.branches[b].adc)?;
     let want: Vec<lut_gen::CommandSent> = window_conversions(s, modes, b, frames, 0)
         .iter()
         .map(|&(m, k, _)| m.commands_in_frame(b)[k].clone())
         .collect();
     let bits = |w: &[bool]| -> String { w.iter().map(|&v| if v { '1' } else { '0' }).collect() };
     if got.len() != want.len() {
-        return Ok(Err(format!(
+        return Err(format!(
             "branch {name}: sigrok decoded {} command words on mosi, the schedule sends {}",
             got.len(),
             want.len()
-        )));
+        ));
     }
     if let Some(k) = (0..got.len()).find(|&k| got[k] != want[k].word) {
-        return Ok(Err(format!(
+        return Err(format!(
             "branch {name}: command word {k}: SPI (sigrok) read {} on mosi, the schedule sends {} (selecting {})",
             bits(&got[k]),
             bits(&want[k].word),
             s.mix.channels[want[k].selects].name
-        )));
+        ));
     }
-    Ok(Ok(()))
+    Ok(())
 }

@@ -2,6 +2,7 @@
 //! per-cycle prediction written from docs/timing.md (not from the gateware).
 #![allow(dead_code)]
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use lut_gen::Pins;
@@ -144,6 +145,20 @@ pub fn data_mix(name: &str) -> Schedule {
     lut_gen::synthesize(&mix).expect("mix is feasible")
 }
 
+/// [`data_mix`] with its clock at `hz` (fewer cycles a frame for the same
+/// channels, slots and tables; the file's `hz = ` line replaced).
+pub fn data_mix_at(name: &str, hz: u64) -> Schedule {
+    let path = root().join(format!("hdl/tests/data/{name}.toml"));
+    let text = std::fs::read_to_string(&path).expect("mix reads");
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("hz = "))
+        .expect("a clock");
+    let text = text.replace(line, &format!("hz = {hz}"));
+    let mix = lut_gen::parse(&path, &text).expect("mix parses");
+    lut_gen::synthesize(&mix).expect("mix is feasible")
+}
+
 /// Behavioural AD7940 (datasheet timing in cycles): the input is sampled at
 /// the CS falling edge; bit 0 (a leading zero) appears t3 after CS falls,
 /// bit i t4 after SCLK falling edge i; old data is held for t7; after falling
@@ -241,20 +256,61 @@ impl Adc {
     }
 }
 
-/// Which channel of a branch the mux pins address (None if no device is enabled).
-pub fn selected(s: &Schedule, b: usize, pins: &Pins) -> Option<usize> {
-    let off: usize = s.branches[..b].iter().map(|x| x.mux_devices as usize).sum();
-    let n = s.branches[b].mux_devices as usize;
-    let en = (pins.mux_en >> off) & ((1u128 << n) - 1);
-    if en.count_ones() != 1 {
-        return None;
+/// Which channel of a branch the mux pins address (None if no device is
+/// enabled), looked up in tables made once per run: a scan of every
+/// channel for every branch in every cycle was most of a 256-channel run.
+pub struct Selector {
+    branches: Vec<BranchMux>,
+}
+
+/// A branch's first bit of `mux_en`, its devices, and the channel at each
+/// (device, select input).
+struct BranchMux {
+    off: usize,
+    devices: usize,
+    at: HashMap<(u32, u32), usize>,
+}
+
+impl Selector {
+    pub fn new(s: &Schedule) -> Selector {
+        let mut off = 0;
+        let branches = (0..s.branches.len())
+            .map(|b| {
+                let n = s.branches[b].mux_devices as usize;
+                let mut at = HashMap::new();
+                for (i, c) in s.channels.iter().enumerate() {
+                    if s.mix.channels[i].branch == b {
+                        // the first of two channels on one input, as a scan finds it
+                        at.entry((c.device, c.select)).or_insert(i);
+                    }
+                }
+                off += n;
+                BranchMux {
+                    off: off - n,
+                    devices: n,
+                    at,
+                }
+            })
+            .collect();
+        Selector { branches }
     }
-    let dev = en.trailing_zeros();
-    let sel = ((pins.mux_sel >> (3 * b)) & 7) as u32;
-    s.channels
-        .iter()
-        .enumerate()
-        .position(|(i, c)| s.mix.channels[i].branch == b && c.device == dev && c.select == sel)
+
+    /// Branch `b`'s bits of `mux_en` in `pins`.
+    pub fn enables(&self, b: usize, pins: &Pins) -> u128 {
+        let m = &self.branches[b];
+        (pins.mux_en >> m.off) & ((1u128 << m.devices) - 1)
+    }
+
+    /// The channel branch `b`'s mux pins address in `pins`.
+    pub fn selected(&self, b: usize, pins: &Pins) -> Option<usize> {
+        let en = self.enables(b, pins);
+        if en.count_ones() != 1 {
+            return None;
+        }
+        let dev = en.trailing_zeros();
+        let sel = ((pins.mux_sel >> (3 * b)) & 7) as u32;
+        self.branches[b].at.get(&(dev, sel)).copied()
+    }
 }
 
 /// docs/timing.md, literally: the pins (except the sample stream) in cycle `c`.
@@ -313,7 +369,8 @@ impl<'a> Reference<'a> {
         }
         let f = first_slot / g.frame_slots;
         let within = first_slot % g.frame_slots;
-        let (frame, slot) = match list.iter().find(|&&t| t >= within) {
+        // the list is in slot order: a binary search, not a scan per cycle
+        let (frame, slot) = match list.get(list.partition_point(|&t| t < within)) {
             Some(&t) => (f, t),
             None => (f + 1, list[0]),
         };
@@ -394,6 +451,7 @@ pub fn run_and_compare_with(s: &Schedule, cycles: u64, form: hdl::LutForm) -> Ru
     let mut expect_next: Option<(usize, u16)> = None;
     let mut last_sample = (0u16, 0u16);
     let mut inflight: Vec<Option<(usize, u16, u64)>> = vec![None; nb];
+    let selector = Selector::new(s);
     for c in 0..cycles {
         let p = sim.step(false, miso);
         let (cs, sclk, sel, en) = reference.pins(c);
@@ -402,10 +460,7 @@ pub fn run_and_compare_with(s: &Schedule, cycles: u64, form: hdl::LutForm) -> Ru
         assert_eq!(p.mux_sel, sel, "mux_sel in cycle {c}");
         assert_eq!(p.mux_en, en, "mux_en in cycle {c}");
         for b in 0..nb {
-            let en_b = {
-                let off: usize = s.branches[..b].iter().map(|x| x.mux_devices as usize).sum();
-                (p.mux_en >> off) & ((1u128 << s.branches[b].mux_devices) - 1)
-            };
+            let en_b = selector.enables(b, &p);
             assert!(
                 en_b.count_ones() <= 1,
                 "two devices of branch {b} enabled in cycle {c}"
@@ -438,7 +493,7 @@ pub fn run_and_compare_with(s: &Schedule, cycles: u64, form: hdl::LutForm) -> Ru
             let cs_b = (p.cs_n >> b) & 1 == 1;
             let sclk_b = (p.sclk >> b) & 1 == 1;
             let fell = (prev_cs >> b) & 1 == 1 && !cs_b;
-            let ch = selected(s, b, &p);
+            let ch = selector.selected(b, &p);
             if fell {
                 instants.push((c, b, ch));
             }

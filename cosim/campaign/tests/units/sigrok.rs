@@ -28,11 +28,7 @@ fn sigrok_reads_the_command_words_on_mosi() {
             "{name}"
         );
         for b in (0..s.branches.len()).filter(|&b| s.has_command(b)) {
-            let got = decode_commands(
-                &dir.path().join(format!("b{b}.vcd")),
-                &s.mix.branches[b].adc,
-            )
-            .unwrap();
+            let got = decode_commands(&dir.path().join("spi.vcd"), &s, b).unwrap();
             let want: Vec<Vec<bool>> = window_conversions(&s, cap.modes(), b, frames, 0)
                 .iter()
                 .map(|&(m, k, _)| m.commands_in_frame(b)[k].word.clone())
@@ -84,11 +80,7 @@ fn sigrok_judges_each_frame_in_the_mode_it_ran_in() {
     );
     let dir = tempfile::tempdir().unwrap();
     assert_eq!(check(&s, &cap, frames, dir.path()).unwrap(), Ok(()));
-    let got = decode_commands(
-        &dir.path().join(format!("b{b}.vcd")),
-        &s.mix.branches[b].adc,
-    )
-    .unwrap();
+    let got = decode_commands(&dir.path().join("spi.vcd"), &s, b).unwrap();
     let want: Vec<Vec<bool>> = window_conversions(&s, cap.modes(), b, frames, 0)
         .iter()
         .map(|&(m, k, _)| m.commands_in_frame(b)[k].word.clone())
