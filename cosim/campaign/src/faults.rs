@@ -868,8 +868,16 @@ fn columns(
 }
 
 /// A clean run of the target under the checker, with and without the
-/// model, timed: [(cycles, seconds) with the model, without].
-fn clean_target_runs(s: &Schedule, target: Target, frames: u64) -> ([(u64, f64); 2], CleanRun) {
+/// model, timed: [(cycles, seconds) with the model, without].  With
+/// `sigrok`, its decode judges the run with the model too, as it judges
+/// every fault's: a decode that rejected every run would "catch" every
+/// fault, and the campaign would vouch for it.
+fn clean_target_runs(
+    s: &Schedule,
+    target: Target,
+    frames: u64,
+    sigrok: bool,
+) -> ([(u64, f64); 2], CleanRun) {
     let timed = |model: bool| -> (u64, f64, Option<String>) {
         let Ok(mut dut) = target_dut(s, target) else {
             return (
@@ -880,10 +888,18 @@ fn clean_target_runs(s: &Schedule, target: Target, frames: u64) -> ([(u64, f64);
         };
         let mut opts = modes::run_options(s, frames);
         opts.check.model = model;
+        let reset = judge::reset_cycles(s, opts.reset_cycles);
+        let mut cap = (sigrok && model).then(|| SpiCapture::new(s, reset));
+        let obs = cap.as_mut().map(|c| c as &mut dyn judge::Observer);
         let t = Instant::now();
-        let r = run_dut(s, &mut dut, frames, &opts, "clean", None);
-        let why = (!r.ok).then(|| r.summary().trim_end().to_string());
-        (r.cycles, t.elapsed().as_secs_f64(), why)
+        let r = run_dut(s, &mut dut, frames, &opts, "clean", obs);
+        let seconds = t.elapsed().as_secs_f64();
+        let why = match (r.ok, &cap) {
+            (false, _) => Some(r.summary().trim_end().to_string()),
+            (true, Some(cap)) => sigrok_rejects(s, cap, frames),
+            (true, None) => None,
+        };
+        (r.cycles, seconds, why)
     };
     let (a, b) = (timed(true), timed(false));
     let clean = CleanRun {
@@ -893,6 +909,21 @@ fn clean_target_runs(s: &Schedule, target: Target, frames: u64) -> ([(u64, f64);
         why: a.2,
     };
     ([(a.0, a.1), (b.0, b.1)], clean)
+}
+
+/// Why sigrok's decode rejects the clean run captured in `cap`, if it does.
+fn sigrok_rejects(s: &Schedule, cap: &SpiCapture, frames: u64) -> Option<String> {
+    if judge::switch::disabled("sigrok") {
+        return None;
+    }
+    let verdict = tempfile::tempdir()
+        .map_err(|e| e.to_string())
+        .and_then(|dir| crate::sigrok::check(s, cap, frames, dir.path()));
+    match verdict {
+        Ok(Ok(())) => None,
+        Ok(Err(e)) => Some(format!("sigrok's decode: {e}")),
+        Err(e) => Some(format!("sigrok could not decode the run: {e}")),
+    }
 }
 
 /// The mix's own clean run on the campaign's target, checked against the
@@ -947,7 +978,7 @@ pub fn campaign_with(s: &Schedule, plan: &Plan) -> Result<Campaign, SimError> {
     };
     // the mix's own clean run first: a campaign on a design that fails
     // clean would vouch for nothing
-    let (clean, clean_run) = clean_target_runs(s, target, frames);
+    let (clean, clean_run) = clean_target_runs(s, target, frames, sigrok);
     count.one();
     let judge_faults = plan.builtin && clean_run.ok;
     let mut judged = Vec::new();
