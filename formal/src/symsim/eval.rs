@@ -259,7 +259,9 @@ impl Eval {
         }
         self.val[v] = lit;
         let feeds = self.feeds_at[v] as usize..self.feeds_at[v + 1] as usize;
-        self.dirty.extend_from_slice(&self.feeds[feeds]);
+        if !feeds.is_empty() {
+            self.dirty.extend_from_slice(&self.feeds[feeds]);
+        }
         self.touch(v)
     }
 
