@@ -685,6 +685,56 @@ fn random_designs_with_free_init_latches_get_the_right_verdicts() {
     }
 }
 
+/// The event-driven step (`eval.rs`: gates queued where a fanin changed,
+/// not those whose other fanin is false; only the latches the last step
+/// moved re-read) against a full evaluation of every gate, step by step:
+/// inputs fresh variables or constants, and now and then a state the last
+/// step did not leave (another path's, or one latch inverted) or a full
+/// evaluation forced (as after a collection).  The moved latches are
+/// exactly those whose value changed.
+#[test]
+fn the_event_driven_step_equals_a_full_evaluation() {
+    let mut rng = Rng(0x2545_F491_4F6C_DD1D);
+    let mut other_states = 0;
+    for _ in 0..500 {
+        let g = random_design(&mut rng, true);
+        let (mut gr, mut ev) = (Graph::new(), eval::Eval::new(&g));
+        let nl = g.latches.len();
+        let mut state: Vec<u32> = (0..nl).map(|j| gr.var(100 + j as u32, 0)).collect();
+        let (mut older, mut left) = (state.clone(), state.clone());
+        for step in 1..60u32 {
+            let inputs: Vec<u32> = (0..g.inputs.len() as u32)
+                .map(|k| match rng.below(3) {
+                    0 => gr.var(k, step),
+                    c => c as u32 - 1,
+                })
+                .collect();
+            match rng.below(10) {
+                0 => state.clone_from(&older),
+                1 => state[rng.below(nl as u64) as usize] ^= 1,
+                2 => ev.invalidate(),
+                _ => {}
+            }
+            other_states += usize::from(state != left);
+            let before = state.clone();
+            let mut want = state.clone();
+            let want_bad = eval::Eval::new(&g).step(&g, &mut gr, &mut want, &inputs);
+            let bad = ev.step(&g, &mut gr, &mut state, &inputs);
+            assert_eq!((bad, &state), (want_bad, &want), "step {step}");
+            let mut moved: Vec<usize> = ev.moved().iter().map(|&j| j as usize).collect();
+            moved.sort_unstable();
+            let changed: Vec<usize> = (0..nl).filter(|&j| state[j] != before[j]).collect();
+            assert_eq!(moved, changed, "step {step}");
+            if rng.below(4) == 0 {
+                older = before;
+            }
+            left.clone_from(&state);
+        }
+    }
+    // the check is only as good as the states it was given
+    assert!(other_states > 2000, "{other_states}");
+}
+
 fn text_of(g: &Aig) -> String {
     format!("{g:?}")
 }

@@ -9,6 +9,14 @@
 //! alone, level by level in the gates' order, gives every gate the value a
 //! full evaluation would (a gate none of whose fanins changed keeps its
 //! value, the graph being hash-consed), at a fraction of the work.
+//!
+//! Two more cuts, both exact.  A gate whose other fanin is false when one
+//! changes stays false: it is not queued (were the other to change later in
+//! the step, that change queues it; a gate left unqueued by every change
+//! was false before and after).  And the latches: a step given the state
+//! the step before left (the usual case, compared as one slice) starts
+//! from the latches that moved in it, and writes only the latches whose
+//! next value's variable changed; any other state is read whole.
 
 use crate::aiger::Aig;
 
@@ -18,8 +26,15 @@ use super::graph::Graph;
 pub(super) struct Eval {
     /// The AND gates, each after its fanins.
     ands: Vec<(u32, u32, u32)>,
-    /// Per AIGER variable: the gates (index in `ands`) that read it.
-    fanout: Vec<Vec<u32>>,
+    /// Per AIGER variable `v`, `fan[fan_at[v]..fan_at[v + 1]]`: the gates
+    /// (index in `ands`) that read it, each with its other fanin (the
+    /// constant true when both read `v`: never skipped).
+    fan_at: Vec<u32>,
+    fan: Vec<(u32, u32)>,
+    /// Per AIGER variable, `feeds[feeds_at[v]..feeds_at[v + 1]]`: the
+    /// latches whose next value it is.
+    feeds_at: Vec<u32>,
+    feeds: Vec<u32>,
     /// Per gate: one more than its deepest fanin gate's level.
     level: Vec<u32>,
     /// Gates waiting, by level, and whether each is waiting.
@@ -30,40 +45,98 @@ pub(super) struct Eval {
     /// Whether `val` holds the last step's values (false at the start and
     /// after the graph was collected, which renumbers its nodes).
     valid: bool,
+    /// The state the last step left, and the latches whose value in it
+    /// differs from the state it was given.
+    out: Vec<u32>,
+    moved: Vec<u32>,
+    /// The latches whose next value's variable changed in this step.
+    dirty: Vec<u32>,
+    /// A buffer for a step's input literals, reused step after step.
+    inputs: Vec<u32>,
+}
+
+/// Per variable, the items `of` lists for it, as one flat array and each
+/// variable's start in it (`at[v]..at[v + 1]`).
+fn flat<T: Copy + Default>(
+    nv: usize,
+    of: impl Iterator<Item = (usize, T)> + Clone,
+) -> (Vec<u32>, Vec<T>) {
+    let mut at = vec![0u32; nv + 1];
+    for (v, _) in of.clone() {
+        at[v + 1] += 1;
+    }
+    for v in 0..nv {
+        at[v + 1] += at[v];
+    }
+    let mut next = at.clone();
+    let mut items = vec![T::default(); at[nv] as usize];
+    for (v, t) in of {
+        items[next[v] as usize] = t;
+        next[v] += 1;
+    }
+    (at, items)
 }
 
 impl Eval {
     pub(super) fn new(g: &Aig) -> Eval {
         let ands = super::in_dependency_order(g);
         let nv = g.max_var as usize + 1;
-        let mut fanout = vec![Vec::new(); nv];
         let mut var_level = vec![0u32; nv];
         let mut level = Vec::with_capacity(ands.len());
-        for (i, &(lhs, x, y)) in ands.iter().enumerate() {
+        for &(lhs, x, y) in &ands {
             let (xv, yv) = ((x >> 1) as usize, (y >> 1) as usize);
-            fanout[xv].push(i as u32);
-            if yv != xv {
-                fanout[yv].push(i as u32);
-            }
             let l = var_level[xv].max(var_level[yv]) + 1;
             var_level[(lhs >> 1) as usize] = l;
             level.push(l);
         }
+        let reads = ands.iter().enumerate().flat_map(|(i, &(_, x, y))| {
+            let i = i as u32;
+            let both = (x >> 1) == (y >> 1);
+            let first = ((x >> 1) as usize, (i, if both { 1 } else { y }));
+            let second = (!both).then_some(((y >> 1) as usize, (i, x)));
+            std::iter::once(first).chain(second)
+        });
+        let (fan_at, fan) = flat(nv, reads);
+        let nexts = (g.latches.iter().enumerate())
+            .map(|(j, &(_, next, _))| ((next >> 1) as usize, j as u32));
+        let (feeds_at, feeds) = flat(nv, nexts);
         let depth = level.iter().copied().max().unwrap_or(0) as usize + 1;
         Eval {
             queued: vec![false; ands.len()],
             ands,
-            fanout,
+            fan_at,
+            fan,
+            feeds_at,
+            feeds,
             level,
             buckets: vec![Vec::new(); depth],
             val: vec![0u32; nv],
             valid: false,
+            out: Vec::new(),
+            moved: Vec::new(),
+            dirty: Vec::new(),
+            inputs: Vec::new(),
         }
     }
 
     /// The graph was collected: every value is evaluated again next step.
     pub(super) fn invalidate(&mut self) {
         self.valid = false;
+    }
+
+    /// The input buffer (empty or last step's), to be given back.
+    pub(super) fn take_inputs(&mut self) -> Vec<u32> {
+        std::mem::take(&mut self.inputs)
+    }
+
+    pub(super) fn give_inputs(&mut self, inputs: Vec<u32>) {
+        self.inputs = inputs;
+    }
+
+    /// The latches whose value the last step changed (its next value is
+    /// not the value it was given), in no particular order.
+    pub(super) fn moved(&self) -> &[u32] {
+        &self.moved
     }
 
     /// One step: input `k` takes `inputs[k]`, every latch starts from
@@ -76,8 +149,11 @@ impl Eval {
         state: &mut [u32],
         inputs: &[u32],
     ) -> u32 {
+        self.dirty.clear();
+        // the state the last step left: only the latches it moved differ
+        let again = self.valid && *state == *self.out;
         if self.valid {
-            self.changed(g, gr, state, inputs);
+            self.changed(g, gr, state, inputs, again);
         } else {
             self.full(g, gr, state, inputs);
         }
@@ -87,8 +163,31 @@ impl Eval {
         for &b in &g.bad {
             bad = gr.and(bad ^ 1, lit(b) ^ 1) ^ 1;
         }
-        for (j, &(_, next, _)) in g.latches.iter().enumerate() {
-            state[j] = lit(next);
+        self.moved.clear();
+        if again {
+            // every other latch's next value is the last step's, which is
+            // the value it has
+            for &j in &self.dirty {
+                let (l, next, _) = g.latches[j as usize];
+                let now = lit(next);
+                state[j as usize] = now;
+                self.out[j as usize] = now;
+                if now != val[(l >> 1) as usize] {
+                    self.moved.push(j);
+                }
+            }
+            // in the latches' order, as a whole state's scan gives them:
+            // the next step touches their readers in that order
+            self.moved.sort_unstable();
+        } else {
+            for (j, &(l, next, _)) in g.latches.iter().enumerate() {
+                state[j] = lit(next);
+                if state[j] != val[(l >> 1) as usize] {
+                    self.moved.push(j as u32);
+                }
+            }
+            self.out.clear();
+            self.out.extend_from_slice(state);
         }
         bad
     }
@@ -112,16 +211,22 @@ impl Eval {
         self.valid = true;
     }
 
-    /// The gates downstream of an input or latch whose value changed.
-    fn changed(&mut self, g: &Aig, gr: &mut Graph, state: &[u32], inputs: &[u32]) {
+    /// The gates downstream of an input or latch whose value changed;
+    /// `again`: the state is the one the last step left, so only the
+    /// latches it moved can differ.
+    fn changed(&mut self, g: &Aig, gr: &mut Graph, state: &[u32], inputs: &[u32], again: bool) {
         let mut top = 0usize;
-        let sources = g.inputs.iter().zip(inputs.iter().copied());
-        let latches = g.latches.iter().map(|l| l.0).zip(state.iter().copied());
-        for (l, lit) in sources.map(|(&i, v)| (i, v)).chain(latches) {
-            let v = (l >> 1) as usize;
-            if self.val[v] != lit {
-                self.val[v] = lit;
-                top = top.max(self.touch(v));
+        for (&i, &lit) in g.inputs.iter().zip(inputs) {
+            top = top.max(self.set((i >> 1) as usize, lit));
+        }
+        if again {
+            for k in 0..self.moved.len() {
+                let j = self.moved[k] as usize;
+                top = top.max(self.set((g.latches[j].0 >> 1) as usize, state[j]));
+            }
+        } else {
+            for (j, &(l, _, _)) in g.latches.iter().enumerate() {
+                top = top.max(self.set((l >> 1) as usize, state[j]));
             }
         }
         let mut lv = 0;
@@ -136,11 +241,7 @@ impl Eval {
                     val[(y >> 1) as usize] ^ (y & 1),
                 );
                 let now = gr.and(x, y);
-                let v = (lhs >> 1) as usize;
-                if self.val[v] != now {
-                    self.val[v] = now;
-                    top = top.max(self.touch(v));
-                }
+                top = top.max(self.set((lhs >> 1) as usize, now));
             }
             bucket.clear();
             self.buckets[lv] = bucket;
@@ -148,10 +249,31 @@ impl Eval {
         }
     }
 
-    /// Queues the gates that read variable `v`; the highest level queued.
+    /// Variable `v` takes `lit`: if that is a change, the gates that read
+    /// it are queued and the latches it feeds noted; the highest level
+    /// queued (0 if none).
+    #[inline]
+    fn set(&mut self, v: usize, lit: u32) -> usize {
+        if self.val[v] == lit {
+            return 0;
+        }
+        self.val[v] = lit;
+        let feeds = self.feeds_at[v] as usize..self.feeds_at[v + 1] as usize;
+        if !feeds.is_empty() {
+            self.dirty.extend_from_slice(&self.feeds[feeds]);
+        }
+        self.touch(v)
+    }
+
+    /// Queues the gates that read variable `v` and may change (not those
+    /// whose other fanin is false); the highest level queued.
     fn touch(&mut self, v: usize) -> usize {
         let mut top = 0;
-        for &i in &self.fanout[v] {
+        let fan = self.fan_at[v] as usize..self.fan_at[v + 1] as usize;
+        for &(i, other) in &self.fan[fan] {
+            if self.val[(other >> 1) as usize] ^ (other & 1) == 0 {
+                continue;
+            }
             let i = i as usize;
             let l = self.level[i] as usize;
             top = top.max(l);

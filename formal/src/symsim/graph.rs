@@ -28,7 +28,13 @@ pub(super) struct Graph {
     /// run in `var`'s lookups.
     rows: FxHashMap<u32, (u32, u32)>,
     pub(super) shared: bool,
+    /// `collect`'s marks and renumbering, kept for the next one.
+    scratch: (Vec<u8>, Vec<u32>),
 }
+
+/// `collect`'s marks: a node is kept; a variable is in a step's row.
+const LIVE: u8 = 1;
+const IN_ROW: u8 = 2;
 
 impl Graph {
     pub(super) fn new() -> Graph {
@@ -39,28 +45,30 @@ impl Graph {
             vars: FxHashMap::default(),
             rows: FxHashMap::default(),
             shared: false,
+            scratch: Default::default(),
         }
     }
 
-    /// The variables of inputs `0..n` at `step` (what `var` gives each).
-    pub(super) fn step_vars(&mut self, n: u32, step: u32) -> Vec<u32> {
+    /// The variables of inputs `0..n` at `step` (what `var` gives each),
+    /// in `out` (cleared first: a buffer reused step after step).
+    pub(super) fn step_vars(&mut self, n: u32, step: u32, out: &mut Vec<u32>) {
+        out.clear();
         if !self.shared {
-            return (0..n).map(|k| self.fresh_var(k, step)).collect();
+            out.extend((0..n).map(|k| self.fresh_var(k, step)));
+            return;
         }
+        let (a, b) = (&mut self.a, &mut self.b);
         let &mut (first, len) = self.rows.entry(step).or_insert_with(|| {
-            let first = self.a.len() as u32;
-            for k in 0..n {
-                self.a.push(VAR | k);
-                self.b.push(step);
-            }
+            let first = a.len() as u32;
+            a.extend((0..n).map(|k| VAR | k));
+            b.resize(b.len() + n as usize, step);
             (first, n)
         });
-        (0..n)
-            .map(|k| match k < len {
-                true => (first + k) * 2,
-                false => self.var(k, step),
-            })
-            .collect()
+        out.extend((0..n.min(len)).map(|k| (first + k) * 2));
+        for k in len..n {
+            let v = self.var(k, step);
+            out.push(v);
+        }
     }
 
     /// A variable node of its own, not shared with `var`'s: a split
@@ -119,6 +127,16 @@ impl Graph {
         })
     }
 
+    /// Room for the graph to grow to `n` nodes without moving (its
+    /// table: to a million more gates at most): it grows by a few nodes a
+    /// step to its next collection.
+    pub(super) fn reserve(&mut self, n: usize) {
+        let more = n.saturating_sub(self.a.len());
+        self.a.reserve(more);
+        self.b.reserve(more);
+        self.table.reserve(more.min(1 << 20));
+    }
+
     pub(super) fn is_var(&self, n: usize) -> bool {
         self.a[n] & VAR != 0
     }
@@ -127,64 +145,67 @@ impl Graph {
     /// a node's fanins stay below it) and rewrites `roots` in place.
     pub(super) fn collect(&mut self, roots: &mut [u32]) {
         let n = self.a.len();
-        let mut live = vec![false; n];
-        live[0] = true;
+        // buffers kept from one collection to the next (fresh pages for
+        // each cost more than the collection: they are all written)
+        let (mut live, mut map) = std::mem::take(&mut self.scratch);
+        live.clear();
+        live.resize(n, 0);
+        map.resize(n, 0);
+        live[0] = LIVE;
         for &r in roots.iter() {
-            live[(r >> 1) as usize] = true;
+            live[(r >> 1) as usize] = LIVE;
         }
         for i in (1..n).rev() {
-            if live[i] && !self.is_var(i) {
-                live[(self.a[i] >> 1) as usize] = true;
-                live[(self.b[i] >> 1) as usize] = true;
+            if live[i] != 0 && !self.is_var(i) {
+                live[(self.a[i] >> 1) as usize] = LIVE;
+                live[(self.b[i] >> 1) as usize] = LIVE;
             }
         }
         // a step's row of inputs stays whole (its nodes consecutive) while
         // any of them is live, and goes when none is
         self.rows.retain(|_, &mut (first, len)| {
             let block = first as usize..(first + len) as usize;
-            let keep = live[block.clone()].iter().any(|&l| l);
+            let keep = live[block.clone()].iter().any(|&l| l != 0);
             if keep {
-                live[block].fill(true);
+                live[block].fill(LIVE | IN_ROW);
             }
             keep
         });
-        let mut in_row = vec![false; n];
-        for &(first, len) in self.rows.values() {
-            in_row[first as usize..(first + len) as usize].fill(true);
-        }
-        let mut map = vec![0u32; n];
-        let (mut a, mut b) = (vec![0u32], vec![0u32]);
-        let mut table = FxHashMap::default();
-        let mut vars = FxHashMap::default();
+        // renumbered in place: node `i` moves down to `map[i] <= i`, after
+        // every node below it was read
+        self.table.clear();
+        self.vars.clear();
         let lit = |map: &[u32], l: u32| (map[(l >> 1) as usize] * 2) | (l & 1);
+        map[0] = 0;
+        let mut to = 1usize;
         for i in 1..n {
-            if !live[i] {
+            if live[i] == 0 {
                 continue;
             }
-            map[i] = a.len() as u32;
-            if self.is_var(i) {
-                if self.shared && !in_row[i] {
-                    vars.insert((self.a[i] & !VAR, self.b[i]), map[i] * 2);
+            map[i] = to as u32;
+            let (x, y) = (self.a[i], self.b[i]);
+            if x & VAR != 0 {
+                if self.shared && live[i] & IN_ROW == 0 {
+                    self.vars.insert((x & !VAR, y), map[i] * 2);
                 }
-                a.push(self.a[i]);
-                b.push(self.b[i]);
+                (self.a[to], self.b[to]) = (x, y);
             } else {
-                let (x, y) = (lit(&map, self.a[i]), lit(&map, self.b[i]));
-                table.insert((u64::from(x) << 32) | u64::from(y), map[i] * 2);
-                a.push(x);
-                b.push(y);
+                let (x, y) = (lit(&map, x), lit(&map, y));
+                self.table
+                    .insert((u64::from(x) << 32) | u64::from(y), map[i] * 2);
+                (self.a[to], self.b[to]) = (x, y);
             }
+            to += 1;
         }
+        self.a.truncate(to);
+        self.b.truncate(to);
         for r in roots.iter_mut() {
             *r = lit(&map, *r);
         }
         for row in self.rows.values_mut() {
             row.0 = map[row.0 as usize];
         }
-        self.a = a;
-        self.b = b;
-        self.table = table;
-        self.vars = vars;
+        self.scratch = (live, map);
     }
 
     /// The state `roots` as a canonical word sequence, inputs of step 0 by

@@ -361,6 +361,8 @@ struct Sim<'a> {
     holding: bool,
     dep: Vec<u8>,
     dep_at: u64,
+    /// A split run's next state, a buffer reused step after step.
+    next: Vec<u32>,
 }
 
 impl<'a> Sim<'a> {
@@ -420,6 +422,7 @@ impl<'a> Sim<'a> {
             holding: false,
             dep: Vec::new(),
             dep_at: 0,
+            next: Vec::new(),
         }
     }
 
@@ -603,6 +606,7 @@ impl<'a> Sim<'a> {
         }
         self.pending_any = roots.pop().unwrap_or(0);
         self.gc_at = (1 << 20).max(4 * self.gr.a.len());
+        self.gr.reserve(self.gc_at);
     }
 }
 
@@ -610,8 +614,11 @@ impl<'a> Sim<'a> {
 /// every latch starts from `state` and leaves it with its next value;
 /// returns the disjunction of the assertions (`val`: each gate's value).
 fn evaluate(g: &Aig, ev: &mut eval::Eval, gr: &mut Graph, state: &mut [u32], step: u64) -> u32 {
-    let inputs = gr.step_vars(g.inputs.len() as u32, step as u32);
-    ev.step(g, gr, state, &inputs)
+    let mut inputs = ev.take_inputs();
+    gr.step_vars(g.inputs.len() as u32, step as u32, &mut inputs);
+    let bad = ev.step(g, gr, state, &inputs);
+    ev.give_inputs(inputs);
+    bad
 }
 
 /// The AND gates, each after its fanins (ASCII AIGER allows any order;

@@ -245,30 +245,32 @@ impl Sim<'_> {
         let (g, ni) = (self.g, self.g.inputs.len());
         let mark = self.gr.a.len();
         // the split inputs' variables first: a node older than them reads none
-        let mut inputs = vec![0u32; ni];
-        for &k in &self.splits {
-            inputs[k] = self.gr.fresh_var(k as u32, step as u32);
+        let mut vars = [0usize; MAX_SPLIT_BITS];
+        for (i, &k) in self.splits.iter().enumerate() {
+            vars[i] = (self.gr.fresh_var(k as u32, step as u32) >> 1) as usize;
         }
-        let shared = self.gr.step_vars(ni as u32, step as u32);
-        for (k, lit) in inputs.iter_mut().enumerate() {
-            if !self.splits.contains(&k) {
-                *lit = shared[k];
-            }
+        let vars = &vars[..self.splits.len()];
+        let mut inputs = self.ev.take_inputs();
+        self.gr.step_vars(ni as u32, step as u32, &mut inputs);
+        for (&k, &n) in self.splits.iter().zip(vars) {
+            inputs[k] = n as u32 * 2;
         }
-        let mut next = self.state.clone();
+        // the next state in a buffer of its own (the state is kept for a
+        // split), reused step after step
+        let mut next = std::mem::take(&mut self.next);
+        next.clear();
+        next.extend_from_slice(&self.state);
         let bad = self.ev.step(g, &mut self.gr, &mut next, &inputs);
-        let vars: Vec<usize> = self
-            .splits
-            .iter()
-            .map(|&k| (inputs[k] >> 1) as usize)
-            .collect();
-        let roots = next.iter().copied().chain([bad]);
-        let read = reads(&self.gr, roots, mark, &vars);
+        // a latch that did not move holds an older node than the variables
+        let roots = (self.ev.moved().iter()).map(|&j| next[j as usize]);
+        let read = reads(&self.gr, roots.chain([bad]), mark, vars);
         if !((read || self.holding) && self.computes(&next, bad, read)) {
             // nothing computes with a split input: a request only copied
             // into registers is held as its variable (`defer.rs`)
             self.holding |= read;
-            self.state = next;
+            std::mem::swap(&mut self.state, &mut next);
+            self.next = next;
+            self.ev.give_inputs(inputs);
             if bad != 0 {
                 self.pending.push((step, bad));
                 self.pending_any = self.gr.and(self.pending_any ^ 1, bad ^ 1) ^ 1;
@@ -352,8 +354,12 @@ impl Sim<'_> {
         if bad >= 2 && self.reads_split((bad >> 1) as usize) {
             return true;
         }
-        if (0..next.len()).any(|j| next[j] != self.state[j] && self.computes_with_split(next[j])) {
-            return true;
+        // the latches whose value changes: those the step moved
+        for k in 0..self.ev.moved().len() {
+            let j = self.ev.moved()[k] as usize;
+            if self.computes_with_split(next[j]) {
+                return true;
+            }
         }
         if !read {
             // only a step that reads its split inputs holds more
@@ -419,8 +425,14 @@ fn reads(
     mark: usize,
     vars: &[usize],
 ) -> bool {
+    let mut stack: Vec<usize> = (roots.map(|r| (r >> 1) as usize))
+        .filter(|&n| n >= mark)
+        .collect();
+    if stack.is_empty() {
+        // no root was made this step: none reads a variable of it
+        return false;
+    }
     let mut seen = std::collections::HashSet::new();
-    let mut stack: Vec<usize> = roots.map(|r| (r >> 1) as usize).collect();
     while let Some(n) = stack.pop() {
         if n < mark || !seen.insert(n) {
             continue;
