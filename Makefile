@@ -206,8 +206,10 @@ fuzz-seeds:
 	$(CARGO) build --quiet --release --bin slotforge
 	fuzz/seeds/make-vcd-seeds.sh $${CARGO_TARGET_DIR:-target}/release/slotforge
 
+# clippy, and the libraries' API docs with no broken or private link.
 lint:
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --workspace --no-deps --lib
 
 # Golden snapshots change only through this command; review the diff like code.
 update-snapshots:

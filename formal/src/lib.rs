@@ -1,9 +1,9 @@
 //! slotforge's formal flow (`slotforge prove`): a harness generated from the
-//! schedule ([`harness`]) asserts the pin contract of `docs/timing.md`
+//! schedule (`harness`) asserts the pin contract of `docs/timing.md`
 //! around `slotforge_top` (slotforge's own Verilog or any design on the port
 //! contract), with MISO free and reset held in the first cycle only; an
-//! engine ([`engine`]) proves it for all time or searches it from reset to a
-//! bound; a violation is replayed ([`replay`]) into a VCD that the judge
+//! engine (`engine`) proves it for all time or searches it from reset to a
+//! bound; a violation is replayed (`replay`) into a VCD that the judge
 //! checks like any other waveform.
 //!
 //! A bounded result is reported as `bounded` with its depth, never as a proof.

@@ -7,10 +7,10 @@
 //! - [`emit`] / [`Emitted`]: `slotforge_top.v`, `ports.json`, `slots.hex` (the LUT), `slot_rom.hex` (the ROM image),
 //!   `slotforge.pcf` (or a board's `.lpf` / `.cst`), `slotforge.sdc`, `slotforge.xdc`, and `slotforge_top.core` (FuseSoC CAPI2);
 //! - [`Board`] / [`stock_board`]: board files (`constraints/*.toml`), one per FPGA part;
-//! - [`RtlSim`] / [`Pins`]: cycle-accurate simulation of the same blocks;
-//! - [`stock_simulation_cycles`] / [`StockRun`]: the same blocks under
+//! - [`RtlSim`] / `lut_gen::Pins`: cycle-accurate simulation of the same blocks;
+//! - `stock_simulation_cycles` / `StockRun` (feature `stock`): the same blocks under
 //!   rust-hdl's stock threaded `Simulation` engine (the reference that
-//!   `RtlSim`'s speed is measured against), and [`rtlsim_cycles`], the
+//!   `RtlSim`'s speed is measured against), and `rtlsim_cycles`, the
 //!   identical run with `RtlSim`.
 //!
 //! The cycle-level behaviour is `docs/timing.md`; the design choices are in

@@ -311,7 +311,7 @@ impl CompactRom {
     }
 }
 
-/// Like [`plan`], with the slot LUT form chosen by the caller.
+/// Like `plan` (feature `stock`), with the slot LUT form chosen by the caller.
 pub fn plan_with(s: &Schedule, form: LutForm) -> Result<Plan, HdlError> {
     let g = &s.grid;
     let compact = check_grid(s, form)?;

@@ -1,6 +1,6 @@
 //! slotforge's link to the host, without any simulator or HDL.
 //!
-//! - [`format`]: the packet format of `docs/packet-format.md` (sync marker,
+//! - [`format`](mod@format): the packet format of `docs/packet-format.md` (sync marker,
 //!   frame counter and slice, per-sample records, CRC-16/MODBUS): the one
 //!   home of every byte's meaning;
 //! - `uart`: the UART character (start, 8 data bits LSB first, parity,

@@ -110,11 +110,11 @@ pub struct Fix {
 pub struct FixSearch {
     pub fixes: Vec<Fix>,
     /// Candidates synthesized (the rest of the candidates were not needed
-    /// or beyond [`MAX_TRIED`]).
+    /// or beyond `MAX_TRIED`).
     pub tried: usize,
 }
 
-/// The order fixes are tried and offered in (see [`Candidate::cost`]).
+/// The order fixes are tried and offered in (see `Candidate::cost`).
 pub fn cost(changes: &[Change], parts_added: u32, channels_changed: usize) -> (bool, u32, usize) {
     (
         changes

@@ -458,7 +458,7 @@ pub fn execute(a: &Args, mix: &Path, o: &mut Output) -> u8 {
 }
 
 /// The golden's event log ([`load_events`]), the scene this run drives
-/// and its stimulus and `mode_sel` requests ([`drive`]), and how that scene
+/// and its stimulus and `mode_sel` requests (`drive`), and how that scene
 /// differs from the golden's (`None`: the same).
 type Loaded = (
     Option<EventLog>,

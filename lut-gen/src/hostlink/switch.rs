@@ -89,7 +89,7 @@ fn side_frames(a: &Schedule, b: &Schedule, line: Line) -> u64 {
     settle(a).max(settle(b)) + 1
 }
 
-/// The FIFO's largest backlog over [`side_frames`] frames of `a` then as
+/// The FIFO's largest backlog over `side_frames` frames of `a` then as
 /// many of `b` (AXI4-Stream: the slowest slave the guarantee allows), from
 /// reset; it stops counting just past `MAX_FIFO_DEPTH`.
 pub fn switch_backlog(a: &Schedule, b: &Schedule, line: Line) -> usize {

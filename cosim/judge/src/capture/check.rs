@@ -165,7 +165,7 @@ pub struct TimedReport {
     pub locked_at_ps: u64,
     pub slot: u64,
     pub phases: usize,
-    /// The violations found: the first [`VIOLATION_CAP`], and the first of
+    /// The violations found: the first `VIOLATION_CAP`, and the first of
     /// every class (rule and channel) beyond them.
     pub violations: Vec<TimedViolation>,
     /// How many violations there were in all.
