@@ -110,18 +110,20 @@ fn choice_shift(n: u32) -> Aig {
     parse(&t).unwrap()
 }
 
+/// The searches of [`choice_shift`]: frames of 4 steps from step 2, 100 steps.
+const SHIFT_LIMITS: Limits = Limits {
+    period: 4,
+    offset: 2,
+    max_steps: 100,
+    deadline: None,
+};
+
 #[test]
 fn an_explicit_search_finds_a_deep_violation_and_its_witness_crosses_marks() {
     // 10 steps: marks every 3 in the unit tests, so the witness is
     // rebuilt from kept sets; a wrong stretch would not replay
     let g = choice_shift(10);
-    let lim = Limits {
-        period: 4,
-        offset: 2,
-        max_steps: 100,
-        deadline: None,
-    };
-    let Some(Found::Violated { step, inputs }) = explicit::run(&g, &[0], &lim) else {
+    let Some(Found::Violated { step, inputs }) = explicit::run(&g, &[0], &SHIFT_LIMITS) else {
         panic!("no violation found");
     };
     assert_eq!(step, 10);
@@ -135,14 +137,14 @@ fn an_explicit_search_past_its_bound_hands_the_part_to_simulation() {
     // the set doubles every step: past 65,536 states the search gives no
     // verdict, and the symbolic run finds the violation
     let g = choice_shift(20);
-    let lim = Limits {
-        period: 4,
-        offset: 2,
-        max_steps: 100,
-        deadline: None,
-    };
-    assert_eq!(explicit::run(&g, &[0], &lim), None);
-    let (f, st) = prove(&g, &[0], &[], false, 4, 2, 100, None);
+    assert_eq!(explicit::run(&g, &[0], &SHIFT_LIMITS), None);
+    let Limits {
+        period,
+        offset,
+        max_steps,
+        ..
+    } = SHIFT_LIMITS;
+    let (f, st) = prove(&g, &[0], &[], false, period, offset, max_steps, None);
     assert!(matches!(f, Found::Violated { step: 20, .. }), "{f:?}");
     assert_eq!(st.parts, [1, 0, 0], "simulated, not enumerated");
 }
