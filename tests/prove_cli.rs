@@ -307,7 +307,9 @@ fn an_8n1_uart_mix_proves_its_line_and_packets() {
     uart_mix_proves(&tiny_uart(dir.path()), dir.path());
 }
 
-fn uart_mix_proves(mix: &std::path::Path, dir: &std::path::Path) {
+/// `prove --json` of `mix` (a UART mix): proved whole, the link's bytes
+/// and packets for all time with the frame counters generalised; the JSON.
+fn uart_mix_proves(mix: &std::path::Path, dir: &std::path::Path) -> serde_json::Value {
     let v = prove_json(&[mix.to_str().unwrap()], &[], dir, 0);
     assert_eq!(v["result"], "proved");
     assert_eq!(v["not_covered"].as_array().unwrap().len(), 0, "{v}");
@@ -323,6 +325,7 @@ fn uart_mix_proves(mix: &std::path::Path, dir: &std::path::Path) {
         "{note}"
     );
     assert!(note.contains("frame counter generalised"), "{note}");
+    v
 }
 
 /// `tiny` with a 1 Mbaud UART (4 cycles a bit), written into `dir`.
@@ -405,12 +408,14 @@ fn axis_mutants() -> Vec<Mutant> {
 
 /// Each of `mutants` of `mix`'s link gateware fails `prove` on the link's
 /// bytes with a counterexample, and the judge rejects its VCD at the cycle
-/// `prove` names; the printed `check` command rejects it too.
+/// `prove` names; the printed `check` command rejects it too.  Each
+/// mutant's `prove --json`, in order.
 fn link_mutants_fail_where_check_does(
     mix: &std::path::Path,
     dir: &std::path::Path,
     mutants: &[Mutant],
-) {
+) -> Vec<serde_json::Value> {
+    let mut proofs = Vec::new();
     let v = dir.join("v");
     slotforge()
         .args(["verilog", mix.to_str().unwrap(), "-o"])
@@ -441,7 +446,9 @@ fn link_mutants_fail_where_check_does(
         let words: Vec<&str> = check.split(' ').collect();
         assert_eq!(words[..2], ["slotforge", "check"]);
         slotforge().args(&words[1..]).assert().code(1);
+        proofs.push(j);
     }
+    proofs
 }
 
 /// The mutants `make test` proves: each link kind's own (its CRC, the
@@ -523,7 +530,10 @@ const MODE_MIX_MUTANTS: [Mutant; 3] = [
 
 /// A pin-select mode mix with a UART (`formal/tests/data/modes-pin-uart.toml`):
 /// the link's bytes are proved for all time in the run split on `mode_sel`
-/// with the frame counters generalised, so nothing is left uncovered.
+/// with the frame counters generalised, so nothing is left uncovered and
+/// every property is proved.  (formal's
+/// `a_pin_mode_mix_with_a_uart_proves_its_packets_and_a_mode_field_swap_fails`,
+/// the same proofs through the library, is `make test-long`'s.)
 #[test]
 fn a_pin_mode_mix_with_a_uart_proves_its_line_and_packets() {
     if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
@@ -531,13 +541,20 @@ fn a_pin_mode_mix_with_a_uart_proves_its_line_and_packets() {
     }
     let dir = tempfile::tempdir().unwrap();
     let mix = crate::common_cli::root().join("formal/tests/data/modes-pin-uart.toml");
-    uart_mix_proves(&mix, dir.path());
+    let v = uart_mix_proves(&mix, dir.path());
+    let note = v["note"].as_str().unwrap();
+    assert!(note.contains("split on the mode requests"), "{note}");
+    for p in v["properties"].as_array().unwrap() {
+        assert_eq!(p["result"], "proved", "{v}");
+    }
 }
 
 /// Its mode-field and CRC mutants each fail `prove` with a trace from
 /// reset that `check` rejects at the same cycle (found by the generalised
 /// run itself; the skipping frame counter, found by the search that
-/// follows it, is in the auto-select test below: about 10 s more).
+/// follows it, is in the auto-select test below: about 10 s more).  The
+/// swapped mode fields are wrong only after a switch: not before the
+/// first frame a request can switch the mode.
 #[test]
 fn link_mutants_of_a_pin_mode_mix_fail_prove_where_check_does() {
     if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
@@ -545,7 +562,15 @@ fn link_mutants_of_a_pin_mode_mix_fail_prove_where_check_does() {
     }
     let dir = tempfile::tempdir().unwrap();
     let mix = crate::common_cli::root().join("formal/tests/data/modes-pin-uart.toml");
-    link_mutants_fail_where_check_does(&mix, dir.path(), &MODE_MIX_MUTANTS[..2]);
+    let failed = link_mutants_fail_where_check_does(&mix, dir.path(), &MODE_MIX_MUTANTS[..2]);
+    let s = lut_gen::synthesize(&lut_gen::load(&mix).unwrap()).unwrap();
+    let c = &failed[0]["counterexample"];
+    assert_eq!(MODE_MIX_MUTANTS[0].0, "mode");
+    assert!(
+        c["cycle"].as_u64().unwrap() >= s.grid.frame_cycles,
+        "{c}: before frame {}",
+        s.grid.frame_cycles
+    );
 }
 
 /// The same on the auto-select mix (`testkit/mixes/modes-auto.toml`, three
