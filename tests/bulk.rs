@@ -98,13 +98,8 @@ fn presets_in_bulk_form_audit_and_emit_as_written_out() {
 /// A random mix written with ranges: rows of channels on random branches
 /// at random rates, some with a first input (counting up), some automatic.
 fn random_bulk_mix(seed: u64) -> String {
-    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = move |n: u64| {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x % n
-    };
+    let mut draw = testkit::modemix::Draw::new(seed);
+    let mut next = |n: u64| draw.below(n);
     let mut t = String::from(
         "name = \"random\"\n[clock]\nhz = 48_000_000\n[frame]\nperiod_us = 2_000\nslice_us = 1_000\n",
     );

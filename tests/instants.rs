@@ -392,13 +392,8 @@ fn the_vdd_advice_works_as_printed() {
 fn random_mixes_are_sampled_where_the_waveform_says() {
     let dir = tempfile::tempdir().unwrap();
     for seed in 1..=4u64 {
-        let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-        let mut next = |n: u64| {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x % n
-        };
+        let mut draw = testkit::modemix::Draw::new(seed);
+        let mut next = |n: u64| draw.below(n);
         let (vdd, sclk) =
             [("", 1_000_000), ("vdd = 5.0\n", 2_000_000), ("", 500_000)][(seed % 3) as usize];
         let mut t = format!(

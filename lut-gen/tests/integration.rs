@@ -1,6 +1,10 @@
 //! All of this crate's integration tests in one binary: each test file is
 //! a module here, so the crate is linked once, not once per file.
 
+// Shared by several test files (one copy in this binary).
+#[path = "common.rs"]
+mod common;
+
 #[path = "modes.rs"]
 mod modes;
 

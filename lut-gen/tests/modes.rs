@@ -7,6 +7,7 @@
 use std::fmt::Write;
 use std::path::Path;
 
+use crate::common::testkit;
 use lut_gen::{Schedule, Trigger, When};
 use proptest::prelude::*;
 
@@ -245,18 +246,6 @@ proptest! {
             }
         }
     }
-}
-
-/// A shared test mix, or else the preset of that name (as `testkit::mix`).
-fn testkit(name: &str) -> lut_gen::Mix {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let own = root.join(format!("testkit/mixes/{name}.toml"));
-    let p = if own.exists() {
-        own
-    } else {
-        root.join(format!("mixes/{name}.toml"))
-    };
-    lut_gen::load(&p).unwrap()
 }
 
 #[test]

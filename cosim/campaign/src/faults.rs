@@ -328,12 +328,7 @@ impl Judged {
         dir: &std::path::Path,
     ) -> Result<(), String> {
         let t = Instant::now();
-        let verdict = if judge::switch::disabled("sigrok") {
-            Ok(())
-        } else {
-            crate::sigrok::check(s, cap, frames, dir)?
-        };
-        self.sigrok = Some(verdict);
+        self.sigrok = Some(sigrok_verdict(s, cap, frames, dir)?);
         self.cost.sigrok_runs += 1;
         self.cost.sigrok_cycles += (frames - 1) * s.grid.frame_cycles;
         self.cost.sigrok_seconds += t.elapsed().as_secs_f64();
@@ -911,14 +906,27 @@ fn clean_target_runs(
     ([(a.0, a.1), (b.0, b.1)], clean)
 }
 
+/// sigrok's verdict on `cap` as the campaign takes it: a pass while the
+/// test switch turns the detector off.  The one place that reads the
+/// switch, for the faulty runs ([`Judged::decode`]) and the clean one
+/// ([`sigrok_rejects`]); `sigrok::check` itself stays the detector.
+fn sigrok_verdict(
+    s: &Schedule,
+    cap: &SpiCapture,
+    frames: u64,
+    dir: &std::path::Path,
+) -> Result<Result<(), String>, String> {
+    if judge::switch::disabled("sigrok") {
+        return Ok(Ok(()));
+    }
+    crate::sigrok::check(s, cap, frames, dir)
+}
+
 /// Why sigrok's decode rejects the clean run captured in `cap`, if it does.
 fn sigrok_rejects(s: &Schedule, cap: &SpiCapture, frames: u64) -> Option<String> {
-    if judge::switch::disabled("sigrok") {
-        return None;
-    }
     let verdict = tempfile::tempdir()
         .map_err(|e| e.to_string())
-        .and_then(|dir| crate::sigrok::check(s, cap, frames, dir.path()));
+        .and_then(|dir| sigrok_verdict(s, cap, frames, dir.path()));
     match verdict {
         Ok(Ok(())) => None,
         Ok(Err(e)) => Some(format!("sigrok's decode: {e}")),

@@ -17,13 +17,8 @@ use crate::tools;
 /// A random mix with an `mcp3208` and an `ad7689` branch (and a listening
 /// one), channels on random inputs at random rates, from `seed`.
 fn random_commanded(seed: u64, mhz: u64) -> Schedule {
-    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = |n: u64| {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x % n
-    };
+    let mut draw = testkit::modemix::Draw::new(seed);
+    let mut next = |n: u64| draw.below(n);
     let mut t = format!(
         "name = \"rc\"\n[clock]\nhz = {mhz}000000\n[frame]\nperiod_us = 1000\nslice_us = 500\n"
     );

@@ -20,7 +20,9 @@ pub fn eskin34() -> Schedule {
     lut_gen::synthesize(&mix).expect("eskin34 is feasible")
 }
 
-fn from_toml(name: &str, text: &str) -> Schedule {
+/// The schedule of mix `text`, as if read from the file `name` (which
+/// only names it in messages).
+pub fn from_toml(name: &str, text: &str) -> Schedule {
     let mix = lut_gen::parse(Path::new(name), text).expect("mix parses");
     lut_gen::synthesize(&mix).expect("mix is feasible")
 }

@@ -2,11 +2,9 @@ use hdl::for_tests::board_constraints;
 use std::path::Path;
 
 use hdl::{stock_board, Board};
-use lut_gen::{Constraints, Fpga, Layout, Schedule};
+use lut_gen::{Constraints, Fpga, Layout};
 
-fn schedule(name: &str, text: &str) -> Schedule {
-    lut_gen::synthesize(&lut_gen::parse(Path::new(name), text).unwrap()).unwrap()
-}
+use crate::common::from_toml as schedule;
 
 /// `(port name, pin)` of each line that places one, in the format's words.
 fn placed(format: Constraints, text: &str) -> Vec<(String, String)> {

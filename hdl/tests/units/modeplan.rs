@@ -1,14 +1,7 @@
 use hdl::for_tests::{plan_with, FrontWord};
 use hdl::LutForm;
-use lut_gen::Schedule;
 
-fn schedule(text: &str) -> Schedule {
-    let path = std::env::temp_dir().join(format!("hdl-modeplan-{}.toml", std::process::id()));
-    std::fs::write(&path, text).unwrap();
-    let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
-    let _ = std::fs::remove_file(&path);
-    s
-}
+use crate::common::from_toml;
 
 #[test]
 fn every_modes_table_sits_at_its_mode_on_the_address() {
@@ -127,7 +120,10 @@ fn a_branch_the_reset_mode_leaves_out_is_refused_with_its_name() {
         "{e}"
     );
     // in the reset mode, and left out of the other: built
-    let s = schedule(&MIX.replace("rates = { a = 0 }", "rates = { b = 0 }"));
+    let s = from_toml(
+        "m.toml",
+        &MIX.replace("rates = { a = 0 }", "rates = { b = 0 }"),
+    );
     assert!(plan_with(&s, LutForm::Auto).is_ok());
     assert!(plan_with(&s, LutForm::Compact).is_err());
 }

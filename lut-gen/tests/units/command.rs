@@ -68,11 +68,7 @@ fn the_audit_names_the_word_and_the_prepared_conversions() {
         let j: serde_json::Value = serde_json::from_str(&a.to_json()).unwrap();
         assert_eq!(j["branches"][0]["command"]["ahead"], c.ahead);
     }
-    let plain = lut_gen::load(Path::new(&format!(
-        "{}/../testkit/mixes/tiny.toml",
-        env!("CARGO_MANIFEST_DIR")
-    )))
-    .unwrap();
+    let plain = crate::common::testkit("tiny");
     let j = lut_gen::AuditReport::of_schedule(&synthesize(&plain).unwrap()).to_json();
     assert!(!j.contains("\"command\""));
 }
@@ -80,11 +76,7 @@ fn the_audit_names_the_word_and_the_prepared_conversions() {
 #[test]
 fn listening_parts_send_nothing() {
     for name in ["tiny", "cnvmix2ms"] {
-        let path = format!(
-            "{}/../testkit/mixes/{name}.toml",
-            env!("CARGO_MANIFEST_DIR")
-        );
-        let m = lut_gen::load(Path::new(&path)).unwrap();
+        let m = crate::common::testkit(name);
         let s = synthesize(&m).unwrap();
         for b in 0..s.branch_count() {
             assert!(!s.has_command(b));

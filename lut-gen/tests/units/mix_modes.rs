@@ -1,21 +1,13 @@
 //! Modes in the mix: what parses, and every refusal named by line and field.
 
-use lut_gen::{load, parse, Mix, MixError, ModeSelect, When};
+use lut_gen::{parse, ModeSelect, When};
 use std::path::Path;
 
-/// `testkit/mixes/<name>.toml`, parsed.
-fn testkit(name: &str) -> Mix {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../testkit/mixes/{name}.toml"));
-    load(&p).unwrap()
-}
+use super::err;
+use crate::common::{testkit, testkit_path};
 
 fn text(name: &str) -> String {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../testkit/mixes/{name}.toml"));
-    std::fs::read_to_string(p).unwrap()
-}
-
-fn err(text: &str) -> MixError {
-    parse(Path::new("m.toml"), text).unwrap_err()
+    std::fs::read_to_string(testkit_path(name)).unwrap()
 }
 
 /// The line of the first occurrence of `needle` in `text` (1-based).

@@ -1,9 +1,7 @@
 use lut_gen::{manifest, Dir, Layout, Schedule};
 
 fn schedule(name: &str) -> Schedule {
-    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join(format!("../testkit/mixes/{name}.toml"));
-    lut_gen::synthesize(&lut_gen::load(&p).unwrap()).unwrap()
+    lut_gen::synthesize(&crate::common::testkit(name)).unwrap()
 }
 
 fn doc(s: &Schedule) -> serde_json::Value {

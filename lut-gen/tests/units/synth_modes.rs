@@ -1,17 +1,7 @@
 use lut_gen::for_tests::{on_grid, one_mode};
-use lut_gen::{synthesize, Mix, Verdict, SEARCH_BUDGET};
+use lut_gen::{synthesize, Verdict, SEARCH_BUDGET};
 
-/// A shared test mix, or else the preset of that name (as `testkit::mix`).
-fn testkit(name: &str) -> Mix {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let own = root.join(format!("testkit/mixes/{name}.toml"));
-    let p = if own.exists() {
-        own
-    } else {
-        root.join(format!("mixes/{name}.toml"))
-    };
-    lut_gen::load(&p).unwrap()
-}
+use crate::common::testkit;
 
 #[test]
 fn every_mode_is_placed_on_one_grid_at_its_rates() {

@@ -127,13 +127,8 @@ fn a_reaction_longer_than_the_audits_worst_is_a_problem() {
 /// it is below 2000 for 1 to 3 frames.
 fn random_auto_mix(seed: u64) -> String {
     use std::fmt::Write;
-    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut next = move |n: u64| {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x % n
-    };
+    let mut draw = testkit::modemix::Draw::new(seed);
+    let mut next = |n: u64| draw.below(n);
     let mut t = format!(
         "name = \"r{seed}\"\n[clock]\nhz = 8_000_000\n[frame]\nperiod_us = 1_000\nslice_us = 500\n\
          [[mode]]\nname = \"low\"\n[[mode]]\nname = \"high\"\n[modes]\nselect = \"auto\"\n\
