@@ -55,7 +55,7 @@ else
 	$(CARGO) test --workspace --locked
 endif
 	$(MAKE) golden GOLDEN_SLOTFORGE=$${CARGO_TARGET_DIR:-target}/debug/slotforge
-	$(MAKE) test-host HOST_SLOTFORGE=$${CARGO_TARGET_DIR:-$(CURDIR)/target}/debug/slotforge
+	$(MAKE) test-host HOST_SLOTFORGE=$${CARGO_TARGET_DIR:-$(CURDIR)/target}/debug/slotforge HOST_PROFILE=dev
 
 # Campaigns, all-preset proofs, long runs and the flows of `make tools-extra`
 # (ECP5, Gowin, FuseSoC): not in `make test`; run before an issue is resolved.
@@ -137,11 +137,15 @@ $(VENV)/.created:
 # part is not a workspace member (its own Cargo.lock; pyo3 unifies other features, so
 # the workspace's artefacts would not be reused anyway): it builds in HOST_TARGET,
 # outside the clone so that CI's fresh clones share it (cargo rebuilds what changed).
+# HOST_PROFILE: cargo's profile of the Rust part; `make test` builds it in `dev`
+# (unoptimised: its tests read small captures, and the build from empty took
+# 24.6 s against 40.2 s of wall time, docs/performance.md).
 HOST_PIP_PACKAGES = maturin pytest matplotlib
 HOST_TARGET ?= $(if $(HOME),$(HOME)/.cache/slotforge/host-python-target,$(CURDIR)/target/host-python)
+HOST_PROFILE ?= release
 host: venv
 	$(VENV)/bin/pip install --quiet $(HOST_PIP_PACKAGES)
-	PATH=$(abspath $(VENV))/bin:$$PATH CARGO_TARGET_DIR=$(HOST_TARGET) MATURIN_PEP517_ARGS=--locked \
+	PATH=$(abspath $(VENV))/bin:$$PATH CARGO_TARGET_DIR=$(HOST_TARGET) MATURIN_PEP517_ARGS="--locked --profile $(HOST_PROFILE)" \
 	  $(VENV)/bin/pip install --quiet --no-build-isolation ./host/python
 
 # Its tests (pytest), which hold it to the CLI: HOST_SLOTFORGE is the binary they

@@ -111,3 +111,49 @@ fn concurrent_builds_of_one_model_verilate_it_once() {
     let verilated = runs.lines().filter(|l| l.contains("--cc")).count();
     assert_eq!(verilated, 1, "verilator runs:\n{runs}");
 }
+
+/// A model's C++ files read `verilated.h` precompiled (the `.gch` built
+/// once beside Verilator's runtime in the cache), not parsed again: `g++`
+/// is a wrapper on PATH that adds `-H`, which prints `! FILE.gch` for a
+/// precompiled header used.
+#[test]
+fn a_models_files_read_verilated_h_precompiled() {
+    if !tools::require_tools(&["verilator", "g++"]) {
+        return;
+    }
+    let cache = tempfile::tempdir().unwrap();
+    let bin = tempfile::tempdir().unwrap();
+    let log = bin.path().join("includes.log");
+    let real = std::env::split_paths(&std::env::var_os("PATH").unwrap())
+        .map(|d| d.join("g++"))
+        .find(|p| p.is_file())
+        .unwrap();
+    let wrapper = bin.path().join("g++");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\nexec '{}' -H \"$@\" 2>>'{}'\n",
+            real.display(),
+            log.display()
+        ),
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let path = std::env::join_paths(
+        std::iter::once(bin.path().to_path_buf())
+            .chain(std::env::split_paths(&std::env::var_os("PATH").unwrap())),
+    )
+    .unwrap();
+    std::env::set_var("PATH", path);
+    std::env::set_var("SLOTFORGE_CACHE", cache.path());
+    let (_, built) = VerilatedDut::new(STANDIN).unwrap();
+    assert!(!built.cached);
+    let includes = std::fs::read_to_string(&log).unwrap();
+    let used = includes
+        .lines()
+        .filter(|l| l.starts_with("! ") && l.ends_with("slotforge_pch.h.gch"))
+        .count();
+    // the model's file and the shim
+    assert_eq!(used, 2, "g++ -H:\n{includes}");
+}
