@@ -426,6 +426,22 @@ fn the_adaptive_preset_proves() {
     assert_whole_contract_proved_split_on_decisions(&p);
 }
 
+/// An unseen glove of the auto kind (`formal/tests/data/glove-auto-uart.toml`:
+/// 24 taxels whose rate a touch raises, a release held for 5 frames, a
+/// second branch, a 3 Mbaud UART, 48 MHz, 10 ms frames) proves the whole
+/// contract, its link's bytes included (about 2 minutes).
+#[test]
+#[ignore = "long: make test-long"]
+fn an_unseen_auto_glove_with_a_uart_proves() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("formal/tests/data/glove-auto-uart.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_whole_contract_proved_split_on_decisions(&p);
+}
+
 /// Whether some mode of `s` samples no channel of some branch: that branch
 /// idles in it and keeps the data, channel and mux of its last conversion
 /// for as long as the requests stay there.

@@ -601,8 +601,8 @@ fn every_preset_and_the_largest_test_mixes_prove() {
         .unwrap()
         .map(|e| format!("mixes/{}", e.unwrap().file_name().to_string_lossy()))
         .filter(|n| n.ends_with(".toml"))
-        // Not the presets with modes: an auto-select mix's search is bounded,
-        // not a proof (tests/modes.rs holds the adaptive preset to that).
+        // Not the presets with modes: tests/modes.rs proves the adaptive
+        // preset on its own (it takes minutes).
         .filter(|n| lut_gen::load(&root().join(n)).unwrap().modes.is_none())
         .collect();
     mixes.sort();
