@@ -309,24 +309,81 @@ pub fn window_conversions<'a>(
     frames: u64,
     margin: u64,
 ) -> Vec<(&'a Schedule, usize, usize)> {
+    in_window(s, modes, b, frames, margin)
+        .into_iter()
+        .map(|(_, m, k, ch)| (m, k, ch))
+        .collect()
+}
+
+/// [`window_conversions`] with each conversion's frame first.
+fn in_window<'a>(
+    s: &'a Schedule,
+    modes: &[u8],
+    b: usize,
+    frames: u64,
+    margin: u64,
+) -> Vec<(u64, &'a Schedule, usize, usize)> {
     let f = s.grid.frame_cycles;
     let read = s.branches[b].spi.read_cycles;
     let mut out = Vec::new();
     for frame in 1..frames {
-        let m = modes
-            .get(frame as usize)
-            .and_then(|&m| s.modes.get(m as usize))
-            .unwrap_or(s);
+        let m = mode_of(s, modes, frame).unwrap_or(s);
         let mine = m
             .instants(frame + 1)
             .filter(|i| i.branch == b && i.cycle / f == frame);
         for (k, i) in mine.enumerate() {
             if i.cycle + read + margin < frames * f {
-                out.push((m, k, i.channel));
+                out.push((frame, m, k, i.channel));
             }
         }
     }
     out
+}
+
+/// The schedule of the mode frame `frame` ran in, as `modes` shows it
+/// (`s` itself for a mix without modes); `None` for a mode mix's frame
+/// that `modes` does not show.
+fn mode_of<'a>(s: &'a Schedule, modes: &[u8], frame: u64) -> Option<&'a Schedule> {
+    if s.modes.is_empty() {
+        return Some(s);
+    }
+    modes
+        .get(frame as usize)
+        .and_then(|&m| s.modes.get(m as usize))
+}
+
+/// The word the schedule sends in each of branch `b`'s conversions in the
+/// window (in [`window_conversions`]' order): its frame's mode's, except
+/// in a frame's last `ahead` conversions (the AD7689's 2), whose words
+/// select the next frame's first conversions in the next frame's mode
+/// (decided while this frame runs); `None` for those whose next frame is
+/// past the run (its mode unknown).
+pub fn window_commands(
+    s: &Schedule,
+    modes: &[u8],
+    b: usize,
+    frames: u64,
+) -> Vec<Option<lut_gen::CommandSent>> {
+    let ahead = s.prepared_conversions(b) as usize;
+    in_window(s, modes, b, frames, 0)
+        .into_iter()
+        .map(|(frame, m, k, _)| {
+            let words = m.commands_in_frame(b);
+            let n = words.len();
+            if k + ahead < n {
+                return Some(words[k].clone());
+            }
+            // word `i` selects conversion `i + ahead`: the next frame's
+            // conversion `j` is selected by its own table's word `j - ahead`
+            let next = mode_of(s, modes, frame + 1)?.commands_in_frame(b);
+            let j = k + ahead - n;
+            let w = &next[(j + next.len() - ahead % next.len()) % next.len()];
+            Some(lut_gen::CommandSent {
+                slot: words[k].slot,
+                ..w.clone()
+            })
+        })
+        .collect()
 }
 
 /// Branch `b`'s decode against the design's samples and, for a converter
@@ -397,10 +454,7 @@ fn check_commands(
     got: &[Vec<bool>],
 ) -> Result<(), String> {
     let name = &s.branches[b].name;
-    let want: Vec<lut_gen::CommandSent> = window_conversions(s, modes, b, frames, 0)
-        .iter()
-        .map(|&(m, k, _)| m.commands_in_frame(b)[k].clone())
-        .collect();
+    let want = window_commands(s, modes, b, frames);
     let bits = |w: &[bool]| -> String { w.iter().map(|&v| if v { '1' } else { '0' }).collect() };
     if got.len() != want.len() {
         return Err(format!(
@@ -409,12 +463,14 @@ fn check_commands(
             want.len()
         ));
     }
-    if let Some(k) = (0..got.len()).find(|&k| got[k] != want[k].word) {
+    let wrong = (got.iter().zip(&want).enumerate())
+        .find_map(|(k, (g, w))| w.as_ref().filter(|w| *g != w.word).map(|w| (k, w)));
+    if let Some((k, w)) = wrong {
         return Err(format!(
             "branch {name}: command word {k}: SPI (sigrok) read {} on mosi, the schedule sends {} (selecting {})",
             bits(&got[k]),
-            bits(&want[k].word),
-            s.mix.channels[want[k].selects].name
+            bits(&w.word),
+            s.mix.channels[w.selects].name
         ));
     }
     Ok(())
