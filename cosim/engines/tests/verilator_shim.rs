@@ -71,30 +71,8 @@ fn concurrent_builds_of_one_model_verilate_it_once() {
         return;
     }
     let cache = tempfile::tempdir().unwrap();
-    let bin = tempfile::tempdir().unwrap();
-    let log = bin.path().join("runs.log");
-    let real = std::env::split_paths(&std::env::var_os("PATH").unwrap())
-        .map(|d| d.join("verilator"))
-        .find(|p| p.is_file())
-        .unwrap();
-    let wrapper = bin.path().join("verilator");
-    std::fs::write(
-        &wrapper,
-        format!(
-            "#!/bin/sh\necho \"$*\" >> '{}'\nexec '{}' \"$@\"\n",
-            log.display(),
-            real.display()
-        ),
-    )
-    .unwrap();
-    use std::os::unix::fs::PermissionsExt;
-    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let path = std::env::join_paths(
-        std::iter::once(bin.path().to_path_buf())
-            .chain(std::env::split_paths(&std::env::var_os("PATH").unwrap())),
-    )
-    .unwrap();
-    std::env::set_var("PATH", path);
+    let (_bin, log) =
+        wrapped_first_on_path("verilator", "echo \"$*\" >> '{log}'\nexec '{real}' \"$@\"");
     std::env::set_var("SLOTFORGE_CACHE", cache.path());
     let keys: Vec<(String, bool)> = std::thread::scope(|s| {
         let h: Vec<_> = (0..2)
@@ -122,30 +100,7 @@ fn a_models_files_read_verilated_h_precompiled() {
         return;
     }
     let cache = tempfile::tempdir().unwrap();
-    let bin = tempfile::tempdir().unwrap();
-    let log = bin.path().join("includes.log");
-    let real = std::env::split_paths(&std::env::var_os("PATH").unwrap())
-        .map(|d| d.join("g++"))
-        .find(|p| p.is_file())
-        .unwrap();
-    let wrapper = bin.path().join("g++");
-    std::fs::write(
-        &wrapper,
-        format!(
-            "#!/bin/sh\nexec '{}' -H \"$@\" 2>>'{}'\n",
-            real.display(),
-            log.display()
-        ),
-    )
-    .unwrap();
-    use std::os::unix::fs::PermissionsExt;
-    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
-    let path = std::env::join_paths(
-        std::iter::once(bin.path().to_path_buf())
-            .chain(std::env::split_paths(&std::env::var_os("PATH").unwrap())),
-    )
-    .unwrap();
-    std::env::set_var("PATH", path);
+    let (_bin, log) = wrapped_first_on_path("g++", "exec '{real}' -H \"$@\" 2>>'{log}'");
     std::env::set_var("SLOTFORGE_CACHE", cache.path());
     let (_, built) = VerilatedDut::new(STANDIN).unwrap();
     assert!(!built.cached);
@@ -156,4 +111,30 @@ fn a_models_files_read_verilated_h_precompiled() {
         .count();
     // the model's file and the shim
     assert_eq!(used, 2, "g++ -H:\n{includes}");
+}
+
+/// Puts a shell wrapper of `tool` first on this process's PATH: `body`
+/// with `{real}` the tool it wraps and `{log}` a file beside it. Returns
+/// the wrapper's directory (kept while the test runs) and the log's path.
+fn wrapped_first_on_path(tool: &str, body: &str) -> (tempfile::TempDir, std::path::PathBuf) {
+    let bin = tempfile::tempdir().unwrap();
+    let log = bin.path().join(format!("{tool}.log"));
+    let real = std::env::split_paths(&std::env::var_os("PATH").unwrap())
+        .map(|d| d.join(tool))
+        .find(|p| p.is_file())
+        .unwrap();
+    let wrapper = bin.path().join(tool);
+    let body = body
+        .replace("{real}", &real.display().to_string())
+        .replace("{log}", &log.display().to_string());
+    std::fs::write(&wrapper, format!("#!/bin/sh\n{body}\n")).unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let path = std::env::join_paths(
+        std::iter::once(bin.path().to_path_buf())
+            .chain(std::env::split_paths(&std::env::var_os("PATH").unwrap())),
+    )
+    .unwrap();
+    std::env::set_var("PATH", path);
+    (bin, log)
 }
