@@ -103,7 +103,22 @@ pub struct Prepared {
 
 /// yosys: harness + design to `design.aig` (+ `design.aim`) or `design.smt2`.
 pub fn prepare(dir: &Path, solver: Solver) -> Result<Prepared, ProveError> {
-    let read = "read_verilog -formal harness.v; read_verilog -formal design.v;";
+    prepare_cut(dir, solver, None)
+}
+
+/// [`prepare`], with the wires `cut` selects (a yosys selection) made cut
+/// points: each driven by a free input in every step (`cutpoint`), so the
+/// AIG has every behaviour of the design and more (an over-approximation:
+/// a property it proves holds of the design; a violation may be of the
+/// extra behaviours only).
+pub fn prepare_cut(dir: &Path, solver: Solver, cut: Option<&str>) -> Result<Prepared, ProveError> {
+    let read = match cut {
+        Some(sel) => format!(
+            "read_verilog -formal harness.v; read_verilog -formal design.v; \
+             hierarchy -top slotforge_formal; proc; cutpoint {sel};"
+        ),
+        None => "read_verilog -formal harness.v; read_verilog -formal design.v;".to_string(),
+    };
     let script = match solver {
         // As SymbiYosys's `abc pdr` engine prepares an AIG (docs/formal.md),
         // but flattened before the first `opt`: `prep` optimises each of the

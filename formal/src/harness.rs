@@ -70,6 +70,41 @@ pub struct Harness {
     pub not_covered: Vec<Clause>,
 }
 
+impl Harness {
+    /// This harness asserting only the properties `keep` selects: the same
+    /// module and inputs, its `ok` the conjunction of those (the others'
+    /// logic stays in the text, read by nothing, and yosys drops it).
+    pub(crate) fn asserting(&self, keep: impl Fn(&PropertyDef) -> bool) -> Harness {
+        let properties: Vec<PropertyDef> = self
+            .properties
+            .iter()
+            .filter(|p| keep(p))
+            .cloned()
+            .collect();
+        let wires: Vec<&str> = properties.iter().map(|p| p.wire.as_str()).collect();
+        let ok = match wires.is_empty() {
+            true => "1'b1".to_string(),
+            false => wires.join(" & "),
+        };
+        let verilog = (self.verilog.lines())
+            .map(|l| match l.starts_with(OK_WIRE) {
+                true => format!("{OK_WIRE}{ok};"),
+                false => l.to_string(),
+            })
+            .collect::<Vec<String>>()
+            .join("\n")
+            + "\n";
+        Harness {
+            verilog,
+            properties,
+            ..self.clone()
+        }
+    }
+}
+
+/// The line that begins the harness's conjunction of its properties.
+const OK_WIRE: &str = "  wire ok = ";
+
 /// Why a schedule has no harness.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{0}")]
@@ -277,7 +312,7 @@ pub fn generate_parts(
     if layout.link {
         link::properties(&mut v, &mut props, s, &layout, bytes);
     }
-    let _ = writeln!(v, "  wire ok = {};", {
+    let _ = writeln!(v, "{OK_WIRE}{};", {
         let w: Vec<&str> = props
             .iter()
             .map(|p: &PropertyDef| p.wire.as_str())

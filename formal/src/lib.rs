@@ -360,6 +360,12 @@ fn main_run(
     work: &Path,
     opts: &ProveOptions,
 ) -> Result<(Outcome, u64, String), ProveError> {
+    let slave = main.inputs.iter().any(|i| i.name == harness::TREADY_ANY);
+    if opts.solver == Solver::Symbolic && slave && harness::auto_frames(s).is_some() {
+        if let Some(proved) = composed(s, main, design, opts)? {
+            return Ok(proved);
+        }
+    }
     write_inputs(work, main, design)?;
     let prep = engine::prepare(work, opts.solver)?;
     let f = main.frame_cycles;
@@ -368,6 +374,80 @@ fn main_run(
         Solver::Abc => strategy::abc(&prep, f, opts),
         Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work, f, opts),
     }
+}
+
+/// The design's mode decision in slotforge's gateware (`hdl`'s modes
+/// block: the mode the next frame runs, from the triggers), as a yosys
+/// selection.  Cut, it is a free input: `nxt` takes any value at every
+/// frame start.  A design without such a wire is not cut (the same AIG).
+const MODE_DECISION: &str = "*/decided";
+
+/// The properties that read an AXI4-Stream slave's choices: the FIFO's
+/// and the held beats'.
+fn reads_slave(p: &PropertyDef) -> bool {
+    (p.covers.iter()).any(|c| {
+        matches!(
+            c,
+            Clause::LinkOverflow | Clause::AxisValidHeld | Clause::AxisPayloadHeld
+        )
+    })
+}
+
+/// Auto select with an AXI4-Stream slave, in two runs.  Together the
+/// slave's choices and the trigger decisions (functions of the codes) make
+/// a FIFO fill per path of codes, which never come round; apart, each
+/// closes.  The properties that read the slave, on the design with its mode
+/// decision cut ([`MODE_DECISION`]): every sequence of modes at frame
+/// starts, those the triggers choose among them, so a proof there holds of
+/// the design (their cone then holds no data, and the explicit search of
+/// the slave's choices decides).  Every other property on the design as it
+/// is (its cone does not read the slave).  `Some` when both are proved;
+/// `None` otherwise, and the whole harness's run decides (a violation of
+/// the cut design may be of its extra behaviours only).
+fn composed(
+    s: &Schedule,
+    main: &Harness,
+    design: &str,
+    opts: &ProveOptions,
+) -> Result<Option<(Outcome, u64, String)>, ProveError> {
+    let (link, rest) = (
+        main.asserting(reads_slave),
+        main.asserting(|p| !reads_slave(p)),
+    );
+    let f = main.frame_cycles;
+    let work = work_dir()?;
+    write_inputs(work.path(), &link, design)?;
+    let prep = engine::prepare_cut(work.path(), Solver::Symbolic, Some(MODE_DECISION))?;
+    let (r1, d1, n1) = symbolic(&prep, f, None, opts)?;
+    if r1 != Outcome::Proved {
+        return Ok(None);
+    }
+    let work = work_dir()?;
+    write_inputs(work.path(), &rest, design)?;
+    let prep = engine::prepare(work.path(), Solver::Symbolic)?;
+    let (r2, d2, n2) = symbolic(&prep, f, harness::auto_frames(s), opts)?;
+    if r2 != Outcome::Proved {
+        return Ok(None);
+    }
+    let how = |n: &str| {
+        n.strip_prefix(PROVED)
+            .unwrap_or(n)
+            .trim_start_matches(": ")
+            .to_string()
+    };
+    let names: Vec<&str> = link.properties.iter().map(|p| p.name.as_str()).collect();
+    Ok(Some((
+        Outcome::Proved,
+        d1.max(d2),
+        format!(
+            "{PROVED}, in two runs: {} with the design's mode decision a free input (any mode \
+             at every frame start, so every sequence the triggers can choose): {}; every other \
+             property on the design as it is: {}",
+            names.join(", "),
+            how(&n1),
+            how(&n2)
+        ),
+    )))
 }
 
 /// The note of a proof whose link's bytes (`b`) ran apart from the rest
