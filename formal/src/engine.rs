@@ -103,29 +103,21 @@ pub struct Prepared {
 
 /// yosys: harness + design to `design.aig` (+ `design.aim`) or `design.smt2`.
 pub fn prepare(dir: &Path, solver: Solver) -> Result<Prepared, ProveError> {
-    prepare_cut(dir, solver, None)
+    prepare_edited(dir, solver, "")
 }
 
-/// [`prepare`], with the wires `cut` selects (a yosys selection) made cut
-/// points: each driven by a free input in every step (`cutpoint`), so the
-/// AIG has every behaviour of the design and more (an over-approximation:
-/// a property it proves holds of the design; a violation may be of the
-/// extra behaviours only).
-pub fn prepare_cut(dir: &Path, solver: Solver, cut: Option<&str>) -> Result<Prepared, ProveError> {
-    let read = match cut {
-        Some(sel) => format!(
-            "read_verilog -formal harness.v; read_verilog -formal design.v; \
-             hierarchy -top slotforge_formal; proc; cutpoint {sel};"
-        ),
-        None => "read_verilog -formal harness.v; read_verilog -formal design.v;".to_string(),
-    };
+/// [`prepare`] for the symbolic engine, with yosys commands `edit` run on
+/// the flattened harness and design before anything is optimised (a cut
+/// point, a wire tied to another: `formal::composed`, `formal::tied`).
+pub fn prepare_edited(dir: &Path, solver: Solver, edit: &str) -> Result<Prepared, ProveError> {
+    let read = "read_verilog -formal harness.v; read_verilog -formal design.v;";
     let script = match solver {
         // As SymbiYosys's `abc pdr` engine prepares an AIG (docs/formal.md),
         // but flattened before the first `opt`: `prep` optimises each of the
         // dozen modules apart and again after flattening, which was 1 s of
         // eskin34's 5.6 s in yosys for the same AIG give or take 15 gates.
         Solver::Symbolic | Solver::Abc | Solver::Pdr => format!(
-            "{read} hierarchy -check -top slotforge_formal; proc; flatten; opt_clean; \
+            "{read} hierarchy -check -top slotforge_formal; proc; flatten; {edit} opt_clean; \
              memory -nomap; memory_map; opt -full; async2sync; \
              chformal -assume -early; setundef -anyseq; opt -full; techmap; opt -fast; \
              dffunmap; abc -g AND -fast; opt_clean; write_aiger -I -B -zinit -map design.aim design.aig; \

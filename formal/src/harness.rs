@@ -102,6 +102,61 @@ impl Harness {
     }
 }
 
+impl Harness {
+    /// This harness with auto select's decision (`dec`, the mode the next
+    /// frame runs) read from a free input `mode_sel` (taken mid-frame)
+    /// instead of its triggers, as pin select's is (a value naming no mode
+    /// keeps `mnext`): `formal::tied` ties the
+    /// design's decision to the same wire.  `None` without that decision.
+    pub(crate) fn deciding_by_input(&self, s: &Schedule) -> Option<Harness> {
+        let n = modes::modes(s)?.names.len();
+        // the request is taken in the middle of a frame, so the design and
+        // the harness, which take a decision a cycle or so apart at the
+        // frame's end, read the same one
+        let g = &s.grid;
+        let mid = match g.frame_slots {
+            1 => format!("cyc == {}", g.slot_cycles / 2),
+            k => format!("slot == {} && cyc == 0", k / 2),
+        };
+        let mut width = None;
+        let mut lines = Vec::new();
+        for l in self.verilog.lines() {
+            let bits = l
+                .strip_prefix("  wire [")
+                .and_then(|r| r.split_once("] dec = "));
+            match bits {
+                Some((w, _)) if width.is_none() && !l.contains(MODE_SEL) => {
+                    lines.push(format!(
+                        "  reg [{w}] dsel = 0;\n  \
+                         always @(posedge clk) if (run && {mid}) dsel <= {MODE_SEL};\n  \
+                         wire [{w}] dec = {{1'b0, dsel}} < {n} ? dsel : mnext;"
+                    ));
+                    width = Some(w.to_string());
+                }
+                _ => lines.push(l.to_string()),
+            }
+        }
+        let w = width?;
+        let top: u32 = w.strip_suffix(":0")?.parse().ok()?;
+        let text = lines.join("\n") + "\n";
+        let end = text.find("\n);")?;
+        let mut inputs = self.inputs.clone();
+        inputs.push(FreeInput {
+            name: MODE_SEL.into(),
+            width: top + 1,
+        });
+        Some(Harness {
+            verilog: format!(
+                "{},\n  input [{w}] {MODE_SEL}{}",
+                &text[..end],
+                &text[end..]
+            ),
+            inputs,
+            ..self.clone()
+        })
+    }
+}
+
 /// The line that begins the harness's conjunction of its properties.
 const OK_WIRE: &str = "  wire ok = ";
 

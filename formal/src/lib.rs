@@ -199,6 +199,11 @@ pub struct ProveOptions {
     /// without simulating 256 frames.  `None`, or a name the design does
     /// not have: the link's bytes are searched as before.
     pub frame_counter: Option<String>,
+    /// The design's mode decision under `slotforge_top` (`hdl::MODE_DECISION`
+    /// for slotforge's gateware): with auto select, the link's properties are
+    /// proved with it cut (`composed`, `tied`).  `None`, or a name the design
+    /// does not have: they are proved with the triggers as before.
+    pub mode_decision: Option<String>,
 }
 
 impl ProveOptions {
@@ -212,6 +217,7 @@ impl ProveOptions {
             own_design: true,
             netlist: None,
             frame_counter: None,
+            mode_decision: None,
         }
     }
 }
@@ -250,7 +256,10 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     // the whole harness with the frame counters generalised: when it
     // decides (proved, or a trace from reset), it is the only run
     let general = match reads_bytes {
-        true => link_generalised(s, &h, design, opts)?,
+        true => match tied(s, &h, design, opts)? {
+            Some(t) => Some(t),
+            None => link_generalised(s, &h, design, opts, None)?,
+        },
         false => None,
     };
     let decided = general
@@ -376,11 +385,118 @@ fn main_run(
     }
 }
 
-/// The design's mode decision in slotforge's gateware (`hdl`'s modes
-/// block: the mode the next frame runs, from the triggers), as a yosys
-/// selection.  Cut, it is a free input: `nxt` takes any value at every
-/// frame start.  A design without such a wire is not cut (the same AIG).
-const MODE_DECISION: &str = "*/decided";
+/// yosys commands that make the design's mode decision (`opts.mode_decision`)
+/// a cut point, a free input in every step; `None` without a name.
+fn decision_cut(opts: &ProveOptions) -> Option<String> {
+    let w = format!("w:dut.{}", opts.mode_decision.as_ref()?);
+    // `opt_clean` first: the readers of the wire then read it, not an alias
+    // of its driver's output (`cutpoint` alone left them reading the driver)
+    Some(format!(
+        "opt_clean; select -assert-count 1 {w}; cutpoint {w};"
+    ))
+}
+
+/// yosys commands that tie the design's mode decision to the harness's
+/// `dec` (which [`Harness::deciding_by_input`] reads from `mode_sel`).
+fn decision_tie(opts: &ProveOptions) -> Option<String> {
+    let w = format!("dut.{}", opts.mode_decision.as_ref()?);
+    Some(format!(
+        "opt_clean; select -assert-count 1 w:{w}; cutpoint w:{w}; connect -unset {w}; \
+         connect -set {w} dec;"
+    ))
+}
+
+/// The properties of the link: its FIFO, a UART's line or an AXI4-Stream's
+/// beats, the packets.
+fn reads_link(p: &PropertyDef) -> bool {
+    (p.covers.iter()).any(|c| {
+        matches!(
+            c,
+            Clause::LinkOverflow
+                | Clause::UartCharacters
+                | Clause::AxisBeats
+                | Clause::AxisValidHeld
+                | Clause::AxisPayloadHeld
+                | Clause::LinkPackets
+        )
+    })
+}
+
+/// Auto select with the link's bytes asserted, in two runs.  The whole
+/// harness splits at frame starts on the trigger decisions, and with the
+/// link's FIFO and packets the states at frame starts are many (the preset
+/// eskin34-adaptive: 495, minutes).  The properties that do not read the
+/// link, on the design as it is (split on the decisions; they close as a
+/// mix without a link does, `mode` among them: the design's decisions are
+/// the triggers'); the link's, with the design's decision and the harness's
+/// tied to one free input (`mode_sel`, split on as pin select's): every
+/// sequence of modes, the design and the harness in the same mode, which on
+/// every real trace they are (`mode`, proved by the first run), so a proof
+/// there holds of the design.  `Some` when both are proved; `None`
+/// otherwise, and the whole harness decides as before.
+fn tied(
+    s: &Schedule,
+    h: &Harness,
+    design: &str,
+    opts: &ProveOptions,
+) -> Result<Option<GeneralRun>, ProveError> {
+    // slotforge's own RTL only: the tie stands for the decision at the
+    // cycles where the gateware takes it (`nxt <= decided`, `hdl`'s modes
+    // block), which is all it reads; another design (or a netlist) might
+    // read a wire of that name elsewhere
+    if !opts.own_design || opts.netlist.is_some() {
+        return Ok(None);
+    }
+    // an AXI4-Stream's bytes split on the slave's choices and the modes
+    // together do not come round in a long frame, tied or not (docs/formal.md,
+    // "Limits"): the runs as before
+    if h.inputs.iter().any(|i| i.name == harness::TREADY_ANY) {
+        return Ok(None);
+    }
+    let (Some(auto), Some(tie)) = (harness::auto_frames(s), decision_tie(opts)) else {
+        return Ok(None);
+    };
+    let Some(link) = h.asserting(reads_link).deciding_by_input(s) else {
+        return Ok(None);
+    };
+    let rest = h.asserting(|p| !reads_link(p));
+    let work = work_dir()?;
+    write_inputs(work.path(), &rest, design)?;
+    let prep = engine::prepare(work.path(), Solver::Symbolic)?;
+    let (r1, d1, n1) = symbolic(&prep, h.frame_cycles, Some(auto), opts)?;
+    if r1 != Outcome::Proved {
+        return Ok(None);
+    }
+    let Some(g) = link_generalised(s, &link, design, opts, Some(&tie))? else {
+        return Ok(None);
+    };
+    if g.run.result != Outcome::Proved {
+        return Ok(None);
+    }
+    let how = |n: &str| {
+        n.strip_prefix(PROVED)
+            .unwrap_or(n)
+            .trim_start_matches(": ")
+            .to_string()
+    };
+    let names: Vec<&str> = link.properties.iter().map(|p| p.name.as_str()).collect();
+    let note = format!(
+        "{PROVED}, in two runs: every property but the link's on the design as it is: {}; \
+         {} with the design's mode decision and the harness's tied to one free input (every \
+         sequence of modes, those the triggers choose among them): {}",
+        how(&n1),
+        names.join(", "),
+        how(&g.run.note)
+    );
+    Ok(Some(GeneralRun {
+        run: BytesRun {
+            note,
+            depth: d1.max(g.run.depth),
+            ..g.run
+        },
+        ..g
+    }))
+}
 
 /// The properties that read an AXI4-Stream slave's choices: the FIFO's
 /// and the held beats'.
@@ -397,7 +513,7 @@ fn reads_slave(p: &PropertyDef) -> bool {
 /// slave's choices and the trigger decisions (functions of the codes) make
 /// a FIFO fill per path of codes, which never come round; apart, each
 /// closes.  The properties that read the slave, on the design with its mode
-/// decision cut ([`MODE_DECISION`]): every sequence of modes at frame
+/// decision cut ([`decision_cut`]): every sequence of modes at frame
 /// starts, those the triggers choose among them, so a proof there holds of
 /// the design (their cone then holds no data, and the explicit search of
 /// the slave's choices decides).  Every other property on the design as it
@@ -414,10 +530,16 @@ fn composed(
         main.asserting(reads_slave),
         main.asserting(|p| !reads_slave(p)),
     );
+    let Some(cut) = decision_cut(opts) else {
+        return Ok(None);
+    };
     let f = main.frame_cycles;
     let work = work_dir()?;
     write_inputs(work.path(), &link, design)?;
-    let prep = engine::prepare_cut(work.path(), Solver::Symbolic, Some(MODE_DECISION))?;
+    // a design without that wire has nothing to cut: the whole run decides
+    let Ok(prep) = engine::prepare_edited(work.path(), Solver::Symbolic, &cut) else {
+        return Ok(None);
+    };
     let (r1, d1, n1) = symbolic(&prep, f, None, opts)?;
     if r1 != Outcome::Proved {
         return Ok(None);
@@ -631,6 +753,7 @@ fn link_generalised(
     h: &Harness,
     design: &str,
     opts: &ProveOptions,
+    tie: Option<&str>,
 ) -> Result<Option<GeneralRun>, ProveError> {
     let name = match (&opts.frame_counter, opts.solver) {
         (Some(n), Solver::Symbolic) if opts.depth.is_none() => n,
@@ -638,7 +761,14 @@ fn link_generalised(
     };
     let work = work_dir()?;
     write_inputs(work.path(), h, design)?;
-    let prep = engine::prepare(work.path(), Solver::Symbolic)?;
+    let prep = match tie {
+        None => engine::prepare(work.path(), Solver::Symbolic)?,
+        // a design without the tied wire: not this run
+        Some(edit) => match engine::prepare_edited(work.path(), Solver::Symbolic, edit) {
+            Ok(p) => p,
+            Err(_) => return Ok(None),
+        },
+    };
     let Some(pairs) = counter_pairs(&prep, &format!("dut.{name}"), harness::FRAME_COUNTER) else {
         return Ok(None);
     };
@@ -651,8 +781,9 @@ fn link_generalised(
     let f = h.frame_cycles;
     let counters = symsim::Counters { pairs, from: 2 };
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
-    // auto select: as deep as the main run may need for its windows
-    let auto = harness::auto_frames(s);
+    // auto select: as deep as the main run may need for its windows (tied,
+    // the decisions are a free input, split as pin select's)
+    let auto = harness::auto_frames(s).filter(|_| tie.is_none());
     // `+ 1`: the frame start at the last step is compared too (a run that
     // comes round there, as an unseen glove mix's did, closes)
     let limit = (GENERAL_FRAMES + auto.unwrap_or(0)) * f + 2 + 1;

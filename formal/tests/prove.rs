@@ -33,6 +33,7 @@ fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
     o.timeout_s = 1200;
     o.bmc_timeout_s = 1200;
     o.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
+    o.mode_decision = Some(hdl::MODE_DECISION.to_string());
     formal::prove(s, design, &o).expect("prove runs")
 }
 

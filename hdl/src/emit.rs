@@ -30,6 +30,13 @@ pub const LINK: &str = "slotforge_link";
 /// come round; a name that no longer matches only costs that.
 pub const LINK_FRAME_COUNTER: &str = "link.hframe";
 
+/// The mode decision of a mix with auto select (the mode the next frame
+/// runs, from the triggers), as a path under `slotforge_top`: `prove` cuts
+/// the design there (`formal`) so that the link's properties are proved for
+/// every sequence of modes apart from the triggers, which are proved on the
+/// design as it is; a name that no longer matches only costs that.
+pub const MODE_DECISION: &str = "core.modes_0.decided";
+
 /// The emitted Verilog file.
 pub const VERILOG_FILE: &str = "slotforge_top.v";
 /// The emitted port manifest.

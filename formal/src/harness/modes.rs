@@ -23,7 +23,7 @@ use super::{width, Clause, FreeInput, PropertyDef, Row};
 pub const MODE_SEL: &str = "mode_sel";
 
 /// The modes of `s` (more than one), else `None`.
-fn modes(s: &Schedule) -> Option<&lut_gen::Modes> {
+pub(super) fn modes(s: &Schedule) -> Option<&lut_gen::Modes> {
     s.mode_plan()
         .filter(|m| m.names.len() > 1 && !s.modes.is_empty())
 }

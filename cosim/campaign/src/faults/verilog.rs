@@ -112,6 +112,7 @@ pub fn prove_in(
     o.timeout_s = PROVE_SECONDS;
     o.bmc_timeout_s = PROVE_SECONDS;
     o.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
+    o.mode_decision = Some(hdl::MODE_DECISION.to_string());
     let p = formal::prove(s, design, &o).map_err(|e| e.to_string())?;
     let v = verdict(&p);
     Ok((p, v))
