@@ -447,6 +447,11 @@ fn tied(
     if !opts.own_design || opts.netlist.is_some() {
         return Ok(None);
     }
+    // the second run is `link_generalised`'s: without it, no first run
+    let general = opts.solver == Solver::Symbolic && opts.depth.is_none();
+    if !general || opts.frame_counter.is_none() {
+        return Ok(None);
+    }
     // an AXI4-Stream's bytes split on the slave's choices and the modes
     // together do not come round in a long frame, tied or not (docs/formal.md,
     // "Limits"): the runs as before
@@ -462,7 +467,10 @@ fn tied(
     let rest = h.asserting(|p| !reads_link(p));
     let work = work_dir()?;
     write_inputs(work.path(), &rest, design)?;
-    let prep = engine::prepare(work.path(), Solver::Symbolic)?;
+    // a tool that fails here fails the runs as before too, with its message
+    let Ok(prep) = engine::prepare(work.path(), Solver::Symbolic) else {
+        return Ok(None);
+    };
     let (r1, d1, n1) = symbolic(&prep, h.frame_cycles, Some(auto), opts)?;
     if r1 != Outcome::Proved {
         return Ok(None);
