@@ -458,43 +458,28 @@ fn tied(
     if h.inputs.iter().any(|i| i.name == harness::TREADY_ANY) {
         return Ok(None);
     }
-    let (Some(auto), Some(tie)) = (harness::auto_frames(s), decision_tie(opts)) else {
+    let (Some(_), Some(tie)) = (harness::auto_frames(s), decision_tie(opts)) else {
         return Ok(None);
     };
     let Some(link) = h.asserting(reads_link).deciding_by_input(s) else {
         return Ok(None);
     };
-    let rest = h.asserting(|p| !reads_link(p));
-    let work = work_dir()?;
-    write_inputs(work.path(), &rest, design)?;
-    // a tool that fails here fails the runs as before too, with its message
-    let Ok(prep) = engine::prepare(work.path(), Solver::Symbolic) else {
+    let Some((d1, n1)) = exactly(s, &h.asserting(|p| !reads_link(p)), design, opts)? else {
         return Ok(None);
     };
-    let (r1, d1, n1) = symbolic(&prep, h.frame_cycles, Some(auto), opts)?;
-    if r1 != Outcome::Proved {
-        return Ok(None);
-    }
     let Some(g) = link_generalised(s, &link, design, opts, Some(&tie))? else {
         return Ok(None);
     };
     if g.run.result != Outcome::Proved {
         return Ok(None);
     }
-    let how = |n: &str| {
-        n.strip_prefix(PROVED)
-            .unwrap_or(n)
-            .trim_start_matches(": ")
-            .to_string()
-    };
-    let names: Vec<&str> = link.properties.iter().map(|p| p.name.as_str()).collect();
     let note = format!(
         "{PROVED}, in two runs: every property but the link's on the design as it is: {}; \
          {} with the design's mode decision and the harness's tied to one free input (every \
          sequence of modes, those the triggers choose among them): {}",
-        how(&n1),
-        names.join(", "),
-        how(&g.run.note)
+        how_proved(&n1),
+        property_names(&link),
+        how_proved(&g.run.note)
     );
     Ok(Some(GeneralRun {
         run: BytesRun {
@@ -504,6 +489,38 @@ fn tied(
         },
         ..g
     }))
+}
+
+/// The first of the two runs (`tied`, `composed`): the properties `rest`
+/// asserts on the design as it is, by the symbolic engine split on auto
+/// select's decisions; its depth and note when proved, else `None` (a tool
+/// that fails here fails the runs as before too, with its message).
+fn exactly(
+    s: &Schedule,
+    rest: &Harness,
+    design: &str,
+    opts: &ProveOptions,
+) -> Result<Option<(u64, String)>, ProveError> {
+    let work = work_dir()?;
+    write_inputs(work.path(), rest, design)?;
+    let Ok(prep) = engine::prepare(work.path(), Solver::Symbolic) else {
+        return Ok(None);
+    };
+    let (r, depth, note) = symbolic(&prep, rest.frame_cycles, harness::auto_frames(s), opts)?;
+    Ok((r == Outcome::Proved).then_some((depth, note)))
+}
+
+/// A proof's note after "proved for all time: " (how it was proved).
+fn how_proved(note: &str) -> &str {
+    note.strip_prefix(PROVED)
+        .unwrap_or(note)
+        .trim_start_matches(": ")
+}
+
+/// The names of the properties `h` asserts, in its order.
+fn property_names(h: &Harness) -> String {
+    let names: Vec<&str> = h.properties.iter().map(|p| p.name.as_str()).collect();
+    names.join(", ")
 }
 
 /// The properties that read an AXI4-Stream slave's choices: the FIFO's
@@ -552,20 +569,9 @@ fn composed(
     if r1 != Outcome::Proved {
         return Ok(None);
     }
-    let work = work_dir()?;
-    write_inputs(work.path(), &rest, design)?;
-    let prep = engine::prepare(work.path(), Solver::Symbolic)?;
-    let (r2, d2, n2) = symbolic(&prep, f, harness::auto_frames(s), opts)?;
-    if r2 != Outcome::Proved {
+    let Some((d2, n2)) = exactly(s, &rest, design, opts)? else {
         return Ok(None);
-    }
-    let how = |n: &str| {
-        n.strip_prefix(PROVED)
-            .unwrap_or(n)
-            .trim_start_matches(": ")
-            .to_string()
     };
-    let names: Vec<&str> = link.properties.iter().map(|p| p.name.as_str()).collect();
     Ok(Some((
         Outcome::Proved,
         d1.max(d2),
@@ -573,9 +579,9 @@ fn composed(
             "{PROVED}, in two runs: {} with the design's mode decision a free input (any mode \
              at every frame start, so every sequence the triggers can choose): {}; every other \
              property on the design as it is: {}",
-            names.join(", "),
-            how(&n1),
-            how(&n2)
+            property_names(&link),
+            how_proved(&n1),
+            how_proved(&n2)
         ),
     )))
 }
