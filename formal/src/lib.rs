@@ -804,7 +804,7 @@ fn link_generalised(
     // an AXI4-Stream slave's choices and mode requests: one path per value
     // where a step reads them, paths in the same state at a step merged
     // (`symsim::split`); auto select's decisions at frame starts (`cases`)
-    let splits = Splits::of(&prep, auto.is_some());
+    let splits = Splits::of(&prep, auto.is_some(), tie.is_some());
     let (found, st) = symsim::prove_generalised(
         &g,
         counters,
@@ -920,14 +920,18 @@ struct Splits {
     mode_sel: Vec<usize>,
     tready: Vec<usize>,
     auto: bool,
+    /// `mode_sel` is auto select's decision tied to a free input (`tied`),
+    /// not pin select's requests.
+    tied: bool,
 }
 
 impl Splits {
-    fn of(prep: &engine::Prepared, auto: bool) -> Splits {
+    fn of(prep: &engine::Prepared, auto: bool, tied: bool) -> Splits {
         Splits {
             mode_sel: named_inputs(prep, harness::MODE_SEL),
             tready: named_inputs(prep, harness::TREADY_ANY),
             auto,
+            tied,
         }
     }
 
@@ -939,7 +943,12 @@ impl Splits {
     /// What the run splits on, in words ("on ... and on ...").
     fn words(&self) -> String {
         let mut on = Vec::new();
-        if !self.mode_sel.is_empty() {
+        if !self.mode_sel.is_empty() && self.tied {
+            on.push(
+                "on the tied mode decision (mode_sel, the free input both decisions are tied to: \
+                 one path per value in each step that reads it)",
+            );
+        } else if !self.mode_sel.is_empty() {
             on.push(
                 "on the mode requests (mode_sel: one path per value in each step that reads it)",
             );

@@ -410,10 +410,13 @@ fn assert_whole_contract_proved_split_on_decisions(p: &Proof) {
         "in two runs",
         "split on the trigger decisions",
         "tied to one free input",
+        "split on the tied mode decision",
         "frame counter generalised",
     ] {
         assert!(p.note.contains(how), "{how}: {}", p.note);
     }
+    // an auto mix has no mode requests to split on
+    assert!(!p.note.contains("mode requests"), "{}", p.note);
 }
 
 /// The preset (48 MHz, 10 ms frames, auto select over a UART) proves the
