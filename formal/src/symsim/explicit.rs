@@ -158,11 +158,15 @@ impl History {
 }
 
 /// A set of states, each `words` long, in insertion order, with the
-/// (predecessor, choice) that first reached each.
+/// (predecessor, choice) that first reached each.  Its index is an
+/// open-addressed table of positions in `flat` (no allocation per state:
+/// a step inserts some 30 states of an AXI4-Stream FIFO's cone, a few
+/// million steps a proof).
 struct States {
     words: usize,
     flat: Vec<u64>,
-    index: HashMap<Vec<u64>, u32>,
+    /// Positions + 1 (0: empty), a power of two long, at most half full.
+    slots: Vec<u32>,
     parents: Vec<(u32, u32)>,
 }
 
@@ -171,7 +175,7 @@ impl States {
         States {
             words,
             flat: Vec::new(),
-            index: HashMap::new(),
+            slots: vec![0; 64],
             parents: Vec::new(),
         }
     }
@@ -181,7 +185,7 @@ impl States {
         States {
             words,
             flat,
-            index: HashMap::new(),
+            slots: Vec::new(),
             parents,
         }
     }
@@ -194,11 +198,41 @@ impl States {
         &self.flat[i * self.words..(i + 1) * self.words]
     }
 
+    /// A state's slot to start probing at (a multiplicative hash).
+    fn home(&self, s: &[u64]) -> usize {
+        let h = (s.iter()).fold(0x9E37_79B9_7F4A_7C15u64, |h, &w| {
+            (h.rotate_left(5) ^ w).wrapping_mul(0x517C_C1B7_2722_0A95)
+        });
+        (h >> 32) as usize & (self.slots.len() - 1)
+    }
+
     fn insert(&mut self, s: &[u64], from: (u32, u32)) {
-        if !self.index.contains_key(s) {
-            self.index.insert(s.to_vec(), self.parents.len() as u32);
-            self.flat.extend_from_slice(s);
-            self.parents.push(from);
+        let mask = self.slots.len() - 1;
+        let mut at = self.home(s);
+        while self.slots[at] != 0 {
+            if self.get(self.slots[at] as usize - 1) == s {
+                return;
+            }
+            at = (at + 1) & mask;
+        }
+        self.flat.extend_from_slice(s);
+        self.parents.push(from);
+        self.slots[at] = self.parents.len() as u32;
+        if 2 * self.parents.len() > self.slots.len() {
+            self.grow();
+        }
+    }
+
+    /// The table twice as long, every state placed again.
+    fn grow(&mut self) {
+        self.slots = vec![0; 2 * self.slots.len()];
+        let mask = self.slots.len() - 1;
+        for i in 0..self.len() {
+            let mut at = self.home(self.get(i));
+            while self.slots[at] != 0 {
+                at = (at + 1) & mask;
+            }
+            self.slots[at] = i as u32 + 1;
         }
     }
 
@@ -210,15 +244,46 @@ impl States {
     }
 }
 
+/// Literal `l`'s bounds `[lo, hi]` in every lane (see `Machine::val`).
+#[inline]
+fn pair(val: &[[u64; 4]], l: u32) -> [u64; 2] {
+    let v = &val[(l >> 1) as usize];
+    let at = 2 * (l & 1) as usize;
+    [v[at], v[at + 1]]
+}
+
+/// Transposes a 64 x 64 bit matrix in place: bit `c` of row `r` becomes
+/// bit `r` of row `c` (the recursive block swap, six rounds).  It turns
+/// 64 lanes' state words into one lane mask per latch and back.
+fn transpose64(m: &mut [u64; 64]) {
+    let mut width = 32;
+    let mut mask: u64 = 0x0000_0000_FFFF_FFFF;
+    while width != 0 {
+        let mut r = 0;
+        while r < 64 {
+            for k in r..r + width {
+                let t = ((m[k] >> width) ^ m[k + width]) & mask;
+                m[k] ^= t << width;
+                m[k + width] ^= t;
+            }
+            r += 2 * width;
+        }
+        width >>= 1;
+        mask ^= mask << width;
+    }
+}
+
 /// The cone's gates, evaluated 64 lanes at a time.
 struct Machine<'a> {
     g: &'a Aig,
     ands: Vec<(u32, u32, u32)>,
     choices: Vec<usize>,
     words: usize,
-    /// Each gate's value in each lane, and whether it is unknown there.
-    val: Vec<u64>,
-    unknown: Vec<u64>,
+    /// Each variable's bounds in each lane and those of its negation:
+    /// `[lo, hi, !hi, !lo]` (known 0: lo = hi = 0; known 1: both 1;
+    /// unknown: lo = 0, hi = 1), so a literal's pair is read at
+    /// `2 * (l & 1)` and a gate is two ANDs.
+    val: Vec<[u64; 4]>,
     /// The inputs that are not choices (their variables): unknown unless a
     /// lane enumerates them.
     others: Vec<u32>,
@@ -231,8 +296,8 @@ impl<'a> Machine<'a> {
             ands: in_dependency_order(g),
             choices: choices.to_vec(),
             words: g.latches.len().div_ceil(64).max(1),
-            val: vec![0u64; g.max_var as usize + 1],
-            unknown: vec![0u64; g.max_var as usize + 1],
+            // the constant (variable 0) is known 0
+            val: vec![[0, 0, !0, !0]; g.max_var as usize + 1],
             others: {
                 // the other inputs the cone reads
                 let read: std::collections::HashSet<u32> = (g.ands.iter())
@@ -262,12 +327,13 @@ impl<'a> Machine<'a> {
             .flat_map(|s| (0..1u32 << nc).map(move |c| (s, c, false)))
             .collect();
         let mut next = States::new(self.words);
+        let mut st = vec![0u64; self.words];
         let mut at = 0;
         while at < lanes.len() {
-            let chunk: Vec<(u32, u32, bool)> = lanes[at..lanes.len().min(at + 64)].to_vec();
-            at += chunk.len();
-            let (bad, unknown, nexts) = self.eval(set, &chunk);
-            for (k, &(s, code, exact)) in chunk.iter().enumerate() {
+            let end = lanes.len().min(at + 64);
+            let (bad, unknown, nexts) = self.eval(set, &lanes[at..end]);
+            for k in 0..end - at {
+                let (s, code, exact) = lanes[at + k];
                 if unknown >> k & 1 == 1 {
                     if exact || self.others.len() > MAX_OTHER_BITS {
                         return None;
@@ -278,65 +344,63 @@ impl<'a> Machine<'a> {
                 } else if bad >> k & 1 == 1 {
                     return Some((next, Some((s, code))));
                 } else {
-                    let st: Vec<u64> = (nexts.chunks(64))
-                        .map(|ws| {
-                            let bits = ws.iter().enumerate();
-                            bits.fold(0, |a, (j, &w)| a | (w >> k & 1) << j)
-                        })
-                        .collect();
+                    for (w, word) in st.iter_mut().enumerate() {
+                        *word = nexts[w][k];
+                    }
                     next.insert(&st, (s, code));
                 }
             }
+            at = end;
         }
         Some((next, None))
     }
 
     /// Evaluates up to 64 lanes: the lanes whose assertion fails, those
-    /// whose successor or assertion is unknown, and each latch's next
-    /// value per lane.
-    fn eval(&mut self, set: &States, chunk: &[(u32, u32, bool)]) -> (u64, u64, Vec<u64>) {
+    /// whose successor or assertion is unknown, and the successors, by
+    /// state word and lane (`[w][k]`: word `w` of lane `k`'s next state).
+    fn eval(&mut self, set: &States, chunk: &[(u32, u32, bool)]) -> (u64, u64, Vec<[u64; 64]>) {
         let nc = self.choices.len();
-        let (val, unknown) = (&mut self.val, &mut self.unknown);
-        for &(l, _, _) in &self.g.latches {
-            (val[(l >> 1) as usize], unknown[(l >> 1) as usize]) = (0, 0);
+        let val = &mut self.val;
+        let known = |v: u64| [v, v, !v, !v];
+        // each latch's value in every lane: the lanes' state words,
+        // transposed 64 latches at a time
+        for w in 0..self.words {
+            let mut m = [0u64; 64];
+            for (k, &(s, _, _)) in chunk.iter().enumerate() {
+                m[k] = set.get(s as usize)[w];
+            }
+            transpose64(&mut m);
+            for (j, &(l, _, _)) in self.g.latches.iter().enumerate().skip(64 * w).take(64) {
+                val[(l >> 1) as usize] = known(m[j - 64 * w]);
+            }
         }
-        for &i in &self.choices {
-            (
-                val[(self.g.inputs[i] >> 1) as usize],
-                unknown[(self.g.inputs[i] >> 1) as usize],
-            ) = (0, 0);
-        }
-        for &v in &self.others {
-            (val[v as usize], unknown[v as usize]) = (0, !0);
-        }
-        let states: Vec<&[u64]> = chunk.iter().map(|&(s, _, _)| set.get(s as usize)).collect();
-        for (j, &(l, _, _)) in self.g.latches.iter().enumerate() {
-            let bits = states.iter().enumerate();
-            val[(l >> 1) as usize] =
-                bits.fold(0, |a, (k, st)| a | (st[j / 64] >> (j % 64) & 1) << k);
-        }
+        let mut choice = vec![0u64; nc];
+        let (mut other, mut other_known) = (vec![0u64; self.others.len()], 0u64);
         for (k, &(_, code, exact)) in chunk.iter().enumerate() {
-            for (b, &i) in self.choices.iter().enumerate() {
-                val[(self.g.inputs[i] >> 1) as usize] |= u64::from(code >> b & 1) << k;
+            for (b, c) in choice.iter_mut().enumerate() {
+                *c |= u64::from(code >> b & 1) << k;
             }
             if exact {
-                for (b, &v) in self.others.iter().enumerate() {
-                    val[v as usize] |= u64::from(code >> (nc + b) & 1) << k;
-                    unknown[v as usize] &= !(1 << k);
+                other_known |= 1 << k;
+                for (b, o) in other.iter_mut().enumerate() {
+                    *o |= u64::from(code >> (nc + b) & 1) << k;
                 }
             }
         }
-        for &(lhs, x, y) in &self.ands {
-            let w = |l: u32| val[(l >> 1) as usize] ^ 0u64.wrapping_sub(u64::from(l & 1));
-            let u = |l: u32| unknown[(l >> 1) as usize];
-            // known 0 if either side is; known 1 if both are
-            let zero = (!w(x) & !u(x)) | (!w(y) & !u(y));
-            let one = w(x) & !u(x) & w(y) & !u(y);
-            val[(lhs >> 1) as usize] = one;
-            unknown[(lhs >> 1) as usize] = !(zero | one);
+        for (&i, &c) in self.choices.iter().zip(&choice) {
+            val[(self.g.inputs[i] >> 1) as usize] = known(c);
         }
-        let w = |l: u32| val[(l >> 1) as usize] ^ 0u64.wrapping_sub(u64::from(l & 1));
-        let u = |l: u32| unknown[(l >> 1) as usize];
+        // unknown unless a lane enumerates them: lo 0, hi 1 there
+        for (&v, &o) in self.others.iter().zip(&other) {
+            let hi = o | !other_known;
+            val[v as usize] = [o, hi, !hi, !o];
+        }
+        for &(lhs, x, y) in &self.ands {
+            let (xv, yv) = (&val[(x >> 1) as usize], &val[(y >> 1) as usize]);
+            let (xa, ya) = (2 * (x & 1) as usize, 2 * (y & 1) as usize);
+            let (lo, hi) = (xv[xa] & yv[ya], xv[xa + 1] & yv[ya + 1]);
+            val[(lhs >> 1) as usize] = [lo, hi, !hi, !lo];
+        }
         let lanes = if chunk.len() == 64 {
             !0
         } else {
@@ -347,9 +411,23 @@ impl<'a> Machine<'a> {
             .bad
             .iter()
             .chain(self.g.latches.iter().map(|(_, nx, _)| nx));
-        let unknown_any = outs.fold(0, |a, &l| a | u(l)) & lanes;
-        let bad = self.g.bad.iter().fold(0, |a, &b| a | w(b)) & lanes;
-        let nexts = self.g.latches.iter().map(|&(_, nx, _)| w(nx)).collect();
+        let unknown_any = outs.fold(0, |a, &l| {
+            let [lo, hi] = pair(val, l);
+            a | (lo ^ hi)
+        }) & lanes;
+        let bad = self.g.bad.iter().fold(0, |a, &b| a | pair(val, b)[0]) & lanes;
+        // the successors: each latch's next value per lane, transposed back
+        let nexts = (0..self.words)
+            .map(|wd| {
+                let mut m = [0u64; 64];
+                let latches = self.g.latches.iter().skip(64 * wd).take(64);
+                for (j, &(_, nx, _)) in latches.enumerate() {
+                    m[j] = pair(val, nx)[0];
+                }
+                transpose64(&mut m);
+                m
+            })
+            .collect();
         (bad, unknown_any, nexts)
     }
 
@@ -405,5 +483,48 @@ impl<'a> Machine<'a> {
             at = from;
         }
         Found::Violated { step, inputs }
+    }
+}
+
+#[cfg(test)]
+mod transpose_tests {
+    use super::{transpose64, States};
+
+    /// Every bit lands where a bit-by-bit transpose puts it.
+    #[test]
+    fn transpose64_moves_bit_c_of_row_r_to_bit_r_of_row_c() {
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut m = [0u64; 64];
+        for row in m.iter_mut() {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            *row = x;
+        }
+        let before = m;
+        transpose64(&mut m);
+        for (r, row) in before.iter().enumerate() {
+            for (c, col) in m.iter().enumerate() {
+                assert_eq!(col >> r & 1, row >> c & 1, "row {r}, bit {c}");
+            }
+        }
+    }
+
+    /// The set keeps each state once, in insertion order, across its
+    /// table's growth, with the parent that first reached it.
+    #[test]
+    fn a_state_set_keeps_each_state_once_in_order() {
+        let mut s = States::new(2);
+        for i in 0..1000u64 {
+            s.insert(&[i % 300, i % 7], (i as u32, 0));
+        }
+        // (i % 300, i % 7) repeats with period 2100: 1000 distinct states
+        assert_eq!(s.len(), 1000);
+        for i in 0..300u64 {
+            s.insert(&[i % 300, i % 7], (u32::MAX, 0));
+        }
+        assert_eq!(s.len(), 1000);
+        assert_eq!(s.get(5), &[5, 5]);
+        assert_eq!(s.parents[999], (999, 0));
     }
 }
