@@ -396,9 +396,8 @@ impl<'a> Machine<'a> {
             val[v as usize] = [o, hi, !hi, !o];
         }
         for &(lhs, x, y) in &self.ands {
-            let (xv, yv) = (&val[(x >> 1) as usize], &val[(y >> 1) as usize]);
-            let (xa, ya) = (2 * (x & 1) as usize, 2 * (y & 1) as usize);
-            let (lo, hi) = (xv[xa] & yv[ya], xv[xa + 1] & yv[ya + 1]);
+            let ([xl, xh], [yl, yh]) = (pair(val, x), pair(val, y));
+            let (lo, hi) = (xl & yl, xh & yh);
             val[(lhs >> 1) as usize] = [lo, hi, !hi, !lo];
         }
         let lanes = if chunk.len() == 64 {
@@ -487,7 +486,7 @@ impl<'a> Machine<'a> {
 }
 
 #[cfg(test)]
-mod transpose_tests {
+mod tests {
     use super::{transpose64, States};
 
     /// Every bit lands where a bit-by-bit transpose puts it.
