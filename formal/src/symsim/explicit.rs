@@ -43,6 +43,19 @@ const MAX_STATES: usize = 1 << 16;
 /// enumerated at every step; `None` if the cone has too many choice bits
 /// or free power-on values for enumeration, or a step depends on another
 /// input.
+/// The latches without a power-on value (each value a start state).
+fn free_latches(g: &Aig) -> Vec<usize> {
+    (0..g.latches.len())
+        .filter(|&j| g.latches[j].2 != 0 && g.latches[j].2 != 1)
+        .collect()
+}
+
+/// Whether [`run`] can start on `g` at all: few enough choice bits and
+/// power-on values to enumerate (it may still give up on too many states).
+pub(super) fn fits(g: &Aig, choices: &[usize]) -> bool {
+    choices.len() <= MAX_CHOICE_BITS && free_latches(g).len() <= MAX_FREE_INIT
+}
+
 pub(super) fn run(g: &Aig, choices: &[usize], lim: &Limits) -> Option<Found> {
     let Limits {
         period,
@@ -50,10 +63,8 @@ pub(super) fn run(g: &Aig, choices: &[usize], lim: &Limits) -> Option<Found> {
         max_steps,
         deadline,
     } = *lim;
-    let free: Vec<usize> = (0..g.latches.len())
-        .filter(|&j| g.latches[j].2 != 0 && g.latches[j].2 != 1)
-        .collect();
-    if choices.len() > MAX_CHOICE_BITS || free.len() > MAX_FREE_INIT {
+    let free = free_latches(g);
+    if !fits(g, choices) {
         return None;
     }
     let mut m = Machine::new(g, choices);

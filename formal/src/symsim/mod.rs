@@ -203,23 +203,44 @@ pub fn prove(
             f => f,
         });
     }
-    if !explicit.is_empty() {
-        let c = cone::cone(&g, &explicit);
-        let sub = cone::restrict(&g, &explicit, &c);
-        match explicit::run(&sub, choices, &whole) {
-            Some(f) => results.push(lift(f, &c.latches, ni, nl)),
-            None => {
-                // too many inputs or states to enumerate: simulated with
-                // the symbolic parts, in one run that has the whole time
-                // limit (a run of its own took it all, and the other's
-                // bound was 0 steps)
-                stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
-                symbolic.extend(explicit);
-            }
-        }
+    // the explicit parts on their cone, when their choices and power-on
+    // values are few enough to enumerate
+    let search = (!explicit.is_empty())
+        .then(|| {
+            let c = cone::cone(&g, &explicit);
+            (cone::restrict(&g, &explicit, &c), c)
+        })
+        .filter(|(sub, _)| explicit::fits(sub, choices));
+    if search.is_none() && !explicit.is_empty() {
+        // else simulated with the symbolic parts, in one run
+        stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
+        symbolic.append(&mut explicit);
     }
-    if !symbolic.is_empty() {
-        let (found, st, c) = simulate(&symbolic, max_steps);
+    // the explicit search and the symbolic simulation side by side, one
+    // thread each (they share nothing; eskin34-axis: about 17 s and 3 s)
+    let explicit_run = |(sub, c): (Aig, cone::Cone)| {
+        explicit::run(&sub, choices, &whole).map(|f| lift(f, &c.latches, ni, nl))
+    };
+    let (searched, mut simulated) = std::thread::scope(|sc| {
+        let search = search.map(|x| sc.spawn(move || explicit_run(x)));
+        let simulated = (!symbolic.is_empty()).then(|| simulate(&symbolic, max_steps));
+        let searched = search.map(|t| t.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
+        (searched, simulated)
+    });
+    match searched {
+        Some(Some(f)) => results.push(f),
+        Some(None) => {
+            // too many inputs or states to enumerate: simulated with the
+            // symbolic parts, in one run that has the whole time limit (a
+            // run of its own took it all, and the other's bound was 0
+            // steps); the simulation beside the search is not kept
+            stats.parts = [stats.parts[0] + stats.parts[2], stats.parts[1], 0];
+            symbolic.extend(explicit);
+            simulated = Some(simulate(&symbolic, max_steps));
+        }
+        None => {}
+    }
+    if let Some((found, st, c)) = simulated {
         stats.sat_calls += st.sat_calls;
         stats.peak_nodes = stats.peak_nodes.max(st.peak_nodes);
         stats.state_nodes = st.state_nodes;

@@ -148,3 +148,63 @@ fn an_explicit_search_past_its_bound_hands_the_part_to_simulation() {
     assert!(matches!(f, Found::Violated { step: 20, .. }), "{f:?}");
     assert_eq!(st.parts, [1, 0, 0], "simulated, not enumerated");
 }
+
+/// A 3-bit counter that counts the steps in which all `n` choice inputs
+/// are high; the assertion: it never reaches 7 (it does, after 7 such
+/// steps). Not 2-inductive (6 counts on to 7), so a part for the explicit
+/// search when it can enumerate `n` choice bits.
+fn all_choices_counter(n: u32) -> Aig {
+    let mut ands: Vec<(u32, u32, u32)> = Vec::new();
+    let mut v = n + 4; // inputs 1..=n, latches n+1..=n+3
+    let mut and = |x: u32, y: u32, ands: &mut Vec<(u32, u32, u32)>| {
+        ands.push((2 * v, x, y));
+        v += 1;
+        2 * (v - 1)
+    };
+    let mut inc = 2;
+    for i in 2..=n {
+        inc = and(inc, 2 * i, &mut ands);
+    }
+    let c: Vec<u32> = (1..=3).map(|k| 2 * (n + k)).collect();
+    let mut next = Vec::new();
+    let mut carry = inc;
+    for &ck in &c {
+        // ck ^ carry, then the carry on
+        let a = and(ck, carry ^ 1, &mut ands);
+        let b = and(ck ^ 1, carry, &mut ands);
+        next.push(and(a ^ 1, b ^ 1, &mut ands) ^ 1);
+        carry = and(ck, carry, &mut ands);
+    }
+    let b1 = and(c[0], c[1], &mut ands);
+    let bad = and(b1, c[2], &mut ands);
+    let mut t = format!("aag {} {n} 3 0 {} 1\n", v - 1, ands.len());
+    for i in 1..=n {
+        t.push_str(&format!("{}\n", 2 * i));
+    }
+    for (ck, nx) in c.iter().zip(&next) {
+        t.push_str(&format!("{ck} {nx} 0\n"));
+    }
+    t.push_str(&format!("{bad}\n"));
+    for (l, x, y) in ands {
+        t.push_str(&format!("{l} {x} {y}\n"));
+    }
+    parse(&t).unwrap()
+}
+
+#[test]
+fn a_part_with_too_many_choice_bits_to_enumerate_is_simulated_instead() {
+    // 6 choice bits: the explicit search; 7: the symbolic simulation
+    // (its limit), and both find the count of 7 at the same step
+    let mut steps = Vec::new();
+    for (n, parts) in [(6, [0, 0, 1]), (7, [1, 0, 0])] {
+        let g = all_choices_counter(n);
+        let choices: Vec<usize> = (0..n as usize).collect();
+        let (f, st) = prove(&g, &choices, &[], false, 4, 2, 40, None);
+        let Found::Violated { step, .. } = f else {
+            panic!("{n} choice bits: {f:?}")
+        };
+        assert_eq!(st.parts, parts, "{n} choice bits");
+        steps.push(step);
+    }
+    assert_eq!(steps[0], steps[1], "{steps:?}");
+}
