@@ -156,20 +156,7 @@ pub fn prove(
     }
     let mut g = g.clone();
     let parts = cone::disjuncts(&mut g);
-    let (mut symbolic, mut inductive, mut explicit) = (Vec::new(), Vec::new(), Vec::new());
-    for part in parts {
-        let c = cone::cone(&g, &[part]);
-        if !c.inputs.iter().any(|i| choices.contains(i)) {
-            symbolic.push(part);
-            continue;
-        }
-        let alone = cone::restrict(&g, &[part], &c);
-        if (1..=2).any(|k| induction::step_case(&alone, k) == Ok(true)) {
-            inductive.push(part);
-        } else {
-            explicit.push(part);
-        }
-    }
+    let [mut symbolic, inductive, mut explicit] = classify(&g, parts, choices);
     let mut stats = SymStats {
         parts: [symbolic.len(), inductive.len(), explicit.len()],
         ..SymStats::default()
@@ -250,6 +237,27 @@ pub fn prove(
         results.push(found);
     }
     (combine(results), stats)
+}
+
+/// The assertion's parts by how they are proved: those whose cone reads
+/// no choice (symbolic simulation), those that read one and are k-inductive
+/// for k <= 2, and the others (explicit-state search).
+fn classify(g: &Aig, parts: Vec<u32>, choices: &[usize]) -> [Vec<u32>; 3] {
+    let (mut symbolic, mut inductive, mut explicit) = (Vec::new(), Vec::new(), Vec::new());
+    for part in parts {
+        let c = cone::cone(g, &[part]);
+        if !c.inputs.iter().any(|i| choices.contains(i)) {
+            symbolic.push(part);
+            continue;
+        }
+        let alone = cone::restrict(g, &[part], &c);
+        if (1..=2).any(|k| induction::step_case(&alone, k) == Ok(true)) {
+            inductive.push(part);
+        } else {
+            explicit.push(part);
+        }
+    }
+    [symbolic, inductive, explicit]
 }
 
 /// A part's verdict in the whole AIG's terms: latch `j` of the part is
