@@ -204,7 +204,7 @@ pub fn prove(
         symbolic.append(&mut explicit);
     }
     // the explicit search and the symbolic simulation side by side, one
-    // thread each (they share nothing; eskin34-axis: about 17 s and 3 s)
+    // thread each (they share nothing but the AIG they read)
     let explicit_run = |(sub, c): (Aig, cone::Cone)| {
         explicit::run(&sub, choices, &whole).map(|f| lift(f, &c.latches, ni, nl))
     };
