@@ -255,14 +255,15 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     let f = h.frame_cycles;
     // the whole harness with the frame counters generalised: when it
     // decides (proved, or a trace from reset), it is the only run
+    // split on the slave's choices and the modes together, the generalised
+    // run never came round (docs/formal.md, "Limits"): the whole timeout
+    // spent for a bound (matrix-102: 300 of 612 s); the bytes are searched
+    // from reset as before
+    let not_general = reads_bytes && axis_with_modes(s, &h);
     let general = match reads_bytes {
         true => match tied(s, &h, design, opts)? {
             Some(t) => Some(t),
-            // split on the slave's choices and the modes together it never
-            // came round (docs/formal.md, "Limits"): the whole timeout spent
-            // for a bound (matrix-102: 300 of 612 s); the bytes are searched
-            // from reset as before
-            None if axis_with_modes(s, &h) => None,
+            None if not_general => None,
             None => link_generalised(s, &h, design, opts, None)?,
         },
         false => None,
@@ -280,7 +281,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     not_covered.extend(harness::bounded_modes(s, result, depth));
     let failure = match &general {
         Some(g) => g.failure.clone(),
-        None if reads_bytes && axis_with_modes(s, &h) => Some(AXIS_WITH_MODES.to_string()),
+        None if not_general => Some(AXIS_WITH_MODES.to_string()),
         None => None,
     };
     // the generalised run found a state whose bytes fail: not a proof
