@@ -255,15 +255,9 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     let f = h.frame_cycles;
     // the whole harness with the frame counters generalised: when it
     // decides (proved, or a trace from reset), it is the only run
-    // split on the slave's choices and the modes together, the generalised
-    // run never came round (docs/formal.md, "Limits"): the whole timeout
-    // spent for a bound (matrix-102: 300 of 612 s); the bytes are searched
-    // from reset as before
-    let not_general = reads_bytes && axis_with_modes(s, &h);
     let general = match reads_bytes {
         true => match tied(s, &h, design, opts)? {
             Some(t) => Some(t),
-            None if not_general => None,
             None => link_generalised(s, &h, design, opts, None)?,
         },
         false => None,
@@ -279,11 +273,7 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
     };
     let mut not_covered: Vec<String> = h.not_covered.iter().map(|c| c.sentence(s)).collect();
     not_covered.extend(harness::bounded_modes(s, result, depth));
-    let failure = match &general {
-        Some(g) => g.failure.clone(),
-        None if not_general => Some(AXIS_WITH_MODES.to_string()),
-        None => None,
-    };
+    let failure = general.as_ref().and_then(|g| g.failure.clone());
     // the generalised run found a state whose bytes fail: not a proof
     let suspect = general.as_ref().is_some_and(|g| g.suspect);
     let bytes = match (general, reads_bytes, result) {
@@ -368,19 +358,6 @@ pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, P
         counterexample,
         cycle,
     })
-}
-
-/// Why the link's bytes of an AXI4-Stream mix with modes are searched from
-/// reset only.
-const AXIS_WITH_MODES: &str = "with an AXI4-Stream slave and modes, the frame counters are \
-     not generalised: split on the slave's choices and the modes together, the state does not \
-     come round at frame starts";
-
-/// An AXI4-Stream slave's choices and modes (pin or auto select) in one
-/// harness.
-fn axis_with_modes(s: &Schedule, h: &Harness) -> bool {
-    let input = |name: &str| h.inputs.iter().any(|i| i.name == name);
-    input(harness::TREADY_ANY) && (input(harness::MODE_SEL) || harness::auto_frames(s).is_some())
 }
 
 /// The harness without the link's bytes (`main`) on `design` by the

@@ -41,7 +41,7 @@ pub fn needed_models(models: &str, netlist: &str) -> String {
     kept.map(|p| p.text).collect()
 }
 
-/// `models` split at `module` and `endmodule` lines. A module whose name
+/// `models` split at `module` and `endmodule` lines (a line may be both). A module whose name
 /// cannot be read is kept as text outside a module (never dropped).
 fn pieces(models: &str) -> Vec<Piece<'_>> {
     let mut out = vec![];
@@ -65,7 +65,8 @@ fn pieces(models: &str) -> Vec<Piece<'_>> {
         }
         cur.text.push_str(line);
         cur.text.push('\n');
-        if inside && t.starts_with("endmodule") {
+        // a model on one line (`module ... endmodule`) ends where it starts
+        if inside && (t.starts_with("endmodule") || t.trim_end().ends_with("endmodule")) {
             out.push(std::mem::replace(
                 &mut cur,
                 Piece {

@@ -32,3 +32,30 @@ fn only_the_models_a_netlist_reaches_are_kept() {
     assert!(!got.contains("blackbox"), "{got}");
     assert!(!got.contains("module SB_DFF "), "{got}");
 }
+
+/// A model written on one line (`module ... endmodule`, as ECP5's
+/// `cells_ff.vh` in a newer yosys) is a module of its own: an unused one
+/// goes alone, and the `` `endif`` after it stays.
+#[test]
+fn a_one_line_model_is_a_module_of_its_own() {
+    let models = "module LUT4(input A, output Z);\n  assign Z = A;\nendmodule\n\
+                  `ifndef NO_INCLUDES\n\
+                  module FD1P3AX(input D, output Q); TRELLIS_FF f (.DI(D), .Q(Q)); endmodule\n\
+                  module FD1P3AY(input D, output Q); TRELLIS_FF f (.DI(D), .Q(Q)); endmodule\n\
+                  `endif\n\
+                  module TRELLIS_FF(input DI, output Q);\n  assign Q = DI;\nendmodule\n";
+    let got = needed_models(
+        models,
+        "LUT4 l (.A(a), .Z(b));\nFD1P3AY d (.D(c), .Q(e));\n",
+    );
+    for kept in [
+        "module LUT4",
+        "module FD1P3AY",
+        "module TRELLIS_FF",
+        "`ifndef NO_INCLUDES\n",
+        "`endif\n",
+    ] {
+        assert!(got.contains(kept), "{kept}:\n{got}");
+    }
+    assert!(!got.contains("FD1P3AX"), "{got}");
+}
