@@ -621,8 +621,7 @@ fn with_axis(file: &str, ready_within: u32) -> lut_gen::Schedule {
 /// A pin-select mix with an AXI4-Stream whose slave may wait (`ready_within
 /// = 2`) proves the whole contract, the beats and their packets for all
 /// time: the run split on the slave's choices and `mode_sel` with the frame
-/// counters generalised comes round (it was not tried before, and the bytes
-/// were searched from reset only).
+/// counters generalised comes round, so no byte is left to a bounded search.
 #[test]
 fn a_pin_mode_mix_with_an_axi_stream_proves_its_beats_for_all_time() {
     if !tools::require_tools(&TOOLS) {
