@@ -41,8 +41,9 @@ pub fn needed_models(models: &str, netlist: &str) -> String {
     kept.map(|p| p.text).collect()
 }
 
-/// `models` split at `module` and `endmodule` lines (a line may be both). A module whose name
-/// cannot be read is kept as text outside a module (never dropped).
+/// `models` split at `module` and `endmodule` lines (one line may be both).
+/// A module whose name cannot be read is kept as text outside a module
+/// (never dropped).
 fn pieces(models: &str) -> Vec<Piece<'_>> {
     let mut out = vec![];
     let mut cur = Piece {
@@ -66,7 +67,7 @@ fn pieces(models: &str) -> Vec<Piece<'_>> {
         cur.text.push_str(line);
         cur.text.push('\n');
         // a model on one line (`module ... endmodule`) ends where it starts
-        if inside && (t.starts_with("endmodule") || t.trim_end().ends_with("endmodule")) {
+        if inside && (t.starts_with("endmodule") || words(t).last() == Some("endmodule")) {
             out.push(std::mem::replace(
                 &mut cur,
                 Piece {

@@ -43,7 +43,8 @@ fn a_one_line_model_is_a_module_of_its_own() {
                   module FD1P3AX(input D, output Q); TRELLIS_FF f (.DI(D), .Q(Q)); endmodule\n\
                   module FD1P3AY(input D, output Q); TRELLIS_FF f (.DI(D), .Q(Q)); endmodule\n\
                   `endif\n\
-                  module TRELLIS_FF(input DI, output Q);\n  assign Q = DI;\nendmodule\n";
+                  module TRELLIS_FF(input DI, output Q);\n  assign Q = DI;\nendmodule\n\
+                  module INV(input A, output Z);\n  // a name that ends like the keyword: z_endmodule\n  assign Z = !A;\nendmodule\n";
     let got = needed_models(
         models,
         "LUT4 l (.A(a), .Z(b));\nFD1P3AY d (.D(c), .Q(e));\n",
@@ -58,4 +59,6 @@ fn a_one_line_model_is_a_module_of_its_own() {
         assert!(got.contains(kept), "{kept}:\n{got}");
     }
     assert!(!got.contains("FD1P3AX"), "{got}");
+    // a word ending in `endmodule` does not end a model: unused, all of it goes
+    assert!(!got.contains("assign Z = !A;"), "{got}");
 }
