@@ -401,6 +401,11 @@ fn edge(p: &LinkParams, r: &mut Regs, input: (bool, u32, u32, u8), tick: bool, t
         }
     }
     nx.n = r.n + (push && room) as usize - pop as usize;
+    // empty and nothing to take: back to entry 0 (the Verilog's rewind)
+    if r.n == 0 && !push {
+        nx.wr = 0;
+        nx.rd = 0;
+    }
     shift(&p, r, &mut nx, tready, last_tick);
     if load {
         load_byte(&p, r, &mut nx);
@@ -886,6 +891,14 @@ fn fifo_update(s: &mut String, p: &LinkParams, w: Widths) {
         }
     };
     let _ = writeln!(s, "    n <= n + {} - {};", zext("push & room"), zext("pop"));
+    // an empty FIFO with nothing to take rewinds to entry 0: where the
+    // pointers stand then no longer depends on every token before (a frame
+    // of T tokens would shift them by T mod depth + 1 each frame), so the
+    // link's state comes round with the frame, not after several (`prove`)
+    let _ = writeln!(
+        s,
+        "    if ((n == {nw}'d0) & !push) begin\n      wr <= {aw}'d0;\n      rd <= {aw}'d0;\n    end"
+    );
 }
 
 /// The byte in transit (bit periods or the beat taken), and the next byte's
