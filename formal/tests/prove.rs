@@ -828,34 +828,38 @@ fn a_uart_proof_reads_the_line_and_a_stuck_line_fails() {
     assert!(matches!(verdict, campaign::ProveVerdict::Failed { .. }));
 }
 
-/// A UART mix whose frame carries 13 tokens (11 words, 2 boundaries)
-/// through a FIFO of 3 entries: the FIFO's pointers rewind when it empties,
-/// so the link's state at a frame start, and the proof with it, comes round
-/// one frame later (without the rewind the pointers moved by 13 mod 3 each
-/// frame and it came round three frames later, at step 16,002).
+/// Mixes whose frame carries 13 tokens (11 words, 2 boundaries) through a
+/// FIFO of 3 entries, with a UART and with an AXI4-Stream: the FIFO's
+/// pointers rewind when it empties, so the link's state at a frame start,
+/// and the proof with it, comes round one frame later (without the rewind
+/// the pointers moved by 13 mod 3 each frame: the UART's proof came round
+/// three frames later, at step 16,002, the AXI4-Stream's at 16,002 too).
 #[test]
-fn a_uart_links_state_comes_round_with_the_frame() {
+fn a_links_state_comes_round_with_the_frame() {
     if !tools::require_tools(&TOOLS) {
         return;
     }
-    let path = root().join("testkit/mixes/tiny.toml");
-    let text = std::fs::read_to_string(&path).unwrap()
-        + "\n[[channel]]\nname = \"B2\"\nbranch = \"slow\"\nrate_hz = 1_000\n\
-           \n[link]\nkind = \"uart\"\nbaud = 1_000_000\n";
-    let mix = lut_gen::parse(Path::new("tiny-uart-13.toml"), &text).expect("parses");
-    let s = lut_gen::synthesize(&mix).expect("feasible");
-    let design = emitted(&s);
-    assert!(
-        design.contains("FIFO of 2 tokens"),
-        "the FIFO's depth moved"
-    );
-    let dir = tempfile::tempdir().unwrap();
-    let p = prove(&s, &design, dir.path());
-    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
-    assert!(p.not_covered.is_empty(), "{:?}", p.not_covered);
-    let f = s.grid.frame_cycles;
-    assert_eq!(p.depth, 2 * f + 2, "{}", p.note);
-    assert!(p.note.contains("1 frame(s) later"), "{}", p.note);
+    let base = std::fs::read_to_string(root().join("testkit/mixes/tiny.toml")).unwrap()
+        + "\n[[channel]]\nname = \"B2\"\nbranch = \"slow\"\nrate_hz = 1_000\n\n";
+    for link in [
+        "[link]\nkind = \"uart\"\nbaud = 1_000_000\n",
+        "[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 8\n",
+    ] {
+        let mix =
+            lut_gen::parse(Path::new("tiny-13.toml"), &(base.clone() + link)).expect("parses");
+        let s = lut_gen::synthesize(&mix).expect("feasible");
+        let design = emitted(&s);
+        assert!(
+            design.contains("FIFO of 2 tokens"),
+            "{link}: the FIFO's depth moved"
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let p = prove(&s, &design, dir.path());
+        assert_eq!(p.result, Outcome::Proved, "{link}: {}", p.summary());
+        assert!(p.not_covered.is_empty(), "{link}: {:?}", p.not_covered);
+        let f = s.grid.frame_cycles;
+        assert_eq!(p.depth, 2 * f + 2, "{link}: {}", p.note);
+    }
 }
 
 /// Without a link the same proof is the whole contract, and excuses.
