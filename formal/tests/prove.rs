@@ -832,8 +832,8 @@ fn a_uart_proof_reads_the_line_and_a_stuck_line_fails() {
 /// FIFO of 3 entries, with a UART and with an AXI4-Stream: the FIFO's
 /// pointers rewind when it empties, so the link's state at a frame start,
 /// and the proof with it, comes round one frame later (without the rewind
-/// the pointers moved by 13 mod 3 each frame: the UART's proof came round
-/// three frames later, at step 16,002, the AXI4-Stream's at 16,002 too).
+/// the pointers moved by 13 mod 3 each frame, and both proofs came round
+/// three frames later, at step 16,002).
 #[test]
 fn a_links_state_comes_round_with_the_frame() {
     if !tools::require_tools(&TOOLS) {
