@@ -177,6 +177,13 @@ fn the_sentences_name_the_pins_and_the_audits_baud() {
             None if axis_bytes_left(&s) => {
                 assert!(said[0].contains("m_axis_tlast"), "{name}: {said:?}");
                 assert!(said[1].contains("m_axis_tdata"), "{name}: {said:?}");
+                // and why: the slave's wait, past what a proof splits on
+                let wait = s.mix.link.as_ref().unwrap().ready_within;
+                let why = format!(
+                    "not asserted: the slave may keep a beat waiting up to \
+                     ready_within = {wait} cycles"
+                );
+                assert!(said.iter().all(|t| t.contains(&why)), "{name}: {said:?}");
             }
             None => {
                 // the beats are read: link.bytes names tlast

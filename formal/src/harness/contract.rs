@@ -13,6 +13,7 @@
 use lut_gen::Layout;
 use lut_gen::Schedule;
 
+use super::link::AXIS_BYTES_MAX_WAIT;
 use super::PropertyDef;
 
 /// One clause of the pin contract at the design's outputs.
@@ -139,10 +140,12 @@ impl Clause {
                 "link_overflow stays low (the link's FIFO never drops a token)".into()
             }
             Clause::UartCharacters => uart_characters(s),
-            Clause::AxisBeats => "the AXI4-Stream's beats: each beat taken (m_axis_tvalid and \
-                 m_axis_tready) carries the next byte of the packets on m_axis_tdata, and \
-                 m_axis_tlast is high on exactly the last byte of each packet"
-                .into(),
+            Clause::AxisBeats => format!(
+                "the AXI4-Stream's beats: each beat taken (m_axis_tvalid and m_axis_tready) \
+                 carries the next byte of the packets on m_axis_tdata, and m_axis_tlast is high \
+                 on exactly the last byte of each packet{}",
+                axis_wait(s)
+            ),
             Clause::AxisValidHeld => {
                 "a beat offered and not taken stays offered (m_axis_tvalid)".into()
             }
@@ -152,7 +155,7 @@ impl Clause {
             Clause::LinkPackets => format!(
                 "the packets the link carries on {} (each slice's header with the frame \
                  counter{} and slice, one record per sample with its channel and code, the \
-                 trailer with the overflow count and CRC-16/MODBUS; docs/packet-format.md)",
+                 trailer with the overflow count and CRC-16/MODBUS; docs/packet-format.md){}",
                 if Layout::new(s).axis {
                     "m_axis_tdata"
                 } else {
@@ -162,10 +165,26 @@ impl Clause {
                     ", the mode"
                 } else {
                     ""
-                }
+                },
+                axis_wait(s)
             ),
             Clause::Mode => mode_sentence(s),
         }
+    }
+}
+
+/// Why an AXI4-Stream's bytes are not asserted, after their clause's
+/// sentence; empty for a mix whose bytes the harness asserts (a UART, or a
+/// slave that keeps a beat waiting at most [`AXIS_BYTES_MAX_WAIT`] cycles).
+fn axis_wait(s: &Schedule) -> String {
+    match s.mix.link.as_ref() {
+        Some(l) if Layout::new(s).axis && l.ready_within.max(1) > AXIS_BYTES_MAX_WAIT => format!(
+            " (not asserted: the slave may keep a beat waiting up to ready_within = {} \
+             cycles, past the {AXIS_BYTES_MAX_WAIT} whose choices a proof splits on; \
+             docs/formal.md, \"Limits\")",
+            l.ready_within
+        ),
+        _ => String::new(),
     }
 }
 
