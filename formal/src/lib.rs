@@ -1202,8 +1202,13 @@ fn symbolic(
             Outcome::Proved,
             steps,
             format!(
-                "{PROVED}: {}every step from reset to step {steps} simulated exactly with every free input bit a variable of its step (MISO; mode_sel too for pin-selected modes; {} latches, {} gates; {} assertion checks went to a SAT solver), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
+                "{PROVED}: {}every step from reset to step {steps} simulated exactly with every free input bit a variable of its step ({}; {} latches, {} gates; {} assertion checks went to a SAT solver), and the state at step {steps} is the state at step {since} with every input {} frame(s) later (state recurrence; {} nodes), so those steps reach every reachable state (symbolic simulation)",
                 parts_note(&st.parts),
+                // the requests only where the harness has them (pin select)
+                match named_inputs(prep, harness::MODE_SEL).is_empty() {
+                    true => "MISO",
+                    false => "MISO, and mode_sel for pin-selected modes",
+                },
                 g.latches.len(),
                 g.ands.len(),
                 st.sat_calls,
