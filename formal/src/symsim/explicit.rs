@@ -183,11 +183,17 @@ struct States {
 
 impl States {
     fn new(words: usize) -> States {
+        States::with_capacity(words, 0)
+    }
+
+    /// An empty set with room for `n` states (a step's successors are
+    /// about as many as its states: no table growth, no reallocation).
+    fn with_capacity(words: usize, n: usize) -> States {
         States {
             words,
-            flat: Vec::new(),
-            slots: vec![0; 64],
-            parents: Vec::new(),
+            flat: Vec::with_capacity(n * words),
+            slots: vec![0; (2 * n + 1).next_power_of_two().max(64)],
+            parents: Vec::with_capacity(n),
         }
     }
 
@@ -255,12 +261,26 @@ impl States {
     }
 }
 
-/// Literal `l`'s bounds `[lo, hi]` in every lane (see `Machine::val`).
+/// Literal `l`'s value in every lane, or its lower bound where it may be
+/// unknown (`Machine::lo`).
 #[inline]
-fn pair(val: &[[u64; 4]], l: u32) -> [u64; 2] {
-    let v = &val[(l >> 1) as usize];
-    let at = 2 * (l & 1) as usize;
-    [v[at], v[at + 1]]
+fn lit(lo: &[u64], l: u32) -> u64 {
+    lo[(l >> 1) as usize] ^ 0u64.wrapping_sub(u64::from(l & 1))
+}
+
+/// Literal `l`'s bounds `[lo, hi]` in every lane: its value twice unless
+/// its variable is `tainted` (see `Machine::hi`).
+#[inline]
+fn bounds(m: &Machine, l: u32) -> (u64, u64) {
+    let v = (l >> 1) as usize;
+    let (lo, hi) = match m.tainted[v] {
+        true => (m.lo[v], m.hi[v]),
+        false => (m.lo[v], m.lo[v]),
+    };
+    match l & 1 {
+        0 => (lo, hi),
+        _ => (!hi, !lo),
+    }
 }
 
 /// Transposes a 64 x 64 bit matrix in place: bit `c` of row `r` becomes
@@ -290,11 +310,20 @@ struct Machine<'a> {
     ands: Vec<(u32, u32, u32)>,
     choices: Vec<usize>,
     words: usize,
-    /// Each variable's bounds in each lane and those of its negation:
-    /// `[lo, hi, !hi, !lo]` (known 0: lo = hi = 0; known 1: both 1;
-    /// unknown: lo = 0, hi = 1), so a literal's pair is read at
-    /// `2 * (l & 1)` and a gate is two ANDs.
-    val: Vec<[u64; 4]>,
+    /// Each variable's value in each lane (one bit a lane); for a
+    /// variable that may be unknown, its lower bound.
+    lo: Vec<u64>,
+    /// The upper bound of a `tainted` variable (unknown: lo 0, hi 1).
+    hi: Vec<u64>,
+    /// The gates outside the tainted fanout (`lo` is their value) and
+    /// those inside it (two bounds), each in dependency order.
+    known: Vec<(u32, u32, u32)>,
+    maybe: Vec<(u32, u32, u32)>,
+    /// The variables an input other than a choice reaches (its fanout):
+    /// only these may be unknown, so only their gates carry two bounds
+    /// (eskin34-axis: 29 of 810 gates; the three-valued loop over all of
+    /// them was 40 % of its search).
+    tainted: Vec<bool>,
     /// The inputs that are not choices (their variables): unknown unless a
     /// lane enumerates them.
     others: Vec<u32>,
@@ -307,8 +336,11 @@ impl<'a> Machine<'a> {
             ands: in_dependency_order(g),
             choices: choices.to_vec(),
             words: g.latches.len().div_ceil(64).max(1),
-            // the constant (variable 0) is known 0
-            val: vec![[0, 0, !0, !0]; g.max_var as usize + 1],
+            lo: vec![0; g.max_var as usize + 1],
+            hi: vec![0; g.max_var as usize + 1],
+            tainted: vec![false; g.max_var as usize + 1],
+            known: Vec::new(),
+            maybe: Vec::new(),
             others: {
                 // the other inputs the cone reads
                 let read: std::collections::HashSet<u32> = (g.ands.iter())
@@ -322,6 +354,25 @@ impl<'a> Machine<'a> {
                     .collect()
             },
         }
+        .with_taint()
+    }
+
+    /// Marks the fanout of the inputs that are not choices (`tainted`) and
+    /// parts the gates: a gate outside it reads none inside, so the `known`
+    /// gates, then the `maybe` ones, each in dependency order, is an order
+    /// of dependency too.
+    fn with_taint(mut self) -> Self {
+        for &v in &self.others {
+            self.tainted[v as usize] = true;
+        }
+        for &(lhs, x, y) in &self.ands {
+            self.tainted[(lhs >> 1) as usize] =
+                self.tainted[(x >> 1) as usize] || self.tainted[(y >> 1) as usize];
+        }
+        let tainted = &self.tainted;
+        (self.maybe, self.known) =
+            (self.ands.iter()).partition(|&&(l, _, _)| tainted[(l >> 1) as usize]);
+        self
     }
 
     /// Every successor of `set` under every choice; or the first (state,
@@ -337,7 +388,7 @@ impl<'a> Machine<'a> {
         let mut lanes: Vec<(u32, u32, bool)> = (0..set.len() as u32)
             .flat_map(|s| (0..1u32 << nc).map(move |c| (s, c, false)))
             .collect();
-        let mut next = States::new(self.words);
+        let mut next = States::with_capacity(self.words, set.len());
         let mut st = vec![0u64; self.words];
         let mut at = 0;
         while at < lanes.len() {
@@ -370,11 +421,49 @@ impl<'a> Machine<'a> {
     /// whose successor or assertion is unknown, and the successors, by
     /// state word and lane (`[w][k]`: word `w` of lane `k`'s next state).
     fn eval(&mut self, set: &States, chunk: &[(u32, u32, bool)]) -> (u64, u64, Vec<[u64; 64]>) {
+        self.load(set, chunk);
+        let lo = &mut self.lo;
+        for &(lhs, x, y) in &self.known {
+            lo[(lhs >> 1) as usize] = lit(lo, x) & lit(lo, y);
+        }
+        for &(lhs, x, y) in &self.maybe {
+            let ((xl, xh), (yl, yh)) = (bounds(self, x), bounds(self, y));
+            let v = (lhs >> 1) as usize;
+            (self.lo[v], self.hi[v]) = (xl & yl, xh & yh);
+        }
+        let lanes = match chunk.len() {
+            64 => !0,
+            n => (1u64 << n) - 1,
+        };
+        let outs = (self.g.bad.iter()).chain(self.g.latches.iter().map(|(_, nx, _)| nx));
+        let unknown_any = outs
+            .filter(|&&l| self.tainted[(l >> 1) as usize])
+            .fold(0, |a, &l| {
+                let (lo, hi) = bounds(self, l);
+                a | (lo ^ hi)
+            })
+            & lanes;
+        let bad = self.g.bad.iter().fold(0, |a, &b| a | lit(&self.lo, b)) & lanes;
+        // the successors: each latch's next value per lane, transposed back
+        let nexts = (0..self.words)
+            .map(|wd| {
+                let mut m = [0u64; 64];
+                let latches = self.g.latches.iter().skip(64 * wd).take(64);
+                for (j, &(_, nx, _)) in latches.enumerate() {
+                    m[j] = lit(&self.lo, nx);
+                }
+                transpose64(&mut m);
+                m
+            })
+            .collect();
+        (bad, unknown_any, nexts)
+    }
+
+    /// The lanes' latches (their states' words, transposed 64 latches at a
+    /// time) and inputs: the choices by the lanes' codes, the other inputs
+    /// unknown unless a lane enumerates them (lo 0, hi 1 there).
+    fn load(&mut self, set: &States, chunk: &[(u32, u32, bool)]) {
         let nc = self.choices.len();
-        let val = &mut self.val;
-        let known = |v: u64| [v, v, !v, !v];
-        // each latch's value in every lane: the lanes' state words,
-        // transposed 64 latches at a time
         for w in 0..self.words {
             let mut m = [0u64; 64];
             for (k, &(s, _, _)) in chunk.iter().enumerate() {
@@ -382,63 +471,23 @@ impl<'a> Machine<'a> {
             }
             transpose64(&mut m);
             for (j, &(l, _, _)) in self.g.latches.iter().enumerate().skip(64 * w).take(64) {
-                val[(l >> 1) as usize] = known(m[j - 64 * w]);
+                self.lo[(l >> 1) as usize] = m[j - 64 * w];
             }
         }
-        let mut choice = vec![0u64; nc];
-        let (mut other, mut other_known) = (vec![0u64; self.others.len()], 0u64);
-        for (k, &(_, code, exact)) in chunk.iter().enumerate() {
-            for (b, c) in choice.iter_mut().enumerate() {
-                *c |= u64::from(code >> b & 1) << k;
-            }
-            if exact {
-                other_known |= 1 << k;
-                for (b, o) in other.iter_mut().enumerate() {
-                    *o |= u64::from(code >> (nc + b) & 1) << k;
-                }
-            }
-        }
-        for (&i, &c) in self.choices.iter().zip(&choice) {
-            val[(self.g.inputs[i] >> 1) as usize] = known(c);
-        }
-        // unknown unless a lane enumerates them: lo 0, hi 1 there
-        for (&v, &o) in self.others.iter().zip(&other) {
-            let hi = o | !other_known;
-            val[v as usize] = [o, hi, !hi, !o];
-        }
-        for &(lhs, x, y) in &self.ands {
-            let ([xl, xh], [yl, yh]) = (pair(val, x), pair(val, y));
-            let (lo, hi) = (xl & yl, xh & yh);
-            val[(lhs >> 1) as usize] = [lo, hi, !hi, !lo];
-        }
-        let lanes = if chunk.len() == 64 {
-            !0
-        } else {
-            (1u64 << chunk.len()) - 1
-        };
-        let outs = self
-            .g
-            .bad
-            .iter()
-            .chain(self.g.latches.iter().map(|(_, nx, _)| nx));
-        let unknown_any = outs.fold(0, |a, &l| {
-            let [lo, hi] = pair(val, l);
-            a | (lo ^ hi)
-        }) & lanes;
-        let bad = self.g.bad.iter().fold(0, |a, &b| a | pair(val, b)[0]) & lanes;
-        // the successors: each latch's next value per lane, transposed back
-        let nexts = (0..self.words)
-            .map(|wd| {
-                let mut m = [0u64; 64];
-                let latches = self.g.latches.iter().skip(64 * wd).take(64);
-                for (j, &(_, nx, _)) in latches.enumerate() {
-                    m[j] = pair(val, nx)[0];
-                }
-                transpose64(&mut m);
-                m
+        let lane_bits = |b: usize| {
+            (chunk.iter().enumerate()).fold(0u64, |a, (k, &(_, code, _))| {
+                a | u64::from(code >> b & 1) << k
             })
-            .collect();
-        (bad, unknown_any, nexts)
+        };
+        for (b, &i) in self.choices.iter().enumerate() {
+            self.lo[(self.g.inputs[i] >> 1) as usize] = lane_bits(b);
+        }
+        let exact =
+            (chunk.iter().enumerate()).fold(0u64, |a, (k, &(_, _, e))| a | u64::from(e) << k);
+        for (b, &v) in self.others.iter().enumerate() {
+            let o = lane_bits(nc + b) & exact;
+            (self.lo[v as usize], self.hi[v as usize]) = (o, o | !exact);
+        }
     }
 
     /// The inputs from reset to a violation at `step` from `state` under

@@ -132,6 +132,42 @@ fn an_explicit_search_finds_a_deep_violation_and_its_witness_crosses_marks() {
     assert_eq!(ones, vec![0, 1], "{inputs:?}");
 }
 
+/// [`choice_shift`] whose first latch takes the choice AND input 1, which
+/// is not a choice (as yosys's `anyseq` bits are not): only that gate and
+/// the latch after it may be unknown, and the search enumerates input 1
+/// in the steps whose successor reads it.
+fn choice_and_other_shift(n: u32) -> Aig {
+    let latch = |k: u32| 6 + 2 * k;
+    let (first, gate) = (latch(n), latch(n) + 2);
+    let mut t = format!("aag {} 2 {n} 0 2 1\n2\n4\n", gate / 2);
+    for k in 0..n {
+        let next = if k == 0 { first } else { latch(k - 1) };
+        t.push_str(&format!("{} {next} 0\n", latch(k)));
+    }
+    t.push_str(&format!(
+        "{gate}\n{first} 2 4\n{gate} {} {}\n",
+        latch(n - 1),
+        latch(n - 2)
+    ));
+    parse(&t).unwrap()
+}
+
+#[test]
+fn an_explicit_search_enumerates_an_input_that_is_not_a_choice_where_a_step_reads_it() {
+    // the violation needs input 1 high with the choice, twice in a row:
+    // evaluated as unknown it would be missed (no verdict) or, taken as 0,
+    // a wrong proof
+    let g = choice_and_other_shift(6);
+    let Some(Found::Violated { step, inputs }) = explicit::run(&g, &[0], &SHIFT_LIMITS) else {
+        panic!("no violation found");
+    };
+    assert_eq!(step, 6);
+    for (i, what) in [(0, "the choice"), (1, "input 1")] {
+        let ones: Vec<usize> = (0..inputs.len()).filter(|&s| inputs[s][i]).collect();
+        assert_eq!(ones, vec![0, 1], "{what}: {inputs:?}");
+    }
+}
+
 #[test]
 fn an_explicit_search_past_its_bound_hands_the_part_to_simulation() {
     // the set doubles every step: past 65,536 states the search gives no
