@@ -34,7 +34,7 @@ endif
 # `PROPTEST_RNG_SEED=random make test` explores new cases.
 export PROPTEST_RNG_SEED ?= 1
 
-.PHONY: baseline test-long run test test-host host tools tools-run tools-extra venv lut audit verilog cosim golden golden-update synth synth-bench bench bench-before update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
+.PHONY: baseline test-long run test test-host host tools tools-run tools-extra venv lut audit verilog cosim golden golden-update synth synth-bench bench bench-before bench-prove update-snapshots lint clean fuzz fuzz-mix fuzz-vcd fuzz-seeds
 
 # The main job on the reference mix: audit, LUT, Verilog, co-simulation, golden,
 # faults, synthesis estimate, and build/eskin34/report.html with its charts.
@@ -190,6 +190,14 @@ bench:
 BASE ?= cc7b699
 bench-before:
 	bash cosim/engines/benches/before_after.sh $(BASE)
+
+# Cold proofs of every preset (or MIXES) at PROVE_BASE and at the working
+# tree, alternately ROUNDS times (docs/performance.md, "Formal proof"): the
+# median walls, their ratios, and exit 1 if a verdict differs.
+PROVE_BASE ?= a03a29f
+ROUNDS ?= 2
+bench-prove:
+	python3 formal/benches/prove_before_after.py --base $(PROVE_BASE) --rounds $(ROUNDS) $(MIXES)
 
 # Long-running fuzzing of the mix parser and the VCD reader (not part of `make test`;
 # docs/fuzzing.md).  Crashes and hangs land in fuzz/crashes/; exit 1 if any.
