@@ -453,8 +453,9 @@ fn tied(
         return Ok(None);
     }
     // an AXI4-Stream's bytes split on the slave's choices and the modes
-    // together do not come round in a long frame, tied or not (docs/formal.md,
-    // "Limits"): the runs as before
+    // together do not come round in a long frame, tied or not: tied, a
+    // slice boundary's burst passes the paths a split run keeps
+    // (docs/formal.md, "Limits"): the runs as before
     if h.inputs.iter().any(|i| i.name == harness::TREADY_ANY) {
         return Ok(None);
     }
