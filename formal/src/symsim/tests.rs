@@ -244,3 +244,25 @@ fn a_part_with_too_many_choice_bits_to_enumerate_is_simulated_instead() {
     }
     assert_eq!(steps[0], steps[1], "{steps:?}");
 }
+
+/// Input 1 copied into latch `h` every step (a request held, `defer.rs`)
+/// while latch `p` is input 0 AND its value a step before (kept in `q`):
+/// the run splits on input 0 in most steps, every path holding the step's
+/// input 1.  Held as one variable node per (input, step), paths that meet
+/// merge and the run proves at its first recurrence; held as a node of each
+/// path's own, they never met and the run stopped at its bound of paths
+/// (bounded at step 14).
+#[test]
+fn paths_that_hold_the_same_request_merge() {
+    // inputs 1, 2; latches q = 3 (input 0), p = 4 (AND 6), h = 5 (input 1)
+    let g = parse("aag 6 2 3 0 1 1\n2\n4\n6 2\n8 12\n10 4\n0\n12 2 6\n").unwrap();
+    let lim = Limits {
+        period: 16,
+        offset: 2,
+        max_steps: 100,
+        deadline: None,
+    };
+    let (f, st) = Sim::split_on(&g, &[0, 1]).run(&lim);
+    assert!(matches!(f, Found::Proved { steps: 18, .. }), "{f:?} {st:?}");
+    assert!(st.merged > 0, "{st:?}");
+}
