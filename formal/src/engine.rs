@@ -110,7 +110,8 @@ pub fn prepare(dir: &Path, solver: Solver) -> Result<Prepared, ProveError> {
 /// the flattened harness and design before anything is optimised (a cut
 /// point, a wire tied to another: `formal::composed`, `formal::tied`).
 pub fn prepare_edited(dir: &Path, solver: Solver, edit: &str) -> Result<Prepared, ProveError> {
-    let read = "read_verilog -formal harness.v; read_verilog -formal design.v;";
+    let design = write_for_yosys(dir)?;
+    let read = format!("read_verilog -formal harness.v; read_verilog -formal {design};");
     let script = match solver {
         // As SymbiYosys's `abc pdr` engine prepares an AIG (docs/formal.md),
         // but flattened before the first `opt`: `prep` optimises each of the
@@ -137,6 +138,26 @@ pub fn prepare_edited(dir: &Path, solver: Solver, edit: &str) -> Result<Prepared
     Ok(Prepared {
         dir: dir.to_path_buf(),
     })
+}
+
+/// `design.v` as yosys reads it, with its memories' tables in `$readmemh`
+/// files (`tables.rs`), written beside it; its name.
+fn write_for_yosys(dir: &Path) -> Result<&'static str, ProveError> {
+    let io = |p: &Path, e: std::io::Error| ProveError::Tool(format!("{}: {e}", p.display()));
+    let path = dir.join("design.v");
+    let text = std::fs::read_to_string(&path).map_err(|e| io(&path, e))?;
+    let (read, tables) = crate::tables::to_hex_files(&text);
+    if tables.is_empty() {
+        return Ok("design.v");
+    }
+    let files = [("design.yosys.v", read.as_str())]
+        .into_iter()
+        .chain(tables.iter().map(|(n, t)| (n.as_str(), t.as_str())));
+    for (name, text) in files {
+        let path = dir.join(name);
+        std::fs::write(&path, text).map_err(|e| io(&path, e))?;
+    }
+    Ok("design.yosys.v")
 }
 
 /// ABC's `bmc3` from reset for at most `frames` steps and `secs` seconds.

@@ -18,6 +18,7 @@ mod harness;
 mod replay;
 mod strategy;
 mod symsim;
+mod tables;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;

@@ -261,6 +261,81 @@ fn tiny_axis() -> lut_gen::Schedule {
     lut_gen::synthesize(&mix).expect("feasible")
 }
 
+/// yosys reads a memory's table of initial words from a `$readmemh` file
+/// (the engine writes one beside the design, `design.yosys.v`): yosys
+/// makes the same memories of it, word for word, as of the table in the
+/// text, and the rest of the text is the same.
+#[test]
+fn tables_read_from_hex_files_give_yosys_the_same_memories() {
+    if !tools::require_tools(&["yosys"]) {
+        return;
+    }
+    for mix in ["testkit/mixes/cmd-modes.toml", "mixes/eskin34.toml"] {
+        let s = schedule(mix);
+        let h = formal::generate(&s).expect("a harness");
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("harness.v"), &h.verilog).unwrap();
+        std::fs::write(dir.path().join("design.v"), emitted(&s)).unwrap();
+        formal::prepare(dir.path(), formal::Solver::Symbolic).expect("yosys");
+        let (given, read) = (
+            memories(dir.path(), "design.v"),
+            memories(dir.path(), "design.yosys.v"),
+        );
+        assert!(given.len() >= 3, "{mix}: {given:?}");
+        assert_eq!(given, read, "{mix}");
+        let text = |f: &str| std::fs::read_to_string(dir.path().join(f)).unwrap();
+        let outside = |t: String| -> Vec<String> {
+            t.lines()
+                .filter(|l| !l.contains("] = ") && !l.contains("initial") && l.trim() != "end")
+                .map(String::from)
+                .collect()
+        };
+        assert_eq!(
+            outside(text("design.v")),
+            outside(text("design.yosys.v")),
+            "{mix}"
+        );
+    }
+}
+
+/// Each memory yosys makes of `file` in `dir`: its module, name, size and
+/// initial words (`write_rtlil` after `memory_collect`).
+fn memories(dir: &Path, file: &str) -> Vec<String> {
+    let script = format!("read_verilog -formal {file}; proc; memory_collect; write_rtlil mems.il");
+    let ok = std::process::Command::new("yosys")
+        .args(["-q", "-p", &script])
+        .current_dir(dir)
+        .status()
+        .unwrap()
+        .success();
+    assert!(ok, "yosys reads {file}");
+    let il = std::fs::read_to_string(dir.join("mems.il")).unwrap();
+    let (mut module, mut cell, mut out) = ("", None::<String>, Vec::new());
+    for line in il.lines().map(str::trim) {
+        if let Some(m) = line.strip_prefix("module ") {
+            module = m;
+        } else if line.starts_with("cell $mem_v2 ") {
+            cell = Some(module.to_string());
+        } else if line == "end" {
+            out.extend(cell.take());
+        } else if let Some(c) = cell.as_mut() {
+            for p in [
+                "parameter \\MEMID ",
+                "parameter \\SIZE ",
+                "parameter \\WIDTH ",
+                "parameter \\INIT ",
+            ] {
+                if let Some(v) = line.strip_prefix(p) {
+                    c.push(' ');
+                    c.push_str(v);
+                }
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
 /// ABC's bounded search from reset of harness + `design`, `steps` deep.
 fn bmc(s: &lut_gen::Schedule, design: &str, steps: u64) -> formal::SolverVerdict {
     let h = formal::generate(s).expect("a harness");
