@@ -6,10 +6,12 @@
 //! Why: yosys makes one `$meminit` cell per assignment and carries each
 //! through `proc`, `flatten` and every `opt` until `memory_collect` merges
 //! them; a `$readmemh` file of consecutive words is one cell. eskin34's
-//! 3,584 table words took 2.7 s of yosys's 6.1 s; the AIG and its map come
-//! out byte for byte the same (a test holds them equal). Anything not in
-//! exactly that form (a gap, a word out of order, a value wider than the
-//! word, an `x`) is left as it is.
+//! 3,584 table words took 2.7 s of yosys's 6.1 s. yosys makes the same
+//! memories of either (a test compares them word for word); eskin34's AIG
+//! came out byte for byte the same, others differ in the latches' order
+//! (yosys numbers its cells as it makes them). Anything not in exactly that
+//! form (a gap, a word out of order, a value wider than the word, an `x`)
+//! is left as it is.
 
 /// The text with each table replaced by `initial $readmemh("FILE", m);`,
 /// and each file's name and contents.
