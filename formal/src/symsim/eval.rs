@@ -16,7 +16,10 @@
 //! was false before and after).  And the latches: a step given the state
 //! the step before left (the usual case, compared as one slice) starts
 //! from the latches that moved in it, and writes only the latches whose
-//! next value's variable changed; any other state is read whole.
+//! next value's variable changed; any other state is read whole.  An input
+//! that only a latch's literal lets through, that literal false in the
+//! state (yosys's power-on inputs once reset has passed), takes false and
+//! no variable (`quiet`).
 
 use crate::aiger::Aig;
 
@@ -53,6 +56,16 @@ pub(super) struct Eval {
     dirty: Vec<u32>,
     /// A buffer for a step's input literals, reused step after step.
     inputs: Vec<u32>,
+    /// Inputs whose value cannot matter while a latch holds a constant:
+    /// (input index, latch index, the latch's value that gates it off).
+    /// yosys's `write_aiger -zinit` reads each uninitialised register's
+    /// power-on value from an input of its own, through `AND(input,
+    /// initstate)` alone, false from step 1 on: 40 of eskin34-adaptive's
+    /// 44 inputs.  A fresh variable for each of them every step was about
+    /// a sixth of its run (making the nodes, collecting them).
+    gated: Vec<(u32, u32, u32)>,
+    /// `quiet`'s buffer, reused step after step.
+    quiet: Vec<bool>,
 }
 
 /// Per variable, the items `of` lists for it, as one flat array and each
@@ -75,6 +88,41 @@ fn flat<T: Copy + Default>(
         next[v] += 1;
     }
     (at, items)
+}
+
+/// The inputs that every reader ANDs with one literal of one latch, and
+/// nothing else reads (no latch's next value, no assertion): with that
+/// literal false the input's value cannot reach anything.
+fn gated_inputs(
+    g: &Aig,
+    fan_at: &[u32],
+    fan: &[(u32, u32)],
+    feeds_at: &[u32],
+) -> Vec<(u32, u32, u32)> {
+    let latch_of: std::collections::HashMap<u32, u32> = (g.latches.iter().enumerate())
+        .map(|(j, &(l, _, _))| (l >> 1, j as u32))
+        .collect();
+    let watched: std::collections::HashSet<u32> = (g.bad.iter().chain(&g.constraints))
+        .map(|&b| b >> 1)
+        .collect();
+    let mut out = Vec::new();
+    for (k, &i) in g.inputs.iter().enumerate() {
+        let v = (i >> 1) as usize;
+        if feeds_at[v] != feeds_at[v + 1] || watched.contains(&(i >> 1)) {
+            continue;
+        }
+        let readers = &fan[fan_at[v] as usize..fan_at[v + 1] as usize];
+        let Some(&(_, other)) = readers.first() else {
+            continue;
+        };
+        let Some(&j) = latch_of.get(&(other >> 1)) else {
+            continue;
+        };
+        if readers.iter().all(|&(_, o)| o == other) {
+            out.push((k as u32, j, other & 1));
+        }
+    }
+    out
 }
 
 impl Eval {
@@ -101,6 +149,7 @@ impl Eval {
             .map(|(j, &(_, next, _))| ((next >> 1) as usize, j as u32));
         let (feeds_at, feeds) = flat(nv, nexts);
         let depth = level.iter().copied().max().unwrap_or(0) as usize + 1;
+        let gated = gated_inputs(g, &fan_at, &fan, &feeds_at);
         Eval {
             queued: vec![false; ands.len()],
             ands,
@@ -116,7 +165,28 @@ impl Eval {
             moved: Vec::new(),
             dirty: Vec::new(),
             inputs: Vec::new(),
+            gated,
+            quiet: Vec::new(),
         }
+    }
+
+    #[cfg(test)]
+    pub(super) fn gates_inputs(&self) -> bool {
+        !self.gated.is_empty()
+    }
+
+    /// Per input, whether it is gated off in `state` (`gated`): it takes
+    /// the constant false rather than a variable, an exact step whatever
+    /// its value.  Empty when none is.
+    pub(super) fn quiet(&mut self, state: &[u32], n: usize) -> &[bool] {
+        self.quiet.clear();
+        for &(k, j, off) in &self.gated {
+            if state[j as usize] == off {
+                self.quiet.resize(n, false);
+                self.quiet[k as usize] = true;
+            }
+        }
+        &self.quiet
     }
 
     /// The graph was collected: every value is evaluated again next step.

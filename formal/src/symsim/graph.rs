@@ -51,10 +51,12 @@ impl Graph {
 
     /// The variables of inputs `0..n` at `step` (what `var` gives each),
     /// in `out` (cleared first: a buffer reused step after step).
-    pub(super) fn step_vars(&mut self, n: u32, step: u32, out: &mut Vec<u32>) {
+    /// Inputs `quiet` marks (`Eval::quiet`) take false and no node.
+    pub(super) fn step_vars(&mut self, n: u32, step: u32, quiet: &[bool], out: &mut Vec<u32>) {
         out.clear();
         if !self.shared {
-            out.extend((0..n).map(|k| self.fresh_var(k, step)));
+            let var = |k: u32| !quiet.get(k as usize).copied().unwrap_or(false);
+            out.extend((0..n).map(|k| if var(k) { self.fresh_var(k, step) } else { 0 }));
             return;
         }
         let (a, b) = (&mut self.a, &mut self.b);
@@ -68,6 +70,11 @@ impl Graph {
         for k in len..n {
             let v = self.var(k, step);
             out.push(v);
+        }
+        for (x, &q) in out.iter_mut().zip(quiet) {
+            if q {
+                *x = 0;
+            }
         }
     }
 

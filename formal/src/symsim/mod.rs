@@ -644,7 +644,8 @@ impl<'a> Sim<'a> {
 /// returns the disjunction of the assertions (`val`: each gate's value).
 fn evaluate(g: &Aig, ev: &mut eval::Eval, gr: &mut Graph, state: &mut [u32], step: u64) -> u32 {
     let mut inputs = ev.take_inputs();
-    gr.step_vars(g.inputs.len() as u32, step as u32, &mut inputs);
+    let quiet = ev.quiet(state, g.inputs.len());
+    gr.step_vars(g.inputs.len() as u32, step as u32, quiet, &mut inputs);
     let bad = ev.step(g, gr, state, &inputs);
     ev.give_inputs(inputs);
     bad

@@ -251,7 +251,9 @@ impl Sim<'_> {
         }
         let vars = &vars[..self.splits.len()];
         let mut inputs = self.ev.take_inputs();
-        self.gr.step_vars(ni as u32, step as u32, &mut inputs);
+        let quiet = self.ev.quiet(&self.state, ni);
+        self.gr
+            .step_vars(ni as u32, step as u32, quiet, &mut inputs);
         for (&k, &n) in self.splits.iter().zip(vars) {
             inputs[k] = n as u32 * 2;
         }
