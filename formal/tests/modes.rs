@@ -726,7 +726,8 @@ fn an_auto_mix_with_an_axi_stream_proves_in_two_runs() {
 /// behaviours only, the whole harness decides: a trace from reset that
 /// `link.overflow` fails, which `check` rejects too, earlier (its model
 /// of the link is exact to the cycle: the beat after the first comes a
-/// cycle late at cycle 12, which the contract allows). About two minutes.
+/// cycle late at cycle 12, which the contract allows). 331-350 s on two
+/// cores beside other work (2026-11-30; about two minutes when written).
 #[test]
 #[ignore = "long: make test-long (the whole harness's run after the cut one's violation)"]
 fn an_auto_axi_stream_gateware_that_ignores_tready_fails_prove() {
