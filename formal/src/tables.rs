@@ -13,8 +13,8 @@
 //! form (a gap, a word out of order, a value wider than the word, an `x`)
 //! is left as it is.
 
-/// The text with each table replaced by `initial $readmemh("FILE", m);`,
-/// and each file's name and contents.
+/// The text with each table replaced by `initial $readmemh("FILE", m);`
+/// and as many empty lines as it had, and each file's name and contents.
 pub(crate) fn to_hex_files(text: &str) -> (String, Vec<(String, String)>) {
     let lines: Vec<&str> = text.split_inclusive('\n').collect();
     let mut out = String::with_capacity(text.len());
@@ -28,6 +28,9 @@ pub(crate) fn to_hex_files(text: &str) -> (String, Vec<(String, String)>) {
             let mem = memory_name(reg).expect("table_at read it");
             out.push_str(reg);
             out.push_str(&format!("{indent}initial $readmemh(\"{name}\", {mem});\n"));
+            // every later line where it was: yosys's messages name the
+            // lines of the Verilog as given
+            out.push_str(&"\n".repeat(used - 2));
             files.push((name, words));
             i += used;
         } else {
@@ -105,8 +108,15 @@ mod tests {
                 "00\n7f\n2A\n01\n".to_string()
             )]
         );
-        assert!(text.contains("    reg [6:0] mem [0:3];\n    initial $readmemh(\"slotforge_table_0.hex\", mem);\n    always"));
+        assert!(text.contains(
+            "    reg [6:0] mem [0:3];\n    initial $readmemh(\"slotforge_table_0.hex\", mem);\n\n\n\n\n\n    always"
+        ));
         assert!(!text.contains("mem[1]"));
+        assert_eq!(
+            text.lines().count(),
+            ROM.lines().count(),
+            "lines where they were"
+        );
     }
 
     #[test]
