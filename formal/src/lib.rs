@@ -828,7 +828,12 @@ fn link_generalised(
         return Ok(None);
     }
     let f = h.frame_cycles;
-    let counters = symsim::Counters { pairs, from: 2 };
+    let counters = symsim::Counters {
+        pairs,
+        from: 2,
+        // an AXI4-Stream slave's: a path waiting less subsumes (`split.rs`)
+        wait: named_latches(&prep, harness::SLAVE_WAIT).unwrap_or_default(),
+    };
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
     // auto select: as deep as the main run may need for its windows (tied,
     // the decisions are a free input, split as pin select's)
@@ -1039,19 +1044,7 @@ fn counter_pairs(
     design: &str,
     harness: &str,
 ) -> Option<Vec<(usize, usize)>> {
-    let aim = std::fs::read_to_string(prep.dir.join("design.aim")).ok()?;
-    let bits = |name: &str| -> Option<Vec<usize>> {
-        let mut by_bit: std::collections::BTreeMap<usize, usize> = Default::default();
-        for l in aim.lines() {
-            let f: Vec<&str> = l.split_whitespace().collect();
-            if f.len() == 4 && f[0] == "latch" && f[3] == name {
-                by_bit.insert(f[2].parse().ok()?, f[1].parse().ok()?);
-            }
-        }
-        let n = by_bit.len();
-        (n > 0 && by_bit.keys().copied().eq(0..n)).then(|| by_bit.into_values().collect())
-    };
-    let (d, h) = (bits(design)?, bits(harness)?);
+    let (d, h) = (named_latches(prep, design)?, named_latches(prep, harness)?);
     (d.len() == h.len()).then(|| d.into_iter().zip(h).collect())
 }
 
@@ -1255,6 +1248,21 @@ fn named_inputs(prep: &engine::Prepared, name: &str) -> Vec<usize> {
             named.then(|| f[1].parse().ok()).flatten()
         })
         .collect()
+}
+
+/// The AIG latches of register `name` (yosys's map), least significant
+/// bit first; `None` unless it has bits `0..n`, `n > 0`.
+fn named_latches(prep: &engine::Prepared, name: &str) -> Option<Vec<usize>> {
+    let aim = std::fs::read_to_string(prep.dir.join("design.aim")).ok()?;
+    let mut by_bit: std::collections::BTreeMap<usize, usize> = Default::default();
+    for l in aim.lines() {
+        let f: Vec<&str> = l.split_whitespace().collect();
+        if f.len() == 4 && f[0] == "latch" && f[3] == name {
+            by_bit.insert(f[2].parse().ok()?, f[1].parse().ok()?);
+        }
+    }
+    let n = by_bit.len();
+    (n > 0 && by_bit.keys().copied().eq(0..n)).then(|| by_bit.into_values().collect())
 }
 
 /// How a design with choice inputs was proved, part by part.

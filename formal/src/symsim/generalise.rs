@@ -33,8 +33,10 @@
 use super::graph::{Assigned, Graph};
 use super::{Found, Sim};
 
-/// The latch pairs one counter's bits occupy in the design and in the
-/// harness, and where generalising starts.
+/// The harness's counters the engine treats apart: the latch pairs one
+/// counter's bits occupy in the design and in the harness (the frame
+/// counters, generalised), where generalising starts, and an AXI4-Stream
+/// slave's wait count (paths subsumed, `split.rs`).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Counters {
     /// `(design's latch, harness's latch)` per bit, least significant
@@ -43,6 +45,11 @@ pub struct Counters {
     /// The first frame-start step at which they are generalised; every
     /// step before it is simulated exactly from reset.
     pub from: u64,
+    /// The slave's wait count (the harness's `waited`; empty without
+    /// one), least significant bit first: read by nothing but the slave's
+    /// `tready`, so a path whose count is lower has every future of one in
+    /// the same state otherwise (`split.rs`).
+    pub wait: Vec<usize>,
 }
 
 /// One path's generalisations: the counter's literals each replaced, and

@@ -370,7 +370,7 @@ struct Sim<'a> {
     splits: Vec<usize>,
     fixed: Vec<graph::Assigned>,
     /// A split run's paths waiting, by the step they continue at.
-    queue: std::collections::BTreeMap<(u64, u64), split::Branch>,
+    queue: std::collections::BTreeMap<(u64, u64, u64), split::Branch>,
     /// Split at frame starts on the values of latches that are functions of
     /// the inputs (`cases.rs`), and the path's condition: conjuncts on the
     /// inputs that every state of the path satisfies.
