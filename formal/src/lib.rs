@@ -932,7 +932,7 @@ fn split_general_note(
 ) -> String {
     format!(
         "{PROVED}: every step from reset simulated exactly with MISO a variable of its step \
-         and split {how} (paths in the same state at a step merged: {} merged; {} latches, \
+         and split {how} (paths in the same state at a step merged: {} merged{}; {} latches, \
          {} gates; {} satisfiability checks); at each frame start, {what}, shown equal in \
          every state, are replaced by one free 8-bit value, so the states simulated from it \
          include every state reachable there; by step {steps} ({:.0} frames) every path's \
@@ -941,6 +941,13 @@ fn split_general_note(
          the link's bytes ({}) included (symbolic simulation with the frame counter \
          generalised: an inductive invariant, checked)",
         st.merged,
+        match st.subsumed {
+            0 => String::new(),
+            n => format!(
+                ", and {n} more in the same state as one whose slave had waited fewer cycles \
+                 (its futures include theirs)"
+            ),
+        },
         g.latches.len(),
         g.ands.len(),
         st.sat_calls,

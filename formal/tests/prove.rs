@@ -478,7 +478,7 @@ fn axis_gateware_has_no_violation_in_a_bounded_search() {
 /// The clean AXI4-Stream gateware proves for all time under every slave
 /// the guarantee allows: the handshake's properties by 2-induction, the
 /// FIFO's fill level by explicit-state search over the slave's choices,
-/// the rest by symbolic simulation.
+/// the rest by symbolic simulation, its paths subsumed by the slave's wait.
 #[test]
 fn axis_gateware_proves_for_every_slave() {
     if !tools::require_tools(&TOOLS) {
@@ -493,7 +493,12 @@ fn axis_gateware_proves_for_every_slave() {
         let r = p.properties.iter().find(|q| q.name == name).unwrap();
         assert_eq!(r.result, Outcome::Proved, "{}", p.summary());
     }
-    for how in ["split on the slave's choices", "frame counter generalised"] {
+    for how in [
+        "split on the slave's choices",
+        "frame counter generalised",
+        // paths equal but for the slave's wait: the lower count kept
+        "whose slave had waited fewer cycles",
+    ] {
         assert!(p.note.contains(how), "{how}: {}", p.note);
     }
 }

@@ -1615,7 +1615,7 @@ fn waiting_design(rng: &mut Rng) -> (Aig, Vec<usize>) {
 #[test]
 fn random_designs_beside_a_waiting_slave_agree_with_an_explicit_state_search() {
     let mut rng = Rng(0x5EED_0F5A_A7E5_7A11);
-    let (mut tally, mut merged) = ([0usize; 3], 0);
+    let (mut tally, mut merged, mut subsumed) = ([0usize; 3], 0, 0);
     for _ in 0..2000 {
         let (g, wait) = waiting_design(&mut rng);
         let (period, offset) = (1 + rng.below(4), rng.below(4));
@@ -1627,10 +1627,10 @@ fn random_designs_beside_a_waiting_slave_agree_with_an_explicit_state_search() {
         let (f, st) = judged_by(&g, period, offset, || {
             prove_generalised(&g, counters, &[0], false, period, offset, 40, None)
         });
-        merged += st.merged;
+        (merged, subsumed) = (merged + st.merged, subsumed + st.subsumed);
         tally[verdict(&f)] += 1;
     }
-    eprintln!("{tally:?} proved/violated/bounded, {merged} paths merged");
+    eprintln!("{tally:?} proved/violated/bounded, {merged} paths merged, {subsumed} subsumed");
     assert!(tally.iter().all(|&n| n > 50), "{tally:?}");
-    assert!(merged > 1000, "{merged} merged");
+    assert!(merged > 1000 && subsumed > 1000, "{merged} merged, {subsumed} subsumed");
 }

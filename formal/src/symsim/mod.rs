@@ -95,6 +95,10 @@ pub struct SymStats {
     /// A split run: paths dropped because another path had reached the
     /// same state at the same step.
     pub merged: u64,
+    /// A split run: paths dropped because another path had reached the
+    /// same state at the same step but for a lower count of the slave's
+    /// wait (`split.rs`: its futures include theirs).
+    pub subsumed: u64,
 }
 
 /// Steps between the checks of the assertions that did not fold (one SAT

@@ -39,7 +39,7 @@
 //! (`ready_within` 64) did not finish in 32 minutes with the bytes
 //! asserted, and finishes in 8 with this.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 use super::graph::Assigned;
 use super::{kept, Found, Limits, Sim, SymStats, CHECK};
@@ -51,6 +51,10 @@ pub(super) const MAX_SPLIT_BITS: usize = 8;
 /// At most this many states at boundaries and paths waiting: past it the
 /// run stops, bounded (a mode mix has a state per pair of modes and data).
 const MAX_PATHS: usize = 4096;
+
+/// The paths started at one step: (step, graph collections, each one's
+/// state and condition, the wait count left out, with that count).
+type Started = (u64, u64, HashMap<Vec<u32>, Option<u64>>);
 
 /// A path waiting at the step it continues from.
 pub(super) struct Branch {
@@ -85,21 +89,27 @@ impl Sim<'_> {
         // the paths started at one step (by their state): paths are taken
         // by their step, so a path whose state one of them had is the same
         // machine in the same state and adds nothing (any of their inputs
-        // is a trace to it); cleared when the graph is collected
-        let mut started: (u64, u64, HashSet<Vec<u32>>) = (u64::MAX, 0, HashSet::new());
+        // is a trace to it), with the slave's wait count, if any (a path
+        // whose count is higher is subsumed); cleared when the graph is
+        // collected
+        let mut started: Started = (u64::MAX, 0, HashMap::new());
         while let Some(((from, _, _), b)) = self.queue.pop_first() {
             let stop = first.as_ref().map_or(lim.max_steps, |f| f.0);
             if from >= stop && first.is_some() {
                 continue; // at or past the earliest violation
             }
             if (started.0, started.1) != (from, self.collections) {
-                started = (from, self.collections, HashSet::new());
+                started = (from, self.collections, HashMap::new());
             }
-            let key = self.merge_key(&b);
-            if !started.2.insert(key) {
-                self.stats.merged += 1;
+            let (key, count) = (self.merge_key(&b), self.wait_count(&b.state));
+            if let Some(&first) = started.2.get(&key) {
+                match first == count {
+                    true => self.stats.merged += 1,
+                    false => self.stats.subsumed += 1,
+                }
                 continue;
             }
+            started.2.insert(key, count);
             if from >= stop {
                 // a path that reached the last step: nothing is said beyond
                 self.stats.branches = seen.len();
