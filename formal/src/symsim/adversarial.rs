@@ -1632,5 +1632,8 @@ fn random_designs_beside_a_waiting_slave_agree_with_an_explicit_state_search() {
     }
     eprintln!("{tally:?} proved/violated/bounded, {merged} paths merged, {subsumed} subsumed");
     assert!(tally.iter().all(|&n| n > 50), "{tally:?}");
-    assert!(merged > 1000 && subsumed > 1000, "{merged} merged, {subsumed} subsumed");
+    assert!(
+        merged > 1000 && subsumed > 1000,
+        "{merged} merged, {subsumed} subsumed"
+    );
 }
