@@ -3,7 +3,8 @@
 //! DESIGN.aag PERIOD [MAX_STEPS [SECONDS]]` (a work directory kept with
 //! `SLOTFORGE_FORMAL_KEEP=1 slotforge prove MIX` holds `design.aag`;
 //! `CHOICES` are the indices of inputs that are an environment's choices,
-//! `tready_any` in its `design.aim`).
+//! `tready_any` in its `design.aim`; `WAIT` the latch indices of its
+//! `waited`, least significant first).
 
 use std::time::{Duration, Instant};
 
@@ -42,9 +43,14 @@ fn main() {
     let splits: Vec<usize> = std::env::var("SPLITS")
         .map(|c| c.split(',').map(|x| num(x, "SPLITS") as usize).collect())
         .unwrap_or_default();
+    // WAIT=j,k: latch indices of a slave's wait count, least significant first
+    let wait: Vec<usize> = std::env::var("WAIT")
+        .map(|c| c.split(',').map(|x| num(x, "WAIT") as usize).collect())
+        .unwrap_or_default();
     let (found, st) = formal::prove_aig(
         &g,
         &choices,
+        &wait,
         &splits,
         std::env::var_os("CASES").is_some(),
         period,

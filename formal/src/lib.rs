@@ -686,6 +686,7 @@ fn link_bytes(
     let (found, _) = symsim::prove(
         &g,
         &[],
+        &[],
         &splits,
         auto.is_some(),
         f,
@@ -1168,8 +1169,20 @@ fn symbolic(
     let limit = (opts.depth).unwrap_or((DEEP_FRAMES + auto.unwrap_or(0)) * f + 2);
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
     let choices = named_inputs(prep, harness::TREADY_ANY);
+    // the slave's wait count: states equal but for it subsumed in the search
+    let wait = named_latches(prep, harness::SLAVE_WAIT).unwrap_or_default();
     let splits = named_inputs(prep, harness::MODE_SEL);
-    let (found, st) = symsim::prove(&g, &choices, &splits, cases, f, 2, limit, Some(deadline));
+    let (found, st) = symsim::prove(
+        &g,
+        &choices,
+        &wait,
+        &splits,
+        cases,
+        f,
+        2,
+        limit,
+        Some(deadline),
+    );
     Ok(match found {
         symsim::Found::Proved { steps, .. } if st.cases > 0 => (
             Outcome::Proved,

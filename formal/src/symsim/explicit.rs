@@ -56,7 +56,10 @@ pub(super) fn fits(g: &Aig, choices: &[usize]) -> bool {
     choices.len() <= MAX_CHOICE_BITS && free_latches(g).len() <= MAX_FREE_INIT
 }
 
-pub(super) fn run(g: &Aig, choices: &[usize], lim: &Limits) -> Option<Found> {
+/// `wait`: the latches of an AXI4-Stream slave's wait count, least
+/// significant first (empty without one): of two successors equal but for
+/// it, the one with the lower count is kept alone (see `States::insert`).
+pub(super) fn run(g: &Aig, choices: &[usize], wait: &[usize], lim: &Limits) -> Option<Found> {
     let Limits {
         period,
         offset,
@@ -68,6 +71,7 @@ pub(super) fn run(g: &Aig, choices: &[usize], lim: &Limits) -> Option<Found> {
         return None;
     }
     let mut m = Machine::new(g, choices);
+    m.wait = wait.to_vec();
     // the power-on set: every value of the free latches
     let mut set = States::new(m.words);
     for v in 0..1u64 << free.len() {
@@ -179,6 +183,10 @@ struct States {
     /// Positions + 1 (0: empty), a power of two long, at most half full.
     slots: Vec<u32>,
     parents: Vec<(u32, u32)>,
+    /// The slave's wait count's latches, and per word the bits outside
+    /// them: states are told apart by those bits alone (`insert`).
+    wait: Vec<usize>,
+    mask: Vec<u64>,
 }
 
 impl States {
@@ -194,7 +202,35 @@ impl States {
             flat: Vec::with_capacity(n * words),
             slots: vec![0; (2 * n + 1).next_power_of_two().max(64)],
             parents: Vec::with_capacity(n),
+            wait: Vec::new(),
+            mask: vec![!0; words],
         }
+    }
+
+    /// This (empty) set keeping, of states equal but for the wait count
+    /// `wait` (latches, least significant first), the lowest count alone.
+    /// Why that is exact: the count is read by nothing but the slave's
+    /// `tready` (`harness::SLAVE_WAIT`), and a lower count allows every
+    /// choice a higher one does, so the lower state's futures include the
+    /// other's; a set that holds, for each reachable state, one equal but
+    /// for a count no higher covers every reachable state, and its
+    /// successors do again (`split.rs` keeps its paths the same way).
+    fn subsuming(mut self, wait: &[usize]) -> States {
+        for &j in wait {
+            self.mask[j / 64] &= !(1u64 << (j % 64));
+        }
+        self.wait = wait.to_vec();
+        self
+    }
+
+    /// The wait count of state `s`.
+    fn count(&self, s: &[u64]) -> u64 {
+        (self.wait.iter().enumerate()).fold(0, |a, (b, &j)| a | (s[j / 64] >> (j % 64) & 1) << b)
+    }
+
+    /// `a` and `b` equal but for the wait count.
+    fn same(&self, a: &[u64], b: &[u64]) -> bool {
+        (a.iter().zip(b).zip(&self.mask)).all(|((x, y), m)| (x ^ y) & m == 0)
     }
 
     /// A set kept as a snapshot, for stepping (not for inserting).
@@ -204,6 +240,8 @@ impl States {
             flat,
             slots: Vec::new(),
             parents,
+            wait: Vec::new(),
+            mask: vec![!0; words],
         }
     }
 
@@ -215,19 +253,28 @@ impl States {
         &self.flat[i * self.words..(i + 1) * self.words]
     }
 
-    /// A state's slot to start probing at (a multiplicative hash).
+    /// A state's slot to start probing at (a multiplicative hash of its
+    /// bits outside the wait count).
     fn home(&self, s: &[u64]) -> usize {
-        let h = (s.iter()).fold(0x9E37_79B9_7F4A_7C15u64, |h, &w| {
-            (h.rotate_left(5) ^ w).wrapping_mul(0x517C_C1B7_2722_0A95)
+        let h = (s.iter().zip(&self.mask)).fold(0x9E37_79B9_7F4A_7C15u64, |h, (&w, &m)| {
+            (h.rotate_left(5) ^ (w & m)).wrapping_mul(0x517C_C1B7_2722_0A95)
         });
         (h >> 32) as usize & (self.slots.len() - 1)
     }
 
+    /// Adds `s`, first reached by `from`, unless the set holds it; of two
+    /// states equal but for the wait count, the lower count's (`subsuming`).
     fn insert(&mut self, s: &[u64], from: (u32, u32)) {
         let mask = self.slots.len() - 1;
         let mut at = self.home(s);
         while self.slots[at] != 0 {
-            if self.get(self.slots[at] as usize - 1) == s {
+            let i = self.slots[at] as usize - 1;
+            if self.same(self.get(i), s) {
+                if !self.wait.is_empty() && self.count(s) < self.count(self.get(i)) {
+                    let w = self.words;
+                    self.flat[i * w..(i + 1) * w].copy_from_slice(s);
+                    self.parents[i] = from;
+                }
                 return;
             }
             at = (at + 1) & mask;
@@ -327,6 +374,8 @@ struct Machine<'a> {
     /// The inputs that are not choices (their variables): unknown unless a
     /// lane enumerates them.
     others: Vec<u32>,
+    /// The slave's wait count's latches (`run`).
+    wait: Vec<usize>,
 }
 
 impl<'a> Machine<'a> {
@@ -341,6 +390,7 @@ impl<'a> Machine<'a> {
             tainted: vec![false; g.max_var as usize + 1],
             known: Vec::new(),
             maybe: Vec::new(),
+            wait: Vec::new(),
             others: {
                 // the other inputs the cone reads
                 let read: std::collections::HashSet<u32> = (g.ands.iter())
@@ -388,7 +438,7 @@ impl<'a> Machine<'a> {
         let mut lanes: Vec<(u32, u32, bool)> = (0..set.len() as u32)
             .flat_map(|s| (0..1u32 << nc).map(move |c| (s, c, false)))
             .collect();
-        let mut next = States::with_capacity(self.words, set.len());
+        let mut next = States::with_capacity(self.words, set.len()).subsuming(&self.wait);
         let mut st = vec![0u64; self.words];
         let mut at = 0;
         while at < lanes.len() {

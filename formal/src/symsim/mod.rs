@@ -136,10 +136,12 @@ pub fn run(
 /// explicit-state search (`explicit`), and if that cannot decide it, by
 /// `run`.  Every part holding in every reachable state is the
 /// whole assertion holding; a part's violation is the assertion's.
+/// `wait`: an AXI4-Stream slave's wait count's latches (`explicit::run`).
 #[allow(clippy::too_many_arguments)]
 pub fn prove(
     g: &Aig,
     choices: &[usize],
+    wait: &[usize],
     splits: &[usize],
     cases: bool,
     period: u64,
@@ -209,8 +211,18 @@ pub fn prove(
     }
     // the explicit search and the symbolic simulation side by side, one
     // thread each (they share nothing but the AIG they read)
+    let all_wait = wait.len();
     let explicit_run = |(sub, c): (Aig, cone::Cone)| {
-        explicit::run(&sub, choices, &whole).map(|f| lift(f, &c.latches, ni, nl))
+        // the slave's wait count in the cone's latches: all of it, or none
+        let wait: Vec<usize> = (wait.iter())
+            .filter_map(|w| c.latches.iter().position(|l| l == w))
+            .collect();
+        let wait = if wait.len() == all_wait {
+            wait
+        } else {
+            Vec::new()
+        };
+        explicit::run(&sub, choices, &wait, &whole).map(|f| lift(f, &c.latches, ni, nl))
     };
     let (searched, mut simulated) = std::thread::scope(|sc| {
         let search = search.map(|x| sc.spawn(move || explicit_run(x)));

@@ -123,7 +123,7 @@ fn an_explicit_search_finds_a_deep_violation_and_its_witness_crosses_marks() {
     // 10 steps: marks every 3 in the unit tests, so the witness is
     // rebuilt from kept sets; a wrong stretch would not replay
     let g = choice_shift(10);
-    let Some(Found::Violated { step, inputs }) = explicit::run(&g, &[0], &SHIFT_LIMITS) else {
+    let Some(Found::Violated { step, inputs }) = explicit::run(&g, &[0], &[], &SHIFT_LIMITS) else {
         panic!("no violation found");
     };
     assert_eq!(step, 10);
@@ -158,7 +158,7 @@ fn an_explicit_search_enumerates_an_input_that_is_not_a_choice_where_a_step_read
     // evaluated as unknown it would be missed (no verdict) or, taken as 0,
     // a wrong proof
     let g = choice_and_other_shift(6);
-    let Some(Found::Violated { step, inputs }) = explicit::run(&g, &[0], &SHIFT_LIMITS) else {
+    let Some(Found::Violated { step, inputs }) = explicit::run(&g, &[0], &[], &SHIFT_LIMITS) else {
         panic!("no violation found");
     };
     assert_eq!(step, 6);
@@ -173,14 +173,14 @@ fn an_explicit_search_past_its_bound_hands_the_part_to_simulation() {
     // the set doubles every step: past 65,536 states the search gives no
     // verdict, and the symbolic run finds the violation
     let g = choice_shift(20);
-    assert_eq!(explicit::run(&g, &[0], &SHIFT_LIMITS), None);
+    assert_eq!(explicit::run(&g, &[0], &[], &SHIFT_LIMITS), None);
     let Limits {
         period,
         offset,
         max_steps,
         ..
     } = SHIFT_LIMITS;
-    let (f, st) = prove(&g, &[0], &[], false, period, offset, max_steps, None);
+    let (f, st) = prove(&g, &[0], &[], &[], false, period, offset, max_steps, None);
     assert!(matches!(f, Found::Violated { step: 20, .. }), "{f:?}");
     assert_eq!(st.parts, [1, 0, 0], "simulated, not enumerated");
 }
@@ -235,7 +235,7 @@ fn a_part_with_too_many_choice_bits_to_enumerate_is_simulated_instead() {
     for (n, parts) in [(6, [0, 0, 1]), (7, [1, 0, 0])] {
         let g = all_choices_counter(n);
         let choices: Vec<usize> = (0..n as usize).collect();
-        let (f, st) = prove(&g, &choices, &[], false, 4, 2, 40, None);
+        let (f, st) = prove(&g, &choices, &[], &[], false, 4, 2, 40, None);
         let Found::Violated { step, .. } = f else {
             panic!("{n} choice bits: {f:?}")
         };
