@@ -106,7 +106,11 @@ pub(super) fn run(g: &Aig, choices: &[usize], wait: &[usize], lim: &Limits) -> O
         if let Some((state, combo)) = bad {
             return Some(m.witness(&history, step, state, combo, &free));
         }
-        if next.len() > MAX_STATES {
+        // the bound on the set as it would be without subsumption: a state
+        // stands for at most 2^bits equal to it but for the wait count, so
+        // this gives up no later than the unsubsumed search did (a cone
+        // that reads the data still gives up, not crawls to the deadline)
+        if next.len() > MAX_STATES >> m.wait.len() {
             return None;
         }
         set = next;

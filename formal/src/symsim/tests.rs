@@ -185,6 +185,49 @@ fn an_explicit_search_past_its_bound_hands_the_part_to_simulation() {
     assert_eq!(st.parts, [1, 0, 0], "simulated, not enumerated");
 }
 
+/// [`choice_shift`] with `tail` more latches after the last, which nothing
+/// reads (as a slave's wait count is read by its `tready` alone): the
+/// latches of the count in [`an_explicit_search_bounds_the_set_its_states_stand_for`].
+fn choice_shift_with_tail(n: u32, tail: u32) -> Aig {
+    let latch = |k: u32| 4 + 2 * k;
+    let gate = latch(n + tail);
+    let mut t = format!("aag {} 1 {} 0 1 1\n2\n", gate / 2, n + tail);
+    for k in 0..n + tail {
+        let next = if k == 0 { 2 } else { latch(k - 1) };
+        t.push_str(&format!("{} {next} 0\n", latch(k)));
+    }
+    t.push_str(&format!(
+        "{gate}\n{gate} {} {}\n",
+        latch(n - 1),
+        latch(n - 2)
+    ));
+    parse(&t).unwrap()
+}
+
+/// With a wait count the bound is on the set as it may be without
+/// subsumption (a state stands for up to 2^bits), so a cone that reads the
+/// data gives up no later than before, not crawls to the deadline (an auto
+/// AXI4-Stream gateware that ignores `tready` was bounded, not refuted,
+/// while its subsumed set was held to the plain bound).
+#[test]
+fn an_explicit_search_bounds_the_set_its_states_stand_for() {
+    // 14 latches and a 3-latch count: 2^14 states at step 14 stand for up
+    // to 2^17, past 65,536; without the count they fit, and the search
+    // finds the violation
+    let g = choice_shift_with_tail(14, 3);
+    assert_eq!(explicit::run(&g, &[0], &[14, 15, 16], &SHIFT_LIMITS), None);
+    let f = explicit::run(&g, &[0], &[], &SHIFT_LIMITS);
+    assert!(matches!(f, Some(Found::Violated { step: 14, .. })), "{f:?}");
+    // a smaller set is searched with the count as without it
+    let g = choice_shift_with_tail(8, 3);
+    let (a, b) = (
+        explicit::run(&g, &[0], &[8, 9, 10], &SHIFT_LIMITS),
+        explicit::run(&g, &[0], &[], &SHIFT_LIMITS),
+    );
+    assert!(matches!(a, Some(Found::Violated { step: 8, .. })), "{a:?}");
+    assert!(matches!(b, Some(Found::Violated { step: 8, .. })), "{b:?}");
+}
+
 /// A 3-bit counter that counts the steps in which all `n` choice inputs
 /// are high; the assertion: it never reaches 7 (it does, after 7 such
 /// steps). Not 2-inductive (6 counts on to 7), so a part for the explicit
