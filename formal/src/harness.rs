@@ -28,7 +28,7 @@ mod packets;
 mod uart;
 pub use contract::{contract, not_covered, Clause};
 pub use link::{LinkBytes, AXIS_BYTES_MAX_WAIT, SLAVE_WAIT, TREADY_ANY};
-pub(crate) use modes::{auto_frames, bounded_modes, MODE_SEL};
+pub(crate) use modes::{auto_frames, bounded_modes, trigger_runs, MODE_SEL};
 pub(crate) use packets::FRAME_COUNTER;
 
 /// The module name of the harness.

@@ -205,6 +205,12 @@ pub struct ProveOptions {
     /// proved with it cut (`composed`, `tied`).  `None`, or a name the design
     /// does not have: they are proved with the triggers as before.
     pub mode_decision: Option<String>,
+    /// With auto select, the design's trigger runs under `slotforge_top`,
+    /// trigger `k`'s named this and `k` (`hdl::TRIGGER_RUN` for slotforge's
+    /// gateware): the symbolic engine generalises each with the harness's
+    /// own at frame starts (`runs_generalised`).  `None`, or names the
+    /// design does not have: the runs are split on as before.
+    pub trigger_run: Option<String>,
 }
 
 impl ProveOptions {
@@ -219,6 +225,7 @@ impl ProveOptions {
             netlist: None,
             frame_counter: None,
             mode_decision: None,
+            trigger_run: None,
         }
     }
 }
@@ -380,7 +387,7 @@ fn main_run(
     let prep = engine::prepare(work, opts.solver)?;
     let f = main.frame_cycles;
     match opts.solver {
-        Solver::Symbolic => symbolic(&prep, f, harness::auto_frames(s), opts),
+        Solver::Symbolic => symbolic(&prep, f, harness::auto_frames(s), &trigger_runs(s), opts),
         Solver::Abc => strategy::abc(&prep, f, opts),
         Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work, f, opts),
     }
@@ -509,7 +516,8 @@ fn exactly(
     let Ok(prep) = engine::prepare(work.path(), Solver::Symbolic) else {
         return Ok(None);
     };
-    let (r, depth, note) = symbolic(&prep, rest.frame_cycles, harness::auto_frames(s), opts)?;
+    let (auto, runs) = (harness::auto_frames(s), trigger_runs(s));
+    let (r, depth, note) = symbolic(&prep, rest.frame_cycles, auto, &runs, opts)?;
     Ok((r == Outcome::Proved).then_some((depth, note)))
 }
 
@@ -586,7 +594,7 @@ fn composed(
         let Ok(prep) = engine::prepare_edited(work.path(), Solver::Symbolic, &cut) else {
             return Ok(None);
         };
-        symbolic(&prep, f, None, opts).map(Some)
+        symbolic(&prep, f, None, &[], opts).map(Some)
     };
     let (first, second) = side_by_side(cut_run, || exactly(s, &rest, design, opts));
     let Some((r1, d1, n1)) = first? else {
@@ -834,6 +842,7 @@ fn link_generalised(
         from: 2,
         // an AXI4-Stream slave's: a path waiting less subsumes (`split.rs`)
         wait: named_latches(&prep, harness::SLAVE_WAIT).unwrap_or_default(),
+        pinned: true,
     };
     let deadline = Instant::now() + std::time::Duration::from_secs(opts.timeout_s);
     // auto select: as deep as the main run may need for its windows (tied,
@@ -1148,10 +1157,13 @@ fn counterexample(
 
 /// The `symbolic` engine on the prepared AIG: exact from reset, proved at the
 /// first frame whose state recurs (`symsim.rs`), else searched to the depth.
+/// `runs`: with auto select, the harness's trigger runs
+/// (`harness::trigger_runs`), generalised first (`runs_generalised`).
 fn symbolic(
     prep: &engine::Prepared,
     f: u64,
     auto: Option<u64>,
+    runs: &[String],
     opts: &ProveOptions,
 ) -> Result<(Outcome, u64, String), ProveError> {
     let text = std::fs::read_to_string(prep.dir.join("design.aag"))
@@ -1172,6 +1184,11 @@ fn symbolic(
     // the slave's wait count: states equal but for it subsumed in the search
     let wait = named_latches(prep, harness::SLAVE_WAIT).unwrap_or_default();
     let splits = named_inputs(prep, harness::MODE_SEL);
+    if cases && choices.is_empty() && opts.depth.is_none() {
+        if let Some(decided) = runs_generalised(prep, &g, (f, &splits), runs, opts, deadline)? {
+            return Ok(decided);
+        }
+    }
     let (found, st) = symsim::prove(
         &g,
         &choices,
@@ -1254,6 +1271,107 @@ fn symbolic(
             ),
         ),
     })
+}
+
+/// The harness's trigger runs of `s` (auto select), by name.
+fn trigger_runs(s: &Schedule) -> Vec<String> {
+    harness::trigger_runs(s)
+}
+
+/// Auto select with the triggers' runs generalised: at each frame start
+/// the design's run of trigger `k` (`opts.trigger_run`) and the harness's
+/// (`runs[k]`), once shown equal, become one free value
+/// (`symsim::prove_generalised`), and the run is split on the rest of the
+/// decision's registers as the exact one is.  A run's count then no longer
+/// tells frame-start states apart, so the paths come round in a few frames
+/// instead of one per count (eskin34-adaptive: 10 frames held).  Decides
+/// when proved, or on a violation (a trace from reset: pinned to the
+/// counts the generalisations replaced); `None` otherwise (a run the
+/// design counts otherwise, no such register, a state that does not come
+/// round): the exact run decides, in the time left.
+fn runs_generalised(
+    prep: &engine::Prepared,
+    g: &Aig,
+    (f, splits): (u64, &[usize]),
+    runs: &[String],
+    opts: &ProveOptions,
+    deadline: Instant,
+) -> Result<Option<(Outcome, u64, String)>, ProveError> {
+    let Some(prefix) = &opts.trigger_run else {
+        return Ok(None);
+    };
+    let mut pairs = Vec::new();
+    let mut names = Vec::new();
+    for (k, h) in runs.iter().enumerate() {
+        // a trigger of one frame may keep no run (yosys drops it)
+        if let Some(p) = counter_pairs(prep, &format!("dut.{prefix}{k}"), h) {
+            pairs.extend(p);
+            names.push(format!("{prefix}{k}"));
+        }
+    }
+    if pairs.is_empty() {
+        return Ok(None);
+    }
+    let counters = symsim::Counters {
+        pairs,
+        // from the second frame start: at the first (step 2) the gateware's
+        // run keeps its count where the harness's may count (a free count
+        // there is shown unequal a frame later)
+        from: 2 + f,
+        wait: Vec::new(),
+        // a run's count is a function of the codes: pinned, every frame's
+        // condition would stay (`Counters::pinned`); a violation after a
+        // generalisation is then the exact run's to find
+        pinned: false,
+    };
+    // `+ 1`: the frame start at the last step is compared too
+    let limit = GENERAL_FRAMES * f + 2 + 1;
+    let (found, st) =
+        symsim::prove_generalised(g, counters, splits, true, f, 2, limit, Some(deadline));
+    Ok(match found {
+        symsim::Found::Proved { steps, .. } => Some((
+            Outcome::Proved,
+            steps,
+            runs_note(g, &st, &names.join(", "), steps, f),
+        )),
+        symsim::Found::Violated { step, inputs } => {
+            std::fs::write(prep.dir.join("cex.aiw"), symsim::witness_text(g, &inputs))
+                .map_err(|e| ProveError::Tool(format!("cex.aiw: {e}")))?;
+            Some((
+                Outcome::Failed,
+                step,
+                format!(
+                    "a trace from reset violates the contract at step {step} (cycle {})",
+                    step as i64 - 2
+                ),
+            ))
+        }
+        symsim::Found::Bounded { .. } => None,
+    })
+}
+
+/// The note of auto select proved with its runs generalised.
+fn runs_note(g: &Aig, st: &SymStats, names: &str, steps: u64, f: u64) -> String {
+    format!(
+        "{PROVED}: every step from reset simulated exactly with every free input bit a variable \
+         of its step (MISO; {} latches, {} gates; {} satisfiability checks), split at each frame \
+         start on the values of the registers that are functions of the MISO codes there (the \
+         mode registers, the design's and the harness's: one path per value some input \
+         reaches, {} in all, each with its condition on the codes kept until those codes have \
+         left the state); at each frame start the triggers' runs of windows ({names} and the \
+         harness's), shown equal in every state, are replaced by one free value each, so the \
+         states simulated from there include every state reachable there; by step {steps} \
+         ({:.0} frames) every path's state and condition at a frame start, so generalised, was \
+         one some path had reached before ({} distinct, up to renaming), so those paths reach \
+         every reachable state (symbolic simulation split on the trigger decisions, the runs \
+         generalised: an inductive invariant, checked)",
+        g.latches.len(),
+        g.ands.len(),
+        st.sat_calls,
+        st.cases,
+        steps.saturating_sub(2) as f64 / f as f64,
+        st.branches,
+    )
 }
 
 /// The AIG inputs (bits) of the harness input `name` (yosys's map): an

@@ -41,6 +41,7 @@ fn prove_to(s: &lut_gen::Schedule, design: &str, out: &Path, depth: Option<u64>)
     o.depth = depth;
     o.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
     o.mode_decision = Some(hdl::MODE_DECISION.to_string());
+    o.trigger_run = Some(hdl::TRIGGER_RUN.to_string());
     let t = Instant::now();
     let p = formal::prove(s, design, &o).expect("prove runs");
     eprintln!(
@@ -400,6 +401,36 @@ fn an_auto_gateware_with_a_trigger_level_off_by_one_fails_prove() {
     assert_fails(&s, &p, &names);
 }
 
+/// A gateware whose trigger fires one window early (its run of 3 taken at
+/// 2) fails: with the runs generalised (both count alike, so they are shown
+/// equal) the decision differs after a generalisation, which gives no
+/// verdict there, and the exact run finds the trace from reset, which
+/// `check` rejects at the same cycle.
+#[test]
+fn an_auto_gateware_that_fires_a_window_early_fails_prove_past_its_generalised_runs() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/modes-auto.toml");
+    let whole = prove(&s, &emitted(&s), tempfile::tempdir().unwrap().path());
+    assert_whole_contract_proved_split_on_decisions(&whole);
+    assert!(
+        whole.note.contains("the runs generalised"),
+        "{}",
+        whole.note
+    );
+    let design = edit(
+        &emitted(&s),
+        "wire fire1 = (nxt == 2'd1) & (cur == nxt) & (runn1 == 2'd3);",
+        "wire fire1 = (nxt == 2'd1) & (cur == nxt) & (runn1 == 2'd2);",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &design, dir.path());
+    // the pins of the early mode fail with (or before) `mode` itself
+    let names: Vec<&str> = p.properties.iter().map(|q| q.name.as_str()).collect();
+    assert_fails(&s, &p, &names);
+}
+
 /// An auto-select mix with a UART proved whole: every property, the
 /// link's bytes too, in two runs: the rest split on the trigger decisions,
 /// the link's with the decisions tied to one free input and the frame
@@ -685,6 +716,7 @@ fn prove_within(s: &lut_gen::Schedule, design: &str, out: &Path, timeout_s: u64)
     o.bmc_timeout_s = timeout_s;
     o.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
     o.mode_decision = Some(hdl::MODE_DECISION.to_string());
+    o.trigger_run = Some(hdl::TRIGGER_RUN.to_string());
     let p = formal::prove(s, design, &o).expect("prove runs");
     eprintln!("{}", p.summary());
     p

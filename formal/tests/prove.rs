@@ -34,6 +34,7 @@ fn prove(s: &lut_gen::Schedule, design: &str, out: &Path) -> Proof {
     o.bmc_timeout_s = 1200;
     o.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
     o.mode_decision = Some(hdl::MODE_DECISION.to_string());
+    o.trigger_run = Some(hdl::TRIGGER_RUN.to_string());
     formal::prove(s, design, &o).expect("prove runs")
 }
 

@@ -37,6 +37,13 @@ pub const LINK_FRAME_COUNTER: &str = "link.hframe";
 /// design as it is; a name that no longer matches only costs that.
 pub const MODE_DECISION: &str = "core.modes_0.decided";
 
+/// With auto select, trigger `k`'s run of windows is the register
+/// `{TRIGGER_RUN}{k}` under `slotforge_top` (a trigger of one frame may
+/// have none): `prove` generalises each with its harness's own at frame
+/// starts (`formal`), so a run of many frames costs no more frames to
+/// prove; a name that no longer matches only costs that.
+pub const TRIGGER_RUN: &str = "core.modes_0.run";
+
 /// The emitted Verilog file.
 pub const VERILOG_FILE: &str = "slotforge_top.v";
 /// The emitted port manifest.

@@ -44,7 +44,7 @@ mod widths;
 pub use board::{stock_board, Board};
 pub use emit::{
     emit, emit_with, verilog_pair, Emitted, LINK_FRAME_COUNTER, MANIFEST_FILE, MODE_DECISION,
-    VERILOG_FILE,
+    TRIGGER_RUN, VERILOG_FILE,
 };
 pub use fault::GatewareFault;
 pub use fusesoc::{vlnv, CORE_FILE, LAUNCHER_FILE};

@@ -130,6 +130,7 @@ pub fn run(a: Args) -> u8 {
     // leaves the search as it was)
     opts.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
     opts.mode_decision = Some(hdl::MODE_DECISION.to_string());
+    opts.trigger_run = Some(hdl::TRIGGER_RUN.to_string());
     opts.netlist = netlist.map(|n| (n.fpga.name().to_string(), n.not_covered()));
     let proof = match formal::prove(&s, &design, &opts) {
         Ok(mut p) => {

@@ -43,6 +43,21 @@ pub(crate) fn auto_frames(s: &Schedule) -> Option<u64> {
     Some(2 * runs)
 }
 
+/// With auto select, each trigger's register holding its run of windows
+/// (`run{k}`, the name yosys's map gives its latches), in file order;
+/// empty without auto select.  The engine generalises them with the
+/// design's at frame starts (`lib.rs`, `runs_generalised`).
+pub(crate) fn trigger_runs(s: &Schedule) -> Vec<String> {
+    let m = modes(s).filter(|m| m.select == ModeSelect::Auto);
+    let n = m.map_or(0, |m| m.triggers.len());
+    (0..n).map(run_name).collect()
+}
+
+/// Trigger `k`'s run register in the harness.
+fn run_name(k: usize) -> String {
+    format!("run{k}")
+}
+
 /// Bits of the mode number (0: no modes).
 pub(super) fn bits(s: &Schedule) -> u32 {
     modes(s).map_or(0, |m| m.select_bits())
@@ -316,6 +331,7 @@ fn triggers(v: &mut String, s: &Schedule, layout: &Layout, m: &lut_gen::Modes) -
     for (k, t) in m.triggers.iter().enumerate() {
         let ff = t.for_frames.max(1) as u64;
         let rb = width(ff + 1);
+        let rn = run_name(k);
         let mut hits = Vec::new();
         for b in 0..nb {
             let watched: Vec<String> = (t.channels.iter())
@@ -349,11 +365,11 @@ fn triggers(v: &mut String, s: &Schedule, layout: &Layout, m: &lut_gen::Modes) -
             v,
             "  reg wa{k} = 1'b0, wx{k} = 1'b0, wn{k} = 1'b0;\n  \
              wire na{k} = wa{k} || {};\n  wire nx{k} = wx{k} || {};\n  wire nn{k} = wn{k} || {};\n  \
-             wire held{k} = {};\n  reg [{}:0] run{k} = 0;\n  \
+             wire held{k} = {};\n  reg [{}:0] {rn} = 0;\n  \
              wire [{}:0] nrun{k} = !held{k} ? {rb}'d0 : (!first && mcur == mprev) ? \
-             (run{k} == {rb}'d{ff} ? run{k} : run{k} + {rb}'d1) : {rb}'d1;\n  \
+             ({rn} == {rb}'d{ff} ? {rn} : {rn} + {rb}'d1) : {rb}'d1;\n  \
              always @(posedge clk) if (run) begin\n    \
-             if (frame_end) begin wa{k} <= 1'b0; wx{k} <= 1'b0; wn{k} <= 1'b0; run{k} <= nrun{k}; end\n    \
+             if (frame_end) begin wa{k} <= 1'b0; wx{k} <= 1'b0; wn{k} <= 1'b0; {rn} <= nrun{k}; end\n    \
              else begin wa{k} <= na{k}; wx{k} <= nx{k}; wn{k} <= nn{k}; end\n  end",
             or(&any),
             or(&above),
@@ -365,13 +381,16 @@ fn triggers(v: &mut String, s: &Schedule, layout: &Layout, m: &lut_gen::Modes) -
             rb - 1,
             rb - 1,
         );
+        // `==`, not `>=`: the same on every count a run reaches (it stops at
+        // `ff`), and on every other the same as the gateware's test, so the
+        // engine may generalise the counts (`trigger_runs`)
         let armed: Vec<String> = (0..m.names.len())
             .filter(|&x| t.leaves(x))
             .map(|x| format!("mnext == {mb}'d{x}"))
             .collect();
         let _ = write!(
             dec,
-            "({}) && mcur == mnext && nrun{k} >= {rb}'d{ff} ? {mb}'d{} : ",
+            "({}) && mcur == mnext && nrun{k} == {rb}'d{ff} ? {mb}'d{} : ",
             or(&armed),
             t.to
         );

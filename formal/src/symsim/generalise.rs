@@ -50,6 +50,14 @@ pub struct Counters {
     /// `tready`, so a path whose count is lower has every future of one in
     /// the same state otherwise (`split.rs`).
     pub wait: Vec<usize>,
+    /// A violation after a generalisation is pinned to the counts it
+    /// replaced, for a trace from reset (the frame counters, whose count is
+    /// the one before plus one).  Without (the trigger runs, whose counts
+    /// are functions of the codes), it is no verdict (`Bounded`, the count
+    /// noted: the caller searches exactly), and the path's condition need
+    /// not keep the codes those counts read alive (`cases.rs`), which would
+    /// keep every frame's condition and the state from coming round.
+    pub pinned: bool,
 }
 
 /// One path's generalisations: the counter's literals each replaced, and
@@ -86,7 +94,7 @@ impl Sim<'_> {
         let Some(c) = self.counters.as_ref().filter(|c| step >= c.from) else {
             return Ok(());
         };
-        let pairs = c.pairs.clone();
+        let (pairs, pinned) = (c.pairs.clone(), c.pinned);
         let mut differ = 0u32;
         for &(d, h) in &pairs {
             let bit = xor(&mut self.gr, self.state[d], self.state[h]);
@@ -115,7 +123,9 @@ impl Sim<'_> {
         }
         for (b, &(d, h)) in pairs.iter().enumerate() {
             let v = self.gr.var(self.counter_input(b), step as u32);
-            self.pin.exact.push(self.state[d]);
+            if pinned {
+                self.pin.exact.push(self.state[d]);
+            }
             self.pin.vars.push(v);
             self.state[d] = v;
             self.state[h] = v;
@@ -139,8 +149,9 @@ impl Sim<'_> {
         if self.pin.vars.is_empty() {
             return None;
         }
-        if let Some(pinned) = self.pinned_model(bad) {
-            return Some(self.violation(step, pinned));
+        let pinned = self.counters.as_ref().is_some_and(|c| c.pinned);
+        if let Some(model) = pinned.then(|| self.pinned_model(bad)).flatten() {
+            return Some(self.violation(step, model));
         }
         let count = self.count_of(assign).unwrap_or(0);
         self.stats.counter_failure = Some(CounterFailure::Violated { step, count });
