@@ -947,7 +947,7 @@ fn split_general_note(
          every state, are replaced by one free 8-bit value, so the states simulated from it \
          include every state reachable there; by step {steps} ({:.0} frames) every path's \
          state at a frame start, so generalised, was one some path had at an earlier frame \
-         start ({} distinct, up to renaming), so those steps reach every reachable state{}, \
+         start ({} distinct, up to renaming{}), so those steps reach every reachable state{}, \
          the link's bytes ({}) included (symbolic simulation with the frame counter \
          generalised: an inductive invariant, checked)",
         st.merged,
@@ -963,6 +963,7 @@ fn split_general_note(
         st.sat_calls,
         steps.saturating_sub(2) as f64 / f as f64,
         st.branches,
+        mid_closed(st),
         match how.contains("tready_any") {
             true => " under every slave the guarantee allows",
             false => "",
@@ -1205,25 +1206,27 @@ fn symbolic(
             Outcome::Proved,
             steps,
             format!(
-                "{PROVED}: {}every step from reset simulated exactly with every free input bit a variable of its step (MISO; {} latches, {} gates; {} satisfiability checks), split at each frame start on the values of the registers that are functions of the MISO codes there (the mode and trigger-run registers, the design's and the harness's: one path per value some input reaches, {} in all, each with its condition on the codes kept until those codes have left the state), until every path reached a frame start whose state and condition, up to renaming, a path had reached before ({} distinct states at frame starts, the deepest at step {steps}), so those paths reach every reachable state (symbolic simulation split on the trigger decisions)",
+                "{PROVED}: {}every step from reset simulated exactly with every free input bit a variable of its step (MISO; {} latches, {} gates; {} satisfiability checks), split at each frame start on the values of the registers that are functions of the MISO codes there (the mode and trigger-run registers, the design's and the harness's: one path per value some input reaches, {} in all, each with its condition on the codes kept until those codes have left the state), until every path reached a frame start whose state and condition, up to renaming, a path had reached before ({} distinct states at frame starts, the deepest at step {steps}{}), so those paths reach every reachable state (symbolic simulation split on the trigger decisions)",
                 parts_note(&st.parts),
                 g.latches.len(),
                 g.ands.len(),
                 st.sat_calls,
                 st.cases,
-                st.branches
+                st.branches,
+                mid_closed(&st)
             ),
         ),
         symsim::Found::Proved { steps, .. } if st.branches > 0 => (
             Outcome::Proved,
             steps,
             format!(
-                "{PROVED}: {}every step from reset simulated exactly with every free input bit a variable of its step (MISO), split on mode_sel where a step reads it (one path per value, every value taken; {} latches, {} gates; {} assertion checks went to a SAT solver), until every path reached a frame start whose state, up to renaming, a path had reached before ({} distinct states at frame starts, the deepest at step {steps}), so those paths reach every reachable state (symbolic simulation split on requests)",
+                "{PROVED}: {}every step from reset simulated exactly with every free input bit a variable of its step (MISO), split on mode_sel where a step reads it (one path per value, every value taken; {} latches, {} gates; {} assertion checks went to a SAT solver), until every path reached a frame start whose state, up to renaming, a path had reached before ({} distinct states at frame starts, the deepest at step {steps}{}), so those paths reach every reachable state (symbolic simulation split on requests)",
                 parts_note(&st.parts),
                 g.latches.len(),
                 g.ands.len(),
                 st.sat_calls,
-                st.branches
+                st.branches,
+                mid_closed(&st)
             ),
         ),
         symsim::Found::Proved { steps, since } => (
@@ -1362,7 +1365,7 @@ fn runs_note(g: &Aig, st: &SymStats, names: &str, steps: u64, f: u64) -> String 
          harness's), shown equal in every state, are replaced by one free value each, so the \
          states simulated from there include every state reachable there; by step {steps} \
          ({:.0} frames) every path's state and condition at a frame start, so generalised, was \
-         one some path had reached before ({} distinct, up to renaming), so those paths reach \
+         one some path had reached before ({} distinct, up to renaming{}), so those paths reach \
          every reachable state (symbolic simulation split on the trigger decisions, the runs \
          generalised: an inductive invariant, checked)",
         g.latches.len(),
@@ -1371,7 +1374,21 @@ fn runs_note(g: &Aig, st: &SymStats, names: &str, steps: u64, f: u64) -> String 
         st.cases,
         steps.saturating_sub(2) as f64 / f as f64,
         st.branches,
+        mid_closed(st),
     )
+}
+
+/// A split run's paths closed where a split started them, in words (empty
+/// if none): their futures are those of a path that started in their state
+/// at the same phase of an earlier frame (`symsim::split`).
+fn mid_closed(st: &SymStats) -> String {
+    match st.mid_closed {
+        0 => String::new(),
+        n => format!(
+            "; {n} more path(s) ended where a split started them, in the state and condition a \
+             path had started in at the same point of an earlier frame"
+        ),
+    }
 }
 
 /// The AIG inputs (bits) of the harness input `name` (yosys's map): an

@@ -99,6 +99,9 @@ pub struct SymStats {
     /// same state at the same step but for a lower count of the slave's
     /// wait (`split.rs`: its futures include theirs).
     pub subsumed: u64,
+    /// A split run: paths closed where a split started them, in the state
+    /// a path had started in at the same phase of an earlier frame.
+    pub mid_closed: u64,
 }
 
 /// Steps between the checks of the assertions that did not fold (one SAT

@@ -56,6 +56,10 @@ const MAX_PATHS: usize = 4096;
 /// state and condition, the wait count left out, with that count).
 type Started = (u64, u64, HashMap<Vec<u32>, Option<u64>>);
 
+/// At most this many states kept of paths started between frame starts
+/// (`started_before`): past it, such paths run to the frame start.
+const MAX_MID: usize = 1 << 14;
+
 /// A path waiting at the step it continues from.
 pub(super) struct Branch {
     pub(super) state: Vec<u32>,
@@ -75,6 +79,8 @@ impl Sim<'_> {
     pub(super) fn run_split(mut self, lim: &Limits) -> (Found, SymStats) {
         self.deadline = lim.deadline;
         let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
+        // the paths a split started between frame starts (`started_before`)
+        let mut mid: HashMap<Vec<u64>, u64> = HashMap::new();
         let (mut seq, mut closed, mut ended) = (0u64, None, false);
         let start = Branch {
             state: std::mem::take(&mut self.state),
@@ -126,6 +132,12 @@ impl Sim<'_> {
             self.holding = !self.held_requests().is_empty();
             self.pending.clear();
             self.pending_any = 0;
+            if self.started_before(from, lim, &mut mid) {
+                // by the next frame start it is closed as a recurrence there
+                let next = from + (lim.period - (from - lim.offset) % lim.period);
+                closed = closed.max(Some(next));
+                continue;
+            }
             let path_lim = Limits {
                 max_steps: stop,
                 ..*lim
@@ -169,6 +181,39 @@ impl Sim<'_> {
             },
             self.stats,
         )
+    }
+
+    /// Whether this path, started by a split at `from` between frame starts
+    /// (no assertion pending: a split checks them first), is in a state
+    /// and condition, up to renaming, that a path started in at the same
+    /// phase of a frame at `from` or before: then its futures are that
+    /// one's (the machine is the same; frame starts, where counters are
+    /// generalised and cases split, fall at the same phases), as a frame
+    /// start's recurrence closes a path, but up to a frame sooner.
+    fn started_before(
+        &mut self,
+        from: u64,
+        lim: &Limits,
+        mid: &mut HashMap<Vec<u64>, u64>,
+    ) -> bool {
+        let phase = from.checked_sub(lim.offset).map(|p| p % lim.period);
+        if phase.is_none_or(|p| p == 0) || mid.len() >= MAX_MID {
+            return false;
+        }
+        let mut roots = self.state.clone();
+        if !self.cond.is_empty() {
+            roots.push(self.cond_lit());
+        }
+        let now = self.gr.canonical_any(&roots);
+        if mid
+            .get(&now)
+            .is_some_and(|&at| at <= from && (from - at).is_multiple_of(lim.period))
+        {
+            self.stats.mid_closed += 1;
+            return true;
+        }
+        mid.entry(now).or_insert(from);
+        false
     }
 
     /// The slave's wait count in `state`, when every bit of it is a
