@@ -69,6 +69,7 @@ pub fn proof(s: &Schedule, out: &Path) -> Result<ShownProof, String> {
     let mut opts = ProveOptions::new(out.join(DIR));
     opts.frame_counter = Some(hdl::LINK_FRAME_COUNTER.to_string());
     opts.mode_decision = Some(hdl::MODE_DECISION.to_string());
+    opts.trigger_run = Some(hdl::TRIGGER_RUN.to_string());
     let p = formal::prove(s, &design, &opts).map_err(|e| e.to_string())?;
     for d in &dirs {
         formal::cache::store(d, &key, &p)?;
