@@ -387,7 +387,13 @@ fn main_run(
     let prep = engine::prepare(work, opts.solver)?;
     let f = main.frame_cycles;
     match opts.solver {
-        Solver::Symbolic => symbolic(&prep, f, harness::auto_frames(s), &trigger_runs(s), opts),
+        Solver::Symbolic => symbolic(
+            &prep,
+            f,
+            harness::auto_frames(s),
+            &harness::trigger_runs(s),
+            opts,
+        ),
         Solver::Abc => strategy::abc(&prep, f, opts),
         Solver::Pdr | Solver::Cvc5 => strategy::closing(&prep, work, f, opts),
     }
@@ -516,7 +522,7 @@ fn exactly(
     let Ok(prep) = engine::prepare(work.path(), Solver::Symbolic) else {
         return Ok(None);
     };
-    let (auto, runs) = (harness::auto_frames(s), trigger_runs(s));
+    let (auto, runs) = (harness::auto_frames(s), harness::trigger_runs(s));
     let (r, depth, note) = symbolic(&prep, rest.frame_cycles, auto, &runs, opts)?;
     Ok((r == Outcome::Proved).then_some((depth, note)))
 }
@@ -1274,11 +1280,6 @@ fn symbolic(
             ),
         ),
     })
-}
-
-/// The harness's trigger runs of `s` (auto select), by name.
-fn trigger_runs(s: &Schedule) -> Vec<String> {
-    harness::trigger_runs(s)
 }
 
 /// Auto select with the triggers' runs generalised: at each frame start

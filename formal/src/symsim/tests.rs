@@ -95,19 +95,7 @@ fn collection_keeps_the_state() {
 /// A slave's choice (input 0) shifted through `n` latches; violated when
 /// the last two hold 1 (the choice was 1 twice in a row, `n` steps ago).
 fn choice_shift(n: u32) -> Aig {
-    let latch = |k: u32| 4 + 2 * k;
-    let gate = latch(n);
-    let mut t = format!("aag {} 1 {n} 0 1 1\n2\n", gate / 2);
-    for k in 0..n {
-        let next = if k == 0 { 2 } else { latch(k - 1) };
-        t.push_str(&format!("{} {next} 0\n", latch(k)));
-    }
-    t.push_str(&format!(
-        "{gate}\n{gate} {} {}\n",
-        latch(n - 1),
-        latch(n - 2)
-    ));
-    parse(&t).unwrap()
+    choice_shift_with_tail(n, 0)
 }
 
 /// The searches of [`choice_shift`]: frames of 4 steps from step 2, 100 steps.
