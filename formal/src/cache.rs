@@ -1,7 +1,8 @@
 //! Proofs remembered by what they proved, so `build` can show a proof
 //! without spending minutes on it again: the key is a hash of the harness,
-//! the design's Verilog, the engine and this crate's version, so any change
-//! to the gateware, the schedule (through the harness) or the flow misses.
+//! the design's Verilog, the engine, this crate's version and a digest of
+//! its source, so any change to the gateware, the schedule (through the
+//! harness) or the flow misses.
 //! Only proofs (`Proved`) are kept: a bounded or failed run is redone.
 
 use std::path::{Path, PathBuf};
@@ -27,6 +28,7 @@ fn fnv64(parts: &[&[u8]]) -> u64 {
 pub fn key(harness: &str, design: &str, solver: Solver) -> String {
     let a = fnv64(&[
         env!("CARGO_PKG_VERSION").as_bytes(),
+        env!("ENGINE_DIGEST").as_bytes(),
         solver.name().as_bytes(),
         harness.as_bytes(),
         design.as_bytes(),
@@ -84,6 +86,16 @@ mod tests {
         assert_ne!(k, key("h", "d", Solver::Pdr));
         assert_ne!(key("ab", "c", Solver::Abc), key("a", "bc", Solver::Abc));
         assert_eq!(k.len(), 32);
+    }
+
+    /// The build script hashed the engine's source: 16 hex digits, not the
+    /// empty hash (which an empty file list would give).
+    #[test]
+    fn the_key_carries_a_digest_of_the_engines_source() {
+        let d = env!("ENGINE_DIGEST");
+        assert_eq!(d.len(), 16);
+        assert!(d.chars().all(|c| c.is_ascii_hexdigit()));
+        assert_ne!(d, "cbf29ce484222325");
     }
 
     fn proof(not_covered: &[&str]) -> Proof {
