@@ -621,6 +621,48 @@ fn command_word_converters_in_an_auto_mode_mix_prove() {
     assert!(p.properties.iter().all(|q| q.result == Outcome::Proved));
 }
 
+/// An unseen mix of both command-word converters with auto select and a
+/// UART (`formal/tests/data/sleeve-auto-cmd.toml`: an MCP3208 and an
+/// AD7689 whose channels change rate between modes, triggers on the
+/// AD7689's): every asserted property proved in the two runs, the link's
+/// bytes among them; not covered only what the converters themselves do
+/// with the words (MISO is free), one item a branch.
+#[test]
+#[ignore = "long: make test-long"]
+fn an_unseen_auto_mix_of_both_command_word_converters_proves() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("formal/tests/data/sleeve-auto-cmd.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    for q in &p.properties {
+        assert_eq!(q.result, Outcome::Proved, "{}: {}", q.name, p.summary());
+    }
+    for name in [
+        "link.bytes",
+        "link.packets",
+        "mode",
+        "mosi[mcp]",
+        "mosi[cfg]",
+    ] {
+        assert!(p.properties.iter().any(|q| q.name == name), "{name}");
+    }
+    assert_eq!(p.not_covered.len(), 2, "{:?}", p.not_covered);
+    for (n, part) in p.not_covered.iter().zip(["mcp3208", "ad7689"]) {
+        assert!(
+            n.contains(part) && n.contains("the part's own behaviour"),
+            "{n}"
+        );
+    }
+    assert!(
+        p.note.contains("split on the trigger decisions"),
+        "{}",
+        p.note
+    );
+}
+
 /// `testkit/mixes/modes-auto.toml` (three modes, auto select) with an
 /// AXI4-Stream link whose slave takes every beat within `ready_within`
 /// cycles (above 8: its bytes are not asserted, the rest is).
