@@ -325,3 +325,38 @@ fn a_uart_mixs_netlist_proves_its_link_bytes() {
         assert!(names.contains(&p), "{names:?}");
     }
 }
+
+/// Modes crossed with a netlist and a link: the iCE40 netlists of a
+/// pin-select mix and an auto-select mix, each with a UART, prove the
+/// whole contract (the mode and the link's bytes among it); 9 and 20 s
+/// (release). Before the LUT models' XORs were read as such, neither
+/// finished in 5 minutes.
+#[test]
+#[ignore = "long: make test-long (two netlist proofs, half a minute)"]
+fn mode_mixes_netlists_with_a_uart_prove_the_whole_contract() {
+    if !tools::require_tools(&["yosys", "yosys-abc"]) {
+        return;
+    }
+    let dir = fresh_dir("netlist-prove-modes");
+    for mix in [
+        "formal/tests/data/modes-pin-uart.toml",
+        "formal/tests/data/auto-uart-small.toml",
+    ] {
+        let out = slotforge()
+            .arg("prove")
+            .arg(crate::common_cli::root().join(mix))
+            .args(["--netlist", "ice40", "--timeout", "300", "--json", "-o"])
+            .arg(dir.join("out"))
+            .assert()
+            .code(0);
+        let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+        assert_eq!(v["result"], "proved", "{mix}: {v}");
+        assert_eq!(v["not_covered"], serde_json::json!([]), "{mix}: {v}");
+        let names: Vec<&str> = (v["properties"].as_array().unwrap().iter())
+            .map(|p| p["name"].as_str().unwrap())
+            .collect();
+        for p in ["mode", "link.bytes", "link.packets"] {
+            assert!(names.contains(&p), "{mix}: {names:?}");
+        }
+    }
+}
