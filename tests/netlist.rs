@@ -292,6 +292,29 @@ fn the_linked_reference_designs_netlist_passes() {
     assert_eq!(v["ok"], true, "{v}");
 }
 
+/// `prove MIX --netlist ice40` within `timeout` seconds: proved, nothing
+/// of the contract left uncovered, `props` among its properties.
+fn ice40_netlist_proves_whole(mix: &Path, dir: &Path, timeout: &str, props: &[&str]) {
+    let out = slotforge()
+        .arg("prove")
+        .arg(mix)
+        .args(["--netlist", "ice40", "--timeout", timeout, "--json", "-o"])
+        .arg(dir.join("out"))
+        .assert()
+        .code(0);
+    let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    let m = mix.display();
+    assert_eq!(v["result"], "proved", "{m}: {v}");
+    assert_eq!(v["netlist"], "ice40-hx8k", "{m}: {v}");
+    assert_eq!(v["not_covered"], serde_json::json!([]), "{m}: {v}");
+    let names: Vec<&str> = (v["properties"].as_array().unwrap().iter())
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    for p in props {
+        assert!(names.contains(p), "{m}: {names:?}");
+    }
+}
+
 /// The tiny mix with a UART: its iCE40 netlist proves the whole contract,
 /// the link's bytes and packets included. A LUT's model computes the CRC's
 /// XORs as multiplexers of an XOR and its complement, which the engine
@@ -307,23 +330,7 @@ fn a_uart_mixs_netlist_proves_its_link_bytes() {
     let text =
         std::fs::read_to_string(tiny()).unwrap() + "\n[link]\nkind = \"uart\"\nbaud = 1_000_000\n";
     std::fs::write(&mix, text).unwrap();
-    let out = slotforge()
-        .arg("prove")
-        .arg(&mix)
-        .args(["--netlist", "ice40", "--timeout", "120", "--json", "-o"])
-        .arg(dir.join("out"))
-        .assert()
-        .code(0);
-    let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
-    assert_eq!(v["result"], "proved", "{v}");
-    assert_eq!(v["netlist"], "ice40-hx8k", "{v}");
-    assert_eq!(v["not_covered"], serde_json::json!([]), "{v}");
-    let names: Vec<&str> = (v["properties"].as_array().unwrap().iter())
-        .map(|p| p["name"].as_str().unwrap())
-        .collect();
-    for p in ["link.bytes", "link.packets"] {
-        assert!(names.contains(&p), "{names:?}");
-    }
+    ice40_netlist_proves_whole(&mix, &dir, "120", &["link.bytes", "link.packets"]);
 }
 
 /// Modes crossed with a netlist and a link: the iCE40 netlists of a
@@ -342,21 +349,7 @@ fn mode_mixes_netlists_with_a_uart_prove_the_whole_contract() {
         "formal/tests/data/modes-pin-uart.toml",
         "formal/tests/data/auto-uart-small.toml",
     ] {
-        let out = slotforge()
-            .arg("prove")
-            .arg(crate::common_cli::root().join(mix))
-            .args(["--netlist", "ice40", "--timeout", "300", "--json", "-o"])
-            .arg(dir.join("out"))
-            .assert()
-            .code(0);
-        let v: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
-        assert_eq!(v["result"], "proved", "{mix}: {v}");
-        assert_eq!(v["not_covered"], serde_json::json!([]), "{mix}: {v}");
-        let names: Vec<&str> = (v["properties"].as_array().unwrap().iter())
-            .map(|p| p["name"].as_str().unwrap())
-            .collect();
-        for p in ["mode", "link.bytes", "link.packets"] {
-            assert!(names.contains(&p), "{mix}: {names:?}");
-        }
+        let mix = crate::common_cli::root().join(mix);
+        ice40_netlist_proves_whole(&mix, &dir, "300", &["mode", "link.bytes", "link.packets"]);
     }
 }
