@@ -586,6 +586,27 @@ fn command_word_converters_in_a_pin_mode_mix_prove() {
     );
 }
 
+/// An AD7689 converted twice a frame in the reset mode, first at slot 0:
+/// that conversion's word selects the first conversion of the frame after
+/// the next, in the mode decided at the edge that begins its own frame.
+/// The gateware that loaded it from the slot ROM's field (set a slot
+/// earlier, before the decision) was proved wrong here (`mosi[b]`, a
+/// trace `check` rejected at the same cycle); every property proves now.
+#[test]
+fn a_frames_first_word_takes_the_mode_decided_as_the_frame_begins() {
+    if !tools::require_tools(&TOOLS) {
+        return;
+    }
+    let s = schedule("testkit/mixes/cmd-ahead-modes.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let p = prove(&s, &emitted(&s), dir.path());
+    assert_eq!(p.result, Outcome::Proved, "{}", p.summary());
+    for name in ["mosi[b]", "mode"] {
+        let q = p.properties.iter().find(|q| q.name == name);
+        assert!(q.is_some_and(|q| q.result == Outcome::Proved), "{name}");
+    }
+}
+
 /// The AD7689's word for the second conversion of a frame that runs mode
 /// `fast`, sent in the frame before, selects the wrong input: only a run
 /// that switches to `fast` sends it, and `mosi[cfg]` fails there. About a

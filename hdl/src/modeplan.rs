@@ -6,7 +6,7 @@
 
 use lut_gen::{ModeSelect, Schedule, When};
 
-use crate::plan::{addr_bits, BranchRom, Plan};
+use crate::plan::{addr_bits, BranchRom, FrontWords, Plan};
 use crate::widths::{MODE_BITS, SLOT_BITS};
 use crate::HdlError;
 
@@ -222,6 +222,20 @@ fn fill(s: &Schedule, b: usize, rom: &mut BranchRom, mode_bits: usize, slot_bits
     rom.words = words;
     rom.addr_bits = slot_bits + mode_bits;
     rom.modes = Some(ModeRom { first, mode_bits });
+    if rom.front.is_none() && word_in_mux_field(s, b).is_some_and(|c| c.ahead > 0) {
+        // The command unit takes the words from a table of its own, as
+        // behind a front mux: the ROM's field is loaded a slot ahead, and
+        // a frame's first word, when the frame has only `ahead` conversions,
+        // selects a conversion of the frame after the next, whose mode is
+        // decided only at the edge that begins the frame (the unit reads
+        // the mode block's `nxt` as it loads the word there).
+        let skipped = s.modes[0].at(0, b).is_some() && s.branches[b].settle_cycles > 1;
+        rom.front = Some(FrontWords {
+            inputs: s.commands_in_frame(b).iter().map(|w| w.input).collect(),
+            first: skipped as u32,
+            modes: None,
+        });
+    }
     if let Some(f) = &mut rom.front {
         f.modes = front_modes(s, b, mode_bits);
     }
@@ -296,7 +310,9 @@ pub struct FrontModes {
 /// Branch `b`'s [`FrontModes`] (`None` without a front mux).
 fn front_modes(s: &Schedule, b: usize, mode_bits: usize) -> Option<FrontModes> {
     let br = &s.mix.branches[b];
-    let ahead = br.adc.command.as_ref().filter(|_| br.fronted)?.ahead as usize;
+    let ahead = (br.adc.command.as_ref())
+        .filter(|c| br.fronted || c.ahead > 0)?
+        .ahead as usize;
     let input = |&c: &usize| s.mix.channels[c].input;
     let (mut words, mut first) = (vec![], vec![]);
     for ms in &s.modes {

@@ -182,6 +182,10 @@ fn command_word_converters_switch_modes_on_rusthdl_and_verilator() {
     for (name, req, stim) in [
         ("cmd-modes", vec![(1, 1), (4, 0)], "pattern"),
         ("cmd-modes-auto", vec![], "touch:C7@1-3"),
+        // two conversions a frame in `rest`, the first at slot 0: its word
+        // selects `busy`'s first conversion of frame 3, decided as frame 2
+        // begins (the ROM's field, loaded a slot earlier, had `rest`'s)
+        ("cmd-ahead-modes", vec![(1, 1), (4, 0)], "pattern"),
     ] {
         let s = schedule(name);
         let stim = Stimulus::parse_for(stim, &s).unwrap();
