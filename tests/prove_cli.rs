@@ -120,11 +120,60 @@ fn an_axi_stream_mix_proves_for_every_slave() {
 /// `tiny` with an AXI4-Stream link whose slave takes every beat within 8
 /// cycles, written into `dir`.
 fn tiny_axis(dir: &std::path::Path) -> std::path::PathBuf {
-    let mix = dir.join("tiny-axis.toml");
+    tiny_axis_within(dir, 8)
+}
+
+/// `tiny` with an AXI4-Stream link whose slave takes every beat within
+/// `n` cycles, written into `dir`.
+fn tiny_axis_within(dir: &std::path::Path, n: u32) -> std::path::PathBuf {
+    let mix = dir.join(format!("tiny-axis{n}.toml"));
     let text = std::fs::read_to_string(tiny()).unwrap()
-        + "\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = 8\n";
+        + &format!("\n[link]\nkind = \"axis\"\ntlast = \"slice\"\nready_within = {n}\n");
     std::fs::write(&mix, text).unwrap();
     mix
+}
+
+/// A slave that may keep a beat waiting 16 cycles (past the 8 a default
+/// proof splits on): the beats' bytes and packets are listed as not
+/// covered, each sentence naming `--axis-bytes`; the advice followed, they
+/// are proved for all time and nothing is left out.
+#[test]
+fn past_eight_cycles_of_wait_the_axi_stream_bytes_are_proved_when_asked() {
+    if !tools::require_tools(&["yosys", "yosys-abc"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mix = tiny_axis_within(dir.path(), 16);
+    let m = mix.to_str().unwrap();
+    let plain = prove_json(&[m], &[], dir.path(), 0);
+    let left = plain["not_covered"].as_array().unwrap();
+    assert_eq!(left.len(), 2, "{plain}");
+    for s in left {
+        assert!(s.as_str().unwrap().contains("--axis-bytes"), "{s}");
+    }
+    let asked = prove_json(&[m, "--axis-bytes"], &[], dir.path(), 0);
+    assert_eq!(asked["result"], "proved", "{asked}");
+    for name in ["link.bytes", "link.packets"] {
+        let p = (asked["properties"].as_array().unwrap().iter())
+            .find(|p| p["name"] == name)
+            .unwrap_or_else(|| panic!("no {name}: {asked}"));
+        assert_eq!(p["result"], "proved", "{asked}");
+    }
+    assert_eq!(asked["not_covered"].as_array().unwrap().len(), 0, "{asked}");
+}
+
+/// The AXI4-Stream mutants with a slave that may wait 16 cycles, proved
+/// with `--axis-bytes`: each fails where `check` does.
+#[test]
+#[ignore = "long: make test-long (make test proves the clean design past 8 cycles of wait)"]
+fn past_eight_cycles_of_wait_link_mutants_fail_prove_where_check_does() {
+    if !tools::require_tools(&["yosys", "yosys-abc", "iverilog"]) {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mix = tiny_axis_within(dir.path(), 16);
+    let m = quick("axis", axis_mutants(), true);
+    link_mutants_fail_with(&mix, dir.path(), &m, &["--axis-bytes"]);
 }
 
 /// A mix with modes goes through `prove` (it was refused, exit 2): a search
@@ -418,6 +467,16 @@ fn link_mutants_fail_where_check_does(
     dir: &std::path::Path,
     mutants: &[Mutant],
 ) -> Vec<serde_json::Value> {
+    link_mutants_fail_with(mix, dir, mutants, &[])
+}
+
+/// [`link_mutants_fail_where_check_does`], `prove` given `extra` too.
+fn link_mutants_fail_with(
+    mix: &std::path::Path,
+    dir: &std::path::Path,
+    mutants: &[Mutant],
+    extra: &[&str],
+) -> Vec<serde_json::Value> {
     let mut proofs = Vec::new();
     let v = dir.join("v");
     slotforge()
@@ -432,7 +491,7 @@ fn link_mutants_fail_where_check_does(
         std::fs::write(&bad, clean.replace(from, to)).unwrap();
         let out = dir.join(what);
         let args = [mix.to_str().unwrap(), "--rtl", bad.to_str().unwrap()];
-        let j = prove_json(&args, &[], &out, 1);
+        let j = prove_json(&args, extra, &out, 1);
         let failed: Vec<&str> = (j["properties"].as_array().unwrap().iter())
             .filter(|p| p["result"] == "failed")
             .map(|p| p["name"].as_str().unwrap())

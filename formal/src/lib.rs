@@ -211,6 +211,11 @@ pub struct ProveOptions {
     /// own at frame starts (`runs_generalised`).  `None`, or names the
     /// design does not have: the runs are split on as before.
     pub trigger_run: Option<String>,
+    /// Assert an AXI4-Stream's bytes (`link.bytes`, `link.packets`) whatever
+    /// the slave's `ready_within`, not only up to [`AXIS_BYTES_MAX_WAIT`]
+    /// (`prove --axis-bytes`): the proof splits on every wait a beat may
+    /// take, minutes on a 48 MHz mix whose slave may wait 64 cycles.
+    pub axis_bytes: bool,
 }
 
 impl ProveOptions {
@@ -226,7 +231,18 @@ impl ProveOptions {
             frame_counter: None,
             mode_decision: None,
             trigger_run: None,
+            axis_bytes: false,
         }
+    }
+}
+
+/// The harness [`prove`] proves `s` under with `opts`: [`generate`]'s, an
+/// AXI4-Stream's bytes asserted whatever the slave's wait with
+/// [`ProveOptions::axis_bytes`].
+pub fn harness_for(s: &Schedule, opts: &ProveOptions) -> Result<Harness, HarnessError> {
+    match opts.axis_bytes {
+        true => harness::generate_parts(s, TableForm::for_schedule(s), harness::LinkBytes::AnyWait),
+        false => harness::generate(s),
     }
 }
 
@@ -247,7 +263,7 @@ fn write_inputs(dir: &Path, h: &Harness, design: &str) -> Result<(), ProveError>
 /// against the schedule `s`.
 pub fn prove(s: &Schedule, design: &str, opts: &ProveOptions) -> Result<Proof, ProveError> {
     let t0 = Instant::now();
-    let h = harness::generate(s)?;
+    let h = harness_for(s, opts)?;
     // the link's bytes are searched apart (`link_bytes`); the rest is proved
     // by a harness without them, whose state comes round
     let reads_bytes = h
@@ -890,7 +906,14 @@ fn link_generalised(
             (Outcome::Proved, steps, note, None)
         }
         symsim::Found::Bounded { steps } => {
-            let why = counter_failure(st.counter_failure, &what, limit, opts.timeout_s);
+            let why = match (st.counter_failure, st.path_limit) {
+                (None, Some(at)) => format!(
+                    "with {what} generalised, the run stopped at step {at} with more than {} \
+                     paths of the split (states at frame starts and paths waiting) at once",
+                    symsim::MAX_PATHS
+                ),
+                (failure, _) => counter_failure(failure, &what, limit, opts.timeout_s),
+            };
             (Outcome::Bounded, steps, why.clone(), Some(why))
         }
     };

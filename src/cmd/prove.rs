@@ -1,4 +1,4 @@
-//! `slotforge prove MIX [--rtl FILE.v | --netlist FAMILY] [--solver symbolic|abc|pdr|cvc5] [--json]`
+//! `slotforge prove MIX [--rtl FILE.v | --netlist FAMILY] [--solver symbolic|abc|pdr|cvc5] [--axis-bytes] [--json]`
 //!
 //! Exit 0: every asserted property proved for all time (what the harness
 //! does not assert is listed, `not_covered`); 1: a counterexample (its VCD, `.gtkw` and
@@ -41,6 +41,9 @@ pub struct Args {
     /// Also write the generated harness here.
     #[arg(long)]
     pub harness: Option<PathBuf>,
+    /// Also assert an AXI4-Stream link's bytes and packets when its slave may keep a beat waiting more than 8 cycles (ready_within): the proof splits on every wait, minutes on a 48 MHz mix.
+    #[arg(long)]
+    pub axis_bytes: bool,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -99,8 +102,10 @@ pub fn run(a: Args) -> u8 {
             return 2;
         }
     };
+    let mut opts = ProveOptions::new(&a.out);
+    opts.axis_bytes = a.axis_bytes;
     if let Some(path) = &harness {
-        match formal::generate(&s) {
+        match formal::harness_for(&s, &opts) {
             Ok(h) => {
                 let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
                 let dir = dir.unwrap_or(std::path::Path::new("."));
@@ -119,7 +124,6 @@ pub fn run(a: Args) -> u8 {
             }
         }
     }
-    let mut opts = ProveOptions::new(&a.out);
     opts.solver = a.solver;
     opts.timeout_s = a.timeout;
     opts.bmc_timeout_s = a.timeout;

@@ -27,8 +27,25 @@ use super::{packets, uart, width, Clause, FreeInput, PropertyDef};
 /// from reset (their frame counter keeps the state from coming round).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LinkBytes {
+    /// Asserted; an AXI4-Stream's only for a slave that keeps a beat
+    /// waiting at most [`AXIS_BYTES_MAX_WAIT`] cycles.
     Asserted,
+    /// Asserted whatever the slave's `ready_within` (`prove --axis-bytes`:
+    /// minutes on a 48 MHz mix whose slave may wait 64 cycles).
+    AnyWait,
     Left,
+}
+
+impl LinkBytes {
+    /// Whether an AXI4-Stream's bytes are asserted for a slave that takes
+    /// every beat within `within` cycles.
+    fn axis_asserted(self, within: u32) -> bool {
+        match self {
+            LinkBytes::Asserted => within <= AXIS_BYTES_MAX_WAIT,
+            LinkBytes::AnyWait => true,
+            LinkBytes::Left => false,
+        }
+    }
 }
 
 /// The harness input that lets the slave take a beat early (any cycle).
@@ -47,7 +64,8 @@ pub const SLAVE_WAIT: &str = "waited";
 /// may take: the tiny mix at 8 proves in 4 s, eskin34-axis at 64 in 8
 /// minutes, modes-auto at 9 / 16 in 137 / 235 s (at most 6 s with the
 /// bytes left out); a proof in every build cannot wait that long.  A mix
-/// beyond it keeps them listed as not covered.
+/// beyond it keeps them listed as not covered, unless asked for
+/// ([`LinkBytes::AnyWait`], `prove --axis-bytes`).
 pub const AXIS_BYTES_MAX_WAIT: u32 = 8;
 
 /// The guarantee of an AXI4-Stream mix's slave (`ready_within`, >= 1);
@@ -141,7 +159,7 @@ pub(super) fn properties(
     let plan = lut_gen::plan_link(s).and_then(Result::ok);
     let depth = plan.as_ref().map_or(0, |p| p.fifo_depth);
     if within.is_none() {
-        if let (LinkBytes::Asserted, Some(c)) = (bytes, uart::Char::of(s)) {
+        if let (LinkBytes::Asserted | LinkBytes::AnyWait, Some(c)) = (bytes, uart::Char::of(s)) {
             uart::receiver(v, props, &c);
             packets::monitor(v, props, s, layout, depth, packets::Line::Uart);
         }
@@ -171,7 +189,7 @@ pub(super) fn properties(
         covers: vec![Clause::AxisPayloadHeld],
         what: "m_axis_tdata and m_axis_tlast do not change while a beat waits for tready".into(),
     });
-    if bytes == LinkBytes::Asserted && within.is_some_and(|w| w <= AXIS_BYTES_MAX_WAIT) {
+    if within.is_some_and(|w| bytes.axis_asserted(w)) {
         let per_frame = plan.as_ref().and_then(|p| p.tlast) == Some("frame");
         packets::beats(v);
         packets::monitor(

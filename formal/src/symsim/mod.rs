@@ -48,6 +48,7 @@ pub use generalise::{CounterFailure, Counters};
 use graph::Graph;
 #[cfg(test)]
 use graph::VAR;
+pub use split::MAX_PATHS;
 
 /// What the symbolic simulation established.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -102,6 +103,9 @@ pub struct SymStats {
     /// A split run: paths closed where a split started them, in the state
     /// a path had started in at the same phase of an earlier frame.
     pub mid_closed: u64,
+    /// A split run that stopped with more states at frame starts and paths
+    /// waiting than it keeps (`split::MAX_PATHS`): the step it stopped at.
+    pub path_limit: Option<u64>,
 }
 
 /// Steps between the checks of the assertions that did not fold (one SAT

@@ -50,7 +50,7 @@ pub(super) const MAX_SPLIT_BITS: usize = 8;
 
 /// At most this many states at boundaries and paths waiting: past it the
 /// run stops, bounded (a mode mix has a state per pair of modes and data).
-const MAX_PATHS: usize = 4096;
+pub const MAX_PATHS: usize = 4096;
 
 /// The paths started at one step: (step, graph collections, each one's
 /// state and condition, the wait count left out, with that count).
@@ -124,6 +124,7 @@ impl Sim<'_> {
             if seen.len() + self.queue.len() > MAX_PATHS {
                 self.stats.branches = seen.len();
                 let steps = self.covered(from);
+                self.stats.path_limit = Some(steps);
                 return (first.map_or(Found::Bounded { steps }, |f| f.1), self.stats);
             }
             (self.state, self.prev_state, self.fixed) = (b.state, b.prev_state, b.fixed);
