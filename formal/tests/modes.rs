@@ -620,8 +620,9 @@ fn a_wrong_command_word_across_a_switch_fails_prove() {
     let s = schedule("testkit/mixes/cmd-modes.toml");
     let design = edit(
         &emitted(&s),
-        "4'd9: begin fuse = 1'b1; fsel = 3'd2; fdev = 1'd0; end",
-        "4'd9: begin fuse = 1'b1; fsel = 3'd3; fdev = 1'd0; end",
+        // the command unit's table: next mode `fast` (1), its conversion 1
+        "2'd3: fchn = 3'd2;",
+        "2'd3: fchn = 3'd3;",
     );
     let dir = tempfile::tempdir().unwrap();
     let p = prove(&s, &design, dir.path());
