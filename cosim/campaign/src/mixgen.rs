@@ -74,7 +74,12 @@ impl Shape {
     /// Mixes around `mix`: its clock, frame, slice, branch count and rates,
     /// with from one channel up to `max_channels` (enough to overload it).
     pub fn around(mix: &lut_gen::Mix, max_channels: u64) -> Shape {
-        let mut rates: Vec<u64> = mix.channels.iter().map(|c| c.rate_hz).collect();
+        // a mix with modes: a channel its reset mode leaves out has rate 0
+        // there, which no mix may ask for (every random mix drawn with it
+        // was refused, and the chart had no point)
+        let mut rates: Vec<u64> = (mix.channels.iter().map(|c| c.rate_hz))
+            .filter(|&r| r > 0)
+            .collect();
         rates.sort_unstable();
         rates.dedup();
         let nb = mix.branches.len() as u64;

@@ -19,3 +19,26 @@ fn mixes_around_the_reference_design_parse() {
         .count();
     assert_eq!(parsed, 20);
 }
+
+/// Around a mix with modes (the schedule's mix, whose rates are its reset
+/// mode's: `cmd-ahead-modes` leaves two channels out of it at 0 Hz), the
+/// random mixes are mixes too: no rate of 0 is drawn.
+#[test]
+fn mixes_around_a_mode_mix_draw_no_rate_of_zero() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../testkit/mixes/cmd-ahead-modes.toml");
+    let s = lut_gen::synthesize(&lut_gen::load(&path).unwrap()).unwrap();
+    assert!(s.mix.channels.iter().any(|c| c.rate_hz == 0));
+    let shape = Shape::around(&s.mix, 512);
+    assert!(!shape.rates_hz.contains(&0), "{:?}", shape.rates_hz);
+    let parsed = (1..=20)
+        .filter(|&seed| {
+            lut_gen::parse(
+                std::path::Path::new("random.toml"),
+                &random_mix(seed, &shape),
+            )
+            .is_ok()
+        })
+        .count();
+    assert_eq!(parsed, 20);
+}
