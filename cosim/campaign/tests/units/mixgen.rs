@@ -8,16 +8,17 @@ fn mixes_around_the_reference_design_parse() {
     let text = std::fs::read_to_string(&path).unwrap();
     let mix = lut_gen::parse(&path, &text).unwrap();
     let shape = Shape::around(&mix, 423);
-    let parsed = (1..=20)
+    assert_eq!(parsed(&shape, 20), 20);
+}
+
+/// Of the random mixes of seeds `1..=n` drawn from `shape`, those that parse.
+fn parsed(shape: &Shape, n: u64) -> usize {
+    (1..=n)
         .filter(|&seed| {
-            lut_gen::parse(
-                std::path::Path::new("random.toml"),
-                &random_mix(seed, &shape),
-            )
-            .is_ok()
+            let text = random_mix(seed, shape);
+            lut_gen::parse(std::path::Path::new("random.toml"), &text).is_ok()
         })
-        .count();
-    assert_eq!(parsed, 20);
+        .count()
 }
 
 /// Around a mix with modes (the schedule's mix, whose rates are its reset
@@ -31,14 +32,5 @@ fn mixes_around_a_mode_mix_draw_no_rate_of_zero() {
     assert!(s.mix.channels.iter().any(|c| c.rate_hz == 0));
     let shape = Shape::around(&s.mix, 512);
     assert!(!shape.rates_hz.contains(&0), "{:?}", shape.rates_hz);
-    let parsed = (1..=20)
-        .filter(|&seed| {
-            lut_gen::parse(
-                std::path::Path::new("random.toml"),
-                &random_mix(seed, &shape),
-            )
-            .is_ok()
-        })
-        .count();
-    assert_eq!(parsed, 20);
+    assert_eq!(parsed(&shape, 20), 20);
 }
